@@ -1,0 +1,56 @@
+"""Conversion of caller arguments to the float64 arrays the native core expects.
+
+The core checks shapes and finiteness and names the argument in its errors; this module only
+turns array-likes into float64 ndarrays and rejects what is not a real number, by name.
+Inputs are never modified: a conversion that needs a new array makes one, and the core copies
+what it reads.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .exceptions import InvalidArgumentError, NotRealError, ShapeError
+
+FloatArray = NDArray[np.float64]
+
+
+def real_array(value: Any, name: str) -> FloatArray:
+    """``value`` as a float64 ndarray, or NotRealError naming ``name``.
+
+    Accepts any real array-like: lists, integer, boolean and float32 arrays, Fortran-ordered
+    and non-contiguous views (the core reads any strides).
+    """
+    if type(value) is np.ndarray and value.dtype == np.float64:
+        return value
+    try:
+        array = np.asarray(value)
+    except ValueError as error:  # ragged nested sequences
+        raise ShapeError(f"{name} must be a rectangular array of numbers: {error}") from None
+    if array.dtype.kind == "c":
+        raise NotRealError(
+            f"{name} must be real, got a complex array (dtype {array.dtype}); "
+            "aerocontrol works with real matrices only"
+        )
+    if array.dtype.kind not in "biuf":
+        raise NotRealError(f"{name} must be an array of real numbers, got dtype {array.dtype}")
+    return array.astype(np.float64, copy=False)
+
+
+def real_scalar(value: Any, name: str) -> float:
+    """``value`` as a Python float, rejecting arrays, complex numbers and non-numbers by name."""
+    array = real_array(value, name)
+    if array.ndim != 0:
+        raise ShapeError(f"{name} must be a scalar, got an array of shape {array.shape}")
+    return float(array)
+
+
+def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
+    """``value`` if it is one of ``choices``, else InvalidArgumentError naming ``name``."""
+    if value not in choices:
+        allowed = ", ".join(repr(c) for c in choices)
+        raise InvalidArgumentError(f"{name} must be one of {allowed}, got {value!r}")
+    return str(value)

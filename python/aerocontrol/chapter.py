@@ -1,0 +1,83 @@
+"""The worked examples of the course chapter, with the matrices exactly as printed.
+
+These are the chapter's own numbers (rounded to four decimals in print), kept as reference
+data for examples, the demo and the tests. The aircraft models that build the same matrices
+from nondimensional derivatives and a flight condition come later; their output is checked
+against these.
+
+Equation numbers refer to "Control of Aircraft Motions" (chapter 6 of the course notes).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validation import FloatArray
+
+__all__ = [
+    "boeing747_lateral",
+    "boeing747_longitudinal",
+    "controllability_example",
+    "state_feedback_example",
+]
+
+
+def boeing747_longitudinal() -> tuple[FloatArray, FloatArray]:
+    """Boeing 747 in powered approach, M = 0.25, sea level: longitudinal A and elevator B.
+
+    State x = (u/u0, α, q, θ) (6.50), input the elevator δe (rad); matrices (6.49).
+
+    Examples
+    --------
+    >>> A, B = boeing747_longitudinal()
+    >>> A.shape, B.shape
+    ((4, 4), (4, 1))
+    """
+    A = np.array(
+        [
+            [-0.0212, 0.0466, 0.0000, -0.1153],
+            [-0.2229, -0.5839, 0.9404, 0.0000],
+            [0.0150, -0.5031, -0.5015, 0.0000],
+            [0.0, 0.0, 1.0, 0.0],
+        ]
+    )
+    B = np.array([[0.0000], [-0.0340], [-0.5746], [0.0000]])
+    return A, B
+
+
+def boeing747_lateral() -> tuple[FloatArray, FloatArray]:
+    """Boeing 747 in powered approach: lateral-directional A and B = [rudder, aileron].
+
+    State x = (β, p, φ, r) (6.151); plant matrix (6.150), rudder column (6.158), aileron
+    column (6.163); inputs (δr, δa) in rad, as in the LQR example (6.224).
+    """
+    A = np.array(
+        [
+            [-0.0999, 0.0000, 0.1153, -1.0000],
+            [-1.6038, -1.0932, 0.0, 0.2850],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.4089, -0.0395, 0.0, -0.2454],
+        ]
+    )
+    B = np.array(
+        [
+            [0.0182, 0.0000],
+            [0.0868, 0.3215],
+            [0.0, 0.0000],
+            [-0.2440, -0.0017],
+        ]
+    )
+    return A, B
+
+
+def controllability_example() -> tuple[FloatArray, FloatArray]:
+    """The controllability example (6.75): A = [[0, 1], [-2, -3]], B = [0, 1]^T."""
+    return np.array([[0.0, 1.0], [-2.0, -3.0]]), np.array([[0.0], [1.0]])
+
+
+def state_feedback_example() -> tuple[FloatArray, FloatArray]:
+    """The state feedback example (6.95): A = [[-3, 8], [0, 0]], B = [0, 4]^T.
+
+    A is singular (a zero eigenvalue): the chapter's step formula (6.43) fails for it.
+    """
+    return np.array([[-3.0, 8.0], [0.0, 0.0]]), np.array([[0.0], [4.0]])

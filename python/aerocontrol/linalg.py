@@ -1,0 +1,166 @@
+"""The matrix exponential, state transition matrices and exact discretisation.
+
+Chapter §6.1.2: the transition matrix of x' = Ax + Bη is Φ(t) = e^{At} (6.22), and the
+response to an input held over a step follows from Φ and two integrals of it (6.9).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from . import _core
+from ._validation import FloatArray, check_choice, real_array, real_scalar
+from .exceptions import ShapeError
+
+__all__ = ["Discretization", "discretize", "expm", "transition_matrix"]
+
+
+def expm(A: Any) -> FloatArray:
+    """The matrix exponential e^A of a real square matrix, or of each matrix of a stack.
+
+    Padé scaling and squaring with the degree (3, 5, 7, 9 or 13) and scaling chosen as in
+    Al-Mohy & Higham (2009), which avoids the overscaling of older algorithms on non-normal
+    matrices; triangular matrices keep their structure and get exact diagonals. A 3-D stack of
+    k matrices is exponentiated in parallel across cores in one call.
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n) or (k, n, n)
+        Real, finite matrix or stack of matrices (any real dtype, order or strides).
+
+    Returns
+    -------
+    ndarray of float64, same shape as ``A``
+        e^A. A result that overflows double precision has infinite entries and comes with a
+        :class:`~aerocontrol.exceptions.NumericalOverflowWarning`, as in scipy.
+
+    Raises
+    ------
+    ShapeError
+        ``A`` is not a square matrix or a stack of square matrices.
+    NonFiniteError
+        ``A`` contains NaN or an infinity (the message names the entry).
+    NotRealError
+        ``A`` is complex.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A = np.array([[0.0, 1.0], [-2.0, -3.0]])   # chapter (6.75)
+    >>> np.round(aerocontrol.expm(A), 6)
+    array([[ 0.600424,  0.232544],
+           [-0.465088, -0.097209]])
+    >>> aerocontrol.expm(np.zeros((3, 2, 2))).shape
+    (3, 2, 2)
+    """
+    return _core.expm(A)
+
+
+def transition_matrix(A: Any, t: Any) -> FloatArray:
+    """The state transition matrix Φ(t) = e^{At} (6.22) at one time or at each of many.
+
+    The powers of A and their norms are computed once for all times; each time then costs a
+    Padé evaluation and its squarings, in parallel across times for small n. Negative times
+    are allowed: Φ(-t) = Φ(t)^-1 (6.27).
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n)
+        Real, finite plant matrix.
+    t : float or array_like, shape (k,)
+        Time or times.
+
+    Returns
+    -------
+    ndarray of float64, shape (n, n) for a scalar ``t``, else (k, n, n)
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A = np.array([[0.0, 1.0], [0.0, 0.0]])     # double integrator: Φ(t) = [[1, t], [0, 1]]
+    >>> aerocontrol.transition_matrix(A, 2.5)
+    array([[1. , 2.5],
+           [0. , 1. ]])
+    >>> aerocontrol.transition_matrix(A, [0.0, 1.0, 2.0]).shape
+    (3, 2, 2)
+    """
+    times = real_array(t, "t")
+    if times.ndim == 0:
+        return _core.transition_matrices(A, times.reshape(1))[0]
+    if times.ndim != 1:
+        raise ShapeError(f"t must be a scalar or a 1-D array of times, got shape {times.shape}")
+    return _core.transition_matrices(A, times)
+
+
+@dataclass(frozen=True)
+class Discretization:
+    """The matrices that advance x' = Ax + Bη exactly over one step of length ``dt``.
+
+    Zero-order hold (η constant over the step)::
+
+        x[k+1] = Phi x[k] + Gamma0 η[k]
+
+    First-order hold (η linear between samples)::
+
+        x[k+1] = Phi x[k] + (Gamma0 - Gamma1) η[k] + Gamma1 η[k+1]
+
+    with Phi = e^{A dt}, Gamma0 = ∫_0^dt e^{Aτ} dτ B and
+    Gamma1 = (1/dt) ∫_0^dt e^{Aτ} (dt - τ) dτ B.
+    """
+
+    Phi: FloatArray
+    """e^{A dt}, shape (n, n)."""
+    Gamma0: FloatArray
+    """∫_0^dt e^{Aτ} dτ B, shape (n, m)."""
+    Gamma1: FloatArray | None
+    """(1/dt) ∫_0^dt e^{Aτ} (dt - τ) dτ B, shape (n, m), for ``method="foh"``; else None."""
+    dt: float
+    """The step."""
+    method: Literal["zoh", "foh"]
+    """The hold: ``"zoh"`` or ``"foh"``."""
+
+
+def discretize(
+    A: Any, B: Any, dt: float, method: Literal["zoh", "foh"] = "zoh"
+) -> Discretization:
+    """Exact discretisation of x' = Ax + Bη over a step ``dt``.
+
+    Φ, Γ0 and Γ1 come from one exponential of an augmented block matrix (Van Loan 1978), so
+    no inverse of A is needed: the result is exact for singular A, where the chapter's step
+    formula (6.43), x(t) = (e^{At} - I) A^-1 B η0, fails (the example (6.95) has a zero
+    eigenvalue).
+
+    Parameters
+    ----------
+    A : array_like, shape (n, n)
+        Plant matrix.
+    B : array_like, shape (n, m) or (n,)
+        Control matrix; a 1-D B is one input column.
+    dt : float
+        Step, positive and finite.
+    method : {"zoh", "foh"}
+        Zero-order hold (input constant over the step) or first-order hold (input linear
+        between samples).
+
+    Returns
+    -------
+    Discretization
+        ``Phi``, ``Gamma0`` and, for ``"foh"``, ``Gamma1`` (see :class:`Discretization`).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A = np.array([[-3.0, 8.0], [0.0, 0.0]]); B = np.array([0.0, 4.0])   # (6.95): singular
+    >>> d = aerocontrol.discretize(A, B, 0.1)
+    >>> np.round(d.Gamma0, 6)
+    array([[0.146546],
+           [0.4     ]])
+    """
+    B = real_array(B, "B")
+    if B.ndim == 1:
+        B = B.reshape(-1, 1)
+    step = real_scalar(dt, "dt")
+    hold = check_choice(method, "method", ("zoh", "foh"))
+    Phi, Gamma0, Gamma1 = _core.discretize(A, B, step, hold)
+    return Discretization(Phi=Phi, Gamma0=Gamma0, Gamma1=Gamma1, dt=step, method=method)

@@ -1,0 +1,242 @@
+//! The one error type of the numerical core, and the argument checks shared by every module.
+//!
+//! Every public function validates its arguments and returns [`Error`] instead of panicking. The
+//! variants carry the context a caller needs to fix the input: which argument, which shape, which
+//! entry. `python.rs` maps each variant to one Python exception class; the message is the
+//! [`Display`](std::fmt::Display) text, so it reads the same from Rust and from Python.
+
+use faer::MatRef;
+use std::fmt;
+
+/// Why a computation could not be done.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// A matrix argument that must be square is not.
+    NotSquare {
+        arg: &'static str,
+        rows: usize,
+        cols: usize,
+    },
+    /// An argument has the wrong number of dimensions, e.g. a vector where a matrix is needed.
+    WrongDimensions {
+        arg: &'static str,
+        expected: &'static str,
+        shape: Vec<usize>,
+    },
+    /// An argument's size does not agree with another argument's.
+    Mismatch {
+        arg: &'static str,
+        what: &'static str,
+        expected: usize,
+        other: &'static str,
+        got: usize,
+    },
+    /// An argument contains NaN or an infinity.
+    NonFinite {
+        arg: &'static str,
+        index: Vec<usize>,
+        value: f64,
+    },
+    /// A scalar argument is out of its domain (e.g. a time step that is not positive).
+    InvalidValue {
+        arg: &'static str,
+        value: f64,
+        requirement: &'static str,
+    },
+    /// One problem of a batch failed; `index` is its position in the stack.
+    InBatch { index: usize, source: Box<Error> },
+}
+
+impl Error {
+    /// Wraps an error of the `index`-th problem of a batch.
+    pub fn in_batch(index: usize, source: Error) -> Self {
+        Error::InBatch {
+            index,
+            source: Box::new(source),
+        }
+    }
+}
+
+fn format_index(index: &[usize]) -> String {
+    let parts: Vec<String> = index.iter().map(usize::to_string).collect();
+    format!("[{}]", parts.join(", "))
+}
+
+fn format_shape(shape: &[usize]) -> String {
+    match shape {
+        [single] => format!("({single},)"),
+        _ => {
+            let parts: Vec<String> = shape.iter().map(usize::to_string).collect();
+            format!("({})", parts.join(", "))
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::NotSquare { arg, rows, cols } => {
+                write!(f, "{arg} must be square, got shape ({rows}, {cols})")
+            }
+            Error::WrongDimensions {
+                arg,
+                expected,
+                shape,
+            } => write!(
+                f,
+                "{arg} must be {expected}, got an array of shape {}",
+                format_shape(shape)
+            ),
+            Error::Mismatch {
+                arg,
+                what,
+                expected,
+                other,
+                got,
+            } => write!(f, "{arg} must have {what} {other} ({expected}), got {got}"),
+            Error::NonFinite { arg, index, value } => write!(
+                f,
+                "{arg} must be finite, but {arg}{} is {value}",
+                format_index(index)
+            ),
+            Error::InvalidValue {
+                arg,
+                value,
+                requirement,
+            } => write!(f, "{arg} must be {requirement}, got {value}"),
+            Error::InBatch { index, source } => write!(f, "problem {index} of the batch: {source}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// Checks that `a` is square.
+pub fn check_square(a: MatRef<'_, f64>, arg: &'static str) -> Result<(), Error> {
+    if a.nrows() == a.ncols() {
+        Ok(())
+    } else {
+        Err(Error::NotSquare {
+            arg,
+            rows: a.nrows(),
+            cols: a.ncols(),
+        })
+    }
+}
+
+/// Checks that every entry of `a` is finite; the error names the first offending entry (in
+/// row-major order, as a reader of the printed matrix would find it).
+pub fn check_finite(a: MatRef<'_, f64>, arg: &'static str) -> Result<(), Error> {
+    for i in 0..a.nrows() {
+        for j in 0..a.ncols() {
+            let value = a[(i, j)];
+            if !value.is_finite() {
+                return Err(Error::NonFinite {
+                    arg,
+                    index: vec![i, j],
+                    value,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks that `b` has as many rows as the square matrix named `other` of order `n`.
+pub fn check_rows(
+    b: MatRef<'_, f64>,
+    arg: &'static str,
+    n: usize,
+    other: &'static str,
+) -> Result<(), Error> {
+    if b.nrows() == n {
+        Ok(())
+    } else {
+        Err(Error::Mismatch {
+            arg,
+            what: "as many rows as",
+            expected: n,
+            other,
+            got: b.nrows(),
+        })
+    }
+}
+
+/// Checks that a scalar is finite and strictly positive.
+pub fn check_positive(value: f64, arg: &'static str) -> Result<(), Error> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidValue {
+            arg,
+            value,
+            requirement: "positive and finite",
+        })
+    }
+}
+
+/// Checks that every value of a sequence of scalars is finite; the error names the first one that
+/// is not.
+pub fn check_finite_values(values: &[f64], arg: &'static str) -> Result<(), Error> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::NonFinite {
+            arg,
+            index: vec![i],
+            value: values[i],
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::Mat;
+
+    #[test]
+    fn messages_name_the_argument_and_the_problem() {
+        let a = Mat::<f64>::zeros(3, 4);
+        let err = check_square(a.as_ref(), "A").unwrap_err();
+        assert_eq!(err.to_string(), "A must be square, got shape (3, 4)");
+
+        let mut b = Mat::<f64>::zeros(2, 2);
+        b[(1, 0)] = f64::NAN;
+        let err = check_finite(b.as_ref(), "B").unwrap_err();
+        assert_eq!(err.to_string(), "B must be finite, but B[1, 0] is NaN");
+
+        let err = check_rows(b.as_ref(), "B", 4, "A").unwrap_err();
+        assert_eq!(err.to_string(), "B must have as many rows as A (4), got 2");
+
+        let err = check_positive(-0.5, "dt").unwrap_err();
+        assert_eq!(err.to_string(), "dt must be positive and finite, got -0.5");
+
+        let err = check_finite_values(&[0.0, 1.0, f64::INFINITY], "t").unwrap_err();
+        assert_eq!(err.to_string(), "t must be finite, but t[2] is inf");
+
+        let err = Error::in_batch(7, err);
+        assert_eq!(
+            err.to_string(),
+            "problem 7 of the batch: t must be finite, but t[2] is inf"
+        );
+
+        let err = Error::WrongDimensions {
+            arg: "A",
+            expected: "a 2-D matrix",
+            shape: vec![3],
+        };
+        assert_eq!(
+            err.to_string(),
+            "A must be a 2-D matrix, got an array of shape (3,)"
+        );
+    }
+
+    #[test]
+    fn valid_arguments_pass() {
+        let a = Mat::<f64>::identity(3, 3);
+        assert!(check_square(a.as_ref(), "A").is_ok());
+        assert!(check_finite(a.as_ref(), "A").is_ok());
+        assert!(check_rows(a.as_ref(), "B", 3, "A").is_ok());
+        assert!(check_positive(1e-300, "dt").is_ok());
+        assert!(check_finite_values(&[], "t").is_ok());
+    }
+}

@@ -1,0 +1,1468 @@
+//! The matrix exponential e^A and the state transition matrix Φ(t) = e^{At} (chapter §6.1.2,
+//! (6.19)-(6.22)), by Padé scaling and squaring.
+//!
+//! # Method
+//!
+//! e^A = (r_m(2^-s A))^(2^s), where r_m = p_m(x) / p_m(-x) is the diagonal [m/m] Padé
+//! approximant of e^x,
+//!
+//! ```text
+//! p_m(x) = sum_{j=0}^{m} b_j x^j,   b_j ∝ (2m - j)! m! / ((2m)! j! (m - j)!),
+//! ```
+//!
+//! with m in {3, 5, 7, 9, 13} and the scaling s chosen as in Algorithm 5.1 of A. H. Al-Mohy and
+//! N. J. Higham, "A new scaling and squaring algorithm for the matrix exponential", SIAM J.
+//! Matrix Anal. Appl. 31(3), 2009, pp. 970-989, which refines N. J. Higham, "The scaling and
+//! squaring method for the matrix exponential revisited", SIAM J. Matrix Anal. Appl. 26(4),
+//! 2005, pp. 1179-1193:
+//!
+//! * The backward error of r_m(2^-s A) is at most the unit roundoff u = 2^-53 when
+//!   2^-s α_p(A) <= θ_m, where α_p(A) = max(||A^p||^(1/p), ||A^(p+1)||^(1/(p+1))) and θ_m is the
+//!   constant of Higham (2005), Table 2.3 (except θ13, lowered to 4.25 for the reason given at
+//!   [`THETA_13`]). Using ||A^k||^(1/k), which can be far smaller than ||A|| for non-normal A,
+//!   instead of ||A|| avoids the overscaling that loses accuracy in the squaring phase. The
+//!   d_k = ||A^k||_1^(1/k) for k = 4, 6 are exact norms of formed powers; d_8 and d_10 are exact
+//!   (products formed) for n <= [`EXACT_NORM_MAX_ORDER`] and estimated above it by the block
+//!   1-norm estimator of Higham & Tisseur (2000), see `norm.rs`.
+//! * The ℓ(A, m) correction (Al-Mohy & Higham 2009, (5.1)-(5.2)) adds squarings when the
+//!   relative forward error bound |c_{2m+1}| || |A|^{2m+1} ||_1 / ||A||_1 exceeds u, with
+//!   |c_{2m+1}| = (m!)^2 / ((2m)! (2m+1)!), the leading coefficient of the error series.
+//! * The denominator is never inverted: with U the odd and V the even part of p_m,
+//!   r_m = (V - U)^-1 (V + U) = I + 2 (V - U)^-1 U, and the second form is evaluated (one LU
+//!   solve with partial pivoting for the right-hand side U), so that the identity is exact and
+//!   the rounding of the solve is relative to the correction U.
+//! * For upper triangular A (and lower triangular, through the transpose), the diagonal and the
+//!   first superdiagonal of every intermediate square are recomputed exactly (Code Fragment 2.1
+//!   of Al-Mohy & Higham 2009), with the divided difference
+//!   (e^λ2 - e^λ1)/(λ2 - λ1) = e^((λ1+λ2)/2) sinh(δ)/δ, δ = (λ2 - λ1)/2.
+//!
+//! The Padé evaluation for m = 13 costs 6 matrix products plus one LU solve, and m = 3, 5, 7, 9
+//! cost 2, 3, 4, 5 products; each squaring is one product.
+//!
+//! # Small orders, and accuracy beyond double precision
+//!
+//! Orders up to [`SMALL_MAX_ORDER`] run on stack matrices of constant size ([`SmallMatrix`]):
+//! flight models are that small, and at these orders a general-order library call costs more
+//! than its arithmetic. For them, an exponential that needs [`DOUBLE_DOUBLE_MIN_SQUARINGS`] or
+//! more squarings is evaluated in double-double arithmetic (`double_double.rs`). Measured against
+//! 50-digit references, the Padé truncation itself is below double-precision resolution on every
+//! test matrix; the error of a double evaluation is the rounding in forming r_m and in the
+//! squarings, which the squarings amplify on stiff and non-normal matrices ("humps") to 1e-13
+//! and more. In double-double those roundings drop below 1e-30 and the result is correct to a
+//! few units in the last place. The cost (about four times a double evaluation) is paid only
+//! where squarings make it worthwhile.
+//!
+//! [`ExponentialPlan`] holds the powers and norms of one matrix so that e^{tA} at many times t
+//! (the transition matrices of a response) reuses them: ||(tA)^k|| = |t|^k ||A^k||, so only the
+//! final Padé evaluation and squaring are repeated per time.
+
+use crate::double_double::DoubleDoubleMatrix;
+use crate::error::{Error, check_finite, check_finite_values, check_square};
+use crate::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
+use crate::pool::{Scratch, scratch};
+use crate::small_matrix::SmallMatrix;
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatMut, MatRef, Par};
+use rayon::prelude::*;
+
+/// For n up to this order the norms ||A^8||_1 and ||A^10||_1 of the degree selection are exact
+/// (from formed products); above it they are estimated (Higham & Tisseur 2000), which costs
+/// O(n^2) instead of a matrix product.
+pub const EXACT_NORM_MAX_ORDER: usize = 48;
+
+/// Matrices of at least this order use multithreaded products and LU in a single exponential.
+pub const PARALLEL_MIN_ORDER: usize = 160;
+
+/// Orders up to this run on fixed-size stack matrices; larger ones on faer.
+pub const SMALL_MAX_ORDER: usize = 8;
+
+/// Small-order exponentials that need at least this many squarings are evaluated in
+/// double-double arithmetic (see the module documentation).
+pub const DOUBLE_DOUBLE_MIN_SQUARINGS: u32 = 2;
+
+/// Matrices whose 1-norm exceeds 2^64 are first scaled down to it, with the difference made up
+/// by extra squarings, so that the powers A^2 ... A^12 of the degree selection cannot overflow.
+const MAX_UNSCALED_NORM_LOG2: f64 = 64.0;
+
+/// Squarings are capped here: 2^-2200 underflows every double, so more can only repeat inf.
+const MAX_SQUARINGS: u32 = 2200;
+
+/// Unit roundoff of IEEE double precision, u = 2^-53.
+const UNIT_ROUNDOFF_LOG2: f64 = -53.0;
+
+/// A diagonal Padé approximant r_m: its degree, the bound θ_m on the scaled norm for which its
+/// backward error is at most u (Higham 2005, Table 2.3), the coefficients b_0 ... b_m of p_m,
+/// log2 |c_{2m+1}| = log2((m!)^2 / ((2m)! (2m+1)!)), the leading coefficient of the series of its
+/// backward error function (Al-Mohy & Higham 2009, Section 5), and the norm below which that
+/// leading term alone is below u, (u / |c_{2m+1}|)^(1/(2m)), so that ℓ = 0 needs no work.
+struct PadeApproximant {
+    degree: usize,
+    theta: f64,
+    coefficients: &'static [f64],
+    log2_error_coefficient: f64,
+    norm_without_extra_squarings: f64,
+}
+
+const PADE_3: [f64; 4] = [120.0, 60.0, 12.0, 1.0];
+const PADE_5: [f64; 6] = [30240.0, 15120.0, 3360.0, 420.0, 30.0, 1.0];
+const PADE_7: [f64; 8] = [
+    17297280.0, 8648640.0, 1995840.0, 277200.0, 25200.0, 1512.0, 56.0, 1.0,
+];
+const PADE_9: [f64; 10] = [
+    17643225600.0,
+    8821612800.0,
+    2075673600.0,
+    302702400.0,
+    30270240.0,
+    2162160.0,
+    110880.0,
+    3960.0,
+    90.0,
+    1.0,
+];
+const PADE_13: [f64; 14] = [
+    64764752532480000.0,
+    32382376266240000.0,
+    7771770303897600.0,
+    1187353796428800.0,
+    129060195264000.0,
+    10559470521600.0,
+    670442572800.0,
+    33522128640.0,
+    1323241920.0,
+    40840800.0,
+    960960.0,
+    16380.0,
+    182.0,
+    1.0,
+];
+
+/// The scaled-norm bound θ13 for degree 13. Higham (2005) derives θ13 = 5.37 from the backward
+/// error alone; near that norm the rounding errors of evaluating r13 (coefficients up to 6e16
+/// against powers of norm up to 5.4^6) dominate, and one more squaring is the cheaper error.
+/// Measured on 600 random matrices (n = 3..8, norms 1e-2..3e2, general, nearly triangular and
+/// badly scaled) against 40-digit references: θ13 = 5.37 was more than twice as inaccurate as
+/// scipy.linalg.expm on 2 of them, θ13 = 4.25 on none, and 3.5 gained only 5% more accuracy
+/// for more squarings. scipy makes the same choice, 4.25.
+const THETA_13: f64 = 4.25;
+
+const APPROXIMANTS: [PadeApproximant; 5] = [
+    PadeApproximant {
+        degree: 3,
+        theta: 1.495585217958292e-2,
+        coefficients: &PADE_3,
+        log2_error_coefficient: -16.62113611327464,
+        norm_without_extra_squarings: 0.014955873861991669,
+    },
+    PadeApproximant {
+        degree: 5,
+        theta: 0.253939833006323,
+        coefficients: &PADE_5,
+        log2_error_coefficient: -33.227772656854167,
+        norm_without_extra_squarings: 0.25397832160209977,
+    },
+    PadeApproximant {
+        degree: 7,
+        theta: 9.504178996162932e-1,
+        coefficients: &PADE_7,
+        log2_error_coefficient: -51.994974307382167,
+        norm_without_extra_squarings: 0.95145837728564,
+    },
+    PadeApproximant {
+        degree: 9,
+        theta: 2.097847961257068e0,
+        coefficients: &PADE_9,
+        log2_error_coefficient: -72.32471809893495,
+        norm_without_extra_squarings: 2.1046720498232245,
+    },
+    PadeApproximant {
+        degree: 13,
+        theta: THETA_13,
+        coefficients: &PADE_13,
+        log2_error_coefficient: -116.447004251763,
+        norm_without_extra_squarings: 5.427430678754456,
+    },
+];
+
+/// Index of each degree in [`APPROXIMANTS`].
+const M3: usize = 0;
+const M5: usize = 1;
+const M7: usize = 2;
+const M9: usize = 3;
+const M13: usize = 4;
+
+/// The degree and the number of squarings chosen for one scaled matrix tA.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PadeChoice {
+    /// Index into the table of approximants (degrees 3, 5, 7, 9, 13).
+    approximant: usize,
+    /// Number of squarings s (including any pre-scaling of a matrix of huge norm).
+    pub squarings: u32,
+}
+
+impl PadeChoice {
+    /// The degree m of the Padé approximant.
+    pub fn degree(&self) -> usize {
+        APPROXIMANTS[self.approximant].degree
+    }
+}
+
+/// The arithmetic of evaluating r_m and squaring: implemented by double matrices of small and
+/// of any order, and by double-double matrices.
+pub(crate) trait PadeArithmetic: Sized {
+    /// alpha * self * rhs.
+    fn product(&self, rhs: &Self, alpha: f64) -> Self;
+    /// self += alpha * lhs * rhs.
+    fn add_product(&mut self, lhs: &Self, rhs: &Self, alpha: f64);
+    /// identity * I + sum_k coefficient_k * M_k, for at least one term.
+    fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self;
+    /// r_m = I + 2 (V - U)^-1 U from the even part V and the odd part U.
+    fn pade_quotient(even: Self, odd: Self) -> Self;
+}
+
+/// The operations the degree selection and the double evaluation need besides arithmetic.
+pub(crate) trait ExpmMatrix: PadeArithmetic + Send + Sync {
+    fn from_ref(a: MatRef<'_, f64>) -> Self;
+    fn order(&self) -> usize;
+    fn get(&self, i: usize, j: usize) -> f64;
+    fn is_upper_triangular(&self) -> bool;
+    fn is_lower_triangular(&self) -> bool;
+    fn transpose(&self) -> Self;
+    fn set(&mut self, i: usize, j: usize, value: f64);
+    fn one_norm(&self) -> f64;
+    /// A lower bound (usually the value) of ||F_1 ... F_k||_1 without forming the product.
+    fn estimate_product_norm(factors: &[&Self]) -> f64;
+    /// ||(|A| / scale)^p||_1.
+    fn absolute_power_norm(&self, scale: f64, p: usize) -> f64;
+    /// Writes the matrix (transposed if asked) into `out`.
+    fn write_to(&self, out: MatMut<'_, f64>, transpose: bool);
+    /// r_m(cA) squared `squarings` times, in double-double arithmetic, if this representation
+    /// supports it; None otherwise (or if the result overflowed).
+    fn double_double_exponential(
+        &self,
+        _c: f64,
+        _approximant: usize,
+        _squarings: u32,
+    ) -> Option<Self> {
+        None
+    }
+}
+
+/// r_m(A) = I + 2 (V - U)^-1 U for the approximant given A, A^2 and the higher even powers
+/// [A^4, A^6, A^8] that the degree needs (the others may be None).
+fn pade_approximant<M: PadeArithmetic>(
+    approximant: usize,
+    a: &M,
+    a2: &[&M; 1],
+    higher: [&Option<M>; 3],
+) -> M {
+    let mut powers = [a2[0]; 4];
+    for (slot, power) in powers[1..].iter_mut().zip(higher) {
+        if let Some(p) = power {
+            *slot = p;
+        }
+    }
+    let b = APPROXIMANTS[approximant].coefficients;
+    let degree = APPROXIMANTS[approximant].degree;
+    let (odd_inner, even) = if degree < 13 {
+        // U = A (b_1 I + b_3 A^2 + ...), V = b_0 I + b_2 A^2 + ...
+        let terms = degree / 2;
+        let mut odd_terms = [(0.0, powers[0]); 4];
+        let mut even_terms = [(0.0, powers[0]); 4];
+        for k in 1..=terms {
+            odd_terms[k - 1] = (b[2 * k + 1], powers[k - 1]);
+            even_terms[k - 1] = (b[2 * k], powers[k - 1]);
+        }
+        (
+            M::combination(b[1], &odd_terms[..terms]),
+            M::combination(b[0], &even_terms[..terms]),
+        )
+    } else {
+        // U = A [A6 (b13 A6 + b11 A4 + b9 A2) + b7 A6 + b5 A4 + b3 A2 + b1 I],
+        // V = A6 (b12 A6 + b10 A4 + b8 A2) + b6 A6 + b4 A4 + b2 A2 + b0 I.
+        let (a2, a4, a6) = (powers[0], powers[1], powers[2]);
+        let odd_high = M::combination(0.0, &[(b[13], a6), (b[11], a4), (b[9], a2)]);
+        let even_high = M::combination(0.0, &[(b[12], a6), (b[10], a4), (b[8], a2)]);
+        let mut odd = M::combination(b[1], &[(b[7], a6), (b[5], a4), (b[3], a2)]);
+        let mut even = M::combination(b[0], &[(b[6], a6), (b[4], a4), (b[2], a2)]);
+        odd.add_product(a6, &odd_high, 1.0);
+        even.add_product(a6, &even_high, 1.0);
+        (odd, even)
+    };
+    M::pade_quotient(even, a.product(&odd_inner, 1.0))
+}
+
+/// X <- X^2, `squarings` times; `refine(X, i)` may correct X, which then approximates
+/// e^{2^-i tA}, after each square (and before the first).
+fn square_repeatedly<M: PadeArithmetic>(
+    mut x: M,
+    squarings: u32,
+    mut refine: impl FnMut(&mut M, u32),
+) -> M {
+    refine(&mut x, squarings);
+    for i in (0..squarings).rev() {
+        x = x.product(&x, 1.0);
+        refine(&mut x, i);
+    }
+    x
+}
+
+/// (e^b - e^a) / (b - a), the exponential's divided difference, without cancellation.
+fn exp_divided_difference(a: f64, b: f64) -> f64 {
+    let half_difference = 0.5 * (b - a);
+    if half_difference == 0.0 {
+        a.exp()
+    } else if half_difference.abs() <= 1.0 {
+        (0.5 * (a + b)).exp() * (half_difference.sinh() / half_difference)
+    } else {
+        (b.exp() - a.exp()) / (b - a)
+    }
+}
+
+/// x^k for a small integer k, by repeated multiplication (inlined, unlike `powi` with a
+/// variable exponent, which is a library call).
+#[inline]
+fn integer_power(x: f64, k: usize) -> f64 {
+    let mut result = 1.0;
+    let mut base = x;
+    let mut exponent = k;
+    while exponent > 0 {
+        if exponent & 1 == 1 {
+            result *= base;
+        }
+        base *= base;
+        exponent >>= 1;
+    }
+    result
+}
+
+fn is_upper_triangular(a: MatRef<'_, f64>) -> bool {
+    (0..a.ncols()).all(|j| (j + 1..a.nrows()).all(|i| a[(i, j)] == 0.0))
+}
+
+/// The powers and norms of one matrix A, from which e^{tA} is computed for any real t.
+///
+/// Building the plan costs one product (A^2); the powers A^4, A^6, A^8 are formed when a chosen
+/// degree needs them, and the norms are cached, so that e^{tA} at many times pays the selection
+/// once and, per time, only the Padé evaluation and the squarings.
+pub(crate) struct ExponentialPlan<M> {
+    /// The matrix the plan works on: A, transposed if A is lower triangular, and scaled by
+    /// 2^-prescale if its norm is huge.
+    a: M,
+    /// True when `a` holds A^T (A lower triangular): results are transposed back.
+    transposed: bool,
+    /// For triangular A, the diagonal and first superdiagonal of `a` before pre-scaling, for
+    /// Code Fragment 2.1.
+    diagonals: Option<(Vec<f64>, Vec<f64>)>,
+    /// Extra squarings that undo the pre-scaling of a matrix of huge norm.
+    prescale: u32,
+    a_norm: f64,
+    exact_norms: bool,
+    a2: M,
+    a4: Option<M>,
+    a6: Option<M>,
+    a8: Option<M>,
+    /// Cached ||A^k||_1 for k = 4, 6, 8, 10, with whether the value is exact.
+    power_norms: [Option<(f64, bool)>; 4],
+    /// Cached || (|A| / ||A||_1)^{2m+1} ||_1 for each approximant.
+    abs_power_norms: [Option<f64>; 5],
+}
+
+impl<M: ExpmMatrix> ExponentialPlan<M> {
+    /// Prepares e^{tA} for a square, finite A of order at least 2 (the caller validates).
+    pub fn new(a: MatRef<'_, f64>) -> Self {
+        let mut a = M::from_ref(a);
+        let mut transposed = false;
+        let mut triangular = a.is_upper_triangular();
+        if !triangular && a.is_lower_triangular() {
+            (a, transposed, triangular) = (a.transpose(), true, true);
+        }
+        let n = a.order();
+        let diagonals = triangular.then(|| {
+            let diagonal = (0..n).map(|i| a.get(i, i)).collect();
+            let superdiagonal = (0..n - 1).map(|i| a.get(i, i + 1)).collect();
+            (diagonal, superdiagonal)
+        });
+        let mut a_norm = a.one_norm();
+        let mut prescale = 0;
+        if a_norm.log2() > MAX_UNSCALED_NORM_LOG2 {
+            prescale = (a_norm.log2() - MAX_UNSCALED_NORM_LOG2).ceil() as u32;
+            a = M::combination(0.0, &[((-(prescale as f64)).exp2(), &a)]);
+            a_norm = a.one_norm();
+        }
+        let a2 = a.product(&a, 1.0);
+        Self {
+            a,
+            transposed,
+            diagonals,
+            prescale,
+            a_norm,
+            exact_norms: n <= EXACT_NORM_MAX_ORDER,
+            a2,
+            a4: None,
+            a6: None,
+            a8: None,
+            power_norms: [None; 4],
+            abs_power_norms: [None; 5],
+        }
+    }
+
+    fn ensure_a4(&mut self) {
+        if self.a4.is_none() {
+            self.a4 = Some(self.a2.product(&self.a2, 1.0));
+        }
+    }
+
+    fn ensure_a6(&mut self) {
+        self.ensure_a4();
+        if self.a6.is_none() {
+            self.a6 = Some(
+                self.a4
+                    .as_ref()
+                    .expect("formed above")
+                    .product(&self.a2, 1.0),
+            );
+        }
+    }
+
+    fn ensure_a8(&mut self) {
+        self.ensure_a4();
+        if self.a8.is_none() {
+            let a4 = self.a4.as_ref().expect("formed above");
+            self.a8 = Some(a4.product(a4, 1.0));
+        }
+    }
+
+    /// ||A^k||_1 for k in {4, 6, 8, 10}: exact from a formed power when there is one (forming it
+    /// if norms are exact at this order), otherwise estimated from the product of the powers at
+    /// hand. Bounded by ||A||_1^k, which also stands in for a power that overflowed.
+    fn power_norm(&mut self, k: usize) -> f64 {
+        let slot = k / 2 - 2;
+        let formed = |plan: &Self| match k {
+            4 => plan.a4.is_some(),
+            6 => plan.a6.is_some(),
+            8 => plan.a8.is_some(),
+            _ => false,
+        };
+        if let Some((value, exact)) = self.power_norms[slot]
+            && (exact || !formed(self))
+        {
+            return value;
+        }
+        if self.exact_norms {
+            match k {
+                4 => self.ensure_a4(),
+                6 => self.ensure_a6(),
+                8 => self.ensure_a8(),
+                _ => self.ensure_a6(),
+            }
+        }
+        let (norm, exact) = match k {
+            4 if self.a4.is_some() => (self.a4.as_ref().unwrap().one_norm(), true),
+            6 if self.a6.is_some() => (self.a6.as_ref().unwrap().one_norm(), true),
+            8 if self.a8.is_some() => (self.a8.as_ref().unwrap().one_norm(), true),
+            10 if self.exact_norms => {
+                let (a4, a6) = (self.a4.as_ref().unwrap(), self.a6.as_ref().unwrap());
+                (a4.product(a6, 1.0).one_norm(), true)
+            }
+            _ => {
+                let a2 = &self.a2;
+                let factors: Vec<&M> = match (k, &self.a4, &self.a6) {
+                    (4, _, _) => vec![a2, a2],
+                    (6, Some(a4), _) => vec![a4, a2],
+                    (6, None, _) => vec![a2, a2, a2],
+                    (8, Some(a4), _) => vec![a4, a4],
+                    (8, None, _) => vec![a2, a2, a2, a2],
+                    (_, Some(a4), Some(a6)) => vec![a4, a6],
+                    _ => vec![a2, a2, a2, a2, a2],
+                };
+                (M::estimate_product_norm(&factors), false)
+            }
+        };
+        // ||A^k|| <= ||A||^k, which stands in for a power that overflowed.
+        let norm = if norm.is_finite() {
+            norm
+        } else {
+            integer_power(self.a_norm, k)
+        };
+        self.power_norms[slot] = Some((norm, exact));
+        norm
+    }
+
+    /// Whether τ max(||A^p||^(1/p), ||A^q||^(1/q)) <= θ, i.e. τ^k ||A^k|| <= θ^k for k = p, q:
+    /// the selection compares powers, so that it needs no roots or logarithms.
+    fn scaled_root_norms_within(&mut self, p: usize, q: usize, tau: f64, theta: f64) -> bool {
+        let ratio = tau / theta;
+        self.power_norm(p) * integer_power(ratio, p) <= 1.0
+            && self.power_norm(q) * integer_power(ratio, q) <= 1.0
+    }
+
+    /// log2 τ d_k, d_k = ||A^k||_1^(1/k).
+    fn log2_scaled_root_norm(&mut self, k: usize, tau: f64) -> f64 {
+        tau.log2() + self.power_norm(k).log2() / k as f64
+    }
+
+    /// ℓ(τA, m) of Al-Mohy & Higham (2009, (5.1)): the extra squarings needed so that the
+    /// truncation of the backward error series at its leading term is below u, for scale τ > 0:
+    ///
+    /// ```text
+    /// ℓ = max(⌈log2(α / u) / (2m)⌉, 0),   α = |c_{2m+1}| || |τA|^{2m+1} ||_1 / ||τA||_1.
+    /// ```
+    ///
+    /// Since || |A|^p ||_1 <= ||A||_1^p, α <= |c_{2m+1}| ||τA||_1^{2m}; when that bound is
+    /// already below u (||τA||_1 below the approximant's `norm_without_extra_squarings`),
+    /// ℓ = 0 without computing the power norm. Otherwise α / u = |c_{2m+1}| / u ||τA||^{2m} N,
+    /// N = ||(|A| / ||A||_1)^{2m+1}||_1 <= 1, is formed directly (logarithms only when ℓ > 0 or
+    /// the product leaves the range of doubles).
+    fn extra_squarings(&mut self, approximant: usize, tau: f64) -> u32 {
+        let pade = &APPROXIMANTS[approximant];
+        let scaled_norm = tau * self.a_norm;
+        if scaled_norm <= pade.norm_without_extra_squarings {
+            return 0;
+        }
+        let m = pade.degree;
+        let power_norm = *self.abs_power_norms[approximant]
+            .get_or_insert_with(|| self.a.absolute_power_norm(self.a_norm, 2 * m + 1));
+        if power_norm == 0.0 {
+            return 0;
+        }
+        let alpha_over_u = (pade.log2_error_coefficient - UNIT_ROUNDOFF_LOG2).exp2()
+            * integer_power(scaled_norm, 2 * m)
+            * power_norm;
+        let log2_alpha_over_u = if alpha_over_u.is_finite() && alpha_over_u > 0.0 {
+            if alpha_over_u <= 1.0 {
+                return 0;
+            }
+            alpha_over_u.log2()
+        } else {
+            pade.log2_error_coefficient - UNIT_ROUNDOFF_LOG2
+                + 2.0 * m as f64 * scaled_norm.log2()
+                + power_norm.log2()
+        };
+        let value = (log2_alpha_over_u / (2 * m) as f64).ceil();
+        if value > 0.0 { value as u32 } else { 0 }
+    }
+
+    /// The Padé degree and number of squarings for e^{tA} (Al-Mohy & Higham 2009, Algorithm 5.1,
+    /// with every norm scaled by τ = |t|).
+    pub fn choose(&mut self, t: f64) -> PadeChoice {
+        let choice = |approximant, squarings: u32| PadeChoice {
+            approximant,
+            squarings: squarings.min(MAX_SQUARINGS),
+        };
+        let tau = t.abs();
+        if tau == 0.0 || self.a_norm == 0.0 {
+            return choice(M3, self.prescale);
+        }
+        // η1 = τ max(d4, d6) <= θ3 (d4 and d6 estimated at large orders, before A4 is formed).
+        if self.scaled_root_norms_within(4, 6, tau, APPROXIMANTS[M3].theta)
+            && self.extra_squarings(M3, tau) == 0
+        {
+            return choice(M3, self.prescale);
+        }
+        // η2 = τ max(d4, d6) <= θ5, with A4 formed (d4 exact).
+        self.ensure_a4();
+        if self.scaled_root_norms_within(4, 6, tau, APPROXIMANTS[M5].theta)
+            && self.extra_squarings(M5, tau) == 0
+        {
+            return choice(M5, self.prescale);
+        }
+        // η3 = τ max(d6, d8) <= θ7 or θ9, with A6 formed.
+        self.ensure_a6();
+        for approximant in [M7, M9] {
+            if self.scaled_root_norms_within(6, 8, tau, APPROXIMANTS[approximant].theta)
+                && self.extra_squarings(approximant, tau) == 0
+            {
+                return choice(approximant, self.prescale);
+            }
+        }
+        // η5 = min(η3, η4), η4 = τ max(d8, d10); s = ⌈log2(η5 / θ13)⌉ plus ℓ.
+        let (d6, d8, d10) = (
+            self.log2_scaled_root_norm(6, tau),
+            self.log2_scaled_root_norm(8, tau),
+            self.log2_scaled_root_norm(10, tau),
+        );
+        let eta5 = d6.max(d8).min(d8.max(d10));
+        let squarings = (eta5 - THETA_13.log2())
+            .ceil()
+            .clamp(0.0, MAX_SQUARINGS as f64) as u32;
+        let squarings = squarings + self.extra_squarings(M13, tau * (-(squarings as f64)).exp2());
+        choice(M13, squarings.saturating_add(self.prescale))
+    }
+
+    /// Forms the powers that evaluating `choice` needs; call before [`Self::exponential`].
+    pub fn prepare(&mut self, choice: PadeChoice) {
+        match choice.approximant {
+            M3 => {}
+            M5 => self.ensure_a4(),
+            M9 => {
+                self.ensure_a6();
+                self.ensure_a8();
+            }
+            _ => self.ensure_a6(),
+        }
+    }
+
+    /// Writes e^{tA}, with the given (prepared) choice of degree and squarings, into `out`.
+    pub fn exponential_into(&self, t: f64, choice: PadeChoice, mut out: MatMut<'_, f64>) {
+        let n = self.a.order();
+        if t == 0.0 {
+            out.fill(0.0);
+            out.diagonal_mut().fill(1.0);
+            return;
+        }
+        // r_m is evaluated at c * (pre-scaled A); the squarings undo both scalings.
+        let c = t * (-(choice.squarings.saturating_sub(self.prescale) as f64)).exp2();
+        let accurate = choice.squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS;
+        let x = accurate
+            .then(|| {
+                self.a
+                    .double_double_exponential(c, choice.approximant, choice.squarings)
+            })
+            .flatten()
+            .unwrap_or_else(|| self.double_exponential(t, c, choice));
+        x.write_to(out.as_mut(), self.transposed);
+        if self.diagonals.is_some() {
+            // The exponential of a triangular matrix is triangular: clear any rounding (or NaN
+            // from an overflowed square) in the other triangle.
+            for j in 0..n {
+                for i in 0..n {
+                    if (i > j) != self.transposed && i != j {
+                        out[(i, j)] = 0.0;
+                    }
+                }
+            }
+        }
+    }
+
+    /// r_m(cA) squared in double precision, refining triangular structure on the way.
+    fn double_exponential(&self, t: f64, c: f64, choice: PadeChoice) -> M {
+        let x = if c == 1.0 {
+            pade_approximant(
+                choice.approximant,
+                &self.a,
+                &[&self.a2],
+                [&self.a4, &self.a6, &self.a8],
+            )
+        } else {
+            // The powers of cA: c^k A^k.
+            let c2 = c * c;
+            let scaled = |power: &Option<M>, factor: f64| {
+                power.as_ref().map(|p| M::combination(0.0, &[(factor, p)]))
+            };
+            let a = M::combination(0.0, &[(c, &self.a)]);
+            let a2 = M::combination(0.0, &[(c2, &self.a2)]);
+            let a4 = scaled(&self.a4, c2 * c2);
+            let a6 = scaled(&self.a6, c2 * c2 * c2);
+            let a8 = scaled(&self.a8, (c2 * c2) * (c2 * c2));
+            pade_approximant(choice.approximant, &a, &[&a2], [&a4, &a6, &a8])
+        };
+        square_repeatedly(x, choice.squarings, |x, i| {
+            if let Some((diagonal, superdiagonal)) = &self.diagonals {
+                let scale = t * (-(i as f64)).exp2();
+                for (k, &d) in diagonal.iter().enumerate() {
+                    x.set(k, k, (scale * d).exp());
+                }
+                for (k, (&s, pair)) in superdiagonal.iter().zip(diagonal.windows(2)).enumerate() {
+                    let value =
+                        scale * s * exp_divided_difference(scale * pair[0], scale * pair[1]);
+                    x.set(k, k + 1, value);
+                }
+            }
+        })
+    }
+}
+
+// ----- faer matrices (any order), pooled ----------------------------------------------------
+
+/// The threading of the products of one exponential of order n.
+pub fn parallelism_for_order(n: usize) -> Par {
+    if n >= PARALLEL_MIN_ORDER {
+        Par::rayon(0)
+    } else {
+        Par::Seq
+    }
+}
+
+impl PadeArithmetic for Scratch {
+    fn product(&self, rhs: &Self, alpha: f64) -> Self {
+        let mut out = scratch(self.nrows(), rhs.ncols());
+        let par = parallelism_for_order(self.nrows());
+        matmul(
+            out.as_mut(),
+            Accum::Replace,
+            self.as_ref(),
+            rhs.as_ref(),
+            alpha,
+            par,
+        );
+        out
+    }
+
+    fn add_product(&mut self, lhs: &Self, rhs: &Self, alpha: f64) {
+        let par = parallelism_for_order(self.nrows());
+        matmul(
+            self.as_mut(),
+            Accum::Add,
+            lhs.as_ref(),
+            rhs.as_ref(),
+            alpha,
+            par,
+        );
+    }
+
+    fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
+        let (&(first_coefficient, first), rest) = terms.split_first().expect("at least one term");
+        let n = first.nrows();
+        let mut out = scratch(n, n);
+        for j in 0..n {
+            let column = out.col_as_slice_mut(j);
+            for (o, m) in column.iter_mut().zip(first.col_as_slice(j)) {
+                *o = first_coefficient * m;
+            }
+            for &(coefficient, matrix) in rest {
+                for (o, m) in column.iter_mut().zip(matrix.col_as_slice(j)) {
+                    *o += coefficient * m;
+                }
+            }
+            column[j] += identity;
+        }
+        out
+    }
+
+    fn pade_quotient(mut even: Self, mut odd: Self) -> Self {
+        let n = even.nrows();
+        for j in 0..n {
+            for (d, u) in even.col_as_slice_mut(j).iter_mut().zip(odd.col_as_slice(j)) {
+                *d -= u;
+            }
+        }
+        crate::lu::solve_in_place(even.as_mut(), odd.as_mut(), parallelism_for_order(n));
+        for j in 0..n {
+            for value in odd.col_as_slice_mut(j) {
+                *value *= 2.0;
+            }
+            odd[(j, j)] += 1.0;
+        }
+        odd
+    }
+}
+
+impl ExpmMatrix for Scratch {
+    fn from_ref(a: MatRef<'_, f64>) -> Self {
+        let mut m = scratch(a.nrows(), a.ncols());
+        m.copy_from(a);
+        m
+    }
+
+    fn order(&self) -> usize {
+        self.nrows()
+    }
+
+    fn get(&self, i: usize, j: usize) -> f64 {
+        self[(i, j)]
+    }
+
+    fn is_upper_triangular(&self) -> bool {
+        is_upper_triangular(self.as_ref())
+    }
+
+    fn is_lower_triangular(&self) -> bool {
+        is_upper_triangular(self.as_ref().transpose())
+    }
+
+    fn transpose(&self) -> Self {
+        Self::from_ref(self.as_ref().transpose())
+    }
+
+    fn set(&mut self, i: usize, j: usize, value: f64) {
+        self[(i, j)] = value;
+    }
+
+    fn one_norm(&self) -> f64 {
+        one_norm(self.as_ref())
+    }
+
+    fn estimate_product_norm(factors: &[&Self]) -> f64 {
+        one_norm_estimate(
+            &MatrixProduct::new(factors.iter().map(|f| f.as_ref()).collect()),
+            2,
+        )
+    }
+
+    fn absolute_power_norm(&self, scale: f64, p: usize) -> f64 {
+        absolute_power_norm(self.as_ref(), scale, p)
+    }
+
+    fn write_to(&self, mut out: MatMut<'_, f64>, transpose: bool) {
+        if transpose {
+            out.copy_from(self.as_ref().transpose());
+        } else {
+            out.copy_from(self.as_ref());
+        }
+    }
+}
+
+// ----- stack matrices of a small order, with the double-double evaluation --------------------
+
+impl<const N: usize> PadeArithmetic for SmallMatrix<N> {
+    fn product(&self, rhs: &Self, alpha: f64) -> Self {
+        SmallMatrix::product(self, rhs, alpha)
+    }
+
+    fn add_product(&mut self, lhs: &Self, rhs: &Self, alpha: f64) {
+        SmallMatrix::add_product(self, lhs, rhs, alpha);
+    }
+
+    fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
+        SmallMatrix::combination(identity, terms)
+    }
+
+    fn pade_quotient(even: Self, odd: Self) -> Self {
+        let denominator = SmallMatrix::combination(0.0, &[(1.0, &even), (-1.0, &odd)]);
+        SmallMatrix::combination(1.0, &[(2.0, &denominator.solve(odd))])
+    }
+}
+
+impl<const N: usize> PadeArithmetic for DoubleDoubleMatrix<N> {
+    fn product(&self, rhs: &Self, alpha: f64) -> Self {
+        DoubleDoubleMatrix::product(self, rhs, alpha)
+    }
+
+    fn add_product(&mut self, lhs: &Self, rhs: &Self, alpha: f64) {
+        let product = lhs.product(rhs, alpha);
+        *self = DoubleDoubleMatrix::combination(0.0, &[(1.0, self), (1.0, &product)]);
+    }
+
+    fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
+        DoubleDoubleMatrix::combination(identity, terms)
+    }
+
+    fn pade_quotient(even: Self, odd: Self) -> Self {
+        let quotient = even.difference(&odd).solve(&odd);
+        DoubleDoubleMatrix::combination(1.0, &[(2.0, &quotient)])
+    }
+}
+
+impl<const N: usize> ExpmMatrix for SmallMatrix<N> {
+    fn from_ref(a: MatRef<'_, f64>) -> Self {
+        SmallMatrix::from_ref(a)
+    }
+
+    fn order(&self) -> usize {
+        N
+    }
+
+    fn get(&self, i: usize, j: usize) -> f64 {
+        self.rows[i][j]
+    }
+
+    fn is_upper_triangular(&self) -> bool {
+        SmallMatrix::is_upper_triangular(self)
+    }
+
+    fn is_lower_triangular(&self) -> bool {
+        SmallMatrix::is_lower_triangular(self)
+    }
+
+    fn transpose(&self) -> Self {
+        SmallMatrix::transpose(self)
+    }
+
+    fn set(&mut self, i: usize, j: usize, value: f64) {
+        self.rows[i][j] = value;
+    }
+
+    fn one_norm(&self) -> f64 {
+        SmallMatrix::one_norm(self)
+    }
+
+    fn estimate_product_norm(factors: &[&Self]) -> f64 {
+        // Small orders always use exact norms; the product is cheap.
+        let (first, rest) = factors.split_first().expect("at least one factor");
+        rest.iter()
+            .fold(**first, |product, factor| product.product(factor, 1.0))
+            .one_norm()
+    }
+
+    fn absolute_power_norm(&self, scale: f64, p: usize) -> f64 {
+        SmallMatrix::absolute_power_norm(self, scale, p)
+    }
+
+    fn write_to(&self, mut out: MatMut<'_, f64>, transpose: bool) {
+        for (i, row) in self.rows.iter().enumerate() {
+            for (j, &value) in row.iter().enumerate() {
+                if transpose {
+                    out[(j, i)] = value;
+                } else {
+                    out[(i, j)] = value;
+                }
+            }
+        }
+    }
+
+    fn double_double_exponential(
+        &self,
+        c: f64,
+        approximant: usize,
+        squarings: u32,
+    ) -> Option<Self> {
+        // Powers of B = cA, formed in double-double from the exactly scaled matrix.
+        let b = DoubleDoubleMatrix::scaled(self, c);
+        let b2 = b.product(&b, 1.0);
+        let degree = APPROXIMANTS[approximant].degree;
+        let b4 = (degree >= 5).then(|| b2.product(&b2, 1.0));
+        let b6 = (degree >= 7).then(|| b4.as_ref().expect("degree >= 5").product(&b2, 1.0));
+        let b8 = (degree == 9).then(|| {
+            let b4 = b4.as_ref().expect("degree >= 5");
+            b4.product(b4, 1.0)
+        });
+        let x = pade_approximant(approximant, &b, &[&b2], [&b4, &b6, &b8]);
+        let x = square_repeatedly(x, squarings, |_, _| {}).round();
+        x.rows.iter().flatten().all(|v| v.is_finite()).then_some(x)
+    }
+}
+
+// ----- public functions ---------------------------------------------------------------------
+
+/// Runs `$body` with `$m` bound to the matrix type for order `$n`: a stack matrix for orders
+/// 2 to [`SMALL_MAX_ORDER`], a pooled faer matrix otherwise.
+macro_rules! with_matrix_type {
+    ($n:expr, $m:ident => $body:expr) => {
+        match $n {
+            2 => {
+                type $m = SmallMatrix<2>;
+                $body
+            }
+            3 => {
+                type $m = SmallMatrix<3>;
+                $body
+            }
+            4 => {
+                type $m = SmallMatrix<4>;
+                $body
+            }
+            5 => {
+                type $m = SmallMatrix<5>;
+                $body
+            }
+            6 => {
+                type $m = SmallMatrix<6>;
+                $body
+            }
+            7 => {
+                type $m = SmallMatrix<7>;
+                $body
+            }
+            8 => {
+                type $m = SmallMatrix<8>;
+                $body
+            }
+            _ => {
+                type $m = Scratch;
+                $body
+            }
+        }
+    };
+}
+
+/// Checks that `a` is a square matrix of finite entries.
+fn check_square_finite(a: MatRef<'_, f64>, arg: &'static str) -> Result<(), Error> {
+    check_square(a, arg)?;
+    check_finite(a, arg)
+}
+
+fn single_exponential<M: ExpmMatrix>(a: MatRef<'_, f64>, out: MatMut<'_, f64>) {
+    let mut plan = ExponentialPlan::<M>::new(a);
+    let choice = plan.choose(1.0);
+    plan.prepare(choice);
+    plan.exponential_into(1.0, choice, out);
+}
+
+/// Writes e^A into `out` (n x n), for a square A of finite entries.
+pub fn expm_into(a: MatRef<'_, f64>, out: MatMut<'_, f64>) -> Result<(), Error> {
+    check_square_finite(a, "A")?;
+    assert_eq!(
+        (out.nrows(), out.ncols()),
+        (a.nrows(), a.nrows()),
+        "the output of expm_into must have the order of A"
+    );
+    expm_into_validated(a, out);
+    Ok(())
+}
+
+/// [`expm_into`] for an A already known to be square and finite, with `out` of its order.
+pub(crate) fn expm_into_validated(a: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+    match a.nrows() {
+        0 => {}
+        1 => out[(0, 0)] = a[(0, 0)].exp(),
+        n => with_matrix_type!(n, M => single_exponential::<M>(a, out)),
+    }
+}
+
+/// The matrix exponential e^A (6.19) of a square matrix of finite entries.
+///
+/// A result that overflows double precision has infinite (or NaN) entries; the caller decides
+/// how to report it.
+///
+/// ```
+/// use faer::mat;
+/// let a = mat![[0.0, 1.0], [-2.0, -3.0]];
+/// let phi = aerocontrol::expm::expm(a.as_ref()).unwrap();
+/// // e^A = [[2e^-1 - e^-2, e^-1 - e^-2], [-2e^-1 + 2e^-2, -e^-1 + 2e^-2]]
+/// let (e1, e2) = ((-1.0f64).exp(), (-2.0f64).exp());
+/// assert!((phi[(0, 0)] - (2.0 * e1 - e2)).abs() < 1e-15);
+/// assert!((phi[(1, 1)] - (2.0 * e2 - e1)).abs() < 1e-15);
+/// ```
+pub fn expm(a: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+    let n = a.nrows();
+    let mut out = Mat::zeros(n, n);
+    expm_into(a, out.as_mut())?;
+    Ok(out)
+}
+
+/// The degree m and number of squarings s that [`expm`] uses for A (for a 1 x 1 or empty A,
+/// which need no approximant, (0, 0)).
+pub fn pade_choice(a: MatRef<'_, f64>) -> Result<(usize, u32), Error> {
+    check_square_finite(a, "A")?;
+    if a.nrows() <= 1 {
+        return Ok((0, 0));
+    }
+    let choice = with_matrix_type!(a.nrows(), M => ExponentialPlan::<M>::new(a).choose(1.0));
+    Ok((choice.degree(), choice.squarings))
+}
+
+fn transition_matrices_with<M: ExpmMatrix>(a: MatRef<'_, f64>, times: &[f64], out: &mut [f64]) {
+    let n = a.nrows();
+    let mut plan = ExponentialPlan::<M>::new(a);
+    let choices: Vec<PadeChoice> = times.iter().map(|&t| plan.choose(t)).collect();
+    for &choice in &choices {
+        plan.prepare(choice);
+    }
+    let plan = &plan;
+    let evaluate = |((&t, &choice), chunk): ((&f64, &PadeChoice), &mut [f64])| {
+        plan.exponential_into(t, choice, MatMut::from_row_major_slice_mut(chunk, n, n));
+    };
+    if n < PARALLEL_MIN_ORDER && times.len() > 1 {
+        times
+            .par_iter()
+            .zip(&choices)
+            .zip(out.par_chunks_mut(n * n))
+            .for_each(evaluate);
+    } else {
+        times
+            .iter()
+            .zip(&choices)
+            .zip(out.chunks_mut(n * n))
+            .for_each(evaluate);
+    }
+}
+
+/// Writes Φ(t_k) = e^{A t_k} for every time of `times` into `out`, a row-major stack of
+/// len(times) n x n matrices (the layout of a C-ordered numpy array).
+pub fn transition_matrices_into(
+    a: MatRef<'_, f64>,
+    times: &[f64],
+    out: &mut [f64],
+) -> Result<(), Error> {
+    check_square_finite(a, "A")?;
+    check_finite_values(times, "t")?;
+    let n = a.nrows();
+    assert_eq!(
+        out.len(),
+        times.len() * n * n,
+        "the output stack has the wrong length"
+    );
+    match n {
+        0 => {}
+        1 => {
+            for (value, &t) in out.iter_mut().zip(times) {
+                *value = (t * a[(0, 0)]).exp();
+            }
+        }
+        n => with_matrix_type!(n, M => transition_matrices_with::<M>(a, times, out)),
+    }
+    Ok(())
+}
+
+/// The state transition matrices Φ(t_k) = e^{A t_k} (6.22) at every time of `times`.
+///
+/// The powers of A and their norms are computed once; each time then costs one Padé evaluation
+/// and its squarings. Times may be negative (e^{-At} = (e^{At})^-1, (6.27)). Computed in
+/// parallel over the times when the matrices are small.
+pub fn transition_matrices(a: MatRef<'_, f64>, times: &[f64]) -> Result<Vec<Mat<f64>>, Error> {
+    let n = a.nrows();
+    let mut stack = vec![0.0; times.len() * n * n];
+    transition_matrices_into(a, times, &mut stack)?;
+    Ok(stack
+        .chunks(n * n)
+        .map(|chunk| MatRef::from_row_major_slice(chunk, n, n).to_owned())
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::mat;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+    use rand_distr::StandardNormal;
+
+    fn random_matrix(n: usize, scale: f64, rng: &mut StdRng) -> Mat<f64> {
+        Mat::from_fn(n, n, |_, _| scale * rng.sample::<f64, _>(StandardNormal))
+    }
+
+    fn relative_difference(x: &Mat<f64>, y: &Mat<f64>) -> f64 {
+        (x - y).norm_l2() / y.norm_l2()
+    }
+
+    /// e^A by its Taylor series on A / 2^s, with s chosen so the series converges fast, then
+    /// squared: an independent (if slower and less careful) reference for A of moderate norm.
+    fn taylor_reference(a: &Mat<f64>) -> Mat<f64> {
+        let n = a.nrows();
+        let s = (one_norm(a.as_ref()).log2().ceil() + 4.0).max(0.0) as i32;
+        let scaled = a * faer::Scale(2f64.powi(-s));
+        let mut term = Mat::<f64>::identity(n, n);
+        let mut sum = Mat::<f64>::identity(n, n);
+        for k in 1..30 {
+            term = &term * &scaled * faer::Scale(1.0 / k as f64);
+            sum += &term;
+        }
+        for _ in 0..s {
+            sum = &sum * &sum;
+        }
+        sum
+    }
+
+    /// e^A for symmetric A = Q diag(λ) Q^T as Q diag(e^λ) Q^T: exact up to rounding, for any norm.
+    fn symmetric_case(eigenvalues: &[f64], seed: u64) -> (Mat<f64>, Mat<f64>) {
+        let n = eigenvalues.len();
+        let mut rng = StdRng::seed_from_u64(seed);
+        let v = random_matrix(n, 1.0, &mut rng);
+        // Householder reflector Q = I - 2 w w^T / (w^T w) from the first column of v.
+        let w = v.col(0).to_owned();
+        let q = Mat::<f64>::identity(n, n)
+            - &w * w.transpose() * faer::Scale(2.0 / w.squared_norm_l2());
+        let d = Mat::from_fn(n, n, |i, j| if i == j { eigenvalues[i] } else { 0.0 });
+        let e = Mat::from_fn(n, n, |i, j| if i == j { eigenvalues[i].exp() } else { 0.0 });
+        (&q * &d * q.transpose(), &q * &e * q.transpose())
+    }
+
+    #[test]
+    fn pade_coefficients_follow_the_factorial_formula() {
+        // b_j ∝ (2m - j)! m! / ((2m)! j! (m - j)!), normalised so that b_m = 1.
+        let factorial = |k: usize| (1..=k).map(|i| i as f64).product::<f64>();
+        for approximant in &APPROXIMANTS {
+            let m = approximant.degree;
+            let formula = |j: usize| {
+                factorial(2 * m - j) * factorial(m)
+                    / (factorial(2 * m) * factorial(j) * factorial(m - j))
+            };
+            for (j, &b) in approximant.coefficients.iter().enumerate() {
+                let expected = formula(j) / formula(m);
+                assert!((b - expected).abs() <= 1e-15 * expected, "m={m} j={j}");
+            }
+        }
+    }
+
+    #[test]
+    fn norms_without_extra_squarings_follow_from_the_error_coefficients() {
+        // (u / |c_{2m+1}|)^(1/(2m)), and close to θ_m: θ_m is where the whole backward error
+        // series, not only its leading term, reaches u.
+        for approximant in &APPROXIMANTS {
+            let m = approximant.degree as f64;
+            let expected =
+                ((UNIT_ROUNDOFF_LOG2 - approximant.log2_error_coefficient) / (2.0 * m)).exp2();
+            assert!((approximant.norm_without_extra_squarings / expected - 1.0).abs() < 1e-14);
+            if approximant.degree < 13 {
+                assert!(
+                    (approximant.norm_without_extra_squarings / approximant.theta - 1.0).abs()
+                        < 0.01
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn leading_error_coefficients_match_their_definition() {
+        // log2((m!)^2 / ((2m)! (2m+1)!)) summed term by term.
+        let log2_factorial = |k: usize| (1..=k).map(|i| (i as f64).log2()).sum::<f64>();
+        for approximant in &APPROXIMANTS {
+            let m = approximant.degree;
+            let expected =
+                2.0 * log2_factorial(m) - log2_factorial(2 * m) - log2_factorial(2 * m + 1);
+            assert!(
+                (approximant.log2_error_coefficient - expected).abs() < 1e-12,
+                "m={m}"
+            );
+        }
+        // The familiar m = 3 value: 1/|c_7| = 6! 7! / (3!)^2 = 100800.
+        assert!((APPROXIMANTS[M3].log2_error_coefficient + 100800f64.log2()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn empty_and_scalar_matrices() {
+        assert_eq!(expm(Mat::<f64>::zeros(0, 0).as_ref()).unwrap().nrows(), 0);
+        let e = expm(mat![[2.5]].as_ref()).unwrap();
+        assert_eq!(e[(0, 0)], 2.5f64.exp());
+        let phi = transition_matrices(mat![[-0.5]].as_ref(), &[0.0, 2.0]).unwrap();
+        assert_eq!((phi[0][(0, 0)], phi[1][(0, 0)]), (1.0, (-1.0f64).exp()));
+    }
+
+    #[test]
+    fn rejects_non_square_and_non_finite() {
+        assert_eq!(
+            expm(Mat::<f64>::zeros(2, 3).as_ref()),
+            Err(Error::NotSquare {
+                arg: "A",
+                rows: 2,
+                cols: 3
+            })
+        );
+        let a = mat![[1.0, f64::NAN], [0.0, 1.0]];
+        assert!(matches!(
+            expm(a.as_ref()),
+            Err(Error::NonFinite { arg: "A", .. })
+        ));
+        assert!(matches!(
+            transition_matrices(mat![[1.0]].as_ref(), &[0.0, f64::NAN]),
+            Err(Error::NonFinite { arg: "t", .. })
+        ));
+    }
+
+    #[test]
+    fn closed_form_two_by_two() {
+        // A = [[0, 1], [-2, -3]] (chapter (6.75)) has eigenvalues -1 and -2. At t = 25 the
+        // exponential's condition number is 275: double evaluation loses digits, double-double
+        // does not.
+        let a = mat![[0.0, 1.0], [-2.0, -3.0]];
+        for t in [0.0, 0.01, 0.7, 3.0, 25.0, -1.5] {
+            let phi = &transition_matrices(a.as_ref(), &[t]).unwrap()[0];
+            let (e1, e2) = ((-t).exp(), (-2.0 * t).exp());
+            let expected = mat![
+                [2.0 * e1 - e2, e1 - e2],
+                [-2.0 * e1 + 2.0 * e2, -e1 + 2.0 * e2]
+            ];
+            let err = relative_difference(phi, &expected);
+            // Double evaluation (fewer than two squarings) is within ten times the condition
+            // number (at most 18 here) times u; double-double is correct to the last bits.
+            let (_, squarings) = pade_choice((&a * faer::Scale(t)).as_ref()).unwrap();
+            let tolerance = if squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS {
+                4e-16
+            } else {
+                1e-14
+            };
+            assert!(err < tolerance, "t={t}: {err}");
+        }
+    }
+
+    #[test]
+    fn every_degree_is_exercised_and_accurate() {
+        // Scaling one symmetric matrix walks the selection through every degree and many
+        // squarings; its exponential is known from the eigendecomposition.
+        let eigenvalues = [-1.0, -0.5, 0.1, 0.4, 0.9, 1.0];
+        let mut degrees = std::collections::BTreeSet::new();
+        for (order, matrix_type) in [(6, "small"), (12, "faer")] {
+            for scale in [1e-3, 1e-2, 0.2, 0.8, 1.8, 4.0, 30.0, 200.0] {
+                let lambda: Vec<f64> = (0..order)
+                    .map(|i| scale * eigenvalues[i % 6] * (1.0 + 0.01 * i as f64))
+                    .collect();
+                let (a, expected) = symmetric_case(&lambda, 3);
+                degrees.insert(pade_choice(a.as_ref()).unwrap().0);
+                let got = expm(a.as_ref()).unwrap();
+                let err = relative_difference(&got, &expected);
+                assert!(
+                    err < 1e-14 * scale.max(10.0),
+                    "{matrix_type} scale {scale}: {err}"
+                );
+            }
+        }
+        assert_eq!(
+            degrees.into_iter().collect::<Vec<_>>(),
+            vec![3, 5, 7, 9, 13]
+        );
+    }
+
+    #[test]
+    fn several_orders_against_the_taylor_reference() {
+        let mut rng = StdRng::seed_from_u64(5);
+        for n in [2, 3, 4, 5, 7, 8, 9, 16, 33, 64, 100] {
+            let a = random_matrix(n, 2.0 / (n as f64).sqrt(), &mut rng);
+            let got = expm(a.as_ref()).unwrap();
+            let err = relative_difference(&got, &taylor_reference(&a));
+            assert!(err < 1e-13, "n={n}: {err}");
+        }
+    }
+
+    #[test]
+    fn small_and_faer_engines_agree() {
+        // The same algorithm on stack matrices and on faer matrices (forced by calling the
+        // generic path directly) differs only by rounding.
+        let mut rng = StdRng::seed_from_u64(13);
+        for scale in [0.05, 1.0, 3.0] {
+            let a = random_matrix(5, scale, &mut rng);
+            let (mut small, mut general) = (Mat::zeros(5, 5), Mat::zeros(5, 5));
+            single_exponential::<SmallMatrix<5>>(a.as_ref(), small.as_mut());
+            single_exponential::<Scratch>(a.as_ref(), general.as_mut());
+            assert!(
+                relative_difference(&small, &general) < 1e-14,
+                "scale {scale}"
+            );
+        }
+    }
+
+    #[test]
+    fn double_double_evaluation_beats_double_on_a_hump() {
+        // Moler & Van Loan's [[-49, 24], [-64, 31]]: eigenvalues -17 and -1, a large hump.
+        // Closed form: e^A = U diag(e^-17, e^-1) V, U = [[3, 1], [4, 2]], V = [[1, -1/2], [-2, 3/2]].
+        let a = mat![[-49.0, 24.0], [-64.0, 31.0]];
+        let (e17, e1) = ((-17.0f64).exp(), (-1.0f64).exp());
+        let expected = mat![
+            [3.0 * e17 - 2.0 * e1, -1.5 * e17 + 1.5 * e1],
+            [4.0 * e17 - 4.0 * e1, -2.0 * e17 + 3.0 * e1]
+        ];
+        let mut plan = ExponentialPlan::<SmallMatrix<2>>::new(a.as_ref());
+        let choice = plan.choose(1.0);
+        assert!(choice.squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS);
+        plan.prepare(choice);
+        let mut accurate = Mat::zeros(2, 2);
+        plan.exponential_into(1.0, choice, accurate.as_mut());
+        let c = (-(choice.squarings as f64)).exp2();
+        let double = plan.double_exponential(1.0, c, choice).to_mat();
+        let (err_dd, err_double) = (
+            relative_difference(&accurate, &expected),
+            relative_difference(&double, &expected),
+        );
+        assert!(err_dd < 2e-16, "double-double {err_dd}");
+        assert!(err_double > 4.0 * err_dd, "double {err_double} vs {err_dd}");
+    }
+
+    #[test]
+    fn exact_and_estimated_norms_choose_alike() {
+        // Above EXACT_NORM_MAX_ORDER the norms of A^8, A^10 are estimated; the result must not
+        // lose accuracy against the exact-norm choice.
+        let mut rng = StdRng::seed_from_u64(9);
+        let n = EXACT_NORM_MAX_ORDER + 20;
+        for scale in [0.5, 3.0, 40.0] {
+            let a = random_matrix(n, scale / (n as f64).sqrt(), &mut rng);
+            let mut estimated = ExponentialPlan::<Scratch>::new(a.as_ref());
+            let mut exact = ExponentialPlan::<Scratch>::new(a.as_ref());
+            exact.exact_norms = true;
+            let (ce, cx) = (estimated.choose(1.0), exact.choose(1.0));
+            assert_eq!(ce.degree(), cx.degree());
+            assert!(ce.squarings.abs_diff(cx.squarings) <= 1, "{ce:?} vs {cx:?}");
+            estimated.prepare(ce);
+            exact.prepare(cx);
+            let (mut x1, mut x2) = (Mat::zeros(n, n), Mat::zeros(n, n));
+            estimated.exponential_into(1.0, ce, x1.as_mut());
+            exact.exponential_into(1.0, cx, x2.as_mut());
+            assert!(relative_difference(&x1, &x2) < 1e-12);
+        }
+    }
+
+    #[test]
+    fn nilpotent_and_triangular_are_exact() {
+        // Strictly upper triangular (Moler & Van Loan): e^A is a finite sum.
+        let a = mat![
+            [0.0, 6.0, 0.0, 0.0],
+            [0.0, 0.0, 6.0, 0.0],
+            [0.0, 0.0, 0.0, 6.0],
+            [0.0, 0.0, 0.0, 0.0]
+        ];
+        let expected = mat![
+            [1.0, 6.0, 18.0, 36.0],
+            [0.0, 1.0, 6.0, 18.0],
+            [0.0, 0.0, 1.0, 6.0],
+            [0.0, 0.0, 0.0, 1.0]
+        ];
+        assert!(relative_difference(&expm(a.as_ref()).unwrap(), &expected) < 1e-15);
+        // The lower triangular transpose goes through the same path.
+        let lower = expm(a.transpose()).unwrap();
+        assert!(relative_difference(&lower, &expected.transpose().to_owned()) < 1e-15);
+        // A huge superdiagonal entry: e^A = [[e, 1e40 e], [0, e]].
+        let a = mat![[1.0, 1e40], [0.0, 1.0]];
+        let e = expm(a.as_ref()).unwrap();
+        let one = 1f64.exp();
+        assert!((e[(0, 1)] / (1e40 * one) - 1.0).abs() < 1e-15);
+        assert!((e[(0, 0)] - one).abs() < 1e-15 && e[(1, 0)] == 0.0);
+        // Triangular of order above the small engine's.
+        let n = 12;
+        let t = Mat::from_fn(n, n, |i, j| {
+            if j >= i {
+                1.0 / (1 + j - i) as f64
+            } else {
+                0.0
+            }
+        });
+        let e = expm(t.as_ref()).unwrap();
+        for k in 0..n {
+            assert!((e[(k, k)] - 1f64.exp()).abs() < 1e-15);
+        }
+        assert!((0..n).all(|j| (j + 1..n).all(|i| e[(i, j)] == 0.0)));
+    }
+
+    #[test]
+    fn huge_norms_overflow_to_infinity_without_hanging() {
+        let e = expm(mat![[1000.0]].as_ref()).unwrap();
+        assert_eq!(e[(0, 0)], f64::INFINITY);
+        let a = mat![[1e300, 1.0], [-1.0, 1e300]];
+        let e = expm(a.as_ref()).unwrap();
+        assert!(e.col_as_slice(0).iter().any(|v| !v.is_finite()));
+        let big = Mat::from_fn(12, 12, |i, j| if i == j { 1e300 } else { 1.0 });
+        let e = expm(big.as_ref()).unwrap();
+        assert!(e.col_as_slice(0).iter().any(|v| !v.is_finite()));
+        // A hugely negative diagonal decays to exactly zero.
+        let a = mat![[-1e200, 3.0], [0.0, -2e200]];
+        let e = expm(a.as_ref()).unwrap();
+        assert_eq!(e[(0, 0)], 0.0);
+        assert_eq!(e[(1, 1)], 0.0);
+    }
+
+    #[test]
+    fn transition_matrices_satisfy_the_semigroup_property() {
+        // Φ(t1 + t2) = Φ(t1) Φ(t2) (6.25) and Φ(-t) = Φ(t)^-1 (6.27), for both engines.
+        let mut rng = StdRng::seed_from_u64(21);
+        for n in [5, 11] {
+            let a = random_matrix(n, 0.6, &mut rng);
+            let times = [0.3, 1.1, 1.4, -1.4];
+            let phi = transition_matrices(a.as_ref(), &times).unwrap();
+            assert!(relative_difference(&(&phi[0] * &phi[1]), &phi[2]) < 1e-14);
+            let identity = Mat::<f64>::identity(n, n);
+            assert!((&phi[2] * &phi[3] - &identity).norm_l2() < 1e-13);
+            // The shared plan gives the same matrices as separate calls.
+            for (t, p) in times.iter().zip(&phi) {
+                let single = expm((&a * faer::Scale(*t)).as_ref()).unwrap();
+                assert!(relative_difference(p, &single) < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn integer_powers_are_exact_for_small_exponents() {
+        for k in 0..12 {
+            assert_eq!(integer_power(2.0, k), 2f64.powi(k as i32));
+            assert!((integer_power(1.1, k) / 1.1f64.powi(k as i32) - 1.0).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn divided_difference_is_accurate_across_regimes() {
+        for &(a, b) in &[
+            (1.0, 1.0),
+            (1.0, 1.0 + 1e-12),
+            (-3.0, 2.0),
+            (0.1, 0.3),
+            (50.0, -40.0),
+        ] {
+            let got = exp_divided_difference(a, b);
+            let expected = if a == b {
+                f64::exp(a)
+            } else if (a - b).abs() < 1e-6 {
+                f64::exp(0.5 * (a + b))
+            } else {
+                (f64::exp(b) - f64::exp(a)) / (b - a)
+            };
+            assert!((got - expected).abs() <= 1e-13 * expected.abs(), "{a} {b}");
+        }
+    }
+}

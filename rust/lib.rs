@@ -1,0 +1,46 @@
+//! aerocontrol: the numerical core of modern linear control of flight vehicles.
+//!
+//! This crate is the Rust half of the `aerocontrol` Python package, and a library in its own
+//! right: every algorithm is a pure function on [faer] matrices that validates its arguments and
+//! returns [`Result`]`<_, `[`Error`]`>`, never panicking on bad input. The PyO3 bindings live in
+//! one module behind the `python` cargo feature, so `cargo test` and `cargo bench` need no
+//! Python.
+//!
+//! Equation numbers such as (6.22) refer to the course chapter "Control of Aircraft Motions"
+//! that the project implements.
+//!
+//! # Modules
+//!
+//! * [`expm`]: the matrix exponential and transition matrices Φ(t) = e^{At}, by Padé scaling and
+//!   squaring (Al-Mohy & Higham 2009).
+//! * [`discretize`]: Φ, Γ0 and Γ1 over a step by one exponential of an augmented matrix
+//!   (Van Loan 1978), exact for singular A.
+//! * [`batch`]: the same operations over stacks of problems, in parallel.
+//! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
+//! * [`lu`]: linear solves by LU with partial pivoting.
+//! * [`small_matrix`]: fixed-size stack matrices for the small orders of flight models.
+//! * [`double_double`]: double-double arithmetic, for results accurate beyond double precision.
+//! * [`pool`]: a per-thread free list of scratch matrices.
+//! * [`error`]: the error type and the argument checks.
+//!
+//! # Which linear algebra library where
+//!
+//! faer does all dense kernels: products, LU, and later QR, Hessenberg and eigenvalues. It is
+//! fast from n = 4 to n = 1024 and lets us pick sequential or parallel execution per call, which
+//! the batch kernels need. nalgebra is not used yet; it enters only where it serves better
+//! (small fixed-size blocks).
+
+pub mod batch;
+pub mod discretize;
+pub mod double_double;
+pub mod error;
+pub mod expm;
+pub mod lu;
+pub mod norm;
+pub mod pool;
+pub mod small_matrix;
+
+#[cfg(feature = "python")]
+mod python;
+
+pub use error::Error;

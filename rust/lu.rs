@@ -1,0 +1,103 @@
+//! Linear solves by LU with partial pivoting (faer), without ever forming an inverse.
+//!
+//! A thin layer over faer's in-place factorisation. For small systems the pivot vectors and
+//! faer's scratch live on the stack, so a solve allocates nothing.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::{factor, solve};
+use faer::{MatMut, Par};
+use std::mem::MaybeUninit;
+
+/// Systems up to this order keep their pivots and scratch on the stack.
+const STACK_ORDER: usize = 64;
+const STACK_BYTES: usize = 4096;
+
+/// Solves A X = B for X, overwriting B, by LU factorisation of A with partial pivoting
+/// (P A = L U, then L Y = P B, U X = Y); A is overwritten by its factors.
+///
+/// A singular A gives infinite or NaN entries, never a panic; callers that can meet a singular
+/// matrix check its conditioning first.
+pub fn solve_in_place(a: MatMut<'_, f64>, b: MatMut<'_, f64>, par: Par) {
+    let n = a.nrows();
+    debug_assert_eq!(n, a.ncols());
+    debug_assert_eq!(n, b.nrows());
+    let requirement = factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default()).or(
+        solve::solve_in_place_scratch::<usize, f64>(n, b.ncols(), par),
+    );
+    if n <= STACK_ORDER && requirement.unaligned_bytes_required() <= STACK_BYTES {
+        let mut perm = [0usize; STACK_ORDER];
+        let mut perm_inverse = [0usize; STACK_ORDER];
+        let mut bytes = [MaybeUninit::<u8>::uninit(); STACK_BYTES];
+        factor_and_solve(
+            a,
+            b,
+            &mut perm[..n],
+            &mut perm_inverse[..n],
+            MemStack::new(&mut bytes),
+            par,
+        );
+    } else {
+        let mut perm = vec![0usize; n];
+        let mut perm_inverse = vec![0usize; n];
+        let mut buffer = MemBuffer::new(requirement.or(StackReq::EMPTY));
+        factor_and_solve(
+            a,
+            b,
+            &mut perm,
+            &mut perm_inverse,
+            MemStack::new(&mut buffer),
+            par,
+        );
+    }
+}
+
+fn factor_and_solve(
+    mut a: MatMut<'_, f64>,
+    b: MatMut<'_, f64>,
+    perm: &mut [usize],
+    perm_inverse: &mut [usize],
+    stack: &mut MemStack,
+    par: Par,
+) {
+    let (_, row_perm) = factor::lu_in_place(
+        a.as_mut(),
+        perm,
+        perm_inverse,
+        par,
+        stack,
+        Default::default(),
+    );
+    // The unit lower factor L and the upper factor U share the storage of `a`.
+    solve::solve_in_place(a.as_ref(), a.as_ref(), row_perm, b, par, stack);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::{Mat, mat};
+
+    #[test]
+    fn solves_a_system_that_needs_pivoting() {
+        let a = mat![[0.0, 2.0, 1.0], [1.0, 1.0, 0.0], [3.0, 0.0, 1.0]];
+        let x_true = mat![[1.0, -2.0], [2.0, 0.5], [-1.0, 4.0]];
+        let mut b = &a * &x_true;
+        solve_in_place(a.clone().as_mut(), b.as_mut(), Par::Seq);
+        assert!((&b - &x_true).norm_l2() < 1e-14);
+    }
+
+    #[test]
+    fn large_systems_use_the_heap() {
+        let n = 80;
+        let a = Mat::from_fn(n, n, |i, j| {
+            if i == j {
+                4.0
+            } else {
+                1.0 / (1 + i + j) as f64
+            }
+        });
+        let x_true = Mat::from_fn(n, 1, |i, _| i as f64 - 7.0);
+        let mut b = &a * &x_true;
+        solve_in_place(a.clone().as_mut(), b.as_mut(), Par::Seq);
+        assert!((&b - &x_true).norm_max() < 1e-12);
+    }
+}

@@ -1,0 +1,410 @@
+//! Matrix 1-norms: exact, and estimated by the block algorithm of Higham & Tisseur.
+//!
+//! The 1-norm ||A||_1 = max_j sum_i |a_ij| (the largest column sum) is the norm of the matrix
+//! exponential's degree selection and, later, of condition estimates. Three tools:
+//!
+//! * [`one_norm`]: the exact norm, O(n^2).
+//! * [`absolute_power_norm`]: the exact norm of a power of |A| (entrywise absolute value), by
+//!   row-vector products: for B >= 0, ||B^p||_1 = max(1^T B^p), so O(p n^2) instead of the
+//!   O(n^3 log p) of forming the power.
+//! * [`one_norm_estimate`]: a lower bound of ||Op||_1 for any operator that can be applied to an
+//!   n x t block and to its transpose, by Algorithm 2.4 of N. J. Higham and F. Tisseur, "A block
+//!   algorithm for matrix 1-norm estimation, with an application to 1-norm pseudospectra",
+//!   SIAM J. Matrix Anal. Appl. 21(4), 2000, pp. 1185-1201. With t = 2 columns the estimate is
+//!   exact in the large majority of cases and rarely more than a factor 3 low (their Table 6.1);
+//!   each iteration costs two applications of the operator to an n x t block, so estimating the
+//!   norm of a product of k n x n matrices costs O(k t n^2) instead of the O(k n^3) of forming it.
+
+use faer::{Mat, MatMut, MatRef};
+
+/// The exact 1-norm, max_j sum_i |a_ij|.
+pub fn one_norm(a: MatRef<'_, f64>) -> f64 {
+    (0..a.ncols())
+        .map(|j| (0..a.nrows()).map(|i| a[(i, j)].abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// ||(|A| / scale)^p||_1, exactly, for square A: for B = |A| / scale >= 0 entrywise, every
+/// column sum of B^p is an entry of the row vector 1^T B^p, so ||B^p||_1 = max(1^T B^p): p
+/// row-vector products, O(p n^2), instead of forming the power. Choosing scale = ||A||_1 keeps
+/// every entry of B^p at most 1, so the iteration cannot overflow.
+pub fn absolute_power_norm(a: MatRef<'_, f64>, scale: f64, p: usize) -> f64 {
+    let n = a.nrows();
+    debug_assert_eq!(n, a.ncols());
+    let inverse = 1.0 / scale;
+    // B row-major, so that a row vector times B is a sum of scaled rows (axpys).
+    let mut b = Vec::with_capacity(n * n);
+    for i in 0..n {
+        b.extend((0..n).map(|j| a[(i, j)].abs() * inverse));
+    }
+    let mut row = vec![1.0; n];
+    let mut next = vec![0.0; n];
+    for _ in 0..p {
+        // Started from the first term, so that no zeroing pass is needed.
+        for (out, &value) in next.iter_mut().zip(&b[..n]) {
+            *out = row[0] * value;
+        }
+        for i in 1..n {
+            axpy(row[i], &b[i * n..(i + 1) * n], &mut next);
+        }
+        std::mem::swap(&mut row, &mut next);
+    }
+    row.into_iter().fold(0.0, f64::max)
+}
+
+/// y += alpha x, in fixed lanes of four so that short vectors (n = 4 to 16, the usual orders
+/// here) run as a few vector operations rather than a scalar remainder loop.
+fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    let mut y_lanes = y.chunks_exact_mut(4);
+    let mut x_lanes = x.chunks_exact(4);
+    for (yl, xl) in (&mut y_lanes).zip(&mut x_lanes) {
+        for k in 0..4 {
+            yl[k] += alpha * xl[k];
+        }
+    }
+    for (yi, xi) in y_lanes.into_remainder().iter_mut().zip(x_lanes.remainder()) {
+        *yi += alpha * xi;
+    }
+}
+
+/// A square linear operator known only through its action on blocks of vectors.
+pub trait LinearOperator {
+    /// The order n of the operator.
+    fn dim(&self) -> usize;
+    /// `out = Op * x` for an n x t block `x`.
+    fn apply(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>);
+    /// `out = Op^T * x` for an n x t block `x`.
+    fn apply_transpose(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>);
+}
+
+/// The product F_1 F_2 ... F_k of square matrices of one order, never formed explicitly.
+pub struct MatrixProduct<'a> {
+    factors: Vec<MatRef<'a, f64>>,
+}
+
+impl<'a> MatrixProduct<'a> {
+    /// The product of `factors`, in order; all must be square of one order.
+    pub fn new(factors: Vec<MatRef<'a, f64>>) -> Self {
+        assert!(!factors.is_empty(), "a product needs at least one factor");
+        let n = factors[0].nrows();
+        assert!(
+            factors.iter().all(|f| f.nrows() == n && f.ncols() == n),
+            "the factors of a product must be square of one order"
+        );
+        Self { factors }
+    }
+}
+
+impl LinearOperator for MatrixProduct<'_> {
+    fn dim(&self) -> usize {
+        self.factors[0].nrows()
+    }
+
+    fn apply(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+        // F_1 (F_2 (... (F_k x))): apply the factors right to left.
+        let mut current = x.to_owned();
+        for factor in self.factors.iter().rev() {
+            current = factor * &current;
+        }
+        out.copy_from(&current);
+    }
+
+    fn apply_transpose(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+        // (F_1 ... F_k)^T x = F_k^T (... (F_1^T x)): apply the transposes left to right.
+        let mut current = x.to_owned();
+        for factor in &self.factors {
+            current = factor.transpose() * &current;
+        }
+        out.copy_from(&current);
+    }
+}
+
+/// The maximum number of iterations of the estimator (Higham & Tisseur use 5).
+const ESTIMATOR_MAX_ITERATIONS: usize = 5;
+
+/// A deterministic source of random signs (SplitMix64), so that estimates are reproducible.
+struct RandomSigns(u64);
+
+impl RandomSigns {
+    fn next_sign(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        if z & 1 == 0 { 1.0 } else { -1.0 }
+    }
+}
+
+/// Two vectors of +-1 entries are parallel when |x^T y| = n.
+fn parallel(x: &[f64], y: &[f64]) -> bool {
+    let dot: f64 = x.iter().zip(y).map(|(a, b)| a * b).sum();
+    dot.abs() == x.len() as f64
+}
+
+fn column(m: &Mat<f64>, j: usize) -> Vec<f64> {
+    (0..m.nrows()).map(|i| m[(i, j)]).collect()
+}
+
+/// A lower bound of ||op||_1 by the block 1-norm estimator with `t` columns (Higham & Tisseur
+/// 2000, Algorithm 2.4). For n <= 4 or t >= n the norm is computed exactly by applying the
+/// operator to the identity.
+pub fn one_norm_estimate(op: &dyn LinearOperator, t: usize) -> f64 {
+    let n = op.dim();
+    if n == 0 {
+        return 0.0;
+    }
+    let t = t.max(1);
+    if n <= 4 || t >= n {
+        let mut image = Mat::<f64>::zeros(n, n);
+        op.apply(Mat::<f64>::identity(n, n).as_ref(), image.as_mut());
+        return one_norm(image.as_ref());
+    }
+
+    let mut signs = RandomSigns(0x005E_ED0F_A3C0_u64);
+    // Starting block: the first column is the vector of ones, the others random +-1 columns not
+    // parallel to an earlier one; all scaled to unit 1-norm.
+    let mut x = Mat::<f64>::zeros(n, t);
+    for i in 0..n {
+        x[(i, 0)] = 1.0;
+    }
+    for j in 1..t {
+        loop {
+            for i in 0..n {
+                x[(i, j)] = signs.next_sign();
+            }
+            let candidate = column(&x, j);
+            if !(0..j).any(|k| parallel(&candidate, &column(&x, k))) {
+                break;
+            }
+        }
+    }
+    for j in 0..t {
+        for i in 0..n {
+            x[(i, j)] /= n as f64;
+        }
+    }
+
+    let mut y = Mat::<f64>::zeros(n, t);
+    let mut z = Mat::<f64>::zeros(n, t);
+    let mut s = Mat::<f64>::zeros(n, t);
+    let mut s_old: Option<Mat<f64>> = None;
+    let mut estimate_old = 0.0;
+    let mut index_best: Option<usize> = None;
+    let mut indices: Vec<usize> = (0..n).collect();
+    let mut history: Vec<usize> = Vec::new();
+    let mut estimate = 0.0;
+
+    for iteration in 1.. {
+        op.apply(x.as_ref(), y.as_mut());
+        let column_norms: Vec<f64> = (0..t)
+            .map(|j| (0..n).map(|i| y[(i, j)].abs()).sum())
+            .collect();
+        let (best_column, &best_norm) = column_norms
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .expect("t >= 1");
+        estimate = best_norm;
+        if estimate > estimate_old || iteration == 2 {
+            // In the first iteration the columns of X are not unit vectors; only later ones are.
+            if iteration >= 2 {
+                index_best = Some(indices[best_column]);
+            }
+        }
+        // (1) No improvement: the previous estimate stands.
+        if iteration >= 2 && estimate <= estimate_old {
+            estimate = estimate_old;
+            break;
+        }
+        estimate_old = estimate;
+        if iteration > ESTIMATOR_MAX_ITERATIONS {
+            break;
+        }
+        for j in 0..t {
+            for i in 0..n {
+                s[(i, j)] = if y[(i, j)] >= 0.0 { 1.0 } else { -1.0 };
+            }
+        }
+        // (2) Every column of S parallel to a column of S_old: converged.
+        if let Some(previous) = &s_old {
+            let all_parallel = (0..t).all(|j| {
+                let sj = column(&s, j);
+                (0..t).any(|k| parallel(&sj, &column(previous, k)))
+            });
+            if all_parallel {
+                break;
+            }
+        }
+        // (3) Replace columns of S parallel to an earlier column of S or to one of S_old.
+        if t > 1 {
+            for j in 0..t {
+                let mut attempts = 0;
+                loop {
+                    let sj = column(&s, j);
+                    let repeated = (0..j).any(|k| parallel(&sj, &column(&s, k)))
+                        || s_old
+                            .as_ref()
+                            .is_some_and(|p| (0..t).any(|k| parallel(&sj, &column(p, k))));
+                    // Give up resampling after n tries (possible only for tiny n).
+                    if !repeated || attempts >= n {
+                        break;
+                    }
+                    for i in 0..n {
+                        s[(i, j)] = signs.next_sign();
+                    }
+                    attempts += 1;
+                }
+            }
+        }
+        op.apply_transpose(s.as_ref(), z.as_mut());
+        let h: Vec<f64> = (0..n)
+            .map(|i| (0..t).map(|j| z[(i, j)].abs()).fold(0.0, f64::max))
+            .collect();
+        let h_max = h.iter().copied().fold(0.0, f64::max);
+        // (4) The largest gradient entry is at the best index already tried: converged.
+        if iteration >= 2 && index_best.is_some_and(|best| h[best] == h_max) {
+            break;
+        }
+        indices = (0..n).collect();
+        indices.sort_by(|&a, &b| h[b].total_cmp(&h[a]));
+        if t > 1 {
+            // (5) The t most promising unit vectors were all tried before: converged.
+            if indices[..t].iter().all(|i| history.contains(i)) {
+                break;
+            }
+            let fresh: Vec<usize> = indices
+                .iter()
+                .copied()
+                .filter(|i| !history.contains(i))
+                .take(t)
+                .collect();
+            let rest: Vec<usize> = indices
+                .iter()
+                .copied()
+                .filter(|i| !fresh.contains(i))
+                .collect();
+            indices = fresh.into_iter().chain(rest).collect();
+        }
+        x.fill(0.0);
+        for j in 0..t.min(n) {
+            x[(indices[j], j)] = 1.0;
+        }
+        history.extend_from_slice(&indices[..t.min(n)]);
+        s_old = Some(s.clone());
+    }
+    estimate
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    fn random_matrix(n: usize, rng: &mut StdRng) -> Mat<f64> {
+        Mat::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0))
+    }
+
+    #[test]
+    fn exact_norm_is_the_largest_column_sum() {
+        let a = Mat::from_fn(2, 3, |i, j| [[1.0, -7.0, 2.0], [-3.0, 1.0, 2.0]][i][j]);
+        assert_eq!(one_norm(a.as_ref()), 8.0);
+        assert_eq!(one_norm(Mat::<f64>::zeros(0, 0).as_ref()), 0.0);
+    }
+
+    #[test]
+    fn absolute_power_norm_equals_the_formed_power() {
+        let mut rng = StdRng::seed_from_u64(11);
+        for n in [1, 3, 8, 17] {
+            let a = random_matrix(n, &mut rng);
+            let scale = 0.5;
+            let abs = Mat::from_fn(n, n, |i, j| a[(i, j)].abs() / scale);
+            let mut power = Mat::<f64>::identity(n, n);
+            for p in 0..9 {
+                let expected = one_norm(power.as_ref());
+                let got = absolute_power_norm(a.as_ref(), scale, p);
+                assert!(
+                    (got - expected).abs() <= 1e-13 * expected.max(1.0),
+                    "n={n} p={p}: {got} vs {expected}"
+                );
+                power = &abs * &power;
+            }
+        }
+    }
+
+    #[test]
+    fn estimate_is_a_lower_bound_and_usually_close() {
+        // Products of two dense random matrices have many columns of nearly equal norm, a hard
+        // case: scipy's onenormest (same algorithm) is exact on 44% of these and within 7% on
+        // average.
+        let mut rng = StdRng::seed_from_u64(7);
+        let mut exact_count = 0;
+        let mut ratio_sum = 0.0;
+        let trials = 60;
+        for trial in 0..trials {
+            let n = [5, 12, 40, 100][trial % 4];
+            let a = random_matrix(n, &mut rng);
+            let b = random_matrix(n, &mut rng);
+            let exact = one_norm((&a * &b).as_ref());
+            let estimate = one_norm_estimate(&MatrixProduct::new(vec![a.as_ref(), b.as_ref()]), 2);
+            assert!(estimate <= exact * (1.0 + 1e-14), "estimate above the norm");
+            // Higham & Tisseur (Table 6.1): t = 2 is rarely worse than a factor 3 low.
+            assert!(estimate >= exact / 3.0, "n={n}: {estimate} vs {exact}");
+            if (estimate - exact).abs() <= 1e-12 * exact {
+                exact_count += 1;
+            }
+            ratio_sum += estimate / exact;
+        }
+        assert!(
+            exact_count * 10 >= trials * 3,
+            "exact in only {exact_count} of {trials}"
+        );
+        assert!(
+            ratio_sum / trials as f64 >= 0.9,
+            "mean ratio {}",
+            ratio_sum / trials as f64
+        );
+    }
+
+    #[test]
+    fn estimate_finds_a_single_large_column() {
+        // The norm is carried by one column that the starting vector of ones averages away.
+        let n = 50;
+        let mut a = Mat::<f64>::zeros(n, n);
+        for i in 0..n {
+            a[(i, 31)] = if i % 2 == 0 { 1.0 } else { -1.0 };
+            a[(i, i)] += 1e-3;
+        }
+        let exact = one_norm(a.as_ref());
+        let estimate = one_norm_estimate(&MatrixProduct::new(vec![a.as_ref()]), 2);
+        assert!(
+            (estimate - exact).abs() <= 1e-12 * exact,
+            "{estimate} vs {exact}"
+        );
+    }
+
+    #[test]
+    fn small_operators_are_normed_exactly() {
+        let mut rng = StdRng::seed_from_u64(3);
+        for n in 1..=4 {
+            let a = random_matrix(n, &mut rng);
+            let estimate = one_norm_estimate(&MatrixProduct::new(vec![a.as_ref()]), 2);
+            assert!((estimate - one_norm(a.as_ref())).abs() <= 1e-15 * n as f64);
+        }
+    }
+
+    #[test]
+    fn estimate_finds_the_norm_of_a_rank_one_product() {
+        // u v^T has 1-norm max|v| * ||u||_1 and the estimator finds it exactly.
+        let n = 30;
+        let u: Vec<f64> = (0..n).map(|i| (i as f64 - 10.0) / 7.0).collect();
+        let v: Vec<f64> = (0..n).map(|i| ((i * 7) % 11) as f64 - 5.0).collect();
+        let a = Mat::from_fn(n, n, |i, j| u[i] * v[j]);
+        let identity = Mat::<f64>::identity(n, n);
+        let estimate =
+            one_norm_estimate(&MatrixProduct::new(vec![a.as_ref(), identity.as_ref()]), 2);
+        let expected = u.iter().map(|x| x.abs()).sum::<f64>() * 5.0;
+        assert!((estimate - expected).abs() <= 1e-12 * expected);
+    }
+}
