@@ -244,8 +244,10 @@ CLOSED_FORMS: dict[str, tuple[np.ndarray, Callable[[], np.ndarray]]] = {
     ),
     "burkardt_4": (
         np.array([[-49.0, 24], [-64, 31]]),
-        lambda: (np.array([[3.0, 1], [4, 2]]) * np.exp([-17.0, -1.0]))
-        @ np.array([[1.0, -0.5], [-2.0, 1.5]]),
+        lambda: (
+            (np.array([[3.0, 1], [4, 2]]) * np.exp([-17.0, -1.0]))
+            @ np.array([[1.0, -0.5], [-2.0, 1.5]])
+        ),
     ),
     "burkardt_5": (
         np.array([[0.0, 6, 0, 0], [0, 0, 6, 0], [0, 0, 0, 6], [0, 0, 0, 0]]),

@@ -6,6 +6,16 @@ Private: call the wrappers in the aerocontrol package, which convert and check a
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+__all__ = [
+    "EXACT_NORM_MAX_ORDER",
+    "FMA_KERNELS",
+    "SMALL_MAX_ORDER",
+    "discretize",
+    "expm",
+    "expm_pade_choice",
+    "transition_matrices",
+]
+
 EXACT_NORM_MAX_ORDER: int
 SMALL_MAX_ORDER: int
 FMA_KERNELS: bool

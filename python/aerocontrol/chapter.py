@@ -50,6 +50,15 @@ def boeing747_lateral() -> tuple[FloatArray, FloatArray]:
 
     State x = (β, p, φ, r) (6.151); plant matrix (6.150), rudder column (6.158), aileron
     column (6.163); inputs (δr, δa) in rad, as in the LQR example (6.224).
+
+    Examples
+    --------
+    The eigenvalues of the printed matrix; the chapter's (6.152), -1.2308, -0.08066 ± 0.7433i,
+    -0.04641, came from the unrounded matrix:
+
+    >>> A, B = boeing747_lateral()
+    >>> np.round(np.sort_complex(np.linalg.eigvals(A)), 4)
+    array([-1.2308+0.j    , -0.0806-0.7433j, -0.0806+0.7433j, -0.0464+0.j    ])
     """
     A = np.array(
         [
@@ -71,7 +80,14 @@ def boeing747_lateral() -> tuple[FloatArray, FloatArray]:
 
 
 def controllability_example() -> tuple[FloatArray, FloatArray]:
-    """The controllability example (6.75): A = [[0, 1], [-2, -3]], B = [0, 1]^T."""
+    """The controllability example (6.75): A = [[0, 1], [-2, -3]], B = [0, 1]^T.
+
+    Examples
+    --------
+    >>> A, B = controllability_example()
+    >>> np.linalg.eigvals(A)
+    array([-1., -2.])
+    """
     return np.array([[0.0, 1.0], [-2.0, -3.0]]), np.array([[0.0], [1.0]])
 
 

@@ -87,7 +87,8 @@ def transition_matrix(A: Any, t: Any) -> FloatArray:
     """
     times = real_array(t, "t")
     if times.ndim == 0:
-        return _core.transition_matrices(A, times.reshape(1))[0]
+        single: FloatArray = _core.transition_matrices(A, times.reshape(1))[0]
+        return single
     if times.ndim != 1:
         raise ShapeError(f"t must be a scalar or a 1-D array of times, got shape {times.shape}")
     return _core.transition_matrices(A, times)
@@ -121,9 +122,7 @@ class Discretization:
     """The hold: ``"zoh"`` or ``"foh"``."""
 
 
-def discretize(
-    A: Any, B: Any, dt: float, method: Literal["zoh", "foh"] = "zoh"
-) -> Discretization:
+def discretize(A: Any, B: Any, dt: float, method: Literal["zoh", "foh"] = "zoh") -> Discretization:
     """Exact discretisation of x' = Ax + Bη over a step ``dt``.
 
     Φ, Γ0 and Γ1 come from one exponential of an augmented block matrix (Van Loan 1978), so
@@ -154,7 +153,7 @@ def discretize(
     >>> A = np.array([[-3.0, 8.0], [0.0, 0.0]]); B = np.array([0.0, 4.0])   # (6.95): singular
     >>> d = aerocontrol.discretize(A, B, 0.1)
     >>> np.round(d.Gamma0, 6)
-    array([[0.146546],
+    array([[0.145131],
            [0.4     ]])
     """
     B = real_array(B, "B")

@@ -1,0 +1,31 @@
+"""Every example in the package's docstrings runs and prints what it shows."""
+
+from __future__ import annotations
+
+import doctest
+import importlib
+import pkgutil
+
+import pytest
+
+import aerocontrol
+
+MODULES = sorted(
+    name
+    for _, name, _ in pkgutil.walk_packages(aerocontrol.__path__, "aerocontrol.")
+    if name not in {"aerocontrol._core", "aerocontrol.__main__"}
+)
+
+
+@pytest.mark.parametrize("name", ["aerocontrol", *MODULES])
+def test_docstring_examples(name: str) -> None:
+    module = importlib.import_module(name)
+    failures, _ = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert failures == 0
+
+
+def test_examples_exist_where_promised() -> None:
+    finder = doctest.DocTestFinder()
+    for name in ("aerocontrol.linalg", "aerocontrol.chapter"):
+        tests = finder.find(importlib.import_module(name))
+        assert sum(len(t.examples) for t in tests) >= 3, name
