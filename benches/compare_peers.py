@@ -13,7 +13,11 @@ Run from the repository root with the package installed::
     python benches/compare_peers.py --json       # JSON list of result records on stdout
     python benches/compare_peers.py -k expm      # only the cases whose name contains "expm"
 
-The ratio is peer time / our time: above 1 means aerocontrol is faster.
+The ratio is peer time / our time: above 1 means aerocontrol is faster. Thread settings matter:
+the header prints them, and ``OPENBLAS_NUM_THREADS=1 RAYON_NUM_THREADS=1`` gives a one-core
+comparison. On small shared machines a multithreaded OpenBLAS has been seen to put a whole
+process in a state where scipy.linalg.expm of a 4x4 matrix takes milliseconds (LAPACK inside
+scipy's pade_UV_calc); a peer time of that order on a tiny case is that, not a real speed-up.
 
 Adding a case
 -------------
@@ -389,10 +393,12 @@ def agreement(pairs: Pairs) -> tuple[bool, float]:
         axes = tuple(range(max(ref.ndim - 2, 0), ref.ndim))
         scale = np.max(np.abs(ref), axis=axes, keepdims=True) if ref.ndim else np.abs(ref)
         ok = ok and bool(np.all(np.abs(ours - ref) <= RTOL * np.abs(ref) + RTOL * scale))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            err = np.abs(ours - ref) / (np.abs(ref) + scale)
+        diff = np.abs(ours - ref)
+        bound = np.abs(ref) + scale
+        err = np.divide(diff, bound, out=np.where(diff > 0, np.inf, 0.0), where=bound > 0)
         if err.size:
-            worst = max(worst, float(np.nanmax(err)))
+            e = float(np.max(err))
+            worst = max(worst, np.inf if np.isnan(e) else e)
     return ok, worst
 
 

@@ -56,6 +56,7 @@
 //! (the transition matrices of a response) reuses them: ||(tA)^k|| = |t|^k ||A^k||, so only the
 //! final Padé evaluation and squaring are repeated per time.
 
+use crate::dispatch::{add_scaled, scale_into};
 use crate::double_double::DoubleDoubleMatrix;
 use crate::error::{Error, check_finite, check_finite_values, check_square};
 use crate::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
@@ -68,10 +69,10 @@ use rayon::prelude::*;
 /// For n up to this order the norms ||A^8||_1 and ||A^10||_1 of the degree selection are exact
 /// (from formed products); above it they are estimated (Higham & Tisseur 2000), which costs
 /// O(n^2) instead of a matrix product.
-pub const EXACT_NORM_MAX_ORDER: usize = 48;
+pub const EXACT_NORM_MAX_ORDER: usize = 150;
 
 /// Matrices of at least this order use multithreaded products and LU in a single exponential.
-pub const PARALLEL_MIN_ORDER: usize = 160;
+pub const PARALLEL_MIN_ORDER: usize = 400;
 
 /// Orders up to this run on fixed-size stack matrices; larger ones on faer.
 pub const SMALL_MAX_ORDER: usize = 8;
@@ -717,13 +718,9 @@ impl PadeArithmetic for Scratch {
         let mut out = scratch(n, n);
         for j in 0..n {
             let column = out.col_as_slice_mut(j);
-            for (o, m) in column.iter_mut().zip(first.col_as_slice(j)) {
-                *o = first_coefficient * m;
-            }
+            scale_into(column, first_coefficient, first.col_as_slice(j));
             for &(coefficient, matrix) in rest {
-                for (o, m) in column.iter_mut().zip(matrix.col_as_slice(j)) {
-                    *o += coefficient * m;
-                }
+                add_scaled(column, coefficient, matrix.col_as_slice(j));
             }
             column[j] += identity;
         }
@@ -733,16 +730,15 @@ impl PadeArithmetic for Scratch {
     fn pade_quotient(mut even: Self, mut odd: Self) -> Self {
         let n = even.nrows();
         for j in 0..n {
-            for (d, u) in even.col_as_slice_mut(j).iter_mut().zip(odd.col_as_slice(j)) {
-                *d -= u;
-            }
+            add_scaled(even.col_as_slice_mut(j), -1.0, odd.col_as_slice(j));
         }
         crate::lu::solve_in_place(even.as_mut(), odd.as_mut(), parallelism_for_order(n));
         for j in 0..n {
-            for value in odd.col_as_slice_mut(j) {
+            let column = odd.col_as_slice_mut(j);
+            for value in column.iter_mut() {
                 *value *= 2.0;
             }
-            odd[(j, j)] += 1.0;
+            column[j] += 1.0;
         }
         odd
     }

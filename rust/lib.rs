@@ -21,6 +21,7 @@
 //! * [`small_matrix`]: fixed-size stack matrices for the small orders of flight models.
 //! * [`double_double`]: double-double arithmetic, for results accurate beyond double precision.
 //! * [`pool`]: a per-thread free list of scratch matrices.
+//! * [`dispatch`]: run-time choice of AVX2 + FMA kernels.
 //! * [`error`]: the error type and the argument checks.
 //!
 //! # Which linear algebra library where
@@ -32,6 +33,7 @@
 
 pub mod batch;
 pub mod discretize;
+pub mod dispatch;
 pub mod double_double;
 pub mod error;
 pub mod expm;

@@ -15,56 +15,48 @@
 //!   each iteration costs two applications of the operator to an n x t block, so estimating the
 //!   norm of a product of k n x n matrices costs O(k t n^2) instead of the O(k n^3) of forming it.
 
-use faer::{Mat, MatMut, MatRef};
+use crate::pool::scratch;
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatMut, MatRef, Par};
 
-/// The exact 1-norm, max_j sum_i |a_ij|.
+/// The exact 1-norm, max_j sum_i |a_ij| (faer's vectorised column sums).
 pub fn one_norm(a: MatRef<'_, f64>) -> f64 {
     (0..a.ncols())
-        .map(|j| (0..a.nrows()).map(|i| a[(i, j)].abs()).sum::<f64>())
+        .map(|j| a.col(j).norm_l1())
         .fold(0.0, f64::max)
 }
 
 /// ||(|A| / scale)^p||_1, exactly, for square A: for B = |A| / scale >= 0 entrywise, every
 /// column sum of B^p is an entry of the row vector 1^T B^p, so ||B^p||_1 = max(1^T B^p): p
-/// row-vector products, O(p n^2), instead of forming the power. Choosing scale = ||A||_1 keeps
-/// every entry of B^p at most 1, so the iteration cannot overflow.
+/// vector-matrix products (faer's, vectorised), O(p n^2), instead of forming the power.
+/// Choosing scale = ||A||_1 keeps every entry of B^p at most 1, so the iteration cannot
+/// overflow.
 pub fn absolute_power_norm(a: MatRef<'_, f64>, scale: f64, p: usize) -> f64 {
     let n = a.nrows();
     debug_assert_eq!(n, a.ncols());
     let inverse = 1.0 / scale;
-    // B row-major, so that a row vector times B is a sum of scaled rows (axpys).
-    let mut b = Vec::with_capacity(n * n);
-    for i in 0..n {
-        b.extend((0..n).map(|j| a[(i, j)].abs() * inverse));
+    let mut b = scratch(n, n);
+    for j in 0..n {
+        for (x, i) in b.col_as_slice_mut(j).iter_mut().zip(0..n) {
+            *x = a[(i, j)].abs() * inverse;
+        }
     }
-    let mut row = vec![1.0; n];
-    let mut next = vec![0.0; n];
+    // The row vector is kept as a column v, and v <- B^T v.
+    let mut v = scratch(n, 1);
+    let mut next = scratch(n, 1);
+    v.fill(1.0);
     for _ in 0..p {
-        // Started from the first term, so that no zeroing pass is needed.
-        for (out, &value) in next.iter_mut().zip(&b[..n]) {
-            *out = row[0] * value;
-        }
-        for i in 1..n {
-            axpy(row[i], &b[i * n..(i + 1) * n], &mut next);
-        }
-        std::mem::swap(&mut row, &mut next);
+        matmul(
+            next.as_mut(),
+            Accum::Replace,
+            b.transpose(),
+            v.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        std::mem::swap(&mut v, &mut next);
     }
-    row.into_iter().fold(0.0, f64::max)
-}
-
-/// y += alpha x, in fixed lanes of four so that short vectors (n = 4 to 16, the usual orders
-/// here) run as a few vector operations rather than a scalar remainder loop.
-fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
-    let mut y_lanes = y.chunks_exact_mut(4);
-    let mut x_lanes = x.chunks_exact(4);
-    for (yl, xl) in (&mut y_lanes).zip(&mut x_lanes) {
-        for k in 0..4 {
-            yl[k] += alpha * xl[k];
-        }
-    }
-    for (yi, xi) in y_lanes.into_remainder().iter_mut().zip(x_lanes.remainder()) {
-        *yi += alpha * xi;
-    }
+    v.col_as_slice(0).iter().copied().fold(0.0, f64::max)
 }
 
 /// A square linear operator known only through its action on blocks of vectors.
@@ -95,27 +87,47 @@ impl<'a> MatrixProduct<'a> {
     }
 }
 
+impl MatrixProduct<'_> {
+    /// out = G_1 (G_2 (... (G_k x))) for the factors G in the order given, sequentially and
+    /// through two scratch blocks (faer's `*` operator would use the global thread pool, whose
+    /// start-up dwarfs products of n x 2 blocks).
+    fn apply_factors<'b>(
+        factors: impl DoubleEndedIterator<Item = MatRef<'b, f64>>,
+        x: MatRef<'_, f64>,
+        mut out: MatMut<'_, f64>,
+    ) {
+        let (n, t) = (x.nrows(), x.ncols());
+        let mut current = scratch(n, t);
+        let mut next = scratch(n, t);
+        current.copy_from(x);
+        for factor in factors.rev() {
+            matmul(
+                next.as_mut(),
+                Accum::Replace,
+                factor,
+                current.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            std::mem::swap(&mut current, &mut next);
+        }
+        out.copy_from(current.as_ref());
+    }
+}
+
 impl LinearOperator for MatrixProduct<'_> {
     fn dim(&self) -> usize {
         self.factors[0].nrows()
     }
 
-    fn apply(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+    fn apply(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>) {
         // F_1 (F_2 (... (F_k x))): apply the factors right to left.
-        let mut current = x.to_owned();
-        for factor in self.factors.iter().rev() {
-            current = factor * &current;
-        }
-        out.copy_from(&current);
+        Self::apply_factors(self.factors.iter().copied(), x, out);
     }
 
-    fn apply_transpose(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
-        // (F_1 ... F_k)^T x = F_k^T (... (F_1^T x)): apply the transposes left to right.
-        let mut current = x.to_owned();
-        for factor in &self.factors {
-            current = factor.transpose() * &current;
-        }
-        out.copy_from(&current);
+    fn apply_transpose(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>) {
+        // (F_1 ... F_k)^T x = F_k^T (... (F_1^T x)): the transposes, left to right.
+        Self::apply_factors(self.factors.iter().rev().map(|f| f.transpose()), x, out);
     }
 }
 

@@ -355,6 +355,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(expm_pade_choice, m)?)?;
     m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
     m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;
-    m.add("FMA_KERNELS", crate::small_matrix::fma_available())?;
+    m.add("FMA_KERNELS", crate::dispatch::fma_available())?;
     Ok(())
 }

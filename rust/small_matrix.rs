@@ -8,7 +8,7 @@
 //! unroll and vectorise, and it allocates nothing. Larger orders use faer.
 //!
 //! Each kernel is compiled twice: for the baseline target and, on x86-64, for AVX2 with fused
-//! multiply-add, chosen at run time by the CPU's features ([`fma_available`]), so that one
+//! multiply-add, chosen at run time by the CPU's features (see `dispatch.rs`), so that one
 //! portable wheel runs at full speed on current CPUs. (Fused multiply-adds round once instead of
 //! twice, so the two variants can differ in the last bit.)
 //!
@@ -17,59 +17,7 @@
 
 use faer::{Mat, MatRef};
 
-/// Whether this CPU runs the AVX2 + FMA variants of the kernels (detected on first use and
-/// cached in one atomic, so the check costs a load).
-#[inline]
-pub fn fma_available() -> bool {
-    use std::sync::atomic::{AtomicU8, Ordering};
-    const UNKNOWN: u8 = 0;
-    const YES: u8 = 1;
-    const NO: u8 = 2;
-    static STATE: AtomicU8 = AtomicU8::new(UNKNOWN);
-    match STATE.load(Ordering::Relaxed) {
-        YES => true,
-        NO => false,
-        _ => {
-            #[cfg(target_arch = "x86_64")]
-            let detected = std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma");
-            #[cfg(not(target_arch = "x86_64"))]
-            let detected = false;
-            STATE.store(if detected { YES } else { NO }, Ordering::Relaxed);
-            detected
-        }
-    }
-}
-
-/// a b + c, fused (one rounding) in the FMA variant of a kernel, else two roundings.
-#[inline(always)]
-pub(crate) fn multiply_add<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
-    if FMA { a.mul_add(b, c) } else { a * b + c }
-}
-
-/// Defines `$name` to run `$kernel::<N, true>` (compiled for AVX2 + FMA) when the CPU has
-/// those features and `$kernel::<N, false>` otherwise. Kernels are `#[inline(always)]`, so the
-/// whole loop nest is compiled with the wrapper's target features.
-macro_rules! fma_dispatch {
-    ($(#[$meta:meta])* $vis:vis fn $name:ident<const N: usize>($($arg:ident: $ty:ty),*) $(-> $ret:ty)? => $kernel:ident) => {
-        $(#[$meta])*
-        $vis fn $name<const N: usize>($($arg: $ty),*) $(-> $ret)? {
-            #[cfg(target_arch = "x86_64")]
-            {
-                #[target_feature(enable = "avx2,fma")]
-                fn fused<const N: usize>($($arg: $ty),*) $(-> $ret)? {
-                    $kernel::<N, true>($($arg),*)
-                }
-                if $crate::small_matrix::fma_available() {
-                    // SAFETY: the CPU supports AVX2 and FMA, checked just above.
-                    return unsafe { fused::<N>($($arg),*) };
-                }
-            }
-            $kernel::<N, false>($($arg),*)
-        }
-    };
-}
-pub(crate) use fma_dispatch;
+use crate::dispatch::{fma_dispatch, multiply_add};
 
 type Rows<const N: usize> = [[f64; N]; N];
 
@@ -415,7 +363,7 @@ mod tests {
             - b.to_mat();
         assert!((combined.to_mat() - expected).norm_max() < 1e-14);
 
-        assert_eq!(a.one_norm(), one_norm(a.to_mat().as_ref()));
+        assert!((a.one_norm() - one_norm(a.to_mat().as_ref())).abs() <= 1e-15 * a.one_norm());
         assert_eq!(a.as_ref()[(N - 1, 0)], a.rows[N - 1][0]);
 
         // Reversing the rows of a random matrix makes pivoting necessary.

@@ -1,0 +1,124 @@
+//! Run-time selection of vectorised kernels by the CPU's features.
+//!
+//! The Python wheel is built for the baseline x86-64 target (SSE2) so that it runs everywhere;
+//! most machines it meets have AVX2 and fused multiply-add, which halve the instructions of
+//! every loop here and, through the fused multiply-add, make error-free products (the
+//! double-double arithmetic) one instruction. Each hot kernel is therefore compiled twice and
+//! [`fma_dispatch!`] picks the variant per call, after a one-time detection.
+
+/// Whether this CPU runs the AVX2 + FMA variants of the kernels (detected on first use and
+/// cached in one atomic, so the check costs a load).
+#[inline]
+pub fn fma_available() -> bool {
+    use std::sync::atomic::{AtomicU8, Ordering};
+    const UNKNOWN: u8 = 0;
+    const YES: u8 = 1;
+    const NO: u8 = 2;
+    static STATE: AtomicU8 = AtomicU8::new(UNKNOWN);
+    match STATE.load(Ordering::Relaxed) {
+        YES => true,
+        NO => false,
+        _ => {
+            #[cfg(target_arch = "x86_64")]
+            let detected = std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma");
+            #[cfg(not(target_arch = "x86_64"))]
+            let detected = false;
+            STATE.store(if detected { YES } else { NO }, Ordering::Relaxed);
+            detected
+        }
+    }
+}
+
+/// a b + c, fused (one rounding) in the FMA variant of a kernel, else two roundings.
+#[inline(always)]
+pub(crate) fn multiply_add<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
+    if FMA { a.mul_add(b, c) } else { a * b + c }
+}
+
+/// Defines `$name` to run `$kernel::<[N,] true>` (compiled for AVX2 + FMA) when the CPU has
+/// those features and `$kernel::<[N,] false>` otherwise; kernels may be generic over a
+/// constant order N. Kernels are `#[inline(always)]`, so the whole loop nest is compiled with
+/// the wrapper's target features.
+macro_rules! fma_dispatch {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),*) $(-> $ret:ty)? => $kernel:ident) => {
+        $(#[$meta])*
+        $vis fn $name($($arg: $ty),*) $(-> $ret)? {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2,fma")]
+                fn fused($($arg: $ty),*) $(-> $ret)? {
+                    $kernel::<true>($($arg),*)
+                }
+                if $crate::dispatch::fma_available() {
+                    // SAFETY: the CPU supports AVX2 and FMA, checked just above.
+                    return unsafe { fused($($arg),*) };
+                }
+            }
+            $kernel::<false>($($arg),*)
+        }
+    };
+    ($(#[$meta:meta])* $vis:vis fn $name:ident<const N: usize>($($arg:ident: $ty:ty),*) $(-> $ret:ty)? => $kernel:ident) => {
+        $(#[$meta])*
+        $vis fn $name<const N: usize>($($arg: $ty),*) $(-> $ret)? {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2,fma")]
+                fn fused<const N: usize>($($arg: $ty),*) $(-> $ret)? {
+                    $kernel::<N, true>($($arg),*)
+                }
+                if $crate::dispatch::fma_available() {
+                    // SAFETY: the CPU supports AVX2 and FMA, checked just above.
+                    return unsafe { fused::<N>($($arg),*) };
+                }
+            }
+            $kernel::<N, false>($($arg),*)
+        }
+    };
+}
+pub(crate) use fma_dispatch;
+
+/// out = coefficient * x (FMA-free: one multiplication per entry).
+#[inline(always)]
+fn scale_into_kernel<const FMA: bool>(out: &mut [f64], coefficient: f64, x: &[f64]) {
+    for (o, &v) in out.iter_mut().zip(x) {
+        *o = coefficient * v;
+    }
+}
+
+fma_dispatch!(
+    /// out = coefficient * x, for slices of one length.
+    pub(crate) fn scale_into(out: &mut [f64], coefficient: f64, x: &[f64]) => scale_into_kernel
+);
+
+#[inline(always)]
+fn add_scaled_kernel<const FMA: bool>(out: &mut [f64], coefficient: f64, x: &[f64]) {
+    for (o, &v) in out.iter_mut().zip(x) {
+        *o = multiply_add::<FMA>(coefficient, v, *o);
+    }
+}
+
+fma_dispatch!(
+    /// out += coefficient * x, for slices of one length.
+    pub(crate) fn add_scaled(out: &mut [f64], coefficient: f64, x: &[f64]) => add_scaled_kernel
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slice_kernels() {
+        let x: Vec<f64> = (0..37).map(|i| i as f64 * 0.25).collect();
+        let mut out = vec![0.0; 37];
+        scale_into(&mut out, 2.0, &x);
+        add_scaled(&mut out, -1.0, &x);
+        assert_eq!(out, x);
+        // Both variants agree where the fused one can run.
+        let mut plain = vec![1.0; 37];
+        add_scaled_kernel::<false>(&mut plain, 3.0, &x);
+        let mut dispatched = vec![1.0; 37];
+        add_scaled(&mut dispatched, 3.0, &x);
+        assert_eq!(plain, dispatched);
+    }
+}
