@@ -4,9 +4,20 @@
 //! faer's scratch live on the stack, so a solve allocates nothing.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
 use faer::linalg::lu::partial_pivoting::{factor, solve};
-use faer::{MatMut, Par};
+use faer::{MatMut, Par, Spec};
 use std::mem::MaybeUninit;
+
+/// The order below which faer's recursive LU switches to its unblocked kernel. faer's default
+/// is 16; 8 measured 10% faster at n = 32 to 256 (12.5 against 14.0 µs at n = 64).
+const LU_RECURSION_THRESHOLD: usize = 8;
+
+fn lu_parameters() -> Spec<PartialPivLuParams, f64> {
+    let mut parameters: Spec<PartialPivLuParams, f64> = Default::default();
+    parameters.config.recursion_threshold = LU_RECURSION_THRESHOLD;
+    parameters
+}
 
 /// Systems up to this order keep their pivots and scratch on the stack.
 const STACK_ORDER: usize = 64;
@@ -21,7 +32,7 @@ pub fn solve_in_place(a: MatMut<'_, f64>, b: MatMut<'_, f64>, par: Par) {
     let n = a.nrows();
     debug_assert_eq!(n, a.ncols());
     debug_assert_eq!(n, b.nrows());
-    let requirement = factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default()).or(
+    let requirement = factor::lu_in_place_scratch::<usize, f64>(n, n, par, lu_parameters()).or(
         solve::solve_in_place_scratch::<usize, f64>(n, b.ncols(), par),
     );
     if n <= STACK_ORDER && requirement.unaligned_bytes_required() <= STACK_BYTES {
@@ -65,7 +76,7 @@ fn factor_and_solve(
         perm_inverse,
         par,
         stack,
-        Default::default(),
+        lu_parameters(),
     );
     // The unit lower factor L and the upper factor U share the storage of `a`.
     solve::solve_in_place(a.as_ref(), a.as_ref(), row_perm, b, par, stack);
