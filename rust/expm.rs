@@ -925,35 +925,14 @@ impl<const N: usize> ExpmMatrix for SmallMatrix<N> {
 /// 2 to [`SMALL_MAX_ORDER`], a pooled faer matrix otherwise.
 macro_rules! with_matrix_type {
     ($n:expr, $m:ident => $body:expr) => {
+        with_matrix_type!(@orders $n, $m, $body, 2 3 4 5 6 7 8)
+    };
+    (@orders $n:expr, $m:ident, $body:expr, $($order:literal)*) => {
         match $n {
-            2 => {
-                type $m = SmallMatrix<2>;
+            $($order => {
+                type $m = SmallMatrix<$order>;
                 $body
-            }
-            3 => {
-                type $m = SmallMatrix<3>;
-                $body
-            }
-            4 => {
-                type $m = SmallMatrix<4>;
-                $body
-            }
-            5 => {
-                type $m = SmallMatrix<5>;
-                $body
-            }
-            6 => {
-                type $m = SmallMatrix<6>;
-                $body
-            }
-            7 => {
-                type $m = SmallMatrix<7>;
-                $body
-            }
-            8 => {
-                type $m = SmallMatrix<8>;
-                $body
-            }
+            })*
             _ => {
                 type $m = Scratch;
                 $body

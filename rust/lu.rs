@@ -70,14 +70,8 @@ fn factor_and_solve(
     stack: &mut MemStack,
     par: Par,
 ) {
-    let (_, row_perm) = factor::lu_in_place(
-        a.as_mut(),
-        perm,
-        perm_inverse,
-        par,
-        stack,
-        lu_parameters(),
-    );
+    let (_, row_perm) =
+        factor::lu_in_place(a.as_mut(), perm, perm_inverse, par, stack, lu_parameters());
     // The unit lower factor L and the upper factor U share the storage of `a`.
     solve::solve_in_place(a.as_ref(), a.as_ref(), row_perm, b, par, stack);
 }
