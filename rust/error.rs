@@ -43,6 +43,8 @@ pub enum Error {
         value: f64,
         requirement: &'static str,
     },
+    /// An iterative algorithm did not converge within its iteration limit.
+    NoConvergence { algorithm: &'static str },
     /// One problem of a batch failed; `index` is its position in the stack.
     InBatch { index: usize, source: Box<Error> },
 }
@@ -104,6 +106,9 @@ impl fmt::Display for Error {
                 value,
                 requirement,
             } => write!(f, "{arg} must be {requirement}, got {value}"),
+            Error::NoConvergence { algorithm } => {
+                write!(f, "{algorithm} did not converge within its iteration limit")
+            }
             Error::InBatch { index, source } => write!(f, "problem {index} of the batch: {source}"),
         }
     }

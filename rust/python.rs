@@ -32,6 +32,7 @@ fn exception_class_name(error: &Error) -> &'static str {
         }
         Error::NonFinite { .. } => "NonFiniteError",
         Error::InvalidValue { .. } => "InvalidArgumentError",
+        Error::NoConvergence { .. } => "ConvergenceError",
         Error::InBatch { source, .. } => exception_class_name(source),
     }
 }

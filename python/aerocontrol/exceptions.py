@@ -12,6 +12,7 @@ class                         raised when
                               an unknown method name); base of the two above
 ``NotRealError``              an argument is complex (``TypeError``): real matrices only
 ``AerocontrolLinAlgError``    a numerical condition makes the problem unsolvable
+``ConvergenceError``          an iteration reached its limit (an ``AerocontrolLinAlgError``)
 ============================  ===========================================================
 
 Warnings (``AerocontrolWarning`` and subclasses) report results that were computed but deserve
@@ -26,6 +27,7 @@ __all__ = [
     "AerocontrolError",
     "AerocontrolLinAlgError",
     "AerocontrolWarning",
+    "ConvergenceError",
     "InvalidArgumentError",
     "NonFiniteError",
     "NotRealError",
@@ -58,6 +60,11 @@ class NotRealError(AerocontrolError, TypeError):
 class AerocontrolLinAlgError(AerocontrolError, np.linalg.LinAlgError):
     """A numerical condition (singularity, no stabilising solution, non-convergence) makes
     the problem unsolvable."""
+
+
+class ConvergenceError(AerocontrolLinAlgError):
+    """An iterative algorithm (an eigenvalue iteration, a Newton refinement) reached its
+    iteration limit without converging."""
 
 
 class AerocontrolWarning(UserWarning):

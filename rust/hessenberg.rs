@@ -1,0 +1,93 @@
+//! Reduction to upper Hessenberg form, A = Q H Q^T, by Householder reflections (faer).
+//!
+//! H is zero below its first subdiagonal and Q is orthogonal. Shifted systems (sI - A) x = b,
+//! solved at many shifts s (the frequency response), then cost O(n^2) each instead of O(n^3):
+//! (sI - A) = Q (sI - H) Q^T, and sI - H is Hessenberg. The reduction is backward stable:
+//! Q H Q^T = A + E with ||E|| = O(u ||A||).
+
+use crate::pool::scratch;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::evd::hessenberg::{hessenberg_in_place, hessenberg_in_place_scratch};
+use faer::linalg::householder::{
+    apply_block_householder_sequence_on_the_right_in_place_scratch,
+    apply_block_householder_sequence_on_the_right_in_place_with_conj,
+};
+use faer::linalg::qr::no_pivoting::factor::recommended_block_size;
+use faer::{Conj, Mat, MatRef, Par};
+
+/// The Hessenberg form of a square matrix: A = Q H Q^T.
+#[derive(Debug, Clone)]
+pub struct Hessenberg {
+    /// Upper Hessenberg (exact zeros below the first subdiagonal).
+    pub h: Mat<f64>,
+    /// Orthogonal.
+    pub q: Mat<f64>,
+}
+
+/// The Hessenberg form of a square matrix (the caller checks that it is square and finite).
+pub fn hessenberg(a: MatRef<'_, f64>) -> Hessenberg {
+    let n = a.nrows();
+    let mut h = a.to_owned();
+    let mut q = Mat::<f64>::identity(n, n);
+    if n <= 2 {
+        // Already Hessenberg.
+        return Hessenberg { h, q };
+    }
+    let par = Par::Seq;
+    let block_size = recommended_block_size::<f64>(n - 1, n - 1);
+    let mut householder = scratch(block_size, n - 1);
+    let requirement = StackReq::any_of(&[
+        hessenberg_in_place_scratch::<f64>(n, block_size, par, Default::default()),
+        apply_block_householder_sequence_on_the_right_in_place_scratch::<f64>(
+            n - 1,
+            block_size,
+            n - 1,
+        ),
+    ]);
+    let mut buffer = MemBuffer::new(requirement);
+    let stack = MemStack::new(&mut buffer);
+    hessenberg_in_place(
+        h.as_mut(),
+        householder.as_mut(),
+        par,
+        stack,
+        Default::default(),
+    );
+    // The reflectors act on rows and columns 1..n; Q = diag(1, Q1).
+    apply_block_householder_sequence_on_the_right_in_place_with_conj(
+        h.as_ref().submatrix(1, 0, n - 1, n - 1),
+        householder.as_ref(),
+        Conj::No,
+        q.as_mut().submatrix_mut(1, 1, n - 1, n - 1),
+        par,
+        stack,
+    );
+    for j in 0..n {
+        for i in j + 2..n {
+            h[(i, j)] = 0.0;
+        }
+    }
+    Hessenberg { h, q }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reconstructs_and_is_orthogonal() {
+        for n in [1usize, 2, 3, 5, 12, 40] {
+            let a = Mat::from_fn(n, n, |i, j| ((i * 7 + j * 13) % 17) as f64 / 8.0 - 1.0);
+            let Hessenberg { h, q } = hessenberg(a.as_ref());
+            for j in 0..n {
+                for i in j + 2..n {
+                    assert_eq!(h[(i, j)], 0.0);
+                }
+            }
+            let residual = (&q * &h * q.transpose() - &a).norm_l2() / a.norm_l2().max(1.0);
+            assert!(residual < 1e-14, "n={n}: {residual}");
+            let orthogonality = (q.transpose() * &q - Mat::<f64>::identity(n, n)).norm_l2();
+            assert!(orthogonality < 1e-14, "n={n}: {orthogonality}");
+        }
+    }
+}

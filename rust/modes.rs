@@ -1,0 +1,417 @@
+//! Modal analysis: eigenvalues, modes and their characteristics, the modal matrix, the
+//! characteristic polynomial (chapter §6.4, (6.58)-(6.62); the mode characteristics of the
+//! earlier chapter's unforced response, used in (6.152)-(6.154)).
+//!
+//! The eigenvalues and eigenvectors come from faer's real eigensolver (Hessenberg reduction and
+//! multishift QR), which returns conjugate pairs adjacent. A conjugate pair is one mode, an
+//! oscillation; a real eigenvalue is one mode, a subsidence or divergence. For a mode with
+//! eigenvalue λ = σ ± jω_d:
+//!
+//! ```text
+//! natural frequency   ω_n = |λ|
+//! damping ratio       ζ   = -σ / |λ|           (NaN for λ = 0)
+//! damped frequency    ω_d = |Im λ|
+//! period              T   = 2π / ω_d           (oscillations)
+//! time to half        t½  = ln 2 / |σ|  for σ < 0;  time to double t₂ = ln 2 / σ for σ > 0
+//! cycles to half      N½  = t½ / T              (oscillations)
+//! time constant       τ   = 1 / |λ|             (real modes)
+//! ```
+//!
+//! The modal matrix P holds the eigenvectors (unit 2-norm) as columns, P^-1 A P = Λ (6.59), and
+//! P^-1 B (6.61) shows which modes each input reaches. A repeated eigenvalue without a full set
+//! of eigenvectors (a defective matrix, such as a double integrator) has no modal matrix: P is
+//! then numerically singular, which [`ModalAnalysis::modal_matrix_condition`] reports, and
+//! P^-1 B is not formed.
+//!
+//! The characteristic polynomial det(λI - A) is multiplied out from the eigenvalues, each
+//! conjugate pair as the real quadratic λ^2 - 2σλ + |λ|^2, so the coefficients are real to the
+//! last bit; they are as accurate as the eigenvalues are well conditioned (the map from roots to
+//! coefficients is backward stable for roots computed backward stably).
+
+use crate::error::{Error, check_finite, check_rows, check_square};
+use faer::diag::Diag;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::evd::{ComputeEigenvectors, evd_real, evd_scratch};
+use faer::linalg::solvers::Solve;
+use faer::{Mat, MatRef, Par, c64};
+
+/// The modal matrix counts as singular (no modal decomposition) above this condition number,
+/// about 1/sqrt(u): beyond it P^-1 B would carry no correct digits in the worst case.
+pub const SINGULAR_MODAL_MATRIX_CONDITION: f64 = 1e8;
+
+/// One mode: a real eigenvalue, or a conjugate pair represented by its member with Im λ > 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    pub eigenvalue: c64,
+    /// True for a conjugate pair (an oscillation).
+    pub oscillatory: bool,
+    pub natural_frequency: f64,
+    pub damping_ratio: f64,
+    pub damped_frequency: f64,
+    /// 2π / ω_d; infinite for a real mode.
+    pub period: f64,
+    /// ln 2 / |σ| for a decaying mode; NaN otherwise.
+    pub time_to_half: f64,
+    /// ln 2 / σ for a growing mode; NaN otherwise.
+    pub time_to_double: f64,
+    /// t½ / T for a decaying oscillation; NaN otherwise.
+    pub cycles_to_half: f64,
+    /// 1 / |λ| for a real mode; NaN for an oscillation.
+    pub time_constant: f64,
+    /// Indices of this mode's eigenvalues (one, or the pair) in the eigenvalue list.
+    pub indices: [usize; 2],
+}
+
+impl Mode {
+    fn new(eigenvalue: c64, oscillatory: bool, indices: [usize; 2]) -> Self {
+        let (sigma, omega_d) = (eigenvalue.re, eigenvalue.im.abs());
+        let natural_frequency = eigenvalue.norm();
+        let ln2 = std::f64::consts::LN_2;
+        let period = if oscillatory {
+            2.0 * std::f64::consts::PI / omega_d
+        } else {
+            f64::INFINITY
+        };
+        let time_to_half = if sigma < 0.0 { ln2 / -sigma } else { f64::NAN };
+        Mode {
+            eigenvalue,
+            oscillatory,
+            natural_frequency,
+            damping_ratio: if natural_frequency > 0.0 {
+                -sigma / natural_frequency
+            } else {
+                f64::NAN
+            },
+            damped_frequency: omega_d,
+            period,
+            time_to_half,
+            time_to_double: if sigma > 0.0 { ln2 / sigma } else { f64::NAN },
+            cycles_to_half: if oscillatory {
+                time_to_half / period
+            } else {
+                f64::NAN
+            },
+            time_constant: if oscillatory || natural_frequency == 0.0 {
+                f64::NAN
+            } else {
+                1.0 / natural_frequency
+            },
+            indices,
+        }
+    }
+}
+
+/// Eigenvalues, modes, modal matrix and characteristic polynomial of a square matrix.
+#[derive(Debug, Clone)]
+pub struct ModalAnalysis {
+    /// The eigenvalues, each conjugate pair adjacent (Im > 0 first), in the order of `modes`.
+    pub eigenvalues: Vec<c64>,
+    /// The modes, by increasing natural frequency (then by decreasing damping).
+    pub modes: Vec<Mode>,
+    /// The modal matrix P (unit eigenvectors as columns, in the order of `eigenvalues`).
+    pub modal_matrix: Mat<c64>,
+    /// κ_2(P) = σ_max / σ_min; infinite when P is exactly singular.
+    pub modal_matrix_condition: f64,
+    /// P^-1 B (6.61), when B was given and P is not singular.
+    pub modal_input: Option<Mat<c64>>,
+    /// Coefficients of det(λI - A), highest power first: [1, a_1, ..., a_n].
+    pub characteristic_polynomial: Vec<f64>,
+}
+
+impl ModalAnalysis {
+    /// Whether P is too ill-conditioned to be a modal matrix (a defective or nearly defective
+    /// eigenvalue).
+    pub fn modal_matrix_is_singular(&self) -> bool {
+        !(self.modal_matrix_condition < SINGULAR_MODAL_MATRIX_CONDITION)
+    }
+}
+
+/// The eigenvalues and unit eigenvectors of a real square matrix, conjugate pairs adjacent with
+/// Im > 0 first.
+pub fn eigen(a: MatRef<'_, f64>) -> Result<(Vec<c64>, Mat<c64>), Error> {
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    let n = a.nrows();
+    let mut real_vectors = Mat::<f64>::zeros(n, n);
+    let mut re = Diag::<f64>::zeros(n);
+    let mut im = Diag::<f64>::zeros(n);
+    let par = Par::Seq;
+    let mut buffer = MemBuffer::new(evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::Yes,
+        par,
+        Default::default(),
+    ));
+    evd_real(
+        a,
+        re.as_mut(),
+        im.as_mut(),
+        None,
+        Some(real_vectors.as_mut()),
+        par,
+        MemStack::new(&mut buffer),
+        Default::default(),
+    )
+    .map_err(|_| Error::NoConvergence {
+        algorithm: "the eigenvalue QR iteration",
+    })?;
+    let mut values = Vec::with_capacity(n);
+    let mut vectors = Mat::<c64>::zeros(n, n);
+    let mut j = 0;
+    while j < n {
+        if im[j] == 0.0 {
+            values.push(c64::new(re[j], 0.0));
+            for i in 0..n {
+                vectors[(i, j)] = c64::new(real_vectors[(i, j)], 0.0);
+            }
+            j += 1;
+        } else {
+            // Columns j and j + 1 hold the real and imaginary parts of the eigenvector of
+            // re + i im; its conjugate belongs to re - i im.
+            let sign = if im[j] > 0.0 { 1.0 } else { -1.0 };
+            values.push(c64::new(re[j], im[j].abs()));
+            values.push(c64::new(re[j], -im[j].abs()));
+            for i in 0..n {
+                let v = c64::new(real_vectors[(i, j)], sign * real_vectors[(i, j + 1)]);
+                vectors[(i, j)] = v;
+                vectors[(i, j + 1)] = v.conj();
+            }
+            j += 2;
+        }
+    }
+    for j in 0..n {
+        let norm = vectors.col(j).norm_l2();
+        if norm > 0.0 {
+            for i in 0..n {
+                vectors[(i, j)] /= norm;
+            }
+        }
+    }
+    Ok((values, vectors))
+}
+
+/// The coefficients of prod (λ - λ_i), highest power first, multiplied out in real arithmetic
+/// with each conjugate pair as one real quadratic. `eigenvalues` must hold conjugate pairs
+/// adjacent (as [`eigen`] returns them).
+pub fn polynomial_from_roots(eigenvalues: &[c64]) -> Vec<f64> {
+    let mut coefficients = vec![1.0];
+    let mut multiply = |factor: &[f64]| {
+        let mut next = vec![0.0; coefficients.len() + factor.len() - 1];
+        for (i, &c) in coefficients.iter().enumerate() {
+            for (j, &f) in factor.iter().enumerate() {
+                next[i + j] += c * f;
+            }
+        }
+        coefficients = next;
+    };
+    let mut k = 0;
+    while k < eigenvalues.len() {
+        let lambda = eigenvalues[k];
+        if lambda.im == 0.0 {
+            multiply(&[1.0, -lambda.re]);
+            k += 1;
+        } else {
+            multiply(&[1.0, -2.0 * lambda.re, lambda.norm_sqr()]);
+            k += 2;
+        }
+    }
+    coefficients
+}
+
+/// The coefficients of det(λI - A), highest power first (see the module documentation for how
+/// and how accurately).
+pub fn characteristic_polynomial(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
+    Ok(polynomial_from_roots(&eigen(a)?.0))
+}
+
+fn condition_number(p: &Mat<c64>) -> f64 {
+    if p.nrows() == 0 {
+        return 1.0;
+    }
+    match p.singular_values() {
+        Ok(s) => {
+            let (largest, smallest) = (s[0], s[s.len() - 1]);
+            if smallest > 0.0 {
+                largest / smallest
+            } else {
+                f64::INFINITY
+            }
+        }
+        Err(_) => f64::INFINITY,
+    }
+}
+
+/// The modal analysis of A, and P^-1 B when `b` is given (n x m).
+pub fn modal_analysis(
+    a: MatRef<'_, f64>,
+    b: Option<MatRef<'_, f64>>,
+) -> Result<ModalAnalysis, Error> {
+    let (values, vectors) = eigen(a)?;
+    if let Some(b) = b {
+        check_rows(b, "B", a.nrows(), "A")?;
+        check_finite(b, "B")?;
+    }
+    // Group into modes and order them by natural frequency, then by decreasing damping.
+    let mut modes = Vec::new();
+    let mut k = 0;
+    while k < values.len() {
+        let oscillatory = values[k].im != 0.0;
+        let indices = if oscillatory { [k, k + 1] } else { [k, k] };
+        modes.push(Mode::new(values[k], oscillatory, indices));
+        k += if oscillatory { 2 } else { 1 };
+    }
+    modes.sort_by(|x, y| {
+        x.natural_frequency
+            .total_cmp(&y.natural_frequency)
+            .then(y.damping_ratio.total_cmp(&x.damping_ratio))
+            .then(x.eigenvalue.re.total_cmp(&y.eigenvalue.re))
+    });
+    // Reorder eigenvalues and eigenvectors to follow the modes.
+    let n = values.len();
+    let order: Vec<usize> = modes
+        .iter()
+        .flat_map(|m| {
+            if m.oscillatory {
+                vec![m.indices[0], m.indices[1]]
+            } else {
+                vec![m.indices[0]]
+            }
+        })
+        .collect();
+    let eigenvalues: Vec<c64> = order.iter().map(|&i| values[i]).collect();
+    let modal_matrix = Mat::from_fn(n, n, |i, j| vectors[(i, order[j])]);
+    let mut position = 0;
+    for mode in &mut modes {
+        mode.indices = if mode.oscillatory {
+            [position, position + 1]
+        } else {
+            [position, position]
+        };
+        position += if mode.oscillatory { 2 } else { 1 };
+    }
+    let modal_matrix_condition = condition_number(&modal_matrix);
+    let characteristic_polynomial = polynomial_from_roots(&eigenvalues);
+    let mut analysis = ModalAnalysis {
+        eigenvalues,
+        modes,
+        modal_matrix,
+        modal_matrix_condition,
+        modal_input: None,
+        characteristic_polynomial,
+    };
+    if let Some(b) = b
+        && !analysis.modal_matrix_is_singular()
+    {
+        let rhs = Mat::from_fn(n, b.ncols(), |i, j| c64::new(b[(i, j)], 0.0));
+        analysis.modal_input = Some(analysis.modal_matrix.partial_piv_lu().solve(&rhs));
+    }
+    Ok(analysis)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::mat;
+
+    #[test]
+    fn lateral_747_matches_the_chapter() {
+        // (6.150)-(6.155): roll -1.2308, Dutch roll -0.08066 ± 0.7433i, spiral -0.04641, from
+        // the unrounded matrix; the printed one gives slightly different last digits.
+        let a = mat![
+            [-0.0999, 0.0000, 0.1153, -1.0000],
+            [-1.6038, -1.0932, 0.0, 0.2850],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.4089, -0.0395, 0.0, -0.2454]
+        ];
+        let analysis = modal_analysis(a.as_ref(), None).unwrap();
+        let modes = &analysis.modes;
+        assert_eq!(modes.len(), 3);
+        let (spiral, dutch_roll, roll) = (&modes[0], &modes[1], &modes[2]);
+        assert!(!spiral.oscillatory && dutch_roll.oscillatory && !roll.oscillatory);
+        assert!((spiral.eigenvalue.re + 0.04641).abs() < 2e-5);
+        assert!((roll.eigenvalue.re + 1.2308).abs() < 2e-4);
+        assert!((dutch_roll.eigenvalue.re + 0.08066).abs() < 5e-5);
+        assert!((dutch_roll.eigenvalue.im - 0.7433).abs() < 1e-4);
+        assert!((dutch_roll.natural_frequency - 0.7477).abs() < 1e-4);
+        assert!((dutch_roll.damping_ratio - 0.1079).abs() < 2e-4);
+        assert!((roll.time_to_half - 0.56).abs() < 5e-3);
+        assert!((spiral.time_to_half - 14.93).abs() < 1e-2);
+        let expected = [1.0, 1.4385, 0.8222, 0.7232, 0.0319];
+        for (c, e) in analysis.characteristic_polynomial.iter().zip(expected) {
+            assert!((c - e).abs() < 2e-4, "{c} vs {e}");
+        }
+        // P^-1 A P = Λ.
+        assert!(analysis.modal_matrix_condition < 100.0);
+    }
+
+    #[test]
+    fn modal_input_of_the_controllability_example() {
+        // (6.75)-(6.88): modes -1 and -2; with B = [-1, 1]^T the second mode is not reached.
+        let a = mat![[0.0, 1.0], [-2.0, -3.0]];
+        let b = mat![[-1.0], [1.0]];
+        let analysis = modal_analysis(a.as_ref(), Some(b.as_ref())).unwrap();
+        let modal_input = analysis.modal_input.unwrap();
+        // Modes ordered by natural frequency: λ = -1 first, then λ = -2.
+        assert!((analysis.eigenvalues[0].re + 1.0).abs() < 1e-14);
+        assert!(modal_input[(0, 0)].norm() > 0.1);
+        assert!(modal_input[(1, 0)].norm() < 1e-14);
+    }
+
+    #[test]
+    fn defective_matrix_has_no_modal_matrix() {
+        // The double integrator: a double eigenvalue 0 with one eigenvector.
+        let a = mat![[0.0, 1.0], [0.0, 0.0]];
+        let b = mat![[0.0], [1.0]];
+        let analysis = modal_analysis(a.as_ref(), Some(b.as_ref())).unwrap();
+        assert!(analysis.modal_matrix_is_singular());
+        assert!(analysis.modal_input.is_none());
+        assert!(analysis.modes[0].damping_ratio.is_nan());
+        assert_eq!(analysis.characteristic_polynomial, vec![1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn mode_characteristics() {
+        // λ = -1 ± 2i: ω_n = √5, ζ = 1/√5, T = π, t½ = ln 2, N½ = ln 2 / π.
+        let a = mat![[-1.0, 2.0], [-2.0, -1.0]];
+        let mode = modal_analysis(a.as_ref(), None).unwrap().modes[0];
+        assert!(mode.oscillatory && mode.eigenvalue.im > 0.0);
+        assert!((mode.natural_frequency - 5f64.sqrt()).abs() < 1e-15);
+        assert!((mode.damping_ratio - 1.0 / 5f64.sqrt()).abs() < 1e-15);
+        assert!((mode.period - std::f64::consts::PI).abs() < 1e-14);
+        assert!((mode.time_to_half - std::f64::consts::LN_2).abs() < 1e-15);
+        assert!(mode.time_to_double.is_nan() && mode.time_constant.is_nan());
+        // An unstable real mode doubles.
+        let mode = modal_analysis(mat![[0.5]].as_ref(), None).unwrap().modes[0];
+        assert!((mode.time_to_double - 2.0 * std::f64::consts::LN_2).abs() < 1e-15);
+        assert!((mode.time_constant - 2.0).abs() < 1e-15 && mode.time_to_half.is_nan());
+        assert_eq!(mode.damping_ratio, -1.0);
+    }
+
+    #[test]
+    fn polynomial_from_conjugate_roots_is_real() {
+        let roots = [
+            c64::new(-1.0, 2.0),
+            c64::new(-1.0, -2.0),
+            c64::new(3.0, 0.0),
+        ];
+        // (λ^2 + 2λ + 5)(λ - 3) = λ^3 - λ^2 - λ - 15.
+        assert_eq!(polynomial_from_roots(&roots), vec![1.0, -1.0, -1.0, -15.0]);
+        assert_eq!(polynomial_from_roots(&[]), vec![1.0]);
+    }
+
+    #[test]
+    fn bad_input() {
+        assert!(matches!(
+            modal_analysis(Mat::<f64>::zeros(2, 3).as_ref(), None),
+            Err(Error::NotSquare { .. })
+        ));
+        let b = Mat::<f64>::zeros(3, 1);
+        assert_eq!(
+            modal_analysis(Mat::<f64>::identity(2, 2).as_ref(), Some(b.as_ref()))
+                .unwrap_err()
+                .to_string(),
+            "B must have as many rows as A (2), got 3"
+        );
+    }
+}
