@@ -79,7 +79,13 @@ fn bench_batch(c: &mut Criterion) {
     }
     let mut out = vec![0.0; k * n * n];
     group.bench_function("4x4", |b| {
-        b.iter(|| expm_batch(MatrixStack::new(black_box(&data), k, n, n), &mut out).unwrap())
+        b.iter(|| {
+            expm_batch(
+                MatrixStack::new(black_box(&data), k, n, n).unwrap(),
+                &mut out,
+            )
+            .unwrap()
+        })
     });
     group.finish();
 }

@@ -5,7 +5,7 @@
 //! copy per matrix. Each problem runs on one rayon task (small problems sequentially inside),
 //! which is the efficient split for many small problems; an error names the index of the problem.
 
-use crate::error::{Error, check_finite};
+use crate::error::{Error, check_finite, check_output_len};
 use crate::expm::expm_into_validated;
 use faer::{MatMut, MatRef};
 use rayon::prelude::*;
@@ -21,18 +21,26 @@ pub struct MatrixStack<'a> {
 
 impl<'a> MatrixStack<'a> {
     /// Views `data` (length count * rows * cols) as a stack of matrices.
-    pub fn new(data: &'a [f64], count: usize, rows: usize, cols: usize) -> Self {
-        assert_eq!(
-            data.len(),
-            count * rows * cols,
-            "stack data has the wrong length"
-        );
-        Self {
+    pub fn new(data: &'a [f64], count: usize, rows: usize, cols: usize) -> Result<Self, Error> {
+        let expected = count
+            .checked_mul(rows)
+            .and_then(|x| x.checked_mul(cols))
+            .unwrap_or(usize::MAX);
+        if data.len() != expected {
+            return Err(Error::Mismatch {
+                arg: "data",
+                what: "as many entries as",
+                expected,
+                other: "count x rows x cols",
+                got: data.len(),
+            });
+        }
+        Ok(Self {
             data,
             count,
             rows,
             cols,
-        }
+        })
     }
 
     /// The number of matrices in the stack.
@@ -68,11 +76,7 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
             cols: stack.cols,
         });
     }
-    assert_eq!(
-        out.len(),
-        stack.len() * n * n,
-        "output has the wrong length"
-    );
+    check_output_len(out.len(), stack.len() * n * n)?;
     // One branch-free pass over the whole stack (vectorised); the matrix at fault is found
     // only when there is one.
     if !stack
@@ -110,7 +114,7 @@ mod tests {
         let data: Vec<f64> = (0..k * n * n)
             .map(|i| ((i * 7919) % 101) as f64 / 50.0 - 1.0)
             .collect();
-        let stack = MatrixStack::new(&data, k, n, n);
+        let stack = MatrixStack::new(&data, k, n, n).unwrap();
         let mut out = vec![0.0; k * n * n];
         expm_batch(stack, &mut out).unwrap();
         for index in 0..k {
@@ -129,7 +133,7 @@ mod tests {
         let mut data = vec![0.5; k * n * n];
         data[2 * n * n + 3] = f64::INFINITY;
         let mut out = vec![0.0; k * n * n];
-        let err = expm_batch(MatrixStack::new(&data, k, n, n), &mut out).unwrap_err();
+        let err = expm_batch(MatrixStack::new(&data, k, n, n).unwrap(), &mut out).unwrap_err();
         assert_eq!(
             err.to_string(),
             "problem 2 of the batch: A must be finite, but A[1, 1] is inf"
@@ -139,7 +143,7 @@ mod tests {
     #[test]
     fn empty_stacks() {
         let mut out = vec![];
-        expm_batch(MatrixStack::new(&[], 0, 3, 3), &mut out).unwrap();
-        expm_batch(MatrixStack::new(&[], 5, 0, 0), &mut out).unwrap();
+        expm_batch(MatrixStack::new(&[], 0, 3, 3).unwrap(), &mut out).unwrap();
+        expm_batch(MatrixStack::new(&[], 5, 0, 0).unwrap(), &mut out).unwrap();
     }
 }

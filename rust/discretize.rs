@@ -26,13 +26,13 @@
 //! inverse of A, so it is exact for the singular A of (6.95) and every system with an
 //! integrator or a neutral mode.
 //!
-//! The integrals are linear in B, so B is scaled by a power of two (exactly) to a norm
+//! The integrals are linear in B, so B is scaled by a power of two (exactly) to a size
 //! comparable with Ah before the exponential and the blocks are scaled back: a B much larger
-//! than Ah would otherwise force extra squarings on the whole augmented matrix.
+//! than Ah would otherwise force extra squarings on the whole augmented matrix, and B h could
+//! overflow or underflow at the edges of the range of doubles.
 
 use crate::error::{Error, check_finite, check_positive, check_rows, check_square};
 use crate::expm::expm;
-use crate::norm::one_norm;
 use faer::Mat;
 use faer::MatRef;
 
@@ -54,6 +54,13 @@ pub struct Discretization {
     pub gamma0: Mat<f64>,
     /// Γ1 = (1/h) ∫_0^h e^{Aτ} (h - τ) dτ B, n x m; present for [`Hold::First`].
     pub gamma1: Option<Mat<f64>>,
+}
+
+/// x 2^e for an integer e of any size, in two exact steps where one power would leave the range
+/// of doubles.
+fn times_power_of_two(x: f64, exponent: f64) -> f64 {
+    let half = (exponent / 2.0).trunc();
+    x * half.exp2() * (exponent - half).exp2()
 }
 
 /// Discretises x' = Ax + Bη over the step `dt` with the given hold (see the module docs).
@@ -86,24 +93,35 @@ pub fn discretize(
     };
     let size = n + blocks * m;
 
-    // Scale B by an exact power of two so that ||B h|| is comparable with max(||A h||, 1).
-    let b_norm = one_norm(b) * dt;
-    let input_scale = if b_norm > 0.0 {
-        let target = (one_norm(a) * dt).max(1.0);
-        (target / b_norm).log2().round().exp2()
-    } else {
-        1.0
-    };
-
     let mut augmented = Mat::<f64>::zeros(size, size);
     for j in 0..n {
         for i in 0..n {
             augmented[(i, j)] = a[(i, j)] * dt;
         }
     }
+    let a_dt_max = augmented.get(..n, ..n).norm_max();
+    if !a_dt_max.is_finite() {
+        return Err(Error::InvalidValue {
+            arg: "dt",
+            value: dt,
+            requirement: "small enough that A dt is finite",
+        });
+    }
+    // The input block is Y = 2^(j - e) B, with 2^e the binade of max|b_ij| and 2^j the
+    // binade of max(||A dt||_1, 1) (bounded through n max|A dt|, which cannot overflow):
+    // exact scalings by powers of two, so Y never overflows or underflows whatever B and dt
+    // are. Then Γ = (block of the exponential) dt 2^(e - j).
+    let b_max = b.norm_max();
+    let (b_exponent, target_exponent) = if b_max > 0.0 {
+        let target = (a_dt_max * n as f64).log2().round().clamp(0.0, 1000.0);
+        (b_max.log2().floor(), target)
+    } else {
+        (0.0, 0.0)
+    };
+    let input_scale = target_exponent - b_exponent;
     for j in 0..m {
         for i in 0..n {
-            augmented[(i, n + j)] = b[(i, j)] * dt * input_scale;
+            augmented[(i, n + j)] = times_power_of_two(b[(i, j)], input_scale);
         }
     }
     if hold == Hold::First {
@@ -113,8 +131,11 @@ pub fn discretize(
     }
     let exponential = expm(augmented.as_ref())?;
 
-    let unscale = 1.0 / input_scale;
-    let block = |col0: usize| Mat::from_fn(n, m, |i, j| exponential[(i, col0 + j)] * unscale);
+    let block = |col0: usize| {
+        Mat::from_fn(n, m, |i, j| {
+            times_power_of_two(exponential[(i, col0 + j)] * dt, -input_scale)
+        })
+    };
     Ok(Discretization {
         phi: exponential.get(..n, ..n).to_owned(),
         gamma0: block(n),
@@ -202,6 +223,37 @@ mod tests {
             let err = discretize(a.as_ref(), b.as_ref(), dt, Hold::Zero).unwrap_err();
             assert!(matches!(err, Error::InvalidValue { arg: "dt", .. }));
         }
+    }
+
+    #[test]
+    fn extreme_magnitudes_of_b_and_dt() {
+        // Γ0 of x' = -x + b u over dt is b (1 - e^-dt): check at the edges of the double range.
+        let a = mat![[-1.0]];
+        for (b, dt) in [
+            (1e-300, 1e-10),
+            (1e300, 1e-10),
+            (1e300, 1.0),
+            (1.0, 5e-324),
+            (3.0, 1e6),
+        ] {
+            let d = discretize(a.as_ref(), mat![[b]].as_ref(), dt, Hold::First).unwrap();
+            let expected = b * -(-dt).exp_m1();
+            assert!(
+                (d.gamma0[(0, 0)] / expected - 1.0).abs() < 1e-14,
+                "b={b} dt={dt}: {} vs {expected}",
+                d.gamma0[(0, 0)]
+            );
+            assert!(d.gamma1.unwrap()[(0, 0)].is_finite());
+        }
+        // A dt overflowing is the step's fault.
+        let err = discretize(
+            mat![[1e300]].as_ref(),
+            mat![[1.0]].as_ref(),
+            1e10,
+            Hold::Zero,
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::InvalidValue { arg: "dt", .. }));
     }
 
     #[test]

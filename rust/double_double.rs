@@ -51,32 +51,28 @@ pub fn two_product<const FMA: bool>(a: f64, b: f64) -> (f64, f64) {
     if FMA {
         (p, a.mul_add(b, -p))
     } else {
-        two_product_split(a, split(a), b, split(b), p)
+        two_product_split(split(a), split(b), p)
     }
 }
 
 /// The error of p = fl(a b) from the splits of a and b (Dekker).
 #[inline(always)]
 fn two_product_split(
-    a: f64,
     (a_high, a_low): (f64, f64),
-    b: f64,
     (b_high, b_low): (f64, f64),
     p: f64,
 ) -> (f64, f64) {
-    let _ = (a, b);
     let e = ((a_high * b_high - p) + a_high * b_low + a_low * b_high) + a_low * b_low;
     (p, e)
 }
 
 type Rows<const N: usize> = [[f64; N]; N];
 
-/// The entries of alpha * a * b accumulated in double-double, not yet normalised.
+/// The entries of a * b accumulated in double-double, not yet normalised.
 #[inline(always)]
 fn product_kernel<const N: usize, const FMA: bool>(
     a: &DoubleDoubleMatrix<N>,
     b: &DoubleDoubleMatrix<N>,
-    alpha: f64,
 ) -> (Rows<N>, Rows<N>) {
     let mut hi = [[0.0; N]; N];
     let mut lo = [[0.0; N]; N];
@@ -92,7 +88,7 @@ fn product_kernel<const N: usize, const FMA: bool>(
     for i in 0..N {
         let (acc_hi, acc_lo) = (&mut hi[i], &mut lo[i]);
         for (k, b_split_row) in b_split.iter().enumerate() {
-            let (a_hi, a_lo) = (a.hi.rows[i][k] * alpha, a.lo.rows[i][k] * alpha);
+            let (a_hi, a_lo) = (a.hi.rows[i][k], a.lo.rows[i][k]);
             let a_split = split(a_hi);
             let (b_hi, b_lo) = (&b.hi.rows[k], &b.lo.rows[k]);
             for j in 0..N {
@@ -100,7 +96,7 @@ fn product_kernel<const N: usize, const FMA: bool>(
                 let (p, mut e) = if FMA {
                     (p, a_hi.mul_add(b_hi[j], -p))
                 } else {
-                    two_product_split(a_hi, a_split, b_hi[j], b_split_row[j], p)
+                    two_product_split(a_split, b_split_row[j], p)
                 };
                 e += a_hi * b_lo[j] + a_lo * b_hi[j];
                 let (s, t) = two_sum(acc_hi[j], p);
@@ -112,7 +108,7 @@ fn product_kernel<const N: usize, const FMA: bool>(
     (hi, lo)
 }
 
-fma_dispatch!(fn accumulate_product<const N: usize>(a: &DoubleDoubleMatrix<N>, b: &DoubleDoubleMatrix<N>, alpha: f64) -> (Rows<N>, Rows<N>) => product_kernel);
+fma_dispatch!(fn accumulate_product<const N: usize>(a: &DoubleDoubleMatrix<N>, b: &DoubleDoubleMatrix<N>) -> (Rows<N>, Rows<N>) => product_kernel);
 
 /// identity * I + sum_k coefficient_k * M_k accumulated in double-double, not yet normalised.
 #[inline(always)]
@@ -193,10 +189,9 @@ impl<const N: usize> DoubleDoubleMatrix<N> {
         out
     }
 
-    /// alpha * self * rhs, with each entry accumulated in double-double (alpha is applied
-    /// exactly when it is a power of two, as every alpha of the exponential is).
-    pub fn product(&self, rhs: &Self, alpha: f64) -> Self {
-        let (hi, lo) = accumulate_product(self, rhs, alpha);
+    /// self * rhs, with each entry accumulated in double-double.
+    pub fn product(&self, rhs: &Self) -> Self {
+        let (hi, lo) = accumulate_product(self, rhs);
         Self::normalize(hi, lo)
     }
 
@@ -241,7 +236,7 @@ impl<const N: usize> DoubleDoubleMatrix<N> {
         let lu = self.hi.lu();
         let mut x = Self::from_double(&lu.solve(rhs.round()));
         for _ in 0..2 {
-            let residual = rhs.difference(&self.product(&x, 1.0));
+            let residual = rhs.difference(&self.product(&x));
             x = x.plus_double(&lu.solve(residual.round()));
         }
         x
@@ -279,7 +274,7 @@ mod tests {
         let epsilon = 2f64.powi(-40);
         let a = DoubleDoubleMatrix::<3>::scaled(&SmallMatrix::identity(), 1.0 + epsilon);
         let b = DoubleDoubleMatrix::<3>::scaled(&SmallMatrix::identity(), 1.0 - epsilon);
-        let p = a.product(&b, 1.0);
+        let p = a.product(&b);
         for i in 0..3 {
             assert_eq!(p.hi.rows[i][i], 1.0);
             assert_eq!(p.lo.rows[i][i], -epsilon * epsilon);

@@ -167,6 +167,21 @@ pub fn check_rows(
     }
 }
 
+/// Checks that an output buffer given by a Rust caller has the length of the result.
+pub fn check_output_len(got: usize, expected: usize) -> Result<(), Error> {
+    if got == expected {
+        Ok(())
+    } else {
+        Err(Error::Mismatch {
+            arg: "out",
+            what: "as many entries as",
+            expected,
+            other: "the result",
+            got,
+        })
+    }
+}
+
 /// Checks that a scalar is finite and strictly positive.
 pub fn check_positive(value: f64, arg: &'static str) -> Result<(), Error> {
     if value.is_finite() && value > 0.0 {

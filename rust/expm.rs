@@ -31,10 +31,12 @@
 //!   r_m = (V - U)^-1 (V + U) = I + 2 (V - U)^-1 U, and the second form is evaluated (one LU
 //!   solve with partial pivoting for the right-hand side U), so that the identity is exact and
 //!   the rounding of the solve is relative to the correction U.
-//! * For upper triangular A (and lower triangular, through the transpose), the diagonal and the
-//!   first superdiagonal of every intermediate square are recomputed exactly (Code Fragment 2.1
-//!   of Al-Mohy & Higham 2009), with the divided difference
-//!   (e^λ2 - e^λ1)/(λ2 - λ1) = e^((λ1+λ2)/2) sinh(δ)/δ, δ = (λ2 - λ1)/2.
+//! * For upper triangular A (and lower triangular, through the transpose), the result is kept
+//!   triangular, and in double-precision evaluation the diagonal and the first superdiagonal of
+//!   every intermediate square are recomputed exactly (Code Fragment 2.1 of Al-Mohy & Higham
+//!   2009), with the divided difference (e^λ2 - e^λ1)/(λ2 - λ1) = e^((λ1+λ2)/2) sinh(δ)/δ,
+//!   δ = (λ2 - λ1)/2. (The double-double evaluation needs no such repair: its squarings lose
+//!   nothing at double precision.)
 //!
 //! The Padé evaluation for m = 13 costs 6 matrix products plus one LU solve, and m = 3, 5, 7, 9
 //! cost 2, 3, 4, 5 products; each squaring is one product.
@@ -58,7 +60,7 @@
 
 use crate::dispatch::{add_scaled, scale_into};
 use crate::double_double::DoubleDoubleMatrix;
-use crate::error::{Error, check_finite, check_finite_values, check_square};
+use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
 use crate::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
 use crate::pool::{Scratch, scratch};
 use crate::small_matrix::SmallMatrix;
@@ -81,8 +83,9 @@ pub const SMALL_MAX_ORDER: usize = 8;
 /// double-double arithmetic (see the module documentation).
 pub const DOUBLE_DOUBLE_MIN_SQUARINGS: u32 = 2;
 
-/// Matrices whose 1-norm exceeds 2^64 are first scaled down to it, with the difference made up
-/// by extra squarings, so that the powers A^2 ... A^12 of the degree selection cannot overflow.
+/// Matrices whose 1-norm may exceed 2^64 (n max|a_ij| > 2^64) are first scaled down below it,
+/// with the difference made up by extra squarings, so that neither the norms nor the powers
+/// A^2 ... A^12 of the degree selection can overflow.
 const MAX_UNSCALED_NORM_LOG2: f64 = 64.0;
 
 /// Squarings are capped here: 2^-2200 underflows every double, so more can only repeat inf.
@@ -211,10 +214,10 @@ impl PadeChoice {
 /// The arithmetic of evaluating r_m and squaring: implemented by double matrices of small and
 /// of any order, and by double-double matrices.
 pub(crate) trait PadeArithmetic: Sized {
-    /// alpha * self * rhs.
-    fn product(&self, rhs: &Self, alpha: f64) -> Self;
-    /// self += alpha * lhs * rhs.
-    fn add_product(&mut self, lhs: &Self, rhs: &Self, alpha: f64);
+    /// self * rhs.
+    fn product(&self, rhs: &Self) -> Self;
+    /// self += lhs * rhs.
+    fn add_product(&mut self, lhs: &Self, rhs: &Self);
     /// identity * I + sum_k coefficient_k * M_k, for at least one term.
     fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self;
     /// r_m = I + 2 (V - U)^-1 U from the even part V and the odd part U.
@@ -231,6 +234,8 @@ pub(crate) trait ExpmMatrix: PadeArithmetic + Send + Sync {
     fn transpose(&self) -> Self;
     fn set(&mut self, i: usize, j: usize, value: f64);
     fn one_norm(&self) -> f64;
+    /// max |a_ij|.
+    fn max_abs(&self) -> f64;
     /// A lower bound (usually the value) of ||F_1 ... F_k||_1 without forming the product.
     fn estimate_product_norm(factors: &[&Self]) -> f64;
     /// ||(|A| / scale)^p||_1.
@@ -286,11 +291,11 @@ fn pade_approximant<M: PadeArithmetic>(
         let even_high = M::combination(0.0, &[(b[12], a6), (b[10], a4), (b[8], a2)]);
         let mut odd = M::combination(b[1], &[(b[7], a6), (b[5], a4), (b[3], a2)]);
         let mut even = M::combination(b[0], &[(b[6], a6), (b[4], a4), (b[2], a2)]);
-        odd.add_product(a6, &odd_high, 1.0);
-        even.add_product(a6, &even_high, 1.0);
+        odd.add_product(a6, &odd_high);
+        even.add_product(a6, &even_high);
         (odd, even)
     };
-    M::pade_quotient(even, a.product(&odd_inner, 1.0))
+    M::pade_quotient(even, a.product(&odd_inner))
 }
 
 /// X <- X^2, `squarings` times; `refine(X, i)` may correct X, which then approximates
@@ -302,13 +307,15 @@ fn square_repeatedly<M: PadeArithmetic>(
 ) -> M {
     refine(&mut x, squarings);
     for i in (0..squarings).rev() {
-        x = x.product(&x, 1.0);
+        x = x.product(&x);
         refine(&mut x, i);
     }
     x
 }
 
-/// (e^b - e^a) / (b - a), the exponential's divided difference, without cancellation.
+/// (e^b - e^a) / (b - a), the exponential's divided difference, without cancellation or
+/// inf - inf: for close arguments e^((a+b)/2) sinh(δ)/δ, δ = (b - a)/2; otherwise
+/// e^max(a,b) (1 - e^-|b-a|) / |b - a|, which overflows only when the value does.
 fn exp_divided_difference(a: f64, b: f64) -> f64 {
     let half_difference = 0.5 * (b - a);
     if half_difference == 0.0 {
@@ -316,7 +323,8 @@ fn exp_divided_difference(a: f64, b: f64) -> f64 {
     } else if half_difference.abs() <= 1.0 {
         (0.5 * (a + b)).exp() * (half_difference.sinh() / half_difference)
     } else {
-        (b.exp() - a.exp()) / (b - a)
+        let distance = (b - a).abs();
+        a.max(b).exp() * (-(-distance).exp_m1() / distance)
     }
 }
 
@@ -384,14 +392,15 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             let superdiagonal = (0..n - 1).map(|i| a.get(i, i + 1)).collect();
             (diagonal, superdiagonal)
         });
-        let mut a_norm = a.one_norm();
+        // ||A||_1 <= n max|a_ij|, a bound that cannot overflow (the column sums can).
+        let log2_norm_bound = a.max_abs().log2() + (n as f64).log2();
         let mut prescale = 0;
-        if a_norm.log2() > MAX_UNSCALED_NORM_LOG2 {
-            prescale = (a_norm.log2() - MAX_UNSCALED_NORM_LOG2).ceil() as u32;
+        if log2_norm_bound > MAX_UNSCALED_NORM_LOG2 {
+            prescale = (log2_norm_bound - MAX_UNSCALED_NORM_LOG2).ceil() as u32;
             a = M::combination(0.0, &[((-(prescale as f64)).exp2(), &a)]);
-            a_norm = a.one_norm();
         }
-        let a2 = a.product(&a, 1.0);
+        let a_norm = a.one_norm();
+        let a2 = a.product(&a);
         Self {
             a,
             transposed,
@@ -410,19 +419,14 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 
     fn ensure_a4(&mut self) {
         if self.a4.is_none() {
-            self.a4 = Some(self.a2.product(&self.a2, 1.0));
+            self.a4 = Some(self.a2.product(&self.a2));
         }
     }
 
     fn ensure_a6(&mut self) {
         self.ensure_a4();
         if self.a6.is_none() {
-            self.a6 = Some(
-                self.a4
-                    .as_ref()
-                    .expect("formed above")
-                    .product(&self.a2, 1.0),
-            );
+            self.a6 = Some(self.a4.as_ref().expect("formed above").product(&self.a2));
         }
     }
 
@@ -430,7 +434,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         self.ensure_a4();
         if self.a8.is_none() {
             let a4 = self.a4.as_ref().expect("formed above");
-            self.a8 = Some(a4.product(a4, 1.0));
+            self.a8 = Some(a4.product(a4));
         }
     }
 
@@ -464,7 +468,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             8 if self.a8.is_some() => (self.a8.as_ref().unwrap().one_norm(), true),
             10 if self.exact_norms => {
                 let (a4, a6) = (self.a4.as_ref().unwrap(), self.a6.as_ref().unwrap());
-                (a4.product(a6, 1.0).one_norm(), true)
+                (a4.product(a6).one_norm(), true)
             }
             _ => {
                 let a2 = &self.a2;
@@ -665,8 +669,12 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
                     x.set(k, k, (scale * d).exp());
                 }
                 for (k, (&s, pair)) in superdiagonal.iter().zip(diagonal.windows(2)).enumerate() {
-                    let value =
-                        scale * s * exp_divided_difference(scale * pair[0], scale * pair[1]);
+                    // A zero entry stays zero (not 0 * inf when the diagonal overflows).
+                    let value = if s == 0.0 {
+                        0.0
+                    } else {
+                        scale * s * exp_divided_difference(scale * pair[0], scale * pair[1])
+                    };
                     x.set(k, k + 1, value);
                 }
             }
@@ -686,7 +694,7 @@ pub fn parallelism_for_order(n: usize) -> Par {
 }
 
 impl PadeArithmetic for Scratch {
-    fn product(&self, rhs: &Self, alpha: f64) -> Self {
+    fn product(&self, rhs: &Self) -> Self {
         let mut out = scratch(self.nrows(), rhs.ncols());
         let par = parallelism_for_order(self.nrows());
         matmul(
@@ -694,20 +702,20 @@ impl PadeArithmetic for Scratch {
             Accum::Replace,
             self.as_ref(),
             rhs.as_ref(),
-            alpha,
+            1.0,
             par,
         );
         out
     }
 
-    fn add_product(&mut self, lhs: &Self, rhs: &Self, alpha: f64) {
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) {
         let par = parallelism_for_order(self.nrows());
         matmul(
             self.as_mut(),
             Accum::Add,
             lhs.as_ref(),
             rhs.as_ref(),
-            alpha,
+            1.0,
             par,
         );
     }
@@ -779,6 +787,10 @@ impl ExpmMatrix for Scratch {
         one_norm(self.as_ref())
     }
 
+    fn max_abs(&self) -> f64 {
+        self.as_ref().norm_max()
+    }
+
     fn estimate_product_norm(factors: &[&Self]) -> f64 {
         one_norm_estimate(
             &MatrixProduct::new(factors.iter().map(|f| f.as_ref()).collect()),
@@ -802,12 +814,12 @@ impl ExpmMatrix for Scratch {
 // ----- stack matrices of a small order, with the double-double evaluation --------------------
 
 impl<const N: usize> PadeArithmetic for SmallMatrix<N> {
-    fn product(&self, rhs: &Self, alpha: f64) -> Self {
-        SmallMatrix::product(self, rhs, alpha)
+    fn product(&self, rhs: &Self) -> Self {
+        SmallMatrix::product(self, rhs)
     }
 
-    fn add_product(&mut self, lhs: &Self, rhs: &Self, alpha: f64) {
-        SmallMatrix::add_product(self, lhs, rhs, alpha);
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) {
+        SmallMatrix::add_product(self, lhs, rhs);
     }
 
     fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
@@ -821,12 +833,12 @@ impl<const N: usize> PadeArithmetic for SmallMatrix<N> {
 }
 
 impl<const N: usize> PadeArithmetic for DoubleDoubleMatrix<N> {
-    fn product(&self, rhs: &Self, alpha: f64) -> Self {
-        DoubleDoubleMatrix::product(self, rhs, alpha)
+    fn product(&self, rhs: &Self) -> Self {
+        DoubleDoubleMatrix::product(self, rhs)
     }
 
-    fn add_product(&mut self, lhs: &Self, rhs: &Self, alpha: f64) {
-        let product = lhs.product(rhs, alpha);
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) {
+        let product = lhs.product(rhs);
         *self = DoubleDoubleMatrix::combination(0.0, &[(1.0, self), (1.0, &product)]);
     }
 
@@ -873,11 +885,18 @@ impl<const N: usize> ExpmMatrix for SmallMatrix<N> {
         SmallMatrix::one_norm(self)
     }
 
+    fn max_abs(&self) -> f64 {
+        self.rows
+            .as_flattened()
+            .iter()
+            .fold(0.0, |m, v| m.max(v.abs()))
+    }
+
     fn estimate_product_norm(factors: &[&Self]) -> f64 {
         // Small orders always use exact norms; the product is cheap.
         let (first, rest) = factors.split_first().expect("at least one factor");
         rest.iter()
-            .fold(**first, |product, factor| product.product(factor, 1.0))
+            .fold(**first, |product, factor| product.product(factor))
             .one_norm()
     }
 
@@ -905,13 +924,13 @@ impl<const N: usize> ExpmMatrix for SmallMatrix<N> {
     ) -> Option<Self> {
         // Powers of B = cA, formed in double-double from the exactly scaled matrix.
         let b = DoubleDoubleMatrix::scaled(self, c);
-        let b2 = b.product(&b, 1.0);
+        let b2 = b.product(&b);
         let degree = APPROXIMANTS[approximant].degree;
-        let b4 = (degree >= 5).then(|| b2.product(&b2, 1.0));
-        let b6 = (degree >= 7).then(|| b4.as_ref().expect("degree >= 5").product(&b2, 1.0));
+        let b4 = (degree >= 5).then(|| b2.product(&b2));
+        let b6 = (degree >= 7).then(|| b4.as_ref().expect("degree >= 5").product(&b2));
         let b8 = (degree == 9).then(|| {
             let b4 = b4.as_ref().expect("degree >= 5");
-            b4.product(b4, 1.0)
+            b4.product(b4)
         });
         let x = pade_approximant(approximant, &b, &[&b2], [&b4, &b6, &b8]);
         let x = square_repeatedly(x, squarings, |_, _| {}).round();
@@ -957,11 +976,8 @@ fn single_exponential<M: ExpmMatrix>(a: MatRef<'_, f64>, out: MatMut<'_, f64>) {
 /// Writes e^A into `out` (n x n), for a square A of finite entries.
 pub fn expm_into(a: MatRef<'_, f64>, out: MatMut<'_, f64>) -> Result<(), Error> {
     check_square_finite(a, "A")?;
-    assert_eq!(
-        (out.nrows(), out.ncols()),
-        (a.nrows(), a.nrows()),
-        "the output of expm_into must have the order of A"
-    );
+    check_output_len(out.nrows() * out.ncols(), a.nrows() * a.nrows())?;
+    check_output_len(out.nrows(), a.nrows())?;
     expm_into_validated(a, out);
     Ok(())
 }
@@ -1043,11 +1059,7 @@ pub fn transition_matrices_into(
     check_square_finite(a, "A")?;
     check_finite_values(times, "t")?;
     let n = a.nrows();
-    assert_eq!(
-        out.len(),
-        times.len() * n * n,
-        "the output stack has the wrong length"
-    );
+    check_output_len(out.len(), times.len() * n * n)?;
     match n {
         0 => {}
         1 => {

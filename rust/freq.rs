@@ -16,7 +16,9 @@
 //! A frequency at an eigenvalue of A on the imaginary axis (a pole of G) gives infinite or NaN
 //! entries, never an error: the caller decides how to report them.
 
-use crate::error::{Error, check_finite, check_finite_values, check_rows, check_square};
+use crate::error::{
+    Error, check_finite, check_finite_values, check_output_len, check_rows, check_square,
+};
 use crate::hessenberg::{Hessenberg, hessenberg};
 use faer::{Mat, MatRef, c64};
 use rayon::prelude::*;
@@ -130,11 +132,7 @@ pub fn frequency_response_into(
     check_state_space(a, b, c, d)?;
     check_finite_values(omega, "omega")?;
     let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
-    assert_eq!(
-        out.len(),
-        omega.len() * p * m,
-        "output has the wrong length"
-    );
+    check_output_len(out.len(), omega.len() * p * m)?;
     if p * m == 0 {
         return Ok(());
     }

@@ -122,7 +122,8 @@ impl ModalAnalysis {
     /// Whether P is too ill-conditioned to be a modal matrix (a defective or nearly defective
     /// eigenvalue).
     pub fn modal_matrix_is_singular(&self) -> bool {
-        !(self.modal_matrix_condition < SINGULAR_MODAL_MATRIX_CONDITION)
+        self.modal_matrix_condition.is_nan()
+            || self.modal_matrix_condition >= SINGULAR_MODAL_MATRIX_CONDITION
     }
 }
 

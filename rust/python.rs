@@ -2,27 +2,32 @@
 //!
 //! Each function reads numpy arrays as faer matrices, runs the pure Rust function and returns
 //! C-ordered float64 arrays. Small problems run on a view of the caller's array with the GIL
-//! held (so no Python code can run, let alone change the array, meanwhile) and write straight
-//! into the new result array; large ones copy their inputs and release the GIL, so that other
-//! Python threads run while they compute. Every [`Error`] maps to one exception class of
-//! `aerocontrol.exceptions`; a Rust panic never reaches Python because no code path here panics
-//! on input (the core validates and returns errors).
+//! held (so no Python code runs, let alone changes the array, meanwhile) and write straight into
+//! the new result array; large ones, and every stack, copy their inputs and release the GIL, so
+//! that other Python threads run while they compute.
 //!
-//! The public Python API lives in `python/aerocontrol/`; these functions are its private
-//! engine (`aerocontrol._core`).
+//! Every [`Error`] maps to one exception class of `aerocontrol.exceptions`. Memory is requested
+//! fallibly: an impossible size (a broadcast array of 10^10 entries, say) raises MemoryError.
+//! The core returns errors rather than panicking; as a last line of defence every call runs
+//! under [`guarded`], which turns a panic that escaped anyway (an allocation inside faer that
+//! failed) into a Python exception instead of unwinding into the interpreter.
 
 use crate::batch::{MatrixStack, expm_batch};
 use crate::discretize::{Hold, discretize as discretize_core};
 use crate::error::{Error, check_square};
 use crate::expm::{expm_into, pade_choice, transition_matrices_into};
+use crate::norm::one_norm;
 use faer::{Mat, MatMut, MatRef};
-use numpy::ndarray::IxDyn;
-use numpy::{PyArray2, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::PyRuntimeError;
+use numpy::npyffi::{PY_ARRAY_API, npy_intp};
+use numpy::{
+    Element, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyType;
 use std::ffi::CString;
+use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// The exception class of `aerocontrol.exceptions` that an error maps to.
 fn exception_class_name(error: &Error) -> &'static str {
@@ -75,6 +80,24 @@ fn warn(py: Python<'_>, class: &str, message: &str) -> PyResult<()> {
 const OVERFLOW_MESSAGE: &str = "the matrix exponential overflowed double precision; \
      the result has infinite or NaN entries";
 
+/// 2^53 = 1/u: at ||tA|| beyond it the exponential's relative condition number (at least
+/// ||tA||_2) times u exceeds 1, so the rounding of the input alone can change every digit.
+const ILL_CONDITIONED_NORM: f64 = 9_007_199_254_740_992.0;
+
+/// Warns when ||A||_1 max|t| makes e^{At} meaningless in double precision.
+fn warn_if_ill_conditioned(py: Python<'_>, a_norm: f64, t_max: f64) -> PyResult<()> {
+    let scaled = a_norm * t_max;
+    if scaled >= ILL_CONDITIONED_NORM {
+        let message = format!(
+            "||tA||_1 = {scaled:.3e} exceeds 1/u = 2^53: the exponential's relative condition \
+             number is at least ||tA||_2, so the rounding of the input alone can change every \
+             digit of the result"
+        );
+        warn(py, "IllConditionedWarning", &message)?;
+    }
+    Ok(())
+}
+
 /// Warns if any entry of a result is not finite.
 fn warn_on_overflow(py: Python<'_>, values: &[f64]) -> PyResult<()> {
     if values.iter().all(|v| v.is_finite()) {
@@ -84,15 +107,68 @@ fn warn_on_overflow(py: Python<'_>, values: &[f64]) -> PyResult<()> {
     }
 }
 
-/// The argument as a float64 numpy array: a float64 array passes through (a C-level type
-/// check); anything else goes through `aerocontrol._validation.real_array`, which converts
-/// array-likes and raises NotRealError naming the argument for complex or non-numeric input.
+/// Runs `f`, turning a panic that escaped the core into a Python exception (MemoryError for a
+/// failed allocation, RuntimeError otherwise) instead of unwinding into the interpreter.
+fn guarded<T>(f: impl FnOnce() -> T) -> PyResult<T> {
+    catch_unwind(AssertUnwindSafe(f)).map_err(|payload| {
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        if message.to_lowercase().contains("alloc") {
+            PyMemoryError::new_err(format!("not enough memory: {message}"))
+        } else {
+            PyRuntimeError::new_err(format!("internal error in aerocontrol: {message}"))
+        }
+    })
+}
+
+/// The number of entries of an array of this shape, or MemoryError if it cannot be addressed.
+fn entries(shape: &[usize]) -> PyResult<usize> {
+    shape
+        .iter()
+        .try_fold(1usize, |total, &d| total.checked_mul(d))
+        .filter(|&total| total <= isize::MAX as usize / std::mem::size_of::<f64>())
+        .ok_or_else(|| {
+            PyMemoryError::new_err(format!(
+                "an array of shape {shape:?} is too large to allocate"
+            ))
+        })
+}
+
+/// `values` copied into a new vector, or MemoryError.
+fn copy_values(values: impl ExactSizeIterator<Item = f64>) -> PyResult<Vec<f64>> {
+    let mut out = Vec::new();
+    out.try_reserve_exact(values.len()).map_err(|_| {
+        PyMemoryError::new_err(format!("not enough memory to copy {} values", values.len()))
+    })?;
+    out.extend(values);
+    Ok(out)
+}
+
+/// Whether numpy may hand this array's memory to Rust as f64: aligned data and strides.
+fn is_aligned(array: &Bound<'_, PyArrayDyn<f64>>) -> bool {
+    let align = std::mem::align_of::<f64>();
+    (array.data() as usize).is_multiple_of(align)
+        && array
+            .strides()
+            .iter()
+            .all(|s| s.unsigned_abs().is_multiple_of(align))
+}
+
+/// The argument as an aligned float64 numpy array: such an array passes through (a C-level
+/// type check); anything else goes through `aerocontrol._validation.real_array`, which converts
+/// array-likes (copying misaligned ones) and raises NotRealError naming the argument for complex
+/// or non-numeric input.
 fn float_array<'py>(
     py: Python<'py>,
     value: &Bound<'py, PyAny>,
     arg: &'static str,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-    if let Ok(array) = value.cast::<PyArrayDyn<f64>>() {
+    if let Ok(array) = value.cast::<PyArrayDyn<f64>>()
+        && is_aligned(array)
+    {
         return Ok(array.clone());
     }
     let convert = REAL_ARRAY.get_or_try_init(py, || {
@@ -114,22 +190,22 @@ fn shape_error(arg: &'static str, expected: &'static str, shape: &[usize]) -> Er
     }
 }
 
-/// A faer view of a 2-D float64 array (any strides, including negative ones).
+/// A faer view of a 2-D aligned float64 array (any strides, including negative ones).
 ///
-/// SAFETY (of using the view): valid while the GIL is held and the array alive; this module
-/// never takes a mutable borrow of an argument, so nothing writes to it meanwhile. (rust-numpy's
-/// dynamic borrow tracking would cost a global lock and a table lookup per call for no
-/// protection beyond that.)
+/// The view is valid while the GIL is held and the array alive: no Python code runs meanwhile,
+/// and this module never takes a mutable borrow of an argument. (rust-numpy's dynamic borrow
+/// tracking would cost a global lock and a table lookup per call for no protection beyond
+/// that.) Work that releases the GIL copies the view first ([`run_on`]).
 fn matrix_view<'a>(
     array: &'a Bound<'_, PyArrayDyn<f64>>,
     arg: &'static str,
 ) -> Result<MatRef<'a, f64>, Error> {
-    // SAFETY: see the function documentation.
+    // SAFETY: the array is aligned (`float_array`), the GIL is held, and the view does not
+    // outlive `array`; see the function documentation.
     let view = unsafe { array.as_array() };
     match (view.shape(), view.strides()) {
         (&[rows, cols], &[row_stride, col_stride]) => {
-            // SAFETY: the pointer, shape and element strides describe the array's own memory,
-            // which outlives the returned view (tied to `array`).
+            // SAFETY: the pointer, shape and element strides describe the array's own memory.
             Ok(
                 unsafe {
                     MatRef::from_raw_parts(view.as_ptr(), rows, cols, row_stride, col_stride)
@@ -140,51 +216,66 @@ fn matrix_view<'a>(
     }
 }
 
-/// A new zero-filled C-ordered float64 array and its data, to be written before it is returned.
-fn new_array<'py>(
-    py: Python<'py>,
-    shape: &[usize],
-) -> (Bound<'py, PyArrayDyn<f64>>, &'py mut [f64]) {
-    let array = PyArrayDyn::<f64>::zeros(py, IxDyn(shape), false);
-    // SAFETY: the array was just created here and is C-contiguous; no other reference to its
-    // data exists until it is returned to Python, after the slice is last used.
-    let data = unsafe { std::slice::from_raw_parts_mut(array.data(), array.len()) };
-    (array, data)
+/// A new zero-filled C-ordered float64 array, or MemoryError.
+fn new_array<'py>(py: Python<'py>, shape: &[usize]) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    entries(shape)?;
+    let mut dims: Vec<npy_intp> = shape.iter().map(|&d| d as npy_intp).collect();
+    let descriptor = f64::get_dtype(py).into_dtype_ptr();
+    // SAFETY: numpy's PyArray_Zeros with a valid shape and a new reference to the float64
+    // descriptor (which it steals); a null result is a raised Python exception.
+    let pointer = unsafe {
+        PY_ARRAY_API.PyArray_Zeros(py, dims.len() as i32, dims.as_mut_ptr(), descriptor, 0)
+    };
+    if pointer.is_null() {
+        return Err(PyErr::fetch(py));
+    }
+    // SAFETY: a new, owned, float64 ndarray.
+    Ok(unsafe {
+        Bound::from_owned_ptr(py, pointer)
+            .cast_into_unchecked::<PyUntypedArray>()
+            .cast_into_unchecked::<PyArrayDyn<f64>>()
+    })
+}
+
+/// The data of an array created by [`new_array`] and not yet handed to Python.
+///
+/// # Safety
+/// No other reference to the array's data may exist while the slice lives. (The same contract
+/// as rust-numpy's `PyArray::as_slice_mut`: the array object is shared, its data is not.)
+#[allow(clippy::mut_from_ref)]
+unsafe fn new_array_data<'a>(array: &'a Bound<'_, PyArrayDyn<f64>>) -> &'a mut [f64] {
+    // SAFETY: a new array is C-contiguous and aligned, holding `len` float64 values; exclusive
+    // access is the caller's promise.
+    unsafe { std::slice::from_raw_parts_mut(array.data(), array.len()) }
 }
 
 /// A new C-ordered numpy array holding `m`.
-fn matrix_to_numpy<'py>(py: Python<'py>, m: &Mat<f64>) -> Bound<'py, PyArray2<f64>> {
-    let array = PyArray2::<f64>::zeros(py, [m.nrows(), m.ncols()], false);
-    // SAFETY: the array was just created here, is C-contiguous, and no other reference to it
-    // exists yet.
-    let data = unsafe { array.as_slice_mut() }.expect("a new array is contiguous");
-    if m.ncols() > 0 {
-        for (i, row) in data.chunks_exact_mut(m.ncols()).enumerate() {
-            for (j, value) in row.iter_mut().enumerate() {
-                *value = m[(i, j)];
-            }
-        }
-    }
-    array
+fn matrix_to_numpy<'py>(py: Python<'py>, m: &Mat<f64>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let array = new_array(py, &[m.nrows(), m.ncols()])?;
+    // SAFETY: the array was just created and is not yet visible to Python.
+    let data = unsafe { new_array_data(&array) };
+    MatMut::from_row_major_slice_mut(data, m.nrows(), m.ncols()).copy_from(m);
+    Ok(array)
 }
 
 /// Work (in multiply-adds) below which releasing and re-acquiring the GIL costs more than it
 /// lets other threads gain: about a 12 x 12 exponential.
 const DETACH_MIN_WORK: usize = 2_000;
 
-/// Runs `f(a)`: on the view itself when the work is small (GIL held), else on a copy with the
-/// GIL released.
+/// Runs `f(a)` guarded: on the view itself when the work is small (GIL held), else on a copy
+/// with the GIL released.
 fn run_on<T: Send>(
     py: Python<'_>,
     a: MatRef<'_, f64>,
     work: usize,
     f: impl FnOnce(MatRef<'_, f64>) -> T + Send,
-) -> T {
+) -> PyResult<T> {
     if work < DETACH_MIN_WORK {
-        f(a)
+        guarded(|| f(a))
     } else {
-        let copy = a.to_owned();
-        py.detach(|| f(copy.as_ref()))
+        entries(&[a.nrows(), a.ncols()])?;
+        let copy = guarded(|| a.to_owned())?;
+        py.detach(|| guarded(|| f(copy.as_ref())))
     }
 }
 
@@ -198,13 +289,16 @@ fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
         [n, _] => {
             let view = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
             check_square(view, "A").map_err(|e| to_py_err(py, e))?;
-            let (out, data) = new_array(py, &[n, n]);
-            run_on(py, view, n * n * n, |a| {
+            let out = new_array(py, &[n, n])?;
+            // SAFETY: `out` is new and not visible to Python until returned.
+            let data = unsafe { new_array_data(&out) };
+            run_on(py, view, n.saturating_pow(3), |a| {
                 expm_into(a, MatMut::from_row_major_slice_mut(data, n, n))
-            })
+            })?
             .map_err(|e| to_py_err(py, e))?;
-            // SAFETY: the result was written above; nothing else refers to it yet.
-            warn_on_overflow(py, unsafe { out.as_slice() }.expect("contiguous"))?;
+            // SAFETY: as above; the mutable slice is no longer used.
+            warn_on_overflow(py, unsafe { new_array_data(&out) })?;
+            warn_if_ill_conditioned(py, one_norm(view), 1.0)?;
             Ok(out)
         }
         [count, rows, cols] => {
@@ -216,26 +310,19 @@ fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
                 };
                 return Err(to_py_err(py, error));
             }
-            // The stack is read in place with the GIL released, as numpy's own functions read
-            // their inputs: rust-numpy's read borrow excludes writers from Rust code, and a
-            // Python thread that writes to an input while a call reads it gets what it asked
-            // for. A non-contiguous stack is copied first.
-            let readonly = a.readonly();
-            let contiguous;
-            let data = match readonly.as_slice() {
-                Ok(slice) => slice,
-                Err(_) => {
-                    contiguous = readonly.as_array().iter().copied().collect::<Vec<f64>>();
-                    &contiguous
-                }
-            };
-            let (out, out_data) = new_array(py, &[count, rows, rows]);
-            let stack = MatrixStack::new(data, count, rows, cols);
-            py.detach(|| expm_batch(stack, out_data))
+            // The stack is copied before the GIL is released, so that no Python thread can
+            // write to what the computation reads.
+            entries(&shape)?;
+            let data = copy_values(a.readonly().as_array().iter().copied())?;
+            let out = new_array(py, &shape)?;
+            // SAFETY: `out` is new and not visible to Python until returned.
+            let out_data = unsafe { new_array_data(&out) };
+            let stack = MatrixStack::new(&data, count, rows, cols).map_err(|e| to_py_err(py, e))?;
+            py.detach(|| guarded(|| expm_batch(stack, out_data)))?
                 .map_err(|e| to_py_err(py, e))?;
             let size = rows * rows;
             // SAFETY: as above.
-            let values = unsafe { out.as_slice() }.expect("contiguous");
+            let values = unsafe { new_array_data(&out) };
             let overflowed: Vec<usize> = (0..count)
                 .filter(|k| {
                     values[k * size..(k + 1) * size]
@@ -247,6 +334,10 @@ fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
                 let message = format!("{OVERFLOW_MESSAGE} (matrices {overflowed:?} of the stack)");
                 warn(py, "NumericalOverflowWarning", &message)?;
             }
+            let largest_norm = (0..count)
+                .map(|k| one_norm(stack.get(k)))
+                .fold(0.0, f64::max);
+            warn_if_ill_conditioned(py, largest_norm, 1.0)?;
             Ok(out)
         }
         _ => Err(to_py_err(
@@ -271,26 +362,31 @@ fn transition_matrices<'py>(
     let a = float_array(py, a, "A")?;
     let t = float_array(py, t, "t")?;
     let view = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
-    let times: Vec<f64> = t.readonly().as_array().iter().copied().collect();
+    check_square(view, "A").map_err(|e| to_py_err(py, e))?;
     if t.ndim() != 1 {
         return Err(to_py_err(py, shape_error("t", "a 1-D array", t.shape())));
     }
-    check_square(view, "A").map_err(|e| to_py_err(py, e))?;
+    let times = copy_values(t.readonly().as_array().iter().copied())?;
     let n = view.nrows();
-    let (out, data) = new_array(py, &[times.len(), n, n]);
-    run_on(py, view, n * n * n * times.len(), |a| {
+    let out = new_array(py, &[times.len(), n, n])?;
+    // SAFETY: `out` is new and not visible to Python until returned.
+    let data = unsafe { new_array_data(&out) };
+    let work = n.saturating_pow(3).saturating_mul(times.len());
+    run_on(py, view, work, |a| {
         transition_matrices_into(a, &times, data)
-    })
+    })?
     .map_err(|e| to_py_err(py, e))?;
-    // SAFETY: the result was written above; nothing else refers to it yet.
-    warn_on_overflow(py, unsafe { out.as_slice() }.expect("contiguous"))?;
+    // SAFETY: as above; the mutable slice is no longer used.
+    warn_on_overflow(py, unsafe { new_array_data(&out) })?;
+    let t_max = times.iter().fold(0.0, |m: f64, t| m.max(t.abs()));
+    warn_if_ill_conditioned(py, one_norm(view), t_max)?;
     Ok(out)
 }
 
 type Discretized<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-    Option<Bound<'py, PyArray2<f64>>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Option<Bound<'py, PyArrayDyn<f64>>>,
 );
 
 /// (Φ, Γ0, Γ1 or None) of x' = Ax + Bη over the step dt, for method "zoh" or "foh".
@@ -316,13 +412,15 @@ fn discretize<'py>(
     };
     let (a, b) = (float_array(py, a, "A")?, float_array(py, b, "B")?);
     let a = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
-    let b = matrix_view(&b, "B")
-        .map_err(|e| to_py_err(py, e))?
-        .to_owned();
-    let size = a.nrows() + 2 * b.ncols();
-    let result = run_on(py, a, size * size * size, |a| {
-        discretize_core(a, b.as_ref(), dt, hold)
-    })
+    let b = matrix_view(&b, "B").map_err(|e| to_py_err(py, e))?;
+    let size = a.nrows().saturating_add(b.ncols().saturating_mul(2));
+    entries(&[size, size])?;
+    let result = if size.saturating_pow(3) < DETACH_MIN_WORK {
+        guarded(|| discretize_core(a, b, dt, hold))?
+    } else {
+        let (a, b) = guarded(|| (a.to_owned(), b.to_owned()))?;
+        py.detach(|| guarded(|| discretize_core(a.as_ref(), b.as_ref(), dt, hold)))?
+    }
     .map_err(|e| to_py_err(py, e))?;
     let gamma1 = result.gamma1.as_ref();
     let finite =
@@ -331,9 +429,9 @@ fn discretize<'py>(
         warn(py, "NumericalOverflowWarning", OVERFLOW_MESSAGE)?;
     }
     Ok((
-        matrix_to_numpy(py, &result.phi),
-        matrix_to_numpy(py, &result.gamma0),
-        gamma1.map(|g| matrix_to_numpy(py, g)),
+        matrix_to_numpy(py, &result.phi)?,
+        matrix_to_numpy(py, &result.gamma0)?,
+        gamma1.map(|g| matrix_to_numpy(py, g)).transpose()?,
     ))
 }
 
@@ -344,11 +442,13 @@ fn discretize<'py>(
 fn expm_pade_choice(py: Python<'_>, a: &Bound<'_, PyAny>) -> PyResult<(usize, u32)> {
     let a = float_array(py, a, "A")?;
     let view = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
-    pade_choice(view).map_err(|e| to_py_err(py, e))
+    check_square(view, "A").map_err(|e| to_py_err(py, e))?;
+    entries(&[view.nrows(), view.nrows()])?;
+    guarded(|| pade_choice(view))?.map_err(|e| to_py_err(py, e))
 }
 
 /// The native core of aerocontrol; use the `aerocontrol` package, not this module.
-#[pymodule(gil_used = false)]
+#[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(expm, m)?)?;
     m.add_function(wrap_pyfunction!(transition_matrices, m)?)?;

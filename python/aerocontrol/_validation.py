@@ -2,8 +2,8 @@
 
 The core checks shapes and finiteness and names the argument in its errors; this module only
 turns array-likes into float64 ndarrays and rejects what is not a real number, by name.
-Inputs are never modified: a conversion that needs a new array makes one, and the core copies
-what it reads.
+Inputs are never modified: a conversion that needs a new array makes one, and the core only
+reads its inputs (copying them before it releases the GIL).
 """
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ def real_array(value: Any, name: str) -> FloatArray:
     """``value`` as a float64 ndarray, or NotRealError naming ``name``.
 
     Accepts any real array-like: lists, integer, boolean and float32 arrays, Fortran-ordered
-    and non-contiguous views (the core reads any strides).
+    and non-contiguous views (the core reads any strides). A misaligned float64 array (a view
+    into a byte buffer at an odd offset) is copied, since the core reads aligned memory only.
     """
     if type(value) is np.ndarray and value.dtype == np.float64:
         return value
@@ -37,7 +38,10 @@ def real_array(value: Any, name: str) -> FloatArray:
         )
     if array.dtype.kind not in "biuf":
         raise NotRealError(f"{name} must be an array of real numbers, got dtype {array.dtype}")
-    return array.astype(np.float64, copy=False)
+    array = array.astype(np.float64, copy=False)
+    if not array.flags.aligned:
+        array = np.array(array, dtype=np.float64)
+    return array
 
 
 def real_scalar(value: Any, name: str) -> float:
@@ -50,7 +54,7 @@ def real_scalar(value: Any, name: str) -> float:
 
 def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
     """``value`` if it is one of ``choices``, else InvalidArgumentError naming ``name``."""
-    if value not in choices:
+    if not isinstance(value, str) or value not in choices:
         allowed = ", ".join(repr(c) for c in choices)
         raise InvalidArgumentError(f"{name} must be one of {allowed}, got {value!r}")
     return str(value)

@@ -28,6 +28,7 @@ __all__ = [
     "AerocontrolLinAlgError",
     "AerocontrolWarning",
     "ConvergenceError",
+    "IllConditionedWarning",
     "InvalidArgumentError",
     "NonFiniteError",
     "NotRealError",
@@ -69,6 +70,11 @@ class ConvergenceError(AerocontrolLinAlgError):
 
 class AerocontrolWarning(UserWarning):
     """Base class of the warnings issued by aerocontrol."""
+
+
+class IllConditionedWarning(AerocontrolWarning, RuntimeWarning):
+    """A result was computed, but its conditioning means it may carry few or no correct
+    digits; the message gives the measure."""
 
 
 class NumericalOverflowWarning(AerocontrolWarning, RuntimeWarning):

@@ -21,8 +21,10 @@ def expm(A: Any) -> FloatArray:
 
     Padé scaling and squaring with the degree (3, 5, 7, 9 or 13) and scaling chosen as in
     Al-Mohy & Higham (2009), which avoids the overscaling of older algorithms on non-normal
-    matrices; triangular matrices keep their structure and get exact diagonals. A 3-D stack of
-    k matrices is exponentiated in parallel across cores in one call.
+    matrices; triangular matrices keep their structure. For orders up to 8, an exponential
+    that needs squarings is evaluated in double-double arithmetic and is correct to a few
+    units in the last place. A 3-D stack of k matrices is exponentiated in parallel across
+    cores in one call.
 
     Parameters
     ----------
@@ -33,7 +35,10 @@ def expm(A: Any) -> FloatArray:
     -------
     ndarray of float64, same shape as ``A``
         e^A. A result that overflows double precision has infinite entries and comes with a
-        :class:`~aerocontrol.exceptions.NumericalOverflowWarning`, as in scipy.
+        :class:`~aerocontrol.exceptions.NumericalOverflowWarning`, as in scipy. When
+        ||A||_1 >= 2^53 the rounding of A alone can change every digit of e^A (its relative
+        condition number is at least ||A||_2), and an
+        :class:`~aerocontrol.exceptions.IllConditionedWarning` says so.
 
     Raises
     ------
@@ -160,6 +165,8 @@ def discretize(A: Any, B: Any, dt: float, method: Literal["zoh", "foh"] = "zoh")
     if B.ndim == 1:
         B = B.reshape(-1, 1)
     step = real_scalar(dt, "dt")
-    hold = check_choice(method, "method", ("zoh", "foh"))
+    hold: Literal["zoh", "foh"] = (
+        "zoh" if check_choice(method, "method", ("zoh", "foh")) == "zoh" else "foh"
+    )
     Phi, Gamma0, Gamma1 = _core.discretize(A, B, step, hold)
-    return Discretization(Phi=Phi, Gamma0=Gamma0, Gamma1=Gamma1, dt=step, method=method)
+    return Discretization(Phi=Phi, Gamma0=Gamma0, Gamma1=Gamma1, dt=step, method=hold)
