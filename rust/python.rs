@@ -313,7 +313,11 @@ fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
             // The stack is copied before the GIL is released, so that no Python thread can
             // write to what the computation reads.
             entries(&shape)?;
-            let data = copy_values(a.readonly().as_array().iter().copied())?;
+            let readonly = a.readonly();
+            let data = match readonly.as_slice() {
+                Ok(contiguous) => copy_values(contiguous.iter().copied())?,
+                Err(_) => copy_values(readonly.as_array().iter().copied())?,
+            };
             let out = new_array(py, &shape)?;
             // SAFETY: `out` is new and not visible to Python until returned.
             let out_data = unsafe { new_array_data(&out) };
@@ -334,8 +338,18 @@ fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
                 let message = format!("{OVERFLOW_MESSAGE} (matrices {overflowed:?} of the stack)");
                 warn(py, "NumericalOverflowWarning", &message)?;
             }
-            let largest_norm = (0..count)
-                .map(|k| one_norm(stack.get(k)))
+            let mut column_sums = vec![0.0; rows];
+            let largest_norm = data
+                .chunks_exact(size.max(1))
+                .map(|matrix| {
+                    column_sums.fill(0.0);
+                    for row in matrix.chunks_exact(rows.max(1)) {
+                        for (sum, value) in column_sums.iter_mut().zip(row) {
+                            *sum += value.abs();
+                        }
+                    }
+                    column_sums.iter().copied().fold(0.0, f64::max)
+                })
                 .fold(0.0, f64::max);
             warn_if_ill_conditioned(py, largest_norm, 1.0)?;
             Ok(out)
