@@ -43,6 +43,12 @@ pub enum Error {
         value: f64,
         requirement: &'static str,
     },
+    /// A matrix that must be invertible has an eigenvalue at zero (to working precision).
+    Singular {
+        arg: &'static str,
+        eigenvalue_re: f64,
+        eigenvalue_im: f64,
+    },
     /// An iterative algorithm did not converge within its iteration limit.
     NoConvergence { algorithm: &'static str },
     /// One problem of a batch failed; `index` is its position in the stack.
@@ -106,6 +112,15 @@ impl fmt::Display for Error {
                 value,
                 requirement,
             } => write!(f, "{arg} must be {requirement}, got {value}"),
+            Error::Singular {
+                arg,
+                eigenvalue_re,
+                eigenvalue_im,
+            } => write!(
+                f,
+                "{arg} is singular: it has the eigenvalue 0 (computed as {eigenvalue_re:e}{eigenvalue_im:+e}i), \
+                 an integrator or neutral mode, so {arg}^-1 does not exist"
+            ),
             Error::NoConvergence { algorithm } => {
                 write!(f, "{algorithm} did not converge within its iteration limit")
             }

@@ -15,6 +15,9 @@
 //!   squaring (Al-Mohy & Higham 2009).
 //! * [`discretize`]: Φ, Γ0 and Γ1 over a step by one exponential of an augmented matrix
 //!   (Van Loan 1978), exact for singular A.
+//! * [`response`]: time responses on a uniform grid, by one discretisation and a recurrence.
+//! * [`freq`]: frequency responses through one Hessenberg reduction ([`hessenberg`]).
+//! * [`modes`]: eigenvalues, modes and their characteristics, the characteristic polynomial.
 //! * [`batch`]: the same operations over stacks of problems, in parallel.
 //! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
 //! * [`lu`]: linear solves by LU with partial pivoting.
@@ -43,6 +46,7 @@ pub mod lu;
 pub mod modes;
 pub mod norm;
 pub mod pool;
+pub mod response;
 pub mod small_matrix;
 
 #[cfg(feature = "python")]

@@ -16,8 +16,14 @@ use crate::batch::{MatrixStack, expm_batch};
 use crate::discretize::{Hold, discretize as discretize_core};
 use crate::error::{Error, check_square};
 use crate::expm::{expm_into, pade_choice, transition_matrices_into};
+use crate::freq::{check_state_space, frequency_response_into};
+use crate::modes::modal_analysis as modal_analysis_core;
 use crate::norm::one_norm;
-use faer::{Mat, MatMut, MatRef};
+use crate::response::{
+    Input, Model, simulate_into, simulate_models_into, steady_state as steady_state_core,
+    uniform_grid_step,
+};
+use faer::{Mat, MatMut, MatRef, c64};
 use numpy::npyffi::{PY_ARRAY_API, npy_intp};
 use numpy::{
     Element, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
@@ -25,7 +31,7 @@ use numpy::{
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
-use pyo3::types::PyType;
+use pyo3::types::{PyDict, PyType};
 use std::ffi::CString;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -38,6 +44,7 @@ fn exception_class_name(error: &Error) -> &'static str {
         Error::NonFinite { .. } => "NonFiniteError",
         Error::InvalidValue { .. } => "InvalidArgumentError",
         Error::NoConvergence { .. } => "ConvergenceError",
+        Error::Singular { .. } => "SingularMatrixError",
         Error::InBatch { source, .. } => exception_class_name(source),
     }
 }
@@ -216,12 +223,15 @@ fn matrix_view<'a>(
     }
 }
 
-/// A new zero-filled C-ordered float64 array, or MemoryError.
-fn new_array<'py>(py: Python<'py>, shape: &[usize]) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+/// A new zero-filled C-ordered array (float64 or complex128), or MemoryError.
+fn new_array<'py, T: Element>(
+    py: Python<'py>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     entries(shape)?;
     let mut dims: Vec<npy_intp> = shape.iter().map(|&d| d as npy_intp).collect();
-    let descriptor = f64::get_dtype(py).into_dtype_ptr();
-    // SAFETY: numpy's PyArray_Zeros with a valid shape and a new reference to the float64
+    let descriptor = T::get_dtype(py).into_dtype_ptr();
+    // SAFETY: numpy's PyArray_Zeros with a valid shape and a new reference to the element's
     // descriptor (which it steals); a null result is a raised Python exception.
     let pointer = unsafe {
         PY_ARRAY_API.PyArray_Zeros(py, dims.len() as i32, dims.as_mut_ptr(), descriptor, 0)
@@ -229,11 +239,11 @@ fn new_array<'py>(py: Python<'py>, shape: &[usize]) -> PyResult<Bound<'py, PyArr
     if pointer.is_null() {
         return Err(PyErr::fetch(py));
     }
-    // SAFETY: a new, owned, float64 ndarray.
+    // SAFETY: a new, owned ndarray of element type T.
     Ok(unsafe {
         Bound::from_owned_ptr(py, pointer)
             .cast_into_unchecked::<PyUntypedArray>()
-            .cast_into_unchecked::<PyArrayDyn<f64>>()
+            .cast_into_unchecked::<PyArrayDyn<T>>()
     })
 }
 
@@ -243,7 +253,7 @@ fn new_array<'py>(py: Python<'py>, shape: &[usize]) -> PyResult<Bound<'py, PyArr
 /// No other reference to the array's data may exist while the slice lives. (The same contract
 /// as rust-numpy's `PyArray::as_slice_mut`: the array object is shared, its data is not.)
 #[allow(clippy::mut_from_ref)]
-unsafe fn new_array_data<'a>(array: &'a Bound<'_, PyArrayDyn<f64>>) -> &'a mut [f64] {
+unsafe fn new_array_data<'a, T: Element>(array: &'a Bound<'_, PyArrayDyn<T>>) -> &'a mut [T] {
     // SAFETY: a new array is C-contiguous and aligned, holding `len` float64 values; exclusive
     // access is the caller's promise.
     unsafe { std::slice::from_raw_parts_mut(array.data(), array.len()) }
@@ -461,6 +471,424 @@ fn expm_pade_choice(py: Python<'_>, a: &Bound<'_, PyAny>) -> PyResult<(usize, u3
     guarded(|| pade_choice(view))?.map_err(|e| to_py_err(py, e))
 }
 
+/// The four matrices of a state-space model as aligned float64 arrays.
+type ModelArrays<'py> = [Bound<'py, PyArrayDyn<f64>>; 4];
+
+fn model_arrays<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    d: &Bound<'py, PyAny>,
+) -> PyResult<ModelArrays<'py>> {
+    Ok([
+        float_array(py, a, "A")?,
+        float_array(py, b, "B")?,
+        float_array(py, c, "C")?,
+        float_array(py, d, "D")?,
+    ])
+}
+
+fn model_views<'a>(arrays: &'a ModelArrays<'_>) -> Result<Model<'a>, Error> {
+    let model = Model {
+        a: matrix_view(&arrays[0], "A")?,
+        b: matrix_view(&arrays[1], "B")?,
+        c: matrix_view(&arrays[2], "C")?,
+        d: matrix_view(&arrays[3], "D")?,
+    };
+    check_state_space(model.a, model.b, model.c, model.d)?;
+    Ok(model)
+}
+
+/// Checks the shapes and values of A, B, C, D of a state-space model, naming the matrix at
+/// fault.
+#[pyfunction]
+#[pyo3(signature = (a, b, c, d, /))]
+fn check_model(
+    py: Python<'_>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
+    c: &Bound<'_, PyAny>,
+    d: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let arrays = model_arrays(py, a, b, c, d)?;
+    model_views(&arrays).map_err(|e| to_py_err(py, e))?;
+    Ok(())
+}
+
+/// The step of a uniform time grid that starts at 0 (an error names `T` otherwise).
+#[pyfunction]
+#[pyo3(signature = (t, /))]
+fn grid_step(py: Python<'_>, t: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let t = float_array(py, t, "T")?;
+    if t.ndim() != 1 {
+        return Err(to_py_err(
+            py,
+            shape_error("T", "a 1-D array of times", t.shape()),
+        ));
+    }
+    let times = copy_values(t.readonly().as_array().iter().copied())?;
+    uniform_grid_step(&times, "T").map_err(|e| to_py_err(py, e))
+}
+
+type SimulationOutput<'py> = (Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>);
+
+/// States (r, steps, n) and outputs (r, steps, p) of r responses from the initial states
+/// x0 (r, n): free (u and eta0 None), a constant input eta0 (m), or sampled inputs u
+/// (r, steps, m) with a zero- or first-order hold.
+#[pyfunction]
+#[pyo3(signature = (a, b, c, d, x0, u, eta0, dt, steps, method, /))]
+#[allow(clippy::too_many_arguments)]
+fn simulate<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    d: &Bound<'py, PyAny>,
+    x0: &Bound<'py, PyAny>,
+    u: Option<&Bound<'py, PyAny>>,
+    eta0: Option<&Bound<'py, PyAny>>,
+    dt: f64,
+    steps: usize,
+    method: &str,
+) -> PyResult<SimulationOutput<'py>> {
+    let hold = match method {
+        "zoh" => Hold::Zero,
+        "foh" => Hold::First,
+        other => {
+            return Err(raise(
+                py,
+                "InvalidArgumentError",
+                format!("method must be \"zoh\" or \"foh\", got {other:?}"),
+            ));
+        }
+    };
+    let arrays = model_arrays(py, a, b, c, d)?;
+    let model = model_views(&arrays).map_err(|e| to_py_err(py, e))?;
+    let (n, p) = (model.a.nrows(), model.c.nrows());
+    let x0 = float_array(py, x0, "x0")?;
+    if x0.ndim() != 2 || x0.shape()[1] != n {
+        let error = Error::WrongDimensions {
+            arg: "x0",
+            expected: "one initial state per response, of the order of A",
+            shape: x0.shape().to_vec(),
+        };
+        return Err(to_py_err(py, error));
+    }
+    let responses = x0.shape()[0];
+    let x0 = copy_values(x0.readonly().as_array().iter().copied())?;
+    let u = u.map(|u| float_array(py, u, "u")).transpose()?;
+    let eta0 = eta0.map(|e| float_array(py, e, "eta0")).transpose()?;
+    let u_values = u
+        .map(|u| copy_values(u.readonly().as_array().iter().copied()))
+        .transpose()?;
+    let eta_values = eta0
+        .map(|e| copy_values(e.readonly().as_array().iter().copied()))
+        .transpose()?;
+    let input = match (&u_values, &eta_values) {
+        (Some(u), _) => Input::Sampled(u),
+        (None, Some(eta)) => Input::Constant(eta),
+        (None, None) => Input::Free,
+    };
+    let x = new_array::<f64>(py, &[responses, steps, n])?;
+    let y = new_array::<f64>(py, &[responses, steps, p])?;
+    // SAFETY: both arrays are new and not visible to Python until returned.
+    let (x_data, y_data) = unsafe { (new_array_data(&x), new_array_data(&y)) };
+    let work = responses
+        .saturating_mul(steps)
+        .saturating_mul(n * n + n * p);
+    let x0 = &x0;
+    let mut run =
+        move |model: Model<'_>| simulate_into(model, x0, input, dt, steps, hold, x_data, y_data);
+    if work < DETACH_MIN_WORK * 100 {
+        guarded(move || run(model))?
+    } else {
+        let owned: Vec<Mat<f64>> = guarded(|| {
+            [model.a, model.b, model.c, model.d]
+                .map(|m| m.to_owned())
+                .into()
+        })?;
+        py.detach(move || {
+            guarded(move || {
+                run(Model {
+                    a: owned[0].as_ref(),
+                    b: owned[1].as_ref(),
+                    c: owned[2].as_ref(),
+                    d: owned[3].as_ref(),
+                })
+            })
+        })?
+    }
+    .map_err(|e| to_py_err(py, e))?;
+    Ok((x, y))
+}
+
+/// A 3-D float64 array copied into a contiguous stack, with its shape.
+fn stack_values(
+    py: Python<'_>,
+    value: &Bound<'_, PyAny>,
+    arg: &'static str,
+) -> PyResult<(Vec<f64>, [usize; 3])> {
+    let array = float_array(py, value, arg)?;
+    match *array.shape() {
+        [count, rows, cols] => {
+            let readonly = array.readonly();
+            let values = copy_values(readonly.as_array().iter().copied())?;
+            Ok((values, [count, rows, cols]))
+        }
+        _ => Err(to_py_err(
+            py,
+            shape_error(arg, "a 3-D stack of matrices", array.shape()),
+        )),
+    }
+}
+
+/// All values of an array argument, copied in C order.
+fn all_values(py: Python<'_>, value: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<Vec<f64>> {
+    let array = float_array(py, value, arg)?;
+    let readonly = array.readonly();
+    copy_values(readonly.as_array().iter().copied())
+}
+
+/// One response of each model of a stack: A (q, n, n), B (q, n, m), C (q, p, n), D (q, p, m),
+/// initial states x0 (q, n), and a free response, a constant input eta0 (q, m) or sampled
+/// inputs u (q, steps, m). Returns states (q, steps, n) and outputs (q, steps, p).
+#[pyfunction]
+#[pyo3(signature = (a, b, c, d, x0, u, eta0, dt, steps, method, /))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_models<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    d: &Bound<'py, PyAny>,
+    x0: &Bound<'py, PyAny>,
+    u: Option<&Bound<'py, PyAny>>,
+    eta0: Option<&Bound<'py, PyAny>>,
+    dt: f64,
+    steps: usize,
+    method: &str,
+) -> PyResult<SimulationOutput<'py>> {
+    let hold = match method {
+        "zoh" => Hold::Zero,
+        "foh" => Hold::First,
+        other => {
+            return Err(raise(
+                py,
+                "InvalidArgumentError",
+                format!("method must be \"zoh\" or \"foh\", got {other:?}"),
+            ));
+        }
+    };
+    let (a, [q, n, na]) = stack_values(py, a, "A")?;
+    let (b, [qb, nb, m]) = stack_values(py, b, "B")?;
+    let (c, [qc, p, nc]) = stack_values(py, c, "C")?;
+    let (d, [qd, pd, md]) = stack_values(py, d, "D")?;
+    if let Some(&got) = [qb, qc, qd].iter().find(|&&count| count != q) {
+        let error = Error::Mismatch {
+            arg: "B, C and D",
+            what: "as many models as",
+            expected: q,
+            other: "A",
+            got,
+        };
+        return Err(to_py_err(py, error));
+    }
+    fn stack(values: &[f64], q: usize, rows: usize, cols: usize) -> Result<MatrixStack<'_>, Error> {
+        MatrixStack::new(values, q, rows, cols)
+    }
+    let stacks = (|| {
+        Ok::<_, Error>((
+            stack(&a, q, n, na)?,
+            stack(&b, q, nb, m)?,
+            stack(&c, q, p, nc)?,
+            stack(&d, q, pd, md)?,
+        ))
+    })();
+    let (a_stack, b_stack, c_stack, d_stack) = stacks.map_err(|e| to_py_err(py, e))?;
+    let models: Vec<Model<'_>> = (0..q)
+        .map(|i| Model {
+            a: a_stack.get(i),
+            b: b_stack.get(i),
+            c: c_stack.get(i),
+            d: d_stack.get(i),
+        })
+        .collect();
+    let x0 = all_values(py, x0, "x0")?;
+    let u = u.map(|u| all_values(py, u, "u")).transpose()?;
+    let eta = eta0.map(|e| all_values(py, e, "eta0")).transpose()?;
+    let input = match (&u, &eta) {
+        (Some(u), _) => Input::Sampled(u),
+        (None, Some(eta)) => Input::Constant(eta),
+        (None, None) => Input::Free,
+    };
+    let x = new_array::<f64>(py, &[q, steps, n])?;
+    let y = new_array::<f64>(py, &[q, steps, p])?;
+    // SAFETY: both arrays are new and not visible to Python until returned.
+    let (x_data, y_data) = unsafe { (new_array_data(&x), new_array_data(&y)) };
+    py.detach(|| {
+        guarded(|| simulate_models_into(&models, &x0, input, dt, steps, hold, x_data, y_data))
+    })?
+    .map_err(|e| to_py_err(py, e))?;
+    Ok((x, y))
+}
+
+/// -A^-1 B eta0, the steady state of a step (6.45).
+#[pyfunction]
+#[pyo3(signature = (a, b, eta0, /))]
+fn steady_state<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    eta0: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let (a, b, eta0) = (
+        float_array(py, a, "A")?,
+        float_array(py, b, "B")?,
+        float_array(py, eta0, "eta0")?,
+    );
+    let a = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
+    let b = matrix_view(&b, "B").map_err(|e| to_py_err(py, e))?;
+    let eta = copy_values(eta0.readonly().as_array().iter().copied())?;
+    let x = guarded(|| steady_state_core(a, b, &eta))?.map_err(|e| to_py_err(py, e))?;
+    let out = new_array::<f64>(py, &[x.len()])?;
+    // SAFETY: new and not visible to Python until returned.
+    unsafe { new_array_data(&out) }.copy_from_slice(&x);
+    Ok(out)
+}
+
+/// G(jω_k) = C (jω_k I - A)^-1 B + D, as a complex (len(omega), p, m) array.
+#[pyfunction]
+#[pyo3(signature = (a, b, c, d, omega, /))]
+fn frequency_response<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    d: &Bound<'py, PyAny>,
+    omega: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<c64>>> {
+    let arrays = model_arrays(py, a, b, c, d)?;
+    let model = model_views(&arrays).map_err(|e| to_py_err(py, e))?;
+    let omega = float_array(py, omega, "omega")?;
+    if omega.ndim() != 1 {
+        return Err(to_py_err(
+            py,
+            shape_error("omega", "a 1-D array of frequencies", omega.shape()),
+        ));
+    }
+    let omega = copy_values(omega.readonly().as_array().iter().copied())?;
+    let (p, m) = (model.c.nrows(), model.b.ncols());
+    let out = new_array::<c64>(py, &[omega.len(), p, m])?;
+    // SAFETY: new and not visible to Python until returned.
+    let data = unsafe { new_array_data(&out) };
+    let Model { a, b, c, d } = model;
+    let (a, b, c, d) = guarded(|| (a.to_owned(), b.to_owned(), c.to_owned(), d.to_owned()))?;
+    py.detach(|| {
+        guarded(|| {
+            frequency_response_into(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), &omega, data)
+        })
+    })?
+    .map_err(|e| to_py_err(py, e))?;
+    Ok(out)
+}
+
+fn complex_matrix<'py>(py: Python<'py>, m: &Mat<c64>) -> PyResult<Bound<'py, PyArrayDyn<c64>>> {
+    let out = new_array::<c64>(py, &[m.nrows(), m.ncols()])?;
+    // SAFETY: new and not visible to Python until returned.
+    let data = unsafe { new_array_data(&out) };
+    for (i, row) in data.chunks_exact_mut(m.ncols().max(1)).enumerate() {
+        for (j, value) in row.iter_mut().enumerate() {
+            *value = m[(i, j)];
+        }
+    }
+    Ok(out)
+}
+
+fn real_vector<'py>(py: Python<'py>, values: &[f64]) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let out = new_array::<f64>(py, &[values.len()])?;
+    // SAFETY: new and not visible to Python until returned.
+    unsafe { new_array_data(&out) }.copy_from_slice(values);
+    Ok(out)
+}
+
+/// The modal analysis of A (and P^-1 B if B is given), as a dict of numpy arrays.
+#[pyfunction]
+#[pyo3(signature = (a, b, /))]
+fn modal_analysis<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let a = float_array(py, a, "A")?;
+    let b = b.map(|b| float_array(py, b, "B")).transpose()?;
+    let a_view = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
+    let b_view = b
+        .as_ref()
+        .map(|b| matrix_view(b, "B"))
+        .transpose()
+        .map_err(|e| to_py_err(py, e))?;
+    let analysis =
+        guarded(|| modal_analysis_core(a_view, b_view))?.map_err(|e| to_py_err(py, e))?;
+    let result = PyDict::new(py);
+    let eigenvalues = new_array::<c64>(py, &[analysis.eigenvalues.len()])?;
+    // SAFETY: new and not visible to Python until returned.
+    unsafe { new_array_data(&eigenvalues) }.copy_from_slice(&analysis.eigenvalues);
+    result.set_item("eigenvalues", eigenvalues)?;
+    let modes = &analysis.modes;
+    let column = |f: fn(&crate::modes::Mode) -> f64| -> Vec<f64> { modes.iter().map(f).collect() };
+    let mode_eigenvalues = new_array::<c64>(py, &[modes.len()])?;
+    // SAFETY: as above.
+    let data = unsafe { new_array_data(&mode_eigenvalues) };
+    for (value, mode) in data.iter_mut().zip(modes) {
+        *value = mode.eigenvalue;
+    }
+    result.set_item("mode_eigenvalue", mode_eigenvalues)?;
+    result.set_item(
+        "oscillatory",
+        modes.iter().map(|m| m.oscillatory).collect::<Vec<bool>>(),
+    )?;
+    result.set_item(
+        "mode_indices",
+        modes
+            .iter()
+            .map(|m| (m.indices[0], m.indices[1]))
+            .collect::<Vec<_>>(),
+    )?;
+    for (name, f) in [
+        (
+            "natural_frequency",
+            (|m| m.natural_frequency) as fn(&crate::modes::Mode) -> f64,
+        ),
+        ("damping_ratio", |m| m.damping_ratio),
+        ("damped_frequency", |m| m.damped_frequency),
+        ("period", |m| m.period),
+        ("time_to_half", |m| m.time_to_half),
+        ("time_to_double", |m| m.time_to_double),
+        ("cycles_to_half", |m| m.cycles_to_half),
+        ("time_constant", |m| m.time_constant),
+    ] {
+        result.set_item(name, real_vector(py, &column(f))?)?;
+    }
+    result.set_item("modal_matrix", complex_matrix(py, &analysis.modal_matrix)?)?;
+    result.set_item("modal_matrix_condition", analysis.modal_matrix_condition)?;
+    result.set_item(
+        "modal_matrix_is_singular",
+        analysis.modal_matrix_is_singular(),
+    )?;
+    let modal_input = analysis
+        .modal_input
+        .as_ref()
+        .map(|m| complex_matrix(py, m))
+        .transpose()?;
+    result.set_item("modal_input", modal_input)?;
+    result.set_item(
+        "characteristic_polynomial",
+        real_vector(py, &analysis.characteristic_polynomial)?,
+    )?;
+    Ok(result)
+}
+
 /// The native core of aerocontrol; use the `aerocontrol` package, not this module.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -468,6 +896,13 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(transition_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(discretize, m)?)?;
     m.add_function(wrap_pyfunction!(expm_pade_choice, m)?)?;
+    m.add_function(wrap_pyfunction!(check_model, m)?)?;
+    m.add_function(wrap_pyfunction!(grid_step, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_models, m)?)?;
+    m.add_function(wrap_pyfunction!(steady_state, m)?)?;
+    m.add_function(wrap_pyfunction!(frequency_response, m)?)?;
+    m.add_function(wrap_pyfunction!(modal_analysis, m)?)?;
     m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
     m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;
     m.add("FMA_KERNELS", crate::dispatch::fma_available())?;

@@ -27,8 +27,23 @@ from .exceptions import (
     NotRealError,
     NumericalOverflowWarning,
     ShapeError,
+    SingularMatrixError,
 )
+from .frequency import FrequencyResponse, bode, default_frequency_grid, frequency_response
 from .linalg import Discretization, discretize, expm, transition_matrix
+from .modal import Modes, characteristic_polynomial, modes
+from .responses import (
+    TimeResponse,
+    dc_gain,
+    default_time_grid,
+    doublet_response,
+    forced_response,
+    impulse_response,
+    initial_response,
+    steady_state,
+    step_response,
+)
+from .statespace import StateSpace, as_state_space
 
 try:
     __version__ = version("aerocontrol")
@@ -41,16 +56,35 @@ __all__ = [
     "AerocontrolWarning",
     "ConvergenceError",
     "Discretization",
+    "FrequencyResponse",
     "IllConditionedWarning",
     "InvalidArgumentError",
+    "Modes",
     "NonFiniteError",
     "NotRealError",
     "NumericalOverflowWarning",
     "ShapeError",
+    "SingularMatrixError",
+    "StateSpace",
+    "TimeResponse",
     "__version__",
+    "as_state_space",
+    "bode",
     "chapter",
+    "characteristic_polynomial",
+    "dc_gain",
+    "default_frequency_grid",
+    "default_time_grid",
     "discretize",
+    "doublet_response",
     "exceptions",
     "expm",
+    "forced_response",
+    "frequency_response",
+    "impulse_response",
+    "initial_response",
+    "modes",
+    "steady_state",
+    "step_response",
     "transition_matrix",
 ]

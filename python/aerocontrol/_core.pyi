@@ -3,6 +3,8 @@
 Private: call the wrappers in the aerocontrol package, which convert and check arguments.
 """
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -10,9 +12,16 @@ __all__ = [
     "EXACT_NORM_MAX_ORDER",
     "FMA_KERNELS",
     "SMALL_MAX_ORDER",
+    "check_model",
     "discretize",
     "expm",
     "expm_pade_choice",
+    "frequency_response",
+    "grid_step",
+    "modal_analysis",
+    "simulate",
+    "simulate_models",
+    "steady_state",
     "transition_matrices",
 ]
 
@@ -26,3 +35,36 @@ def discretize(
     a: ArrayLike, b: ArrayLike, dt: float, method: str, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]: ...
 def expm_pade_choice(a: ArrayLike, /) -> tuple[int, int]: ...
+def check_model(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /) -> None: ...
+def grid_step(t: ArrayLike, /) -> float: ...
+def simulate(
+    a: ArrayLike,
+    b: ArrayLike,
+    c: ArrayLike,
+    d: ArrayLike,
+    x0: ArrayLike,
+    u: ArrayLike | None,
+    eta0: ArrayLike | None,
+    dt: float,
+    steps: int,
+    method: str,
+    /,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+def simulate_models(
+    a: ArrayLike,
+    b: ArrayLike,
+    c: ArrayLike,
+    d: ArrayLike,
+    x0: ArrayLike,
+    u: ArrayLike | None,
+    eta0: ArrayLike | None,
+    dt: float,
+    steps: int,
+    method: str,
+    /,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+def steady_state(a: ArrayLike, b: ArrayLike, eta0: ArrayLike, /) -> NDArray[np.float64]: ...
+def frequency_response(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, omega: ArrayLike, /
+) -> NDArray[np.complex128]: ...
+def modal_analysis(a: ArrayLike, b: ArrayLike | None, /) -> dict[str, Any]: ...

@@ -13,6 +13,7 @@ class                         raised when
 ``NotRealError``              an argument is complex (``TypeError``): real matrices only
 ``AerocontrolLinAlgError``    a numerical condition makes the problem unsolvable
 ``ConvergenceError``          an iteration reached its limit (an ``AerocontrolLinAlgError``)
+``SingularMatrixError``       a matrix to invert has a zero eigenvalue (likewise)
 ============================  ===========================================================
 
 Warnings (``AerocontrolWarning`` and subclasses) report results that were computed but deserve
@@ -34,6 +35,7 @@ __all__ = [
     "NotRealError",
     "NumericalOverflowWarning",
     "ShapeError",
+    "SingularMatrixError",
 ]
 
 
@@ -61,6 +63,11 @@ class NotRealError(AerocontrolError, TypeError):
 class AerocontrolLinAlgError(AerocontrolError, np.linalg.LinAlgError):
     """A numerical condition (singularity, no stabilising solution, non-convergence) makes
     the problem unsolvable."""
+
+
+class SingularMatrixError(AerocontrolLinAlgError):
+    """A matrix that must be invertible is singular; the message names the zero eigenvalue
+    (an integrator or neutral mode, for a plant matrix)."""
 
 
 class ConvergenceError(AerocontrolLinAlgError):

@@ -1,0 +1,128 @@
+"""Frequency response G(jω) = C (jωI - A)^-1 B + D and Bode plots (chapter §6.3).
+
+The Rust core reduces A to Hessenberg form once and solves each frequency in O(n^2) (see
+``rust/freq.rs``). :func:`bode` chooses a default grid from the modes: 1000 log-spaced
+frequencies from a tenth of the slowest to ten times the fastest natural frequency.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import _core
+from ._validation import FloatArray, real_array
+from .exceptions import ShapeError
+from .statespace import as_state_space
+
+__all__ = ["FrequencyResponse", "bode", "default_frequency_grid", "frequency_response"]
+
+DEFAULT_FREQUENCIES = 1000
+
+
+@dataclass(frozen=True, eq=False)
+class FrequencyResponse:
+    """G(jω) at the frequencies ``omega`` (rad/s): ``response`` is (len(omega), p, m)."""
+
+    omega: FloatArray
+    response: NDArray[np.complex128]
+    input_names: tuple[str, ...]
+    output_names: tuple[str, ...]
+
+    @property
+    def magnitude(self) -> FloatArray:
+        """|G(jω)|."""
+        return np.abs(self.response)
+
+    @property
+    def magnitude_db(self) -> FloatArray:
+        """20 log10 |G(jω)| in decibels."""
+        with np.errstate(divide="ignore"):
+            return 20.0 * np.log10(self.magnitude)
+
+    @property
+    def phase(self) -> FloatArray:
+        """arg G(jω) in radians, unwrapped along the frequencies."""
+        return np.unwrap(np.angle(self.response), axis=0)
+
+    @property
+    def phase_deg(self) -> FloatArray:
+        """The unwrapped phase in degrees."""
+        return np.degrees(self.phase)
+
+    def __str__(self) -> str:
+        lines = [
+            f"frequency response: {len(self.omega)} frequencies, "
+            f"{self.omega.min():.4g} ... {self.omega.max():.4g} rad/s"
+        ]
+        for i, out in enumerate(self.output_names):
+            for j, inp in enumerate(self.input_names):
+                k = int(np.argmax(self.magnitude[:, i, j]))
+                lines.append(
+                    f"  {inp} -> {out}: peak {self.magnitude_db[k, i, j]:.2f} dB "
+                    f"at {self.omega[k]:.4g} rad/s"
+                )
+        return "\n".join(lines)
+
+    def plot(self, ax: Any = None, output: int = 0, input: int = 0) -> Any:
+        """Bode plot (magnitude in dB and phase in degrees) of one input-output pair;
+        ``ax`` is a pair of axes."""
+        from .plotting import plot_bode
+
+        return plot_bode(self, ax=ax, output=output, input=input)
+
+
+def frequency_response(sys: Any, omega: Any) -> FrequencyResponse:
+    """G(jω) = C (jωI - A)^-1 B + D at each frequency of ``omega`` (rad/s).
+
+    A frequency at an imaginary-axis pole gives infinite or NaN entries.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> g = aerocontrol.frequency_response(([[-2.0]], [[1.0]]), [0.0, 2.0])
+    >>> np.round(g.response[:, 0, 0], 4)            # 1 / (jω + 2)
+    array([0.5 +0.j  , 0.25-0.25j])
+    """
+    model = as_state_space(sys)
+    frequencies = real_array(omega, "omega")
+    if frequencies.ndim == 0:
+        frequencies = frequencies.reshape(1)
+    if frequencies.ndim != 1:
+        raise ShapeError(f"omega must be a 1-D array of frequencies, got {frequencies.shape}")
+    response = _core.frequency_response(model.A, model.B, model.C, model.D, frequencies)
+    return FrequencyResponse(
+        omega=np.array(frequencies, dtype=np.float64),
+        response=response,
+        input_names=model.input_names,
+        output_names=model.output_names,
+    )
+
+
+def default_frequency_grid(sys: Any, count: int = DEFAULT_FREQUENCIES) -> FloatArray:
+    """Log-spaced frequencies from a tenth of the slowest to ten times the fastest nonzero
+    natural frequency of the modes (0.01 to 100 rad/s when every eigenvalue is zero)."""
+    model = as_state_space(sys)
+    magnitudes = np.abs(np.linalg.eigvals(model.A)) if model.n_states else np.array([])
+    nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
+    low, high = (nonzero.min() / 10, nonzero.max() * 10) if nonzero.size else (0.01, 100.0)
+    return np.logspace(np.log10(low), np.log10(high), count)
+
+
+def bode(sys: Any, omega: Any = None) -> FrequencyResponse:
+    """The frequency response for a Bode plot: ``.magnitude_db``, ``.phase_deg`` (unwrapped),
+    ``.plot()``. Without ``omega``, the default grid of :func:`default_frequency_grid`.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_longitudinal()
+    >>> b = aerocontrol.bode((A, B))
+    >>> b.magnitude_db.shape
+    (1000, 4, 1)
+    """
+    frequencies = default_frequency_grid(sys) if omega is None else omega
+    return frequency_response(sys, frequencies)

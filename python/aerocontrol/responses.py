@@ -1,0 +1,451 @@
+"""Time responses of x' = Ax + Bη, y = Cx + Dη (chapter §6.2).
+
+Every response is one exact discretisation and a recurrence in the Rust core (see
+``rust/response.rs``), so there is no integration error on the grid:
+
+* :func:`impulse_response`: η = η0 δ(t), x(t) = e^{At} B η0 (6.36), the free response from
+  x(0) = B η0 (the impulse of the feedthrough D at t = 0 is not part of y);
+* :func:`doublet_response`: η = η0 δ'(t), x(t) = e^{At} A B η0 (6.38);
+* :func:`step_response`: η = η0 H(t), exact for singular A, where (6.43) fails;
+* :func:`initial_response`: the free response from x0;
+* :func:`forced_response`: a sampled input, held constant (ZOH) or linear (FOH) between samples.
+
+η0 weights the inputs as in the chapter. Without it, a single-input system gets η0 = 1 and a
+multi-input system one response per input (η0 the unit vectors).
+
+Time grids must be uniform and start at 0 (anything else is an error that says what is wrong;
+resample yourself with ``numpy.interp`` if needed). ``T`` may be a grid, a final time, or None
+for the default grid: a step of 1/(20 |λ|max), twenty samples per time constant of the fastest
+mode, and a final time of 7 time constants 1/|σ| of the slowest decaying mode (to 0.1 % of its
+amplitude), or 10/|λ|min when no mode decays; at most 100,001 samples (the step grows to fit).
+
+Several responses come in one call: several initial states x0 (r, n), several input histories
+u (r, k, m), or a list of models of one size (``[sys1, sys2, ...]``); the result then has a
+leading response axis, ``x.shape == (r, k, n)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from . import _core
+from ._validation import FloatArray, check_choice, real_array
+from .exceptions import ShapeError
+from .statespace import StateSpace, as_state_space
+
+__all__ = [
+    "TimeResponse",
+    "dc_gain",
+    "default_time_grid",
+    "doublet_response",
+    "forced_response",
+    "impulse_response",
+    "initial_response",
+    "steady_state",
+    "step_response",
+]
+
+MAX_DEFAULT_SAMPLES = 100_001
+
+
+@dataclass(frozen=True, eq=False)
+class TimeResponse:
+    """States, outputs and inputs of one or several responses on a uniform time grid.
+
+    With a single response ``x`` is (len(t), n); with several, (r, len(t), n), and likewise
+    ``y`` and ``u``. ``u`` is None for free, impulse and doublet responses.
+    """
+
+    t: FloatArray
+    x: FloatArray
+    y: FloatArray
+    u: FloatArray | None
+    kind: str
+    state_names: tuple[str, ...]
+    input_names: tuple[str, ...]
+    output_names: tuple[str, ...]
+    response_names: tuple[str, ...]
+    """One label per response (the input driven, the model index, or 'response k')."""
+
+    @property
+    def n_responses(self) -> int:
+        return 1 if self.x.ndim == 2 else int(self.x.shape[0])
+
+    def states(self, response: int = 0) -> FloatArray:
+        """The (len(t), n) states of one response."""
+        return self.x if self.x.ndim == 2 else self.x[response]
+
+    def outputs(self, response: int = 0) -> FloatArray:
+        """The (len(t), p) outputs of one response."""
+        return self.y if self.y.ndim == 2 else self.y[response]
+
+    def __str__(self) -> str:
+        lines = [
+            f"{self.kind} response: {self.n_responses} response(s), {len(self.t)} samples, "
+            f"t = 0 ... {self.t[-1]:g} s (step {self.t[1] - self.t[0]:g} s)"
+        ]
+        for r in range(self.n_responses):
+            x = self.states(r)
+            lines.append(f"  {self.response_names[r]}: final state")
+            for name, value, peak in zip(
+                self.state_names, x[-1], np.abs(x).max(axis=0), strict=True
+            ):
+                lines.append(f"    {name:<14} {value:+.6g}   (peak |x| {peak:.4g})")
+        return "\n".join(lines)
+
+    def plot(self, ax: Any = None, signal: str = "states", response: int = 0) -> Any:
+        """Plot the states (or ``signal="outputs"``) of one response against time."""
+        from .plotting import plot_time_response
+
+        return plot_time_response(self, ax=ax, signal=signal, response=response)
+
+
+def _systems(sys: Any) -> tuple[list[StateSpace], bool]:
+    """The models, and whether several were given as a list."""
+    if isinstance(sys, list) and sys and (isinstance(sys[0], StateSpace) or hasattr(sys[0], "A")):
+        models = [as_state_space(s, f"sys[{k}]") for k, s in enumerate(sys)]
+        first = models[0]
+        for k, model in enumerate(models[1:], start=1):
+            if (model.n_states, model.n_inputs, model.n_outputs) != (
+                first.n_states,
+                first.n_inputs,
+                first.n_outputs,
+            ):
+                raise ShapeError(
+                    f"sys[{k}] must have the states, inputs and outputs of sys[0] "
+                    f"({first.n_states}, {first.n_inputs}, {first.n_outputs}), got "
+                    f"({model.n_states}, {model.n_inputs}, {model.n_outputs})"
+                )
+        return models, True
+    return [as_state_space(sys)], False
+
+
+def default_time_grid(sys: Any) -> FloatArray:
+    """The default grid of the responses (see the module documentation)."""
+    models, _ = _systems(sys)
+    step, final = _default_step_and_final(models)
+    samples = int(np.ceil(final / step)) + 1
+    return np.linspace(0.0, (samples - 1) * step, samples)
+
+
+def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
+    eigenvalues = np.concatenate([np.linalg.eigvals(m.A) for m in models])
+    magnitudes = np.abs(eigenvalues)
+    nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
+    if nonzero.size == 0:
+        return 0.01, 10.0
+    step = 1.0 / (20.0 * nonzero.max())
+    decaying = -eigenvalues.real[eigenvalues.real < -1e-12 * nonzero.max()]
+    final = 7.0 / decaying.min() if decaying.size else 10.0 / nonzero.min()
+    final = max(final, 100 * step)
+    if final / step > MAX_DEFAULT_SAMPLES - 1:
+        step = final / (MAX_DEFAULT_SAMPLES - 1)
+    return step, final
+
+
+def _grid(T: Any, models: list[StateSpace]) -> tuple[FloatArray, float]:
+    """(t, step) for the T given: a grid, a final time, or None."""
+    if T is None:
+        t = default_time_grid(models)
+        return t, float(t[1] - t[0])
+    times = real_array(T, "T")
+    if times.ndim == 0:
+        final = float(times)
+        if not np.isfinite(final) or final <= 0:
+            raise ShapeError(f"T as a final time must be positive and finite, got {final}")
+        step, _ = _default_step_and_final(models)
+        samples = min(max(int(np.ceil(final / step)) + 1, 101), MAX_DEFAULT_SAMPLES)
+        t = np.linspace(0.0, final, samples)
+        return t, float(t[1] - t[0])
+    step = _core.grid_step(times)
+    return np.array(times, dtype=np.float64), step
+
+
+def _input_weights(eta0: Any, m: int) -> tuple[FloatArray, tuple[str, ...] | None]:
+    """The η0 of each response (r, m) and, for the unit vectors, None (names from inputs)."""
+    if eta0 is None:
+        return np.eye(m), None
+    weights = real_array(eta0, "eta0")
+    if weights.ndim != 1 or weights.shape[0] != m:
+        raise ShapeError(f"eta0 must have one weight per input ({m}), got shape {weights.shape}")
+    return weights.reshape(1, m), ("eta0",)
+
+
+def _assemble(
+    kind: str,
+    t: FloatArray,
+    x: FloatArray,
+    y: FloatArray,
+    u: FloatArray | None,
+    model: StateSpace,
+    names: Sequence[str],
+    several: bool,
+) -> TimeResponse:
+    if not several:
+        x, y = x[0], y[0]
+        u = None if u is None else u[0]
+    return TimeResponse(
+        t=t,
+        x=x,
+        y=y,
+        u=u,
+        kind=kind,
+        state_names=model.state_names,
+        input_names=model.input_names,
+        output_names=model.output_names,
+        response_names=tuple(names),
+    )
+
+
+def _free_responses(
+    kind: str, sys: Any, T: Any, initial: Any, names: Sequence[str] | None = None
+) -> TimeResponse:
+    """Free responses from initial states computed per model by ``initial(model)`` (r, n)."""
+    models, several_models = _systems(sys)
+    t, step = _grid(T, models)
+    first = models[0]
+    if several_models:
+        x0 = np.stack([initial(m)[0] for m in models])
+        x, y = _core.simulate_models(
+            np.stack([m.A for m in models]),
+            np.stack([m.B for m in models]),
+            np.stack([m.C for m in models]),
+            np.stack([m.D for m in models]),
+            x0,
+            None,
+            None,
+            step,
+            len(t),
+            "zoh",
+        )
+        model_labels = [f"model {k}" for k in range(len(models))]
+        return _assemble(kind, t, x, y, None, first, model_labels, True)
+    x0 = initial(first)
+    x, y = _core.simulate(first.A, first.B, first.C, first.D, x0, None, None, step, len(t), "zoh")
+    labels: Sequence[str] = (
+        names if names is not None else [f"response {k}" for k in range(len(x0))]
+    )
+    return _assemble(kind, t, x, y, None, first, labels, len(x0) > 1)
+
+
+def impulse_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
+    """Response to η = η0 δ(t): x(t) = e^{At} B η0, y = C x (chapter (6.36)).
+
+    Equal to the free response from x(0) = B η0. Without ``eta0`` a multi-input system gives
+    one response per input.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_longitudinal()
+    >>> r = aerocontrol.impulse_response((A, B), T=np.linspace(0, 20, 201))
+    >>> r.x.shape
+    (201, 4)
+    >>> np.allclose(r.x[0], B[:, 0])
+    True
+    """
+    models, _ = _systems(sys)
+    weights, names = _input_weights(eta0, models[0].n_inputs)
+    labels = names or models[0].input_names
+    return _free_responses("impulse", sys, T, lambda m: weights @ m.B.T, labels)
+
+
+def doublet_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
+    """Response to η = η0 δ'(t): x(t) = e^{At} A B η0, y = C x (chapter (6.38)).
+
+    Equal to the free response from x(0) = A B η0.
+    """
+    models, _ = _systems(sys)
+    weights, names = _input_weights(eta0, models[0].n_inputs)
+    labels = names or models[0].input_names
+    return _free_responses("doublet", sys, T, lambda m: weights @ (m.A @ m.B).T, labels)
+
+
+def initial_response(sys: Any, x0: Any, T: Any = None) -> TimeResponse:
+    """The free response x(t) = e^{At} x0 (6.31), y = C x.
+
+    ``x0`` is one initial state (n,) or several (r, n), computed in one call.
+    """
+    models, _ = _systems(sys)
+    n = models[0].n_states
+    states = real_array(x0, "x0")
+    if states.ndim == 1:
+        states = states.reshape(1, -1)
+    if states.ndim != 2 or states.shape[1] != n:
+        raise ShapeError(
+            f"x0 must be one initial state of {n} values or an (r, {n}) array, "
+            f"got shape {real_array(x0, 'x0').shape}"
+        )
+    return _free_responses("initial", sys, T, lambda m: states)
+
+
+def step_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
+    """Response to η = η0 H(t) from rest (chapter (6.39)-(6.45)).
+
+    Computed exactly through the augmented exponential, so it is right for singular A (an
+    integrator), where the chapter's x(t) = (e^{At} - I) A^-1 B η0 (6.43) cannot be used.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_longitudinal()
+    >>> r = aerocontrol.step_response((A, B), T=np.linspace(0, 8000, 4001), eta0=[np.pi / 180])
+    >>> np.round(r.x[-1], 4)                                      # (6.51)
+    array([ 0.046 , -0.0186,  0.    , -0.016 ])
+    """
+    models, several_models = _systems(sys)
+    first = models[0]
+    t, step = _grid(T, models)
+    weights, names = _input_weights(eta0, first.n_inputs)
+    if several_models:
+        x, y = _core.simulate_models(
+            np.stack([m.A for m in models]),
+            np.stack([m.B for m in models]),
+            np.stack([m.C for m in models]),
+            np.stack([m.D for m in models]),
+            np.zeros((len(models), first.n_states)),
+            None,
+            np.repeat(weights[:1], len(models), axis=0),
+            step,
+            len(t),
+            "zoh",
+        )
+        u = np.broadcast_to(weights[:1], (len(models), len(t), first.n_inputs))
+        return _assemble(
+            "step", t, x, y, np.array(u), first, [f"model {k}" for k in range(len(models))], True
+        )
+    responses = weights.shape[0]
+    x0 = np.zeros((responses, first.n_states))
+    if responses == 1:
+        x, y = _core.simulate(
+            first.A, first.B, first.C, first.D, x0, None, weights[0], step, len(t), "zoh"
+        )
+    else:
+        u_all = np.repeat(weights[:, None, :], len(t), axis=1)
+        x, y = _core.simulate(
+            first.A, first.B, first.C, first.D, x0, u_all, None, step, len(t), "zoh"
+        )
+    u = np.repeat(weights[:, None, :], len(t), axis=1)
+    labels: Sequence[str] = names or first.input_names
+    return _assemble("step", t, x, y, u, first, labels, responses > 1)
+
+
+def forced_response(
+    sys: Any,
+    T: Any,
+    u: Any,
+    x0: Any = None,
+    method: Literal["zoh", "foh"] = "zoh",
+) -> TimeResponse:
+    """Response to a sampled input u on the uniform grid T, from x0 (default rest).
+
+    Parameters
+    ----------
+    sys : system
+    T : array_like, shape (k,)
+        Uniform time grid starting at 0.
+    u : array_like, shape (k,), (k, m) or (r, k, m)
+        Input samples: one input, several inputs, or r input histories at once.
+    x0 : array_like, shape (n,) or (r, n), optional
+    method : {"zoh", "foh"}
+        Input held constant between samples (zero-order hold) or linear between them
+        (first-order hold, as scipy.signal.lsim's default interpolation).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_longitudinal()
+    >>> t = np.linspace(0, 10, 101)
+    >>> r = aerocontrol.forced_response((A, B), t, np.sin(t) * np.pi / 180, method="foh")
+    >>> r.y.shape
+    (101, 4)
+    """
+    models, several_models = _systems(sys)
+    if several_models:
+        raise ShapeError("forced_response takes one model; call it per model for several")
+    model = models[0]
+    hold = check_choice(method, "method", ("zoh", "foh"))
+    times = real_array(T, "T")
+    if times.ndim != 1:
+        raise ShapeError(f"T must be a 1-D grid of times, got shape {times.shape}")
+    step = _core.grid_step(times)
+    k, m, n = len(times), model.n_inputs, model.n_states
+    inputs = real_array(u, "u")
+    if inputs.ndim == 1 and m == 1:
+        inputs = inputs.reshape(1, -1, 1)
+    elif inputs.ndim == 2:
+        inputs = inputs.reshape(1, *inputs.shape)
+    if inputs.ndim != 3 or inputs.shape[1:] != (k, m):
+        raise ShapeError(
+            f"u must have one row of {m} input(s) per time ({k} times): shape ({k},) for one "
+            f"input, ({k}, {m}) or (r, {k}, {m}), got {real_array(u, 'u').shape}"
+        )
+    responses = inputs.shape[0]
+    if x0 is None:
+        states = np.zeros((responses, n))
+    else:
+        states = real_array(x0, "x0")
+        states = states.reshape(1, -1) if states.ndim == 1 else states
+        if states.shape[-1] != n or states.ndim != 2:
+            raise ShapeError(f"x0 must have {n} values per response, got shape {states.shape}")
+        if states.shape[0] == 1 and responses > 1:
+            states = np.repeat(states, responses, axis=0)
+        if states.shape[0] != responses:
+            raise ShapeError(
+                f"x0 must have one initial state per input history ({responses}), "
+                f"got {states.shape[0]}"
+            )
+    if inputs.shape[0] == 1 and states.shape[0] > 1:
+        inputs = np.repeat(inputs, states.shape[0], axis=0)
+        responses = states.shape[0]
+    x, y = _core.simulate(
+        model.A,
+        model.B,
+        model.C,
+        model.D,
+        states,
+        np.ascontiguousarray(inputs),
+        None,
+        step,
+        k,
+        hold,
+    )
+    labels = [f"response {r}" for r in range(responses)]
+    return _assemble("forced", times, x, y, inputs, model, labels, responses > 1)
+
+
+def steady_state(sys: Any, eta0: Any) -> FloatArray:
+    """The state a step η0 settles to, x∞ = -A^-1 B η0 (6.45), for a stable system.
+
+    Raises SingularMatrixError naming the zero eigenvalue when A is singular (an integrator
+    has no steady state).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_longitudinal()
+    >>> np.round(aerocontrol.steady_state((A, B), [np.pi / 180]), 6)   # (6.51)
+    array([ 0.045965, -0.018563,  0.      , -0.015954])
+    """
+    model = as_state_space(sys)
+    weights = real_array(eta0, "eta0")
+    result: FloatArray = _core.steady_state(model.A, model.B, weights)
+    return result
+
+
+def dc_gain(sys: Any) -> FloatArray:
+    """The zero-frequency gain D - C A^-1 B (p, m): the steady output per unit step input.
+
+    Raises SingularMatrixError naming the zero eigenvalue when A is singular.
+    """
+    model = as_state_space(sys)
+    columns = [
+        model.C @ _core.steady_state(model.A, model.B, np.eye(model.n_inputs)[j]) + model.D[:, j]
+        for j in range(model.n_inputs)
+    ]
+    gain: FloatArray = np.stack(columns, axis=1) if columns else np.zeros((model.n_outputs, 0))
+    return gain

@@ -1,0 +1,647 @@
+//! Time responses on a uniform grid (chapter §6.2): one exact discretisation, then a recurrence.
+//!
+//! Over a step h the solution (6.9) of x' = Ax + Bη is exactly
+//!
+//! ```text
+//! x[k+1] = Φ x[k] + (Γ0 - Γ1) η[k] + Γ1 η[k+1],     y[k] = C x[k] + D η[k],
+//! ```
+//!
+//! with Φ, Γ0, Γ1 from `discretize.rs` (Γ1 = 0 for a zero-order hold, where η is constant over
+//! each step; first-order hold takes η linear between samples). The recurrence is exact up to
+//! rounding for inputs of that form, so impulse (6.36), doublet (6.38) and step (6.43)
+//! responses carry no discretisation error at all: the first two are free responses from
+//! x(0) = Bη0 and x(0) = ABη0, the step a constant input, and the augmented exponential behind
+//! Γ0 makes the step exact for a singular A, where (6.43) fails.
+//!
+//! Several responses of one model (initial conditions or input histories) run in parallel after
+//! one discretisation; the outputs are written into caller-provided row-major buffers, so a
+//! 5001-sample response allocates nothing per step.
+
+use crate::discretize::{Discretization, Hold, discretize};
+use crate::error::{Error, check_finite, check_finite_values, check_output_len};
+use crate::freq::check_state_space;
+use faer::{Mat, MatRef};
+use rayon::prelude::*;
+
+/// The input of a simulation.
+#[derive(Debug, Clone, Copy)]
+pub enum Input<'a> {
+    /// No input: the free response.
+    Free,
+    /// η[k] = η0 for every sample (m values).
+    Constant(&'a [f64]),
+    /// Sampled input histories, one per response: responses x steps x m values, row-major.
+    Sampled(&'a [f64]),
+}
+
+/// The step of a uniform time grid starting at 0, or an error that names `arg` and says what
+/// is wrong. Uniform means |t[k] - k h| <= 1e-9 h for h = (t[last] - t[0]) / (len - 1).
+pub fn uniform_grid_step(t: &[f64], arg: &'static str) -> Result<f64, Error> {
+    check_finite_values(t, arg)?;
+    if t.len() < 2 {
+        return Err(Error::InvalidValue {
+            arg,
+            value: t.len() as f64,
+            requirement: "a grid of at least 2 times (the length)",
+        });
+    }
+    if t[0] != 0.0 {
+        return Err(Error::InvalidValue {
+            arg,
+            value: t[0],
+            requirement: "a grid that starts at 0 (its first time)",
+        });
+    }
+    let step = t[t.len() - 1] / (t.len() - 1) as f64;
+    if let Some(k) = t.windows(2).position(|pair| pair[1] <= pair[0]) {
+        return Err(Error::InvalidValue {
+            arg,
+            value: t[k + 1],
+            requirement: "strictly increasing (this time follows a larger or equal one)",
+        });
+    }
+    if let Some(k) = (0..t.len()).find(|&k| (t[k] - k as f64 * step).abs() > 1e-9 * step) {
+        return Err(Error::InvalidValue {
+            arg,
+            value: t[k],
+            requirement: "a uniform grid (this time is off the spacing of the first and last)",
+        });
+    }
+    Ok(step)
+}
+
+/// The matrices of the recurrence, row-major for the inner loops.
+struct Recurrence {
+    n: usize,
+    m: usize,
+    p: usize,
+    phi: Vec<f64>,
+    /// Γ0 - Γ1, applied to η[k].
+    gamma_now: Vec<f64>,
+    /// Γ1, applied to η[k+1] (absent for a zero-order hold).
+    gamma_next: Option<Vec<f64>>,
+    c: Vec<f64>,
+    d: Vec<f64>,
+}
+
+fn row_major(m: MatRef<'_, f64>) -> Vec<f64> {
+    (0..m.nrows())
+        .flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)]))
+        .collect()
+}
+
+impl Recurrence {
+    fn new(d: &Discretization, c: MatRef<'_, f64>, dd: MatRef<'_, f64>) -> Self {
+        let gamma_now = match &d.gamma1 {
+            Some(g1) => &d.gamma0 - g1,
+            None => d.gamma0.clone(),
+        };
+        Recurrence {
+            n: d.phi.nrows(),
+            m: d.gamma0.ncols(),
+            p: c.nrows(),
+            phi: row_major(d.phi.as_ref()),
+            gamma_now: row_major(gamma_now.as_ref()),
+            gamma_next: d.gamma1.as_ref().map(|g| row_major(g.as_ref())),
+            c: row_major(c),
+            d: row_major(dd),
+        }
+    }
+
+    /// out = M v for a row-major `rows` x len(v) matrix M.
+    fn multiply(matrix: &[f64], v: &[f64], out: &mut [f64]) {
+        let cols = v.len();
+        for (o, row) in out.iter_mut().zip(matrix.chunks_exact(cols.max(1))) {
+            *o = row.iter().zip(v).map(|(a, b)| a * b).sum();
+        }
+    }
+
+    /// out += M v.
+    fn multiply_add(matrix: &[f64], v: &[f64], out: &mut [f64]) {
+        let cols = v.len();
+        for (o, row) in out.iter_mut().zip(matrix.chunks_exact(cols.max(1))) {
+            *o += row.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
+        }
+    }
+
+    /// Runs one response: `x` (steps x n) and `y` (steps x p) row-major, from `x0`, with
+    /// `input(k)` the m values of η[k] (empty for a free response).
+    fn run<'a>(
+        &self,
+        x0: &[f64],
+        input: impl Fn(usize) -> &'a [f64],
+        x: &mut [f64],
+        y: &mut [f64],
+    ) {
+        let (n, p) = (self.n, self.p);
+        let steps = x.len() / n.max(1);
+        if n > 0 {
+            x[..n].copy_from_slice(x0);
+        }
+        for k in 0..steps {
+            let (done, rest) = x.split_at_mut((k + 1) * n);
+            let current = &done[k * n..];
+            let eta = input(k);
+            let y_k = &mut y[k * p..(k + 1) * p];
+            Self::multiply(&self.c, current, y_k);
+            if self.m > 0 && !eta.is_empty() {
+                Self::multiply_add(&self.d, eta, y_k);
+            }
+            if k + 1 < steps {
+                let next = &mut rest[..n];
+                Self::multiply(&self.phi, current, next);
+                if self.m > 0 && !eta.is_empty() {
+                    Self::multiply_add(&self.gamma_now, eta, next);
+                    if let Some(gamma_next) = &self.gamma_next {
+                        Self::multiply_add(gamma_next, input(k + 1), next);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A state-space model x' = Ax + Bη, y = Cx + Dη.
+#[derive(Debug, Clone, Copy)]
+pub struct Model<'a> {
+    pub a: MatRef<'a, f64>,
+    pub b: MatRef<'a, f64>,
+    pub c: MatRef<'a, f64>,
+    pub d: MatRef<'a, f64>,
+}
+
+/// Simulates `responses` responses of one model over `steps` samples of step `dt`: initial
+/// states `x0` (responses x n, row-major), the input, and the hold between input samples.
+/// Writes the states into `x` (responses x steps x n) and the outputs into `y`
+/// (responses x steps x p), row-major.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_into(
+    model: Model<'_>,
+    x0: &[f64],
+    input: Input<'_>,
+    dt: f64,
+    steps: usize,
+    hold: Hold,
+    x: &mut [f64],
+    y: &mut [f64],
+) -> Result<(), Error> {
+    let Model { a, b, c, d } = model;
+    check_state_space(a, b, c, d)?;
+    let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
+    if n == 0 {
+        return Err(Error::InvalidValue {
+            arg: "A",
+            value: 0.0,
+            requirement: "at least one state (its order)",
+        });
+    }
+    let responses = x0.len() / n;
+    check_output_len(x0.len(), responses * n)?;
+    check_finite_values(x0, "x0")?;
+    match input {
+        Input::Free => {}
+        Input::Constant(eta) => {
+            if eta.len() != m {
+                return Err(Error::Mismatch {
+                    arg: "eta0",
+                    what: "one value per input, as many as the columns of",
+                    expected: m,
+                    other: "B",
+                    got: eta.len(),
+                });
+            }
+            check_finite_values(eta, "eta0")?;
+        }
+        Input::Sampled(u) => {
+            if u.len() != responses * steps * m {
+                return Err(Error::Mismatch {
+                    arg: "u",
+                    what: "one row of inputs per time, as many values as",
+                    expected: responses * steps * m,
+                    other: "times x inputs",
+                    got: u.len(),
+                });
+            }
+            check_finite_values(u, "u")?;
+        }
+    }
+    check_output_len(x.len(), responses * steps * n)?;
+    check_output_len(y.len(), responses * steps * p)?;
+    let discretization = discretize(a, b, dt, hold)?;
+    let recurrence = Recurrence::new(&discretization, c, d);
+    let no_input: &[f64] = &[];
+    let run = |(r, (x_r, y_r)): (usize, (&mut [f64], &mut [f64]))| {
+        let x0_r = &x0[r * n..(r + 1) * n];
+        match input {
+            Input::Free => recurrence.run(x0_r, |_| no_input, x_r, y_r),
+            Input::Constant(eta) => recurrence.run(x0_r, |_| eta, x_r, y_r),
+            Input::Sampled(u) => {
+                let u_r = &u[r * steps * m..(r + 1) * steps * m];
+                recurrence.run(x0_r, |k| &u_r[k * m..(k + 1) * m], x_r, y_r)
+            }
+        }
+    };
+    let x_chunks = x.chunks_mut((steps * n).max(1));
+    let y_chunks = y.chunks_mut((steps * p).max(1));
+    if responses > 1 {
+        x.par_chunks_mut((steps * n).max(1))
+            .zip(y.par_chunks_mut((steps * p).max(1)))
+            .enumerate()
+            .for_each(run);
+    } else {
+        x_chunks.zip(y_chunks).enumerate().for_each(run);
+    }
+    Ok(())
+}
+
+/// Simulates one response of each of several models of one size, in parallel: model `i` has
+/// the initial state x0[i] (models x n), the input slice i of `input` (a constant η0 per model,
+/// models x m values, or sampled inputs, models x steps x m), and writes its states and outputs
+/// at index i of `x` (models x steps x n) and `y` (models x steps x p). An error names the model.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_models_into(
+    models: &[Model<'_>],
+    x0: &[f64],
+    input: Input<'_>,
+    dt: f64,
+    steps: usize,
+    hold: Hold,
+    x: &mut [f64],
+    y: &mut [f64],
+) -> Result<(), Error> {
+    let Some(first) = models.first() else {
+        return Ok(());
+    };
+    let (n, m, p) = (first.a.nrows(), first.b.ncols(), first.c.nrows());
+    let q = models.len();
+    check_output_len(x0.len(), q * n)?;
+    check_output_len(x.len(), q * steps * n)?;
+    check_output_len(y.len(), q * steps * p)?;
+    let per_model_input = match input {
+        Input::Free => 0,
+        Input::Constant(eta) => {
+            check_output_len(eta.len(), q * m)?;
+            m
+        }
+        Input::Sampled(u) => {
+            check_output_len(u.len(), q * steps * m)?;
+            steps * m
+        }
+    };
+    for (index, model) in models.iter().enumerate() {
+        let shapes = (model.a.nrows(), model.b.ncols(), model.c.nrows());
+        if shapes != (n, m, p) {
+            let error = Error::Mismatch {
+                arg: "models",
+                what: "the states, inputs and outputs of",
+                expected: n,
+                other: "the first model",
+                got: model.a.nrows(),
+            };
+            return Err(Error::in_batch(index, error));
+        }
+    }
+    x.par_chunks_mut((steps * n).max(1))
+        .zip(y.par_chunks_mut((steps * p).max(1)))
+        .enumerate()
+        .try_for_each(|(i, (x_i, y_i))| {
+            let range = i * per_model_input..(i + 1) * per_model_input;
+            let input_i = match input {
+                Input::Free => Input::Free,
+                Input::Constant(eta) => Input::Constant(&eta[range]),
+                Input::Sampled(u) => Input::Sampled(&u[range]),
+            };
+            simulate_into(
+                models[i],
+                &x0[i * n..(i + 1) * n],
+                input_i,
+                dt,
+                steps,
+                hold,
+                x_i,
+                y_i,
+            )
+            .map_err(|e| Error::in_batch(i, e))
+        })
+}
+
+/// The steady state -A^-1 B η0 of a step (6.45), or an error naming the eigenvalue of A that
+/// makes it singular (an integrator or neutral mode has no steady state).
+pub fn steady_state(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    eta0: &[f64],
+) -> Result<Vec<f64>, Error> {
+    check_finite(a, "A")?;
+    let empty = Mat::<f64>::zeros(0, a.nrows());
+    let no_feedthrough = Mat::<f64>::zeros(0, b.ncols());
+    check_state_space(a, b, empty.as_ref(), no_feedthrough.as_ref())?;
+    if eta0.len() != b.ncols() {
+        return Err(Error::Mismatch {
+            arg: "eta0",
+            what: "one value per input, as many as the columns of",
+            expected: b.ncols(),
+            other: "B",
+            got: eta0.len(),
+        });
+    }
+    check_finite_values(eta0, "eta0")?;
+    let (eigenvalues, _) = crate::modes::eigen(a)?;
+    let scale = a.norm_max().max(f64::MIN_POSITIVE);
+    let n = a.nrows() as f64;
+    if let Some(lambda) = eigenvalues
+        .iter()
+        .find(|l| l.norm() <= 100.0 * n * f64::EPSILON * scale)
+    {
+        return Err(Error::Singular {
+            arg: "A",
+            eigenvalue_re: lambda.re,
+            eigenvalue_im: lambda.im,
+        });
+    }
+    let bu = b * Mat::from_fn(b.ncols(), 1, |i, _| eta0[i]);
+    let mut x = -bu;
+    crate::lu::solve_in_place(a.to_owned().as_mut(), x.as_mut(), faer::Par::Seq);
+    Ok((0..a.nrows()).map(|i| x[(i, 0)]).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::mat;
+
+    fn lon747() -> (Mat<f64>, Mat<f64>) {
+        (
+            mat![
+                [-0.0212, 0.0466, 0.0000, -0.1153],
+                [-0.2229, -0.5839, 0.9404, 0.0000],
+                [0.0150, -0.5031, -0.5015, 0.0000],
+                [0.0, 0.0, 1.0, 0.0]
+            ],
+            mat![[0.0000], [-0.0340], [-0.5746], [0.0000]],
+        )
+    }
+
+    #[test]
+    fn grid_checks_name_the_problem() {
+        assert_eq!(uniform_grid_step(&[0.0, 0.5, 1.0], "T").unwrap(), 0.5);
+        let err = uniform_grid_step(&[0.1, 0.5], "T").unwrap_err().to_string();
+        assert!(err.contains("T must be a grid that starts at 0"), "{err}");
+        let err = uniform_grid_step(&[0.0, 0.5, 0.4], "T")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("strictly increasing"), "{err}");
+        let err = uniform_grid_step(&[0.0, 0.1, 0.5, 0.6], "T")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("uniform"), "{err}");
+        assert!(uniform_grid_step(&[0.0], "T").is_err());
+        let grid: Vec<f64> = (0..50001).map(|k| k as f64 * 500.0 / 50000.0).collect();
+        assert!((uniform_grid_step(&grid, "T").unwrap() - 0.01).abs() < 1e-15);
+    }
+
+    #[test]
+    fn step_response_reaches_the_chapter_steady_state() {
+        // (6.51): one degree of elevator.
+        let (a, b) = lon747();
+        let c = Mat::<f64>::identity(4, 4);
+        let d = Mat::<f64>::zeros(4, 1);
+        let eta0 = [std::f64::consts::PI / 180.0];
+        let steps = 801;
+        let (mut x, mut y) = (vec![0.0; steps * 4], vec![0.0; steps * 4]);
+        let model = Model {
+            a: a.as_ref(),
+            b: b.as_ref(),
+            c: c.as_ref(),
+            d: d.as_ref(),
+        };
+        simulate_into(
+            model,
+            &[0.0; 4],
+            Input::Constant(&eta0),
+            10.0,
+            steps,
+            Hold::Zero,
+            &mut x,
+            &mut y,
+        )
+        .unwrap();
+        let steady = steady_state(a.as_ref(), b.as_ref(), &eta0).unwrap();
+        let last = &x[(steps - 1) * 4..];
+        for (l, s) in last.iter().zip(&steady) {
+            assert!((l - s).abs() < 1e-7, "{l} vs {s}");
+        }
+        assert!((steady[0] - 0.045965).abs() < 1e-6 && (steady[3] + 0.015954).abs() < 1e-6);
+        assert_eq!(x, y);
+    }
+
+    #[test]
+    fn impulse_is_the_free_response_from_b() {
+        // (6.36): x(t) = e^{At} B η0, the free response from x(0) = B η0.
+        let (a, b) = lon747();
+        let c = Mat::<f64>::identity(4, 4);
+        let d = Mat::<f64>::zeros(4, 1);
+        let model = Model {
+            a: a.as_ref(),
+            b: b.as_ref(),
+            c: c.as_ref(),
+            d: d.as_ref(),
+        };
+        let steps = 201;
+        let x0: Vec<f64> = (0..4).map(|i| b[(i, 0)]).collect();
+        let (mut x, mut y) = (vec![0.0; steps * 4], vec![0.0; steps * 4]);
+        simulate_into(
+            model,
+            &x0,
+            Input::Free,
+            0.1,
+            steps,
+            Hold::Zero,
+            &mut x,
+            &mut y,
+        )
+        .unwrap();
+        let expected = crate::expm::expm((&a * faer::Scale(20.0)).as_ref()).unwrap() * &b;
+        for i in 0..4 {
+            assert!((x[200 * 4 + i] - expected[(i, 0)]).abs() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn several_responses_match_one_at_a_time() {
+        let (a, b) = lon747();
+        let c = Mat::from_fn(2, 4, |i, j| (i + j) as f64);
+        let d = Mat::from_fn(2, 1, |i, _| i as f64);
+        let model = Model {
+            a: a.as_ref(),
+            b: b.as_ref(),
+            c: c.as_ref(),
+            d: d.as_ref(),
+        };
+        let (responses, steps) = (3, 50);
+        let x0: Vec<f64> = (0..responses * 4).map(|i| i as f64 * 0.01).collect();
+        let u: Vec<f64> = (0..responses * steps)
+            .map(|i| (i as f64 * 0.3).sin())
+            .collect();
+        let (mut x, mut y) = (
+            vec![0.0; responses * steps * 4],
+            vec![0.0; responses * steps * 2],
+        );
+        simulate_into(
+            model,
+            &x0,
+            Input::Sampled(&u),
+            0.05,
+            steps,
+            Hold::First,
+            &mut x,
+            &mut y,
+        )
+        .unwrap();
+        for r in 0..responses {
+            let (mut x1, mut y1) = (vec![0.0; steps * 4], vec![0.0; steps * 2]);
+            let u_r = &u[r * steps..(r + 1) * steps];
+            simulate_into(
+                model,
+                &x0[r * 4..(r + 1) * 4],
+                Input::Sampled(u_r),
+                0.05,
+                steps,
+                Hold::First,
+                &mut x1,
+                &mut y1,
+            )
+            .unwrap();
+            assert_eq!(&x[r * steps * 4..(r + 1) * steps * 4], &x1[..]);
+            assert_eq!(&y[r * steps * 2..(r + 1) * steps * 2], &y1[..]);
+        }
+    }
+
+    #[test]
+    fn a_stack_of_models_equals_one_at_a_time() {
+        let (a, b) = lon747();
+        let a2 = &a * faer::Scale(2.0);
+        let c = Mat::<f64>::identity(4, 4);
+        let d = Mat::<f64>::zeros(4, 1);
+        fn model<'a>(
+            a: &'a Mat<f64>,
+            b: &'a Mat<f64>,
+            c: &'a Mat<f64>,
+            d: &'a Mat<f64>,
+        ) -> Model<'a> {
+            Model {
+                a: a.as_ref(),
+                b: b.as_ref(),
+                c: c.as_ref(),
+                d: d.as_ref(),
+            }
+        }
+        let models = [model(&a, &b, &c, &d), model(&a2, &b, &c, &d)];
+        let steps = 30;
+        let eta = [0.1, -0.2];
+        let (mut x, mut y) = (vec![0.0; 2 * steps * 4], vec![0.0; 2 * steps * 4]);
+        simulate_models_into(
+            &models,
+            &[0.0; 8],
+            Input::Constant(&eta),
+            0.1,
+            steps,
+            Hold::Zero,
+            &mut x,
+            &mut y,
+        )
+        .unwrap();
+        for (i, m) in models.iter().enumerate() {
+            let (mut x1, mut y1) = (vec![0.0; steps * 4], vec![0.0; steps * 4]);
+            simulate_into(
+                *m,
+                &[0.0; 4],
+                Input::Constant(&eta[i..i + 1]),
+                0.1,
+                steps,
+                Hold::Zero,
+                &mut x1,
+                &mut y1,
+            )
+            .unwrap();
+            assert_eq!(&x[i * steps * 4..(i + 1) * steps * 4], &x1[..]);
+        }
+        // A non-finite model is reported with its index.
+        let bad = Mat::from_fn(4, 4, |i, j| if i + j == 0 { f64::NAN } else { 0.0 });
+        let models = [model(&a, &b, &c, &d), model(&bad, &b, &c, &d)];
+        let err = simulate_models_into(
+            &models,
+            &[0.0; 8],
+            Input::Free,
+            0.1,
+            steps,
+            Hold::Zero,
+            &mut x,
+            &mut y,
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("problem 1 of the batch: A must be finite"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn singular_a_has_no_steady_state() {
+        // (6.95): A has the eigenvalue 0.
+        let a = mat![[-3.0, 8.0], [0.0, 0.0]];
+        let b = mat![[0.0], [4.0]];
+        let err = steady_state(a.as_ref(), b.as_ref(), &[1.0]).unwrap_err();
+        assert!(
+            matches!(err, Error::Singular { arg: "A", eigenvalue_re, .. } if eigenvalue_re == 0.0)
+        );
+        assert!(err.to_string().contains("eigenvalue 0"), "{err}");
+    }
+
+    #[test]
+    fn input_lengths_are_checked() {
+        let (a, b) = lon747();
+        let c = Mat::<f64>::identity(4, 4);
+        let d = Mat::<f64>::zeros(4, 1);
+        let model = Model {
+            a: a.as_ref(),
+            b: b.as_ref(),
+            c: c.as_ref(),
+            d: d.as_ref(),
+        };
+        let (mut x, mut y) = (vec![0.0; 40], vec![0.0; 40]);
+        let err = simulate_into(
+            model,
+            &[0.0; 4],
+            Input::Sampled(&[0.0; 9]),
+            0.1,
+            10,
+            Hold::Zero,
+            &mut x,
+            &mut y,
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("u must have one row of inputs per time"),
+            "{err}"
+        );
+        let err = simulate_into(
+            model,
+            &[0.0; 4],
+            Input::Constant(&[1.0, 2.0]),
+            0.1,
+            10,
+            Hold::Zero,
+            &mut x,
+            &mut y,
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("eta0 must have one value per input"),
+            "{err}"
+        );
+    }
+}

@@ -1,0 +1,243 @@
+"""Time responses (chapter §6.2): the chapter's numbers, identities of the responses, and
+agreement with scipy.signal.lsim and python-control's forced_response.
+"""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+import scipy.integrate
+import scipy.linalg
+import scipy.signal
+
+import aerocontrol
+from aerocontrol import InvalidArgumentError, NonFiniteError, ShapeError, SingularMatrixError
+
+A_LON, B_LON = aerocontrol.chapter.boeing747_longitudinal()
+A_LAT, B_LAT = aerocontrol.chapter.boeing747_lateral()
+ONE_DEGREE = np.pi / 180
+LON = aerocontrol.StateSpace(
+    A_LON, B_LON, state_names=["u/u0", "alpha", "q", "theta"], input_names=["elevator"]
+)
+
+
+def _random_stable(n: int, m: int, p: int, seed: int) -> aerocontrol.StateSpace:
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    A -= (np.abs(np.linalg.eigvals(A).real).max() + 0.1) * np.eye(n)
+    return aerocontrol.StateSpace(
+        A, rng.standard_normal((n, m)), rng.standard_normal((p, n)), rng.standard_normal((p, m))
+    )
+
+
+def _relative(x: np.ndarray, reference: np.ndarray) -> float:
+    return float(np.abs(x - reference).max() / np.abs(reference).max())
+
+
+def test_steady_state_of_a_one_degree_step() -> None:
+    # (6.51), printed [0.0459 -0.0186 0.0 -0.0160]; computed [0.045965, -0.018563, 0, -0.015954].
+    steady = aerocontrol.steady_state(LON, [ONE_DEGREE])
+    np.testing.assert_allclose(steady, [0.045965, -0.018563, 0.0, -0.015954], atol=1e-6)
+    np.testing.assert_allclose(steady, [0.0459, -0.0186, 0.0, -0.0160], atol=1e-4)
+    np.testing.assert_allclose(
+        steady, -np.linalg.solve(A_LON, B_LON[:, 0]) * ONE_DEGREE, rtol=1e-14, atol=1e-18
+    )
+
+
+def test_lift_change_of_the_static_and_dynamic_analyses() -> None:
+    # (6.53)-(6.55): ΔCL = CLα α∞ + CLδe δe = -0.100, and the static δe / (Cmα / Δ).
+    cl_alpha, cl_de, cm_alpha, cm_de = 5.70, 0.338, -1.26, -1.34
+    alpha = aerocontrol.steady_state(LON, [ONE_DEGREE])[1]
+    dynamic = cl_alpha * alpha + cl_de * ONE_DEGREE
+    delta = -cl_alpha * cm_de + cm_alpha * cl_de
+    static = ONE_DEGREE / (cm_alpha / delta)
+    assert round(delta, 3) == 7.212
+    assert round(dynamic, 3) == -0.100 and round(static, 3) == -0.100
+    assert abs(dynamic - static) < 2e-4
+
+
+def test_step_response_settles_to_the_steady_state() -> None:
+    t = np.linspace(0.0, 8000.0, 8001)
+    r = aerocontrol.step_response(LON, T=t, eta0=[ONE_DEGREE])
+    np.testing.assert_allclose(r.x[-1], aerocontrol.steady_state(LON, [ONE_DEGREE]), atol=1e-7)
+    np.testing.assert_array_equal(r.x, r.y)
+    assert r.u is not None and np.all(r.u == ONE_DEGREE)
+
+
+def test_impulse_is_the_free_response_from_b_eta0() -> None:
+    # (6.36): x(t) = e^{At} B η0.
+    t = np.linspace(0.0, 20.0, 401)
+    impulse = aerocontrol.impulse_response(LON, T=t, eta0=[2.0])
+    free = aerocontrol.initial_response(LON, 2.0 * B_LON[:, 0], T=t)
+    np.testing.assert_array_equal(impulse.x, free.x)
+    np.testing.assert_allclose(
+        impulse.x[-1], scipy.linalg.expm(20.0 * A_LON) @ B_LON[:, 0] * 2.0, rtol=1e-12
+    )
+
+
+def test_doublet_is_the_free_response_from_a_b_eta0() -> None:
+    # (6.38): x(t) = e^{At} A B η0, and it is the derivative of the impulse response.
+    t = np.linspace(0.0, 20.0, 2001)
+    doublet = aerocontrol.doublet_response(LON, T=t)
+    free = aerocontrol.initial_response(LON, A_LON @ B_LON[:, 0], T=t)
+    np.testing.assert_array_equal(doublet.x, free.x)
+    impulse = aerocontrol.impulse_response(LON, T=t)
+    derivative = np.gradient(impulse.x, t, axis=0)
+    np.testing.assert_allclose(derivative[5:-5], doublet.x[5:-5], atol=2e-4)
+
+
+@pytest.mark.parametrize("method", ["zoh", "foh"])
+@pytest.mark.parametrize(
+    "system",
+    [
+        aerocontrol.StateSpace(A_LON, B_LON),
+        aerocontrol.StateSpace(A_LAT, B_LAT),
+        _random_stable(6, 2, 3, 1),
+        _random_stable(12, 3, 2, 2),
+    ],
+    ids=["747-longitudinal", "747-lateral", "random-6", "random-12"],
+)
+def test_forced_response_against_scipy_and_control(system, method: str) -> None:  # type: ignore[no-untyped-def]
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 30.0, 601)
+    u = np.cumsum(rng.standard_normal((len(t), system.n_inputs)), axis=0) * 0.01
+    x0 = rng.standard_normal(system.n_states) * 0.1
+    ours = aerocontrol.forced_response(system, t, u, x0=x0, method=method)
+    _, y, x = scipy.signal.lsim(
+        (system.A, system.B, system.C, system.D), u, t, X0=x0, interp=(method == "foh")
+    )
+    assert _relative(ours.x, x) <= 1e-10
+    assert _relative(ours.y, y.reshape(ours.y.shape)) <= 1e-10
+    if method == "foh":
+        peer = control.forced_response(
+            control.ss(system.A, system.B, system.C, system.D), t, u.T, X0=x0
+        )
+        assert _relative(ours.x, peer.states.T) <= 1e-10
+        assert _relative(ours.y, peer.outputs.T.reshape(ours.y.shape)) <= 1e-10
+
+
+def test_step_of_the_singular_example_against_quadrature() -> None:
+    # (6.95): A = [[-3, 8], [0, 0]] has a zero eigenvalue, so (6.43) cannot be used; the
+    # reference integrates x(t) = ∫_0^t e^{Aτ} dτ B by adaptive quadrature.
+    A, B = aerocontrol.chapter.state_feedback_example()
+    t = np.linspace(0.0, 3.0, 31)
+    r = aerocontrol.step_response((A, B), T=t)
+    for k in (1, 10, 30):
+        reference, _ = scipy.integrate.quad_vec(
+            lambda tau: scipy.linalg.expm(A * tau) @ B[:, 0], 0.0, t[k], epsrel=1e-13
+        )
+        np.testing.assert_allclose(r.x[k], reference, rtol=1e-12)
+    with pytest.raises(SingularMatrixError, match="eigenvalue 0"):
+        aerocontrol.steady_state((A, B), [1.0])
+    with pytest.raises(SingularMatrixError):
+        aerocontrol.dc_gain((A, B))
+
+
+def test_multi_input_gives_one_response_per_input() -> None:
+    t = np.linspace(0.0, 10.0, 101)
+    lateral = aerocontrol.StateSpace(A_LAT, B_LAT, input_names=["rudder", "aileron"])
+    r = aerocontrol.impulse_response(lateral, T=t)
+    assert r.x.shape == (2, 101, 4) and r.response_names == ("rudder", "aileron")
+    for j in range(2):
+        # One input column makes a different augmented matrix: equal to rounding.
+        single = aerocontrol.impulse_response((A_LAT, B_LAT[:, [j]]), T=t)
+        np.testing.assert_allclose(r.x[j], single.x, rtol=1e-12, atol=1e-15)
+    steps = aerocontrol.step_response(lateral, T=t)
+    weighted = aerocontrol.step_response(lateral, T=t, eta0=[1.0, 0.0])
+    np.testing.assert_allclose(steps.x[0], weighted.x, rtol=1e-14, atol=1e-16)
+    assert weighted.x.shape == (101, 4)
+
+
+def test_several_initial_states_and_inputs_in_one_call() -> None:
+    t = np.linspace(0.0, 5.0, 51)
+    x0 = np.random.default_rng(4).standard_normal((5, 4))
+    batch = aerocontrol.initial_response(LON, x0, T=t)
+    assert batch.x.shape == (5, 51, 4)
+    for r in range(5):
+        np.testing.assert_array_equal(batch.x[r], aerocontrol.initial_response(LON, x0[r], T=t).x)
+    u = np.random.default_rng(5).standard_normal((3, 51, 1))
+    forced = aerocontrol.forced_response(LON, t, u, method="foh")
+    for r in range(3):
+        single = aerocontrol.forced_response(LON, t, u[r], method="foh")
+        np.testing.assert_array_equal(forced.x[r], single.x)
+
+
+def test_a_list_of_models_in_one_call() -> None:
+    t = np.linspace(0.0, 10.0, 101)
+    models = [aerocontrol.StateSpace(A_LON * s, B_LON) for s in (0.5, 1.0, 2.0)]
+    batch = aerocontrol.step_response(models, T=t)
+    assert batch.x.shape == (3, 101, 4)
+    for k, model in enumerate(models):
+        np.testing.assert_array_equal(batch.x[k], aerocontrol.step_response(model, T=t).x)
+    impulses = aerocontrol.impulse_response(models, T=t)
+    np.testing.assert_array_equal(impulses.x[2], aerocontrol.impulse_response(models[2], T=t).x)
+    with pytest.raises(ShapeError, match=r"sys\[1\] must have the states"):
+        aerocontrol.step_response([models[0], (A_LAT, B_LAT)], T=t)
+
+
+def test_python_control_models_are_accepted() -> None:
+    sysc = control.ss(A_LON, B_LON, np.eye(4), np.zeros((4, 1)))
+    t = np.linspace(0.0, 10.0, 101)
+    ours = aerocontrol.step_response(sysc, T=t)
+    peer = control.step_response(sysc, T=t)
+    np.testing.assert_allclose(ours.y, peer.outputs[:, 0, :].T, rtol=1e-10, atol=1e-14)
+
+
+def test_default_grid_resolves_the_fastest_and_slowest_modes() -> None:
+    t = aerocontrol.default_time_grid(LON)
+    fastest = np.abs(np.linalg.eigvals(A_LON)).max()
+    slowest_decay = np.abs(np.linalg.eigvals(A_LON).real).min()
+    assert t[0] == 0.0 and np.allclose(np.diff(t), t[1])
+    assert t[1] <= 1.0 / (20 * fastest) * (1 + 1e-12)
+    assert t[-1] >= 7.0 / slowest_decay * (1 - 1e-12)
+    final_only = aerocontrol.step_response(LON, T=20.0)
+    assert final_only.t[-1] == 20.0 and final_only.t[1] <= t[1] * 1.001
+
+
+@pytest.mark.parametrize(
+    ("T", "message"),
+    [
+        ([0.1, 0.2, 0.3], "T must be a grid that starts at 0"),
+        ([0.0, 0.2, 0.1], "strictly increasing"),
+        ([0.0, 0.1, 0.3, 0.4], "uniform"),
+        ([0.0], "at least 2 times"),
+    ],
+)
+def test_bad_time_grids(T: list[float], message: str) -> None:
+    with pytest.raises(InvalidArgumentError, match=message):
+        aerocontrol.step_response(LON, T=T)
+
+
+def test_bad_arguments_are_named() -> None:
+    t = np.linspace(0.0, 1.0, 11)
+    with pytest.raises(ShapeError, match=r"u must have one row of 1 input\(s\) per time"):
+        aerocontrol.forced_response(LON, t, np.zeros(10))
+    with pytest.raises(ShapeError, match="x0 must be one initial state of 4 values"):
+        aerocontrol.initial_response(LON, [1.0, 2.0], T=t)
+    with pytest.raises(ShapeError, match=r"eta0 must have one weight per input \(2\)"):
+        aerocontrol.step_response((A_LAT, B_LAT), T=t, eta0=[1.0])
+    with pytest.raises(NonFiniteError, match=r"u\[3\]"):
+        u = np.zeros(11)
+        u[3] = np.nan
+        aerocontrol.forced_response(LON, t, u)
+    with pytest.raises(NonFiniteError, match=r"T\[2\]"):
+        aerocontrol.step_response(LON, T=[0.0, 0.1, np.inf])
+    with pytest.raises(ShapeError, match=r"C must have as many columns as A \(4\), got 3"):
+        aerocontrol.StateSpace(A_LON, B_LON, np.eye(3))
+    with pytest.raises(ShapeError, match=r"D must have as many columns as B \(1\), got 2"):
+        aerocontrol.StateSpace(A_LON, B_LON, np.eye(4), np.zeros((4, 2)))
+    with pytest.raises(ShapeError, match="state_names must have 4 names, got 2"):
+        aerocontrol.StateSpace(A_LON, B_LON, state_names=["a", "b"])
+    with pytest.raises(TypeError, match="sys must be a StateSpace"):
+        aerocontrol.step_response("not a system")  # type: ignore[arg-type]
+
+
+def test_inputs_are_not_modified() -> None:
+    A, B = A_LON.copy(), B_LON.copy()
+    u = np.linspace(0.0, 1.0, 11)
+    before = (A.copy(), B.copy(), u.copy())
+    aerocontrol.forced_response((A, B), np.linspace(0.0, 1.0, 11), u, method="foh")
+    aerocontrol.step_response((A, B), T=1.0)
+    for now, then in zip((A, B, u), before, strict=True):
+        np.testing.assert_array_equal(now, then)
