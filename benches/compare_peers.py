@@ -1,4 +1,4 @@
-"""Side-by-side timings of aerocontrol against its peers (scipy), in one process.
+"""Side-by-side timings of aerocontrol against its peers (scipy, python-control), in one process.
 
 Every case builds its inputs once from ``numpy.random.default_rng(seed)``, checks that our
 output agrees with each peer's, then times our callable and the peer's on the same inputs, with
@@ -41,6 +41,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+import control
 import numpy as np
 import scipy
 import scipy.linalg
@@ -375,6 +376,191 @@ def _discretize(A: np.ndarray, B: np.ndarray, dt: float, method: str) -> Any:
     return aerocontrol.discretize(A, B, dt, method=method)  # type: ignore[arg-type]
 
 
+def _boeing747_times(rng: np.random.Generator, samples: int) -> tuple[Any, ...]:
+    """The 747 longitudinal model and ``samples`` times uniformly on [0, 500] s."""
+    A, B = aerocontrol.chapter.boeing747_longitudinal()
+    return A, B, np.linspace(0.0, 500.0, samples)
+
+
+def _compare_control_time_response(ours: Any, peer: Any) -> Pairs:
+    """Our outputs and states (len(t), p) and (len(t), n) against python-control's
+    ``outputs`` and ``states``, (p, [1,] len(t)) and (n, [1,] len(t)) (squeezed or not)."""
+    k = len(ours.t)
+    return [
+        (ours.y, np.asarray(peer.outputs).reshape(-1, k).T),
+        (ours.x, np.asarray(peer.states).reshape(-1, k).T),
+    ]
+
+
+def _step_ours(A: np.ndarray, B: np.ndarray, t: np.ndarray) -> Any:
+    """A unit step (eta0 = 1, as the peers' steps), not the chapter's one degree."""
+    return aerocontrol.step_response((A, B), T=t, eta0=[1.0])
+
+
+def _step_control(A: np.ndarray, B: np.ndarray, t: np.ndarray) -> Any:
+    return control.step_response(control.ss(A, B, *identity_outputs(A, B)), T=t)
+
+
+def _step_scipy(A: np.ndarray, B: np.ndarray, t: np.ndarray) -> Any:
+    return scipy.signal.step((A, B, *identity_outputs(A, B)), T=t)
+
+
+@operation
+def step_response_cases() -> list[Case]:
+    """Unit step response of the 747 longitudinal model (C = I) on 5001 and 50001 samples of
+    [0, 500] s.
+
+    Peers: python-control's step_response and scipy.signal.step on (A, B, I, 0).
+    """
+    cases = []
+    for samples in (5001, 50001):
+        cases.append(
+            Case(
+                op="step_response 747",
+                size=f"{samples} samples",
+                seed=0,
+                setup=functools.partial(_boeing747_times, samples=samples),
+                ours=_step_ours,
+                peers=[
+                    Peer(
+                        "control.step_response",
+                        _step_control,
+                        compare=_compare_control_time_response,
+                        target=Target("step vs control: ratio >= 50", min_ratio=50.0),
+                    ),
+                    Peer(
+                        "scipy.signal.step",
+                        _step_scipy,
+                        compare=lambda ours, peer: [(ours.y, peer[1])],
+                        target=Target("step vs scipy: ratio >= 30", min_ratio=30.0),
+                    ),
+                ],
+                repeat=3 if samples >= 50001 else None,
+            )
+        )
+    return cases
+
+
+def _forced_setup(rng: np.random.Generator, samples: int) -> tuple[Any, ...]:
+    """The 747 and one degree of sinusoidal elevator at 0.3 rad/s (between the phugoid and the
+    short period) on ``samples`` times of [0, 500] s."""
+    A, B, t = _boeing747_times(rng, samples)
+    return A, B, t, np.sin(0.3 * t) * np.pi / 180
+
+
+def _forced_ours(A: np.ndarray, B: np.ndarray, t: np.ndarray, u: np.ndarray) -> Any:
+    return aerocontrol.forced_response((A, B), t, u, method="foh")
+
+
+def _forced_scipy(A: np.ndarray, B: np.ndarray, t: np.ndarray, u: np.ndarray) -> Any:
+    """scipy.signal.lsim with its default interp=True: a first-order hold, like ours."""
+    return scipy.signal.lsim((A, B, *identity_outputs(A, B)), u, t)
+
+
+def _forced_control(A: np.ndarray, B: np.ndarray, t: np.ndarray, u: np.ndarray) -> Any:
+    return control.forced_response(control.ss(A, B, *identity_outputs(A, B)), t, u)
+
+
+@operation
+def forced_response_cases() -> list[Case]:
+    """Response of the 747 (C = I) to a sampled sinusoidal elevator, first-order hold, on 50001
+    samples of [0, 500] s.
+
+    Peers: scipy.signal.lsim (interp=True, first-order hold) and python-control's
+    forced_response (also linear between input samples).
+    """
+    samples = 50001
+    return [
+        Case(
+            op="forced_response 747",
+            size=f"{samples} samples",
+            seed=0,
+            setup=functools.partial(_forced_setup, samples=samples),
+            ours=_forced_ours,
+            peers=[
+                Peer(
+                    "scipy.signal.lsim",
+                    _forced_scipy,
+                    compare=lambda ours, peer: [(ours.y, peer[1]), (ours.x, peer[2])],
+                    target=Target("forced (foh) vs scipy lsim: ratio >= 50", min_ratio=50.0),
+                ),
+                Peer(
+                    "control.forced_response",
+                    _forced_control,
+                    compare=_compare_control_time_response,
+                ),
+            ],
+            repeat=3,
+        )
+    ]
+
+
+def _bode747(rng: np.random.Generator) -> tuple[Any, ...]:
+    """The 747 longitudinal (C = I, D = 0) over 10^-3 ... 10 rad/s (phugoid to short period)."""
+    A, B = aerocontrol.chapter.boeing747_longitudinal()
+    return A, B, *identity_outputs(A, B), np.logspace(-3, 1, 1000)
+
+
+def _bode_random(rng: np.random.Generator, n: int, m: int, p: int) -> tuple[Any, ...]:
+    """A random stable model: A standard normal shifted so that its rightmost eigenvalue has
+    real part -0.1; B, C standard normal, D = 0; 10^-2 ... 10^2 rad/s."""
+    A = rng.standard_normal((n, n))
+    A -= (np.max(np.linalg.eigvals(A).real) + 0.1) * np.eye(n)
+    B = rng.standard_normal((n, m))
+    C = rng.standard_normal((p, n))
+    return A, B, C, np.zeros((p, m)), np.logspace(-2, 2, 1000)
+
+
+def _frequency_ours(A: Any, B: Any, C: Any, D: Any, omega: np.ndarray) -> Any:
+    return aerocontrol.frequency_response((A, B, C, D), omega)
+
+
+def _frequency_control(A: Any, B: Any, C: Any, D: Any, omega: np.ndarray) -> Any:
+    """python-control's frequency_response: with slycot installed, TB05AD (Laub's Hessenberg
+    method, the same algorithm as ours) called once per frequency from a Python loop."""
+    return control.frequency_response(control.ss(A, B, C, D), omega)
+
+
+def _compare_magnitudes(ours: Any, peer: Any) -> Pairs:
+    """|G(jω)|: ours (len(omega), p, m) against control's magnitude (p, m, len(omega)), which
+    is squeezed to (len(omega),) for a SISO system."""
+    k, p, m = ours.response.shape
+    magnitude = np.asarray(peer.magnitude).reshape(p, m, k)
+    return [(ours.magnitude, np.moveaxis(magnitude, -1, 0))]
+
+
+@operation
+def bode_cases() -> list[Case]:
+    """G(jω) at 1000 log-spaced frequencies: the 747 longitudinal (n=4, 4 outputs, 1 input)
+    and a random stable n=64 model with 2 inputs and 2 outputs. Agreement is on |G|.
+
+    Peer: python-control's frequency_response.
+    """
+    target = Target("bode 1000 w vs control: ratio >= 10", min_ratio=10.0)
+    setups = (
+        ("n=4 747", 0, _bode747),
+        ("n=64 m=2 p=2", 64, functools.partial(_bode_random, n=64, m=2, p=2)),
+    )
+    return [
+        Case(
+            op="bode 1000 frequencies",
+            size=size,
+            seed=seed,
+            setup=setup,
+            ours=_frequency_ours,
+            peers=[
+                Peer(
+                    "control.frequency_response",
+                    _frequency_control,
+                    compare=_compare_magnitudes,
+                    target=target,
+                )
+            ],
+        )
+        for size, seed, setup in setups
+    ]
+
+
 # ---------------------------------------------------------------------------------------------
 # Measurement
 # ---------------------------------------------------------------------------------------------
@@ -504,6 +690,7 @@ def environment() -> dict[str, Any]:
         "env": {name: os.environ.get(name) for name in THREAD_ENV_VARS},
         "numpy": np.__version__,
         "scipy": scipy.__version__,
+        "control": control.__version__,
         "aerocontrol": aerocontrol.__version__,
         "FMA_KERNELS": getattr(_core, "FMA_KERNELS", None),
     }
@@ -536,7 +723,10 @@ def format_environment(env: dict[str, Any]) -> str:
                 f"{pool['version']} num_threads={pool['num_threads']}"
             )
     lines.append(f"aerocontrol._core.FMA_KERNELS = {env['FMA_KERNELS']}")
-    lines.append(f"numpy {env['numpy']}, scipy {env['scipy']}, aerocontrol {env['aerocontrol']}")
+    lines.append(
+        f"numpy {env['numpy']}, scipy {env['scipy']}, control {env['control']}, "
+        f"aerocontrol {env['aerocontrol']}"
+    )
     return "\n".join(lines)
 
 

@@ -16,6 +16,7 @@
 //! A frequency at an eigenvalue of A on the imaginary axis (a pole of G) gives infinite or NaN
 //! entries, never an error: the caller decides how to report them.
 
+use crate::dispatch::{fma_dispatch, multiply_add};
 use crate::error::{
     Error, check_finite, check_finite_values, check_output_len, check_rows, check_square,
 };
@@ -58,66 +59,164 @@ pub fn check_state_space(
     check_finite(d, "D")
 }
 
-/// The model in Hessenberg coordinates: H, Q^T B, C Q, D.
+/// The model in Hessenberg coordinates, laid out for the per-frequency kernel: H row-major,
+/// Q^T B column by column, C Q and D row-major.
 struct HessenbergModel {
-    h: Mat<f64>,
-    b: Mat<f64>,
-    c: Mat<f64>,
-    d: Mat<f64>,
+    n: usize,
+    m: usize,
+    p: usize,
+    h: Vec<f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+    d: Vec<f64>,
 }
 
-/// Solves (jωI - H) X = B̃ into `x` (n x m row-major) with `work` (n x n row-major) as the
-/// eliminated matrix.
-fn solve_shifted(model: &HessenbergModel, omega: f64, work: &mut [c64], x: &mut [c64]) {
-    let n = model.h.nrows();
-    let m = model.b.ncols();
+/// One frequency's scratch: the real and imaginary planes of the eliminated jωI - H
+/// (row-major) and of the solution X (column by column), kept apart so that every inner loop
+/// is a vectorisable pass over contiguous reals.
+struct Workspace {
+    re: Vec<f64>,
+    im: Vec<f64>,
+    x_re: Vec<f64>,
+    x_im: Vec<f64>,
+}
+
+/// Σ u_i v_i for complex vectors given as real and imaginary planes, in four independent lanes
+/// (a single running sum is a chain of dependent fused multiply-adds; lanes let the compiler
+/// vectorise and overlap them).
+#[inline(always)]
+fn complex_dot<const FMA: bool>(ur: &[f64], ui: &[f64], vr: &[f64], vi: &[f64]) -> (f64, f64) {
+    const LANES: usize = 4;
+    let (mut re, mut im) = ([0.0; LANES], [0.0; LANES]);
+    let chunks = ur.len() / LANES;
+    for c in 0..chunks {
+        let range = c * LANES..(c + 1) * LANES;
+        let (ur, ui, vr, vi) = (
+            &ur[range.clone()],
+            &ui[range.clone()],
+            &vr[range.clone()],
+            &vi[range],
+        );
+        for l in 0..LANES {
+            re[l] = multiply_add::<FMA>(ur[l], vr[l], multiply_add::<FMA>(-ui[l], vi[l], re[l]));
+            im[l] = multiply_add::<FMA>(ur[l], vi[l], multiply_add::<FMA>(ui[l], vr[l], im[l]));
+        }
+    }
+    let (mut sum_re, mut sum_im) = (
+        (re[0] + re[1]) + (re[2] + re[3]),
+        (im[0] + im[1]) + (im[2] + im[3]),
+    );
+    for i in chunks * LANES..ur.len() {
+        sum_re = multiply_add::<FMA>(ur[i], vr[i], multiply_add::<FMA>(-ui[i], vi[i], sum_re));
+        sum_im = multiply_add::<FMA>(ur[i], vi[i], multiply_add::<FMA>(ui[i], vr[i], sum_im));
+    }
+    (sum_re, sum_im)
+}
+
+/// G(jω) into `g` (p x m row-major): fill jωI - H, eliminate its subdiagonal with pivoting
+/// between the two rows involved, back-substitute each right-hand side, and form C Q X + D.
+#[inline(always)]
+fn evaluate_kernel<const FMA: bool>(
+    model: &HessenbergModel,
+    omega: f64,
+    ws: &mut Workspace,
+    g: &mut [c64],
+) {
+    let (n, m, p) = (model.n, model.m, model.p);
+    let Workspace { re, im, x_re, x_im } = ws;
+    // jωI - H; entries left of the subdiagonal are never read.
     for i in 0..n {
-        for j in 0..n {
-            work[i * n + j] = c64::new(-model.h[(i, j)], 0.0);
+        let start = i * n + i.saturating_sub(1);
+        let end = (i + 1) * n;
+        for (r, &h) in re[start..end].iter_mut().zip(&model.h[start..end]) {
+            *r = -h;
         }
-        work[i * n + i].im += omega;
-        for j in 0..m {
-            x[i * m + j] = c64::new(model.b[(i, j)], 0.0);
-        }
+        im[start..end].fill(0.0);
+        im[i * n + i] = omega;
     }
-    // Eliminate the subdiagonal, column by column, pivoting between rows k and k + 1.
+    x_re.copy_from_slice(&model.b);
+    x_im.fill(0.0);
     for k in 0..n.saturating_sub(1) {
-        let (upper, lower) = work.split_at_mut((k + 1) * n);
-        let (row_k, row_next) = (&mut upper[k * n..], &mut lower[..n]);
-        if row_next[k].norm_sqr() > row_k[k].norm_sqr() {
-            row_k[k..].swap_with_slice(&mut row_next[k..]);
-            let (x_upper, x_lower) = x.split_at_mut((k + 1) * m);
-            x_upper[k * m..].swap_with_slice(&mut x_lower[..m]);
-        }
-        if row_next[k] == c64::new(0.0, 0.0) {
-            continue;
-        }
-        let factor = row_next[k] / row_k[k];
-        row_next[k] = c64::new(0.0, 0.0);
-        for j in k + 1..n {
-            row_next[j] -= factor * row_k[j];
-        }
-        let (x_upper, x_lower) = x.split_at_mut((k + 1) * m);
-        for j in 0..m {
-            x_lower[j] -= factor * x_upper[k * m + j];
-        }
-    }
-    // Back substitution with the upper triangular result.
-    for k in (0..n).rev() {
-        let (done_rows, below) = x.split_at_mut((k + 1) * m);
-        let row = &mut done_rows[k * m..];
-        for (i, solved) in below.chunks_exact(m).enumerate() {
-            let coefficient = work[k * n + k + 1 + i];
-            for (value, s) in row.iter_mut().zip(solved) {
-                *value -= coefficient * s;
+        let (this, next) = (k * n, (k + 1) * n);
+        let magnitude = |row: usize, re: &[f64], im: &[f64]| {
+            re[row + k] * re[row + k] + im[row + k] * im[row + k]
+        };
+        if magnitude(next, re, im) > magnitude(this, re, im) {
+            for j in k..n {
+                re.swap(this + j, next + j);
+                im.swap(this + j, next + j);
+            }
+            for column in 0..m {
+                x_re.swap(column * n + k, column * n + k + 1);
+                x_im.swap(column * n + k, column * n + k + 1);
             }
         }
-        let pivot = work[k * n + k];
-        for value in row.iter_mut() {
-            *value /= pivot;
+        let (pr, pi) = (re[this + k], im[this + k]);
+        let (sr, si) = (re[next + k], im[next + k]);
+        if sr == 0.0 && si == 0.0 {
+            continue;
+        }
+        // factor = sub / pivot.
+        let denominator = pr * pr + pi * pi;
+        let (fr, fi) = (
+            (sr * pr + si * pi) / denominator,
+            (si * pr - sr * pi) / denominator,
+        );
+        let (upper_re, lower_re) = re.split_at_mut(next);
+        let (upper_im, lower_im) = im.split_at_mut(next);
+        let (row_re, row_im) = (&upper_re[this + k + 1..], &upper_im[this + k + 1..]);
+        let (next_re, next_im) = (&mut lower_re[k + 1..n], &mut lower_im[k + 1..n]);
+        for j in 0..n - k - 1 {
+            let (a, b) = (row_re[j], row_im[j]);
+            next_re[j] = multiply_add::<FMA>(-fr, a, multiply_add::<FMA>(fi, b, next_re[j]));
+            next_im[j] = multiply_add::<FMA>(-fr, b, multiply_add::<FMA>(-fi, a, next_im[j]));
+        }
+        for column in 0..m {
+            let (a, b) = (x_re[column * n + k], x_im[column * n + k]);
+            let i = column * n + k + 1;
+            x_re[i] -= fr * a - fi * b;
+            x_im[i] -= fr * b + fi * a;
+        }
+    }
+    // Back substitution, x_k = (b_k - U_k,k+1.. x_k+1..) / U_kk, row by row; every right-hand
+    // side uses a row while it is in the fastest cache.
+    for k in (0..n).rev() {
+        let (row_re, row_im) = (
+            &re[k * n + k + 1..(k + 1) * n],
+            &im[k * n + k + 1..(k + 1) * n],
+        );
+        let (pr, pi) = (re[k * n + k], im[k * n + k]);
+        let denominator = pr * pr + pi * pi;
+        for column in 0..m {
+            let (xr, xi) = (
+                &mut x_re[column * n..(column + 1) * n],
+                &mut x_im[column * n..(column + 1) * n],
+            );
+            let (dr, di) = complex_dot::<FMA>(row_re, row_im, &xr[k + 1..], &xi[k + 1..]);
+            let (sr, si) = (xr[k] - dr, xi[k] - di);
+            xr[k] = (sr * pr + si * pi) / denominator;
+            xi[k] = (si * pr - sr * pi) / denominator;
+        }
+    }
+    // G = C Q X + D.
+    for i in 0..p {
+        let c_row = &model.c[i * n..(i + 1) * n];
+        for column in 0..m {
+            let (xr, xi) = (
+                &x_re[column * n..(column + 1) * n],
+                &x_im[column * n..(column + 1) * n],
+            );
+            let (mut gr, mut gi) = (model.d[i * m + column], 0.0);
+            for ((&c, &vr), &vi) in c_row.iter().zip(xr).zip(xi) {
+                gr = multiply_add::<FMA>(c, vr, gr);
+                gi = multiply_add::<FMA>(c, vi, gi);
+            }
+            g[i * m + column] = c64::new(gr, gi);
         }
     }
 }
+
+fma_dispatch!(fn evaluate_frequency(model: &HessenbergModel, omega: f64, ws: &mut Workspace, g: &mut [c64]) => evaluate_kernel);
 
 /// Writes G(jω_k) = C (jω_k I - A)^-1 B + D for every ω_k into `out`, a row-major
 /// len(omega) x p x m stack.
@@ -137,35 +236,37 @@ pub fn frequency_response_into(
         return Ok(());
     }
     let Hessenberg { h, q } = hessenberg(a);
+    let (qb, cq) = (q.transpose() * b, c * &q);
+    let row_major = |x: &Mat<f64>| -> Vec<f64> {
+        (0..x.nrows())
+            .flat_map(|i| (0..x.ncols()).map(move |j| x[(i, j)]))
+            .collect()
+    };
     let model = HessenbergModel {
-        h,
-        b: q.transpose() * b,
-        c: c * &q,
-        d: d.to_owned(),
+        n,
+        m,
+        p,
+        h: row_major(&h),
+        b: (0..m)
+            .flat_map(|j| (0..n).map(move |i| (j, i)))
+            .map(|(j, i)| qb[(i, j)])
+            .collect(),
+        c: row_major(&cq),
+        d: row_major(&d.to_owned()),
     };
-    let evaluate = |(work, x): &mut (Vec<c64>, Vec<c64>), (&w, g): (&f64, &mut [c64])| {
-        solve_shifted(&model, w, work, x);
-        for i in 0..p {
-            for j in 0..m {
-                let mut value = c64::new(model.d[(i, j)], 0.0);
-                for k in 0..n {
-                    value += model.c[(i, k)] * x[k * m + j];
-                }
-                g[i * m + j] = value;
-            }
-        }
-    };
-    let workspace = || {
-        (
-            vec![c64::new(0.0, 0.0); n * n],
-            vec![c64::new(0.0, 0.0); n * m],
-        )
+    let workspace = || Workspace {
+        re: vec![0.0; n * n],
+        im: vec![0.0; n * n],
+        x_re: vec![0.0; n * m],
+        x_im: vec![0.0; n * m],
     };
     omega
         .par_iter()
         .zip(out.par_chunks_mut(p * m))
-        .with_min_len(16)
-        .for_each_init(workspace, evaluate);
+        .with_min_len(32)
+        .for_each_init(workspace, |ws, (&w, g)| {
+            evaluate_frequency(&model, w, ws, g)
+        });
     Ok(())
 }
 

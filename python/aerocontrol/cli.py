@@ -14,6 +14,7 @@ import numpy as np
 
 from . import __version__, chapter
 from .linalg import discretize, transition_matrix
+from .modal import modes
 
 DEMO_TIMES = (0.0, 1.0, 5.0, 20.0, 100.0)
 
@@ -51,6 +52,11 @@ def transition_demo(times: Sequence[float] = DEMO_TIMES) -> str:
         + np.array2string(steady, precision=4, suppress_small=True)
         + "  (chapter (6.51): [0.0459 -0.0186 0.0 -0.0160])"
     )
+    lines += ["", "Longitudinal modes (chapter (6.49)):"]
+    lines.append(str(modes(A, mode_names=["phugoid", "short period"])))
+    A_lat, _ = chapter.boeing747_lateral()
+    lines += ["", "Lateral-directional modes (chapter (6.150)-(6.154)):"]
+    lines.append(str(modes(A_lat, mode_names=["spiral", "Dutch roll", "roll"])))
     return "\n".join(lines)
 
 
