@@ -413,6 +413,19 @@ type Discretized<'py> = (
     Option<Bound<'py, PyArrayDyn<f64>>>,
 );
 
+/// The input hold named by the `method` argument: "zoh" (zero order) or "foh" (first order).
+fn hold_from_method(py: Python<'_>, method: &str) -> PyResult<Hold> {
+    match method {
+        "zoh" => Ok(Hold::Zero),
+        "foh" => Ok(Hold::First),
+        other => Err(raise(
+            py,
+            "InvalidArgumentError",
+            format!("method must be \"zoh\" or \"foh\", got {other:?}"),
+        )),
+    }
+}
+
 /// (Φ, Γ0, Γ1 or None) of x' = Ax + Bη over the step dt, for method "zoh" or "foh".
 #[pyfunction]
 #[pyo3(signature = (a, b, dt, method, /))]
@@ -423,17 +436,7 @@ fn discretize<'py>(
     dt: f64,
     method: &str,
 ) -> PyResult<Discretized<'py>> {
-    let hold = match method {
-        "zoh" => Hold::Zero,
-        "foh" => Hold::First,
-        other => {
-            return Err(raise(
-                py,
-                "InvalidArgumentError",
-                format!("method must be \"zoh\" or \"foh\", got {other:?}"),
-            ));
-        }
-    };
+    let hold = hold_from_method(py, method)?;
     let (a, b) = (float_array(py, a, "A")?, float_array(py, b, "B")?);
     let a = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
     let b = matrix_view(&b, "B").map_err(|e| to_py_err(py, e))?;
@@ -552,17 +555,7 @@ fn simulate<'py>(
     steps: usize,
     method: &str,
 ) -> PyResult<SimulationOutput<'py>> {
-    let hold = match method {
-        "zoh" => Hold::Zero,
-        "foh" => Hold::First,
-        other => {
-            return Err(raise(
-                py,
-                "InvalidArgumentError",
-                format!("method must be \"zoh\" or \"foh\", got {other:?}"),
-            ));
-        }
-    };
+    let hold = hold_from_method(py, method)?;
     let arrays = model_arrays(py, a, b, c, d)?;
     let model = model_views(&arrays).map_err(|e| to_py_err(py, e))?;
     let (n, p) = (model.a.nrows(), model.c.nrows());
@@ -669,17 +662,7 @@ fn simulate_models<'py>(
     steps: usize,
     method: &str,
 ) -> PyResult<SimulationOutput<'py>> {
-    let hold = match method {
-        "zoh" => Hold::Zero,
-        "foh" => Hold::First,
-        other => {
-            return Err(raise(
-                py,
-                "InvalidArgumentError",
-                format!("method must be \"zoh\" or \"foh\", got {other:?}"),
-            ));
-        }
-    };
+    let hold = hold_from_method(py, method)?;
     let (a, [q, n, na]) = stack_values(py, a, "A")?;
     let (b, [qb, nb, m]) = stack_values(py, b, "B")?;
     let (c, [qc, p, nc]) = stack_values(py, c, "C")?;

@@ -370,6 +370,16 @@ mod tests {
     use super::*;
     use faer::mat;
 
+    /// The model (A, B, C, D) viewed from owned matrices.
+    fn model<'a>(a: &'a Mat<f64>, b: &'a Mat<f64>, c: &'a Mat<f64>, d: &'a Mat<f64>) -> Model<'a> {
+        Model {
+            a: a.as_ref(),
+            b: b.as_ref(),
+            c: c.as_ref(),
+            d: d.as_ref(),
+        }
+    }
+
     fn lon747() -> (Mat<f64>, Mat<f64>) {
         (
             mat![
@@ -409,12 +419,7 @@ mod tests {
         let eta0 = [std::f64::consts::PI / 180.0];
         let steps = 801;
         let (mut x, mut y) = (vec![0.0; steps * 4], vec![0.0; steps * 4]);
-        let model = Model {
-            a: a.as_ref(),
-            b: b.as_ref(),
-            c: c.as_ref(),
-            d: d.as_ref(),
-        };
+        let model = model(&a, &b, &c, &d);
         simulate_into(
             model,
             &[0.0; 4],
@@ -441,12 +446,7 @@ mod tests {
         let (a, b) = lon747();
         let c = Mat::<f64>::identity(4, 4);
         let d = Mat::<f64>::zeros(4, 1);
-        let model = Model {
-            a: a.as_ref(),
-            b: b.as_ref(),
-            c: c.as_ref(),
-            d: d.as_ref(),
-        };
+        let model = model(&a, &b, &c, &d);
         let steps = 201;
         let x0: Vec<f64> = (0..4).map(|i| b[(i, 0)]).collect();
         let (mut x, mut y) = (vec![0.0; steps * 4], vec![0.0; steps * 4]);
@@ -472,12 +472,7 @@ mod tests {
         let (a, b) = lon747();
         let c = Mat::from_fn(2, 4, |i, j| (i + j) as f64);
         let d = Mat::from_fn(2, 1, |i, _| i as f64);
-        let model = Model {
-            a: a.as_ref(),
-            b: b.as_ref(),
-            c: c.as_ref(),
-            d: d.as_ref(),
-        };
+        let model = model(&a, &b, &c, &d);
         let (responses, steps) = (3, 50);
         let x0: Vec<f64> = (0..responses * 4).map(|i| i as f64 * 0.01).collect();
         let u: Vec<f64> = (0..responses * steps)
@@ -523,19 +518,6 @@ mod tests {
         let a2 = &a * faer::Scale(2.0);
         let c = Mat::<f64>::identity(4, 4);
         let d = Mat::<f64>::zeros(4, 1);
-        fn model<'a>(
-            a: &'a Mat<f64>,
-            b: &'a Mat<f64>,
-            c: &'a Mat<f64>,
-            d: &'a Mat<f64>,
-        ) -> Model<'a> {
-            Model {
-                a: a.as_ref(),
-                b: b.as_ref(),
-                c: c.as_ref(),
-                d: d.as_ref(),
-            }
-        }
         let models = [model(&a, &b, &c, &d), model(&a2, &b, &c, &d)];
         let steps = 30;
         let eta = [0.1, -0.2];
@@ -604,12 +586,7 @@ mod tests {
         let (a, b) = lon747();
         let c = Mat::<f64>::identity(4, 4);
         let d = Mat::<f64>::zeros(4, 1);
-        let model = Model {
-            a: a.as_ref(),
-            b: b.as_ref(),
-            c: c.as_ref(),
-            d: d.as_ref(),
-        };
+        let model = model(&a, &b, &c, &d);
         let (mut x, mut y) = (vec![0.0; 40], vec![0.0; 40]);
         let err = simulate_into(
             model,
