@@ -13,7 +13,7 @@ use faer::linalg::householder::{
     apply_block_householder_sequence_on_the_right_in_place_with_conj,
 };
 use faer::linalg::qr::no_pivoting::factor::recommended_block_size;
-use faer::{Conj, Mat, MatRef, Par};
+use faer::{Conj, Mat, MatMut, MatRef, Par};
 
 /// The Hessenberg form of a square matrix: A = Q H Q^T.
 #[derive(Debug, Clone)]
@@ -29,9 +29,24 @@ pub fn hessenberg(a: MatRef<'_, f64>) -> Hessenberg {
     let n = a.nrows();
     let mut h = a.to_owned();
     let mut q = Mat::<f64>::identity(n, n);
+    reduce(h.as_mut(), Some(q.as_mut()));
+    Hessenberg { h, q }
+}
+
+/// H alone, when the transformation is not needed (eigenvalues).
+pub fn hessenberg_matrix(a: MatRef<'_, f64>) -> Mat<f64> {
+    let mut h = a.to_owned();
+    reduce(h.as_mut(), None);
+    h
+}
+
+/// Reduces `h` to Hessenberg form in place and, if given, overwrites `q` (the identity on
+/// entry) with the transformation.
+fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) {
+    let n = h.nrows();
     if n <= 2 {
         // Already Hessenberg.
-        return Hessenberg { h, q };
+        return;
     }
     let par = Par::Seq;
     let block_size = recommended_block_size::<f64>(n - 1, n - 1);
@@ -53,21 +68,22 @@ pub fn hessenberg(a: MatRef<'_, f64>) -> Hessenberg {
         stack,
         Default::default(),
     );
-    // The reflectors act on rows and columns 1..n; Q = diag(1, Q1).
-    apply_block_householder_sequence_on_the_right_in_place_with_conj(
-        h.as_ref().submatrix(1, 0, n - 1, n - 1),
-        householder.as_ref(),
-        Conj::No,
-        q.as_mut().submatrix_mut(1, 1, n - 1, n - 1),
-        par,
-        stack,
-    );
+    if let Some(q) = q {
+        // The reflectors act on rows and columns 1..n; Q = diag(1, Q1).
+        apply_block_householder_sequence_on_the_right_in_place_with_conj(
+            h.as_ref().submatrix(1, 0, n - 1, n - 1),
+            householder.as_ref(),
+            Conj::No,
+            q.submatrix_mut(1, 1, n - 1, n - 1),
+            par,
+            stack,
+        );
+    }
     for j in 0..n {
         for i in j + 2..n {
             h[(i, j)] = 0.0;
         }
     }
-    Hessenberg { h, q }
 }
 
 #[cfg(test)]

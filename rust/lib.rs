@@ -47,6 +47,7 @@ pub mod modes;
 pub mod norm;
 pub mod pool;
 pub mod response;
+pub mod schur;
 pub mod small_matrix;
 
 #[cfg(feature = "python")]

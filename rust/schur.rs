@@ -1,0 +1,795 @@
+//! The real Schur form A = Z T Z^T, by Hessenberg reduction and the Francis double-shift QR
+//! algorithm, and the eigenvalues of a real matrix.
+//!
+//! T is quasi-upper-triangular: 1 x 1 diagonal blocks hold real eigenvalues, 2 x 2 blocks hold
+//! complex conjugate pairs, and every 2 x 2 block is in standard form
+//!
+//! ```text
+//! [ a  b ]
+//! [ c  a ]      b c < 0,   eigenvalues a ± sqrt(-b c) i,
+//! ```
+//!
+//! Z is orthogonal. The reduction is backward stable: Z T Z^T = A + E with ||E|| = O(u ||A||).
+//!
+//! # Algorithm
+//!
+//! A is first reduced to upper Hessenberg form H = Q^T A Q ([`crate::hessenberg`], faer's blocked
+//! Householder reduction). The QR iteration then works on the active window H[l..=i, l..=i]
+//! between negligible subdiagonal entries (the deflation test of Ahues & Tisseur, as in LAPACK's
+//! small-matrix QR, which declares h_{k,k-1} negligible only when doing so perturbs the
+//! eigenvalues of the neighbouring 2 x 2 block by at most u times their size). Each step is an
+//! implicit double shift (Francis 1961/62) with the two eigenvalues of the trailing 2 x 2 block:
+//! a 3 x 3 Householder reflector introduces a bulge at the top of the window and further
+//! reflectors chase it to the bottom, so the step costs O(n^2) and keeps H real and Hessenberg.
+//! Every tenth iteration without a deflation uses an exceptional shift (Wilkinson's ad hoc
+//! values 3/4 s and -0.4375 s) to break the rare cycles of the standard shifts. A converged
+//! 2 x 2 block is rotated into standard form by [`standardize_block`], which also splits it
+//! into two 1 x 1 blocks when its eigenvalues are real.
+//!
+//! The single-window, double-shift iteration is the right tool at the orders of flight-control
+//! models (n <= 100; LAPACK itself uses it below n = 75): at n = 4 it finds the eigenvalues in a
+//! fraction of the time of a general multishift solver, whose set-up dominates at that size.
+//!
+//! [`eigenvalues`] first balances A (Parlett & Reinsch 1969: a diagonal similarity by powers of
+//! two that equalises row and column norms, exact in floating point), which can only improve
+//! the computed eigenvalues of badly scaled matrices such as models in mixed units. The Schur
+//! form itself is not balanced, since its Z must be orthogonal.
+
+use crate::error::{Error, check_finite, check_square};
+use crate::hessenberg::{hessenberg, hessenberg_matrix};
+use faer::{Mat, MatRef, c64};
+use std::ops::{Index, IndexMut, Range};
+
+/// The Schur form A = Z T Z^T.
+#[derive(Debug, Clone)]
+pub struct RealSchur {
+    /// Quasi-upper-triangular, 2 x 2 blocks in standard form, exact zeros elsewhere below the
+    /// diagonal.
+    pub t: Mat<f64>,
+    /// Orthogonal.
+    pub z: Mat<f64>,
+}
+
+/// Iterations without a deflation after which an exceptional shift is used.
+const EXCEPTIONAL_SHIFT_INTERVAL: usize = 10;
+
+/// Up to this order the Hessenberg reduction is the plain Householder loop below; above it,
+/// faer's blocked reduction (whose set-up costs more than the whole reduction at n = 4).
+const UNBLOCKED_HESSENBERG_MAX_ORDER: usize = 32;
+
+/// A square matrix stored by columns in one contiguous buffer: the QR iteration touches single
+/// entries in tight loops, where a plain slice index is cheaper than a strided view.
+#[derive(Clone)]
+struct Square {
+    n: usize,
+    data: Vec<f64>,
+}
+
+impl Square {
+    fn from_mat(a: MatRef<'_, f64>) -> Self {
+        let n = a.nrows();
+        let mut data = Vec::with_capacity(n * n);
+        for j in 0..n {
+            data.extend(a.col(j).iter());
+        }
+        Self { n, data }
+    }
+
+    fn identity(n: usize) -> Self {
+        let mut data = vec![0.0; n * n];
+        for i in 0..n {
+            data[i * (n + 1)] = 1.0;
+        }
+        Self { n, data }
+    }
+
+    fn to_mat(&self) -> Mat<f64> {
+        Mat::from_fn(self.n, self.n, |i, j| self[(i, j)])
+    }
+
+    /// Rows r and r + 1, columns `columns`: x <- cs x + sn y, y <- cs y - sn x.
+    fn rotate_rows(&mut self, r: usize, columns: Range<usize>, cs: f64, sn: f64) {
+        for j in columns {
+            let (x, y) = (self[(r, j)], self[(r + 1, j)]);
+            self[(r, j)] = cs * x + sn * y;
+            self[(r + 1, j)] = cs * y - sn * x;
+        }
+    }
+
+    /// Columns c and c + 1, rows `rows`: x <- cs x + sn y, y <- cs y - sn x.
+    fn rotate_columns(&mut self, c: usize, rows: Range<usize>, cs: f64, sn: f64) {
+        let n = self.n;
+        let (left, right) = self.data.split_at_mut((c + 1) * n);
+        let (x_column, y_column) = (&mut left[c * n..], &mut right[..n]);
+        for i in rows {
+            let (x, y) = (x_column[i], y_column[i]);
+            x_column[i] = cs * x + sn * y;
+            y_column[i] = cs * y - sn * x;
+        }
+    }
+
+    /// Applies I - τ w w^T (w = [1, v...], 2 or 3 long) from the left to rows k.. of the
+    /// columns `columns`.
+    fn reflect_rows(&mut self, k: usize, w: &[f64], tau: f64, columns: Range<usize>) {
+        let n = self.n;
+        for j in columns {
+            let column = &mut self.data[j * n + k..j * n + k + w.len()];
+            let sum: f64 = column.iter().zip(w).map(|(x, v)| x * v).sum();
+            let scaled = tau * sum;
+            for (x, v) in column.iter_mut().zip(w) {
+                *x -= scaled * v;
+            }
+        }
+    }
+
+    /// Applies I - τ w w^T from the right to columns k.. of the rows `rows`.
+    fn reflect_columns(&mut self, k: usize, w: &[f64], tau: f64, rows: Range<usize>) {
+        let n = self.n;
+        let columns = &mut self.data[k * n..(k + w.len()) * n];
+        for i in rows {
+            let sum: f64 = w
+                .iter()
+                .enumerate()
+                .map(|(r, v)| v * columns[r * n + i])
+                .sum();
+            let scaled = tau * sum;
+            for (r, v) in w.iter().enumerate() {
+                columns[r * n + i] -= scaled * v;
+            }
+        }
+    }
+}
+
+impl Index<(usize, usize)> for Square {
+    type Output = f64;
+    #[inline]
+    fn index(&self, (i, j): (usize, usize)) -> &f64 {
+        &self.data[i + j * self.n]
+    }
+}
+
+impl IndexMut<(usize, usize)> for Square {
+    #[inline]
+    fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut f64 {
+        &mut self.data[i + j * self.n]
+    }
+}
+
+/// The real Schur form of a square, finite matrix.
+pub fn real_schur(a: MatRef<'_, f64>) -> Result<RealSchur, Error> {
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    let n = a.nrows();
+    let (mut t, mut z) = if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+        let (mut h, mut q) = (Square::from_mat(a), Square::identity(n));
+        reduce_to_hessenberg(&mut h, Some(&mut q));
+        (h, q)
+    } else {
+        let reduced = hessenberg(a);
+        (
+            Square::from_mat(reduced.h.as_ref()),
+            Square::from_mat(reduced.q.as_ref()),
+        )
+    };
+    francis_qr(&mut t, Some(&mut z), true)?;
+    Ok(RealSchur {
+        t: t.to_mat(),
+        z: z.to_mat(),
+    })
+}
+
+/// The eigenvalues of a square, finite matrix, in the order of the diagonal of its Schur form,
+/// each conjugate pair adjacent with Im > 0 first (and exactly conjugate).
+pub fn eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    let mut h = Square::from_mat(a);
+    balance(&mut h);
+    if h.n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+        reduce_to_hessenberg(&mut h, None);
+    } else {
+        h = Square::from_mat(hessenberg_matrix(h.to_mat().as_ref()).as_ref());
+    }
+    francis_qr(&mut h, None, false)?;
+    Ok(quasi_triangular_eigenvalues(h.to_mat().as_ref()))
+}
+
+/// The eigenvalues of a quasi-upper-triangular matrix whose 2 x 2 blocks are in standard form.
+pub fn quasi_triangular_eigenvalues(t: MatRef<'_, f64>) -> Vec<c64> {
+    let n = t.nrows();
+    let mut values = Vec::with_capacity(n);
+    let mut k = 0;
+    while k < n {
+        if k + 1 < n && t[(k + 1, k)] != 0.0 {
+            let (re, b, c) = (t[(k, k)], t[(k, k + 1)], t[(k + 1, k)]);
+            let im = b.abs().sqrt() * c.abs().sqrt();
+            values.push(c64::new(re, im));
+            values.push(c64::new(re, -im));
+            k += 2;
+        } else {
+            values.push(c64::new(t[(k, k)], 0.0));
+            k += 1;
+        }
+    }
+    values
+}
+
+/// Householder reduction to upper Hessenberg form in place, H = Q^T A Q; `q` (the identity on
+/// entry) becomes Q. Reflector k maps column k below the subdiagonal onto e_{k+1}.
+fn reduce_to_hessenberg(h: &mut Square, mut q: Option<&mut Square>) {
+    let n = h.n;
+    let mut w = vec![0.0; n];
+    for k in 0..n.saturating_sub(2) {
+        let length = n - k - 1;
+        let w = &mut w[..length];
+        for (r, x) in w.iter_mut().enumerate() {
+            *x = h[(k + 1 + r, k)];
+        }
+        let (beta, tau) = reflector(w);
+        if tau == 0.0 {
+            continue;
+        }
+        w[0] = 1.0;
+        h.reflect_rows(k + 1, w, tau, k + 1..n);
+        h.reflect_columns(k + 1, w, tau, 0..n);
+        h[(k + 1, k)] = beta;
+        for r in k + 2..n {
+            h[(r, k)] = 0.0;
+        }
+        if let Some(q) = q.as_deref_mut() {
+            q.reflect_columns(k + 1, w, tau, 0..n);
+        }
+    }
+}
+
+/// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
+/// row and column i are scaled until their off-diagonal 2-norms are within a factor of two, and
+/// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more.
+fn balance(a: &mut Square) {
+    let n = a.n;
+    let mut changed = true;
+    let mut sweeps = 0;
+    while changed && sweeps < 100 {
+        changed = false;
+        sweeps += 1;
+        for i in 0..n {
+            let (mut column_squares, mut row_squares) = (0.0, 0.0);
+            for k in (0..n).filter(|&k| k != i) {
+                column_squares += a[(k, i)] * a[(k, i)];
+                row_squares += a[(i, k)] * a[(i, k)];
+            }
+            let (column, row) = (column_squares.sqrt(), row_squares.sqrt());
+            if column == 0.0 || row == 0.0 || !(column + row).is_finite() {
+                continue;
+            }
+            let sum = column + row;
+            let (mut c, mut r, mut f) = (column, row, 1.0f64);
+            while c < r / 2.0 && f < 2f64.powi(500) {
+                (c, r, f) = (c * 2.0, r / 2.0, f * 2.0);
+            }
+            while c >= r * 2.0 && f > 2f64.powi(-500) {
+                (c, r, f) = (c / 2.0, r * 2.0, f / 2.0);
+            }
+            if c + r < 0.95 * sum {
+                changed = true;
+                for k in 0..n {
+                    a[(i, k)] /= f;
+                    a[(k, i)] *= f;
+                }
+            }
+        }
+    }
+}
+
+/// A 2 x 2 block [[a, b], [c, d]] rotated into standard form by the rotation
+/// G = [[cs, -sn], [sn, cs]]: G^T [[a0, b0], [c0, d0]] G = [[a, b], [c, d]].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StandardBlock {
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+    pub d: f64,
+    pub cs: f64,
+    pub sn: f64,
+}
+
+/// The Schur factorisation of a real 2 x 2 matrix in standard form: upper triangular (c = 0)
+/// when the eigenvalues are real, equal diagonal and b c < 0 when they are complex.
+///
+/// With p = (a - d)/2 and bcmis = min(|b|, |c|) sign(b) sign(c), the discriminant
+/// z = p^2 + b c is formed as p (p / s) + max(|b|, |c|) (bcmis / s) s, scaled by s = max(|p|,
+/// max(|b|, |c|)) against overflow. Real eigenvalues (z >= 4u): a rotation through the
+/// eigenvector [z, c] triangularises the block, and the eigenvalue of larger magnitude is
+/// formed as d + z' with z' = p + sign(p) sqrt(s) sqrt(z) (no cancellation), the other from
+/// the determinant. Otherwise a rotation by the angle that equalises the diagonal, after which
+/// b and c have opposite signs (complex pair) or, when the eigenvalues are real but close,
+/// a second rotation triangularises.
+pub fn standardize_block(a: f64, b: f64, c: f64, d: f64) -> StandardBlock {
+    let eps = f64::EPSILON;
+    let identity = |a, b, c, d| StandardBlock {
+        a,
+        b,
+        c,
+        d,
+        cs: 1.0,
+        sn: 0.0,
+    };
+    if c == 0.0 {
+        return identity(a, b, c, d);
+    }
+    if b == 0.0 {
+        // Swap rows and columns.
+        return StandardBlock {
+            a: d,
+            b: -c,
+            c: 0.0,
+            d: a,
+            cs: 0.0,
+            sn: 1.0,
+        };
+    }
+    if a - d == 0.0 && b.signum() != c.signum() {
+        return identity(a, b, c, d);
+    }
+    let temp = a - d;
+    let p = 0.5 * temp;
+    let bcmax = b.abs().max(c.abs());
+    let bcmis = b.abs().min(c.abs()) * b.signum() * c.signum();
+    let scale = p.abs().max(bcmax);
+    let z = p / scale * p + bcmax / scale * bcmis;
+    if z >= 4.0 * eps {
+        // Real eigenvalues.
+        let z = p + p.signum() * scale.sqrt() * z.sqrt();
+        let a_new = d + z;
+        let d_new = d - bcmax / z * bcmis;
+        let tau = c.hypot(z);
+        return StandardBlock {
+            a: a_new,
+            b: b - c,
+            c: 0.0,
+            d: d_new,
+            cs: z / tau,
+            sn: c / tau,
+        };
+    }
+    // Complex or nearly equal real eigenvalues: equalise the diagonal.
+    let sigma = b + c;
+    let tau = sigma.hypot(temp);
+    let mut cs = (0.5 * (1.0 + sigma.abs() / tau)).sqrt();
+    let mut sn = -(p / (tau * cs)) * sigma.signum();
+    // [aa bb; cc dd] = [a b; c d] G, then G^T [aa bb; cc dd].
+    let (aa, bb) = (a * cs + b * sn, -a * sn + b * cs);
+    let (cc, dd) = (c * cs + d * sn, -c * sn + d * cs);
+    let mut b = bb * cs + dd * sn;
+    let mut c = -aa * sn + cc * cs;
+    let mean = 0.5 * ((aa * cs + cc * sn) + (-bb * sn + dd * cs));
+    let (mut a, mut d) = (mean, mean);
+    if c != 0.0 {
+        if b != 0.0 {
+            if b.signum() == c.signum() {
+                // Real eigenvalues: triangularise with a second rotation.
+                let sab = b.abs().sqrt();
+                let sac = c.abs().sqrt();
+                let p = sab * sac * c.signum();
+                let tau = 1.0 / (b + c).abs().sqrt();
+                a = mean + p;
+                d = mean - p;
+                b -= c;
+                c = 0.0;
+                let (cs1, sn1) = (sab * tau, sac * tau);
+                (cs, sn) = (cs * cs1 - sn * sn1, cs * sn1 + sn * cs1);
+            }
+        } else {
+            b = -c;
+            c = 0.0;
+            (cs, sn) = (-sn, cs);
+        }
+    }
+    StandardBlock { a, b, c, d, cs, sn }
+}
+
+/// The Householder reflector I - τ [1; v][1; v]^T that maps x (length 2 or 3) to β e1:
+/// returns (β, τ) and leaves v in x[1..].
+fn reflector(x: &mut [f64]) -> (f64, f64) {
+    let alpha = x[0];
+    let tail_squares: f64 = x[1..].iter().map(|v| v * v).sum();
+    if tail_squares == 0.0 {
+        return (alpha, 0.0);
+    }
+    let squares = alpha * alpha + tail_squares;
+    // Plain sums of squares unless they left the normal range (then rescale; hypot is slow).
+    let norm =
+        if (f64::MIN_POSITIVE..f64::MAX).contains(&squares) && tail_squares >= f64::MIN_POSITIVE {
+            squares.sqrt()
+        } else {
+            let scale = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            scale * x.iter().map(|v| (v / scale).powi(2)).sum::<f64>().sqrt()
+        };
+    let beta = -alpha.signum() * norm;
+    let tau = (beta - alpha) / beta;
+    let scale = 1.0 / (alpha - beta);
+    for v in &mut x[1..] {
+        *v *= scale;
+    }
+    (beta, tau)
+}
+
+/// The Francis double-shift QR iteration on an upper Hessenberg `h`, in place.
+///
+/// With `full` the whole of `h` is transformed into the Schur form T (and `z`, if given, is
+/// multiplied on the right by the orthogonal transformations); without it only the diagonal
+/// blocks are formed, which suffices for the eigenvalues.
+fn francis_qr(h: &mut Square, mut z: Option<&mut Square>, full: bool) -> Result<(), Error> {
+    let n = h.n;
+    if n == 0 {
+        return Ok(());
+    }
+    let ulp = f64::EPSILON;
+    let small = f64::MIN_POSITIVE * (n as f64 / ulp);
+    let max_iterations = 30 * n.max(10);
+    let mut iterations_since_deflation = 0;
+    // The window is rows and columns l..=i; the eigenvalues below i have converged.
+    let mut i = n - 1;
+    loop {
+        let mut l = 0;
+        let mut converged = false;
+        for _ in 0..=max_iterations {
+            // Find the lowest negligible subdiagonal entry h[k, k-1], l < k <= i.
+            let mut k = i;
+            while k > l {
+                let sub = h[(k, k - 1)].abs();
+                if sub <= small {
+                    break;
+                }
+                let mut test = h[(k - 1, k - 1)].abs() + h[(k, k)].abs();
+                if test == 0.0 {
+                    if k >= l + 2 {
+                        test += h[(k - 1, k - 2)].abs();
+                    }
+                    if k < i {
+                        test += h[(k + 1, k)].abs();
+                    }
+                }
+                if sub <= ulp * test {
+                    // Ahues & Tisseur (1997): negligible if the 2 x 2 block's eigenvalues move
+                    // by at most u times their size.
+                    let sup = h[(k - 1, k)].abs();
+                    let (ab, ba) = (sub.max(sup), sub.min(sup));
+                    let diff = (h[(k - 1, k - 1)] - h[(k, k)]).abs();
+                    let (aa, bb) = (h[(k, k)].abs().max(diff), h[(k, k)].abs().min(diff));
+                    let s = aa + ab;
+                    if ba * (ab / s) <= small.max(ulp * (bb * (aa / s))) {
+                        break;
+                    }
+                }
+                k -= 1;
+            }
+            l = k;
+            if l > 0 {
+                h[(l, l - 1)] = 0.0;
+            }
+            if l + 1 >= i {
+                converged = true;
+                break;
+            }
+            iterations_since_deflation += 1;
+            let (first, last) = if full { (0, n - 1) } else { (l, i) };
+
+            // The shifts: the eigenvalues of the trailing 2 x 2 block, or exceptional ones.
+            let (h11, h12, h21, h22) =
+                if iterations_since_deflation % (2 * EXCEPTIONAL_SHIFT_INTERVAL) == 0 {
+                    let s = h[(i, i - 1)].abs() + h[(i - 1, i - 2)].abs();
+                    (0.75 * s + h[(i, i)], -0.4375 * s, s, 0.75 * s + h[(i, i)])
+                } else if iterations_since_deflation % EXCEPTIONAL_SHIFT_INTERVAL == 0 {
+                    let s = h[(l + 1, l)].abs() + h[(l + 2, l + 1)].abs();
+                    (0.75 * s + h[(l, l)], -0.4375 * s, s, 0.75 * s + h[(l, l)])
+                } else {
+                    (h[(i - 1, i - 1)], h[(i - 1, i)], h[(i, i - 1)], h[(i, i)])
+                };
+            let (shift1, shift2) = double_shift(h11, h12, h21, h22);
+
+            // Start the bulge at the highest m >= l where two consecutive small subdiagonal
+            // entries make the first column of (H - s1)(H - s2) nearly a multiple of e_m.
+            let mut m = i - 2;
+            let mut v = [0.0; 3];
+            loop {
+                let h21s = h[(m + 1, m)];
+                let s = (h[(m, m)] - shift2.re).abs() + shift2.im.abs() + h21s.abs();
+                let h21s = h21s / s;
+                v[0] = h21s * h[(m, m + 1)]
+                    + (h[(m, m)] - shift1.re) * ((h[(m, m)] - shift2.re) / s)
+                    - shift1.im * (shift2.im / s);
+                v[1] = h21s * (h[(m, m)] + h[(m + 1, m + 1)] - shift1.re - shift2.re);
+                v[2] = h21s * h[(m + 2, m + 1)];
+                let s = v[0].abs() + v[1].abs() + v[2].abs();
+                for x in &mut v {
+                    *x /= s;
+                }
+                if m == l {
+                    break;
+                }
+                let h00 = h[(m, m - 1)].abs() * (v[1].abs() + v[2].abs());
+                let h01 = v[0].abs()
+                    * (h[(m - 1, m - 1)].abs() + h[(m, m)].abs() + h[(m + 1, m + 1)].abs());
+                if h00 <= ulp * h01 {
+                    break;
+                }
+                m -= 1;
+            }
+
+            // Chase the bulge from row m to the bottom of the window.
+            for k in m..i {
+                let rows = 3.min(i - k + 1);
+                if k > m {
+                    for (r, x) in v.iter_mut().enumerate().take(rows) {
+                        *x = h[(k + r, k - 1)];
+                    }
+                }
+                let (beta, tau) = reflector(&mut v[..rows]);
+                if k > m {
+                    h[(k, k - 1)] = beta;
+                    h[(k + 1, k - 1)] = 0.0;
+                    if k + 2 <= i {
+                        h[(k + 2, k - 1)] = 0.0;
+                    }
+                } else if m > l {
+                    // = -h[k, k-1] in exact arithmetic; this form stays right when v underflows.
+                    h[(k, k - 1)] *= 1.0 - tau;
+                }
+                let w = [1.0, v[1], v[2]];
+                let w = &w[..rows];
+                h.reflect_rows(k, w, tau, k..last + 1);
+                h.reflect_columns(k, w, tau, first..(k + 3).min(i) + 1);
+                if let Some(z) = z.as_deref_mut() {
+                    z.reflect_columns(k, w, tau, 0..n);
+                }
+            }
+        }
+        if !converged {
+            return Err(Error::NoConvergence {
+                algorithm: "the Francis double-shift QR iteration",
+            });
+        }
+        if l + 1 == i {
+            // A 2 x 2 block: standardise it, and carry its rotation through the rest.
+            let block =
+                standardize_block(h[(i - 1, i - 1)], h[(i - 1, i)], h[(i, i - 1)], h[(i, i)]);
+            h[(i - 1, i - 1)] = block.a;
+            h[(i - 1, i)] = block.b;
+            h[(i, i - 1)] = block.c;
+            h[(i, i)] = block.d;
+            if full {
+                h.rotate_rows(i - 1, i + 1..n, block.cs, block.sn);
+                h.rotate_columns(i - 1, 0..i - 1, block.cs, block.sn);
+            }
+            if let Some(z) = z.as_deref_mut() {
+                z.rotate_columns(i - 1, 0..n, block.cs, block.sn);
+            }
+        }
+        iterations_since_deflation = 0;
+        if l == 0 {
+            return Ok(());
+        }
+        i = l - 1;
+    }
+}
+
+/// The two shifts of a double-shift step: the eigenvalues of [[h11, h12], [h21, h22]] when
+/// they are complex; when they are real, the one nearer h22, twice.
+fn double_shift(h11: f64, h12: f64, h21: f64, h22: f64) -> (c64, c64) {
+    let s = h11.abs() + h12.abs() + h21.abs() + h22.abs();
+    if s == 0.0 {
+        return (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
+    }
+    let (h11, h12, h21, h22) = (h11 / s, h12 / s, h21 / s, h22 / s);
+    let trace_half = (h11 + h22) / 2.0;
+    let det = (h11 - trace_half) * (h22 - trace_half) - h12 * h21;
+    let root = det.abs().sqrt();
+    if det >= 0.0 {
+        let re = trace_half * s;
+        (c64::new(re, root * s), c64::new(re, -root * s))
+    } else {
+        let (high, low) = (trace_half + root, trace_half - root);
+        let nearer = if (high - h22).abs() <= (low - h22).abs() {
+            high
+        } else {
+            low
+        };
+        (c64::new(nearer * s, 0.0), c64::new(nearer * s, 0.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::linalg::solvers::DenseSolveCore;
+    use faer::mat;
+
+    /// A deterministic pseudo-random matrix with entries in [-1, 1).
+    fn seeded(n: usize, seed: u64) -> Mat<f64> {
+        let mut state = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
+        Mat::from_fn(n, n, |_, _| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        })
+    }
+
+    fn assert_schur_form(a: &Mat<f64>, what: &str) {
+        let n = a.nrows();
+        let RealSchur { t, z } = real_schur(a.as_ref()).unwrap();
+        let scale = a.norm_l2().max(f64::MIN_POSITIVE);
+        let residual = (&z * &t * z.transpose() - a).norm_l2() / scale;
+        assert!(
+            residual < 1e-14 * (n as f64).max(1.0),
+            "{what}: residual {residual}"
+        );
+        let orthogonality = (z.transpose() * &z - Mat::<f64>::identity(n, n)).norm_l2();
+        assert!(
+            orthogonality < 1e-14 * (n as f64).max(1.0),
+            "{what}: {orthogonality}"
+        );
+        // Quasi-triangular, no two consecutive subdiagonal entries, blocks standard.
+        for j in 0..n {
+            for i in j + 2..n {
+                assert_eq!(t[(i, j)], 0.0, "{what}: T[{i}, {j}]");
+            }
+        }
+        for k in 0..n.saturating_sub(1) {
+            if t[(k + 1, k)] != 0.0 {
+                assert_eq!(t[(k, k)], t[(k + 1, k + 1)], "{what}: block {k} diagonal");
+                assert!(
+                    t[(k, k + 1)] * t[(k + 1, k)] < 0.0,
+                    "{what}: block {k} signs"
+                );
+                if k + 2 < n {
+                    assert_eq!(t[(k + 2, k + 1)], 0.0, "{what}: overlapping blocks at {k}");
+                }
+            }
+        }
+    }
+
+    fn sorted(mut values: Vec<c64>) -> Vec<c64> {
+        values.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+        values
+    }
+
+    #[test]
+    fn random_matrices_reduce_to_standard_schur_form() {
+        for n in [1usize, 2, 3, 4, 5, 8, 13, 30, 64] {
+            for seed in 0..4 {
+                assert_schur_form(
+                    &seeded(n, seed * 100 + n as u64),
+                    &format!("n={n} seed={seed}"),
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn structured_matrices_reduce_to_standard_schur_form() {
+        let n = 12;
+        let cases: Vec<(&str, Mat<f64>)> = vec![
+            ("zero", Mat::zeros(n, n)),
+            ("identity", Mat::identity(n, n)),
+            (
+                "Jordan block",
+                Mat::from_fn(n, n, |i, j| {
+                    if j == i + 1 {
+                        1.0
+                    } else if i == j {
+                        2.0
+                    } else {
+                        0.0
+                    }
+                }),
+            ),
+            (
+                // Companion matrix of λ^n - 1: roots on the unit circle, a hard case for shifts.
+                "cyclic shift",
+                Mat::from_fn(n, n, |i, j| if (i + 1) % n == j { 1.0 } else { 0.0 }),
+            ),
+            (
+                "graded",
+                Mat::from_fn(n, n, |i, j| {
+                    10f64.powi(i as i32 - j as i32) * ((i + 2 * j) % 5) as f64
+                }),
+            ),
+            (
+                "nilpotent upper",
+                Mat::from_fn(n, n, |i, j| if j > i { 1.0 } else { 0.0 }),
+            ),
+            (
+                "rotation blocks",
+                Mat::from_fn(n, n, |i, j| match (i % 2, j as isize - i as isize) {
+                    (0, 1) => 1.0,
+                    (1, -1) => -1.0,
+                    _ => 0.0,
+                }),
+            ),
+        ];
+        for (what, a) in &cases {
+            assert_schur_form(a, what);
+        }
+    }
+
+    #[test]
+    fn eigenvalues_agree_with_faer() {
+        for n in [2usize, 3, 4, 7, 16, 40] {
+            let a = seeded(n, 7 * n as u64);
+            let ours = sorted(eigenvalues(a.as_ref()).unwrap());
+            let theirs = sorted(a.eigenvalues().unwrap());
+            for (x, y) in ours.iter().zip(&theirs) {
+                assert!((x - y).norm() < 1e-12 * (n as f64), "n={n}: {x} vs {y}");
+            }
+        }
+    }
+
+    #[test]
+    fn eigenvalues_of_the_747_lateral_model() {
+        // (6.150), (6.152).
+        let a = mat![
+            [-0.0999, 0.0000, 0.1153, -1.0000],
+            [-1.6038, -1.0932, 0.0, 0.2850],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.4089, -0.0395, 0.0, -0.2454]
+        ];
+        let values = eigenvalues(a.as_ref()).unwrap();
+        let expected = [
+            c64::new(-0.08066, 0.7433),
+            c64::new(-1.2308, 0.0),
+            c64::new(-0.04641, 0.0),
+        ];
+        for e in expected {
+            assert!(
+                values.iter().any(|v| (v - e).norm() < 2e-4),
+                "{e} in {values:?}"
+            );
+        }
+        // Pairs adjacent, Im > 0 first, exactly conjugate.
+        let k = values.iter().position(|v| v.im != 0.0).unwrap();
+        assert!(values[k].im > 0.0 && values[k + 1] == values[k].conj());
+    }
+
+    #[test]
+    fn balancing_recovers_eigenvalues_of_a_badly_scaled_matrix() {
+        // D^-1 M D with D = diag(1, 1e6, 1e-6): the eigenvalues of M are 1, 2, 3.
+        let d = [1.0, 1e6, 1e-6];
+        let m = mat![[1.0, 1.0, 1.0], [0.0, 2.0, 1.0], [0.0, 0.0, 3.0]];
+        let p = mat![[1.0, 0.5, 0.25], [0.3, 1.0, 0.7], [0.2, 0.1, 1.0]];
+        let similar = &p * &m * p.partial_piv_lu().inverse();
+        let a = Mat::from_fn(3, 3, |i, j| similar[(i, j)] * d[j] / d[i]);
+        let values = sorted(eigenvalues(a.as_ref()).unwrap());
+        for (v, e) in values.iter().zip([1.0, 2.0, 3.0]) {
+            assert!((v.re - e).abs() < 1e-12 && v.im == 0.0, "{v} vs {e}");
+        }
+    }
+
+    #[test]
+    fn standard_blocks() {
+        let cases = [
+            (1.0, 2.0, 3.0, 4.0),        // real eigenvalues
+            (1.0, -2.0, 3.0, 4.0),       // complex
+            (0.0, 1.0, -1.0, 0.0),       // already standard
+            (2.0, 0.0, 5.0, 3.0),        // b = 0: swap
+            (1.0, 1e-20, -1e-20, 1.0),   // tiny coupling
+            (1e300, 1e300, -1e300, 0.0), // large entries
+            (3.0, 1.0, 1e-18, 3.0),      // nearly equal real eigenvalues
+        ];
+        for (a, b, c, d) in cases {
+            let s = standardize_block(a, b, c, d);
+            let g = mat![[s.cs, -s.sn], [s.sn, s.cs]];
+            let m = mat![[a, b], [c, d]];
+            let rotated = g.transpose() * &m * &g;
+            let scale = m.norm_l2();
+            let result = mat![[s.a, s.b], [s.c, s.d]];
+            assert!(
+                (&rotated - &result).norm_l2() <= 4e-16 * scale,
+                "{a} {b} {c} {d}: {s:?}"
+            );
+            assert!((s.cs * s.cs + s.sn * s.sn - 1.0).abs() < 4e-16);
+            assert!(s.c == 0.0 || (s.a == s.d && s.b * s.c < 0.0), "{s:?}");
+        }
+    }
+}
