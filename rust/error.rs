@@ -49,6 +49,15 @@ pub enum Error {
         eigenvalue_re: f64,
         eigenvalue_im: f64,
     },
+    /// An argument breaks a rule that the other variants do not describe; the message says
+    /// which and how.
+    InvalidArgument { arg: &'static str, message: String },
+    /// A pair (A, B) is not controllable (or (A, C) not observable) to the rank tolerance.
+    Uncontrollable {
+        pair: &'static str,
+        eigenvalues: Vec<faer::c64>,
+        tolerance: f64,
+    },
     /// An iterative algorithm did not converge within its iteration limit.
     NoConvergence { algorithm: &'static str },
     /// One problem of a batch failed; `index` is its position in the stack.
@@ -77,6 +86,15 @@ fn format_shape(shape: &[usize]) -> String {
             let parts: Vec<String> = shape.iter().map(usize::to_string).collect();
             format!("({})", parts.join(", "))
         }
+    }
+}
+
+/// A complex number as Python prints it, e.g. -0.08066+0.7433j, or a real one plainly.
+pub fn format_complex(z: faer::c64) -> String {
+    if z.im == 0.0 {
+        format!("{}", z.re)
+    } else {
+        format!("{}{:+}j", z.re, z.im)
     }
 }
 
@@ -121,6 +139,21 @@ impl fmt::Display for Error {
                 "{arg} is singular: it has the eigenvalue 0 (computed as {eigenvalue_re:e}{eigenvalue_im:+e}i), \
                  an integrator or neutral mode, so {arg}^-1 does not exist"
             ),
+            Error::InvalidArgument { message, .. } => write!(f, "{message}"),
+            Error::Uncontrollable {
+                pair,
+                eigenvalues,
+                tolerance,
+            } => {
+                let listed: Vec<String> = eigenvalues.iter().map(|e| format_complex(*e)).collect();
+                write!(
+                    f,
+                    "{pair} is not controllable: no state feedback can move the eigenvalue{} {} \
+                     (rank tolerance {tolerance:.3e})",
+                    if eigenvalues.len() == 1 { "" } else { "s" },
+                    listed.join(", ")
+                )
+            }
             Error::NoConvergence { algorithm } => {
                 write!(f, "{algorithm} did not converge within its iteration limit")
             }

@@ -18,6 +18,9 @@
 //! * [`response`]: time responses on a uniform grid, by one discretisation and a recurrence.
 //! * [`freq`]: frequency responses through one Hessenberg reduction ([`hessenberg`]).
 //! * [`modes`]: eigenvalues, modes and their characteristics, the characteristic polynomial.
+//! * [`schur`]: the real Schur form and eigenvalues (Francis double-shift QR).
+//! * [`ctrb`]: controllability and observability matrices and the staircase verdict.
+//! * [`place`]: pole placement: Bass–Gura, Ackermann and the robust multi-input method.
 //! * [`batch`]: the same operations over stacks of problems, in parallel.
 //! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
 //! * [`lu`]: linear solves by LU with partial pivoting.
@@ -35,6 +38,7 @@
 //! (small fixed-size blocks).
 
 pub mod batch;
+pub mod ctrb;
 pub mod discretize;
 pub mod dispatch;
 pub mod double_double;
@@ -45,6 +49,7 @@ pub mod hessenberg;
 pub mod lu;
 pub mod modes;
 pub mod norm;
+pub mod place;
 pub mod pool;
 pub mod response;
 pub mod schur;

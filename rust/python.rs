@@ -42,7 +42,8 @@ fn exception_class_name(error: &Error) -> &'static str {
             "ShapeError"
         }
         Error::NonFinite { .. } => "NonFiniteError",
-        Error::InvalidValue { .. } => "InvalidArgumentError",
+        Error::InvalidValue { .. } | Error::InvalidArgument { .. } => "InvalidArgumentError",
+        Error::Uncontrollable { .. } => "UncontrollableError",
         Error::NoConvergence { .. } => "ConvergenceError",
         Error::Singular { .. } => "SingularMatrixError",
         Error::InBatch { source, .. } => exception_class_name(source),

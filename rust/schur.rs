@@ -388,9 +388,9 @@ pub fn standardize_block(a: f64, b: f64, c: f64, d: f64) -> StandardBlock {
     StandardBlock { a, b, c, d, cs, sn }
 }
 
-/// The Householder reflector I - τ [1; v][1; v]^T that maps x (length 2 or 3) to β e1:
-/// returns (β, τ) and leaves v in x[1..].
-fn reflector(x: &mut [f64]) -> (f64, f64) {
+/// The Householder reflector I - τ [1; v][1; v]^T that maps x to β e1: returns (β, τ) and
+/// leaves v in x[1..]. τ = 0 (the identity) when x[1..] is zero.
+pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
     let alpha = x[0];
     let tail_squares: f64 = x[1..].iter().map(|v| v * v).sum();
     if tail_squares == 0.0 {

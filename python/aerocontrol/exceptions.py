@@ -14,6 +14,7 @@ class                         raised when
 ``AerocontrolLinAlgError``    a numerical condition makes the problem unsolvable
 ``ConvergenceError``          an iteration reached its limit (an ``AerocontrolLinAlgError``)
 ``SingularMatrixError``       a matrix to invert has a zero eigenvalue (likewise)
+``UncontrollableError``       a pair (A, B) has a mode that no feedback can move (likewise)
 ============================  ===========================================================
 
 Warnings (``AerocontrolWarning`` and subclasses) report results that were computed but deserve
@@ -36,6 +37,7 @@ __all__ = [
     "NumericalOverflowWarning",
     "ShapeError",
     "SingularMatrixError",
+    "UncontrollableError",
 ]
 
 
@@ -68,6 +70,11 @@ class AerocontrolLinAlgError(AerocontrolError, np.linalg.LinAlgError):
 class SingularMatrixError(AerocontrolLinAlgError):
     """A matrix that must be invertible is singular; the message names the zero eigenvalue
     (an integrator or neutral mode, for a plant matrix)."""
+
+
+class UncontrollableError(AerocontrolLinAlgError):
+    """A pair (A, B) is not controllable to the rank tolerance (or (A, C) not observable);
+    the message names the eigenvalues that feedback cannot move."""
 
 
 class ConvergenceError(AerocontrolLinAlgError):
