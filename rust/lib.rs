@@ -30,6 +30,15 @@
 //! * [`dispatch`]: run-time choice of AVX2 + FMA kernels.
 //! * [`error`]: the error type and the argument checks.
 //!
+//! # Threads
+//!
+//! Functions that work on stacks of problems use rayon and say so; every faer kernel of the
+//! single-problem functions runs with an explicit `Par::Seq` where it matters for speed, except
+//! faer's convenience methods (`qr()`, `partial_piv_lu()`, `singular_values()`), which follow
+//! faer's global parallelism. Its default (rayon) costs more in dispatch than a 4 x 4
+//! factorisation takes, so callers of the Rust API should call
+//! `faer::set_global_parallelism(faer::Par::Seq)` once, as the Python module does at import.
+//!
 //! # Which linear algebra library where
 //!
 //! faer does all dense kernels: products, LU, and later QR, Hessenberg and eigenvalues. It is

@@ -13,12 +13,18 @@
 //! failed) into a Python exception instead of unwinding into the interpreter.
 
 use crate::batch::{MatrixStack, expm_batch};
+use crate::ctrb::{
+    controllability as controllability_core, ctrb, observability as observability_core, obsv,
+};
 use crate::discretize::{Hold, discretize as discretize_core};
 use crate::error::{Error, check_square};
 use crate::expm::{expm_into, pade_choice, transition_matrices_into};
 use crate::freq::{check_state_space, frequency_response_into};
-use crate::modes::modal_analysis as modal_analysis_core;
+use crate::modes::{charpoly as charpoly_core, modal_analysis as modal_analysis_core};
 use crate::norm::one_norm;
+use crate::place::{
+    companion_form as companion_form_core, place as place_core, place_ackermann, place_bass_gura,
+};
 use crate::response::{
     Input, Model, simulate_into, simulate_models_into, steady_state as steady_state_core,
     uniform_grid_step,
@@ -873,9 +879,184 @@ fn modal_analysis<'py>(
     Ok(result)
 }
 
+/// Two matrix views of one call, or the error naming the first bad one.
+fn two_views<'a>(
+    py: Python<'_>,
+    first: (&'a Bound<'_, PyArrayDyn<f64>>, &'static str),
+    second: (&'a Bound<'_, PyArrayDyn<f64>>, &'static str),
+) -> PyResult<(MatRef<'a, f64>, MatRef<'a, f64>)> {
+    let a = matrix_view(first.0, first.1).map_err(|e| to_py_err(py, e))?;
+    let b = matrix_view(second.0, second.1).map_err(|e| to_py_err(py, e))?;
+    Ok((a, b))
+}
+
+/// The controllability matrix [B AB ... A^{n-1}B] (6.74), or with `dual` the observability
+/// matrix [C; CA; ...] (6.89) of (A, C).
+#[pyfunction]
+#[pyo3(signature = (a, b, dual, /))]
+fn krylov_matrix<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    dual: bool,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let second_name = if dual { "C" } else { "B" };
+    let (a, b) = (float_array(py, a, "A")?, float_array(py, b, second_name)?);
+    let (a, b) = two_views(py, (&a, "A"), (&b, second_name))?;
+    let matrix =
+        guarded(|| if dual { obsv(a, b) } else { ctrb(a, b) })?.map_err(|e| to_py_err(py, e))?;
+    matrix_to_numpy(py, &matrix)
+}
+
+fn complex_vector<'py>(py: Python<'py>, values: &[c64]) -> PyResult<Bound<'py, PyArrayDyn<c64>>> {
+    let out = new_array::<c64>(py, &[values.len()])?;
+    // SAFETY: new and not visible to Python until returned.
+    unsafe { new_array_data(&out) }.copy_from_slice(values);
+    Ok(out)
+}
+
+/// The controllability of (A, B) (or with `dual` the observability of (A, C)) as a dict.
+#[pyfunction]
+#[pyo3(signature = (a, b, tol, modal_test, with_transformation, dual, /))]
+fn controllability<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    tol: Option<f64>,
+    modal_test: bool,
+    with_transformation: bool,
+    dual: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let second_name = if dual { "C" } else { "B" };
+    let (a, b) = (float_array(py, a, "A")?, float_array(py, b, second_name)?);
+    let (a, b) = two_views(py, (&a, "A"), (&b, second_name))?;
+    let analysis = guarded(|| {
+        if dual {
+            observability_core(a, b, tol, modal_test, with_transformation)
+        } else {
+            controllability_core(a, b, tol, modal_test, with_transformation)
+        }
+    })?
+    .map_err(|e| to_py_err(py, e))?;
+    let result = PyDict::new(py);
+    let staircase = &analysis.staircase;
+    result.set_item("a", matrix_to_numpy(py, &staircase.a)?)?;
+    result.set_item("b", matrix_to_numpy(py, &staircase.b)?)?;
+    result.set_item("z", matrix_to_numpy(py, &staircase.z)?)?;
+    result.set_item("block_sizes", staircase.block_sizes.clone())?;
+    result.set_item("controllable_order", staircase.controllable_order)?;
+    result.set_item("smallest_pivot", staircase.smallest_pivot)?;
+    result.set_item(
+        "staircase_eigenvalues",
+        complex_vector(py, &staircase.uncontrollable_eigenvalues)?,
+    )?;
+    result.set_item("eigenvalues", complex_vector(py, &analysis.eigenvalues)?)?;
+    result.set_item("modal_measure", real_vector(py, &analysis.modal_measure)?)?;
+    result.set_item(
+        "uncontrollable_eigenvalues",
+        complex_vector(py, &analysis.uncontrollable_eigenvalues)?,
+    )?;
+    result.set_item("tolerance", analysis.tolerance)?;
+    Ok(result)
+}
+
+/// The coefficients [1, a_1, ..., a_n] of det(λI - A).
+#[pyfunction]
+#[pyo3(signature = (a, /))]
+fn charpoly<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let a = float_array(py, a, "A")?;
+    let a = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
+    let coefficients = guarded(|| charpoly_core(a))?.map_err(|e| to_py_err(py, e))?;
+    real_vector(py, &coefficients)
+}
+
+/// The companion-form transformation (6.116)-(6.145) as a dict.
+#[pyfunction]
+#[pyo3(signature = (a, b, /))]
+fn companion_form<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (a, b) = (float_array(py, a, "A")?, float_array(py, b, "B")?);
+    let (a, b) = two_views(py, (&a, "A"), (&b, "B"))?;
+    let form = guarded(|| companion_form_core(a, b))?.map_err(|e| to_py_err(py, e))?;
+    let result = PyDict::new(py);
+    result.set_item("V", matrix_to_numpy(py, &form.v)?)?;
+    result.set_item("W", matrix_to_numpy(py, &form.w)?)?;
+    result.set_item("T", matrix_to_numpy(py, &form.t)?)?;
+    result.set_item("companion", matrix_to_numpy(py, &form.companion)?)?;
+    result.set_item("coefficients", real_vector(py, &form.coefficients)?)?;
+    Ok(result)
+}
+
+/// Pole placement by `method` ("bass-gura", "ackermann" or "knv0"), as a tuple (K, A - BK,
+/// poles, achieved poles, max relative error, iterations, converged, κ(V), κ(X)).
+#[pyfunction]
+#[pyo3(signature = (a, b, poles, method, /))]
+#[allow(clippy::type_complexity)]
+fn place<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    poles: &Bound<'py, PyAny>,
+    method: &str,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    f64,
+    usize,
+    bool,
+    f64,
+    f64,
+)> {
+    let (a, b) = (float_array(py, a, "A")?, float_array(py, b, "B")?);
+    let (a, b) = two_views(py, (&a, "A"), (&b, "B"))?;
+    let poles = poles.cast::<PyArrayDyn<c64>>()?;
+    let requested = copy_complex(poles)?;
+    let placer = match method {
+        "bass-gura" => place_bass_gura,
+        "ackermann" => place_ackermann,
+        "knv0" => place_core,
+        other => {
+            return Err(raise(
+                py,
+                "InvalidArgumentError",
+                format!("unknown placement method {other:?}"),
+            ));
+        }
+    };
+    let design = guarded(|| placer(a, b, &requested))?.map_err(|e| to_py_err(py, e))?;
+    Ok((
+        matrix_to_numpy(py, &design.gain)?,
+        matrix_to_numpy(py, &design.closed_loop)?,
+        complex_vector(py, &design.poles)?,
+        complex_vector(py, &design.achieved_poles)?,
+        design.max_relative_error,
+        design.iterations,
+        design.converged,
+        design.controllability_condition,
+        design.eigenvector_condition,
+    ))
+}
+
+/// The values of a complex128 array, in C order.
+fn copy_complex(array: &Bound<'_, PyArrayDyn<c64>>) -> PyResult<Vec<c64>> {
+    let readonly = array.readonly();
+    let view = readonly.as_array();
+    entries(view.shape())?;
+    Ok(view.iter().copied().collect())
+}
+
 /// The native core of aerocontrol; use the `aerocontrol` package, not this module.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // Every kernel whose size warrants threads gets its Par explicitly; faer's convenience
+    // methods (small QR, LU and SVD in the placement code) follow the global setting, whose
+    // default, rayon, costs more in dispatch than a 4 x 4 factorisation takes.
+    faer::set_global_parallelism(faer::Par::Seq);
     m.add_function(wrap_pyfunction!(expm, m)?)?;
     m.add_function(wrap_pyfunction!(transition_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(discretize, m)?)?;
@@ -887,6 +1068,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(steady_state, m)?)?;
     m.add_function(wrap_pyfunction!(frequency_response, m)?)?;
     m.add_function(wrap_pyfunction!(modal_analysis, m)?)?;
+    m.add_function(wrap_pyfunction!(krylov_matrix, m)?)?;
+    m.add_function(wrap_pyfunction!(controllability, m)?)?;
+    m.add_function(wrap_pyfunction!(charpoly, m)?)?;
+    m.add_function(wrap_pyfunction!(companion_form, m)?)?;
+    m.add_function(wrap_pyfunction!(place, m)?)?;
     m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
     m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;
     m.add("FMA_KERNELS", crate::dispatch::fma_available())?;

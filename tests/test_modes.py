@@ -85,6 +85,6 @@ def test_mode_characteristics_in_closed_form() -> None:
     assert np.isnan(m.time_to_half[real]) and m.time_constant[real] == pytest.approx(2.0)
 
 
-def test_characteristic_polynomial_of_the_state_feedback_example() -> None:
+def test_charpoly_of_the_state_feedback_example() -> None:
     A, _ = aerocontrol.chapter.state_feedback_example()
-    np.testing.assert_array_equal(aerocontrol.characteristic_polynomial(A), [1.0, 3.0, 0.0])
+    np.testing.assert_array_equal(aerocontrol.charpoly(A), [1.0, 3.0, 0.0])

@@ -16,6 +16,15 @@ from __future__ import annotations
 from importlib.metadata import PackageNotFoundError, version
 
 from . import chapter, exceptions
+from .controllability import (
+    Controllability,
+    controllability,
+    ctrb,
+    is_controllable,
+    is_observable,
+    observability,
+    obsv,
+)
 from .exceptions import (
     AerocontrolError,
     AerocontrolLinAlgError,
@@ -28,10 +37,20 @@ from .exceptions import (
     NumericalOverflowWarning,
     ShapeError,
     SingularMatrixError,
+    UncontrollableError,
 )
 from .frequency import FrequencyResponse, bode, default_frequency_grid, frequency_response
 from .linalg import Discretization, discretize, expm, transition_matrix
-from .modal import Modes, characteristic_polynomial, modes
+from .modal import Modes, charpoly, modes
+from .placement import (
+    CompanionForm,
+    Placement,
+    augment_mode,
+    companion_form,
+    place,
+    place_ackermann,
+    place_bass_gura,
+)
 from .responses import (
     TimeResponse,
     dc_gain,
@@ -54,6 +73,8 @@ __all__ = [
     "AerocontrolError",
     "AerocontrolLinAlgError",
     "AerocontrolWarning",
+    "CompanionForm",
+    "Controllability",
     "ConvergenceError",
     "Discretization",
     "FrequencyResponse",
@@ -63,15 +84,21 @@ __all__ = [
     "NonFiniteError",
     "NotRealError",
     "NumericalOverflowWarning",
+    "Placement",
     "ShapeError",
     "SingularMatrixError",
     "StateSpace",
     "TimeResponse",
+    "UncontrollableError",
     "__version__",
     "as_state_space",
+    "augment_mode",
     "bode",
     "chapter",
-    "characteristic_polynomial",
+    "charpoly",
+    "companion_form",
+    "controllability",
+    "ctrb",
     "dc_gain",
     "default_frequency_grid",
     "default_time_grid",
@@ -83,7 +110,14 @@ __all__ = [
     "frequency_response",
     "impulse_response",
     "initial_response",
+    "is_controllable",
+    "is_observable",
     "modes",
+    "observability",
+    "obsv",
+    "place",
+    "place_ackermann",
+    "place_bass_gura",
     "steady_state",
     "step_response",
     "transition_matrix",

@@ -12,13 +12,18 @@ __all__ = [
     "EXACT_NORM_MAX_ORDER",
     "FMA_KERNELS",
     "SMALL_MAX_ORDER",
+    "charpoly",
     "check_model",
+    "companion_form",
+    "controllability",
     "discretize",
     "expm",
     "expm_pade_choice",
     "frequency_response",
     "grid_step",
+    "krylov_matrix",
     "modal_analysis",
+    "place",
     "simulate",
     "simulate_models",
     "steady_state",
@@ -68,3 +73,28 @@ def frequency_response(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, omega: ArrayLike, /
 ) -> NDArray[np.complex128]: ...
 def modal_analysis(a: ArrayLike, b: ArrayLike | None, /) -> dict[str, Any]: ...
+def krylov_matrix(a: ArrayLike, b: ArrayLike, dual: bool, /) -> NDArray[np.float64]: ...
+def controllability(
+    a: ArrayLike,
+    b: ArrayLike,
+    tol: float | None,
+    modal_test: bool,
+    with_transformation: bool,
+    dual: bool,
+    /,
+) -> dict[str, Any]: ...
+def charpoly(a: ArrayLike, /) -> NDArray[np.float64]: ...
+def companion_form(a: ArrayLike, b: ArrayLike, /) -> dict[str, Any]: ...
+def place(
+    a: ArrayLike, b: ArrayLike, poles: NDArray[np.complex128], method: str, /
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.complex128],
+    NDArray[np.complex128],
+    float,
+    int,
+    bool,
+    float,
+    float,
+]: ...

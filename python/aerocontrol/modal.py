@@ -36,7 +36,7 @@ from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning
 from .statespace import StateSpace, as_state_space
 
-__all__ = ["Modes", "characteristic_polynomial", "modes"]
+__all__ = ["Modes", "charpoly", "modes"]
 
 ComplexArray = NDArray[np.complex128]
 
@@ -187,20 +187,21 @@ def modes(A_or_sys: Any, mode_names: list[str] | None = None) -> Modes:
     )
 
 
-def characteristic_polynomial(A: Any) -> FloatArray:
-    """Coefficients of det(λI - A), highest power first ([1, a_1, ..., a_n]).
+def charpoly(A: Any) -> FloatArray:
+    """Coefficients of det(λI - A), highest power first ([1, a_1, ..., a_n], (6.106)).
 
-    Multiplied out from the eigenvalues, each conjugate pair as one real quadratic, so the
-    coefficients are exactly real; they are as accurate as the eigenvalues are well
-    conditioned.
+    Computed from the eigenvalues of the balanced A (Francis QR), each conjugate pair
+    multiplied in as one real quadratic, so the coefficients are exactly real. Accuracy: each
+    a_k carries an absolute error of about (k u + the eigenvalue error) times e_k(|λ|), the
+    elementary symmetric function of the eigenvalue moduli; a coefficient that is small only
+    by cancellation is correspondingly less accurate relatively. Never formed from powers of A
+    (the Krylov or Faddeev-LeVerrier recurrences lose digits geometrically with n).
 
     Examples
     --------
     >>> import numpy as np, aerocontrol
     >>> A, _ = aerocontrol.chapter.boeing747_lateral()
-    >>> np.round(aerocontrol.characteristic_polynomial(A), 4)    # (6.155)
+    >>> np.round(aerocontrol.charpoly(A), 4)    # (6.155)
     array([1.    , 1.4385, 0.8222, 0.7232, 0.0319])
     """
-    result = _core.modal_analysis(real_array(A, "A"), None)
-    polynomial: FloatArray = result["characteristic_polynomial"]
-    return polynomial
+    return _core.charpoly(A)

@@ -1,0 +1,360 @@
+"""Pole placement by state feedback (chapter §6.5, (6.90)-(6.165)).
+
+The control law η = -K x + η' (6.91) turns x' = A x + B η into x' = (A - B K) x + B η'
+(6.93). Given the desired closed-loop poles:
+
+* :func:`place_bass_gura`: the chapter's single-input method, k = ((VW)^-1)^T (ā - a)
+  (6.145), by a triangular solve and an LU solve, never an inverse;
+* :func:`place_ackermann`: k^T = e_n^T V^-1 φ(A), an independent single-input check;
+* :func:`place`: several inputs, by the robust method of Kautsky, Nichols & Van Dooren (1985,
+  method 0), which spends the freedom of a multi-input gain on a well-conditioned closed-loop
+  eigenvector matrix; a pole may repeat up to rank(B) times.
+
+Every function returns a :class:`Placement` with K (m x n), A - BK, the achieved poles and
+their largest relative error. The single-input formulas are only as accurate as the
+controllability matrix V is well conditioned; they warn (``IllConditionedWarning``) when
+κ(V) >= 1e8 or an achieved pole misses by more than 1e-6 relatively.
+
+:func:`augment_mode` builds the chapter's design request (6.156): the pole set that moves one
+mode (the Dutch roll to ζ = 0.30 at its ω_n, say) and keeps every other pole.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import _core
+from ._validation import FloatArray, real_array, real_scalar
+from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
+from .modal import Modes, modes
+from .statespace import StateSpace, as_state_space
+
+__all__ = [
+    "CompanionForm",
+    "Placement",
+    "augment_mode",
+    "companion_form",
+    "place",
+    "place_ackermann",
+    "place_bass_gura",
+]
+
+ComplexArray = NDArray[np.complex128]
+
+#: κ(V) from which the single-input gains are flagged: beyond 1e8 about half the digits of
+#: the gains may be lost to the conditioning of the controllability matrix.
+ILL_CONDITIONED_CONTROLLABILITY = 1e8
+#: Achieved-pole relative error from which any placement is flagged.
+POLE_ERROR_WARNING = 1e-6
+
+
+@dataclass(frozen=True, eq=False, slots=True)
+class Placement:
+    """A state-feedback design η = -K x (6.91).
+
+    ``k`` is the gain vector of a single-input design (the chapter's k^T = K[0]).
+    """
+
+    K: FloatArray
+    """The gain matrix, m x n."""
+    closed_loop: FloatArray
+    """A - B K (6.93)."""
+    poles: ComplexArray
+    """The requested poles, each conjugate pair adjacent with Im > 0 first."""
+    achieved_poles: ComplexArray
+    """The eigenvalues of the computed A - B K, matched to ``poles``."""
+    max_relative_error: float
+    """max |achieved - requested| / |requested| (relative to ||A - BK||_F for a pole at 0)."""
+    iterations: int
+    """Sweeps of the robust method; 0 for the single-input formulas."""
+    converged: bool
+    method: str
+    controllability_condition: float
+    """κ_1(V) for the single-input formulas, NaN for the robust method."""
+    eigenvector_condition: float
+    """κ_2(X) of the closed-loop eigenvectors for the robust method, NaN otherwise."""
+
+    @property
+    def k(self) -> FloatArray:
+        """The gain vector of a single-input design, shape (n,)."""
+        if self.K.shape[0] != 1:
+            raise ShapeError(f"k is defined for one input; this design has {self.K.shape[0]}")
+        gains: FloatArray = self.K[0]
+        return gains
+
+    def __str__(self) -> str:
+        lines = [f"pole placement ({self.method}), K = {np.array2string(self.K, precision=6)}"]
+        lines.append(f"{'requested':>28}{'achieved':>28}")
+        for want, got in zip(self.poles, self.achieved_poles, strict=True):
+            lines.append(f"{complex(want):>28.6g}{complex(got):>28.6g}")
+        lines.append(f"largest relative pole error {self.max_relative_error:.2e}")
+        return "\n".join(lines)
+
+
+def _poles(poles: Any) -> ComplexArray:
+    try:
+        array = np.asarray(poles, dtype=np.complex128)
+    except (TypeError, ValueError) as error:
+        raise InvalidArgumentError(f"poles must be numbers: {error}") from None
+    if array.ndim != 1:
+        raise ShapeError(f"poles must be a 1-D sequence, got an array of shape {array.shape}")
+    return np.ascontiguousarray(array)
+
+
+def _plant(A_or_sys: Any, B: Any) -> tuple[Any, Any]:
+    if B is not None:
+        return A_or_sys, B
+    if isinstance(A_or_sys, (StateSpace, tuple, list)) or hasattr(A_or_sys, "A"):
+        sys = as_state_space(A_or_sys)
+        return sys.A, sys.B
+    raise TypeError("give a system or both A and B")
+
+
+def _single_input(b: Any) -> Any:
+    """b as an n x 1 matrix: a 1-D vector becomes a column."""
+    if type(b) is np.ndarray and b.ndim == 2:
+        return b
+    array = real_array(b, "B")
+    return array[:, None] if array.ndim == 1 else array
+
+
+def _design(A: Any, B: Any, poles: Any, method: str, name: str) -> Placement:
+    K, closed, wanted, achieved, error, iterations, converged, kappa_v, kappa_x = _core.place(
+        A, B, _poles(poles), method
+    )
+    design = Placement(
+        K, closed, wanted, achieved, error, iterations, converged, name, kappa_v, kappa_x
+    )
+    if kappa_v >= ILL_CONDITIONED_CONTROLLABILITY or error > POLE_ERROR_WARNING:
+        if method == "knv0":
+            measure = f"closed-loop eigenvector condition number {kappa_x:.2e}"
+        else:
+            measure = f"controllability matrix condition number {kappa_v:.2e}"
+        warnings.warn(
+            f"{name}: the achieved poles miss the requested ones by up to {error:.2e} "
+            f"relatively ({measure}); the gains may be inaccurate, and poles that are repeated "
+            "or close together are inherently sensitive (a k-fold pole moves by about u^(1/k))",
+            IllConditionedWarning,
+            stacklevel=3,
+        )
+    return design
+
+
+def place_bass_gura(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placement:
+    """Single-input pole placement by the Bass-Gura formula (6.145).
+
+    k = ((VW)^-1)^T (ā - a), with V the controllability matrix (6.125), W the Toeplitz matrix of
+    the open-loop coefficients a (6.131) and ā the desired coefficients (6.114), computed as
+    W^T z = ā - a and V^T k = z.
+
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n), or a system with A and a single-input B
+    b : array_like (n,) or (n, 1)
+    poles : sequence of n numbers; complex ones in conjugate pairs
+
+    Raises
+    ------
+    UncontrollableError
+        naming the eigenvalues that b cannot move.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, b = [[-3, 8], [0, 0]], [0, 4]                     # (6.95)
+    >>> wn, zeta = 25.0, 0.707
+    >>> s = complex(-zeta * wn, wn * np.sqrt(1 - zeta**2))
+    >>> design = aerocontrol.place_bass_gura(A, b, [s, s.conjugate()])
+    >>> np.round(design.k, 5)                                # (6.102)
+    array([16.49844,  8.0875 ])
+    """
+    if poles is None:
+        A_or_sys, b, poles = *_plant(A_or_sys, None), b
+    return _design(A_or_sys, _single_input(b), poles, "bass-gura", "Bass-Gura")
+
+
+def place_ackermann(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placement:
+    """Single-input pole placement by Ackermann's formula k^T = e_n^T V^-1 φ(A).
+
+    φ is the desired characteristic polynomial; V^T w = e_n is solved by LU and φ(A)^T w is
+    evaluated by Horner's rule on vectors, so φ(A) is never formed. Same arguments as
+    :func:`place_bass_gura`, and the same gains in exact arithmetic.
+
+    >>> import aerocontrol
+    >>> design = aerocontrol.place_ackermann([[0, 1], [-2, -3]], [0, 1], [-5, -6])
+    >>> design.k
+    array([28.,  8.])
+    """
+    if poles is None:
+        A_or_sys, b, poles = *_plant(A_or_sys, None), b
+    return _design(A_or_sys, _single_input(b), poles, "ackermann", "Ackermann")
+
+
+def place(A_or_sys: Any, B: Any = None, poles: Any = None) -> Placement:
+    """Pole placement for one or several inputs, by Kautsky-Nichols-Van Dooren method 0.
+
+    The eigenvector of each pole is chosen in its admissible subspace to make the closed-loop
+    eigenvector matrix X as well conditioned as the method can (|det X| maximised column by
+    column, sweeps until it grows by less than 1e-3 relatively, at most 100); a robustly
+    placed pole moves little under perturbations of A and B. ``eigenvector_condition`` reports
+    κ_2(X).
+
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n), or a system with A and B
+    B : array_like (n, m), full column rank, no zero column
+    poles : sequence of n numbers; complex ones in conjugate pairs; each at most rank(B) times
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_lateral()      # rudder and aileron
+    >>> design = aerocontrol.place(A, B, [-0.5 + 0.8j, -0.5 - 0.8j, -1.2, -0.1])
+    >>> design.K.shape, bool(design.max_relative_error < 1e-12)
+    ((2, 4), True)
+    """
+    if poles is None:
+        A_or_sys, B, poles = *_plant(A_or_sys, None), B
+    return _design(A_or_sys, B, poles, "knv0", "Kautsky-Nichols-Van Dooren")
+
+
+@dataclass(frozen=True, eq=False)
+class CompanionForm:
+    """The transformation z = T x to the first companion form (6.116)-(6.145)."""
+
+    V: FloatArray
+    """The controllability matrix (6.125)."""
+    W: FloatArray
+    """The upper triangular Toeplitz matrix of the coefficients (6.131)."""
+    T: FloatArray
+    """(VW)^-1 (6.144)."""
+    companion: FloatArray
+    """T A T^-1, the first companion form (6.116), built from the coefficients."""
+    coefficients: FloatArray
+    """[1, a_1, ..., a_n] of det(λI - A) (6.106)."""
+
+
+def companion_form(A_or_sys: Any, b: Any = None) -> CompanionForm:
+    """The first companion form of a controllable single-input pair (6.116)-(6.145).
+
+    >>> import aerocontrol
+    >>> form = aerocontrol.companion_form([[0, 1], [-2, -3]], [0, 1])
+    >>> form.companion
+    array([[-3., -2.],
+           [ 1.,  0.]])
+    """
+    A, b = _plant(A_or_sys, b)
+    result = _core.companion_form(A, _single_input(b))
+    return CompanionForm(
+        V=result["V"],
+        W=result["W"],
+        T=result["T"],
+        companion=result["companion"],
+        coefficients=result["coefficients"],
+    )
+
+
+def _select_mode(analysis: Modes, mode: Any) -> int:
+    """The index of a mode given by index, name, or (approximate) eigenvalue."""
+    count = len(analysis)
+    if isinstance(mode, str):
+        names = [name.lower() for name in analysis.mode_names]
+        if mode.lower() not in names:
+            raise InvalidArgumentError(
+                f"mode {mode!r} is not one of the modes {list(analysis.mode_names)}"
+            )
+        return names.index(mode.lower())
+    if isinstance(mode, (int, np.integer)) and not isinstance(mode, bool):
+        if not -count <= mode < count:
+            raise InvalidArgumentError(f"mode index {mode} is out of range for {count} modes")
+        return int(mode) % count
+    if isinstance(mode, (float, complex, np.floating, np.complexfloating)):
+        value = complex(mode)
+        distances = np.abs(analysis.eigenvalue - complex(value.real, abs(value.imag)))
+        return int(np.argmin(distances))
+    raise InvalidArgumentError(
+        f"mode must be a mode index, a mode name or an eigenvalue, got {mode!r}"
+    )
+
+
+def augment_mode(
+    sys_or_A: Any,
+    mode: Any,
+    zeta: float | None = None,
+    omega_n: float | None = None,
+) -> ComplexArray:
+    """The desired pole set of (6.156): one mode changed, every other pole kept.
+
+    Parameters
+    ----------
+    sys_or_A : system, plant matrix, or :class:`~aerocontrol.Modes`
+    mode : int, str or complex
+        The mode to change: its index in mode order (increasing natural frequency), its name
+        (with named modes), or an eigenvalue near it.
+    zeta, omega_n : float, optional
+        The new damping ratio and natural frequency of an oscillatory mode; either defaults to
+        the mode's present value. For a real mode give ``omega_n`` only: the new pole is
+        -omega_n. A ζ >= 1 splits the pair into two real poles -ζω_n ± ω_n sqrt(ζ² - 1).
+
+    Returns
+    -------
+    ndarray of complex, length n: the open-loop eigenvalues with the chosen ones replaced.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, _ = aerocontrol.chapter.boeing747_lateral()
+    >>> poles = aerocontrol.augment_mode(A, 1, zeta=0.30)           # the Dutch roll
+    >>> np.round(np.poly(poles).real, 4)                            # (6.156)
+    array([1.    , 1.7258, 1.1891, 0.7396, 0.0319])
+    """
+    analysis = sys_or_A if isinstance(sys_or_A, Modes) else modes(_plant_matrix(sys_or_A))
+    k = _select_mode(analysis, mode)
+    eigenvalue = complex(analysis.eigenvalue[k])
+    wn = analysis.natural_frequency[k] if omega_n is None else real_scalar(omega_n, "omega_n")
+    if wn <= 0 or not np.isfinite(wn):
+        raise InvalidArgumentError(f"omega_n must be positive and finite, got {wn}")
+    if analysis.oscillatory[k]:
+        z = analysis.damping_ratio[k] if zeta is None else real_scalar(zeta, "zeta")
+        if not np.isfinite(z) or z < 0:
+            raise InvalidArgumentError(f"zeta must be finite and non-negative, got {z}")
+        if z < 1:
+            root = complex(-z * wn, wn * np.sqrt(1 - z * z))
+            new = [root, root.conjugate()]
+        else:
+            spread = wn * np.sqrt(z * z - 1)
+            new = [complex(-z * wn + spread), complex(-z * wn - spread)]
+        old = [eigenvalue, eigenvalue.conjugate()]
+    else:
+        if zeta is not None:
+            raise InvalidArgumentError(
+                f"mode {k} is real (eigenvalue {eigenvalue.real:.6g}): it has no damping "
+                "ratio; give omega_n (the new pole is -omega_n)"
+            )
+        new, old = [complex(-wn)], [eigenvalue]
+    poles = np.array(analysis.eigenvalues, dtype=np.complex128)
+    for before, after in zip(old, new, strict=True):
+        position = int(np.argmin(np.abs(poles - before)))
+        poles[position] = after
+    return poles
+
+
+def _plant_matrix(sys_or_A: Any) -> FloatArray:
+    if isinstance(sys_or_A, (StateSpace, tuple, list)) and not _is_matrix(sys_or_A):
+        return as_state_space(sys_or_A).A
+    if hasattr(sys_or_A, "A"):
+        return as_state_space(sys_or_A).A
+    return real_array(sys_or_A, "A")
+
+
+def _is_matrix(value: Any) -> bool:
+    """Whether a list or tuple is a nested list of numbers (a matrix), not (A, B)."""
+    try:
+        return np.asarray(value, dtype=np.float64).ndim == 2
+    except (TypeError, ValueError):
+        return False
