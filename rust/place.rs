@@ -298,7 +298,8 @@ fn place_single_input(
     // V is exactly singular for an uncontrollable pair, but its computed condition number can
     // stay well below 1/u when A^k b loses digits to cancellation; from SCREEN_CONDITION on the
     // staircase decides (and names the eigenvalues it cannot move).
-    if !(condition < SCREEN_CONDITION) {
+    // (A NaN condition number, from a V singular in floating point, also takes this branch.)
+    if condition.is_nan() || condition >= SCREEN_CONDITION {
         require_controllable_single_input(a, b)?;
     }
     if !solution.is_all_finite() {
