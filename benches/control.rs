@@ -13,17 +13,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use faer::{Mat, c64, mat};
 use std::hint::black_box;
 
-/// A deterministic pseudo-random matrix with entries in [-1, 1).
-fn seeded_matrix(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
-    let mut state = seed;
-    let mut next = move || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    };
-    Mat::from_fn(rows, cols, |_, _| next())
-}
+mod common;
+use common::seeded_matrix;
 
 /// The 747 lateral plant (6.150) with rudder and aileron (6.158), (6.163).
 fn boeing747_lateral() -> (Mat<f64>, Mat<f64>) {

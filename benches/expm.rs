@@ -10,16 +10,12 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
 use std::hint::black_box;
 
-/// A deterministic pseudo-random matrix with entries in [-1, 1), scaled to 1-norm `norm`.
-fn seeded_matrix(rows: usize, cols: usize, seed: u64, norm: f64) -> Mat<f64> {
-    let mut state = seed;
-    let mut next = move || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    };
-    let m = Mat::from_fn(rows, cols, |_, _| next());
+mod common;
+use common::seeded_matrix;
+
+/// [`seeded_matrix`] scaled to 1-norm `norm`.
+fn seeded_matrix_with_norm(rows: usize, cols: usize, seed: u64, norm: f64) -> Mat<f64> {
+    let m = seeded_matrix(rows, cols, seed);
     let current = (0..cols)
         .map(|j| (0..rows).map(|i| m[(i, j)].abs()).sum::<f64>())
         .fold(0.0, f64::max);
@@ -29,7 +25,7 @@ fn seeded_matrix(rows: usize, cols: usize, seed: u64, norm: f64) -> Mat<f64> {
 fn bench_expm(c: &mut Criterion) {
     let mut group = c.benchmark_group("expm");
     for n in [4usize, 8, 16, 64, 256, 1024] {
-        let a = seeded_matrix(n, n, n as u64, 2.0);
+        let a = seeded_matrix_with_norm(n, n, n as u64, 2.0);
         if n >= 256 {
             group.sample_size(10);
         }
@@ -43,7 +39,7 @@ fn bench_expm(c: &mut Criterion) {
 fn bench_transition_matrices(c: &mut Criterion) {
     let mut group = c.benchmark_group("transition_matrices_100_times");
     for n in [4usize, 16, 64] {
-        let a = seeded_matrix(n, n, 3 + n as u64, 2.0);
+        let a = seeded_matrix_with_norm(n, n, 3 + n as u64, 2.0);
         let times: Vec<f64> = (0..100).map(|k| 0.05 * k as f64).collect();
         group.bench_with_input(BenchmarkId::from_parameter(n), &a, |b, a| {
             b.iter(|| transition_matrices(black_box(a.as_ref()), black_box(&times)).unwrap())
@@ -55,8 +51,8 @@ fn bench_transition_matrices(c: &mut Criterion) {
 fn bench_discretize(c: &mut Criterion) {
     let mut group = c.benchmark_group("discretize_foh");
     for n in [4usize, 16, 64] {
-        let a = seeded_matrix(n, n, 7 + n as u64, 2.0);
-        let b = seeded_matrix(n, 2, 11 + n as u64, 1.0);
+        let a = seeded_matrix_with_norm(n, n, 7 + n as u64, 2.0);
+        let b = seeded_matrix_with_norm(n, 2, 11 + n as u64, 1.0);
         group.bench_with_input(BenchmarkId::from_parameter(n), &(a, b), |bench, (a, b)| {
             bench.iter(|| discretize(a.as_ref(), b.as_ref(), 0.01, Hold::First).unwrap())
         });
@@ -70,7 +66,7 @@ fn bench_batch(c: &mut Criterion) {
     let (k, n) = (10_000usize, 4usize);
     let mut data = Vec::with_capacity(k * n * n);
     for index in 0..k {
-        let m = seeded_matrix(n, n, index as u64, 2.0);
+        let m = seeded_matrix_with_norm(n, n, index as u64, 2.0);
         for i in 0..n {
             for j in 0..n {
                 data.push(m[(i, j)]);

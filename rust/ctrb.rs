@@ -76,8 +76,8 @@ pub fn ctrb(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
     Ok(krylov_blocks(a, b))
 }
 
-/// The observability matrix [C; CA; CA^2; ...; CA^{n-1}] (6.89), np x n.
-pub fn obsv(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+/// Checks A (square, finite) and C (one column per state, finite).
+fn check_output_pair(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<(), Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     if c.ncols() != a.nrows() {
@@ -89,7 +89,12 @@ pub fn obsv(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
             got: c.ncols(),
         });
     }
-    check_finite(c, "C")?;
+    check_finite(c, "C")
+}
+
+/// The observability matrix [C; CA; CA^2; ...; CA^{n-1}] (6.89), np x n.
+pub fn obsv(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+    check_output_pair(a, c)?;
     Ok(krylov_blocks(a.transpose(), c.transpose())
         .transpose()
         .to_owned())
@@ -163,18 +168,7 @@ pub fn observability_staircase(
     tolerance: Option<f64>,
     with_transformation: bool,
 ) -> Result<Staircase, Error> {
-    check_square(a, "A")?;
-    check_finite(a, "A")?;
-    if c.ncols() != a.nrows() {
-        return Err(Error::Mismatch {
-            arg: "C",
-            what: "one column per row of",
-            expected: a.nrows(),
-            other: "A",
-            got: c.ncols(),
-        });
-    }
-    check_finite(c, "C")?;
+    check_output_pair(a, c)?;
     let dual = staircase(a.transpose(), c.transpose(), tolerance, with_transformation)?;
     Ok(Staircase {
         a: dual.a.transpose().to_owned(),
