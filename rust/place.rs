@@ -394,17 +394,8 @@ pub fn place(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64]) -> Result<Pl
     check_plant(a, b)?;
     let (n, m) = (a.nrows(), b.ncols());
     let poles = normalize_poles(poles, n)?;
-    let InputBasis { u0, u1, z } = input_basis(b)?;
-    check_multiplicities(&poles, m)?;
-    let verdict = controllability(a, b, None, true, false)?;
-    if !verdict.is_complete() {
-        return Err(Error::Uncontrollable {
-            pair: "(A, B)",
-            eigenvalues: verdict.uncontrollable_eigenvalues,
-            tolerance: verdict.tolerance,
-        });
-    }
     if n == 0 {
+        // Nothing to place (and a 0 x m B has no columns to check).
         return finish(
             a,
             b,
@@ -416,6 +407,16 @@ pub fn place(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64]) -> Result<Pl
             0,
             true,
         );
+    }
+    let InputBasis { u0, u1, z } = input_basis(b)?;
+    check_multiplicities(&poles, m)?;
+    let verdict = controllability(a, b, None, true, false)?;
+    if !verdict.is_complete() {
+        return Err(Error::Uncontrollable {
+            pair: "(A, B)",
+            eigenvalues: verdict.uncontrollable_eigenvalues,
+            tolerance: verdict.tolerance,
+        });
     }
     let subspaces: Vec<Mat<c64>> = poles
         .iter()

@@ -350,3 +350,9 @@ def test_augment_mode_selects_and_changes_one_mode() -> None:
         aerocontrol.augment_mode(modes, "phugoid", zeta=0.5)
     with pytest.raises(InvalidArgumentError, match="out of range"):
         aerocontrol.augment_mode(A_LAT, 7, zeta=0.5)
+
+
+@pytest.mark.parametrize("placer", [*SINGLE_INPUT, aerocontrol.place])
+def test_an_empty_system_has_nothing_to_place(placer) -> None:
+    design = placer(np.zeros((0, 0)), np.zeros((0, 1)), [])
+    assert design.K.shape == (1, 0) and design.max_relative_error == 0.0
