@@ -49,6 +49,7 @@ use crate::ctrb::{controllability, controllability_staircase, krylov_blocks};
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
 use crate::lu::solve_in_place;
 use crate::modes::polynomial_from_roots;
+use crate::norm::one_norm;
 use crate::schur::eigenvalues;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, Par, c64};
@@ -329,12 +330,6 @@ fn place_single_input(
 /// V is then at relative distance 1/κ >= 1e-6 from the nearest singular matrix, which no
 /// rounding error in forming it explains.
 const SCREEN_CONDITION: f64 = 1e6;
-
-fn one_norm(m: MatRef<'_, f64>) -> f64 {
-    (0..m.ncols())
-        .map(|j| m.col(j).iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-}
 
 /// The closed loop, its poles matched to the requested ones, and the result.
 #[allow(clippy::too_many_arguments)]
