@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from . import _core
 from ._validation import FloatArray, check_choice, real_scalar
-from .statespace import StateSpace, as_state_space
+from .statespace import plant_pair
 
 __all__ = [
     "Controllability",
@@ -43,21 +43,6 @@ __all__ = [
 
 ComplexArray = NDArray[np.complex128]
 _METHODS = ("full", "staircase")
-
-
-def _pair(A_or_sys: Any, second: Any, attribute: str) -> tuple[Any, Any]:
-    """(A, B) or (A, C) from a system, an (A, B) tuple, or two matrices."""
-    if second is not None:
-        return A_or_sys, second
-    if (
-        isinstance(A_or_sys, StateSpace)
-        or hasattr(A_or_sys, "A")
-        or isinstance(A_or_sys, (tuple, list))
-    ):
-        sys = as_state_space(A_or_sys)
-        return sys.A, getattr(sys, attribute)
-    name = "B" if attribute == "B" else "C"
-    raise TypeError(f"give a system or both A and {name}")
 
 
 def ctrb(A: Any, B: Any) -> FloatArray:
@@ -173,7 +158,7 @@ def controllability(
     >>> print(aerocontrol.controllability(A, [[-1], [1]]))              # (6.84)
     not controllable: eigenvalues -2+0j (tolerance 1.66e-15)
     """
-    A, B = _pair(A_or_sys, B, "B")
+    A, B = plant_pair(A_or_sys, B, "B")
     return _analyse(A, B, tol, method, dual=False)
 
 
@@ -186,7 +171,7 @@ def observability(
     >>> aerocontrol.observability([[-3, 8], [0, 0]], [[1, 0]]).controllable
     True
     """
-    A, C = _pair(A_or_sys, C, "C")
+    A, C = plant_pair(A_or_sys, C, "C")
     return _analyse(A, C, tol, method, dual=True)
 
 
@@ -200,7 +185,7 @@ def is_controllable(
     >>> aerocontrol.is_controllable([[0, 1], [-2, -3]], [[-1], [1]])
     False
     """
-    A, B = _pair(A_or_sys, B, "B")
+    A, B = plant_pair(A_or_sys, B, "B")
     return _analyse(A, B, tol, method, dual=False, transformation=False).controllable
 
 
@@ -213,5 +198,5 @@ def is_observable(
     >>> aerocontrol.is_observable([[-3, 8], [0, 0]], [[0, 1]])
     False
     """
-    A, C = _pair(A_or_sys, C, "C")
+    A, C = plant_pair(A_or_sys, C, "C")
     return _analyse(A, C, tol, method, dual=True, transformation=False).controllable

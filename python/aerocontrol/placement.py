@@ -32,7 +32,7 @@ from . import _core
 from ._validation import FloatArray, real_array, real_scalar
 from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
 from .modal import Modes, modes
-from .statespace import StateSpace, as_state_space
+from .statespace import StateSpace, as_state_space, plant_pair
 
 __all__ = [
     "CompanionForm",
@@ -106,15 +106,6 @@ def _poles(poles: Any) -> ComplexArray:
     return np.ascontiguousarray(array)
 
 
-def _plant(A_or_sys: Any, B: Any) -> tuple[Any, Any]:
-    if B is not None:
-        return A_or_sys, B
-    if isinstance(A_or_sys, (StateSpace, tuple, list)) or hasattr(A_or_sys, "A"):
-        sys = as_state_space(A_or_sys)
-        return sys.A, sys.B
-    raise TypeError("give a system or both A and B")
-
-
 def _single_input(b: Any) -> Any:
     """b as an n x 1 matrix: a 1-D vector becomes a column."""
     if type(b) is np.ndarray and b.ndim == 2:
@@ -174,7 +165,7 @@ def place_bass_gura(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placemen
     array([16.49844,  8.0875 ])
     """
     if poles is None:
-        A_or_sys, b, poles = *_plant(A_or_sys, None), b
+        A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
     return _design(A_or_sys, _single_input(b), poles, "bass-gura", "Bass-Gura")
 
 
@@ -191,7 +182,7 @@ def place_ackermann(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placemen
     array([28.,  8.])
     """
     if poles is None:
-        A_or_sys, b, poles = *_plant(A_or_sys, None), b
+        A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
     return _design(A_or_sys, _single_input(b), poles, "ackermann", "Ackermann")
 
 
@@ -219,7 +210,7 @@ def place(A_or_sys: Any, B: Any = None, poles: Any = None) -> Placement:
     ((2, 4), True)
     """
     if poles is None:
-        A_or_sys, B, poles = *_plant(A_or_sys, None), B
+        A_or_sys, B, poles = *plant_pair(A_or_sys, None, "B"), B
     return _design(A_or_sys, B, poles, "knv0", "Kautsky-Nichols-Van Dooren")
 
 
@@ -248,7 +239,7 @@ def companion_form(A_or_sys: Any, b: Any = None) -> CompanionForm:
     array([[-3., -2.],
            [ 1.,  0.]])
     """
-    A, b = _plant(A_or_sys, b)
+    A, b = plant_pair(A_or_sys, b, "B")
     result = _core.companion_form(A, _single_input(b))
     return CompanionForm(
         V=result["V"],

@@ -171,3 +171,14 @@ def as_state_space(model: Any, name: str = "sys") -> StateSpace:
         f"{name} must be a StateSpace, a tuple (A, B) or (A, B, C, D), or an object with A, B, "
         f"C and D attributes, got {type(model).__name__}"
     )
+
+
+def plant_pair(A_or_sys: Any, second: Any, attribute: str) -> tuple[Any, Any]:
+    """(A, B) or (A, C): the two matrices when ``second`` is given, else taken from a system,
+    an (A, B) tuple or any object with the attributes (``attribute`` names the second one)."""
+    if second is not None:
+        return A_or_sys, second
+    if isinstance(A_or_sys, (StateSpace, tuple, list)) or hasattr(A_or_sys, "A"):
+        sys = as_state_space(A_or_sys)
+        return sys.A, getattr(sys, attribute)
+    raise TypeError(f"give a system or both A and {attribute}")
