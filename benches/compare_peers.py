@@ -583,6 +583,10 @@ def _place_gain(A: Any, B: Any, poles: Any) -> Any:
     return aerocontrol.place_bass_gura(A, B, poles).K
 
 
+def _ackermann_gain(A: Any, B: Any, poles: Any) -> Any:
+    return aerocontrol.place_ackermann(A, B, poles).K
+
+
 def _acker(A: Any, B: Any, poles: Any) -> Any:
     return np.atleast_2d(control.acker(A, B, poles))
 
@@ -614,13 +618,14 @@ def placement_cases() -> list[Case]:
     mimo = Target("MIMO m=2 vs scipy place_poles: ratio >= 20", min_ratio=20.0)
     cases = [
         Case(
-            op="place SISO (Bass-Gura)",
+            op=f"place SISO ({name})",
             size="n=4 747 rudder",
             seed=0,
             setup=_dutch_roll_rudder,
-            ours=_place_gain,
+            ours=ours,
             peers=[Peer("control.acker", _acker, target=siso)],
         )
+        for name, ours in (("Bass-Gura", _place_gain), ("Ackermann", _ackermann_gain))
     ]
     for n in (4, 16):
         cases.append(

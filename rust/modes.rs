@@ -196,24 +196,28 @@ pub fn eigen(a: MatRef<'_, f64>) -> Result<(Vec<c64>, Mat<c64>), Error> {
 /// with each conjugate pair as one real quadratic. `eigenvalues` must hold conjugate pairs
 /// adjacent (as [`eigen`] returns them).
 pub fn polynomial_from_roots(eigenvalues: &[c64]) -> Vec<f64> {
-    let mut coefficients = vec![1.0];
+    let mut coefficients = Vec::with_capacity(eigenvalues.len() + 1);
+    coefficients.push(1.0);
+    // Multiplies by the monic factor [1, f...] in place, highest power first.
     let mut multiply = |factor: &[f64]| {
-        let mut next = vec![0.0; coefficients.len() + factor.len() - 1];
-        for (i, &c) in coefficients.iter().enumerate() {
-            for (j, &f) in factor.iter().enumerate() {
-                next[i + j] += c * f;
+        coefficients.extend(factor.iter().map(|_| 0.0));
+        for i in (1..coefficients.len()).rev() {
+            for (j, &f) in factor.iter().enumerate().take(i) {
+                coefficients[i] += f * coefficients[i - j - 1];
             }
         }
-        coefficients = next;
     };
     let mut k = 0;
     while k < eigenvalues.len() {
         let lambda = eigenvalues[k];
         if lambda.im == 0.0 {
-            multiply(&[1.0, -lambda.re]);
+            multiply(&[-lambda.re]);
             k += 1;
         } else {
-            multiply(&[1.0, -2.0 * lambda.re, lambda.norm_sqr()]);
+            multiply(&[
+                -2.0 * lambda.re,
+                lambda.re * lambda.re + lambda.im * lambda.im,
+            ]);
             k += 2;
         }
     }

@@ -293,9 +293,14 @@ fn place_single_input(
             }
         }
     }
-    let mut factors = v.transpose().to_owned();
-    solve_in_place(factors.as_mut(), solution.as_mut(), Par::Seq);
-    let condition = one_norm(v.as_ref()) * one_norm(solution.as_ref().subcols(1, n));
+    let v_norm = one_norm(v.as_ref());
+    let mut factors = v;
+    solve_in_place(
+        factors.as_mut().transpose_mut(),
+        solution.as_mut(),
+        Par::Seq,
+    );
+    let condition = v_norm * one_norm(solution.as_ref().subcols(1, n));
     // V is exactly singular for an uncontrollable pair, but its computed condition number can
     // stay well below 1/u when A^k b loses digits to cancellation; from SCREEN_CONDITION on the
     // staircase decides (and names the eigenvalues it cannot move).
@@ -313,16 +318,24 @@ fn place_single_input(
             ),
         });
     }
-    let mut gain = solution.subcols(0, 1).transpose().to_owned();
-    if method == Method::Ackermann {
-        // k = φ(A)^T w by Horner's rule: y <- A^T y + ā_i w.
-        let w = solution.subcols(0, 1).to_owned();
-        let mut y = w.clone();
-        for &coefficient in &desired[1..] {
-            y = a.transpose() * &y + coefficient * &w;
+    let w = solution.col(0);
+    let gain = match method {
+        Method::Ackermann => {
+            // k = φ(A)^T w by Horner's rule: y <- A^T y + ā_i w.
+            let mut y: Vec<f64> = w.iter().copied().collect();
+            let mut next = vec![0.0; n];
+            for &coefficient in &desired[1..] {
+                for (j, entry) in next.iter_mut().enumerate() {
+                    let column = a.col(j);
+                    *entry =
+                        coefficient * w[j] + column.iter().zip(&y).map(|(x, z)| x * z).sum::<f64>();
+                }
+                std::mem::swap(&mut y, &mut next);
+            }
+            Mat::from_fn(1, n, |_, j| y[j])
         }
-        gain = y.transpose().to_owned();
-    }
+        _ => Mat::from_fn(1, n, |_, j| w[j]),
+    };
     finish(a, b, gain, poles, method, condition, f64::NAN, 0, true)
 }
 
@@ -344,7 +357,14 @@ fn finish(
     iterations: usize,
     converged: bool,
 ) -> Result<Placement, Error> {
-    let closed_loop = a - b * &gain;
+    // A - B K entry by entry: at these sizes a general product costs more to dispatch than to
+    // compute.
+    let closed_loop = Mat::from_fn(a.nrows(), a.ncols(), |i, j| {
+        a[(i, j)]
+            - (0..gain.nrows())
+                .map(|k| b[(i, k)] * gain[(k, j)])
+                .sum::<f64>()
+    });
     let computed = eigenvalues(closed_loop.as_ref())?;
     let scale = closed_loop.norm_l2();
     let mut taken = vec![false; computed.len()];
