@@ -60,6 +60,14 @@ pub enum Error {
     },
     /// An iterative algorithm did not converge within its iteration limit.
     NoConvergence { algorithm: &'static str },
+    /// A symmetric matrix that must be positive definite (a control weight R) is not.
+    NotPositiveDefinite { arg: &'static str, message: String },
+    /// A Riccati equation has no stabilising solution (the Hamiltonian has eigenvalues on or
+    /// too near the imaginary axis); the message gives the evidence.
+    NoStabilizingSolution { message: String },
+    /// A computation would lose every digit to ill-conditioning and was refused (a rejected
+    /// Schur swap, a numerically singular basis of an invariant subspace).
+    IllConditioned { message: String },
     /// One problem of a batch failed; `index` is its position in the stack.
     InBatch { index: usize, source: Box<Error> },
 }
@@ -157,6 +165,9 @@ impl fmt::Display for Error {
             Error::NoConvergence { algorithm } => {
                 write!(f, "{algorithm} did not converge within its iteration limit")
             }
+            Error::NotPositiveDefinite { message, .. }
+            | Error::NoStabilizingSolution { message }
+            | Error::IllConditioned { message } => write!(f, "{message}"),
             Error::InBatch { index, source } => write!(f, "problem {index} of the batch: {source}"),
         }
     }

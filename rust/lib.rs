@@ -47,6 +47,7 @@
 //! (small fixed-size blocks).
 
 pub mod batch;
+pub mod care;
 pub mod ctrb;
 pub mod discretize;
 pub mod dispatch;
@@ -56,13 +57,17 @@ pub mod expm;
 pub mod freq;
 pub mod hessenberg;
 pub mod lu;
+pub mod lyapunov;
 pub mod modes;
 pub mod norm;
 pub mod place;
 pub mod pool;
+pub mod reorder;
 pub mod response;
+pub mod riccati_ode;
 pub mod schur;
 pub mod small_matrix;
+mod sylvester;
 
 #[cfg(feature = "python")]
 mod python;

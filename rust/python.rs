@@ -13,6 +13,7 @@
 //! failed) into a Python exception instead of unwinding into the interpreter.
 
 use crate::batch::{MatrixStack, expm_batch};
+use crate::care::{CareOptions, solve_care as solve_care_core};
 use crate::ctrb::{
     controllability as controllability_core, ctrb, observability as observability_core, obsv,
 };
@@ -20,15 +21,19 @@ use crate::discretize::{Hold, discretize as discretize_core};
 use crate::error::{Error, check_square};
 use crate::expm::{expm_into, pade_choice, transition_matrices_into};
 use crate::freq::{check_state_space, frequency_response_into};
+use crate::lyapunov::solve_lyapunov as solve_lyapunov_core;
 use crate::modes::{charpoly as charpoly_core, modal_analysis as modal_analysis_core};
 use crate::norm::one_norm;
 use crate::place::{
     companion_form as companion_form_core, place as place_core, place_ackermann, place_bass_gura,
 };
+use crate::reorder::reorder_schur;
 use crate::response::{
     Input, Model, simulate_into, simulate_models_into, steady_state as steady_state_core,
     uniform_grid_step,
 };
+use crate::riccati_ode::riccati_ode as riccati_ode_core;
+use crate::schur::{quasi_triangular_eigenvalues, real_schur};
 use faer::{Mat, MatMut, MatRef, c64};
 use numpy::npyffi::{PY_ARRAY_API, npy_intp};
 use numpy::{
@@ -37,7 +42,7 @@ use numpy::{
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
-use pyo3::types::{PyDict, PyType};
+use pyo3::types::{PyComplex, PyDict, PyType};
 use std::ffi::CString;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -52,6 +57,9 @@ fn exception_class_name(error: &Error) -> &'static str {
         Error::Uncontrollable { .. } => "UncontrollableError",
         Error::NoConvergence { .. } => "ConvergenceError",
         Error::Singular { .. } => "SingularMatrixError",
+        Error::NotPositiveDefinite { .. } => "NotPositiveDefiniteError",
+        Error::NoStabilizingSolution { .. } => "NoStabilizingSolutionError",
+        Error::IllConditioned { .. } => "IllConditionedError",
         Error::InBatch { source, .. } => exception_class_name(source),
     }
 }
@@ -1042,6 +1050,183 @@ fn place<'py>(
     ))
 }
 
+/// The real Schur form A = Z T Z^T, reordered when `select` (a callable on an eigenvalue,
+/// called once per diagonal block) is given: (T, Z, eigenvalues, number selected).
+#[pyfunction]
+#[pyo3(signature = (a, select, /))]
+fn schur<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    select: Option<&Bound<'py, PyAny>>,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    usize,
+)> {
+    let a = float_array(py, a, "A")?;
+    let a = matrix_view(&a, "A").map_err(|e| to_py_err(py, e))?;
+    let form = guarded(|| real_schur(a))?.map_err(|e| to_py_err(py, e))?;
+    let Some(select) = select else {
+        let values = quasi_triangular_eigenvalues(form.t.as_ref());
+        let n = values.len();
+        return Ok((
+            matrix_to_numpy(py, &form.t)?,
+            matrix_to_numpy(py, &form.z)?,
+            complex_vector(py, &values)?,
+            n,
+        ));
+    };
+    // The first exception raised by `select` is kept and re-raised after the reordering.
+    let mut failure: Option<PyErr> = None;
+    let chooser = |lambda: c64| -> bool {
+        if failure.is_some() {
+            return false;
+        }
+        let value = PyComplex::from_doubles(py, lambda.re, lambda.im);
+        match select.call1((value,)).and_then(|r| r.is_truthy()) {
+            Ok(chosen) => chosen,
+            Err(error) => {
+                failure = Some(error);
+                false
+            }
+        }
+    };
+    let ordered = guarded(|| reorder_schur(form, chooser))?;
+    if let Some(error) = failure {
+        return Err(error);
+    }
+    let ordered = ordered.map_err(|e| to_py_err(py, e))?;
+    Ok((
+        matrix_to_numpy(py, &ordered.t)?,
+        matrix_to_numpy(py, &ordered.z)?,
+        complex_vector(py, &ordered.eigenvalues)?,
+        ordered.selected,
+    ))
+}
+
+/// The solution X of A X + X A^T + Q = 0.
+#[pyfunction]
+#[pyo3(signature = (a, q, /))]
+fn solve_lyapunov<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let (a, q) = (float_array(py, a, "A")?, float_array(py, q, "Q")?);
+    let (a, q) = two_views(py, (&a, "A"), (&q, "Q"))?;
+    let x = guarded(|| solve_lyapunov_core(a, q))?.map_err(|e| to_py_err(py, e))?;
+    matrix_to_numpy(py, &x)
+}
+
+/// The stabilising solution of the CARE (6.228): (X, K, closed-loop eigenvalues, relative
+/// residual, rcond(U11), Newton steps).
+#[pyfunction]
+#[pyo3(signature = (a, b, q, r, s, e, refine, /))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn solve_care<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+    s: Option<&Bound<'py, PyAny>>,
+    e: Option<&Bound<'py, PyAny>>,
+    refine: bool,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    f64,
+    f64,
+    usize,
+)> {
+    let (a, b) = (float_array(py, a, "A")?, float_array(py, b, "B")?);
+    let (q, r) = (float_array(py, q, "Q")?, float_array(py, r, "R")?);
+    let s = s.map(|s| float_array(py, s, "S")).transpose()?;
+    let e = e.map(|e| float_array(py, e, "E")).transpose()?;
+    let (a, b) = two_views(py, (&a, "A"), (&b, "B"))?;
+    let (q, r) = two_views(py, (&q, "Q"), (&r, "R"))?;
+    let options = CareOptions {
+        s: optional_view(py, &s, "S")?,
+        e: optional_view(py, &e, "E")?,
+        refine,
+    };
+    let solution =
+        guarded(|| solve_care_core(a, b, q, r, options))?.map_err(|e| to_py_err(py, e))?;
+    Ok((
+        matrix_to_numpy(py, &solution.x)?,
+        matrix_to_numpy(py, &solution.gain)?,
+        complex_vector(py, &solution.closed_loop_eigenvalues)?,
+        solution.residual,
+        solution.rcond,
+        solution.refinement_steps,
+    ))
+}
+
+/// The Riccati differential equation (6.196) backward over the grid `t`: (S (k, n, n),
+/// K (k, m, n), substeps).
+#[pyfunction]
+#[pyo3(signature = (a, b, q, r, t, sf, /))]
+#[allow(clippy::type_complexity)]
+fn riccati_ode<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+    t: &Bound<'py, PyAny>,
+    sf: Option<&Bound<'py, PyAny>>,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    usize,
+)> {
+    let (a, b) = (float_array(py, a, "A")?, float_array(py, b, "B")?);
+    let (q, r) = (float_array(py, q, "Q")?, float_array(py, r, "R")?);
+    let sf = sf.map(|s| float_array(py, s, "Sf")).transpose()?;
+    let times = all_values(py, t, "t")?;
+    let (a, b) = two_views(py, (&a, "A"), (&b, "B"))?;
+    let (q, r) = two_views(py, (&q, "Q"), (&r, "R"))?;
+    let sf = optional_view(py, &sf, "Sf")?;
+    let solution =
+        guarded(|| riccati_ode_core(a, b, q, r, &times, sf))?.map_err(|e| to_py_err(py, e))?;
+    Ok((
+        matrices_to_numpy(py, &solution.s)?,
+        matrices_to_numpy(py, &solution.gains)?,
+        solution.substeps,
+    ))
+}
+
+/// A new C-ordered (k, rows, cols) array holding equally shaped matrices.
+fn matrices_to_numpy<'py>(
+    py: Python<'py>,
+    matrices: &[Mat<f64>],
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let (rows, cols) = matrices.first().map_or((0, 0), |m| (m.nrows(), m.ncols()));
+    let array = new_array(py, &[matrices.len(), rows, cols])?;
+    // SAFETY: the array was just created and is not yet visible to Python.
+    let data = unsafe { new_array_data(&array) };
+    if rows * cols > 0 {
+        for (chunk, m) in data.chunks_exact_mut(rows * cols).zip(matrices) {
+            MatMut::from_row_major_slice_mut(chunk, rows, cols).copy_from(m);
+        }
+    }
+    Ok(array)
+}
+
+/// A faer view of an optional matrix argument.
+fn optional_view<'a>(
+    py: Python<'_>,
+    array: &'a Option<Bound<'_, PyArrayDyn<f64>>>,
+    arg: &'static str,
+) -> PyResult<Option<MatRef<'a, f64>>> {
+    array
+        .as_ref()
+        .map(|array| matrix_view(array, arg).map_err(|e| to_py_err(py, e)))
+        .transpose()
+}
+
 /// The values of a complex128 array, in C order.
 fn copy_complex(array: &Bound<'_, PyArrayDyn<c64>>) -> PyResult<Vec<c64>> {
     let readonly = array.readonly();
@@ -1073,6 +1258,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(charpoly, m)?)?;
     m.add_function(wrap_pyfunction!(companion_form, m)?)?;
     m.add_function(wrap_pyfunction!(place, m)?)?;
+    m.add_function(wrap_pyfunction!(schur, m)?)?;
+    m.add_function(wrap_pyfunction!(solve_lyapunov, m)?)?;
+    m.add_function(wrap_pyfunction!(solve_care, m)?)?;
+    m.add_function(wrap_pyfunction!(riccati_ode, m)?)?;
     m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
     m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;
     m.add("FMA_KERNELS", crate::dispatch::fma_available())?;

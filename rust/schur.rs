@@ -240,7 +240,7 @@ pub fn eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let mut h = Square::from_mat(a);
-    balance(&mut h);
+    let _ = balance(&mut h);
     if h.n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         reduce_to_hessenberg(&mut h, None);
     } else {
@@ -301,11 +301,19 @@ fn reduce_to_hessenberg(h: &mut Square, mut q: Option<&mut Square>) {
     }
 }
 
+/// The diagonal D (powers of two) of the balancing D^-1 A D of a square matrix (see
+/// [`balance`]).
+pub(crate) fn balancing_scale(a: MatRef<'_, f64>) -> Vec<f64> {
+    balance(&mut Square::from_mat(a))
+}
+
 /// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
 /// row and column i are scaled until their off-diagonal 2-norms are within a factor of two, and
-/// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more.
-fn balance(a: &mut Square) {
+/// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more. Returns
+/// the diagonal of D.
+fn balance(a: &mut Square) -> Vec<f64> {
     let n = a.n;
+    let mut scale = vec![1.0; n];
     let mut changed = true;
     let mut sweeps = 0;
     while changed && sweeps < 100 {
@@ -334,6 +342,7 @@ fn balance(a: &mut Square) {
             if f != 1.0 && c.sqrt() + r.sqrt() < 0.95 * (column_squares.sqrt() + row_squares.sqrt())
             {
                 changed = true;
+                scale[i] *= f;
                 for k in 0..n {
                     a[(i, k)] /= f;
                     a[(k, i)] *= f;
@@ -341,6 +350,7 @@ fn balance(a: &mut Square) {
             }
         }
     }
+    scale
 }
 
 /// A 2 x 2 block [[a, b], [c, d]] rotated into standard form by the rotation

@@ -15,6 +15,10 @@ class                         raised when
 ``ConvergenceError``          an iteration reached its limit (an ``AerocontrolLinAlgError``)
 ``SingularMatrixError``       a matrix to invert has a zero eigenvalue (likewise)
 ``UncontrollableError``       a pair (A, B) has a mode that no feedback can move (likewise)
+``NoStabilizingSolutionError``  a Riccati equation has no stabilising solution (likewise)
+``IllConditionedError``       a step would lose every digit and was refused (likewise)
+``NotPositiveDefiniteError``  a weight such as R is not symmetric positive definite
+                              (an ``InvalidArgumentError``)
 ============================  ===========================================================
 
 Warnings (``AerocontrolWarning`` and subclasses) report results that were computed but deserve
@@ -30,9 +34,12 @@ __all__ = [
     "AerocontrolLinAlgError",
     "AerocontrolWarning",
     "ConvergenceError",
+    "IllConditionedError",
     "IllConditionedWarning",
     "InvalidArgumentError",
+    "NoStabilizingSolutionError",
     "NonFiniteError",
+    "NotPositiveDefiniteError",
     "NotRealError",
     "NumericalOverflowWarning",
     "ShapeError",
@@ -58,6 +65,11 @@ class NonFiniteError(InvalidArgumentError):
     """An argument contains NaN or an infinity; the message names the first such entry."""
 
 
+class NotPositiveDefiniteError(InvalidArgumentError):
+    """A matrix that must be symmetric positive definite (the control weight R) is not; the
+    message names it and says whether symmetry or definiteness fails."""
+
+
 class NotRealError(AerocontrolError, TypeError):
     """An argument is complex or not numeric; aerocontrol works with real matrices only."""
 
@@ -75,6 +87,17 @@ class SingularMatrixError(AerocontrolLinAlgError):
 class UncontrollableError(AerocontrolLinAlgError):
     """A pair (A, B) is not controllable to the rank tolerance (or (A, C) not observable);
     the message names the eigenvalues that feedback cannot move."""
+
+
+class NoStabilizingSolutionError(AerocontrolLinAlgError):
+    """A Riccati equation has no stabilising solution: its Hamiltonian has eigenvalues on or
+    too near the imaginary axis (an undamped mode that is neither controllable nor penalised),
+    or its stable invariant subspace is not the graph of a matrix."""
+
+
+class IllConditionedError(AerocontrolLinAlgError):
+    """A step would lose every digit to ill-conditioning and was refused, for example the
+    exchange of two Schur blocks with nearly equal eigenvalues."""
 
 
 class ConvergenceError(AerocontrolLinAlgError):

@@ -1,0 +1,471 @@
+//! The continuous-time algebraic Riccati equation (chapter (6.199), and its general form
+//! (6.228) as MATLAB's care(A, B, Q, R, S, E) states it):
+//!
+//! ```text
+//! A^T X E + E^T X A - (E^T X B + S) R^-1 (B^T X E + S^T) + Q = 0,
+//! K = R^-1 (B^T X E + S^T),      closed loop eig(A - B K, E),
+//! ```
+//!
+//! for the stabilising solution X = X^T (every closed-loop eigenvalue in Re λ < 0), by the
+//! Hamiltonian ordered-Schur method of Laub (1979), with scaling and Newton refinement.
+//!
+//! # Reduction to the standard equation
+//!
+//! A nonsingular E is removed by Ã = E^-1 A, B̃ = E^-1 B (LU solves): Y = E^T X E then solves
+//! the equation with E = I, and X = E^-T Y E^-1. (MATLAB keeps E in a pencil and uses the QZ
+//! algorithm; the LU route is as accurate when κ(E) is moderate, which is checked.) With the
+//! Cholesky factor R = L L^T, B̂ = B̃ L^-T and Ŝ = S L^-T, the cross term is absorbed:
+//!
+//! ```text
+//! Ā = Ã - B̂ Ŝ^T,   G = B̂ B̂^T,   Q̄ = Q - Ŝ Ŝ^T:     Ā^T Y + Y Ā - Y G Y + Q̄ = 0,
+//! ```
+//!
+//! with R^-1 formed nowhere.
+//!
+//! # The Hamiltonian method
+//!
+//! H = [[Ā, -G], [-Q̄, -Ā^T]] has eigenvalues symmetric about the imaginary axis. If none lies
+//! on it and the stable invariant subspace is spanned by the columns of [U11; U21] with U11
+//! nonsingular, Y = U21 U11^-1 is the stabilising solution and the stable eigenvalues of H are
+//! the closed-loop ones. The subspace comes from the real Schur form of H ([`crate::schur`])
+//! reordered to put Re λ < 0 first ([`crate::reorder`]); Y from U11^T Y = U21^T by an LU
+//! solve, then symmetrised.
+//!
+//! Before that H is scaled twice, by similarities that keep it Hamiltonian: by ρ, a power of
+//! two near sqrt(||Q̄||_F / ||G||_F), to G ρ and Q̄ / ρ (the scaling of Pandey and of Benner's
+//! CAREX study: it balances the two off-diagonal blocks, whose norms can differ by 10^10 in
+//! flight-control weights like R = I / c^2), and by diag(D, D^-1) with D the powers of two
+//! nearest to the square roots of a Parlett–Reinsch balancing of H, as scipy's
+//! solve_continuous_are balances its pencil. Both are exact in floating point and are undone
+//! on Y.
+//!
+//! # Refinement and the reported numbers
+//!
+//! The Schur method is backward stable for the Hamiltonian but not for the Riccati equation
+//! itself; Newton's method (Kleinman 1968) restores a small residual: with A_k = Ā - G Y_k,
+//! A_k^T Δ + Δ A_k = -Res(Y_k) ([`crate::lyapunov`]), Y_{k+1} = Y_k + Δ, repeated while the
+//! residual decreases (at most [`MAX_REFINEMENT_STEPS`] times). Reported: the relative residual
+//! of the general equation,
+//!
+//! ```text
+//! ||Res||_F / (||Q||_F + 2 ||A^T X E||_F + ||M^T K||_F),      M = B^T X E + S^T,
+//! ```
+//!
+//! and the reciprocal 1-norm condition number of U11 (small: the subspace is nearly not a
+//! graph and X is inaccurate).
+//!
+//! # Errors
+//!
+//! R not symmetric positive definite; E singular; eigenvalues of H within
+//! [`AXIS_TOLERANCE`] ||H||_F of the imaginary axis (no stabilising solution: an undamped mode
+//! that the input cannot move or the weight does not see); U11 singular to working precision.
+
+use crate::error::{Error, check_finite, check_rows, check_square};
+use crate::lu::solve_in_place;
+use crate::lyapunov::{solve_lyapunov, symmetrize};
+use crate::norm::one_norm;
+use crate::reorder::reorder_schur;
+use crate::schur::{balancing_scale, eigenvalues, real_schur};
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{Mat, MatRef, Par, Side, c64};
+
+/// Eigenvalues of H with |Re λ| <= AXIS_TOLERANCE ||H||_F count as on the imaginary axis.
+pub const AXIS_TOLERANCE: f64 = 100.0 * f64::EPSILON;
+
+/// Newton steps at most; each costs one Lyapunov solve (about the price of the Schur form of
+/// an n x n matrix, an eighth of that of H).
+pub const MAX_REFINEMENT_STEPS: usize = 10;
+
+/// Asymmetry ||M - M^T||_max / ||M||_max that Q and R may carry (rounding in how the caller
+/// formed them); they are then symmetrised.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-12;
+
+/// The solution of a CARE and its diagnostics.
+#[derive(Debug, Clone)]
+pub struct Care {
+    /// The stabilising solution X = X^T.
+    pub x: Mat<f64>,
+    /// K = R^-1 (B^T X E + S^T), m x n.
+    pub gain: Mat<f64>,
+    /// The eigenvalues of (A - B K, E), pairs adjacent with Im > 0 first.
+    pub closed_loop_eigenvalues: Vec<c64>,
+    /// The relative residual of the general equation (see the module documentation).
+    pub residual: f64,
+    /// The reciprocal 1-norm condition number of U11.
+    pub rcond: f64,
+    /// Newton steps taken.
+    pub refinement_steps: usize,
+}
+
+/// The optional arguments of [`solve_care`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CareOptions<'a> {
+    /// The cross weight S (n x m), the N of python-control's lqr.
+    pub s: Option<MatRef<'a, f64>>,
+    /// The descriptor matrix E (n x n, nonsingular).
+    pub e: Option<MatRef<'a, f64>>,
+    /// Newton refinement after the Schur solution.
+    pub refine: bool,
+}
+
+/// The standard-form data Ā, G, Q̄ and what is needed to return to the general form.
+struct Standard {
+    a: Mat<f64>,
+    g: Mat<f64>,
+    q: Mat<f64>,
+    /// B̂ = E^-1 B L^-T and Ŝ = S L^-T, for the gain K = L^-T (B̂^T Y + Ŝ^T).
+    b_hat: Mat<f64>,
+    s_hat: Option<Mat<f64>>,
+}
+
+/// Solves the CARE for its stabilising solution.
+pub fn solve_care(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    options: CareOptions<'_>,
+) -> Result<Care, Error> {
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    let n = a.nrows();
+    check_rows(b, "B", n, "A")?;
+    check_finite(b, "B")?;
+    let m = b.ncols();
+    let q = symmetric(q, "Q", n, "A")?;
+    let r = symmetric(r, "R", m, "the columns of B")?;
+    if let Some(s) = options.s {
+        check_rows(s, "S", n, "A")?;
+        if s.ncols() != m {
+            return Err(Error::Mismatch {
+                arg: "S",
+                what: "as many columns as",
+                expected: m,
+                other: "B",
+                got: s.ncols(),
+            });
+        }
+        check_finite(s, "S")?;
+    }
+    let cholesky = r
+        .as_ref()
+        .llt(Side::Lower)
+        .map_err(|_| Error::NotPositiveDefinite {
+            arg: "R",
+            message: "R must be symmetric positive definite, but its Cholesky factorisation \
+                  failed: R has an eigenvalue <= 0 (to working precision)"
+                .into(),
+        })?;
+    let l = cholesky.L();
+    let (a_tilde, b_tilde) = match options.e {
+        Some(e) => remove_descriptor(a, b, e)?,
+        None => (a.to_owned(), b.to_owned()),
+    };
+    let standard = standardize(&a_tilde, &b_tilde, &q, l, options.s);
+    if n == 0 {
+        return Ok(Care {
+            x: Mat::zeros(0, 0),
+            gain: Mat::zeros(m, 0),
+            closed_loop_eigenvalues: Vec::new(),
+            residual: 0.0,
+            rcond: 1.0,
+            refinement_steps: 0,
+        });
+    }
+    let (mut y, rcond) = hamiltonian_solution(&standard)?;
+    let mut refinement_steps = 0;
+    if options.refine {
+        refinement_steps = refine(&standard, &mut y);
+    }
+    // K = L^-T (B̂^T Y + Ŝ^T); X = E^-T Y E^-1.
+    let mut gain = standard.b_hat.transpose() * &y;
+    if let Some(s_hat) = &standard.s_hat {
+        gain += s_hat.transpose();
+    }
+    solve_upper_triangular_in_place(l.transpose(), gain.as_mut(), Par::Seq);
+    let closed_loop = &standard.a - &standard.g * &y;
+    let closed_loop_eigenvalues = eigenvalues(closed_loop.as_ref())?;
+    let x = match options.e {
+        Some(e) => {
+            let mut x = y.clone();
+            let mut factors = e.transpose().to_owned();
+            solve_in_place(factors.as_mut(), x.as_mut(), Par::Seq);
+            let mut xt = x.transpose().to_owned();
+            let mut factors = e.transpose().to_owned();
+            solve_in_place(factors.as_mut(), xt.as_mut(), Par::Seq);
+            let mut x = xt.transpose().to_owned();
+            symmetrize(&mut x);
+            x
+        }
+        None => y,
+    };
+    let residual = general_residual(a, b, q.as_ref(), options.s, options.e, &x, &gain);
+    Ok(Care {
+        x,
+        gain,
+        closed_loop_eigenvalues,
+        residual,
+        rcond,
+        refinement_steps,
+    })
+}
+
+/// A square, finite, symmetric (to [`SYMMETRY_TOLERANCE`]) matrix, symmetrised.
+fn symmetric(
+    matrix: MatRef<'_, f64>,
+    arg: &'static str,
+    order: usize,
+    other: &'static str,
+) -> Result<Mat<f64>, Error> {
+    check_square(matrix, arg)?;
+    check_rows(matrix, arg, order, other)?;
+    check_finite(matrix, arg)?;
+    let largest = matrix.norm_max();
+    let asymmetry = (matrix - matrix.transpose()).norm_max();
+    if asymmetry > SYMMETRY_TOLERANCE * largest {
+        let message = format!(
+            "{arg} must be symmetric, but max|{arg} - {arg}^T| = {asymmetry:.3e} is more than \
+             {SYMMETRY_TOLERANCE:.0e} times max|{arg}| = {largest:.3e}"
+        );
+        return Err(if arg == "R" {
+            Error::NotPositiveDefinite { arg, message }
+        } else {
+            Error::InvalidArgument { arg, message }
+        });
+    }
+    let mut symmetric = matrix.to_owned();
+    symmetrize(&mut symmetric);
+    Ok(symmetric)
+}
+
+/// (E^-1 A, E^-1 B), refusing an E that is singular to working precision.
+fn remove_descriptor(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    e: MatRef<'_, f64>,
+) -> Result<(Mat<f64>, Mat<f64>), Error> {
+    let n = a.nrows();
+    check_square(e, "E")?;
+    check_rows(e, "E", n, "A")?;
+    check_finite(e, "E")?;
+    let m = b.ncols();
+    let mut rhs = Mat::<f64>::zeros(n, 2 * n + m);
+    rhs.as_mut().subcols_mut(0, n).copy_from(a);
+    rhs.as_mut().subcols_mut(n, m).copy_from(b);
+    for i in 0..n {
+        rhs[(i, n + m + i)] = 1.0;
+    }
+    let mut factors = e.to_owned();
+    solve_in_place(factors.as_mut(), rhs.as_mut(), Par::Seq);
+    let condition = one_norm(e) * one_norm(rhs.as_ref().subcols(n + m, n));
+    let singular = condition.is_nan() || condition * f64::EPSILON * n.max(1) as f64 > 1.0;
+    if singular {
+        return Err(Error::InvalidArgument {
+            arg: "E",
+            message: format!(
+                "E must be nonsingular, but its condition number is {condition:.3e}: \
+                 singular to working precision"
+            ),
+        });
+    }
+    Ok((
+        rhs.as_ref().subcols(0, n).to_owned(),
+        rhs.as_ref().subcols(n, m).to_owned(),
+    ))
+}
+
+/// Ā = Ã - B̂ Ŝ^T, G = B̂ B̂^T, Q̄ = Q - Ŝ Ŝ^T with B̂ = B̃ L^-T, Ŝ = S L^-T.
+fn standardize(
+    a_tilde: &Mat<f64>,
+    b_tilde: &Mat<f64>,
+    q: &Mat<f64>,
+    l: MatRef<'_, f64>,
+    s: Option<MatRef<'_, f64>>,
+) -> Standard {
+    // X L^T = Y  <=>  L X^T = Y^T.
+    let right_divide = |y: MatRef<'_, f64>| {
+        let mut transposed = y.transpose().to_owned();
+        solve_lower_triangular_in_place(l, transposed.as_mut(), Par::Seq);
+        transposed.transpose().to_owned()
+    };
+    let b_hat = right_divide(b_tilde.as_ref());
+    let mut g = &b_hat * b_hat.transpose();
+    symmetrize(&mut g);
+    let (a, q, s_hat) = match s {
+        Some(s) => {
+            let s_hat = right_divide(s);
+            let a = a_tilde - &b_hat * s_hat.transpose();
+            let mut q = q - &s_hat * s_hat.transpose();
+            symmetrize(&mut q);
+            (a, q, Some(s_hat))
+        }
+        None => (a_tilde.clone(), q.clone(), None),
+    };
+    Standard {
+        a,
+        g,
+        q,
+        b_hat,
+        s_hat,
+    }
+}
+
+/// Y from the ordered Schur form of the scaled Hamiltonian, and rcond(U11).
+fn hamiltonian_solution(standard: &Standard) -> Result<(Mat<f64>, f64), Error> {
+    let n = standard.a.nrows();
+    let (g_norm, q_norm) = (standard.g.norm_l2(), standard.q.norm_l2());
+    let rho = if g_norm > 0.0 && q_norm > 0.0 {
+        nearest_power_of_two((q_norm / g_norm).sqrt())
+    } else {
+        1.0
+    };
+    let mut h = Mat::<f64>::zeros(2 * n, 2 * n);
+    for j in 0..n {
+        for i in 0..n {
+            h[(i, j)] = standard.a[(i, j)];
+            h[(i, n + j)] = -rho * standard.g[(i, j)];
+            h[(n + i, j)] = -standard.q[(i, j)] / rho;
+            h[(n + i, n + j)] = -standard.a[(j, i)];
+        }
+    }
+    // The symplectic balancing diag(D, D^-1): d_i from the balancing of rows i and n + i.
+    let scale = balancing_scale(h.as_ref());
+    let d: Vec<f64> = (0..n)
+        .map(|i| nearest_power_of_two((scale[i] / scale[n + i]).sqrt()))
+        .collect();
+    for j in 0..n {
+        for i in 0..n {
+            h[(i, j)] *= d[j] / d[i];
+            h[(i, n + j)] /= d[i] * d[j];
+            h[(n + i, j)] *= d[i] * d[j];
+            h[(n + i, n + j)] *= d[i] / d[j];
+        }
+    }
+    let h_norm = h.norm_l2();
+    let ordered = reorder_schur(real_schur(h.as_ref())?, |lambda| lambda.re < 0.0)?;
+    let on_axis: Vec<c64> = ordered
+        .eigenvalues
+        .iter()
+        .copied()
+        .filter(|lambda| lambda.re.abs() <= AXIS_TOLERANCE * h_norm)
+        .collect();
+    if !on_axis.is_empty() || ordered.selected != n {
+        let listed: Vec<String> = on_axis
+            .iter()
+            .map(|z| crate::error::format_complex(*z))
+            .collect();
+        return Err(Error::NoStabilizingSolution {
+            message: format!(
+                "the Riccati equation has no stabilising solution: the Hamiltonian matrix has \
+                 {} eigenvalue(s) on the imaginary axis to working precision ({}; |Re| <= \
+                 {:.1e} ||H||), so some undamped mode can be neither moved by B nor seen by Q",
+                on_axis.len().max(2 * n - 2 * ordered.selected.min(n)),
+                if listed.is_empty() {
+                    "stable and unstable eigenvalues do not pair up".to_owned()
+                } else {
+                    listed.join(", ")
+                },
+                AXIS_TOLERANCE
+            ),
+        });
+    }
+    // U11^T Y'^T = U21^T together with U11^T W = I, for rcond(U11).
+    let z = ordered.z.as_ref();
+    let u11 = z.submatrix(0, 0, n, n);
+    let mut rhs = Mat::<f64>::zeros(n, 2 * n);
+    rhs.as_mut()
+        .subcols_mut(0, n)
+        .copy_from(z.submatrix(n, 0, n, n).transpose());
+    for i in 0..n {
+        rhs[(i, n + i)] = 1.0;
+    }
+    let mut factors = u11.transpose().to_owned();
+    solve_in_place(factors.as_mut(), rhs.as_mut(), Par::Seq);
+    let rcond = 1.0 / (one_norm(u11) * one_norm(rhs.as_ref().subcols(n, n).transpose()));
+    if rcond.is_nan() || rcond <= n as f64 * f64::EPSILON {
+        return Err(Error::IllConditioned {
+            message: format!(
+                "the stable invariant subspace of the Hamiltonian is not the graph of a matrix \
+                 (U11 is singular to working precision, rcond = {rcond:.2e}): (A, B) is \
+                 probably not stabilisable, or (Q, A) not detectable"
+            ),
+        });
+    }
+    // Undo the scalings: Y = rho D^-1 Y' D^-1.
+    let y_scaled = rhs.as_ref().subcols(0, n).transpose();
+    let mut y = Mat::from_fn(n, n, |i, j| rho * y_scaled[(i, j)] / (d[i] * d[j]));
+    symmetrize(&mut y);
+    Ok((y, rcond))
+}
+
+fn nearest_power_of_two(value: f64) -> f64 {
+    if value.is_finite() && value > 0.0 {
+        2f64.powi(value.log2().round() as i32)
+    } else {
+        1.0
+    }
+}
+
+/// Res(Y) = Ā^T Y + Y Ā - Y G Y + Q̄.
+fn standard_residual(standard: &Standard, y: &Mat<f64>) -> Mat<f64> {
+    let ay = standard.a.transpose() * y;
+    let mut residual = &ay + ay.transpose() - y * &standard.g * y + &standard.q;
+    symmetrize(&mut residual);
+    residual
+}
+
+/// Newton (Kleinman) steps while the residual decreases; returns the number accepted.
+fn refine(standard: &Standard, y: &mut Mat<f64>) -> usize {
+    let mut residual = standard_residual(standard, y);
+    let mut residual_norm = residual.norm_l2();
+    let mut steps = 0;
+    while steps < MAX_REFINEMENT_STEPS && residual_norm > 0.0 {
+        let closed_loop = &standard.a - &standard.g * &*y;
+        let Ok(delta) = solve_lyapunov(closed_loop.transpose(), residual.as_ref()) else {
+            break;
+        };
+        let mut candidate = &*y + &delta;
+        symmetrize(&mut candidate);
+        let candidate_residual = standard_residual(standard, &candidate);
+        let candidate_norm = candidate_residual.norm_l2();
+        if candidate_norm.is_nan() || candidate_norm >= residual_norm {
+            break;
+        }
+        *y = candidate;
+        residual = candidate_residual;
+        residual_norm = candidate_norm;
+        steps += 1;
+    }
+    steps
+}
+
+/// The relative residual of A^T X E + E^T X A - M^T K + Q = 0, M = B^T X E + S^T.
+fn general_residual(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    s: Option<MatRef<'_, f64>>,
+    e: Option<MatRef<'_, f64>>,
+    x: &Mat<f64>,
+    gain: &Mat<f64>,
+) -> f64 {
+    let xe = match e {
+        Some(e) => x * e,
+        None => x.clone(),
+    };
+    let axe = a.transpose() * &xe;
+    let mut m = b.transpose() * &xe;
+    if let Some(s) = s {
+        m += s.transpose();
+    }
+    let quadratic = m.transpose() * gain;
+    let residual = &axe + axe.transpose() - &quadratic + q;
+    let scale = q.norm_l2() + 2.0 * axe.norm_l2() + quadratic.norm_l2();
+    if scale > 0.0 {
+        residual.norm_l2() / scale
+    } else {
+        residual.norm_l2()
+    }
+}

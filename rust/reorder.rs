@@ -1,0 +1,357 @@
+//! Reordering of the real Schur form: A = Z T Z^T becomes A = Z' T' Z'^T with a chosen set
+//! of eigenvalues in the leading diagonal blocks of T', so that the leading columns of Z' span
+//! their invariant subspace (what the Riccati solver needs: the stable subspace of the
+//! Hamiltonian).
+//!
+//! # Swapping two adjacent blocks (Bai & Demmel 1993)
+//!
+//! Let T11 (order p) and T22 (order q) be adjacent diagonal blocks, p, q in {1, 2}, and
+//!
+//! ```text
+//! D = [ T11  T12 ]
+//!     [ 0    T22 ]
+//! ```
+//!
+//! If X solves the Sylvester equation T11 X - X T22 = T12 ([`crate::sylvester`]), then
+//! D [-X; I] = [-X; I] T22, so the columns of [-X; I] span the invariant subspace of T22's
+//! eigenvalues. With the QR factorisation [-X; I] = Q R, the orthogonal Q gives
+//!
+//! ```text
+//! Q^T D Q = [ T22'  *    ]      T22' = R T22 R^-1,  T11' similar to T11.
+//!           [ E     T11' ]
+//! ```
+//!
+//! E is zero in exact arithmetic and of order u ||D|| / sep(T11, T22) in floating point. The
+//! swap is accepted only if it passes both stability tests of Bai & Demmel: the weak test
+//! ||E||_max <= thresh and the strong test ||D - Q [T22' *; 0 T11'] Q^T||_max <= thresh, with
+//! thresh = 10 u max|D_ij| (the threshold LAPACK's dtrexc uses). Then E is set to zero and the
+//! transformation is applied to the rest of T and to Z; the swap is backward stable. When T11
+//! and T22 have (nearly) equal eigenvalues the Sylvester equation is (nearly) singular and the
+//! tests fail: the swap is refused with [`Error::IllConditioned`] rather than returning an
+//! inaccurate invariant subspace. Two 1 x 1 blocks are exchanged by the single plane rotation
+//! whose first column is the eigenvector [t12, t22 - t11] of t22, which is always stable.
+//!
+//! New 2 x 2 blocks are put back in standard form ([`crate::schur::standardize_block`]); a
+//! block whose eigenvalues the rounding errors have made real splits into two 1 x 1 blocks.
+//!
+//! # Ordering
+//!
+//! The blocks are scanned from the top; each selected block is moved up, one adjacent swap at
+//! a time, to just below the selected ones already in place, as LAPACK's dtrsen does. A
+//! complex pair is selected by its member with positive imaginary part.
+
+use crate::error::Error;
+use crate::schur::{RealSchur, quasi_triangular_eigenvalues, reflector, standardize_block};
+use crate::sylvester::solve_small_sylvester;
+use faer::{Mat, c64};
+
+/// A real Schur form A = Z T Z^T whose leading `selected` eigenvalues are the chosen ones.
+#[derive(Debug, Clone)]
+pub struct OrderedSchur {
+    pub t: Mat<f64>,
+    pub z: Mat<f64>,
+    /// The eigenvalues in the order of T's diagonal (pairs adjacent, Im > 0 first).
+    pub eigenvalues: Vec<c64>,
+    /// The number of leading eigenvalues that `select` chose.
+    pub selected: usize,
+}
+
+/// Reorders a real Schur form so that the eigenvalues for which `select` is true come first.
+pub fn reorder_schur(
+    schur: RealSchur,
+    mut select: impl FnMut(c64) -> bool,
+) -> Result<OrderedSchur, Error> {
+    let RealSchur { mut t, mut z } = schur;
+    let n = t.nrows();
+    // Rows and columns above `position` hold selected blocks only.
+    let mut position = 0;
+    let mut k = 0;
+    while k < n {
+        let size = block_size(&t, k);
+        if !select(block_eigenvalue(&t, k, size)) {
+            k += size;
+            continue;
+        }
+        let mut current = k;
+        let mut split = false;
+        while current > position {
+            let previous_size = if current >= position + 2 && t[(current - 1, current - 2)] != 0.0 {
+                2
+            } else {
+                1
+            };
+            let previous = current - previous_size;
+            swap_blocks(&mut t, &mut z, previous, previous_size, size)?;
+            current = previous;
+            if size == 2 && t[(current + 1, current)] == 0.0 {
+                split = true;
+                break;
+            }
+        }
+        if split {
+            // The moving pair turned into two real eigenvalues: scan again from the boundary.
+            k = position;
+            continue;
+        }
+        position += size;
+        k += size;
+    }
+    let eigenvalues = quasi_triangular_eigenvalues(t.as_ref());
+    Ok(OrderedSchur {
+        t,
+        z,
+        eigenvalues,
+        selected: position,
+    })
+}
+
+/// The order (1 or 2) of the diagonal block that starts at row k.
+fn block_size(t: &Mat<f64>, k: usize) -> usize {
+    if k + 1 < t.nrows() && t[(k + 1, k)] != 0.0 {
+        2
+    } else {
+        1
+    }
+}
+
+/// The eigenvalue of a block, the one with Im > 0 for a pair.
+fn block_eigenvalue(t: &Mat<f64>, k: usize, size: usize) -> c64 {
+    if size == 1 {
+        c64::new(t[(k, k)], 0.0)
+    } else {
+        let im = t[(k, k + 1)].abs().sqrt() * t[(k + 1, k)].abs().sqrt();
+        c64::new(t[(k, k)], im)
+    }
+}
+
+/// Exchanges the adjacent diagonal blocks of orders p (at row j) and q (at row j + p) of T,
+/// updating Z.
+// The 4 x 4 kernels below read most clearly with indices.
+#[allow(clippy::needless_range_loop)]
+pub(crate) fn swap_blocks(
+    t: &mut Mat<f64>,
+    z: &mut Mat<f64>,
+    j: usize,
+    p: usize,
+    q: usize,
+) -> Result<(), Error> {
+    if p == 1 && q == 1 {
+        swap_one_by_one(t, z, j);
+        return Ok(());
+    }
+    let order = p + q;
+    let mut d = [[0.0f64; 4]; 4];
+    for (r, row) in d.iter_mut().enumerate().take(order) {
+        for (c, value) in row.iter_mut().enumerate().take(order) {
+            *value = t[(j + r, j + c)];
+        }
+    }
+    let d_max = d
+        .iter()
+        .flat_map(|row| row.iter())
+        .fold(0.0f64, |acc, v| acc.max(v.abs()));
+    let threshold = (10.0 * f64::EPSILON * d_max).max(f64::MIN_POSITIVE / f64::EPSILON);
+
+    // T11 X - X T22 = T12.
+    let mut t11 = [[0.0; 2]; 2];
+    let mut minus_t22 = [[0.0; 2]; 2];
+    let mut t12 = [[0.0; 2]; 2];
+    for r in 0..2 {
+        for c in 0..2 {
+            if r < p && c < p {
+                t11[r][c] = d[r][c];
+            }
+            if r < q && c < q {
+                minus_t22[r][c] = -d[p + r][p + c];
+            }
+            if r < p && c < q {
+                t12[r][c] = d[r][p + c];
+            }
+        }
+    }
+    let x = solve_small_sylvester(&t11, p, &minus_t22, q, &t12).x;
+
+    // Q from the Householder QR of [-X; I] (order x q).
+    let mut basis = [[0.0f64; 2]; 4];
+    for r in 0..p {
+        for c in 0..q {
+            basis[r][c] = -x[r][c];
+        }
+    }
+    for c in 0..q {
+        basis[p + c][c] = 1.0;
+    }
+    let mut q_matrix = [[0.0f64; 4]; 4];
+    for (r, row) in q_matrix.iter_mut().enumerate().take(order) {
+        row[r] = 1.0;
+    }
+    for c in 0..q {
+        let mut v = [0.0f64; 4];
+        for r in c..order {
+            v[r - c] = basis[r][c];
+        }
+        let length = order - c;
+        let (_, tau) = reflector(&mut v[..length]);
+        if tau == 0.0 {
+            continue;
+        }
+        v[0] = 1.0;
+        // basis <- H basis (remaining columns), Q <- Q H.
+        for cc in c + 1..q {
+            let dot: f64 = (0..length).map(|r| v[r] * basis[c + r][cc]).sum();
+            for r in 0..length {
+                basis[c + r][cc] -= tau * dot * v[r];
+            }
+        }
+        for row in q_matrix.iter_mut().take(order) {
+            let dot: f64 = (0..length).map(|r| row[c + r] * v[r]).sum();
+            for r in 0..length {
+                row[c + r] -= tau * dot * v[r];
+            }
+        }
+    }
+
+    // D' = Q^T D Q and the two stability tests.
+    let product = |left: &[[f64; 4]; 4], right: &[[f64; 4]; 4], transpose_left: bool| {
+        let mut out = [[0.0f64; 4]; 4];
+        for (r, row) in out.iter_mut().enumerate().take(order) {
+            for (c, value) in row.iter_mut().enumerate().take(order) {
+                *value = (0..order)
+                    .map(|s| {
+                        let l = if transpose_left {
+                            left[s][r]
+                        } else {
+                            left[r][s]
+                        };
+                        l * right[s][c]
+                    })
+                    .sum();
+            }
+        }
+        out
+    };
+    let transpose = |m: &[[f64; 4]; 4]| {
+        let mut out = [[0.0f64; 4]; 4];
+        for r in 0..order {
+            for c in 0..order {
+                out[r][c] = m[c][r];
+            }
+        }
+        out
+    };
+    let mut swapped = product(&q_matrix, &product(&d, &q_matrix, false), true);
+    let weak = (q..order)
+        .flat_map(|r| (0..q).map(move |c| (r, c)))
+        .fold(0.0f64, |acc, (r, c)| acc.max(swapped[r][c].abs()));
+    for row in swapped.iter_mut().take(order).skip(q) {
+        for value in row.iter_mut().take(q) {
+            *value = 0.0;
+        }
+    }
+    let rebuilt = product(
+        &q_matrix,
+        &product(&swapped, &transpose(&q_matrix), false),
+        false,
+    );
+    let strong = (0..order)
+        .flat_map(|r| (0..order).map(move |c| (r, c)))
+        .fold(0.0f64, |acc, (r, c)| {
+            acc.max((rebuilt[r][c] - d[r][c]).abs())
+        });
+    if !(weak <= threshold && strong <= threshold) {
+        return Err(Error::IllConditioned {
+            message: format!(
+                "the exchange of the Schur blocks at rows {j} and {} was rejected as too \
+                 ill-conditioned (their eigenvalues are too close: the swapped form would be \
+                 off by {:.2e}, the threshold is {threshold:.2e})",
+                j + p,
+                weak.max(strong)
+            ),
+        });
+    }
+
+    // Apply Q to the rest of T and to Z, and write the swapped block.
+    let n = t.nrows();
+    let mut buffer = [0.0f64; 4];
+    for c in j + order..n {
+        for (r, value) in buffer.iter_mut().enumerate().take(order) {
+            *value = (0..order).map(|s| q_matrix[s][r] * t[(j + s, c)]).sum();
+        }
+        for (r, value) in buffer.iter().enumerate().take(order) {
+            t[(j + r, c)] = *value;
+        }
+    }
+    multiply_columns(t, j, j, &q_matrix, order);
+    multiply_columns(z, z.nrows(), j, &q_matrix, order);
+    for r in 0..order {
+        for c in 0..order {
+            t[(j + r, j + c)] = swapped[r][c];
+        }
+    }
+    if q == 2 {
+        standardize_at(t, z, j);
+    }
+    if p == 2 {
+        standardize_at(t, z, j + q);
+    }
+    Ok(())
+}
+
+/// Rows 0..rows of columns j..j+order of `matrix` times the order x order `q`.
+fn multiply_columns(matrix: &mut Mat<f64>, rows: usize, j: usize, q: &[[f64; 4]; 4], order: usize) {
+    let mut buffer = [0.0f64; 4];
+    for r in 0..rows {
+        for (c, value) in buffer.iter_mut().enumerate().take(order) {
+            *value = (0..order).map(|s| matrix[(r, j + s)] * q[s][c]).sum();
+        }
+        for (c, value) in buffer.iter().enumerate().take(order) {
+            matrix[(r, j + c)] = *value;
+        }
+    }
+}
+
+/// Exchanges two 1 x 1 blocks at rows j and j + 1 by one plane rotation.
+fn swap_one_by_one(t: &mut Mat<f64>, z: &mut Mat<f64>, j: usize) {
+    let (t11, t12, t22) = (t[(j, j)], t[(j, j + 1)], t[(j + 1, j + 1)]);
+    if t11 == t22 {
+        return;
+    }
+    // The first column of the rotation is the eigenvector [t12, t22 - t11] of t22.
+    let norm = t12.hypot(t22 - t11);
+    let (cs, sn) = (t12 / norm, (t22 - t11) / norm);
+    rotate(t, z, j, cs, sn);
+    t[(j, j)] = t22;
+    t[(j + 1, j + 1)] = t11;
+    t[(j + 1, j)] = 0.0;
+}
+
+/// Puts the 2 x 2 block at row j in standard form (or splits it) and carries the rotation.
+fn standardize_at(t: &mut Mat<f64>, z: &mut Mat<f64>, j: usize) {
+    let block = standardize_block(t[(j, j)], t[(j, j + 1)], t[(j + 1, j)], t[(j + 1, j + 1)]);
+    rotate(t, z, j, block.cs, block.sn);
+    t[(j, j)] = block.a;
+    t[(j, j + 1)] = block.b;
+    t[(j + 1, j)] = block.c;
+    t[(j + 1, j + 1)] = block.d;
+}
+
+/// T <- G^T T G and Z <- Z G for the rotation G = [[cs, -sn], [sn, cs]] in the plane (j, j+1);
+/// the 2 x 2 diagonal block itself is left to the caller.
+fn rotate(t: &mut Mat<f64>, z: &mut Mat<f64>, j: usize, cs: f64, sn: f64) {
+    let n = t.nrows();
+    for c in j + 2..n {
+        let (x, y) = (t[(j, c)], t[(j + 1, c)]);
+        t[(j, c)] = cs * x + sn * y;
+        t[(j + 1, c)] = cs * y - sn * x;
+    }
+    for r in 0..j {
+        let (x, y) = (t[(r, j)], t[(r, j + 1)]);
+        t[(r, j)] = cs * x + sn * y;
+        t[(r, j + 1)] = cs * y - sn * x;
+    }
+    for r in 0..n {
+        let (x, y) = (z[(r, j)], z[(r, j + 1)]);
+        z[(r, j)] = cs * x + sn * y;
+        z[(r, j + 1)] = cs * y - sn * x;
+    }
+}
