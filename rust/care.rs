@@ -62,7 +62,7 @@
 
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::lu::solve_in_place;
-use crate::lyapunov::{solve_lyapunov, symmetrize};
+use crate::lyapunov::{self, Singularity, symmetrize};
 use crate::norm::one_norm;
 use crate::reorder::reorder_schur;
 use crate::schur::{balancing_scale, eigenvalues, real_schur};
@@ -110,14 +110,49 @@ pub struct CareOptions<'a> {
     pub refine: bool,
 }
 
-/// The standard-form data Ā, G, Q̄ and what is needed to return to the general form.
+/// The data of the Hamiltonian: Ā, G and Q̄.
 struct Standard {
     a: Mat<f64>,
     g: Mat<f64>,
     q: Mat<f64>,
-    /// B̂ = E^-1 B L^-T and Ŝ = S L^-T, for the gain K = L^-T (B̂^T Y + Ŝ^T).
-    b_hat: Mat<f64>,
-    s_hat: Option<Mat<f64>>,
+}
+
+/// The equation with E removed, Ã^T Y + Y Ã - (Y B̃ + S) R^-1 (B̃^T Y + S^T) + Q = 0, in which
+/// the refinement works: its quadratic term, (Y B̃ + S) K with K from two triangular solves
+/// with the Cholesky factor, keeps its accuracy when R is ill-conditioned, where
+/// Y B̂ B̂^T Y (B̂ = B̃ L^-T, entries of size ||B|| / σ_min(L)) loses digits to cancellation.
+struct Reduced<'a> {
+    a: Mat<f64>,
+    b: Mat<f64>,
+    q: &'a Mat<f64>,
+    s: Option<MatRef<'a, f64>>,
+    l: MatRef<'a, f64>,
+}
+
+impl Reduced<'_> {
+    /// K = R^-1 (B̃^T Y + S^T) = L^-T L^-1 (B̃^T Y + S^T).
+    fn gain(&self, y: &Mat<f64>) -> Mat<f64> {
+        let mut gain = self.b.transpose() * y;
+        if let Some(s) = self.s {
+            gain += s.transpose();
+        }
+        solve_lower_triangular_in_place(self.l, gain.as_mut(), Par::Seq);
+        solve_upper_triangular_in_place(self.l.transpose(), gain.as_mut(), Par::Seq);
+        gain
+    }
+
+    /// The residual Res(Y) (symmetrised) and the gain K of Y.
+    fn residual(&self, y: &Mat<f64>) -> (Mat<f64>, Mat<f64>) {
+        let gain = self.gain(y);
+        let mut coupling = y * &self.b;
+        if let Some(s) = self.s {
+            coupling += s;
+        }
+        let ay = self.a.transpose() * y;
+        let mut residual = &ay + ay.transpose() - &coupling * &gain + self.q;
+        symmetrize(&mut residual);
+        (residual, gain)
+    }
 }
 
 /// Solves the CARE for its stabilising solution.
@@ -164,6 +199,13 @@ pub fn solve_care(
         None => (a.to_owned(), b.to_owned()),
     };
     let standard = standardize(&a_tilde, &b_tilde, &q, l, options.s);
+    let reduced = Reduced {
+        a: a_tilde,
+        b: b_tilde,
+        q: &q,
+        s: options.s,
+        l,
+    };
     if n == 0 {
         return Ok(Care {
             x: Mat::zeros(0, 0),
@@ -177,15 +219,11 @@ pub fn solve_care(
     let (mut y, rcond) = hamiltonian_solution(&standard)?;
     let mut refinement_steps = 0;
     if options.refine {
-        refinement_steps = refine(&standard, &mut y);
+        refinement_steps = refine(&reduced, &mut y);
     }
-    // K = L^-T (B̂^T Y + Ŝ^T); X = E^-T Y E^-1.
-    let mut gain = standard.b_hat.transpose() * &y;
-    if let Some(s_hat) = &standard.s_hat {
-        gain += s_hat.transpose();
-    }
-    solve_upper_triangular_in_place(l.transpose(), gain.as_mut(), Par::Seq);
-    let closed_loop = &standard.a - &standard.g * &y;
+    // X = E^-T Y E^-1.
+    let gain = reduced.gain(&y);
+    let closed_loop = &reduced.a - &reduced.b * &gain;
     let closed_loop_eigenvalues = eigenvalues(closed_loop.as_ref())?;
     let x = match options.e {
         Some(e) => {
@@ -260,7 +298,8 @@ fn remove_descriptor(
     let mut factors = e.to_owned();
     solve_in_place(factors.as_mut(), rhs.as_mut(), Par::Seq);
     let condition = one_norm(e) * one_norm(rhs.as_ref().subcols(n + m, n));
-    let singular = condition.is_nan() || condition * f64::EPSILON * n.max(1) as f64 > 1.0;
+    // (one_norm skips NaN, so a solve that broke down is caught by the finiteness test.)
+    let singular = !rhs.is_all_finite() || condition * f64::EPSILON * n.max(1) as f64 > 1.0;
     if singular {
         return Err(Error::InvalidArgument {
             arg: "E",
@@ -293,23 +332,17 @@ fn standardize(
     let b_hat = right_divide(b_tilde.as_ref());
     let mut g = &b_hat * b_hat.transpose();
     symmetrize(&mut g);
-    let (a, q, s_hat) = match s {
+    let (a, q) = match s {
         Some(s) => {
             let s_hat = right_divide(s);
             let a = a_tilde - &b_hat * s_hat.transpose();
             let mut q = q - &s_hat * s_hat.transpose();
             symmetrize(&mut q);
-            (a, q, Some(s_hat))
+            (a, q)
         }
-        None => (a_tilde.clone(), q.clone(), None),
+        None => (a_tilde.clone(), q.clone()),
     };
-    Standard {
-        a,
-        g,
-        q,
-        b_hat,
-        s_hat,
-    }
+    Standard { a, g, q }
 }
 
 /// Y from the ordered Schur form of the scaled Hamiltonian, and rcond(U11).
@@ -384,7 +417,7 @@ fn hamiltonian_solution(standard: &Standard) -> Result<(Mat<f64>, f64), Error> {
     let mut factors = u11.transpose().to_owned();
     solve_in_place(factors.as_mut(), rhs.as_mut(), Par::Seq);
     let rcond = 1.0 / (one_norm(u11) * one_norm(rhs.as_ref().subcols(n, n).transpose()));
-    if rcond.is_nan() || rcond <= n as f64 * f64::EPSILON {
+    if !rhs.is_all_finite() || rcond.is_nan() || rcond <= n as f64 * f64::EPSILON {
         return Err(Error::IllConditioned {
             message: format!(
                 "the stable invariant subspace of the Hamiltonian is not the graph of a matrix \
@@ -408,32 +441,31 @@ fn nearest_power_of_two(value: f64) -> f64 {
     }
 }
 
-/// Res(Y) = Ā^T Y + Y Ā - Y G Y + Q̄.
-fn standard_residual(standard: &Standard, y: &Mat<f64>) -> Mat<f64> {
-    let ay = standard.a.transpose() * y;
-    let mut residual = &ay + ay.transpose() - y * &standard.g * y + &standard.q;
-    symmetrize(&mut residual);
-    residual
-}
-
-/// Newton (Kleinman) steps while the residual decreases; returns the number accepted.
-fn refine(standard: &Standard, y: &mut Mat<f64>) -> usize {
-    let mut residual = standard_residual(standard, y);
+/// Newton (Kleinman) steps while the residual decreases; returns the number accepted. The
+/// step solves (Ã - B̃ K)^T Δ + Δ (Ã - B̃ K) = -Res(Y), K the gain of Y.
+fn refine(reduced: &Reduced<'_>, y: &mut Mat<f64>) -> usize {
+    let (mut residual, mut gain) = reduced.residual(y);
     let mut residual_norm = residual.norm_l2();
     let mut steps = 0;
     while steps < MAX_REFINEMENT_STEPS && residual_norm > 0.0 {
-        let closed_loop = &standard.a - &standard.g * &*y;
-        let Ok(delta) = solve_lyapunov(closed_loop.transpose(), residual.as_ref()) else {
+        let closed_loop = &reduced.a - &reduced.b * &gain;
+        let step = lyapunov::solve(
+            closed_loop.transpose(),
+            residual.as_ref(),
+            Singularity::Perturb,
+        );
+        let Ok(delta) = step else {
             break;
         };
         let mut candidate = &*y + &delta;
         symmetrize(&mut candidate);
-        let candidate_residual = standard_residual(standard, &candidate);
+        let (candidate_residual, candidate_gain) = reduced.residual(&candidate);
         let candidate_norm = candidate_residual.norm_l2();
         if candidate_norm.is_nan() || candidate_norm >= residual_norm {
             break;
         }
         *y = candidate;
+        gain = candidate_gain;
         residual = candidate_residual;
         residual_norm = candidate_norm;
         steps += 1;

@@ -31,6 +31,27 @@ use faer::{Accum, Mat, MatRef, Par};
 
 /// The solution X of A X + X A^T + Q = 0 (symmetric when Q is).
 pub fn solve_lyapunov(a: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+    solve(a, q, Singularity::Refuse)
+}
+
+/// What to do when a pivot of the small systems falls below u times their size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Singularity {
+    /// Fail with [`Error::IllConditioned`]: a public solve must not return a solution that
+    /// may have no correct digit.
+    Refuse,
+    /// Replace the pivot by u times the system's size and go on (LAPACK's dtrsyl does this):
+    /// a correction whose effect the caller measures, such as a Newton step that is kept only
+    /// if it reduces the residual.
+    Perturb,
+}
+
+/// [`solve_lyapunov`] with a choice of what a near-singular equation does.
+pub(crate) fn solve(
+    a: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    singularity: Singularity,
+) -> Result<Mat<f64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     check_square(q, "Q")?;
@@ -42,7 +63,7 @@ pub fn solve_lyapunov(a: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Result<Mat<f64>
     let mut f = Mat::<f64>::zeros(n, n);
     let zq = z.transpose() * q;
     faer::linalg::matmul::matmul(f.as_mut(), Accum::Replace, &zq, z, -1.0, Par::Seq);
-    let y = solve_quasi_triangular(t, f)?;
+    let y = solve_quasi_triangular(t, f, singularity)?;
     let mut x = z * &y * z.transpose();
     if is_symmetric(q) {
         symmetrize(&mut x);
@@ -51,9 +72,10 @@ pub fn solve_lyapunov(a: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Result<Mat<f64>
 }
 
 /// Solves T Y + Y T^T = F for quasi-upper-triangular T (2 x 2 blocks in standard form).
-pub(crate) fn solve_quasi_triangular(
+fn solve_quasi_triangular(
     t: MatRef<'_, f64>,
     mut f: Mat<f64>,
+    singularity: Singularity,
 ) -> Result<Mat<f64>, Error> {
     let n = t.nrows();
     let mut blocks = Vec::with_capacity(n);
@@ -101,7 +123,7 @@ pub(crate) fn solve_quasi_triangular(
                 }
             }
             let solved = solve_small_sylvester(&l, p, &r, q, &rhs);
-            if solved.perturbed {
+            if solved.perturbed && singularity == Singularity::Refuse {
                 return Err(Error::IllConditioned {
                     message: "the Lyapunov equation is singular to working precision: A has \
                               two eigenvalues whose sum is (nearly) zero (a mode on the \

@@ -1054,6 +1054,7 @@ fn place<'py>(
 /// called once per diagonal block) is given: (T, Z, eigenvalues, number selected).
 #[pyfunction]
 #[pyo3(signature = (a, select, /))]
+#[allow(clippy::type_complexity)]
 fn schur<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,

@@ -3,6 +3,7 @@
 Private: call the wrappers in the aerocontrol package, which convert and check arguments.
 """
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -24,8 +25,12 @@ __all__ = [
     "krylov_matrix",
     "modal_analysis",
     "place",
+    "riccati_ode",
+    "schur",
     "simulate",
     "simulate_models",
+    "solve_care",
+    "solve_lyapunov",
     "steady_state",
     "transition_matrices",
 ]
@@ -98,3 +103,26 @@ def place(
     float,
     float,
 ]: ...
+def schur(
+    a: ArrayLike, select: Callable[[complex], bool] | None, /
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], int]: ...
+def solve_lyapunov(a: ArrayLike, q: ArrayLike, /) -> NDArray[np.float64]: ...
+def solve_care(
+    a: ArrayLike,
+    b: ArrayLike,
+    q: ArrayLike,
+    r: ArrayLike,
+    s: ArrayLike | None,
+    e: ArrayLike | None,
+    refine: bool,
+    /,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], float, float, int]: ...
+def riccati_ode(
+    a: ArrayLike,
+    b: ArrayLike,
+    q: ArrayLike,
+    r: ArrayLike,
+    t: ArrayLike,
+    sf: ArrayLike | None,
+    /,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], int]: ...

@@ -1,0 +1,264 @@
+"""Optimal control: the algebraic and differential Riccati equations and LQR (chapter §6.6).
+
+The regulator that minimises J = ∫ (x^T Q x + η^T R η) dt (6.190) is η = -K x with
+K = R^-1 B^T S (6.200), where S solves the Riccati differential equation (6.196) backward from
+S(t_f) = S_f, or, for an infinite horizon, the algebraic equation (6.199).
+
+* :func:`solve_care`: the algebraic equation in the general form of MATLAB's care (6.228),
+  with a cross weight S and a descriptor matrix E, by the Hamiltonian ordered-Schur method
+  (scaled, then refined by Newton's method), with its residual and conditioning;
+* :func:`lqr`: python-control's ``lqr`` call and return convention, (K, S, E);
+* :func:`riccati_ode` and :func:`lqr_finite`: the finite-horizon solution S(t) and gain K(t)
+  on a time grid, exact up to rounding at any step (the Hamiltonian transition matrix,
+  re-normalised every step).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import _core
+from ._validation import FloatArray, real_array
+from .exceptions import IllConditionedWarning, InvalidArgumentError
+from .statespace import StateSpace, as_state_space
+
+__all__ = [
+    "CareSolution",
+    "RiccatiSolution",
+    "lqr",
+    "lqr_finite",
+    "riccati_ode",
+    "solve_care",
+]
+
+ComplexArray = NDArray[np.complex128]
+
+#: rcond(U11) below which the solution is flagged: about half the digits of X may be lost
+#: to the basis of the invariant subspace before refinement.
+RCOND_WARNING = 1e-8
+#: Relative residual above which the solution is flagged.
+RESIDUAL_WARNING = 1e-8
+
+
+@dataclass(frozen=True, eq=False)
+class CareSolution:
+    """The stabilising solution of a continuous algebraic Riccati equation.
+
+    The equation is A^T X E + E^T X A - (E^T X B + S) R^-1 (B^T X E + S^T) + Q = 0 (6.228),
+    with E = I and S = 0 by default.
+    """
+
+    X: FloatArray
+    """The stabilising solution, symmetric, n x n."""
+    K: FloatArray
+    """The optimal gain R^-1 (B^T X E + S^T), m x n (6.200)."""
+    closed_loop_poles: ComplexArray
+    """The eigenvalues of (A - B K, E), all with Re < 0; pairs adjacent, Im > 0 first."""
+    residual: float
+    """||Res||_F / (||Q||_F + 2 ||A^T X E||_F + ||(E^T X B + S) K||_F)."""
+    rcond: float
+    """Reciprocal 1-norm condition number of U11, the top half of the stable invariant
+    subspace's basis: small means X is sensitive."""
+    refinement_steps: int
+    """Newton steps taken after the Schur solution."""
+
+
+def solve_care(
+    A: Any,
+    B: Any,
+    Q: Any,
+    R: Any,
+    S: Any = None,
+    E: Any = None,
+    refine: bool = True,
+) -> CareSolution:
+    """The stabilising solution of the continuous algebraic Riccati equation (6.199, 6.228).
+
+    Solves A^T X E + E^T X A - (E^T X B + S) R^-1 (B^T X E + S^T) + Q = 0 for the X that
+    makes every eigenvalue of (A - B K, E) stable, K = R^-1 (B^T X E + S^T).
+
+    Method: the Hamiltonian matrix [[Ā, -G], [-Q̄, -Ā^T]] of the equation reduced to E = I,
+    S = 0 (Ā = E^-1 A - B̂ Ŝ^T, G = B̂ B̂^T with B̂ = E^-1 B L^-T, R = L L^T), scaled by exact
+    powers of two that balance it and keep it Hamiltonian; its real Schur form, reordered to
+    put the stable eigenvalues first; X from the stable invariant subspace [U11; U21] as
+    U21 U11^-1 by an LU solve; then Newton (Kleinman) steps, each a Lyapunov solve, while the
+    residual decreases.
+
+    Parameters
+    ----------
+    A, Q : array_like (n, n)
+    B : array_like (n, m)
+    R : array_like (m, m), symmetric positive definite
+    S : array_like (n, m), optional; the cross weight (python-control's N)
+    E : array_like (n, n), optional; nonsingular
+    refine : bool
+        Newton refinement (default True).
+
+    Raises
+    ------
+    NotPositiveDefiniteError
+        R is not symmetric positive definite.
+    NoStabilizingSolutionError
+        The Hamiltonian has eigenvalues on the imaginary axis to working precision: some
+        undamped mode is neither controllable nor penalised.
+    IllConditionedError
+        U11 is singular: (A, B) is not stabilisable or (Q, A) not detectable.
+
+    Warns
+    -----
+    IllConditionedWarning
+        rcond(U11) < 1e-8 or relative residual > 1e-8.
+
+    Examples
+    --------
+    The chapter's inverted pendulum (6.202)-(6.218), γ = 1, c = 1:
+
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.solve_care([[0, 1], [1, 0]], [[0], [1]], np.diag([1.0, 0.0]), [[1.0]])
+    >>> np.round(sol.K, 6)                       # [γ + √2, √2 (γ + √2)^½]
+    array([[2.414214, 2.197368]])
+    >>> bool(sol.residual < 1e-15)
+    True
+    """
+    X, K, poles, residual, rcond, steps = _core.solve_care(
+        A,
+        B,
+        _matrix(Q, "Q"),
+        _matrix(R, "R"),
+        None if S is None else _matrix(S, "S"),
+        None if E is None else _matrix(E, "E"),
+        bool(refine),
+    )
+    solution = CareSolution(X, K, poles, residual, rcond, steps)
+    if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
+        warnings.warn(
+            f"the Riccati solution may be inaccurate: rcond(U11) = {rcond:.2e}, relative "
+            f"residual {residual:.2e} (the closed loop is close to losing stabilisability "
+            "or detectability, or the weights differ by many orders of magnitude)",
+            IllConditionedWarning,
+            stacklevel=2,
+        )
+    return solution
+
+
+def _matrix(value: Any, name: str) -> FloatArray:
+    """A weight as a 2-D array: a scalar becomes 1 x 1 (python-control accepts R = 1)."""
+    array = real_array(value, name)
+    return np.atleast_2d(array) if array.ndim < 2 else array
+
+
+def lqr(sys_or_A: Any, *args: Any, N: Any = None) -> tuple[FloatArray, FloatArray, ComplexArray]:
+    """The linear-quadratic regulator, called and returning as python-control's ``lqr``.
+
+    ``lqr(sys, Q, R)``, ``lqr(A, B, Q, R)`` or ``lqr(A, B, Q, R, N)`` minimise
+    J = ∫ (x^T Q x + η^T R η + 2 x^T N η) dt for x' = A x + B η.
+
+    Returns
+    -------
+    K : ndarray (m, n)
+        The gain of η = -K x.
+    S : ndarray (n, n)
+        The solution of the Riccati equation.
+    E : ndarray (n,) of complex128
+        The closed-loop eigenvalues, eig(A - B K).
+
+    See :func:`solve_care` for the method, the errors and the diagnostics (which ``lqr``
+    drops, as python-control does; call :func:`solve_care` to see them).
+
+    >>> import numpy as np, aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_lateral()
+    >>> K, S, E = aerocontrol.lqr(A, B, np.eye(4), np.eye(2))      # (6.224)-(6.227), c = 1
+    >>> bool(np.all(E.real < 0))
+    True
+    """
+    if isinstance(sys_or_A, StateSpace) or hasattr(sys_or_A, "A"):
+        if len(args) not in (2, 3):
+            raise InvalidArgumentError("lqr(sys, Q, R[, N]) takes a system and two weights")
+        sys = as_state_space(sys_or_A)
+        A, B, (Q, R, *rest) = sys.A, sys.B, args
+    else:
+        if len(args) not in (3, 4):
+            raise InvalidArgumentError("lqr(A, B, Q, R[, N]) takes four or five matrices")
+        A, (B, Q, R, *rest) = sys_or_A, args
+    if rest:
+        if N is not None:
+            raise InvalidArgumentError("N given both by position and by keyword")
+        N = rest[0]
+    solution = solve_care(A, B, Q, R, S=N)
+    return solution.K, solution.X, solution.closed_loop_poles
+
+
+@dataclass(frozen=True, eq=False)
+class RiccatiSolution:
+    """S(t) and K(t) of the finite-horizon regulator on a time grid (6.196)-(6.200)."""
+
+    t: FloatArray
+    """The times, increasing; S(t[-1]) = Sf."""
+    S: FloatArray
+    """S(t_k), shape (len(t), n, n), symmetric."""
+    K: FloatArray
+    """K(t_k) = R^-1 B^T S(t_k), shape (len(t), m, n)."""
+    substeps: int
+    """Steps of the transition-matrix recursion over the horizon (each interval of t is
+    divided so that the Hamiltonian's modes grow by at most e across a step)."""
+
+
+def riccati_ode(
+    A_or_sys: Any, B: Any, Q: Any, R: Any = None, t: Any = None, Sf: Any = None
+) -> RiccatiSolution:
+    """The Riccati differential equation -dS/dt = S A + A^T S - S B R^-1 B^T S + Q (6.196),
+    integrated backward from S(t_f) = Sf (default 0, (6.197)) over the grid ``t``.
+
+    Called as ``riccati_ode(A, B, Q, R, t, Sf=None)`` or ``riccati_ode(sys, Q, R, t, Sf=None)``.
+
+    Method: with H the Hamiltonian [[A, -G], [-Q, -A^T]] (G = B R^-1 B^T), S = Y X^-1 where
+    [X; Y] follows the linear equation d/dτ [X; Y] = -H [X; Y] in reverse time; each step
+    propagates [I; S] by the transition matrix e^{-Hh} and forms S = Y X^-1 anew (the modified
+    Davison-Maki method). There is no truncation error, so the accuracy (about 1e-13
+    relative) does not depend on the grid; a long horizon converges to the algebraic solution.
+
+    Parameters
+    ----------
+    t : array_like (k,), strictly increasing; t[-1] is the final time t_f.
+    Sf : array_like (n, n), optional; the terminal weight S(t_f).
+
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.riccati_ode([[0, 1], [1, 0]], [[0], [1]], np.diag([1.0, 0]), [[1.0]],
+    ...                                np.linspace(0, 20, 5))
+    >>> np.round(sol.K[0], 6)            # the algebraic (steady-state) gain, t_f - t = 20
+    array([[2.414214, 2.197368]])
+    """
+    if isinstance(A_or_sys, StateSpace) or hasattr(A_or_sys, "A"):
+        sys = as_state_space(A_or_sys)
+        # riccati_ode(sys, Q, R, t, Sf): every argument shifts one place to the left.
+        A, B, Q, R, t, Sf = sys.A, sys.B, B, Q, R, (t if t is not None else Sf)
+    else:
+        A = A_or_sys
+    if t is None or R is None:
+        raise InvalidArgumentError("riccati_ode needs the weights Q, R and the time grid t")
+    times = np.atleast_1d(real_array(t, "t"))
+    if times.ndim != 1:
+        raise InvalidArgumentError(f"t must be 1-D, got an array of shape {times.shape}")
+    S, K, substeps = _core.riccati_ode(
+        A,
+        B,
+        _matrix(Q, "Q"),
+        _matrix(R, "R"),
+        times,
+        None if Sf is None else _matrix(Sf, "Sf"),
+    )
+    return RiccatiSolution(np.array(times, dtype=np.float64), S, K, substeps)
+
+
+def lqr_finite(
+    A_or_sys: Any, B: Any, Q: Any, R: Any = None, t: Any = None, Sf: Any = None
+) -> FloatArray:
+    """The time-varying gain K(t) = R^-1 B^T S(t) of the finite-horizon regulator (6.200), shape
+    (len(t), m, n); arguments as :func:`riccati_ode`."""
+    gains: FloatArray = riccati_ode(A_or_sys, B, Q, R, t, Sf).K
+    return gains
