@@ -686,6 +686,120 @@ def controllability_cases() -> list[Case]:
     ]
 
 
+def _lqr_747(rng: np.random.Generator) -> tuple[Any, ...]:
+    """The chapter's lateral regulator (6.224)-(6.227) at c = 1: rudder and aileron."""
+    A, B = aerocontrol.chapter.boeing747_lateral()
+    return A, B, np.eye(4), np.eye(2)
+
+
+def _lqr_problem(rng: np.random.Generator, n: int) -> tuple[Any, ...]:
+    """A random n-state, 2-input plant with Q = I, R = I: A = G / sqrt(n) - 3/2 I, spectrum in
+    a disc of radius about 1 centred at -3/2. (A Gaussian A with only 2 inputs has dozens of
+    unstable modes and a solution with κ(X) ~ 1e15 at n = 64: a test of conditioning, not
+    of speed.)"""
+    A = rng.standard_normal((n, n)) / np.sqrt(n) - 1.5 * np.eye(n)
+    return A, rng.standard_normal((n, 2)), np.eye(n), np.eye(2)
+
+
+def _lqr_ours(A: Any, B: Any, Q: Any, R: Any) -> Any:
+    return aerocontrol.lqr(A, B, Q, R)[0]
+
+
+def _lqr_control(A: Any, B: Any, Q: Any, R: Any) -> Any:
+    return control.lqr(A, B, Q, R)[0]
+
+
+def _lqr_scipy(A: Any, B: Any, Q: Any, R: Any) -> Any:
+    X = scipy.linalg.solve_continuous_are(A, B, Q, R)
+    return np.linalg.solve(R, B.T @ X)
+
+
+@operation
+def lqr_cases() -> list[Case]:
+    """LQR (CARE + gain): ours against python-control's lqr (slycot SB02MD) and
+    scipy.linalg.solve_continuous_are plus the gain, agreement on K."""
+    small_control = Target("lqr n=4: <= 10 us and >= 5x control.lqr", 5.0, 10e-6)
+    small_scipy = Target("lqr n=4: >= 30x scipy", 30.0)
+    large_control = Target("lqr n=64/256: faster than control.lqr", 1.0)
+    large_scipy = Target("lqr n=64/256: >= 3x scipy", 3.0)
+    cases = [
+        Case(
+            op="lqr",
+            size="n=4 747 lateral",
+            seed=0,
+            setup=_lqr_747,
+            ours=_lqr_ours,
+            peers=[
+                Peer("control.lqr", _lqr_control, target=small_control),
+                Peer("scipy CARE + gain", _lqr_scipy, target=small_scipy),
+            ],
+        )
+    ]
+    for n in (64, 256):
+        cases.append(
+            Case(
+                op="lqr",
+                size=f"n={n} m=2",
+                seed=n,
+                setup=functools.partial(_lqr_problem, n=n),
+                ours=_lqr_ours,
+                peers=[
+                    Peer("control.lqr", _lqr_control, target=large_control),
+                    Peer("scipy CARE + gain", _lqr_scipy, target=large_scipy),
+                ],
+                repeat=1 if n > 64 else 3,
+            )
+        )
+    return cases
+
+
+def _stable_problem(rng: np.random.Generator, n: int) -> tuple[Any, ...]:
+    A = rng.standard_normal((n, n)) - 2 * np.sqrt(n) * np.eye(n)
+    C = rng.standard_normal((n, n))
+    return A, C @ C.T
+
+
+@operation
+def schur_lyapunov_cases() -> list[Case]:
+    """The real Schur form (against scipy.linalg.schur, agreement on the eigenvalues'
+    real parts, sorted) and the Lyapunov equation (against solve_continuous_lyapunov)."""
+    cases = []
+    for n in (4, 64, 256):
+        cases.append(
+            Case(
+                op="schur",
+                size=f"n={n}",
+                seed=n,
+                setup=lambda rng, n=n: (rng.standard_normal((n, n)),),
+                ours=lambda A: np.sort(np.diag(aerocontrol.schur(A)[0])),
+                peers=[
+                    Peer(
+                        "scipy.linalg.schur",
+                        lambda A: np.sort(np.diag(scipy.linalg.schur(A)[0])),
+                    )
+                ],
+                repeat=1 if n > 64 else None,
+            )
+        )
+        cases.append(
+            Case(
+                op="solve_lyapunov",
+                size=f"n={n}",
+                seed=n,
+                setup=functools.partial(_stable_problem, n=n),
+                ours=aerocontrol.solve_lyapunov,
+                peers=[
+                    Peer(
+                        "scipy solve_continuous_lyapunov",
+                        lambda A, Q: scipy.linalg.solve_continuous_lyapunov(A, -Q),
+                    )
+                ],
+                repeat=1 if n > 64 else None,
+            )
+        )
+    return cases
+
+
 # ---------------------------------------------------------------------------------------------
 # Measurement
 # ---------------------------------------------------------------------------------------------

@@ -141,17 +141,20 @@ impl Reduced<'_> {
         gain
     }
 
-    /// The residual Res(Y) (symmetrised) and the gain K of Y.
-    fn residual(&self, y: &Mat<f64>) -> (Mat<f64>, Mat<f64>) {
+    /// The residual Res(Y) (symmetrised), the gain K of Y, and the size of the terms,
+    /// ||Q||_F + 2 ||Ã^T Y||_F + ||(Y B̃ + S) K||_F, against which it is judged.
+    fn residual(&self, y: &Mat<f64>) -> (Mat<f64>, Mat<f64>, f64) {
         let gain = self.gain(y);
         let mut coupling = y * &self.b;
         if let Some(s) = self.s {
             coupling += s;
         }
         let ay = self.a.transpose() * y;
-        let mut residual = &ay + ay.transpose() - &coupling * &gain + self.q;
+        let quadratic = &coupling * &gain;
+        let scale = self.q.norm_l2() + 2.0 * ay.norm_l2() + quadratic.norm_l2();
+        let mut residual = &ay + ay.transpose() - &quadratic + self.q;
         symmetrize(&mut residual);
-        (residual, gain)
+        (residual, gain, scale)
     }
 }
 
@@ -441,13 +444,14 @@ fn nearest_power_of_two(value: f64) -> f64 {
     }
 }
 
-/// Newton (Kleinman) steps while the residual decreases; returns the number accepted. The
-/// step solves (Ã - B̃ K)^T Δ + Δ (Ã - B̃ K) = -Res(Y), K the gain of Y.
+/// Newton (Kleinman) steps while the residual decreases and is above rounding level (u times
+/// the size of the terms); returns the number accepted. The step solves
+/// (Ã - B̃ K)^T Δ + Δ (Ã - B̃ K) = -Res(Y), K the gain of Y.
 fn refine(reduced: &Reduced<'_>, y: &mut Mat<f64>) -> usize {
-    let (mut residual, mut gain) = reduced.residual(y);
+    let (mut residual, mut gain, mut scale) = reduced.residual(y);
     let mut residual_norm = residual.norm_l2();
     let mut steps = 0;
-    while steps < MAX_REFINEMENT_STEPS && residual_norm > 0.0 {
+    while steps < MAX_REFINEMENT_STEPS && residual_norm > f64::EPSILON * scale {
         let closed_loop = &reduced.a - &reduced.b * &gain;
         let step = lyapunov::solve(
             closed_loop.transpose(),
@@ -459,13 +463,14 @@ fn refine(reduced: &Reduced<'_>, y: &mut Mat<f64>) -> usize {
         };
         let mut candidate = &*y + &delta;
         symmetrize(&mut candidate);
-        let (candidate_residual, candidate_gain) = reduced.residual(&candidate);
+        let (candidate_residual, candidate_gain, candidate_scale) = reduced.residual(&candidate);
         let candidate_norm = candidate_residual.norm_l2();
         if candidate_norm.is_nan() || candidate_norm >= residual_norm {
             break;
         }
         *y = candidate;
         gain = candidate_gain;
+        scale = candidate_scale;
         residual = candidate_residual;
         residual_norm = candidate_norm;
         steps += 1;

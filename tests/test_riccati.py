@@ -218,6 +218,7 @@ def test_lqr_call_forms_and_cross_term() -> None:
     np.testing.assert_array_equal(K1, K2)
     N = 0.1 * np.ones((4, 2))
     K3, X3, E3 = aerocontrol.lqr(A, B, Q, R, N)
+    assert np.all(E3.real < 0)
     K_control, X_control, _ = control.lqr(A, B, Q, R, N)
     np.testing.assert_allclose(K3, K_control, rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(X3, X_control, rtol=1e-10, atol=1e-12)
