@@ -66,6 +66,7 @@ use crate::lyapunov::{self, Singularity, symmetrize};
 use crate::norm::one_norm;
 use crate::reorder::reorder_schur;
 use crate::schur::{balancing_scale, eigenvalues, real_schur};
+use faer::linalg::solvers::Llt;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
@@ -166,14 +167,8 @@ pub fn solve_care(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<Care, Error> {
-    check_square(a, "A")?;
-    check_finite(a, "A")?;
-    let n = a.nrows();
-    check_rows(b, "B", n, "A")?;
-    check_finite(b, "B")?;
-    let m = b.ncols();
-    let q = symmetric(q, "Q", n, "A")?;
-    let r = symmetric(r, "R", m, "the columns of B")?;
+    let (q, cholesky) = check_problem(a, b, q, r)?;
+    let (n, m) = (a.nrows(), b.ncols());
     if let Some(s) = options.s {
         check_rows(s, "S", n, "A")?;
         if s.ncols() != m {
@@ -187,15 +182,6 @@ pub fn solve_care(
         }
         check_finite(s, "S")?;
     }
-    let cholesky = r
-        .as_ref()
-        .llt(Side::Lower)
-        .map_err(|_| Error::NotPositiveDefinite {
-            arg: "R",
-            message: "R must be symmetric positive definite, but its Cholesky factorisation \
-                  failed: R has an eigenvalue <= 0 (to working precision)"
-                .into(),
-        })?;
     let l = cholesky.L();
     let (a_tilde, b_tilde) = match options.e {
         Some(e) => remove_descriptor(a, b, e)?,
@@ -251,6 +237,34 @@ pub fn solve_care(
         rcond,
         refinement_steps,
     })
+}
+
+/// The checks shared by the algebraic and differential Riccati equations: A square and finite,
+/// B with n rows, Q (n x n) and R (m x m) finite and symmetric, R positive definite. Returns
+/// Q symmetrised and the Cholesky factorisation of R.
+pub(crate) fn check_problem(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+) -> Result<(Mat<f64>, Llt<f64>), Error> {
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    let n = a.nrows();
+    check_rows(b, "B", n, "A")?;
+    check_finite(b, "B")?;
+    let q = symmetric(q, "Q", n, "A")?;
+    let r = symmetric(r, "R", b.ncols(), "the columns of B")?;
+    let cholesky = r
+        .as_ref()
+        .llt(Side::Lower)
+        .map_err(|_| Error::NotPositiveDefinite {
+            arg: "R",
+            message: "R must be symmetric positive definite, but its Cholesky factorisation \
+                  failed: R has an eigenvalue <= 0 (to working precision)"
+                .into(),
+        })?;
+    Ok((q, cholesky))
 }
 
 /// A square, finite, symmetric (to [`SYMMETRY_TOLERANCE`]) matrix, symmetrised.

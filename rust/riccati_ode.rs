@@ -29,6 +29,7 @@
 //!
 //! For a uniform grid (the usual case) one exponential serves every step.
 
+use crate::care::check_problem;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::expm::expm;
 use crate::lu::solve_in_place;
@@ -37,7 +38,7 @@ use crate::schur::eigenvalues;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
-use faer::{Mat, MatRef, Par, Side};
+use faer::{Mat, MatRef, Par};
 
 /// The largest h max|Re λ(H)| of one substep.
 pub const MAX_GROWTH_EXPONENT: f64 = 1.0;
@@ -62,17 +63,8 @@ pub fn riccati_ode(
     times: &[f64],
     terminal: Option<MatRef<'_, f64>>,
 ) -> Result<RiccatiSolution, Error> {
-    check_square(a, "A")?;
-    check_finite(a, "A")?;
+    let (q, cholesky) = check_problem(a, b, q, r)?;
     let n = a.nrows();
-    check_rows(b, "B", n, "A")?;
-    check_finite(b, "B")?;
-    let m = b.ncols();
-    for (matrix, arg, order, other) in [(q, "Q", n, "A"), (r, "R", m, "the columns of B")] {
-        check_square(matrix, arg)?;
-        check_rows(matrix, arg, order, other)?;
-        check_finite(matrix, arg)?;
-    }
     check_times(times)?;
     let mut s = match terminal {
         Some(sf) => {
@@ -84,16 +76,6 @@ pub fn riccati_ode(
         None => Mat::zeros(n, n),
     };
     symmetrize(&mut s);
-    let mut r_symmetric = r.to_owned();
-    symmetrize(&mut r_symmetric);
-    let cholesky = r_symmetric
-        .llt(Side::Lower)
-        .map_err(|_| Error::NotPositiveDefinite {
-            arg: "R",
-            message: "R must be symmetric positive definite, but its Cholesky factorisation \
-                      failed"
-                .into(),
-        })?;
     let l = cholesky.L();
     // G = B R^-1 B^T = B̂ B̂^T with B̂^T = L^-1 B^T.
     let mut b_hat_t = b.transpose().to_owned();
@@ -105,7 +87,7 @@ pub fn riccati_ode(
         for i in 0..n {
             minus_h[(i, j)] = -a[(i, j)];
             minus_h[(i, n + j)] = g[(i, j)];
-            minus_h[(n + i, j)] = 0.5 * (q[(i, j)] + q[(j, i)]);
+            minus_h[(n + i, j)] = q[(i, j)];
             minus_h[(n + i, n + j)] = a[(j, i)];
         }
     }
