@@ -61,7 +61,7 @@
 //! that the input cannot move or the weight does not see); U11 singular to working precision.
 
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::lu::solve_in_place;
+use crate::lu::{solve_in_place, solve_with_inverse};
 use crate::lyapunov::{self, Singularity, symmetrize};
 use crate::norm::one_norm;
 use crate::reorder::reorder_schur;
@@ -306,17 +306,14 @@ fn remove_descriptor(
     check_rows(e, "E", n, "A")?;
     check_finite(e, "E")?;
     let m = b.ncols();
-    let mut rhs = Mat::<f64>::zeros(n, 2 * n + m);
-    rhs.as_mut().subcols_mut(0, n).copy_from(a);
-    rhs.as_mut().subcols_mut(n, m).copy_from(b);
-    for i in 0..n {
-        rhs[(i, n + m + i)] = 1.0;
-    }
-    let mut factors = e.to_owned();
-    solve_in_place(factors.as_mut(), rhs.as_mut(), Par::Seq);
-    let condition = one_norm(e) * one_norm(rhs.as_ref().subcols(n + m, n));
+    let mut plant = Mat::<f64>::zeros(n, n + m);
+    plant.as_mut().subcols_mut(0, n).copy_from(a);
+    plant.as_mut().subcols_mut(n, m).copy_from(b);
+    let combined = solve_with_inverse(e.to_owned().as_mut(), plant.as_ref());
+    let (solution, inverse) = combined.as_ref().split_at_col(n + m);
+    let condition = one_norm(e) * one_norm(inverse);
     // (one_norm skips NaN, so a solve that broke down is caught by the finiteness test.)
-    let singular = !rhs.is_all_finite() || condition * f64::EPSILON * n.max(1) as f64 > 1.0;
+    let singular = !inverse.is_all_finite() || condition * f64::EPSILON * n.max(1) as f64 > 1.0;
     if singular {
         return Err(Error::InvalidArgument {
             arg: "E",
@@ -327,8 +324,8 @@ fn remove_descriptor(
         });
     }
     Ok((
-        rhs.as_ref().subcols(0, n).to_owned(),
-        rhs.as_ref().subcols(n, m).to_owned(),
+        solution.subcols(0, n).to_owned(),
+        solution.subcols(n, m).to_owned(),
     ))
 }
 
@@ -421,20 +418,17 @@ fn hamiltonian_solution(standard: &Standard) -> Result<(Mat<f64>, f64), Error> {
             ),
         });
     }
-    // U11^T Y'^T = U21^T together with U11^T W = I, for rcond(U11).
+    // U11^T Y'^T = U21^T, with U11^-T for rcond(U11).
     let z = ordered.z.as_ref();
     let u11 = z.submatrix(0, 0, n, n);
-    let mut rhs = Mat::<f64>::zeros(n, 2 * n);
-    rhs.as_mut()
-        .subcols_mut(0, n)
-        .copy_from(z.submatrix(n, 0, n, n).transpose());
-    for i in 0..n {
-        rhs[(i, n + i)] = 1.0;
-    }
-    let mut factors = u11.transpose().to_owned();
-    solve_in_place(factors.as_mut(), rhs.as_mut(), Par::Seq);
-    let rcond = 1.0 / (one_norm(u11) * one_norm(rhs.as_ref().subcols(n, n).transpose()));
-    if !rhs.is_all_finite() || rcond.is_nan() || rcond <= n as f64 * f64::EPSILON {
+    let combined = solve_with_inverse(
+        u11.transpose().to_owned().as_mut(),
+        z.submatrix(n, 0, n, n).transpose(),
+    );
+    let (y_transposed, inverse_transposed) = combined.as_ref().split_at_col(n);
+    let rcond = 1.0 / (one_norm(u11) * one_norm(inverse_transposed.transpose()));
+    let broke_down = !y_transposed.is_all_finite() || !inverse_transposed.is_all_finite();
+    if broke_down || rcond.is_nan() || rcond <= n as f64 * f64::EPSILON {
         return Err(Error::IllConditioned {
             message: format!(
                 "the stable invariant subspace of the Hamiltonian is not the graph of a matrix \
@@ -444,7 +438,7 @@ fn hamiltonian_solution(standard: &Standard) -> Result<(Mat<f64>, f64), Error> {
         });
     }
     // Undo the scalings: Y = rho D^-1 Y' D^-1.
-    let y_scaled = rhs.as_ref().subcols(0, n).transpose();
+    let y_scaled = y_transposed.transpose();
     let mut y = Mat::from_fn(n, n, |i, j| rho * y_scaled[(i, j)] / (d[i] * d[j]));
     symmetrize(&mut y);
     Ok((y, rcond))

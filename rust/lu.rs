@@ -6,7 +6,7 @@
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
 use faer::linalg::lu::partial_pivoting::{factor, solve};
-use faer::{MatMut, Par, Spec};
+use faer::{Mat, MatMut, MatRef, Par, Spec};
 use std::mem::MaybeUninit;
 
 /// The order below which faer's recursive LU switches to its unblocked kernel. faer's default
@@ -61,6 +61,22 @@ pub fn solve_in_place(a: MatMut<'_, f64>, b: MatMut<'_, f64>, par: Par) {
             par,
         );
     }
+}
+
+/// Solves A X = B together with A X' = I, in one factorisation: returns [X | A^-1] (split it
+/// with `split_at_col(B.ncols())`). For callers
+/// that need a condition number of A beside the solution; the inverse costs what n more
+/// right-hand sides cost, and is used for its norm, never to form X. A is overwritten by its
+/// factors; a singular A gives non-finite entries.
+pub fn solve_with_inverse(a: MatMut<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+    let (n, k) = (a.nrows(), b.ncols());
+    let mut rhs = Mat::<f64>::zeros(n, k + n);
+    rhs.as_mut().subcols_mut(0, k).copy_from(b);
+    for i in 0..n {
+        rhs[(i, k + i)] = 1.0;
+    }
+    solve_in_place(a, rhs.as_mut(), Par::Seq);
+    rhs
 }
 
 fn factor_and_solve(

@@ -47,12 +47,12 @@
 
 use crate::ctrb::{controllability, controllability_staircase, krylov_blocks};
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
-use crate::lu::solve_in_place;
+use crate::lu::solve_with_inverse;
 use crate::modes::polynomial_from_roots;
 use crate::norm::one_norm;
 use crate::schur::eigenvalues;
 use faer::linalg::solvers::Solve;
-use faer::{Mat, MatRef, Par, c64};
+use faer::{Mat, MatRef, c64};
 
 /// Sweeps of method 0 stop when |det X| grows by less than this, relatively. Method 0
 /// converges linearly and, after the first few sweeps, slowly (on the 747 lateral model with
@@ -272,35 +272,29 @@ fn place_single_input(
     }
     let desired = polynomial_from_roots(&poles);
     let v = krylov_blocks(a, b);
-    // One LU solve with V^T for [right-hand side | I]: the first column gives the gains, the
-    // rest V^-T, whose norm (and nothing else) gives κ_1(V).
-    let mut solution = Mat::<f64>::zeros(n, n + 1);
-    for i in 0..n {
-        solution[(i, i + 1)] = 1.0;
-    }
+    // One LU solve with V^T for the right-hand side and I: the first gives the gains, the
+    // second V^-T, whose norm (and nothing else) gives κ_1(V).
+    let mut rhs = Mat::<f64>::zeros(n, 1);
     match method {
         // Ackermann: V^T w = e_n.
-        Method::Ackermann => solution[(n.saturating_sub(1), 0)] = 1.0,
+        Method::Ackermann => rhs[(n.saturating_sub(1), 0)] = 1.0,
         // Bass–Gura: W^T z = k̄ (unit lower triangular Toeplitz), then V^T k = z.
         _ => {
             let open_loop = polynomial_from_roots(&eigenvalues(a)?);
             for i in 0..n {
                 let mut value = desired[i + 1] - open_loop[i + 1];
                 for j in 0..i {
-                    value -= open_loop[i - j] * solution[(j, 0)];
+                    value -= open_loop[i - j] * rhs[(j, 0)];
                 }
-                solution[(i, 0)] = value;
+                rhs[(i, 0)] = value;
             }
         }
     }
     let v_norm = one_norm(v.as_ref());
     let mut factors = v;
-    solve_in_place(
-        factors.as_mut().transpose_mut(),
-        solution.as_mut(),
-        Par::Seq,
-    );
-    let condition = v_norm * one_norm(solution.as_ref().subcols(1, n));
+    let combined = solve_with_inverse(factors.as_mut().transpose_mut(), rhs.as_ref());
+    let (solution, inverse) = combined.as_ref().split_at_col(1);
+    let condition = v_norm * one_norm(inverse);
     // V is exactly singular for an uncontrollable pair, but its computed condition number can
     // stay well below 1/u when A^k b loses digits to cancellation; from SCREEN_CONDITION on the
     // staircase decides (and names the eigenvalues it cannot move).
