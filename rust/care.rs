@@ -142,9 +142,8 @@ impl Reduced<'_> {
         gain
     }
 
-    /// The residual Res(Y) (symmetrised), the gain K of Y, and the size of the terms,
-    /// ||Q||_F + 2 ||Ã^T Y||_F + ||(Y B̃ + S) K||_F, against which it is judged.
-    fn residual(&self, y: &Mat<f64>) -> (Mat<f64>, Mat<f64>, f64) {
+    /// The residual of Y and its gain.
+    fn evaluate(&self, y: &Mat<f64>) -> Evaluation {
         let gain = self.gain(y);
         let mut coupling = y * &self.b;
         if let Some(s) = self.s {
@@ -155,7 +154,28 @@ impl Reduced<'_> {
         let scale = self.q.norm_l2() + 2.0 * ay.norm_l2() + quadratic.norm_l2();
         let mut residual = &ay + ay.transpose() - &quadratic + self.q;
         symmetrize(&mut residual);
-        (residual, gain, scale)
+        Evaluation {
+            residual_norm: residual.norm_l2(),
+            residual,
+            gain,
+            scale,
+        }
+    }
+}
+
+/// Res(Y) (symmetrised) of the reduced equation, its Frobenius norm, the gain K of Y, and the
+/// size of the terms, ||Q||_F + 2 ||Ã^T Y||_F + ||(Y B̃ + S) K||_F, against which it is judged.
+/// Without E this is the residual of the caller's equation and is reported as it is.
+struct Evaluation {
+    residual: Mat<f64>,
+    residual_norm: f64,
+    gain: Mat<f64>,
+    scale: f64,
+}
+
+impl Evaluation {
+    fn relative_residual(&self) -> f64 {
+        relative(self.residual_norm, self.scale)
     }
 }
 
@@ -206,15 +226,18 @@ pub fn solve_care(
         });
     }
     let (mut y, rcond) = hamiltonian_solution(&standard)?;
-    let mut refinement_steps = 0;
-    if options.refine {
-        refinement_steps = refine(&reduced, &mut y);
-    }
-    // X = E^-T Y E^-1.
-    let gain = reduced.gain(&y);
+    let mut evaluation = reduced.evaluate(&y);
+    let refinement_steps = if options.refine {
+        refine(&reduced, &mut y, &mut evaluation)
+    } else {
+        0
+    };
+    let reduced_residual = evaluation.relative_residual();
+    let gain = evaluation.gain;
     let closed_loop = &reduced.a - &reduced.b * &gain;
     let closed_loop_eigenvalues = eigenvalues(closed_loop.as_ref())?;
-    let x = match options.e {
+    // X = E^-T Y E^-1.
+    let (x, residual) = match options.e {
         Some(e) => {
             let mut x = y.clone();
             let mut factors = e.transpose().to_owned();
@@ -224,11 +247,11 @@ pub fn solve_care(
             solve_in_place(factors.as_mut(), xt.as_mut(), Par::Seq);
             let mut x = xt.transpose().to_owned();
             symmetrize(&mut x);
-            x
+            let residual = general_residual(a, b, q.as_ref(), options.s, e, &x, &gain);
+            (x, residual)
         }
-        None => y,
+        None => (y, reduced_residual),
     };
-    let residual = general_residual(a, b, q.as_ref(), options.s, options.e, &x, &gain);
     Ok(Care {
         x,
         gain,
@@ -453,17 +476,16 @@ fn nearest_power_of_two(value: f64) -> f64 {
 }
 
 /// Newton (Kleinman) steps while the residual decreases and is above rounding level (u times
-/// the size of the terms); returns the number accepted. The step solves
-/// (Ã - B̃ K)^T Δ + Δ (Ã - B̃ K) = -Res(Y), K the gain of Y.
-fn refine(reduced: &Reduced<'_>, y: &mut Mat<f64>) -> usize {
-    let (mut residual, mut gain, mut scale) = reduced.residual(y);
-    let mut residual_norm = residual.norm_l2();
+/// the size of the terms); returns the number accepted, and leaves `evaluation` that of the
+/// final Y. The step solves (Ã - B̃ K)^T Δ + Δ (Ã - B̃ K) = -Res(Y), K the gain of Y.
+fn refine(reduced: &Reduced<'_>, y: &mut Mat<f64>, evaluation: &mut Evaluation) -> usize {
     let mut steps = 0;
-    while steps < MAX_REFINEMENT_STEPS && residual_norm > f64::EPSILON * scale {
-        let closed_loop = &reduced.a - &reduced.b * &gain;
+    while steps < MAX_REFINEMENT_STEPS && evaluation.residual_norm > f64::EPSILON * evaluation.scale
+    {
+        let closed_loop = &reduced.a - &reduced.b * &evaluation.gain;
         let step = lyapunov::solve(
             closed_loop.transpose(),
-            residual.as_ref(),
+            evaluation.residual.as_ref(),
             Singularity::Perturb,
         );
         let Ok(delta) = step else {
@@ -471,16 +493,13 @@ fn refine(reduced: &Reduced<'_>, y: &mut Mat<f64>) -> usize {
         };
         let mut candidate = &*y + &delta;
         symmetrize(&mut candidate);
-        let (candidate_residual, candidate_gain, candidate_scale) = reduced.residual(&candidate);
-        let candidate_norm = candidate_residual.norm_l2();
-        if candidate_norm.is_nan() || candidate_norm >= residual_norm {
+        let candidate_evaluation = reduced.evaluate(&candidate);
+        let candidate_norm = candidate_evaluation.residual_norm;
+        if candidate_norm.is_nan() || candidate_norm >= evaluation.residual_norm {
             break;
         }
         *y = candidate;
-        gain = candidate_gain;
-        scale = candidate_scale;
-        residual = candidate_residual;
-        residual_norm = candidate_norm;
+        *evaluation = candidate_evaluation;
         steps += 1;
     }
     steps
@@ -492,14 +511,11 @@ fn general_residual(
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     s: Option<MatRef<'_, f64>>,
-    e: Option<MatRef<'_, f64>>,
+    e: MatRef<'_, f64>,
     x: &Mat<f64>,
     gain: &Mat<f64>,
 ) -> f64 {
-    let xe = match e {
-        Some(e) => x * e,
-        None => x.clone(),
-    };
+    let xe = x * e;
     let axe = a.transpose() * &xe;
     let mut m = b.transpose() * &xe;
     if let Some(s) = s {
@@ -508,9 +524,14 @@ fn general_residual(
     let quadratic = m.transpose() * gain;
     let residual = &axe + axe.transpose() - &quadratic + q;
     let scale = q.norm_l2() + 2.0 * axe.norm_l2() + quadratic.norm_l2();
+    relative(residual.norm_l2(), scale)
+}
+
+/// ||Res|| / scale, or ||Res|| itself when every term is zero.
+fn relative(residual_norm: f64, scale: f64) -> f64 {
     if scale > 0.0 {
-        residual.norm_l2() / scale
+        residual_norm / scale
     } else {
-        residual.norm_l2()
+        residual_norm
     }
 }

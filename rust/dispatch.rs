@@ -30,6 +30,23 @@ pub fn fma_available() -> bool {
     }
 }
 
+/// Clears the upper halves of the AVX registers (`vzeroupper`) on CPUs where faer runs its
+/// AVX2 kernels.
+///
+/// Some of faer's kernels return with those halves dirty. The crate itself is compiled for
+/// baseline x86-64 (legacy SSE encoding), and on such CPUs every SSE instruction executed in
+/// that state pays a transition penalty: the QR sweeps of an 88 x 88 Schur form ran six times
+/// slower after faer's Hessenberg reduction (110 µs per sweep against 19 µs). Each hot scalar
+/// kernel that runs after faer calls starts with this; it costs about a cycle.
+#[inline]
+pub fn clear_upper_avx_state() {
+    #[cfg(target_arch = "x86_64")]
+    if fma_available() {
+        // SAFETY: the CPU has AVX2 (checked just above), hence AVX, which vzeroupper needs.
+        unsafe { std::arch::x86_64::_mm256_zeroupper() }
+    }
+}
+
 /// a b + c, fused (one rounding) in the FMA variant of a kernel, else two roundings.
 #[inline(always)]
 pub(crate) fn multiply_add<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {

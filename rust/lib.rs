@@ -21,6 +21,10 @@
 //! * [`schur`]: the real Schur form and eigenvalues (Francis double-shift QR).
 //! * [`ctrb`]: controllability and observability matrices and the staircase verdict.
 //! * [`place`]: pole placement: Bass–Gura, Ackermann and the robust multi-input method.
+//! * [`reorder`]: reordering of the real Schur form by direct block swaps (Bai & Demmel 1993).
+//! * [`lyapunov`]: the continuous Lyapunov equation by Bartels–Stewart.
+//! * [`care`]: the algebraic Riccati equation by the Hamiltonian ordered-Schur method, and LQR.
+//! * [`riccati_ode`]: the Riccati differential equation of finite-horizon LQR.
 //! * [`batch`]: the same operations over stacks of problems, in parallel.
 //! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
 //! * [`lu`]: linear solves by LU with partial pivoting.

@@ -24,6 +24,7 @@
 //! The cost is that of the Schur form, about 25 n^3 flops, plus 4 n^3 for the transformations
 //! and n^3 for the triangular solve (the updates are column operations, as in LAPACK's dtrsyl).
 
+use crate::dispatch::clear_upper_avx_state;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::schur::real_schur;
 use crate::sylvester::solve_small_sylvester;
@@ -77,6 +78,7 @@ fn solve_quasi_triangular(
     mut f: Mat<f64>,
     singularity: Singularity,
 ) -> Result<Mat<f64>, Error> {
+    clear_upper_avx_state();
     let n = t.nrows();
     let mut blocks = Vec::with_capacity(n);
     let mut k = 0;

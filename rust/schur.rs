@@ -35,6 +35,7 @@
 //! the computed eigenvalues of badly scaled matrices such as models in mixed units. The Schur
 //! form itself is not balanced, since its Z must be orthogonal.
 
+use crate::dispatch::clear_upper_avx_state;
 use crate::error::{Error, check_finite, check_square};
 use crate::hessenberg::{hessenberg, hessenberg_matrix};
 use faer::{Mat, MatRef, c64};
@@ -276,6 +277,7 @@ fn block_eigenvalues(n: usize, t: impl Fn(usize, usize) -> f64) -> Vec<c64> {
 /// Householder reduction to upper Hessenberg form in place, H = Q^T A Q; `q` (the identity on
 /// entry) becomes Q. Reflector k maps column k below the subdiagonal onto e_{k+1}.
 fn reduce_to_hessenberg(h: &mut Square, mut q: Option<&mut Square>) {
+    clear_upper_avx_state();
     let n = h.n;
     let mut w = [0.0; UNBLOCKED_HESSENBERG_MAX_ORDER];
     for k in 0..n.saturating_sub(2) {
@@ -312,6 +314,7 @@ pub(crate) fn balancing_scale(a: MatRef<'_, f64>) -> Vec<f64> {
 /// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more. Returns
 /// the diagonal of D.
 fn balance(a: &mut Square) -> Vec<f64> {
+    clear_upper_avx_state();
     let n = a.n;
     let mut scale = vec![1.0; n];
     let mut changed = true;
@@ -492,6 +495,7 @@ pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
 /// multiplied on the right by the orthogonal transformations); without it only the diagonal
 /// blocks are formed, which suffices for the eigenvalues.
 fn francis_qr(h: &mut Square, mut z: Option<&mut Square>, full: bool) -> Result<(), Error> {
+    clear_upper_avx_state();
     let n = h.n;
     if n == 0 {
         return Ok(());

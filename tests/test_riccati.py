@@ -253,6 +253,21 @@ def test_descriptor_and_cross_term(seed: int) -> None:
         np.testing.assert_allclose(X, X_scipy, rtol=1e-12, atol=1e-12 * np.abs(X).max())
 
 
+def test_large_random_problem_against_scipy() -> None:
+    # The 128-state problem of benches/compare_peers.py. Its Hamiltonian needs 2x2-block swaps
+    # whose strong stability test, evaluated in floating point, lands near 10 u max|D|: the
+    # threshold of LAPACK's dtrexc rejected one (2.8e-14 > 2.6e-14). See rust/reorder.rs.
+    rng = np.random.default_rng(0)
+    rng.standard_normal((64, 64)), rng.standard_normal((64, 2))
+    n = 128
+    A = rng.standard_normal((n, n)) / np.sqrt(n) - 1.5 * np.eye(n)
+    B = rng.standard_normal((n, 2))
+    sol = aerocontrol.solve_care(A, B, np.eye(n), np.eye(2))
+    X_scipy = sl.solve_continuous_are(A, B, np.eye(n), np.eye(2))
+    assert sol.residual < 1e-15
+    assert np.linalg.norm(sol.X - X_scipy) <= 1e-13 * np.linalg.norm(X_scipy)
+
+
 # --------------------------------------------------------------------------------------------
 # Errors
 # --------------------------------------------------------------------------------------------
