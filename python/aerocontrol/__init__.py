@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import chapter, exceptions
+from . import aircraft, chapter, exceptions
 from .controllability import (
     Controllability,
     controllability,
@@ -108,6 +108,7 @@ __all__ = [
     "TimeResponse",
     "UncontrollableError",
     "__version__",
+    "aircraft",
     "as_state_space",
     "augment_mode",
     "bode",

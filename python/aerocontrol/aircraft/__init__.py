@@ -1,0 +1,42 @@
+"""Aircraft models: a flight condition and nondimensional derivatives -> the chapter's
+longitudinal and lateral-directional state-space models, with their modes named.
+
+Aircraft are described by TOML files (read with tomllib), one flight condition per file, with a
+citation for every number; the chapter's Boeing 747 in powered approach ships as the default,
+beside further aircraft and flight conditions from public sources (:func:`available`).
+
+>>> from aerocontrol import aircraft
+>>> "b747-approach" in aircraft.available()
+True
+>>> b747 = aircraft.load()                  # the default: the chapter's 747 in approach
+>>> print(b747.modes("lateral"))            # doctest: +ELLIPSIS
+mode ...
+"""
+
+from __future__ import annotations
+
+from .atmosphere import Atmosphere, standard_atmosphere
+from .model import (
+    LATERAL_DERIVATIVES,
+    LONGITUDINAL_DERIVATIVES,
+    Aircraft,
+    AircraftDataError,
+    available,
+    body_to_stability,
+    load,
+)
+from .naming import classify_modes, name_modes
+
+__all__ = [
+    "LATERAL_DERIVATIVES",
+    "LONGITUDINAL_DERIVATIVES",
+    "Aircraft",
+    "AircraftDataError",
+    "Atmosphere",
+    "available",
+    "body_to_stability",
+    "classify_modes",
+    "load",
+    "name_modes",
+    "standard_atmosphere",
+]

@@ -1,0 +1,1 @@
+"""The shipped aircraft files (TOML), read by :func:`aerocontrol.aircraft.load`."""

@@ -1,0 +1,591 @@
+"""An aircraft at a flight condition, from its nondimensional derivatives to state-space models.
+
+The dimensional derivatives are those of the course chapter, (6.48) and (6.148): forces per
+unit mass and moments per unit moment of inertia, per unit perturbation of the velocity
+components u, v, w (ft/s or m/s), of their rate ẇ, and of the body rates p, q, r. With
+m = W/g, the flight speed u0, the density ρ and the Mach number M:
+
+==========  =====================================  ==========  ===================================
+Xu          -(ρ S u0 / 2m) (2 CD + M CD_M)          Xw          (ρ S u0 / 2m) (CL - CD_α)
+Zu          -(ρ S u0 / 2m) (2 CL + M CL_M)          Zw          -(ρ S u0 / 2m) (CL_α + CD)
+Zẇ          -(ρ S c̄ / 4m) CL_α̇                      Zq          -(ρ u0 S c̄ / 4m) CL_q
+Mu          (ρ u0 S c̄ / 2Iy) M Cm_M                 Mw          (ρ u0 S c̄ / 2Iy) Cm_α
+Mẇ          (ρ S c̄² / 4Iy) Cm_α̇                     Mq          (ρ u0 S c̄² / 4Iy) Cm_q
+Xδe         -(ρ u0² S / 2m) CD_δe                   Zδe         -(ρ u0² S / 2m) CL_δe
+Mδe         (ρ u0² S c̄ / 2Iy) Cm_δe
+Yv          (ρ u0 S / 2m) Cy_β                      Yp, Yr      (ρ u0 S b / 4m) Cy_p, Cy_r
+Lv          (ρ u0 S b / 2Ix) Cl_β                   Lp, Lr      (ρ u0 S b² / 4Ix) Cl_p, Cl_r
+Nv          (ρ u0 S b / 2Iz) Cn_β                   Np, Nr      (ρ u0 S b² / 4Iz) Cn_p, Cn_r
+Yδ, Lδ, Nδ  (ρ u0² S / 2) (Cy_δ / m, b Cl_δ / Ix, b Cn_δ / Iz)
+==========  =====================================  ==========  ===================================
+
+(Xu and Zu take the thrust as balancing the drag and independent of speed, as the chapter
+does.) With ix = Ixz/Ix and iz = Ixz/Iz (6.149) in stability axes, the longitudinal model in
+x = (u/u0, α, q, θ) (6.49)-(6.50) is
+
+    d(u/u0)/dt = Xu u/u0 + Xw α - (g cos Θ0 / u0) θ + (Xδe / u0) δe
+    (1 - Zẇ) dα/dt = Zu u/u0 + Zw α + (1 + Zq/u0) q - (g sin Θ0 / u0) θ + (Zδe / u0) δe
+    dq/dt = u0 Mu u/u0 + u0 Mw α + Mq q + u0 Mẇ dα/dt + Mδe δe,        dθ/dt = q,
+
+and the lateral-directional model in x = (β, p, φ, r) (6.150)-(6.151), β = v/u0, is
+
+    dβ/dt = Yv β + (Yp/u0) p + (g cos Θ0 / u0) φ + (Yr/u0 - 1) r + (Yδ/u0) δ
+    dp/dt - ix dr/dt = u0 Lv β + Lp p + Lr r + Lδ δ,     dφ/dt = p + tan Θ0 r,
+    dr/dt - iz dp/dt = u0 Nv β + Np p + Nr r + Nδ δ,
+
+solved for dp/dt and dr/dt by dividing by 1 - ix iz. Angles are in radians.
+
+Inertias given in body axes are rotated into the stability axes by the trim angle of attack α0
+of the body x axis (positive nose up): Ix' = Ix cos²α0 + Iz sin²α0 - Ixz sin 2α0,
+Iz' = Ix sin²α0 + Iz cos²α0 + Ixz sin 2α0, Ixz' = (Ix - Iz)/2 sin 2α0 + Ixz cos 2α0.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import InvalidArgumentError
+from ..modal import Modes, modes
+from ..statespace import StateSpace
+from .atmosphere import standard_atmosphere
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = [
+    "LATERAL_DERIVATIVES",
+    "LONGITUDINAL_DERIVATIVES",
+    "Aircraft",
+    "AircraftDataError",
+    "available",
+    "load",
+]
+
+LONGITUDINAL_DERIVATIVES = (
+    "CL",
+    "CD",
+    "CL_alpha",
+    "CL_alphadot",
+    "CL_q",
+    "CL_M",
+    "CD_alpha",
+    "CD_M",
+    "Cm_alpha",
+    "Cm_alphadot",
+    "Cm_q",
+    "Cm_M",
+    "CL_de",
+    "CD_de",
+    "Cm_de",
+)
+"""The longitudinal coefficients and derivatives (per radian) an aircraft file must give."""
+
+LATERAL_DERIVATIVES = (
+    "Cy_beta",
+    "Cy_p",
+    "Cy_r",
+    "Cl_beta",
+    "Cl_p",
+    "Cl_r",
+    "Cn_beta",
+    "Cn_p",
+    "Cn_r",
+    "Cy_dr",
+    "Cl_dr",
+    "Cn_dr",
+    "Cy_da",
+    "Cl_da",
+    "Cn_da",
+)
+"""The lateral-directional derivatives (per radian) an aircraft file must give."""
+
+_GRAVITY = {"english": 32.174, "si": 9.80665}
+_UNIT_NAMES = {
+    "english": {"length": "ft", "speed": "ft/s", "density": "slug/ft^3", "force": "lbf"},
+    "si": {"length": "m", "speed": "m/s", "density": "kg/m^3", "force": "N"},
+}
+_CLASSES = ("I", "II-C", "II-L", "III", "IV")
+_CATEGORIES = ("A", "B", "C")
+_DATA = "aerocontrol.aircraft.data"
+_TABLES = (
+    "aircraft",
+    "flight",
+    "mass",
+    "geometry",
+    "longitudinal",
+    "lateral",
+    "published",
+    "sources",
+)
+_FLIGHT_KEYS = ("speed", "mach", "altitude", "density", "theta0_deg", "alpha0_deg")
+
+LONGITUDINAL_STATES = ("u/u0", "alpha", "q", "theta")
+LATERAL_STATES = ("beta", "p", "phi", "r")
+
+
+class AircraftDataError(InvalidArgumentError):
+    """An aircraft file or table is malformed: an unknown or missing key, a value of the wrong
+    type or sign, or numbers inconsistent with the declared units. The message names the file
+    and the key."""
+
+
+@dataclass(frozen=True)
+class Aircraft:
+    """An aircraft at one flight condition: geometry, mass, the flight condition and the
+    nondimensional derivatives, from which the dimensional derivatives and the chapter's
+    longitudinal and lateral-directional models follow.
+
+    Build one with :func:`load` (a shipped aircraft or a TOML file) or
+    :meth:`Aircraft.from_dict`. All quantities are in the file's units (``"english"``: ft, slug,
+    lbf; ``"si"``: m, kg, N), inertias in stability axes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from aerocontrol import aircraft
+    >>> b747 = aircraft.load("b747-approach")
+    >>> np.round(b747.lateral().A, 4)               # the chapter's (6.150)
+    array([[-0.0999,  0.    ,  0.1153, -1.    ],
+           [-1.6038, -1.0932,  0.    ,  0.285 ],
+           [ 0.    ,  1.    ,  0.    ,  0.    ],
+           [ 0.4089, -0.0395,  0.    , -0.2454]])
+    """
+
+    name: str
+    identifier: str
+    description: str
+    aircraft_class: str
+    """MIL-F-8785C class: "I", "II-C", "II-L", "III" or "IV"."""
+    category: str
+    """MIL-F-8785C flight-phase category of this condition: "A", "B" or "C"."""
+    units: str
+    speed: float
+    """Flight speed u0 (ft/s or m/s)."""
+    altitude: float
+    density: float
+    mach: float
+    theta0: float
+    """Equilibrium flight-path angle Θ0 (rad)."""
+    mass: float
+    gravity: float
+    Ix: float
+    Iy: float
+    Iz: float
+    Ixz: float
+    """Inertias in stability axes."""
+    S: float
+    cbar: float
+    b: float
+    derivatives: Mapping[str, float]
+    published: Mapping[str, Any] = field(default_factory=dict)
+    sources: Mapping[str, str] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------------------------
+    # Construction
+    # ------------------------------------------------------------------------------------
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], origin: str = "<dict>") -> Aircraft:
+        """An aircraft from the tables of an aircraft file (see the shipped files in
+        ``aerocontrol/aircraft/data``), checking every key; ``origin`` names the file in errors.
+        """
+        reader = _Reader(data, origin)
+        info = reader.table("aircraft", required=("name", "class", "category", "units"))
+        units = reader.choice(info, "aircraft", "units", ("english", "si"))
+        aircraft_class = reader.choice(info, "aircraft", "class", (*_CLASSES, "II"))
+        if aircraft_class == "II":
+            aircraft_class = "II-L"
+        category = reader.choice(info, "aircraft", "category", _CATEGORIES)
+        reader.only(info, "aircraft", ("name", "description", "class", "category", "units"))
+
+        flight = reader.table("flight", required=("altitude",))
+        reader.only(flight, "flight", _FLIGHT_KEYS)
+        altitude = reader.number(flight, "flight", "altitude")
+        atmosphere = reader.atmosphere(altitude, units)
+        if ("speed" in flight) == ("mach" in flight):
+            raise AircraftDataError(f"{origin}: [flight] must give exactly one of speed and mach")
+        if "speed" in flight:
+            speed = reader.positive(flight, "flight", "speed")
+            mach = speed / atmosphere.speed_of_sound
+        else:
+            mach = reader.positive(flight, "flight", "mach")
+            speed = mach * atmosphere.speed_of_sound
+        density = atmosphere.density
+        if "density" in flight:
+            density = reader.positive(flight, "flight", "density")
+            if not 0.5 <= density / atmosphere.density <= 2.0:
+                names = _UNIT_NAMES[units]
+                raise AircraftDataError(
+                    f"{origin}: [flight] density = {density:g} {names['density']} is not plausible "
+                    f"at {altitude:g} {names['length']} (the standard atmosphere gives "
+                    f"{atmosphere.density:.5g} {names['density']}): are the units {units!r}?"
+                )
+        theta0 = math.radians(reader.number(flight, "flight", "theta0_deg", default=0.0))
+        if abs(theta0) >= math.pi / 2:
+            raise AircraftDataError(f"{origin}: [flight] theta0_deg must lie in (-90, 90) degrees")
+        gravity = _GRAVITY[units]
+
+        mass_table = reader.table("mass", required=("Ix", "Iy", "Iz", "Ixz", "axes"))
+        reader.only(mass_table, "mass", ("weight", "mass", "Ix", "Iy", "Iz", "Ixz", "axes"))
+        if ("weight" in mass_table) == ("mass" in mass_table):
+            raise AircraftDataError(f"{origin}: [mass] must give exactly one of weight and mass")
+        if "weight" in mass_table:
+            mass = reader.positive(mass_table, "mass", "weight") / gravity
+        else:
+            mass = reader.positive(mass_table, "mass", "mass")
+        Ix, Iy, Iz = (reader.positive(mass_table, "mass", key) for key in ("Ix", "Iy", "Iz"))
+        Ixz = reader.number(mass_table, "mass", "Ixz")
+        axes = reader.choice(mass_table, "mass", "axes", ("stability", "body"))
+        if axes == "body":
+            if "alpha0_deg" not in flight:
+                raise AircraftDataError(
+                    f"{origin}: [mass] axes = 'body' needs [flight] alpha0_deg, the trim angle "
+                    "of attack of the body x axis, to rotate the inertias into stability axes"
+                )
+            Ix, Iz, Ixz = body_to_stability(
+                Ix, Iz, Ixz, math.radians(reader.number(flight, "flight", "alpha0_deg"))
+            )
+        if Ix * Iz <= Ixz**2:
+            raise AircraftDataError(
+                f"{origin}: [mass] the inertia tensor must be positive definite, but "
+                f"Ix Iz = {Ix * Iz:.4g} <= Ixz^2 = {Ixz**2:.4g}"
+            )
+
+        geometry = reader.table("geometry", required=("S", "cbar", "b"))
+        reader.only(geometry, "geometry", ("S", "cbar", "b"))
+        S, cbar, b = (reader.positive(geometry, "geometry", key) for key in ("S", "cbar", "b"))
+
+        derivatives: dict[str, float] = {}
+        for table_name, keys in (
+            ("longitudinal", LONGITUDINAL_DERIVATIVES),
+            ("lateral", LATERAL_DERIVATIVES),
+        ):
+            table = reader.table(table_name, required=keys)
+            reader.only(table, table_name, keys)
+            derivatives.update({key: reader.number(table, table_name, key) for key in keys})
+
+        published = dict(data.get("published", {}))
+        sources = reader.table("sources", required=("default",)) if "sources" in data else {}
+        reader.only_tables(_TABLES)
+        return cls(
+            name=str(info["name"]),
+            identifier=Path(origin).stem,
+            description=str(info.get("description", "")),
+            aircraft_class=aircraft_class,
+            category=category,
+            units=units,
+            speed=speed,
+            altitude=altitude,
+            density=density,
+            mach=mach,
+            theta0=theta0,
+            mass=mass,
+            gravity=gravity,
+            Ix=Ix,
+            Iy=Iy,
+            Iz=Iz,
+            Ixz=Ixz,
+            S=S,
+            cbar=cbar,
+            b=b,
+            derivatives=derivatives,
+            published=published,
+            sources={str(k): str(v) for k, v in sources.items()},
+        )
+
+    # ------------------------------------------------------------------------------------
+    # Dimensional derivatives
+    # ------------------------------------------------------------------------------------
+
+    @property
+    def dynamic_pressure(self) -> float:
+        """q̄ = ρ u0² / 2."""
+        return 0.5 * self.density * self.speed**2
+
+    def dimensional_longitudinal(self) -> dict[str, float]:
+        """Xu, Xw, Xde, Zu, Zw, Zwdot, Zq, Zde, Mu, Mw, Mwdot, Mq, Mde: the chapter's (6.48)."""
+        c = self.derivatives
+        rho, u0, S, cbar, m, Iy, M = (
+            self.density,
+            self.speed,
+            self.S,
+            self.cbar,
+            self.mass,
+            self.Iy,
+            self.mach,
+        )
+        force = rho * S * u0 / (2 * m)
+        control_force = rho * u0**2 * S / (2 * m)
+        moment = rho * u0 * S * cbar / (2 * Iy)
+        values = {
+            "Xu": -force * (2 * c["CD"] + M * c["CD_M"]),
+            "Xw": force * (c["CL"] - c["CD_alpha"]),
+            "Xde": -control_force * c["CD_de"],
+            "Zu": -force * (2 * c["CL"] + M * c["CL_M"]),
+            "Zw": -force * (c["CL_alpha"] + c["CD"]),
+            "Zwdot": -rho * S * cbar / (4 * m) * c["CL_alphadot"],
+            "Zq": -rho * u0 * S * cbar / (4 * m) * c["CL_q"],
+            "Zde": -control_force * c["CL_de"],
+            "Mu": moment * M * c["Cm_M"],
+            "Mw": moment * c["Cm_alpha"],
+            "Mwdot": rho * S * cbar**2 / (4 * Iy) * c["Cm_alphadot"],
+            "Mq": rho * u0 * S * cbar**2 / (4 * Iy) * c["Cm_q"],
+            "Mde": rho * u0**2 * S * cbar / (2 * Iy) * c["Cm_de"],
+        }
+        return {key: value + 0.0 for key, value in values.items()}
+
+    def dimensional_lateral(self) -> dict[str, float]:
+        """Yv, Yp, Yr, Ydr, Yda, Lv, Lp, Lr, Ldr, Lda, Nv, Np, Nr, Ndr, Nda and the product-of-
+        inertia factors ix = Ixz/Ix, iz = Ixz/Iz: the chapter's (6.148)-(6.149)."""
+        c = self.derivatives
+        rho, u0, S, b, m = self.density, self.speed, self.S, self.b, self.mass
+        values = {
+            "Yv": rho * u0 * S / (2 * m) * c["Cy_beta"],
+            "Yp": rho * u0 * S * b / (4 * m) * c["Cy_p"],
+            "Yr": rho * u0 * S * b / (4 * m) * c["Cy_r"],
+            "Ydr": rho * u0**2 * S / (2 * m) * c["Cy_dr"],
+            "Yda": rho * u0**2 * S / (2 * m) * c["Cy_da"],
+        }
+        for letter, inertia in (("L", self.Ix), ("N", self.Iz)):
+            coefficient = "Cl" if letter == "L" else "Cn"
+            values[f"{letter}v"] = rho * u0 * S * b / (2 * inertia) * c[f"{coefficient}_beta"]
+            for rate in ("p", "r"):
+                values[f"{letter}{rate}"] = (
+                    rho * u0 * S * b**2 / (4 * inertia) * c[f"{coefficient}_{rate}"]
+                )
+            for surface in ("dr", "da"):
+                values[f"{letter}{surface}"] = (
+                    rho * u0**2 * S * b / (2 * inertia) * c[f"{coefficient}_{surface}"]
+                )
+        values["ix"] = self.Ixz / self.Ix
+        values["iz"] = self.Ixz / self.Iz
+        return {key: value + 0.0 for key, value in values.items()}
+
+    # ------------------------------------------------------------------------------------
+    # State-space models
+    # ------------------------------------------------------------------------------------
+
+    def longitudinal(self) -> StateSpace:
+        """The longitudinal model (6.49): x = (u/u0, α, q, θ), input the elevator δe (rad)."""
+        d = self.dimensional_longitudinal()
+        u0, g, theta0 = self.speed, self.gravity, self.theta0
+        A = np.zeros((4, 4))
+        B = np.zeros((4, 1))
+        A[0] = [d["Xu"], d["Xw"], 0.0, -g * math.cos(theta0) / u0]
+        B[0, 0] = d["Xde"] / u0
+        scale = 1.0 / (1.0 - d["Zwdot"])
+        A[1] = [
+            d["Zu"] * scale,
+            d["Zw"] * scale,
+            (1.0 + d["Zq"] / u0) * scale,
+            -g * math.sin(theta0) / u0 * scale,
+        ]
+        B[1, 0] = d["Zde"] / u0 * scale
+        alpha_rate = u0 * d["Mwdot"]
+        A[2] = [u0 * d["Mu"], u0 * d["Mw"], d["Mq"], 0.0] + alpha_rate * A[1]
+        B[2, 0] = d["Mde"] + alpha_rate * B[1, 0]
+        A[3, 2] = 1.0
+        # (+ 0.0 turns the negative zeros of -g sin 0 and -CD_de = -0 into zeros.)
+        A, B = A + 0.0, B + 0.0
+        return StateSpace(A, B, state_names=list(LONGITUDINAL_STATES), input_names=["elevator"])
+
+    def lateral(self) -> StateSpace:
+        """The lateral-directional model (6.150): x = (β, p, φ, r), inputs (rudder, aileron) in
+        rad, the order of the chapter's LQR example (6.224)."""
+        d = self.dimensional_lateral()
+        u0, g, theta0 = self.speed, self.gravity, self.theta0
+        A = np.zeros((4, 4))
+        B = np.zeros((4, 2))
+        A[0] = [d["Yv"], d["Yp"] / u0, g * math.cos(theta0) / u0, d["Yr"] / u0 - 1.0]
+        B[0] = [d["Ydr"] / u0, d["Yda"] / u0]
+        ix, iz = d["ix"], d["iz"]
+        coupling = 1.0 - ix * iz
+        roll = np.array([u0 * d["Lv"], d["Lp"], 0.0, d["Lr"]])
+        yaw = np.array([u0 * d["Nv"], d["Np"], 0.0, d["Nr"]])
+        roll_control = np.array([d["Ldr"], d["Lda"]])
+        yaw_control = np.array([d["Ndr"], d["Nda"]])
+        A[1] = (roll + ix * yaw) / coupling
+        B[1] = (roll_control + ix * yaw_control) / coupling
+        A[2] = [0.0, 1.0, 0.0, math.tan(theta0)]
+        A[3] = (yaw + iz * roll) / coupling
+        B[3] = (yaw_control + iz * roll_control) / coupling
+        A, B = A + 0.0, B + 0.0
+        return StateSpace(A, B, state_names=list(LATERAL_STATES), input_names=["rudder", "aileron"])
+
+    def modes(self, axis: str) -> Modes:
+        """The modes of the longitudinal or lateral model, named ("phugoid", "short period";
+        "spiral", "Dutch roll", "roll") by :func:`aerocontrol.aircraft.name_modes`."""
+        from .naming import name_modes
+
+        system = self._model(axis)
+        unnamed = modes(system)
+        return modes(system, mode_names=list(name_modes(unnamed, axis)))
+
+    def _model(self, axis: str) -> StateSpace:
+        if axis == "longitudinal":
+            return self.longitudinal()
+        if axis == "lateral":
+            return self.lateral()
+        raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
+
+    def summary(self) -> str:
+        """A few lines: the flight condition, mass and geometry, in the file's units."""
+        names = _UNIT_NAMES[self.units]
+        return (
+            f"{self.name}: u0 = {self.speed:.5g} {names['speed']} (M = {self.mach:.3f}), "
+            f"altitude {self.altitude:g} {names['length']}, ρ = {self.density:.5g} "
+            f"{names['density']}, Θ0 = {math.degrees(self.theta0):g} deg; "
+            f"W = {self.mass * self.gravity:.6g} {names['force']}; class {self.aircraft_class}, "
+            f"category {self.category}"
+        )
+
+
+def body_to_stability(
+    Ix: float, Iz: float, Ixz: float, alpha0: float
+) -> tuple[float, float, float]:
+    """(Ix, Iz, Ixz) rotated from body axes into stability axes, α0 the angle of attack of the
+    body x axis (rad, positive nose up)."""
+    c2, s2 = math.cos(alpha0) ** 2, math.sin(alpha0) ** 2
+    sin2, cos2 = math.sin(2 * alpha0), math.cos(2 * alpha0)
+    return (
+        Ix * c2 + Iz * s2 - Ixz * sin2,
+        Ix * s2 + Iz * c2 + Ixz * sin2,
+        0.5 * (Ix - Iz) * sin2 + Ixz * cos2,
+    )
+
+
+class _Reader:
+    """Typed access to the tables of an aircraft file, raising AircraftDataError by name."""
+
+    def __init__(self, data: Mapping[str, Any], origin: str) -> None:
+        if not isinstance(data, Mapping):
+            raise AircraftDataError(f"{origin}: an aircraft must be a table of tables")
+        self.data, self.origin = data, origin
+
+    def table(self, name: str, required: tuple[str, ...]) -> Mapping[str, Any]:
+        table = self.data.get(name)
+        if not isinstance(table, Mapping):
+            raise AircraftDataError(f"{self.origin}: the table [{name}] is missing")
+        missing = [key for key in required if key not in table]
+        if missing:
+            hint = ""
+            if name in ("longitudinal", "lateral"):
+                hint = " (write 0.0 for a derivative the source does not give)"
+            raise AircraftDataError(
+                f"{self.origin}: [{name}] is missing {', '.join(missing)}{hint}"
+            )
+        return table
+
+    def only(self, table: Mapping[str, Any], name: str, allowed: tuple[str, ...]) -> None:
+        unknown = [key for key in table if key not in allowed]
+        if unknown:
+            raise AircraftDataError(
+                f"{self.origin}: [{name}] has unknown key(s) {', '.join(unknown)}; "
+                f"the keys are {', '.join(allowed)}"
+            )
+
+    def only_tables(self, allowed: tuple[str, ...]) -> None:
+        unknown = [key for key in self.data if key not in allowed]
+        if unknown:
+            raise AircraftDataError(
+                f"{self.origin}: unknown table(s) {', '.join(unknown)}; the tables are "
+                f"{', '.join(allowed)}"
+            )
+
+    def number(
+        self, table: Mapping[str, Any], name: str, key: str, default: float | None = None
+    ) -> float:
+        if key not in table and default is not None:
+            return default
+        value = table[key]
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not number or not math.isfinite(value):
+            raise AircraftDataError(
+                f"{self.origin}: [{name}] {key} must be a finite number, got {value!r}"
+            )
+        return float(value)
+
+    def positive(self, table: Mapping[str, Any], name: str, key: str) -> float:
+        value = self.number(table, name, key)
+        if value <= 0.0:
+            raise AircraftDataError(
+                f"{self.origin}: [{name}] {key} must be positive, got {value!r}"
+            )
+        return value
+
+    def choice(
+        self, table: Mapping[str, Any], name: str, key: str, choices: tuple[str, ...]
+    ) -> str:
+        value = table.get(key)
+        if value not in choices:
+            listed = ", ".join(repr(c) for c in choices)
+            raise AircraftDataError(
+                f"{self.origin}: [{name}] {key} must be one of {listed}, got {value!r}"
+            )
+        return str(value)
+
+    def atmosphere(self, altitude: float, units: str) -> Any:
+        try:
+            return standard_atmosphere(altitude, units)
+        except InvalidArgumentError as error:
+            raise AircraftDataError(f"{self.origin}: [flight] {error}") from None
+
+
+def available() -> tuple[str, ...]:
+    """The identifiers of the shipped aircraft, sorted (``load`` takes any of them)."""
+    return tuple(
+        sorted(
+            entry.name.removesuffix(".toml")
+            for entry in resources.files(_DATA).iterdir()
+            if entry.name.endswith(".toml")
+        )
+    )
+
+
+def load(name_or_path: str | Path = "b747-approach") -> Aircraft:
+    """A shipped aircraft by identifier (see :func:`available`), or an aircraft file by path.
+
+    Raises AircraftDataError for an unknown identifier, a missing or unreadable file, malformed
+    TOML, or a table that does not validate; the message names the file and the key.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> b747 = aircraft.load()                     # the chapter's 747 in powered approach
+    >>> round(b747.dimensional_lateral()["Lp"], 4) # (6.148)
+    -1.0994
+    """
+    text, origin = _read(name_or_path)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise AircraftDataError(f"{origin}: not valid TOML: {error}") from None
+    return Aircraft.from_dict(data, origin)
+
+
+def _read(name_or_path: str | Path) -> tuple[str, str]:
+    if isinstance(name_or_path, str) and name_or_path in available():
+        resource = resources.files(_DATA).joinpath(f"{name_or_path}.toml")
+        return resource.read_text(encoding="utf-8"), f"{name_or_path}.toml"
+    path = Path(name_or_path)
+    if path.suffix != ".toml":
+        raise AircraftDataError(
+            f"unknown aircraft {str(name_or_path)!r}: give a file ending in .toml or one of "
+            f"{', '.join(available())}"
+        )
+    try:
+        return path.read_text(encoding="utf-8"), str(path)
+    except OSError as error:
+        raise AircraftDataError(
+            f"cannot read the aircraft file {str(path)!r}: {error.strerror}"
+        ) from None

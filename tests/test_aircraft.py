@@ -1,0 +1,296 @@
+"""Aircraft models: the standard atmosphere, the chapter's derivative chain (6.47) -> (6.48) ->
+(6.49) and (6.147) -> (6.148) -> (6.150) at printed precision, the published modes of every
+shipped aircraft, mode naming, and the validation of aircraft files."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import aerocontrol
+from aerocontrol import aircraft
+from aerocontrol.aircraft import AircraftDataError, standard_atmosphere
+
+# Printed values carry four decimals: 2e-3 relative, and half a unit in the last place printed.
+PRINTED = {"rtol": 2e-3, "atol": 5e-5}
+
+
+# --------------------------------------------------------------------------------------------
+# Standard atmosphere (U.S. Standard Atmosphere 1976, Table 4: the layer base values)
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("altitude", "temperature", "pressure"),
+    [
+        (0.0, 288.15, 101_325.0),
+        (11_000.0, 216.65, 22_632.06),
+        (20_000.0, 216.65, 5_474.889),
+        (32_000.0, 228.65, 868.0187),
+        (47_000.0, 270.65, 110.9063),
+        (51_000.0, 270.65, 66.93887),
+        (71_000.0, 214.65, 3.956420),
+    ],
+)
+def test_standard_atmosphere_layer_bases(
+    altitude: float, temperature: float, pressure: float
+) -> None:
+    # The table lists the bases by geopotential altitude H; we take geometric Z.
+    state = standard_atmosphere(6_356_766.0 * altitude / (6_356_766.0 - altitude))
+    assert state.temperature == pytest.approx(temperature, rel=1e-12)
+    # The table's pressures are printed to 7 digits from the standard's rounded constants.
+    assert state.pressure == pytest.approx(pressure, rel=1e-5)
+
+
+def test_standard_atmosphere_sea_level_and_english_units() -> None:
+    sea_level = standard_atmosphere(0.0)
+    assert sea_level.density == pytest.approx(1.2250, rel=1e-4)
+    assert sea_level.speed_of_sound == pytest.approx(340.294, rel=1e-5)
+    english = standard_atmosphere(0.0, units="english")
+    assert english.density == pytest.approx(0.0023769, rel=1e-4)  # slug/ft^3
+    assert english.speed_of_sound == pytest.approx(1116.45, rel=1e-5)  # ft/s
+    assert english.pressure == pytest.approx(2116.22, rel=1e-5)  # lbf/ft^2
+    high = standard_atmosphere(40_000.0, units="english")
+    assert high.density * aircraft.atmosphere.SLUG_PER_CUBIC_FOOT == pytest.approx(
+        standard_atmosphere(40_000.0 * 0.3048).density, rel=1e-12
+    )
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="altitude must lie between"):
+        standard_atmosphere(90_000.0)
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="units must be"):
+        standard_atmosphere(0.0, units="imperial")
+
+
+# --------------------------------------------------------------------------------------------
+# The chapter's 747: (6.46)-(6.49) and (6.146)-(6.155)
+# --------------------------------------------------------------------------------------------
+
+
+def test_747_longitudinal_chain() -> None:
+    b747 = aircraft.load("b747-approach")
+    assert b747.mach == pytest.approx(0.25, abs=5e-4)
+    d = b747.dimensional_longitudinal()
+    printed = {  # (6.48)
+        "Xu": -0.0212,
+        "Xw": 0.0466,
+        "Zu": -0.2306,
+        "Zw": -0.6038,
+        "Zwdot": -0.0341,
+        "Zq": -7.674,
+        "Zde": -9.8175,
+        "Mu": 0.0,
+        "Mw": -0.0019,
+        "Mwdot": -0.0002,
+        "Mq": -0.4381,
+        "Mde": -0.5769,
+    }
+    for key, value in printed.items():
+        np.testing.assert_allclose(d[key], value, **PRINTED, err_msg=key)
+    sys = b747.longitudinal()
+    A, B = aerocontrol.chapter.boeing747_longitudinal()  # (6.49)
+    np.testing.assert_allclose(sys.A, A, rtol=2e-3, atol=1e-4)
+    np.testing.assert_allclose(sys.B, B, rtol=2e-3, atol=1e-4)
+    assert sys.state_names == ("u/u0", "alpha", "q", "theta")
+    assert sys.input_names == ("elevator",)
+    # The eigenvalues computed from the printed matrix (seed values): short period
+    # -0.55154 ± 0.68799i, phugoid -0.00176 ± 0.13389i.
+    named = aircraft.classify_modes(b747.modes("longitudinal"), "longitudinal")
+    np.testing.assert_allclose(named["short period"][0], -0.55154 + 0.68799j, rtol=1e-3)
+    np.testing.assert_allclose(named["phugoid"][0], -0.00176 + 0.13389j, rtol=1e-3, atol=2e-5)
+
+
+def test_747_lateral_chain() -> None:
+    b747 = aircraft.load("b747-approach")
+    d = b747.dimensional_lateral()
+    printed = {  # (6.148), (6.149)
+        "Yv": -0.0999,
+        "Yp": 0.0,
+        "Yr": 0.0,
+        "Ydr": 5.083,
+        "Yda": 0.0,
+        "Lv": -0.0055,
+        "Lp": -1.0994,
+        "Lr": 0.2468,
+        "Ldr": 0.0488,
+        "Lda": 0.3212,
+        "Nv": 0.0012,
+        "Np": -0.0933,
+        "Nr": -0.2314,
+        "Ndr": -0.2398,
+        "Nda": 0.0141,
+        "ix": -0.156,
+        "iz": -0.0492,
+    }
+    for key, value in printed.items():
+        np.testing.assert_allclose(d[key], value, **PRINTED, err_msg=key)
+    sys = b747.lateral()
+    A, B = aerocontrol.chapter.boeing747_lateral()  # (6.150), (6.158), (6.163)
+    np.testing.assert_allclose(sys.A, A, rtol=2e-3, atol=1e-4)
+    np.testing.assert_allclose(sys.B, B, rtol=2e-3, atol=1e-4)
+    assert sys.input_names == ("rudder", "aileron")
+    # (6.152)-(6.155), from the model built from the coefficients.
+    named = aircraft.classify_modes(b747.modes("lateral"), "lateral")
+    np.testing.assert_allclose(named["dutch roll"][0], -0.08066 + 0.7433j, rtol=2e-4)
+    np.testing.assert_allclose(named["roll"][0], -1.2308, rtol=1e-4)
+    np.testing.assert_allclose(named["spiral"][0], -0.04641, rtol=2e-4)
+    np.testing.assert_allclose(
+        aerocontrol.charpoly(sys.A), [1.0, 1.4385, 0.8222, 0.7232, 0.0319], **PRINTED
+    )
+    lateral_modes = b747.modes("lateral")
+    assert lateral_modes.mode_names == ("spiral", "Dutch roll", "roll")
+    np.testing.assert_allclose(lateral_modes.natural_frequency[1], 0.7477, rtol=2e-4)
+    np.testing.assert_allclose(lateral_modes.damping_ratio[1], 0.1079, rtol=1e-3)
+    np.testing.assert_allclose(lateral_modes.time_to_half[[0, 2]], [14.93, 0.56], rtol=6e-3)
+
+
+# --------------------------------------------------------------------------------------------
+# Every shipped aircraft: it loads, its models are finite, and its published modes are met
+# --------------------------------------------------------------------------------------------
+
+
+def _characteristics(values: tuple[complex, ...]) -> dict[str, float]:
+    if len(values) == 2:
+        omega_n = math.sqrt((values[0] * values[1]).real)
+        return {"omega_n": omega_n, "zeta": -(values[0] + values[1]).real / (2 * omega_n)}
+    root = values[0].real
+    out = {"time_constant": 1.0 / abs(root)}
+    out["time_to_half" if root < 0 else "time_to_double"] = math.log(2.0) / abs(root)
+    return out
+
+
+@pytest.mark.parametrize("identifier", aircraft.available())
+def test_shipped_aircraft_reproduce_their_published_modes(identifier: str) -> None:
+    plane = aircraft.load(identifier)
+    assert plane.sources.get("default"), "every file names its source"
+    for table in ("flight", "mass", "geometry", "longitudinal", "lateral"):
+        assert table in plane.sources, f"{identifier}: no citation for [{table}]"
+    published = dict(plane.published)
+    tolerance = float(published.pop("tolerance", 0.02))
+    named = {
+        **aircraft.classify_modes(plane.modes("longitudinal"), "longitudinal"),
+        **aircraft.classify_modes(plane.modes("lateral"), "lateral"),
+    }
+    for mode, expected in published.items():
+        key = mode.replace("_", " ")
+        ours = _characteristics(named[key])
+        for quantity, value in expected.items():
+            assert ours[quantity] == pytest.approx(value, rel=tolerance), (
+                f"{identifier}: {key} {quantity} = {ours[quantity]:.5g}, published {value}"
+            )
+
+
+# --------------------------------------------------------------------------------------------
+# Mode naming and inertia axes
+# --------------------------------------------------------------------------------------------
+
+
+def test_split_modes_are_named_by_magnitude() -> None:
+    # A longitudinal model whose short period has split into two real roots.
+    A = np.diag([-3.0, -1.5, 0.0, 0.0])
+    A[2:, 2:] = [[-0.01, 0.1], [-0.1, -0.01]]
+    longitudinal = aerocontrol.modes(A)
+    named = aircraft.classify_modes(longitudinal, "longitudinal")
+    assert named["short period"] == (-1.5 + 0j, -3.0 + 0j)
+    assert aircraft.name_modes(longitudinal, "longitudinal") == (
+        "phugoid",
+        "short period (1)",
+        "short period (2)",
+    )
+    # A lateral model with the Dutch roll damped past critical: four real roots.
+    lateral = aerocontrol.modes(np.diag([-0.02, -0.5, -0.7, -2.0]))
+    named = aircraft.classify_modes(lateral, "lateral")
+    assert named["spiral"] == (-0.02 + 0j,) and named["roll"] == (-2.0 + 0j,)
+    assert named["dutch roll"] == (-0.5 + 0j, -0.7 + 0j)
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="axis must be"):
+        aircraft.classify_modes(lateral, "vertical")
+
+
+def test_body_to_stability_axes() -> None:
+    Ix, Iz, Ixz = 14.3e6, 45.3e6, -2.23e6
+    assert aircraft.body_to_stability(Ix, Iz, Ixz, 0.0) == (Ix, Iz, Ixz)
+    rotated = aircraft.body_to_stability(Ix, Iz, Ixz, math.radians(8.5))
+    # The invariants of the x-z block: trace and determinant.
+    assert sum(rotated[:2]) == pytest.approx(Ix + Iz, rel=1e-14)
+    assert rotated[0] * rotated[1] - rotated[2] ** 2 == pytest.approx(Ix * Iz - Ixz**2, rel=1e-12)
+    # A quarter turn exchanges the x and z axes and reverses the product of inertia.
+    quarter = aircraft.body_to_stability(Ix, Iz, Ixz, math.pi / 2)
+    np.testing.assert_allclose(quarter, (Iz, Ix, -Ixz), rtol=1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# Validation of aircraft files
+# --------------------------------------------------------------------------------------------
+
+B747_FILE = Path(aircraft.__file__).parent / "data" / "b747-approach.toml"
+
+
+def _edited(tmp_path: Path, old: str, new: str) -> Path:
+    text = B747_FILE.read_text()
+    assert old in text
+    path = tmp_path / "edited.toml"
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        ("Cm_q = -20.8\n", "", r"\[longitudinal\] is missing Cm_q"),
+        ("Cn_r = -0.30\n", "Cn_r = -0.30\nCn_rr = 1.0\n", r"unknown key\(s\) Cn_rr"),
+        ("weight = 564032.0", "weight = -564032.0", r"\[mass\] weight must be positive"),
+        ("density = 0.002377", "density = 1.225", r"density = 1.225 slug/ft\^3 is not plausible"),
+        ('units = "english"', 'units = "imperial"', "units must be one of"),
+        ('axes = "stability"', 'axes = "body"', "needs \\[flight\\] alpha0_deg"),
+        ("speed = 279.1", "speed = 279.1\nmach = 0.25", "exactly one of speed and mach"),
+        ("Ixz = -2.23e6", "Ixz = -30e6", "must be positive definite"),
+        ("CL = 1.108", 'CL = "1.108"', r"CL must be a finite number, got '1.108'"),
+        ("[geometry]", "[geometri]", r"the table \[geometry\] is missing"),
+    ],
+)
+def test_bad_aircraft_files_raise_named_errors(
+    tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    with pytest.raises(AircraftDataError, match=message):
+        aircraft.load(_edited(tmp_path, old, new))
+
+
+def test_unknown_or_unreadable_aircraft(tmp_path: Path) -> None:
+    with pytest.raises(AircraftDataError, match="unknown aircraft 'concorde'"):
+        aircraft.load("concorde")
+    with pytest.raises(AircraftDataError, match="cannot read the aircraft file"):
+        aircraft.load(tmp_path / "absent.toml")
+    broken = tmp_path / "broken.toml"
+    broken.write_text("[aircraft\nname = 1")
+    with pytest.raises(AircraftDataError, match=r"broken\.toml: not valid TOML"):
+        aircraft.load(broken)
+    assert issubclass(AircraftDataError, ValueError)
+
+
+def test_si_file_matches_the_english_one(tmp_path: Path) -> None:
+    # The same aircraft in SI units gives the same (dimensionless and per-second) models.
+    foot, slug = 0.3048, 14.5939029372
+    text = B747_FILE.read_text()
+    replacements = {
+        'units = "english"': 'units = "si"',
+        "speed = 279.1": f"speed = {279.1 * foot!r}",
+        "density = 0.002377": f"density = {0.002377 * slug / foot**3!r}",
+        "weight = 564032.0": f"mass = {564032.0 / 32.174 * slug!r}",
+        "Ix = 14.3e6": f"Ix = {14.3e6 * slug * foot**2!r}",
+        "Iy = 32.3e6": f"Iy = {32.3e6 * slug * foot**2!r}",
+        "Iz = 45.3e6": f"Iz = {45.3e6 * slug * foot**2!r}",
+        "Ixz = -2.23e6": f"Ixz = {-2.23e6 * slug * foot**2!r}",
+        "S = 5500.0": f"S = {5500.0 * foot**2!r}",
+        "cbar = 27.3": f"cbar = {27.3 * foot!r}",
+        "b = 195.7": f"b = {195.7 * foot!r}",
+    }
+    for old, new in replacements.items():
+        assert old in text
+        text = text.replace(old, new, 1)
+    path = tmp_path / "si.toml"
+    path.write_text(text)
+    si, english = aircraft.load(path), aircraft.load("b747-approach")
+    # The models differ only through g (9.80665 m/s^2 against 32.174 ft/s^2: 3e-6 relative).
+    np.testing.assert_allclose(si.lateral().A, english.lateral().A, rtol=1e-5, atol=1e-12)
+    np.testing.assert_allclose(si.longitudinal().B, english.longitudinal().B, rtol=1e-5)
