@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import aircraft, chapter, exceptions
+from . import aircraft, chapter, design, exceptions
 from .controllability import (
     Controllability,
     controllability,
@@ -120,6 +120,7 @@ __all__ = [
     "dc_gain",
     "default_frequency_grid",
     "default_time_grid",
+    "design",
     "discretize",
     "doublet_response",
     "exceptions",

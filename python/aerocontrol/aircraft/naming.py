@@ -18,6 +18,7 @@ Keys are lower case ("short period", "phugoid", "dutch roll", "roll", "spiral",
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..exceptions import InvalidArgumentError
 from ..modal import Modes
@@ -34,8 +35,11 @@ DISPLAY_NAMES = {
 }
 
 
-def classify_modes(modes: Modes, axis: str) -> dict[str, tuple[complex, ...]]:
+def classify_modes(modes: Modes | ArrayLike, axis: str) -> dict[str, tuple[complex, ...]]:
     """The eigenvalues of each classical mode of a 4-state longitudinal or lateral model.
+
+    ``modes`` is a :class:`~aerocontrol.Modes` or the 4 eigenvalues themselves (then a lateral
+    model with two complex pairs, which needs the eigenvectors, raises InvalidArgumentError).
 
     Examples
     --------
@@ -44,7 +48,7 @@ def classify_modes(modes: Modes, axis: str) -> dict[str, tuple[complex, ...]]:
     >>> sorted(named), round(named["roll"][0].real, 4)
     (['dutch roll', 'roll', 'spiral'], -1.2308)
     """
-    values = np.asarray(modes.eigenvalues)
+    values = np.asarray(modes.eigenvalues if isinstance(modes, Modes) else modes, dtype=complex)
     if values.shape != (4,):
         raise InvalidArgumentError(
             f"mode naming needs the 4 eigenvalues of an aircraft model, got {values.shape[0]}"
@@ -68,6 +72,11 @@ def classify_modes(modes: Modes, axis: str) -> dict[str, tuple[complex, ...]]:
             "dutch roll": _pair(by_size[1:3]),
             "roll": (by_size[3],),
         }
+    if not isinstance(modes, Modes):
+        raise InvalidArgumentError(
+            "the lateral eigenvalues form two complex pairs: telling the Dutch roll from the "
+            "coupled roll-spiral needs the eigenvectors, so pass aerocontrol.modes(A)"
+        )
     return _two_pairs(modes)
 
 
