@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import aircraft, chapter, design, exceptions
+from . import aircraft, chapter, design, exceptions, handling
 from .controllability import (
     Controllability,
     controllability,
@@ -127,6 +127,7 @@ __all__ = [
     "expm",
     "forced_response",
     "frequency_response",
+    "handling",
     "impulse_response",
     "initial_response",
     "is_controllable",

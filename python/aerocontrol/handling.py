@@ -1,0 +1,711 @@
+"""Handling qualities: the modes of an aircraft judged against MIL-F-8785C.
+
+MIL-F-8785C, *Military Specification: Flying Qualities of Piloted Airplanes* (5 November 1980),
+states its dynamic requirements as limits on each mode's damping, frequency, time constant or
+time to double amplitude. Each limit comes in three Levels (1.5): Level 1, flying qualities
+clearly adequate for the mission Flight Phase; Level 2, adequate, with some increase in pilot
+workload or loss of mission effectiveness; Level 3, the airplane can be controlled safely but the
+workload is excessive or mission effectiveness inadequate. This module reports Level 4 for a
+value that meets none of the three (worse than Level 3).
+
+Which limits apply depends on the airplane Class (1.3: I small and light; II medium weight,
+low-to-medium maneuverability; III large and heavy, low-to-medium maneuverability; IV high
+maneuverability; a suffix -L for land-based and -C for carrier-based airplanes, 1.3.1) and on the
+Flight Phase Category (1.4: A, nonterminal phases needing rapid maneuvering, precision tracking
+or precise flight-path control, such as air-to-air combat, ground attack, close formation; B,
+nonterminal phases flown with gradual maneuvers, such as climb, cruise, loiter, descent; C,
+terminal phases: takeoff, approach, wave-off, landing).
+
+==============  ==========================================  ===================================
+mode            quantity, comparison                        source
+==============  ==========================================  ===================================
+short period    ζ_sp within [min, max]                       3.2.2.1.2, Table IV
+phugoid         ζ_p at least 0.04 / 0; T2 at least 55 s      3.2.1.2
+dutch roll      ζ_d, ζ_d ω_nd, ω_nd exceed the minimums      3.3.1.1, Table VI
+roll            τ_R no greater than the maximum              3.3.1.2, Table VII
+spiral          T2 greater than the minimum                  3.3.1.3, Table VIII
+==============  ==========================================  ===================================
+
+Every number below was read from a scan of the specification (the EverySpec copy, "Downloaded
+from https://www.everyspec.com" on each page; the printed page numbers are the PDF's page
+numbers): Table IV on p. 13, 3.2.1.2 on p. 12, Table VI on p. 22, Tables VII and VIII on p. 23,
+the definition of T2 in 6.2.1 on p. 71. The comparisons follow the wording of each paragraph:
+"at least" (>=) for the phugoid, "within the limits" (inclusive) for Table IV, "shall exceed"
+(>) for Table VI, "no greater than" (<=) for Table VII and "greater than" (>) for Table VIII.
+
+What is *not* applied: the specification states it, but the eigenvalues, Class and Category
+given here cannot decide it, so it is left to the caller:
+
+* Table VI's first row, ζ_d >= 0.4 and ω_nd >= 1.0 for Class IV in the Category A phases
+  air-to-air combat (CO) and ground attack (GA): the API takes the Category, not the Flight
+  Phase, so Class IV Category A is judged by the general Category A row (ζ_d > 0.19).
+* Table VI's increase of the minimum ζ_d ω_nd when ω_nd² |φ/β|_d > 20 (rad/s)², which needs
+  the Dutch roll's mode shape, and the exemption of Class III from the minimum ω_nd "subject to
+  approval by the procuring activity" (Table VI, note **).
+* The short-period frequency limits of 3.2.2.1.1 (Figures 1-3, against n/α), and Table IV's
+  note that the Level 3 minimum may be reduced above 20,000 ft if the procuring activity
+  approves.
+* The coupled roll-spiral oscillation of 3.3.1.4: a complex roll or spiral eigenvalue is
+  refused.
+
+Examples
+--------
+The chapter's Boeing 747 in powered approach (Class III, Category C), lateral modes (6.152):
+
+>>> from aerocontrol.handling import assess
+>>> hq = assess(
+...     {"dutch roll": [-0.08066 + 0.7433j, -0.08066 - 0.7433j],
+...      "roll": [-1.2308], "spiral": [-0.04641]},
+...     "III", "C")
+>>> hq.levels
+{'dutch roll': 2, 'roll': 1, 'spiral': 1}
+>>> print(hq)
+MIL-F-8785C handling qualities: Class III, Flight Phase Category C
+mode        quantity        value          level  limits                              reference
+----------  --------------  -------------  -----  ----------------------------------  -------------------
+dutch roll  zeta            0.1079         1      L1 > 0.08; L2 > 0.02; L3 > 0        3.3.1.1, Table VI
+dutch roll  zeta*omega_n    0.08066 rad/s  2      L1 > 0.1 or zeta >= 0.7;            3.3.1.1, Table VI
+                                                  L2 > 0.05 or zeta >= 0.7; L3 none
+dutch roll  omega_n         0.7477 rad/s   1      L1 > 0.4; L2 > 0.4; L3 > 0.4        3.3.1.1, Table VI
+roll        time constant   0.8125 s       1      L1 <= 1.4 s; L2 <= 3 s; L3 <= 10 s  3.3.1.2, Table VII
+spiral      time to double  inf            1      L1 > 12 s; L2 > 8 s; L3 > 4 s       3.3.1.3, Table VIII
+"""  # noqa: E501 (the example table is wider than a line of code)
+
+from __future__ import annotations
+
+import math
+import textwrap
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .exceptions import InvalidArgumentError, NonFiniteError, ShapeError
+
+__all__ = [
+    "AIRCRAFT_CLASSES",
+    "CATEGORIES",
+    "MODES",
+    "HandlingQualities",
+    "Requirement",
+    "assess",
+    "compare",
+]
+
+SPECIFICATION = "MIL-F-8785C"
+
+#: The modes that can be assessed, in the order the tables list them.
+MODES: tuple[str, ...] = ("short period", "phugoid", "dutch roll", "roll", "spiral")
+#: Airplane Classes (1.3, 1.3.1); "II" alone is taken as "II-L".
+AIRCRAFT_CLASSES: tuple[str, ...] = ("I", "II-C", "II-L", "III", "IV")
+#: Flight Phase Categories (1.4).
+CATEGORIES: tuple[str, ...] = ("A", "B", "C")
+
+_OSCILLATORY = frozenset({"short period", "phugoid", "dutch roll"})
+_CLASS_ALIASES = {"II": "II-L"}
+_LN2 = math.log(2.0)
+
+_REFERENCES = {
+    "short period": f"{SPECIFICATION} 3.2.2.1.2, Table IV",
+    "phugoid": f"{SPECIFICATION} 3.2.1.2",
+    "dutch roll": f"{SPECIFICATION} 3.3.1.1, Table VI",
+    "roll": f"{SPECIFICATION} 3.3.1.2, Table VII",
+    "spiral": f"{SPECIFICATION} 3.3.1.3, Table VIII",
+}
+_UNITS = {
+    "zeta": "",
+    "zeta*omega_n": "rad/s",
+    "omega_n": "rad/s",
+    "time constant": "s",
+    "time to double": "s",
+}
+
+# --- The requirements, as printed ------------------------------------------------------------
+# Each tuple holds the limit for Levels 1, 2 and 3; None: the table sets no limit at that Level.
+
+#: 3.2.1.2 Phugoid stability (p. 12): "a. Level 1 ----- ζp at least 0.04; b. Level 2 ----- ζp
+#: at least 0; c. Level 3 ----- T2 at least 55 seconds". Pitch control free and fixed.
+PHUGOID_MIN_ZETA: tuple[float, float] = (0.04, 0.0)
+PHUGOID_MIN_TIME_TO_DOUBLE = 55.0
+
+#: 3.2.2.1.2 Short-period damping, TABLE IV "Short-period damping ratio limits" (p. 13):
+#: (minimum, maximum) ζ_sp per Level; Level 3 has a minimum of 0.15 and no maximum (its note:
+#: "May be reduced at altitudes above 20,000 feet if approved by the procuring activity").
+SHORT_PERIOD_ZETA: dict[str, tuple[tuple[float, float | None], ...]] = {
+    "A": ((0.35, 1.30), (0.25, 2.00), (0.15, None)),
+    "B": ((0.30, 2.00), (0.20, 2.00), (0.15, None)),
+    "C": ((0.35, 1.30), (0.25, 2.00), (0.15, None)),
+}
+
+#: 3.3.1.1 Lateral-directional oscillations (Dutch roll), TABLE VI "Minimum Dutch roll
+#: frequency and damping" (p. 22), Level 1 rows: (min ζ_d, min ζ_d ω_nd rad/s, min ω_nd rad/s)
+#: by Category and Class. Category A splits Classes I, IV from II, III; Category C splits
+#: I, II-C, IV from II-L, III. The table's first row (Category A "CO and GA", Class IV: ζ_d 0.4,
+#: ω_nd 1.0) needs the Flight Phase and is not applied (see the module notes).
+DUTCH_ROLL_LEVEL1: dict[tuple[str, str], tuple[float, float, float]] = {
+    **{("A", c): (0.19, 0.35, 1.0) for c in ("I", "IV")},
+    **{("A", c): (0.19, 0.35, 0.4) for c in ("II-C", "II-L", "III")},
+    **{("B", c): (0.08, 0.15, 0.4) for c in AIRCRAFT_CLASSES},
+    **{("C", c): (0.08, 0.15, 1.0) for c in ("I", "II-C", "IV")},
+    **{("C", c): (0.08, 0.10, 0.4) for c in ("II-L", "III")},
+}
+#: TABLE VI, Levels 2 and 3, all Categories and Classes: Level 2 ζ_d 0.02, ζ_d ω_nd 0.05,
+#: ω_nd 0.4; Level 3 ζ_d 0, no ζ_d ω_nd ("-"), ω_nd 0.4.
+DUTCH_ROLL_LEVEL2: tuple[float, float, float] = (0.02, 0.05, 0.4)
+DUTCH_ROLL_LEVEL3: tuple[float, float | None, float] = (0.0, None, 0.4)
+#: TABLE VI note *: "The governing damping requirement is that yielding the larger value of
+#: ζd, except that a ζd of 0.7 is the maximum required for Class III."
+DUTCH_ROLL_CLASS_III_MAX_REQUIRED_ZETA = 0.7
+
+#: 3.3.1.2 Roll mode, TABLE VII "Maximum roll-mode time constant, seconds" (p. 23): τ_R for
+#: Levels 1, 2, 3; Level 3 is 10 s for every row. (The scan's text layer reads 1.8 for Category
+#: A, Classes II and III, Level 1; the printed page shows 1.4.)
+ROLL_MODE_MAX_TIME_CONSTANT: dict[tuple[str, str], tuple[float, float, float]] = {
+    **{("A", c): (1.0, 1.4, 10.0) for c in ("I", "IV")},
+    **{("A", c): (1.4, 3.0, 10.0) for c in ("II-C", "II-L", "III")},
+    **{("B", c): (1.4, 3.0, 10.0) for c in AIRCRAFT_CLASSES},
+    **{("C", c): (1.0, 1.4, 10.0) for c in ("I", "II-C", "IV")},
+    **{("C", c): (1.4, 3.0, 10.0) for c in ("II-L", "III")},
+}
+
+#: 3.3.1.3 Spiral stability, TABLE VIII "Spiral stability - minimum time to double amplitude"
+#: (p. 23): by Category only, the same for every Class: "A & C" 12, 8, 4 s; "B" 20, 8, 4 s.
+#: Following a bank disturbance of up to 20 degrees, the time for the bank angle to double
+#: "shall be greater than" these.
+SPIRAL_MIN_TIME_TO_DOUBLE: dict[str, tuple[float, float, float]] = {
+    "A": (12.0, 8.0, 4.0),
+    "B": (20.0, 8.0, 4.0),
+    "C": (12.0, 8.0, 4.0),
+}
+
+
+@dataclass(frozen=True)
+class Requirement:
+    """One quantity of one mode, judged against the limits of the specification.
+
+    Examples
+    --------
+    >>> from aerocontrol.handling import assess
+    >>> r = assess({"roll": [-1.2308]}, "III", "C").requirements[0]
+    >>> r.quantity, round(r.value, 4), r.level
+    ('time constant', 0.8125, 1)
+    >>> r.limits
+    'L1 <= 1.4 s; L2 <= 3 s; L3 <= 10 s'
+    >>> r.reference
+    'MIL-F-8785C 3.3.1.2, Table VII'
+    """
+
+    mode: str
+    """The mode: "short period", "phugoid", "dutch roll", "roll" or "spiral"."""
+    quantity: str
+    """"zeta", "zeta*omega_n", "omega_n", "time constant" or "time to double"."""
+    value: float
+    """The mode's value of the quantity (rad/s or s); inf where it never happens (the time to
+    double of a mode that does not grow), NaN where it is undefined (the ζ of two real roots of
+    opposite sign)."""
+    level: int
+    """1, 2 or 3: the best Level whose limit the value meets; 4: worse than Level 3."""
+    limits: str
+    """The limits that applied for Levels 1, 2 and 3, as text ("none": no limit at that Level)."""
+    reference: str
+    """Paragraph and table of the specification."""
+
+
+@dataclass(frozen=True)
+class HandlingQualities:
+    """The Levels of the assessed modes for one airplane Class and Flight Phase Category.
+
+    Examples
+    --------
+    >>> from aerocontrol.handling import assess
+    >>> hq = assess({"short period": [-0.5515 + 0.6880j, -0.5515 - 0.6880j],
+    ...              "phugoid": [-0.001764 + 0.1339j, -0.001764 - 0.1339j]}, "III", "C")
+    >>> hq.level("short period"), hq.level("phugoid")
+    (1, 2)
+    >>> hq.levels
+    {'short period': 1, 'phugoid': 2}
+    """
+
+    aircraft_class: str
+    """One of ``AIRCRAFT_CLASSES`` ("II" was stored as "II-L")."""
+    category: str
+    """The Flight Phase Category, "A", "B" or "C"."""
+    requirements: tuple[Requirement, ...]
+    """Every quantity judged, modes in the order of ``MODES``."""
+
+    @property
+    def modes(self) -> tuple[str, ...]:
+        """The modes assessed, in the order of ``MODES``."""
+        return tuple(dict.fromkeys(r.mode for r in self.requirements))
+
+    def level(self, mode: str) -> int:
+        """The Level of one mode: the worst over its requirements (4: worse than Level 3).
+
+        Parameters
+        ----------
+        mode : str
+            A mode that was assessed (case, hyphens and underscores do not matter).
+
+        Raises
+        ------
+        InvalidArgumentError
+            If ``mode`` is not a mode name or was not assessed.
+
+        Examples
+        --------
+        >>> from aerocontrol.handling import assess
+        >>> assess({"spiral": [0.05]}, "IV", "B").level("Spiral")   # T2 = 13.9 s < 20 s
+        2
+        """
+        name = _mode_name(mode, "mode")
+        levels = [r.level for r in self.requirements if r.mode == name]
+        if not levels:
+            assessed = ", ".join(repr(m) for m in self.modes)
+            raise InvalidArgumentError(
+                f"mode {name!r} was not assessed; the assessed modes are {assessed}"
+            )
+        return max(levels)
+
+    @property
+    def levels(self) -> dict[str, int]:
+        """The Level of each assessed mode, in the order of ``MODES``."""
+        return {mode: self.level(mode) for mode in self.modes}
+
+    def table(self) -> str:
+        """A plain-text table: mode, quantity, value, Level, limits and reference per row.
+
+        The title names the specification, Class and Category; the reference column gives the
+        paragraph and table of MIL-F-8785C; a Level 4 row adds a line that explains it.
+        """
+        header = ("mode", "quantity", "value", "level", "limits", "reference")
+        rows = [
+            (
+                r.mode,
+                r.quantity,
+                _format_value(r.value, _UNITS[r.quantity]),
+                str(r.level),
+                r.limits,
+                r.reference.removeprefix(f"{SPECIFICATION} "),
+            )
+            for r in self.requirements
+        ]
+        title = (
+            f"{SPECIFICATION} handling qualities: Class {self.aircraft_class}, "
+            f"Flight Phase Category {self.category}"
+        )
+        lines = [title, *_columns(header, rows, wrap={4: 40})]
+        if any(r.level == 4 for r in self.requirements):
+            lines.append("level 4: worse than Level 3 (no Level's limit is met)")
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.table()
+
+
+def assess(modes: Mapping[str, Any], aircraft_class: str, category: str) -> HandlingQualities:
+    """Judge the modes' eigenvalues against MIL-F-8785C for a Class and Flight Phase Category.
+
+    For an oscillatory mode given as two roots λ1, λ2 (a conjugate pair, or two real roots
+    when the mode has split), ω_n² = Re(λ1 λ2) and 2 ζ ω_n = -Re(λ1 + λ2); two real roots of
+    opposite sign have no ω_n or ζ (NaN, which meets no limit). A roll mode λ gives the time
+    constant τ_R = -1/λ (inf, so Level 4, if λ >= 0: it never converges). A spiral or phugoid
+    gives the time to double amplitude T2 = ln 2 / max Re λ (6.2.1: T2 = -0.693/(ζ ω_n) for
+    oscillations, 0.693 τ for first-order divergences), inf if it does not grow.
+
+    Quantities judged:
+
+    * short period: "zeta" against Table IV (Categories A and C share a column);
+    * phugoid: "zeta" (Level 1 ζ >= 0.04, Level 2 ζ >= 0) and "time to double" (Level 3
+      T2 >= 55 s), so a divergent phugoid (ζ < 0) is Level 3 if T2 >= 55 s and 4 otherwise;
+    * dutch roll: "zeta", "zeta*omega_n" and "omega_n" against Table VI (for Class III a
+      ζ >= 0.7 meets the ζ ω_n minimum, Table VI note *);
+    * roll: "time constant" against Table VII;
+    * spiral: "time to double" against Table VIII (a stable spiral: inf, Level 1).
+
+    Parameters
+    ----------
+    modes : mapping of str to sequence of complex
+        Mode name ("short period", "phugoid", "dutch roll", "roll", "spiral"; any subset, in
+        any case, with hyphens or underscores for spaces) to its eigenvalues: two for the
+        oscillatory modes, one real eigenvalue (or a bare number) for roll and spiral.
+    aircraft_class : str
+        "I", "II-C" (carrier-based), "II-L" (land-based), "III" or "IV" (1.3, 1.3.1); "II" is
+        taken as "II-L". The two differ only in Category C (Tables VI and VII), where II-C is
+        judged with Classes I and IV and II-L with Class III.
+    category : str
+        Flight Phase Category "A", "B" or "C" (1.4).
+
+    Returns
+    -------
+    HandlingQualities
+
+    Raises
+    ------
+    InvalidArgumentError
+        A mode name that is not one of the five (the message names it), an ``aircraft_class``
+        or ``category`` not among the choices (the message lists them), eigenvalues that are not
+        numbers, an oscillatory pair that is not a conjugate pair or two real roots, a complex
+        roll or spiral eigenvalue, or no modes at all.
+    ShapeError
+        The wrong number of eigenvalues for a mode (an ``InvalidArgumentError``).
+    NonFiniteError
+        A NaN or infinite eigenvalue (an ``InvalidArgumentError``).
+
+    Examples
+    --------
+    The 747's Dutch roll is Level 2 in approach (ζ ω_n = 0.081 < 0.10 rad/s); with the
+    chapter's yaw damper (ζ = 0.30 at the same ω_n) it is Level 1:
+
+    >>> import numpy as np
+    >>> from aerocontrol.handling import assess
+    >>> before = assess({"dutch roll": [-0.08066 + 0.7433j, -0.08066 - 0.7433j]}, "III", "C")
+    >>> wn = abs(-0.08066 + 0.7433j)
+    >>> pole = complex(-0.30 * wn, wn * np.sqrt(1 - 0.30**2))
+    >>> after = assess({"dutch roll": [pole, pole.conjugate()]}, "III", "C")
+    >>> before.level("dutch roll"), after.level("dutch roll")
+    (2, 1)
+    """
+    cls = _aircraft_class(aircraft_class)
+    cat = _category(category)
+    eigenvalues = _eigenvalues(modes)
+    requirements: list[Requirement] = []
+    for mode in MODES:
+        if mode not in eigenvalues:
+            continue
+        lam = eigenvalues[mode]
+        if mode == "short period":
+            requirements.extend(_short_period(lam, cat))
+        elif mode == "phugoid":
+            requirements.extend(_phugoid(lam))
+        elif mode == "dutch roll":
+            requirements.extend(_dutch_roll(lam, cls, cat))
+        elif mode == "roll":
+            requirements.append(_roll(lam, cls, cat))
+        else:
+            requirements.append(_spiral(lam, cat))
+    return HandlingQualities(aircraft_class=cls, category=cat, requirements=tuple(requirements))
+
+
+def compare(before: HandlingQualities, after: HandlingQualities) -> str:
+    """A table of each mode's Level before and after augmentation, with the change.
+
+    The last row, "all modes", is the worst Level over the modes assessed.
+
+    Parameters
+    ----------
+    before, after : HandlingQualities
+        Assessments for the same airplane Class and Flight Phase Category.
+
+    Raises
+    ------
+    InvalidArgumentError
+        If either is not a ``HandlingQualities``, or their Class or Category differ.
+
+    Examples
+    --------
+    >>> from aerocontrol.handling import assess, compare
+    >>> open_loop = {"dutch roll": [-0.08066 + 0.7433j, -0.08066 - 0.7433j],
+    ...              "roll": [-1.2308], "spiral": [-0.04641]}
+    >>> damped = {**open_loop, "dutch roll": [-0.2243 + 0.7133j, -0.2243 - 0.7133j]}
+    >>> print(compare(assess(open_loop, "III", "C"), assess(damped, "III", "C")))
+    MIL-F-8785C Levels: Class III, Flight Phase Category C
+    mode        before  after  change
+    ----------  ------  -----  --------
+    dutch roll  2       1      improved
+    roll        1       1      same
+    spiral      1       1      same
+    all modes   2       1      improved
+    """
+    for name, value in (("before", before), ("after", after)):
+        if not isinstance(value, HandlingQualities):
+            raise InvalidArgumentError(
+                f"{name} must be a HandlingQualities (from assess), got {type(value).__name__}"
+            )
+    if (before.aircraft_class, before.category) != (after.aircraft_class, after.category):
+        raise InvalidArgumentError(
+            "before and after must be assessed for the same Class and Category: before is "
+            f"Class {before.aircraft_class}, Category {before.category}; after is "
+            f"Class {after.aircraft_class}, Category {after.category}"
+        )
+    old, new = before.levels, after.levels
+    rows = []
+    for mode in (m for m in MODES if m in old or m in new):
+        rows.append((mode, *_change(old.get(mode), new.get(mode))))
+    worst_old = max(old.values()) if old else None
+    worst_new = max(new.values()) if new else None
+    rows.append(("all modes", *_change(worst_old, worst_new)))
+    title = (
+        f"{SPECIFICATION} Levels: Class {before.aircraft_class}, "
+        f"Flight Phase Category {before.category}"
+    )
+    lines = [title, *_columns(("mode", "before", "after", "change"), rows)]
+    if 4 in (*old.values(), *new.values()):
+        lines.append("level 4: worse than Level 3 (no Level's limit is met)")
+    return "\n".join(lines)
+
+
+# --- Arguments -------------------------------------------------------------------------------
+
+
+def _choices(values: tuple[str, ...]) -> str:
+    return ", ".join(repr(v) for v in values)
+
+
+def _aircraft_class(value: Any) -> str:
+    if isinstance(value, str):
+        key = value.strip().upper()
+        key = _CLASS_ALIASES.get(key, key)
+        if key in AIRCRAFT_CLASSES:
+            return key
+    raise InvalidArgumentError(
+        f"aircraft_class must be one of {_choices(AIRCRAFT_CLASSES)} (or 'II', taken as "
+        f"'II-L'), got {value!r}"
+    )
+
+
+def _category(value: Any) -> str:
+    if isinstance(value, str) and value.strip().upper() in CATEGORIES:
+        return value.strip().upper()
+    raise InvalidArgumentError(f"category must be one of {_choices(CATEGORIES)}, got {value!r}")
+
+
+def _mode_name(key: Any, name: str) -> str:
+    if isinstance(key, str):
+        normal = " ".join(key.lower().replace("-", " ").replace("_", " ").split())
+        if normal in MODES:
+            return normal
+    raise InvalidArgumentError(f"{name} {key!r} is not a mode; the modes are {_choices(MODES)}")
+
+
+def _eigenvalues(modes: Any) -> dict[str, np.ndarray[Any, np.dtype[np.complex128]]]:
+    if not isinstance(modes, Mapping):
+        raise InvalidArgumentError(
+            f"modes must be a mapping from mode name to eigenvalues, got {type(modes).__name__}"
+        )
+    if not modes:
+        raise InvalidArgumentError(f"modes is empty; give at least one of {_choices(MODES)}")
+    result: dict[str, np.ndarray[Any, np.dtype[np.complex128]]] = {}
+    for key, value in modes.items():
+        mode = _mode_name(key, "modes key")
+        label = f"modes[{key!r}]"
+        if mode in result:
+            raise InvalidArgumentError(f"{label} repeats the mode {mode!r}")
+        try:
+            array = np.asarray(value)
+        except ValueError as error:
+            raise InvalidArgumentError(f"{label} must be a sequence of numbers: {error}") from None
+        if array.dtype.kind not in "biufc":
+            raise InvalidArgumentError(
+                f"{label} must be a sequence of numbers, got dtype {array.dtype}"
+            )
+        lam = np.atleast_1d(array.astype(np.complex128))
+        count = 2 if mode in _OSCILLATORY else 1
+        if lam.ndim != 1 or lam.size != count:
+            what = (
+                "two eigenvalues (a conjugate pair, or two real roots)"
+                if count == 2
+                else "one real eigenvalue"
+            )
+            raise ShapeError(f"{label} must hold {what}, got an array of shape {lam.shape}")
+        if not np.all(np.isfinite(lam)):
+            raise NonFiniteError(f"{label} must be finite, got {lam.tolist()}")
+        if count == 2:
+            l1, l2 = complex(lam[0]), complex(lam[1])
+            scale = max(abs(l1), abs(l2))
+            real_pair = l1.imag == 0 and l2.imag == 0
+            if not real_pair and abs(l1 - l2.conjugate()) > 1e-9 * scale:
+                raise InvalidArgumentError(
+                    f"{label} must be a conjugate pair or two real roots, got {l1} and {l2}"
+                )
+        elif abs(lam[0].imag) > 1e-9 * abs(lam[0]):
+            raise InvalidArgumentError(
+                f"{label} must be real, got {complex(lam[0])}: a complex roll or spiral "
+                "root is a coupled roll-spiral oscillation (3.3.1.4), which is not assessed"
+            )
+        result[mode] = lam
+    return result
+
+
+# --- The modes -------------------------------------------------------------------------------
+
+
+def _pair(lam: np.ndarray[Any, np.dtype[np.complex128]]) -> tuple[float, float, float]:
+    """(ω_n, ζ, ζ ω_n) of two roots; ω_n and ζ NaN for real roots of opposite sign."""
+    l1, l2 = complex(lam[0]), complex(lam[1])
+    wn2 = (l1 * l2).real
+    zw = -0.5 * (l1 + l2).real
+    if wn2 > 0:
+        wn = math.sqrt(wn2)
+        return wn, zw / wn, zw
+    if wn2 == 0:
+        zeta = math.copysign(math.inf, zw) if zw != 0 else math.nan
+        return 0.0, zeta, zw
+    return math.nan, math.nan, zw
+
+
+def _time_to_double(growth: float) -> float:
+    """T2 = ln 2 / σ for a growth rate σ > 0; inf for a mode that does not grow."""
+    return _LN2 / growth if growth > 0 else math.inf
+
+
+def _requirement(
+    mode: str, quantity: str, value: float, checks: Sequence[tuple[str | None, bool]]
+) -> Requirement:
+    """A row from the limit texts of Levels 1-3 (None: no limit) and whether each is met."""
+    level = 4
+    for k, (text, met) in enumerate(checks, start=1):
+        if text is None or met:
+            level = k
+            break
+    limits = "; ".join(
+        f"L{k} {'none' if text is None else text}" for k, (text, _) in enumerate(checks, start=1)
+    )
+    return Requirement(
+        mode=mode,
+        quantity=quantity,
+        value=float(value),
+        level=level,
+        limits=limits,
+        reference=_REFERENCES[mode],
+    )
+
+
+def _short_period(
+    lam: np.ndarray[Any, np.dtype[np.complex128]], category: str
+) -> list[Requirement]:
+    _, zeta, _ = _pair(lam)
+    checks: list[tuple[str | None, bool]] = []
+    for low, high in SHORT_PERIOD_ZETA[category]:
+        if high is None:
+            checks.append((f">= {low:g}", zeta >= low))
+        else:
+            checks.append((f"{low:g} to {high:g}", low <= zeta <= high))
+    return [_requirement("short period", "zeta", zeta, checks)]
+
+
+def _phugoid(lam: np.ndarray[Any, np.dtype[np.complex128]]) -> list[Requirement]:
+    _, zeta, _ = _pair(lam)
+    level1, level2 = PHUGOID_MIN_ZETA
+    t2 = _time_to_double(float(np.max(lam.real)))
+    stable = "no growth"
+    return [
+        _requirement(
+            "phugoid",
+            "zeta",
+            zeta,
+            [(f">= {level1:g}", zeta >= level1), (f">= {level2:g}", zeta >= level2), (None, True)],
+        ),
+        _requirement(
+            "phugoid",
+            "time to double",
+            t2,
+            [
+                (stable, t2 == math.inf),
+                (stable, t2 == math.inf),
+                (f">= {PHUGOID_MIN_TIME_TO_DOUBLE:g} s", t2 >= PHUGOID_MIN_TIME_TO_DOUBLE),
+            ],
+        ),
+    ]
+
+
+def _dutch_roll(
+    lam: np.ndarray[Any, np.dtype[np.complex128]], aircraft_class: str, category: str
+) -> list[Requirement]:
+    wn, zeta, zw = _pair(lam)
+    rows = (DUTCH_ROLL_LEVEL1[category, aircraft_class], DUTCH_ROLL_LEVEL2, DUTCH_ROLL_LEVEL3)
+    capped = aircraft_class == "III"
+    cap = DUTCH_ROLL_CLASS_III_MAX_REQUIRED_ZETA
+    zeta_checks: list[tuple[str | None, bool]] = []
+    zw_checks: list[tuple[str | None, bool]] = []
+    wn_checks: list[tuple[str | None, bool]] = []
+    for min_zeta, min_zw, min_wn in rows:
+        zeta_checks.append((f"> {min_zeta:g}", zeta > min_zeta))
+        if min_zw is None:
+            zw_checks.append((None, True))
+        elif capped:
+            zw_checks.append((f"> {min_zw:g} or zeta >= {cap:g}", zw > min_zw or zeta >= cap))
+        else:
+            zw_checks.append((f"> {min_zw:g}", zw > min_zw))
+        wn_checks.append((f"> {min_wn:g}", wn > min_wn))
+    return [
+        _requirement("dutch roll", "zeta", zeta, zeta_checks),
+        _requirement("dutch roll", "zeta*omega_n", zw, zw_checks),
+        _requirement("dutch roll", "omega_n", wn, wn_checks),
+    ]
+
+
+def _roll(
+    lam: np.ndarray[Any, np.dtype[np.complex128]], aircraft_class: str, category: str
+) -> Requirement:
+    root = float(lam[0].real)
+    tau = -1.0 / root if root < 0 else math.inf
+    limits = ROLL_MODE_MAX_TIME_CONSTANT[category, aircraft_class]
+    return _requirement("roll", "time constant", tau, [(f"<= {m:g} s", tau <= m) for m in limits])
+
+
+def _spiral(lam: np.ndarray[Any, np.dtype[np.complex128]], category: str) -> Requirement:
+    t2 = _time_to_double(float(lam[0].real))
+    limits = SPIRAL_MIN_TIME_TO_DOUBLE[category]
+    return _requirement("spiral", "time to double", t2, [(f"> {m:g} s", t2 > m) for m in limits])
+
+
+# --- Text ------------------------------------------------------------------------------------
+
+
+def _format_value(value: float, unit: str) -> str:
+    if math.isnan(value):
+        return "undefined"
+    if math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    text = f"{value:.4g}"
+    return f"{text} {unit}" if unit else text
+
+
+def _change(old: int | None, new: int | None) -> tuple[str, str, str]:
+    if old is None or new is None:
+        change = ""
+    elif new < old:
+        change = "improved"
+    elif new > old:
+        change = "worse"
+    else:
+        change = "same"
+    return ("-" if old is None else str(old), "-" if new is None else str(new), change)
+
+
+def _wrap(text: str, width: int) -> list[str]:
+    """``text`` in lines of at most ``width`` characters, broken after a "; " where it can."""
+    segments = text.split("; ")
+    tokens = [segment + ";" for segment in segments[:-1]] + segments[-1:]
+    lines: list[str] = []
+    for token in tokens:
+        if lines and len(lines[-1]) + 1 + len(token) <= width:
+            lines[-1] += " " + token
+        else:
+            lines.extend(textwrap.wrap(token, width) or [""])
+    return lines
+
+
+def _columns(
+    header: Sequence[str], rows: Sequence[Sequence[str]], wrap: Mapping[int, int] | None = None
+) -> list[str]:
+    """Left-aligned columns under a header and a rule; ``wrap`` caps a column's width."""
+    wrap = wrap or {}
+    cells: list[list[list[str]]] = [[[cell] for cell in header]]
+    for row in rows:
+        cells.append([_wrap(cell, wrap[k]) if k in wrap else [cell] for k, cell in enumerate(row)])
+    widths = [
+        max(len(line) for line_cells in cells for line in line_cells[k]) for k in range(len(header))
+    ]
+    lines: list[str] = []
+    for index, line_cells in enumerate(cells):
+        for j in range(max(len(cell) for cell in line_cells)):
+            parts = [
+                (cell[j] if j < len(cell) else "").ljust(width)
+                for cell, width in zip(line_cells, widths, strict=True)
+            ]
+            lines.append("  ".join(parts).rstrip())
+        if index == 0:
+            lines.append("  ".join("-" * width for width in widths))
+    return lines
