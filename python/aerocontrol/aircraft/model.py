@@ -45,7 +45,7 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -427,9 +427,8 @@ class Aircraft:
         "spiral", "Dutch roll", "roll") by :func:`aerocontrol.aircraft.name_modes`."""
         from .naming import name_modes
 
-        system = self._model(axis)
-        unnamed = modes(system)
-        return modes(system, mode_names=list(name_modes(unnamed, axis)))
+        unnamed = modes(self._model(axis))
+        return replace(unnamed, mode_names=name_modes(unnamed, axis))
 
     def _model(self, axis: str) -> StateSpace:
         if axis == "longitudinal":
