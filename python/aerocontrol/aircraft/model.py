@@ -56,6 +56,7 @@ from ..exceptions import InvalidArgumentError
 from ..modal import Modes, modes
 from ..statespace import StateSpace
 from .atmosphere import standard_atmosphere
+from .naming import name_modes
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -425,8 +426,6 @@ class Aircraft:
     def modes(self, axis: str) -> Modes:
         """The modes of the longitudinal or lateral model, named ("phugoid", "short period";
         "spiral", "Dutch roll", "roll") by :func:`aerocontrol.aircraft.name_modes`."""
-        from .naming import name_modes
-
         unnamed = modes(self._model(axis))
         return replace(unnamed, mode_names=name_modes(unnamed, axis))
 
