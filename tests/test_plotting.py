@@ -1,4 +1,5 @@
-"""Plots draw with no display (Agg), label their axes, and name the lines."""
+"""Plots draw with no display (Agg), label their axes with units, and name the lines; the
+penalty terms integrate to the performance index."""
 
 from __future__ import annotations
 
@@ -9,11 +10,21 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+import scipy.linalg
 
 import aerocontrol
+from aerocontrol import plotting
+from aerocontrol.design import lqr_root_locus
 
 A, B = aerocontrol.chapter.boeing747_longitudinal()
 SYS = aerocontrol.StateSpace(A, B, state_names=["u/u0", "alpha", "q", "theta"])
+LATERAL = aerocontrol.aircraft.load().lateral()
+STATE_LABELS = [
+    "sideslip β (rad)",
+    "roll rate p (rad/s)",
+    "roll angle φ (rad)",
+    "yaw rate r (rad/s)",
+]
 
 
 @pytest.fixture(autouse=True)
@@ -22,19 +33,140 @@ def _close_figures():  # type: ignore[no-untyped-def]
     plt.close("all")
 
 
+def _labels(ax) -> list[str]:  # type: ignore[no-untyped-def]
+    return [line.get_label() for line in ax.get_lines() if not line.get_label().startswith("_")]
+
+
+def _regulator(c: float) -> tuple[np.ndarray, np.ndarray, aerocontrol.TimeResponse]:
+    """The chapter's lateral regulator at weight c and its response to a unit sideslip."""
+    R = np.eye(2) / c**2
+    K, S, _ = aerocontrol.lqr(LATERAL.A, LATERAL.B, np.eye(4), R)
+    closed = aerocontrol.StateSpace(
+        LATERAL.A - LATERAL.B @ K, LATERAL.B, state_names=LATERAL.state_names,
+        input_names=LATERAL.input_names,
+    )  # fmt: skip
+    response = aerocontrol.initial_response(closed, [1.0, 0, 0, 0], T=np.linspace(0, 60, 12001))
+    return K, S, response
+
+
 def test_time_response_plot() -> None:
     ax = aerocontrol.step_response(SYS, T=20.0).plot()
     assert ax.get_xlabel() == "time (s)"
-    assert [line.get_label() for line in ax.get_lines()] == ["u/u0", "alpha", "q", "theta"]
+    assert ax.get_ylabel() == "states (rad, rad/s, u/u0 nondimensional)"
+    assert _labels(ax) == [
+        "speed u/u0",
+        "angle of attack α (rad)",
+        "pitch rate q (rad/s)",
+        "pitch angle θ (rad)",
+    ]
     _, given = plt.subplots()
     assert aerocontrol.impulse_response(SYS, T=5.0).plot(ax=given, signal="outputs") is given
+    generic = aerocontrol.step_response(aerocontrol.StateSpace(A, B), T=5.0).plot()
+    assert _labels(generic) == ["x0", "x1", "x2", "x3"]
+    assert generic.get_ylabel() == "states (model units)"
+
+
+def test_time_response_plot_rejects_bad_arguments() -> None:
+    response = aerocontrol.step_response(SYS, T=5.0)
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="signal"):
+        plotting.plot_time_response(response, signal="inputs")
+    with pytest.raises(aerocontrol.InvalidArgumentError, match=r"response must be in 0 \.\.\. 0"):
+        plotting.plot_time_response(response, response=1)
+
+
+def test_two_time_scales_cut_the_same_response() -> None:
+    """Figures 6.1, 6.2: the left axes show the first 20 s of the 500 s response."""
+    response = aerocontrol.impulse_response(SYS, T=np.linspace(0, 500, 25001))
+    short, long = plotting.plot_time_scales(response, 20.0)
+    assert short.get_lines()[0].get_xdata().max() == pytest.approx(20.0)
+    assert long.get_lines()[0].get_xdata().max() == pytest.approx(500.0)
+    np.testing.assert_array_equal(
+        short.get_lines()[1].get_ydata(), response.x[response.t <= 20.0, 1]
+    )
+    assert (short.get_title(), long.get_title()) == ("short period scale", "phugoid scale")
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="short must be between 0"):
+        plotting.plot_time_scales(response, 600.0)
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="pair of matplotlib axes"):
+        plotting.plot_time_scales(response, 20.0, axes=plt.subplots()[1])
+
+
+def test_open_closed_shares_the_scale() -> None:
+    damper = aerocontrol.design.dutch_roll_damper(LATERAL, surface="rudder")
+    closed = aerocontrol.StateSpace(damper.closed_loop, LATERAL.B[:, :1])
+    x0 = [np.radians(5.0), 0, 0, 0]
+    grid = np.linspace(0, 30, 601)
+    first, second = plotting.plot_open_closed(
+        aerocontrol.initial_response(LATERAL, x0, T=grid),
+        aerocontrol.initial_response(closed, x0, T=grid),
+    )
+    assert first.get_shared_y_axes().joined(first, second)
+    assert (first.get_title(), second.get_title()) == ("(a) open loop", "(b) closed loop")
+
+
+def test_with_controls_draws_the_deflections() -> None:
+    """(6.230): the dashed lines are η = -K x, named by the inputs."""
+    K, _, response = _regulator(1.0)
+    ax = plotting.plot_with_controls(response, K)
+    assert _labels(ax) == [*STATE_LABELS, "rudder δr (rad)", "aileron δa (rad)"]
+    lines = ax.get_lines()
+    np.testing.assert_allclose(lines[4].get_ydata(), -response.x @ K[0], rtol=0, atol=1e-15)
+    assert lines[5].get_linestyle() == "--"
+    with pytest.raises(aerocontrol.ShapeError, match="K must be m x 4"):
+        plotting.plot_with_controls(response, np.ones((2, 3)))
+
+
+def test_penalty_terms_integrate_to_the_index() -> None:
+    """Figure 6.11: the area between x'Qx and -η'Rη is J = x0' S x0 (to the trapezoidal
+    rule's error, dt = 0.005 s over 60 s)."""
+    for c in (0.5, 1.0, 2.0):
+        K, S, response = _regulator(c)
+        state, control = plotting.penalty_terms(response, K, np.eye(4), np.eye(2) / c**2)
+        area = float(np.sum((state + control)[1:] + (state + control)[:-1]) * 0.0025)
+        assert area == pytest.approx(S[0, 0], rel=1e-5)
+        ax = plotting.plot_penalty(response, K, np.eye(4), np.eye(2) / c**2, name=f"c = {c:g}")
+        assert f"(J = {S[0, 0]:.4g})" in _labels(ax)[0]
+    with pytest.raises(aerocontrol.ShapeError, match="R must be 2 x 2"):
+        plotting.penalty_terms(response, K, np.eye(4), np.eye(3))
+
+
+def test_root_locus_follows_each_root() -> None:
+    """Figure 6.12: one line per root, each continuous over the sweep of c."""
+    weights = np.unique(np.r_[np.geomspace(1e-3, 9.0, 300), 0.5, 1.0, 2.0])
+    poles = lqr_root_locus(LATERAL, weights)
+    ax = plotting.plot_root_locus(weights, poles, marked=[0.5, 1.0, 2.0])
+    paths = [line for line in ax.get_lines() if line.get_label().startswith("_")][:4]
+    for line in paths:
+        path = np.asarray(line.get_xdata()) + 1j * np.asarray(line.get_ydata())
+        assert np.all(np.abs(np.diff(path)) < 0.1 * np.abs(path[1:]))  # no jumps between roots
+    ends = sorted(complex(line.get_xdata()[-1], line.get_ydata()[-1]).real for line in paths)
+    np.testing.assert_allclose(ends, np.sort(poles[-1].real), rtol=1e-12)
+    assert _labels(ax) == ["c = 0.5", "c = 1", "c = 2"]
+    assert ax.get_xlabel() == "real part (1/s)"
+    unmarked = plotting.plot_root_locus(weights, poles)
+    assert _labels(unmarked) == ["c = 0.001"]
+    with pytest.raises(aerocontrol.ShapeError, match="poles must be"):
+        plotting.plot_root_locus(weights[:-1], poles)
 
 
 def test_bode_and_modes_plots() -> None:
     magnitude_axis, phase_axis = aerocontrol.bode(SYS).plot()
     assert magnitude_axis.get_ylabel() == "magnitude (dB)"
     assert phase_axis.get_xlabel() == "frequency (rad/s)"
+    with pytest.raises(aerocontrol.InvalidArgumentError, match=r"output must be in 0 \.\.\. 3"):
+        aerocontrol.bode(SYS).plot(output=4)
     ax = aerocontrol.modes(A, mode_names=["phugoid", "short period"]).plot()
-    labels = [line.get_label() for line in ax.get_lines() if not line.get_label().startswith("_")]
-    assert labels == ["phugoid", "short period"]
-    assert np.isclose(len(ax.get_lines()[0].get_xdata()), 2)
+    assert _labels(ax) == ["phugoid", "short period"]
+    assert len(ax.get_lines()[0].get_xdata()) == 2
+    plotting.plot_modes(aerocontrol.modes(A - np.outer(B, [0, 0, 1, 0])), ax=ax, marker="o",
+                        suffix=" (closed)")  # fmt: skip
+    assert _labels(ax)[2:] == ["mode 1 (closed)", "mode 2 (closed)"]
+
+
+def test_plots_do_not_modify_the_results() -> None:
+    K, _, response = _regulator(1.0)
+    before = response.x.copy(), K.copy()
+    plotting.plot_with_controls(response, K)
+    plotting.plot_penalty(response, K, np.eye(4), np.eye(2))
+    np.testing.assert_array_equal(response.x, before[0])
+    np.testing.assert_array_equal(K, before[1])
+    assert scipy.linalg.norm(K) > 0

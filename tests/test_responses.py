@@ -63,6 +63,15 @@ def test_step_response_settles_to_the_steady_state() -> None:
     np.testing.assert_allclose(r.x[-1], aerocontrol.steady_state(LON, [ONE_DEGREE]), atol=1e-7)
     np.testing.assert_array_equal(r.x, r.y)
     assert r.u is not None and np.all(r.u == ONE_DEGREE)
+    # A number is the weight of the one input; a multi-input model still needs a vector.
+    number = aerocontrol.step_response(LON, T=t, eta0=ONE_DEGREE)
+    np.testing.assert_array_equal(number.x, r.x)
+    np.testing.assert_array_equal(
+        aerocontrol.steady_state(LON, ONE_DEGREE), aerocontrol.steady_state(LON, [ONE_DEGREE])
+    )
+    lateral = aerocontrol.aircraft.load().lateral()
+    with pytest.raises(aerocontrol.ShapeError, match=r"eta0 must have one weight per input \(2\)"):
+        aerocontrol.step_response(lateral, T=t, eta0=1.0)
 
 
 def test_impulse_is_the_free_response_from_b_eta0() -> None:

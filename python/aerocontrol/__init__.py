@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import aircraft, chapter, design, exceptions, handling
+from . import aircraft, chapter, design, exceptions, handling, plotting, report
 from .controllability import (
     Controllability,
     controllability,
@@ -140,6 +140,8 @@ __all__ = [
     "place",
     "place_ackermann",
     "place_bass_gura",
+    "plotting",
+    "report",
     "riccati_ode",
     "schur",
     "solve_care",

@@ -1,84 +1,394 @@
-"""Plots of responses, frequency responses and modes (matplotlib).
+"""Plots of the chapter's figures: responses, frequency responses, modes and root loci.
 
 The only module that imports matplotlib, and only when a plot is asked for. Every function
-takes ``ax=`` (a new figure when None), labels its axes with units, and returns what it drew.
+takes ``ax=`` (or ``axes=`` for a pair; new axes when None), labels its axes with units, names
+each line in a legend, and returns what it drew on. Nothing needs a display: give axes of a
+``matplotlib.figure.Figure`` (as the report does) or select a non-interactive backend.
+
+=============================  ===============================================================
+function                       the chapter's figure
+=============================  ===============================================================
+:func:`plot_time_response`     one response, states or outputs against time
+:func:`plot_time_scales`       one response at two time scales, short period and phugoid
+                               (Figures 6.1, 6.2)
+:func:`plot_open_closed`       open loop beside closed loop (Figures 6.4, 6.5, 6.6)
+:func:`plot_with_controls`     a regulated response with the control deflections η = -K x
+                               (6.230; Figures 6.9, 6.10)
+:func:`plot_penalty`           x^T Q x and -η^T R η against time; the area between is J
+                               (Figure 6.11)
+:func:`plot_root_locus`        closed-loop roots over a weight c (Figures 6.8, 6.12)
+:func:`plot_bode`              magnitude and phase of one input-output pair
+:func:`plot_modes`             the eigenvalues in the complex plane, by mode
+=============================  ===============================================================
+
+States, inputs and outputs with the names of the aircraft models (``u/u0``, ``alpha``, ...,
+``rudder``) are labelled with their physical names and units; other names are used as given.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from ._validation import FloatArray, real_array
+from .exceptions import InvalidArgumentError, ShapeError
 
 if TYPE_CHECKING:
     from .frequency import FrequencyResponse
     from .modal import Modes
     from .responses import TimeResponse
 
-__all__ = ["plot_bode", "plot_modes", "plot_time_response"]
+__all__ = [
+    "label",
+    "penalty_terms",
+    "plot_bode",
+    "plot_modes",
+    "plot_open_closed",
+    "plot_penalty",
+    "plot_root_locus",
+    "plot_time_response",
+    "plot_time_scales",
+    "plot_with_controls",
+]
+
+# The aircraft models' variable names: what they are, and their unit.
+_DESCRIPTIONS: dict[str, tuple[str, str]] = {
+    "u/u0": ("speed u/u0", ""),
+    "alpha": ("angle of attack α", "rad"),
+    "q": ("pitch rate q", "rad/s"),
+    "theta": ("pitch angle θ", "rad"),
+    "beta": ("sideslip β", "rad"),
+    "p": ("roll rate p", "rad/s"),
+    "phi": ("roll angle φ", "rad"),
+    "r": ("yaw rate r", "rad/s"),
+    "elevator": ("elevator δe", "rad"),
+    "rudder": ("rudder δr", "rad"),
+    "aileron": ("aileron δa", "rad"),
+}
 
 
-def _new_axes(rows: int = 1) -> Any:
+def label(name: str) -> str:
+    """The legend label of a variable: its description and unit for the aircraft models'
+    names, the name itself otherwise.
+
+    >>> label("alpha"), label("u/u0"), label("x3")
+    ('angle of attack α (rad)', 'speed u/u0', 'x3')
+    """
+    description, unit = _DESCRIPTIONS.get(name, (name, ""))
+    return f"{description} ({unit})" if unit else description
+
+
+def _axis_label(names: Sequence[str], what: str) -> str:
+    """A y-axis label that lists the units present, e.g. 'states (rad, rad/s)'."""
+    units = list(dict.fromkeys(_DESCRIPTIONS[n][1] for n in names if n in _DESCRIPTIONS))
+    units = [u for u in units if u]
+    if any(n not in _DESCRIPTIONS for n in names):
+        units.append("model units")
+    elif "u/u0" in names:
+        units.append("u/u0 nondimensional")
+    return f"{what} ({', '.join(units)})" if units else what
+
+
+def _new_axes(rows: int = 1, columns: int = 1, **options: Any) -> Any:
     import matplotlib.pyplot as plt
 
-    _, axes = plt.subplots(rows, 1, sharex=True, squeeze=True)
+    _, axes = plt.subplots(rows, columns, squeeze=True, **options)
     return axes
 
 
-def plot_time_response(
-    result: TimeResponse, ax: Any = None, signal: str = "states", response: int = 0
-) -> Any:
-    """States (``signal="states"``) or outputs of one response against time, one named line
-    each. Returns the axes."""
-    if signal not in ("states", "outputs"):
-        raise ValueError(f"signal must be 'states' or 'outputs', got {signal!r}")
-    ax = _new_axes() if ax is None else ax
-    if signal == "states":
-        values, names = result.states(response), result.state_names
-    else:
-        values, names = result.outputs(response), result.output_names
-    for column, name in zip(values.T, names, strict=True):
-        ax.plot(result.t, column, label=name)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel(f"{signal} (model units: rad, rad/s, or normalised speed)")
-    title = f"{result.kind} response"
-    if result.n_responses > 1:
-        title += f": {result.response_names[response]}"
-    ax.set_title(title)
+def _finish(ax: Any, xlabel: str, ylabel: str, title: str | None = None) -> None:
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize="small")
+
+
+def _pair(axes: Any, name: str) -> tuple[Any, Any]:
+    try:
+        first, second = axes
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(f"{name} must be a pair of matplotlib axes") from None
+    return first, second
+
+
+def _signal(result: TimeResponse, signal: str, response: int) -> tuple[FloatArray, tuple[str, ...]]:
+    if signal == "states":
+        return result.states(response), result.state_names
+    if signal == "outputs":
+        return result.outputs(response), result.output_names
+    raise InvalidArgumentError(f"signal must be 'states' or 'outputs', got {signal!r}")
+
+
+def _response_index(result: TimeResponse, response: int) -> int:
+    if not 0 <= response < result.n_responses:
+        raise InvalidArgumentError(
+            f"response must be in 0 ... {result.n_responses - 1}, got {response}"
+        )
+    return response
+
+
+def plot_time_response(
+    result: TimeResponse,
+    ax: Any = None,
+    signal: str = "states",
+    response: int = 0,
+    t_max: float | None = None,
+    title: str | None = None,
+) -> Any:
+    """States (``signal="states"``) or outputs of one response against time, one named line
+    each, up to ``t_max`` seconds (the whole grid when None). Returns the axes.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> from aerocontrol import aircraft, step_response
+    >>> ax = step_response(aircraft.load().longitudinal(), T=20.0).plot()
+    >>> ax.get_ylabel()
+    'states (rad, rad/s, u/u0 nondimensional)'
+    """
+    values, names = _signal(result, signal, _response_index(result, response))
+    ax = _new_axes() if ax is None else ax
+    shown = slice(None) if t_max is None else result.t <= t_max
+    for column, name in zip(values.T, names, strict=True):
+        ax.plot(result.t[shown], column[shown], label=label(name))
+    if title is None:
+        title = f"{result.kind} response"
+        if result.n_responses > 1:
+            title += f": {result.response_names[response]}"
+    _finish(ax, "time (s)", _axis_label(names, signal), title)
+    return ax
+
+
+def plot_time_scales(
+    result: TimeResponse,
+    short: float,
+    axes: Any = None,
+    signal: str = "states",
+    response: int = 0,
+) -> tuple[Any, Any]:
+    """One response at two time scales, as the chapter shows the longitudinal motions: the
+    first ``short`` seconds (the short period) and the whole grid (the phugoid), Figures 6.1
+    and 6.2. Returns the pair of axes.
+
+    Compute the response on a grid fine enough for the short scale and long enough for the
+    long one, e.g. ``T=np.arange(0, 500.0, 0.02)``.
+    """
+    if not 0 < short < result.t[-1]:
+        raise InvalidArgumentError(
+            f"short must be between 0 and the response's final time {result.t[-1]:g} s, got {short}"
+        )
+    first, second = _pair(_new_axes(1, 2, figsize=(11, 4)) if axes is None else axes, "axes")
+    plot_time_response(result, first, signal, response, t_max=short, title="short period scale")
+    plot_time_response(result, second, signal, response, title="phugoid scale")
+    return first, second
+
+
+def plot_open_closed(
+    open_loop: TimeResponse,
+    closed_loop: TimeResponse,
+    axes: Any = None,
+    titles: tuple[str, str] = ("(a) open loop", "(b) closed loop"),
+    signal: str = "states",
+) -> tuple[Any, Any]:
+    """The open-loop response beside the closed-loop one on a common scale (Figures 6.4-6.6).
+    Returns the pair of axes."""
+    first, second = _pair(
+        _new_axes(1, 2, figsize=(11, 4), sharey=True) if axes is None else axes, "axes"
+    )
+    plot_time_response(open_loop, first, signal, title=titles[0])
+    plot_time_response(closed_loop, second, signal, title=titles[1])
+    return first, second
+
+
+def _gain(K: Any, result: TimeResponse) -> FloatArray:
+    gain = real_array(K, "K")
+    gain = gain.reshape(1, -1) if gain.ndim == 1 else gain
+    n = len(result.state_names)
+    if gain.ndim != 2 or gain.shape[1] != n:
+        raise ShapeError(f"K must be m x {n} (one column per state), got shape {gain.shape}")
+    return gain
+
+
+def _control_names(result: TimeResponse, m: int) -> tuple[str, ...]:
+    names = result.input_names
+    return names if len(names) == m else tuple(f"u{j}" for j in range(m))
+
+
+def plot_with_controls(
+    result: TimeResponse,
+    K: Any,
+    ax: Any = None,
+    response: int = 0,
+    title: str | None = None,
+) -> Any:
+    """A regulated response with the control deflections η = -K x (6.230) that produce it,
+    dashed, on the same axes (Figures 6.9, 6.10). ``result`` is a response of the closed loop
+    A - B K whose input names (if it has one per row of K) name the controls. Returns the axes.
+    """
+    gain = _gain(K, result)
+    states = result.states(_response_index(result, response))
+    controls = -states @ gain.T
+    ax = plot_time_response(result, ax, "states", response, title=title)
+    names = _control_names(result, gain.shape[0])
+    for column, name in zip(controls.T, names, strict=True):
+        ax.plot(result.t, column, "--", label=label(name))
+    _finish(ax, "time (s)", _axis_label((*result.state_names, *names), "states and controls"))
+    return ax
+
+
+def penalty_terms(
+    result: TimeResponse, K: Any, Q: Any, R: Any, response: int = 0
+) -> tuple[FloatArray, FloatArray]:
+    """The integrands of the performance index along a regulated response: x^T Q x and
+    η^T R η with η = -K x (the terms of J, (6.198); R includes the weight 1/c²).
+
+    The integral of their sum over a long response is J = x0^T S x0.
+    """
+    gain = _gain(K, result)
+    states = result.states(_response_index(result, response))
+    n, m = gain.shape[1], gain.shape[0]
+    Q_matrix, R_matrix = real_array(Q, "Q"), real_array(R, "R")
+    if Q_matrix.shape != (n, n):
+        raise ShapeError(f"Q must be {n} x {n}, got shape {Q_matrix.shape}")
+    if R_matrix.shape != (m, m):
+        raise ShapeError(f"R must be {m} x {m}, got shape {R_matrix.shape}")
+    controls = -states @ gain.T
+    state_term = np.einsum("ti,ij,tj->t", states, Q_matrix, states)
+    control_term = np.einsum("ti,ij,tj->t", controls, R_matrix, controls)
+    return state_term, control_term
+
+
+def plot_penalty(
+    result: TimeResponse,
+    K: Any,
+    Q: Any,
+    R: Any,
+    ax: Any = None,
+    name: str = "",
+    response: int = 0,
+) -> Any:
+    """x^T Q x above the axis and -η^T R η below it along a regulated response, the area
+    between them shaded: it is the performance index J (Figure 6.11). The legend gives J by
+    the trapezoidal rule. Call once per design on the same axes to compare. Returns the axes.
+    """
+    state_term, control_term = penalty_terms(result, K, Q, R, response)
+    total = state_term + control_term
+    J = float(0.5 * np.sum((total[1:] + total[:-1]) * np.diff(result.t)))
+    ax = _new_axes() if ax is None else ax
+    prefix = f"{name}: " if name else ""
+    (line,) = ax.plot(result.t, state_term, label=f"{prefix}x'Qx (J = {J:.4g})")
+    ax.plot(result.t, -control_term, "--", color=line.get_color(), label=f"{prefix}-η'Rη")
+    ax.fill_between(result.t, -control_term, state_term, color=line.get_color(), alpha=0.12)
+    ax.axhline(0.0, color="black", linewidth=0.8)
+    _finish(ax, "time (s)", "penalty terms (model units)", "penalty terms of J")
+    return ax
+
+
+def _tracks(poles: np.ndarray[Any, Any]) -> np.ndarray[Any, Any]:
+    """Reorder each row of ``poles`` so that column j follows one root from row to row:
+    greedy nearest matching to the previous row."""
+    tracked = np.array(poles, dtype=np.complex128, copy=True)
+    for k in range(1, len(tracked)):
+        previous, current = tracked[k - 1], poles[k]
+        distance = np.abs(previous[:, None] - current[None, :])
+        order = np.empty(len(current), dtype=int)
+        for _ in range(len(current)):
+            i, j = np.unravel_index(np.argmin(distance), distance.shape)
+            order[i] = j
+            distance[i, :] = np.inf
+            distance[:, j] = np.inf
+        tracked[k] = current[order]
+    return tracked
+
+
+def plot_root_locus(
+    weights: Any,
+    poles: Any,
+    ax: Any = None,
+    marked: Sequence[float] | None = None,
+    weight_name: str = "c",
+    title: str = "closed-loop roots over the weight",
+) -> Any:
+    """The closed-loop roots as the weight varies (Figures 6.8, 6.12): one line per root
+    through ``poles`` (shape (len(weights), n), e.g. from
+    :func:`aerocontrol.design.lqr_root_locus`), a symbol per value in ``marked`` (at the
+    nearest computed weight), or an open circle at the smallest weight when none is marked.
+    Returns the axes.
+    """
+    c_values = np.atleast_1d(real_array(weights, "weights"))
+    roots = np.asarray(poles)
+    if roots.ndim != 2 or roots.shape[0] != len(c_values):
+        raise ShapeError(
+            f"poles must be (len(weights), n) = ({len(c_values)}, n), got shape {roots.shape}"
+        )
+    ax = _new_axes() if ax is None else ax
+    tracked = _tracks(roots)
+    for j in range(tracked.shape[1]):
+        ax.plot(tracked[:, j].real, tracked[:, j].imag, color="0.55", linewidth=1.0)
+    if not marked:  # the start of each root's path
+        start = tracked[0]
+        ax.plot(
+            start.real,
+            start.imag,
+            "o",
+            mfc="none",
+            color="black",
+            label=f"{weight_name} = {c_values[0]:g}",
+        )
+    markers = "sD^v<>ph*+x"
+    for index, value in enumerate(marked or ()):
+        row = int(np.argmin(np.abs(np.log(c_values) - np.log(value))))
+        symbol = markers[index % len(markers)]
+        ax.plot(
+            tracked[row].real,
+            tracked[row].imag,
+            symbol,
+            mfc="none",
+            label=f"{weight_name} = {c_values[row]:.6g}",
+        )
+    ax.axvline(0.0, color="black", linewidth=0.8)
+    ax.axhline(0.0, color="black", linewidth=0.8)
+    _finish(ax, "real part (1/s)", "imaginary part (rad/s)", title)
     return ax
 
 
 def plot_bode(result: FrequencyResponse, ax: Any = None, output: int = 0, input: int = 0) -> Any:
     """Magnitude (dB) and phase (degrees) against frequency (rad/s, log scale) of one
     input-output pair, on a pair of axes. Returns the pair."""
-    axes = _new_axes(2) if ax is None else ax
-    magnitude_axis, phase_axis = axes
-    label = f"{result.input_names[input]} -> {result.output_names[output]}"
-    magnitude_axis.semilogx(result.omega, result.magnitude_db[:, output, input], label=label)
-    phase_axis.semilogx(result.omega, result.phase_deg[:, output, input], label=label)
+    for value, names, argument in (
+        (output, result.output_names, "output"),
+        (input, result.input_names, "input"),
+    ):
+        if not 0 <= value < len(names):
+            raise InvalidArgumentError(f"{argument} must be in 0 ... {len(names) - 1}, got {value}")
+    magnitude_axis, phase_axis = _pair(_new_axes(2, 1, sharex=True) if ax is None else ax, "ax")
+    text = f"{result.input_names[input]} -> {result.output_names[output]}"
+    magnitude_axis.semilogx(result.omega, result.magnitude_db[:, output, input], label=text)
+    phase_axis.semilogx(result.omega, result.phase_deg[:, output, input], label=text)
     magnitude_axis.set_ylabel("magnitude (dB)")
     phase_axis.set_ylabel("phase (deg)")
     phase_axis.set_xlabel("frequency (rad/s)")
-    for axis in axes:
+    for axis in (magnitude_axis, phase_axis):
         axis.grid(True, which="both", alpha=0.3)
     magnitude_axis.legend(loc="best", fontsize="small")
-    return axes
+    return magnitude_axis, phase_axis
 
 
-def plot_modes(modes: Modes, ax: Any = None) -> Any:
-    """The eigenvalues in the complex plane (rad/s), one marker and label per mode."""
+def plot_modes(modes: Modes, ax: Any = None, marker: str = "x", suffix: str = "") -> Any:
+    """The eigenvalues in the complex plane (rad/s), one marker and label per mode; give
+    ``marker`` and ``suffix`` (appended to the labels) to overlay two sets, e.g. open and
+    closed loop."""
     ax = _new_axes() if ax is None else ax
     for k, name in enumerate(modes.mode_names):
         lam = modes.eigenvalue[k]
         points = np.array([lam, np.conj(lam)]) if modes.oscillatory[k] else np.array([lam])
-        ax.plot(points.real, points.imag, "x", markersize=9, label=name)
+        ax.plot(points.real, points.imag, marker, markersize=9, mfc="none", label=name + suffix)
     ax.axvline(0.0, color="black", linewidth=0.8)
     ax.axhline(0.0, color="black", linewidth=0.8)
-    ax.set_xlabel("real part (1/s)")
-    ax.set_ylabel("imaginary part (rad/s)")
-    ax.set_title("modes")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize="small")
+    _finish(ax, "real part (1/s)", "imaginary part (rad/s)", "modes")
     return ax

@@ -170,6 +170,8 @@ def _input_weights(eta0: Any, m: int) -> tuple[FloatArray, tuple[str, ...] | Non
     if eta0 is None:
         return np.eye(m), None
     weights = real_array(eta0, "eta0")
+    if weights.ndim == 0 and m == 1:  # a number for the one input
+        weights = weights.reshape(1)
     if weights.ndim != 1 or weights.shape[0] != m:
         raise ShapeError(f"eta0 must have one weight per input ({m}), got shape {weights.shape}")
     return weights.reshape(1, m), ("eta0",)
@@ -433,6 +435,8 @@ def steady_state(sys: Any, eta0: Any) -> FloatArray:
     """
     model = as_state_space(sys)
     weights = real_array(eta0, "eta0")
+    if weights.ndim == 0 and model.n_inputs == 1:  # a number for the one input
+        weights = weights.reshape(1)
     result: FloatArray = _core.steady_state(model.A, model.B, weights)
     return result
 

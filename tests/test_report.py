@@ -1,0 +1,211 @@
+"""The report of the chapter's analyses: its content on the embedded 747 (the chapter's numbers
+through the public API), every shipped aircraft, and the folder it writes (self-contained HTML,
+Markdown, PNG figures; nothing half-written)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import pytest
+
+import aerocontrol
+from aerocontrol import report as report_module
+from aerocontrol.report import Report, build_report, write_report
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+FIGURES = {
+    "modes.png",
+    "elevator-impulse.png",
+    "elevator-step.png",
+    "lateral-steps.png",
+    "bode.png",
+    "damper-rudder.png",
+    "damper-aileron.png",
+    "lqr-small-c.png",
+    "lqr-responses.png",
+    "lqr-penalty.png",
+    "root-locus.png",
+}
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
+    """The default report, written once for the module; with its progress lines."""
+    lines: list[str] = []
+    path = write_report(out=tmp_path_factory.mktemp("report") / "out", progress=lines.append)
+    return path, lines
+
+
+def _table_row(markdown: str, first_cell: str, last: bool = False) -> list[str]:
+    """The cells of the first (or last) table row that starts with ``first_cell``."""
+    lines = markdown.splitlines()
+    for line in reversed(lines) if last else lines:
+        cells = [cell.strip() for cell in line.strip().strip("|").split("|")]
+        if cells and cells[0] == first_cell:
+            return cells
+    raise AssertionError(f"no table row starting with {first_cell!r}")
+
+
+def test_the_folder_has_the_report_and_every_figure(written: tuple[Path, list[str]]) -> None:
+    path, _ = written
+    folder = path.parent
+    assert path.name == "report.html"
+    assert sorted(p.name for p in folder.iterdir()) == ["figures", "report.html", "report.md"]
+    assert {p.name for p in (folder / "figures").iterdir()} == FIGURES
+    for figure in (folder / "figures").iterdir():
+        assert figure.read_bytes().startswith(PNG_SIGNATURE)
+    page = path.read_text(encoding="utf-8")
+    # Self-contained: every image embedded, nothing fetched from elsewhere.
+    assert page.count('src="data:image/png;base64,') == len(FIGURES)
+    assert not re.search(r'(src|href)="(?!data:)', page)
+    markdown = (folder / "report.md").read_text(encoding="utf-8")
+    for name in FIGURES:
+        assert f"(figures/{name})" in markdown
+
+
+def test_progress_is_one_line_per_step(written: tuple[Path, list[str]]) -> None:
+    _, lines = written
+    starts = [line.split(":")[0].split(" (")[0] for line in lines]
+    assert starts == [
+        "models",
+        "modes",
+        "handling qualities",
+        "responses",
+        "Dutch-roll damper",
+        "LQR",
+        "root locus",
+        "levels after augmentation",
+        "chapter check",
+        "writing 11 figures and the report",
+    ]
+    assert "critically damped at c = 9.772714" in lines[6]
+    assert "dutch roll 2 -> damper (rudder) 1, damper (aileron) 1" in lines[7]
+
+
+def test_the_report_has_the_chapters_results(written: tuple[Path, list[str]]) -> None:
+    """The tables carry the chapter's numbers, computed from the coefficients."""
+    markdown = (written[0].parent / "report.md").read_text(encoding="utf-8")
+    # Modes (6.152)-(6.154).
+    dutch = _table_row(markdown, "Dutch roll")
+    assert dutch[1] == "-0.080661 ± 0.74331j" and dutch[2] == "0.1079" and dutch[3] == "0.7477"
+    assert _table_row(markdown, "roll")[5] == "0.5632"
+    assert _table_row(markdown, "spiral")[5] == "14.93"
+    # Dampers: from the coefficients, both come out as printed in (6.159) and (6.164).
+    assert _table_row(markdown, "rudder")[1:5] == ["0.1383", "0.0943", "0.1250", "-1.1333"]
+    assert _table_row(markdown, "aileron")[1:5] == ["-3.5417", "0.8715", "0.6746", "-4.0504"]
+    # The regulator at c = 1 against scipy (see test_chapter.py for the tolerances).
+    row = _table_row(markdown, "1")
+    assert row[1] == "[1.379, -0.4307, -0.3976, -2.816]"
+    assert float(row[4]) == pytest.approx(7.088, abs=1e-3)
+    assert float(row[5]) < 1e-13
+    assert "critically damped at c = 9.772714" in markdown
+    # Levels: the Dutch roll is Level 2 open loop, Level 1 with either damper.
+    levels = _table_row(markdown, "dutch roll", last=True)
+    header = next(line for line in markdown.splitlines() if "| open loop |" in line)
+    assert [cell.strip() for cell in header.strip("|").split("|")][:4] == [
+        "mode",
+        "open loop",
+        "damper (rudder)",
+        "damper (aileron)",
+    ]
+    assert levels[1:4] == ["2", "1", "1"]
+    steady = _table_row(markdown, "steady state (6.51)")[2].strip("[]").split(", ")
+    assert [round(float(v), 4) for v in steady] == [0.0459, -0.0186, 0.0, -0.0160]  # as printed
+
+
+@pytest.mark.parametrize("identifier", aerocontrol.aircraft.available())
+def test_every_shipped_aircraft_reports(identifier: str) -> None:
+    lines: list[str] = []
+    built = build_report(identifier, progress=lines.append)
+    assert len(built.figures) == len(FIGURES)
+    assert built.title.endswith(aerocontrol.aircraft.load(identifier).name)
+    assert lines[0].startswith("models: ")
+    assert ("chapter check" in lines[-1]) == (identifier == "b747-approach")
+    for _, figure in built.figures:
+        figure.clear()
+
+
+def test_a_design_that_does_not_apply_is_reported_and_the_rest_goes_on(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise aerocontrol.UncontrollableError("the Dutch roll is not controllable from here")
+
+    monkeypatch.setattr(report_module, "dutch_roll_damper", refuse)
+    lines: list[str] = []
+    built = build_report(progress=lines.append)
+    markdown = built.markdown()
+    assert "The damper with the rudder alone is not available: the Dutch roll" in markdown
+    assert "rudder: not available (the Dutch roll is not controllable from here)" in lines[4]
+    assert "Optimal regulator" in markdown and len(built.figures) == len(FIGURES) - 2
+
+
+def _tiny(*args: object, **kwargs: object) -> Report:
+    from matplotlib.figure import Figure
+
+    tiny = Report("tiny")
+    tiny.heading("a <heading> & more")
+    tiny.paragraph("text | with a bar")
+    tiny.table(("a", "b"), [("1", "x|y")])
+    tiny.figure("one", "a figure", Figure(figsize=(1, 1)))
+    return tiny
+
+
+def test_rendering_escapes_html_and_markdown(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    monkeypatch.setattr(report_module, "build_report", _tiny)
+    path = write_report(out=tmp_path / "tiny")
+    page = path.read_text(encoding="utf-8")
+    assert "<h2>a &lt;heading&gt; &amp; more</h2>" in page
+    assert "| 1 | x\\|y |" in (tmp_path / "tiny" / "report.md").read_text(encoding="utf-8")
+
+
+def test_rewriting_a_folder_replaces_the_report(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    monkeypatch.setattr(report_module, "build_report", _tiny)
+    out = tmp_path / "out"
+    (out / "figures").mkdir(parents=True)
+    (out / "figures" / "stale.png").write_bytes(b"old")
+    (out / "notes.txt").write_text("mine")
+    write_report(out=out)
+    assert sorted(p.name for p in out.iterdir()) == [
+        "figures",
+        "notes.txt",
+        "report.html",
+        "report.md",
+    ]
+    assert [p.name for p in (out / "figures").iterdir()] == ["one.png"]
+
+
+@pytest.mark.parametrize("existing", [False, True])
+def test_a_failure_leaves_nothing_half_written(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, existing: bool
+) -> None:
+    def fail(ctx: object) -> str:
+        raise aerocontrol.ConvergenceError("the regulator failed")
+
+    monkeypatch.setattr(report_module, "_section_regulator", fail)
+    out = tmp_path / "out"
+    if existing:
+        out.mkdir()
+        (out / "notes.txt").write_text("mine")
+    with pytest.raises(aerocontrol.ConvergenceError, match="the regulator failed"):
+        write_report(out=out)
+    if existing:
+        assert [p.name for p in out.iterdir()] == ["notes.txt"]
+    else:
+        assert not out.exists()
+
+
+def test_an_unwritable_folder_is_one_clear_error(tmp_path: Path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    with pytest.raises(OSError, match=r"cannot write the report into '.*file/out'"):
+        write_report(out=blocker / "out")
