@@ -31,6 +31,8 @@ FIGURES = {
     "lqr-penalty.png",
     "root-locus.png",
 }
+#: The chapter's two small examples, in the embedded 747's report only.
+EXAMPLES = {"feedback-example.png", "pendulum-root-locus.png"}
 
 
 @pytest.fixture(scope="module")
@@ -56,15 +58,15 @@ def test_the_folder_has_the_report_and_every_figure(written: tuple[Path, list[st
     folder = path.parent
     assert path.name == "report.html"
     assert sorted(p.name for p in folder.iterdir()) == ["figures", "report.html", "report.md"]
-    assert {p.name for p in (folder / "figures").iterdir()} == FIGURES
+    assert {p.name for p in (folder / "figures").iterdir()} == FIGURES | EXAMPLES
     for figure in (folder / "figures").iterdir():
         assert figure.read_bytes().startswith(PNG_SIGNATURE)
     page = path.read_text(encoding="utf-8")
     # Self-contained: every image embedded, nothing fetched from elsewhere.
-    assert page.count('src="data:image/png;base64,') == len(FIGURES)
+    assert page.count('src="data:image/png;base64,') == len(FIGURES | EXAMPLES)
     assert not re.search(r'(src|href)="(?!data:)', page)
     markdown = (folder / "report.md").read_text(encoding="utf-8")
-    for name in FIGURES:
+    for name in FIGURES | EXAMPLES:
         assert f"(figures/{name})" in markdown
 
 
@@ -81,7 +83,7 @@ def test_progress_is_one_line_per_step(written: tuple[Path, list[str]]) -> None:
         "root locus",
         "levels after augmentation",
         "chapter check",
-        "writing 11 figures and the report",
+        "writing 13 figures and the report",
     ]
     assert "critically damped at c = 9.772714" in lines[6]
     assert "dutch roll 2 -> damper (rudder) 1, damper (aileron) 1" in lines[7]
@@ -114,6 +116,10 @@ def test_the_report_has_the_chapters_results(written: tuple[Path, list[str]]) ->
         "damper (aileron)",
     ]
     assert levels[1:4] == ["2", "1", "1"]
+    # The small examples: Figure 6.4's gains (6.95), the pendulum's closed form (6.218).
+    assert _table_row(markdown, "feedback gains (6.95)-(6.102)")[2] == "[16.49844, 8.0875]"
+    pendulum = _table_row(markdown, "pendulum gain (6.218), γ = c = 1")
+    assert pendulum[1] == pendulum[2] == "[2.414213562, 2.197368227]"
     steady = _table_row(markdown, "steady state (6.51)")[2].strip("[]").split(", ")
     assert [round(float(v), 4) for v in steady] == [0.0459, -0.0186, 0.0, -0.0160]  # as printed
 
@@ -122,10 +128,11 @@ def test_the_report_has_the_chapters_results(written: tuple[Path, list[str]]) ->
 def test_every_shipped_aircraft_reports(identifier: str) -> None:
     lines: list[str] = []
     built = build_report(identifier, progress=lines.append)
-    assert len(built.figures) == len(FIGURES)
+    chapter = identifier == "b747-approach"
+    assert len(built.figures) == len(FIGURES) + (len(EXAMPLES) if chapter else 0)
     assert built.title.endswith(aerocontrol.aircraft.load(identifier).name)
     assert lines[0].startswith("models: ")
-    assert ("chapter check" in lines[-1]) == (identifier == "b747-approach")
+    assert ("chapter check" in lines[-1]) == chapter
     for _, figure in built.figures:
         figure.clear()
 
@@ -142,7 +149,8 @@ def test_a_design_that_does_not_apply_is_reported_and_the_rest_goes_on(
     markdown = built.markdown()
     assert "The damper with the rudder alone is not available: the Dutch roll" in markdown
     assert "rudder: not available (the Dutch roll is not controllable from here)" in lines[4]
-    assert "Optimal regulator" in markdown and len(built.figures) == len(FIGURES) - 2
+    assert "Optimal regulator" in markdown
+    assert len(built.figures) == len(FIGURES | EXAMPLES) - 2
 
 
 def _tiny(*args: object, **kwargs: object) -> Report:

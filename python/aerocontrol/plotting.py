@@ -138,9 +138,14 @@ def plot_time_response(
     response: int = 0,
     t_max: float | None = None,
     title: str | None = None,
+    suffix: str = "",
+    linestyle: str = "-",
 ) -> Any:
     """States (``signal="states"``) or outputs of one response against time, one named line
     each, up to ``t_max`` seconds (the whole grid when None). Returns the axes.
+
+    ``suffix`` (appended to the legend labels) and ``linestyle`` tell two responses apart on
+    the same axes, as Figure 6.4 shows the original system and the one with feedback.
 
     Examples
     --------
@@ -155,7 +160,7 @@ def plot_time_response(
     ax = _new_axes() if ax is None else ax
     shown = slice(None) if t_max is None else result.t <= t_max
     for column, name in zip(values.T, names, strict=True):
-        ax.plot(result.t[shown], column[shown], label=label(name))
+        ax.plot(result.t[shown], column[shown], linestyle, label=label(name) + suffix)
     if title is None:
         title = f"{result.kind} response"
         if result.n_responses > 1:

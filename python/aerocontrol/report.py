@@ -14,7 +14,8 @@ contained: the figures are embedded) and ``report.md`` with ``figures/*.png``. T
 5. the lateral regulator at the chapter's weights c (6.224-6.227, Figures 6.9-6.11), its root
    locus over c with the weight at which the Dutch roll becomes critically damped (Figure 6.12);
 6. the Levels after augmentation;
-7. for the embedded 747, the chapter's printed numbers beside ours.
+7. for the embedded 747, the chapter's two small examples (Figures 6.4 and 6.8) and its
+   printed numbers beside ours.
 
 A design that does not apply to an aircraft (for example a lateral model without an
 oscillatory Dutch roll) is reported as such and the rest of the report goes on.
@@ -31,9 +32,9 @@ Dutch-roll damper (Bass-Gura): rudder k = [0.1383, 0.09435, 0.125, -1.133], ...
 LQR (Figures 6.9-6.11): c = 0.001: J∞ = 16.57; c = 0.5: J∞ = 10.56; c = 1: J∞ = 7.088; ...
 root locus (Figure 6.12): The Dutch roll becomes critically damped at c = 9.772714 ...
 levels after augmentation: dutch roll 2 -> damper (rudder) 1, damper (aileron) 1, ...
-chapter check: 4 results beside the printed values
+chapter check: Figures 6.4 and 6.8, 6 results beside the printed values
 >>> len(report.figures)
-11
+13
 """
 
 from __future__ import annotations
@@ -58,6 +59,7 @@ from .design import critical_weight, dutch_roll_damper, lqr_root_locus
 from .exceptions import AerocontrolError, InvalidArgumentError
 from .frequency import bode
 from .modal import Modes, modes
+from .placement import place_bass_gura
 from .responses import impulse_response, initial_response, steady_state, step_response
 from .riccati import solve_care
 from .statespace import StateSpace
@@ -500,7 +502,7 @@ def _section_damper(ctx: _Context) -> str:
                 "[0.1383, 0.0943, 0.1250, -1.1333]"
                 if surface == "rudder"
                 else "[-3.5417, 0.8715, 0.6746, -4.0504]",
-                _vector(design.k),
+                _vector(design.k, 5),
             )
         )
         if dutch:
@@ -698,16 +700,93 @@ def _section_levels(ctx: _Context) -> str:
     return "levels after augmentation: " + ("; ".join(changed) or "no Level changes")
 
 
+def _feedback_example(ctx: _Context) -> None:
+    """Figure 6.4: the second-order example (6.94)-(6.102), original system and with the
+    feedback that places ω_n = 25 1/s, ζ = 0.707, from two initial states."""
+    A, B = np.array([[-3.0, 8.0], [0.0, 0.0]]), np.array([0.0, 4.0])
+    zeta, omega_n = 0.707, 25.0
+    pole = complex(-zeta * omega_n, omega_n * math.sqrt(1.0 - zeta**2))
+    poles = np.array([pole, pole.conjugate()])
+    design = place_bass_gura(A, B, poles)
+    original = StateSpace(A, B, state_names=["x1", "x2"])
+    feedback = StateSpace(design.closed_loop, B, state_names=["x1", "x2"])
+    figure, axes = _new_figure(2)
+    for column, (x0, final) in enumerate((([1.0, 0.0], 2.0), ([1.0, 0.1], 5.0))):
+        grid = np.linspace(0.0, final, 2001)
+        ax = axes[0, column]
+        plotting.plot_time_response(
+            initial_response(original, x0, T=grid), ax=ax, suffix=", original system"
+        )
+        plotting.plot_time_response(
+            initial_response(feedback, x0, T=grid),
+            ax=ax,
+            suffix=", with feedback",
+            linestyle="--",
+            title=f"({'ab'[column]}) x(0) = {x0}",
+        )
+    ctx.report.figure(
+        "feedback-example",
+        "Figure 6.4: the second-order system with λ = -3, 0, original and with state feedback "
+        "placing ω_n = 25 1/s, ζ = 0.707 (k = "
+        + _vector(design.k, 7)
+        + "); (a) x(0) = [1, 0], (b) x(0) = [1, 0.1].",
+        figure,
+    )
+    ctx.checks.append(("feedback gains (6.95)-(6.102)", "[16.5, 8.09]", _vector(design.k, 7)))
+
+
+def _pendulum_example(ctx: _Context) -> None:
+    """Figure 6.8: the inverted pendulum's regulator (6.202)-(6.223) with γ = 1, the roots over
+    c/γ and their asymptotes ζ = 1/√2 for large c."""
+    gamma = 1.0
+    pendulum = StateSpace(np.array([[0.0, 1.0], [gamma, 0.0]]), np.array([0.0, 1.0]))
+    Q, R = np.diag([1.0, 0.0]), np.eye(1)
+    weights = np.unique(np.r_[np.geomspace(1e-3, 1e3, 400), 1.0, 10.0, 100.0])
+    poles = lqr_root_locus(pendulum, weights, Q, R)
+    figure, axes = _new_figure(1, width=8.0, height=6.0)
+    ax = axes[0, 0]
+    plotting.plot_root_locus(
+        weights, poles, ax=ax, marked=[1e-3, 1.0, 10.0, 100.0, 1000.0], weight_name="c/γ",
+        title="inverted pendulum: closed-loop roots over c/γ (units of γ)",
+    )  # fmt: skip
+    reach = 1.1 * float(np.abs(poles).max())
+    for sign in (1.0, -1.0):
+        ax.plot([0.0, -reach / math.sqrt(2)], [0.0, sign * reach / math.sqrt(2)], color="c",
+                linewidth=0.8, label="asymptotes, ζ = 1/√2" if sign > 0 else None)  # fmt: skip
+    ax.set_aspect("equal")
+    ax.legend(loc="best", fontsize="small")
+    ctx.report.figure(
+        "pendulum-root-locus",
+        "Figure 6.8: the inverted pendulum's closed-loop roots for c/γ from 0.001 (the double "
+        "root at -γ) to 1000, with the asymptotes of large c/γ.",
+        figure,
+    )
+    c = 1.0
+    closed_form = [
+        gamma + math.sqrt(gamma**2 + c**2),
+        math.sqrt(2 * (gamma + math.sqrt(gamma**2 + c**2))),
+    ]
+    K = solve_care(pendulum.A, pendulum.B, Q, R / c**2).K[0]
+    ctx.checks.append(
+        ("pendulum gain (6.218), γ = c = 1", _vector(closed_form, 10), _vector(K, 10))
+    )
+
+
 def _section_chapter(ctx: _Context) -> str:
     report = ctx.report
-    report.heading("The chapter's numbers")
+    report.heading("The chapter's examples and numbers")
     report.paragraph(
-        "The chapter's printed values beside ours, computed from the coefficients (6.47), "
-        "(6.147). The printed aileron gains (6.164) came from unrounded matrices; the chapter "
-        "states the critical c twice, differently: the computed value settles it."
+        "The chapter's two small examples, then its printed values beside ours, computed from "
+        "the coefficients (6.47), (6.147). The printed aileron gains (6.164) came from "
+        "unrounded matrices; the chapter states the critical c twice, differently: the computed "
+        "value settles it."
     )
+    _feedback_example(ctx)
+    _pendulum_example(ctx)
     report.table(("result", "chapter", "aerocontrol"), [tuple(row) for row in ctx.checks])
-    return f"chapter check: {len(ctx.checks)} results beside the printed values"
+    return (
+        f"chapter check: Figures 6.4 and 6.8, {len(ctx.checks)} results beside the printed values"
+    )
 
 
 # --- Entry points -----------------------------------------------------------------------------

@@ -129,6 +129,18 @@ _TABLES = (
     "sources",
 )
 _FLIGHT_KEYS = ("speed", "mach", "altitude", "density", "theta0_deg", "alpha0_deg")
+_OSCILLATORY = ("omega_n", "zeta")
+_APERIODIC = ("time_constant", "time_to_half", "time_to_double")
+_PUBLISHED_MODES = {
+    "short_period": _OSCILLATORY,
+    "phugoid": _OSCILLATORY,
+    "dutch_roll": _OSCILLATORY,
+    "roll": _APERIODIC,
+    "spiral": _APERIODIC,
+}
+"""The modes a file's [published] table may give, each with the quantities it may carry
+(omega_n in rad/s, zeta; time_constant, time_to_half and time_to_double in s). Any mode may also
+carry its own relative ``tolerance``, which then replaces the file-level ``tolerance``."""
 
 LONGITUDINAL_STATES = ("u/u0", "alpha", "q", "theta")
 LATERAL_STATES = ("beta", "p", "phi", "r")
@@ -189,6 +201,9 @@ class Aircraft:
     b: float
     derivatives: Mapping[str, float]
     published: Mapping[str, Any] = field(default_factory=dict)
+    """The source's own mode characteristics, validated: an optional relative ``tolerance``
+    and, per mode ("short_period", "phugoid", "dutch_roll", "roll", "spiral"), its quantities
+    and an optional ``tolerance`` of its own that replaces the file-level one."""
     sources: Mapping[str, str] = field(default_factory=dict)
 
     # ------------------------------------------------------------------------------------
@@ -275,7 +290,7 @@ class Aircraft:
             reader.only(table, table_name, keys)
             derivatives.update({key: reader.number(table, table_name, key) for key in keys})
 
-        published = dict(data.get("published", {}))
+        published = reader.published()
         sources = reader.table("sources", required=("default",)) if "sources" in data else {}
         reader.only_tables(_TABLES)
         return cls(
@@ -531,6 +546,55 @@ class _Reader:
                 f"{self.origin}: [{name}] {key} must be one of {listed}, got {value!r}"
             )
         return str(value)
+
+    def published(self) -> dict[str, Any]:
+        """[published]: an optional relative ``tolerance`` and, per mode, its quantities and an
+        optional ``tolerance`` of its own; every value a positive finite number (zeta may be
+        negative, an unstable oscillation, but not zero)."""
+        table = self.data.get("published", {})
+        if not isinstance(table, Mapping):
+            raise AircraftDataError(f"{self.origin}: [published] must be a table, got {table!r}")
+        published: dict[str, Any] = {}
+        for mode, entry in table.items():
+            if mode == "tolerance":
+                published[mode] = self.positive(table, "published", mode)
+                continue
+            if mode not in _PUBLISHED_MODES:
+                raise AircraftDataError(
+                    f"{self.origin}: [published] has unknown mode {mode!r}; the modes are "
+                    f"{', '.join(_PUBLISHED_MODES)} (and the file-level tolerance)"
+                )
+            name = f"published.{mode}"
+            if not isinstance(entry, Mapping):
+                raise AircraftDataError(
+                    f"{self.origin}: [{name}] must be a table of quantities such as "
+                    f"{{ {_PUBLISHED_MODES[mode][0]} = ... }}, got {entry!r}"
+                )
+            allowed = (*_PUBLISHED_MODES[mode], "tolerance")
+            unknown = [key for key in entry if key not in allowed]
+            if unknown:
+                raise AircraftDataError(
+                    f"{self.origin}: [{name}] has unknown quantity {', '.join(unknown)}; "
+                    f"the quantities of the {mode} are {', '.join(allowed)}"
+                )
+            if not any(key != "tolerance" for key in entry):
+                raise AircraftDataError(
+                    f"{self.origin}: [{name}] gives no quantity; give one of "
+                    f"{', '.join(_PUBLISHED_MODES[mode])}"
+                )
+            values: dict[str, float] = {}
+            for key in entry:
+                if key == "zeta":
+                    values[key] = self.number(entry, name, key)
+                    if values[key] == 0.0:
+                        raise AircraftDataError(
+                            f"{self.origin}: [{name}] zeta must not be zero (a relative "
+                            "tolerance cannot check it)"
+                        )
+                else:
+                    values[key] = self.positive(entry, name, key)
+            published[mode] = values
+        return published
 
     def atmosphere(self, altitude: float, units: str) -> Any:
         try:
