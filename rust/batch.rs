@@ -5,9 +5,10 @@
 //! copy per matrix. Each problem runs on one rayon task (small problems sequentially inside),
 //! which is the efficient split for many small problems; an error names the index of the problem.
 
+use crate::care::{CareOptions, solve_care};
 use crate::error::{Error, check_finite, check_output_len};
 use crate::expm::expm_into_validated;
-use faer::{MatMut, MatRef};
+use faer::{MatMut, MatRef, c64};
 use rayon::prelude::*;
 
 /// A read-only stack of `count` matrices of shape `rows` x `cols`, row-major and contiguous.
@@ -103,6 +104,129 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
     Ok(())
 }
 
+/// The data of a batch of Riccati equations A^T X + X A - X B R^-1 B^T X + Q = 0 (6.199).
+/// Each stack holds either one matrix, shared by every problem, or one per problem; so a
+/// sweep of one model over k weights is A, B, Q of one matrix each and a stack of k R's.
+#[derive(Debug, Clone, Copy)]
+pub struct CareStacks<'a> {
+    pub a: MatrixStack<'a>,
+    pub b: MatrixStack<'a>,
+    pub q: MatrixStack<'a>,
+    pub r: MatrixStack<'a>,
+}
+
+impl CareStacks<'_> {
+    /// The number of problems k: the stacks that do not hold one matrix must all hold k (an
+    /// empty stack makes an empty batch); k = 1 when every stack holds one.
+    pub fn count(&self) -> Result<usize, Error> {
+        let stacks = [
+            ("A", self.a.len()),
+            ("B", self.b.len()),
+            ("Q", self.q.len()),
+            ("R", self.r.len()),
+        ];
+        let Some(&(first, count)) = stacks.iter().find(|&&(_, len)| len != 1) else {
+            return Ok(1);
+        };
+        for (arg, len) in stacks {
+            if len != 1 && len != count {
+                return Err(Error::Mismatch {
+                    arg,
+                    what: "one matrix, or as many matrices as",
+                    expected: count,
+                    other: first,
+                    got: len,
+                });
+            }
+        }
+        Ok(count)
+    }
+}
+
+/// The k-th matrix of a stack that holds one (shared) or k.
+fn member<'a>(stack: &MatrixStack<'a>, index: usize) -> MatRef<'a, f64> {
+    stack.get(if stack.len() == 1 { 0 } else { index })
+}
+
+/// Where [`care_batch`] writes: for problem k, X (n x n) and K (m x n) row-major at
+/// k n^2 and k m n, the closed-loop eigenvalues at k n, the relative residual and rcond(U11)
+/// at k.
+pub struct CareBatchOutput<'a> {
+    pub x: &'a mut [f64],
+    pub gain: &'a mut [f64],
+    pub poles: &'a mut [c64],
+    pub residual: &'a mut [f64],
+    pub rcond: &'a mut [f64],
+}
+
+/// Solves every Riccati equation of a batch, in parallel (one problem per rayon task, each
+/// exactly as [`solve_care`] solves it alone, so the results are bitwise those of single
+/// calls). Every problem is attempted; if any fails, the error of the lowest index is
+/// returned, naming that index, and the outputs are unspecified.
+pub fn care_batch(
+    stacks: CareStacks<'_>,
+    refine: bool,
+    out: CareBatchOutput<'_>,
+) -> Result<(), Error> {
+    let count = stacks.count()?;
+    let (n, m) = (stacks.a.rows, stacks.b.cols);
+    check_output_len(out.x.len(), count * n * n)?;
+    check_output_len(out.gain.len(), count * m * n)?;
+    check_output_len(out.poles.len(), count * n)?;
+    check_output_len(out.residual.len(), count)?;
+    check_output_len(out.rcond.len(), count)?;
+    if count == 0 || n == 0 {
+        return Ok(());
+    }
+    let options = CareOptions {
+        refine,
+        ..CareOptions::default()
+    };
+    // Without inputs (m = 0) K is empty; a placeholder chunk per problem keeps the zip whole.
+    let mut placeholder = Vec::new();
+    let (gains, gain_size) = if m == 0 {
+        placeholder.resize(count, 0.0);
+        (&mut placeholder[..], 1)
+    } else {
+        (out.gain, m * n)
+    };
+    let failure = out
+        .x
+        .par_chunks_mut(n * n)
+        .zip(gains.par_chunks_mut(gain_size))
+        .zip(out.poles.par_chunks_mut(n))
+        .zip(out.residual.par_iter_mut())
+        .zip(out.rcond.par_iter_mut())
+        .enumerate()
+        .filter_map(|(index, ((((x, gain), poles), residual), rcond))| {
+            let solved = solve_care(
+                member(&stacks.a, index),
+                member(&stacks.b, index),
+                member(&stacks.q, index),
+                member(&stacks.r, index),
+                options,
+            );
+            match solved {
+                Ok(care) => {
+                    MatMut::from_row_major_slice_mut(x, n, n).copy_from(&care.x);
+                    if m > 0 {
+                        MatMut::from_row_major_slice_mut(gain, m, n).copy_from(&care.gain);
+                    }
+                    poles.copy_from_slice(&care.closed_loop_eigenvalues);
+                    *residual = care.residual;
+                    *rcond = care.rcond;
+                    None
+                }
+                Err(error) => Some((index, error)),
+            }
+        })
+        .min_by_key(|(index, _)| *index);
+    match failure {
+        Some((index, error)) => Err(Error::in_batch(index, error)),
+        None => Ok(()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -145,5 +269,154 @@ mod tests {
         let mut out = vec![];
         expm_batch(MatrixStack::new(&[], 0, 3, 3).unwrap(), &mut out).unwrap();
         expm_batch(MatrixStack::new(&[], 5, 0, 0).unwrap(), &mut out).unwrap();
+    }
+
+    /// The 747 lateral model (6.150) with B = [rudder, aileron] (6.158), (6.163).
+    fn lateral() -> (Vec<f64>, Vec<f64>) {
+        let a = vec![
+            -0.0999, 0.0, 0.1153, -1.0, -1.6038, -1.0932, 0.0, 0.2850, 0.0, 1.0, 0.0, 0.0, 0.4089,
+            -0.0395, 0.0, -0.2454,
+        ];
+        let b = vec![0.0182, 0.0, 0.0868, 0.3215, 0.0, 0.0, -0.2440, -0.0017];
+        (a, b)
+    }
+
+    fn identity(n: usize) -> Vec<f64> {
+        (0..n * n)
+            .map(|i| if i % (n + 1) == 0 { 1.0 } else { 0.0 })
+            .collect()
+    }
+
+    struct Outputs {
+        x: Vec<f64>,
+        gain: Vec<f64>,
+        poles: Vec<c64>,
+        residual: Vec<f64>,
+        rcond: Vec<f64>,
+    }
+
+    fn run(stacks: CareStacks<'_>, count: usize, n: usize, m: usize) -> Result<Outputs, Error> {
+        let mut o = Outputs {
+            x: vec![0.0; count * n * n],
+            gain: vec![0.0; count * m * n],
+            poles: vec![c64::new(0.0, 0.0); count * n],
+            residual: vec![0.0; count],
+            rcond: vec![0.0; count],
+        };
+        let out = CareBatchOutput {
+            x: &mut o.x,
+            gain: &mut o.gain,
+            poles: &mut o.poles,
+            residual: &mut o.residual,
+            rcond: &mut o.rcond,
+        };
+        care_batch(stacks, true, out).map(|()| o)
+    }
+
+    /// A sweep of the chapter's weight c (R = I / c^2, (6.226)) over one model.
+    fn weights(cs: &[f64]) -> Vec<f64> {
+        cs.iter()
+            .flat_map(|c| [1.0 / (c * c), 0.0, 0.0, 1.0 / (c * c)])
+            .collect()
+    }
+
+    #[test]
+    fn care_batch_equals_one_at_a_time_bitwise() {
+        let (a, b) = lateral();
+        let q = identity(4);
+        let cs = [0.001, 0.5, 1.0, 2.0, 9.7727, 10.0, 50.0];
+        let r = weights(&cs);
+        let stacks = CareStacks {
+            a: MatrixStack::new(&a, 1, 4, 4).unwrap(),
+            b: MatrixStack::new(&b, 1, 4, 2).unwrap(),
+            q: MatrixStack::new(&q, 1, 4, 4).unwrap(),
+            r: MatrixStack::new(&r, cs.len(), 2, 2).unwrap(),
+        };
+        let o = run(stacks, cs.len(), 4, 2).unwrap();
+        for (k, _) in cs.iter().enumerate() {
+            let single = solve_care(
+                stacks.a.get(0),
+                stacks.b.get(0),
+                stacks.q.get(0),
+                stacks.r.get(k),
+                CareOptions {
+                    refine: true,
+                    ..CareOptions::default()
+                },
+            )
+            .unwrap();
+            for i in 0..4 {
+                for j in 0..4 {
+                    assert_eq!(
+                        o.x[k * 16 + i * 4 + j].to_bits(),
+                        single.x[(i, j)].to_bits()
+                    );
+                }
+                for row in 0..2 {
+                    assert_eq!(o.gain[k * 8 + row * 4 + i], single.gain[(row, i)]);
+                }
+            }
+            assert_eq!(
+                &o.poles[k * 4..(k + 1) * 4],
+                &single.closed_loop_eigenvalues[..]
+            );
+            assert_eq!(o.residual[k], single.residual);
+            assert_eq!(o.rcond[k], single.rcond);
+        }
+    }
+
+    #[test]
+    fn care_batch_reports_the_lowest_failing_index() {
+        let (a, b) = lateral();
+        let q = identity(4);
+        let mut r = weights(&[1.0, 1.0, 1.0, 1.0, 1.0]);
+        r[3 * 4] = -1.0; // R of problem 3 is indefinite
+        r[4 * 4 + 1] = 0.5; // R of problem 4 is not symmetric
+        let stacks = CareStacks {
+            a: MatrixStack::new(&a, 1, 4, 4).unwrap(),
+            b: MatrixStack::new(&b, 1, 4, 2).unwrap(),
+            q: MatrixStack::new(&q, 1, 4, 4).unwrap(),
+            r: MatrixStack::new(&r, 5, 2, 2).unwrap(),
+        };
+        let error = run(stacks, 5, 4, 2).err().unwrap();
+        assert!(matches!(error, Error::InBatch { index: 3, .. }));
+        assert!(
+            error
+                .to_string()
+                .starts_with("problem 3 of the batch: R must be symmetric positive definite")
+        );
+    }
+
+    #[test]
+    fn care_batch_stacks_must_agree() {
+        let (a, b) = lateral();
+        let q = [identity(4), identity(4)].concat();
+        let r = weights(&[1.0, 2.0, 3.0]);
+        let stacks = CareStacks {
+            a: MatrixStack::new(&a, 1, 4, 4).unwrap(),
+            b: MatrixStack::new(&b, 1, 4, 2).unwrap(),
+            q: MatrixStack::new(&q, 2, 4, 4).unwrap(),
+            r: MatrixStack::new(&r, 3, 2, 2).unwrap(),
+        };
+        let error = run(stacks, 3, 4, 2).err().unwrap();
+        assert_eq!(
+            error.to_string(),
+            "R must have one matrix, or as many matrices as Q (2), got 3"
+        );
+    }
+
+    #[test]
+    fn care_batch_without_inputs_solves_lyapunov_equations() {
+        // m = 0: A^T X + X A + Q = 0; for A = -I, Q = I, X = I / 2.
+        let a = [-1.0, 0.0, 0.0, -1.0];
+        let q = identity(2);
+        let stacks = CareStacks {
+            a: MatrixStack::new(&a, 1, 2, 2).unwrap(),
+            b: MatrixStack::new(&[], 1, 2, 0).unwrap(),
+            q: MatrixStack::new(&q, 1, 2, 2).unwrap(),
+            r: MatrixStack::new(&[], 3, 0, 0).unwrap(),
+        };
+        let o = run(stacks, 3, 2, 0).unwrap();
+        assert_eq!(o.x, [0.5, 0.0, 0.0, 0.5].repeat(3));
     }
 }

@@ -12,7 +12,9 @@
 //! under [`guarded`], which turns a panic that escaped anyway (an allocation inside faer that
 //! failed) into a Python exception instead of unwinding into the interpreter.
 
-use crate::batch::{MatrixStack, expm_batch};
+use crate::batch::{
+    CareBatchOutput, CareStacks, MatrixStack, care_batch as care_batch_core, expm_batch,
+};
 use crate::care::{CareOptions, solve_care as solve_care_core};
 use crate::ctrb::{
     controllability as controllability_core, ctrb, observability as observability_core, obsv,
@@ -1165,6 +1167,66 @@ fn solve_care<'py>(
     ))
 }
 
+/// The outputs of a batch of Riccati equations: X, K, closed-loop eigenvalues, residuals,
+/// rcond(U11).
+type CareBatchArrays<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+);
+
+/// A batch of Riccati equations (6.199) solved in parallel with the GIL released: A, B, Q
+/// and R are 3-D stacks of one matrix (shared by every problem) or k. Returns X (k, n, n),
+/// K (k, m, n), the closed-loop eigenvalues (k, n), the relative residuals (k,) and
+/// rcond(U11) (k,); an error names the lowest failing index.
+#[pyfunction]
+#[pyo3(signature = (a, b, q, r, refine, /))]
+fn care_batch<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+    refine: bool,
+) -> PyResult<CareBatchArrays<'py>> {
+    // Copied before the GIL is released, so that no Python thread can change what is read.
+    let (a, [ka, n, na]) = stack_values(py, a, "A")?;
+    let (b, [kb, nb, m]) = stack_values(py, b, "B")?;
+    let (q, [kq, nq, mq]) = stack_values(py, q, "Q")?;
+    let (r, [kr, nr, mr]) = stack_values(py, r, "R")?;
+    let stacks = (|| {
+        Ok::<_, Error>(CareStacks {
+            a: MatrixStack::new(&a, ka, n, na)?,
+            b: MatrixStack::new(&b, kb, nb, m)?,
+            q: MatrixStack::new(&q, kq, nq, mq)?,
+            r: MatrixStack::new(&r, kr, nr, mr)?,
+        })
+    })()
+    .map_err(|e| to_py_err(py, e))?;
+    let count = stacks.count().map_err(|e| to_py_err(py, e))?;
+    entries(&[count, n.max(m), n])?;
+    let x = new_array::<f64>(py, &[count, n, n])?;
+    let gain = new_array::<f64>(py, &[count, m, n])?;
+    let poles = new_array::<c64>(py, &[count, n])?;
+    let residual = new_array::<f64>(py, &[count])?;
+    let rcond = new_array::<f64>(py, &[count])?;
+    // SAFETY: the arrays are new and not visible to Python until returned.
+    let out = unsafe {
+        CareBatchOutput {
+            x: new_array_data(&x),
+            gain: new_array_data(&gain),
+            poles: new_array_data(&poles),
+            residual: new_array_data(&residual),
+            rcond: new_array_data(&rcond),
+        }
+    };
+    py.detach(|| guarded(|| care_batch_core(stacks, refine, out)))?
+        .map_err(|e| to_py_err(py, e))?;
+    Ok((x, gain, poles, residual, rcond))
+}
+
 /// The Riccati differential equation (6.196) backward over the grid `t`: (S (k, n, n),
 /// K (k, m, n), substeps).
 #[pyfunction]
@@ -1262,6 +1324,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(schur, m)?)?;
     m.add_function(wrap_pyfunction!(solve_lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(solve_care, m)?)?;
+    m.add_function(wrap_pyfunction!(care_batch, m)?)?;
     m.add_function(wrap_pyfunction!(riccati_ode, m)?)?;
     m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
     m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;

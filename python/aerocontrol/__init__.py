@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import aircraft, chapter, design, exceptions, handling, plotting, report
+from . import aircraft, batch, chapter, design, exceptions, handling, plotting, report
 from .controllability import (
     Controllability,
     controllability,
@@ -111,6 +111,7 @@ __all__ = [
     "aircraft",
     "as_state_space",
     "augment_mode",
+    "batch",
     "bode",
     "chapter",
     "charpoly",

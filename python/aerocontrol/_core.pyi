@@ -13,6 +13,7 @@ __all__ = [
     "EXACT_NORM_MAX_ORDER",
     "FMA_KERNELS",
     "SMALL_MAX_ORDER",
+    "care_batch",
     "charpoly",
     "check_model",
     "companion_form",
@@ -117,6 +118,20 @@ def solve_care(
     refine: bool,
     /,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], float, float, int]: ...
+def care_batch(
+    a: ArrayLike,
+    b: ArrayLike,
+    q: ArrayLike,
+    r: ArrayLike,
+    refine: bool,
+    /,
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.complex128],
+    NDArray[np.float64],
+    NDArray[np.float64],
+]: ...
 def riccati_ode(
     a: ArrayLike,
     b: ArrayLike,

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from ._validation import real_array, real_scalar
 from .aircraft.model import Aircraft
 from .aircraft.naming import classify_modes
+from .batch import lqr_sweep
 from .exceptions import InvalidArgumentError
 from .modal import modes
 from .placement import Placement, augment_mode, place_bass_gura
@@ -74,14 +75,20 @@ def lqr_root_locus(sys: StateSpace, weights: Any, Q: Any = None, R: Any = None) 
     """The closed-loop eigenvalues of the regulator for each control weight c (Figure 6.12):
     an array (len(weights), n), each row as :func:`aerocontrol.lqr` returns its E.
 
-    Q and R default to identities (the chapter's (6.225)-(6.226)).
+    Q and R default to identities (the chapter's (6.225)-(6.226)). The weights are solved in
+    one parallel call (:func:`aerocontrol.batch.lqr_sweep`).
     """
-    c_values = np.atleast_1d(real_array(weights, "weights"))
-    if c_values.ndim != 1 or np.any(c_values <= 0) or not np.all(np.isfinite(c_values)):
-        raise InvalidArgumentError("weights must be a 1-D array of positive, finite numbers")
-    Q_matrix, R_matrix = _weights(sys.n_states, sys.n_inputs, Q, R)
-    rows = [lqr(sys.A, sys.B, Q_matrix, R_matrix / c**2)[2] for c in c_values]
-    return np.array(rows, dtype=np.complex128).reshape(len(c_values), sys.n_states)
+    return lqr_sweep(sys, Q=Q, R=R, weights=weights).poles
+
+
+def _split(poles: ComplexArray, mode: str) -> float:
+    """((λ1 - λ2) / 2)² of the mode's two roots: -ω_d² while complex, >= 0 once split."""
+    members = classify_modes(poles, "lateral").get(mode)
+    if members is None or len(members) != 2:
+        raise InvalidArgumentError(
+            f"mode must name an oscillatory lateral mode ('dutch roll'), got {mode!r}"
+        )
+    return float((((members[0] - members[1]) / 2) ** 2).real)
 
 
 def critical_weight(
@@ -114,16 +121,10 @@ def critical_weight(
         raise InvalidArgumentError(f"bounds must satisfy 0 < low < high, got {bounds}")
 
     def measure(c: float) -> float:
-        poles = lqr(sys.A, sys.B, Q_matrix, R_matrix / c**2)[2]
-        members = classify_modes(poles, "lateral").get(mode)
-        if members is None or len(members) != 2:
-            raise InvalidArgumentError(
-                f"mode must name an oscillatory lateral mode ('dutch roll'), got {mode!r}"
-            )
-        return float((((members[0] - members[1]) / 2) ** 2).real)
+        return _split(lqr(sys.A, sys.B, Q_matrix, R_matrix / c**2)[2], mode)
 
     grid = np.geomspace(low, high, 61)
-    values = [measure(c) for c in grid]
+    values = [_split(poles, mode) for poles in lqr_sweep(sys, Q=Q, R=R, weights=grid).poles]
     for k in range(len(grid) - 1):
         if values[k] < 0 <= values[k + 1]:
             a, b = math.log(grid[k]), math.log(grid[k + 1])

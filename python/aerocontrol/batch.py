@@ -1,0 +1,196 @@
+"""Sweeps: many Riccati equations in one call, solved in parallel in the native core.
+
+Design work is sweeps: gains over weights, models over the flight envelope, Monte Carlo over
+uncertain derivatives. A loop over :func:`aerocontrol.lqr` pays the Python crossing per
+problem; here the whole stack crosses once, the GIL is released, and the problems are spread
+over the cores (one problem per task, each solved exactly as :func:`aerocontrol.solve_care`
+solves it alone, so the results are bitwise the one-at-a-time results).
+
+* :func:`solve_care_batch`: stacks of (A, B, Q, R); any of them may be one matrix shared by
+  every problem;
+* :func:`lqr_sweep`: one model over an array of the chapter's weights c, R/c² (6.226).
+
+An error in one problem raises the exception of that problem with its index ("problem 7 of
+the batch: ..."), the lowest failing index when several fail; nothing partial is returned.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import _core
+from ._validation import FloatArray, real_array
+from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
+from .riccati import RCOND_WARNING, RESIDUAL_WARNING
+from .statespace import StateSpace, as_state_space
+
+__all__ = ["CareBatch", "LqrSweep", "lqr_sweep", "solve_care_batch"]
+
+ComplexArray = NDArray[np.complex128]
+
+
+@dataclass(frozen=True, eq=False)
+class CareBatch:
+    """The solutions of a batch of Riccati equations, problem index first."""
+
+    X: FloatArray
+    """The stabilising solutions, (k, n, n)."""
+    K: FloatArray
+    """The gains R^-1 B^T X, (k, m, n)."""
+    closed_loop_poles: ComplexArray
+    """eig(A - B K) of each problem, (k, n), as :func:`aerocontrol.lqr` returns its E."""
+    residual: FloatArray
+    """The relative residual of each equation, (k,)."""
+    rcond: FloatArray
+    """rcond(U11) of each problem, (k,)."""
+
+    def __len__(self) -> int:
+        return int(self.X.shape[0])
+
+
+@dataclass(frozen=True, eq=False)
+class LqrSweep:
+    """The regulator of one model for each weight c of a sweep (Figure 6.12)."""
+
+    weights: FloatArray
+    """The weights c, (k,)."""
+    K: FloatArray
+    """The gains, (k, m, n)."""
+    poles: ComplexArray
+    """The closed-loop eigenvalues, (k, n): the root locus over c."""
+    X: FloatArray
+    """The Riccati solutions, (k, n, n)."""
+    residual: FloatArray
+    """The relative residual of each equation, (k,)."""
+    rcond: FloatArray
+    """rcond(U11) of each problem, (k,)."""
+
+    def __len__(self) -> int:
+        return len(self.weights)
+
+
+def _stack(value: Any, name: str) -> FloatArray:
+    array = real_array(value, name)
+    if array.ndim == 2:
+        return array[np.newaxis]
+    if array.ndim == 1 and name == "B":  # one input, as the single-problem functions take it
+        return array.reshape(1, -1, 1)
+    if array.ndim != 3:
+        raise ShapeError(
+            f"{name} must be a matrix (shared by every problem) or a 3-D stack of matrices, "
+            f"got shape {array.shape}"
+        )
+    return array
+
+
+def _warn(batch: CareBatch) -> None:
+    flagged = np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING))
+    if flagged.size:
+        shown = ", ".join(str(i) for i in flagged[:10]) + (" ..." if flagged.size > 10 else "")
+        warnings.warn(
+            f"{flagged.size} of the {len(batch)} Riccati solutions may be inaccurate "
+            f"(rcond(U11) < {RCOND_WARNING:.0e} or relative residual > {RESIDUAL_WARNING:.0e}): "
+            f"problems {shown}",
+            IllConditionedWarning,
+            stacklevel=3,
+        )
+
+
+def solve_care_batch(A: Any, B: Any, Q: Any, R: Any, refine: bool = True) -> CareBatch:
+    """Solve A_i^T X_i + X_i A_i - X_i B_i R_i^-1 B_i^T X_i + Q_i = 0 for every problem i of a
+    batch, in parallel.
+
+    Each of A (k, n, n), B (k, n, m), Q (k, n, n) and R (k, m, m) is a 3-D stack of k
+    matrices or a single matrix shared by every problem. The method, checks and diagnostics
+    are those of :func:`aerocontrol.solve_care` (without the cross weight and E).
+
+    Raises
+    ------
+    ShapeError
+        A stack that is neither one matrix nor k matrices, or shapes that disagree.
+    AerocontrolError
+        The first failing problem's own error (NotPositiveDefiniteError,
+        NoStabilizingSolutionError, ...), its message starting "problem i of the batch".
+
+    Warns
+    -----
+    IllConditionedWarning
+        Naming the problems whose rcond(U11) < 1e-8 or residual > 1e-8.
+
+    Examples
+    --------
+    Monte Carlo over an uncertain derivative: the 747's lateral regulator (c = 1) with its
+    (β, r) entry of A, the weathercock stability, scattered by 10 %:
+
+    >>> import numpy as np, aerocontrol
+    >>> sys = aerocontrol.aircraft.load().lateral()
+    >>> rng = np.random.default_rng(1)
+    >>> A = np.repeat(sys.A[np.newaxis], 500, axis=0)
+    >>> A[:, 3, 0] *= 1 + 0.1 * rng.standard_normal(500)
+    >>> batch = aerocontrol.batch.solve_care_batch(A, sys.B, np.eye(4), np.eye(2))
+    >>> batch.K.shape, bool(np.all(batch.closed_loop_poles.real < 0))
+    ((500, 2, 4), True)
+    """
+    batch = CareBatch(
+        *_core.care_batch(
+            _stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"), bool(refine)
+        )
+    )
+    _warn(batch)
+    return batch
+
+
+def lqr_sweep(
+    sys_or_A: Any, B: Any = None, Q: Any = None, R: Any = None, weights: Any = None
+) -> LqrSweep:
+    """The regulator of one model for each weight c: J = ∫ x^T Q x + (1/c²) η^T R η dt
+    ((6.224)-(6.227); R/c² is the control weight), all solved in one parallel call.
+
+    ``lqr_sweep(sys, Q=..., R=..., weights=c)`` or ``lqr_sweep(A, B, Q, R, weights=c)``; Q and
+    R default to identities, as in the chapter. Returns the gains (k, m, n), the closed-loop
+    poles (k, n) (each row as :func:`aerocontrol.lqr` returns its E), X, the residuals and the
+    weights.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> sweep = aerocontrol.batch.lqr_sweep(aerocontrol.aircraft.load().lateral(),
+    ...                                     weights=np.geomspace(1e-3, 10, 1000))
+    >>> sweep.K.shape, sweep.poles.shape
+    ((1000, 2, 4), (1000, 4))
+    """
+    if isinstance(sys_or_A, StateSpace) or hasattr(sys_or_A, "A"):
+        if B is not None:
+            raise InvalidArgumentError("lqr_sweep(sys, Q=..., R=..., weights=...) takes no B")
+        sys = as_state_space(sys_or_A)
+        A_matrix, B_matrix = sys.A, sys.B
+    else:
+        if B is None:
+            raise InvalidArgumentError("lqr_sweep(A, B, Q, R, weights) needs B")
+        A_matrix, B_matrix = real_array(sys_or_A, "A"), real_array(B, "B")
+        if B_matrix.ndim == 1:
+            B_matrix = B_matrix.reshape(-1, 1)
+    if weights is None:
+        raise InvalidArgumentError("weights must be given: a 1-D array of positive numbers c")
+    c = np.atleast_1d(real_array(weights, "weights"))
+    if c.ndim != 1:
+        raise ShapeError(f"weights must be a 1-D array, got shape {c.shape}")
+    bad = np.flatnonzero(~(np.isfinite(c) & (c > 0)))
+    if bad.size:
+        raise InvalidArgumentError(
+            f"weights must be positive and finite, but weights[{bad[0]}] = {c[bad[0]]}"
+        )
+    n = A_matrix.shape[0] if A_matrix.ndim == 2 else 0
+    m = B_matrix.shape[1] if B_matrix.ndim == 2 else 0
+    Q_matrix = np.eye(n) if Q is None else real_array(Q, "Q")
+    R_matrix = np.eye(m) if R is None else np.atleast_2d(real_array(R, "R"))
+    if R_matrix.ndim != 2:
+        raise ShapeError(f"R must be one m x m matrix, got shape {R_matrix.shape}")
+    R_stack = R_matrix[np.newaxis] / (c * c)[:, np.newaxis, np.newaxis]
+    batch = solve_care_batch(A_matrix, B_matrix, Q_matrix, R_stack)
+    return LqrSweep(c, batch.K, batch.closed_loop_poles, batch.X, batch.residual, batch.rcond)

@@ -1,0 +1,107 @@
+"""Batches of Riccati equations: equal to the one-at-a-time results bitwise, to scipy within
+1e-10, and an error names the failing problem's index."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+import aerocontrol
+from aerocontrol.batch import lqr_sweep, solve_care_batch
+
+LATERAL = aerocontrol.aircraft.load().lateral()
+WEIGHTS = np.geomspace(1e-3, 10.0, 200)
+
+
+def test_sweep_equals_one_lqr_at_a_time_bitwise() -> None:
+    sweep = lqr_sweep(LATERAL, weights=WEIGHTS)
+    assert sweep.K.shape == (200, 2, 4) and sweep.poles.shape == (200, 4) and len(sweep) == 200
+    for k, c in enumerate(WEIGHTS):
+        K, S, E = aerocontrol.lqr(LATERAL.A, LATERAL.B, np.eye(4), np.eye(2) / c**2)
+        assert np.array_equal(sweep.K[k], K)
+        assert np.array_equal(sweep.X[k], S)
+        assert np.array_equal(sweep.poles[k], E)
+    np.testing.assert_array_equal(sweep.weights, WEIGHTS)
+    assert sweep.residual.max() < 1e-14
+
+
+def test_sweep_against_scipy() -> None:
+    """Within 1e-10 relative of scipy's solution on every weight where scipy is accurate
+    (its own residual below 1e-10)."""
+    sweep = lqr_sweep(LATERAL.A, LATERAL.B, np.eye(4), np.eye(2), weights=WEIGHTS[::10])
+    for k, c in enumerate(WEIGHTS[::10]):
+        X = scipy.linalg.solve_continuous_are(LATERAL.A, LATERAL.B, np.eye(4), np.eye(2) / c**2)
+        assert np.linalg.norm(sweep.X[k] - X) <= 1e-10 * np.linalg.norm(X)
+
+
+def test_root_locus_and_critical_weight_use_the_sweep() -> None:
+    poles = aerocontrol.design.lqr_root_locus(LATERAL, WEIGHTS)
+    np.testing.assert_array_equal(poles, lqr_sweep(LATERAL, weights=WEIGHTS).poles)
+
+
+def test_monte_carlo_stack_with_shared_weights() -> None:
+    """A stack of plants, one B, Q and R shared by all: each equals its single solve."""
+    rng = np.random.default_rng(7)
+    A = np.repeat(LATERAL.A[np.newaxis], 50, axis=0)
+    A[:, 3, 0] *= 1 + 0.2 * rng.standard_normal(50)
+    original = A.copy()
+    batch = solve_care_batch(A, LATERAL.B, np.eye(4), np.eye(2))
+    np.testing.assert_array_equal(A, original)  # the inputs are not modified
+    for k in (0, 17, 49):
+        single = aerocontrol.solve_care(A[k], LATERAL.B, np.eye(4), np.eye(2))
+        assert np.array_equal(batch.X[k], single.X)
+        assert np.array_equal(batch.closed_loop_poles[k], single.closed_loop_poles)
+        assert batch.residual[k] == single.residual and batch.rcond[k] == single.rcond
+    assert len(batch) == 50
+
+
+def test_single_input_and_empty_sweeps() -> None:
+    rudder = lqr_sweep(LATERAL.A, LATERAL.B[:, 0], weights=[1.0, 2.0])
+    assert rudder.K.shape == (2, 1, 4)
+    K, _, _ = aerocontrol.lqr(LATERAL.A, LATERAL.B[:, :1], np.eye(4), np.eye(1))
+    assert np.array_equal(rudder.K[0], K)
+    empty = lqr_sweep(LATERAL, weights=np.array([]))
+    assert empty.K.shape == (0, 2, 4) and empty.poles.shape == (0, 4)
+
+
+def test_an_error_names_the_lowest_failing_index() -> None:
+    R = np.repeat(np.eye(2)[np.newaxis], 6, axis=0)
+    R[4, 0, 0] = -1.0
+    R[2, 1, 1] = 0.0
+    with pytest.raises(
+        aerocontrol.NotPositiveDefiniteError, match=r"^problem 2 of the batch: R must be"
+    ):
+        solve_care_batch(LATERAL.A, LATERAL.B, np.eye(4), R)
+    # No stabilising solution in problem 1 only (the chapter's undamped example, (6.5)).
+    A = np.array([[[-1.0, 0.0], [0.0, -2.0]], [[0.0, 1.0], [-1.0, 0.0]]])
+    with pytest.raises(aerocontrol.NoStabilizingSolutionError, match=r"^problem 1 of the batch"):
+        solve_care_batch(A, [[0.0], [1.0]], np.zeros((2, 2)), [[1.0]])
+    A_bad = np.repeat(LATERAL.A[np.newaxis], 3, axis=0)
+    A_bad[1, 2, 2] = np.nan
+    with pytest.raises(aerocontrol.NonFiniteError, match=r"^problem 1 of the batch: A must be"):
+        solve_care_batch(A_bad, LATERAL.B, np.eye(4), np.eye(2))
+
+
+@pytest.mark.parametrize(
+    ("arguments", "error", "message"),
+    [
+        ({"weights": [1.0, 0.0]}, aerocontrol.InvalidArgumentError, r"weights\[1\] = 0.0"),
+        ({"weights": [1.0, np.inf]}, aerocontrol.InvalidArgumentError, r"weights\[1\] = inf"),
+        ({"weights": [[1.0]]}, aerocontrol.ShapeError, "weights must be a 1-D array"),
+        ({}, aerocontrol.InvalidArgumentError, "weights must be given"),
+        ({"weights": [1.0], "R": np.ones((2, 2, 2))}, aerocontrol.ShapeError, "R must be one"),
+    ],
+)
+def test_bad_sweep_arguments(arguments: dict[str, object], error: type, message: str) -> None:
+    with pytest.raises(error, match=message):
+        lqr_sweep(LATERAL, **arguments)  # type: ignore[arg-type]
+
+
+def test_stacks_must_agree() -> None:
+    A = np.repeat(LATERAL.A[np.newaxis], 3, axis=0)
+    R = np.repeat(np.eye(2)[np.newaxis], 2, axis=0)
+    with pytest.raises(aerocontrol.ShapeError, match=r"R must have one matrix, or as many matrices as A \(3\), got 2"):
+        solve_care_batch(A, LATERAL.B, np.eye(4), R)
+    with pytest.raises(aerocontrol.ShapeError, match=r"A must be a matrix .* or a 3-D stack"):
+        solve_care_batch(np.zeros((1, 1, 4, 4)), LATERAL.B, np.eye(4), np.eye(2))
