@@ -44,6 +44,7 @@ __all__ = [
     "label",
     "penalty_terms",
     "plot_bode",
+    "plot_levels",
     "plot_modes",
     "plot_open_closed",
     "plot_penalty",
@@ -382,6 +383,52 @@ def plot_bode(result: FrequencyResponse, ax: Any = None, output: int = 0, input:
         axis.grid(True, which="both", alpha=0.3)
     magnitude_axis.legend(loc="best", fontsize="small")
     return magnitude_axis, phase_axis
+
+
+_LEVEL_COLOURS = ("0.8", "#4daf4a", "#ffd92f", "#ff7f00", "#e41a1c")
+_LEVEL_NAMES = ("not assessed", "Level 1", "Level 2", "Level 3", "worse than Level 3")
+
+
+def _edges(centres: FloatArray) -> FloatArray:
+    """Cell edges around grid points: midpoints, the ends mirrored (±5 % for one point)."""
+    if len(centres) == 1:
+        half = 0.05 * abs(centres[0]) or 0.5
+        return np.array([centres[0] - half, centres[0] + half])
+    middle = 0.5 * (centres[1:] + centres[:-1])
+    return np.concatenate([[2 * centres[0] - middle[0]], middle, [2 * centres[-1] - middle[-1]]])
+
+
+def plot_levels(
+    machs: Any, altitudes: Any, levels: Any, ax: Any = None, title: str = "Levels"
+) -> Any:
+    """MIL-F-8785C Levels over a grid of flight conditions: one cell per (Mach, altitude),
+    coloured and labelled by its Level (0: not assessed). ``levels`` is (len(altitudes),
+    len(machs)). Returns the axes."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.patches import Patch
+
+    x, y = np.asarray(real_array(machs, "machs")), np.asarray(real_array(altitudes, "altitudes"))
+    values = np.asarray(levels)
+    if values.shape != (len(y), len(x)):
+        raise ShapeError(
+            f"levels must be (len(altitudes), len(machs)) = ({len(y)}, {len(x)}), "
+            f"got shape {values.shape}"
+        )
+    ax = _new_axes() if ax is None else ax
+    colours = ListedColormap(_LEVEL_COLOURS)
+    ax.pcolormesh(
+        _edges(x), _edges(y), values, cmap=colours, norm=BoundaryNorm(np.arange(-0.5, 5), 5)
+    )
+    if values.size <= 400:
+        for (i, j), level in np.ndenumerate(values):
+            ax.text(x[j], y[i], str(level), ha="center", va="center", fontsize="small")
+    present = sorted(set(values.ravel().tolist()))
+    handles = [Patch(color=_LEVEL_COLOURS[v], label=_LEVEL_NAMES[v]) for v in present]
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
+    ax.set_xlabel("Mach number")
+    ax.set_ylabel("altitude")
+    ax.set_title(title)
+    return ax
 
 
 def plot_modes(modes: Modes, ax: Any = None, marker: str = "x", suffix: str = "") -> Any:

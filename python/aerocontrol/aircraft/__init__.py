@@ -16,6 +16,7 @@ mode ...
 from __future__ import annotations
 
 from .atmosphere import Atmosphere, standard_atmosphere
+from .envelope import Envelope, envelope_sweep
 from .model import (
     LATERAL_DERIVATIVES,
     LONGITUDINAL_DERIVATIVES,
@@ -33,9 +34,11 @@ __all__ = [
     "Aircraft",
     "AircraftDataError",
     "Atmosphere",
+    "Envelope",
     "available",
     "body_to_stability",
     "classify_modes",
+    "envelope_sweep",
     "load",
     "name_modes",
     "standard_atmosphere",

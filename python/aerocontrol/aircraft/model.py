@@ -52,6 +52,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validation import real_scalar
 from ..exceptions import InvalidArgumentError
 from ..modal import Modes, modes
 from ..statespace import StateSpace
@@ -451,6 +452,79 @@ class Aircraft:
             return self.lateral()
         raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
 
+    # ------------------------------------------------------------------------------------
+    # Other flight conditions
+    # ------------------------------------------------------------------------------------
+
+    def at(
+        self,
+        altitude: float | None = None,
+        mach: float | None = None,
+        weight: float | None = None,
+    ) -> Aircraft:
+        """The same aircraft at another flight condition, trimmed in steady flight at the
+        same flight-path angle Θ0.
+
+        What changes: the density and speed of sound (1976 standard atmosphere at the new
+        altitude; a density given in the file applies to its own altitude only), the speed
+        u0 = M a, the mass, the lift coefficient that trims the new condition (CL ∝ W / q̄, the
+        file's CL scaled, so that ``at()`` with no argument is the file's condition exactly),
+        and the drag coefficient from the parabolic polar CD = CD0 + k CL² through the file's
+        point with the file's slope dCD/dCL = CD_alpha / CL_alpha (so
+        k = CD_alpha / (2 CL CL_alpha)). What does not: every other nondimensional
+        derivative, the inertias and the geometry. That is the usual first approximation
+        near the file's condition; away from it (other Mach regime, other configuration)
+        give the derivatives of that condition in a file of its own.
+
+        Parameters
+        ----------
+        altitude : float, optional
+            Geometric altitude in the file's length unit (ft or m); the file's when None.
+        mach : float, optional
+            Mach number; the file's when None.
+        weight : float, optional
+            Weight in the file's force unit (lbf or N); the file's when None.
+
+        Examples
+        --------
+        >>> from aerocontrol import aircraft
+        >>> b747 = aircraft.load()
+        >>> higher = b747.at(altitude=10_000.0)          # same Mach, thinner air
+        >>> round(higher.derivatives["CL"] / b747.derivatives["CL"], 4)   # 1 / (ρ a² ratio)
+        1.4539
+        """
+        density, speed_of_sound = self.density, self.speed / self.mach
+        new_altitude = self.altitude if altitude is None else _finite(altitude, "altitude")
+        if new_altitude != self.altitude:
+            atmosphere = standard_atmosphere(new_altitude, self.units)
+            density, speed_of_sound = atmosphere.density, atmosphere.speed_of_sound
+        new_mach = self.mach if mach is None else _positive(mach, "mach")
+        mass = self.mass if weight is None else _positive(weight, "weight") / self.gravity
+        speed = new_mach * speed_of_sound
+        c = dict(self.derivatives)
+        # CL ∝ W / q̄ at a fixed Θ0; scaling the file's CL reproduces the file at its own
+        # condition exactly.
+        lift = c["CL"] * (mass / self.mass) * (self.density * self.speed**2) / (density * speed**2)
+        k = max(c["CD_alpha"] / (2.0 * c["CL"] * c["CL_alpha"]), 0.0) if c["CL_alpha"] else 0.0
+        drag_zero = c["CD"] - k * c["CL"] ** 2
+        c["CL"], c["CD"] = lift, drag_zero + k * lift**2
+        names = _UNIT_NAMES[self.units]
+        condition = (
+            f"M = {new_mach:.3g}, {new_altitude:g} {names['length']}, "
+            f"W = {mass * self.gravity:.6g} {names['force']}"
+        )
+        return replace(
+            self,
+            name=f"{self.name.split(' @ ')[0]} @ {condition}",
+            altitude=new_altitude,
+            density=density,
+            mach=new_mach,
+            speed=speed,
+            mass=mass,
+            derivatives=c,
+            published={},
+        )
+
     def summary(self) -> str:
         """A few lines: the flight condition, mass and geometry, in the file's units."""
         names = _UNIT_NAMES[self.units]
@@ -461,6 +535,20 @@ class Aircraft:
             f"W = {self.mass * self.gravity:.6g} {names['force']}; class {self.aircraft_class}, "
             f"category {self.category}"
         )
+
+
+def _finite(value: Any, name: str) -> float:
+    number = real_scalar(value, name)
+    if not math.isfinite(number):
+        raise InvalidArgumentError(f"{name} must be finite, got {number}")
+    return number
+
+
+def _positive(value: Any, name: str) -> float:
+    number = _finite(value, name)
+    if number <= 0:
+        raise InvalidArgumentError(f"{name} must be positive, got {number:g}")
+    return number
 
 
 def body_to_stability(

@@ -1,0 +1,163 @@
+"""The flight envelope swept in one call: a grid of flight conditions (altitude, Mach, weight)
+-> the models -> the modes -> the MIL-F-8785C Levels.
+
+Each condition is the aircraft file's condition moved by :meth:`Aircraft.at` (standard
+atmosphere, trimmed CL, CD from the polar, the other derivatives held), or the aircraft a
+caller's ``derivatives`` function returns for it (for derivatives tabulated over Mach, say).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import handling
+from .._validation import real_array
+from ..exceptions import AerocontrolError, InvalidArgumentError, ShapeError
+from ..modal import modes
+from .model import Aircraft
+from .naming import classify_modes
+
+__all__ = ["Envelope", "envelope_sweep"]
+
+#: What a condition's Level is when it could not be assessed (see ``Envelope.failures``).
+NOT_ASSESSED = 0
+
+
+@dataclass(frozen=True, eq=False)
+class Envelope:
+    """The Levels of each mode over a grid of flight conditions.
+
+    Arrays are indexed [altitude, Mach, weight].
+    """
+
+    altitudes: NDArray[np.float64]
+    machs: NDArray[np.float64]
+    weights: NDArray[np.float64]
+    aircraft_class: str
+    category: str
+    length_unit: str
+    """The unit of the altitudes ("ft" or "m")."""
+    levels: dict[str, NDArray[np.int_]]
+    """The Level of each mode (1-4) at each condition; 0 where it was not assessed."""
+    eigenvalues: dict[str, NDArray[np.complex128]]
+    """Each mode's eigenvalue with Im >= 0 (the larger real root of a split pair)."""
+    failures: dict[tuple[int, int, int], str]
+    """Conditions whose model or modes could not be assessed, with the reason."""
+
+    @property
+    def worst(self) -> NDArray[np.int_]:
+        """The worst Level over the modes at each condition (0 where none was assessed)."""
+        worst: NDArray[np.int_] = np.stack(list(self.levels.values())).max(axis=0)
+        return worst
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return (len(self.altitudes), len(self.machs), len(self.weights))
+
+    def table(self) -> str:
+        """One row per condition: altitude, Mach, weight and each mode's Level."""
+        modes_ = list(self.levels)
+        header = ["altitude", "Mach", "weight", *modes_, "worst"]
+        lines = ["  ".join(f"{h:>12}" for h in header)]
+        worst = self.worst
+        for index in np.ndindex(self.shape):
+            i, j, k = index
+            cells = [f"{self.altitudes[i]:12g}", f"{self.machs[j]:12.3g}", f"{self.weights[k]:12g}"]
+            cells += [f"{self.levels[m][index]:>12d}" for m in modes_]
+            cells.append(f"{worst[index]:>12d}")
+            lines.append("  ".join(cells))
+        return "\n".join(lines)
+
+    def plot(self, ax: Any = None, mode: str | None = None, weight: int = 0) -> Any:
+        """The Levels over Mach (x) and altitude (y) at one weight of the grid: the worst over
+        the modes, or one ``mode``'s. Returns the axes."""
+        from ..plotting import plot_levels
+
+        values = self.worst if mode is None else self.levels[mode]
+        title = f"{'worst mode' if mode is None else mode}, W = {self.weights[weight]:g}"
+        ax = plot_levels(self.machs, self.altitudes, values[:, :, weight], ax=ax, title=title)
+        ax.set_ylabel(f"altitude ({self.length_unit})")
+        return ax
+
+
+def _grid(values: Any, name: str, default: float) -> NDArray[np.float64]:
+    if values is None:
+        return np.array([default])
+    grid = np.atleast_1d(real_array(values, name)).astype(np.float64)
+    if grid.ndim != 1 or grid.size == 0:
+        raise ShapeError(f"{name} must be a non-empty 1-D array, got shape {grid.shape}")
+    if not np.all(np.isfinite(grid)):
+        raise InvalidArgumentError(f"{name} must be finite")
+    return grid
+
+
+def envelope_sweep(
+    plane: Aircraft,
+    altitudes: Sequence[float] | NDArray[np.float64] | None = None,
+    machs: Sequence[float] | NDArray[np.float64] | None = None,
+    weights: Sequence[float] | NDArray[np.float64] | None = None,
+    derivatives: Callable[[Aircraft], Aircraft] | None = None,
+) -> Envelope:
+    """The modes and MIL-F-8785C Levels of ``plane`` at every combination of the given
+    altitudes, Mach numbers and weights (each defaults to the file's own value).
+
+    ``derivatives``, if given, receives each condition's aircraft (from :meth:`Aircraft.at`)
+    and returns the aircraft to analyse there, e.g. with Mach-dependent derivatives put in
+    with ``dataclasses.replace``. A condition whose model cannot be built or whose modes
+    cannot be named is recorded in ``failures`` (Level 0) and the sweep goes on.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from aerocontrol import aircraft
+    >>> b747 = aircraft.load()
+    >>> env = aircraft.envelope_sweep(b747, altitudes=[0, 5000, 10000],
+    ...                               machs=[0.2, 0.25, 0.3], weights=[500e3, 564032])
+    >>> env.shape, env.levels["dutch roll"][0, 1, 1]     # the chapter's condition: Level 2
+    ((3, 3, 2), np.int64(2))
+    """
+    if not isinstance(plane, Aircraft):
+        raise InvalidArgumentError(f"plane must be an Aircraft, got {type(plane).__name__}")
+    altitude_grid = _grid(altitudes, "altitudes", plane.altitude)
+    mach_grid = _grid(machs, "machs", plane.mach)
+    weight_grid = _grid(weights, "weights", plane.mass * plane.gravity)
+    shape = (len(altitude_grid), len(mach_grid), len(weight_grid))
+    levels = {mode: np.zeros(shape, dtype=np.int_) for mode in handling.MODES}
+    eigenvalues = {mode: np.full(shape, np.nan + 0j) for mode in handling.MODES}
+    failures: dict[tuple[int, int, int], str] = {}
+    for index in np.ndindex(shape):
+        i, j, k = index
+        try:
+            condition = plane.at(altitude_grid[i], mach_grid[j], weight_grid[k])
+            if derivatives is not None:
+                condition = derivatives(condition)
+            named = {
+                **classify_modes(modes(condition.longitudinal().A), "longitudinal"),
+                **classify_modes(modes(condition.lateral().A), "lateral"),
+            }
+            assessable = {key: value for key, value in named.items() if key in levels}
+            assessed = handling.assess(assessable, plane.aircraft_class, plane.category)
+        except AerocontrolError as error:
+            failures[index] = str(error)
+            continue
+        for mode, level in assessed.levels.items():
+            levels[mode][index] = level
+            eigenvalues[mode][index] = max(named[mode], key=lambda v: (v.imag, v.real))
+        if "roll-spiral" in named:
+            failures[index] = "roll and spiral coupled (3.3.1.4): not assessed"
+    return Envelope(
+        altitude_grid,
+        mach_grid,
+        weight_grid,
+        plane.aircraft_class,
+        plane.category,
+        "ft" if plane.units == "english" else "m",
+        levels,
+        eigenvalues,
+        failures,
+    )

@@ -1,0 +1,135 @@
+"""Other flight conditions of an aircraft (Aircraft.at) and the envelope sweep of its Levels."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+
+import aerocontrol
+from aerocontrol import aircraft, handling
+from aerocontrol.aircraft.naming import classify_modes
+
+B747 = aircraft.load()
+WEIGHT = B747.mass * B747.gravity
+
+
+def _levels(plane: aircraft.Aircraft) -> dict[str, int]:
+    named = {
+        **classify_modes(plane.modes("longitudinal"), "longitudinal"),
+        **classify_modes(plane.modes("lateral"), "lateral"),
+    }
+    return handling.assess(named, plane.aircraft_class, plane.category).levels
+
+
+def test_at_its_own_condition_is_the_file() -> None:
+    same = B747.at()
+    assert same.derivatives == B747.derivatives
+    assert np.array_equal(same.longitudinal().A, B747.longitudinal().A)
+    assert np.array_equal(same.lateral().B, B747.lateral().B)
+
+
+def test_at_another_condition_trims_and_follows_the_polar() -> None:
+    """Standard atmosphere at the new altitude, u0 = M a, CL ∝ W / q̄, CD on the polar through
+    the file's point with the file's slope dCD/dCL = CD_alpha / CL_alpha."""
+    moved = B747.at(altitude=15_000.0, mach=0.4, weight=0.8 * WEIGHT)
+    air = aircraft.standard_atmosphere(15_000.0, "english")
+    assert moved.density == air.density
+    assert moved.speed == pytest.approx(0.4 * air.speed_of_sound, rel=1e-15)
+    q_file = 0.5 * B747.density * B747.speed**2
+    q_new = 0.5 * air.density * moved.speed**2
+    assert moved.derivatives["CL"] * q_new == pytest.approx(
+        0.8 * B747.derivatives["CL"] * q_file, rel=1e-14
+    )
+    c = B747.derivatives
+    k = c["CD_alpha"] / (2 * c["CL"] * c["CL_alpha"])
+    CD0 = c["CD"] - k * c["CL"] ** 2
+    assert moved.derivatives["CD"] == pytest.approx(CD0 + k * moved.derivatives["CL"] ** 2)
+    unchanged = {key for key in c if key not in ("CL", "CD")}
+    assert all(moved.derivatives[key] == c[key] for key in unchanged)
+    assert (moved.Ix, moved.Iz, moved.S) == (B747.Ix, B747.Iz, B747.S)
+    assert moved.name == "Boeing 747, powered approach @ M = 0.4, 15000 ft, W = 451226 lbf"
+    assert moved.published == {}
+    # The chapter's Xu = -ρ S u0 CD / m (6.48 with CD_M = 0) at the new condition.
+    Xu = -moved.density * moved.S * moved.speed * moved.derivatives["CD"] / moved.mass
+    assert moved.dimensional_longitudinal()["Xu"] == pytest.approx(Xu, rel=1e-14)
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ({"mach": -0.2}, "mach must be positive, got -0.2"),
+        ({"weight": 0.0}, "weight must be positive, got 0"),
+        ({"altitude": math.nan}, "altitude must be finite"),
+        ({"altitude": "high"}, "altitude must be an array of real numbers"),
+    ],
+)
+def test_at_rejects_bad_conditions(arguments: dict[str, object], message: str) -> None:
+    with pytest.raises(aerocontrol.AerocontrolError, match=message):
+        B747.at(**arguments)  # type: ignore[arg-type]
+
+
+def test_envelope_sweep_matches_each_condition_alone() -> None:
+    altitudes, machs, weights = [0.0, 8_000.0, 16_000.0], [0.2, B747.mach, 0.4], [WEIGHT]
+    env = aircraft.envelope_sweep(B747, altitudes, machs, weights)
+    assert env.shape == (3, 3, 1) and env.failures == {}
+    for index in np.ndindex(env.shape):
+        i, j, k = index
+        expected = _levels(B747.at(altitudes[i], machs[j], weights[k]))
+        assert {mode: int(env.levels[mode][index]) for mode in expected} == expected
+        assert env.worst[index] == max(expected.values())
+    # The chapter's own condition: Dutch roll Level 2 (ζ ω_n = 0.081 < 0.10), eigenvalue (6.152).
+    assert env.levels["dutch roll"][0, 1, 0] == 2
+    assert env.eigenvalues["dutch roll"][0, 1, 0] == pytest.approx(-0.08066 + 0.74331j, abs=1e-5)
+    assert "dutch roll" in env.table().splitlines()[0]
+    assert len(env.table().splitlines()) == 1 + 9
+
+
+def test_envelope_sweep_with_derivatives_and_failures() -> None:
+    """The caller's derivatives per condition are used, and a condition that fails is
+    recorded with its reason while the sweep goes on."""
+
+    def bigger_fin(plane: aircraft.Aircraft) -> aircraft.Aircraft:
+        if plane.mach > 0.35:
+            raise aerocontrol.InvalidArgumentError("no data above M = 0.35")
+        return dataclasses.replace(
+            plane, derivatives={**plane.derivatives, "Cn_beta": 1.2 * plane.derivatives["Cn_beta"]}
+        )
+
+    env = aircraft.envelope_sweep(B747, machs=[B747.mach, 0.4], derivatives=bigger_fin)
+    direct = dataclasses.replace(
+        B747, derivatives={**B747.derivatives, "Cn_beta": 1.2 * B747.derivatives["Cn_beta"]}
+    )
+    named = classify_modes(direct.modes("lateral"), "lateral")
+    assert env.eigenvalues["dutch roll"][0, 0, 0] == named["dutch roll"][0]
+    assert env.failures == {(0, 1, 0): "no data above M = 0.35"}
+    assert env.worst[0, 1, 0] == 0
+
+
+def test_envelope_plot() -> None:
+    env = aircraft.envelope_sweep(B747, altitudes=[0.0, 10_000.0], machs=[0.2, 0.3, 0.4])
+    ax = env.plot()
+    assert ax.get_ylabel() == "altitude (ft)" and ax.get_xlabel() == "Mach number"
+    assert sorted(t.get_text() for t in ax.texts) == sorted(
+        str(v) for v in env.worst[:, :, 0].ravel()
+    )
+    assert "worst mode" in ax.get_title()
+    ax = env.plot(mode="dutch roll")
+    assert ax.get_title().startswith("dutch roll")
+    with pytest.raises(aerocontrol.ShapeError, match="levels must be"):
+        aerocontrol.plotting.plot_levels([0.2], [0.0, 1.0], np.ones((3, 3)))
+    plt.close("all")
+
+
+def test_envelope_rejects_bad_grids() -> None:
+    with pytest.raises(aerocontrol.ShapeError, match="machs must be a non-empty 1-D array"):
+        aircraft.envelope_sweep(B747, machs=[])
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="plane must be an Aircraft"):
+        aircraft.envelope_sweep("b747-approach")  # type: ignore[arg-type]
