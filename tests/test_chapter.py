@@ -1,9 +1,13 @@
 """The chapter's numbered results reproduced through the public API, starting from the
 coefficients of the embedded Boeing 747 (../shared/reference/seed-values.md).
 
-The models themselves, (6.47) -> (6.48) -> (6.49) and (6.147) -> (6.148) -> (6.150), are checked
-in test_aircraft.py; here the analyses and designs that follow from them. Printed values carry
-four decimals: 2e-3 relative and half a unit in the last printed place.
+The models themselves, (6.47) -> (6.48) -> (6.49) and (6.147) -> (6.148) -> (6.150), and the
+modes (6.152)-(6.154) are checked in test_aircraft.py; here the analyses and designs that follow
+from them. Printed values carry four decimals: 2e-3 relative and half a unit in the last printed
+place. The chapter's abstract examples, which have no coefficients, are reproduced beside their
+algorithms: the controllability example (6.75)-(6.88) in test_controllability.py, the
+state-feedback example (6.94)-(6.102) in test_placement.py, the inverted pendulum (6.202)-(6.223)
+in test_riccati.py; the report (test_report.py) prints them beside the chapter's values.
 """
 
 from __future__ import annotations
@@ -108,9 +112,44 @@ def test_lqr_root_locus_matches_scipy(b747: aircraft.Aircraft) -> None:
     )
 
 
+@pytest.mark.parametrize("c", [0.001, 0.5, 1.0, 2.0])
+def test_lateral_regulator_against_scipy_and_control(b747: aircraft.Aircraft, c: float) -> None:
+    """(6.224)-(6.227): Q = I, R = I / c² on the model built from the coefficients, against
+    scipy and python-control (slycot) within 1e-10."""
+    import control
+
+    sys = b747.lateral()
+    K, X, poles = aerocontrol.lqr(sys, np.eye(4), np.eye(2) / c**2)
+    X_scipy = sl.solve_continuous_are(sys.A, sys.B, np.eye(4), np.eye(2) / c**2)
+    K_control, X_control, _ = control.lqr(sys.A, sys.B, np.eye(4), np.eye(2) / c**2)
+    for reference in (X_scipy, X_control):
+        assert np.linalg.norm(X - reference) <= 1e-10 * np.linalg.norm(reference)
+    assert np.linalg.norm(K - K_control) <= 1e-10 * np.linalg.norm(K_control)
+    np.testing.assert_allclose(
+        np.sort_complex(poles), np.sort_complex(np.linalg.eigvals(sys.A - sys.B @ K)), rtol=1e-12
+    )
+
+
+def test_performance_index_is_the_area_between_the_penalties(b747: aircraft.Aircraft) -> None:
+    """Figure 6.11: for a unit sideslip, J = x0^T X x0 equals the integral of x^T Q x + η^T R η
+    along the closed-loop response (Simpson's rule on 0.005 s over 120 s, within 1e-6)."""
+    sys = b747.lateral()
+    for c in (0.5, 1.0, 2.0):
+        R = np.eye(2) / c**2
+        K, X, _ = aerocontrol.lqr(sys, np.eye(4), R)
+        closed = aerocontrol.StateSpace(sys.A - sys.B @ K, sys.B)
+        t = np.linspace(0.0, 120.0, 24001)
+        response = aerocontrol.initial_response(closed, [1.0, 0.0, 0.0, 0.0], T=t)
+        state, control = aerocontrol.plotting.penalty_terms(response, K, np.eye(4), R)
+        f = state + control
+        integral = (t[1] - t[0]) / 3 * (f[0] + f[-1] + 4 * f[1:-1:2].sum() + 2 * f[2:-1:2].sum())
+        assert integral == pytest.approx(X[0, 0], rel=1e-6)
+
+
 def test_critical_weight_of_the_dutch_roll(b747: aircraft.Aircraft) -> None:
-    # The caption of Figure 6.12 says 9.7227 < c < 9.7228; its symbols sit at 9.7727 and
-    # 9.7728. The model from the coefficients puts the critical c between the symbols.
+    # The caption of Figure 6.12 says 9.7227 < c < 9.7228 and the text "approximately
+    # c = 9.973"; the figure's symbols sit at 9.7727 and 9.7728. The model from the
+    # coefficients puts the critical c between the symbols.
     c = design.critical_weight(b747.lateral())
     assert 9.7727 < c < 9.7728
     assert c == pytest.approx(9.772714283, rel=1e-8)
