@@ -8,6 +8,7 @@
 use crate::care::{CareOptions, solve_care};
 use crate::error::{Error, check_finite, check_output_len};
 use crate::expm::expm_into_validated;
+use crate::place::Placement;
 use faer::{MatMut, MatRef, c64};
 use rayon::prelude::*;
 
@@ -119,28 +120,34 @@ impl CareStacks<'_> {
     /// The number of problems k: the stacks that do not hold one matrix must all hold k (an
     /// empty stack makes an empty batch); k = 1 when every stack holds one.
     pub fn count(&self) -> Result<usize, Error> {
-        let stacks = [
+        batch_count(&[
             ("A", self.a.len()),
             ("B", self.b.len()),
             ("Q", self.q.len()),
             ("R", self.r.len()),
-        ];
-        let Some(&(first, count)) = stacks.iter().find(|&&(_, len)| len != 1) else {
-            return Ok(1);
-        };
-        for (arg, len) in stacks {
-            if len != 1 && len != count {
-                return Err(Error::Mismatch {
-                    arg,
-                    what: "one matrix, or as many matrices as",
-                    expected: count,
-                    other: first,
-                    got: len,
-                });
-            }
-        }
-        Ok(count)
+        ])
     }
+}
+
+/// The number of problems k of arguments that each hold one member (shared by every problem)
+/// or k: the arguments that do not hold one must all hold k (an empty argument makes an
+/// empty batch); k = 1 when every argument holds one.
+pub fn batch_count(lengths: &[(&'static str, usize)]) -> Result<usize, Error> {
+    let Some(&(first, count)) = lengths.iter().find(|&&(_, len)| len != 1) else {
+        return Ok(1);
+    };
+    for &(arg, len) in lengths {
+        if len != 1 && len != count {
+            return Err(Error::Mismatch {
+                arg,
+                what: "1 (shared by every problem) or as many problems as",
+                expected: count,
+                other: first,
+                got: len,
+            });
+        }
+    }
+    Ok(count)
 }
 
 /// The k-th matrix of a stack that holds one (shared) or k.
@@ -215,6 +222,90 @@ pub fn care_batch(
                     poles.copy_from_slice(&care.closed_loop_eigenvalues);
                     *residual = care.residual;
                     *rcond = care.rcond;
+                    None
+                }
+                Err(error) => Some((index, error)),
+            }
+        })
+        .min_by_key(|(index, _)| *index);
+    match failure {
+        Some((index, error)) => Err(Error::in_batch(index, error)),
+        None => Ok(()),
+    }
+}
+
+/// A pole-placement algorithm of [`crate::place`].
+pub type Placer = fn(MatRef<'_, f64>, MatRef<'_, f64>, &[c64]) -> Result<Placement, Error>;
+
+/// Where [`place_batch`] writes: for problem k, K (m x n) row-major at k m n, the achieved
+/// poles (in the order of the requested ones) at k n, the largest relative pole error and
+/// the condition number that bounds it (κ(V) of the single-input formulas, κ(X) of the
+/// robust method) at k.
+pub struct PlaceBatchOutput<'a> {
+    pub gain: &'a mut [f64],
+    pub achieved: &'a mut [c64],
+    pub max_relative_error: &'a mut [f64],
+    pub condition: &'a mut [f64],
+}
+
+/// Places the poles of every problem of a batch, in parallel, each exactly as `placer`
+/// places them alone. `a` and `b` hold one matrix (shared) or one per problem, `poles` one
+/// row of n requested poles (shared) or one per problem. If any problem fails, the error of
+/// the lowest index is returned, naming it.
+pub fn place_batch(
+    a: MatrixStack<'_>,
+    b: MatrixStack<'_>,
+    poles: &[c64],
+    placer: Placer,
+    out: PlaceBatchOutput<'_>,
+) -> Result<(), Error> {
+    let (n, m) = (a.rows, b.cols);
+    if n == 0 || m == 0 {
+        return Err(Error::InvalidArgument {
+            arg: "A, B",
+            message: format!(
+                "pole placement needs at least one state and one input, got n = {n}, m = {m}"
+            ),
+        });
+    }
+    if !poles.len().is_multiple_of(n) {
+        return Err(Error::InvalidArgument {
+            arg: "poles",
+            message: format!(
+                "poles must hold rows of n = {n} poles, got {} values",
+                poles.len()
+            ),
+        });
+    }
+    let rows = poles.len() / n;
+    let count = batch_count(&[("A", a.len()), ("B", b.len()), ("poles", rows)])?;
+    check_output_len(out.gain.len(), count * m * n)?;
+    check_output_len(out.achieved.len(), count * n)?;
+    check_output_len(out.max_relative_error.len(), count)?;
+    check_output_len(out.condition.len(), count)?;
+    let failure = out
+        .gain
+        .par_chunks_mut(m * n)
+        .zip(out.achieved.par_chunks_mut(n))
+        .zip(out.max_relative_error.par_iter_mut())
+        .zip(out.condition.par_iter_mut())
+        .enumerate()
+        .filter_map(|(index, (((gain, achieved), error), condition))| {
+            let row = if rows == 1 { 0 } else { index };
+            match placer(
+                member(&a, index),
+                member(&b, index),
+                &poles[row * n..(row + 1) * n],
+            ) {
+                Ok(design) => {
+                    MatMut::from_row_major_slice_mut(gain, m, n).copy_from(&design.gain);
+                    achieved.copy_from_slice(&design.achieved_poles);
+                    *error = design.max_relative_error;
+                    *condition = if design.controllability_condition.is_nan() {
+                        design.eigenvector_condition
+                    } else {
+                        design.controllability_condition
+                    };
                     None
                 }
                 Err(error) => Some((index, error)),
@@ -401,7 +492,7 @@ mod tests {
         let error = run(stacks, 3, 4, 2).err().unwrap();
         assert_eq!(
             error.to_string(),
-            "R must have one matrix, or as many matrices as Q (2), got 3"
+            "R must have 1 (shared by every problem) or as many problems as Q (2), got 3"
         );
     }
 
@@ -418,5 +509,72 @@ mod tests {
         };
         let o = run(stacks, 3, 2, 0).unwrap();
         assert_eq!(o.x, [0.5, 0.0, 0.0, 0.5].repeat(3));
+    }
+
+    #[test]
+    fn place_batch_equals_one_at_a_time_and_names_the_failing_index() {
+        use crate::place::{place, place_bass_gura};
+        let (a, b) = lateral();
+        let rudder: Vec<f64> = b.chunks(2).map(|row| row[0]).collect();
+        // Two designs per problem: move the Dutch roll to each damping ratio, keep the rest.
+        let designs = [0.2, 0.3, 0.5];
+        let poles: Vec<c64> = designs
+            .iter()
+            .flat_map(|zeta: &f64| {
+                let omega = 0.7477;
+                let (re, im) = (-zeta * omega, omega * (1.0 - zeta * zeta).sqrt());
+                [
+                    c64::new(re, im),
+                    c64::new(re, -im),
+                    c64::new(-1.2308, 0.0),
+                    c64::new(-0.04641, 0.0),
+                ]
+            })
+            .collect();
+        let a_stack = MatrixStack::new(&a, 1, 4, 4).unwrap();
+        for (input, placer, m) in [
+            (&rudder[..], place_bass_gura as Placer, 1),
+            (&b[..], place as Placer, 2),
+        ] {
+            let b_stack = MatrixStack::new(input, 1, 4, m).unwrap();
+            let (mut gain, mut achieved) = (vec![0.0; 3 * m * 4], vec![c64::new(0.0, 0.0); 12]);
+            let (mut error, mut condition) = (vec![0.0; 3], vec![0.0; 3]);
+            let out = PlaceBatchOutput {
+                gain: &mut gain,
+                achieved: &mut achieved,
+                max_relative_error: &mut error,
+                condition: &mut condition,
+            };
+            place_batch(a_stack, b_stack, &poles, placer, out).unwrap();
+            for k in 0..3 {
+                let single =
+                    placer(a_stack.get(0), b_stack.get(0), &poles[4 * k..4 * k + 4]).unwrap();
+                for row in 0..m {
+                    for col in 0..4 {
+                        assert_eq!(gain[k * m * 4 + row * 4 + col], single.gain[(row, col)]);
+                    }
+                }
+                assert_eq!(&achieved[4 * k..4 * k + 4], &single.achieved_poles[..]);
+                assert_eq!(error[k], single.max_relative_error);
+                assert!(error[k] < 1e-10 && condition[k].is_finite());
+            }
+        }
+        // A complex pole without its conjugate in problem 1 of 3.
+        let mut broken = poles.clone();
+        broken[5] = c64::new(-0.2, 0.5);
+        let b_stack = MatrixStack::new(&rudder, 1, 4, 1).unwrap();
+        let (mut gain, mut achieved) = (vec![0.0; 12], vec![c64::new(0.0, 0.0); 12]);
+        let (mut error, mut condition) = (vec![0.0; 3], vec![0.0; 3]);
+        let out = PlaceBatchOutput {
+            gain: &mut gain,
+            achieved: &mut achieved,
+            max_relative_error: &mut error,
+            condition: &mut condition,
+        };
+        let failure = place_batch(a_stack, b_stack, &broken, place_bass_gura, out).unwrap_err();
+        assert!(
+            matches!(failure, Error::InBatch { index: 1, .. }),
+            "{failure}"
+        );
     }
 }

@@ -13,7 +13,8 @@
 //! failed) into a Python exception instead of unwinding into the interpreter.
 
 use crate::batch::{
-    CareBatchOutput, CareStacks, MatrixStack, care_batch as care_batch_core, expm_batch,
+    CareBatchOutput, CareStacks, MatrixStack, PlaceBatchOutput, Placer, batch_count,
+    care_batch as care_batch_core, expm_batch, place_batch as place_batch_core,
 };
 use crate::care::{CareOptions, solve_care as solve_care_core};
 use crate::ctrb::{
@@ -1052,6 +1053,69 @@ fn place<'py>(
     ))
 }
 
+/// Pole placement over a batch, in parallel with the GIL released: A (k or 1, n, n),
+/// B (k or 1, n, m), poles (k or 1, n) complex, `method` as for `place`. Returns K (k, m, n),
+/// the achieved poles (k, n), the largest relative pole errors (k,) and the condition numbers
+/// (k,); an error names the lowest failing index.
+#[pyfunction]
+#[pyo3(signature = (a, b, poles, method, /))]
+#[allow(clippy::type_complexity)]
+fn place_batch<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    poles: &Bound<'py, PyAny>,
+    method: &str,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+)> {
+    let placer: Placer = match method {
+        "bass-gura" => place_bass_gura,
+        "ackermann" => place_ackermann,
+        "knv0" => place_core,
+        other => {
+            return Err(raise(
+                py,
+                "InvalidArgumentError",
+                format!("unknown placement method {other:?}"),
+            ));
+        }
+    };
+    let (a, [ka, n, na]) = stack_values(py, a, "A")?;
+    let (b, [kb, nb, m]) = stack_values(py, b, "B")?;
+    let requested = copy_complex(poles.cast::<PyArrayDyn<c64>>()?)?;
+    let (a_stack, b_stack) = (|| {
+        Ok::<_, Error>((
+            MatrixStack::new(&a, ka, n, na)?,
+            MatrixStack::new(&b, kb, nb, m)?,
+        ))
+    })()
+    .map_err(|e| to_py_err(py, e))?;
+    let rows = requested.len().checked_div(n).unwrap_or(0);
+    let count =
+        batch_count(&[("A", ka), ("B", kb), ("poles", rows)]).map_err(|e| to_py_err(py, e))?;
+    entries(&[count, m.max(1), n])?;
+    let gain = new_array::<f64>(py, &[count, m, n])?;
+    let achieved = new_array::<c64>(py, &[count, n])?;
+    let error = new_array::<f64>(py, &[count])?;
+    let condition = new_array::<f64>(py, &[count])?;
+    // SAFETY: the arrays are new and not visible to Python until returned.
+    let out = unsafe {
+        PlaceBatchOutput {
+            gain: new_array_data(&gain),
+            achieved: new_array_data(&achieved),
+            max_relative_error: new_array_data(&error),
+            condition: new_array_data(&condition),
+        }
+    };
+    py.detach(|| guarded(|| place_batch_core(a_stack, b_stack, &requested, placer, out)))?
+        .map_err(|e| to_py_err(py, e))?;
+    Ok((gain, achieved, error, condition))
+}
+
 /// The real Schur form A = Z T Z^T, reordered when `select` (a callable on an eigenvalue,
 /// called once per diagonal block) is given: (T, Z, eigenvalues, number selected).
 #[pyfunction]
@@ -1325,6 +1389,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve_lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(solve_care, m)?)?;
     m.add_function(wrap_pyfunction!(care_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(place_batch, m)?)?;
     m.add_function(wrap_pyfunction!(riccati_ode, m)?)?;
     m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
     m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;

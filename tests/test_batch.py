@@ -101,7 +101,76 @@ def test_bad_sweep_arguments(arguments: dict[str, object], error: type, message:
 def test_stacks_must_agree() -> None:
     A = np.repeat(LATERAL.A[np.newaxis], 3, axis=0)
     R = np.repeat(np.eye(2)[np.newaxis], 2, axis=0)
-    with pytest.raises(aerocontrol.ShapeError, match=r"R must have one matrix, or as many matrices as A \(3\), got 2"):
+    with pytest.raises(
+        aerocontrol.ShapeError,
+        match=r"R must have 1 \(shared by every problem\) or as many problems as A \(3\), got 2",
+    ):
         solve_care_batch(A, LATERAL.B, np.eye(4), R)
     with pytest.raises(aerocontrol.ShapeError, match=r"A must be a matrix .* or a 3-D stack"):
         solve_care_batch(np.zeros((1, 1, 4, 4)), LATERAL.B, np.eye(4), np.eye(2))
+
+
+def _damper_poles(zetas: np.ndarray) -> np.ndarray:
+    """The chapter's damper request (6.156) for each damping ratio: the Dutch roll moved to
+    ζ at its ω_n, the roll and spiral roots kept."""
+    open_loop = aerocontrol.modes(LATERAL.A)
+    rows = [aerocontrol.augment_mode(open_loop, 1, zeta=float(z)) for z in zetas]
+    return np.array(rows)
+
+
+@pytest.mark.parametrize(
+    ("method", "single", "inputs"),
+    [
+        ("bass-gura", aerocontrol.place_bass_gura, [0]),
+        ("ackermann", aerocontrol.place_ackermann, [1]),
+        ("knv", aerocontrol.place, [0, 1]),
+    ],
+)
+def test_place_batch_equals_one_at_a_time(method: str, single: object, inputs: list[int]) -> None:
+    poles = _damper_poles(np.linspace(0.15, 0.6, 12))
+    B = LATERAL.B[:, inputs]
+    batch = aerocontrol.batch.place_batch(LATERAL.A, B, poles, method)
+    assert batch.K.shape == (12, len(inputs), 4) and len(batch) == 12
+    for k in (0, 5, 11):
+        design = single(LATERAL.A, B, poles[k])  # type: ignore[operator]
+        assert np.array_equal(batch.K[k], design.K)
+        assert np.array_equal(batch.achieved_poles[k], design.achieved_poles)
+        assert batch.max_relative_error[k] == design.max_relative_error
+    assert batch.max_relative_error.max() < 1e-10
+
+
+def test_place_batch_over_plants_with_shared_poles() -> None:
+    rng = np.random.default_rng(3)
+    A = np.repeat(LATERAL.A[np.newaxis], 20, axis=0)
+    A[:, 1, 0] *= 1 + 0.1 * rng.standard_normal(20)  # L'_beta, the dihedral effect, ±10 %
+    poles = _damper_poles(np.array([0.3]))[0]
+    batch = aerocontrol.batch.place_batch(A, LATERAL.B[:, 0], poles, "bass-gura")
+    for k in range(20):
+        closed = A[k] - np.outer(LATERAL.B[:, 0], batch.K[k, 0])
+        np.testing.assert_allclose(
+            np.sort_complex(np.linalg.eigvals(closed)), np.sort_complex(poles), rtol=1e-10
+        )
+
+
+def test_place_batch_errors_name_the_problem() -> None:
+    poles = _damper_poles(np.array([0.2, 0.3, 0.4]))
+    poles[2, 0] = -0.2 + 0.5j  # its conjugate is missing
+    with pytest.raises(aerocontrol.InvalidArgumentError, match=r"^problem 2 of the batch"):
+        aerocontrol.batch.place_batch(LATERAL.A, LATERAL.B[:, 0], poles, "bass-gura")
+    B = np.repeat(LATERAL.B[np.newaxis, :, :1], 3, axis=0)
+    B[1] = [[-1.0], [1.0], [0.0], [0.0]]
+    A = np.repeat(
+        np.array([[[0.0, 1.0, 0, 0], [-2, -3, 0, 0], [0, 0, -1, 0], [0, 0, 0, -4]]]), 3, 0
+    )
+    A[[0, 2]] = LATERAL.A
+    with pytest.raises(aerocontrol.UncontrollableError, match=r"^problem 1 of the batch"):
+        aerocontrol.batch.place_batch(A, B, [-1, -2, -3, -5], "knv")
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="method must be one of"):
+        aerocontrol.batch.place_batch(LATERAL.A, LATERAL.B, poles[0], "lqr")
+    with pytest.raises(aerocontrol.ShapeError, match=r"poles must be \(n,\) or \(k, n\)"):
+        aerocontrol.batch.place_batch(LATERAL.A, LATERAL.B, np.ones((1, 1, 4)))
+    with pytest.raises(
+        aerocontrol.ShapeError,
+        match=r"poles must have 1 \(shared by every problem\) or as many problems as A \(3\)",
+    ):
+        aerocontrol.batch.place_batch(A, B, poles[:2])

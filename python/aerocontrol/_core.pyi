@@ -26,6 +26,7 @@ __all__ = [
     "krylov_matrix",
     "modal_analysis",
     "place",
+    "place_batch",
     "riccati_ode",
     "schur",
     "simulate",
@@ -127,6 +128,18 @@ def care_batch(
     /,
 ) -> tuple[
     NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.complex128],
+    NDArray[np.float64],
+    NDArray[np.float64],
+]: ...
+def place_batch(
+    a: ArrayLike,
+    b: ArrayLike,
+    poles: NDArray[np.complex128],
+    method: str,
+    /,
+) -> tuple[
     NDArray[np.float64],
     NDArray[np.complex128],
     NDArray[np.float64],

@@ -8,7 +8,9 @@ solves it alone, so the results are bitwise the one-at-a-time results).
 
 * :func:`solve_care_batch`: stacks of (A, B, Q, R); any of them may be one matrix shared by
   every problem;
-* :func:`lqr_sweep`: one model over an array of the chapter's weights c, R/c² (6.226).
+* :func:`lqr_sweep`: one model over an array of the chapter's weights c, R/c² (6.226);
+* :func:`place_batch`: pole placement over stacks of (A, B, poles), by Bass-Gura (6.145),
+  Ackermann or Kautsky-Nichols-Van Dooren method 0.
 
 An error in one problem raises the exception of that problem with its index ("problem 7 of
 the batch: ..."), the lowest failing index when several fail; nothing partial is returned.
@@ -26,10 +28,11 @@ from numpy.typing import NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
+from .placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
 from .riccati import RCOND_WARNING, RESIDUAL_WARNING
 from .statespace import StateSpace, as_state_space
 
-__all__ = ["CareBatch", "LqrSweep", "lqr_sweep", "solve_care_batch"]
+__all__ = ["CareBatch", "LqrSweep", "PlaceBatch", "lqr_sweep", "place_batch", "solve_care_batch"]
 
 ComplexArray = NDArray[np.complex128]
 
@@ -72,6 +75,95 @@ class LqrSweep:
 
     def __len__(self) -> int:
         return len(self.weights)
+
+
+@dataclass(frozen=True, eq=False)
+class PlaceBatch:
+    """State-feedback designs η = -K_i x over a batch, problem index first."""
+
+    K: FloatArray
+    """The gains, (k, m, n)."""
+    achieved_poles: ComplexArray
+    """The eigenvalues of A_i - B_i K_i in the order of the requested poles (conjugate pairs
+    adjacent, Im > 0 first), (k, n)."""
+    max_relative_error: FloatArray
+    """The largest relative error of an achieved pole, per problem, (k,)."""
+    condition: FloatArray
+    """κ(V) of the single-input formulas or κ_2(X) of the robust method, per problem, (k,)."""
+
+    def __len__(self) -> int:
+        return int(self.K.shape[0])
+
+
+_METHODS = {"bass-gura": "bass-gura", "ackermann": "ackermann", "knv": "knv0"}
+
+
+def place_batch(A: Any, B: Any, poles: Any, method: str = "knv") -> PlaceBatch:
+    """Pole placement for every problem of a batch, in parallel, each exactly as the single
+    function places it (:func:`aerocontrol.place_bass_gura`, :func:`aerocontrol.place_ackermann`
+    or :func:`aerocontrol.place`).
+
+    Parameters
+    ----------
+    A : array_like (n, n) or (k, n, n)
+    B : array_like (n, m) or (k, n, m); (n,) for one input
+    poles : array_like (n,) or (k, n)
+        The requested poles, complex ones in conjugate pairs; one row shared or one per
+        problem.
+    method : "knv" (default, any m), "bass-gura" or "ackermann" (one input)
+
+    Raises
+    ------
+    AerocontrolError
+        The first failing problem's own error (UncontrollableError, InvalidArgumentError for
+        a pole without its conjugate, ...), its message starting "problem i of the batch".
+
+    Warns
+    -----
+    IllConditionedWarning
+        Naming the problems whose achieved poles miss by more than 1e-6 relatively or whose
+        controllability matrix has κ(V) >= 1e8 (single input), as the single functions do.
+
+    Examples
+    --------
+    The 747's Dutch-roll damper (6.156)-(6.159) for ten damping ratios at once:
+
+    >>> import numpy as np, aerocontrol
+    >>> sys = aerocontrol.aircraft.load().lateral()
+    >>> zeta, wn = np.linspace(0.15, 0.6, 10), 0.74767
+    >>> dutch = -zeta * wn + 1j * wn * np.sqrt(1 - zeta**2)
+    >>> poles = np.stack([dutch, dutch.conj(), np.full(10, -1.23079), np.full(10, -0.046413)], 1)
+    >>> designs = aerocontrol.batch.place_batch(sys.A, sys.B[:, 0], poles, "bass-gura")
+    >>> designs.K.shape, bool(designs.max_relative_error.max() < 1e-10)
+    ((10, 1, 4), True)
+    """
+    if method not in _METHODS:
+        allowed = ", ".join(repr(m) for m in _METHODS)
+        raise InvalidArgumentError(f"method must be one of {allowed}, got {method!r}")
+    try:
+        requested = np.asarray(poles, dtype=np.complex128)
+    except (TypeError, ValueError) as error:
+        raise InvalidArgumentError(f"poles must be numbers: {error}") from None
+    if requested.ndim not in (1, 2):
+        raise ShapeError(f"poles must be (n,) or (k, n), got shape {requested.shape}")
+    requested = np.ascontiguousarray(np.atleast_2d(requested))
+    B_stack = _stack(B, "B")
+    batch = PlaceBatch(*_core.place_batch(_stack(A, "A"), B_stack, requested, _METHODS[method]))
+    single_input = method != "knv"
+    flagged = np.flatnonzero(
+        (batch.max_relative_error > POLE_ERROR_WARNING)
+        | (single_input & (batch.condition >= ILL_CONDITIONED_CONTROLLABILITY))
+    )
+    if flagged.size:
+        shown = ", ".join(str(i) for i in flagged[:10]) + (" ..." if flagged.size > 10 else "")
+        warnings.warn(
+            f"{flagged.size} of the {len(batch)} placements may be inaccurate (achieved poles "
+            f"off by more than {POLE_ERROR_WARNING:.0e} relatively, or an ill-conditioned "
+            f"controllability matrix): problems {shown}",
+            IllConditionedWarning,
+            stacklevel=2,
+        )
+    return batch
 
 
 def _stack(value: Any, name: str) -> FloatArray:
