@@ -37,7 +37,7 @@ def test_default_run_writes_the_report_of_the_747(tmp_path: Path) -> None:
     report = tmp_path / "aerocontrol-report" / "report.html"
     assert lines[-1] == f"report: {Path('aerocontrol-report') / 'report.html'}"
     assert report.is_file() and (report.parent / "report.md").is_file()
-    assert len(list((report.parent / "figures").glob("*.png"))) == 13
+    assert len(list((report.parent / "figures").glob("*.png"))) == 14
     assert result.stderr == ""
 
 

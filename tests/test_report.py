@@ -30,6 +30,7 @@ FIGURES = {
     "lqr-responses.png",
     "lqr-penalty.png",
     "root-locus.png",
+    "envelope.png",
 }
 #: The chapter's two small examples, in the embedded 747's report only.
 EXAMPLES = {"feedback-example.png", "pendulum-root-locus.png"}
@@ -82,8 +83,9 @@ def test_progress_is_one_line_per_step(written: tuple[Path, list[str]]) -> None:
         "LQR",
         "root locus",
         "levels after augmentation",
+        "envelope",
         "chapter check",
-        "writing 13 figures and the report",
+        "writing 14 figures and the report",
     ]
     assert "critically damped at c = 9.772714" in lines[6]
     assert "dutch roll 2 -> damper (rudder) 1, damper (aileron) 1" in lines[7]

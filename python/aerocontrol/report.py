@@ -13,7 +13,8 @@ contained: the figures are embedded) and ``report.md`` with ``figures/*.png``. T
    6.6);
 5. the lateral regulator at the chapter's weights c (6.224-6.227, Figures 6.9-6.11), its root
    locus over c with the weight at which the Dutch roll becomes critically damped (Figure 6.12);
-6. the Levels after augmentation;
+6. the Levels after augmentation, and the open-loop Levels over Mach and altitude around the
+   file's condition;
 7. for the embedded 747, the chapter's two small examples (Figures 6.4 and 6.8) and its
    printed numbers beside ours.
 
@@ -32,9 +33,10 @@ Dutch-roll damper (Bass-Gura): rudder k = [0.1383, 0.09435, 0.125, -1.133], ...
 LQR (Figures 6.9-6.11): c = 0.001: J∞ = 16.57; c = 0.5: J∞ = 10.56; c = 1: J∞ = 7.088; ...
 root locus (Figure 6.12): The Dutch roll becomes critically damped at c = 9.772714 ...
 levels after augmentation: dutch roll 2 -> damper (rudder) 1, damper (aileron) 1, ...
+envelope: 63 conditions around the file's (Level 2: 41, Level 3: 20, Level 4: 2)
 chapter check: Figures 6.4 and 6.8, 6 results beside the printed values
 >>> len(report.figures)
-13
+14
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ from typing import Any
 import numpy as np
 
 from . import handling, plotting
+from .aircraft.envelope import envelope_sweep
 from .aircraft.model import Aircraft, load
 from .aircraft.naming import DISPLAY_NAMES, classify_modes
 from .design import critical_weight, dutch_roll_damper, lqr_root_locus
@@ -700,6 +703,34 @@ def _section_levels(ctx: _Context) -> str:
     return "levels after augmentation: " + ("; ".join(changed) or "no Level changes")
 
 
+def _section_envelope(ctx: _Context) -> str:
+    """The open-loop Levels around the file's condition: Mach from 0.8 to 1.4 times the file's,
+    altitude within 10,000 ft (3,000 m) of it, at the file's weight (derivatives held)."""
+    plane = ctx.plane
+    span = 10_000.0 if plane.units == "english" else 3_000.0
+    altitudes = np.linspace(max(plane.altitude - span, 0.0), plane.altitude + span, 9)
+    machs = plane.mach * np.linspace(0.8, 1.4, 7)
+    envelope = envelope_sweep(plane, altitudes=altitudes, machs=machs)
+    ctx.report.heading("Levels around the flight condition")
+    ctx.report.paragraph(
+        "The open-loop Levels (worst mode) as the Mach number and altitude move away from the "
+        "file's condition at its weight: each condition trimmed (CL), with the drag from the "
+        "file's polar and every other derivative held at the file's values, so the map is a "
+        "first look at the sensitivity, not a substitute for the derivatives of each condition."
+    )
+    figure, axes = _new_figure(1, width=9.0, height=5.0)
+    envelope.plot(ax=axes[0, 0])
+    ctx.report.figure(
+        "envelope",
+        "Open-loop MIL-F-8785C Levels (worst mode) over Mach and altitude around the file's "
+        "condition, derivatives held.",
+        figure,
+    )
+    counts = np.bincount(envelope.worst.ravel(), minlength=5)
+    summary = ", ".join(f"Level {lvl}: {counts[lvl]}" for lvl in range(1, 5) if counts[lvl])
+    return f"envelope: {envelope.worst.size} conditions around the file's ({summary})"
+
+
 def _feedback_example(ctx: _Context) -> None:
     """Figure 6.4: the second-order example (6.94)-(6.102), original system and with the
     feedback that places ω_n = 25 1/s, ζ = 0.707, from two initial states."""
@@ -809,6 +840,7 @@ def build_report(
         _section_damper,
         _section_regulator,
         _section_levels,
+        _section_envelope,
     ]
     if aircraft.identifier == "b747-approach":
         steps.append(_section_chapter)

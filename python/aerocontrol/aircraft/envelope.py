@@ -42,6 +42,8 @@ class Envelope:
     category: str
     length_unit: str
     """The unit of the altitudes ("ft" or "m")."""
+    force_unit: str
+    """The unit of the weights ("lbf" or "N")."""
     levels: dict[str, NDArray[np.int_]]
     """The Level of each mode (1-4) at each condition; 0 where it was not assessed."""
     eigenvalues: dict[str, NDArray[np.complex128]]
@@ -79,7 +81,10 @@ class Envelope:
         from ..plotting import plot_levels
 
         values = self.worst if mode is None else self.levels[mode]
-        title = f"{'worst mode' if mode is None else mode}, W = {self.weights[weight]:g}"
+        title = (
+            f"{'worst mode' if mode is None else mode}, "
+            f"W = {self.weights[weight]:g} {self.force_unit}"
+        )
         ax = plot_levels(self.machs, self.altitudes, values[:, :, weight], ax=ax, title=title)
         ax.set_ylabel(f"altitude ({self.length_unit})")
         return ax
@@ -157,6 +162,7 @@ def envelope_sweep(
         plane.aircraft_class,
         plane.category,
         "ft" if plane.units == "english" else "m",
+        "lbf" if plane.units == "english" else "N",
         levels,
         eigenvalues,
         failures,
