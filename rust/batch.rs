@@ -155,6 +155,14 @@ fn member<'a>(stack: &MatrixStack<'a>, index: usize) -> MatRef<'a, f64> {
     stack.get(if stack.len() == 1 { 0 } else { index })
 }
 
+/// Err naming the lowest failing index of a batch (with its error), or Ok when none failed.
+fn lowest_failure(failure: Option<(usize, Error)>) -> Result<(), Error> {
+    match failure {
+        Some((index, error)) => Err(Error::in_batch(index, error)),
+        None => Ok(()),
+    }
+}
+
 /// Where [`care_batch`] writes: for problem k, X (n x n) and K (m x n) row-major at
 /// k n^2 and k m n, the closed-loop eigenvalues at k n, the relative residual and rcond(U11)
 /// at k.
@@ -228,10 +236,7 @@ pub fn care_batch(
             }
         })
         .min_by_key(|(index, _)| *index);
-    match failure {
-        Some((index, error)) => Err(Error::in_batch(index, error)),
-        None => Ok(()),
-    }
+    lowest_failure(failure)
 }
 
 /// A pole-placement algorithm of [`crate::place`].
@@ -312,10 +317,7 @@ pub fn place_batch(
             }
         })
         .min_by_key(|(index, _)| *index);
-    match failure {
-        Some((index, error)) => Err(Error::in_batch(index, error)),
-        None => Ok(()),
-    }
+    lowest_failure(failure)
 }
 
 #[cfg(test)]

@@ -1001,6 +1001,20 @@ fn companion_form<'py>(
     Ok(result)
 }
 
+/// The placement algorithm named by `method`: "bass-gura", "ackermann" or "knv0".
+fn placer_for(py: Python<'_>, method: &str) -> PyResult<Placer> {
+    match method {
+        "bass-gura" => Ok(place_bass_gura),
+        "ackermann" => Ok(place_ackermann),
+        "knv0" => Ok(place_core),
+        other => Err(raise(
+            py,
+            "InvalidArgumentError",
+            format!("unknown placement method {other:?}"),
+        )),
+    }
+}
+
 /// Pole placement by `method` ("bass-gura", "ackermann" or "knv0"), as a tuple (K, A - BK,
 /// poles, achieved poles, max relative error, iterations, converged, κ(V), κ(X)).
 #[pyfunction]
@@ -1027,18 +1041,7 @@ fn place<'py>(
     let (a, b) = two_views(py, (&a, "A"), (&b, "B"))?;
     let poles = poles.cast::<PyArrayDyn<c64>>()?;
     let requested = copy_complex(poles)?;
-    let placer = match method {
-        "bass-gura" => place_bass_gura,
-        "ackermann" => place_ackermann,
-        "knv0" => place_core,
-        other => {
-            return Err(raise(
-                py,
-                "InvalidArgumentError",
-                format!("unknown placement method {other:?}"),
-            ));
-        }
-    };
+    let placer = placer_for(py, method)?;
     let design = guarded(|| placer(a, b, &requested))?.map_err(|e| to_py_err(py, e))?;
     Ok((
         matrix_to_numpy(py, &design.gain)?,
@@ -1072,18 +1075,7 @@ fn place_batch<'py>(
     Bound<'py, PyArrayDyn<f64>>,
     Bound<'py, PyArrayDyn<f64>>,
 )> {
-    let placer: Placer = match method {
-        "bass-gura" => place_bass_gura,
-        "ackermann" => place_ackermann,
-        "knv0" => place_core,
-        other => {
-            return Err(raise(
-                py,
-                "InvalidArgumentError",
-                format!("unknown placement method {other:?}"),
-            ));
-        }
-    };
+    let placer = placer_for(py, method)?;
     let (a, [ka, n, na]) = stack_values(py, a, "A")?;
     let (b, [kb, nb, m]) = stack_values(py, b, "B")?;
     let requested = copy_complex(poles.cast::<PyArrayDyn<c64>>()?)?;

@@ -174,3 +174,15 @@ def test_place_batch_errors_name_the_problem() -> None:
         match=r"poles must have 1 \(shared by every problem\) or as many problems as A \(3\)",
     ):
         aerocontrol.batch.place_batch(A, B, poles[:2])
+
+
+def test_batches_warn_naming_the_doubtful_problems() -> None:
+    """As the single functions do: here problem 1's fourth state is barely reachable
+    (κ(V) >= 1e8), problem 0 is well conditioned."""
+    A = np.diag([-1.0, -2.0, -3.0, -4.0])
+    b = np.array([[[1.0], [1.0], [1.0], [1.0]], [[1.0], [1.0], [1.0], [1e-9]]])
+    with pytest.warns(aerocontrol.IllConditionedWarning, match=r"^1 of the 2 placements .* 1$"):
+        aerocontrol.batch.place_batch(A, b, [-5.0, -6.0, -7.0, -8.0], "bass-gura")
+    with pytest.warns(aerocontrol.IllConditionedWarning) as single:
+        aerocontrol.place_bass_gura(A, b[1], [-5.0, -6.0, -7.0, -8.0])
+    assert len(single) == 1

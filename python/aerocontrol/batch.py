@@ -154,15 +154,11 @@ def place_batch(A: Any, B: Any, poles: Any, method: str = "knv") -> PlaceBatch:
         (batch.max_relative_error > POLE_ERROR_WARNING)
         | (single_input & (batch.condition >= ILL_CONDITIONED_CONTROLLABILITY))
     )
-    if flagged.size:
-        shown = ", ".join(str(i) for i in flagged[:10]) + (" ..." if flagged.size > 10 else "")
-        warnings.warn(
-            f"{flagged.size} of the {len(batch)} placements may be inaccurate (achieved poles "
-            f"off by more than {POLE_ERROR_WARNING:.0e} relatively, or an ill-conditioned "
-            f"controllability matrix): problems {shown}",
-            IllConditionedWarning,
-            stacklevel=2,
-        )
+    _warn(
+        flagged,
+        f"of the {len(batch)} placements may be inaccurate (achieved poles off by more than "
+        f"{POLE_ERROR_WARNING:.0e} relatively, or an ill-conditioned controllability matrix)",
+    )
     return batch
 
 
@@ -180,16 +176,12 @@ def _stack(value: Any, name: str) -> FloatArray:
     return array
 
 
-def _warn(batch: CareBatch) -> None:
-    flagged = np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING))
+def _warn(flagged: NDArray[np.intp], what: str) -> None:
+    """One IllConditionedWarning naming the flagged problems (the first ten)."""
     if flagged.size:
         shown = ", ".join(str(i) for i in flagged[:10]) + (" ..." if flagged.size > 10 else "")
         warnings.warn(
-            f"{flagged.size} of the {len(batch)} Riccati solutions may be inaccurate "
-            f"(rcond(U11) < {RCOND_WARNING:.0e} or relative residual > {RESIDUAL_WARNING:.0e}): "
-            f"problems {shown}",
-            IllConditionedWarning,
-            stacklevel=3,
+            f"{flagged.size} {what}: problems {shown}", IllConditionedWarning, stacklevel=3
         )
 
 
@@ -233,7 +225,11 @@ def solve_care_batch(A: Any, B: Any, Q: Any, R: Any, refine: bool = True) -> Car
             _stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"), bool(refine)
         )
     )
-    _warn(batch)
+    _warn(
+        np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING)),
+        f"of the {len(batch)} Riccati solutions may be inaccurate (rcond(U11) < "
+        f"{RCOND_WARNING:.0e} or relative residual > {RESIDUAL_WARNING:.0e})",
+    )
     return batch
 
 
