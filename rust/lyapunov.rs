@@ -29,7 +29,7 @@ use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::schur::real_schur;
 use crate::small_matrix::product;
 use crate::sylvester::solve_small_sylvester;
-use faer::{Mat, MatRef};
+use faer::{Accum, Mat, MatRef, Par};
 
 /// The solution X of A X + X A^T + Q = 0 (symmetric when Q is).
 pub fn solve_lyapunov(a: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
@@ -98,16 +98,18 @@ fn solve_quasi_triangular(
     let mut y = Mat::<f64>::zeros(n, n);
     for &(j0, q) in blocks.iter().rev() {
         let after = j0 + q;
-        // F[:, J] -= Y[:, after..] T[J, after..]^T (the columns of Y already known).
-        for c in 0..q {
-            for s in after..n {
-                let coupling = t[(j0 + c, s)];
-                if coupling != 0.0 {
-                    for row in 0..n {
-                        f[(row, j0 + c)] -= y[(row, s)] * coupling;
-                    }
-                }
-            }
+        if after < n {
+            // F[:, J] -= Y[:, after..] T[J, after..]^T (the columns of Y already known).
+            let known = y.as_ref().subcols(after, n - after);
+            let coupling = t.submatrix(j0, after, q, n - after);
+            faer::linalg::matmul::matmul(
+                f.as_mut().subcols_mut(j0, q),
+                Accum::Add,
+                known,
+                coupling.transpose(),
+                -1.0,
+                Par::Seq,
+            );
         }
         let mut r = [[0.0; 2]; 2];
         for c in 0..q {
