@@ -27,7 +27,8 @@
 //! H = [[Ā, -G], [-Q̄, -Ā^T]] has eigenvalues symmetric about the imaginary axis. If none lies
 //! on it and the stable invariant subspace is spanned by the columns of [U11; U21] with U11
 //! nonsingular, Y = U21 U11^-1 is the stabilising solution and the stable eigenvalues of H are
-//! the closed-loop ones. The subspace comes from the real Schur form of H ([`crate::schur`])
+//! the closed-loop ones. The subspace comes from the real Schur form of H ([`crate::schur`],
+//! whose QR iteration uses the symmetry of the spectrum for its shifts)
 //! reordered to put Re λ < 0 first ([`crate::reorder`]); Y from U11^T Y = U21^T by an LU
 //! solve, then symmetrised.
 //!
@@ -65,7 +66,8 @@ use crate::lu::{solve_in_place, solve_with_inverse};
 use crate::lyapunov::{self, Singularity, symmetrize};
 use crate::norm::one_norm;
 use crate::reorder::reorder_schur;
-use crate::schur::{balancing_scale, eigenvalues, real_schur};
+use crate::schur::{Spectrum, balancing_scale, eigenvalues, real_schur_with};
+use crate::small_matrix::product;
 use faer::linalg::solvers::Llt;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
@@ -133,7 +135,7 @@ struct Reduced<'a> {
 impl Reduced<'_> {
     /// K = R^-1 (B̃^T Y + S^T) = L^-T L^-1 (B̃^T Y + S^T).
     fn gain(&self, y: &Mat<f64>) -> Mat<f64> {
-        let mut gain = self.b.transpose() * y;
+        let mut gain = product(self.b.transpose(), y.as_ref());
         if let Some(s) = self.s {
             gain += s.transpose();
         }
@@ -145,14 +147,17 @@ impl Reduced<'_> {
     /// The residual of Y and its gain.
     fn evaluate(&self, y: &Mat<f64>) -> Evaluation {
         let gain = self.gain(y);
-        let mut coupling = y * &self.b;
+        let mut coupling = product(y.as_ref(), self.b.as_ref());
         if let Some(s) = self.s {
             coupling += s;
         }
-        let ay = self.a.transpose() * y;
-        let quadratic = &coupling * &gain;
+        let ay = product(self.a.transpose(), y.as_ref());
+        let quadratic = product(coupling.as_ref(), gain.as_ref());
         let scale = self.q.norm_l2() + 2.0 * ay.norm_l2() + quadratic.norm_l2();
-        let mut residual = &ay + ay.transpose() - &quadratic + self.q;
+        let n = y.nrows();
+        let mut residual = Mat::from_fn(n, n, |i, j| {
+            ay[(i, j)] + ay[(j, i)] - quadratic[(i, j)] + self.q[(i, j)]
+        });
         symmetrize(&mut residual);
         Evaluation {
             residual_norm: residual.norm_l2(),
@@ -160,6 +165,12 @@ impl Reduced<'_> {
             gain,
             scale,
         }
+    }
+
+    /// Ã - B̃ K.
+    fn closed_loop(&self, gain: &Mat<f64>) -> Mat<f64> {
+        let bk = product(self.b.as_ref(), gain.as_ref());
+        Mat::from_fn(bk.nrows(), bk.ncols(), |i, j| self.a[(i, j)] - bk[(i, j)])
     }
 }
 
@@ -234,7 +245,7 @@ pub fn solve_care(
     };
     let reduced_residual = evaluation.relative_residual();
     let gain = evaluation.gain;
-    let closed_loop = &reduced.a - &reduced.b * &gain;
+    let closed_loop = reduced.closed_loop(&gain);
     let closed_loop_eigenvalues = eigenvalues(closed_loop.as_ref())?;
     // X = E^-T Y E^-1.
     let (x, residual) = match options.e {
@@ -301,7 +312,9 @@ fn symmetric(
     check_rows(matrix, arg, order, other)?;
     check_finite(matrix, arg)?;
     let largest = matrix.norm_max();
-    let asymmetry = (matrix - matrix.transpose()).norm_max();
+    let asymmetry = (0..order)
+        .flat_map(|j| (0..j).map(move |i| (matrix[(i, j)] - matrix[(j, i)]).abs()))
+        .fold(0.0, f64::max);
     if asymmetry > SYMMETRY_TOLERANCE * largest {
         let message = format!(
             "{arg} must be symmetric, but max|{arg} - {arg}^T| = {asymmetry:.3e} is more than \
@@ -367,7 +380,7 @@ fn standardize(
         transposed.transpose().to_owned()
     };
     let b_hat = right_divide(b_tilde.as_ref());
-    let mut g = &b_hat * b_hat.transpose();
+    let mut g = product(b_hat.as_ref(), b_hat.transpose());
     symmetrize(&mut g);
     let (a, q) = match s {
         Some(s) => {
@@ -414,7 +427,10 @@ fn hamiltonian_solution(standard: &Standard) -> Result<(Mat<f64>, f64), Error> {
         }
     }
     let h_norm = h.norm_l2();
-    let ordered = reorder_schur(real_schur(h.as_ref())?, |lambda| lambda.re < 0.0)?;
+    let ordered = reorder_schur(
+        real_schur_with(h.as_ref(), Spectrum::Hamiltonian)?,
+        |lambda| lambda.re < 0.0,
+    )?;
     let on_axis: Vec<c64> = ordered
         .eigenvalues
         .iter()
@@ -482,7 +498,7 @@ fn refine(reduced: &Reduced<'_>, y: &mut Mat<f64>, evaluation: &mut Evaluation) 
     let mut steps = 0;
     while steps < MAX_REFINEMENT_STEPS && evaluation.residual_norm > f64::EPSILON * evaluation.scale
     {
-        let closed_loop = &reduced.a - &reduced.b * &evaluation.gain;
+        let closed_loop = reduced.closed_loop(&evaluation.gain);
         let step = lyapunov::solve(
             closed_loop.transpose(),
             evaluation.residual.as_ref(),

@@ -27,6 +27,7 @@
 use crate::dispatch::clear_upper_avx_state;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::schur::real_schur;
+use crate::small_matrix::product;
 use crate::sylvester::solve_small_sylvester;
 use faer::{Accum, Mat, MatRef, Par};
 
@@ -61,11 +62,14 @@ pub(crate) fn solve(
     let n = a.nrows();
     let schur = real_schur(a)?;
     let (t, z) = (schur.t.as_ref(), schur.z.as_ref());
-    let mut f = Mat::<f64>::zeros(n, n);
-    let zq = z.transpose() * q;
-    faer::linalg::matmul::matmul(f.as_mut(), Accum::Replace, &zq, z, -1.0, Par::Seq);
+    let mut f = product(product(z.transpose(), q).as_ref(), z);
+    for j in 0..n {
+        for x in f.col_mut(j).iter_mut() {
+            *x = -*x;
+        }
+    }
     let y = solve_quasi_triangular(t, f, singularity)?;
-    let mut x = z * &y * z.transpose();
+    let mut x = product(product(z, y.as_ref()).as_ref(), z.transpose());
     if is_symmetric(q) {
         symmetrize(&mut x);
     }
@@ -96,7 +100,7 @@ fn solve_quasi_triangular(
         let after = j0 + q;
         if after < n {
             // F[:, J] -= Y[:, after..] T[J, after..]^T (the columns of Y already known).
-            let (known, _) = (y.as_ref().subcols(after, n - after), ());
+            let known = y.as_ref().subcols(after, n - after);
             let coupling = t.submatrix(j0, after, q, n - after);
             faer::linalg::matmul::matmul(
                 f.as_mut().subcols_mut(j0, q),

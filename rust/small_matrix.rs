@@ -164,6 +164,32 @@ fn lu_solve_kernel<const N: usize, const FMA: bool>(
 
 fma_dispatch!(fn lu_solve<const N: usize>(lu: &Rows<N>, pivots: &[usize; N], rhs: &mut Rows<N>) => lu_solve_kernel);
 
+/// Products of at most this many multiply-adds are formed by [`product`]'s plain loop: below
+/// it faer's dispatch and blocking decisions cost more than the arithmetic.
+const LOOP_PRODUCT_MAX_WORK: usize = 16 * 16 * 16;
+
+/// lhs * rhs for matrices of any (conforming) shapes and strides: a plain column-by-column
+/// loop when the product is small (the Riccati and Lyapunov solvers form a dozen products of
+/// order n and m at n = 4), faer's blocked kernel otherwise.
+pub fn product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
+    let (rows, inner, cols) = (lhs.nrows(), lhs.ncols(), rhs.ncols());
+    debug_assert_eq!(inner, rhs.nrows());
+    if rows * inner * cols > LOOP_PRODUCT_MAX_WORK {
+        return lhs * rhs;
+    }
+    let mut out = Mat::<f64>::zeros(rows, cols);
+    for j in 0..cols {
+        let mut column = out.col_mut(j);
+        for k in 0..inner {
+            let coefficient = rhs[(k, j)];
+            for i in 0..rows {
+                column[i] += lhs[(i, k)] * coefficient;
+            }
+        }
+    }
+    out
+}
+
 /// An N x N matrix stored on the stack, row-major.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SmallMatrix<const N: usize> {

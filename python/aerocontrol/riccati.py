@@ -125,7 +125,22 @@ def solve_care(
     >>> bool(sol.residual < 1e-15)
     True
     """
-    X, K, poles, residual, rcond, steps = _core.solve_care(
+    # The frozen dataclass's __init__ sets each field through object.__setattr__, which costs
+    # a tenth of a 4-state solve; filling the instance dictionary directly is the same object.
+    X, K, poles, residual, rcond, steps = _solve_care(A, B, Q, R, S, E, refine)
+    solution = object.__new__(CareSolution)
+    vars(solution).update(
+        X=X, K=K, closed_loop_poles=poles, residual=residual, rcond=rcond, refinement_steps=steps
+    )
+    return solution
+
+
+def _solve_care(
+    A: Any, B: Any, Q: Any, R: Any, S: Any, E: Any, refine: bool
+) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
+    """The native solve, as (X, K, poles, residual, rcond, steps), warning (at the caller of
+    :func:`solve_care` or :func:`lqr`) when the solution may be inaccurate."""
+    result: tuple[FloatArray, FloatArray, ComplexArray, float, float, int] = _core.solve_care(
         A,
         B,
         _matrix(Q, "Q"),
@@ -134,16 +149,16 @@ def solve_care(
         None if E is None else _matrix(E, "E"),
         bool(refine),
     )
-    solution = CareSolution(X, K, poles, residual, rcond, steps)
+    rcond, residual = result[4], result[3]
     if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
         warnings.warn(
             f"the Riccati solution may be inaccurate: rcond(U11) = {rcond:.2e}, relative "
             f"residual {residual:.2e} (the closed loop is close to losing stabilisability "
             "or detectability, or the weights differ by many orders of magnitude)",
             IllConditionedWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
-    return solution
+    return result
 
 
 def _matrix(value: Any, name: str) -> FloatArray:
@@ -176,7 +191,9 @@ def lqr(sys_or_A: Any, *args: Any, N: Any = None) -> tuple[FloatArray, FloatArra
     >>> bool(np.all(E.real < 0))
     True
     """
-    if isinstance(sys_or_A, StateSpace) or hasattr(sys_or_A, "A"):
+    if type(sys_or_A) is not np.ndarray and (
+        isinstance(sys_or_A, StateSpace) or hasattr(sys_or_A, "A")
+    ):
         if len(args) not in (2, 3):
             raise InvalidArgumentError("lqr(sys, Q, R[, N]) takes a system and two weights")
         sys = as_state_space(sys_or_A)
@@ -189,8 +206,8 @@ def lqr(sys_or_A: Any, *args: Any, N: Any = None) -> tuple[FloatArray, FloatArra
         if N is not None:
             raise InvalidArgumentError("N given both by position and by keyword")
         N = rest[0]
-    solution = solve_care(A, B, Q, R, S=N)
-    return solution.K, solution.X, solution.closed_loop_poles
+    X, K, poles, *_ = _solve_care(A, B, Q, R, N, None, True)
+    return K, X, poles
 
 
 @dataclass(frozen=True, eq=False)
