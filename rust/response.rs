@@ -21,8 +21,9 @@ use crate::discretize::{Discretization, Hold, discretize};
 use crate::error::{Error, check_finite, check_finite_values, check_output_len};
 use crate::freq::check_state_space;
 use crate::norm::{LinearOperator, one_norm_estimate};
+use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::{PartialPivLu, ShapeCore, Solve};
-use faer::{Mat, MatMut, MatRef};
+use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
 /// The input of a simulation.
@@ -92,6 +93,29 @@ fn row_major(m: MatRef<'_, f64>) -> Vec<f64> {
         .collect()
 }
 
+/// Independent partial sums of [`dot`]: enough to hide the latency of the additions and to
+/// fill the vector registers (a single running sum is one dependent addition per entry).
+const DOT_LANES: usize = 8;
+
+/// Σ a_i b_i, in [`DOT_LANES`] partial sums over the full chunks and one over the remainder.
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut lanes = [0.0; DOT_LANES];
+    let (a_chunks, b_chunks) = (a.chunks_exact(DOT_LANES), b.chunks_exact(DOT_LANES));
+    let tail: f64 = a_chunks
+        .remainder()
+        .iter()
+        .zip(b_chunks.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in a_chunks.zip(b_chunks) {
+        for lane in 0..DOT_LANES {
+            lanes[lane] += x[lane] * y[lane];
+        }
+    }
+    let (low, high) = lanes.split_at(DOT_LANES / 2);
+    low.iter().zip(high).map(|(l, h)| l + h).sum::<f64>() + tail
+}
+
 impl Recurrence {
     fn new(d: &Discretization, c: MatRef<'_, f64>, dd: MatRef<'_, f64>) -> Self {
         let gamma_now = match &d.gamma1 {
@@ -114,7 +138,7 @@ impl Recurrence {
     fn multiply(matrix: &[f64], v: &[f64], out: &mut [f64]) {
         let cols = v.len();
         for (o, row) in out.iter_mut().zip(matrix.chunks_exact(cols.max(1))) {
-            *o = row.iter().zip(v).map(|(a, b)| a * b).sum();
+            *o = dot(row, v);
         }
     }
 
@@ -122,7 +146,7 @@ impl Recurrence {
     fn multiply_add(matrix: &[f64], v: &[f64], out: &mut [f64]) {
         let cols = v.len();
         for (o, row) in out.iter_mut().zip(matrix.chunks_exact(cols.max(1))) {
-            *o += row.iter().zip(v).map(|(a, b)| a * b).sum::<f64>();
+            *o += dot(row, v);
         }
     }
 
@@ -140,23 +164,37 @@ impl Recurrence {
         if n > 0 {
             x[..n].copy_from_slice(x0);
         }
-        for k in 0..steps {
+        for k in 0..steps.saturating_sub(1) {
             let (done, rest) = x.split_at_mut((k + 1) * n);
             let current = &done[k * n..];
             let eta = input(k);
-            let y_k = &mut y[k * p..(k + 1) * p];
-            Self::multiply(&self.c, current, y_k);
+            let next = &mut rest[..n];
+            Self::multiply(&self.phi, current, next);
             if self.m > 0 && !eta.is_empty() {
-                Self::multiply_add(&self.d, eta, y_k);
+                Self::multiply_add(&self.gamma_now, eta, next);
+                if let Some(gamma_next) = &self.gamma_next {
+                    Self::multiply_add(gamma_next, input(k + 1), next);
+                }
             }
-            if k + 1 < steps {
-                let next = &mut rest[..n];
-                Self::multiply(&self.phi, current, next);
+        }
+        // The outputs of all samples at once, Y = X C^T (one matrix product instead of a
+        // matrix-vector product per step), then D η[k].
+        if steps > 0 && p > 0 {
+            let states = MatRef::from_row_major_slice(x, steps, n);
+            let c = MatRef::from_row_major_slice(&self.c, p, n);
+            let outputs = MatMut::from_row_major_slice_mut(y, steps, p);
+            matmul(
+                outputs,
+                Accum::Replace,
+                states,
+                c.transpose(),
+                1.0,
+                Par::Seq,
+            );
+            for k in 0..steps {
+                let eta = input(k);
                 if self.m > 0 && !eta.is_empty() {
-                    Self::multiply_add(&self.gamma_now, eta, next);
-                    if let Some(gamma_next) = &self.gamma_next {
-                        Self::multiply_add(gamma_next, input(k + 1), next);
-                    }
+                    Self::multiply_add(&self.d, eta, &mut y[k * p..(k + 1) * p]);
                 }
             }
         }
