@@ -93,6 +93,11 @@ fn row_major(m: MatRef<'_, f64>) -> Vec<f64> {
         .collect()
 }
 
+/// From this order on the outputs of a response are one matrix product; below it the
+/// matrix-vector products per step are faster (the product of a long, 4-column X with a 4 x 4
+/// C^T runs far below the speed of a square one).
+const OUTPUT_PRODUCT_MIN_ORDER: usize = 16;
+
 /// Independent partial sums of [`dot`]: enough to hide the latency of the additions and to
 /// fill the vector registers (a single running sum is one dependent addition per entry).
 const DOT_LANES: usize = 8;
@@ -137,16 +142,22 @@ impl Recurrence {
     /// out = M v for a row-major `rows` x len(v) matrix M.
     fn multiply(matrix: &[f64], v: &[f64], out: &mut [f64]) {
         let cols = v.len();
-        for (o, row) in out.iter_mut().zip(matrix.chunks_exact(cols.max(1))) {
-            *o = dot(row, v);
+        let rows = out.iter_mut().zip(matrix.chunks_exact(cols.max(1)));
+        if cols < DOT_LANES {
+            rows.for_each(|(o, row)| *o = row.iter().zip(v).map(|(a, b)| a * b).sum());
+        } else {
+            rows.for_each(|(o, row)| *o = dot(row, v));
         }
     }
 
     /// out += M v.
     fn multiply_add(matrix: &[f64], v: &[f64], out: &mut [f64]) {
         let cols = v.len();
-        for (o, row) in out.iter_mut().zip(matrix.chunks_exact(cols.max(1))) {
-            *o += dot(row, v);
+        let rows = out.iter_mut().zip(matrix.chunks_exact(cols.max(1)));
+        if cols < DOT_LANES {
+            rows.for_each(|(o, row)| *o += row.iter().zip(v).map(|(a, b)| a * b).sum::<f64>());
+        } else {
+            rows.for_each(|(o, row)| *o += dot(row, v));
         }
     }
 
@@ -164,39 +175,40 @@ impl Recurrence {
         if n > 0 {
             x[..n].copy_from_slice(x0);
         }
-        for k in 0..steps.saturating_sub(1) {
+        // The outputs C x[k] + D η[k]: for larger models all samples at once after the
+        // recurrence, Y = X C^T (one matrix product instead of a matrix-vector product per
+        // step); for small ones in the same pass, while x[k] is in registers.
+        let product = n >= OUTPUT_PRODUCT_MIN_ORDER && p > 0;
+        for k in 0..steps {
             let (done, rest) = x.split_at_mut((k + 1) * n);
             let current = &done[k * n..];
             let eta = input(k);
-            let next = &mut rest[..n];
-            Self::multiply(&self.phi, current, next);
+            let y_k = &mut y[k * p..(k + 1) * p];
+            if product {
+                y_k.fill(0.0);
+            } else {
+                Self::multiply(&self.c, current, y_k);
+            }
             if self.m > 0 && !eta.is_empty() {
-                Self::multiply_add(&self.gamma_now, eta, next);
-                if let Some(gamma_next) = &self.gamma_next {
-                    Self::multiply_add(gamma_next, input(k + 1), next);
+                Self::multiply_add(&self.d, eta, y_k);
+            }
+            if k + 1 < steps {
+                let next = &mut rest[..n];
+                Self::multiply(&self.phi, current, next);
+                if self.m > 0 && !eta.is_empty() {
+                    Self::multiply_add(&self.gamma_now, eta, next);
+                    if let Some(gamma_next) = &self.gamma_next {
+                        Self::multiply_add(gamma_next, input(k + 1), next);
+                    }
                 }
             }
         }
-        // The outputs of all samples at once, Y = X C^T (one matrix product instead of a
-        // matrix-vector product per step), then D η[k].
-        if steps > 0 && p > 0 {
+        if product && steps > 0 {
             let states = MatRef::from_row_major_slice(x, steps, n);
             let c = MatRef::from_row_major_slice(&self.c, p, n);
             let outputs = MatMut::from_row_major_slice_mut(y, steps, p);
-            matmul(
-                outputs,
-                Accum::Replace,
-                states,
-                c.transpose(),
-                1.0,
-                Par::Seq,
-            );
-            for k in 0..steps {
-                let eta = input(k);
-                if self.m > 0 && !eta.is_empty() {
-                    Self::multiply_add(&self.d, eta, &mut y[k * p..(k + 1) * p]);
-                }
-            }
+            // Y already holds D η[k]; add X C^T.
+            matmul(outputs, Accum::Add, states, c.transpose(), 1.0, Par::Seq);
         }
     }
 }

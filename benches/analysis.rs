@@ -1,0 +1,84 @@
+//! Criterion benches of the analysis kernels that `benches/compare_peers.py` times against
+//! numpy, scipy and python-control: modal analysis and the characteristic polynomial, the
+//! controllability and observability matrices and the staircase verdict, the companion form,
+//! the steady state of a step, and the Riccati differential equation. Seeded random matrices
+//! at n = 4, 16, 64 and 256 (the companion form and the Riccati ODE stop where their peers do:
+//! 16 and 64).
+
+use aerocontrol::ctrb::{controllability_staircase, ctrb, obsv};
+use aerocontrol::modes::{charpoly, modal_analysis};
+use aerocontrol::place::companion_form;
+use aerocontrol::response::steady_state;
+use aerocontrol::riccati_ode::riccati_ode;
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use faer::Mat;
+use std::hint::black_box;
+
+mod common;
+use common::seeded_matrix;
+
+/// G - 2 sqrt(n) I: a stable random matrix (no eigenvalue near zero, for the steady state).
+fn stable(n: usize, seed: u64) -> Mat<f64> {
+    let g = seeded_matrix(n, n, seed);
+    Mat::from_fn(n, n, |i, j| {
+        g[(i, j)] - if i == j { 2.0 * (n as f64).sqrt() } else { 0.0 }
+    })
+}
+
+fn spectra(c: &mut Criterion) {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut group = c.benchmark_group("analysis");
+    group.sample_size(10);
+    for n in [4, 16, 64, 256] {
+        let (a, b) = (stable(n, n as u64), seeded_matrix(n, 2, 3));
+        let c_out = seeded_matrix(2, n, 4);
+        group.bench_with_input(BenchmarkId::new("modal_analysis", n), &a, |bench, a| {
+            bench.iter(|| modal_analysis(black_box(a.as_ref()), Some(b.as_ref())))
+        });
+        group.bench_with_input(BenchmarkId::new("charpoly", n), &a, |bench, a| {
+            bench.iter(|| charpoly(black_box(a.as_ref())))
+        });
+        group.bench_with_input(BenchmarkId::new("ctrb", n), &a, |bench, a| {
+            bench.iter(|| ctrb(black_box(a.as_ref()), b.as_ref()))
+        });
+        group.bench_with_input(BenchmarkId::new("obsv", n), &a, |bench, a| {
+            bench.iter(|| obsv(black_box(a.as_ref()), c_out.as_ref()))
+        });
+        group.bench_with_input(BenchmarkId::new("staircase verdict", n), &a, |bench, a| {
+            bench.iter(|| controllability_staircase(black_box(a.as_ref()), b.as_ref(), None, false))
+        });
+        group.bench_with_input(BenchmarkId::new("steady_state", n), &a, |bench, a| {
+            bench.iter(|| steady_state(black_box(a.as_ref()), b.as_ref(), &[1.0, 0.5]))
+        });
+        if n <= 16 {
+            let b1 = seeded_matrix(n, 1, 5);
+            group.bench_with_input(BenchmarkId::new("companion_form", n), &a, |bench, a| {
+                bench.iter(|| companion_form(black_box(a.as_ref()), b1.as_ref()))
+            });
+        }
+        if n <= 64 {
+            let (q, r) = (Mat::<f64>::identity(n, n), Mat::<f64>::identity(2, 2));
+            let times: Vec<f64> = (0..101).map(|k| 0.1 * k as f64).collect();
+            group.bench_with_input(
+                BenchmarkId::new("riccati_ode 101 times", n),
+                &a,
+                |bench, a| {
+                    bench.iter(|| {
+                        riccati_ode(
+                            black_box(a.as_ref()),
+                            b.as_ref(),
+                            q.as_ref(),
+                            r.as_ref(),
+                            &times,
+                            None,
+                        )
+                    })
+                },
+            );
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, spectra);
+criterion_main!(benches);
