@@ -245,7 +245,6 @@ def _new_figure(columns: int = 1, rows: int = 1, width: float = 11.0, height: fl
 class _Context:
     plane: Aircraft
     report: Report
-    progress: Callable[[str], None]
     longitudinal: StateSpace = field(init=False)
     lateral: StateSpace = field(init=False)
     open_loop: handling.HandlingQualities | None = None
@@ -832,7 +831,7 @@ def build_report(
     aircraft = plane if isinstance(plane, Aircraft) else load(plane)
     say = progress if progress is not None else (lambda line: None)
     report = Report(f"aerocontrol {_version()}: {aircraft.name}")
-    ctx = _Context(aircraft, report, say)
+    ctx = _Context(aircraft, report)
     steps: list[Callable[[_Context], str]] = [
         _section_models,
         _section_modes,
