@@ -37,15 +37,8 @@
 //! transformations stay orthogonal either way, so the form is as backward stable as before.
 //!
 //! The single-window, double-shift iteration is the right tool at the orders of flight-control
-//! models (LAPACK itself uses it below n = 75): at n = 4 it finds the eigenvalues in a fraction
-//! of the time of a general multishift solver, whose set-up dominates at that size. Active
-//! windows of order 75 (`AED_MIN_ORDER`) and more add aggressive early deflation (Braman, Byers &
-//! Mathias 2002): the Schur form of the trailing block of the window shows which of its
-//! eigenvalues have already converged to working precision, so many deflate at once instead of
-//! one or two per few sweeps, and the rest are the shifts of the next double-shift sweeps (on
-//! the Hamiltonian of order 512 of the n = 256 regulator, 20 % faster than without). The
-//! sweeps themselves are still one bulge at a time; LAPACK's chains of small bulges with
-//! blocked updates remain about twice as fast at that order.
+//! models (n <= 100; LAPACK itself uses it below n = 75): at n = 4 it finds the eigenvalues in a
+//! fraction of the time of a general multishift solver, whose set-up dominates at that size.
 //!
 //! [`eigenvalues`] first balances A (Parlett & Reinsch 1969: a diagonal similarity by powers of
 //! two that equalises row and column norms, exact in floating point), which can only improve
@@ -592,8 +585,6 @@ fn francis_qr(
         Spectrum::General => None,
         Spectrum::Hamiltonian => Some(Mirrors::default()),
     };
-    // Shifts that a pass of aggressive early deflation left for the sweeps that follow it.
-    let mut queued: Vec<(c64, c64)> = Vec::new();
     // The window is rows and columns l..=i; the eigenvalues below i have converged.
     let mut i = n - 1;
     loop {
@@ -641,26 +632,6 @@ fn francis_qr(
             iterations_since_deflation += 1;
             let (first, last) = if full { (0, n - 1) } else { (l, i) };
 
-            // Large windows: aggressive early deflation, whose undeflated eigenvalues are the
-            // shifts of the next sweeps.
-            if i + 1 - l >= AED_MIN_ORDER && queued.is_empty() {
-                let w = deflation_window(i + 1 - l);
-                let found = aggressive_early_deflation(h, z.as_deref_mut(), (l, i), w, full)?;
-                if found.deflated > 0 {
-                    i -= found.deflated;
-                    iterations_since_deflation = 0;
-                }
-                if found.deflated * 100 > AED_SKIP_SWEEPS_PERCENT * w {
-                    continue;
-                }
-                queued = shift_pairs(&found.shifts, w / 2);
-                if i + 1 - l < 3 || queued.is_empty() {
-                    continue;
-                }
-            } else if i + 1 - l < AED_MIN_ORDER {
-                queued.clear();
-            }
-
             // The shifts: right after a deflation the mirror image of an eigenvalue already
             // found (Hamiltonian spectra), else the eigenvalues of the trailing 2 x 2 block,
             // or exceptional ones.
@@ -669,8 +640,6 @@ fn francis_qr(
                 _ => None,
             };
             let (shift1, shift2) = if let Some(shifts) = mirrored {
-                shifts
-            } else if let Some(shifts) = queued.pop() {
                 shifts
             } else {
                 let (h11, h12, h21, h22) =
@@ -792,235 +761,6 @@ fn francis_qr(
     }
 }
 
-/// Active windows of at least this order use aggressive early deflation (LAPACK's crossover
-/// from its small-matrix QR is 75).
-const AED_MIN_ORDER: usize = 75;
-
-/// A deflation pass that deflates more than this share of its window is followed by another
-/// pass instead of QR sweeps (LAPACK's "nibble" crossover, 14 %).
-const AED_SKIP_SWEEPS_PERCENT: usize = 14;
-
-/// The order of the deflation window for an active window of `order` rows: an eighth of it,
-/// between 12 and 96, and always less than the window (so that a row stays above it).
-fn deflation_window(order: usize) -> usize {
-    (order / 8).clamp(12, 96).min(order - 1)
-}
-
-/// What a pass of aggressive early deflation found: how many eigenvalues at the bottom of the
-/// window converged, and the eigenvalues of the rest of the deflation window, to use as
-/// shifts (pairs adjacent, Im > 0 first).
-struct EarlyDeflation {
-    deflated: usize,
-    shifts: Vec<c64>,
-}
-
-/// Up to `count` shifts from the end of `eigenvalues` (the bottom of the deflation window, the
-/// best converged) as double-shift pairs, the last pair first to be used: a complex pair
-/// together, real ones two by two.
-fn shift_pairs(eigenvalues: &[c64], count: usize) -> Vec<(c64, c64)> {
-    let mut pairs = Vec::new();
-    let mut taken = 0;
-    let mut k = eigenvalues.len();
-    let mut pending_real: Option<c64> = None;
-    while k > 0 && taken < count {
-        let lambda = eigenvalues[k - 1];
-        if lambda.im != 0.0 {
-            // The conjugate pair occupies k - 2 (Im > 0) and k - 1.
-            pairs.push((eigenvalues[k - 2], lambda));
-            k -= 2;
-            taken += 2;
-        } else {
-            match pending_real.take() {
-                Some(other) => {
-                    pairs.push((other, lambda));
-                    taken += 2;
-                }
-                None => pending_real = Some(lambda),
-            }
-            k -= 1;
-        }
-    }
-    if let Some(real) = pending_real {
-        pairs.push((real, real));
-    }
-    pairs.reverse();
-    pairs
-}
-
-/// Aggressive early deflation (Braman, Byers & Mathias 2002, as LAPACK's dlaqr3) on the bottom
-/// `w` rows of the active window l..=i of `h`.
-///
-/// The trailing w x w block is reduced to its real Schur form S = V^T H_ww V; the coupling to
-/// the rest of the window, the spike s = h[top, top-1] V[0, :], tells which eigenvalues have
-/// converged: a diagonal block of S whose spike entries are below u |λ| is deflated where it
-/// stands, at the bottom; any other block is moved to the top of the window by Schur swaps.
-/// When some deflated, a Householder reflector folds the spike of the undeflated part back
-/// into one entry and a Hessenberg reduction restores the form above the deflated blocks; the
-/// orthogonal V is applied to the rest of H (and to Z). The deflated blocks are in standard
-/// form; the eigenvalues of the undeflated part are good shifts for the next sweeps.
-fn aggressive_early_deflation(
-    h: &mut Square,
-    z: Option<&mut Square>,
-    (l, i): (usize, usize),
-    w: usize,
-    full: bool,
-) -> Result<EarlyDeflation, Error> {
-    use crate::reorder::swap_blocks;
-    use faer::linalg::matmul::matmul;
-    use faer::{Accum, MatMut, Par};
-
-    let n = h.n;
-    let top = i + 1 - w;
-    debug_assert!(top > l, "a row stays above the deflation window");
-    let spike = h[(top, top - 1)];
-    let window = Mat::from_fn(w, w, |r, c| h[(top + r, top + c)]);
-    let RealSchur { mut t, z: mut v } = real_schur(window.as_ref())?;
-
-    // The scan from the bottom: t[..ns] is not yet judged, t[..undeflated] holds the blocks
-    // judged not deflatable.
-    let ulp = f64::EPSILON;
-    let small = f64::MIN_POSITIVE * (n as f64 / ulp);
-    let (mut ns, mut undeflated) = (w, 0);
-    while undeflated < ns {
-        let size = if ns >= 2 && t[(ns - 1, ns - 2)] != 0.0 {
-            2
-        } else {
-            1
-        };
-        let k = ns - size;
-        let mut magnitude = if size == 1 {
-            t[(k, k)].abs()
-        } else {
-            t[(k + 1, k + 1)].abs() + t[(k + 1, k)].abs().sqrt() * t[(k, k + 1)].abs().sqrt()
-        };
-        if magnitude == 0.0 {
-            magnitude = spike.abs();
-        }
-        let coupling = (k..ns).fold(0.0f64, |m, c| m.max((spike * v[(0, c)]).abs()));
-        if coupling <= small.max(ulp * magnitude) {
-            ns = k;
-            continue;
-        }
-        // Not converged: move the block up to the top of the unjudged part.
-        let mut current = k;
-        while current > undeflated {
-            let above = if current >= undeflated + 2 && t[(current - 1, current - 2)] != 0.0 {
-                2
-            } else {
-                1
-            };
-            let previous = current - above;
-            if swap_blocks(&mut t, &mut v, previous, above, size).is_err() {
-                break;
-            }
-            current = previous;
-        }
-        if current > undeflated {
-            // A refused swap: leave the rest of the window undeflated.
-            break;
-        }
-        undeflated += size;
-    }
-    let deflated = w - ns;
-    let shifts = quasi_triangular_eigenvalues(t.as_ref().submatrix(0, 0, ns, ns));
-    if deflated == 0 {
-        return Ok(EarlyDeflation { deflated, shifts });
-    }
-
-    // The spike of the undeflated part, s = spike V[0, ..ns], folded into its first entry.
-    let mut coupling_entry = 0.0;
-    if ns > 0 {
-        let mut s: Vec<f64> = (0..ns).map(|c| spike * v[(0, c)]).collect();
-        let (beta, tau) = reflector(&mut s);
-        coupling_entry = beta;
-        if tau != 0.0 {
-            let u: Vec<f64> = std::iter::once(1.0).chain(s[1..].iter().copied()).collect();
-            // T <- P T P on the leading ns rows and columns (P = I - τ u u^T), V <- V P.
-            for c in 0..w {
-                let dot: f64 = (0..ns).map(|r| u[r] * t[(r, c)]).sum();
-                for r in 0..ns {
-                    t[(r, c)] -= tau * dot * u[r];
-                }
-            }
-            for r in 0..ns {
-                let dot: f64 = (0..ns).map(|c| t[(r, c)] * u[c]).sum();
-                for c in 0..ns {
-                    t[(r, c)] -= tau * dot * u[c];
-                }
-            }
-            for r in 0..w {
-                let dot: f64 = (0..ns).map(|c| v[(r, c)] * u[c]).sum();
-                for c in 0..ns {
-                    v[(r, c)] -= tau * dot * u[c];
-                }
-            }
-        }
-        if ns > 2 {
-            let reduced = hessenberg(t.as_ref().submatrix(0, 0, ns, ns));
-            let right = reduced.q.transpose() * t.as_ref().submatrix(0, ns, ns, w - ns);
-            t.as_mut().submatrix_mut(0, 0, ns, ns).copy_from(&reduced.h);
-            t.as_mut()
-                .submatrix_mut(0, ns, ns, w - ns)
-                .copy_from(&right);
-            let columns = v.as_ref().submatrix(0, 0, w, ns) * &reduced.q;
-            v.as_mut().submatrix_mut(0, 0, w, ns).copy_from(&columns);
-        }
-    }
-
-    // Back into H: the window, the coupling entry, and V applied to the rest.
-    h[(top, top - 1)] = coupling_entry;
-    for c in 0..w {
-        for r in 0..w {
-            h[(top + r, top + c)] = t[(r, c)];
-        }
-    }
-    let (first, last) = if full { (0, n - 1) } else { (l, i) };
-    let mut full_h = MatMut::from_column_major_slice_mut(&mut h.data, n, n);
-    if top > first {
-        let above = full_h
-            .as_ref()
-            .submatrix(first, top, top - first, w)
-            .to_owned();
-        matmul(
-            full_h.as_mut().submatrix_mut(first, top, top - first, w),
-            Accum::Replace,
-            above.as_ref(),
-            v.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-    }
-    if last > i {
-        let right = full_h
-            .as_ref()
-            .submatrix(top, i + 1, w, last - i)
-            .to_owned();
-        matmul(
-            full_h.as_mut().submatrix_mut(top, i + 1, w, last - i),
-            Accum::Replace,
-            v.transpose(),
-            right.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-    }
-    if let Some(z) = z {
-        let rows = z.n;
-        let mut full_z = MatMut::from_column_major_slice_mut(&mut z.data, rows, rows);
-        let columns = full_z.as_ref().submatrix(0, top, rows, w).to_owned();
-        matmul(
-            full_z.as_mut().submatrix_mut(0, top, rows, w),
-            Accum::Replace,
-            columns.as_ref(),
-            v.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-    }
-    clear_upper_avx_state();
-    Ok(EarlyDeflation { deflated, shifts })
-}
-
 /// The two shifts of a double-shift step: the eigenvalues of [[h11, h12], [h21, h22]] when
 /// they are complex; when they are real, the one nearer h22, twice.
 fn double_shift(h11: f64, h12: f64, h21: f64, h22: f64) -> (c64, c64) {
@@ -1117,72 +857,6 @@ mod tests {
                 );
             }
         }
-    }
-
-    #[test]
-    fn large_windows_deflate_early_and_keep_the_form() {
-        // Orders from the crossover of aggressive early deflation up: random matrices, and a
-        // matrix Q D Q^T with known eigenvalues (clusters, complex pairs, a spread of scales).
-        for n in [AED_MIN_ORDER, 120, 200] {
-            assert_schur_form(&seeded(n, 31 + n as u64), &format!("random n={n}"));
-        }
-        let n = 150;
-        let q = seeded(n, 5).qr().compute_Q();
-        let mut d = Mat::<f64>::zeros(n, n);
-        let mut known = Vec::new();
-        let mut k = 0;
-        while k < n {
-            let re = -1.0 - (k % 7) as f64 * 0.5 + if k % 3 == 0 { 1e-3 } else { 0.0 };
-            if k + 1 < n && k % 4 == 0 {
-                let im = 0.25 + k as f64 / 50.0;
-                d[(k, k)] = re;
-                d[(k + 1, k + 1)] = re;
-                d[(k, k + 1)] = im;
-                d[(k + 1, k)] = -im;
-                known.extend([c64::new(re, im), c64::new(re, -im)]);
-                k += 2;
-            } else {
-                d[(k, k)] = re * 10f64.powi((k % 5) as i32 - 2);
-                known.push(c64::new(d[(k, k)], 0.0));
-                k += 1;
-            }
-        }
-        let a = &q * &d * q.transpose();
-        assert_schur_form(&a, "known spectrum n=150");
-        let found = eigenvalues(a.as_ref()).unwrap();
-        assert_eq!(found.len(), n);
-        for y in &known {
-            let nearest = found
-                .iter()
-                .map(|x| (x - y).norm())
-                .fold(f64::INFINITY, f64::min);
-            assert!(
-                nearest < 1e-9 * y.norm().max(1.0),
-                "{y}: nearest at {nearest}"
-            );
-        }
-    }
-
-    #[test]
-    fn shift_pairs_keep_conjugates_together() {
-        let eigenvalues = [
-            c64::new(-1.0, 2.0),
-            c64::new(-1.0, -2.0),
-            c64::new(-3.0, 0.0),
-            c64::new(-4.0, 0.0),
-            c64::new(-5.0, 0.0),
-        ];
-        let pairs = shift_pairs(&eigenvalues, 10);
-        // Popped from the end: the bottom eigenvalues first, a lone real one last (twice).
-        assert_eq!(
-            pairs,
-            vec![
-                (eigenvalues[2], eigenvalues[2]),
-                (eigenvalues[0], eigenvalues[1]),
-                (eigenvalues[4], eigenvalues[3]),
-            ]
-        );
-        assert_eq!(shift_pairs(&eigenvalues, 2).len(), 1);
     }
 
     #[test]
