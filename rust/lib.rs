@@ -31,6 +31,8 @@
 //! * [`small_matrix`]: fixed-size stack matrices for the small orders of flight models.
 //! * [`double_double`]: double-double arithmetic, for results accurate beyond double precision.
 //! * [`pool`]: a per-thread free list of scratch matrices.
+//! * `allocator` (feature `small-block-allocator`, on in the Python extension): mimalloc for
+//!   small blocks as the global allocator.
 //! * [`dispatch`]: run-time choice of AVX2 + FMA kernels.
 //! * [`error`]: the error type and the argument checks.
 //!
@@ -50,6 +52,8 @@
 //! the batch kernels need. nalgebra is not used yet; it enters only where it serves better
 //! (small fixed-size blocks).
 
+#[cfg(feature = "small-block-allocator")]
+pub mod allocator;
 pub mod batch;
 pub mod care;
 pub mod ctrb;
@@ -77,3 +81,8 @@ mod sylvester;
 mod python;
 
 pub use error::Error;
+
+/// See [`allocator`]: for the Python extension, and for benches that measure as it runs.
+#[cfg(feature = "small-block-allocator")]
+#[global_allocator]
+static ALLOCATOR: allocator::SmallBlockAllocator = allocator::SmallBlockAllocator;

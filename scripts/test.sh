@@ -32,7 +32,8 @@ echo "${wheels[0]##*/}"
 
 echo "== cargo test"
 cargo_log=$(mktemp)
-cargo test --release 2>&1 | tee "$cargo_log"
+# With the allocator of the Python extension, so the kernels are tested as Python runs them.
+cargo test --release --features small-block-allocator 2>&1 | tee "$cargo_log"
 cargo_passed=$(grep -Eo 'test result: ok\. [0-9]+ passed' "$cargo_log" | awk '{s += $4} END {print s + 0}')
 rm -f "$cargo_log"
 if [ "$cargo_passed" -eq 0 ]; then

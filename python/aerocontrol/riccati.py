@@ -87,7 +87,8 @@ def solve_care(
     powers of two that balance it and keep it Hamiltonian; its real Schur form, reordered to
     put the stable eigenvalues first; X from the stable invariant subspace [U11; U21] as
     U21 U11^-1 by an LU solve; then Newton (Kleinman) steps, each a Lyapunov solve, while the
-    residual decreases.
+    residual decreases and is above 4 u (relative; below that it is mostly the rounding of its
+    own evaluation, and a step cannot improve it).
 
     Parameters
     ----------
@@ -191,23 +192,27 @@ def lqr(sys_or_A: Any, *args: Any, N: Any = None) -> tuple[FloatArray, FloatArra
     >>> bool(np.all(E.real < 0))
     True
     """
+    # Plain indexing, not star-unpacking: this wrapper's own cost is part of a 4-state lqr's.
+    count = len(args)
     if type(sys_or_A) is not np.ndarray and (
         isinstance(sys_or_A, StateSpace) or hasattr(sys_or_A, "A")
     ):
-        if len(args) not in (2, 3):
+        if count not in (2, 3):
             raise InvalidArgumentError("lqr(sys, Q, R[, N]) takes a system and two weights")
         sys = as_state_space(sys_or_A)
-        A, B, (Q, R, *rest) = sys.A, sys.B, args
+        A, B, Q, R = sys.A, sys.B, args[0], args[1]
+        weights_given = 2
     else:
-        if len(args) not in (3, 4):
+        if count not in (3, 4):
             raise InvalidArgumentError("lqr(A, B, Q, R[, N]) takes four or five matrices")
-        A, (B, Q, R, *rest) = sys_or_A, args
-    if rest:
+        A, B, Q, R = sys_or_A, args[0], args[1], args[2]
+        weights_given = 3
+    if count > weights_given:
         if N is not None:
             raise InvalidArgumentError("N given both by position and by keyword")
-        N = rest[0]
-    X, K, poles, *_ = _solve_care(A, B, Q, R, N, None, True)
-    return K, X, poles
+        N = args[weights_given]
+    result = _solve_care(A, B, Q, R, N, None, True)
+    return result[1], result[0], result[2]
 
 
 @dataclass(frozen=True, eq=False)
