@@ -1,0 +1,621 @@
+//! The small-bulge multishift QR iteration with aggressive early deflation, for the real Schur
+//! form of large upper Hessenberg matrices (from order [`MULTISHIFT_MIN_ORDER`]).
+//!
+//! The double-shift iteration of [`crate::schur`] chases one bulge at a time and applies each
+//! 3 x 3 reflector as a rank-1 update of whole rows and columns: O(n^2) memory traffic per
+//! sweep for O(n^2) flops, so at orders of a few hundred it runs at the speed of memory, not of
+//! the arithmetic units. This module does what Braman, Byers & Mathias (2002) proposed and
+//! LAPACK's dhseqr (dlaqr0, dlaqr3, dlaqr5) does:
+//!
+//! * **Aggressive early deflation** (Braman, Byers & Mathias 2002, part II). The trailing
+//!   w x w block of the active window is reduced to Schur form S = V^T H_ww V (recursively,
+//!   by this same iteration when w is large). Its coupling to the rest of the window is the
+//!   spike s = h[top, top-1] V[0, :]; every diagonal block of S whose spike entries are below
+//!   u times its eigenvalue has converged and deflates where it stands, and the others are moved
+//!   to the top of S by Schur swaps. The spike of the undeflated part is folded into one entry by
+//!   a reflector and the undeflated part is returned to Hessenberg form. Many eigenvalues
+//!   deflate at once, long before a subdiagonal entry becomes small, and the eigenvalues of the
+//!   undeflated part are the shifts of the next sweep.
+//! * **A chain of small bulges** (part I). A sweep uses `2 b` shifts at once as b bulges of
+//!   the ordinary double-shift kind, introduced at the top one after another and chased down
+//!   together, three rows apart. All the reflectors of one step are independent (they act on
+//!   disjoint rows and columns), and the chase proceeds in slabs: the chain moves about its own
+//!   length down the diagonal while every reflector is applied only within the near-diagonal
+//!   window it lives in and accumulated into one orthogonal U. The rows above the window, the
+//!   columns to its right and Z are then updated by three matrix products (faer's, sequential)
+//!   with U. Most of the flops thereby become level-3 products.
+//!
+//! Each iteration of [`multishift_qr`] first looks for negligible subdiagonal entries (the
+//! test of [`negligible_subdiagonal`]), then runs aggressive early deflation on the bottom of the
+//! active block; unless that deflated much (then it runs again instead), a sweep follows with the
+//! smallest of its undeflated eigenvalues as shifts. An active block smaller than
+//! [`MULTISHIFT_MIN_ORDER`] is finished by the double-shift iteration. Every sixth iteration
+//! without a deflation uses exceptional shifts (Wilkinson's ad hoc ones), and after five the
+//! deflation window doubles.
+//!
+//! Every transformation is an orthogonal similarity (reflectors, Schur swaps that passed the
+//! stability tests of Bai & Demmel, and rotations), and what is set to zero is either negligible
+//! by the Ahues-Tisseur test or a spike entry below u |λ|, so the form is backward stable as the
+//! double-shift one: Z T Z^T = A + E with ||E|| = O(u ||A||).
+//!
+//! References: K. Braman, R. Byers, R. Mathias, The multishift QR algorithm. Part I:
+//! Maintaining well-focused shifts and level 3 performance; Part II: Aggressive early
+//! deflation. SIAM J. Matrix Anal. Appl. 23 (2002) 929-947 and 948-973.
+
+use crate::dispatch::clear_upper_avx_state;
+use crate::error::Error;
+use crate::hessenberg::hessenberg;
+use crate::reorder::swap_blocks;
+use crate::schur::{
+    MULTISHIFT_MIN_ORDER, Spectrum, Square, block_eigenvalues, double_shift, francis_qr,
+    negligible_subdiagonal, quasi_triangular_eigenvalues, reflector, schur_of_hessenberg,
+    shift_polynomial_column,
+};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par, c64};
+
+/// The iteration limit is this many iterations (deflation passes, each with at most one sweep)
+/// per row, as in the double-shift iteration and LAPACK.
+const ITERATIONS_PER_ORDER: usize = 30;
+
+/// Every this many iterations without a deflation, the sweep uses exceptional shifts.
+const EXCEPTIONAL_SHIFT_INTERVAL: usize = 6;
+
+/// After this many iterations without a deflation, the deflation window doubles.
+const WIDEN_WINDOW_AFTER: usize = 5;
+
+/// A deflation pass that deflated more than this percentage of its window is followed by
+/// another pass instead of a sweep: the next pass is likely to deflate as much for a fraction
+/// of a sweep's cost (LAPACK's "nibble" crossover, 14 %).
+const NIBBLE_PERCENT: usize = 14;
+
+/// Rows between consecutive bulges of a chain: a bulge's reflector spans three rows, and with
+/// this spacing the reflectors of one step touch disjoint rows and columns.
+const BULGE_SPACING: usize = 3;
+
+/// The number of shifts of a sweep on an active block of the given order (even): about
+/// order / log2(order), between 10 and 64 (the values of LAPACK's iparmq, which balance the
+/// sweep's level-3 efficiency against the convergence lost to a long chain).
+fn shift_count(order: usize) -> usize {
+    let count = if order < 150 {
+        10
+    } else if order < 590 {
+        let log2 = (order as f64).log2().round() as usize;
+        (order / log2).max(10)
+    } else {
+        64
+    };
+    count - count % 2
+}
+
+/// The order of the deflation window for `shifts` shifts on an active block of the given
+/// order: as many rows as shifts, half as many more above order 500 (iparmq's choice).
+fn deflation_window(order: usize, shifts: usize) -> usize {
+    if order <= 500 { shifts } else { 3 * shifts / 2 }
+}
+
+/// The Schur form of the upper Hessenberg `h` (of order at least 3), in place, with `z`
+/// multiplied on the right by the transformations; `full` as in [`schur_of_hessenberg`].
+pub(crate) fn multishift_qr(
+    h: &mut Square,
+    mut z: Option<&mut Square>,
+    full: bool,
+) -> Result<(), Error> {
+    let n = h.n;
+    let small = f64::MIN_POSITIVE * (n as f64 / f64::EPSILON);
+    let nominal_shifts = shift_count(n);
+    let nominal_window = deflation_window(n, nominal_shifts);
+    // Rows end.. have converged; `stalls` counts the iterations since the last deflation.
+    let mut end = n;
+    let mut stalls = 0;
+    for _ in 0..ITERATIONS_PER_ORDER * n.max(10) {
+        if end == 0 {
+            return Ok(());
+        }
+        let kbot = end - 1;
+        // The active block ktop..=kbot: below the lowest negligible subdiagonal entry.
+        let mut ktop = kbot;
+        while ktop > 0 && !negligible_subdiagonal(h, ktop, (0, kbot), small) {
+            ktop -= 1;
+        }
+        if ktop > 0 {
+            h[(ktop, ktop - 1)] = 0.0;
+        }
+        let order = kbot + 1 - ktop;
+        if order < MULTISHIFT_MIN_ORDER {
+            francis_qr(h, z.as_deref_mut(), (ktop, kbot), full, Spectrum::General)?;
+            end = ktop;
+            stalls = 0;
+            continue;
+        }
+
+        // Aggressive early deflation on a window that leaves a row of the block above it,
+        // one row larger where that puts its top at the smaller of two subdiagonal entries.
+        let widened = if stalls >= WIDEN_WINDOW_AFTER { 2 } else { 1 };
+        let mut window = (widened * nominal_window).min(order - 1);
+        let top = kbot + 1 - window;
+        if window + 1 < order && h[(top, top - 1)].abs() > h[(top - 1, top - 2)].abs() {
+            window += 1;
+        }
+        let deflation =
+            aggressive_early_deflation(h, z.as_deref_mut(), full, (ktop, kbot), window)?;
+        end -= deflation.deflated;
+        if deflation.deflated > 0 {
+            stalls = 0;
+        } else {
+            stalls += 1;
+        }
+        let remaining = end - ktop;
+        let nibbled = 100 * deflation.deflated > NIBBLE_PERCENT * window;
+        if (deflation.deflated > 0 && nibbled) || remaining < MULTISHIFT_MIN_ORDER {
+            continue;
+        }
+
+        // A sweep over the active block with the smallest undeflated eigenvalues as shifts.
+        let kbot = end - 1;
+        let count = nominal_shifts.min(remaining - 1);
+        let count = count - count % 2;
+        let shifts = if stalls > 0 && stalls % EXCEPTIONAL_SHIFT_INTERVAL == 0 {
+            exceptional_shifts(h, (ktop, kbot), count)
+        } else if deflation.shifts.len() > count / 2 {
+            select_shifts(&deflation.shifts, count, h[(kbot, kbot)])
+        } else {
+            select_shifts(
+                &trailing_eigenvalues(h, kbot, count),
+                count,
+                h[(kbot, kbot)],
+            )
+        };
+        let shifts = if shifts.is_empty() {
+            // Too few candidates (a lone real one): the shifts of the trailing 2 x 2 block.
+            vec![trailing_double_shift(h, kbot)]
+        } else {
+            shifts
+        };
+        small_bulge_sweep(h, z.as_deref_mut(), full, (ktop, kbot), &shifts);
+    }
+    Err(Error::NoConvergence {
+        algorithm: "the multishift QR iteration",
+    })
+}
+
+/// What a pass of aggressive early deflation found: how many eigenvalues at the bottom of the
+/// window converged, and the eigenvalues of the rest of the window (pairs adjacent, Im > 0
+/// first), the shifts of the next sweep.
+struct EarlyDeflation {
+    deflated: usize,
+    shifts: Vec<c64>,
+}
+
+/// Aggressive early deflation on the bottom `window` rows of the active block ktop..=kbot of
+/// `h` (window <= kbot - ktop, so the spike h[top, top-1] is inside the block).
+///
+/// The window W is reduced to Schur form S = V^T W V. The spike column h[top.., top-1] becomes
+/// s = h[top, top-1] V[0, :]^T; from the bottom, each diagonal block of S whose spike entries are
+/// at most max(small, u |λ|) deflates (its spike entries are set to zero, a backward error of
+/// that size), and each other block is moved by Schur swaps to the top of the part not yet
+/// judged. A refused swap (nearly equal eigenvalues) ends the scan. Then a reflector P with
+/// P s_u = β e1 folds the spike of the undeflated part into one entry, P S_uu P (and the
+/// columns to its right) is reduced back to Hessenberg form, and V, updated alike, is applied
+/// to the rows above the window, the columns to its right and Z.
+fn aggressive_early_deflation(
+    h: &mut Square,
+    z: Option<&mut Square>,
+    full: bool,
+    (ktop, kbot): (usize, usize),
+    window: usize,
+) -> Result<EarlyDeflation, Error> {
+    let n = h.n;
+    let top = kbot + 1 - window;
+    debug_assert!(
+        top > ktop,
+        "a row of the block stays above the deflation window"
+    );
+    let spike = h[(top, top - 1)];
+    let mut t = Square::identity(window);
+    for c in 0..window {
+        for r in 0..=(c + 1).min(window - 1) {
+            t[(r, c)] = h[(top + r, top + c)];
+        }
+    }
+    let mut v = Square::identity(window);
+    schur_of_hessenberg(&mut t, Some(&mut v), true, Spectrum::General)?;
+    let (mut t, mut v) = (t.to_mat(), v.to_mat());
+    clear_upper_avx_state();
+
+    // The scan from the bottom: t[..unjudged] is not yet judged, and of it t[..undeflated]
+    // holds the blocks judged not deflatable.
+    let ulp = f64::EPSILON;
+    let small = f64::MIN_POSITIVE * (n as f64 / ulp);
+    let (mut unjudged, mut undeflated) = (window, 0);
+    while undeflated < unjudged {
+        let size = if unjudged >= 2 && t[(unjudged - 1, unjudged - 2)] != 0.0 {
+            2
+        } else {
+            1
+        };
+        let k = unjudged - size;
+        let mut magnitude = if size == 1 {
+            t[(k, k)].abs()
+        } else {
+            t[(k + 1, k + 1)].abs() + t[(k + 1, k)].abs().sqrt() * t[(k, k + 1)].abs().sqrt()
+        };
+        if magnitude == 0.0 {
+            magnitude = spike.abs();
+        }
+        let coupling = (k..unjudged).fold(0.0f64, |m, c| m.max((spike * v[(0, c)]).abs()));
+        if coupling <= small.max(ulp * magnitude) {
+            unjudged = k;
+            continue;
+        }
+        // Not converged: move the block up to the top of the unjudged part.
+        let mut current = k;
+        while current > undeflated {
+            let above = if current >= undeflated + 2 && t[(current - 1, current - 2)] != 0.0 {
+                2
+            } else {
+                1
+            };
+            let previous = current - above;
+            if swap_blocks(&mut t, &mut v, previous, above, size).is_err() {
+                break;
+            }
+            current = previous;
+        }
+        if current > undeflated {
+            // A refused swap: leave the rest of the window undeflated.
+            break;
+        }
+        undeflated += size;
+    }
+    let kept = unjudged;
+    let deflated = window - kept;
+    let shifts = quasi_triangular_eigenvalues(t.as_ref().submatrix(0, 0, kept, kept));
+    if deflated == 0 {
+        return Ok(EarlyDeflation { deflated, shifts });
+    }
+
+    // The spike of the undeflated part, s = spike V[0, ..kept], folded into its first entry.
+    let mut coupling_entry = 0.0;
+    if kept > 0 {
+        let mut s: Vec<f64> = (0..kept).map(|c| spike * v[(0, c)]).collect();
+        let (beta, tau) = reflector(&mut s);
+        coupling_entry = beta;
+        if tau != 0.0 {
+            s[0] = 1.0;
+            // T <- P T on the leading rows, then T <- T P and V <- V P on the leading columns.
+            for c in 0..window {
+                let dot: f64 = (0..kept).map(|r| s[r] * t[(r, c)]).sum();
+                for r in 0..kept {
+                    t[(r, c)] -= tau * dot * s[r];
+                }
+            }
+            for r in 0..kept {
+                let dot: f64 = (0..kept).map(|c| t[(r, c)] * s[c]).sum();
+                for c in 0..kept {
+                    t[(r, c)] -= tau * dot * s[c];
+                }
+            }
+            for r in 0..window {
+                let dot: f64 = (0..kept).map(|c| v[(r, c)] * s[c]).sum();
+                for c in 0..kept {
+                    v[(r, c)] -= tau * dot * s[c];
+                }
+            }
+        }
+        if kept > 2 {
+            let reduced = hessenberg(t.as_ref().submatrix(0, 0, kept, kept));
+            let right = reduced.q.transpose() * t.as_ref().submatrix(0, kept, kept, window - kept);
+            t.as_mut()
+                .submatrix_mut(0, 0, kept, kept)
+                .copy_from(&reduced.h);
+            t.as_mut()
+                .submatrix_mut(0, kept, kept, window - kept)
+                .copy_from(&right);
+            let columns = v.as_ref().submatrix(0, 0, window, kept) * &reduced.q;
+            v.as_mut()
+                .submatrix_mut(0, 0, window, kept)
+                .copy_from(&columns);
+        }
+    }
+
+    // Back into H: the window, the coupling entry, and V applied to the rest.
+    h[(top, top - 1)] = coupling_entry;
+    for c in 0..window {
+        for r in 0..window {
+            h[(top + r, top + c)] = t[(r, c)];
+        }
+    }
+    let outside = if full { (0, n - 1) } else { (ktop, kbot) };
+    let mut scratch = Vec::new();
+    apply_outside_window(h, z, outside, (top, kbot), v.as_ref(), &mut scratch);
+    clear_upper_avx_state();
+    Ok(EarlyDeflation { deflated, shifts })
+}
+
+/// Completes an orthogonal similarity U^T H U whose U acts on rows and columns w0..=w1 and
+/// which has already been applied to the window H[w0..=w1, w0..=w1] itself: the rows
+/// first..w0 above the window become H U, the columns w1+1..=last to its right U^T H, and the
+/// columns w0..=w1 of Z become Z U. (H is zero left of and below the window, outside the
+/// active block, so nothing else changes.)
+fn apply_outside_window(
+    h: &mut Square,
+    z: Option<&mut Square>,
+    (first, last): (usize, usize),
+    (w0, w1): (usize, usize),
+    u: MatRef<'_, f64>,
+    scratch: &mut Vec<f64>,
+) {
+    let n = h.n;
+    let w = w1 + 1 - w0;
+    let mut full_h = MatMut::from_column_major_slice_mut(&mut h.data, n, n);
+    if w0 > first {
+        multiply_on_the_right(
+            full_h.as_mut().submatrix_mut(first, w0, w0 - first, w),
+            u,
+            scratch,
+        );
+    }
+    if last > w1 {
+        let block = full_h.as_mut().submatrix_mut(w0, w1 + 1, w, last - w1);
+        let (rows, columns) = (block.nrows(), block.ncols());
+        scratch.clear();
+        scratch.resize(rows * columns, 0.0);
+        let mut copy = MatMut::from_column_major_slice_mut(scratch, rows, columns);
+        copy.copy_from(block.as_ref());
+        matmul(
+            block,
+            Accum::Replace,
+            u.transpose(),
+            copy.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+    }
+    if let Some(z) = z {
+        let rows = z.n;
+        let mut full_z = MatMut::from_column_major_slice_mut(&mut z.data, rows, rows);
+        multiply_on_the_right(full_z.as_mut().submatrix_mut(0, w0, rows, w), u, scratch);
+    }
+}
+
+/// block <- block U, through a copy of the block in `scratch`.
+fn multiply_on_the_right(block: MatMut<'_, f64>, u: MatRef<'_, f64>, scratch: &mut Vec<f64>) {
+    let (rows, columns) = (block.nrows(), block.ncols());
+    scratch.clear();
+    scratch.resize(rows * columns, 0.0);
+    let mut copy = MatMut::from_column_major_slice_mut(scratch, rows, columns);
+    copy.copy_from(block.as_ref());
+    matmul(block, Accum::Replace, copy.as_ref(), u, 1.0, Par::Seq);
+}
+
+/// One small-bulge multishift QR sweep over the active block ktop..=kbot (at least 3 rows)
+/// with one bulge per pair of shifts, the first pair's bulge introduced first.
+///
+/// Bulge m (0-based) is introduced at step 3m and at step t has its reflector on rows p..p+2,
+/// p = ktop + t - 3m, while ktop <= p <= kbot - 1 (the last one, at kbot - 1, spans 2 rows).
+/// In a step, the bulges are handled from the bottom up: a bulge's reflector is computed from
+/// column p - 1 (at p = ktop, from the shifts) before the bulge above, whose right
+/// multiplication reaches row p, moves; apart from that the reflectors of a step act on
+/// disjoint rows and columns. The steps are grouped into slabs of 3 b steps (b bulges), the
+/// chain's own length, which minimises the flops of the products: the reflectors of a slab are
+/// applied within the slab's diagonal window and accumulated into U, which then updates the
+/// rest of H and Z by matrix products ([`apply_outside_window`]).
+fn small_bulge_sweep(
+    h: &mut Square,
+    mut z: Option<&mut Square>,
+    full: bool,
+    (ktop, kbot): (usize, usize),
+    shifts: &[(c64, c64)],
+) {
+    let n = h.n;
+    let bulges = shifts.len();
+    if bulges == 0 || kbot < ktop + 2 {
+        return;
+    }
+    let outside = if full { (0, n - 1) } else { (ktop, kbot) };
+    // Bulge positions p run over ktop..=kbot-1, i.e. t - 3m over 0..=span.
+    let span = kbot - 1 - ktop;
+    let last_step = span + BULGE_SPACING * (bulges - 1);
+    // The bulges active at step t, from the lowest (m_low, largest p) to the highest.
+    let active = |t: usize| {
+        let highest = (t / BULGE_SPACING).min(bulges - 1);
+        let lowest = t.saturating_sub(span).div_ceil(BULGE_SPACING);
+        (lowest <= highest).then_some((lowest, highest))
+    };
+    let slab_steps = BULGE_SPACING * bulges;
+    let mut scratch = Vec::new();
+    let mut t0 = 0;
+    while t0 <= last_step {
+        let t1 = (t0 + slab_steps - 1).min(last_step);
+        // The slab's window: from the column left of the highest reflector (or ktop) to the
+        // row below the lowest.
+        let (mut p_top, mut p_bottom) = (usize::MAX, 0);
+        for t in t0..=t1 {
+            if let Some((lowest, highest)) = active(t) {
+                p_top = p_top.min(ktop + t - BULGE_SPACING * highest);
+                p_bottom = p_bottom.max(ktop + t - BULGE_SPACING * lowest);
+            }
+        }
+        let w0 = if p_top > ktop { p_top - 1 } else { ktop };
+        let w1 = (p_bottom + 3).min(kbot);
+        let w = w1 + 1 - w0;
+        let mut u = Square::identity(w);
+        clear_upper_avx_state();
+        for t in t0..=t1 {
+            let Some((lowest, highest)) = active(t) else {
+                continue;
+            };
+            for (m, &pair) in shifts.iter().enumerate().take(highest + 1).skip(lowest) {
+                let p = ktop + t - BULGE_SPACING * m;
+                let rows_below = (p + 3).min(kbot) + 1;
+                if p + 2 <= kbot {
+                    let mut v = if p == ktop {
+                        shift_polynomial_column(h, p, pair)
+                    } else {
+                        [h[(p, p - 1)], h[(p + 1, p - 1)], h[(p + 2, p - 1)]]
+                    };
+                    let (beta, tau) = reflector(&mut v);
+                    if p > ktop {
+                        h[(p, p - 1)] = beta;
+                        h[(p + 1, p - 1)] = 0.0;
+                        h[(p + 2, p - 1)] = 0.0;
+                    }
+                    if tau == 0.0 {
+                        continue;
+                    }
+                    let v = [1.0, v[1], v[2]];
+                    h.reflect_rows_fixed(p, v, tau, p..w1 + 1);
+                    h.reflect_columns_fixed(p, v, tau, w0..rows_below);
+                    u.reflect_columns_fixed(p - w0, v, tau, 0..w);
+                } else {
+                    // The bottom of the block (p = kbot - 1, hence p > ktop): a 2 x 2
+                    // reflector.
+                    let mut v = [h[(p, p - 1)], h[(p + 1, p - 1)]];
+                    let (beta, tau) = reflector(&mut v);
+                    h[(p, p - 1)] = beta;
+                    h[(p + 1, p - 1)] = 0.0;
+                    if tau == 0.0 {
+                        continue;
+                    }
+                    let v = [1.0, v[1]];
+                    h.reflect_rows_fixed(p, v, tau, p..w1 + 1);
+                    h.reflect_columns_fixed(p, v, tau, w0..rows_below);
+                    u.reflect_columns_fixed(p - w0, v, tau, 0..w);
+                }
+            }
+        }
+        let u = MatRef::from_column_major_slice(&u.data, w, w);
+        apply_outside_window(h, z.as_deref_mut(), outside, (w0, w1), u, &mut scratch);
+        t0 = t1 + 1;
+    }
+    clear_upper_avx_state();
+}
+
+/// Shifts for a sweep of `count` (even) from `candidates` (conjugate pairs adjacent, Im > 0
+/// first): those of smallest magnitude, complex ones as conjugate pairs and real ones paired,
+/// ordered by decreasing magnitude (the first bulge introduced gets the largest). Two real
+/// shifts alone are replaced by the one nearer the corner entry h[kbot, kbot], twice.
+fn select_shifts(candidates: &[c64], count: usize, corner: f64) -> Vec<(c64, c64)> {
+    // Each candidate as (eigenvalue, whether it stands for a conjugate pair).
+    let mut units = Vec::with_capacity(candidates.len());
+    let mut k = 0;
+    while k < candidates.len() {
+        let lambda = candidates[k];
+        if lambda.im != 0.0 && k + 1 < candidates.len() {
+            units.push((c64::new(lambda.re, lambda.im.abs()), true));
+            k += 2;
+        } else {
+            units.push((c64::new(lambda.re, 0.0), false));
+            k += 1;
+        }
+    }
+    units.sort_by(|x, y| x.0.norm().total_cmp(&y.0.norm()));
+    let mut taken = 0;
+    let mut pairs = Vec::new();
+    let mut reals = Vec::new();
+    for &(lambda, pair) in &units {
+        if pair && taken + 2 <= count {
+            pairs.push((lambda, lambda.conj()));
+            taken += 2;
+        } else if !pair && taken < count {
+            reals.push(lambda);
+            taken += 1;
+        }
+    }
+    // An odd number of real shifts: drop the largest.
+    if reals.len() % 2 == 1 {
+        reals.pop();
+    }
+    if pairs.is_empty() && reals.len() == 2 {
+        let nearer = if (reals[0].re - corner).abs() <= (reals[1].re - corner).abs() {
+            reals[0]
+        } else {
+            reals[1]
+        };
+        return vec![(nearer, nearer)];
+    }
+    pairs.extend(reals.chunks_exact(2).map(|two| (two[1], two[0])));
+    pairs.sort_by(|x, y| y.0.norm().total_cmp(&x.0.norm()));
+    pairs
+}
+
+/// Exceptional shifts for a sweep of `count` (even) after iterations without a deflation:
+/// for each pair, a conjugate pair built from the size of two subdiagonal entries near the
+/// bottom (Wilkinson's ad hoc 3/4 s and -0.4375 s, as in the double-shift iteration), which
+/// breaks the rare cycles of the ordinary shifts.
+fn exceptional_shifts(h: &Square, (ktop, kbot): (usize, usize), count: usize) -> Vec<(c64, c64)> {
+    (0..count / 2)
+        .map(|j| 2 * j)
+        .take_while(|&offset| kbot >= ktop + 2 + offset)
+        .map(|offset| {
+            let i = kbot - offset;
+            let s = h[(i, i - 1)].abs() + h[(i - 1, i - 2)].abs();
+            let d = 0.75 * s + h[(i, i)];
+            double_shift(d, -0.4375 * s, s, d)
+        })
+        .collect()
+}
+
+/// The eigenvalues of the trailing `count` x `count` block of the Hessenberg `h` ending at row
+/// kbot (pairs adjacent, Im > 0 first): shifts when a deflation pass left too few. Should
+/// their iteration fail, the eigenvalues of the trailing 2 x 2 block.
+fn trailing_eigenvalues(h: &Square, kbot: usize, count: usize) -> Vec<c64> {
+    let top = kbot + 1 - count;
+    let mut block = Square::identity(count);
+    for c in 0..count {
+        for r in 0..=(c + 1).min(count - 1) {
+            block[(r, c)] = h[(top + r, top + c)];
+        }
+    }
+    match schur_of_hessenberg(&mut block, None, false, Spectrum::General) {
+        Ok(()) => block_eigenvalues(count, |i, j| block[(i, j)]),
+        Err(_) => {
+            let (s1, s2) = trailing_double_shift(h, kbot);
+            vec![s1, s2]
+        }
+    }
+}
+
+/// The shifts of the double-shift iteration: those of the trailing 2 x 2 block.
+fn trailing_double_shift(h: &Square, kbot: usize) -> (c64, c64) {
+    double_shift(
+        h[(kbot - 1, kbot - 1)],
+        h[(kbot - 1, kbot)],
+        h[(kbot, kbot - 1)],
+        h[(kbot, kbot)],
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shifts_are_the_smallest_in_pairs() {
+        let candidates = [
+            c64::new(-1.0, 2.0),
+            c64::new(-1.0, -2.0),
+            c64::new(-3.0, 0.0),
+            c64::new(-4.0, 0.0),
+            c64::new(-5.0, 0.0),
+            c64::new(0.5, 0.0),
+        ];
+        // The four smallest: 0.5, the pair of modulus 2.24, -3; two reals pair up.
+        let shifts = select_shifts(&candidates, 4, 0.0);
+        assert_eq!(
+            shifts,
+            vec![
+                (c64::new(-3.0, 0.0), c64::new(0.5, 0.0)),
+                (c64::new(-1.0, 2.0), c64::new(-1.0, -2.0)),
+            ]
+        );
+        // Two real shifts: the one nearer the corner, twice.
+        let reals = [c64::new(1.0, 0.0), c64::new(3.0, 0.0)];
+        assert_eq!(
+            select_shifts(&reals, 2, 2.9),
+            vec![(c64::new(3.0, 0.0), c64::new(3.0, 0.0))]
+        );
+        assert!(select_shifts(&[], 4, 0.0).is_empty());
+    }
+}
