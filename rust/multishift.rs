@@ -42,7 +42,7 @@
 //! Maintaining well-focused shifts and level 3 performance; Part II: Aggressive early
 //! deflation. SIAM J. Matrix Anal. Appl. 23 (2002) 929-947 and 948-973.
 
-use crate::dispatch::clear_upper_avx_state;
+use crate::dispatch::{clear_upper_avx_state, fma_dispatch, multiply_add};
 use crate::error::Error;
 use crate::hessenberg::hessenberg;
 use crate::reorder::swap_blocks;
@@ -53,6 +53,7 @@ use crate::schur::{
 };
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par, c64};
+use std::ops::Range;
 
 /// The iteration limit is this many iterations (deflation passes, each with at most one sweep)
 /// per row, as in the double-shift iteration and LAPACK.
@@ -123,7 +124,7 @@ pub(crate) fn multishift_qr(
         }
         let order = kbot + 1 - ktop;
         if order < MULTISHIFT_MIN_ORDER {
-            francis_qr(h, z.as_deref_mut(), (ktop, kbot), full, Spectrum::General)?;
+            finish_small_block(h, z.as_deref_mut(), full, (ktop, kbot))?;
             end = ktop;
             stalls = 0;
             continue;
@@ -179,6 +180,55 @@ pub(crate) fn multishift_qr(
     })
 }
 
+/// The Schur form of the active block ktop..=kbot, of order below [`MULTISHIFT_MIN_ORDER`], by
+/// the double-shift iteration. With `full`, on a copy of the block with its own transformation
+/// V, which then updates the rest of H and Z by matrix products ([`apply_outside_window`]):
+/// the double-shift iteration would otherwise apply each reflector to whole rows of H and Z,
+/// and finishing the last blocks of order 512 that way took a quarter of the time.
+fn finish_small_block(
+    h: &mut Square,
+    z: Option<&mut Square>,
+    full: bool,
+    (ktop, kbot): (usize, usize),
+) -> Result<(), Error> {
+    let n = h.n;
+    let order = kbot + 1 - ktop;
+    if !full || order == n {
+        return francis_qr(h, z, (ktop, kbot), full, Spectrum::General);
+    }
+    let mut block = hessenberg_block(h, ktop, order);
+    let mut v = Square::identity(order);
+    francis_qr(
+        &mut block,
+        Some(&mut v),
+        (0, order - 1),
+        true,
+        Spectrum::General,
+    )?;
+    for c in 0..order {
+        for r in 0..order {
+            h[(ktop + r, ktop + c)] = block[(r, c)];
+        }
+    }
+    let v = MatRef::from_column_major_slice(&v.data, order, order);
+    apply_outside_window(h, z, (0, n - 1), (ktop, kbot), v, &mut Vec::new());
+    clear_upper_avx_state();
+    Ok(())
+}
+
+/// A copy of the diagonal block of `h` of the given order from row and column `top`, with the
+/// entries below its subdiagonal zero.
+fn hessenberg_block(h: &Square, top: usize, order: usize) -> Square {
+    let mut block = Square::identity(order);
+    for c in 0..order {
+        block[(c, c)] = 0.0;
+        for r in 0..=(c + 1).min(order - 1) {
+            block[(r, c)] = h[(top + r, top + c)];
+        }
+    }
+    block
+}
+
 /// What a pass of aggressive early deflation found: how many eigenvalues at the bottom of the
 /// window converged, and the eigenvalues of the rest of the window (pairs adjacent, Im > 0
 /// first), the shifts of the next sweep.
@@ -212,12 +262,7 @@ fn aggressive_early_deflation(
         "a row of the block stays above the deflation window"
     );
     let spike = h[(top, top - 1)];
-    let mut t = Square::identity(window);
-    for c in 0..window {
-        for r in 0..=(c + 1).min(window - 1) {
-            t[(r, c)] = h[(top + r, top + c)];
-        }
-    }
+    let mut t = hessenberg_block(h, top, window);
     let mut v = Square::identity(window);
     schur_of_hessenberg(&mut t, Some(&mut v), true, Spectrum::General)?;
     let (mut t, mut v) = (t.to_mat(), v.to_mat());
@@ -394,13 +439,10 @@ fn multiply_on_the_right(block: MatMut<'_, f64>, u: MatRef<'_, f64>, scratch: &m
 ///
 /// Bulge m (0-based) is introduced at step 3m and at step t has its reflector on rows p..p+2,
 /// p = ktop + t - 3m, while ktop <= p <= kbot - 1 (the last one, at kbot - 1, spans 2 rows).
-/// In a step, the bulges are handled from the bottom up: a bulge's reflector is computed from
-/// column p - 1 (at p = ktop, from the shifts) before the bulge above, whose right
-/// multiplication reaches row p, moves; apart from that the reflectors of a step act on
-/// disjoint rows and columns. The steps are grouped into slabs of 3 b steps (b bulges), the
-/// chain's own length, which minimises the flops of the products: the reflectors of a slab are
-/// applied within the slab's diagonal window and accumulated into U, which then updates the
-/// rest of H and Z by matrix products ([`apply_outside_window`]).
+/// The steps are grouped into slabs of 3 b steps (b bulges), the chain's own length, which
+/// minimises the flops of the products: the reflectors of a slab are applied within the slab's
+/// diagonal window ([`chase_slab`]) and accumulated into U, which then updates the rest of H
+/// and Z by matrix products ([`apply_outside_window`]).
 fn small_bulge_sweep(
     h: &mut Square,
     mut z: Option<&mut Square>,
@@ -409,87 +451,221 @@ fn small_bulge_sweep(
     shifts: &[(c64, c64)],
 ) {
     let n = h.n;
-    let bulges = shifts.len();
-    if bulges == 0 || kbot < ktop + 2 {
+    if shifts.is_empty() || kbot < ktop + 2 {
         return;
     }
     let outside = if full { (0, n - 1) } else { (ktop, kbot) };
-    // Bulge positions p run over ktop..=kbot-1, i.e. t - 3m over 0..=span.
-    let span = kbot - 1 - ktop;
-    let last_step = span + BULGE_SPACING * (bulges - 1);
-    // The bulges active at step t, from the lowest (m_low, largest p) to the highest.
-    let active = |t: usize| {
-        let highest = (t / BULGE_SPACING).min(bulges - 1);
-        let lowest = t.saturating_sub(span).div_ceil(BULGE_SPACING);
-        (lowest <= highest).then_some((lowest, highest))
-    };
-    let slab_steps = BULGE_SPACING * bulges;
+    let chain = Chain { ktop, kbot, shifts };
+    let slab_steps = BULGE_SPACING * shifts.len();
     let mut scratch = Vec::new();
+    let mut reflectors = Vec::with_capacity(shifts.len());
     let mut t0 = 0;
-    while t0 <= last_step {
-        let t1 = (t0 + slab_steps - 1).min(last_step);
+    while t0 <= chain.last_step() {
+        let t1 = (t0 + slab_steps - 1).min(chain.last_step());
         // The slab's window: from the column left of the highest reflector (or ktop) to the
         // row below the lowest.
         let (mut p_top, mut p_bottom) = (usize::MAX, 0);
         for t in t0..=t1 {
-            if let Some((lowest, highest)) = active(t) {
-                p_top = p_top.min(ktop + t - BULGE_SPACING * highest);
-                p_bottom = p_bottom.max(ktop + t - BULGE_SPACING * lowest);
+            if let Some((lowest, highest)) = chain.active(t) {
+                p_top = p_top.min(chain.position(t, highest));
+                p_bottom = p_bottom.max(chain.position(t, lowest));
             }
         }
         let w0 = if p_top > ktop { p_top - 1 } else { ktop };
         let w1 = (p_bottom + 3).min(kbot);
         let w = w1 + 1 - w0;
         let mut u = Square::identity(w);
-        clear_upper_avx_state();
-        for t in t0..=t1 {
-            let Some((lowest, highest)) = active(t) else {
-                continue;
-            };
-            for (m, &pair) in shifts.iter().enumerate().take(highest + 1).skip(lowest) {
-                let p = ktop + t - BULGE_SPACING * m;
-                let rows_below = (p + 3).min(kbot) + 1;
-                if p + 2 <= kbot {
-                    let mut v = if p == ktop {
-                        shift_polynomial_column(h, p, pair)
-                    } else {
-                        [h[(p, p - 1)], h[(p + 1, p - 1)], h[(p + 2, p - 1)]]
-                    };
-                    let (beta, tau) = reflector(&mut v);
-                    if p > ktop {
-                        h[(p, p - 1)] = beta;
-                        h[(p + 1, p - 1)] = 0.0;
-                        h[(p + 2, p - 1)] = 0.0;
-                    }
-                    if tau == 0.0 {
-                        continue;
-                    }
-                    let v = [1.0, v[1], v[2]];
-                    h.reflect_rows_fixed(p, v, tau, p..w1 + 1);
-                    h.reflect_columns_fixed(p, v, tau, w0..rows_below);
-                    u.reflect_columns_fixed(p - w0, v, tau, 0..w);
-                } else {
-                    // The bottom of the block (p = kbot - 1, hence p > ktop): a 2 x 2
-                    // reflector.
-                    let mut v = [h[(p, p - 1)], h[(p + 1, p - 1)]];
-                    let (beta, tau) = reflector(&mut v);
-                    h[(p, p - 1)] = beta;
-                    h[(p + 1, p - 1)] = 0.0;
-                    if tau == 0.0 {
-                        continue;
-                    }
-                    let v = [1.0, v[1]];
-                    h.reflect_rows_fixed(p, v, tau, p..w1 + 1);
-                    h.reflect_columns_fixed(p, v, tau, w0..rows_below);
-                    u.reflect_columns_fixed(p - w0, v, tau, 0..w);
-                }
-            }
-        }
+        chase_slab(h, &mut u, &chain, (t0, t1), (w0, w1), &mut reflectors);
         let u = MatRef::from_column_major_slice(&u.data, w, w);
         apply_outside_window(h, z.as_deref_mut(), outside, (w0, w1), u, &mut scratch);
         t0 = t1 + 1;
     }
     clear_upper_avx_state();
+}
+
+/// A chain of bulges over the active block ktop..=kbot, one per pair of shifts.
+struct Chain<'a> {
+    ktop: usize,
+    kbot: usize,
+    shifts: &'a [(c64, c64)],
+}
+
+impl Chain<'_> {
+    /// The last step of the sweep, when the highest bulge leaves the block.
+    fn last_step(&self) -> usize {
+        self.kbot - 1 - self.ktop + BULGE_SPACING * (self.shifts.len() - 1)
+    }
+
+    /// The top row of bulge m's reflector at step t (when it is active).
+    fn position(&self, t: usize, m: usize) -> usize {
+        self.ktop + t - BULGE_SPACING * m
+    }
+
+    /// The bulges active at step t, (lowest, highest): m in lowest..=highest, the lowest with
+    /// the largest position.
+    fn active(&self, t: usize) -> Option<(usize, usize)> {
+        let highest = (t / BULGE_SPACING).min(self.shifts.len() - 1);
+        let lowest = t
+            .saturating_sub(self.kbot - 1 - self.ktop)
+            .div_ceil(BULGE_SPACING);
+        (lowest <= highest).then_some((lowest, highest))
+    }
+}
+
+/// One reflector I - τ v v^T of a chase step, on rows p..p+len, with the first row of U it
+/// can reach.
+#[derive(Clone, Copy)]
+struct StepReflector {
+    p: usize,
+    len: usize,
+    v: [f64; 3],
+    tau: f64,
+    first_row_of_u: usize,
+}
+
+/// The steps t0..=t1 of a sweep, within the window w0..=w1 of H, accumulating the reflectors
+/// into U (of the window's order, the identity on entry).
+///
+/// A step first computes the reflectors of all its bulges, from the bottom up: a bulge's
+/// reflector comes from column p - 1 (at p = ktop, from its shifts), which the right
+/// multiplication of the bulge above reaches. With the bulges three rows apart, the reflectors
+/// of a step then act on disjoint rows and on disjoint columns, and commute: the left
+/// multiplications go column by column through all the bulges (one pass over each column's
+/// rows), the right multiplications reflector by reflector over the rows of the window above
+/// and the rows of U. The columns of U that a bulge's reflector combines are nonzero only from
+/// the row where that bulge entered the slab down to the lowest row any reflector of the slab
+/// has reached so far (by induction: a reflector only mixes columns within its own reach), and
+/// only those rows are updated.
+fn chase_slab_kernel<const FMA: bool>(
+    h: &mut Square,
+    u: &mut Square,
+    chain: &Chain<'_>,
+    (t0, t1): (usize, usize),
+    (w0, w1): (usize, usize),
+    reflectors: &mut Vec<StepReflector>,
+) {
+    let (ktop, kbot) = (chain.ktop, chain.kbot);
+    let n = h.n;
+    let w = u.n;
+    // The rows of U below this one are still those of the identity.
+    let mut u_rows_end = 0;
+    for t in t0..=t1 {
+        let Some((lowest, highest)) = chain.active(t) else {
+            continue;
+        };
+        reflectors.clear();
+        for (m, &pair) in chain
+            .shifts
+            .iter()
+            .enumerate()
+            .take(highest + 1)
+            .skip(lowest)
+        {
+            let p = chain.position(t, m);
+            let len = if p + 2 <= kbot { 3 } else { 2 };
+            let mut v = if p == ktop {
+                shift_polynomial_column(h, p, pair)
+            } else if len == 3 {
+                [h[(p, p - 1)], h[(p + 1, p - 1)], h[(p + 2, p - 1)]]
+            } else {
+                [h[(p, p - 1)], h[(p + 1, p - 1)], 0.0]
+            };
+            let (beta, tau) = reflector(&mut v[..len]);
+            if p > ktop {
+                h[(p, p - 1)] = beta;
+                for r in 1..len {
+                    h[(p + r, p - 1)] = 0.0;
+                }
+            }
+            if tau != 0.0 {
+                let first_step = t0.max(BULGE_SPACING * m);
+                reflectors.push(StepReflector {
+                    p,
+                    len,
+                    v: [1.0, v[1], if len == 3 { v[2] } else { 0.0 }],
+                    tau,
+                    first_row_of_u: chain.position(first_step, m) - w0,
+                });
+            }
+        }
+        let (Some(top), Some(bottom)) = (reflectors.last().copied(), reflectors.first().copied())
+        else {
+            continue;
+        };
+        // From the left, column by column: the reflectors with p <= j, the highest first.
+        for j in top.p..=w1 {
+            let column = &mut h.data[j * n..(j + 1) * n];
+            for r in reflectors.iter().rev().take_while(|r| r.p <= j) {
+                reflect_entries::<FMA>(column, r);
+            }
+        }
+        // From the right, on the rows of the window above each reflector and on U.
+        u_rows_end = u_rows_end.max((bottom.p + 3 - w0).min(w));
+        for r in reflectors.iter() {
+            let rows = w0..(r.p + 3).min(kbot) + 1;
+            reflect_columns::<FMA>(&mut h.data, n, r.p, r, rows);
+            reflect_columns::<FMA>(&mut u.data, w, r.p - w0, r, r.first_row_of_u..u_rows_end);
+        }
+    }
+}
+
+fma_dispatch!(
+    /// [`chase_slab_kernel`], compiled for AVX2 and FMA where the CPU has them.
+    fn chase_slab(h: &mut Square, u: &mut Square, chain: &Chain<'_>, steps: (usize, usize), window: (usize, usize), reflectors: &mut Vec<StepReflector>) => chase_slab_kernel
+);
+
+/// x[p..p+len] <- (I - τ v v^T) x[p..p+len] for one column x.
+#[inline(always)]
+fn reflect_entries<const FMA: bool>(column: &mut [f64], r: &StepReflector) {
+    let p = r.p;
+    let [_, v1, v2] = r.v;
+    if r.len == 3 {
+        let x = &mut column[p..p + 3];
+        let sum = multiply_add::<FMA>(v2, x[2], multiply_add::<FMA>(v1, x[1], x[0]));
+        let s = r.tau * sum;
+        x[0] -= s;
+        x[1] = multiply_add::<FMA>(-s, v1, x[1]);
+        x[2] = multiply_add::<FMA>(-s, v2, x[2]);
+    } else {
+        let x = &mut column[p..p + 2];
+        let s = r.tau * multiply_add::<FMA>(v1, x[1], x[0]);
+        x[0] -= s;
+        x[1] = multiply_add::<FMA>(-s, v1, x[1]);
+    }
+}
+
+/// Columns c..c+len of the column-major matrix `data` (leading dimension `ld`), rows `rows`,
+/// multiplied on the right by I - τ v v^T.
+#[inline(always)]
+fn reflect_columns<const FMA: bool>(
+    data: &mut [f64],
+    ld: usize,
+    c: usize,
+    r: &StepReflector,
+    rows: Range<usize>,
+) {
+    let [_, v1, v2] = r.v;
+    let tau = r.tau;
+    let block = &mut data[c * ld..(c + r.len) * ld];
+    let (x0, rest) = block.split_at_mut(ld);
+    let (x1, x2) = rest.split_at_mut(ld);
+    let (x0, x1) = (&mut x0[rows.clone()], &mut x1[rows.clone()]);
+    if r.len == 3 {
+        let x2 = &mut x2[rows];
+        for ((a, b), c) in x0.iter_mut().zip(x1.iter_mut()).zip(x2.iter_mut()) {
+            let sum = multiply_add::<FMA>(v2, *c, multiply_add::<FMA>(v1, *b, *a));
+            let s = tau * sum;
+            *a -= s;
+            *b = multiply_add::<FMA>(-s, v1, *b);
+            *c = multiply_add::<FMA>(-s, v2, *c);
+        }
+    } else {
+        for (a, b) in x0.iter_mut().zip(x1.iter_mut()) {
+            let s = tau * multiply_add::<FMA>(v1, *b, *a);
+            *a -= s;
+            *b = multiply_add::<FMA>(-s, v1, *b);
+        }
+    }
 }
 
 /// Shifts for a sweep of `count` (even) from `candidates` (conjugate pairs adjacent, Im > 0
@@ -561,13 +737,7 @@ fn exceptional_shifts(h: &Square, (ktop, kbot): (usize, usize), count: usize) ->
 /// kbot (pairs adjacent, Im > 0 first): shifts when a deflation pass left too few. Should
 /// their iteration fail, the eigenvalues of the trailing 2 x 2 block.
 fn trailing_eigenvalues(h: &Square, kbot: usize, count: usize) -> Vec<c64> {
-    let top = kbot + 1 - count;
-    let mut block = Square::identity(count);
-    for c in 0..count {
-        for r in 0..=(c + 1).min(count - 1) {
-            block[(r, c)] = h[(top + r, top + c)];
-        }
-    }
+    let mut block = hessenberg_block(h, kbot + 1 - count, count);
     match schur_of_hessenberg(&mut block, None, false, Spectrum::General) {
         Ok(()) => block_eigenvalues(count, |i, j| block[(i, j)]),
         Err(_) => {
