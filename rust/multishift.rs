@@ -70,6 +70,15 @@ const WIDEN_WINDOW_AFTER: usize = 5;
 /// of a sweep's cost (LAPACK's "nibble" crossover, 14 %).
 const NIBBLE_PERCENT: usize = 14;
 
+/// The smallest active block the multishift iteration takes on after the double-shift iteration
+/// failed on a block of order below [`MULTISHIFT_MIN_ORDER`]: any block with room for a
+/// deflation window below a row and for one bulge. (On skew-symmetric matrices of orders 90 to
+/// 200 the double-shift iteration can stall on a block of order 4 whose two pairs ±iω are
+/// coupled by a subdiagonal entry of 1e-162 that the Ahues-Tisseur test, with the block's zero
+/// diagonal, will not neglect; a sweep that starts its bulge at the top of the block does
+/// deflate it.)
+const FALLBACK_MIN_ORDER: usize = 3;
+
 /// Rows between consecutive bulges of a chain: a bulge's reflector spans three rows, and with
 /// this spacing the reflectors of one step touch disjoint rows and columns.
 const BULGE_SPACING: usize = 3;
@@ -106,6 +115,9 @@ pub(crate) fn multishift_qr(
     // Rows end.. have converged; `stalls` counts the iterations since the last deflation.
     let mut end = n;
     let mut stalls = 0;
+    // Blocks of this order and more stay with the multishift iteration; lowered for good should
+    // the double-shift iteration fail on a block.
+    let mut multishift_floor = MULTISHIFT_MIN_ORDER;
     for _ in 0..ITERATIONS_PER_ORDER * n.max(10) {
         if end == 0 {
             return Ok(());
@@ -120,10 +132,20 @@ pub(crate) fn multishift_qr(
             h[(ktop, ktop - 1)] = 0.0;
         }
         let order = kbot + 1 - ktop;
-        if order < MULTISHIFT_MIN_ORDER {
-            finish_small_block(h, z.as_deref_mut(), full, (ktop, kbot))?;
-            end = ktop;
-            stalls = 0;
+        if order < multishift_floor {
+            match finish_small_block(h, z.as_deref_mut(), full, (ktop, kbot)) {
+                Ok(()) => {
+                    end = ktop;
+                    stalls = 0;
+                }
+                // The double-shift iteration stagnated (as it can on skew-symmetric
+                // matrices, whose eigenvalues come in pairs ±iω): continue on this block with
+                // aggressive early deflation and sweeps, which see a wider set of shifts.
+                Err(_) if multishift_floor > FALLBACK_MIN_ORDER => {
+                    multishift_floor = FALLBACK_MIN_ORDER;
+                }
+                Err(error) => return Err(error),
+            }
             continue;
         }
 
@@ -135,8 +157,7 @@ pub(crate) fn multishift_qr(
         if window + 1 < order && h[(top, top - 1)].abs() > h[(top - 1, top - 2)].abs() {
             window += 1;
         }
-        let deflation =
-            aggressive_early_deflation(h, z.as_deref_mut(), full, (ktop, kbot), window)?;
+        let deflation = aggressive_early_deflation(h, z.as_deref_mut(), full, (ktop, kbot), window);
         end -= deflation.deflated;
         if deflation.deflated > 0 {
             stalls = 0;
@@ -145,7 +166,7 @@ pub(crate) fn multishift_qr(
         }
         let remaining = end - ktop;
         let nibbled = 100 * deflation.deflated > NIBBLE_PERCENT * window;
-        if (deflation.deflated > 0 && nibbled) || remaining < MULTISHIFT_MIN_ORDER {
+        if (deflation.deflated > 0 && nibbled) || remaining < multishift_floor {
             continue;
         }
 
@@ -251,7 +272,7 @@ fn aggressive_early_deflation(
     full: bool,
     (ktop, kbot): (usize, usize),
     window: usize,
-) -> Result<EarlyDeflation, Error> {
+) -> EarlyDeflation {
     let n = h.n;
     let top = kbot + 1 - window;
     debug_assert!(
@@ -261,7 +282,14 @@ fn aggressive_early_deflation(
     let spike = h[(top, top - 1)];
     let mut t = hessenberg_block(h, top, window);
     let mut v = Square::identity(window);
-    schur_of_hessenberg(&mut t, Some(&mut v), true, Spectrum::General)?;
+    if schur_of_hessenberg(&mut t, Some(&mut v), true, Spectrum::General).is_err() {
+        // The window's iteration failed: no deflation this time (H is untouched), and the
+        // shifts come from elsewhere.
+        return EarlyDeflation {
+            deflated: 0,
+            shifts: Vec::new(),
+        };
+    }
     let (mut t, mut v) = (t.to_mat(), v.to_mat());
     clear_upper_avx_state();
 
@@ -314,7 +342,7 @@ fn aggressive_early_deflation(
     let deflated = window - kept;
     let shifts = quasi_triangular_eigenvalues(t.as_ref().submatrix(0, 0, kept, kept));
     if deflated == 0 {
-        return Ok(EarlyDeflation { deflated, shifts });
+        return EarlyDeflation { deflated, shifts };
     }
 
     // The spike of the undeflated part, s = spike V[0, ..kept], folded into its first entry.
@@ -372,7 +400,7 @@ fn aggressive_early_deflation(
     let mut scratch = Vec::new();
     apply_outside_window(h, z, outside, (top, kbot), v.as_ref(), &mut scratch);
     clear_upper_avx_state();
-    Ok(EarlyDeflation { deflated, shifts })
+    EarlyDeflation { deflated, shifts }
 }
 
 /// Completes an orthogonal similarity U^T H U whose U acts on rows and columns w0..=w1 and

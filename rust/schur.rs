@@ -1172,6 +1172,39 @@ mod tests {
     }
 
     #[test]
+    fn multishift_handles_skew_symmetric_matrices() {
+        // Eigenvalues in pairs ±iω (and 0 at odd orders): the double-shift iteration can stall
+        // on the blocks the multishift one leaves it, which then takes them on itself (it does
+        // for (84, 2), (115, 0) and (152, 0), found by a search over orders 75-230).
+        let cases = [
+            (75usize, 0u64),
+            (84, 2),
+            (115, 0),
+            (121, 1),
+            (152, 0),
+            (200, 3),
+        ];
+        for (n, seed) in cases {
+            let g = seeded(n, 40 * seed + n as u64);
+            let a = Mat::from_fn(n, n, |i, j| g[(i, j)] - g[(j, i)]);
+            let what = format!("skew-symmetric n={n} seed={seed}");
+            let t =
+                assert_schur_form_within(&a, Spectrum::General, multishift_tolerances(n), &what);
+            let found = quasi_triangular_eigenvalues(t.as_ref());
+            assert!(
+                found.iter().all(|x| x.re.abs() < 1e-12 * a.norm_l2()),
+                "{what}: real parts"
+            );
+            let values = eigenvalues(a.as_ref()).unwrap();
+            let distance = spectral_distance(&values, &found);
+            assert!(
+                distance < 1e-10 * a.norm_l2(),
+                "{what}: eigenvalues {distance}"
+            );
+        }
+    }
+
+    #[test]
     fn structured_matrices_reduce_to_standard_schur_form() {
         let n = 12;
         let cases: Vec<(&str, Mat<f64>)> = vec![
