@@ -29,9 +29,18 @@
 //! test of [`negligible_subdiagonal`]), then runs aggressive early deflation on the bottom of the
 //! active block; unless that deflated much (then it runs again instead), a sweep follows with the
 //! smallest of its undeflated eigenvalues as shifts. An active block smaller than
-//! [`MULTISHIFT_MIN_ORDER`] is finished by the double-shift iteration. Every sixth iteration
-//! without a deflation uses exceptional shifts (Wilkinson's ad hoc ones), and after five the
-//! deflation window doubles.
+//! [`MULTISHIFT_MIN_ORDER`] is finished by the double-shift iteration, on a copy whose
+//! transformation then updates the rest of H and Z by products (should that iteration fail,
+//! the multishift one goes on down to blocks of order 3). Every sixth iteration without a
+//! deflation uses exceptional shifts (Wilkinson's ad hoc ones), and after five the deflation
+//! window doubles.
+//!
+//! The sweep's shift count and the deflation window follow LAPACK's iparmq (about n / log2 n
+//! shifts) except that the window is never larger than the shift count (measured below). The
+//! time goes, at order 512, about equally to the Hessenberg reduction, the deflation passes
+//! (the window's Schur form and the swaps) and the sweeps; against the double-shift iteration
+//! alone the Schur form is 1.5 times faster at order 128, 4 times at 256 and 12 times at 512
+//! (whose column stride of 4 KiB made the one-bulge sweeps miss the cache on every column).
 //!
 //! Every transformation is an orthogonal similarity (reflectors, Schur swaps that passed the
 //! stability tests of Bai & Demmel, and rotations), and what is set to zero is either negligible
