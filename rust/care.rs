@@ -571,3 +571,51 @@ fn relative(residual_norm: f64, scale: f64) -> f64 {
         residual_norm
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic pseudo-random matrix with entries in [-1, 1).
+    fn seeded(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
+        let mut state = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
+        Mat::from_fn(rows, cols, |_, _| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        })
+    }
+
+    #[test]
+    fn large_regulators_through_the_multishift_schur_form() {
+        // n = 40 (Hamiltonian of order 80) and 150 (order 300): the Schur form of the
+        // Hamiltonian by the multishift iteration, reordered; A^T X + X A - X B B^T X + I = 0
+        // and A - B K stable.
+        for n in [40usize, 150] {
+            let g = seeded(n, n, 3);
+            let a = Mat::from_fn(n, n, |i, j| {
+                g[(i, j)] / (n as f64).sqrt() - if i == j { 1.5 } else { 0.0 }
+            });
+            let b = seeded(n, 2, 4);
+            let (q, r) = (Mat::<f64>::identity(n, n), Mat::<f64>::identity(2, 2));
+            let care = solve_care(
+                a.as_ref(),
+                b.as_ref(),
+                q.as_ref(),
+                r.as_ref(),
+                CareOptions::default(),
+            )
+            .unwrap();
+            let x = &care.x;
+            let equation = a.transpose() * x + x * &a - x * &b * b.transpose() * x + &q;
+            let scale = q.norm_l2() + 2.0 * (a.transpose() * x).norm_l2();
+            let residual = equation.norm_l2() / scale;
+            assert!(residual < 1e-12, "n={n}: residual {residual}");
+            assert!(
+                care.closed_loop_eigenvalues.iter().all(|z| z.re < 0.0),
+                "n={n}: closed loop"
+            );
+        }
+    }
+}

@@ -18,7 +18,8 @@
 //! * [`response`]: time responses on a uniform grid, by one discretisation and a recurrence.
 //! * [`freq`]: frequency responses through one Hessenberg reduction ([`hessenberg`]).
 //! * [`modes`]: eigenvalues, modes and their characteristics, the characteristic polynomial.
-//! * [`schur`]: the real Schur form and eigenvalues (Francis double-shift QR).
+//! * [`schur`]: the real Schur form and eigenvalues (Francis double-shift QR, and the
+//!   small-bulge multishift QR with aggressive early deflation of `multishift` at large orders).
 //! * [`ctrb`]: controllability and observability matrices and the staircase verdict.
 //! * [`place`]: pole placement: Bass–Gura, Ackermann and the robust multi-input method.
 //! * [`reorder`]: reordering of the real Schur form by direct block swaps (Bai & Demmel 1993).
@@ -67,6 +68,7 @@ pub mod hessenberg;
 pub mod lu;
 pub mod lyapunov;
 pub mod modes;
+mod multishift;
 pub mod norm;
 pub mod place;
 pub mod pool;

@@ -68,8 +68,9 @@ pub fn reorder_schur(
     mut select: impl FnMut(c64) -> bool,
 ) -> Result<OrderedSchur, Error> {
     clear_upper_avx_state();
-    let RealSchur { mut t, mut z } = schur;
+    let RealSchur { t, mut z } = schur;
     let n = t.nrows();
+    let mut t = with_padded_columns(t);
     // Rows and columns above `position` hold selected blocks only.
     let mut position = 0;
     let mut k = 0;
@@ -110,6 +111,30 @@ pub fn reorder_schur(
         eigenvalues,
         selected: position,
     })
+}
+
+/// From this order on, [`reorder_schur`] works on a copy of T whose columns are 8 entries
+/// longer than T's (see [`with_padded_columns`]).
+const PADDED_MIN_ORDER: usize = 256;
+
+/// T itself below [`PADDED_MIN_ORDER`], else a copy whose column stride is 8 entries (one cache
+/// line) more than the order.
+///
+/// Every swap sweeps two or four adjacent rows of T across all the columns to the right. With a
+/// stride of a multiple of 512 bytes, consecutive columns fall into a handful of the L1 cache's
+/// sets and each sweep misses the cache on every column; one extra cache line per column
+/// spreads them over all the sets, so the rows a sweep touches stay in L1 for the next swap
+/// (reordering the Schur form of a Hamiltonian of order 512 by the stable eigenvalues: 73 ->
+/// 33 ms; order 256: 7.7 -> 5.1 ms; at orders 128 to 200 it gained nothing).
+fn with_padded_columns(t: Mat<f64>) -> Mat<f64> {
+    let n = t.nrows();
+    if n < PADDED_MIN_ORDER || n != t.ncols() {
+        return t;
+    }
+    let mut padded = Mat::<f64>::with_capacity(n + 8, n);
+    padded.resize_with(n, n, |_, _| 0.0);
+    padded.copy_from(&t);
+    padded
 }
 
 /// The order (1 or 2) of the diagonal block that starts at row k.
@@ -367,5 +392,52 @@ fn rotate(t: &mut Mat<f64>, z: &mut Mat<f64>, j: usize, cs: f64, sn: f64) {
         let (x, y) = (z[(r, j)], z[(r, j + 1)]);
         z[(r, j)] = cs * x + sn * y;
         z[(r, j + 1)] = cs * y - sn * x;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::schur::real_schur;
+
+    /// A deterministic pseudo-random matrix with entries in [-1, 1).
+    fn seeded(n: usize, seed: u64) -> Mat<f64> {
+        let mut state = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
+        Mat::from_fn(n, n, |_, _| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        })
+    }
+
+    #[test]
+    fn left_half_plane_first_below_and_above_the_padded_order() {
+        for n in [40usize, PADDED_MIN_ORDER, 300] {
+            let a = seeded(n, n as u64);
+            let ordered = reorder_schur(real_schur(a.as_ref()).unwrap(), |z| z.re < 0.0).unwrap();
+            let OrderedSchur {
+                t,
+                z,
+                eigenvalues,
+                selected,
+            } = ordered;
+            let residual = (&z * &t * z.transpose() - &a).norm_l2() / a.norm_l2();
+            assert!(residual < 1e-13, "n={n}: residual {residual}");
+            let orthogonality = (z.transpose() * &z - Mat::<f64>::identity(n, n)).norm_l2();
+            assert!(orthogonality < 1e-15 * n as f64, "n={n}: {orthogonality}");
+            for j in 0..n {
+                for i in j + 2..n {
+                    assert_eq!(t[(i, j)], 0.0, "n={n}: T[{i}, {j}]");
+                }
+            }
+            assert_eq!(
+                selected,
+                eigenvalues.iter().filter(|z| z.re < 0.0).count(),
+                "n={n}"
+            );
+            assert!(eigenvalues[..selected].iter().all(|z| z.re < 0.0), "n={n}");
+            assert_eq!(eigenvalues, quasi_triangular_eigenvalues(t.as_ref()));
+        }
     }
 }

@@ -37,8 +37,13 @@
 //! transformations stay orthogonal either way, so the form is as backward stable as before.
 //!
 //! The single-window, double-shift iteration is the right tool at the orders of flight-control
-//! models (n <= 100; LAPACK itself uses it below n = 75): at n = 4 it finds the eigenvalues in a
-//! fraction of the time of a general multishift solver, whose set-up dominates at that size.
+//! models: at n = 4 it finds the eigenvalues in a fraction of the time of a general multishift
+//! solver, whose set-up dominates at that size. From order 75 (`MULTISHIFT_MIN_ORDER`) on, the QR
+//! iteration is instead the small-bulge multishift iteration with aggressive early deflation of
+//! the `multishift` module (Braman, Byers & Mathias 2002, as LAPACK's dhseqr), whose sweeps do
+//! most of their work in matrix products; it hands the active blocks it leaves below that order
+//! back to the double-shift iteration. The mirrored shifts of Hamiltonian spectra serve the
+//! double-shift iteration only (the Riccati solver asks for them up to order 16).
 //!
 //! [`eigenvalues`] first balances A (Parlett & Reinsch 1969: a diagonal similarity by powers of
 //! two that equalises row and column norms, exact in floating point), which can only improve
@@ -48,6 +53,7 @@
 use crate::dispatch::clear_upper_avx_state;
 use crate::error::{Error, check_finite, check_square};
 use crate::hessenberg::{hessenberg, hessenberg_matrix};
+use crate::multishift::multishift_qr;
 use faer::{Mat, MatRef, c64};
 use std::ops::{Index, IndexMut, Range};
 
@@ -121,6 +127,12 @@ impl Mirrors {
     }
 }
 
+/// From this order on the QR iteration is the small-bulge multishift iteration with aggressive
+/// early deflation ([`crate::multishift`]); below it, and on the active blocks below it that the
+/// multishift iteration leaves, the double-shift iteration of this module, whose set-up is
+/// nothing. LAPACK's crossover is 75 (its NMIN); measured here, see the module docs.
+pub(crate) const MULTISHIFT_MIN_ORDER: usize = 75;
+
 /// Up to this order the Hessenberg reduction is the plain Householder loop below; above it,
 /// faer's blocked reduction (whose set-up costs more than the whole reduction at n = 4).
 const UNBLOCKED_HESSENBERG_MAX_ORDER: usize = 32;
@@ -128,13 +140,13 @@ const UNBLOCKED_HESSENBERG_MAX_ORDER: usize = 32;
 /// A square matrix stored by columns in one contiguous buffer: the QR iteration touches single
 /// entries in tight loops, where a plain slice index is cheaper than a strided view.
 #[derive(Clone)]
-struct Square {
-    n: usize,
-    data: Vec<f64>,
+pub(crate) struct Square {
+    pub(crate) n: usize,
+    pub(crate) data: Vec<f64>,
 }
 
 impl Square {
-    fn from_mat(a: MatRef<'_, f64>) -> Self {
+    pub(crate) fn from_mat(a: MatRef<'_, f64>) -> Self {
         let n = a.nrows();
         let mut data = Vec::with_capacity(n * n);
         for j in 0..n {
@@ -143,7 +155,7 @@ impl Square {
         Self { n, data }
     }
 
-    fn identity(n: usize) -> Self {
+    pub(crate) fn identity(n: usize) -> Self {
         let mut data = vec![0.0; n * n];
         for i in 0..n {
             data[i * (n + 1)] = 1.0;
@@ -151,12 +163,12 @@ impl Square {
         Self { n, data }
     }
 
-    fn to_mat(&self) -> Mat<f64> {
+    pub(crate) fn to_mat(&self) -> Mat<f64> {
         Mat::from_fn(self.n, self.n, |i, j| self[(i, j)])
     }
 
     /// Rows r and r + 1, columns `columns`: x <- cs x + sn y, y <- cs y - sn x.
-    fn rotate_rows(&mut self, r: usize, columns: Range<usize>, cs: f64, sn: f64) {
+    pub(crate) fn rotate_rows(&mut self, r: usize, columns: Range<usize>, cs: f64, sn: f64) {
         for j in columns {
             let (x, y) = (self[(r, j)], self[(r + 1, j)]);
             self[(r, j)] = cs * x + sn * y;
@@ -165,7 +177,7 @@ impl Square {
     }
 
     /// Columns c and c + 1, rows `rows`: x <- cs x + sn y, y <- cs y - sn x.
-    fn rotate_columns(&mut self, c: usize, rows: Range<usize>, cs: f64, sn: f64) {
+    pub(crate) fn rotate_columns(&mut self, c: usize, rows: Range<usize>, cs: f64, sn: f64) {
         let n = self.n;
         let (left, right) = self.data.split_at_mut((c + 1) * n);
         let (x_column, y_column) = (&mut left[c * n..], &mut right[..n]);
@@ -178,7 +190,7 @@ impl Square {
 
     /// Applies I - τ w w^T (w = [1, v...], 2 or 3 long) from the left to rows k.. of the
     /// columns `columns`.
-    fn reflect_rows(&mut self, k: usize, w: &[f64], tau: f64, columns: Range<usize>) {
+    pub(crate) fn reflect_rows(&mut self, k: usize, w: &[f64], tau: f64, columns: Range<usize>) {
         let n = self.n;
         for j in columns {
             let column = &mut self.data[j * n + k..j * n + k + w.len()];
@@ -191,7 +203,7 @@ impl Square {
     }
 
     /// Applies I - τ w w^T from the right to columns k.. of the rows `rows`.
-    fn reflect_columns(&mut self, k: usize, w: &[f64], tau: f64, rows: Range<usize>) {
+    pub(crate) fn reflect_columns(&mut self, k: usize, w: &[f64], tau: f64, rows: Range<usize>) {
         let n = self.n;
         let columns = &mut self.data[k * n..(k + w.len()) * n];
         for i in rows {
@@ -213,7 +225,7 @@ impl Square {
 /// roughly halves the cost of a QR sweep at the small orders of flight-control models.
 impl Square {
     /// [`Square::reflect_rows`] for a reflector of length `N`.
-    fn reflect_rows_fixed<const N: usize>(
+    pub(crate) fn reflect_rows_fixed<const N: usize>(
         &mut self,
         k: usize,
         w: [f64; N],
@@ -239,7 +251,7 @@ impl Square {
     /// [`Square::reflect_columns`] for a reflector of length `N`.
     // Row i of N column slices at once: an index, not an iterator, is the natural form.
     #[allow(clippy::needless_range_loop)]
-    fn reflect_columns_fixed<const N: usize>(
+    pub(crate) fn reflect_columns_fixed<const N: usize>(
         &mut self,
         k: usize,
         w: [f64; N],
@@ -300,7 +312,7 @@ pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSch
             Square::from_mat(reduced.q.as_ref()),
         )
     };
-    francis_qr(&mut t, Some(&mut z), true, spectrum)?;
+    schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
     Ok(RealSchur {
         t: t.to_mat(),
         z: z.to_mat(),
@@ -319,7 +331,7 @@ pub fn eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
     } else {
         h = Square::from_mat(hessenberg_matrix(h.to_mat().as_ref()).as_ref());
     }
-    francis_qr(&mut h, None, false, Spectrum::General)?;
+    schur_of_hessenberg(&mut h, None, false, Spectrum::General)?;
     Ok(block_eigenvalues(h.n, |i, j| h[(i, j)]))
 }
 
@@ -328,7 +340,7 @@ pub fn quasi_triangular_eigenvalues(t: MatRef<'_, f64>) -> Vec<c64> {
     block_eigenvalues(t.nrows(), |i, j| t[(i, j)])
 }
 
-fn block_eigenvalues(n: usize, t: impl Fn(usize, usize) -> f64) -> Vec<c64> {
+pub(crate) fn block_eigenvalues(n: usize, t: impl Fn(usize, usize) -> f64) -> Vec<c64> {
     let mut values = Vec::with_capacity(n);
     let mut k = 0;
     while k < n {
@@ -561,14 +573,38 @@ pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
     (beta, tau)
 }
 
-/// The Francis double-shift QR iteration on an upper Hessenberg `h`, in place.
+/// The QR iteration on an upper Hessenberg `h`, in place: the double-shift iteration below
+/// [`MULTISHIFT_MIN_ORDER`], the small-bulge multishift iteration ([`crate::multishift`]) from
+/// there.
 ///
 /// With `full` the whole of `h` is transformed into the Schur form T (and `z`, if given, is
 /// multiplied on the right by the orthogonal transformations); without it only the diagonal
-/// blocks are formed, which suffices for the eigenvalues.
-fn francis_qr(
+/// blocks are formed, which suffices for the eigenvalues. The mirrored shifts of a Hamiltonian
+/// `spectrum` serve the double-shift iteration only.
+pub(crate) fn schur_of_hessenberg(
+    h: &mut Square,
+    z: Option<&mut Square>,
+    full: bool,
+    spectrum: Spectrum,
+) -> Result<(), Error> {
+    if h.n < MULTISHIFT_MIN_ORDER {
+        francis_qr(h, z, (0, h.n.saturating_sub(1)), full, spectrum)
+    } else {
+        multishift_qr(h, z, full)
+    }
+}
+
+/// The Francis double-shift QR iteration on the diagonal block `lo..=hi` of an upper Hessenberg
+/// `h`, in place, whose subdiagonal entries h[lo, lo-1] and h[hi+1, hi] are zero.
+///
+/// With `full` the whole of `h` is transformed (the rows above and the columns to the right of
+/// the block too, toward the Schur form T; and `z`, if given, is multiplied on the right by the
+/// orthogonal transformations); without it only the block itself, which suffices for the
+/// eigenvalues.
+pub(crate) fn francis_qr(
     h: &mut Square,
     mut z: Option<&mut Square>,
+    (lo, hi): (usize, usize),
     full: bool,
     spectrum: Spectrum,
 ) -> Result<(), Error> {
@@ -579,46 +615,21 @@ fn francis_qr(
     }
     let ulp = f64::EPSILON;
     let small = f64::MIN_POSITIVE * (n as f64 / ulp);
-    let max_iterations = 30 * n.max(10);
+    let max_iterations = 30 * (hi + 1 - lo).max(10);
     let mut iterations_since_deflation = 0;
     let mut mirrors = match spectrum {
         Spectrum::General => None,
         Spectrum::Hamiltonian => Some(Mirrors::default()),
     };
     // The window is rows and columns l..=i; the eigenvalues below i have converged.
-    let mut i = n - 1;
+    let mut i = hi;
     loop {
-        let mut l = 0;
+        let mut l = lo;
         let mut converged = false;
         for _ in 0..=max_iterations {
             // Find the lowest negligible subdiagonal entry h[k, k-1], l < k <= i.
             let mut k = i;
-            while k > l {
-                let sub = h[(k, k - 1)].abs();
-                if sub <= small {
-                    break;
-                }
-                let mut test = h[(k - 1, k - 1)].abs() + h[(k, k)].abs();
-                if test == 0.0 {
-                    if k >= l + 2 {
-                        test += h[(k - 1, k - 2)].abs();
-                    }
-                    if k < i {
-                        test += h[(k + 1, k)].abs();
-                    }
-                }
-                if sub <= ulp * test {
-                    // Ahues & Tisseur (1997): negligible if the 2 x 2 block's eigenvalues move
-                    // by at most u times their size.
-                    let sup = h[(k - 1, k)].abs();
-                    let (ab, ba) = (sub.max(sup), sub.min(sup));
-                    let diff = (h[(k - 1, k - 1)] - h[(k, k)]).abs();
-                    let (aa, bb) = (h[(k, k)].abs().max(diff), h[(k, k)].abs().min(diff));
-                    let s = aa + ab;
-                    if ba * (ab / s) <= small.max(ulp * (bb * (aa / s))) {
-                        break;
-                    }
-                }
+            while k > l && !negligible_subdiagonal(h, k, (l, i), small) {
                 k -= 1;
             }
             l = k;
@@ -658,20 +669,9 @@ fn francis_qr(
             // Start the bulge at the highest m >= l where two consecutive small subdiagonal
             // entries make the first column of (H - s1)(H - s2) nearly a multiple of e_m.
             let mut m = i - 2;
-            let mut v = [0.0; 3];
+            let mut v;
             loop {
-                let h21s = h[(m + 1, m)];
-                let s = (h[(m, m)] - shift2.re).abs() + shift2.im.abs() + h21s.abs();
-                let h21s = h21s / s;
-                v[0] = h21s * h[(m, m + 1)]
-                    + (h[(m, m)] - shift1.re) * ((h[(m, m)] - shift2.re) / s)
-                    - shift1.im * (shift2.im / s);
-                v[1] = h21s * (h[(m, m)] + h[(m + 1, m + 1)] - shift1.re - shift2.re);
-                v[2] = h21s * h[(m + 2, m + 1)];
-                let inverse = 1.0 / (v[0].abs() + v[1].abs() + v[2].abs());
-                for x in &mut v {
-                    *x *= inverse;
-                }
+                v = shift_polynomial_column(h, m, (shift1, shift2));
                 if m == l {
                     break;
                 }
@@ -754,16 +754,85 @@ fn francis_qr(
             }
         }
         iterations_since_deflation = 0;
-        if l == 0 {
+        if l == lo {
             return Ok(());
         }
         i = l - 1;
     }
 }
 
+/// Whether the subdiagonal entry h[k, k-1] of the active window l..=i (l < k <= i) is
+/// negligible: at most `small` (underflow), or at most u times its diagonal neighbours and such
+/// that setting it to zero moves the eigenvalues of the 2 x 2 block h[k-1..=k, k-1..=k] by at
+/// most u times their size (Ahues & Tisseur 1997, as LAPACK's dlahqr).
+#[inline]
+pub(crate) fn negligible_subdiagonal(
+    h: &Square,
+    k: usize,
+    (l, i): (usize, usize),
+    small: f64,
+) -> bool {
+    let ulp = f64::EPSILON;
+    let sub = h[(k, k - 1)].abs();
+    if sub <= small {
+        return true;
+    }
+    let mut test = h[(k - 1, k - 1)].abs() + h[(k, k)].abs();
+    if test == 0.0 {
+        if k >= l + 2 {
+            test += h[(k - 1, k - 2)].abs();
+        }
+        if k < i {
+            test += h[(k + 1, k)].abs();
+        }
+    }
+    if sub > ulp * test {
+        return false;
+    }
+    let sup = h[(k - 1, k)].abs();
+    let (ab, ba) = (sub.max(sup), sub.min(sup));
+    let diff = (h[(k - 1, k - 1)] - h[(k, k)]).abs();
+    let (aa, bb) = (h[(k, k)].abs().max(diff), h[(k, k)].abs().min(diff));
+    let s = aa + ab;
+    ba * (ab / s) <= small.max(ulp * (bb * (aa / s)))
+}
+
+/// The first column of (H - s1)(H - s2) restricted to rows m..m+3 (its only nonzero entries
+/// when the block starts at row m), scaled to unit 1-norm: the vector whose reflector starts a
+/// double-shift bulge at row m. With s1, s2 real or a conjugate pair it is real. Zero (no
+/// bulge) in the degenerate case where all three entries vanish.
+#[inline]
+pub(crate) fn shift_polynomial_column(
+    h: &Square,
+    m: usize,
+    (shift1, shift2): (c64, c64),
+) -> [f64; 3] {
+    let h21s = h[(m + 1, m)];
+    let s = (h[(m, m)] - shift2.re).abs() + shift2.im.abs() + h21s.abs();
+    if s == 0.0 {
+        return [0.0; 3];
+    }
+    let h21s = h21s / s;
+    let mut v = [
+        h21s * h[(m, m + 1)] + (h[(m, m)] - shift1.re) * ((h[(m, m)] - shift2.re) / s)
+            - shift1.im * (shift2.im / s),
+        h21s * (h[(m, m)] + h[(m + 1, m + 1)] - shift1.re - shift2.re),
+        h21s * h[(m + 2, m + 1)],
+    ];
+    let norm = v[0].abs() + v[1].abs() + v[2].abs();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return [0.0; 3];
+    }
+    let inverse = 1.0 / norm;
+    for x in &mut v {
+        *x *= inverse;
+    }
+    v
+}
+
 /// The two shifts of a double-shift step: the eigenvalues of [[h11, h12], [h21, h22]] when
 /// they are complex; when they are real, the one nearer h22, twice.
-fn double_shift(h11: f64, h12: f64, h21: f64, h22: f64) -> (c64, c64) {
+pub(crate) fn double_shift(h11: f64, h12: f64, h21: f64, h22: f64) -> (c64, c64) {
     let s = h11.abs() + h12.abs() + h21.abs() + h22.abs();
     if s == 0.0 {
         return (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
@@ -809,18 +878,27 @@ mod tests {
     }
 
     fn assert_structured_schur_form(a: &Mat<f64>, spectrum: Spectrum, what: &str) {
+        let tolerance = 1e-14 * (a.nrows() as f64).max(1.0);
+        assert_schur_form_within(a, spectrum, (tolerance, tolerance), what);
+    }
+
+    /// Checks the Schur form of `a` (||Z T Z^T - A||_2 / ||A||_2 and ||Z^T Z - I||_2 below the
+    /// two `tolerances`, T quasi-triangular with standard blocks) and returns T.
+    fn assert_schur_form_within(
+        a: &Mat<f64>,
+        spectrum: Spectrum,
+        (residual_tolerance, orthogonality_tolerance): (f64, f64),
+        what: &str,
+    ) -> Mat<f64> {
         let n = a.nrows();
         let RealSchur { t, z } = real_schur_with(a.as_ref(), spectrum).unwrap();
         let scale = a.norm_l2().max(f64::MIN_POSITIVE);
         let residual = (&z * &t * z.transpose() - a).norm_l2() / scale;
-        assert!(
-            residual < 1e-14 * (n as f64).max(1.0),
-            "{what}: residual {residual}"
-        );
+        assert!(residual < residual_tolerance, "{what}: residual {residual}");
         let orthogonality = (z.transpose() * &z - Mat::<f64>::identity(n, n)).norm_l2();
         assert!(
-            orthogonality < 1e-14 * (n as f64).max(1.0),
-            "{what}: {orthogonality}"
+            orthogonality < orthogonality_tolerance,
+            "{what}: orthogonality {orthogonality}"
         );
         // Quasi-triangular, no two consecutive subdiagonal entries, blocks standard.
         for j in 0..n {
@@ -840,6 +918,57 @@ mod tests {
                 }
             }
         }
+        t
+    }
+
+    /// The eigenvalues by the double-shift iteration alone, whatever the order: the reference
+    /// for the multishift iteration.
+    fn double_shift_eigenvalues(a: &Mat<f64>) -> Vec<c64> {
+        let n = a.nrows();
+        let mut h = Square::from_mat(hessenberg_matrix(a.as_ref()).as_ref());
+        francis_qr(&mut h, None, (0, n - 1), false, Spectrum::General).unwrap();
+        block_eigenvalues(n, |i, j| h[(i, j)])
+    }
+
+    /// The largest distance from an eigenvalue of `expected` to its partner in `found`, each
+    /// found eigenvalue partnered once (nearest first).
+    fn spectral_distance(found: &[c64], expected: &[c64]) -> f64 {
+        assert_eq!(found.len(), expected.len());
+        let mut unused: Vec<c64> = found.to_vec();
+        let mut worst = 0.0f64;
+        for y in expected {
+            let (k, distance) = unused
+                .iter()
+                .map(|x| (x - y).norm())
+                .enumerate()
+                .min_by(|p, q| p.1.total_cmp(&q.1))
+                .unwrap();
+            unused.swap_remove(k);
+            worst = worst.max(distance);
+        }
+        worst
+    }
+
+    /// Q D Q^T with Q orthogonal (from a seeded QR) and D block diagonal with the given
+    /// eigenvalues (pairs adjacent, Im > 0 first) as 1 x 1 and standard 2 x 2 blocks.
+    fn with_spectrum(spectrum: &[c64], seed: u64) -> Mat<f64> {
+        let n = spectrum.len();
+        let q = seeded(n, seed).qr().compute_Q();
+        let mut d = Mat::<f64>::zeros(n, n);
+        let mut k = 0;
+        while k < n {
+            let lambda = spectrum[k];
+            d[(k, k)] = lambda.re;
+            if lambda.im != 0.0 {
+                d[(k + 1, k + 1)] = lambda.re;
+                d[(k, k + 1)] = lambda.im;
+                d[(k + 1, k)] = -lambda.im;
+                k += 2;
+            } else {
+                k += 1;
+            }
+        }
+        &q * &d * q.transpose()
     }
 
     fn sorted(mut values: Vec<c64>) -> Vec<c64> {
@@ -856,6 +985,222 @@ mod tests {
                     &format!("n={n} seed={seed}"),
                 );
             }
+        }
+    }
+
+    /// The bounds on ||Z T Z^T - A||_2 / ||A||_2 and ||Z^T Z - I||_2 of the multishift tests
+    /// at order n: 5e-14, and 1e-15 n. Both iterations reach about 1e-14 and 4e-16 n on random
+    /// matrices of orders 100 to 512 (the loss of orthogonality grows with the number of
+    /// reflectors applied to Z, and forming Z^T Z alone costs about n u).
+    fn multishift_tolerances(n: usize) -> (f64, f64) {
+        (5e-14, 1e-15 * n as f64)
+    }
+
+    #[test]
+    fn multishift_random_matrices_agree_with_the_double_shift_iteration() {
+        // Orders from the crossover up: the Schur form, and the eigenvalues of both the Schur
+        // form and `eigenvalues` against those of the double-shift iteration alone.
+        for n in [MULTISHIFT_MIN_ORDER, 100, 160, 256, 401, 600] {
+            let a = seeded(n, 1000 + n as u64);
+            let what = format!("random n={n}");
+            let t =
+                assert_schur_form_within(&a, Spectrum::General, multishift_tolerances(n), &what);
+            let reference = double_shift_eigenvalues(&a);
+            let scale = a.norm_l2();
+            let distance = spectral_distance(&quasi_triangular_eigenvalues(t.as_ref()), &reference);
+            assert!(distance < 1e-10 * scale, "{what}: Schur form {distance}");
+            let distance = spectral_distance(&eigenvalues(a.as_ref()).unwrap(), &reference);
+            assert!(distance < 1e-10 * scale, "{what}: eigenvalues {distance}");
+        }
+    }
+
+    #[test]
+    fn multishift_finds_known_spectra() {
+        // Distinct eigenvalues over five decades, complex pairs among them, in a non-normal
+        // matrix Q (D + N) Q^T (N strictly upper triangular); and a normal matrix whose
+        // eigenvalues are four values of multiplicity 60 (two real, a complex pair).
+        let n = 300;
+        let mut distinct = Vec::new();
+        let mut k = 0;
+        while k < n {
+            let re = -1.0 - (k % 7) as f64 * 0.5 + if k % 3 == 0 { 1e-3 } else { 0.0 };
+            if k + 1 < n && k % 4 == 0 {
+                let im = 0.25 + k as f64 / 50.0;
+                distinct.extend([c64::new(re, im), c64::new(re, -im)]);
+                k += 2;
+            } else {
+                distinct.push(c64::new(re * 10f64.powi((k % 5) as i32 - 2), 0.0));
+                k += 1;
+            }
+        }
+        let q = seeded(n, 5).qr().compute_Q();
+        let mut d = q.transpose() * with_spectrum(&distinct, 5) * &q;
+        let upper = seeded(n, 6);
+        for j in 0..n {
+            for i in 0..j {
+                if d[(i, j)] == 0.0 {
+                    d[(i, j)] = 0.1 * upper[(i, j)];
+                }
+            }
+        }
+        let nonnormal = &q * &d * q.transpose();
+        let repeated: Vec<c64> = (0..60)
+            .flat_map(|_| {
+                [
+                    c64::new(1.0, 0.0),
+                    c64::new(-2.0, 0.0),
+                    c64::new(0.5, 1.0),
+                    c64::new(0.5, -1.0),
+                ]
+            })
+            .collect();
+        let normal = with_spectrum(&repeated, 7);
+        for (what, a, known, accuracy) in [
+            ("distinct, non-normal", &nonnormal, &distinct, 1e-9),
+            ("repeated, normal", &normal, &repeated, 1e-12),
+        ] {
+            let t = assert_schur_form_within(
+                a,
+                Spectrum::General,
+                multishift_tolerances(a.nrows()),
+                what,
+            );
+            let found = quasi_triangular_eigenvalues(t.as_ref());
+            let distance = spectral_distance(&found, known);
+            assert!(distance < accuracy * a.norm_l2(), "{what}: {distance}");
+            let distance = spectral_distance(&eigenvalues(a.as_ref()).unwrap(), known);
+            assert!(
+                distance < accuracy * a.norm_l2(),
+                "{what}: eigenvalues {distance}"
+            );
+        }
+    }
+
+    #[test]
+    fn multishift_handles_structured_and_graded_matrices() {
+        let n = 150;
+        let random = seeded(n, 77);
+        let cases: Vec<(&str, Mat<f64>)> = vec![
+            ("zero", Mat::zeros(n, n)),
+            ("identity", Mat::identity(n, n)),
+            (
+                "Jordan block",
+                Mat::from_fn(n, n, |i, j| match j as isize - i as isize {
+                    0 => 2.0,
+                    1 => 1.0,
+                    _ => 0.0,
+                }),
+            ),
+            (
+                "cyclic shift",
+                Mat::from_fn(n, n, |i, j| if (i + 1) % n == j { 1.0 } else { 0.0 }),
+            ),
+            (
+                "nilpotent upper",
+                Mat::from_fn(n, n, |i, j| if j > i { 1.0 } else { 0.0 }),
+            ),
+            (
+                "rotation blocks",
+                Mat::from_fn(n, n, |i, j| match (i % 2, j as isize - i as isize) {
+                    (0, 1) => 1.0,
+                    (1, -1) => -1.0,
+                    _ => 0.0,
+                }),
+            ),
+            (
+                // Entries from 1 down to 1e-24 along the diagonal, growing away from it.
+                "graded",
+                Mat::from_fn(n, n, |i, j| {
+                    random[(i, j)] * 10f64.powf(-12.0 * (i + j) as f64 / n as f64)
+                }),
+            ),
+            (
+                "graded the other way",
+                Mat::from_fn(n, n, |i, j| {
+                    random[(i, j)] * 10f64.powf(12.0 * (i + j) as f64 / n as f64 - 24.0)
+                }),
+            ),
+        ];
+        for (what, a) in &cases {
+            let t = assert_schur_form_within(
+                a,
+                Spectrum::General,
+                multishift_tolerances(a.nrows()),
+                what,
+            );
+            // Each eigenvalue against the double-shift iteration's, relative to its own size
+            // for the graded ones (whose small eigenvalues are well determined).
+            if what.starts_with("graded") {
+                let found = quasi_triangular_eigenvalues(t.as_ref());
+                let distance = spectral_distance(&found, &double_shift_eigenvalues(a));
+                assert!(distance < 1e-10 * a.norm_l2(), "{what}: {distance}");
+            }
+        }
+    }
+
+    #[test]
+    fn multishift_hamiltonian_spectra_are_symmetric() {
+        // Hamiltonians of the Riccati solver's kind at orders 200, 300 and 512: the Schur form,
+        // the eigenvalues against the double-shift iteration's, and the symmetry λ, -λ̄.
+        for n in [100usize, 150, 256] {
+            let a = Mat::from_fn(n, n, |i, j| {
+                seeded(n, 3)[(i, j)] / (n as f64).sqrt() - if i == j { 1.5 } else { 0.0 }
+            });
+            let b = seeded(n, 4).subcols(0, 2).to_owned();
+            let g = &b * b.transpose();
+            let h = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+                (true, true) => a[(i, j)],
+                (true, false) => -g[(i, j - n)],
+                (false, true) => -(if i - n == j { 1.0 } else { 0.0 }),
+                (false, false) => -a[(j - n, i - n)],
+            });
+            let what = format!("Hamiltonian n={n}");
+            let t = assert_schur_form_within(
+                &h,
+                Spectrum::Hamiltonian,
+                multishift_tolerances(n),
+                &what,
+            );
+            let found = quasi_triangular_eigenvalues(t.as_ref());
+            let scale = h.norm_l2();
+            let distance = spectral_distance(&found, &double_shift_eigenvalues(&h));
+            assert!(distance < 1e-10 * scale, "{what}: {distance}");
+            let mirrored: Vec<c64> = found.iter().map(|x| c64::new(-x.re, x.im)).collect();
+            let distance = spectral_distance(&found, &mirrored);
+            assert!(distance < 1e-10 * scale, "{what}: symmetry {distance}");
+        }
+    }
+
+    #[test]
+    fn multishift_handles_skew_symmetric_matrices() {
+        // Eigenvalues in pairs ±iω (and 0 at odd orders): the double-shift iteration can stall
+        // on the blocks the multishift one leaves it, which then takes them on itself (it does
+        // for (84, 2), (115, 0) and (152, 0), found by a search over orders 75-230).
+        let cases = [
+            (75usize, 0u64),
+            (84, 2),
+            (115, 0),
+            (121, 1),
+            (152, 0),
+            (200, 3),
+        ];
+        for (n, seed) in cases {
+            let g = seeded(n, 40 * seed + n as u64);
+            let a = Mat::from_fn(n, n, |i, j| g[(i, j)] - g[(j, i)]);
+            let what = format!("skew-symmetric n={n} seed={seed}");
+            let t =
+                assert_schur_form_within(&a, Spectrum::General, multishift_tolerances(n), &what);
+            let found = quasi_triangular_eigenvalues(t.as_ref());
+            assert!(
+                found.iter().all(|x| x.re.abs() < 1e-12 * a.norm_l2()),
+                "{what}: real parts"
+            );
+            let values = eigenvalues(a.as_ref()).unwrap();
+            let distance = spectral_distance(&values, &found);
+            assert!(
+                distance < 1e-10 * a.norm_l2(),
+                "{what}: eigenvalues {distance}"
+            );
         }
     }
 
