@@ -301,6 +301,14 @@ pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSch
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let n = a.nrows();
+    let scale = range_scale(a);
+    let scaled;
+    let a = if scale == 1.0 {
+        a
+    } else {
+        scaled = Mat::from_fn(n, n, |i, j| a[(i, j)] / scale);
+        scaled.as_ref()
+    };
     let (mut t, mut z) = if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         let (mut h, mut q) = (Square::from_mat(a), Square::identity(n));
         reduce_to_hessenberg(&mut h, Some(&mut q));
@@ -314,9 +322,27 @@ pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSch
     };
     schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
     Ok(RealSchur {
-        t: t.to_mat(),
+        t: Mat::from_fn(n, n, |i, j| t[(i, j)] * scale),
         z: z.to_mat(),
     })
+}
+
+/// Entries of the largest magnitude outside [`SMALL_ENTRY`], 1 / [`SMALL_ENTRY`] are brought
+/// to 1 first (as LAPACK's dgees scales): the deflation tests compare entries with the
+/// smallest normal number, so a matrix whose entries are all below about 1e-290 would
+/// otherwise count as negligible everywhere and come back as a wrong Schur form (residual
+/// 0.7), and one near the overflow threshold would overflow in the shifts.
+const SMALL_ENTRY: f64 = 1.0e-150;
+
+/// The power of two by which `a` is divided before its Schur form, 1 when its largest entry
+/// is in range (the scaling is exact, and A = Z (s T) Z^T with the same Z).
+fn range_scale(a: MatRef<'_, f64>) -> f64 {
+    let largest = a.norm_max();
+    if largest > 0.0 && !(SMALL_ENTRY..=1.0 / SMALL_ENTRY).contains(&largest) {
+        2f64.powi(largest.log2().round() as i32)
+    } else {
+        1.0
+    }
 }
 
 /// The eigenvalues of a square, finite matrix, in the order of the diagonal of its Schur form,
@@ -324,7 +350,11 @@ pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSch
 pub fn eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
+    let scale = range_scale(a);
     let mut h = Square::from_mat(a);
+    if scale != 1.0 {
+        h.data.iter_mut().for_each(|x| *x /= scale);
+    }
     let _ = balance(&mut h);
     if h.n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         reduce_to_hessenberg(&mut h, None);
@@ -332,7 +362,7 @@ pub fn eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
         h = Square::from_mat(hessenberg_matrix(h.to_mat().as_ref()).as_ref());
     }
     schur_of_hessenberg(&mut h, None, false, Spectrum::General)?;
-    Ok(block_eigenvalues(h.n, |i, j| h[(i, j)]))
+    Ok(block_eigenvalues(h.n, |i, j| h[(i, j)] * scale))
 }
 
 /// The eigenvalues of a quasi-upper-triangular matrix whose 2 x 2 blocks are in standard form.
@@ -974,6 +1004,36 @@ mod tests {
     fn sorted(mut values: Vec<c64>) -> Vec<c64> {
         values.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
         values
+    }
+
+    /// Matrices near the ends of the floating-point range: scaled by a power of two into it,
+    /// the form and the eigenvalues are those of the unscaled matrix times the scale (before,
+    /// entries below about 1e-290 all counted as negligible and the residual was 0.7).
+    #[test]
+    fn tiny_and_huge_matrices_keep_their_schur_form() {
+        for n in [6usize, 100] {
+            let base = seeded(n, 7 + n as u64);
+            let expected = sorted(eigenvalues(base.as_ref()).unwrap());
+            for scale in [1e-300, 1e-200, 1e200, 1e300] {
+                let a = &base * faer::Scale(scale);
+                let RealSchur { t, z } = real_schur(a.as_ref()).unwrap();
+                let unscale = faer::Scale(1.0 / scale);
+                let residual = ((&z * (&t * unscale) * z.transpose()) - &base).norm_l2();
+                assert!(
+                    residual < 1e-13 * base.norm_l2(),
+                    "n={n} scale={scale:e}: residual {residual:e}"
+                );
+                let found: Vec<c64> = sorted(eigenvalues(a.as_ref()).unwrap())
+                    .iter()
+                    .map(|lambda| lambda / scale)
+                    .collect();
+                let distance = spectral_distance(&found, &expected);
+                assert!(
+                    distance < 1e-12,
+                    "n={n} scale={scale:e}: eigenvalues off by {distance:e}"
+                );
+            }
+        }
     }
 
     #[test]
