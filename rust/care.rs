@@ -576,16 +576,7 @@ fn relative(residual_norm: f64, scale: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// A deterministic pseudo-random matrix with entries in [-1, 1).
-    fn seeded(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
-        let mut state = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
-        Mat::from_fn(rows, cols, |_, _| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        })
-    }
+    use crate::test_matrices::seeded;
 
     #[test]
     fn large_regulators_through_the_multishift_schur_form() {

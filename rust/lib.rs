@@ -78,6 +78,8 @@ pub mod riccati_ode;
 pub mod schur;
 pub mod small_matrix;
 mod sylvester;
+#[cfg(test)]
+mod test_matrices;
 
 #[cfg(feature = "python")]
 mod python;

@@ -400,16 +400,7 @@ mod tests {
     use super::*;
     use crate::schur::real_schur;
 
-    /// A deterministic pseudo-random matrix with entries in [-1, 1).
-    fn seeded(n: usize, seed: u64) -> Mat<f64> {
-        let mut state = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
-        Mat::from_fn(n, n, |_, _| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        })
-    }
+    use crate::test_matrices::seeded_square as seeded;
 
     #[test]
     fn left_half_plane_first_below_and_above_the_padded_order() {

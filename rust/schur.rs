@@ -892,16 +892,7 @@ mod tests {
     use faer::linalg::solvers::DenseSolveCore;
     use faer::mat;
 
-    /// A deterministic pseudo-random matrix with entries in [-1, 1).
-    fn seeded(n: usize, seed: u64) -> Mat<f64> {
-        let mut state = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
-        Mat::from_fn(n, n, |_, _| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        })
-    }
+    use crate::test_matrices::seeded_square as seeded;
 
     fn assert_schur_form(a: &Mat<f64>, what: &str) {
         assert_structured_schur_form(a, Spectrum::General, what);
@@ -1136,11 +1127,11 @@ mod tests {
         }
     }
 
-    #[test]
-    fn multishift_handles_structured_and_graded_matrices() {
-        let n = 150;
-        let random = seeded(n, 77);
-        let cases: Vec<(&str, Mat<f64>)> = vec![
+    /// Matrices of order n whose structure is hard on the QR iteration: zero, the identity, a
+    /// Jordan block, the cyclic shift (companion matrix of λ^n - 1: roots on the unit circle),
+    /// a nilpotent upper triangle, and rotation blocks (±i, each repeated).
+    fn structured_cases(n: usize) -> Vec<(&'static str, Mat<f64>)> {
+        vec![
             ("zero", Mat::zeros(n, n)),
             ("identity", Mat::identity(n, n)),
             (
@@ -1167,6 +1158,15 @@ mod tests {
                     _ => 0.0,
                 }),
             ),
+        ]
+    }
+
+    #[test]
+    fn multishift_handles_structured_and_graded_matrices() {
+        let n = 150;
+        let random = seeded(n, 77);
+        let mut cases = structured_cases(n);
+        cases.extend([
             (
                 // Entries from 1 down to 1e-24 along the diagonal, growing away from it.
                 "graded",
@@ -1180,7 +1180,7 @@ mod tests {
                     random[(i, j)] * 10f64.powf(12.0 * (i + j) as f64 / n as f64 - 24.0)
                 }),
             ),
-        ];
+        ]);
         for (what, a) in &cases {
             let t = assert_schur_form_within(
                 a,
@@ -1267,45 +1267,13 @@ mod tests {
     #[test]
     fn structured_matrices_reduce_to_standard_schur_form() {
         let n = 12;
-        let cases: Vec<(&str, Mat<f64>)> = vec![
-            ("zero", Mat::zeros(n, n)),
-            ("identity", Mat::identity(n, n)),
-            (
-                "Jordan block",
-                Mat::from_fn(n, n, |i, j| {
-                    if j == i + 1 {
-                        1.0
-                    } else if i == j {
-                        2.0
-                    } else {
-                        0.0
-                    }
-                }),
-            ),
-            (
-                // Companion matrix of λ^n - 1: roots on the unit circle, a hard case for shifts.
-                "cyclic shift",
-                Mat::from_fn(n, n, |i, j| if (i + 1) % n == j { 1.0 } else { 0.0 }),
-            ),
-            (
-                "graded",
-                Mat::from_fn(n, n, |i, j| {
-                    10f64.powi(i as i32 - j as i32) * ((i + 2 * j) % 5) as f64
-                }),
-            ),
-            (
-                "nilpotent upper",
-                Mat::from_fn(n, n, |i, j| if j > i { 1.0 } else { 0.0 }),
-            ),
-            (
-                "rotation blocks",
-                Mat::from_fn(n, n, |i, j| match (i % 2, j as isize - i as isize) {
-                    (0, 1) => 1.0,
-                    (1, -1) => -1.0,
-                    _ => 0.0,
-                }),
-            ),
-        ];
+        let mut cases = structured_cases(n);
+        cases.push((
+            "graded",
+            Mat::from_fn(n, n, |i, j| {
+                10f64.powi(i as i32 - j as i32) * ((i + 2 * j) % 5) as f64
+            }),
+        ));
         for (what, a) in &cases {
             assert_schur_form(a, what);
         }
