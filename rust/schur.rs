@@ -35,6 +35,10 @@
 //! sweeps instead of 16). A mirror image matches an eigenvalue deflated later within a relative
 //! 1e-6 and is then dropped; a mismatch only costs a sweep with an ordinary shift, and the
 //! transformations stay orthogonal either way, so the form is as backward stable as before.
+//! [`eigenvalues_near`] does the same with estimates the caller knows ([`Spectrum::Near`]):
+//! the requested poles of a placement, or the Hamiltonian's stable eigenvalues for the closed
+//! loop of a Riccati solution (the 747 regulator's closed-loop eigenvalues in 0.72 µs instead
+//! of 1.17).
 //!
 //! The single-window, double-shift iteration is the right tool at the orders of flight-control
 //! models: at n = 4 it finds the eigenvalues in a fraction of the time of a general multishift
@@ -71,28 +75,51 @@ pub struct RealSchur {
 const EXCEPTIONAL_SHIFT_INTERVAL: usize = 10;
 
 /// What the QR iteration may assume about the spectrum.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Spectrum {
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Spectrum<'a> {
     /// No structure.
     General,
     /// Symmetric about the imaginary axis, λ and -λ̄ eigenvalues together with equal
     /// multiplicities: the spectrum of a (real) Hamiltonian matrix.
     Hamiltonian,
+    /// Close to these estimates (conjugate pairs given by either member or both): the
+    /// eigenvalues of a closed loop whose poles were requested or come from a Hamiltonian.
+    /// The double-shift iteration takes them as its shifts, one after each deflation: an
+    /// accurate shift deflates in one sweep where the trailing block's shifts take two or
+    /// three. The estimates steer only the convergence; the eigenvalues are those of the
+    /// matrix, as backward stable as without them.
+    Near(&'a [c64]),
 }
 
-/// A deflated eigenvalue and a pending mirror image match within this relative distance.
+/// A deflated eigenvalue and a pending known one match within this relative distance.
 /// A false match or a missed one only costs a sweep with an ordinary shift.
 const MIRROR_MATCH: f64 = 1e-6;
 
-/// The mirror images -λ̄ of the eigenvalues deflated so far whose own mirror image has not
-/// been deflated yet (complex pairs by their member with Im > 0), most recent last: in a
-/// Hamiltonian spectrum each is an eigenvalue still in the active part of H.
-#[derive(Default)]
+/// Eigenvalues known to be in the active part of H and not deflated yet (complex pairs by
+/// their member with Im > 0), most recent last: for a Hamiltonian spectrum the mirror images
+/// -λ̄ of the eigenvalues deflated so far whose own mirror image has not deflated yet; for
+/// [`Spectrum::Near`] the estimates not yet matched.
 struct Mirrors {
     pending: Vec<c64>,
+    /// Whether an eigenvalue that matches no pending one adds its mirror image (Hamiltonian).
+    mirrored: bool,
 }
 
 impl Mirrors {
+    fn for_spectrum(spectrum: Spectrum<'_>) -> Option<Self> {
+        match spectrum {
+            Spectrum::General => None,
+            Spectrum::Hamiltonian => Some(Self {
+                pending: Vec::new(),
+                mirrored: true,
+            }),
+            Spectrum::Near(estimates) => Some(Self {
+                pending: estimates.iter().filter(|z| z.im >= 0.0).copied().collect(),
+                mirrored: false,
+            }),
+        }
+    }
+
     /// Records a deflated eigenvalue (of a pair, the member with Im > 0).
     fn found(&mut self, lambda: c64) {
         let tolerance = MIRROR_MATCH * lambda.norm();
@@ -104,7 +131,8 @@ impl Mirrors {
             Some(k) => {
                 self.pending.remove(k);
             }
-            None => self.pending.push(c64::new(-lambda.re, lambda.im)),
+            None if self.mirrored => self.pending.push(c64::new(-lambda.re, lambda.im)),
+            None => {}
         }
     }
 
@@ -348,6 +376,16 @@ fn range_scale(a: MatRef<'_, f64>) -> f64 {
 /// The eigenvalues of a square, finite matrix, in the order of the diagonal of its Schur form,
 /// each conjugate pair adjacent with Im > 0 first (and exactly conjugate).
 pub fn eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
+    eigenvalues_with(a, Spectrum::General)
+}
+
+/// [`eigenvalues`], for a matrix whose eigenvalues are close to `estimates` (see
+/// [`Spectrum::Near`]; the closed-loop eigenvalues of a design, for example).
+pub fn eigenvalues_near(a: MatRef<'_, f64>, estimates: &[c64]) -> Result<Vec<c64>, Error> {
+    eigenvalues_with(a, Spectrum::Near(estimates))
+}
+
+fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let scale = range_scale(a);
@@ -361,7 +399,13 @@ pub fn eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
     } else {
         h = Square::from_mat(hessenberg_matrix(h.to_mat().as_ref()).as_ref());
     }
-    schur_of_hessenberg(&mut h, None, false, Spectrum::General)?;
+    // Estimates are of the unscaled matrix's eigenvalues (and scaling is rare): dropped.
+    let spectrum = if scale == 1.0 {
+        spectrum
+    } else {
+        Spectrum::General
+    };
+    schur_of_hessenberg(&mut h, None, false, spectrum)?;
     Ok(block_eigenvalues(h.n, |i, j| h[(i, j)] * scale))
 }
 
@@ -647,10 +691,7 @@ pub(crate) fn francis_qr(
     let small = f64::MIN_POSITIVE * (n as f64 / ulp);
     let max_iterations = 30 * (hi + 1 - lo).max(10);
     let mut iterations_since_deflation = 0;
-    let mut mirrors = match spectrum {
-        Spectrum::General => None,
-        Spectrum::Hamiltonian => Some(Mirrors::default()),
-    };
+    let mut mirrors = Mirrors::for_spectrum(spectrum);
     // The window is rows and columns l..=i; the eigenvalues below i have converged.
     let mut i = hi;
     loop {
@@ -1308,9 +1349,42 @@ mod tests {
         }
     }
 
+    /// Estimates only steer the shifts: exact, perturbed, wrong or partial ones all give the
+    /// eigenvalues the plain iteration gives.
+    #[test]
+    fn estimates_steer_the_shifts_but_not_the_eigenvalues() {
+        for n in [2usize, 4, 7, 12, 40] {
+            for seed in 0..5 {
+                let a = seeded(n, 1000 + 10 * n as u64 + seed);
+                let reference = sorted(eigenvalues(a.as_ref()).unwrap());
+                let scale = a.norm_l2();
+                let perturbed: Vec<c64> = reference
+                    .iter()
+                    .map(|z| z * (1.0 + 1e-3) + c64::new(1e-4, 0.0))
+                    .collect();
+                let wrong: Vec<c64> = (0..n).map(|k| c64::new(k as f64 * 10.0, 0.0)).collect();
+                let partial = &reference[..n / 2];
+                for (what, estimates) in [
+                    ("exact", &reference[..]),
+                    ("perturbed", &perturbed[..]),
+                    ("wrong", &wrong[..]),
+                    ("partial", partial),
+                    ("none", &[][..]),
+                ] {
+                    let found = sorted(eigenvalues_near(a.as_ref(), estimates).unwrap());
+                    let distance = spectral_distance(&found, &reference);
+                    assert!(
+                        distance < 1e-12 * scale,
+                        "n={n} seed={seed} {what}: off by {distance:e}"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn mirror_images_are_paired_off() {
-        let mut mirrors = Mirrors::default();
+        let mut mirrors = Mirrors::for_spectrum(Spectrum::Hamiltonian).unwrap();
         mirrors.found(c64::new(0.5, 0.0));
         mirrors.found(c64::new(-0.3, 0.8));
         assert_eq!(
