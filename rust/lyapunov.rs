@@ -77,7 +77,7 @@ pub(crate) fn solve(
 }
 
 /// Solves T Y + Y T^T = F for quasi-upper-triangular T (2 x 2 blocks in standard form).
-fn solve_quasi_triangular(
+pub(crate) fn solve_quasi_triangular(
     t: MatRef<'_, f64>,
     mut f: Mat<f64>,
     singularity: Singularity,
