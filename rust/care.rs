@@ -49,7 +49,7 @@
 //! residual decreases and is above [`REFINEMENT_FLOOR`], a few units of rounding (at most
 //! [`MAX_REFINEMENT_STEPS`] times). The first step needs no Schur form of A_0: the Hamiltonian's
 //! reordered Schur form already factors the closed loop of the Schur solution as V T11 V^-1
-//! ([`ClosedLoopFactors`]), which leaves only the quasi-triangular half of Bartels–Stewart
+//! (`ClosedLoopFactors`), which leaves only the quasi-triangular half of Bartels–Stewart
 //! (10-13 % of the whole solve at n = 16 to 128). Reported: the relative residual of the
 //! general equation,
 //!
