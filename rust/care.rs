@@ -448,30 +448,36 @@ struct HamiltonianSolution {
 /// cost of a Lyapunov solve (at n = 64, 0.5 of 0.75 ms). The factorisation holds for the
 /// Schur solution only up to rounding amplified by κ(U11); the step is therefore an inexact
 /// Newton step, kept like every step only if it reduces the residual.
+///
+/// It keeps the matrices the solution was computed from (moved, not copied: a solve that
+/// needs no refinement pays nothing for it).
 struct ClosedLoopFactors {
-    t11: Mat<f64>,
-    u11: Mat<f64>,
-    /// U11^-T, formed anyway for rcond(U11).
-    u11_inverse_transposed: Mat<f64>,
+    /// The reordered Schur form of the scaled Hamiltonian; T11 is its leading n x n block.
+    t: Mat<f64>,
+    /// Its Schur vectors; U11 is their leading n x n block.
+    z: Mat<f64>,
+    /// [Y'^T | U11^-T], the solve for Y' (U11^-T is formed anyway for rcond(U11)).
+    solve: Mat<f64>,
     d: Vec<f64>,
 }
 
 impl ClosedLoopFactors {
     /// Δ solving (Ā - G Y)^T Δ + Δ (Ā - G Y) = -Res for the Schur solution's Y.
     fn newton_step(&self, residual: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
-        let (n, d) = (self.t11.nrows(), &self.d);
-        let v = Mat::from_fn(n, n, |i, j| d[i] * self.u11[(i, j)]);
+        let (n, d) = (self.d.len(), &self.d);
+        let (t11, u11) = (self.t.submatrix(0, 0, n, n), self.z.submatrix(0, 0, n, n));
+        let v = Mat::from_fn(n, n, |i, j| d[i] * u11[(i, j)]);
         let f = product(product(v.transpose(), residual).as_ref(), v.as_ref());
         // T11^T W + W T11 = F is T W' + W' T^T = F' for T = P T11^T P and W' = P W P, F' = P F P
         // with P the reversal permutation: T is quasi-upper-triangular with standard blocks.
         let reverse = |i: usize| n - 1 - i;
-        let t = Mat::from_fn(n, n, |i, j| self.t11[(reverse(j), reverse(i))]);
+        let t = Mat::from_fn(n, n, |i, j| t11[(reverse(j), reverse(i))]);
         let f_reversed = Mat::from_fn(n, n, |i, j| -f[(reverse(i), reverse(j))]);
         let w_reversed =
             lyapunov::solve_quasi_triangular(t.as_ref(), f_reversed, Singularity::Perturb)?;
         let w = Mat::from_fn(n, n, |i, j| w_reversed[(reverse(i), reverse(j))]);
         // Δ = V^-T W V^-1 = D^-1 U11^-T W U11^-1 D^-1.
-        let inverse_transposed = self.u11_inverse_transposed.as_ref();
+        let inverse_transposed = self.solve.subcols(n, n);
         let m = product(
             product(inverse_transposed, w.as_ref()).as_ref(),
             inverse_transposed.transpose(),
@@ -571,9 +577,9 @@ fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Erro
     let mut y = Mat::from_fn(n, n, |i, j| rho * y_scaled[(i, j)] / (d[i] * d[j]));
     symmetrize(&mut y);
     let closed_loop = ClosedLoopFactors {
-        t11: ordered.t.submatrix(0, 0, n, n).to_owned(),
-        u11: u11.to_owned(),
-        u11_inverse_transposed: inverse_transposed.to_owned(),
+        t: ordered.t,
+        z: ordered.z,
+        solve: combined,
         d,
     };
     let mut stable_eigenvalues = ordered.eigenvalues;
