@@ -114,7 +114,12 @@ impl Mirrors {
                 mirrored: true,
             }),
             Spectrum::Near(estimates) => Some(Self {
-                pending: estimates.iter().filter(|z| z.im >= 0.0).copied().collect(),
+                // Non-finite estimates would carry NaN into H through the shifts: dropped.
+                pending: estimates
+                    .iter()
+                    .filter(|z| z.im >= 0.0 && z.re.is_finite() && z.im.is_finite())
+                    .copied()
+                    .collect(),
                 mirrored: false,
             }),
         }
@@ -1364,7 +1369,9 @@ mod tests {
                     .collect();
                 let wrong: Vec<c64> = (0..n).map(|k| c64::new(k as f64 * 10.0, 0.0)).collect();
                 let partial = &reference[..n / 2];
+                let non_finite = [c64::new(f64::NAN, 0.0), c64::new(f64::INFINITY, 1.0)];
                 for (what, estimates) in [
+                    ("non-finite", &non_finite[..]),
                     ("exact", &reference[..]),
                     ("perturbed", &perturbed[..]),
                     ("wrong", &wrong[..]),
