@@ -88,8 +88,9 @@ def solve_care(
     put the stable eigenvalues first; X from the stable invariant subspace [U11; U21] as
     U21 U11^-1 by an LU solve; then Newton (Kleinman) steps, each a Lyapunov solve (the first
     through the closed loop's factors V T11 V^-1 that the Hamiltonian's Schur form already
-    gives, so without a Schur form of its own), while the residual decreases and is above 4 u (relative; below that it is mostly the rounding of its
-    own evaluation, and a step cannot improve it).
+    gives, so without a Schur form of its own), while the residual decreases and is above 4 u
+    (relative; below that it is mostly the rounding of its own evaluation, and a step cannot
+    improve it).
 
     Parameters
     ----------
