@@ -63,6 +63,7 @@
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::modes::eigen;
 use crate::schur::{eigenvalues, reflector};
+use crate::small_matrix::product;
 use faer::linalg::matmul::matmul;
 use faer::prelude::{IntoConst, Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par, c64};
@@ -111,7 +112,9 @@ pub(crate) fn krylov_blocks(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> 
     for k in 1..n {
         let (previous, mut next) = v.as_mut().split_at_col_mut(k * m);
         let previous = previous.into_const().subcols((k - 1) * m, m);
-        next.as_mut().subcols_mut(0, m).copy_from(a * previous);
+        next.as_mut()
+            .subcols_mut(0, m)
+            .copy_from(product(a, previous));
     }
     v
 }

@@ -19,6 +19,11 @@ fn lu_parameters() -> Spec<PartialPivLuParams, f64> {
     parameters
 }
 
+/// Systems up to this order are solved by [`eliminate_and_substitute`]: below it the set-up of
+/// faer's recursive factorisation (scratch, permutations, dispatch) costs more than the
+/// arithmetic.
+const UNBLOCKED_MAX_ORDER: usize = 12;
+
 /// Systems up to this order keep their pivots and scratch on the stack.
 const STACK_ORDER: usize = 64;
 const STACK_BYTES: usize = 4096;
@@ -33,6 +38,9 @@ pub fn solve_in_place(a: MatMut<'_, f64>, b: MatMut<'_, f64>, par: Par) {
     let n = a.nrows();
     debug_assert_eq!(n, a.ncols());
     debug_assert_eq!(n, b.nrows());
+    if n <= UNBLOCKED_MAX_ORDER {
+        return eliminate_and_substitute(a, b);
+    }
     let requirement = factor::lu_in_place_scratch::<usize, f64>(n, n, par, lu_parameters()).or(
         solve::solve_in_place_scratch::<usize, f64>(n, b.ncols(), par),
     );
@@ -79,6 +87,86 @@ pub fn solve_with_inverse(a: MatMut<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
     rhs
 }
 
+/// Gaussian elimination with partial pivoting (LAPACK's dgetf2 order: at step k the largest
+/// |a_ik|, i >= k, is swapped into the pivot position, the multipliers l_ik = a_ik / a_kk are
+/// stored below the diagonal and the trailing columns are updated), then for each column of B
+/// the row swaps, L Y = P B and U X = Y (dgetrs). The factors are formed in a copy on the
+/// stack, where the loops index plain arrays, and written back to A. A zero pivot, which only
+/// an exactly singular A produces, is skipped, and the substitution then yields non-finite
+/// entries.
+fn eliminate_and_substitute(mut a: MatMut<'_, f64>, mut b: MatMut<'_, f64>) {
+    const CAPACITY: usize = UNBLOCKED_MAX_ORDER;
+    let n = a.nrows();
+    debug_assert!(n <= CAPACITY);
+    // Column-major: lu[k][i] = a_ik.
+    let mut lu = [[0.0; CAPACITY]; CAPACITY];
+    for (k, column) in lu.iter_mut().enumerate().take(n) {
+        for (i, entry) in column.iter_mut().enumerate().take(n) {
+            *entry = a[(i, k)];
+        }
+    }
+    let mut pivots = [0usize; CAPACITY];
+    for k in 0..n {
+        let mut pivot_row = k;
+        for i in k + 1..n {
+            if lu[k][i].abs() > lu[k][pivot_row].abs() {
+                pivot_row = i;
+            }
+        }
+        pivots[k] = pivot_row;
+        if pivot_row != k {
+            for column in lu.iter_mut().take(n) {
+                column.swap(k, pivot_row);
+            }
+        }
+        let pivot = lu[k][k];
+        if pivot == 0.0 {
+            continue;
+        }
+        for multiplier in &mut lu[k][k + 1..n] {
+            *multiplier /= pivot;
+        }
+        let (done, trailing) = lu.split_at_mut(k + 1);
+        let multipliers = &done[k];
+        for column in trailing.iter_mut().take(n - k - 1) {
+            let upper = column[k];
+            for i in k + 1..n {
+                column[i] -= multipliers[i] * upper;
+            }
+        }
+    }
+    for (k, column) in lu.iter().enumerate().take(n) {
+        for (i, &entry) in column.iter().enumerate().take(n) {
+            a[(i, k)] = entry;
+        }
+    }
+    let mut x = [0.0; CAPACITY];
+    for j in 0..b.ncols() {
+        for (i, entry) in x.iter_mut().enumerate().take(n) {
+            *entry = b[(i, j)];
+        }
+        for (k, &pivot_row) in pivots.iter().enumerate().take(n) {
+            x.swap(k, pivot_row);
+        }
+        for k in 0..n {
+            let solved = x[k];
+            for i in k + 1..n {
+                x[i] -= lu[k][i] * solved;
+            }
+        }
+        for k in (0..n).rev() {
+            x[k] /= lu[k][k];
+            let solved = x[k];
+            for i in 0..k {
+                x[i] -= lu[k][i] * solved;
+            }
+        }
+        for (i, &entry) in x.iter().enumerate().take(n) {
+            b[(i, j)] = entry;
+        }
+    }
+}
+
 fn factor_and_solve(
     mut a: MatMut<'_, f64>,
     b: MatMut<'_, f64>,
@@ -105,6 +193,54 @@ mod tests {
         let mut b = &a * &x_true;
         solve_in_place(a.clone().as_mut(), b.as_mut(), Par::Seq);
         assert!((&b - &x_true).norm_l2() < 1e-14);
+    }
+
+    #[test]
+    fn small_systems_agree_with_the_blocked_factorisation() {
+        for n in 1..=UNBLOCKED_MAX_ORDER {
+            let a = crate::test_matrices::seeded(n, n, n as u64);
+            let b = crate::test_matrices::seeded(n, 3, 100 + n as u64);
+            // A transposed view (row stride 1), as the pole placement passes V^T.
+            let mut small = b.clone();
+            let mut factors = a.transpose().to_owned();
+            eliminate_and_substitute(factors.as_mut(), small.as_mut());
+            let mut blocked = b.clone();
+            let mut perm = vec![0; n];
+            let mut perm_inverse = vec![0; n];
+            let requirement =
+                factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, lu_parameters())
+                    .or(solve::solve_in_place_scratch::<usize, f64>(n, 3, Par::Seq));
+            let mut buffer = MemBuffer::new(requirement);
+            let mut transposed = a.clone();
+            factor_and_solve(
+                transposed.as_mut().transpose_mut(),
+                blocked.as_mut(),
+                &mut perm,
+                &mut perm_inverse,
+                MemStack::new(&mut buffer),
+                Par::Seq,
+            );
+            let residual = (a.transpose() * &small - &b).norm_max();
+            assert!(
+                residual <= 1e-13 * (1.0 + small.norm_max()),
+                "n = {n}: {residual:e}"
+            );
+            assert!(
+                (&small - &blocked).norm_max() <= 1e-12 * small.norm_max(),
+                "n = {n}"
+            );
+        }
+    }
+
+    #[test]
+    fn singular_small_systems_give_non_finite_entries() {
+        let a = mat![[1.0, 2.0, 3.0], [2.0, 4.0, 6.0], [0.0, 1.0, 1.0]];
+        let mut b = mat![[1.0], [1.0], [1.0]];
+        solve_in_place(a.clone().as_mut(), b.as_mut(), Par::Seq);
+        assert!(!b.is_all_finite());
+        let mut b = Mat::<f64>::ones(2, 1);
+        solve_in_place(Mat::<f64>::zeros(2, 2).as_mut(), b.as_mut(), Par::Seq);
+        assert!(!b.is_all_finite());
     }
 
     #[test]

@@ -48,9 +48,9 @@
 use crate::ctrb::{controllability, controllability_staircase, krylov_blocks};
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
 use crate::lu::solve_with_inverse;
-use crate::modes::polynomial_from_roots;
+use crate::modes::{charpoly, polynomial_from_roots};
 use crate::norm::one_norm;
-use crate::schur::{eigenvalues, eigenvalues_near};
+use crate::schur::eigenvalues_near;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, c64};
 
@@ -207,7 +207,7 @@ pub fn companion_form(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<Companio
     check_single_input(b, "companion_form")?;
     require_controllable_single_input(a, b)?;
     let n = a.nrows();
-    let coefficients = polynomial_from_roots(&eigenvalues(a)?);
+    let coefficients = charpoly(a)?;
     let v = krylov_blocks(a, b);
     let w = Mat::from_fn(n, n, |i, j| if j >= i { coefficients[j - i] } else { 0.0 });
     let t = (&v * &w).partial_piv_lu().solve(Mat::<f64>::identity(n, n));
@@ -280,7 +280,7 @@ fn place_single_input(
         Method::Ackermann => rhs[(n.saturating_sub(1), 0)] = 1.0,
         // Bass–Gura: W^T z = k̄ (unit lower triangular Toeplitz), then V^T k = z.
         _ => {
-            let open_loop = polynomial_from_roots(&eigenvalues(a)?);
+            let open_loop = charpoly(a)?;
             for i in 0..n {
                 let mut value = desired[i + 1] - open_loop[i + 1];
                 for j in 0..i {
@@ -367,13 +367,13 @@ fn finish(
     let mut achieved_poles = Vec::with_capacity(poles.len());
     let mut max_relative_error = 0.0f64;
     for &pole in &poles {
-        let nearest = (0..computed.len())
-            .filter(|&k| !taken[k])
-            .min_by(|&i, &j| {
-                (computed[i] - pole)
-                    .norm()
-                    .total_cmp(&(computed[j] - pole).norm())
-            })
+        // Greedy matching: the nearest eigenvalue not yet taken.
+        let (nearest, distance) = computed
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| !taken[k])
+            .map(|(k, &value)| (k, (value - pole).norm()))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
             .expect("as many eigenvalues as poles");
         taken[nearest] = true;
         achieved_poles.push(computed[nearest]);
@@ -384,7 +384,7 @@ fn finish(
         } else {
             1.0
         };
-        max_relative_error = max_relative_error.max((computed[nearest] - pole).norm() / reference);
+        max_relative_error = max_relative_error.max(distance / reference);
     }
     Ok(Placement {
         gain,
@@ -633,6 +633,7 @@ fn condition_number(x: &Mat<c64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::schur::eigenvalues;
     use faer::mat;
 
     fn real(values: &[f64]) -> Vec<c64> {

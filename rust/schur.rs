@@ -393,6 +393,22 @@ pub fn eigenvalues_near(a: MatRef<'_, f64>, estimates: &[c64]) -> Result<Vec<c64
 fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
+    let (mut h, scale) = balanced_hessenberg(a);
+    // Estimates are of the unscaled matrix's eigenvalues (and scaling is rare): dropped.
+    let spectrum = if scale == 1.0 {
+        spectrum
+    } else {
+        Spectrum::General
+    };
+    schur_of_hessenberg(&mut h, None, false, spectrum)?;
+    Ok(block_eigenvalues(h.n, |i, j| h[(i, j)] * scale))
+}
+
+/// The upper Hessenberg form H of the balanced D^-1 (A / s) D, with s the power of two that
+/// brings A's entries into range ([`range_scale`]): returns (H, s). H is similar to A / s, so
+/// it has the eigenvalues and the characteristic polynomial of A / s (the balancing is exact,
+/// the reduction backward stable). The caller checks that A is square and finite.
+pub(crate) fn balanced_hessenberg(a: MatRef<'_, f64>) -> (Square, f64) {
     let scale = range_scale(a);
     let mut h = Square::from_mat(a);
     if scale != 1.0 {
@@ -404,14 +420,7 @@ fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c6
     } else {
         h = Square::from_mat(hessenberg_matrix(h.to_mat().as_ref()).as_ref());
     }
-    // Estimates are of the unscaled matrix's eigenvalues (and scaling is rare): dropped.
-    let spectrum = if scale == 1.0 {
-        spectrum
-    } else {
-        Spectrum::General
-    };
-    schur_of_hessenberg(&mut h, None, false, spectrum)?;
-    Ok(block_eigenvalues(h.n, |i, j| h[(i, j)] * scale))
+    (h, scale)
 }
 
 /// The eigenvalues of a quasi-upper-triangular matrix whose 2 x 2 blocks are in standard form.

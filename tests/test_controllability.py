@@ -173,6 +173,18 @@ def test_charpoly_against_exact_rational_arithmetic(seed: int) -> None:
     assert np.all(np.abs(computed - exact) <= bound), (computed - exact) / e
 
 
+def test_charpoly_does_not_inherit_ill_conditioned_eigenvalues() -> None:
+    # The Frank matrix is upper Hessenberg with integer entries and det = 1; its small
+    # eigenvalues are very ill conditioned, so multiplying out computed eigenvalues
+    # (np.poly(np.linalg.eigvals(F))) misses the coefficients by about 1e-7 relatively at
+    # n = 12. La Budde's recurrence on the Hessenberg form does not go through the eigenvalues.
+    n = 12
+    F = np.array([[n - max(i, j) if j >= i - 1 else 0 for j in range(n)] for i in range(n)])
+    exact = np.array([float(c) for c in _exact_charpoly(F.tolist())])
+    np.testing.assert_allclose(aerocontrol.charpoly(F), exact, rtol=1e-14)
+    assert exact[-1] == 1.0
+
+
 def test_charpoly_of_the_chapter_lateral_model() -> None:
     A, _ = aerocontrol.chapter.boeing747_lateral()
     np.testing.assert_allclose(

@@ -190,12 +190,17 @@ def modes(A_or_sys: Any, mode_names: list[str] | None = None) -> Modes:
 def charpoly(A: Any) -> FloatArray:
     """Coefficients of det(λI - A), highest power first ([1, a_1, ..., a_n], (6.106)).
 
-    Computed from the eigenvalues of the balanced A (Francis QR), each conjugate pair
-    multiplied in as one real quadratic, so the coefficients are exactly real. Accuracy: each
-    a_k carries an absolute error of about (k u + the eigenvalue error) times e_k(|λ|), the
-    elementary symmetric function of the eigenvalue moduli; a coefficient that is small only
-    by cancellation is correspondingly less accurate relatively. Never formed from powers of A
-    (the Krylov or Faddeev-LeVerrier recurrences lose digits geometrically with n).
+    Computed by La Budde's method (Rehman & Ipsen 2011): the balanced A is reduced to upper
+    Hessenberg form H by orthogonal similarity, and det(λI - H) follows in real arithmetic from
+    the characteristic polynomials of H's leading principal submatrices. No eigenvalues are
+    computed, so ill-conditioned eigenvalues do not spoil the coefficients (for the Frank
+    matrix of order 12 the result is exact, where multiplying out its computed eigenvalues
+    errs by 1e-7 relatively). Accuracy: each a_k carries an absolute error of a modest
+    multiple of u e_k(|λ|) on typical matrices (e_k the elementary symmetric function of the
+    eigenvalue moduli; measured against 80-digit arithmetic on random, graded and non-normal
+    matrices of orders 2 to 10); a coefficient that is small only by cancellation is
+    correspondingly less accurate relatively. Never formed from powers of A (the Krylov or
+    Faddeev-LeVerrier recurrences lose digits geometrically with n).
 
     Examples
     --------
