@@ -91,6 +91,10 @@ pub enum Spectrum<'a> {
     Near(&'a [c64]),
 }
 
+/// Known eigenvalues (mirror images, estimates) serve as shifts in this many sweeps after each
+/// deflation; then the trailing block's eigenvalues take over.
+const KNOWN_SHIFT_SWEEPS: usize = 2;
+
 /// A deflated eigenvalue and a pending known one match within this relative distance.
 /// A false match or a missed one only costs a sweep with an ordinary shift.
 const MIRROR_MATCH: f64 = 1e-6;
@@ -127,11 +131,13 @@ impl Mirrors {
 
     /// Records a deflated eigenvalue (of a pair, the member with Im > 0).
     fn found(&mut self, lambda: c64) {
-        let tolerance = MIRROR_MATCH * lambda.norm();
+        // Squared distances: no hypot in the iteration's inner loop (overflow only past
+        // 1e154, where a missed match costs a sweep).
+        let tolerance = MIRROR_MATCH * MIRROR_MATCH * lambda.norm_sqr();
         match self
             .pending
             .iter()
-            .position(|&p| (p - lambda).norm() <= tolerance)
+            .position(|&p| (p - lambda).norm_sqr() <= tolerance)
         {
             Some(k) => {
                 self.pending.remove(k);
@@ -141,22 +147,37 @@ impl Mirrors {
         }
     }
 
-    /// The shifts of the next double-shift step: the latest pending pair, or the latest two
-    /// pending real eigenvalues (one of them twice if there is only one).
-    fn shifts(&self) -> Option<(c64, c64)> {
-        let &latest = self.pending.last()?;
-        if latest.im != 0.0 {
-            return Some((latest, latest.conj()));
+    /// The shifts of the next double-shift step, given the eigenvalues of the window's
+    /// trailing 2 x 2 block (toward which the iteration converges anyway): the pending
+    /// eigenvalue nearest to them, with its conjugate if complex; if real, with the real
+    /// pending one nearest to them after it (or itself again). Choosing by proximity rather
+    /// than by age keeps an exact shift from being spent on an eigenvalue that has nearly
+    /// split off higher up, where the sweep would undo that split (forward instability).
+    fn shifts(&self, trailing: [c64; 2]) -> Option<(c64, c64)> {
+        let distance = |p: &c64| {
+            trailing
+                .iter()
+                .map(|t| (*p - c64::new(t.re, t.im.abs())).norm_sqr())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let nearest = |candidates: &mut dyn Iterator<Item = (usize, &c64)>| {
+            candidates
+                .map(|(k, p)| (k, distance(p)))
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .map(|(k, _)| k)
+        };
+        let first = nearest(&mut self.pending.iter().enumerate())?;
+        let shift = self.pending[first];
+        if shift.im != 0.0 {
+            return Some((shift, shift.conj()));
         }
-        let other = self
+        let mut other_reals = self
             .pending
             .iter()
-            .rev()
-            .skip(1)
-            .find(|p| p.im == 0.0)
-            .copied()
-            .unwrap_or(latest);
-        Some((latest, other))
+            .enumerate()
+            .filter(|&(k, p)| k != first && p.im == 0.0);
+        let second = nearest(&mut other_reals).map_or(shift, |k| self.pending[k]);
+        Some((shift, second))
     }
 }
 
@@ -728,14 +749,19 @@ pub(crate) fn francis_qr(
             iterations_since_deflation += 1;
             let (first, last) = if full { (0, n - 1) } else { (l, i) };
 
-            // The shifts: right after a deflation the mirror image of an eigenvalue already
-            // found (Hamiltonian spectra), else the eigenvalues of the trailing 2 x 2 block,
-            // or exceptional ones.
-            let mirrored = match iterations_since_deflation {
-                1 => mirrors.as_ref().and_then(Mirrors::shifts),
+            // The shifts: in the first sweeps after a deflation the known eigenvalue nearest to
+            // the trailing block's (Hamiltonian mirror images, estimates), else the
+            // eigenvalues of the trailing 2 x 2 block, or exceptional ones.
+            let known = match (iterations_since_deflation, mirrors.as_ref()) {
+                (1..=KNOWN_SHIFT_SWEEPS, Some(mirrors)) => mirrors.shifts(block_eigenvalues_2x2(
+                    h[(i - 1, i - 1)],
+                    h[(i - 1, i)],
+                    h[(i, i - 1)],
+                    h[(i, i)],
+                )),
                 _ => None,
             };
-            let (shift1, shift2) = if let Some(shifts) = mirrored {
+            let (shift1, shift2) = if let Some(shifts) = known {
                 shifts
             } else {
                 let (h11, h12, h21, h22) =
@@ -918,9 +944,24 @@ pub(crate) fn shift_polynomial_column(
 /// The two shifts of a double-shift step: the eigenvalues of [[h11, h12], [h21, h22]] when
 /// they are complex; when they are real, the one nearer h22, twice.
 pub(crate) fn double_shift(h11: f64, h12: f64, h21: f64, h22: f64) -> (c64, c64) {
+    let [first, second] = block_eigenvalues_2x2(h11, h12, h21, h22);
+    if first.im != 0.0 {
+        return (first, second);
+    }
+    let nearer = if (first.re - h22).abs() <= (second.re - h22).abs() {
+        first
+    } else {
+        second
+    };
+    (nearer, nearer)
+}
+
+/// The eigenvalues of [[h11, h12], [h21, h22]]: a conjugate pair (Im > 0 first) or two reals,
+/// from the scaled trace and determinant (a shift needs no more accuracy than this).
+fn block_eigenvalues_2x2(h11: f64, h12: f64, h21: f64, h22: f64) -> [c64; 2] {
     let s = h11.abs() + h12.abs() + h21.abs() + h22.abs();
     if s == 0.0 {
-        return (c64::new(0.0, 0.0), c64::new(0.0, 0.0));
+        return [c64::new(0.0, 0.0); 2];
     }
     let inverse = 1.0 / s;
     let (h11, h12, h21, h22) = (h11 * inverse, h12 * inverse, h21 * inverse, h22 * inverse);
@@ -929,15 +970,12 @@ pub(crate) fn double_shift(h11: f64, h12: f64, h21: f64, h22: f64) -> (c64, c64)
     let root = det.abs().sqrt();
     if det >= 0.0 {
         let re = trace_half * s;
-        (c64::new(re, root * s), c64::new(re, -root * s))
+        [c64::new(re, root * s), c64::new(re, -root * s)]
     } else {
-        let (high, low) = (trace_half + root, trace_half - root);
-        let nearer = if (high - h22).abs() <= (low - h22).abs() {
-            high
-        } else {
-            low
-        };
-        (c64::new(nearer * s, 0.0), c64::new(nearer * s, 0.0))
+        [
+            c64::new((trace_half + root) * s, 0.0),
+            c64::new((trace_half - root) * s, 0.0),
+        ]
     }
 }
 
@@ -1401,25 +1439,36 @@ mod tests {
     #[test]
     fn mirror_images_are_paired_off() {
         let mut mirrors = Mirrors::for_spectrum(Spectrum::Hamiltonian).unwrap();
+        let trailing = |a: f64, b: f64| [c64::new(a, b), c64::new(a, -b)];
         mirrors.found(c64::new(0.5, 0.0));
         mirrors.found(c64::new(-0.3, 0.8));
+        // Pending: -0.5 and 0.3 ± 0.8i; the one nearer the trailing block's eigenvalues.
         assert_eq!(
-            mirrors.shifts(),
+            mirrors.shifts(trailing(0.2, 0.7)),
             Some((c64::new(0.3, 0.8), c64::new(0.3, -0.8)))
+        );
+        assert_eq!(
+            mirrors.shifts(trailing(-0.4, 0.1)),
+            Some((c64::new(-0.5, 0.0), c64::new(-0.5, 0.0)))
         );
         mirrors.found(c64::new(0.3, 0.8));
         assert_eq!(
-            mirrors.shifts(),
+            mirrors.shifts(trailing(0.2, 0.7)),
             Some((c64::new(-0.5, 0.0), c64::new(-0.5, 0.0)))
         );
+        // Two real ones pending: both, nearest first.
         mirrors.found(c64::new(2.0, 0.0));
         assert_eq!(
-            mirrors.shifts(),
+            mirrors.shifts([c64::new(-1.9, 0.0), c64::new(0.0, 0.0)]),
             Some((c64::new(-2.0, 0.0), c64::new(-0.5, 0.0)))
+        );
+        assert_eq!(
+            mirrors.shifts([c64::new(-0.6, 0.0), c64::new(-1.0, 0.0)]),
+            Some((c64::new(-0.5, 0.0), c64::new(-2.0, 0.0)))
         );
         mirrors.found(c64::new(-0.5, 0.0));
         mirrors.found(c64::new(-2.0, 0.0));
-        assert_eq!(mirrors.shifts(), None);
+        assert_eq!(mirrors.shifts(trailing(0.2, 0.7)), None);
     }
 
     #[test]
