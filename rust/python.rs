@@ -69,6 +69,8 @@ fn exception_class_name(error: &Error) -> &'static str {
 
 static EXCEPTIONS_MODULE: PyOnceLock<Py<PyModule>> = PyOnceLock::new();
 static REAL_ARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+/// `aerocontrol.placement._poles`, for requested poles that are not a complex vector.
+static POLES: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
 
 fn exceptions_module(py: Python<'_>) -> PyResult<&Bound<'_, PyModule>> {
     EXCEPTIONS_MODULE
@@ -1039,8 +1041,7 @@ fn place<'py>(
 )> {
     let (a, b) = (float_array(py, a, "A")?, float_array(py, b, "B")?);
     let (a, b) = two_views(py, (&a, "A"), (&b, "B"))?;
-    let poles = poles.cast::<PyArrayDyn<c64>>()?;
-    let requested = copy_complex(poles)?;
+    let requested = pole_values(py, poles)?;
     let placer = placer_for(py, method)?;
     let design = guarded(|| placer(a, b, &requested))?.map_err(|e| to_py_err(py, e))?;
     Ok((
@@ -1054,6 +1055,22 @@ fn place<'py>(
         design.controllability_condition,
         design.eigenvector_condition,
     ))
+}
+
+/// The requested poles: a 1-D complex128 array as it is, anything else through
+/// `aerocontrol.placement._poles` (its conversion and its errors).
+fn pole_values(py: Python<'_>, poles: &Bound<'_, PyAny>) -> PyResult<Vec<c64>> {
+    if let Ok(array) = poles.cast::<PyArrayDyn<c64>>()
+        && array.ndim() == 1
+    {
+        return copy_complex(array);
+    }
+    let convert = POLES.get_or_try_init(py, || {
+        PyModule::import(py, "aerocontrol.placement")?
+            .getattr("_poles")
+            .map(Bound::unbind)
+    })?;
+    copy_complex(convert.bind(py).call1((poles,))?.cast::<PyArrayDyn<c64>>()?)
 }
 
 /// Pole placement over a batch, in parallel with the GIL released: A (k or 1, n, n),

@@ -93,7 +93,7 @@ def controllability(
 def charpoly(a: ArrayLike, /) -> NDArray[np.float64]: ...
 def companion_form(a: ArrayLike, b: ArrayLike, /) -> dict[str, Any]: ...
 def place(
-    a: ArrayLike, b: ArrayLike, poles: NDArray[np.complex128], method: str, /
+    a: ArrayLike, b: ArrayLike, poles: ArrayLike, method: str, /
 ) -> tuple[
     NDArray[np.float64],
     NDArray[np.float64],

@@ -97,6 +97,8 @@ class Placement:
 
 
 def _poles(poles: Any) -> ComplexArray:
+    """Requested poles as a contiguous complex vector (the core calls this for anything that
+    is not one already)."""
     try:
         array = np.asarray(poles, dtype=np.complex128)
     except (TypeError, ValueError) as error:
@@ -116,7 +118,7 @@ def _single_input(b: Any) -> Any:
 
 def _design(A: Any, B: Any, poles: Any, method: str, name: str) -> Placement:
     K, closed, wanted, achieved, error, iterations, converged, kappa_v, kappa_x = _core.place(
-        A, B, _poles(poles), method
+        A, B, poles, method
     )
     # The frozen dataclass's __init__ sets each field through object.__setattr__, which costs
     # more than the whole 4-state design; filling the instance dictionary directly is the
