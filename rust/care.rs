@@ -69,7 +69,7 @@
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::lu::{solve_in_place, solve_with_inverse};
 use crate::lyapunov::{self, Singularity, symmetrize};
-use crate::norm::one_norm;
+use crate::norm::{frobenius_norm, one_norm};
 use crate::reorder::reorder_schur;
 use crate::schur::{Spectrum, balancing_scale, eigenvalues_near, real_schur_with};
 use crate::small_matrix::product;
@@ -172,14 +172,16 @@ impl Reduced<'_> {
         }
         let ay = product(self.a.transpose(), y.as_ref());
         let quadratic = product(coupling.as_ref(), gain.as_ref());
-        let scale = self.q.norm_l2() + 2.0 * ay.norm_l2() + quadratic.norm_l2();
+        let scale = frobenius_norm(self.q.as_ref())
+            + 2.0 * frobenius_norm(ay.as_ref())
+            + frobenius_norm(quadratic.as_ref());
         let n = y.nrows();
         let mut residual = Mat::from_fn(n, n, |i, j| {
             ay[(i, j)] + ay[(j, i)] - quadratic[(i, j)] + self.q[(i, j)]
         });
         symmetrize(&mut residual);
         Evaluation {
-            residual_norm: residual.norm_l2(),
+            residual_norm: frobenius_norm(residual.as_ref()),
             residual,
             gain,
             scale,
@@ -490,7 +492,10 @@ impl ClosedLoopFactors {
 
 fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Error> {
     let n = standard.a.nrows();
-    let (g_norm, q_norm) = (standard.g.norm_l2(), standard.q.norm_l2());
+    let (g_norm, q_norm) = (
+        frobenius_norm(standard.g.as_ref()),
+        frobenius_norm(standard.q.as_ref()),
+    );
     let rho = if g_norm > 0.0 && q_norm > 0.0 {
         nearest_power_of_two((q_norm / g_norm).sqrt())
     } else {
@@ -518,7 +523,7 @@ fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Erro
             h[(n + i, n + j)] *= d[i] / d[j];
         }
     }
-    let h_norm = h.norm_l2();
+    let h_norm = frobenius_norm(h.as_ref());
     let spectrum = if 2 * n <= MIRROR_SHIFT_MAX_ORDER {
         Spectrum::Hamiltonian
     } else {
@@ -667,8 +672,10 @@ fn general_residual(
     }
     let quadratic = m.transpose() * gain;
     let residual = &axe + axe.transpose() - &quadratic + q;
-    let scale = q.norm_l2() + 2.0 * axe.norm_l2() + quadratic.norm_l2();
-    relative(residual.norm_l2(), scale)
+    let scale = frobenius_norm(q.as_ref())
+        + 2.0 * frobenius_norm(axe.as_ref())
+        + frobenius_norm(quadratic.as_ref());
+    relative(frobenius_norm(residual.as_ref()), scale)
 }
 
 /// ||Res|| / scale, or ||Res|| itself when every term is zero.

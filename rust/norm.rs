@@ -19,6 +19,29 @@ use crate::pool::scratch;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
+/// Matrices of up to this many entries take [`frobenius_norm`]'s plain sum of squares.
+const PLAIN_FROBENIUS_MAX_ENTRIES: usize = 256;
+
+/// The Frobenius norm ||A||_F = sqrt(sum a_ij^2). Small matrices (the 4-state Riccati solve
+/// takes seven such norms) use a plain sum of squares when it stays in the normal range:
+/// relative error at most about (mn/2 + 1) u, which is all a scale or a residual needs, where
+/// faer's scaled pairwise sum costs more to set up than the arithmetic. Larger matrices, and
+/// sums that overflow or underflow, use faer's `norm_l2`.
+pub fn frobenius_norm(a: MatRef<'_, f64>) -> f64 {
+    if a.nrows() * a.ncols() <= PLAIN_FROBENIUS_MAX_ENTRIES {
+        let mut squares = 0.0;
+        for j in 0..a.ncols() {
+            for x in a.col(j).iter() {
+                squares += x * x;
+            }
+        }
+        if (f64::MIN_POSITIVE..f64::MAX).contains(&squares) {
+            return squares.sqrt();
+        }
+    }
+    a.norm_l2()
+}
+
 /// The exact 1-norm, max_j sum_i |a_ij| (faer's vectorised column sums).
 pub fn one_norm(a: MatRef<'_, f64>) -> f64 {
     (0..a.ncols())
@@ -316,6 +339,31 @@ mod tests {
 
     fn random_matrix(n: usize, rng: &mut StdRng) -> Mat<f64> {
         Mat::from_fn(n, n, |_, _| rng.random_range(-1.0..1.0))
+    }
+
+    #[test]
+    fn frobenius_norm_agrees_with_faer_and_survives_extreme_scales() {
+        let mut rng = StdRng::seed_from_u64(11);
+        for n in [1usize, 4, 8, 16, 17] {
+            let a = random_matrix(n, &mut rng);
+            let (ours, faer) = (frobenius_norm(a.as_ref()), a.norm_l2());
+            assert!((ours - faer).abs() <= 1e-14 * faer, "n = {n}");
+            // Squares that overflow or underflow go to faer's scaled sum.
+            for scale in [1e200, 1e-200] {
+                let scaled = &a * faer::Scale(scale);
+                let expected = faer * scale;
+                let got = frobenius_norm(scaled.as_ref());
+                assert!(
+                    (got - expected).abs() <= 1e-13 * expected,
+                    "n = {n}, {scale:e}"
+                );
+            }
+        }
+        assert_eq!(frobenius_norm(Mat::<f64>::zeros(3, 3).as_ref()), 0.0);
+        assert_eq!(frobenius_norm(Mat::<f64>::zeros(0, 2).as_ref()), 0.0);
+        let mut nan = Mat::<f64>::identity(2, 2);
+        nan[(0, 1)] = f64::NAN;
+        assert!(frobenius_norm(nan.as_ref()).is_nan());
     }
 
     #[test]

@@ -49,7 +49,7 @@ use crate::ctrb::{controllability, controllability_staircase, krylov_blocks};
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
 use crate::lu::solve_with_inverse;
 use crate::modes::{charpoly, polynomial_from_roots};
-use crate::norm::one_norm;
+use crate::norm::{frobenius_norm, one_norm};
 use crate::schur::eigenvalues_near;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, c64};
@@ -362,7 +362,7 @@ fn finish(
     // The requested poles as the QR iteration's shifts: near the eigenvalues when the design
     // succeeded, it then converges in fewer sweeps (and finds them as accurately either way).
     let computed = eigenvalues_near(closed_loop.as_ref(), &poles)?;
-    let scale = closed_loop.norm_l2();
+    let scale = frobenius_norm(closed_loop.as_ref());
     let mut taken = vec![false; computed.len()];
     let mut achieved_poles = Vec::with_capacity(poles.len());
     let mut max_relative_error = 0.0f64;

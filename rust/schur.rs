@@ -256,20 +256,35 @@ impl Square {
         }
     }
 
-    /// Applies I - τ w w^T from the right to columns k.. of the rows `rows`.
+    /// Applies I - τ w w^T from the right to columns k.. of the rows `rows`: y = τ H w is
+    /// accumulated column by column (contiguous in storage, so the loops vectorise), in
+    /// chunks of rows, then column k + r loses w_r y. (The operations of the row-by-row
+    /// order, in the same order for each entry, so the same rounding.)
     pub(crate) fn reflect_columns(&mut self, k: usize, w: &[f64], tau: f64, rows: Range<usize>) {
+        const CHUNK: usize = 32;
         let n = self.n;
         let columns = &mut self.data[k * n..(k + w.len()) * n];
-        for i in rows {
-            let sum: f64 = w
-                .iter()
-                .enumerate()
-                .map(|(r, v)| v * columns[r * n + i])
-                .sum();
-            let scaled = tau * sum;
+        let mut start = rows.start;
+        while start < rows.end {
+            let chunk = start..(start + CHUNK).min(rows.end);
+            let mut y = [0.0; CHUNK];
+            let y = &mut y[..chunk.len()];
             for (r, v) in w.iter().enumerate() {
-                columns[r * n + i] -= scaled * v;
+                let column = &columns[r * n + chunk.start..r * n + chunk.end];
+                for (sum, x) in y.iter_mut().zip(column) {
+                    *sum += v * x;
+                }
             }
+            for sum in y.iter_mut() {
+                *sum *= tau;
+            }
+            for (r, v) in w.iter().enumerate() {
+                let column = &mut columns[r * n + chunk.start..r * n + chunk.end];
+                for (x, scaled) in column.iter_mut().zip(y.iter()) {
+                    *x -= scaled * v;
+                }
+            }
+            start = chunk.end;
         }
     }
 }
