@@ -1070,7 +1070,12 @@ fn pole_values(py: Python<'_>, poles: &Bound<'_, PyAny>) -> PyResult<Vec<c64>> {
             .getattr("_poles")
             .map(Bound::unbind)
     })?;
-    copy_complex(convert.bind(py).call1((poles,))?.cast::<PyArrayDyn<c64>>()?)
+    copy_complex(
+        convert
+            .bind(py)
+            .call1((poles,))?
+            .cast::<PyArrayDyn<c64>>()?,
+    )
 }
 
 /// Pole placement over a batch, in parallel with the GIL released: A (k or 1, n, n),
