@@ -29,10 +29,13 @@
 //! For a Hamiltonian matrix ([`Spectrum::Hamiltonian`], the Riccati solver's) the spectrum is
 //! symmetric about the imaginary axis: with λ an eigenvalue, so is -λ̄. Once a block deflates,
 //! the mirror image of its eigenvalues is known to be an eigenvalue of the part still active,
-//! and the first sweep after the deflation uses it as its shifts (two real ones, or a conjugate
-//! pair): an exact shift deflates in one step in exact arithmetic, where the shifts of the
-//! trailing block take two to four (on the 747 lateral regulator's Hamiltonian of order 8, 11
-//! sweeps instead of 16). A mirror image matches an eigenvalue deflated later within a relative
+//! and the first two sweeps after the deflation use the known eigenvalue nearest to the
+//! trailing block's as their shifts (two real ones, or a conjugate pair): an exact shift
+//! deflates in one step in exact arithmetic, where the shifts of the trailing block take two to
+//! four (on the 747 lateral regulator's Hamiltonian of order 8, 11 sweeps instead of 16). The
+//! nearest, not the latest: an exact shift spent on an eigenvalue that has nearly split off
+//! higher up makes the sweep undo the split (forward instability; the 747's closed loop at
+//! c = 0.5 took 8 sweeps that way, and takes 2). A mirror image matches an eigenvalue deflated later within a relative
 //! 1e-6 and is then dropped; a mismatch only costs a sweep with an ordinary shift, and the
 //! transformations stay orthogonal either way, so the form is as backward stable as before.
 //! [`eigenvalues_near`] does the same with estimates the caller knows ([`Spectrum::Near`]):
@@ -84,9 +87,9 @@ pub enum Spectrum<'a> {
     Hamiltonian,
     /// Close to these estimates (conjugate pairs given by either member or both): the
     /// eigenvalues of a closed loop whose poles were requested or come from a Hamiltonian.
-    /// The double-shift iteration takes them as its shifts, one after each deflation: an
-    /// accurate shift deflates in one sweep where the trailing block's shifts take two or
-    /// three. The estimates steer only the convergence; the eigenvalues are those of the
+    /// The double-shift iteration takes the one nearest the trailing block's eigenvalues as
+    /// its shifts in the first two sweeps after each deflation: an accurate shift deflates in
+    /// one sweep where the trailing block's shifts take two or three. The estimates steer only the convergence; the eigenvalues are those of the
     /// matrix, as backward stable as without them.
     Near(&'a [c64]),
 }
