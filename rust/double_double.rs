@@ -136,7 +136,7 @@ fn combination_kernel<const N: usize, const FMA: bool>(
 
 fma_dispatch!(fn accumulate_combination<const N: usize>(identity: f64, terms: &[(f64, &DoubleDoubleMatrix<N>)]) -> (Rows<N>, Rows<N>) => combination_kernel);
 
-/// An N x N matrix of double-double numbers: entry (i, j) is hi[i][j] + lo[i][j].
+/// An N x N matrix of double-double numbers: entry (i, j) is `hi[i][j] + lo[i][j]`.
 #[derive(Clone, Copy, Debug)]
 pub struct DoubleDoubleMatrix<const N: usize> {
     pub hi: SmallMatrix<N>,

@@ -227,7 +227,7 @@ pub fn polynomial_from_roots(eigenvalues: &[c64]) -> Vec<f64> {
 /// The coefficients [1, a_1, ..., a_n] of det(λI - A) (6.106), highest power first, by La
 /// Budde's method (Rehman & Ipsen, "La Budde's method for computing characteristic
 /// polynomials", 2011): the balanced A is reduced to upper Hessenberg form H by orthogonal
-/// similarity ([`crate::schur::balanced_hessenberg`]), and det(λI - H) follows from the
+/// similarity (`schur::balanced_hessenberg`), and det(λI - H) follows from the
 /// characteristic polynomials p_i of H's leading i x i submatrices,
 ///
 /// ```text

@@ -31,14 +31,14 @@ use rayon::prelude::*;
 pub enum Input<'a> {
     /// No input: the free response.
     Free,
-    /// η[k] = η0 for every sample (m values).
+    /// `η[k]` = η0 for every sample (m values).
     Constant(&'a [f64]),
     /// Sampled input histories, one per response: responses x steps x m values, row-major.
     Sampled(&'a [f64]),
 }
 
 /// The step of a uniform time grid starting at 0, or an error that names `arg` and says what
-/// is wrong. Uniform means |t[k] - k h| <= 1e-9 h for h = (t[last] - t[0]) / (len - 1).
+/// is wrong. Uniform means `|t[k] - k h| <= 1e-9 h` for `h = (t[last] - t[0]) / (len - 1)`.
 pub fn uniform_grid_step(t: &[f64], arg: &'static str) -> Result<f64, Error> {
     check_finite_values(t, arg)?;
     if t.len() < 2 {
@@ -307,7 +307,7 @@ pub fn simulate_into(
 }
 
 /// Simulates one response of each of several models of one size, in parallel: model `i` has
-/// the initial state x0[i] (models x n), the input slice i of `input` (a constant η0 per model,
+/// the initial state `x0[i]` (models x n), the input slice i of `input` (a constant η0 per model,
 /// models x m values, or sampled inputs, models x steps x m), and writes its states and outputs
 /// at index i of `x` (models x steps x n) and `y` (models x steps x p). An error names the model.
 #[allow(clippy::too_many_arguments)]
