@@ -262,7 +262,7 @@ pub fn charpoly(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
 
 /// det(λI - H) of an upper Hessenberg H by La Budde's recurrence (see [`charpoly`]),
 /// highest power first.
-fn hessenberg_characteristic_polynomial(h: &Square) -> Vec<f64> {
+pub(crate) fn hessenberg_characteristic_polynomial(h: &Square) -> Vec<f64> {
     let n = h.n;
     // p_i's coefficients, lowest power first, at p[start(i)..start(i) + i + 1].
     let start = |i: usize| i * (i + 1) / 2;
