@@ -1,7 +1,7 @@
 //! Criterion benches of the optimal-control kernels: the real Schur form and its reordering,
 //! the Lyapunov solver and the CARE (`benches/compare_peers.py` times them against scipy and
-//! python-control). Seeded random matrices at n = 4, 16, 64 (and 256 for Schur and
-//! Lyapunov, with fewer samples); the CARE also on the chapter's 747 lateral regulator.
+//! python-control). Seeded random matrices at n = 4, 16, 64 and 256; the CARE also on the
+//! chapter's 747 lateral regulator (6.224)-(6.227) with Q = I, R = I.
 
 use aerocontrol::care::{CareOptions, solve_care};
 use aerocontrol::lyapunov::solve_lyapunov;
@@ -56,7 +56,31 @@ fn care(c: &mut Criterion) {
         refine: true,
         ..Default::default()
     };
-    for n in [4, 16, 64] {
+    let lateral = faer::mat![
+        [-0.0999, 0.0, 0.1153, -1.0],
+        [-1.6038, -1.0932, 0.0, 0.285],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.4089, -0.0395, 0.0, -0.2454]
+    ];
+    let rudder_aileron = faer::mat![
+        [0.0182, 0.0],
+        [0.0868, 0.3215],
+        [0.0, 0.0],
+        [-0.244, -0.0017]
+    ];
+    let (q, r) = (Mat::<f64>::identity(4, 4), Mat::<f64>::identity(2, 2));
+    group.bench_function("solve_care 747 lateral", |bench| {
+        bench.iter(|| {
+            solve_care(
+                black_box(lateral.as_ref()),
+                rudder_aileron.as_ref(),
+                q.as_ref(),
+                r.as_ref(),
+                options,
+            )
+        })
+    });
+    for n in [4, 16, 64, 256] {
         let (a, b) = (stable(n, 11), seeded_matrix(n, 2, 12));
         let (q, r) = (Mat::<f64>::identity(n, n), Mat::<f64>::identity(2, 2));
         group.bench_with_input(BenchmarkId::new("solve_care m=2", n), &n, |bench, _| {
