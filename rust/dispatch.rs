@@ -4,7 +4,7 @@
 //! most machines it meets have AVX2 and fused multiply-add, which halve the instructions of
 //! every loop here and, through the fused multiply-add, make error-free products (the
 //! double-double arithmetic) one instruction. Each hot kernel is therefore compiled twice and
-//! [`fma_dispatch!`] picks the variant per call, after a one-time detection.
+//! `fma_dispatch!` picks the variant per call, after a one-time detection.
 
 /// Whether this CPU runs the AVX2 + FMA variants of the kernels (detected on first use and
 /// cached in one atomic, so the check costs a load).

@@ -19,7 +19,7 @@
 //! * The backward error of r_m(2^-s A) is at most the unit roundoff u = 2^-53 when
 //!   2^-s α_p(A) <= θ_m, where α_p(A) = max(||A^p||^(1/p), ||A^(p+1)||^(1/(p+1))) and θ_m is the
 //!   constant of Higham (2005), Table 2.3 (except θ13, lowered to 4.25 for the reason given at
-//!   [`THETA_13`]). Using ||A^k||^(1/k), which can be far smaller than ||A|| for non-normal A,
+//!   `THETA_13`). Using ||A^k||^(1/k), which can be far smaller than ||A|| for non-normal A,
 //!   instead of ||A|| avoids the overscaling that loses accuracy in the squaring phase. The
 //!   d_k = ||A^k||_1^(1/k) for k = 4, 6 are exact norms of formed powers; d_8 and d_10 are exact
 //!   (products formed) for n <= [`EXACT_NORM_MAX_ORDER`] and estimated above it by the block
@@ -54,7 +54,7 @@
 //! few units in the last place. The cost (about four times a double evaluation) is paid only
 //! where squarings make it worthwhile.
 //!
-//! [`ExponentialPlan`] holds the powers and norms of one matrix so that e^{tA} at many times t
+//! `ExponentialPlan` holds the powers and norms of one matrix so that e^{tA} at many times t
 //! (the transition matrices of a response) reuses them: ||(tA)^k|| = |t|^k ||A^k||, so only the
 //! final Padé evaluation and squaring are repeated per time.
 

@@ -14,7 +14,7 @@
 //! ```
 //!
 //! so the blocks follow one another from the bottom right, each a Sylvester equation of order
-//! at most 4 ([`crate::sylvester`]). The solution exists and is unique exactly when no two
+//! at most 4 (`crate::sylvester`). The solution exists and is unique exactly when no two
 //! eigenvalues of A add up to zero (λ_i + λ_j ≠ 0); a stable A qualifies. Near that
 //! singularity a pivot of the small systems is perturbed and the solver refuses the result
 //! ([`Error::IllConditioned`]). The method is backward stable in the sense of Higham (1993):

@@ -43,7 +43,7 @@ pub fn frobenius_norm(a: MatRef<'_, f64>) -> f64 {
 }
 
 /// The exact 1-norm, max_j sum_i |a_ij|: plain column sums up to
-/// [`PLAIN_FROBENIUS_MAX_ENTRIES`] entries, faer's vectorised ones beyond. A column with a NaN
+/// `PLAIN_FROBENIUS_MAX_ENTRIES` entries, faer's vectorised ones beyond. A column with a NaN
 /// is skipped.
 pub fn one_norm(a: MatRef<'_, f64>) -> f64 {
     if a.nrows() * a.ncols() <= PLAIN_FROBENIUS_MAX_ENTRIES {
@@ -58,7 +58,7 @@ pub fn one_norm(a: MatRef<'_, f64>) -> f64 {
 }
 
 /// The largest magnitude max |a_ij| (0 for an empty matrix): a plain scan up to
-/// [`PLAIN_FROBENIUS_MAX_ENTRIES`] entries, where faer's vectorised reduction costs more to
+/// `PLAIN_FROBENIUS_MAX_ENTRIES` entries, where faer's vectorised reduction costs more to
 /// set up than the scan (the 4-state Riccati solve takes five), faer's `norm_max` beyond.
 /// For finite matrices.
 pub fn max_abs(a: MatRef<'_, f64>) -> f64 {

@@ -12,7 +12,7 @@
 //!     [ 0    T22 ]
 //! ```
 //!
-//! If X solves the Sylvester equation T11 X - X T22 = T12 ([`crate::sylvester`]), then
+//! If X solves the Sylvester equation T11 X - X T22 = T12 (`crate::sylvester`), then
 //! D [-X; I] = [-X; I] T22, so the columns of [-X; I] span the invariant subspace of T22's
 //! eigenvalues. With the QR factorisation [-X; I] = Q R, the orthogonal Q gives
 //!
