@@ -378,18 +378,14 @@ pub fn modal_analysis(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_matrices::lateral_747;
     use faer::mat;
 
     #[test]
     fn lateral_747_matches_the_chapter() {
         // (6.150)-(6.155): roll -1.2308, Dutch roll -0.08066 ± 0.7433i, spiral -0.04641, from
         // the unrounded matrix; the printed one gives slightly different last digits.
-        let a = mat![
-            [-0.0999, 0.0000, 0.1153, -1.0000],
-            [-1.6038, -1.0932, 0.0, 0.2850],
-            [0.0, 1.0, 0.0, 0.0],
-            [0.4089, -0.0395, 0.0, -0.2454]
-        ];
+        let a = lateral_747();
         let analysis = modal_analysis(a.as_ref(), None).unwrap();
         let modes = &analysis.modes;
         assert_eq!(modes.len(), 3);

@@ -640,15 +640,7 @@ mod tests {
         values.iter().map(|&v| c64::new(v, 0.0)).collect()
     }
 
-    /// The 747 lateral plant (6.150).
-    fn lateral() -> Mat<f64> {
-        mat![
-            [-0.0999, 0.0, 0.1153, -1.0],
-            [-1.6038, -1.0932, 0.0, 0.2850],
-            [0.0, 1.0, 0.0, 0.0],
-            [0.4089, -0.0395, 0.0, -0.2454],
-        ]
-    }
+    use crate::test_matrices::lateral_747 as lateral;
 
     /// (6.156): the Dutch roll pair moved to ζ = 0.30 at its ω_n, the other roots kept.
     fn dutch_roll_request(a: MatRef<'_, f64>) -> Vec<c64> {

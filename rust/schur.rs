@@ -1063,6 +1063,7 @@ fn block_eigenvalues_2x2(h11: f64, h12: f64, h21: f64, h22: f64) -> [c64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_matrices::{lateral_747, lateral_747_inputs};
     use faer::linalg::solvers::DenseSolveCore;
     use faer::mat;
 
@@ -1518,18 +1519,7 @@ mod tests {
     /// well-separated cases; the Riccati solver reorders whatever comes out).
     #[test]
     fn hamiltonian_schur_form_comes_out_ordered() {
-        let lateral = mat![
-            [-0.0999, 0.0, 0.1153, -1.0],
-            [-1.6038, -1.0932, 0.0, 0.285],
-            [0.0, 1.0, 0.0, 0.0],
-            [0.4089, -0.0395, 0.0, -0.2454]
-        ];
-        let b = mat![
-            [0.0182, 0.0],
-            [0.0868, 0.3215],
-            [0.0, 0.0],
-            [-0.244, -0.0017]
-        ];
+        let (lateral, b) = (lateral_747(), lateral_747_inputs());
         let g = &b * b.transpose();
         let h747 = Mat::from_fn(8, 8, |i, j| match (i < 4, j < 4) {
             (true, true) => lateral[(i, j)],
@@ -1667,12 +1657,7 @@ mod tests {
     #[test]
     fn eigenvalues_of_the_747_lateral_model() {
         // (6.150), (6.152).
-        let a = mat![
-            [-0.0999, 0.0000, 0.1153, -1.0000],
-            [-1.6038, -1.0932, 0.0, 0.2850],
-            [0.0, 1.0, 0.0, 0.0],
-            [0.4089, -0.0395, 0.0, -0.2454]
-        ];
+        let a = lateral_747();
         let values = eigenvalues(a.as_ref()).unwrap();
         let expected = [
             c64::new(-0.08066, 0.7433),

@@ -17,3 +17,23 @@ pub(crate) fn seeded(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
 pub(crate) fn seeded_square(n: usize, seed: u64) -> Mat<f64> {
     seeded(n, n, seed)
 }
+
+/// The chapter's 747 lateral model (6.150): state [β, p, φ, r].
+pub(crate) fn lateral_747() -> Mat<f64> {
+    faer::mat![
+        [-0.0999, 0.0, 0.1153, -1.0],
+        [-1.6038, -1.0932, 0.0, 0.2850],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.4089, -0.0395, 0.0, -0.2454],
+    ]
+}
+
+/// Its input matrix (6.224): columns rudder and aileron.
+pub(crate) fn lateral_747_inputs() -> Mat<f64> {
+    faer::mat![
+        [0.0182, 0.0],
+        [0.0868, 0.3215],
+        [0.0, 0.0],
+        [-0.2440, -0.0017],
+    ]
+}
