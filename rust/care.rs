@@ -99,11 +99,14 @@ pub const HAMILTONIAN_SHIFT_MAX_ORDER: usize = 16;
 /// an n x n matrix, an eighth of that of H).
 pub const MAX_REFINEMENT_STEPS: usize = 10;
 
-/// Newton refinement stops once the relative residual is below this: a few units of rounding,
-/// where the computed residual is mostly the rounding of its own evaluation (every entry of
-/// Ã^T Y and (Y B̃ + S) K is rounded by u relative to its size, and the sums by more) and a
-/// step can only exchange one rounding pattern for another. On the 747's regulator the Schur
-/// solution lands at 1.5 u, and the step it no longer takes cost as much as the Schur solution.
+/// Newton refinement stops once the relative residual is below this: a few units of rounding.
+/// A speed trade, measured against 50-digit solutions on 41 weights of the 747 lateral
+/// regulator (c from 1e-3 to 10): the correctly rounded solution has a residual of 0.1 to 1 u;
+/// the Schur solutions had residuals of 1.5 to 37 u and forward errors of 1.3 to 23 u; a Newton
+/// step brought the forward error to 0.3 to 1.9 u. Those left below the floor (no step) kept
+/// forward errors of 1.3 to 12.6 u. Overall: median 1.8 u, largest 12.6 u, against scipy's
+/// 15 u and 82 u and python-control's 70 u and 628 u on the same weights. A step costs about a
+/// fifth of the 4-state solve, which the 747's regulator at c = 1 (1.8 u) does not pay.
 pub const REFINEMENT_FLOOR: f64 = 4.0 * f64::EPSILON;
 
 /// Asymmetry ||M - M^T||_max / ||M||_max that Q and R may carry (rounding in how the caller
