@@ -42,15 +42,20 @@
 //!   gives from the Hessenberg form in O(n^3) ([`crate::modes::charpoly`]); the roots μ of q
 //!   (the eigenvalues of its companion matrix, of half the order) give the eigenvalue pairs
 //!   ±sqrt(μ). The unstable ones serve as shifts until as many eigenvalues as they number have
-//!   deflated, then the stable ones. The unstable half thus deflates at the bottom first, and
+//!   deflated, then the stable ones join them (a stable eigenvalue that deflates early is
+//!   matched against its estimate all the same, and an unstable estimate that matched nothing
+//!   stays a candidate, chosen only if the trailing block comes near it). The unstable half
+//!   thus deflates at the bottom first, and
 //!   the form usually comes out already ordered with the stable eigenvalues leading, as the
 //!   Riccati solver needs it: on the 747 lateral regulator's Hamiltonian of order 8 over
 //!   200 weights, 6 sweeps each and no reordering swap, where mirror images alone (below)
 //!   took 10 sweeps and 3.6 swaps. The estimates lose accuracy as the order grows (the roots of
 //!   a polynomial are more sensitive than the eigenvalues of a matrix); a poor one only costs
 //!   sweeps, and the Riccati solver's reordering puts right any eigenvalue left out of place.
-//! - When the polynomial is not finite, the mirror images: once a block deflates, the mirror
-//!   image -λ̄ of its eigenvalues is known to be an eigenvalue of the part still active.
+//! - Without estimates (a polynomial that is not finite or a companion matrix whose QR
+//!   iteration fails, an odd order, or a window that is not the whole matrix), the mirror
+//!   images: once a block deflates, the mirror image -λ̄ of its eigenvalues is known to be an
+//!   eigenvalue of the part still active.
 //! - [`eigenvalues_near`] takes estimates the caller knows ([`Spectrum::Near`]): the requested
 //!   poles of a placement, or the Hamiltonian's stable eigenvalues for the closed loop of a
 //!   Riccati solution (the 747 regulator's closed-loop eigenvalues in 0.72 µs instead of 1.17).
@@ -97,9 +102,10 @@ pub enum Spectrum<'a> {
     /// No structure.
     General,
     /// Symmetric about the imaginary axis, λ and -λ̄ eigenvalues together with equal
-    /// multiplicities: the spectrum of a (real) Hamiltonian matrix. The QR iteration
-    /// estimates the eigenvalues from the characteristic polynomial and deflates the unstable
-    /// half first (see the module documentation).
+    /// multiplicities: the spectrum of a (real) Hamiltonian matrix. The double-shift QR
+    /// iteration (below `MULTISHIFT_MIN_ORDER`) estimates the eigenvalues from the
+    /// characteristic polynomial and deflates the unstable half first (see the module
+    /// documentation); the multishift iteration ignores the structure.
     Hamiltonian,
     /// Close to these estimates (conjugate pairs given by either member or both): the
     /// eigenvalues of a closed loop whose poles were requested or come from a Hamiltonian.
@@ -125,9 +131,13 @@ const MIRROR_MATCH: f64 = 1e-6;
 /// [`Spectrum::Near`] the estimates not yet matched.
 struct Mirrors {
     pending: Vec<c64>,
-    /// Known eigenvalues that become pending once `pending` is empty (the stable half of a
-    /// Hamiltonian spectrum, after the unstable half).
+    /// Known eigenvalues that join `pending` once `deflations_before_later` eigenvalues have
+    /// deflated (the stable half of a Hamiltonian spectrum, after the unstable half; estimates
+    /// on the imaginary axis are in `pending` only).
     later: Vec<c64>,
+    /// Deflations (each real eigenvalue and each complex pair counts one) left before `later`
+    /// joins `pending`: at first, the number of unstable estimates.
+    deflations_before_later: usize,
     /// Whether an eigenvalue that matches no pending one adds its mirror image (a Hamiltonian
     /// spectrum without estimates; with them, the estimate of the mirror image is in `later`
     /// already, and measured on graded Riccati problems adding it cost sweeps).
@@ -140,10 +150,13 @@ impl Mirrors {
             Spectrum::General => None,
             Spectrum::Hamiltonian => {
                 let stable = h.map_or_else(Vec::new, hamiltonian_estimates);
+                let unstable: Vec<c64> = stable.iter().map(|z| c64::new(-z.re, z.im)).collect();
                 Some(Self {
-                    pending: stable.iter().map(|z| c64::new(-z.re, z.im)).collect(),
+                    deflations_before_later: unstable.len(),
+                    pending: unstable,
                     mirrored: stable.is_empty(),
-                    later: stable,
+                    // An estimate on the imaginary axis is its own mirror image: once is enough.
+                    later: stable.into_iter().filter(|z| z.re != 0.0).collect(),
                 })
             }
             Spectrum::Near(estimates) => Some(Self {
@@ -154,6 +167,7 @@ impl Mirrors {
                     .copied()
                     .collect(),
                 later: Vec::new(),
+                deflations_before_later: 0,
                 mirrored: false,
             }),
         }
@@ -164,19 +178,17 @@ impl Mirrors {
         // Squared distances: no hypot in the iteration's inner loop (overflow only past
         // 1e154, where a missed match costs a sweep).
         let tolerance = MIRROR_MATCH * MIRROR_MATCH * lambda.norm_sqr();
-        match self
-            .pending
-            .iter()
-            .position(|&p| (p - lambda).norm_sqr() <= tolerance)
-        {
-            Some(k) => {
-                self.pending.remove(k);
-            }
-            None if self.mirrored => self.pending.push(c64::new(-lambda.re, lambda.im)),
-            None => {}
+        let matches = |p: &c64| (p - lambda).norm_sqr() <= tolerance;
+        if let Some(k) = self.pending.iter().position(matches) {
+            self.pending.remove(k);
+        } else if let Some(k) = self.later.iter().position(matches) {
+            self.later.remove(k);
+        } else if self.mirrored {
+            self.pending.push(c64::new(-lambda.re, lambda.im));
         }
-        if self.pending.is_empty() {
-            std::mem::swap(&mut self.pending, &mut self.later);
+        self.deflations_before_later = self.deflations_before_later.saturating_sub(1);
+        if self.deflations_before_later == 0 {
+            self.pending.append(&mut self.later);
         }
     }
 
@@ -736,7 +748,7 @@ pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
 ///
 /// With `full` the whole of `h` is transformed into the Schur form T (and `z`, if given, is
 /// multiplied on the right by the orthogonal transformations); without it only the diagonal
-/// blocks are formed, which suffices for the eigenvalues. The mirrored shifts of a Hamiltonian
+/// blocks are formed, which suffices for the eigenvalues. The known shifts of a Hamiltonian
 /// `spectrum` serve the double-shift iteration only.
 pub(crate) fn schur_of_hessenberg(
     h: &mut Square,
@@ -992,8 +1004,9 @@ pub(crate) fn shift_polynomial_column(
 
 /// Estimates of the stable eigenvalues (Re λ <= 0; of a pair, the member with Im >= 0) of a
 /// Hamiltonian matrix in upper Hessenberg form, from its characteristic polynomial, which is
-/// even: det(λI - H) = q(λ²), and each root μ of q gives the pair ±sqrt(μ). Empty if the
-/// polynomial is not finite.
+/// even: det(λI - H) = q(λ²), and each root μ of q gives the pair ±sqrt(μ). Empty for an odd
+/// order, or if the polynomial is not finite or the companion matrix's QR iteration fails.
+/// A root μ < 0 gives an estimate on the imaginary axis (Re = -0).
 fn hamiltonian_estimates(h: &Square) -> Vec<c64> {
     let order = h.n / 2;
     if order == 0 || !h.n.is_multiple_of(2) {
@@ -1014,9 +1027,12 @@ fn hamiltonian_estimates(h: &Square) -> Vec<c64> {
             .iter()
             .filter(|mu| mu.im >= 0.0)
             .map(|mu| {
+                // |Im|: an Im sqrt(μ) that underflowed to -0 would otherwise give the member
+                // with Im < 0.
                 let root = mu.sqrt();
-                c64::new(-root.re, root.im)
+                c64::new(-root.re, root.im.abs())
             })
+            .filter(|z| z.re.is_finite() && z.im.is_finite())
             .collect(),
         Err(_) => Vec::new(),
     }
@@ -1509,9 +1525,83 @@ mod tests {
                 );
             }
         }
-        // Odd orders are not Hamiltonian, and a 0 x 0 matrix has nothing to estimate.
+        // Odd orders are not Hamiltonian (the polynomial of I_3 is not even; read as one it
+        // would give an estimate).
         assert!(hamiltonian_estimates(&Square::identity(3)).is_empty());
-        assert!(hamiltonian_estimates(&Square::identity(0)).is_empty());
+    }
+
+    /// The Hamiltonian [[A, G], [Q, -A^T]] of order 2n from its blocks.
+    fn hamiltonian(a: &Mat<f64>, g: &Mat<f64>, q: &Mat<f64>) -> Mat<f64> {
+        let n = a.nrows();
+        Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+            (true, true) => a[(i, j)],
+            (true, false) => g[(i, j - n)],
+            (false, true) => q[(i - n, j)],
+            (false, false) => -a[(j - n, i - n)],
+        })
+    }
+
+    /// Eigenvalues on the imaginary axis (a root μ < 0 of q) are estimated once, not as an
+    /// unstable and a stable estimate of the same eigenvalue; and the form still converges.
+    #[test]
+    fn imaginary_axis_estimates_are_pending_once() {
+        // A = diag(0, -1), G = diag(1, 0), Q = diag(-4, -3): eigenvalues ±2i and ±1.
+        let a = Mat::from_fn(2, 2, |i, j| if (i, j) == (1, 1) { -1.0 } else { 0.0 });
+        let g = Mat::from_fn(2, 2, |i, j| if (i, j) == (0, 0) { 1.0 } else { 0.0 });
+        let q = Mat::from_fn(2, 2, |i, j| [[-4.0, 0.0], [0.0, -3.0]][i][j]);
+        // An orthogonal symplectic similarity (a rotation of each state with its co-state)
+        // makes the Hessenberg form non-trivial.
+        let (c, s) = (0.6, 0.8);
+        let rotation = Mat::from_fn(4, 4, |i, j| match (i % 2 == j % 2, i / 2 == j / 2) {
+            (true, true) => c,
+            (true, false) => {
+                if i < j {
+                    s
+                } else {
+                    -s
+                }
+            }
+            _ => 0.0,
+        });
+        let h = rotation.transpose() * hamiltonian(&a, &g, &q) * &rotation;
+        let mut hessenberg = Square::from_mat(h.as_ref());
+        reduce_to_hessenberg(&mut hessenberg, None);
+        let mirrors = Mirrors::for_spectrum(Spectrum::Hamiltonian, Some(&hessenberg)).unwrap();
+        assert_eq!(mirrors.pending.len(), 2, "{:?}", mirrors.pending);
+        assert_eq!(mirrors.later.len(), 1, "{:?}", mirrors.later);
+        assert!((mirrors.later[0] - c64::new(-1.0, 0.0)).norm() < 1e-12);
+        let t = real_schur_with(h.as_ref(), Spectrum::Hamiltonian)
+            .unwrap()
+            .t;
+        let found = sorted(quasi_triangular_eigenvalues(t.as_ref()));
+        let expected = sorted(vec![
+            c64::new(0.0, 2.0),
+            c64::new(0.0, -2.0),
+            c64::new(-1.0, 0.0),
+            c64::new(1.0, 0.0),
+        ]);
+        assert!(spectral_distance(&found, &expected) < 1e-7, "{found:?}");
+    }
+
+    /// A double root of q (a Jordan block in A, with Q = 0): the estimates repeat, and the
+    /// form still comes out with the stable pair leading.
+    #[test]
+    fn repeated_estimates_are_each_spent() {
+        let a = faer::mat![[-1.0, 1.0], [0.0, -1.0]];
+        let g = Mat::<f64>::identity(2, 2);
+        let h = hamiltonian(&a, &g, &Mat::zeros(2, 2));
+        let t = real_schur_with(h.as_ref(), Spectrum::Hamiltonian)
+            .unwrap()
+            .t;
+        let values = quasi_triangular_eigenvalues(t.as_ref());
+        // A defective double eigenvalue is found to about sqrt(u).
+        for (k, value) in values.iter().enumerate() {
+            let expected = if k < 2 { -1.0 } else { 1.0 };
+            assert!(
+                (value - c64::new(expected, 0.0)).norm() < 1e-7,
+                "{values:?}"
+            );
+        }
     }
 
     /// With the unstable estimates as the first shifts, the unstable half deflates at the
@@ -1587,6 +1677,7 @@ mod tests {
         let mut mirrors = Mirrors {
             pending: vec![c64::new(1.0, 0.0), c64::new(0.5, 2.0)],
             later: vec![c64::new(-1.0, 0.0), c64::new(-0.5, 2.0)],
+            deflations_before_later: 2,
             mirrored: false,
         };
         let trailing = [c64::new(-1.0, 0.0), c64::new(-0.9, 0.0)];
@@ -1605,6 +1696,34 @@ mod tests {
         mirrors.found(c64::new(7.0, 0.0));
         assert_eq!(mirrors.pending.len(), 2);
         assert!(mirrors.later.is_empty());
+    }
+
+    /// Deflations out of order: a stable eigenvalue that deflates while the unstable
+    /// estimates are pending is struck from the stable ones, and an unstable estimate that
+    /// matched nothing does not hold the stable ones back.
+    #[test]
+    fn stale_estimates_do_not_block_the_stable_half() {
+        let mut mirrors = Mirrors {
+            pending: vec![c64::new(1.0, 0.0), c64::new(0.5, 2.0)],
+            later: vec![c64::new(-1.0, 0.0), c64::new(-0.5, 2.0)],
+            deflations_before_later: 2,
+            mirrored: false,
+        };
+        mirrors.found(c64::new(-0.5, 2.0));
+        assert_eq!(mirrors.later, vec![c64::new(-1.0, 0.0)]);
+        // The unstable 0.5 + 2i deflates as 0.5 + 2.1i, too far off to match; the two
+        // deflations bring in the rest of the stable half.
+        mirrors.found(c64::new(0.5, 2.1));
+        assert!(mirrors.later.is_empty());
+        assert_eq!(
+            mirrors.pending,
+            vec![c64::new(1.0, 0.0), c64::new(0.5, 2.0), c64::new(-1.0, 0.0)]
+        );
+        // Chosen by proximity: near the stable -1, the stale estimates are not spent.
+        assert_eq!(
+            mirrors.shifts([c64::new(-0.9, 0.0), c64::new(-0.2, 0.0)]),
+            Some((c64::new(-1.0, 0.0), c64::new(1.0, 0.0)))
+        );
     }
 
     #[test]
