@@ -4,6 +4,7 @@ examples of scipy's own tests, a property test, and bad requests."""
 
 from __future__ import annotations
 
+import pickle
 import warnings
 
 import numpy as np
@@ -327,6 +328,41 @@ def test_systems_are_accepted() -> None:
     assert "Kautsky-Nichols-Van Dooren" in text and "largest relative pole error" in text
     with pytest.raises(ShapeError, match="k is defined for one input"):
         _ = aerocontrol.place(A_LAT, B_LAT, poles).k
+
+
+def test_the_result_is_frozen_and_pickles() -> None:
+    design = aerocontrol.place_ackermann([[0, 1], [-2, -3]], [0, 1], [-5, -6])
+    assert isinstance(design, aerocontrol.Placement)
+    with pytest.raises(AttributeError):
+        design.K = np.zeros((1, 2))  # type: ignore[misc]
+    copy = pickle.loads(pickle.dumps(design))
+    np.testing.assert_array_equal(copy.K, [[28.0, 8.0]])
+    np.testing.assert_array_equal(copy.closed_loop, [[0.0, 1.0], [-30.0, -11.0]])
+    np.testing.assert_array_equal(copy.achieved_poles, design.achieved_poles)
+    assert (copy.method, copy.iterations, copy.converged) == ("Ackermann", 0, True)
+    assert copy.controllability_condition == design.controllability_condition == 16.0
+    assert np.isnan(copy.eigenvector_condition)
+    text = repr(design)
+    assert text.startswith("Placement(K=array([[28.,  8.]]), closed_loop=array(")
+    assert "method='Ackermann'" in text and "eigenvector_condition=nan)" in text
+    assert "controllability_condition=16.0" in text and "converged=True" in text
+
+
+def test_strided_and_reversed_views_are_read_as_given() -> None:
+    # The core reads numpy's shape and strides directly: transposed, reversed and sliced
+    # views must give what their copies give.
+    poles = _dutch_roll_request()
+    reference = aerocontrol.place(A_LAT, B_LAT, poles)
+    wide = np.zeros((4, 8))
+    wide[:, ::2] = A_LAT
+    for A, B, P in (
+        (np.asfortranarray(A_LAT), np.asfortranarray(B_LAT), poles),
+        (wide[:, ::2], B_LAT[::-1][::-1], np.repeat(poles, 2)[::2]),
+        (A_LAT.T.copy().T, np.ascontiguousarray(B_LAT[:, ::-1])[:, ::-1], poles[::-1][::-1]),
+    ):
+        design = aerocontrol.place(A, B, P)
+        np.testing.assert_array_equal(design.K, reference.K)
+        np.testing.assert_array_equal(design.poles, reference.poles)
 
 
 def test_augment_mode_selects_and_changes_one_mode() -> None:

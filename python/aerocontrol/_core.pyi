@@ -4,7 +4,7 @@ Private: call the wrappers in the aerocontrol package, which convert and check a
 """
 
 from collections.abc import Callable
-from typing import Any
+from typing import Any, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -13,6 +13,7 @@ __all__ = [
     "EXACT_NORM_MAX_ORDER",
     "FMA_KERNELS",
     "SMALL_MAX_ORDER",
+    "Placement",
     "care_batch",
     "charpoly",
     "check_model",
@@ -92,19 +93,48 @@ def controllability(
 ) -> dict[str, Any]: ...
 def charpoly(a: ArrayLike, /) -> NDArray[np.float64]: ...
 def companion_form(a: ArrayLike, b: ArrayLike, /) -> dict[str, Any]: ...
-def place(
-    a: ArrayLike, b: ArrayLike, poles: ArrayLike, method: str, /
-) -> tuple[
-    NDArray[np.float64],
-    NDArray[np.float64],
-    NDArray[np.complex128],
-    NDArray[np.complex128],
-    float,
-    int,
-    bool,
-    float,
-    float,
-]: ...
+
+@final
+class Placement:
+    """A state-feedback design η = -K x (6.91)."""
+
+    def __new__(
+        cls,
+        K: NDArray[np.float64],
+        closed_loop: NDArray[np.float64],
+        poles: NDArray[np.complex128],
+        achieved_poles: NDArray[np.complex128],
+        max_relative_error: float,
+        iterations: int,
+        converged: bool,
+        method: str,
+        controllability_condition: float,
+        eigenvector_condition: float,
+    ) -> Placement: ...
+    @property
+    def K(self) -> NDArray[np.float64]: ...
+    @property
+    def closed_loop(self) -> NDArray[np.float64]: ...
+    @property
+    def poles(self) -> NDArray[np.complex128]: ...
+    @property
+    def achieved_poles(self) -> NDArray[np.complex128]: ...
+    @property
+    def max_relative_error(self) -> float: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def controllability_condition(self) -> float: ...
+    @property
+    def eigenvector_condition(self) -> float: ...
+    @property
+    def k(self) -> NDArray[np.float64]: ...
+
+def place(a: ArrayLike, b: ArrayLike, poles: ArrayLike, method: str, /) -> Placement: ...
 def schur(
     a: ArrayLike, select: Callable[[complex], bool] | None, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], int]: ...

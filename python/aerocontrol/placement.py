@@ -53,47 +53,23 @@ ILL_CONDITIONED_CONTROLLABILITY = 1e8
 POLE_ERROR_WARNING = 1e-6
 
 
-@dataclass(frozen=True, eq=False)
-class Placement:
-    """A state-feedback design η = -K x (6.91).
+#: The result of every placement function: a state-feedback design η = -K x (6.91), with
+#: K (m x n), ``closed_loop`` A - BK (6.93), the requested ``poles`` and the
+#: ``achieved_poles`` matched to them, ``max_relative_error``, ``iterations`` and ``converged``
+#: of the robust method, the ``method``'s name, ``controllability_condition`` κ_1(V) (the
+#: single-input formulas) and ``eigenvector_condition`` κ_2(X) (the robust method), and ``k``,
+#: the gain vector of a single-input design. Built by the core (a frozen class; pickles).
+Placement = _core.Placement
 
-    ``k`` is the gain vector of a single-input design (the chapter's k^T = K[0]).
-    """
 
-    K: FloatArray
-    """The gain matrix, m x n."""
-    closed_loop: FloatArray
-    """A - B K (6.93)."""
-    poles: ComplexArray
-    """The requested poles, each conjugate pair adjacent with Im > 0 first."""
-    achieved_poles: ComplexArray
-    """The eigenvalues of the computed A - B K, matched to ``poles``."""
-    max_relative_error: float
-    """max |achieved - requested| / |requested| (relative to ||A - BK||_F for a pole at 0)."""
-    iterations: int
-    """Sweeps of the robust method; 0 for the single-input formulas."""
-    converged: bool
-    method: str
-    controllability_condition: float
-    """κ_1(V) for the single-input formulas, NaN for the robust method."""
-    eigenvector_condition: float
-    """κ_2(X) of the closed-loop eigenvectors for the robust method, NaN otherwise."""
-
-    @property
-    def k(self) -> FloatArray:
-        """The gain vector of a single-input design, shape (n,)."""
-        if self.K.shape[0] != 1:
-            raise ShapeError(f"k is defined for one input; this design has {self.K.shape[0]}")
-        gains: FloatArray = self.K[0]
-        return gains
-
-    def __str__(self) -> str:
-        lines = [f"pole placement ({self.method}), K = {np.array2string(self.K, precision=6)}"]
-        lines.append(f"{'requested':>28}{'achieved':>28}")
-        for want, got in zip(self.poles, self.achieved_poles, strict=True):
-            lines.append(f"{complex(want):>28.6g}{complex(got):>28.6g}")
-        lines.append(f"largest relative pole error {self.max_relative_error:.2e}")
-        return "\n".join(lines)
+def _describe(design: Placement) -> str:
+    """``str(design)``: the gains and the requested and achieved poles side by side."""
+    lines = [f"pole placement ({design.method}), K = {np.array2string(design.K, precision=6)}"]
+    lines.append(f"{'requested':>28}{'achieved':>28}")
+    for want, got in zip(design.poles, design.achieved_poles, strict=True):
+        lines.append(f"{complex(want):>28.6g}{complex(got):>28.6g}")
+    lines.append(f"largest relative pole error {design.max_relative_error:.2e}")
+    return "\n".join(lines)
 
 
 def _poles(poles: Any) -> ComplexArray:
@@ -108,41 +84,16 @@ def _poles(poles: Any) -> ComplexArray:
     return np.ascontiguousarray(array)
 
 
-def _single_input(b: Any) -> Any:
-    """b as an n x 1 matrix: a 1-D vector becomes a column."""
-    if type(b) is np.ndarray and b.ndim == 2:
-        return b
-    array = real_array(b, "B")
-    return array[:, None] if array.ndim == 1 else array
-
-
-def _design(A: Any, B: Any, poles: Any, method: str, name: str) -> Placement:
-    K, closed, wanted, achieved, error, iterations, converged, kappa_v, kappa_x = _core.place(
-        A, B, poles, method
-    )
-    # The frozen dataclass's __init__ sets each field through object.__setattr__, which costs
-    # more than the whole 4-state design; filling the instance dictionary directly is the
-    # same object, built in a fifth of the time.
-    design = object.__new__(Placement)
-    vars(design).update(
-        K=K,
-        closed_loop=closed,
-        poles=wanted,
-        achieved_poles=achieved,
-        max_relative_error=error,
-        iterations=iterations,
-        converged=converged,
-        method=name,
-        controllability_condition=kappa_v,
-        eigenvector_condition=kappa_x,
-    )
+def _design(A: Any, B: Any, poles: Any, method: str) -> Placement:
+    design = _core.place(A, B, poles, method)
+    error, kappa_v = design.max_relative_error, design.controllability_condition
     if kappa_v >= ILL_CONDITIONED_CONTROLLABILITY or error > POLE_ERROR_WARNING:
         if method == "knv0":
-            measure = f"closed-loop eigenvector condition number {kappa_x:.2e}"
+            measure = f"closed-loop eigenvector condition number {design.eigenvector_condition:.2e}"
         else:
             measure = f"controllability matrix condition number {kappa_v:.2e}"
         warnings.warn(
-            f"{name}: the achieved poles miss the requested ones by up to {error:.2e} "
+            f"{design.method}: the achieved poles miss the requested ones by up to {error:.2e} "
             f"relatively ({measure}); the gains may be inaccurate, and poles that are repeated "
             "or close together are inherently sensitive (a k-fold pole moves by about u^(1/k))",
             IllConditionedWarning,
@@ -181,7 +132,7 @@ def place_bass_gura(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placemen
     """
     if poles is None:
         A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
-    return _design(A_or_sys, _single_input(b), poles, "bass-gura", "Bass-Gura")
+    return _design(A_or_sys, b, poles, "bass-gura")
 
 
 def place_ackermann(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placement:
@@ -198,7 +149,7 @@ def place_ackermann(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placemen
     """
     if poles is None:
         A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
-    return _design(A_or_sys, _single_input(b), poles, "ackermann", "Ackermann")
+    return _design(A_or_sys, b, poles, "ackermann")
 
 
 def place(A_or_sys: Any, B: Any = None, poles: Any = None) -> Placement:
@@ -226,7 +177,7 @@ def place(A_or_sys: Any, B: Any = None, poles: Any = None) -> Placement:
     """
     if poles is None:
         A_or_sys, B, poles = *plant_pair(A_or_sys, None, "B"), B
-    return _design(A_or_sys, B, poles, "knv0", "Kautsky-Nichols-Van Dooren")
+    return _design(A_or_sys, B, poles, "knv0")
 
 
 @dataclass(frozen=True, eq=False)
@@ -255,7 +206,7 @@ def companion_form(A_or_sys: Any, b: Any = None) -> CompanionForm:
            [ 1.,  0.]])
     """
     A, b = plant_pair(A_or_sys, b, "B")
-    result = _core.companion_form(A, _single_input(b))
+    result = _core.companion_form(A, b)
     return CompanionForm(
         V=result["V"],
         W=result["W"],
