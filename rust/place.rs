@@ -59,6 +59,14 @@ use faer::{Mat, MatRef, c64};
 /// two inputs |det X| grows 0.506, 0.632, 0.6337, then by 3e-5 per sweep); the conditioning
 /// it buys beyond 1e-3 is negligible. (scipy's place_poles uses the same default.)
 pub const KNV_RELATIVE_TOLERANCE: f64 = 1e-3;
+
+/// κ_1(V) from which a single-input design is flagged (the Python layer warns): beyond 1e8
+/// about half the digits of the gains may be lost to the conditioning of the controllability
+/// matrix.
+pub const ILL_CONDITIONED_CONTROLLABILITY: f64 = 1e8;
+
+/// Achieved-pole relative error from which any design is flagged.
+pub const POLE_ERROR_WARNING: f64 = 1e-6;
 /// The most sweeps of method 0.
 pub const KNV_MAX_SWEEPS: usize = 100;
 

@@ -28,7 +28,8 @@ use crate::lyapunov::solve_lyapunov as solve_lyapunov_core;
 use crate::modes::{charpoly as charpoly_core, modal_analysis as modal_analysis_core};
 use crate::norm::one_norm;
 use crate::place::{
-    companion_form as companion_form_core, place as place_core, place_ackermann, place_bass_gura,
+    ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING, companion_form as companion_form_core,
+    place as place_core, place_ackermann, place_bass_gura,
 };
 use crate::reorder::reorder_schur;
 use crate::response::{
@@ -43,7 +44,6 @@ use numpy::{
     Element, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError};
-use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyComplex, PyDict, PyFloat, PyString, PyType};
@@ -1209,7 +1209,9 @@ impl PlacementResult {
 }
 
 /// Pole placement by `method` ("bass-gura", "ackermann" or "knv0"; the single-input ones
-/// take b as a vector or an n x 1 matrix), as a `Placement`.
+/// take b as a vector or an n x 1 matrix), as a `Placement`. Warns (IllConditionedWarning, at
+/// the caller of the Python wrapper) when an achieved pole misses by more than
+/// `POLE_ERROR_WARNING` relatively or κ(V) reaches `ILL_CONDITIONED_CONTROLLABILITY`.
 #[pyfunction]
 #[pyo3(signature = (a, b, poles, method, /))]
 fn place<'py>(
@@ -1231,11 +1233,26 @@ fn place<'py>(
     .map_err(|e| to_py_err(py, e))?;
     let requested = pole_values(py, poles)?;
     let design = guarded(|| placer(a, b, &requested))?.map_err(|e| to_py_err(py, e))?;
-    let name = match method {
-        "bass-gura" => intern!(py, "Bass-Gura"),
-        "ackermann" => intern!(py, "Ackermann"),
-        _ => intern!(py, "Kautsky-Nichols-Van Dooren"),
+    let (name, measure) = match method {
+        "bass-gura" => ("Bass-Gura", "controllability matrix"),
+        "ackermann" => ("Ackermann", "controllability matrix"),
+        _ => ("Kautsky-Nichols-Van Dooren", "closed-loop eigenvector"),
     };
+    let (error, condition) = match method {
+        "knv0" => (design.max_relative_error, design.eigenvector_condition),
+        _ => (design.max_relative_error, design.controllability_condition),
+    };
+    if error > POLE_ERROR_WARNING
+        || design.controllability_condition >= ILL_CONDITIONED_CONTROLLABILITY
+    {
+        let message = format!(
+            "{name}: the achieved poles miss the requested ones by up to {error:.2e} relatively \
+             ({measure} condition number {condition:.2e}); the gains may be inaccurate, and \
+             poles that are repeated or close together are inherently sensitive (a k-fold pole \
+             moves by about u^(1/k))"
+        );
+        warn(py, "IllConditionedWarning", &message)?;
+    }
     Bound::new(
         py,
         PlacementResult {
@@ -1246,7 +1263,7 @@ fn place<'py>(
             max_relative_error: design.max_relative_error,
             iterations: design.iterations,
             converged: design.converged,
-            method: name.clone().unbind(),
+            method: PyString::intern(py, name).unbind(),
             controllability_condition: design.controllability_condition,
             eigenvector_condition: design.eigenvector_condition,
         },
@@ -1620,5 +1637,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
     m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;
     m.add("FMA_KERNELS", crate::dispatch::fma_available())?;
+    m.add(
+        "ILL_CONDITIONED_CONTROLLABILITY",
+        crate::place::ILL_CONDITIONED_CONTROLLABILITY,
+    )?;
+    m.add("POLE_ERROR_WARNING", crate::place::POLE_ERROR_WARNING)?;
     Ok(())
 }

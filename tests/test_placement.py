@@ -298,9 +298,13 @@ def test_ill_conditioned_controllability_warns() -> None:
     n = 8
     A = np.diag(10.0 ** np.arange(n))
     b = np.ones(n)
-    with pytest.warns(IllConditionedWarning, match="controllability matrix condition number"):
+    with pytest.warns(
+        IllConditionedWarning, match="controllability matrix condition number"
+    ) as record:
         design = aerocontrol.place_ackermann(A, b, -np.arange(1.0, n + 1))
     assert design.controllability_condition > 1e8
+    # The warning points at the caller, not into the package.
+    assert record[0].filename == __file__
 
 
 def test_inputs_are_not_modified_and_results_are_fresh() -> None:

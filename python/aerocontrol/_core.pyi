@@ -12,6 +12,8 @@ from numpy.typing import ArrayLike, NDArray
 __all__ = [
     "EXACT_NORM_MAX_ORDER",
     "FMA_KERNELS",
+    "ILL_CONDITIONED_CONTROLLABILITY",
+    "POLE_ERROR_WARNING",
     "SMALL_MAX_ORDER",
     "Placement",
     "care_batch",
@@ -41,6 +43,8 @@ __all__ = [
 EXACT_NORM_MAX_ORDER: int
 SMALL_MAX_ORDER: int
 FMA_KERNELS: bool
+ILL_CONDITIONED_CONTROLLABILITY: float
+POLE_ERROR_WARNING: float
 
 def expm(a: ArrayLike, /) -> NDArray[np.float64]: ...
 def transition_matrices(a: ArrayLike, t: ArrayLike, /) -> NDArray[np.float64]: ...

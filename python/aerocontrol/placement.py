@@ -21,7 +21,6 @@ mode (the Dutch roll to ζ = 0.30 at its ω_n, say) and keeps every other pole.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -30,7 +29,7 @@ from numpy.typing import NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array, real_scalar
-from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
+from .exceptions import InvalidArgumentError, ShapeError
 from .modal import Modes, modes
 from .statespace import StateSpace, as_state_space, plant_pair
 
@@ -48,9 +47,9 @@ ComplexArray = NDArray[np.complex128]
 
 #: κ(V) from which the single-input gains are flagged: beyond 1e8 about half the digits of
 #: the gains may be lost to the conditioning of the controllability matrix.
-ILL_CONDITIONED_CONTROLLABILITY = 1e8
+ILL_CONDITIONED_CONTROLLABILITY: float = _core.ILL_CONDITIONED_CONTROLLABILITY
 #: Achieved-pole relative error from which any placement is flagged.
-POLE_ERROR_WARNING = 1e-6
+POLE_ERROR_WARNING: float = _core.POLE_ERROR_WARNING
 
 
 #: The result of every placement function: a state-feedback design η = -K x (6.91), with
@@ -84,24 +83,6 @@ def _poles(poles: Any) -> ComplexArray:
     return np.ascontiguousarray(array)
 
 
-def _design(A: Any, B: Any, poles: Any, method: str) -> Placement:
-    design = _core.place(A, B, poles, method)
-    error, kappa_v = design.max_relative_error, design.controllability_condition
-    if kappa_v >= ILL_CONDITIONED_CONTROLLABILITY or error > POLE_ERROR_WARNING:
-        if method == "knv0":
-            measure = f"closed-loop eigenvector condition number {design.eigenvector_condition:.2e}"
-        else:
-            measure = f"controllability matrix condition number {kappa_v:.2e}"
-        warnings.warn(
-            f"{design.method}: the achieved poles miss the requested ones by up to {error:.2e} "
-            f"relatively ({measure}); the gains may be inaccurate, and poles that are repeated "
-            "or close together are inherently sensitive (a k-fold pole moves by about u^(1/k))",
-            IllConditionedWarning,
-            stacklevel=3,
-        )
-    return design
-
-
 def place_bass_gura(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placement:
     """Single-input pole placement by the Bass-Gura formula (6.145).
 
@@ -132,7 +113,7 @@ def place_bass_gura(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placemen
     """
     if poles is None:
         A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
-    return _design(A_or_sys, b, poles, "bass-gura")
+    return _core.place(A_or_sys, b, poles, "bass-gura")
 
 
 def place_ackermann(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placement:
@@ -149,7 +130,7 @@ def place_ackermann(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placemen
     """
     if poles is None:
         A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
-    return _design(A_or_sys, b, poles, "ackermann")
+    return _core.place(A_or_sys, b, poles, "ackermann")
 
 
 def place(A_or_sys: Any, B: Any = None, poles: Any = None) -> Placement:
@@ -177,7 +158,7 @@ def place(A_or_sys: Any, B: Any = None, poles: Any = None) -> Placement:
     """
     if poles is None:
         A_or_sys, B, poles = *plant_pair(A_or_sys, None, "B"), B
-    return _design(A_or_sys, B, poles, "knv0")
+    return _core.place(A_or_sys, B, poles, "knv0")
 
 
 @dataclass(frozen=True, eq=False)
