@@ -577,9 +577,11 @@ fn balance(a: &mut Square) -> Vec<f64> {
         sweeps += 1;
         for i in 0..n {
             let (mut column_squares, mut row_squares) = (0.0, 0.0);
-            for k in (0..n).filter(|&k| k != i) {
-                column_squares += a[(k, i)] * a[(k, i)];
-                row_squares += a[(i, k)] * a[(i, k)];
+            for k in 0..n {
+                if k != i {
+                    column_squares += a[(k, i)] * a[(k, i)];
+                    row_squares += a[(i, k)] * a[(i, k)];
+                }
             }
             if column_squares == 0.0
                 || row_squares == 0.0

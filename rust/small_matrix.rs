@@ -179,11 +179,21 @@ pub fn product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
     }
     let mut out = Mat::<f64>::zeros(rows, cols);
     for j in 0..cols {
-        let mut column = out.col_mut(j);
+        let column = out.col_as_slice_mut(j);
         for k in 0..inner {
             let coefficient = rhs[(k, j)];
-            for i in 0..rows {
-                column[i] += lhs[(i, k)] * coefficient;
+            // Contiguous columns (faer's own matrices) as slices: no per-entry index checks.
+            match lhs.col(k).try_as_col_major() {
+                Some(lhs_column) => {
+                    for (entry, x) in column.iter_mut().zip(lhs_column.as_slice()) {
+                        *entry += x * coefficient;
+                    }
+                }
+                None => {
+                    for (i, entry) in column.iter_mut().enumerate() {
+                        *entry += lhs[(i, k)] * coefficient;
+                    }
+                }
             }
         }
     }
