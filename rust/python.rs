@@ -1091,6 +1091,7 @@ impl PlacementResult {
         converged, method, controllability_condition, eigenvector_condition))]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     fn new(
+        py: Python<'_>,
         K: Py<PyArrayDyn<f64>>,
         closed_loop: Py<PyArrayDyn<f64>>,
         poles: Py<PyArrayDyn<c64>>,
@@ -1101,8 +1102,26 @@ impl PlacementResult {
         method: Py<PyString>,
         controllability_condition: f64,
         eigenvector_condition: f64,
-    ) -> Self {
-        Self {
+    ) -> PyResult<Self> {
+        // The getters and `__str__` index these: shapes checked once, here.
+        let (gain_shape, loop_shape) = (K.bind(py).shape(), closed_loop.bind(py).shape());
+        let (requested, achieved) = (poles.bind(py).shape(), achieved_poles.bind(py).shape());
+        let consistent = matches!(loop_shape, &[rows, cols] if rows == cols)
+            && matches!(gain_shape, &[_, cols] if cols == loop_shape[0])
+            && requested == [loop_shape[0]]
+            && achieved == requested;
+        if !consistent {
+            return Err(raise(
+                py,
+                "ShapeError",
+                format!(
+                    "Placement needs K (m, n), closed_loop (n, n) and poles and \
+                     achieved_poles (n,); got shapes {gain_shape:?}, {loop_shape:?}, \
+                     {requested:?} and {achieved:?}"
+                ),
+            ));
+        }
+        Ok(Self {
             gain: K,
             closed_loop,
             poles,
@@ -1113,7 +1132,7 @@ impl PlacementResult {
             method,
             controllability_condition,
             eigenvector_condition,
-        }
+        })
     }
 
     /// The gain vector of a single-input design, shape (n,).
@@ -1583,25 +1602,37 @@ fn optional_view<'a>(
 
 /// The values of a complex128 array, in C order.
 fn copy_complex(array: &Bound<'_, PyArrayDyn<c64>>) -> PyResult<Vec<c64>> {
-    // The common case, a 1-D array of aligned complex128 (the requested poles), is read
-    // directly; the checked `readonly` borrow and ndarray view cost 0.1 µs, a twentieth of a
+    // Read by byte offsets and unaligned loads (plain loads on x86-64): numpy allows strides
+    // that are not multiples of the item size and misaligned data (a field of a structured
+    // array, a buffer at an odd offset), which an element-strided view would misread. The
+    // checked `readonly` borrow and ndarray view would also cost 0.1 µs, a twentieth of a
     // 4-state placement called from Python.
-    const SIZE: isize = std::mem::size_of::<c64>() as isize;
-    if let (&[len], &[stride]) = (array.shape(), array.strides())
-        && stride % SIZE == 0
-        && (array.data() as usize).is_multiple_of(std::mem::align_of::<c64>())
-    {
-        entries(&[len, 2])?;
-        // SAFETY: aligned, `len` elements `stride / SIZE` apart in the array's own memory,
-        // copied at once with the GIL held, so no Python code can write the array meanwhile.
-        return Ok((0..len as isize)
-            .map(|k| unsafe { *array.data().offset(k * (stride / SIZE)) })
-            .collect());
+    let (shape, strides) = (array.shape(), array.strides());
+    let count = entries(shape)?;
+    entries(&[count, 2])?;
+    let base = array.data().cast::<u8>().cast_const();
+    let mut index = vec![0usize; shape.len()];
+    let mut values = Vec::with_capacity(count);
+    for _ in 0..count {
+        let offset: isize = index
+            .iter()
+            .zip(strides)
+            .map(|(&i, &s)| i as isize * s)
+            .sum();
+        // SAFETY: `index` stays within `shape`, so the offset addresses one of the array's own
+        // elements; the read is unaligned-safe; the GIL is held throughout, so no Python code
+        // writes the array meanwhile.
+        values.push(unsafe { base.offset(offset).cast::<c64>().read_unaligned() });
+        // The next index in C order.
+        for axis in (0..shape.len()).rev() {
+            index[axis] += 1;
+            if index[axis] < shape[axis] {
+                break;
+            }
+            index[axis] = 0;
+        }
     }
-    let readonly = array.readonly();
-    let view = readonly.as_array();
-    entries(view.shape())?;
-    Ok(view.iter().copied().collect())
+    Ok(values)
 }
 
 /// The native core of aerocontrol; use the `aerocontrol` package, not this module.

@@ -369,6 +369,45 @@ def test_strided_and_reversed_views_are_read_as_given() -> None:
         np.testing.assert_array_equal(design.poles, reference.poles)
 
 
+def test_odd_strides_and_misaligned_data_are_read_as_given() -> None:
+    # numpy allows byte strides that are not multiples of the item size (a field of a packed
+    # structured array) and data at odd addresses: both must be read as their copies are,
+    # never reinterpreted at rounded-down strides.
+    poles = _dutch_roll_request()
+    reference = aerocontrol.place(A_LAT, B_LAT, poles)
+    packed = np.zeros((4, 4), dtype=[("x", "<f8"), ("pad", "V1")])
+    packed["x"] = A_LAT
+    assert packed["x"].strides == (36, 9) and not packed["x"].flags.aligned
+    np.testing.assert_array_equal(aerocontrol.place(packed["x"], B_LAT, poles).K, reference.K)
+    np.testing.assert_array_equal(aerocontrol.expm(packed["x"]), aerocontrol.expm(A_LAT))
+    shifted = np.frombuffer(b"\0" + poles.astype(complex).tobytes(), dtype=complex, offset=1)
+    packed_poles = np.zeros(4, dtype=[("z", "<c16"), ("pad", "V1")])
+    packed_poles["z"] = poles
+    for P in (shifted, packed_poles["z"]):
+        assert not P.flags.aligned
+        np.testing.assert_array_equal(aerocontrol.place(A_LAT, B_LAT, P).K, reference.K)
+    # Complex poles read 8 bytes apart: the values numpy shows, -1 and -2j, whose missing
+    # conjugate is named (a rounded-down stride would have read -1 four times and placed them).
+    halves = np.lib.stride_tricks.as_strided(np.array([-1, -2, -3, -4], complex), (2,), (8,))
+    with pytest.raises(aerocontrol.InvalidArgumentError, match=r"poles\[1\] = 0-2j"):
+        aerocontrol.place_bass_gura([[0, 1], [-2, -3]], [0, 1], halves)
+
+
+def test_a_placement_built_by_hand_checks_its_shapes() -> None:
+    design = aerocontrol.place_ackermann([[0, 1], [-2, -3]], [0, 1], [-5, -6])
+    fields = (design.K, design.closed_loop, design.poles, design.achieved_poles)
+    scalars = (0.0, 0, True, "hand", 1.0, 1.0)
+    assert aerocontrol.Placement(*fields, *scalars).k.tolist() == [28.0, 8.0]
+    for broken in (
+        (np.array(1.0), *fields[1:]),
+        (design.K.ravel(), *fields[1:]),
+        (*fields[:3], design.achieved_poles[:1]),
+        (design.K, np.zeros((2, 3)), *fields[2:]),
+    ):
+        with pytest.raises(aerocontrol.ShapeError, match="Placement needs K"):
+            aerocontrol.Placement(*broken, *scalars)
+
+
 def test_augment_mode_selects_and_changes_one_mode() -> None:
     modes = aerocontrol.modes(A_LAT, mode_names=["spiral", "Dutch roll", "roll"])
     by_name = aerocontrol.augment_mode(modes, "dutch roll", zeta=0.30)

@@ -25,7 +25,7 @@ def real_array(value: Any, name: str) -> FloatArray:
     and non-contiguous views (the core reads any strides). A misaligned float64 array (a view
     into a byte buffer at an odd offset) is copied, since the core reads aligned memory only.
     """
-    if type(value) is np.ndarray and value.dtype == np.float64:
+    if type(value) is np.ndarray and value.dtype == np.float64 and value.flags.aligned:
         return value
     try:
         array = np.asarray(value)

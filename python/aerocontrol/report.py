@@ -270,13 +270,23 @@ def _mode_rows(modes: Modes, named: dict[str, tuple[complex, ...]]) -> list[tupl
             text = _complex(lam)
         half, double = modes.time_to_half[k], modes.time_to_double[k]
         timing = f"{half:.4g}" if np.isfinite(half) else f"{_number(double)} (doubles)"
+        # A first-order mode (one real root) has a time constant, not a damping ratio, a
+        # natural frequency or a period.
+        first_order = len(members) == 1 and lam.imag == 0.0
+        oscillation = (
+            ("-", "-", "-")
+            if first_order
+            else (
+                _number(modes.damping_ratio[k]),
+                _number(modes.natural_frequency[k]),
+                _number(modes.period[k]),
+            )
+        )
         rows.append(
             (
                 DISPLAY_NAMES[key],
                 text,
-                _number(modes.damping_ratio[k]),
-                _number(modes.natural_frequency[k]),
-                _number(modes.period[k]),
+                *oscillation,
                 timing,
                 _number(modes.time_constant[k]),
             )
@@ -788,7 +798,7 @@ def _pendulum_example(ctx: _Context) -> None:
     ctx.report.figure(
         "pendulum-root-locus",
         "Figure 6.8: the inverted pendulum's closed-loop roots for c/γ from 0.001 (the double "
-        "root at -γ) to 1000, with the asymptotes of large c/γ.",
+        "root at -√γ) to 1000, with the asymptotes of large c/γ.",
         figure,
     )
     c = 1.0
