@@ -637,7 +637,9 @@ def _root_locus(ctx: _Context, Q: np.ndarray[Any, Any], R: np.ndarray[Any, Any])
     if critical:
         text = (
             f"The Dutch roll becomes critically damped at c = {critical:.6f} (the weight at "
-            "which its two roots meet on the real axis, found by bisection to 1e-12)."
+            "which its two roots meet on the real axis, found by bisection to 1e-12). It is "
+            "sensitive to the model's fifth digit: from the chapter's four-digit matrices "
+            "(6.150, 6.151) it is 9.7749."
         )
         ctx.checks.append(
             (
@@ -697,8 +699,12 @@ def _section_levels(ctx: _Context) -> str:
     report.paragraph(
         f"MIL-F-8785C Levels, Class {ctx.plane.aircraft_class}, Flight Phase Category "
         f"{ctx.plane.category}, open loop and with each design of the lateral motion (the "
-        "longitudinal modes are not changed). A coupled roll-spiral oscillation (3.3.1.4) is "
-        "shown but not assessed."
+        "longitudinal modes are not changed)."
+        + (
+            " A coupled roll-spiral oscillation (3.3.1.4) is listed but not assessed."
+            if "roll-spiral" in modes
+            else ""
+        )
     )
     report.table(("mode", *columns), rows)
     changed = [
@@ -818,8 +824,9 @@ def _section_chapter(ctx: _Context) -> str:
     report.paragraph(
         "The chapter's two small examples, then its printed values beside ours, computed from "
         "the coefficients (6.47), (6.147). The printed aileron gains (6.164) came from "
-        "unrounded matrices; the chapter states the critical c twice, differently: the computed "
-        "value settles it."
+        "unrounded matrices; the chapter states the critical c twice, differently (the "
+        "caption's 9.7227 is evidently a slip for the figure's 9.7727, which the unrounded "
+        "model reproduces)."
     )
     _feedback_example(ctx)
     _pendulum_example(ctx)
