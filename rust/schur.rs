@@ -373,10 +373,14 @@ impl Square {
         rows: Range<usize>,
     ) {
         let n = self.n;
-        let block = &mut self.data[k * n..(k + N) * n];
-        let mut split = block.chunks_exact_mut(n);
-        let columns: [&mut [f64]; N] =
-            std::array::from_fn(|_| &mut split.next().expect("N columns")[rows.clone()]);
+        // Split off column by column: chunks_exact_mut would divide by n (an integer division,
+        // tens of cycles, at every reflector).
+        let mut rest = &mut self.data[k * n..(k + N) * n];
+        let columns: [&mut [f64]; N] = std::array::from_fn(|_| {
+            let (column, after) = std::mem::take(&mut rest).split_at_mut(n);
+            rest = after;
+            &mut column[rows.clone()]
+        });
         for i in 0..rows.len() {
             let mut sum = 0.0;
             for r in 0..N {
