@@ -4,6 +4,7 @@ shipped aircraft, mode naming, and the validation of aircraft files."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from pathlib import Path
@@ -105,6 +106,26 @@ def test_747_longitudinal_chain() -> None:
     named = aircraft.classify_modes(b747.modes("longitudinal"), "longitudinal")
     np.testing.assert_allclose(named["short period"][0], -0.55154 + 0.68799j, rtol=1e-3)
     np.testing.assert_allclose(named["phugoid"][0], -0.00176 + 0.13389j, rtol=1e-3, atol=2e-5)
+
+
+def test_747_longitudinal_matrices_used_the_unrounded_chord() -> None:
+    # (6.49) differs from the model of the printed inputs (6.46), (6.47) in the fourth digit of
+    # the q row. The chapter evidently used c̄ = 27.31 ft (the 747's mean aerodynamic chord,
+    # 8.324 m), printed as 27.3: with it every entry of A and B is within half a unit of its
+    # last printed digit, except A[1,0] (-0.22301 against the printed -0.2229).
+    A, B = aerocontrol.chapter.boeing747_longitudinal()
+    printed = np.c_[A, B]
+    half_unit = 0.5e-4 + 1e-12
+    b747 = aircraft.load("b747-approach")
+    for chord, expected in ((27.3, [(1, 0), (2, 1), (2, 2), (2, 4)]), (27.31, [(1, 0)])):
+        sys = dataclasses.replace(b747, cbar=chord).longitudinal()
+        outside = np.argwhere(np.abs(np.c_[sys.A, sys.B] - printed) > half_unit)
+        assert [tuple(int(i) for i in index) for index in outside] == expected, chord
+    # The short period computed from the printed matrix, to all five digits with 27.31 ft.
+    named = aircraft.classify_modes(
+        dataclasses.replace(b747, cbar=27.31).modes("longitudinal"), "longitudinal"
+    )
+    assert abs(named["short period"][0] - (-0.55154 + 0.68799j)) < 2e-5
 
 
 def test_747_lateral_chain() -> None:

@@ -84,6 +84,8 @@ def test_two_time_scales_cut_the_same_response() -> None:
         short.get_lines()[1].get_ydata(), response.x[response.t <= 20.0, 1]
     )
     assert (short.get_title(), long.get_title()) == ("short period scale", "phugoid scale")
+    # One legend, on the short scale: the phugoid's oscillation fills the long panel.
+    assert short.get_legend() is not None and long.get_legend() is None
     with pytest.raises(aerocontrol.InvalidArgumentError, match="short must be between 0"):
         plotting.plot_time_scales(response, 600.0)
     with pytest.raises(aerocontrol.InvalidArgumentError, match="pair of matplotlib axes"):
@@ -101,6 +103,18 @@ def test_open_closed_shares_the_scale() -> None:
     )
     assert first.get_shared_y_axes().joined(first, second)
     assert (first.get_title(), second.get_title()) == ("(a) open loop", "(b) closed loop")
+    # On the caller's own (unshared) axes the scale is common too: the larger of the two.
+    _, given = plt.subplots(1, 2)
+    first, second = plotting.plot_open_closed(
+        aerocontrol.initial_response(LATERAL, x0, T=grid),
+        aerocontrol.initial_response(closed, x0, T=grid),
+        axes=given,
+    )
+    assert first.get_ylim() == second.get_ylim()
+    low, high = first.get_ylim()
+    for axis in (first, second):
+        for line in axis.get_lines():
+            assert low <= np.min(line.get_ydata()) and np.max(line.get_ydata()) <= high
 
 
 def test_with_controls_draws_the_deflections() -> None:
@@ -141,6 +155,10 @@ def test_root_locus_follows_each_root() -> None:
     ends = sorted(complex(line.get_xdata()[-1], line.get_ydata()[-1]).real for line in paths)
     np.testing.assert_allclose(ends, np.sort(poles[-1].real), rtol=1e-12)
     assert _labels(ax) == ["c = 0.5", "c = 1", "c = 2"]
+    # Each marked weight its own colour, darkest first.
+    colours = [line.get_color() for line in ax.get_lines() if not line.get_label().startswith("_")]
+    assert len({tuple(np.round(colour, 6)) for colour in colours}) == 3
+    assert np.sum(colours[0][:3]) < np.sum(colours[-1][:3])
     assert ax.get_xlabel() == "real part (1/s)"
     unmarked = plotting.plot_root_locus(weights, poles)
     assert _labels(unmarked) == ["c = 0.001"]

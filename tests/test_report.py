@@ -11,6 +11,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import numpy as np
 import pytest
 
 import aerocontrol
@@ -118,12 +119,38 @@ def test_the_report_has_the_chapters_results(written: tuple[Path, list[str]]) ->
         "damper (aileron)",
     ]
     assert levels[1:4] == ["2", "1", "1"]
+    # (6.49) against the model at the printed chord and at the unrounded one.
+    assert _table_row(markdown, "longitudinal A, B (6.49)")[2] == (
+        "largest difference 3.6e-04 (c̄ = 27.3 ft), 1.1e-04 (c̄ = 27.31 ft)"
+    )
     # The small examples: Figure 6.4's gains (6.95), the pendulum's closed form (6.218).
     assert _table_row(markdown, "feedback gains (6.95)-(6.102)")[2] == "[16.49844, 8.0875]"
     pendulum = _table_row(markdown, "pendulum gain (6.218), γ = c = 1")
     assert pendulum[1] == pendulum[2] == "[2.414213562, 2.197368227]"
     steady = _table_row(markdown, "steady state (6.51)")[2].strip("[]").split(", ")
     assert [round(float(v), 4) for v in steady] == [0.0459, -0.0186, 0.0, -0.0160]  # as printed
+
+
+def test_the_loci_name_their_modes_and_mark_the_critical_weight() -> None:
+    """Figure 6.12 names the lateral modes where their branches start and marks the Dutch
+    roll's double root at the critical c; Figure 6.8 adds a panel near the origin."""
+    built = dict(build_report().figures)
+    (locus,) = built["root-locus.png"].axes
+    texts = {text.get_text(): text for text in locus.texts}
+    assert {"Dutch roll", "roll", "spiral", "critical c = 9.7727"} <= set(texts)
+    # The mark is on the real axis, where the closed loop at the critical c has its double root.
+    lateral = aerocontrol.aircraft.load().lateral()
+    critical = aerocontrol.design.critical_weight(lateral, "dutch roll", bounds=(1e-3, 1e3))
+    roots = aerocontrol.design.lqr_root_locus(lateral, [critical])[0]
+    x, y = texts["critical c = 9.7727"].xy
+    assert y == 0.0
+    assert np.min(np.abs(roots - x)) < 1e-4
+    pendulum = built["pendulum-root-locus.png"].axes
+    titles = [ax.get_title() for ax in pendulum]
+    assert titles == ["(a) c/γ from 0.001 to 1000", "(b) near the origin"]
+    assert pendulum[1].get_xlim()[0] == -3.0
+    for figure in built.values():
+        figure.clear()
 
 
 @pytest.mark.parametrize("identifier", aerocontrol.aircraft.available())

@@ -191,6 +191,8 @@ def plot_time_scales(
     first, second = _pair(_new_axes(1, 2, figsize=(11, 4)) if axes is None else axes, "axes")
     plot_time_response(result, first, signal, response, t_max=short, title="short period scale")
     plot_time_response(result, second, signal, response, title="phugoid scale")
+    # One legend for both (the same lines): the long panel's oscillation leaves no corner free.
+    second.get_legend().remove()
     return first, second
 
 
@@ -208,6 +210,10 @@ def plot_open_closed(
     )
     plot_time_response(open_loop, first, signal, title=titles[0])
     plot_time_response(closed_loop, second, signal, title=titles[1])
+    # A common scale on the caller's axes too (those made here share it already).
+    limits = (*first.get_ylim(), *second.get_ylim())
+    for axis in (first, second):
+        axis.set_ylim(min(limits), max(limits))
     return first, second
 
 
@@ -323,9 +329,11 @@ def plot_root_locus(
     """The closed-loop roots as the weight varies (Figures 6.8, 6.12): one line per root
     through ``poles`` (shape (len(weights), n), e.g. from
     :func:`aerocontrol.design.lqr_root_locus`), a symbol per value in ``marked`` (at the
-    nearest computed weight), or an open circle at the smallest weight when none is marked.
-    Returns the axes.
+    nearest computed weight; its colour runs from dark to light as the weight grows), or an
+    open circle at the smallest weight when none is marked. Returns the axes.
     """
+    from matplotlib import colormaps
+
     c_values = np.atleast_1d(real_array(weights, "weights"))
     roots = np.asarray(poles)
     if roots.ndim != 2 or roots.shape[0] != len(c_values):
@@ -347,7 +355,10 @@ def plot_root_locus(
             label=f"{weight_name} = {c_values[0]:g}",
         )
     markers = "sD^v<>ph*+x"
-    for index, value in enumerate(marked or ()):
+    marked = list(marked or ())
+    # viridis up to 0.85: its last yellows are too light on white.
+    colours = colormaps["viridis"](np.linspace(0.0, 0.85, len(marked)))
+    for index, value in enumerate(marked):
         row = int(np.argmin(np.abs(np.log(c_values) - np.log(value))))
         symbol = markers[index % len(markers)]
         ax.plot(
@@ -355,6 +366,7 @@ def plot_root_locus(
             tracked[row].imag,
             symbol,
             mfc="none",
+            color=colours[index],
             label=f"{weight_name} = {c_values[row]:.6g}",
         )
     ax.axvline(0.0, color="black", linewidth=0.8)

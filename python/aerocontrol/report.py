@@ -34,7 +34,7 @@ LQR (Figures 6.9-6.11): c = 0.001: J∞ = 16.57; c = 0.5: J∞ = 10.56; c = 1: J
 root locus (Figure 6.12): The Dutch roll becomes critically damped at c = 9.772714 ...
 levels after augmentation: dutch roll 2 -> damper (rudder) 1, damper (aileron) 1, ...
 envelope: 63 conditions around the file's (Level 2: 41, Level 3: 20, Level 4: 2)
-chapter check: Figures 6.4 and 6.8, 6 results beside the printed values
+chapter check: Figures 6.4 and 6.8, 7 results beside the printed values
 >>> len(report.figures)
 14
 """
@@ -48,13 +48,13 @@ import math
 import shutil
 import tempfile
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from . import handling, plotting
+from . import chapter, handling, plotting
 from .aircraft.envelope import envelope_sweep
 from .aircraft.model import Aircraft, load
 from .aircraft.naming import DISPLAY_NAMES, classify_modes
@@ -230,11 +230,18 @@ def _nice_ceiling(value: float) -> float:
     return 10.0 ** (exponent + 1)  # pragma: no cover - the loop always returns
 
 
-def _new_figure(columns: int = 1, rows: int = 1, width: float = 11.0, height: float = 4.2) -> Any:
+def _new_figure(
+    columns: int = 1,
+    rows: int = 1,
+    width: float = 11.0,
+    height: float = 4.2,
+    sharey: bool = False,
+) -> Any:
+    """A figure of rows x columns axes; ``sharey`` for panels that compare designs."""
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(width, height), layout="constrained")
-    axes = figure.subplots(rows, columns, squeeze=False)
+    axes = figure.subplots(rows, columns, squeeze=False, sharey=sharey)
     return figure, axes
 
 
@@ -576,7 +583,7 @@ def _section_regulator(ctx: _Context) -> str:
     responses = {
         c: initial_response(_closed_loop(sys, designs[c].K), x0, T=grid) for c in CHAPTER_WEIGHTS
     }
-    figure, axes = _new_figure(2, height=4.4)
+    figure, axes = _new_figure(2, height=4.4, sharey=True)
     plotting.plot_time_response(open_response, ax=axes[0, 0], title="(a) no feedback")
     first = CHAPTER_WEIGHTS[0]
     plotting.plot_with_controls(
@@ -589,11 +596,14 @@ def _section_regulator(ctx: _Context) -> str:
         figure,
     )
     others = CHAPTER_WEIGHTS[1:]
-    figure, axes = _new_figure(len(others), height=4.4, width=15.0)
+    figure, axes = _new_figure(len(others), height=4.4, width=15.0, sharey=True)
     for column, c in enumerate(others):
         plotting.plot_with_controls(
             responses[c], designs[c].K, ax=axes[0, column], title=f"c = {c:g}"
         )
+        if column:  # the scale, the label and the legend are the first panel's
+            axes[0, column].set_ylabel("")
+            axes[0, column].get_legend().remove()
     report.figure(
         "lqr-responses",
         "Figure 6.10: optimal closed-loop responses to a unit sideslip perturbation for c = "
@@ -617,6 +627,43 @@ def _section_regulator(ctx: _Context) -> str:
     return f"LQR (Figures 6.9-6.11): {gains}\n{locus_line}"
 
 
+def _label_locus(
+    ctx: _Context, ax: Any, critical: float | None, critical_roots: np.ndarray[Any, Any] | None
+) -> None:
+    """Names the lateral modes where their branches start (the open-loop roots, which those
+    of c = 0.001 match to the plot's resolution) and marks the Dutch roll's double root at the
+    critical c."""
+    lateral = {"dutch roll", "roll", "spiral", "roll-spiral"}
+    for key, members in ctx.open_loop_named.items():
+        if key in lateral:
+            root = members[0]
+            ax.annotate(
+                DISPLAY_NAMES[key],
+                (root.real, abs(root.imag)),
+                textcoords="offset points",
+                # Inside the Dutch roll's arc (below its start); above a real root.
+                xytext=(-6, -14) if root.imag else (-4, 9),
+                ha="right",
+                fontsize="small",
+            )
+    if critical is not None and critical_roots is not None:
+        # The two roots nearest each other: the Dutch roll's, met on the real axis.
+        roots = list(critical_roots)
+        pairs = [(abs(a - b), a, b) for i, a in enumerate(roots) for b in roots[i + 1 :]]
+        _, a, b = min(pairs, key=lambda pair: pair[0])
+        meeting = (a + b) / 2
+        ax.plot(meeting.real, 0.0, "*", color="black", markersize=11, zorder=5)
+        ax.annotate(
+            f"critical c = {critical:.4f}",
+            (meeting.real, 0.0),
+            textcoords="offset points",
+            xytext=(-70, -45),
+            ha="center",
+            fontsize="small",
+            arrowprops={"arrowstyle": "->", "linewidth": 0.8},
+        )
+
+
 def _root_locus(ctx: _Context, Q: np.ndarray[Any, Any], R: np.ndarray[Any, Any]) -> str:
     report, sys = ctx.report, ctx.lateral
     try:
@@ -631,9 +678,9 @@ def _root_locus(ctx: _Context, Q: np.ndarray[Any, Any], R: np.ndarray[Any, Any])
     poles = lqr_root_locus(sys, weights, Q, R)
     marked = [c for c in LOCUS_WEIGHTS if c <= top]
     figure, axes = _new_figure(1, width=9.0, height=5.5)
-    plotting.plot_root_locus(
-        weights, poles, ax=axes[0, 0], marked=marked, title="closed-loop roots over c"
-    )
+    ax = axes[0, 0]
+    plotting.plot_root_locus(weights, poles, ax=ax, marked=marked, title="closed-loop roots over c")
+    _label_locus(ctx, ax, critical, lqr_root_locus(sys, [critical], Q, R)[0] if critical else None)
     if critical:
         text = (
             f"The Dutch roll becomes critically damped at c = {critical:.6f} (the weight at "
@@ -789,22 +836,31 @@ def _pendulum_example(ctx: _Context) -> None:
     Q, R = np.diag([1.0, 0.0]), np.eye(1)
     weights = np.unique(np.r_[np.geomspace(1e-3, 1e3, 400), 1.0, 10.0, 100.0])
     poles = lqr_root_locus(pendulum, weights, Q, R)
-    figure, axes = _new_figure(1, width=8.0, height=6.0)
-    ax = axes[0, 0]
-    plotting.plot_root_locus(
-        weights, poles, ax=ax, marked=[1e-3, 1.0, 10.0, 100.0, 1000.0], weight_name="c/γ",
-        title="inverted pendulum: closed-loop roots over c/γ (units of γ)",
-    )  # fmt: skip
+    figure, axes = _new_figure(2, width=9.0, height=5.5)
     reach = 1.1 * float(np.abs(poles).max())
-    for sign in (1.0, -1.0):
-        ax.plot([0.0, -reach / math.sqrt(2)], [0.0, sign * reach / math.sqrt(2)], color="c",
-                linewidth=0.8, label="asymptotes, ζ = 1/√2" if sign > 0 else None)  # fmt: skip
-    ax.set_aspect("equal")
-    ax.legend(loc="best", fontsize="small")
+    # (a) the whole locus, to c/γ = 1000; (b) its start near the origin, squeezed in (a).
+    for ax, title, half_width in (
+        (axes[0, 0], "(a) c/γ from 0.001 to 1000", reach),
+        (axes[0, 1], "(b) near the origin", 3.0),
+    ):
+        plotting.plot_root_locus(
+            weights, poles, ax=ax, marked=[1e-3, 1.0, 10.0, 100.0, 1000.0], weight_name="c/γ",
+            title=title,
+        )  # fmt: skip
+        for sign in (1.0, -1.0):
+            ax.plot([0.0, -reach / math.sqrt(2)], [0.0, sign * reach / math.sqrt(2)], color="c",
+                    linewidth=0.8, label="asymptotes, ζ = 1/√2" if sign > 0 else None)  # fmt: skip
+        ax.set_xlim(-half_width, 0.1 * half_width)
+        ax.set_ylim(-half_width, half_width)
+        ax.set_aspect("equal")
+    # Between the branches, which the equal aspect leaves empty.
+    axes[0, 0].legend(loc="center left", fontsize="small")
+    axes[0, 1].get_legend().remove()
     ctx.report.figure(
         "pendulum-root-locus",
-        "Figure 6.8: the inverted pendulum's closed-loop roots for c/γ from 0.001 (the double "
-        "root at -√γ) to 1000, with the asymptotes of large c/γ.",
+        "Figure 6.8: the inverted pendulum's closed-loop roots (units of γ) for c/γ from 0.001 "
+        "(the double root at -√γ) to 1000, with the asymptotes of large c/γ; (b) the start of "
+        "the locus.",
         figure,
     )
     c = 1.0
@@ -818,16 +874,42 @@ def _pendulum_example(ctx: _Context) -> None:
     )
 
 
+def _longitudinal_matrix_check(ctx: _Context) -> None:
+    """The largest difference between the model and the printed (6.49), at the printed chord
+    and at the unrounded one the chapter evidently used."""
+    A, B = chapter.boeing747_longitudinal()
+    printed = np.c_[A, B]
+
+    def largest_difference(sys: StateSpace) -> float:
+        return float(np.abs(np.c_[sys.A, sys.B] - printed).max())
+
+    unrounded = replace(ctx.plane, cbar=27.31).longitudinal()
+    ctx.checks.insert(
+        0,
+        (
+            "longitudinal A, B (6.49)",
+            "four decimals",
+            f"largest difference {largest_difference(ctx.longitudinal):.1e} (c̄ = 27.3 ft), "
+            f"{largest_difference(unrounded):.1e} (c̄ = 27.31 ft)",
+        ),
+    )
+
+
 def _section_chapter(ctx: _Context) -> str:
     report = ctx.report
     report.heading("The chapter's examples and numbers")
     report.paragraph(
         "The chapter's two small examples, then its printed values beside ours, computed from "
-        "the coefficients (6.47), (6.147). The printed aileron gains (6.164) came from "
-        "unrounded matrices; the chapter states the critical c twice, differently (the "
-        "caption's 9.7227 is evidently a slip for the figure's 9.7727, which the unrounded "
-        "model reproduces)."
+        "the coefficients (6.47), (6.147). The printed matrices (6.49) were evidently computed "
+        "with the unrounded chord c̄ = 27.31 ft (the 747's mean aerodynamic chord, 8.324 m) "
+        "where (6.46) prints 27.3 ft: with it every entry is reproduced to its last printed "
+        "digit except A21 (-0.2230 against -0.2229), while from 27.3 ft the q row differs in "
+        "the fourth digit (Mq and Mδe scale with c̄² and c̄). The printed aileron gains (6.164) "
+        "came from unrounded matrices; the chapter states the critical c twice, differently "
+        "(the caption's 9.7227 is evidently a slip for the figure's 9.7727, which the "
+        "unrounded model reproduces)."
     )
+    _longitudinal_matrix_check(ctx)
     _feedback_example(ctx)
     _pendulum_example(ctx)
     report.table(("result", "chapter", "aerocontrol"), [tuple(row) for row in ctx.checks])
