@@ -119,6 +119,23 @@ def test_the_report_has_the_chapters_results(written: tuple[Path, list[str]]) ->
         "damper (aileron)",
     ]
     assert levels[1:4] == ["2", "1", "1"]
+    # The damper's polynomials (6.155)-(6.157) and closed loops (6.162), (6.165), as printed.
+    assert _table_row(markdown, "a (open loop)")[1:] == ["1.4385", "0.8222", "0.7232", "0.0319"]
+    assert _table_row(markdown, "ā (target)")[1:] == ["1.7258", "1.1891", "0.7396", "0.0319"]
+    assert _table_row(markdown, "k̄ = ā - a")[1:] == ["0.2873", "0.3669", "0.0164", "0.0000"]
+    after = markdown.split("The closed loop A - b k^T with the rudder (6.162):")[1]
+    assert _table_row(after, "p")[1:5] == ["-1.6158", "-1.1014", "-0.0109", "0.3834"]
+    assert _table_row(after, "r")[1:5] == ["0.4427", "-0.0165", "0.0305", "-0.5220"]
+    assert _table_row(markdown, "aileron closed loop (6.165)")[2] == "largest difference 2.6e-05"
+    # The small examples and the static check, each as printed.
+    for name, printed in (
+        ("static check (6.52)-(6.55)", "Δ = 7.212, ΔCL = -0.100"),
+        ("controllability (6.81), B = [0, 1]", "det V = -1"),
+        ("controllability matrix (6.98)", "det V = -128"),
+    ):
+        assert _table_row(markdown, name)[1:] == [printed, printed]
+    lost = _table_row(markdown, "controllability (6.84)-(6.88), B = [-1, 1]")
+    assert lost[2] == "det V = 0; not controllable: -2"
     # (6.49) against the model at the printed chord and at the unrounded one.
     assert _table_row(markdown, "longitudinal A, B (6.49)")[2] == (
         "largest difference 3.6e-04 (c̄ = 27.3 ft), 1.1e-04 (c̄ = 27.31 ft)"

@@ -15,6 +15,7 @@ import numpy as np
 from ._validation import FloatArray
 
 __all__ = [
+    "boeing747_damper_closed_loops",
     "boeing747_lateral",
     "boeing747_longitudinal",
     "controllability_example",
@@ -77,6 +78,36 @@ def boeing747_lateral() -> tuple[FloatArray, FloatArray]:
         ]
     )
     return A, B
+
+
+def boeing747_damper_closed_loops() -> dict[str, FloatArray]:
+    """The closed-loop matrices A - b k^T of the chapter's Dutch-roll dampers (ζ = 0.3 at the
+    same ω_n, roll and spiral roots kept, (6.156)): rudder feedback (6.162) and aileron
+    feedback (6.165), as printed, in the state x = (β, p, φ, r).
+
+    Examples
+    --------
+    >>> closed = boeing747_damper_closed_loops()
+    >>> sorted(closed), closed["rudder"].shape
+    (['aileron', 'rudder'], (4, 4))
+    """
+    rudder = np.array(
+        [
+            [-0.1024, -0.0017, 0.1130, -0.9794],
+            [-1.6158, -1.1014, -0.0109, 0.3834],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.4427, -0.0165, 0.0305, -0.5220],
+        ]
+    )
+    aileron = np.array(
+        [
+            [-0.0999, 0.0, 0.1153, -1.0],
+            [-0.4651, -1.3734, -0.2169, 1.5873],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.4027, -0.0380, 0.0012, -0.2525],
+        ]
+    )
+    return {"rudder": rudder, "aileron": aileron}
 
 
 def controllability_example() -> tuple[FloatArray, FloatArray]:

@@ -9,14 +9,15 @@ contained: the figures are embedded) and ``report.md`` with ``figures/*.png``. T
 2. the modes (6.152-6.154) and their MIL-F-8785C Levels;
 3. the elevator impulse and step at the chapter's two time scales (Figures 6.1, 6.2), the
    steady state of the step (6.51), rudder and aileron steps, and Bode plots;
-4. the Dutch-roll damper by Bass-Gura with rudder and with aileron (6.156-6.165, Figures 6.5,
+4. the Dutch-roll damper by Bass-Gura with rudder and with aileron: the characteristic
+   polynomials, companion-form gains, gains and closed-loop matrices (6.155-6.165, Figures 6.5,
    6.6);
 5. the lateral regulator at the chapter's weights c (6.224-6.227, Figures 6.9-6.11), its root
    locus over c with the weight at which the Dutch roll becomes critically damped (Figure 6.12);
 6. the Levels after augmentation, and the open-loop Levels over Mach and altitude around the
    file's condition;
-7. for the embedded 747, the chapter's two small examples (Figures 6.4 and 6.8) and its
-   printed numbers beside ours.
+7. for the embedded 747, the chapter's small examples (controllability (6.75-6.88), Figures 6.4
+   and 6.8) and its printed numbers beside ours, among them the static check (6.52-6.55).
 
 A design that does not apply to an aircraft (for example a lateral model without an
 oscillatory Dutch roll) is reported as such and the rest of the report goes on.
@@ -34,7 +35,7 @@ LQR (Figures 6.9-6.11): c = 0.001: J∞ = 16.57; c = 0.5: J∞ = 10.56; c = 1: J
 root locus (Figure 6.12): The Dutch roll becomes critically damped at c = 9.772714 ...
 levels after augmentation: dutch roll 2 -> damper (rudder) 1, damper (aileron) 1, ...
 envelope: 63 conditions around the file's (Level 2: 41, Level 3: 20, Level 4: 2)
-chapter check: Figures 6.4 and 6.8, 7 results beside the printed values
+chapter check: Figures 6.4 and 6.8, 16 results beside the printed values
 >>> len(report.figures)
 14
 """
@@ -58,11 +59,12 @@ from . import chapter, handling, plotting
 from .aircraft.envelope import envelope_sweep
 from .aircraft.model import Aircraft, load
 from .aircraft.naming import DISPLAY_NAMES, classify_modes
+from .controllability import controllability, ctrb
 from .design import critical_weight, dutch_roll_damper, lqr_root_locus
 from .exceptions import AerocontrolError, InvalidArgumentError
 from .frequency import bode
-from .modal import Modes, modes
-from .placement import place_bass_gura
+from .modal import Modes, charpoly, modes
+from .placement import Placement, place_bass_gura
 from .responses import impulse_response, initial_response, steady_state, step_response
 from .riccati import solve_care
 from .statespace import StateSpace
@@ -427,6 +429,18 @@ def _section_responses(ctx: _Context) -> str:
         + "."
     )
     ctx.checks.append(("steady state (6.51)", "[0.0459, -0.0186, 0, -0.0160]", _vector(final)))
+    # The static check (6.52)-(6.55): the lift change of the new trim, from the steady state's
+    # α and the elevator, against the chapter's static moment-and-lift balance (determinant Δ).
+    c = ctx.plane.derivatives
+    determinant = -c["CL_alpha"] * c["Cm_de"] + c["Cm_alpha"] * c["CL_de"]
+    lift_change = c["CL_alpha"] * final[sys.state_names.index("alpha")] + c["CL_de"] * ONE_DEGREE
+    ctx.checks.append(
+        (
+            "static check (6.52)-(6.55)",
+            "Δ = 7.212, ΔCL = -0.100",
+            f"Δ = {determinant:.4g}, ΔCL = {lift_change:.3f}",
+        )
+    )
 
     lateral_time = 30.0
     lateral_step = step_response(ctx.lateral, T=np.linspace(0, lateral_time, 1501), eta0=None)
@@ -481,6 +495,7 @@ def _section_damper(ctx: _Context) -> str:
     grid = np.linspace(0.0, 30.0, 1501)
     open_response = initial_response(sys, x0, T=grid)
     rows, lines = [], []
+    designs: dict[str, Placement] = {}
     for surface, number in (("rudder", "6.5"), ("aileron", "6.6")):
         try:
             design = dutch_roll_damper(sys, zeta=DAMPER_ZETA, surface=surface)
@@ -488,6 +503,7 @@ def _section_damper(ctx: _Context) -> str:
             report.paragraph(f"The damper with the {surface} alone is not available: {error}")
             lines.append(f"{surface}: not available ({error})")
             continue
+        designs[surface] = design
         closed = _closed_loop(sys, design.K, [surface])
         named = classify_modes(modes(closed.A), "lateral")
         ctx.augmented[f"damper ({surface})"] = named
@@ -537,7 +553,60 @@ def _section_damper(ctx: _Context) -> str:
             ),
             rows,
         )
+    if designs:
+        _damper_polynomials_and_closed_loops(ctx, designs)
     return "Dutch-roll damper (Bass-Gura): " + "; ".join(lines)
+
+
+def _damper_polynomials_and_closed_loops(ctx: _Context, designs: dict[str, Placement]) -> None:
+    """The characteristic polynomials (6.155), (6.156), the companion-form gains (6.157) and
+    the closed-loop matrices A - b k^T (6.162), (6.165) of the dampers."""
+    report, sys = ctx.report, ctx.lateral
+    n = sys.n_states
+    open_loop = charpoly(sys.A)
+    # Every design aims at the same roots, so at the same polynomial.
+    target = np.real(np.poly(next(iter(designs.values())).poles))
+    companion_gains = target - open_loop
+    report.paragraph(
+        "The characteristic polynomials, open loop (6.155) and the target (6.156), and the "
+        "gains of the companion form (6.157), k̄ = ā - a, the difference of their coefficients:"
+    )
+    powers = [f"s^{k}" if k > 1 else ("s" if k == 1 else "1") for k in range(n - 1, -1, -1)]
+    report.table(
+        ("", *powers),
+        [
+            (label, *(f"{v:.4f}" for v in values[1:]))
+            for label, values in (
+                ("a (open loop)", open_loop),
+                ("ā (target)", target),
+                ("k̄ = ā - a", companion_gains),
+            )
+        ],
+    )
+    for surface, design in designs.items():
+        number = "6.162" if surface == "rudder" else "6.165"
+        report.paragraph(f"The closed loop A - b k^T with the {surface} ({number}):")
+        closed = _closed_loop(sys, design.K, [surface])
+        _matrix_table(ctx, closed)
+    printed = chapter.boeing747_damper_closed_loops()
+    ctx.checks += [
+        ("characteristic polynomial (6.155)", "[1.4385, 0.8222, 0.7232, 0.0319]",
+         _vector(open_loop[1:], 5)),
+        ("target polynomial (6.156)", "[1.7258, 1.1891, 0.7396, 0.0319]",
+         _vector(target[1:], 5)),
+        ("companion-form gains (6.157)", "[0.2873, 0.3669, 0.0164, 0.0000]",
+         "[" + ", ".join(f"{v:.4f}" for v in companion_gains[1:]) + "]"),
+    ]  # fmt: skip
+    for surface, design in designs.items():
+        if design.closed_loop.shape == printed[surface].shape:
+            difference = float(np.abs(design.closed_loop - printed[surface]).max())
+            ctx.checks.append(
+                (
+                    f"{surface} closed loop " + ("(6.162)" if surface == "rudder" else "(6.165)"),
+                    "four decimals",
+                    f"largest difference {difference:.1e}",
+                )
+            )
 
 
 def _section_regulator(ctx: _Context) -> str:
@@ -793,6 +862,24 @@ def _section_envelope(ctx: _Context) -> str:
     return f"envelope: {envelope.worst.size} conditions around the file's ({summary})"
 
 
+def _controllability_example(ctx: _Context) -> None:
+    """The controllability example (6.75)-(6.88): V = [B, AB] and the modes each input
+    reaches, for B = [0, 1]^T and B = [-1, 1]^T."""
+    A, B = chapter.controllability_example()
+    lost = np.array([[-1.0], [1.0]])
+    verdict = controllability(A, lost)
+    reached = f"det V = {np.linalg.det(ctrb(A, B)):.4g}"
+    lost_modes = ", ".join(_complex(v) for v in verdict.uncontrollable_eigenvalues)
+    ctx.checks += [
+        ("controllability (6.81), B = [0, 1]", "det V = -1", reached),
+        (
+            "controllability (6.84)-(6.88), B = [-1, 1]",
+            "det V = 0; the mode at -2 not controllable",
+            f"det V = {np.linalg.det(ctrb(A, lost)):.4g}; not controllable: {lost_modes}",
+        ),
+    ]
+
+
 def _feedback_example(ctx: _Context) -> None:
     """Figure 6.4: the second-order example (6.94)-(6.102), original system and with the
     feedback that places ω_n = 25 1/s, ζ = 0.707, from two initial states."""
@@ -826,6 +913,8 @@ def _feedback_example(ctx: _Context) -> None:
         figure,
     )
     ctx.checks.append(("feedback gains (6.95)-(6.102)", "[16.5, 8.09]", _vector(design.k, 7)))
+    determinant = np.linalg.det(ctrb(A, B.reshape(-1, 1)))
+    ctx.checks.append(("controllability matrix (6.98)", "det V = -128", f"det V = {determinant:g}"))
 
 
 def _pendulum_example(ctx: _Context) -> None:
@@ -910,6 +999,7 @@ def _section_chapter(ctx: _Context) -> str:
         "unrounded model reproduces)."
     )
     _longitudinal_matrix_check(ctx)
+    _controllability_example(ctx)
     _feedback_example(ctx)
     _pendulum_example(ctx)
     report.table(("result", "chapter", "aerocontrol"), [tuple(row) for row in ctx.checks])
