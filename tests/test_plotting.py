@@ -175,6 +175,11 @@ def test_bode_and_modes_plots() -> None:
     ax = aerocontrol.modes(A, mode_names=["phugoid", "short period"]).plot()
     assert _labels(ax) == ["phugoid", "short period"]
     assert len(ax.get_lines()[0].get_xdata()) == 2
+    # A margin of a tenth of the span beyond the extreme eigenvalues: no marker cut by the frame.
+    eigenvalues = np.linalg.eigvals(A)
+    low, high = ax.get_ylim()
+    span = np.ptp(eigenvalues.imag)
+    assert low < eigenvalues.imag.min() - 0.1 * span and high > eigenvalues.imag.max() + 0.1 * span
     plotting.plot_modes(aerocontrol.modes(A - np.outer(B, [0, 0, 1, 0])), ax=ax, marker="o",
                         suffix=" (closed)")  # fmt: skip
     assert _labels(ax)[2:] == ["mode 1 (closed)", "mode 2 (closed)"]

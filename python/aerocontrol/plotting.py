@@ -452,6 +452,7 @@ def plot_modes(modes: Modes, ax: Any = None, marker: str = "x", suffix: str = ""
         lam = modes.eigenvalue[k]
         points = np.array([lam, np.conj(lam)]) if modes.oscillatory[k] else np.array([lam])
         ax.plot(points.real, points.imag, marker, markersize=9, mfc="none", label=name + suffix)
+    ax.margins(0.12)  # the extreme markers whole, not cut by the frame
     ax.axvline(0.0, color="black", linewidth=0.8)
     ax.axhline(0.0, color="black", linewidth=0.8)
     _finish(ax, "real part (1/s)", "imaginary part (rad/s)", "modes")
