@@ -28,7 +28,7 @@
 //! arithmetic and without computing eigenvalues.
 
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::schur::Square;
+use crate::schur::{Dynamic, Fixed, Order, Square, with_order};
 use faer::diag::Diag;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::{ComputeEigenvectors, evd_real, evd_scratch};
@@ -249,8 +249,10 @@ pub fn polynomial_from_roots(eigenvalues: &[c64]) -> Vec<f64> {
 pub fn charpoly(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
-    let (h, scale) = crate::schur::balanced_hessenberg(a);
-    let mut coefficients = hessenberg_characteristic_polynomial(&h);
+    let (mut coefficients, scale) = with_order!(a.nrows(), order => {
+        let (h, scale) = crate::schur::balanced_hessenberg(order, a);
+        (hessenberg_characteristic_polynomial(&h), scale)
+    });
     // H is similar to A / s: a_k(A) = s^k a_k(A / s), exactly for s a power of two.
     let mut power = 1.0;
     for coefficient in &mut coefficients {
@@ -262,8 +264,8 @@ pub fn charpoly(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
 
 /// det(λI - H) of an upper Hessenberg H by La Budde's recurrence (see [`charpoly`]),
 /// highest power first.
-pub(crate) fn hessenberg_characteristic_polynomial(h: &Square) -> Vec<f64> {
-    let n = h.n;
+pub(crate) fn hessenberg_characteristic_polynomial<O: Order>(h: &Square<O>) -> Vec<f64> {
+    let n = h.n();
     // p_i's coefficients, lowest power first, at p[start(i)..start(i) + i + 1].
     let start = |i: usize| i * (i + 1) / 2;
     let mut p = vec![0.0; start(n + 1)];

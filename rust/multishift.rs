@@ -114,7 +114,7 @@ pub(crate) fn multishift_qr(
     mut z: Option<&mut Square>,
     full: bool,
 ) -> Result<(), Error> {
-    let n = h.n;
+    let n = h.n();
     let small = f64::MIN_POSITIVE * (n as f64 / f64::EPSILON);
     let nominal_shifts = shift_count(n);
     // The deflation window has as many rows as the sweep has shifts. (LAPACK's iparmq makes it
@@ -218,7 +218,7 @@ fn finish_small_block(
     full: bool,
     (ktop, kbot): (usize, usize),
 ) -> Result<(), Error> {
-    let n = h.n;
+    let n = h.n();
     let order = kbot + 1 - ktop;
     if !full || order == n {
         return francis_qr(h, z, (ktop, kbot), full, Spectrum::General);
@@ -282,7 +282,7 @@ fn aggressive_early_deflation(
     (ktop, kbot): (usize, usize),
     window: usize,
 ) -> EarlyDeflation {
-    let n = h.n;
+    let n = h.n();
     let top = kbot + 1 - window;
     debug_assert!(
         top > ktop,
@@ -425,7 +425,7 @@ fn apply_outside_window(
     u: MatRef<'_, f64>,
     scratch: &mut Vec<f64>,
 ) {
-    let n = h.n;
+    let n = h.n();
     let w = w1 + 1 - w0;
     let mut full_h = MatMut::from_column_major_slice_mut(&mut h.data, n, n);
     if w0 > first {
@@ -452,7 +452,7 @@ fn apply_outside_window(
         );
     }
     if let Some(z) = z {
-        let rows = z.n;
+        let rows = z.n();
         let mut full_z = MatMut::from_column_major_slice_mut(&mut z.data, rows, rows);
         multiply_on_the_right(full_z.as_mut().submatrix_mut(0, w0, rows, w), u, scratch);
     }
@@ -484,7 +484,7 @@ fn small_bulge_sweep(
     (ktop, kbot): (usize, usize),
     shifts: &[(c64, c64)],
 ) {
-    let n = h.n;
+    let n = h.n();
     if shifts.is_empty() || kbot < ktop + 2 {
         return;
     }
@@ -579,8 +579,8 @@ fn chase_slab_kernel<const FMA: bool>(
     reflectors: &mut Vec<StepReflector>,
 ) {
     let (ktop, kbot) = (chain.ktop, chain.kbot);
-    let n = h.n;
-    let w = u.n;
+    let n = h.n();
+    let w = u.n();
     // The rows of U below this one are still those of the identity.
     let mut u_rows_end = 0;
     for t in t0..=t1 {

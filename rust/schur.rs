@@ -145,7 +145,7 @@ struct Mirrors {
 }
 
 impl Mirrors {
-    fn for_spectrum(spectrum: Spectrum<'_>, h: Option<&Square>) -> Option<Self> {
+    fn for_spectrum<O: Order>(spectrum: Spectrum<'_>, h: Option<&Square<O>>) -> Option<Self> {
         match spectrum {
             Spectrum::General => None,
             Spectrum::Hamiltonian => {
@@ -236,34 +236,161 @@ pub(crate) const MULTISHIFT_MIN_ORDER: usize = 75;
 /// faer's blocked reduction (whose set-up costs more than the whole reduction at n = 4).
 const UNBLOCKED_HESSENBERG_MAX_ORDER: usize = 32;
 
+// The unblocked orders take the double-shift iteration directly.
+const _: () = assert!(UNBLOCKED_HESSENBERG_MAX_ORDER < MULTISHIFT_MIN_ORDER);
+
+/// The order of a [`Square`] matrix: fixed at compile time ([`Fixed`]) for the small orders
+/// of flight models, or known at run time ([`Dynamic`]).
+///
+/// With the order a constant, the index arithmetic of the QR iteration folds, its loops over
+/// whole rows and columns unroll, and the matrix lives on the stack; the arithmetic, and so
+/// every result, is the same bit for bit as with the run-time order. [`with_order`] picks
+/// the order type for n.
+pub(crate) trait Order: Copy {
+    /// Storage for the order^2 entries.
+    type Data: AsRef<[f64]> + AsMut<[f64]> + Clone;
+    /// Whether the order is a compile-time constant.
+    const FIXED: bool;
+    /// The order.
+    fn get(self) -> usize;
+    /// Zeroed storage.
+    fn zeros(self) -> Self::Data;
+}
+
+/// An order known at run time; the entries on the heap.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Dynamic(pub(crate) usize);
+
+impl Order for Dynamic {
+    type Data = Vec<f64>;
+    const FIXED: bool = false;
+    #[inline(always)]
+    fn get(self) -> usize {
+        self.0
+    }
+    fn zeros(self) -> Vec<f64> {
+        vec![0.0; self.0 * self.0]
+    }
+}
+
+/// An order fixed at compile time; the entries in an array.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Fixed<const N: usize>;
+
+/// The fixed orders: those of 2- to 4-state models, their Hamiltonians (twice the states)
+/// and 5- to 8-state augmented models.
+macro_rules! fixed_orders {
+    ($($n:literal),*) => {
+        $(
+            impl Order for Fixed<$n> {
+                type Data = [f64; $n * $n];
+                const FIXED: bool = true;
+                #[inline(always)]
+                fn get(self) -> usize {
+                    $n
+                }
+                #[inline(always)]
+                fn zeros(self) -> Self::Data {
+                    [0.0; $n * $n]
+                }
+            }
+        )*
+    };
+}
+
+fixed_orders!(2, 3, 4, 5, 6, 7, 8);
+
+/// Evaluates `$body` with `$order` bound to the [`Order`] of an n x n matrix: [`Fixed`] for
+/// the orders of [`fixed_orders`], [`Dynamic`] otherwise (the body is compiled for each).
+macro_rules! with_order {
+    ($n:expr, $order:ident => $body:expr) => {
+        match $n {
+            2 => {
+                let $order = Fixed::<2>;
+                $body
+            }
+            3 => {
+                let $order = Fixed::<3>;
+                $body
+            }
+            4 => {
+                let $order = Fixed::<4>;
+                $body
+            }
+            5 => {
+                let $order = Fixed::<5>;
+                $body
+            }
+            6 => {
+                let $order = Fixed::<6>;
+                $body
+            }
+            7 => {
+                let $order = Fixed::<7>;
+                $body
+            }
+            8 => {
+                let $order = Fixed::<8>;
+                $body
+            }
+            n => {
+                let $order = Dynamic(n);
+                $body
+            }
+        }
+    };
+}
+pub(crate) use with_order;
+
 /// A square matrix stored by columns in one contiguous buffer: the QR iteration touches single
 /// entries in tight loops, where a plain slice index is cheaper than a strided view.
 #[derive(Clone)]
-pub(crate) struct Square {
-    pub(crate) n: usize,
-    pub(crate) data: Vec<f64>,
+pub(crate) struct Square<O: Order = Dynamic> {
+    order: O,
+    pub(crate) data: O::Data,
 }
 
 impl Square {
     pub(crate) fn from_mat(a: MatRef<'_, f64>) -> Self {
-        let n = a.nrows();
-        let mut data = Vec::with_capacity(n * n);
-        for j in 0..n {
-            data.extend(a.col(j).iter());
-        }
-        Self { n, data }
+        Self::from_mat_in(Dynamic(a.nrows()), a)
     }
 
     pub(crate) fn identity(n: usize) -> Self {
-        let mut data = vec![0.0; n * n];
-        for i in 0..n {
-            data[i * (n + 1)] = 1.0;
+        Self::identity_in(Dynamic(n))
+    }
+}
+
+impl<O: Order> Square<O> {
+    /// The order.
+    #[inline(always)]
+    pub(crate) fn n(&self) -> usize {
+        self.order.get()
+    }
+
+    /// A copy of the square matrix `a`, whose order is `order`.
+    pub(crate) fn from_mat_in(order: O, a: MatRef<'_, f64>) -> Self {
+        let n = order.get();
+        debug_assert!(a.nrows() == n && a.ncols() == n);
+        let mut data = order.zeros();
+        for (j, column) in data.as_mut().chunks_exact_mut(n.max(1)).enumerate() {
+            for (i, x) in column.iter_mut().enumerate() {
+                *x = a[(i, j)];
+            }
         }
-        Self { n, data }
+        Self { order, data }
+    }
+
+    pub(crate) fn identity_in(order: O) -> Self {
+        let n = order.get();
+        let mut data = order.zeros();
+        for i in 0..n {
+            data.as_mut()[i * (n + 1)] = 1.0;
+        }
+        Self { order, data }
     }
 
     pub(crate) fn to_mat(&self) -> Mat<f64> {
-        Mat::from_fn(self.n, self.n, |i, j| self[(i, j)])
+        Mat::from_fn(self.n(), self.n(), |i, j| self[(i, j)])
     }
 
     /// Rows r and r + 1, columns `columns`: x <- cs x + sn y, y <- cs y - sn x.
@@ -277,8 +404,8 @@ impl Square {
 
     /// Columns c and c + 1, rows `rows`: x <- cs x + sn y, y <- cs y - sn x.
     pub(crate) fn rotate_columns(&mut self, c: usize, rows: Range<usize>, cs: f64, sn: f64) {
-        let n = self.n;
-        let (left, right) = self.data.split_at_mut((c + 1) * n);
+        let n = self.n();
+        let (left, right) = self.data.as_mut().split_at_mut((c + 1) * n);
         let (x_column, y_column) = (&mut left[c * n..], &mut right[..n]);
         for i in rows {
             let (x, y) = (x_column[i], y_column[i]);
@@ -290,9 +417,9 @@ impl Square {
     /// Applies I - τ w w^T (w = [1, v...], 2 or 3 long) from the left to rows k.. of the
     /// columns `columns`.
     pub(crate) fn reflect_rows(&mut self, k: usize, w: &[f64], tau: f64, columns: Range<usize>) {
-        let n = self.n;
+        let n = self.n();
         for j in columns {
-            let column = &mut self.data[j * n + k..j * n + k + w.len()];
+            let column = &mut self.data.as_mut()[j * n + k..j * n + k + w.len()];
             let sum: f64 = column.iter().zip(w).map(|(x, v)| x * v).sum();
             let scaled = tau * sum;
             for (x, v) in column.iter_mut().zip(w) {
@@ -307,8 +434,8 @@ impl Square {
     /// order, in the same order for each entry, so the same rounding.)
     pub(crate) fn reflect_columns(&mut self, k: usize, w: &[f64], tau: f64, rows: Range<usize>) {
         const CHUNK: usize = 32;
-        let n = self.n;
-        let columns = &mut self.data[k * n..(k + w.len()) * n];
+        let n = self.n();
+        let columns = &mut self.data.as_mut()[k * n..(k + w.len()) * n];
         let mut start = rows.start;
         while start < rows.end {
             let chunk = start..(start + CHUNK).min(rows.end);
@@ -337,7 +464,7 @@ impl Square {
 /// The reflectors of the bulge chase are 3 long (2 at the bottom of the window): with the
 /// length fixed at compile time the updates unroll and the column update vectorises, which
 /// roughly halves the cost of a QR sweep at the small orders of flight-control models.
-impl Square {
+impl<O: Order> Square<O> {
     /// [`Square::reflect_rows`] for a reflector of length `N`.
     pub(crate) fn reflect_rows_fixed<const N: usize>(
         &mut self,
@@ -346,9 +473,9 @@ impl Square {
         tau: f64,
         columns: Range<usize>,
     ) {
-        let n = self.n;
+        let n = self.n();
         for j in columns {
-            let column: &mut [f64; N] = (&mut self.data[j * n + k..j * n + k + N])
+            let column: &mut [f64; N] = (&mut self.data.as_mut()[j * n + k..j * n + k + N])
                 .try_into()
                 .expect("N entries");
             let mut sum = 0.0;
@@ -372,10 +499,10 @@ impl Square {
         tau: f64,
         rows: Range<usize>,
     ) {
-        let n = self.n;
+        let n = self.n();
         // Split off column by column: chunks_exact_mut would divide by n (an integer division,
         // tens of cycles, at every reflector).
-        let mut rest = &mut self.data[k * n..(k + N) * n];
+        let mut rest = &mut self.data.as_mut()[k * n..(k + N) * n];
         let columns: [&mut [f64]; N] = std::array::from_fn(|_| {
             let (column, after) = std::mem::take(&mut rest).split_at_mut(n);
             rest = after;
@@ -394,18 +521,18 @@ impl Square {
     }
 }
 
-impl Index<(usize, usize)> for Square {
+impl<O: Order> Index<(usize, usize)> for Square<O> {
     type Output = f64;
     #[inline]
     fn index(&self, (i, j): (usize, usize)) -> &f64 {
-        &self.data[i + j * self.n]
+        &self.data.as_ref()[i + j * self.order.get()]
     }
 }
 
-impl IndexMut<(usize, usize)> for Square {
+impl<O: Order> IndexMut<(usize, usize)> for Square<O> {
     #[inline]
     fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut f64 {
-        &mut self.data[i + j * self.n]
+        &mut self.data.as_mut()[i + j * self.order.get()]
     }
 }
 
@@ -427,18 +554,40 @@ pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSch
         scaled = Mat::from_fn(n, n, |i, j| a[(i, j)] / scale);
         scaled.as_ref()
     };
-    let (mut t, mut z) = if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
-        let (mut h, mut q) = (Square::from_mat(a), Square::identity(n));
-        reduce_to_hessenberg(&mut h, Some(&mut q));
-        (h, q)
-    } else {
-        let reduced = hessenberg(a);
-        (
-            Square::from_mat(reduced.h.as_ref()),
-            Square::from_mat(reduced.q.as_ref()),
-        )
-    };
+    if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+        return with_order!(n, order => small_real_schur(order, a, scale, spectrum));
+    }
+    let reduced = hessenberg(a);
+    let (mut t, mut z) = (
+        Square::from_mat(reduced.h.as_ref()),
+        Square::from_mat(reduced.q.as_ref()),
+    );
     schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
+    Ok(RealSchur {
+        t: Mat::from_fn(n, n, |i, j| t[(i, j)] * scale),
+        z: z.to_mat(),
+    })
+}
+
+/// The Schur form of `a` (entries already divided by `scale`) with T multiplied back by
+/// `scale`, for orders up to [`UNBLOCKED_HESSENBERG_MAX_ORDER`]: the unblocked Hessenberg
+/// reduction and the double-shift iteration, at the order type `order`.
+fn small_real_schur<O: Order>(
+    order: O,
+    a: MatRef<'_, f64>,
+    scale: f64,
+    spectrum: Spectrum,
+) -> Result<RealSchur, Error> {
+    let n = order.get();
+    let (mut t, mut z) = (Square::from_mat_in(order, a), Square::identity_in(order));
+    reduce_to_hessenberg(&mut t, Some(&mut z));
+    francis_qr(
+        &mut t,
+        Some(&mut z),
+        (0, n.saturating_sub(1)),
+        true,
+        spectrum,
+    )?;
     Ok(RealSchur {
         t: Mat::from_fn(n, n, |i, j| t[(i, j)] * scale),
         z: z.to_mat(),
@@ -478,32 +627,44 @@ pub fn eigenvalues_near(a: MatRef<'_, f64>, estimates: &[c64]) -> Result<Vec<c64
 fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
-    let (mut h, scale) = balanced_hessenberg(a);
+    let n = a.nrows();
     // Estimates are of the unscaled matrix's eigenvalues (and scaling is rare): dropped.
-    let spectrum = if scale == 1.0 {
-        spectrum
-    } else {
-        Spectrum::General
+    let unscaled = |scale: f64| {
+        if scale == 1.0 {
+            spectrum
+        } else {
+            Spectrum::General
+        }
     };
-    schur_of_hessenberg(&mut h, None, false, spectrum)?;
-    Ok(block_eigenvalues(h.n, |i, j| h[(i, j)] * scale))
+    if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+        with_order!(n, order => {
+            let (mut h, scale) = balanced_hessenberg(order, a);
+            francis_qr(&mut h, None, (0, n.saturating_sub(1)), false, unscaled(scale))?;
+            Ok(block_eigenvalues(n, |i, j| h[(i, j)] * scale))
+        })
+    } else {
+        let (mut h, scale) = balanced_hessenberg(Dynamic(n), a);
+        schur_of_hessenberg(&mut h, None, false, unscaled(scale))?;
+        Ok(block_eigenvalues(n, |i, j| h[(i, j)] * scale))
+    }
 }
 
 /// The upper Hessenberg form H of the balanced D^-1 (A / s) D, with s the power of two that
 /// brings A's entries into range ([`range_scale`]): returns (H, s). H is similar to A / s, so
 /// it has the eigenvalues and the characteristic polynomial of A / s (the balancing is exact,
-/// the reduction backward stable). The caller checks that A is square and finite.
-pub(crate) fn balanced_hessenberg(a: MatRef<'_, f64>) -> (Square, f64) {
+/// the reduction backward stable). The caller checks that A is square and finite, of the
+/// order of `order`.
+pub(crate) fn balanced_hessenberg<O: Order>(order: O, a: MatRef<'_, f64>) -> (Square<O>, f64) {
     let scale = range_scale(a);
-    let mut h = Square::from_mat(a);
+    let mut h = Square::from_mat_in(order, a);
     if scale != 1.0 {
-        h.data.iter_mut().for_each(|x| *x /= scale);
+        h.data.as_mut().iter_mut().for_each(|x| *x /= scale);
     }
     let _ = balance(&mut h);
-    if h.n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+    if h.n() <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         reduce_to_hessenberg(&mut h, None);
     } else {
-        h = Square::from_mat(hessenberg_matrix(h.to_mat().as_ref()).as_ref());
+        h = Square::from_mat_in(order, hessenberg_matrix(h.to_mat().as_ref()).as_ref());
     }
     (h, scale)
 }
@@ -533,9 +694,9 @@ pub(crate) fn block_eigenvalues(n: usize, t: impl Fn(usize, usize) -> f64) -> Ve
 
 /// Householder reduction to upper Hessenberg form in place, H = Q^T A Q; `q` (the identity on
 /// entry) becomes Q. Reflector k maps column k below the subdiagonal onto e_{k+1}.
-fn reduce_to_hessenberg(h: &mut Square, mut q: Option<&mut Square>) {
+fn reduce_to_hessenberg<O: Order>(h: &mut Square<O>, mut q: Option<&mut Square<O>>) {
     clear_upper_avx_state();
-    let n = h.n;
+    let n = h.n();
     let mut w = [0.0; UNBLOCKED_HESSENBERG_MAX_ORDER];
     for k in 0..n.saturating_sub(2) {
         let length = n - k - 1;
@@ -563,16 +724,16 @@ fn reduce_to_hessenberg(h: &mut Square, mut q: Option<&mut Square>) {
 /// The diagonal D (powers of two) of the balancing D^-1 A D of a square matrix (see
 /// [`balance`]).
 pub(crate) fn balancing_scale(a: MatRef<'_, f64>) -> Vec<f64> {
-    balance(&mut Square::from_mat(a))
+    with_order!(a.nrows(), order => balance(&mut Square::from_mat_in(order, a)))
 }
 
 /// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
 /// row and column i are scaled until their off-diagonal 2-norms are within a factor of two, and
 /// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more. Returns
 /// the diagonal of D.
-fn balance(a: &mut Square) -> Vec<f64> {
+fn balance<O: Order>(a: &mut Square<O>) -> Vec<f64> {
     clear_upper_avx_state();
-    let n = a.n;
+    let n = a.n();
     let mut scale = vec![1.0; n];
     let mut changed = true;
     let mut sweeps = 0;
@@ -762,8 +923,8 @@ pub(crate) fn schur_of_hessenberg(
     full: bool,
     spectrum: Spectrum,
 ) -> Result<(), Error> {
-    if h.n < MULTISHIFT_MIN_ORDER {
-        francis_qr(h, z, (0, h.n.saturating_sub(1)), full, spectrum)
+    if h.n() < MULTISHIFT_MIN_ORDER {
+        francis_qr(h, z, (0, h.n().saturating_sub(1)), full, spectrum)
     } else {
         multishift_qr(h, z, full)
     }
@@ -776,15 +937,15 @@ pub(crate) fn schur_of_hessenberg(
 /// the block too, toward the Schur form T; and `z`, if given, is multiplied on the right by the
 /// orthogonal transformations); without it only the block itself, which suffices for the
 /// eigenvalues.
-pub(crate) fn francis_qr(
-    h: &mut Square,
-    mut z: Option<&mut Square>,
+pub(crate) fn francis_qr<O: Order>(
+    h: &mut Square<O>,
+    mut z: Option<&mut Square<O>>,
     (lo, hi): (usize, usize),
     full: bool,
     spectrum: Spectrum,
 ) -> Result<(), Error> {
     clear_upper_avx_state();
-    let n = h.n;
+    let n = h.n();
     if n == 0 {
         return Ok(());
     }
@@ -881,7 +1042,14 @@ pub(crate) fn francis_qr(
                     // = -h[k, k-1] in exact arithmetic; this form stays right when v underflows.
                     h[(k, k - 1)] *= 1.0 - tau;
                 }
-                let column_rows = first..(k + 3).min(i) + 1;
+                // Rows below k + 3 and below the window hold zeros in these columns, and stay
+                // zero (up to sign); at a fixed order all rows are updated, in loops of
+                // constant length that vectorise.
+                let column_rows = if O::FIXED {
+                    0..n
+                } else {
+                    first..(k + 3).min(i) + 1
+                };
                 if rows == 3 {
                     let w = [1.0, v[1], v[2]];
                     h.reflect_rows_fixed(k, w, tau, k..last + 1);
@@ -944,8 +1112,8 @@ pub(crate) fn francis_qr(
 /// that setting it to zero moves the eigenvalues of the 2 x 2 block h[k-1..=k, k-1..=k] by at
 /// most u times their size (Ahues & Tisseur 1997, as LAPACK's dlahqr).
 #[inline]
-pub(crate) fn negligible_subdiagonal(
-    h: &Square,
+pub(crate) fn negligible_subdiagonal<O: Order>(
+    h: &Square<O>,
     k: usize,
     (l, i): (usize, usize),
     small: f64,
@@ -980,8 +1148,8 @@ pub(crate) fn negligible_subdiagonal(
 /// double-shift bulge at row m. With s1, s2 real or a conjugate pair it is real. Zero (no
 /// bulge) in the degenerate case where all three entries vanish.
 #[inline]
-pub(crate) fn shift_polynomial_column(
-    h: &Square,
+pub(crate) fn shift_polynomial_column<O: Order>(
+    h: &Square<O>,
     m: usize,
     (shift1, shift2): (c64, c64),
 ) -> [f64; 3] {
@@ -1013,9 +1181,9 @@ pub(crate) fn shift_polynomial_column(
 /// even: det(λI - H) = q(λ²), and each root μ of q gives the pair ±sqrt(μ). Empty for an odd
 /// order, or if the polynomial is not finite or the companion matrix's QR iteration fails.
 /// A root μ < 0 gives an estimate on the imaginary axis (Re = -0).
-fn hamiltonian_estimates(h: &Square) -> Vec<c64> {
-    let order = h.n / 2;
-    if order == 0 || !h.n.is_multiple_of(2) {
+fn hamiltonian_estimates<O: Order>(h: &Square<O>) -> Vec<c64> {
+    let order = h.n() / 2;
+    if order == 0 || !h.n().is_multiple_of(2) {
         return Vec::new();
     }
     let p = hessenberg_characteristic_polynomial(h);
@@ -1734,7 +1902,7 @@ mod tests {
 
     #[test]
     fn mirror_images_are_paired_off() {
-        let mut mirrors = Mirrors::for_spectrum(Spectrum::Hamiltonian, None).unwrap();
+        let mut mirrors = Mirrors::for_spectrum::<Dynamic>(Spectrum::Hamiltonian, None).unwrap();
         let trailing = |a: f64, b: f64| [c64::new(a, b), c64::new(a, -b)];
         mirrors.found(c64::new(0.5, 0.0));
         mirrors.found(c64::new(-0.3, 0.8));
