@@ -67,13 +67,16 @@
 //! [`AXIS_TOLERANCE`] ||H||_F of the imaginary axis (no stabilising solution: an undamped mode
 //! that the input cannot move or the weight does not see); U11 singular to working precision.
 
+use crate::dense::{Dense, product, transposed_product};
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::lu::{solve_in_place, solve_with_inverse};
 use crate::lyapunov::{self, Singularity, symmetrize};
 use crate::norm::{frobenius_norm, max_abs, one_norm};
 use crate::reorder::reorder_schur;
-use crate::schur::{Spectrum, balancing_scale, eigenvalues_near, real_schur_with};
-use crate::small_matrix::product;
+use crate::schur::{
+    Dynamic, Fixed, Order, Spectrum, Square, balance, eigenvalues_near, square_real_schur,
+    with_order,
+};
 use faer::linalg::solvers::Llt;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
@@ -143,9 +146,9 @@ pub struct CareOptions<'a> {
 
 /// The data of the Hamiltonian: Ā, G and Q̄.
 struct Standard {
-    a: Mat<f64>,
-    g: Mat<f64>,
-    q: Mat<f64>,
+    a: Dense,
+    g: Dense,
+    q: Dense,
 }
 
 /// The equation with E removed, Ã^T Y + Y Ã - (Y B̃ + S) R^-1 (B̃^T Y + S^T) + Q = 0, in which
@@ -153,19 +156,25 @@ struct Standard {
 /// with the Cholesky factor, keeps its accuracy when R is ill-conditioned, where
 /// Y B̂ B̂^T Y (B̂ = B̃ L^-T, entries of size ||B|| / σ_min(L)) loses digits to cancellation.
 struct Reduced<'a> {
-    a: Mat<f64>,
-    b: Mat<f64>,
-    q: &'a Mat<f64>,
-    s: Option<MatRef<'a, f64>>,
+    a: Dense,
+    b: Dense,
+    q: &'a Dense,
+    /// ||Q||_F.
+    q_norm: f64,
+    s: Option<&'a Dense>,
     l: MatRef<'a, f64>,
 }
 
 impl Reduced<'_> {
     /// K = R^-1 (B̃^T Y + S^T) = L^-T L^-1 (B̃^T Y + S^T).
-    fn gain(&self, y: &Mat<f64>) -> Mat<f64> {
-        let mut gain = product(self.b.transpose(), y.as_ref());
+    fn gain(&self, y: &Dense) -> Dense {
+        let mut gain = transposed_product(&self.b, y);
         if let Some(s) = self.s {
-            gain += s.transpose();
+            for j in 0..gain.ncols() {
+                for i in 0..gain.nrows() {
+                    gain[(i, j)] += s[(j, i)];
+                }
+            }
         }
         solve_lower_triangular_in_place(self.l, gain.as_mut(), Par::Seq);
         solve_upper_triangular_in_place(self.l.transpose(), gain.as_mut(), Par::Seq);
@@ -173,24 +182,24 @@ impl Reduced<'_> {
     }
 
     /// The residual of Y and its gain.
-    fn evaluate(&self, y: &Mat<f64>) -> Evaluation {
+    fn evaluate(&self, y: &Dense) -> Evaluation {
         let gain = self.gain(y);
-        let mut coupling = product(y.as_ref(), self.b.as_ref());
+        let mut coupling = product(y, &self.b);
         if let Some(s) = self.s {
-            coupling += s;
+            for (x, &v) in coupling.as_mut_slice().iter_mut().zip(s.as_slice()) {
+                *x += v;
+            }
         }
-        let ay = product(self.a.transpose(), y.as_ref());
-        let quadratic = product(coupling.as_ref(), gain.as_ref());
-        let scale = frobenius_norm(self.q.as_ref())
-            + 2.0 * frobenius_norm(ay.as_ref())
-            + frobenius_norm(quadratic.as_ref());
+        let ay = transposed_product(&self.a, y);
+        let quadratic = product(&coupling, &gain);
+        let scale = self.q_norm + 2.0 * ay.frobenius_norm() + quadratic.frobenius_norm();
         let n = y.nrows();
-        let mut residual = Mat::from_fn(n, n, |i, j| {
+        let mut residual = Dense::from_fn(n, n, |i, j| {
             ay[(i, j)] + ay[(j, i)] - quadratic[(i, j)] + self.q[(i, j)]
         });
-        symmetrize(&mut residual);
+        residual.symmetrize();
         Evaluation {
-            residual_norm: frobenius_norm(residual.as_ref()),
+            residual_norm: residual.frobenius_norm(),
             residual,
             gain,
             scale,
@@ -198,9 +207,12 @@ impl Reduced<'_> {
     }
 
     /// Ã - B̃ K.
-    fn closed_loop(&self, gain: &Mat<f64>) -> Mat<f64> {
-        let bk = product(self.b.as_ref(), gain.as_ref());
-        Mat::from_fn(bk.nrows(), bk.ncols(), |i, j| self.a[(i, j)] - bk[(i, j)])
+    fn closed_loop(&self, gain: &Dense) -> Dense {
+        let mut closed_loop = product(&self.b, gain);
+        for (x, &a) in closed_loop.as_mut_slice().iter_mut().zip(self.a.as_slice()) {
+            *x = a - *x;
+        }
+        closed_loop
     }
 }
 
@@ -208,9 +220,9 @@ impl Reduced<'_> {
 /// size of the terms, ||Q||_F + 2 ||Ã^T Y||_F + ||(Y B̃ + S) K||_F, against which it is judged.
 /// Without E this is the residual of the caller's equation and is reported as it is.
 struct Evaluation {
-    residual: Mat<f64>,
+    residual: Dense,
     residual_norm: f64,
-    gain: Mat<f64>,
+    gain: Dense,
     scale: f64,
 }
 
@@ -246,14 +258,16 @@ pub fn solve_care(
     let l = cholesky.L();
     let (a_tilde, b_tilde) = match options.e {
         Some(e) => remove_descriptor(a, b, e)?,
-        None => (a.to_owned(), b.to_owned()),
+        None => (Dense::from_ref(a), Dense::from_ref(b)),
     };
-    let standard = standardize(&a_tilde, &b_tilde, &q, l, options.s);
+    let s = options.s.map(Dense::from_ref);
+    let standard = standardize(&a_tilde, &b_tilde, &q, l, s.as_ref());
     let reduced = Reduced {
         a: a_tilde,
         b: b_tilde,
+        q_norm: q.frobenius_norm(),
         q: &q,
-        s: options.s,
+        s: s.as_ref(),
         l,
     };
     if n == 0 {
@@ -287,7 +301,7 @@ pub fn solve_care(
     // X = E^-T Y E^-1.
     let (x, residual) = match options.e {
         Some(e) => {
-            let mut x = y.clone();
+            let mut x = y.to_mat();
             let mut factors = e.transpose().to_owned();
             solve_in_place(factors.as_mut(), x.as_mut(), Par::Seq);
             let mut xt = x.transpose().to_owned();
@@ -295,14 +309,15 @@ pub fn solve_care(
             solve_in_place(factors.as_mut(), xt.as_mut(), Par::Seq);
             let mut x = xt.transpose().to_owned();
             symmetrize(&mut x);
+            let gain = gain.to_mat();
             let residual = general_residual(a, b, q.as_ref(), options.s, e, &x, &gain);
             (x, residual)
         }
-        None => (y, reduced_residual),
+        None => (y.to_mat(), reduced_residual),
     };
     Ok(Care {
         x,
-        gain,
+        gain: gain.to_mat(),
         closed_loop_eigenvalues,
         residual,
         rcond,
@@ -318,7 +333,7 @@ pub(crate) fn check_problem(
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
-) -> Result<(Mat<f64>, Llt<f64>), Error> {
+) -> Result<(Dense, Llt<f64>), Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let n = a.nrows();
@@ -344,13 +359,15 @@ fn symmetric(
     arg: &'static str,
     order: usize,
     other: &'static str,
-) -> Result<Mat<f64>, Error> {
+) -> Result<Dense, Error> {
     check_square(matrix, arg)?;
     check_rows(matrix, arg, order, other)?;
     check_finite(matrix, arg)?;
-    let largest = max_abs(matrix);
+    let mut symmetric = Dense::from_ref(matrix);
+    let largest = max_abs(symmetric.as_ref());
     let asymmetry = (0..order)
-        .flat_map(|j| (0..j).map(move |i| (matrix[(i, j)] - matrix[(j, i)]).abs()))
+        .flat_map(|j| (0..j).map(move |i| (i, j)))
+        .map(|(i, j)| (symmetric[(i, j)] - symmetric[(j, i)]).abs())
         .fold(0.0, f64::max);
     if asymmetry > SYMMETRY_TOLERANCE * largest {
         let message = format!(
@@ -363,8 +380,7 @@ fn symmetric(
             Error::InvalidArgument { arg, message }
         });
     }
-    let mut symmetric = matrix.to_owned();
-    symmetrize(&mut symmetric);
+    symmetric.symmetrize();
     Ok(symmetric)
 }
 
@@ -373,7 +389,7 @@ fn remove_descriptor(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     e: MatRef<'_, f64>,
-) -> Result<(Mat<f64>, Mat<f64>), Error> {
+) -> Result<(Dense, Dense), Error> {
     let n = a.nrows();
     check_square(e, "E")?;
     check_rows(e, "E", n, "A")?;
@@ -397,35 +413,42 @@ fn remove_descriptor(
         });
     }
     Ok((
-        solution.subcols(0, n).to_owned(),
-        solution.subcols(n, m).to_owned(),
+        Dense::from_ref(solution.subcols(0, n)),
+        Dense::from_ref(solution.subcols(n, m)),
     ))
 }
 
 /// Ā = Ã - B̂ Ŝ^T, G = B̂ B̂^T, Q̄ = Q - Ŝ Ŝ^T with B̂ = B̃ L^-T, Ŝ = S L^-T.
 fn standardize(
-    a_tilde: &Mat<f64>,
-    b_tilde: &Mat<f64>,
-    q: &Mat<f64>,
+    a_tilde: &Dense,
+    b_tilde: &Dense,
+    q: &Dense,
     l: MatRef<'_, f64>,
-    s: Option<MatRef<'_, f64>>,
+    s: Option<&Dense>,
 ) -> Standard {
-    // X L^T = Y  <=>  L X^T = Y^T.
-    let right_divide = |y: MatRef<'_, f64>| {
-        let mut transposed = y.transpose().to_owned();
+    // X L^T = Y  <=>  L X^T = Y^T: returns X^T.
+    let right_divide_transposed = |y: &Dense| {
+        let mut transposed = y.transpose();
         solve_lower_triangular_in_place(l, transposed.as_mut(), Par::Seq);
-        transposed.transpose().to_owned()
+        transposed
     };
-    let b_hat = right_divide(b_tilde.as_ref());
-    let mut g = product(b_hat.as_ref(), b_hat.transpose());
-    symmetrize(&mut g);
+    let b_hat_t = right_divide_transposed(b_tilde);
+    let b_hat = b_hat_t.transpose();
+    let mut g = product(&b_hat, &b_hat_t);
+    g.symmetrize();
     let (a, q) = match s {
         Some(s) => {
-            let s_hat = right_divide(s);
-            let a = a_tilde - &b_hat * s_hat.transpose();
-            let mut q = q - &s_hat * s_hat.transpose();
-            symmetrize(&mut q);
-            (a, q)
+            let s_hat_t = right_divide_transposed(s);
+            let mut a = product(&b_hat, &s_hat_t);
+            for (x, &v) in a.as_mut_slice().iter_mut().zip(a_tilde.as_slice()) {
+                *x = v - *x;
+            }
+            let mut q_bar = product(&s_hat_t.transpose(), &s_hat_t);
+            for (x, &v) in q_bar.as_mut_slice().iter_mut().zip(q.as_slice()) {
+                *x = v - *x;
+            }
+            q_bar.symmetrize();
+            (a, q_bar)
         }
         None => (a_tilde.clone(), q.clone()),
     };
@@ -436,7 +459,7 @@ fn standardize(
 /// eigenvalues of H (the scalings are similarities, so they are the Hamiltonian's own), and
 /// the closed loop's Schur-like factorisation for the first Newton step.
 struct HamiltonianSolution {
-    y: Mat<f64>,
+    y: Dense,
     rcond: f64,
     stable_eigenvalues: Vec<c64>,
     closed_loop: ClosedLoopFactors,
@@ -459,58 +482,56 @@ struct HamiltonianSolution {
 /// cost of a Lyapunov solve (at n = 64, 0.5 of 0.75 ms). The factorisation holds for the
 /// Schur solution only up to rounding amplified by κ(U11); the step is therefore an inexact
 /// Newton step, kept like every step only if it reduces the residual.
-///
-/// It keeps the matrices the solution was computed from (moved, not copied: a solve that
-/// needs no refinement pays nothing for it).
 struct ClosedLoopFactors {
-    /// The reordered Schur form of the scaled Hamiltonian; T11 is its leading n x n block.
-    t: Mat<f64>,
-    /// Its Schur vectors; U11 is their leading n x n block.
-    z: Mat<f64>,
-    /// [Y'^T | U11^-T], the solve for Y' (U11^-T is formed anyway for rcond(U11)).
-    solve: Mat<f64>,
+    /// T11, the leading n x n block of the reordered Schur form of the scaled Hamiltonian.
+    t11: Dense,
+    /// V = D U11.
+    v: Dense,
+    /// U11^-T (formed anyway for rcond(U11)).
+    inverse_transposed: Dense,
     d: Vec<f64>,
 }
 
 impl ClosedLoopFactors {
     /// Δ solving (Ā - G Y)^T Δ + Δ (Ā - G Y) = -Res for the Schur solution's Y.
-    fn newton_step(&self, residual: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+    fn newton_step(&self, residual: &Dense) -> Result<Dense, Error> {
         let (n, d) = (self.d.len(), &self.d);
-        let (t11, u11) = (self.t.submatrix(0, 0, n, n), self.z.submatrix(0, 0, n, n));
-        let v = Mat::from_fn(n, n, |i, j| d[i] * u11[(i, j)]);
-        let f = product(product(v.transpose(), residual).as_ref(), v.as_ref());
+        let f = product(&transposed_product(&self.v, residual), &self.v);
         // T11^T W + W T11 = F is T W' + W' T^T = F' for T = P T11^T P and W' = P W P, F' = P F P
         // with P the reversal permutation: T is quasi-upper-triangular with standard blocks.
         let reverse = |i: usize| n - 1 - i;
-        let t = Mat::from_fn(n, n, |i, j| t11[(reverse(j), reverse(i))]);
-        let f_reversed = Mat::from_fn(n, n, |i, j| -f[(reverse(i), reverse(j))]);
-        let w_reversed =
-            lyapunov::solve_quasi_triangular(t.as_ref(), f_reversed, Singularity::Perturb)?;
-        let w = Mat::from_fn(n, n, |i, j| w_reversed[(reverse(i), reverse(j))]);
+        let t = Dense::from_fn(n, n, |i, j| self.t11[(reverse(j), reverse(i))]);
+        let f_reversed = Dense::from_fn(n, n, |i, j| -f[(reverse(i), reverse(j))]);
+        let w_reversed = lyapunov::solve_quasi_triangular(&t, f_reversed, Singularity::Perturb)?;
+        let w = Dense::from_fn(n, n, |i, j| w_reversed[(reverse(i), reverse(j))]);
         // Δ = V^-T W V^-1 = D^-1 U11^-T W U11^-1 D^-1.
-        let inverse_transposed = self.solve.subcols(n, n);
         let m = product(
-            product(inverse_transposed, w.as_ref()).as_ref(),
-            inverse_transposed.transpose(),
+            &product(&self.inverse_transposed, &w),
+            &self.inverse_transposed.transpose(),
         );
-        let mut delta = Mat::from_fn(n, n, |i, j| m[(i, j)] / (d[i] * d[j]));
-        symmetrize(&mut delta);
+        let mut delta = Dense::from_fn(n, n, |i, j| m[(i, j)] / (d[i] * d[j]));
+        delta.symmetrize();
         Ok(delta)
     }
 }
 
 fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Error> {
+    with_order!(2 * standard.a.nrows(), order => hamiltonian_solution_in(order, standard))
+}
+
+/// [`hamiltonian_solution`] with H of the order type `order` (2n).
+fn hamiltonian_solution_in<O: Order>(
+    order: O,
+    standard: &Standard,
+) -> Result<HamiltonianSolution, Error> {
     let n = standard.a.nrows();
-    let (g_norm, q_norm) = (
-        frobenius_norm(standard.g.as_ref()),
-        frobenius_norm(standard.q.as_ref()),
-    );
+    let (g_norm, q_norm) = (standard.g.frobenius_norm(), standard.q.frobenius_norm());
     let rho = if g_norm > 0.0 && q_norm > 0.0 {
         nearest_power_of_two((q_norm / g_norm).sqrt())
     } else {
         1.0
     };
-    let mut h = Mat::<f64>::zeros(2 * n, 2 * n);
+    let mut h = Square::zeros_in(order);
     for j in 0..n {
         for i in 0..n {
             h[(i, j)] = standard.a[(i, j)];
@@ -520,7 +541,7 @@ fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Erro
         }
     }
     // The symplectic balancing diag(D, D^-1): d_i from the balancing of rows i and n + i.
-    let scale = balancing_scale(h.as_ref());
+    let scale = balance(&mut h.clone());
     let d: Vec<f64> = (0..n)
         .map(|i| nearest_power_of_two((scale[i] / scale[n + i]).sqrt()))
         .collect();
@@ -538,9 +559,7 @@ fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Erro
     } else {
         Spectrum::General
     };
-    let ordered = reorder_schur(real_schur_with(h.as_ref(), spectrum)?, |lambda| {
-        lambda.re < 0.0
-    })?;
+    let ordered = reorder_schur(square_real_schur(h, spectrum)?, |lambda| lambda.re < 0.0)?;
     let on_axis: Vec<c64> = ordered
         .eigenvalues
         .iter()
@@ -567,16 +586,21 @@ fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Erro
             ),
         });
     }
-    // U11^T Y'^T = U21^T, with U11^-T for rcond(U11).
+    // U11^T Y'^T = U21^T, with U11^-T for rcond(U11): the right-hand sides [U21^T | I].
     let z = ordered.z.as_ref();
-    let u11 = z.submatrix(0, 0, n, n);
-    let combined = solve_with_inverse(
-        u11.transpose().to_owned().as_mut(),
-        z.submatrix(n, 0, n, n).transpose(),
-    );
-    let (y_transposed, inverse_transposed) = combined.as_ref().split_at_col(n);
-    let rcond = 1.0 / (one_norm(u11) * one_norm(inverse_transposed.transpose()));
-    let broke_down = !y_transposed.is_all_finite() || !inverse_transposed.is_all_finite();
+    let u11 = Dense::from_ref(z.submatrix(0, 0, n, n));
+    let mut factors = u11.transpose();
+    let mut combined = Dense::zeros(n, 2 * n);
+    for j in 0..n {
+        for i in 0..n {
+            combined[(i, j)] = z[(n + j, i)];
+        }
+        combined[(j, n + j)] = 1.0;
+    }
+    solve_in_place(factors.as_mut(), combined.as_mut(), Par::Seq);
+    let inverse_transposed = Dense::from_fn(n, n, |i, j| combined[(i, n + j)]);
+    let rcond = 1.0 / (one_norm(u11.as_ref()) * one_norm(inverse_transposed.as_ref().transpose()));
+    let broke_down = !combined.as_slice().iter().all(|x| x.is_finite());
     if broke_down || rcond.is_nan() || rcond <= n as f64 * f64::EPSILON {
         return Err(Error::IllConditioned {
             message: format!(
@@ -586,14 +610,13 @@ fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Erro
             ),
         });
     }
-    // Undo the scalings: Y = rho D^-1 Y' D^-1.
-    let y_scaled = y_transposed.transpose();
-    let mut y = Mat::from_fn(n, n, |i, j| rho * y_scaled[(i, j)] / (d[i] * d[j]));
-    symmetrize(&mut y);
+    // Undo the scalings: Y = rho D^-1 Y' D^-1, Y' the transpose of the solve's first n columns.
+    let mut y = Dense::from_fn(n, n, |i, j| rho * combined[(j, i)] / (d[i] * d[j]));
+    y.symmetrize();
     let closed_loop = ClosedLoopFactors {
-        t: ordered.t,
-        z: ordered.z,
-        solve: combined,
+        t11: Dense::from_ref(ordered.t.as_ref().submatrix(0, 0, n, n)),
+        v: Dense::from_fn(n, n, |i, j| d[i] * u11[(i, j)]),
+        inverse_transposed,
         d,
     };
     let mut stable_eigenvalues = ordered.eigenvalues;
@@ -623,7 +646,7 @@ fn nearest_power_of_two(value: f64) -> f64 {
 /// the residual, an exact one follows.
 fn refine(
     reduced: &Reduced<'_>,
-    y: &mut Mat<f64>,
+    y: &mut Dense,
     evaluation: &mut Evaluation,
     mut factors: Option<ClosedLoopFactors>,
 ) -> usize {
@@ -632,19 +655,23 @@ fn refine(
     while steps < MAX_REFINEMENT_STEPS && evaluation.residual_norm > floor {
         let inexact = factors.take();
         let step = match &inexact {
-            Some(factors) => factors.newton_step(evaluation.residual.as_ref()),
+            Some(factors) => factors.newton_step(&evaluation.residual),
             None => {
                 let closed_loop = reduced.closed_loop(&evaluation.gain);
                 lyapunov::solve(
-                    closed_loop.transpose(),
+                    closed_loop.as_ref().transpose(),
                     evaluation.residual.as_ref(),
                     Singularity::Perturb,
                 )
+                .map(|delta| Dense::from_ref(delta.as_ref()))
             }
         };
         let improved = step.ok().and_then(|delta| {
-            let mut candidate = &*y + &delta;
-            symmetrize(&mut candidate);
+            let mut candidate = y.clone();
+            for (x, &v) in candidate.as_mut_slice().iter_mut().zip(delta.as_slice()) {
+                *x += v;
+            }
+            candidate.symmetrize();
             let candidate_evaluation = reduced.evaluate(&candidate);
             let norm = candidate_evaluation.residual_norm;
             (norm < evaluation.residual_norm).then_some((candidate, candidate_evaluation))
@@ -749,26 +776,28 @@ mod tests {
             let q = Mat::<f64>::identity(n, n);
             let r = Mat::from_fn(2, 2, |i, j| if i == j { 2.0 } else { 0.5 });
             let s = seeded(n, 2, 13) * faer::Scale(0.1);
-            let s = with_cross_term.then_some(s.as_ref());
+            let s = with_cross_term.then(|| Dense::from_ref(s.as_ref()));
             let (q, cholesky) =
                 check_problem(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref()).unwrap();
-            let (a_tilde, b_tilde) = (a.clone(), b.clone());
-            let standard = standardize(&a_tilde, &b_tilde, &q, cholesky.L(), s);
+            let (a_tilde, b_tilde) = (Dense::from_ref(a.as_ref()), Dense::from_ref(b.as_ref()));
+            let standard = standardize(&a_tilde, &b_tilde, &q, cholesky.L(), s.as_ref());
             let reduced = Reduced {
                 a: a_tilde,
                 b: b_tilde,
                 q: &q,
-                s,
+                q_norm: q.frobenius_norm(),
+                s: s.as_ref(),
                 l: cholesky.L(),
             };
             let solution = hamiltonian_solution(&standard).unwrap();
             let evaluation = reduced.evaluate(&solution.y);
             let inexact = solution
                 .closed_loop
-                .newton_step(evaluation.residual.as_ref())
-                .unwrap();
+                .newton_step(&evaluation.residual)
+                .unwrap()
+                .to_mat();
             let exact = lyapunov::solve(
-                reduced.closed_loop(&evaluation.gain).transpose(),
+                reduced.closed_loop(&evaluation.gain).as_ref().transpose(),
                 evaluation.residual.as_ref(),
                 Singularity::Perturb,
             )

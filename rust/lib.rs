@@ -29,6 +29,7 @@
 //! * [`batch`]: the same operations over stacks of problems, in parallel.
 //! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
 //! * [`lu`]: linear solves by LU with partial pivoting.
+//! * `dense`: small dense temporaries, lent to faer as views.
 //! * [`small_matrix`]: fixed-size stack matrices for the small orders of flight models.
 //! * [`double_double`]: double-double arithmetic, for results accurate beyond double precision.
 //! * [`pool`]: a per-thread free list of scratch matrices.
@@ -58,6 +59,7 @@ pub mod allocator;
 pub mod batch;
 pub mod care;
 pub mod ctrb;
+mod dense;
 pub mod discretize;
 pub mod dispatch;
 pub mod double_double;

@@ -24,6 +24,7 @@
 //! The cost is that of the Schur form, about 25 n^3 flops, plus 4 n^3 for the transformations
 //! and n^3 for the triangular solve (the updates are column operations, as in LAPACK's dtrsyl).
 
+use crate::dense::Dense;
 use crate::dispatch::clear_upper_avx_state;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::schur::real_schur;
@@ -59,16 +60,13 @@ pub(crate) fn solve(
     check_square(q, "Q")?;
     check_rows(q, "Q", a.nrows(), "A")?;
     check_finite(q, "Q")?;
-    let n = a.nrows();
     let schur = real_schur(a)?;
     let (t, z) = (schur.t.as_ref(), schur.z.as_ref());
-    let mut f = product(product(z.transpose(), q).as_ref(), z);
-    for j in 0..n {
-        for x in f.col_mut(j).iter_mut() {
-            *x = -*x;
-        }
+    let mut f = Dense::from_ref(product(product(z.transpose(), q).as_ref(), z).as_ref());
+    for x in f.as_mut_slice() {
+        *x = -*x;
     }
-    let y = solve_quasi_triangular(t, f, singularity)?;
+    let y = solve_quasi_triangular(&Dense::from_ref(t), f, singularity)?;
     let mut x = product(product(z, y.as_ref()).as_ref(), z.transpose());
     if is_symmetric(q) {
         symmetrize(&mut x);
@@ -78,10 +76,10 @@ pub(crate) fn solve(
 
 /// Solves T Y + Y T^T = F for quasi-upper-triangular T (2 x 2 blocks in standard form).
 pub(crate) fn solve_quasi_triangular(
-    t: MatRef<'_, f64>,
-    mut f: Mat<f64>,
+    t: &Dense,
+    mut f: Dense,
     singularity: Singularity,
-) -> Result<Mat<f64>, Error> {
+) -> Result<Dense, Error> {
     clear_upper_avx_state();
     let n = t.nrows();
     let mut blocks = Vec::with_capacity(n);
@@ -95,13 +93,13 @@ pub(crate) fn solve_quasi_triangular(
         blocks.push((k, size));
         k += size;
     }
-    let mut y = Mat::<f64>::zeros(n, n);
+    let mut y = Dense::zeros(n, n);
     for &(j0, q) in blocks.iter().rev() {
         let after = j0 + q;
         if after < n {
             // F[:, J] -= Y[:, after..] T[J, after..]^T (the columns of Y already known).
             let known = y.as_ref().subcols(after, n - after);
-            let coupling = t.submatrix(j0, after, q, n - after);
+            let coupling = t.as_ref().submatrix(j0, after, q, n - after);
             faer::linalg::matmul::matmul(
                 f.as_mut().subcols_mut(j0, q),
                 Accum::Add,
@@ -143,10 +141,10 @@ pub(crate) fn solve_quasi_triangular(
                     let value = solved.x[a][c];
                     y[(i0 + a, j0 + c)] = value;
                     if value != 0.0 {
-                        let column = t.col(i0 + a);
-                        let mut target = f.col_mut(j0 + c);
-                        for row in 0..i0 {
-                            target[row] -= value * column[row];
+                        let column = &t.col(i0 + a)[..i0];
+                        let target = &mut f.col_mut(j0 + c)[..i0];
+                        for (x, &t_entry) in target.iter_mut().zip(column) {
+                            *x -= value * t_entry;
                         }
                     }
                 }

@@ -380,6 +380,13 @@ impl<O: Order> Square<O> {
         Self { order, data }
     }
 
+    pub(crate) fn zeros_in(order: O) -> Self {
+        Self {
+            order,
+            data: order.zeros(),
+        }
+    }
+
     pub(crate) fn identity_in(order: O) -> Self {
         let n = order.get();
         let mut data = order.zeros();
@@ -390,7 +397,25 @@ impl<O: Order> Square<O> {
     }
 
     pub(crate) fn to_mat(&self) -> Mat<f64> {
-        Mat::from_fn(self.n(), self.n(), |i, j| self[(i, j)])
+        self.to_mat_scaled(1.0)
+    }
+
+    /// A faer matrix of the entries times `scale`.
+    pub(crate) fn to_mat_scaled(&self, scale: f64) -> Mat<f64> {
+        let n = self.n();
+        let mut out = Mat::zeros(n, n);
+        for j in 0..n {
+            let column = &self.data.as_ref()[j * n..(j + 1) * n];
+            for (x, &value) in out.col_as_slice_mut(j).iter_mut().zip(column) {
+                *x = value * scale;
+            }
+        }
+        out
+    }
+
+    /// A faer view of the matrix.
+    pub(crate) fn as_ref(&self) -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice(self.data.as_ref(), self.n(), self.n())
     }
 
     /// Rows r and r + 1, columns `columns`: x <- cs x + sn y, y <- cs y - sn x.
@@ -544,54 +569,50 @@ pub fn real_schur(a: MatRef<'_, f64>) -> Result<RealSchur, Error> {
 /// The real Schur form of a square, finite matrix whose spectrum has the given structure.
 pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSchur, Error> {
     check_square(a, "A")?;
-    check_finite(a, "A")?;
-    let n = a.nrows();
-    let scale = range_scale(a);
-    let scaled;
-    let a = if scale == 1.0 {
-        a
-    } else {
-        scaled = Mat::from_fn(n, n, |i, j| a[(i, j)] / scale);
-        scaled.as_ref()
-    };
-    if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
-        return with_order!(n, order => small_real_schur(order, a, scale, spectrum));
-    }
-    let reduced = hessenberg(a);
-    let (mut t, mut z) = (
-        Square::from_mat(reduced.h.as_ref()),
-        Square::from_mat(reduced.q.as_ref()),
-    );
-    schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
-    Ok(RealSchur {
-        t: Mat::from_fn(n, n, |i, j| t[(i, j)] * scale),
-        z: z.to_mat(),
-    })
+    with_order!(a.nrows(), order => square_real_schur(Square::from_mat_in(order, a), spectrum))
 }
 
-/// The Schur form of `a` (entries already divided by `scale`) with T multiplied back by
-/// `scale`, for orders up to [`UNBLOCKED_HESSENBERG_MAX_ORDER`]: the unblocked Hessenberg
-/// reduction and the double-shift iteration, at the order type `order`.
-fn small_real_schur<O: Order>(
-    order: O,
-    a: MatRef<'_, f64>,
-    scale: f64,
+/// [`real_schur_with`] of a matrix held as a [`Square`] (as the Riccati solver builds its
+/// Hamiltonian): checked finite, scaled into range, reduced by the unblocked Hessenberg
+/// reduction and the double-shift iteration at the order type of `a` up to
+/// [`UNBLOCKED_HESSENBERG_MAX_ORDER`], by faer's blocked reduction and the QR iteration of
+/// [`schur_of_hessenberg`] above it.
+pub(crate) fn square_real_schur<O: Order>(
+    mut a: Square<O>,
     spectrum: Spectrum,
 ) -> Result<RealSchur, Error> {
-    let n = order.get();
-    let (mut t, mut z) = (Square::from_mat_in(order, a), Square::identity_in(order));
-    reduce_to_hessenberg(&mut t, Some(&mut z));
-    francis_qr(
-        &mut t,
-        Some(&mut z),
-        (0, n.saturating_sub(1)),
-        true,
-        spectrum,
-    )?;
-    Ok(RealSchur {
-        t: Mat::from_fn(n, n, |i, j| t[(i, j)] * scale),
-        z: z.to_mat(),
-    })
+    check_finite(a.as_ref(), "A")?;
+    let n = a.n();
+    let scale = range_scale(a.as_ref());
+    if scale != 1.0 {
+        a.data.as_mut().iter_mut().for_each(|x| *x /= scale);
+    }
+    if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+        let mut z = Square::identity_in(a.order);
+        reduce_to_hessenberg(&mut a, Some(&mut z));
+        francis_qr(
+            &mut a,
+            Some(&mut z),
+            (0, n.saturating_sub(1)),
+            true,
+            spectrum,
+        )?;
+        Ok(RealSchur {
+            t: a.to_mat_scaled(scale),
+            z: z.to_mat(),
+        })
+    } else {
+        let reduced = hessenberg(a.as_ref());
+        let (mut t, mut z) = (
+            Square::from_mat(reduced.h.as_ref()),
+            Square::from_mat(reduced.q.as_ref()),
+        );
+        schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
+        Ok(RealSchur {
+            t: t.to_mat_scaled(scale),
+            z: z.to_mat(),
+        })
+    }
 }
 
 /// Entries of the largest magnitude outside [`SMALL_ENTRY`], 1 / [`SMALL_ENTRY`] are brought
@@ -721,17 +742,11 @@ fn reduce_to_hessenberg<O: Order>(h: &mut Square<O>, mut q: Option<&mut Square<O
     }
 }
 
-/// The diagonal D (powers of two) of the balancing D^-1 A D of a square matrix (see
-/// [`balance`]).
-pub(crate) fn balancing_scale(a: MatRef<'_, f64>) -> Vec<f64> {
-    with_order!(a.nrows(), order => balance(&mut Square::from_mat_in(order, a)))
-}
-
 /// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
 /// row and column i are scaled until their off-diagonal 2-norms are within a factor of two, and
 /// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more. Returns
 /// the diagonal of D.
-fn balance<O: Order>(a: &mut Square<O>) -> Vec<f64> {
+pub(crate) fn balance<O: Order>(a: &mut Square<O>) -> Vec<f64> {
     clear_upper_avx_state();
     let n = a.n();
     let mut scale = vec![1.0; n];

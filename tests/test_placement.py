@@ -131,7 +131,17 @@ def test_robust_placement_against_scipy(n: int, seed: int) -> None:
             theirs = signal.place_poles(A, B, poles)
         their_error = _matched_error(np.linalg.eigvals(A - B @ theirs.gain_matrix), poles)
         our_error = _matched_error(np.linalg.eigvals(A - B @ ours.K), poles)
-        assert our_error <= 10 * their_error + 1e-13, (n, m, our_error, their_error)
+        if m == 1:
+            # One input: the gain is unique, both methods compute it up to rounding, and which
+            # one's rounding places the poles better is luck (scipy's BLAS kernels differ by
+            # CPU). The bound is first-order perturbation theory: |δλ| <= κ(X) ||δ(A - B K)||,
+            # with ||δ(A - B K)|| a few u (||A|| + ||B|| ||K||); here up to 6e-11 at κ = 1e5.
+            scale = np.linalg.norm(A, 2) + np.linalg.norm(B, 2) * np.linalg.norm(ours.K, 2)
+            bound = ours.eigenvector_condition * np.finfo(float).eps * scale
+            assert our_error <= 10 * bound / np.abs(poles).min(), (n, our_error, bound)
+            assert np.abs(ours.K - theirs.gain_matrix).max() <= 1e-6 * np.abs(ours.K).max()
+        else:
+            assert our_error <= 10 * their_error + 1e-13, (n, m, our_error, their_error)
         if ours.eigenvector_condition < 1e6:  # well conditioned: the 1e-8
             assert ours.max_relative_error <= 1e-8
         assert ours.K.shape == (m, n)

@@ -1,0 +1,258 @@
+//! Small dense matrices for the temporaries of the control algorithms.
+//!
+//! A 4-state Riccati solve forms some forty temporaries of order n and m (products, residuals,
+//! gains, factors). As faer matrices each costs an aligned allocation and faer's construction
+//! machinery, and every entry access a bounds-checked strided index, which together cost more
+//! than the arithmetic. [`Dense`] is a plain column-major `Vec<f64>` with its shape: one
+//! unaligned small allocation (the fast path of the extension's allocator), contiguous columns
+//! as slices, and [`Dense::as_ref`] and [`Dense::as_mut`] to lend it to faer as a view (no copy)
+//! for the factorisations and the blocked products of large orders. (Storing the entries inline
+//! up to 8 x 8 was measured 10 % slower on the 4-state Riccati solve: moving the 528-byte
+//! values between functions cost more than the allocations it saved.)
+
+use faer::{Mat, MatMut, MatRef};
+use std::ops::{Index, IndexMut};
+
+/// A column-major matrix.
+#[derive(Clone, Debug)]
+pub(crate) struct Dense {
+    rows: usize,
+    cols: usize,
+    data: Vec<f64>,
+}
+
+impl Dense {
+    /// The rows x cols zero matrix.
+    pub(crate) fn zeros(rows: usize, cols: usize) -> Self {
+        Self {
+            rows,
+            cols,
+            data: vec![0.0; rows * cols],
+        }
+    }
+
+    /// The matrix with entries f(i, j), evaluated column by column.
+    pub(crate) fn from_fn(
+        rows: usize,
+        cols: usize,
+        mut f: impl FnMut(usize, usize) -> f64,
+    ) -> Self {
+        let mut data = Vec::with_capacity(rows * cols);
+        for j in 0..cols {
+            for i in 0..rows {
+                data.push(f(i, j));
+            }
+        }
+        Self { rows, cols, data }
+    }
+
+    /// A copy of a faer matrix (any strides).
+    pub(crate) fn from_ref(a: MatRef<'_, f64>) -> Self {
+        let mut data = Vec::with_capacity(a.nrows() * a.ncols());
+        for j in 0..a.ncols() {
+            match a.col(j).try_as_col_major() {
+                Some(column) => data.extend_from_slice(column.as_slice()),
+                None => data.extend(a.col(j).iter().copied()),
+            }
+        }
+        Self {
+            rows: a.nrows(),
+            cols: a.ncols(),
+            data,
+        }
+    }
+
+    pub(crate) fn nrows(&self) -> usize {
+        self.rows
+    }
+
+    pub(crate) fn ncols(&self) -> usize {
+        self.cols
+    }
+
+    /// Column j.
+    #[inline]
+    pub(crate) fn col(&self, j: usize) -> &[f64] {
+        &self.data[j * self.rows..(j + 1) * self.rows]
+    }
+
+    /// Column j, mutably.
+    #[inline]
+    pub(crate) fn col_mut(&mut self, j: usize) -> &mut [f64] {
+        &mut self.data[j * self.rows..(j + 1) * self.rows]
+    }
+
+    /// All entries, column by column.
+    pub(crate) fn as_slice(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// All entries, column by column, mutably.
+    pub(crate) fn as_mut_slice(&mut self) -> &mut [f64] {
+        &mut self.data
+    }
+
+    /// A faer view of the matrix.
+    pub(crate) fn as_ref(&self) -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice(&self.data, self.rows, self.cols)
+    }
+
+    /// A mutable faer view of the matrix.
+    pub(crate) fn as_mut(&mut self) -> MatMut<'_, f64> {
+        MatMut::from_column_major_slice_mut(&mut self.data, self.rows, self.cols)
+    }
+
+    /// A faer matrix holding the same values.
+    pub(crate) fn to_mat(&self) -> Mat<f64> {
+        let mut out = Mat::zeros(self.rows, self.cols);
+        for j in 0..self.cols {
+            out.col_as_slice_mut(j).copy_from_slice(self.col(j));
+        }
+        out
+    }
+
+    /// The transpose.
+    pub(crate) fn transpose(&self) -> Self {
+        Self::from_fn(self.cols, self.rows, |i, j| self[(j, i)])
+    }
+
+    /// X <- (X + X^T) / 2, for square X.
+    pub(crate) fn symmetrize(&mut self) {
+        debug_assert_eq!(self.rows, self.cols);
+        let n = self.rows;
+        for j in 0..n {
+            for i in j + 1..n {
+                let mean = 0.5 * (self[(i, j)] + self[(j, i)]);
+                self[(i, j)] = mean;
+                self[(j, i)] = mean;
+            }
+        }
+    }
+
+    /// sqrt(sum x_ij^2), by a plain sum of squares while it stays in the normal range, faer's
+    /// scaled sum otherwise (as [`crate::norm::frobenius_norm`]).
+    pub(crate) fn frobenius_norm(&self) -> f64 {
+        crate::norm::frobenius_norm(self.as_ref())
+    }
+}
+
+impl Index<(usize, usize)> for Dense {
+    type Output = f64;
+    #[inline]
+    fn index(&self, (i, j): (usize, usize)) -> &f64 {
+        debug_assert!(i < self.rows && j < self.cols);
+        &self.data[i + j * self.rows]
+    }
+}
+
+impl IndexMut<(usize, usize)> for Dense {
+    #[inline]
+    fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut f64 {
+        debug_assert!(i < self.rows && j < self.cols);
+        &mut self.data[i + j * self.rows]
+    }
+}
+
+/// Products of at most this many multiply-adds are plain loops, larger ones faer's blocked
+/// kernel (as [`crate::small_matrix::product`]).
+const LOOP_PRODUCT_MAX_WORK: usize = 16 * 16 * 16;
+
+/// lhs * rhs. Each entry of a small product is the sum over k, in order, of
+/// lhs[i, k] rhs[k, j], as [`crate::small_matrix::product`] forms it.
+pub(crate) fn product(lhs: &Dense, rhs: &Dense) -> Dense {
+    let (rows, inner, cols) = (lhs.rows, lhs.cols, rhs.cols);
+    debug_assert_eq!(inner, rhs.rows);
+    let mut out = Dense::zeros(rows, cols);
+    if rows * inner * cols > LOOP_PRODUCT_MAX_WORK {
+        faer::linalg::matmul::matmul(
+            out.as_mut(),
+            faer::Accum::Replace,
+            lhs.as_ref(),
+            rhs.as_ref(),
+            1.0,
+            faer::Par::Seq,
+        );
+        return out;
+    }
+    for j in 0..cols {
+        let (rhs_column, column) = (rhs.col(j), &mut out.data[j * rows..(j + 1) * rows]);
+        for (k, &coefficient) in rhs_column.iter().enumerate() {
+            for (entry, x) in column.iter_mut().zip(lhs.col(k)) {
+                *entry += x * coefficient;
+            }
+        }
+    }
+    out
+}
+
+/// lhs^T * rhs: each entry a dot product of two columns, summed in order (the same values as
+/// [`product`] of the transpose).
+pub(crate) fn transposed_product(lhs: &Dense, rhs: &Dense) -> Dense {
+    let (rows, inner, cols) = (lhs.cols, lhs.rows, rhs.cols);
+    debug_assert_eq!(inner, rhs.rows);
+    if rows * inner * cols > LOOP_PRODUCT_MAX_WORK {
+        let mut out = Dense::zeros(rows, cols);
+        faer::linalg::matmul::matmul(
+            out.as_mut(),
+            faer::Accum::Replace,
+            lhs.as_ref().transpose(),
+            rhs.as_ref(),
+            1.0,
+            faer::Par::Seq,
+        );
+        return out;
+    }
+    Dense::from_fn(rows, cols, |i, j| {
+        let mut sum = 0.0;
+        for (x, y) in lhs.col(i).iter().zip(rhs.col(j)) {
+            sum += x * y;
+        }
+        sum
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_matrices::seeded;
+
+    #[test]
+    fn products_agree_with_faer() {
+        for (rows, inner, cols) in [(4, 4, 4), (4, 2, 3), (1, 5, 1), (0, 3, 2), (20, 20, 20)] {
+            let (a, b) = (seeded(rows, inner, 1), seeded(inner, cols, 2));
+            let (da, db) = (Dense::from_ref(a.as_ref()), Dense::from_ref(b.as_ref()));
+            let expected = &a * &b;
+            let found = product(&da, &db).to_mat();
+            assert!((&found - &expected).norm_max() <= 1e-14 * (inner as f64 + 1.0));
+            let at = Dense::from_ref(a.transpose());
+            let found = transposed_product(&at, &db).to_mat();
+            assert!((&found - &expected).norm_max() <= 1e-14 * (inner as f64 + 1.0));
+        }
+    }
+
+    #[test]
+    fn small_products_round_like_the_faer_matrix_product_loop() {
+        let (a, b) = (seeded(4, 4, 3), seeded(4, 2, 4));
+        let expected = crate::small_matrix::product(a.as_ref(), b.as_ref());
+        let found = product(&Dense::from_ref(a.as_ref()), &Dense::from_ref(b.as_ref()));
+        assert_eq!(found.to_mat(), expected);
+        let found = transposed_product(
+            &Dense::from_ref(a.transpose()),
+            &Dense::from_ref(b.as_ref()),
+        );
+        assert_eq!(found.to_mat(), expected);
+    }
+
+    #[test]
+    fn views_copies_and_symmetrisation() {
+        let a = seeded(9, 9, 5);
+        let mut d = Dense::from_ref(a.transpose());
+        assert_eq!(d.to_mat(), a.transpose().to_owned());
+        assert_eq!(d.as_ref(), a.transpose());
+        d.as_mut()[(3, 4)] = 7.0;
+        assert_eq!(d[(3, 4)], 7.0);
+        d.symmetrize();
+        assert_eq!(d[(3, 4)], d[(4, 3)]);
+        assert_eq!(d.transpose().to_mat(), d.to_mat().transpose().to_owned());
+    }
+}
