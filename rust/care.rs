@@ -74,8 +74,8 @@ use crate::lyapunov::{self, Singularity, symmetrize};
 use crate::norm::{frobenius_norm, max_abs, one_norm};
 use crate::reorder::reorder_schur;
 use crate::schur::{
-    Dynamic, Fixed, Order, Spectrum, Square, balance, eigenvalues_near, square_real_schur,
-    with_order,
+    Dynamic, Finished, Fixed, Order, Spectrum, Square, Until, balance, eigenvalues_near,
+    quasi_triangular_eigenvalues, real_schur_with, square_real_schur, with_order,
 };
 use faer::linalg::solvers::Llt;
 use faer::linalg::triangular_solve::{
@@ -483,8 +483,11 @@ struct HamiltonianSolution {
 /// Schur solution only up to rounding amplified by κ(U11); the step is therefore an inexact
 /// Newton step, kept like every step only if it reduces the residual.
 struct ClosedLoopFactors {
-    /// T11, the leading n x n block of the reordered Schur form of the scaled Hamiltonian.
+    /// T11, the leading n x n block of the reordered Schur form of the scaled Hamiltonian, or
+    /// of its partial Schur form ([`Until::UnstableHalf`]), where it is upper Hessenberg.
     t11: Dense,
+    /// For a Hessenberg T11, estimates of its eigenvalues (shifts for its Schur form).
+    hessenberg: Option<Vec<c64>>,
     /// V = D U11.
     v: Dense,
     /// U11^-T (formed anyway for rcond(U11)).
@@ -496,18 +499,35 @@ impl ClosedLoopFactors {
     /// Δ solving (Ā - G Y)^T Δ + Δ (Ā - G Y) = -Res for the Schur solution's Y.
     fn newton_step(&self, residual: &Dense) -> Result<Dense, Error> {
         let (n, d) = (self.d.len(), &self.d);
-        let f = product(&transposed_product(&self.v, residual), &self.v);
+        // A Hessenberg T11 = Q S Q^T: V T11 V^-1 = (V Q) S (V Q)^-1, and (V Q)^-T = V^-T Q.
+        let triangularised = match &self.hessenberg {
+            Some(estimates) => {
+                let schur = real_schur_with(self.t11.as_ref(), Spectrum::Near(estimates))?;
+                let q = Dense::from_ref(schur.z.as_ref());
+                Some((
+                    Dense::from_ref(schur.t.as_ref()),
+                    product(&self.v, &q),
+                    product(&self.inverse_transposed, &q),
+                ))
+            }
+            None => None,
+        };
+        let (t11, v, inverse_transposed) = match &triangularised {
+            Some((t11, v, inverse_transposed)) => (t11, v, inverse_transposed),
+            None => (&self.t11, &self.v, &self.inverse_transposed),
+        };
+        let f = product(&transposed_product(v, residual), v);
         // T11^T W + W T11 = F is T W' + W' T^T = F' for T = P T11^T P and W' = P W P, F' = P F P
         // with P the reversal permutation: T is quasi-upper-triangular with standard blocks.
         let reverse = |i: usize| n - 1 - i;
-        let t = Dense::from_fn(n, n, |i, j| self.t11[(reverse(j), reverse(i))]);
+        let t = Dense::from_fn(n, n, |i, j| t11[(reverse(j), reverse(i))]);
         let f_reversed = Dense::from_fn(n, n, |i, j| -f[(reverse(i), reverse(j))]);
         let w_reversed = lyapunov::solve_quasi_triangular(&t, f_reversed, Singularity::Perturb)?;
         let w = Dense::from_fn(n, n, |i, j| w_reversed[(reverse(i), reverse(j))]);
         // Δ = V^-T W V^-1 = D^-1 U11^-T W U11^-1 D^-1.
         let m = product(
-            &product(&self.inverse_transposed, &w),
-            &self.inverse_transposed.transpose(),
+            &product(inverse_transposed, &w),
+            &inverse_transposed.transpose(),
         );
         let mut delta = Dense::from_fn(n, n, |i, j| m[(i, j)] / (d[i] * d[j]));
         delta.symmetrize();
@@ -559,35 +579,27 @@ fn hamiltonian_solution_in<O: Order>(
     } else {
         Spectrum::General
     };
-    let ordered = reorder_schur(square_real_schur(h, spectrum)?, |lambda| lambda.re < 0.0)?;
-    let on_axis: Vec<c64> = ordered
-        .eigenvalues
-        .iter()
-        .copied()
-        .filter(|lambda| lambda.re.abs() <= AXIS_TOLERANCE * h_norm)
-        .collect();
-    if !on_axis.is_empty() || ordered.selected != n {
-        let listed: Vec<String> = on_axis
-            .iter()
-            .map(|z| crate::error::format_complex(*z))
-            .collect();
-        return Err(Error::NoStabilizingSolution {
-            message: format!(
-                "the Riccati equation has no stabilising solution: the Hamiltonian matrix has \
-                 {} eigenvalue(s) on the imaginary axis to working precision ({}; |Re| <= \
-                 {:.1e} ||H||), so some undamped mode can be neither moved by B nor seen by Q",
-                on_axis.len().max(2 * n - 2 * ordered.selected.min(n)),
-                if listed.is_empty() {
-                    "stable and unstable eigenvalues do not pair up".to_owned()
-                } else {
-                    listed.join(", ")
-                },
-                AXIS_TOLERANCE
-            ),
-        });
-    }
+    let margin = AXIS_TOLERANCE * h_norm;
+    let (schur, finished) = square_real_schur(h, spectrum, Until::UnstableHalf { margin })?;
+    let (t, z, stable_eigenvalues) = match finished {
+        // The trailing half holds the unstable eigenvalues, each with Re λ > the margin, and
+        // the leading Hessenberg block the stable ones: by the symmetry of the spectrum their
+        // mirror images -λ̄.
+        Finished::UnstableHalf => {
+            let unstable = quasi_triangular_eigenvalues(schur.t.as_ref().submatrix(n, n, n, n));
+            let stable = unstable.iter().map(|z| c64::new(-z.re, z.im)).collect();
+            (schur.t, schur.z, stable)
+        }
+        Finished::Complete => {
+            let ordered = reorder_schur(schur, |lambda| lambda.re < 0.0)?;
+            check_separated(&ordered.eigenvalues, ordered.selected, n, margin)?;
+            let mut stable = ordered.eigenvalues;
+            stable.truncate(n);
+            (ordered.t, ordered.z, stable)
+        }
+    };
     // U11^T Y'^T = U21^T, with U11^-T for rcond(U11): the right-hand sides [U21^T | I].
-    let z = ordered.z.as_ref();
+    let z = z.as_ref();
     let u11 = Dense::from_ref(z.submatrix(0, 0, n, n));
     let mut factors = u11.transpose();
     let mut combined = Dense::zeros(n, 2 * n);
@@ -614,18 +626,53 @@ fn hamiltonian_solution_in<O: Order>(
     let mut y = Dense::from_fn(n, n, |i, j| rho * combined[(j, i)] / (d[i] * d[j]));
     y.symmetrize();
     let closed_loop = ClosedLoopFactors {
-        t11: Dense::from_ref(ordered.t.as_ref().submatrix(0, 0, n, n)),
+        t11: Dense::from_ref(t.as_ref().submatrix(0, 0, n, n)),
+        hessenberg: (finished == Finished::UnstableHalf).then(|| stable_eigenvalues.clone()),
         v: Dense::from_fn(n, n, |i, j| d[i] * u11[(i, j)]),
         inverse_transposed,
         d,
     };
-    let mut stable_eigenvalues = ordered.eigenvalues;
-    stable_eigenvalues.truncate(n);
     Ok(HamiltonianSolution {
         y,
         rcond,
         stable_eigenvalues,
         closed_loop,
+    })
+}
+
+/// The error for a Hamiltonian with eigenvalues within `margin` of the imaginary axis, or whose
+/// complete, reordered Schur form does not lead with exactly n stable ones (`selected`).
+fn check_separated(
+    eigenvalues: &[c64],
+    selected: usize,
+    n: usize,
+    margin: f64,
+) -> Result<(), Error> {
+    let on_axis: Vec<c64> = eigenvalues
+        .iter()
+        .copied()
+        .filter(|lambda| lambda.re.abs() <= margin)
+        .collect();
+    if on_axis.is_empty() && selected == n {
+        return Ok(());
+    }
+    let listed: Vec<String> = on_axis
+        .iter()
+        .map(|z| crate::error::format_complex(*z))
+        .collect();
+    Err(Error::NoStabilizingSolution {
+        message: format!(
+            "the Riccati equation has no stabilising solution: the Hamiltonian matrix has {} \
+             eigenvalue(s) on the imaginary axis to working precision ({}; |Re| <= {:.1e} \
+             ||H||), so some undamped mode can be neither moved by B nor seen by Q",
+            on_axis.len().max(2 * n - 2 * selected.min(n)),
+            if listed.is_empty() {
+                "stable and unstable eigenvalues do not pair up".to_owned()
+            } else {
+                listed.join(", ")
+            },
+            AXIS_TOLERANCE
+        ),
     })
 }
 

@@ -491,6 +491,7 @@ impl<O: Order> Square<O> {
 /// roughly halves the cost of a QR sweep at the small orders of flight-control models.
 impl<O: Order> Square<O> {
     /// [`Square::reflect_rows`] for a reflector of length `N`.
+    #[inline(always)]
     pub(crate) fn reflect_rows_fixed<const N: usize>(
         &mut self,
         k: usize,
@@ -517,6 +518,7 @@ impl<O: Order> Square<O> {
     /// [`Square::reflect_columns`] for a reflector of length `N`.
     // Row i of N column slices at once: an index, not an iterator, is the natural form.
     #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
     pub(crate) fn reflect_columns_fixed<const N: usize>(
         &mut self,
         k: usize,
@@ -525,22 +527,15 @@ impl<O: Order> Square<O> {
         rows: Range<usize>,
     ) {
         let n = self.n();
-        // Split off column by column: chunks_exact_mut would divide by n (an integer division,
-        // tens of cycles, at every reflector).
-        let mut rest = &mut self.data.as_mut()[k * n..(k + N) * n];
-        let columns: [&mut [f64]; N] = std::array::from_fn(|_| {
-            let (column, after) = std::mem::take(&mut rest).split_at_mut(n);
-            rest = after;
-            &mut column[rows.clone()]
-        });
-        for i in 0..rows.len() {
+        let columns = &mut self.data.as_mut()[k * n..(k + N) * n];
+        for i in rows {
             let mut sum = 0.0;
             for r in 0..N {
-                sum += w[r] * columns[r][i];
+                sum += w[r] * columns[r * n + i];
             }
             let scaled = tau * sum;
             for r in 0..N {
-                columns[r][i] -= scaled * w[r];
+                columns[r * n + i] -= scaled * w[r];
             }
         }
     }
@@ -569,18 +564,22 @@ pub fn real_schur(a: MatRef<'_, f64>) -> Result<RealSchur, Error> {
 /// The real Schur form of a square, finite matrix whose spectrum has the given structure.
 pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSchur, Error> {
     check_square(a, "A")?;
-    with_order!(a.nrows(), order => square_real_schur(Square::from_mat_in(order, a), spectrum))
+    with_order!(a.nrows(), order => {
+        square_real_schur(Square::from_mat_in(order, a), spectrum, Until::Complete)
+            .map(|(schur, _)| schur)
+    })
 }
 
 /// [`real_schur_with`] of a matrix held as a [`Square`] (as the Riccati solver builds its
-/// Hamiltonian): checked finite, scaled into range, reduced by the unblocked Hessenberg
-/// reduction and the double-shift iteration at the order type of `a` up to
-/// [`UNBLOCKED_HESSENBERG_MAX_ORDER`], by faer's blocked reduction and the QR iteration of
-/// [`schur_of_hessenberg`] above it.
+/// Hamiltonian), possibly partial (see [`Until`]; up to [`UNBLOCKED_HESSENBERG_MAX_ORDER`]):
+/// checked finite, scaled into range, reduced by the unblocked Hessenberg reduction and the
+/// double-shift iteration at the order type of `a` up to that order, by faer's blocked
+/// reduction and the QR iteration of [`schur_of_hessenberg`] above it.
 pub(crate) fn square_real_schur<O: Order>(
     mut a: Square<O>,
     spectrum: Spectrum,
-) -> Result<RealSchur, Error> {
+    until: Until,
+) -> Result<(RealSchur, Finished), Error> {
     check_finite(a.as_ref(), "A")?;
     let n = a.n();
     let scale = range_scale(a.as_ref());
@@ -590,17 +589,26 @@ pub(crate) fn square_real_schur<O: Order>(
     if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         let mut z = Square::identity_in(a.order);
         reduce_to_hessenberg(&mut a, Some(&mut z));
-        francis_qr(
+        // The iteration works on A / scale.
+        let until = match until {
+            Until::UnstableHalf { margin } => Until::UnstableHalf {
+                margin: margin / scale,
+            },
+            Until::Complete => Until::Complete,
+        };
+        let finished = francis_qr_until(
             &mut a,
             Some(&mut z),
             (0, n.saturating_sub(1)),
             true,
             spectrum,
+            until,
         )?;
-        Ok(RealSchur {
+        let schur = RealSchur {
             t: a.to_mat_scaled(scale),
             z: z.to_mat(),
-        })
+        };
+        Ok((schur, finished))
     } else {
         let reduced = hessenberg(a.as_ref());
         let (mut t, mut z) = (
@@ -608,10 +616,11 @@ pub(crate) fn square_real_schur<O: Order>(
             Square::from_mat(reduced.q.as_ref()),
         );
         schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
-        Ok(RealSchur {
+        let schur = RealSchur {
             t: t.to_mat_scaled(scale),
             z: z.to_mat(),
-        })
+        };
+        Ok((schur, Finished::Complete))
     }
 }
 
@@ -900,6 +909,7 @@ pub fn standardize_block(a: f64, b: f64, c: f64, d: f64) -> StandardBlock {
 
 /// The Householder reflector I - τ [1; v][1; v]^T that maps x to β e1: returns (β, τ) and
 /// leaves v in x[1..]. τ = 0 (the identity) when x[1..] is zero.
+#[inline(always)]
 pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
     let alpha = x[0];
     let tail_squares: f64 = x[1..].iter().map(|v| v * v).sum();
@@ -954,15 +964,50 @@ pub(crate) fn schur_of_hessenberg(
 /// eigenvalues.
 pub(crate) fn francis_qr<O: Order>(
     h: &mut Square<O>,
+    z: Option<&mut Square<O>>,
+    window: (usize, usize),
+    full: bool,
+    spectrum: Spectrum,
+) -> Result<(), Error> {
+    francis_qr_until(h, z, window, full, spectrum, Until::Complete).map(|_| ())
+}
+
+/// How much of the Schur form the QR iteration forms.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Until {
+    /// All of it.
+    Complete,
+    /// Only until the trailing half of the eigenvalues of the whole matrix (even order) has
+    /// deflated, if those all have Re λ > `margin`: the unstable half of a Hamiltonian
+    /// spectrum, which the estimated shifts of [`Spectrum::Hamiltonian`] deflate first. The
+    /// leading columns of Z then span the stable invariant subspace, which is all the Riccati
+    /// solver needs, and the leading half of T stays upper Hessenberg (the sweeps that would
+    /// triangularise it, a fifth of the iteration at order 8, are saved). Should any other
+    /// eigenvalue deflate among the trailing half, the iteration goes on to the complete form.
+    UnstableHalf { margin: f64 },
+}
+
+/// Whether the QR iteration stopped early ([`Until::UnstableHalf`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Finished {
+    Complete,
+    UnstableHalf,
+}
+
+/// [`francis_qr`] that may stop early (see [`Until`]).
+pub(crate) fn francis_qr_until<O: Order>(
+    h: &mut Square<O>,
     mut z: Option<&mut Square<O>>,
     (lo, hi): (usize, usize),
     full: bool,
     spectrum: Spectrum,
-) -> Result<(), Error> {
+    until: Until,
+) -> Result<Finished, Error> {
     clear_upper_avx_state();
+
     let n = h.n();
     if n == 0 {
-        return Ok(());
+        return Ok(Finished::Complete);
     }
     let ulp = f64::EPSILON;
     let small = f64::MIN_POSITIVE * (n as f64 / ulp);
@@ -970,6 +1015,11 @@ pub(crate) fn francis_qr<O: Order>(
     let mut iterations_since_deflation = 0;
     let whole = (lo, hi) == (0, n - 1);
     let mut mirrors = Mirrors::for_spectrum(spectrum, whole.then_some(&*h));
+    // Until::UnstableHalf: the margin, while every eigenvalue deflated so far exceeds it.
+    let mut unstable_margin = match until {
+        Until::UnstableHalf { margin } if whole && n.is_multiple_of(2) => Some(margin),
+        _ => None,
+    };
     // The window is rows and columns l..=i; the eigenvalues below i have converged.
     let mut i = hi;
     loop {
@@ -1046,7 +1096,12 @@ pub(crate) fn francis_qr<O: Order>(
                         *x = h[(k + r, k - 1)];
                     }
                 }
-                let (beta, tau) = reflector(&mut v[..rows]);
+                // Lengths fixed at compile time: the reflector's loops unroll.
+                let (beta, tau) = if rows == 3 {
+                    reflector(&mut v[..3])
+                } else {
+                    reflector(&mut v[..2])
+                };
                 if k > m {
                     h[(k, k - 1)] = beta;
                     h[(k + 1, k - 1)] = 0.0;
@@ -1115,8 +1170,18 @@ pub(crate) fn francis_qr<O: Order>(
             }
         }
         iterations_since_deflation = 0;
+        if let Some(margin) = unstable_margin {
+            // Re λ of the block's eigenvalues: its diagonal (a standard 2 x 2 block's is a, a).
+            if (l..=i).all(|k| h[(k, k)] > margin) {
+                if l == n / 2 {
+                    return Ok(Finished::UnstableHalf);
+                }
+            } else {
+                unstable_margin = None;
+            }
+        }
         if l == lo {
-            return Ok(());
+            return Ok(Finished::Complete);
         }
         i = l - 1;
     }
