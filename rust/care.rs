@@ -67,21 +67,20 @@
 //! [`AXIS_TOLERANCE`] ||H||_F of the imaginary axis (no stabilising solution: an undamped mode
 //! that the input cannot move or the weight does not see); U11 singular to working precision.
 
-use crate::dense::{Dense, product, transposed_product};
+use crate::dense::{
+    Dense, cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place,
+    transposed_product,
+};
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::lu::{solve_in_place, solve_with_inverse};
-use crate::lyapunov::{self, Singularity, symmetrize};
+use crate::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity, symmetrize};
 use crate::norm::{frobenius_norm, max_abs, one_norm};
 use crate::reorder::reorder_schur;
 use crate::schur::{
     Dynamic, Finished, Fixed, Order, Spectrum, Square, Until, balance, eigenvalues_near,
     quasi_triangular_eigenvalues, real_schur_with, square_real_schur, with_order,
 };
-use faer::linalg::solvers::Llt;
-use faer::linalg::triangular_solve::{
-    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
-};
-use faer::{Mat, MatRef, Par, Side, c64};
+use faer::{Mat, MatRef, Par, c64};
 
 /// Eigenvalues of H with |Re λ| <= AXIS_TOLERANCE ||H||_F count as on the imaginary axis.
 pub const AXIS_TOLERANCE: f64 = 100.0 * f64::EPSILON;
@@ -162,7 +161,7 @@ struct Reduced<'a> {
     /// ||Q||_F.
     q_norm: f64,
     s: Option<&'a Dense>,
-    l: MatRef<'a, f64>,
+    l: &'a Dense,
 }
 
 impl Reduced<'_> {
@@ -176,8 +175,8 @@ impl Reduced<'_> {
                 }
             }
         }
-        solve_lower_triangular_in_place(self.l, gain.as_mut(), Par::Seq);
-        solve_upper_triangular_in_place(self.l.transpose(), gain.as_mut(), Par::Seq);
+        solve_lower_in_place(self.l, &mut gain);
+        solve_lower_transposed_in_place(self.l, &mut gain);
         gain
     }
 
@@ -240,7 +239,7 @@ pub fn solve_care(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<Care, Error> {
-    let (q, cholesky) = check_problem(a, b, q, r)?;
+    let (q, l) = check_problem(a, b, q, r)?;
     let (n, m) = (a.nrows(), b.ncols());
     if let Some(s) = options.s {
         check_rows(s, "S", n, "A")?;
@@ -255,20 +254,19 @@ pub fn solve_care(
         }
         check_finite(s, "S")?;
     }
-    let l = cholesky.L();
     let (a_tilde, b_tilde) = match options.e {
         Some(e) => remove_descriptor(a, b, e)?,
         None => (Dense::from_ref(a), Dense::from_ref(b)),
     };
     let s = options.s.map(Dense::from_ref);
-    let standard = standardize(&a_tilde, &b_tilde, &q, l, s.as_ref());
+    let standard = standardize(&a_tilde, &b_tilde, &q, &l, s.as_ref());
     let reduced = Reduced {
         a: a_tilde,
         b: b_tilde,
         q_norm: q.frobenius_norm(),
         q: &q,
         s: s.as_ref(),
-        l,
+        l: &l,
     };
     if n == 0 {
         return Ok(Care {
@@ -288,7 +286,7 @@ pub fn solve_care(
     } = hamiltonian_solution(&standard)?;
     let mut evaluation = reduced.evaluate(&y);
     let refinement_steps = if options.refine {
-        refine(&reduced, &mut y, &mut evaluation, Some(factors))
+        refine(&reduced, &mut y, &mut evaluation, factors)
     } else {
         0
     };
@@ -298,6 +296,7 @@ pub fn solve_care(
     // The stable eigenvalues of H are those of the closed loop of the exact solution: as
     // shifts they make the QR iteration converge in fewer sweeps.
     let closed_loop_eigenvalues = eigenvalues_near(closed_loop.as_ref(), &stable_eigenvalues)?;
+    check_stabilising(&closed_loop_eigenvalues)?;
     // X = E^-T Y E^-1.
     let (x, residual) = match options.e {
         Some(e) => {
@@ -327,13 +326,13 @@ pub fn solve_care(
 
 /// The checks shared by the algebraic and differential Riccati equations: A square and finite,
 /// B with n rows, Q (n x n) and R (m x m) finite and symmetric, R positive definite. Returns
-/// Q symmetrised and the Cholesky factorisation of R.
+/// Q symmetrised and the Cholesky factor L of R = L L^T.
 pub(crate) fn check_problem(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
-) -> Result<(Dense, Llt<f64>), Error> {
+) -> Result<(Dense, Dense), Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let n = a.nrows();
@@ -341,16 +340,13 @@ pub(crate) fn check_problem(
     check_finite(b, "B")?;
     let q = symmetric(q, "Q", n, "A")?;
     let r = symmetric(r, "R", b.ncols(), "the columns of B")?;
-    let cholesky = r
-        .as_ref()
-        .llt(Side::Lower)
-        .map_err(|_| Error::NotPositiveDefinite {
-            arg: "R",
-            message: "R must be symmetric positive definite, but its Cholesky factorisation \
+    let l = cholesky(&r).ok_or_else(|| Error::NotPositiveDefinite {
+        arg: "R",
+        message: "R must be symmetric positive definite, but its Cholesky factorisation \
                   failed: R has an eigenvalue <= 0 (to working precision)"
-                .into(),
-        })?;
-    Ok((q, cholesky))
+            .into(),
+    })?;
+    Ok((q, l))
 }
 
 /// A square, finite, symmetric (to [`SYMMETRY_TOLERANCE`]) matrix, symmetrised.
@@ -423,13 +419,13 @@ fn standardize(
     a_tilde: &Dense,
     b_tilde: &Dense,
     q: &Dense,
-    l: MatRef<'_, f64>,
+    l: &Dense,
     s: Option<&Dense>,
 ) -> Standard {
     // X L^T = Y  <=>  L X^T = Y^T: returns X^T.
     let right_divide_transposed = |y: &Dense| {
         let mut transposed = y.transpose();
-        solve_lower_triangular_in_place(l, transposed.as_mut(), Par::Seq);
+        solve_lower_in_place(l, &mut transposed);
         transposed
     };
     let b_hat_t = right_divide_transposed(b_tilde);
@@ -457,12 +453,13 @@ fn standardize(
 
 /// Y from the ordered Schur form of the scaled Hamiltonian, rcond(U11), the stable
 /// eigenvalues of H (the scalings are similarities, so they are the Hamiltonian's own), and
-/// the closed loop's Schur-like factorisation for the first Newton step.
+/// above [`KRONECKER_MAX_ORDER`] the closed loop's Schur-like factorisation for the first
+/// Newton step (up to that order an exact step, solved directly, costs less).
 struct HamiltonianSolution {
     y: Dense,
     rcond: f64,
     stable_eigenvalues: Vec<c64>,
-    closed_loop: ClosedLoopFactors,
+    closed_loop: Option<ClosedLoopFactors>,
 }
 
 /// The closed loop of the Schur solution as V T11 V^-1.
@@ -625,13 +622,13 @@ fn hamiltonian_solution_in<O: Order>(
     // Undo the scalings: Y = rho D^-1 Y' D^-1, Y' the transpose of the solve's first n columns.
     let mut y = Dense::from_fn(n, n, |i, j| rho * combined[(j, i)] / (d[i] * d[j]));
     y.symmetrize();
-    let closed_loop = ClosedLoopFactors {
+    let closed_loop = (n > KRONECKER_MAX_ORDER).then(|| ClosedLoopFactors {
         t11: Dense::from_ref(t.as_ref().submatrix(0, 0, n, n)),
         hessenberg: (finished == Finished::UnstableHalf).then(|| stable_eigenvalues.clone()),
         v: Dense::from_fn(n, n, |i, j| d[i] * u11[(i, j)]),
         inverse_transposed,
         d,
-    };
+    });
     Ok(HamiltonianSolution {
         y,
         rcond,
@@ -672,6 +669,30 @@ fn check_separated(
                 listed.join(", ")
             },
             AXIS_TOLERANCE
+        ),
+    })
+}
+
+/// The error for a solution whose closed loop is not stable: the Hamiltonian's eigenvalues
+/// were separated by the imaginary axis, but some pair so ill-conditioned that the computed
+/// stable subspace is not the stable one.
+fn check_stabilising(closed_loop_eigenvalues: &[c64]) -> Result<(), Error> {
+    let unstable: Vec<String> = closed_loop_eigenvalues
+        .iter()
+        .filter(|lambda| lambda.re >= 0.0 || lambda.re.is_nan())
+        .map(|z| crate::error::format_complex(*z))
+        .collect();
+    if unstable.is_empty() {
+        return Ok(());
+    }
+    Err(Error::NoStabilizingSolution {
+        message: format!(
+            "the Riccati equation has no stabilising solution to working precision: the \
+             computed solution leaves the closed loop with {} eigenvalue(s) of A - B K in \
+             Re >= 0 ({}), the Hamiltonian's stable and unstable eigenvalues being too \
+             ill-conditioned to separate",
+            unstable.len(),
+            unstable.join(", ")
         ),
     })
 }
@@ -824,22 +845,22 @@ mod tests {
             let r = Mat::from_fn(2, 2, |i, j| if i == j { 2.0 } else { 0.5 });
             let s = seeded(n, 2, 13) * faer::Scale(0.1);
             let s = with_cross_term.then(|| Dense::from_ref(s.as_ref()));
-            let (q, cholesky) =
-                check_problem(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref()).unwrap();
+            let (q, l) = check_problem(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref()).unwrap();
             let (a_tilde, b_tilde) = (Dense::from_ref(a.as_ref()), Dense::from_ref(b.as_ref()));
-            let standard = standardize(&a_tilde, &b_tilde, &q, cholesky.L(), s.as_ref());
+            let standard = standardize(&a_tilde, &b_tilde, &q, &l, s.as_ref());
             let reduced = Reduced {
                 a: a_tilde,
                 b: b_tilde,
                 q: &q,
                 q_norm: q.frobenius_norm(),
                 s: s.as_ref(),
-                l: cholesky.L(),
+                l: &l,
             };
             let solution = hamiltonian_solution(&standard).unwrap();
             let evaluation = reduced.evaluate(&solution.y);
             let inexact = solution
                 .closed_loop
+                .expect("factors above KRONECKER_MAX_ORDER")
                 .newton_step(&evaluation.residual)
                 .unwrap()
                 .to_mat();

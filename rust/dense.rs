@@ -211,6 +211,93 @@ pub(crate) fn transposed_product(lhs: &Dense, rhs: &Dense) -> Dense {
     })
 }
 
+/// Up to this order the triangular solves and the Cholesky factorisation below are plain
+/// loops; above it faer's blocked kernels (whose dispatch costs more than a 2 x 2 solve).
+const SMALL_FACTOR_MAX_ORDER: usize = 16;
+
+/// The lower-triangular Cholesky factor L of a symmetric positive definite R = L L^T (only
+/// its lower triangle is read), or `None` when a pivot is not positive: R is not positive
+/// definite to working precision.
+pub(crate) fn cholesky(r: &Dense) -> Option<Dense> {
+    let m = r.rows;
+    debug_assert_eq!(m, r.cols);
+    if m > SMALL_FACTOR_MAX_ORDER {
+        let factor = r.as_ref().llt(faer::Side::Lower).ok()?;
+        return Some(Dense::from_ref(factor.L()));
+    }
+    let mut l = Dense::zeros(m, m);
+    for j in 0..m {
+        let mut pivot = r[(j, j)];
+        for k in 0..j {
+            pivot -= l[(j, k)] * l[(j, k)];
+        }
+        // Not positive, or NaN.
+        if pivot <= 0.0 || pivot.is_nan() {
+            return None;
+        }
+        let pivot = pivot.sqrt();
+        l[(j, j)] = pivot;
+        for i in j + 1..m {
+            let mut entry = r[(i, j)];
+            for k in 0..j {
+                entry -= l[(i, k)] * l[(j, k)];
+            }
+            l[(i, j)] = entry / pivot;
+        }
+    }
+    Some(l)
+}
+
+/// Solves L X = B in place (X overwrites B) for lower-triangular L, by forward substitution.
+pub(crate) fn solve_lower_in_place(l: &Dense, b: &mut Dense) {
+    let m = l.rows;
+    debug_assert_eq!(m, b.rows);
+    if m > SMALL_FACTOR_MAX_ORDER {
+        let view = l.as_ref();
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+            view,
+            b.as_mut(),
+            faer::Par::Seq,
+        );
+        return;
+    }
+    for j in 0..b.cols {
+        let x = b.col_mut(j);
+        for k in 0..m {
+            x[k] /= l[(k, k)];
+            let solved = x[k];
+            for i in k + 1..m {
+                x[i] -= l[(i, k)] * solved;
+            }
+        }
+    }
+}
+
+/// Solves L^T X = B in place for lower-triangular L, by back substitution.
+pub(crate) fn solve_lower_transposed_in_place(l: &Dense, b: &mut Dense) {
+    let m = l.rows;
+    debug_assert_eq!(m, b.rows);
+    if m > SMALL_FACTOR_MAX_ORDER {
+        let view = l.as_ref().transpose();
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            view,
+            b.as_mut(),
+            faer::Par::Seq,
+        );
+        return;
+    }
+    for j in 0..b.cols {
+        let x = b.col_mut(j);
+        for k in (0..m).rev() {
+            let mut value = x[k];
+            for i in k + 1..m {
+                value -= l[(i, k)] * x[i];
+            }
+            x[k] = value / l[(k, k)];
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -241,6 +328,36 @@ mod tests {
             &Dense::from_ref(b.as_ref()),
         );
         assert_eq!(found.to_mat(), expected);
+    }
+
+    #[test]
+    fn cholesky_and_triangular_solves_agree_with_faer() {
+        for m in [1, 2, 5, 16, 20] {
+            let g = seeded(m, m, 6);
+            let r = &g * g.transpose() + Mat::<f64>::identity(m, m);
+            let l = cholesky(&Dense::from_ref(r.as_ref())).unwrap();
+            let expected = r.as_ref().llt(faer::Side::Lower).unwrap();
+            let difference = (&l.to_mat() - expected.L()).norm_max();
+            assert!(difference <= 1e-13 * r.norm_max(), "m={m}: {difference:e}");
+            let b = seeded(m, 3, 7);
+            let mut x = Dense::from_ref(b.as_ref());
+            solve_lower_in_place(&l, &mut x);
+            assert!((&l.to_mat() * x.to_mat() - &b).norm_max() <= 1e-12, "m={m}");
+            let mut x = Dense::from_ref(b.as_ref());
+            solve_lower_transposed_in_place(&l, &mut x);
+            assert!(
+                (l.to_mat().transpose() * x.to_mat() - &b).norm_max() <= 1e-12,
+                "m={m}"
+            );
+        }
+        // Not positive definite: a zero, a negative and a NaN pivot.
+        for r in [
+            faer::mat![[1.0, 1.0], [1.0, 1.0]],
+            faer::mat![[1.0, 2.0], [2.0, 1.0]],
+            faer::mat![[f64::NAN, 0.0], [0.0, 1.0]],
+        ] {
+            assert!(cholesky(&Dense::from_ref(r.as_ref())).is_none());
+        }
     }
 
     #[test]

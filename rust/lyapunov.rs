@@ -60,6 +60,10 @@ pub(crate) fn solve(
     check_square(q, "Q")?;
     check_rows(q, "Q", a.nrows(), "A")?;
     check_finite(q, "Q")?;
+    if a.nrows() <= KRONECKER_MAX_ORDER && is_symmetric(q) {
+        let x = solve_kronecker(&Dense::from_ref(a), &Dense::from_ref(q), singularity)?;
+        return Ok(x.to_mat());
+    }
     let schur = real_schur(a)?;
     let (t, z) = (schur.t.as_ref(), schur.z.as_ref());
     let mut f = Dense::from_ref(product(product(z.transpose(), q).as_ref(), z).as_ref());
@@ -73,6 +77,102 @@ pub(crate) fn solve(
     }
     Ok(x)
 }
+
+/// Up to this order a Lyapunov equation with symmetric Q is solved in its vectorised form
+/// ([`solve_kronecker`]): the n(n+1)/2 unknowns on and above the diagonal of X, by one LU
+/// factorisation of their order-n(n+1)/2 system. That costs O(n^6) flops against the O(n^3) of
+/// Bartels–Stewart, but needs no Schur form; at n = 4 (a 10 x 10 system) it takes a fifth of
+/// the instructions, at n = 5 (15 x 15) about a third.
+pub(crate) const KRONECKER_MAX_ORDER: usize = 5;
+
+/// Solves A X + X A^T + Q = 0 for symmetric Q (only its upper triangle is read) and order up
+/// to [`KRONECKER_MAX_ORDER`], directly: with x = (x_ij, i <= j) by columns, equation (i, j),
+/// i <= j, reads
+///
+/// ```text
+/// sum_k a_ik x_kj + sum_k a_jk x_ik = -q_ij,        x_kj = x_jk,
+/// ```
+///
+/// an order-n(n+1)/2 linear system solved by Gaussian elimination with partial pivoting. It is
+/// singular exactly when two eigenvalues of A add up to zero. A pivot below
+/// `smin = max(u max|M|, tiny)` signals that: [`Singularity::Refuse`] fails, and
+/// [`Singularity::Perturb`] replaces it by `smin`, as the small Sylvester systems of
+/// Bartels–Stewart do.
+pub(crate) fn solve_kronecker(
+    a: &Dense,
+    q: &Dense,
+    singularity: Singularity,
+) -> Result<Dense, Error> {
+    const CAPACITY: usize = KRONECKER_MAX_ORDER * (KRONECKER_MAX_ORDER + 1) / 2;
+    let n = a.nrows();
+    debug_assert!(n <= KRONECKER_MAX_ORDER);
+    let size = n * (n + 1) / 2;
+    // The unknown x_ij (i <= j), by columns of the upper triangle.
+    let unknown = |i: usize, j: usize| {
+        let (i, j) = if i <= j { (i, j) } else { (j, i) };
+        j * (j + 1) / 2 + i
+    };
+    let mut m = [[0.0f64; CAPACITY]; CAPACITY];
+    let mut rhs = [0.0f64; CAPACITY];
+    for j in 0..n {
+        for i in 0..=j {
+            let row = unknown(i, j);
+            rhs[row] = -q[(i, j)];
+            for k in 0..n {
+                m[row][unknown(k, j)] += a[(i, k)];
+                m[row][unknown(i, k)] += a[(j, k)];
+            }
+        }
+    }
+    let largest = m
+        .iter()
+        .take(size)
+        .flat_map(|row| row.iter().take(size))
+        .fold(0.0f64, |acc, v| acc.max(v.abs()));
+    let smin = (f64::EPSILON * largest).max(f64::MIN_POSITIVE / f64::EPSILON);
+    for step in 0..size {
+        let pivot_row = (step..size)
+            .max_by(|&x, &y| m[x][step].abs().total_cmp(&m[y][step].abs()))
+            .expect("a row");
+        m.swap(step, pivot_row);
+        rhs.swap(step, pivot_row);
+        if m[step][step].abs() < smin {
+            if singularity == Singularity::Refuse {
+                return Err(Error::IllConditioned {
+                    message: "the Lyapunov equation is singular to working precision: A has \
+                              two eigenvalues whose sum is (nearly) zero (a mode on the \
+                              imaginary axis, or a pair mirrored across it)"
+                        .into(),
+                });
+            }
+            m[step][step] = smin;
+        }
+        let (done, below) = m.split_at_mut(step + 1);
+        let pivot = &done[step];
+        for (offset, row) in below.iter_mut().take(size - step - 1).enumerate() {
+            let factor = row[step] / pivot[step];
+            if factor != 0.0 {
+                for (x, &p) in row[step..size].iter_mut().zip(&pivot[step..size]) {
+                    *x -= factor * p;
+                }
+                rhs[step + 1 + offset] -= factor * rhs[step];
+            }
+        }
+    }
+    let mut solution = [0.0f64; CAPACITY];
+    for i in (0..size).rev() {
+        let mut value = rhs[i];
+        for j in i + 1..size {
+            value -= m[i][j] * solution[j];
+        }
+        solution[i] = value / m[i][i];
+    }
+    Ok(Dense::from_fn(n, n, |i, j| solution[unknown(i, j)]))
+}
+
+/// Up to this order the quasi-triangular solve updates the right-hand side by plain column
+/// operations; above it by faer's product.
+const SMALL_UPDATE_MAX_ORDER: usize = 16;
 
 /// Solves T Y + Y T^T = F for quasi-upper-triangular T (2 x 2 blocks in standard form).
 pub(crate) fn solve_quasi_triangular(
@@ -96,8 +196,9 @@ pub(crate) fn solve_quasi_triangular(
     let mut y = Dense::zeros(n, n);
     for &(j0, q) in blocks.iter().rev() {
         let after = j0 + q;
-        if after < n {
-            // F[:, J] -= Y[:, after..] T[J, after..]^T (the columns of Y already known).
+        // F[:, J] -= Y[:, after..] T[J, after..]^T (the columns of Y already known): column
+        // updates for small orders, where faer's product costs more to set up than it saves.
+        if after < n && n > SMALL_UPDATE_MAX_ORDER {
             let known = y.as_ref().subcols(after, n - after);
             let coupling = t.as_ref().submatrix(j0, after, q, n - after);
             faer::linalg::matmul::matmul(
@@ -108,6 +209,15 @@ pub(crate) fn solve_quasi_triangular(
                 -1.0,
                 Par::Seq,
             );
+        } else {
+            for c in j0..after {
+                for s in after..n {
+                    let coefficient = t[(c, s)];
+                    for (x, &known) in f.col_mut(c).iter_mut().zip(y.col(s)) {
+                        *x -= known * coefficient;
+                    }
+                }
+            }
         }
         let mut r = [[0.0; 2]; 2];
         for c in 0..q {
@@ -208,6 +318,58 @@ mod tests {
         let x = solve_lyapunov(a.as_ref(), q.as_ref()).unwrap();
         let expected = mat![[1.0, 1.0], [1.0, 1.0]];
         assert!((&x - &expected).norm_max() < 1e-15);
+    }
+
+    /// The direct solve of small orders agrees with Bartels–Stewart (forced through the
+    /// quasi-triangular solve by a non-symmetric Q of the same upper triangle plus its
+    /// transpose's correction) to rounding, and refuses or perturbs a singular equation as
+    /// the Schur route does.
+    #[test]
+    fn direct_small_solves_agree_with_bartels_stewart() {
+        for n in 1..=KRONECKER_MAX_ORDER {
+            for seed in 0..20u64 {
+                let g = crate::test_matrices::seeded(n, n, 40 + 7 * seed + n as u64);
+                let a = Mat::from_fn(n, n, |i, j| g[(i, j)] - if i == j { 1.5 } else { 0.0 });
+                let h = crate::test_matrices::seeded(n, n, 90 + seed);
+                let q = &h * h.transpose();
+                let direct = solve_kronecker(
+                    &Dense::from_ref(a.as_ref()),
+                    &Dense::from_ref(q.as_ref()),
+                    Singularity::Refuse,
+                )
+                .unwrap()
+                .to_mat();
+                // The Schur route: real_schur, then the quasi-triangular solve.
+                let schur = real_schur(a.as_ref()).unwrap();
+                let (t, z) = (schur.t.as_ref(), schur.z.as_ref());
+                let mut f = Dense::from_ref((z.transpose() * &q * z).as_ref());
+                for x in f.as_mut_slice() {
+                    *x = -*x;
+                }
+                let y =
+                    solve_quasi_triangular(&Dense::from_ref(t), f, Singularity::Refuse).unwrap();
+                let schur_route = z * y.to_mat() * z.transpose();
+                let scale = direct.norm_max();
+                assert!(
+                    (&direct - &schur_route).norm_max() <= 1e-12 * scale,
+                    "n={n} seed={seed}"
+                );
+                assert!(residual(a.as_ref(), direct.as_ref(), q.as_ref()) <= 1e-13 * scale);
+                assert_eq!(direct, direct.transpose().to_owned());
+            }
+        }
+        let rotation = mat![[0.0, 1.0], [-1.0, 0.0]];
+        let q = Mat::<f64>::identity(2, 2);
+        let (a, q) = (
+            Dense::from_ref(rotation.as_ref()),
+            Dense::from_ref(q.as_ref()),
+        );
+        assert!(matches!(
+            solve_kronecker(&a, &q, Singularity::Refuse),
+            Err(Error::IllConditioned { .. })
+        ));
+        let perturbed = solve_kronecker(&a, &q, Singularity::Perturb).unwrap();
+        assert!(perturbed.as_slice().iter().all(|x| x.is_finite()));
     }
 
     #[test]

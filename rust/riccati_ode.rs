@@ -63,7 +63,7 @@ pub fn riccati_ode(
     times: &[f64],
     terminal: Option<MatRef<'_, f64>>,
 ) -> Result<RiccatiSolution, Error> {
-    let (q, cholesky) = check_problem(a, b, q, r)?;
+    let (q, l) = check_problem(a, b, q, r)?;
     let n = a.nrows();
     check_times(times)?;
     let mut s = match terminal {
@@ -76,7 +76,7 @@ pub fn riccati_ode(
         None => Mat::zeros(n, n),
     };
     symmetrize(&mut s);
-    let l = cholesky.L();
+    let l = l.as_ref();
     // G = B R^-1 B^T = B̂ B̂^T with B̂^T = L^-1 B^T.
     let mut b_hat_t = b.transpose().to_owned();
     solve_lower_triangular_in_place(l, b_hat_t.as_mut(), Par::Seq);

@@ -34,6 +34,19 @@ pub(crate) fn solve_small_sylvester(
     c: &[[f64; 2]; 2],
 ) -> SmallSylvester {
     let size = p * q;
+    if size == 1 {
+        // l x + x r = c: the general elimination below, with nothing to eliminate.
+        let mut pivot = l[0][0] + r[0][0];
+        let smin = (f64::EPSILON * pivot.abs()).max(f64::MIN_POSITIVE / f64::EPSILON);
+        let perturbed = pivot.abs() < smin;
+        if perturbed {
+            pivot = smin;
+        }
+        return SmallSylvester {
+            x: [[c[0][0] / pivot, 0.0], [0.0, 0.0]],
+            perturbed,
+        };
+    }
     let unknown = |i: usize, k: usize| i + p * k;
     let mut m = [[0.0f64; 4]; 4];
     let mut rhs = [0.0f64; 4];
