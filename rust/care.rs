@@ -165,8 +165,9 @@ struct Reduced<'a> {
 }
 
 impl Reduced<'_> {
-    /// K = R^-1 (B̃^T Y + S^T) = L^-T L^-1 (B̃^T Y + S^T).
-    fn gain(&self, y: &Dense) -> Dense {
+    /// The residual of Y (symmetric) and its gain K = R^-1 (B̃^T Y + S^T) = L^-T L^-1 M^T, with
+    /// M = Y B̃ + S the coupling of the quadratic term, (Y B̃ + S) K.
+    fn evaluate(&self, y: &Dense) -> Evaluation {
         let mut gain = transposed_product(&self.b, y);
         if let Some(s) = self.s {
             for j in 0..gain.ncols() {
@@ -175,20 +176,10 @@ impl Reduced<'_> {
                 }
             }
         }
+        // (B̃^T Y + S^T)^T = Y B̃ + S, entry by entry the same sums, Y being symmetric.
+        let coupling = gain.transpose();
         solve_lower_in_place(self.l, &mut gain);
         solve_lower_transposed_in_place(self.l, &mut gain);
-        gain
-    }
-
-    /// The residual of Y and its gain.
-    fn evaluate(&self, y: &Dense) -> Evaluation {
-        let gain = self.gain(y);
-        let mut coupling = product(y, &self.b);
-        if let Some(s) = self.s {
-            for (x, &v) in coupling.as_mut_slice().iter_mut().zip(s.as_slice()) {
-                *x += v;
-            }
-        }
         let ay = transposed_product(&self.a, y);
         let quadratic = product(&coupling, &gain);
         let scale = self.q_norm + 2.0 * ay.frobenius_norm() + quadratic.frobenius_norm();

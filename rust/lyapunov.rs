@@ -98,6 +98,8 @@ pub(crate) const KRONECKER_MAX_ORDER: usize = 5;
 /// `smin = max(u max|M|, tiny)` signals that: [`Singularity::Refuse`] fails, and
 /// [`Singularity::Perturb`] replaces it by `smin`, as the small Sylvester systems of
 /// Bartels–Stewart do.
+// The system's rows and columns are indexed by unknowns: indices read most clearly.
+#[allow(clippy::needless_range_loop)]
 pub(crate) fn solve_kronecker(
     a: &Dense,
     q: &Dense,
@@ -107,33 +109,36 @@ pub(crate) fn solve_kronecker(
     let n = a.nrows();
     debug_assert!(n <= KRONECKER_MAX_ORDER);
     let size = n * (n + 1) / 2;
-    // The unknown x_ij (i <= j), by columns of the upper triangle.
-    let unknown = |i: usize, j: usize| {
-        let (i, j) = if i <= j { (i, j) } else { (j, i) };
-        j * (j + 1) / 2 + i
-    };
-    let mut m = [[0.0f64; CAPACITY]; CAPACITY];
-    let mut rhs = [0.0f64; CAPACITY];
+    // unknown[i][j]: the position of x_ij = x_ji, by columns of the upper triangle.
+    let mut unknown = [[0usize; KRONECKER_MAX_ORDER]; KRONECKER_MAX_ORDER];
     for j in 0..n {
         for i in 0..=j {
-            let row = unknown(i, j);
-            rhs[row] = -q[(i, j)];
-            for k in 0..n {
-                m[row][unknown(k, j)] += a[(i, k)];
-                m[row][unknown(i, k)] += a[(j, k)];
-            }
+            unknown[i][j] = j * (j + 1) / 2 + i;
+            unknown[j][i] = unknown[i][j];
         }
     }
-    let largest = m
-        .iter()
-        .take(size)
-        .flat_map(|row| row.iter().take(size))
-        .fold(0.0f64, |acc, v| acc.max(v.abs()));
+    let mut m = [[0.0f64; CAPACITY]; CAPACITY];
+    let mut rhs = [0.0f64; CAPACITY];
+    let mut largest = 0.0f64;
+    for j in 0..n {
+        for i in 0..=j {
+            let row = &mut m[unknown[i][j]];
+            rhs[unknown[i][j]] = -q[(i, j)];
+            for k in 0..n {
+                row[unknown[k][j]] += a[(i, k)];
+                row[unknown[i][k]] += a[(j, k)];
+            }
+            largest = row[..size].iter().fold(largest, |acc, v| acc.max(v.abs()));
+        }
+    }
     let smin = (f64::EPSILON * largest).max(f64::MIN_POSITIVE / f64::EPSILON);
     for step in 0..size {
-        let pivot_row = (step..size)
-            .max_by(|&x, &y| m[x][step].abs().total_cmp(&m[y][step].abs()))
-            .expect("a row");
+        let mut pivot_row = step;
+        for i in step + 1..size {
+            if m[i][step].abs() > m[pivot_row][step].abs() {
+                pivot_row = i;
+            }
+        }
         m.swap(step, pivot_row);
         rhs.swap(step, pivot_row);
         if m[step][step].abs() < smin {
@@ -148,11 +153,11 @@ pub(crate) fn solve_kronecker(
             m[step][step] = smin;
         }
         let (done, below) = m.split_at_mut(step + 1);
-        let pivot = &done[step];
-        for (offset, row) in below.iter_mut().take(size - step - 1).enumerate() {
-            let factor = row[step] / pivot[step];
+        let pivot = &done[step][step..size];
+        for (offset, row) in below[..size - step - 1].iter_mut().enumerate() {
+            let factor = row[step] / pivot[0];
             if factor != 0.0 {
-                for (x, &p) in row[step..size].iter_mut().zip(&pivot[step..size]) {
+                for (x, &p) in row[step..size].iter_mut().zip(pivot) {
                     *x -= factor * p;
                 }
                 rhs[step + 1 + offset] -= factor * rhs[step];
@@ -167,7 +172,7 @@ pub(crate) fn solve_kronecker(
         }
         solution[i] = value / m[i][i];
     }
-    Ok(Dense::from_fn(n, n, |i, j| solution[unknown(i, j)]))
+    Ok(Dense::from_fn(n, n, |i, j| solution[unknown[i][j]]))
 }
 
 /// Up to this order the quasi-triangular solve updates the right-hand side by plain column

@@ -668,12 +668,12 @@ fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c6
     };
     if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         with_order!(n, order => {
-            let (mut h, scale) = balanced_hessenberg(order, a);
+            let (mut h, scale) = balanced_hessenberg(Square::from_mat_in(order, a));
             francis_qr(&mut h, None, (0, n.saturating_sub(1)), false, unscaled(scale))?;
             Ok(block_eigenvalues(n, |i, j| h[(i, j)] * scale))
         })
     } else {
-        let (mut h, scale) = balanced_hessenberg(Dynamic(n), a);
+        let (mut h, scale) = balanced_hessenberg(Square::from_mat(a));
         schur_of_hessenberg(&mut h, None, false, unscaled(scale))?;
         Ok(block_eigenvalues(n, |i, j| h[(i, j)] * scale))
     }
@@ -682,11 +682,9 @@ fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c6
 /// The upper Hessenberg form H of the balanced D^-1 (A / s) D, with s the power of two that
 /// brings A's entries into range ([`range_scale`]): returns (H, s). H is similar to A / s, so
 /// it has the eigenvalues and the characteristic polynomial of A / s (the balancing is exact,
-/// the reduction backward stable). The caller checks that A is square and finite, of the
-/// order of `order`.
-pub(crate) fn balanced_hessenberg<O: Order>(order: O, a: MatRef<'_, f64>) -> (Square<O>, f64) {
-    let scale = range_scale(a);
-    let mut h = Square::from_mat_in(order, a);
+/// the reduction backward stable). The caller checks that A is finite.
+pub(crate) fn balanced_hessenberg<O: Order>(mut h: Square<O>) -> (Square<O>, f64) {
+    let scale = range_scale(h.as_ref());
     if scale != 1.0 {
         h.data.as_mut().iter_mut().for_each(|x| *x /= scale);
     }
@@ -694,7 +692,7 @@ pub(crate) fn balanced_hessenberg<O: Order>(order: O, a: MatRef<'_, f64>) -> (Sq
     if h.n() <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         reduce_to_hessenberg(&mut h, None);
     } else {
-        h = Square::from_mat_in(order, hessenberg_matrix(h.to_mat().as_ref()).as_ref());
+        h = Square::from_mat_in(h.order, hessenberg_matrix(h.to_mat().as_ref()).as_ref());
     }
     (h, scale)
 }
@@ -1267,16 +1265,24 @@ fn hamiltonian_estimates<O: Order>(h: &Square<O>) -> Vec<c64> {
         return Vec::new();
     }
     let p = hessenberg_characteristic_polynomial(h);
-    let companion = Mat::from_fn(order, order, |i, j| {
-        if i == 0 {
-            -p[2 * (j + 1)]
-        } else if i == j + 1 {
-            1.0
-        } else {
-            0.0
+    if !p.iter().all(|c| c.is_finite()) {
+        return Vec::new();
+    }
+    // The roots of q(μ) = μ^order + p_2 μ^(order-1) + ... + p_2order: the eigenvalues of its
+    // companion matrix (upper Hessenberg already; its reduction costs a scan).
+    let roots = with_order!(order, companion_order => {
+        let mut companion = Square::zeros_in(companion_order);
+        for j in 0..order {
+            companion[(0, j)] = -p[2 * (j + 1)];
+            if j + 1 < order {
+                companion[(j + 1, j)] = 1.0;
+            }
         }
+        let (mut companion, scale) = balanced_hessenberg(companion);
+        francis_qr(&mut companion, None, (0, order - 1), false, Spectrum::General)
+            .map(|()| block_eigenvalues(order, |i, j| companion[(i, j)] * scale))
     });
-    match eigenvalues(companion.as_ref()) {
+    match roots {
         Ok(roots) => roots
             .iter()
             .filter(|mu| mu.im >= 0.0)
