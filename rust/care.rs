@@ -31,8 +31,15 @@
 //! Re λ < 0 first ([`crate::reorder`]); Y from U11^T Y = U21^T by an LU solve, then
 //! symmetrised. Up to order [`HAMILTONIAN_SHIFT_MAX_ORDER`] the QR iteration
 //! ([`crate::schur`]) estimates the eigenvalues of H from its even characteristic polynomial
-//! and takes the unstable ones as its first shifts, so that the unstable half deflates first
-//! and the form usually comes out ordered, the reordering then swapping nothing.
+//! and takes the unstable ones as its first shifts, so that the unstable half deflates first.
+//! The iteration then stops ([`crate::schur`]'s `Until::UnstableHalf`): once the trailing n
+//! eigenvalues have deflated, all of them with Re λ beyond the axis tolerance, the leading n
+//! columns of Z span the stable subspace already, and the sweeps that would triangularise the
+//! leading block (two of six on the 747's regulator) are saved; the stable eigenvalues are
+//! then known as the mirror images -λ̄ of the unstable ones. Should a stable eigenvalue
+//! deflate among the trailing half, the iteration completes the Schur form, which is reordered.
+//! For a 4-state model H is of order 8, held on the stack with its order fixed at compile
+//! time.
 //!
 //! Before that H is scaled twice, by similarities that keep it Hamiltonian: by ρ, a power of
 //! two near sqrt(||Q̄||_F / ||G||_F), to G ρ and Q̄ / ρ (the scaling of Pandey and of Benner's
@@ -48,11 +55,14 @@
 //! itself; Newton's method (Kleinman 1968) restores a small residual: with A_k = Ā - G Y_k,
 //! A_k^T Δ + Δ A_k = -Res(Y_k) ([`crate::lyapunov`]), Y_{k+1} = Y_k + Δ, repeated while the
 //! residual decreases and is above [`REFINEMENT_FLOOR`], a few units of rounding (at most
-//! [`MAX_REFINEMENT_STEPS`] times). The first step needs no Schur form of A_0: the Hamiltonian's
-//! reordered Schur form already factors the closed loop of the Schur solution as V T11 V^-1
-//! (`ClosedLoopFactors`), which leaves only the quasi-triangular half of Bartels–Stewart
-//! (10-13 % of the whole solve at n = 16 to 128). Reported: the relative residual of the
-//! general equation,
+//! [`MAX_REFINEMENT_STEPS`] times). Up to n = [`crate::lyapunov::KRONECKER_MAX_ORDER`] each step
+//! is an exact step whose Lyapunov equation is solved directly in its vectorised form (10
+//! unknowns at n = 4: a fifth of the cost of the Schur route). Above, the first step needs no
+//! Schur form of A_0: the Hamiltonian's Schur form already factors the closed loop of the Schur
+//! solution as V T11 V^-1 (`ClosedLoopFactors`; a T11 left in Hessenberg form by the early stop
+//! is triangularised first, at order n), which leaves only the quasi-triangular half of
+//! Bartels–Stewart (10-13 % of the whole solve at n = 16 to 128). Reported: the relative
+//! residual of the general equation,
 //!
 //! ```text
 //! ||Res||_F / (||Q||_F + 2 ||A^T X E||_F + ||M^T K||_F),      M = B^T X E + S^T,
@@ -65,7 +75,9 @@
 //!
 //! R not symmetric positive definite; E singular; eigenvalues of H within
 //! [`AXIS_TOLERANCE`] ||H||_F of the imaginary axis (no stabilising solution: an undamped mode
-//! that the input cannot move or the weight does not see); U11 singular to working precision.
+//! that the input cannot move or the weight does not see); U11 singular to working precision;
+//! a computed solution whose closed loop A - B K has an eigenvalue with Re λ >= 0 (the stable
+//! and unstable eigenvalues of H too ill-conditioned to be told apart).
 
 use crate::dense::{
     Dense, cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place,
@@ -817,6 +829,54 @@ mod tests {
                 care.closed_loop_eigenvalues.iter().all(|z| z.re < 0.0),
                 "n={n}: closed loop"
             );
+        }
+    }
+
+    /// Up to `KRONECKER_MAX_ORDER` the Newton steps are exact steps solved directly, above it
+    /// the first goes through the Hamiltonian's factors. On random regulators of orders 1 to 7
+    /// with control weights over six decades, refinement never leaves a larger residual than
+    /// the Schur solution's, takes steps from order 3 on, and ends within 64 u (measured: at
+    /// most 37 u, at rcond(U11) = 5e-4, from Schur solutions of up to 8600 u; 52 steps).
+    #[test]
+    fn refinement_reduces_the_residual_of_small_regulators() {
+        let mut steps = 0;
+        for n in 1..=7usize {
+            for seed in 0..12u64 {
+                let g = seeded(n, n, 300 + 10 * n as u64 + seed);
+                let a = Mat::from_fn(n, n, |i, j| g[(i, j)] - if i == j { 0.3 } else { 0.0 });
+                let b = seeded(n, 2, 400 + seed);
+                let q = Mat::<f64>::identity(n, n);
+                let r = Mat::<f64>::identity(2, 2) * faer::Scale(10f64.powi(seed as i32 % 7 - 3));
+                let solve = |refine| {
+                    let options = CareOptions {
+                        refine,
+                        ..CareOptions::default()
+                    };
+                    solve_care(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref(), options).unwrap()
+                };
+                let (refined, schur) = (solve(true), solve(false));
+                let what = format!("n={n} seed={seed}");
+                assert!(refined.residual <= schur.residual, "{what}");
+                assert!(refined.residual <= 64.0 * f64::EPSILON, "{what}");
+                steps += refined.refinement_steps;
+            }
+        }
+        assert!(steps >= 20, "{steps} Newton steps in 84 problems");
+    }
+
+    #[test]
+    fn an_unstable_closed_loop_is_refused() {
+        assert!(check_stabilising(&[c64::new(-1.0, 2.0), c64::new(-1.0, -2.0)]).is_ok());
+        let refused = check_stabilising(&[
+            c64::new(-1.0, 0.0),
+            c64::new(0.0, 0.0),
+            c64::new(f64::NAN, 0.0),
+        ]);
+        match refused {
+            Err(Error::NoStabilizingSolution { message }) => {
+                assert!(message.contains("2 eigenvalue(s)"), "{message}")
+            }
+            other => panic!("{other:?}"),
         }
     }
 

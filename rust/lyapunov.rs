@@ -23,6 +23,11 @@
 //!
 //! The cost is that of the Schur form, about 25 n^3 flops, plus 4 n^3 for the transformations
 //! and n^3 for the triangular solve (the updates are column operations, as in LAPACK's dtrsyl).
+//!
+//! Up to order [`KRONECKER_MAX_ORDER`] a symmetric Q is instead solved for directly: the
+//! n(n+1)/2 distinct entries of X satisfy a linear system of that order (`solve_kronecker`),
+//! whose elimination costs O(n^6) flops but fewer than the Schur form's constant factor at
+//! these orders (the 4-state models of flight dynamics, and the Riccati solver's Newton steps).
 
 use crate::dense::Dense;
 use crate::dispatch::clear_upper_avx_state;
@@ -79,11 +84,11 @@ pub(crate) fn solve(
 }
 
 /// Up to this order a Lyapunov equation with symmetric Q is solved in its vectorised form
-/// ([`solve_kronecker`]): the n(n+1)/2 unknowns on and above the diagonal of X, by one LU
+/// (`solve_kronecker`): the n(n+1)/2 unknowns on and above the diagonal of X, by one LU
 /// factorisation of their order-n(n+1)/2 system. That costs O(n^6) flops against the O(n^3) of
 /// Bartels–Stewart, but needs no Schur form; at n = 4 (a 10 x 10 system) it takes a fifth of
 /// the instructions, at n = 5 (15 x 15) about a third.
-pub(crate) const KRONECKER_MAX_ORDER: usize = 5;
+pub const KRONECKER_MAX_ORDER: usize = 5;
 
 /// Solves A X + X A^T + Q = 0 for symmetric Q (only its upper triangle is read) and order up
 /// to [`KRONECKER_MAX_ORDER`], directly: with x = (x_ij, i <= j) by columns, equation (i, j),
