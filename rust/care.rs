@@ -551,12 +551,14 @@ fn hamiltonian_solution_in<O: Order>(
     } else {
         1.0
     };
+    // Powers of two: their reciprocals are exact, and multiplying by them rounds as dividing.
+    let rho_inverse = 1.0 / rho;
     let mut h = Square::zeros_in(order);
     for j in 0..n {
         for i in 0..n {
             h[(i, j)] = standard.a[(i, j)];
             h[(i, n + j)] = -rho * standard.g[(i, j)];
-            h[(n + i, j)] = -standard.q[(i, j)] / rho;
+            h[(n + i, j)] = -standard.q[(i, j)] * rho_inverse;
             h[(n + i, n + j)] = -standard.a[(j, i)];
         }
     }
@@ -565,12 +567,13 @@ fn hamiltonian_solution_in<O: Order>(
     let d: Vec<f64> = (0..n)
         .map(|i| nearest_power_of_two((scale[i] / scale[n + i]).sqrt()))
         .collect();
+    let d_inverse: Vec<f64> = d.iter().map(|x| 1.0 / x).collect();
     for j in 0..n {
         for i in 0..n {
-            h[(i, j)] *= d[j] / d[i];
-            h[(i, n + j)] /= d[i] * d[j];
+            h[(i, j)] *= d[j] * d_inverse[i];
+            h[(i, n + j)] *= d_inverse[i] * d_inverse[j];
             h[(n + i, j)] *= d[i] * d[j];
-            h[(n + i, n + j)] *= d[i] / d[j];
+            h[(n + i, n + j)] *= d[i] * d_inverse[j];
         }
     }
     let h_norm = frobenius_norm(h.as_ref());
@@ -623,7 +626,9 @@ fn hamiltonian_solution_in<O: Order>(
         });
     }
     // Undo the scalings: Y = rho D^-1 Y' D^-1, Y' the transpose of the solve's first n columns.
-    let mut y = Dense::from_fn(n, n, |i, j| rho * combined[(j, i)] / (d[i] * d[j]));
+    let mut y = Dense::from_fn(n, n, |i, j| {
+        rho * combined[(j, i)] * (d_inverse[i] * d_inverse[j])
+    });
     y.symmetrize();
     let closed_loop = (n > KRONECKER_MAX_ORDER).then(|| ClosedLoopFactors {
         t11: Dense::from_ref(t.as_ref().submatrix(0, 0, n, n)),

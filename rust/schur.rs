@@ -788,8 +788,10 @@ pub(crate) fn balance<O: Order>(a: &mut Square<O>) -> Vec<f64> {
             {
                 changed = true;
                 scale[i] *= f;
+                // f is a power of two: multiplying by 1 / f rounds as dividing by f.
+                let f_inverse = 1.0 / f;
                 for k in 0..n {
-                    a[(i, k)] /= f;
+                    a[(i, k)] *= f_inverse;
                     a[(k, i)] *= f;
                 }
             }
