@@ -11,6 +11,7 @@ Run from the repository root with the package installed::
     python benches/compare_peers.py              # full run, table
     python benches/compare_peers.py --quick      # smoke run: every case once, a few minutes
     python benches/compare_peers.py --json       # JSON list of result records on stdout
+    python benches/compare_peers.py --markdown   # the table as README.md shows it
     python benches/compare_peers.py -k expm      # only the cases whose name contains "expm"
 
 The ratio is peer time / our time: above 1 means aerocontrol is faster. Thread settings matter:
@@ -1966,6 +1967,31 @@ def format_time(seconds: float) -> str:
     return f"{seconds / 1e-9:7.1f} ns"
 
 
+def format_markdown(records: list[dict]) -> str:
+    """The results as the Markdown table of README.md's performance record."""
+    lines = [
+        "| operation | size | peer | aerocontrol | peer time | peer / ours | target |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for r in records:
+        flag = ""
+        if r["target"]:
+            flag = f"{'PASS' if r['target_met'] else 'MISS'} {r['target']}"
+        if not r["agree"]:
+            flag = f"DISAGREE {flag}".strip()
+        cells = (
+            r["op"],
+            r["size"],
+            r["peer"],
+            format_time(r["ours_s"]).strip(),
+            format_time(r["peer_s"]).strip(),
+            f"{r['ratio']:.2f}x",
+            flag,
+        )
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def format_table(records: list[dict]) -> str:
     """The results, one row per (case, peer), then the targets."""
     headers = ("case", "size", "peer", "ours", "peer time", "peer/ours", "target")
@@ -2021,6 +2047,9 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--json", action="store_true", help="print a JSON list of records")
     parser.add_argument(
+        "--markdown", action="store_true", help="print the table as README.md's Markdown"
+    )
+    parser.add_argument(
         "--quick", action="store_true", help="fewer, shorter repeats: a smoke run (< ~60 s)"
     )
     parser.add_argument("-k", "--filter", default="", help="run cases whose name contains this")
@@ -2037,8 +2066,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse_args(argv)
     repeat = args.repeat or (3 if args.quick else 7)
     min_time = args.min_time if args.min_time is not None else (0.01 if args.quick else 0.1)
-    # In --json mode stdout carries only the JSON list; the header and warnings go to stderr.
-    info = sys.stderr if args.json else sys.stdout
+    # In --json and --markdown mode stdout carries only the records; the header and warnings
+    # go to stderr.
+    info = sys.stderr if args.json or args.markdown else sys.stdout
 
     def warn(message: str) -> None:
         print(message, file=info, flush=True)
@@ -2060,6 +2090,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         records.extend(run_case(replace(case, repeat=case_repeat), repeat, min_time, warn))
     if args.json:
         print(json.dumps(records, indent=1))
+    elif args.markdown:
+        print(format_markdown(records))
     else:
         print(format_table(records))
     return 0

@@ -69,6 +69,16 @@
 //! back to the double-shift iteration. The known shifts of Hamiltonian spectra serve the
 //! double-shift iteration only (the Riccati solver asks for them up to order 16).
 //!
+//! Since the Hamiltonian estimates deflate the unstable half first, the Riccati solver lets the
+//! iteration stop there (`Until::UnstableHalf`): the leading columns of Z then span the stable
+//! invariant subspace, and the leading block of T is left in Hessenberg form.
+//!
+//! Up to order 8 (`fixed_orders`: 2- to 4-state models, their Hamiltonians, augmented models)
+//! the matrices are held on the stack with their order a compile-time constant (`Order`,
+//! `Fixed`), so that index arithmetic folds and the column updates of a reflector run over
+//! whole columns of constant length; the values are those of the run-time order bit for bit
+//! (up to the sign of the zeros below the Hessenberg form).
+//!
 //! [`eigenvalues`] first balances A (Parlett & Reinsch 1969: a diagonal similarity by powers of
 //! two that equalises row and column norms, exact in floating point), which can only improve
 //! the computed eigenvalues of badly scaled matrices such as models in mixed units. The Schur
@@ -304,35 +314,14 @@ fixed_orders!(2, 3, 4, 5, 6, 7, 8);
 /// the orders of [`fixed_orders`], [`Dynamic`] otherwise (the body is compiled for each).
 macro_rules! with_order {
     ($n:expr, $order:ident => $body:expr) => {
+        with_order!(@orders $n, $order, $body; 2 3 4 5 6 7 8)
+    };
+    (@orders $n:expr, $order:ident, $body:expr; $($fixed:literal)*) => {
         match $n {
-            2 => {
-                let $order = Fixed::<2>;
+            $($fixed => {
+                let $order = Fixed::<$fixed>;
                 $body
-            }
-            3 => {
-                let $order = Fixed::<3>;
-                $body
-            }
-            4 => {
-                let $order = Fixed::<4>;
-                $body
-            }
-            5 => {
-                let $order = Fixed::<5>;
-                $body
-            }
-            6 => {
-                let $order = Fixed::<6>;
-                $body
-            }
-            7 => {
-                let $order = Fixed::<7>;
-                $body
-            }
-            8 => {
-                let $order = Fixed::<8>;
-                $body
-            }
+            })*
             n => {
                 let $order = Dynamic(n);
                 $body
