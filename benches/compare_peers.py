@@ -1967,6 +1967,16 @@ def format_time(seconds: float) -> str:
     return f"{seconds / 1e-9:7.1f} ns"
 
 
+def format_flag(record: dict, separator: str = "  ") -> str:
+    """PASS or MISS and the target's label, DISAGREE when the peer's answer differs."""
+    flag = ""
+    if record["target"]:
+        flag = f"{'PASS' if record['target_met'] else 'MISS'}{separator}{record['target']}"
+    if not record["agree"]:
+        flag = f"DISAGREE {flag}".strip()
+    return flag
+
+
 def format_markdown(records: list[dict]) -> str:
     """The results as the Markdown table of README.md's performance record."""
     lines = [
@@ -1974,11 +1984,6 @@ def format_markdown(records: list[dict]) -> str:
         "| --- | --- | --- | --- | --- | --- | --- |",
     ]
     for r in records:
-        flag = ""
-        if r["target"]:
-            flag = f"{'PASS' if r['target_met'] else 'MISS'} {r['target']}"
-        if not r["agree"]:
-            flag = f"DISAGREE {flag}".strip()
         cells = (
             r["op"],
             r["size"],
@@ -1986,7 +1991,7 @@ def format_markdown(records: list[dict]) -> str:
             format_time(r["ours_s"]).strip(),
             format_time(r["peer_s"]).strip(),
             f"{r['ratio']:.2f}x",
-            flag,
+            format_flag(r, " "),
         )
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
@@ -1997,11 +2002,6 @@ def format_table(records: list[dict]) -> str:
     headers = ("case", "size", "peer", "ours", "peer time", "peer/ours", "target")
     rows = []
     for r in records:
-        flag = ""
-        if r["target"]:
-            flag = f"{'PASS' if r['target_met'] else 'MISS'}  {r['target']}"
-        if not r["agree"]:
-            flag = f"DISAGREE {flag}".strip()
         rows.append(
             (
                 r["op"],
@@ -2010,7 +2010,7 @@ def format_table(records: list[dict]) -> str:
                 format_time(r["ours_s"]),
                 format_time(r["peer_s"]),
                 f"{r['ratio']:8.2f}x",
-                flag,
+                format_flag(r),
             )
         )
     widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(headers)]
