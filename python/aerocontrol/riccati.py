@@ -109,7 +109,9 @@ def solve_care(
         R is not symmetric positive definite.
     NoStabilizingSolutionError
         The Hamiltonian has eigenvalues on the imaginary axis to working precision: some
-        undamped mode is neither controllable nor penalised.
+        undamped mode is neither controllable nor penalised; or the computed solution leaves
+        an eigenvalue of A - B K in Re >= 0 (stable and unstable eigenvalues of the Hamiltonian
+        too ill-conditioned to be told apart).
     IllConditionedError
         U11 is singular: (A, B) is not stabilisable or (Q, A) not detectable.
 
