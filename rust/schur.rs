@@ -479,7 +479,9 @@ impl<O: Order> Square<O> {
 /// length fixed at compile time the updates unroll and the column update vectorises, which
 /// roughly halves the cost of a QR sweep at the small orders of flight-control models.
 impl<O: Order> Square<O> {
-    /// [`Square::reflect_rows`] for a reflector of length `N`.
+    /// [`Square::reflect_rows`] for a reflector of length `N` whose w_0 = 1 (as every
+    /// reflector of the bulge chase): the products with w_0 are left out, as LAPACK's dlahqr
+    /// leaves them (the same values, up to the sign of a zero).
     #[inline(always)]
     pub(crate) fn reflect_rows_fixed<const N: usize>(
         &mut self,
@@ -493,18 +495,21 @@ impl<O: Order> Square<O> {
             let column: &mut [f64; N] = (&mut self.data.as_mut()[j * n + k..j * n + k + N])
                 .try_into()
                 .expect("N entries");
-            let mut sum = 0.0;
-            for r in 0..N {
+            debug_assert_eq!(w[0], 1.0);
+            let mut sum = column[0];
+            for r in 1..N {
                 sum += column[r] * w[r];
             }
             let scaled = tau * sum;
-            for r in 0..N {
+            column[0] -= scaled;
+            for r in 1..N {
                 column[r] -= scaled * w[r];
             }
         }
     }
 
-    /// [`Square::reflect_columns`] for a reflector of length `N`.
+    /// [`Square::reflect_columns`] for a reflector of length `N` whose w_0 = 1 (see
+    /// [`Square::reflect_rows_fixed`]).
     // Row i of N column slices at once: an index, not an iterator, is the natural form.
     #[allow(clippy::needless_range_loop)]
     #[inline(always)]
@@ -517,13 +522,15 @@ impl<O: Order> Square<O> {
     ) {
         let n = self.n();
         let columns = &mut self.data.as_mut()[k * n..(k + N) * n];
+        debug_assert_eq!(w[0], 1.0);
         for i in rows {
-            let mut sum = 0.0;
-            for r in 0..N {
+            let mut sum = columns[i];
+            for r in 1..N {
                 sum += w[r] * columns[r * n + i];
             }
             let scaled = tau * sum;
-            for r in 0..N {
+            columns[i] -= scaled;
+            for r in 1..N {
                 columns[r * n + i] -= scaled * w[r];
             }
         }
