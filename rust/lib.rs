@@ -22,6 +22,7 @@
 //!   small-bulge multishift QR with aggressive early deflation of `multishift` at large orders).
 //! * [`ctrb`]: controllability and observability matrices and the staircase verdict.
 //! * [`place`]: pole placement: Bass–Gura, Ackermann and the robust multi-input method.
+//! * `polynomial_roots`: closed-form roots of polynomials of degree <= 4 (QR shifts).
 //! * [`reorder`]: reordering of the real Schur form by direct block swaps (Bai & Demmel 1993).
 //! * [`lyapunov`]: the continuous Lyapunov equation by Bartels–Stewart.
 //! * [`care`]: the algebraic Riccati equation by the Hamiltonian ordered-Schur method, and LQR.
@@ -73,6 +74,7 @@ pub mod modes;
 mod multishift;
 pub mod norm;
 pub mod place;
+mod polynomial_roots;
 pub mod pool;
 pub mod reorder;
 pub mod response;

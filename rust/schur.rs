@@ -90,6 +90,7 @@ use crate::hessenberg::{hessenberg, hessenberg_matrix};
 use crate::modes::hessenberg_characteristic_polynomial;
 use crate::multishift::multishift_qr;
 use crate::norm::max_abs;
+use crate::polynomial_roots::monic_roots;
 use faer::{Mat, MatRef, c64};
 use std::ops::{Index, IndexMut, Range};
 
@@ -1266,20 +1267,25 @@ fn hamiltonian_estimates<O: Order>(h: &Square<O>) -> Vec<c64> {
     if !p.iter().all(|c| c.is_finite()) {
         return Vec::new();
     }
-    // The roots of q(μ) = μ^order + p_2 μ^(order-1) + ... + p_2order: the eigenvalues of its
-    // companion matrix (upper Hessenberg already; its reduction costs a scan).
-    let roots = with_order!(order, companion_order => {
-        let mut companion = Square::zeros_in(companion_order);
-        for j in 0..order {
-            companion[(0, j)] = -p[2 * (j + 1)];
-            if j + 1 < order {
-                companion[(j + 1, j)] = 1.0;
+    // The roots of q(μ) = μ^order + p_2 μ^(order-1) + ... + p_2order: in closed form up to
+    // degree four, else (or if those fail their check) the eigenvalues of q's companion matrix
+    // (upper Hessenberg already; its reduction costs a scan).
+    let q: Vec<f64> = (1..=order).map(|j| p[2 * j]).collect();
+    let roots = match monic_roots(&q) {
+        Some(roots) => Ok(roots.as_slice().to_vec()),
+        None => with_order!(order, companion_order => {
+            let mut companion = Square::zeros_in(companion_order);
+            for j in 0..order {
+                companion[(0, j)] = -q[j];
+                if j + 1 < order {
+                    companion[(j + 1, j)] = 1.0;
+                }
             }
-        }
-        let (mut companion, scale) = balanced_hessenberg(companion);
-        francis_qr(&mut companion, None, (0, order - 1), false, Spectrum::General)
-            .map(|()| block_eigenvalues(order, |i, j| companion[(i, j)] * scale))
-    });
+            let (mut companion, scale) = balanced_hessenberg(companion);
+            francis_qr(&mut companion, None, (0, order - 1), false, Spectrum::General)
+                .map(|()| block_eigenvalues(order, |i, j| companion[(i, j)] * scale))
+        }),
+    };
     match roots {
         Ok(roots) => roots
             .iter()
