@@ -174,15 +174,41 @@ pub(crate) fn product(lhs: &Dense, rhs: &Dense) -> Dense {
         );
         return out;
     }
-    for j in 0..cols {
-        let (rhs_column, column) = (rhs.col(j), &mut out.data[j * rows..(j + 1) * rows]);
-        for (k, &coefficient) in rhs_column.iter().enumerate() {
-            for (entry, x) in column.iter_mut().zip(lhs.col(k)) {
-                *entry += x * coefficient;
+    match rows {
+        1 => product_in::<1>(lhs, rhs, &mut out),
+        2 => product_in::<2>(lhs, rhs, &mut out),
+        3 => product_in::<3>(lhs, rhs, &mut out),
+        4 => product_in::<4>(lhs, rhs, &mut out),
+        5 => product_in::<5>(lhs, rhs, &mut out),
+        6 => product_in::<6>(lhs, rhs, &mut out),
+        7 => product_in::<7>(lhs, rhs, &mut out),
+        8 => product_in::<8>(lhs, rhs, &mut out),
+        _ => {
+            for j in 0..cols {
+                let (rhs_column, column) = (rhs.col(j), &mut out.data[j * rows..(j + 1) * rows]);
+                for (k, &coefficient) in rhs_column.iter().enumerate() {
+                    for (entry, x) in column.iter_mut().zip(lhs.col(k)) {
+                        *entry += x * coefficient;
+                    }
+                }
             }
         }
     }
     out
+}
+
+/// The loops of [`product`] for columns of length R known at compile time: each column update
+/// is a few vector operations instead of a loop (the same operations in the same order).
+fn product_in<const R: usize>(lhs: &Dense, rhs: &Dense, out: &mut Dense) {
+    for (j, column) in out.data.chunks_exact_mut(R).enumerate() {
+        let column: &mut [f64; R] = column.try_into().expect("columns of R entries");
+        for (k, &coefficient) in rhs.col(j).iter().enumerate() {
+            let lhs_column: &[f64; R] = lhs.col(k).try_into().expect("columns of R entries");
+            for r in 0..R {
+                column[r] += lhs_column[r] * coefficient;
+            }
+        }
+    }
 }
 
 /// lhs^T * rhs: each entry a dot product of two columns, summed in order (the same values as
@@ -202,13 +228,42 @@ pub(crate) fn transposed_product(lhs: &Dense, rhs: &Dense) -> Dense {
         );
         return out;
     }
-    Dense::from_fn(rows, cols, |i, j| {
-        let mut sum = 0.0;
-        for (x, y) in lhs.col(i).iter().zip(rhs.col(j)) {
-            sum += x * y;
+    match inner {
+        1 => transposed_product_in::<1>(lhs, rhs),
+        2 => transposed_product_in::<2>(lhs, rhs),
+        3 => transposed_product_in::<3>(lhs, rhs),
+        4 => transposed_product_in::<4>(lhs, rhs),
+        5 => transposed_product_in::<5>(lhs, rhs),
+        6 => transposed_product_in::<6>(lhs, rhs),
+        7 => transposed_product_in::<7>(lhs, rhs),
+        8 => transposed_product_in::<8>(lhs, rhs),
+        _ => Dense::from_fn(rows, cols, |i, j| {
+            let mut sum = 0.0;
+            for (x, y) in lhs.col(i).iter().zip(rhs.col(j)) {
+                sum += x * y;
+            }
+            sum
+        }),
+    }
+}
+
+/// [`transposed_product`] for an inner dimension K known at compile time: each dot product
+/// unrolls (summed in the same order).
+fn transposed_product_in<const K: usize>(lhs: &Dense, rhs: &Dense) -> Dense {
+    let mut out = Dense::zeros(lhs.cols, rhs.cols);
+    let rows = lhs.cols;
+    for (j, column) in out.data.chunks_exact_mut(rows.max(1)).enumerate() {
+        let y: &[f64; K] = rhs.col(j).try_into().expect("columns of K entries");
+        for (i, entry) in column.iter_mut().enumerate() {
+            let x: &[f64; K] = lhs.col(i).try_into().expect("columns of K entries");
+            let mut sum = 0.0;
+            for k in 0..K {
+                sum += x[k] * y[k];
+            }
+            *entry = sum;
         }
-        sum
-    })
+    }
+    out
 }
 
 /// Up to this order the triangular solves and the Cholesky factorisation below are plain
