@@ -5,7 +5,8 @@
 //! copy per matrix. Each problem runs on one rayon task (small problems sequentially inside),
 //! which is the efficient split for many small problems; an error names the index of the problem.
 
-use crate::care::{CareOptions, solve_care};
+use crate::care::{CareOptions, solve_care_dense};
+use crate::dense::Dense;
 use crate::error::{Error, check_finite, check_output_len};
 use crate::expm::expm_into_validated;
 use crate::place::Placement;
@@ -150,6 +151,16 @@ pub fn batch_count(lengths: &[(&'static str, usize)]) -> Result<usize, Error> {
     Ok(count)
 }
 
+/// A matrix's entries, row by row.
+fn write_row_major(matrix: &Dense, out: &mut [f64]) {
+    let cols = matrix.ncols();
+    for (i, row) in out.chunks_exact_mut(cols).enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = matrix[(i, j)];
+        }
+    }
+}
+
 /// The k-th matrix of a stack that holds one (shared) or k.
 fn member<'a>(stack: &MatrixStack<'a>, index: usize) -> MatRef<'a, f64> {
     stack.get(if stack.len() == 1 { 0 } else { index })
@@ -214,7 +225,7 @@ pub fn care_batch(
         .zip(out.rcond.par_iter_mut())
         .enumerate()
         .filter_map(|(index, ((((x, gain), poles), residual), rcond))| {
-            let solved = solve_care(
+            let solved = solve_care_dense(
                 member(&stacks.a, index),
                 member(&stacks.b, index),
                 member(&stacks.q, index),
@@ -223,9 +234,9 @@ pub fn care_batch(
             );
             match solved {
                 Ok(care) => {
-                    MatMut::from_row_major_slice_mut(x, n, n).copy_from(&care.x);
+                    write_row_major(&care.x, x);
                     if m > 0 {
-                        MatMut::from_row_major_slice_mut(gain, m, n).copy_from(&care.gain);
+                        write_row_major(&care.gain, gain);
                     }
                     poles.copy_from_slice(&care.closed_loop_eigenvalues);
                     *residual = care.residual;
@@ -323,6 +334,7 @@ pub fn place_batch(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::care::solve_care;
     use crate::expm::expm;
 
     #[test]

@@ -89,8 +89,8 @@ use crate::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity, symmetrize};
 use crate::norm::{frobenius_norm, max_abs, one_norm};
 use crate::reorder::reorder_schur;
 use crate::schur::{
-    Dynamic, Finished, Fixed, Order, Spectrum, Square, Until, balance, eigenvalues_near,
-    quasi_triangular_eigenvalues, real_schur_with, square_real_schur, with_order,
+    Dynamic, Finished, Fixed, Order, RealSchur, Spectrum, Square, Until, balance, eigenvalues_near,
+    quasi_triangular_eigenvalues, real_schur_with, square_schur_form, with_order,
 };
 use faer::{Mat, MatRef, Par, c64};
 
@@ -242,6 +242,35 @@ pub fn solve_care(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<Care, Error> {
+    solve_care_dense(a, b, q, r, options).map(|care| Care {
+        x: care.x.to_mat(),
+        gain: care.gain.to_mat(),
+        closed_loop_eigenvalues: care.closed_loop_eigenvalues,
+        residual: care.residual,
+        rcond: care.rcond,
+        refinement_steps: care.refinement_steps,
+    })
+}
+
+/// [`Care`] with X and K as the solver forms them, for callers that copy them on (the batch
+/// kernels), sparing the conversion.
+pub(crate) struct CareDense {
+    pub(crate) x: Dense,
+    pub(crate) gain: Dense,
+    pub(crate) closed_loop_eigenvalues: Vec<c64>,
+    pub(crate) residual: f64,
+    pub(crate) rcond: f64,
+    pub(crate) refinement_steps: usize,
+}
+
+/// [`solve_care`], returning [`CareDense`].
+pub(crate) fn solve_care_dense(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    options: CareOptions<'_>,
+) -> Result<CareDense, Error> {
     let (q, l) = check_problem(a, b, q, r)?;
     let (n, m) = (a.nrows(), b.ncols());
     if let Some(s) = options.s {
@@ -272,9 +301,9 @@ pub fn solve_care(
         l: &l,
     };
     if n == 0 {
-        return Ok(Care {
-            x: Mat::zeros(0, 0),
-            gain: Mat::zeros(m, 0),
+        return Ok(CareDense {
+            x: Dense::zeros(0, 0),
+            gain: Dense::zeros(m, 0),
             closed_loop_eigenvalues: Vec::new(),
             residual: 0.0,
             rcond: 1.0,
@@ -313,13 +342,13 @@ pub fn solve_care(
             symmetrize(&mut x);
             let gain = gain.to_mat();
             let residual = general_residual(a, b, q.as_ref(), options.s, e, &x, &gain);
-            (x, residual)
+            (Dense::from_ref(x.as_ref()), residual)
         }
-        None => (y.to_mat(), reduced_residual),
+        None => (y, reduced_residual),
     };
-    Ok(Care {
+    Ok(CareDense {
         x,
-        gain: gain.to_mat(),
+        gain,
         closed_loop_eigenvalues,
         residual,
         rcond,
@@ -583,26 +612,34 @@ fn hamiltonian_solution_in<O: Order>(
         Spectrum::General
     };
     let margin = AXIS_TOLERANCE * h_norm;
-    let (schur, finished) = square_real_schur(h, spectrum, Until::UnstableHalf { margin })?;
-    let (t, z, stable_eigenvalues) = match finished {
+    let (schur, finished) = square_schur_form(h, spectrum, Until::UnstableHalf { margin })?;
+    // Views of T / t_scale and Z: of the partial form as the iteration left it, or of the
+    // complete form reordered.
+    let ordered;
+    let (t, z, t_scale, stable_eigenvalues) = match finished {
         // The trailing half holds the unstable eigenvalues, each with Re λ > the margin, and
         // the leading Hessenberg block the stable ones: by the symmetry of the spectrum their
         // mirror images -λ̄.
         Finished::UnstableHalf => {
             let unstable = quasi_triangular_eigenvalues(schur.t.as_ref().submatrix(n, n, n, n));
-            let stable = unstable.iter().map(|z| c64::new(-z.re, z.im)).collect();
-            (schur.t, schur.z, stable)
+            let stable = unstable
+                .iter()
+                .map(|z| c64::new(-z.re, z.im) * schur.scale)
+                .collect();
+            (schur.t.as_ref(), schur.z.as_ref(), schur.scale, stable)
         }
         Finished::Complete => {
-            let ordered = reorder_schur(schur, |lambda| lambda.re < 0.0)?;
+            let complete = RealSchur {
+                t: schur.t.to_mat_scaled(schur.scale),
+                z: schur.z.to_mat(),
+            };
+            ordered = reorder_schur(complete, |lambda| lambda.re < 0.0)?;
             check_separated(&ordered.eigenvalues, ordered.selected, n, margin)?;
-            let mut stable = ordered.eigenvalues;
-            stable.truncate(n);
-            (ordered.t, ordered.z, stable)
+            let stable = ordered.eigenvalues[..n].to_vec();
+            (ordered.t.as_ref(), ordered.z.as_ref(), 1.0, stable)
         }
     };
     // U11^T Y'^T = U21^T, with U11^-T for rcond(U11): the right-hand sides [U21^T | I].
-    let z = z.as_ref();
     let u11 = Dense::from_ref(z.submatrix(0, 0, n, n));
     let mut factors = u11.transpose();
     let mut combined = Dense::zeros(n, 2 * n);
@@ -631,7 +668,7 @@ fn hamiltonian_solution_in<O: Order>(
     });
     y.symmetrize();
     let closed_loop = (n > KRONECKER_MAX_ORDER).then(|| ClosedLoopFactors {
-        t11: Dense::from_ref(t.as_ref().submatrix(0, 0, n, n)),
+        t11: Dense::from_fn(n, n, |i, j| t[(i, j)] * t_scale),
         hessenberg: (finished == Finished::UnstableHalf).then(|| stable_eigenvalues.clone()),
         v: Dense::from_fn(n, n, |i, j| d[i] * u11[(i, j)]),
         inverse_transposed,

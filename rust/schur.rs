@@ -573,10 +573,36 @@ pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSch
 /// double-shift iteration at the order type of `a` up to that order, by faer's blocked
 /// reduction and the QR iteration of [`schur_of_hessenberg`] above it.
 pub(crate) fn square_real_schur<O: Order>(
-    mut a: Square<O>,
+    a: Square<O>,
     spectrum: Spectrum,
     until: Until,
 ) -> Result<(RealSchur, Finished), Error> {
+    square_schur_form(a, spectrum, until).map(|(schur, finished)| {
+        let real_schur = RealSchur {
+            t: schur.t.to_mat_scaled(schur.scale),
+            z: schur.z.to_mat(),
+        };
+        (real_schur, finished)
+    })
+}
+
+/// The (possibly partial) Schur form of [`square_schur_form`]: A = Z (s T) Z^T, held at the
+/// order type of A.
+pub(crate) struct SquareSchur<O: Order> {
+    /// The Schur form of A / s.
+    pub(crate) t: Square<O>,
+    pub(crate) z: Square<O>,
+    /// s, the power of two of [`range_scale`].
+    pub(crate) scale: f64,
+}
+
+/// [`square_real_schur`] without the conversion to faer matrices, for a caller that reads a
+/// few blocks of T and Z (the Riccati solver).
+pub(crate) fn square_schur_form<O: Order>(
+    mut a: Square<O>,
+    spectrum: Spectrum,
+    until: Until,
+) -> Result<(SquareSchur<O>, Finished), Error> {
     check_finite(a.as_ref(), "A")?;
     let n = a.n();
     let scale = range_scale(a.as_ref());
@@ -601,23 +627,20 @@ pub(crate) fn square_real_schur<O: Order>(
             spectrum,
             until,
         )?;
-        let schur = RealSchur {
-            t: a.to_mat_scaled(scale),
-            z: z.to_mat(),
-        };
-        Ok((schur, finished))
+        Ok((SquareSchur { t: a, z, scale }, finished))
     } else {
+        // (Above the fixed orders: O is Dynamic, and the copies back are O(n^2).)
         let reduced = hessenberg(a.as_ref());
         let (mut t, mut z) = (
             Square::from_mat(reduced.h.as_ref()),
             Square::from_mat(reduced.q.as_ref()),
         );
         schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
-        let schur = RealSchur {
-            t: t.to_mat_scaled(scale),
-            z: z.to_mat(),
-        };
-        Ok((schur, Finished::Complete))
+        let (t, z) = (
+            Square::from_mat_in(a.order, t.as_ref()),
+            Square::from_mat_in(a.order, z.as_ref()),
+        );
+        Ok((SquareSchur { t, z, scale }, Finished::Complete))
     }
 }
 
