@@ -37,13 +37,15 @@ impl Dense {
         cols: usize,
         mut f: impl FnMut(usize, usize) -> f64,
     ) -> Self {
-        let mut data = Vec::with_capacity(rows * cols);
-        for j in 0..cols {
-            for i in 0..rows {
-                data.push(f(i, j));
+        let mut out = Self::zeros(rows, cols);
+        if rows > 0 {
+            for (j, column) in out.data.chunks_exact_mut(rows).enumerate() {
+                for (i, x) in column.iter_mut().enumerate() {
+                    *x = f(i, j);
+                }
             }
         }
-        Self { rows, cols, data }
+        out
     }
 
     /// A copy of a faer matrix (any strides).

@@ -103,27 +103,46 @@ pub const KRONECKER_MAX_ORDER: usize = 5;
 /// `smin = max(u max|M|, tiny)` signals that: [`Singularity::Refuse`] fails, and
 /// [`Singularity::Perturb`] replaces it by `smin`, as the small Sylvester systems of
 /// Bartels–Stewart do.
-// The system's rows and columns are indexed by unknowns: indices read most clearly.
-#[allow(clippy::needless_range_loop)]
 pub(crate) fn solve_kronecker(
     a: &Dense,
     q: &Dense,
     singularity: Singularity,
 ) -> Result<Dense, Error> {
-    const CAPACITY: usize = KRONECKER_MAX_ORDER * (KRONECKER_MAX_ORDER + 1) / 2;
-    let n = a.nrows();
-    debug_assert!(n <= KRONECKER_MAX_ORDER);
-    let size = n * (n + 1) / 2;
+    // The order N and the system's order S = N(N+1)/2 as constants: the loops over rows of S
+    // entries unroll, and the system takes no more stack than it needs.
+    match a.nrows() {
+        0 => Ok(Dense::zeros(0, 0)),
+        1 => solve_kronecker_in::<1, 1>(a, q, singularity),
+        2 => solve_kronecker_in::<2, 3>(a, q, singularity),
+        3 => solve_kronecker_in::<3, 6>(a, q, singularity),
+        4 => solve_kronecker_in::<4, 10>(a, q, singularity),
+        5 => solve_kronecker_in::<5, 15>(a, q, singularity),
+        n => unreachable!("solve_kronecker of order {n} > KRONECKER_MAX_ORDER"),
+    }
+}
+
+/// [`solve_kronecker`] at the order N, S = N(N+1)/2.
+// The system's rows and columns are indexed by unknowns: indices read most clearly.
+#[allow(clippy::needless_range_loop)]
+fn solve_kronecker_in<const N: usize, const S: usize>(
+    a: &Dense,
+    q: &Dense,
+    singularity: Singularity,
+) -> Result<Dense, Error> {
+    const { assert!(S == N * (N + 1) / 2) };
+    let n = N;
+    debug_assert_eq!(a.nrows(), N);
+    let size = S;
     // unknown[i][j]: the position of x_ij = x_ji, by columns of the upper triangle.
-    let mut unknown = [[0usize; KRONECKER_MAX_ORDER]; KRONECKER_MAX_ORDER];
+    let mut unknown = [[0usize; N]; N];
     for j in 0..n {
         for i in 0..=j {
             unknown[i][j] = j * (j + 1) / 2 + i;
             unknown[j][i] = unknown[i][j];
         }
     }
-    let mut m = [[0.0f64; CAPACITY]; CAPACITY];
-    let mut rhs = [0.0f64; CAPACITY];
+    let mut m = [[0.0f64; S]; S];
+    let mut rhs = [0.0f64; S];
     let mut largest = 0.0f64;
     for j in 0..n {
         for i in 0..=j {
@@ -169,7 +188,7 @@ pub(crate) fn solve_kronecker(
             }
         }
     }
-    let mut solution = [0.0f64; CAPACITY];
+    let mut solution = [0.0f64; S];
     for i in (0..size).rev() {
         let mut value = rhs[i];
         for j in i + 1..size {
