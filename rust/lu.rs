@@ -94,18 +94,39 @@ pub fn solve_with_inverse(a: MatMut<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
 /// stack, where the loops index plain arrays, and written back to A. A zero pivot, which only
 /// an exactly singular A produces, is skipped, and the substitution then yields non-finite
 /// entries.
-fn eliminate_and_substitute(mut a: MatMut<'_, f64>, mut b: MatMut<'_, f64>) {
-    const CAPACITY: usize = UNBLOCKED_MAX_ORDER;
-    let n = a.nrows();
-    debug_assert!(n <= CAPACITY);
+fn eliminate_and_substitute(a: MatMut<'_, f64>, b: MatMut<'_, f64>) {
+    // At its order as a constant: the loops over a column unroll.
+    match a.nrows() {
+        0 => {}
+        1 => eliminate_and_substitute_in::<1>(a, b),
+        2 => eliminate_and_substitute_in::<2>(a, b),
+        3 => eliminate_and_substitute_in::<3>(a, b),
+        4 => eliminate_and_substitute_in::<4>(a, b),
+        5 => eliminate_and_substitute_in::<5>(a, b),
+        6 => eliminate_and_substitute_in::<6>(a, b),
+        7 => eliminate_and_substitute_in::<7>(a, b),
+        8 => eliminate_and_substitute_in::<8>(a, b),
+        9 => eliminate_and_substitute_in::<9>(a, b),
+        10 => eliminate_and_substitute_in::<10>(a, b),
+        11 => eliminate_and_substitute_in::<11>(a, b),
+        12 => eliminate_and_substitute_in::<12>(a, b),
+        n => unreachable!("eliminate_and_substitute of order {n} > UNBLOCKED_MAX_ORDER"),
+    }
+}
+
+/// [`eliminate_and_substitute`] at the order N.
+fn eliminate_and_substitute_in<const N: usize>(mut a: MatMut<'_, f64>, mut b: MatMut<'_, f64>) {
+    const { assert!(N <= UNBLOCKED_MAX_ORDER) };
+    let n = N;
+    debug_assert_eq!(a.nrows(), N);
     // Column-major: lu[k][i] = a_ik.
-    let mut lu = [[0.0; CAPACITY]; CAPACITY];
+    let mut lu = [[0.0; N]; N];
     for (k, column) in lu.iter_mut().enumerate().take(n) {
         for (i, entry) in column.iter_mut().enumerate().take(n) {
             *entry = a[(i, k)];
         }
     }
-    let mut pivots = [0usize; CAPACITY];
+    let mut pivots = [0usize; N];
     for k in 0..n {
         let mut pivot_row = k;
         for i in k + 1..n {
@@ -145,7 +166,7 @@ fn eliminate_and_substitute(mut a: MatMut<'_, f64>, mut b: MatMut<'_, f64>) {
     // waiting on its previous step (the operations on each entry are those of one column at a
     // time).
     const GROUP: usize = 8;
-    let mut x = [[0.0; CAPACITY]; GROUP];
+    let mut x = [[0.0; N]; GROUP];
     for first in (0..b.ncols()).step_by(GROUP) {
         let group = GROUP.min(b.ncols() - first);
         let x = &mut x[..group];
