@@ -196,9 +196,13 @@ impl Reduced<'_> {
         let quadratic = product(&coupling, &gain);
         let scale = self.q_norm + 2.0 * ay.frobenius_norm() + quadratic.frobenius_norm();
         let n = y.nrows();
-        let mut residual = Dense::from_fn(n, n, |i, j| {
-            ay[(i, j)] + ay[(j, i)] - quadratic[(i, j)] + self.q[(i, j)]
-        });
+        let ay_transposed = ay.transpose();
+        let mut residual = Dense::zeros(n, n);
+        let terms = ay.as_slice().iter().zip(ay_transposed.as_slice());
+        let terms = terms.zip(quadratic.as_slice()).zip(self.q.as_slice());
+        for (x, (((&ay, &ya), &quadratic), &q)) in residual.as_mut_slice().iter_mut().zip(terms) {
+            *x = ay + ya - quadratic + q;
+        }
         residual.symmetrize();
         Evaluation {
             residual_norm: residual.frobenius_norm(),

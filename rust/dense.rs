@@ -318,13 +318,37 @@ pub(crate) fn solve_lower_in_place(l: &Dense, b: &mut Dense) {
         );
         return;
     }
-    for j in 0..b.cols {
-        let x = b.col_mut(j);
-        for k in 0..m {
-            x[k] /= l[(k, k)];
+    match m {
+        1 => solve_lower_in::<1>(l, b),
+        2 => solve_lower_in::<2>(l, b),
+        3 => solve_lower_in::<3>(l, b),
+        4 => solve_lower_in::<4>(l, b),
+        _ => {
+            for j in 0..b.cols {
+                let x = b.col_mut(j);
+                for k in 0..m {
+                    x[k] /= l[(k, k)];
+                    let solved = x[k];
+                    for i in k + 1..m {
+                        x[i] -= l[(i, k)] * solved;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`solve_lower_in_place`] for L of order M known at compile time (the same operations).
+// Row and column indices of a triangle: indices read most clearly.
+#[allow(clippy::needless_range_loop)]
+fn solve_lower_in<const M: usize>(l: &Dense, b: &mut Dense) {
+    for x in b.data.chunks_exact_mut(M) {
+        let x: &mut [f64; M] = x.try_into().expect("columns of M entries");
+        for k in 0..M {
+            x[k] /= l.data[k + k * M];
             let solved = x[k];
-            for i in k + 1..m {
-                x[i] -= l[(i, k)] * solved;
+            for i in k + 1..M {
+                x[i] -= l.data[i + k * M] * solved;
             }
         }
     }
@@ -343,14 +367,38 @@ pub(crate) fn solve_lower_transposed_in_place(l: &Dense, b: &mut Dense) {
         );
         return;
     }
-    for j in 0..b.cols {
-        let x = b.col_mut(j);
-        for k in (0..m).rev() {
-            let mut value = x[k];
-            for i in k + 1..m {
-                value -= l[(i, k)] * x[i];
+    match m {
+        1 => solve_lower_transposed_in::<1>(l, b),
+        2 => solve_lower_transposed_in::<2>(l, b),
+        3 => solve_lower_transposed_in::<3>(l, b),
+        4 => solve_lower_transposed_in::<4>(l, b),
+        _ => {
+            for j in 0..b.cols {
+                let x = b.col_mut(j);
+                for k in (0..m).rev() {
+                    let mut value = x[k];
+                    for i in k + 1..m {
+                        value -= l[(i, k)] * x[i];
+                    }
+                    x[k] = value / l[(k, k)];
+                }
             }
-            x[k] = value / l[(k, k)];
+        }
+    }
+}
+
+/// [`solve_lower_transposed_in_place`] for L of order M known at compile time (the same
+/// operations).
+#[allow(clippy::needless_range_loop)]
+fn solve_lower_transposed_in<const M: usize>(l: &Dense, b: &mut Dense) {
+    for x in b.data.chunks_exact_mut(M) {
+        let x: &mut [f64; M] = x.try_into().expect("columns of M entries");
+        for k in (0..M).rev() {
+            let mut value = x[k];
+            for i in k + 1..M {
+                value -= l.data[i + k * M] * x[i];
+            }
+            x[k] = value / l.data[k + k * M];
         }
     }
 }
