@@ -577,7 +577,10 @@ fn hamiltonian_solution_in<O: Order>(
     order: O,
     standard: &Standard,
 ) -> Result<HamiltonianSolution, Error> {
-    let n = standard.a.nrows();
+    // n from the order type: a constant at the fixed orders, so that the loops over the
+    // blocks of H unroll.
+    let n = order.get() / 2;
+    debug_assert_eq!(n, standard.a.nrows());
     let (g_norm, q_norm) = (standard.g.frobenius_norm(), standard.q.frobenius_norm());
     let rho = if g_norm > 0.0 && q_norm > 0.0 {
         nearest_power_of_two((q_norm / g_norm).sqrt())

@@ -115,7 +115,15 @@ impl Dense {
 
     /// The transpose.
     pub(crate) fn transpose(&self) -> Self {
-        Self::from_fn(self.cols, self.rows, |i, j| self[(j, i)])
+        let mut out = Self::zeros(self.cols, self.rows);
+        if self.rows > 0 {
+            for (j, column) in self.data.chunks_exact(self.rows).enumerate() {
+                for (i, &x) in column.iter().enumerate() {
+                    out.data[j + i * self.cols] = x;
+                }
+            }
+        }
+        out
     }
 
     /// X <- (X + X^T) / 2, for square X.
