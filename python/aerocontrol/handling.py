@@ -73,6 +73,8 @@ spiral      time to double  inf            1      L1 > 12 s; L2 > 8 s; L3 > 4 s 
 
 from __future__ import annotations
 
+import cmath
+import functools
 import math
 import textwrap
 from collections.abc import Mapping, Sequence
@@ -478,6 +480,24 @@ def _mode_name(key: Any, name: str) -> str:
     raise InvalidArgumentError(f"{name} {key!r} is not a mode; the modes are {_choices(MODES)}")
 
 
+def _as_eigenvalues(value: Any, label: str) -> np.ndarray[Any, np.dtype[np.complex128]]:
+    """A 1-D complex array of the numbers in ``value`` (a tuple or list of Python or numpy
+    scalars, as the mode namers return them, without numpy's dtype discovery)."""
+    if isinstance(value, (tuple, list)) and all(
+        isinstance(v, (int, float, complex, np.number)) for v in value
+    ):
+        return np.array(value, dtype=np.complex128)
+    try:
+        array = np.asarray(value)
+    except ValueError as error:
+        raise InvalidArgumentError(f"{label} must be a sequence of numbers: {error}") from None
+    if array.dtype.kind not in "biufc":
+        raise InvalidArgumentError(
+            f"{label} must be a sequence of numbers, got dtype {array.dtype}"
+        )
+    return np.atleast_1d(array.astype(np.complex128))
+
+
 def _eigenvalues(modes: Any) -> dict[str, np.ndarray[Any, np.dtype[np.complex128]]]:
     if not isinstance(modes, Mapping):
         raise InvalidArgumentError(
@@ -491,15 +511,7 @@ def _eigenvalues(modes: Any) -> dict[str, np.ndarray[Any, np.dtype[np.complex128
         label = f"modes[{key!r}]"
         if mode in result:
             raise InvalidArgumentError(f"{label} repeats the mode {mode!r}")
-        try:
-            array = np.asarray(value)
-        except ValueError as error:
-            raise InvalidArgumentError(f"{label} must be a sequence of numbers: {error}") from None
-        if array.dtype.kind not in "biufc":
-            raise InvalidArgumentError(
-                f"{label} must be a sequence of numbers, got dtype {array.dtype}"
-            )
-        lam = np.atleast_1d(array.astype(np.complex128))
+        lam = _as_eigenvalues(value, label)
         count = 2 if mode in _OSCILLATORY else 1
         if lam.ndim != 1 or lam.size != count:
             what = (
@@ -508,7 +520,7 @@ def _eigenvalues(modes: Any) -> dict[str, np.ndarray[Any, np.dtype[np.complex128
                 else "one real eigenvalue"
             )
             raise ShapeError(f"{label} must hold {what}, got an array of shape {lam.shape}")
-        if not np.all(np.isfinite(lam)):
+        if not all(cmath.isfinite(z) for z in lam.tolist()):
             raise NonFiniteError(f"{label} must be finite, got {lam.tolist()}")
         if count == 2:
             l1, l2 = complex(lam[0]), complex(lam[1])
@@ -549,6 +561,15 @@ def _time_to_double(growth: float) -> float:
     return _LN2 / growth if growth > 0 else math.inf
 
 
+@functools.lru_cache(maxsize=256)
+def _limits(texts: tuple[str | None, ...]) -> str:
+    """ "L1 ...; L2 ...; L3 ..." from the limit texts of the Levels (None: no limit); the same
+    few texts recur at every condition of an envelope, hence the cache."""
+    return "; ".join(
+        f"L{k} {'none' if text is None else text}" for k, text in enumerate(texts, start=1)
+    )
+
+
 def _requirement(
     mode: str, quantity: str, value: float, checks: Sequence[tuple[str | None, bool]]
 ) -> Requirement:
@@ -558,9 +579,7 @@ def _requirement(
         if text is None or met:
             level = k
             break
-    limits = "; ".join(
-        f"L{k} {'none' if text is None else text}" for k, (text, _) in enumerate(checks, start=1)
-    )
+    limits = _limits(tuple(text for text, _ in checks))
     return Requirement(
         mode=mode,
         quantity=quantity,

@@ -394,48 +394,62 @@ class Aircraft:
 
     def longitudinal(self) -> StateSpace:
         """The longitudinal model (6.49): x = (u/u0, α, q, θ), input the elevator δe (rad)."""
+        # Rows as Python floats (the same double-precision operations as numpy's, without a
+        # numpy call per row), one array at the end.
         d = self.dimensional_longitudinal()
         u0, g, theta0 = self.speed, self.gravity, self.theta0
-        A = np.zeros((4, 4))
-        B = np.zeros((4, 1))
-        A[0] = [d["Xu"], d["Xw"], 0.0, -g * math.cos(theta0) / u0]
-        B[0, 0] = d["Xde"] / u0
+        surge = [d["Xu"], d["Xw"], 0.0, -g * math.cos(theta0) / u0]
         scale = 1.0 / (1.0 - d["Zwdot"])
-        A[1] = [
+        heave = [
             d["Zu"] * scale,
             d["Zw"] * scale,
             (1.0 + d["Zq"] / u0) * scale,
             -g * math.sin(theta0) / u0 * scale,
         ]
-        B[1, 0] = d["Zde"] / u0 * scale
+        heave_control = d["Zde"] / u0 * scale
         alpha_rate = u0 * d["Mwdot"]
-        A[2] = [u0 * d["Mu"], u0 * d["Mw"], d["Mq"], 0.0] + alpha_rate * A[1]
-        B[2, 0] = d["Mde"] + alpha_rate * B[1, 0]
-        A[3, 2] = 1.0
+        pitch = [
+            x + alpha_rate * z
+            for x, z in zip([u0 * d["Mu"], u0 * d["Mw"], d["Mq"], 0.0], heave, strict=True)
+        ]
+        pitch_control = d["Mde"] + alpha_rate * heave_control
         # (+ 0.0 turns the negative zeros of -g sin 0 and -CD_de = -0 into zeros.)
-        A, B = A + 0.0, B + 0.0
+        A = np.array([surge, heave, pitch, [0.0, 0.0, 1.0, 0.0]]) + 0.0
+        B = np.array([[d["Xde"] / u0], [heave_control], [pitch_control], [0.0]]) + 0.0
         return StateSpace(A, B, state_names=list(LONGITUDINAL_STATES), input_names=["elevator"])
 
     def lateral(self) -> StateSpace:
         """The lateral-directional model (6.150): x = (β, p, φ, r), inputs (rudder, aileron) in
         rad, the order of the chapter's LQR example (6.224)."""
+        # Rows as Python floats, as in longitudinal().
         d = self.dimensional_lateral()
         u0, g, theta0 = self.speed, self.gravity, self.theta0
-        A = np.zeros((4, 4))
-        B = np.zeros((4, 2))
-        A[0] = [d["Yv"], d["Yp"] / u0, g * math.cos(theta0) / u0, d["Yr"] / u0 - 1.0]
-        B[0] = [d["Ydr"] / u0, d["Yda"] / u0]
         ix, iz = d["ix"], d["iz"]
         coupling = 1.0 - ix * iz
-        roll = np.array([u0 * d["Lv"], d["Lp"], 0.0, d["Lr"]])
-        yaw = np.array([u0 * d["Nv"], d["Np"], 0.0, d["Nr"]])
-        roll_control = np.array([d["Ldr"], d["Lda"]])
-        yaw_control = np.array([d["Ndr"], d["Nda"]])
-        A[1] = (roll + ix * yaw) / coupling
-        B[1] = (roll_control + ix * yaw_control) / coupling
-        A[2] = [0.0, 1.0, 0.0, math.tan(theta0)]
-        A[3] = (yaw + iz * roll) / coupling
-        B[3] = (yaw_control + iz * roll_control) / coupling
+        roll = [u0 * d["Lv"], d["Lp"], 0.0, d["Lr"]]
+        yaw = [u0 * d["Nv"], d["Np"], 0.0, d["Nr"]]
+        roll_control = [d["Ldr"], d["Lda"]]
+        yaw_control = [d["Ndr"], d["Nda"]]
+
+        def combined(first: list[float], second: list[float], factor: float) -> list[float]:
+            return [(x + factor * y) / coupling for x, y in zip(first, second, strict=True)]
+
+        A = np.array(
+            [
+                [d["Yv"], d["Yp"] / u0, g * math.cos(theta0) / u0, d["Yr"] / u0 - 1.0],
+                combined(roll, yaw, ix),
+                [0.0, 1.0, 0.0, math.tan(theta0)],
+                combined(yaw, roll, iz),
+            ]
+        )
+        B = np.array(
+            [
+                [d["Ydr"] / u0, d["Yda"] / u0],
+                combined(roll_control, yaw_control, ix),
+                [0.0, 0.0],
+                combined(yaw_control, roll_control, iz),
+            ]
+        )
         A, B = A + 0.0, B + 0.0
         return StateSpace(A, B, state_names=list(LATERAL_STATES), input_names=["rudder", "aileron"])
 
