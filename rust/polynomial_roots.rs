@@ -439,22 +439,13 @@ mod tests {
             expected.push(*z);
             expected.push(z.conj());
         }
-        let mut left: Vec<c64> = computed.as_slice().to_vec();
-        assert_eq!(left.len(), expected.len(), "{what}: {left:?}");
-        for e in &expected {
-            let (k, distance) = left
-                .iter()
-                .map(|z| (z - e).norm())
-                .enumerate()
-                .min_by(|x, y| x.1.total_cmp(&y.1))
-                .unwrap();
+        let partners = crate::test_matrices::nearest_partners(computed.as_slice(), &expected);
+        for (e, z) in partners {
             assert!(
-                distance <= tolerance * e.norm().max(f64::MIN_POSITIVE),
-                "{what}: root {e} computed as {} ({:?})",
-                left[k],
+                (z - e).norm() <= tolerance * e.norm().max(f64::MIN_POSITIVE),
+                "{what}: root {e} computed as {z} ({:?})",
                 computed.as_slice()
             );
-            left.remove(k);
         }
     }
 

@@ -1434,20 +1434,10 @@ mod tests {
     /// The largest distance from an eigenvalue of `expected` to its partner in `found`, each
     /// found eigenvalue partnered once (nearest first).
     fn spectral_distance(found: &[c64], expected: &[c64]) -> f64 {
-        assert_eq!(found.len(), expected.len());
-        let mut unused: Vec<c64> = found.to_vec();
-        let mut worst = 0.0f64;
-        for y in expected {
-            let (k, distance) = unused
-                .iter()
-                .map(|x| (x - y).norm())
-                .enumerate()
-                .min_by(|p, q| p.1.total_cmp(&q.1))
-                .unwrap();
-            unused.swap_remove(k);
-            worst = worst.max(distance);
-        }
-        worst
+        crate::test_matrices::nearest_partners(found, expected)
+            .iter()
+            .map(|(y, x)| (x - y).norm())
+            .fold(0.0, f64::max)
     }
 
     /// Q D Q^T with Q orthogonal (from a seeded QR) and D block diagonal with the given

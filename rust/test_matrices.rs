@@ -1,6 +1,6 @@
 //! Deterministic pseudo-random matrices for the unit tests.
 
-use faer::Mat;
+use faer::{Mat, c64};
 
 /// A rows x cols matrix with entries in [-1, 1) from a xorshift generator seeded by `seed`.
 pub(crate) fn seeded(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
@@ -36,4 +36,27 @@ pub(crate) fn lateral_747_inputs() -> Mat<f64> {
         [0.0, 0.0],
         [-0.2440, -0.0017],
     ]
+}
+
+/// Each value of `expected` with its partner in `found`, nearest first, each found value
+/// partnered once (the same count).
+pub(crate) fn nearest_partners(found: &[c64], expected: &[c64]) -> Vec<(c64, c64)> {
+    assert_eq!(
+        found.len(),
+        expected.len(),
+        "{found:?} against {expected:?}"
+    );
+    let mut unused: Vec<c64> = found.to_vec();
+    expected
+        .iter()
+        .map(|y| {
+            let (k, _) = unused
+                .iter()
+                .map(|x| (x - y).norm())
+                .enumerate()
+                .min_by(|p, q| p.1.total_cmp(&q.1))
+                .expect("as many found as expected");
+            (*y, unused.swap_remove(k))
+        })
+        .collect()
 }
