@@ -98,13 +98,15 @@ pub fn monic_roots(coefficients: &[f64]) -> Option<Roots> {
         return Some(roots);
     };
     let s = 2f64.powi(exponent);
-    if !(s.is_finite() && s > 0.0) {
-        return None;
-    }
     let mut scaled = [0.0; 4];
     let mut power = 1.0;
     for (x, &c) in scaled.iter_mut().zip(coefficients) {
         power *= s;
+        // s^k out of range (coefficients spread over more than the exponent range): the
+        // scaled coefficients would lose the small roots.
+        if !(power.is_finite() && power > 0.0) {
+            return None;
+        }
         *x = c / power;
     }
     let scaled = &scaled[..degree];
@@ -544,6 +546,8 @@ mod tests {
 
     #[test]
     fn refused_inputs() {
+        // x² + 1e300 x + 1: scaling by s ~ 1e300 would take s² past the overflow threshold.
+        assert!(monic_roots(&[1e300, 1.0]).is_none());
         assert!(monic_roots(&[1.0; 5]).is_none());
         assert!(monic_roots(&[f64::NAN, 1.0]).is_none());
         assert!(monic_roots(&[1.0, f64::INFINITY, 0.0]).is_none());
