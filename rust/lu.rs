@@ -121,8 +121,8 @@ fn eliminate_and_substitute_in<const N: usize>(mut a: MatMut<'_, f64>, mut b: Ma
     debug_assert_eq!(a.nrows(), N);
     // Column-major: lu[k][i] = a_ik.
     let mut lu = [[0.0; N]; N];
-    for (k, column) in lu.iter_mut().enumerate().take(n) {
-        for (i, entry) in column.iter_mut().enumerate().take(n) {
+    for (k, column) in lu.iter_mut().enumerate() {
+        for (i, entry) in column.iter_mut().enumerate() {
             *entry = a[(i, k)];
         }
     }
@@ -136,7 +136,7 @@ fn eliminate_and_substitute_in<const N: usize>(mut a: MatMut<'_, f64>, mut b: Ma
         }
         pivots[k] = pivot_row;
         if pivot_row != k {
-            for column in lu.iter_mut().take(n) {
+            for column in lu.iter_mut() {
                 column.swap(k, pivot_row);
             }
         }
@@ -156,8 +156,8 @@ fn eliminate_and_substitute_in<const N: usize>(mut a: MatMut<'_, f64>, mut b: Ma
             }
         }
     }
-    for (k, column) in lu.iter().enumerate().take(n) {
-        for (i, &entry) in column.iter().enumerate().take(n) {
+    for (k, column) in lu.iter().enumerate() {
+        for (i, &entry) in column.iter().enumerate() {
             a[(i, k)] = entry;
         }
     }
@@ -171,10 +171,10 @@ fn eliminate_and_substitute_in<const N: usize>(mut a: MatMut<'_, f64>, mut b: Ma
         let group = GROUP.min(b.ncols() - first);
         let x = &mut x[..group];
         for (c, column) in x.iter_mut().enumerate() {
-            for (i, entry) in column.iter_mut().enumerate().take(n) {
+            for (i, entry) in column.iter_mut().enumerate() {
                 *entry = b[(i, first + c)];
             }
-            for (k, &pivot_row) in pivots.iter().enumerate().take(n) {
+            for (k, &pivot_row) in pivots.iter().enumerate() {
                 column.swap(k, pivot_row);
             }
         }
@@ -196,7 +196,7 @@ fn eliminate_and_substitute_in<const N: usize>(mut a: MatMut<'_, f64>, mut b: Ma
             }
         }
         for (c, column) in x.iter().enumerate() {
-            for (i, &entry) in column.iter().enumerate().take(n) {
+            for (i, &entry) in column.iter().enumerate() {
                 b[(i, first + c)] = entry;
             }
         }
