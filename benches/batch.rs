@@ -105,7 +105,7 @@ fn dampers(c: &mut Criterion) {
                     max_relative_error: &mut error,
                     condition: &mut condition,
                 };
-                place_batch(black_box(a), b, &poles, placer, out).unwrap()
+                place_batch(black_box(a), b, &poles, count, placer, out).unwrap()
             })
         });
     }

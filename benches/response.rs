@@ -12,7 +12,7 @@ use aerocontrol::freq::frequency_response_into;
 use aerocontrol::modes::eigen;
 use aerocontrol::response::{Input, Model, simulate_into};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use faer::{Mat, c64, mat};
+use faer::{Mat, MatRef, c64, mat};
 use std::hint::black_box;
 
 mod common;
@@ -72,7 +72,7 @@ fn bench_step_response(c: &mut Criterion) {
             bench.iter(|| {
                 simulate_into(
                     black_box(model),
-                    &[0.0; 4],
+                    MatRef::from_row_major_slice(&[0.0; 4], 1, 4),
                     Input::Constant(&[1.0]),
                     dt,
                     steps,

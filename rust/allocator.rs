@@ -13,8 +13,40 @@
 //! request at once: the core meets one when a caller passes a broadcast array of 10^10 entries,
 //! and turns the refusal into MemoryError (mimalloc reserves address space for such a request
 //! instead, and the tests that make one stalled).
+//!
+//! mimalloc reserves the address space of its arenas 1 GiB at a time by default, which made
+//! `import aerocontrol` take 1.2 GB of address space, and a process under an address-space limit
+//! (`ulimit -v`) short of it. The small blocks need a few megabytes; [`ARENA_RESERVE_KIB`] is
+//! set when the library is loaded, before its first allocation.
 
 use std::alloc::{GlobalAlloc, Layout, System};
+
+/// The address space mimalloc reserves for an arena at a time, in KiB (its option
+/// `arena_reserve`; it grows the reservation for later arenas).
+pub const ARENA_RESERVE_KIB: std::ffi::c_long = 8 << 10;
+
+/// `mi_option_arena_reserve` in the `mi_option_t` of the mimalloc that libmimalloc-sys 0.1.49
+/// builds (v3; the crate's Rust constants stop before it). Cargo.toml pins that version.
+const MI_OPTION_ARENA_RESERVE: libmimalloc_sys::mi_option_t = 23;
+
+/// Sets mimalloc's options; runs when the library is loaded.
+extern "C" fn configure_mimalloc() {
+    // SAFETY: mi_option_set only stores the value of a valid option index.
+    unsafe { libmimalloc_sys::mi_option_set(MI_OPTION_ARENA_RESERVE, ARENA_RESERVE_KIB) }
+}
+
+/// Runs [`configure_mimalloc`] when the shared library is loaded (an ELF initialiser), before
+/// any code of the library allocates.
+#[cfg(target_os = "linux")]
+#[used]
+#[unsafe(link_section = ".init_array")]
+static CONFIGURE_MIMALLOC: extern "C" fn() = configure_mimalloc;
+
+/// The same, as a Mach-O module initialiser.
+#[cfg(target_os = "macos")]
+#[used]
+#[unsafe(link_section = "__DATA,__mod_init_func")]
+static CONFIGURE_MIMALLOC: extern "C" fn() = configure_mimalloc;
 
 /// Blocks of this many bytes or more come from the system allocator (a 90 x 90 matrix of
 /// f64 is 64 800 bytes, below it).
@@ -111,6 +143,14 @@ mod tests {
             assert!((0..512).all(|i| *back.add(i) == (i % 251) as u8));
             allocator.dealloc(back, Layout::from_size_align(512, 64).expect("valid"));
         }
+    }
+
+    #[test]
+    fn arenas_are_reserved_in_small_steps() {
+        configure_mimalloc();
+        // SAFETY: reads the value of a valid option index.
+        let reserve = unsafe { libmimalloc_sys::mi_option_get(MI_OPTION_ARENA_RESERVE) };
+        assert_eq!(reserve, ARENA_RESERVE_KIB);
     }
 
     #[test]

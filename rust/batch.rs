@@ -10,6 +10,7 @@ use crate::dense::Dense;
 use crate::error::{Error, check_finite, check_output_len};
 use crate::expm::expm_into_validated;
 use crate::place::Placement;
+use crate::platform::parallel::{ParallelContext, par_chunks};
 use faer::{MatMut, MatRef, c64};
 use rayon::prelude::*;
 
@@ -94,16 +95,19 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
     if n == 0 {
         return Ok(());
     }
+    let context = ParallelContext::capture();
     out.par_chunks_mut(n * n)
         .enumerate()
-        .for_each(|(index, chunk)| {
-            // Validated above: every matrix is square and finite.
-            expm_into_validated(
-                stack.get(index),
-                MatMut::from_row_major_slice_mut(chunk, n, n),
-            );
-        });
-    Ok(())
+        .try_for_each(|(index, chunk)| {
+            context.run(|| {
+                // Validated above: every matrix is square and finite.
+                expm_into_validated(
+                    stack.get(index),
+                    MatMut::from_row_major_slice_mut(chunk, n, n),
+                );
+                Ok(())
+            })
+        })
 }
 
 /// The data of a batch of Riccati equations A^T X + X A - X B R^-1 B^T X + Q = 0 (6.199).
@@ -154,10 +158,8 @@ pub fn batch_count(lengths: &[(&'static str, usize)]) -> Result<usize, Error> {
 /// A matrix's entries, row by row.
 fn write_row_major(matrix: &Dense, out: &mut [f64]) {
     let cols = matrix.ncols();
-    for (i, row) in out.chunks_exact_mut(cols).enumerate() {
-        for (j, x) in row.iter_mut().enumerate() {
-            *x = matrix[(i, j)];
-        }
+    for (index, x) in out.iter_mut().enumerate() {
+        *x = matrix[(index / cols, index % cols)];
     }
 }
 
@@ -208,36 +210,29 @@ pub fn care_batch(
         refine,
         ..CareOptions::default()
     };
-    // Without inputs (m = 0) K is empty; a placeholder chunk per problem keeps the zip whole.
-    let mut placeholder = Vec::new();
-    let (gains, gain_size) = if m == 0 {
-        placeholder.resize(count, 0.0);
-        (&mut placeholder[..], 1)
-    } else {
-        (out.gain, m * n)
-    };
+    let context = ParallelContext::capture();
     let failure = out
         .x
         .par_chunks_mut(n * n)
-        .zip(gains.par_chunks_mut(gain_size))
+        .zip(par_chunks(out.gain, m * n, count))
         .zip(out.poles.par_chunks_mut(n))
         .zip(out.residual.par_iter_mut())
         .zip(out.rcond.par_iter_mut())
         .enumerate()
         .filter_map(|(index, ((((x, gain), poles), residual), rcond))| {
-            let solved = solve_care_dense(
-                member(&stacks.a, index),
-                member(&stacks.b, index),
-                member(&stacks.q, index),
-                member(&stacks.r, index),
-                options,
-            );
+            let solved = context.run(|| {
+                solve_care_dense(
+                    member(&stacks.a, index),
+                    member(&stacks.b, index),
+                    member(&stacks.q, index),
+                    member(&stacks.r, index),
+                    options,
+                )
+            });
             match solved {
                 Ok(care) => {
                     write_row_major(&care.x, x);
-                    if m > 0 {
-                        write_row_major(&care.gain, gain);
-                    }
+                    write_row_major(&care.gain, gain);
                     poles.copy_from_slice(&care.closed_loop_eigenvalues);
                     *residual = care.residual;
                     *rcond = care.rcond;
@@ -265,13 +260,14 @@ pub struct PlaceBatchOutput<'a> {
 }
 
 /// Places the poles of every problem of a batch, in parallel, each exactly as `placer`
-/// places them alone. `a` and `b` hold one matrix (shared) or one per problem, `poles` one
-/// row of n requested poles (shared) or one per problem. If any problem fails, the error of
-/// the lowest index is returned, naming it.
+/// places them alone. `a` and `b` hold one matrix (shared) or one per problem, `poles` holds
+/// `rows` rows of n requested poles, row-major: one (shared) or one per problem. If any problem
+/// fails, the error of the lowest index is returned, naming it.
 pub fn place_batch(
     a: MatrixStack<'_>,
     b: MatrixStack<'_>,
     poles: &[c64],
+    rows: usize,
     placer: Placer,
     out: PlaceBatchOutput<'_>,
 ) -> Result<(), Error> {
@@ -284,21 +280,21 @@ pub fn place_batch(
             ),
         });
     }
-    if !poles.len().is_multiple_of(n) {
-        return Err(Error::InvalidArgument {
+    if poles.len() != rows.saturating_mul(n) {
+        return Err(Error::Mismatch {
             arg: "poles",
-            message: format!(
-                "poles must hold rows of n = {n} poles, got {} values",
-                poles.len()
-            ),
+            what: "one row of poles per problem, rows x n values with n the order of",
+            expected: rows.saturating_mul(n),
+            other: "A",
+            got: poles.len(),
         });
     }
-    let rows = poles.len() / n;
     let count = batch_count(&[("A", a.len()), ("B", b.len()), ("poles", rows)])?;
     check_output_len(out.gain.len(), count * m * n)?;
     check_output_len(out.achieved.len(), count * n)?;
     check_output_len(out.max_relative_error.len(), count)?;
     check_output_len(out.condition.len(), count)?;
+    let context = ParallelContext::capture();
     let failure = out
         .gain
         .par_chunks_mut(m * n)
@@ -308,11 +304,14 @@ pub fn place_batch(
         .enumerate()
         .filter_map(|(index, (((gain, achieved), error), condition))| {
             let row = if rows == 1 { 0 } else { index };
-            match placer(
-                member(&a, index),
-                member(&b, index),
-                &poles[row * n..(row + 1) * n],
-            ) {
+            let placed = context.run(|| {
+                placer(
+                    member(&a, index),
+                    member(&b, index),
+                    &poles[row * n..(row + 1) * n],
+                )
+            });
+            match placed {
                 Ok(design) => {
                     MatMut::from_row_major_slice_mut(gain, m, n).copy_from(&design.gain);
                     achieved.copy_from_slice(&design.achieved_poles);
@@ -559,7 +558,7 @@ mod tests {
                 max_relative_error: &mut error,
                 condition: &mut condition,
             };
-            place_batch(a_stack, b_stack, &poles, placer, out).unwrap();
+            place_batch(a_stack, b_stack, &poles, 3, placer, out).unwrap();
             for k in 0..3 {
                 let single =
                     placer(a_stack.get(0), b_stack.get(0), &poles[4 * k..4 * k + 4]).unwrap();
@@ -585,7 +584,7 @@ mod tests {
             max_relative_error: &mut error,
             condition: &mut condition,
         };
-        let failure = place_batch(a_stack, b_stack, &broken, place_bass_gura, out).unwrap_err();
+        let failure = place_batch(a_stack, b_stack, &broken, 3, place_bass_gura, out).unwrap_err();
         assert!(
             matches!(failure, Error::InBatch { index: 1, .. }),
             "{failure}"

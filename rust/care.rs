@@ -332,7 +332,7 @@ pub(crate) fn solve_care_dense(
     // The stable eigenvalues of H are those of the closed loop of the exact solution: as
     // shifts they make the QR iteration converge in fewer sweeps.
     let closed_loop_eigenvalues = eigenvalues_near(closed_loop.as_ref(), &stable_eigenvalues)?;
-    check_stabilising(&closed_loop_eigenvalues)?;
+    check_stabilising(&closed_loop_eigenvalues, closed_loop.frobenius_norm())?;
     // X = E^-T Y E^-1.
     let (x, residual) = match options.e {
         Some(e) => {
@@ -725,13 +725,18 @@ fn check_separated(
     })
 }
 
-/// The error for a solution whose closed loop is not stable: the Hamiltonian's eigenvalues
-/// were separated by the imaginary axis, but some pair so ill-conditioned that the computed
-/// stable subspace is not the stable one.
-fn check_stabilising(closed_loop_eigenvalues: &[c64]) -> Result<(), Error> {
+/// The error for a solution whose closed loop is not stable to working precision: an
+/// eigenvalue of A - B K with Re λ > -[`AXIS_TOLERANCE`] ||A - B K||_F (on or beyond the
+/// imaginary axis, within rounding). This happens when the Hamiltonian's eigenvalues were
+/// separated by the axis but some pair was so ill-conditioned that the computed stable subspace
+/// is not the stable one; typically an undamped mode that B cannot move, whose double
+/// eigenvalue on the axis rounding has split into a pair just off it (a cross term S hides it
+/// from the Hamiltonian's own test).
+fn check_stabilising(closed_loop_eigenvalues: &[c64], closed_loop_norm: f64) -> Result<(), Error> {
+    let margin = AXIS_TOLERANCE * closed_loop_norm;
     let unstable: Vec<String> = closed_loop_eigenvalues
         .iter()
-        .filter(|lambda| lambda.re >= 0.0 || lambda.re.is_nan())
+        .filter(|lambda| lambda.re.is_nan() || lambda.re >= -margin)
         .map(|z| crate::error::format_complex(*z))
         .collect();
     if unstable.is_empty() {
@@ -740,9 +745,10 @@ fn check_stabilising(closed_loop_eigenvalues: &[c64]) -> Result<(), Error> {
     Err(Error::NoStabilizingSolution {
         message: format!(
             "the Riccati equation has no stabilising solution to working precision: the \
-             computed solution leaves the closed loop with {} eigenvalue(s) of A - B K in \
-             Re >= 0 ({}), the Hamiltonian's stable and unstable eigenvalues being too \
-             ill-conditioned to separate",
+             computed solution leaves the closed loop with {} eigenvalue(s) of A - B K on or \
+             beyond the imaginary axis ({}; Re >= -{margin:.1e} = -{AXIS_TOLERANCE:.1e} \
+             ||A - BK||), so some undamped or unstable mode can be neither moved by B nor \
+             separated from its mirror image",
             unstable.len(),
             unstable.join(", ")
         ),
@@ -915,17 +921,46 @@ mod tests {
 
     #[test]
     fn an_unstable_closed_loop_is_refused() {
-        assert!(check_stabilising(&[c64::new(-1.0, 2.0), c64::new(-1.0, -2.0)]).is_ok());
-        let refused = check_stabilising(&[
-            c64::new(-1.0, 0.0),
-            c64::new(0.0, 0.0),
-            c64::new(f64::NAN, 0.0),
-        ]);
+        assert!(check_stabilising(&[c64::new(-1.0, 2.0), c64::new(-1.0, -2.0)], 3.0).is_ok());
+        let refused = check_stabilising(
+            &[
+                c64::new(-1.0, 0.0),
+                c64::new(0.0, 0.0),
+                c64::new(f64::NAN, 0.0),
+                // Within rounding of the axis, for a closed loop of norm 2: on it.
+                c64::new(-2.8e-17, 1.0),
+            ],
+            2.0,
+        );
         match refused {
             Err(Error::NoStabilizingSolution { message }) => {
-                assert!(message.contains("2 eigenvalue(s)"), "{message}")
+                assert!(message.contains("3 eigenvalue(s)"), "{message}")
             }
             other => panic!("{other:?}"),
+        }
+    }
+
+    /// An undamped mode that B cannot move has no stabilising solution, with or without a
+    /// cross term S (which hides it from the Hamiltonian's test: the computed closed loop
+    /// keeps it at -3e-17 ± 1j).
+    #[test]
+    fn an_uncontrollable_undamped_mode_is_refused_with_a_cross_term() {
+        let a = faer::mat![[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -1.0]];
+        let b = faer::mat![[0.0], [0.0], [1.0]];
+        let q = Mat::<f64>::identity(3, 3);
+        let r = Mat::<f64>::identity(1, 1);
+        for s in [None, Some(faer::mat![[0.1], [0.2], [0.3]])] {
+            let options = CareOptions {
+                s: s.as_ref().map(|s| s.as_ref()),
+                e: None,
+                refine: true,
+            };
+            let solved = solve_care(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref(), options);
+            assert!(
+                matches!(solved, Err(Error::NoStabilizingSolution { .. })),
+                "{:?}",
+                solved.map(|care| care.closed_loop_eigenvalues)
+            );
         }
     }
 

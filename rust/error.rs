@@ -70,6 +70,10 @@ pub enum Error {
     IllConditioned { message: String },
     /// One problem of a batch failed; `index` is its position in the stack.
     InBatch { index: usize, source: Box<Error> },
+    /// The memory a computation needs cannot be had ([`crate::platform::memory`]).
+    OutOfMemory { bytes: usize },
+    /// The computation was interrupted by its caller ([`crate::platform::interrupt`]).
+    Interrupted,
 }
 
 impl Error {
@@ -169,6 +173,13 @@ impl fmt::Display for Error {
             | Error::NoStabilizingSolution { message }
             | Error::IllConditioned { message } => write!(f, "{message}"),
             Error::InBatch { index, source } => write!(f, "problem {index} of the batch: {source}"),
+            Error::OutOfMemory { bytes } => write!(
+                f,
+                "not enough memory: the system refused {bytes} bytes ({:.1} MiB) that the \
+                 computation needs",
+                *bytes as f64 / (1u64 << 20) as f64
+            ),
+            Error::Interrupted => write!(f, "the computation was interrupted"),
         }
     }
 }

@@ -62,6 +62,7 @@ use crate::dispatch::{add_scaled, scale_into};
 use crate::double_double::DoubleDoubleMatrix;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
 use crate::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
+use crate::platform::parallel::ParallelContext;
 use crate::pool::{Scratch, scratch};
 use crate::small_matrix::SmallMatrix;
 use faer::linalg::matmul::matmul;
@@ -1023,7 +1024,11 @@ pub fn pade_choice(a: MatRef<'_, f64>) -> Result<(usize, u32), Error> {
     Ok((choice.degree(), choice.squarings))
 }
 
-fn transition_matrices_with<M: ExpmMatrix>(a: MatRef<'_, f64>, times: &[f64], out: &mut [f64]) {
+fn transition_matrices_with<M: ExpmMatrix>(
+    a: MatRef<'_, f64>,
+    times: &[f64],
+    out: &mut [f64],
+) -> Result<(), Error> {
     let n = a.nrows();
     let mut plan = ExponentialPlan::<M>::new(a);
     let choices: Vec<PadeChoice> = times.iter().map(|&t| plan.choose(t)).collect();
@@ -1031,21 +1036,25 @@ fn transition_matrices_with<M: ExpmMatrix>(a: MatRef<'_, f64>, times: &[f64], ou
         plan.prepare(choice);
     }
     let plan = &plan;
+    let context = ParallelContext::capture();
     let evaluate = |((&t, &choice), chunk): ((&f64, &PadeChoice), &mut [f64])| {
-        plan.exponential_into(t, choice, MatMut::from_row_major_slice_mut(chunk, n, n));
+        context.run(|| {
+            plan.exponential_into(t, choice, MatMut::from_row_major_slice_mut(chunk, n, n));
+            Ok(())
+        })
     };
     if n < PARALLEL_MIN_ORDER && times.len() > 1 {
         times
             .par_iter()
             .zip(&choices)
             .zip(out.par_chunks_mut(n * n))
-            .for_each(evaluate);
+            .try_for_each(evaluate)
     } else {
         times
             .iter()
             .zip(&choices)
             .zip(out.chunks_mut(n * n))
-            .for_each(evaluate);
+            .try_for_each(evaluate)
     }
 }
 
@@ -1067,7 +1076,7 @@ pub fn transition_matrices_into(
                 *value = (t * a[(0, 0)]).exp();
             }
         }
-        n => with_matrix_type!(n, M => transition_matrices_with::<M>(a, times, out)),
+        n => with_matrix_type!(n, M => transition_matrices_with::<M>(a, times, out))?,
     }
     Ok(())
 }

@@ -21,6 +21,7 @@ use crate::error::{
     Error, check_finite, check_finite_values, check_output_len, check_rows, check_square,
 };
 use crate::hessenberg::{Hessenberg, hessenberg};
+use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
 use rayon::prelude::*;
 
@@ -260,14 +261,17 @@ pub fn frequency_response_into(
         x_re: vec![0.0; n * m],
         x_im: vec![0.0; n * m],
     };
+    let context = ParallelContext::capture();
     omega
         .par_iter()
         .zip(out.par_chunks_mut(p * m))
         .with_min_len(32)
-        .for_each_init(workspace, |ws, (&w, g)| {
-            evaluate_frequency(&model, w, ws, g)
-        });
-    Ok(())
+        .try_for_each_init(workspace, |ws, (&w, g)| {
+            context.run(|| {
+                evaluate_frequency(&model, w, ws, g);
+                Ok(())
+            })
+        })
 }
 
 /// G(jω) for every ω, as a vector of p x m complex matrices.

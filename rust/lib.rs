@@ -3,7 +3,7 @@
 //! This crate is the Rust half of the `aerocontrol` Python package, and a library in its own
 //! right: every algorithm is a pure function on [faer] matrices that validates its arguments and
 //! returns [`Result`]`<_, `[`Error`]`>`, never panicking on bad input. The PyO3 bindings live in
-//! one module behind the `python` cargo feature, so `cargo test` and `cargo bench` need no
+//! `bindings/`, behind the `python` cargo feature, so `cargo test` and `cargo bench` need no
 //! Python.
 //!
 //! Equation numbers such as (6.22) refer to the course chapter "Control of Aircraft Motions"
@@ -34,6 +34,8 @@
 //! * [`small_matrix`]: fixed-size stack matrices for the small orders of flight models.
 //! * [`double_double`]: double-double arithmetic, for results accurate beyond double precision.
 //! * [`pool`]: a per-thread free list of scratch matrices.
+//! * [`platform`]: cooperative interruption of long computations, and memory requested so that
+//!   a shortage is an error rather than an abort.
 //! * `allocator` (feature `small-block-allocator`, on in the Python extension): mimalloc for
 //!   small blocks as the global allocator.
 //! * [`dispatch`]: run-time choice of AVX2 + FMA kernels.
@@ -74,6 +76,7 @@ pub mod modes;
 mod multishift;
 pub mod norm;
 pub mod place;
+pub mod platform;
 mod polynomial_roots;
 pub mod pool;
 pub mod reorder;
@@ -86,7 +89,7 @@ mod sylvester;
 mod test_matrices;
 
 #[cfg(feature = "python")]
-mod python;
+mod bindings;
 
 pub use error::Error;
 

@@ -32,6 +32,7 @@
 use crate::dense::Dense;
 use crate::dispatch::clear_upper_avx_state;
 use crate::error::{Error, check_finite, check_rows, check_square};
+use crate::platform::interrupt;
 use crate::schur::real_schur;
 use crate::small_matrix::product;
 use crate::sylvester::solve_small_sylvester;
@@ -224,6 +225,7 @@ pub(crate) fn solve_quasi_triangular(
     }
     let mut y = Dense::zeros(n, n);
     for &(j0, q) in blocks.iter().rev() {
+        interrupt::check()?;
         let after = j0 + q;
         // F[:, J] -= Y[:, after..] T[J, after..]^T (the columns of Y already known): column
         // updates for small orders, where faer's product costs more to set up than it saves.

@@ -54,6 +54,7 @@
 use crate::dispatch::{clear_upper_avx_state, fma_dispatch, multiply_add};
 use crate::error::Error;
 use crate::hessenberg::hessenberg;
+use crate::platform::interrupt;
 use crate::reorder::swap_blocks;
 use crate::schur::{
     MULTISHIFT_MIN_ORDER, Spectrum, Square, block_eigenvalues, double_shift, francis_qr,
@@ -131,6 +132,7 @@ pub(crate) fn multishift_qr(
         if end == 0 {
             return Ok(());
         }
+        interrupt::check()?;
         let kbot = end - 1;
         // The active block ktop..=kbot: below the lowest negligible subdiagonal entry.
         let mut ktop = kbot;

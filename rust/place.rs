@@ -50,6 +50,7 @@ use crate::error::{Error, check_finite, check_rows, check_square, format_complex
 use crate::lu::solve_with_inverse;
 use crate::modes::{charpoly, polynomial_from_roots};
 use crate::norm::{frobenius_norm, one_norm};
+use crate::platform::interrupt;
 use crate::schur::eigenvalues_near;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, c64};
@@ -441,7 +442,7 @@ pub fn place(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64]) -> Result<Pl
         .iter()
         .map(|&p| eigenvector_subspace(a, u1.as_ref(), p))
         .collect();
-    let (x, iterations, converged) = knv_method_0(&poles, &subspaces);
+    let (x, iterations, converged) = knv_method_0(&poles, &subspaces)?;
     // M = X Λ X^-1 from X^T M^T = (X Λ)^T; real up to rounding.
     let x_lambda = Mat::from_fn(n, n, |i, j| x[(i, j)] * poles[j]);
     let m_transpose = x
@@ -589,7 +590,7 @@ fn project(s: &Mat<c64>, y: MatRef<'_, c64>, real: bool) -> Mat<c64> {
 
 /// KNV method 0 on the subspaces S_j: returns X, the sweeps made and whether |det X|
 /// settled.
-fn knv_method_0(poles: &[c64], subspaces: &[Mat<c64>]) -> (Mat<c64>, usize, bool) {
+fn knv_method_0(poles: &[c64], subspaces: &[Mat<c64>]) -> Result<(Mat<c64>, usize, bool), Error> {
     let n = poles.len();
     let mut x = Mat::<c64>::zeros(n, n);
     // The columns that are free: a real pole, or the first of a pair (its partner follows).
@@ -609,11 +610,12 @@ fn knv_method_0(poles: &[c64], subspaces: &[Mat<c64>]) -> (Mat<c64>, usize, bool
     }
     let dimension = subspaces.first().map_or(0, |s| s.ncols());
     if dimension <= 1 {
-        return (x, 0, true);
+        return Ok((x, 0, true));
     }
     let mut previous = x.determinant().norm();
     for sweep in 1..=KNV_MAX_SWEEPS {
         for &j in &free {
+            interrupt::check()?;
             // y = X^-H e_j is orthogonal to every other column of X.
             let mut e_j = Mat::<c64>::zeros(n, 1);
             e_j[(j, 0)] = c64::new(1.0, 0.0);
@@ -623,11 +625,11 @@ fn knv_method_0(poles: &[c64], subspaces: &[Mat<c64>]) -> (Mat<c64>, usize, bool
         }
         let determinant = x.determinant().norm();
         if (determinant - previous).abs() <= KNV_RELATIVE_TOLERANCE * determinant {
-            return (x, sweep, true);
+            return Ok((x, sweep, true));
         }
         previous = determinant;
     }
-    (x, KNV_MAX_SWEEPS, false)
+    Ok((x, KNV_MAX_SWEEPS, false))
 }
 
 fn condition_number(x: &Mat<c64>) -> f64 {

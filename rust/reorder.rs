@@ -46,6 +46,7 @@
 
 use crate::dispatch::clear_upper_avx_state;
 use crate::error::Error;
+use crate::platform::interrupt;
 use crate::schur::{RealSchur, quasi_triangular_eigenvalues, reflector, standardize_block};
 use crate::sylvester::solve_small_sylvester;
 use faer::{Mat, c64};
@@ -75,6 +76,7 @@ pub fn reorder_schur(
     let mut position = 0;
     let mut k = 0;
     while k < n {
+        interrupt::check()?;
         let size = block_size(&t, k);
         if !select(block_eigenvalue(&t, k, size)) {
             k += size;

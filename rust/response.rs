@@ -21,6 +21,8 @@ use crate::discretize::{Discretization, Hold, discretize};
 use crate::error::{Error, check_finite, check_finite_values, check_output_len};
 use crate::freq::check_state_space;
 use crate::norm::{LinearOperator, one_norm_estimate};
+use crate::platform::interrupt;
+use crate::platform::parallel::{ParallelContext, chunks, par_chunks};
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::{PartialPivLu, ShapeCore, Solve};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
@@ -142,7 +144,11 @@ impl Recurrence {
     /// out = M v for a row-major `rows` x len(v) matrix M.
     fn multiply(matrix: &[f64], v: &[f64], out: &mut [f64]) {
         let cols = v.len();
-        let rows = out.iter_mut().zip(matrix.chunks_exact(cols.max(1)));
+        if cols == 0 {
+            out.fill(0.0);
+            return;
+        }
+        let rows = out.iter_mut().zip(matrix.chunks_exact(cols));
         if cols < DOT_LANES {
             rows.for_each(|(o, row)| *o = row.iter().zip(v).map(|(a, b)| a * b).sum());
         } else {
@@ -153,7 +159,10 @@ impl Recurrence {
     /// out += M v.
     fn multiply_add(matrix: &[f64], v: &[f64], out: &mut [f64]) {
         let cols = v.len();
-        let rows = out.iter_mut().zip(matrix.chunks_exact(cols.max(1)));
+        if cols == 0 {
+            return;
+        }
+        let rows = out.iter_mut().zip(matrix.chunks_exact(cols));
         if cols < DOT_LANES {
             rows.for_each(|(o, row)| *o += row.iter().zip(v).map(|(a, b)| a * b).sum::<f64>());
         } else {
@@ -161,18 +170,19 @@ impl Recurrence {
         }
     }
 
-    /// Runs one response: `x` (steps x n) and `y` (steps x p) row-major, from `x0`, with
-    /// `input(k)` the m values of η[k] (empty for a free response).
+    /// Runs one response of `steps` samples: `x` (steps x n) and `y` (steps x p) row-major,
+    /// from `x0`, with `input(k)` the m values of η[k] (empty for a free response). Checks for
+    /// an interruption every [`STEPS_PER_CHECK`] samples.
     fn run<'a>(
         &self,
         x0: &[f64],
         input: impl Fn(usize) -> &'a [f64],
+        steps: usize,
         x: &mut [f64],
         y: &mut [f64],
-    ) {
+    ) -> Result<(), Error> {
         let (n, p) = (self.n, self.p);
-        let steps = x.len() / n.max(1);
-        if n > 0 {
+        if steps > 0 {
             x[..n].copy_from_slice(x0);
         }
         // The outputs C x[k] + D η[k]: for larger models all samples at once after the
@@ -180,6 +190,9 @@ impl Recurrence {
         // step); for small ones in the same pass, while x[k] is in registers.
         let product = n >= OUTPUT_PRODUCT_MIN_ORDER && p > 0;
         for k in 0..steps {
+            if k % STEPS_PER_CHECK == 0 {
+                interrupt::check()?;
+            }
             let (done, rest) = x.split_at_mut((k + 1) * n);
             let current = &done[k * n..];
             let eta = input(k);
@@ -210,8 +223,12 @@ impl Recurrence {
             // Y already holds D η[k]; add X C^T.
             matmul(outputs, Accum::Add, states, c.transpose(), 1.0, Par::Seq);
         }
+        Ok(())
     }
 }
+
+/// Samples of a response between two checks for an interruption.
+const STEPS_PER_CHECK: usize = 4096;
 
 /// A state-space model x' = Ax + Bη, y = Cx + Dη.
 #[derive(Debug, Clone, Copy)]
@@ -222,14 +239,14 @@ pub struct Model<'a> {
     pub d: MatRef<'a, f64>,
 }
 
-/// Simulates `responses` responses of one model over `steps` samples of step `dt`: initial
-/// states `x0` (responses x n, row-major), the input, and the hold between input samples.
-/// Writes the states into `x` (responses x steps x n) and the outputs into `y`
-/// (responses x steps x p), row-major.
+/// Simulates one response per row of `x0` (responses x n initial states) of one model over
+/// `steps` samples of step `dt`, with the input and the hold between input samples. Writes the
+/// states into `x` (responses x steps x n) and the outputs into `y` (responses x steps x p),
+/// row-major. Any of n, m and p may be 0.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_into(
     model: Model<'_>,
-    x0: &[f64],
+    x0: MatRef<'_, f64>,
     input: Input<'_>,
     dt: f64,
     steps: usize,
@@ -240,16 +257,17 @@ pub fn simulate_into(
     let Model { a, b, c, d } = model;
     check_state_space(a, b, c, d)?;
     let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
-    if n == 0 {
-        return Err(Error::InvalidValue {
-            arg: "A",
-            value: 0.0,
-            requirement: "at least one state (its order)",
+    let responses = x0.nrows();
+    if x0.ncols() != n {
+        return Err(Error::Mismatch {
+            arg: "x0",
+            what: "one initial state per response, as many values as the order of",
+            expected: n,
+            other: "A",
+            got: x0.ncols(),
         });
     }
-    let responses = x0.len() / n;
-    check_output_len(x0.len(), responses * n)?;
-    check_finite_values(x0, "x0")?;
+    check_finite(x0, "x0")?;
     match input {
         Input::Free => {}
         Input::Constant(eta) => {
@@ -282,38 +300,39 @@ pub fn simulate_into(
     let discretization = discretize(a, b, dt, hold)?;
     let recurrence = Recurrence::new(&discretization, c, d);
     let no_input: &[f64] = &[];
+    let context = ParallelContext::capture();
     let run = |(r, (x_r, y_r)): (usize, (&mut [f64], &mut [f64]))| {
-        let x0_r = &x0[r * n..(r + 1) * n];
-        match input {
-            Input::Free => recurrence.run(x0_r, |_| no_input, x_r, y_r),
-            Input::Constant(eta) => recurrence.run(x0_r, |_| eta, x_r, y_r),
+        let x0_r: Vec<f64> = (0..n).map(|j| x0[(r, j)]).collect();
+        context.run(|| match input {
+            Input::Free => recurrence.run(&x0_r, |_| no_input, steps, x_r, y_r),
+            Input::Constant(eta) => recurrence.run(&x0_r, |_| eta, steps, x_r, y_r),
             Input::Sampled(u) => {
                 let u_r = &u[r * steps * m..(r + 1) * steps * m];
-                recurrence.run(x0_r, |k| &u_r[k * m..(k + 1) * m], x_r, y_r)
+                recurrence.run(&x0_r, |k| &u_r[k * m..(k + 1) * m], steps, x_r, y_r)
             }
-        }
+        })
     };
-    let x_chunks = x.chunks_mut((steps * n).max(1));
-    let y_chunks = y.chunks_mut((steps * p).max(1));
     if responses > 1 {
-        x.par_chunks_mut((steps * n).max(1))
-            .zip(y.par_chunks_mut((steps * p).max(1)))
+        par_chunks(x, steps * n, responses)
+            .zip(par_chunks(y, steps * p, responses))
             .enumerate()
-            .for_each(run);
+            .try_for_each(run)
     } else {
-        x_chunks.zip(y_chunks).enumerate().for_each(run);
+        chunks(x, steps * n, responses)
+            .zip(chunks(y, steps * p, responses))
+            .enumerate()
+            .try_for_each(run)
     }
-    Ok(())
 }
 
 /// Simulates one response of each of several models of one size, in parallel: model `i` has
-/// the initial state `x0[i]` (models x n), the input slice i of `input` (a constant η0 per model,
+/// the initial state in row i of `x0` (models x n), the input slice i of `input` (a constant η0 per model,
 /// models x m values, or sampled inputs, models x steps x m), and writes its states and outputs
 /// at index i of `x` (models x steps x n) and `y` (models x steps x p). An error names the model.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_models_into(
     models: &[Model<'_>],
-    x0: &[f64],
+    x0: MatRef<'_, f64>,
     input: Input<'_>,
     dt: f64,
     steps: usize,
@@ -326,7 +345,15 @@ pub fn simulate_models_into(
     };
     let (n, m, p) = (first.a.nrows(), first.b.ncols(), first.c.nrows());
     let q = models.len();
-    check_output_len(x0.len(), q * n)?;
+    if (x0.nrows(), x0.ncols()) != (q, n) {
+        return Err(Error::Mismatch {
+            arg: "x0",
+            what: "one initial state per model, as many rows as",
+            expected: q,
+            other: "models",
+            got: x0.nrows(),
+        });
+    }
     check_output_len(x.len(), q * steps * n)?;
     check_output_len(y.len(), q * steps * p)?;
     let per_model_input = match input {
@@ -353,8 +380,9 @@ pub fn simulate_models_into(
             return Err(Error::in_batch(index, error));
         }
     }
-    x.par_chunks_mut((steps * n).max(1))
-        .zip(y.par_chunks_mut((steps * p).max(1)))
+    let context = ParallelContext::capture();
+    par_chunks(x, steps * n, q)
+        .zip(par_chunks(y, steps * p, q))
         .enumerate()
         .try_for_each(|(i, (x_i, y_i))| {
             let range = i * per_model_input..(i + 1) * per_model_input;
@@ -363,17 +391,20 @@ pub fn simulate_models_into(
                 Input::Constant(eta) => Input::Constant(&eta[range]),
                 Input::Sampled(u) => Input::Sampled(&u[range]),
             };
-            simulate_into(
-                models[i],
-                &x0[i * n..(i + 1) * n],
-                input_i,
-                dt,
-                steps,
-                hold,
-                x_i,
-                y_i,
-            )
-            .map_err(|e| Error::in_batch(i, e))
+            context
+                .run(|| {
+                    simulate_into(
+                        models[i],
+                        x0.subrows(i, 1),
+                        input_i,
+                        dt,
+                        steps,
+                        hold,
+                        x_i,
+                        y_i,
+                    )
+                })
+                .map_err(|e| Error::in_batch(i, e))
         })
 }
 
@@ -451,6 +482,11 @@ mod tests {
     use super::*;
     use faer::mat;
 
+    /// `values` as initial states of order n, one per row.
+    fn states(values: &[f64], n: usize) -> MatRef<'_, f64> {
+        MatRef::from_row_major_slice(values, values.len() / n, n)
+    }
+
     /// The model (A, B, C, D) viewed from owned matrices.
     fn model<'a>(a: &'a Mat<f64>, b: &'a Mat<f64>, c: &'a Mat<f64>, d: &'a Mat<f64>) -> Model<'a> {
         Model {
@@ -503,7 +539,7 @@ mod tests {
         let model = model(&a, &b, &c, &d);
         simulate_into(
             model,
-            &[0.0; 4],
+            states(&[0.0; 4], 4),
             Input::Constant(&eta0),
             10.0,
             steps,
@@ -533,7 +569,7 @@ mod tests {
         let (mut x, mut y) = (vec![0.0; steps * 4], vec![0.0; steps * 4]);
         simulate_into(
             model,
-            &x0,
+            states(&x0, 4),
             Input::Free,
             0.1,
             steps,
@@ -565,7 +601,7 @@ mod tests {
         );
         simulate_into(
             model,
-            &x0,
+            states(&x0, 4),
             Input::Sampled(&u),
             0.05,
             steps,
@@ -579,7 +615,7 @@ mod tests {
             let u_r = &u[r * steps..(r + 1) * steps];
             simulate_into(
                 model,
-                &x0[r * 4..(r + 1) * 4],
+                states(&x0[r * 4..(r + 1) * 4], 4),
                 Input::Sampled(u_r),
                 0.05,
                 steps,
@@ -605,7 +641,7 @@ mod tests {
         let (mut x, mut y) = (vec![0.0; 2 * steps * 4], vec![0.0; 2 * steps * 4]);
         simulate_models_into(
             &models,
-            &[0.0; 8],
+            states(&[0.0; 8], 4),
             Input::Constant(&eta),
             0.1,
             steps,
@@ -618,7 +654,7 @@ mod tests {
             let (mut x1, mut y1) = (vec![0.0; steps * 4], vec![0.0; steps * 4]);
             simulate_into(
                 *m,
-                &[0.0; 4],
+                states(&[0.0; 4], 4),
                 Input::Constant(&eta[i..i + 1]),
                 0.1,
                 steps,
@@ -634,7 +670,7 @@ mod tests {
         let models = [model(&a, &b, &c, &d), model(&bad, &b, &c, &d)];
         let err = simulate_models_into(
             &models,
-            &[0.0; 8],
+            states(&[0.0; 8], 4),
             Input::Free,
             0.1,
             steps,
@@ -686,7 +722,7 @@ mod tests {
         let (mut x, mut y) = (vec![0.0; 40], vec![0.0; 40]);
         let err = simulate_into(
             model,
-            &[0.0; 4],
+            states(&[0.0; 4], 4),
             Input::Sampled(&[0.0; 9]),
             0.1,
             10,
@@ -702,7 +738,7 @@ mod tests {
         );
         let err = simulate_into(
             model,
-            &[0.0; 4],
+            states(&[0.0; 4], 4),
             Input::Constant(&[1.0, 2.0]),
             0.1,
             10,

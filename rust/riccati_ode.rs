@@ -34,6 +34,7 @@ use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::expm::expm;
 use crate::lu::solve_in_place;
 use crate::lyapunov::symmetrize;
+use crate::platform::interrupt;
 use crate::schur::eigenvalues;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
@@ -111,6 +112,7 @@ pub fn riccati_ode(
     let mut cached: Option<(f64, Mat<f64>)> = None;
     let mut substeps = 0;
     for k in (0..count - 1).rev() {
+        interrupt::check()?;
         let interval = times[k + 1] - times[k];
         let pieces = ((interval * growth_rate / MAX_GROWTH_EXPONENT).ceil() as usize).max(1);
         let h = interval / pieces as f64;

@@ -92,6 +92,7 @@ use crate::hessenberg::{hessenberg, hessenberg_matrix};
 use crate::modes::hessenberg_characteristic_polynomial;
 use crate::multishift::multishift_qr;
 use crate::norm::max_abs;
+use crate::platform::interrupt;
 use crate::polynomial_roots::monic_roots;
 use faer::{Mat, MatRef, c64};
 use std::ops::{Index, IndexMut, Range};
@@ -1048,6 +1049,7 @@ pub(crate) fn francis_qr_until<O: Order>(
         let mut l = lo;
         let mut converged = false;
         for _ in 0..=max_iterations {
+            interrupt::check()?;
             // Find the lowest negligible subdiagonal entry h[k, k-1], l < k <= i.
             let mut k = i;
             while k > l && !negligible_subdiagonal(h, k, (l, i), small) {

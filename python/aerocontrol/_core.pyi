@@ -14,6 +14,7 @@ __all__ = [
     "FMA_KERNELS",
     "ILL_CONDITIONED_CONTROLLABILITY",
     "POLE_ERROR_WARNING",
+    "PRODUCT_WORKSPACE_BYTES",
     "SMALL_MAX_ORDER",
     "Placement",
     "care_batch",
@@ -45,6 +46,7 @@ SMALL_MAX_ORDER: int
 FMA_KERNELS: bool
 ILL_CONDITIONED_CONTROLLABILITY: float
 POLE_ERROR_WARNING: float
+PRODUCT_WORKSPACE_BYTES: int
 
 def expm(a: ArrayLike, /) -> NDArray[np.float64]: ...
 def transition_matrices(a: ArrayLike, t: ArrayLike, /) -> NDArray[np.float64]: ...

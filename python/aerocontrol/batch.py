@@ -30,7 +30,7 @@ from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
 from .placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
 from .riccati import RCOND_WARNING, RESIDUAL_WARNING
-from .statespace import StateSpace, as_state_space
+from .statespace import as_state_space, is_system
 
 __all__ = ["CareBatch", "LqrSweep", "PlaceBatch", "lqr_sweep", "place_batch", "solve_care_batch"]
 
@@ -252,7 +252,7 @@ def lqr_sweep(
     >>> sweep.K.shape, sweep.poles.shape
     ((1000, 2, 4), (1000, 4))
     """
-    if isinstance(sys_or_A, StateSpace) or hasattr(sys_or_A, "A"):
+    if is_system(sys_or_A):
         if B is not None:
             raise InvalidArgumentError("lqr_sweep(sys, Q=..., R=..., weights=...) takes no B")
         sys = as_state_space(sys_or_A)

@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning
-from .statespace import StateSpace, as_state_space
+from .statespace import as_state_space, is_system
 
 __all__ = ["Modes", "charpoly", "modes"]
 
@@ -119,7 +119,7 @@ class Modes:
 
 def _plant(A_or_sys: Any) -> tuple[FloatArray, FloatArray | None]:
     """(A, B or None) from a plant matrix or a system."""
-    if isinstance(A_or_sys, StateSpace) or hasattr(A_or_sys, "A"):
+    if is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
         return sys.A, sys.B
     if isinstance(A_or_sys, tuple):

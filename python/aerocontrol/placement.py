@@ -31,7 +31,7 @@ from . import _core
 from ._validation import FloatArray, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
 from .modal import Modes, modes
-from .statespace import StateSpace, as_state_space, plant_pair
+from .statespace import StateSpace, as_state_space, is_system, plant_pair
 
 __all__ = [
     "CompanionForm",
@@ -200,6 +200,8 @@ def companion_form(A_or_sys: Any, b: Any = None) -> CompanionForm:
 def _select_mode(analysis: Modes, mode: Any) -> int:
     """The index of a mode given by index, name, or (approximate) eigenvalue."""
     count = len(analysis)
+    if count == 0:
+        raise InvalidArgumentError("the system has no modes (no states): nothing to augment")
     if isinstance(mode, str):
         names = [name.lower() for name in analysis.mode_names]
         if mode.lower() not in names:
@@ -285,7 +287,7 @@ def augment_mode(
 def _plant_matrix(sys_or_A: Any) -> FloatArray:
     if isinstance(sys_or_A, (StateSpace, tuple, list)) and not _is_matrix(sys_or_A):
         return as_state_space(sys_or_A).A
-    if hasattr(sys_or_A, "A"):
+    if is_system(sys_or_A):
         return as_state_space(sys_or_A).A
     return real_array(sys_or_A, "A")
 

@@ -34,8 +34,8 @@ import numpy as np
 
 from . import _core
 from ._validation import FloatArray, check_choice, real_array
-from .exceptions import ShapeError
-from .statespace import StateSpace, as_state_space
+from .exceptions import InvalidArgumentError, ShapeError
+from .statespace import StateSpace, as_state_space, is_system
 
 __all__ = [
     "TimeResponse",
@@ -106,7 +106,7 @@ class TimeResponse:
 
 def _systems(sys: Any) -> tuple[list[StateSpace], bool]:
     """The models, and whether several were given as a list."""
-    if isinstance(sys, list) and sys and (isinstance(sys[0], StateSpace) or hasattr(sys[0], "A")):
+    if isinstance(sys, list) and sys and is_system(sys[0]):
         models = [as_state_space(s, f"sys[{k}]") for k, s in enumerate(sys)]
         first = models[0]
         for k, model in enumerate(models[1:], start=1):
@@ -156,7 +156,9 @@ def _grid(T: Any, models: list[StateSpace]) -> tuple[FloatArray, float]:
     if times.ndim == 0:
         final = float(times)
         if not np.isfinite(final) or final <= 0:
-            raise ShapeError(f"T as a final time must be positive and finite, got {final}")
+            raise InvalidArgumentError(
+                f"T as a final time must be positive and finite, got {final}"
+            )
         step, _ = _default_step_and_final(models)
         samples = min(max(int(np.ceil(final / step)) + 1, 101), MAX_DEFAULT_SAMPLES)
         t = np.linspace(0.0, final, samples)

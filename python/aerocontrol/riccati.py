@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError
-from .statespace import StateSpace, as_state_space
+from .statespace import as_state_space, is_system
 
 __all__ = [
     "CareSolution",
@@ -205,9 +205,7 @@ def lqr(sys_or_A: Any, *args: Any, N: Any = None) -> tuple[FloatArray, FloatArra
     """
     # Plain indexing, not star-unpacking: this wrapper's own cost is part of a 4-state lqr's.
     count = len(args)
-    if type(sys_or_A) is not np.ndarray and (
-        isinstance(sys_or_A, StateSpace) or hasattr(sys_or_A, "A")
-    ):
+    if is_system(sys_or_A):
         if count not in (2, 3):
             raise InvalidArgumentError("lqr(sys, Q, R[, N]) takes a system and two weights")
         sys = as_state_space(sys_or_A)
@@ -266,7 +264,7 @@ def riccati_ode(
     >>> np.round(sol.K[0], 6)            # the algebraic (steady-state) gain, t_f - t = 20
     array([[2.414214, 2.197368]])
     """
-    if isinstance(A_or_sys, StateSpace) or hasattr(A_or_sys, "A"):
+    if is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
         # riccati_ode(sys, Q, R, t, Sf): every argument shifts one place to the left.
         A, B, Q, R, t, Sf = sys.A, sys.B, B, Q, R, (t if t is not None else Sf)

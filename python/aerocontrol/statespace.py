@@ -135,6 +135,17 @@ class StateSpace:
         )
 
 
+def is_system(value: Any) -> bool:
+    """Whether ``value`` is a model rather than a matrix: a :class:`StateSpace`, or an object
+    with ``A``, ``B``, ``C`` and ``D`` attributes such as python-control's StateSpace. Arrays
+    are matrices, ``numpy.matrix`` included (its ``.A`` is the plain array, not a plant)."""
+    if isinstance(value, StateSpace):
+        return True
+    if isinstance(value, np.ndarray):
+        return False
+    return all(hasattr(value, attribute) for attribute in "ABCD")
+
+
 def as_state_space(model: Any, name: str = "sys") -> StateSpace:
     """``model`` as a :class:`StateSpace`.
 
@@ -150,7 +161,7 @@ def as_state_space(model: Any, name: str = "sys") -> StateSpace:
                 f"{name} as a sequence must be (A, B) or (A, B, C, D), got {len(model)} items"
             )
         return StateSpace(*model)
-    if all(hasattr(model, attribute) for attribute in "ABCD"):
+    if is_system(model):
         names: dict[str, Any] = {}
         for ours, theirs in [
             ("state_names", "state_labels"),
@@ -178,7 +189,7 @@ def plant_pair(A_or_sys: Any, second: Any, attribute: str) -> tuple[Any, Any]:
     an (A, B) tuple or any object with the attributes (``attribute`` names the second one)."""
     if second is not None:
         return A_or_sys, second
-    if isinstance(A_or_sys, (StateSpace, tuple, list)) or hasattr(A_or_sys, "A"):
+    if isinstance(A_or_sys, (tuple, list)) or is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
         return sys.A, getattr(sys, attribute)
     raise TypeError(f"give a system or both A and {attribute}")

@@ -1,0 +1,220 @@
+//! Bindings of `aerocontrol.linalg`: the matrix exponential, transition matrices and exact
+//! discretisation.
+
+use super::compute::{Cost, compute};
+use super::conversion::{Outputs, Real, new_array, new_array_data};
+use super::errors::{raise, to_py_err, warn};
+use crate::discretize::{Hold, discretize as discretize_core};
+use crate::error::{Error, check_square};
+use crate::expm::{expm_into, pade_choice, transition_matrices_into};
+use crate::norm::one_norm;
+use faer::{MatMut, MatRef};
+use numpy::PyArrayDyn;
+use pyo3::prelude::*;
+
+/// Floating-point operations of one exponential of order n (a Padé evaluation of degree 13 and
+/// a few squarings: about ten products).
+pub fn expm_flops(n: usize) -> f64 {
+    20.0 * (n as f64).powi(3)
+}
+
+/// Temporaries of one exponential: the powers, the Padé terms, the LU factors.
+const EXPM_TEMPORARIES: f64 = 24.0;
+
+/// 2^53 = 1/u: at ||tA|| beyond it the exponential's relative condition number (at least
+/// ||tA||_2) times u exceeds 1, so the rounding of the input alone can change every digit.
+const ILL_CONDITIONED_NORM: f64 = 9_007_199_254_740_992.0;
+
+/// Warns when ||A||_1 max|t| makes e^{At} meaningless in double precision.
+fn warn_if_ill_conditioned(py: Python<'_>, a_norm: f64, t_max: f64) -> PyResult<()> {
+    let scaled = a_norm * t_max;
+    if scaled >= ILL_CONDITIONED_NORM {
+        let message = format!(
+            "||tA||_1 = {scaled:.3e} exceeds 1/u = 2^53: the exponential's relative condition \
+             number is at least ||tA||_2, so the rounding of the input alone can change every \
+             digit of the result"
+        );
+        warn(py, "IllConditionedWarning", &message)?;
+    }
+    Ok(())
+}
+
+/// e^A for a 2-D A, or for every matrix of a 3-D stack (in parallel).
+#[pyfunction]
+#[pyo3(signature = (a, /))]
+fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let a = Real::convert(py, a, "A")?;
+    match *a.shape() {
+        [n, _] => {
+            let matrix = a.matrix().map_err(|e| to_py_err(py, e))?;
+            check_square(matrix, "A").map_err(|e| to_py_err(py, e))?;
+            let out = new_array(py, &[n, n])?;
+            // SAFETY: `out` is new and not visible to Python until returned.
+            let data = unsafe { new_array_data(&out) };
+            let cost = Cost::of(expm_flops(n), EXPM_TEMPORARIES, n);
+            compute(py, cost, || {
+                expm_into(matrix, MatMut::from_row_major_slice_mut(data, n, n))
+            })?;
+            let mut outputs = Outputs::new(py);
+            // SAFETY: as above; the computation is over.
+            outputs.check("e^A", unsafe { new_array_data(&out) });
+            outputs.finish()?;
+            warn_if_ill_conditioned(py, one_norm(matrix), 1.0)?;
+            Ok(out)
+        }
+        [_, rows, cols] => {
+            let stack = a.stack().map_err(|e| to_py_err(py, e))?;
+            if rows != cols {
+                return Err(to_py_err(
+                    py,
+                    Error::NotSquare {
+                        arg: "A",
+                        rows,
+                        cols,
+                    },
+                ));
+            }
+            let out = new_array(py, a.shape())?;
+            // SAFETY: `out` is new and not visible to Python until returned.
+            let data = unsafe { new_array_data(&out) };
+            let threads = rayon::current_num_threads() as f64;
+            let cost =
+                Cost::of(expm_flops(rows), EXPM_TEMPORARIES * threads, rows).times(stack.len());
+            compute(py, cost, || crate::batch::expm_batch(stack, data))?;
+            // SAFETY: as above; the computation is over.
+            let values = unsafe { new_array_data(&out) };
+            let size = rows * rows;
+            if size > 0 {
+                let overflowed: Vec<usize> = values
+                    .chunks_exact(size)
+                    .enumerate()
+                    .filter(|(_, m)| m.iter().any(|v| !v.is_finite()))
+                    .map(|(k, _)| k)
+                    .collect();
+                if !overflowed.is_empty() {
+                    let message = format!(
+                        "the matrix exponential overflowed double precision: the result has \
+                         infinite or NaN entries (matrices {overflowed:?} of the stack)"
+                    );
+                    warn(py, "NumericalOverflowWarning", &message)?;
+                }
+                let largest_norm = a
+                    .values()
+                    .chunks_exact(size)
+                    .map(|m| one_norm(MatRef::from_row_major_slice(m, rows, rows)))
+                    .fold(0.0, f64::max);
+                warn_if_ill_conditioned(py, largest_norm, 1.0)?;
+            }
+            Ok(out)
+        }
+        _ => Err(to_py_err(
+            py,
+            Error::WrongDimensions {
+                arg: "A",
+                expected: "a 2-D square matrix or a 3-D stack of square matrices",
+                shape: a.shape().to_vec(),
+            },
+        )),
+    }
+}
+
+/// Φ(t_k) = e^{A t_k} for a 1-D array of times, as a len(t) x n x n array.
+#[pyfunction]
+#[pyo3(signature = (a, t, /))]
+fn transition_matrices<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    t: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let (a, t) = (Real::convert(py, a, "A")?, Real::convert(py, t, "t")?);
+    let matrix = a.matrix().map_err(|e| to_py_err(py, e))?;
+    check_square(matrix, "A").map_err(|e| to_py_err(py, e))?;
+    let times = t.vector("a 1-D array").map_err(|e| to_py_err(py, e))?;
+    let n = matrix.nrows();
+    let out = new_array(py, &[times.len(), n, n])?;
+    // SAFETY: `out` is new and not visible to Python until returned.
+    let data = unsafe { new_array_data(&out) };
+    let cost = Cost::of(expm_flops(n), EXPM_TEMPORARIES, n).times(times.len());
+    compute(py, cost, || transition_matrices_into(matrix, times, data))?;
+    let mut outputs = Outputs::new(py);
+    // SAFETY: as above; the computation is over.
+    outputs.check("Φ(t)", unsafe { new_array_data(&out) });
+    outputs.finish()?;
+    let t_max = times.iter().fold(0.0, |m: f64, t| m.max(t.abs()));
+    warn_if_ill_conditioned(py, one_norm(matrix), t_max)?;
+    Ok(out)
+}
+
+type Discretized<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Option<Bound<'py, PyArrayDyn<f64>>>,
+);
+
+/// The input hold named by the `method` argument: "zoh" (zero order) or "foh" (first order).
+pub fn hold_from_method(py: Python<'_>, method: &str) -> PyResult<Hold> {
+    match method {
+        "zoh" => Ok(Hold::Zero),
+        "foh" => Ok(Hold::First),
+        other => Err(raise(
+            py,
+            "InvalidArgumentError",
+            format!("method must be \"zoh\" or \"foh\", got {other:?}"),
+        )),
+    }
+}
+
+/// The cost of discretising a model of n states and m inputs: one exponential of the augmented
+/// matrix of order n + 2m.
+pub fn discretize_cost(n: usize, m: usize) -> Cost {
+    let order = n.saturating_add(m.saturating_mul(2));
+    Cost::of(expm_flops(order), EXPM_TEMPORARIES, order)
+}
+
+/// (Φ, Γ0, Γ1 or None) of x' = Ax + Bη over the step dt, for method "zoh" or "foh".
+#[pyfunction]
+#[pyo3(signature = (a, b, dt, method, /))]
+fn discretize<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    dt: f64,
+    method: &str,
+) -> PyResult<Discretized<'py>> {
+    let hold = hold_from_method(py, method)?;
+    let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
+    let a = a.matrix().map_err(|e| to_py_err(py, e))?;
+    let b = b.matrix().map_err(|e| to_py_err(py, e))?;
+    let cost = discretize_cost(a.nrows(), b.ncols());
+    let result = compute(py, cost, || discretize_core(a, b, dt, hold))?;
+    let mut outputs = Outputs::new(py);
+    let phi = outputs.matrix("Phi", result.phi.as_ref())?;
+    let gamma0 = outputs.matrix("Gamma0", result.gamma0.as_ref())?;
+    let gamma1 = result
+        .gamma1
+        .as_ref()
+        .map(|g| outputs.matrix("Gamma1", g.as_ref()))
+        .transpose()?;
+    outputs.finish()?;
+    Ok((phi, gamma0, gamma1))
+}
+
+/// The Padé degree m and the number of squarings s that the exponential of A uses: a
+/// diagnostic for tests and for users comparing algorithms.
+#[pyfunction]
+#[pyo3(signature = (a, /))]
+fn expm_pade_choice(py: Python<'_>, a: &Bound<'_, PyAny>) -> PyResult<(usize, u32)> {
+    let a = Real::convert(py, a, "A")?;
+    let a = a.matrix().map_err(|e| to_py_err(py, e))?;
+    check_square(a, "A").map_err(|e| to_py_err(py, e))?;
+    let n = a.nrows();
+    compute(py, Cost::of(expm_flops(n) / 4.0, 8.0, n), || pade_choice(a))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(expm, m)?)?;
+    m.add_function(wrap_pyfunction!(transition_matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(discretize, m)?)?;
+    m.add_function(wrap_pyfunction!(expm_pade_choice, m)?)?;
+    Ok(())
+}

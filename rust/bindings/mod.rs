@@ -1,0 +1,59 @@
+//! The Python bindings (cargo feature `python`): the only PyO3 code in the crate.
+//!
+//! One file per module of the Python package, each converting its arguments, running the core
+//! and making its results through the three shared pieces:
+//!
+//! * [`conversion`]: every argument becomes an owned copy in C order, whatever its layout,
+//!   before anything is computed; every result is a new C-ordered array, checked for overflow.
+//! * [`compute`]: the computation runs with the GIL held, released, or released and
+//!   interruptible by Ctrl-C, by its cost, after the memory it needs has been requested.
+//! * [`errors`]: each core error maps to one exception class of `aerocontrol.exceptions`
+//!   (MemoryError and KeyboardInterrupt for a refused allocation and an interruption).
+
+mod batch;
+mod compute;
+mod controllability;
+mod conversion;
+mod errors;
+mod frequency;
+mod linalg;
+mod modal;
+mod placement;
+mod responses;
+mod riccati;
+mod schur;
+mod statespace;
+
+use pyo3::prelude::*;
+
+/// The native core of aerocontrol; use the `aerocontrol` package, not this module.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // Every kernel whose size warrants threads gets its Par explicitly; faer's convenience
+    // methods (small QR, LU and SVD in the placement code) follow the global setting, whose
+    // default, rayon, costs more in dispatch than a 4 x 4 factorisation takes.
+    faer::set_global_parallelism(faer::Par::Seq);
+    linalg::register(m)?;
+    statespace::register(m)?;
+    responses::register(m)?;
+    frequency::register(m)?;
+    modal::register(m)?;
+    controllability::register(m)?;
+    placement::register(m)?;
+    schur::register(m)?;
+    riccati::register(m)?;
+    batch::register(m)?;
+    m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
+    m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;
+    m.add("FMA_KERNELS", crate::dispatch::fma_available())?;
+    m.add(
+        "ILL_CONDITIONED_CONTROLLABILITY",
+        crate::place::ILL_CONDITIONED_CONTROLLABILITY,
+    )?;
+    m.add("POLE_ERROR_WARNING", crate::place::POLE_ERROR_WARNING)?;
+    m.add(
+        "PRODUCT_WORKSPACE_BYTES",
+        crate::platform::memory::product_workspace_bytes(),
+    )?;
+    Ok(())
+}

@@ -1,0 +1,134 @@
+//! Bindings of `aerocontrol.riccati`: the algebraic Riccati equation and the Riccati
+//! differential equation.
+
+use super::compute::{Cost, compute};
+use super::conversion::{Outputs, Real};
+use super::errors::to_py_err;
+use super::linalg::expm_flops;
+use crate::care::{CareOptions, solve_care as solve_care_core};
+use crate::riccati_ode::riccati_ode as riccati_ode_core;
+use faer::c64;
+use numpy::PyArrayDyn;
+use pyo3::prelude::*;
+
+/// The cost of one CARE of n states: the real Schur form of the Hamiltonian (order 2n), its
+/// reordering, and a few Newton steps.
+pub fn care_cost(n: usize) -> Cost {
+    let order = 2 * n;
+    Cost::of(40.0 * (order as f64).powi(3), 16.0, order)
+}
+
+type CareOutput<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    f64,
+    f64,
+    usize,
+);
+
+/// The stabilising solution of the CARE (6.228): (X, K, closed-loop eigenvalues, relative
+/// residual, rcond(U11), Newton steps).
+#[pyfunction]
+#[pyo3(signature = (a, b, q, r, s, e, refine, /))]
+#[allow(clippy::too_many_arguments)]
+fn solve_care<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+    s: Option<&Bound<'py, PyAny>>,
+    e: Option<&Bound<'py, PyAny>>,
+    refine: bool,
+) -> PyResult<CareOutput<'py>> {
+    let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
+    let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
+    let s = Real::convert_optional(py, s, "S")?;
+    let e = Real::convert_optional(py, e, "E")?;
+    let (a, b, q, r, options) = (|| {
+        let options = CareOptions {
+            s: s.as_ref().map(|s| s.matrix()).transpose()?,
+            e: e.as_ref().map(|e| e.matrix()).transpose()?,
+            refine,
+        };
+        Ok((a.matrix()?, b.matrix()?, q.matrix()?, r.matrix()?, options))
+    })()
+    .map_err(|e| to_py_err(py, e))?;
+    let solution = compute(py, care_cost(a.nrows()), || {
+        solve_care_core(a, b, q, r, options)
+    })?;
+    let mut outputs = Outputs::new(py);
+    let n = solution.closed_loop_eigenvalues.len();
+    let result = (
+        outputs.matrix("X", solution.x.as_ref())?,
+        outputs.matrix("K", solution.gain.as_ref())?,
+        outputs.complex(
+            "the closed-loop eigenvalues",
+            &[n],
+            &solution.closed_loop_eigenvalues,
+        )?,
+        solution.residual,
+        solution.rcond,
+        solution.refinement_steps,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
+
+type RiccatiOdeOutput<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    usize,
+);
+
+/// The Riccati differential equation (6.196) backward over the grid `t`: (S (k, n, n),
+/// K (k, m, n), substeps).
+#[pyfunction]
+#[pyo3(signature = (a, b, q, r, t, sf, /))]
+#[allow(clippy::too_many_arguments)]
+fn riccati_ode<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+    t: &Bound<'py, PyAny>,
+    sf: Option<&Bound<'py, PyAny>>,
+) -> PyResult<RiccatiOdeOutput<'py>> {
+    let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
+    let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
+    let t = Real::convert(py, t, "t")?;
+    let sf = Real::convert_optional(py, sf, "Sf")?;
+    let (a, b, q, r, sf, times) = (|| {
+        let sf = sf.as_ref().map(|s| s.matrix()).transpose()?;
+        let times = t.vector("a 1-D array of times")?;
+        Ok((
+            a.matrix()?,
+            b.matrix()?,
+            q.matrix()?,
+            r.matrix()?,
+            sf,
+            times,
+        ))
+    })()
+    .map_err(|e| to_py_err(py, e))?;
+    let (n, m) = (a.nrows(), b.ncols());
+    // Per interval a few exponentials of the order-2n Hamiltonian.
+    let cost = Cost::of(4.0 * expm_flops(2 * n), 30.0, 2 * n).times(times.len());
+    let solution = compute(py, cost, || riccati_ode_core(a, b, q, r, times, sf))?;
+    let mut outputs = Outputs::new(py);
+    let result = (
+        outputs.matrices("S", &solution.s, n, n)?,
+        outputs.matrices("K", &solution.gains, m, n)?,
+        solution.substeps,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(solve_care, m)?)?;
+    m.add_function(wrap_pyfunction!(riccati_ode, m)?)?;
+    Ok(())
+}

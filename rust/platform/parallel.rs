@@ -1,0 +1,93 @@
+//! Parallel loops over the problems of a batch: the context their items take from the thread
+//! that started them, and chunking that stays whole when the chunks are empty.
+
+use super::interrupt::{self, Token};
+use super::memory;
+use crate::error::Error;
+use rayon::iter::Either;
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// What the items of a parallel loop take from the thread that started it: the interrupt token
+/// of its computation. Each item runs through [`ParallelContext::run`], which installs the token
+/// on the item's thread, stops if the computation was interrupted, and makes sure the thread
+/// holds faer's product workspace before the item multiplies.
+#[derive(Debug, Clone, Default)]
+pub struct ParallelContext {
+    token: Option<Arc<Token>>,
+}
+
+impl ParallelContext {
+    /// The context of the calling thread's computation.
+    pub fn capture() -> Self {
+        Self {
+            token: interrupt::current(),
+        }
+    }
+
+    /// Runs one item of the loop on the current thread.
+    pub fn run<T>(&self, item: impl FnOnce() -> Result<T, Error>) -> Result<T, Error> {
+        interrupt::within(self.token.clone(), || {
+            interrupt::check()?;
+            memory::ensure_product_workspace()?;
+            item()
+        })
+    }
+}
+
+/// The `count` consecutive chunks of `size` entries of `data` (which holds `count * size`), as
+/// an indexed parallel iterator: `count` empty slices when `size` is 0, where rayon's
+/// `par_chunks_mut` would yield none (and panics for a size of 0).
+pub fn par_chunks<T: Send>(
+    data: &mut [T],
+    size: usize,
+    count: usize,
+) -> impl IndexedParallelIterator<Item = &mut [T]> {
+    debug_assert_eq!(data.len(), size * count);
+    if size == 0 {
+        Either::Left((0..count).into_par_iter().map(|_| <&mut [T]>::default()))
+    } else {
+        Either::Right(data.par_chunks_mut(size))
+    }
+}
+
+/// The sequential counterpart of [`par_chunks`].
+pub fn chunks<T>(data: &mut [T], size: usize, count: usize) -> impl Iterator<Item = &mut [T]> {
+    debug_assert_eq!(data.len(), size * count);
+    let (empty, full) = if size == 0 {
+        (count, None)
+    } else {
+        (0, Some(data.chunks_mut(size)))
+    };
+    std::iter::repeat_with(<&mut [T]>::default)
+        .take(empty)
+        .chain(full.into_iter().flatten())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn empty_chunks_keep_their_count() {
+        let mut empty: Vec<f64> = vec![];
+        assert_eq!(par_chunks(&mut empty, 0, 5).count(), 5);
+        assert_eq!(chunks(&mut empty, 0, 5).count(), 5);
+        let mut data: Vec<usize> = (0..6).collect();
+        let sums: Vec<usize> = par_chunks(&mut data, 2, 3)
+            .map(|c| c.iter().sum())
+            .collect();
+        assert_eq!(sums, [1, 5, 9]);
+        let lengths: Vec<usize> = chunks(&mut data, 3, 2).map(|c| c.len()).collect();
+        assert_eq!(lengths, [3, 3]);
+    }
+
+    #[test]
+    fn items_stop_once_interrupted() {
+        let token = Arc::new(Token::default());
+        let context = interrupt::within(Some(token.clone()), ParallelContext::capture);
+        assert_eq!(context.run(|| Ok(1)), Ok(1));
+        token.cancel();
+        assert_eq!(context.run(|| Ok(1)), Err(Error::Interrupted));
+    }
+}
