@@ -687,7 +687,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 
 /// The threading of the products of one exponential of order n.
 pub fn parallelism_for_order(n: usize) -> Par {
-    if n >= PARALLEL_MIN_ORDER {
+    if n >= PARALLEL_MIN_ORDER && crate::platform::memory::parallel_products_allowed() {
         Par::rayon(0)
     } else {
         Par::Seq

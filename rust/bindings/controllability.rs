@@ -43,6 +43,7 @@ fn krylov_matrix<'py>(
     let cost = Cost {
         flops: 2.0 * (n as f64).powi(3) * width as f64,
         bytes: 0.0,
+        order: n.max(width),
     };
     let matrix = compute(py, cost, || if dual { obsv(a, b) } else { ctrb(a, b) })?;
     let mut outputs = Outputs::new(py);
@@ -71,13 +72,10 @@ fn controllability<'py>(
     let (a, b) = pair(py, a, b, dual)?;
     let (a, b) = (|| Ok((a.matrix()?, b.matrix()?)))().map_err(|e| to_py_err(py, e))?;
     let n = a.nrows();
-    let staircase = Cost::of(10.0 * (n as f64).powi(3), 6.0, n);
+    let width = if dual { b.nrows() } else { b.ncols() };
+    let staircase = Cost::of(10.0 * (n as f64).powi(3), 6.0, n.max(width));
     let cost = if modal_test {
-        let modal = eigen_cost(n);
-        Cost {
-            flops: staircase.flops + modal.flops,
-            bytes: staircase.bytes + modal.bytes,
-        }
+        staircase.then(eigen_cost(n))
     } else {
         staircase
     };

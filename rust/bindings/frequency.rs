@@ -37,6 +37,7 @@ fn frequency_response<'py>(
     let cost = Cost {
         flops: 10.0 * (n as f64).powi(3) + omega.len() as f64 * per_frequency,
         bytes: (8.0 + 4.0 * threads) * (n * n.max(m)) as f64 * 8.0,
+        order: n.max(m).max(p),
     };
     compute(py, cost, || {
         frequency_response_into(model.a, model.b, model.c, model.d, omega, data)

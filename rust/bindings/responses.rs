@@ -24,7 +24,7 @@ fn grid_step(py: Python<'_>, t: &Bound<'_, PyAny>) -> PyResult<f64> {
         .map_err(|e| to_py_err(py, e))?;
     let cost = Cost {
         flops: times.len() as f64,
-        bytes: 0.0,
+        ..Cost::default()
     };
     compute(py, cost, || uniform_grid_step(times, "T"))
 }
@@ -49,7 +49,7 @@ fn simulation_cost(responses: usize, steps: usize, n: usize, m: usize, p: usize)
     let discretization = discretize_cost(n, m);
     Cost {
         flops: discretization.flops + recurrence,
-        bytes: discretization.bytes,
+        ..discretization
     }
 }
 

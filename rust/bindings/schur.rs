@@ -96,11 +96,7 @@ fn solve_lyapunov<'py>(
     let (a, q) = (Real::convert(py, a, "A")?, Real::convert(py, q, "Q")?);
     let (a, q) = (|| Ok((a.matrix()?, q.matrix()?)))().map_err(|e| to_py_err(py, e))?;
     let n = a.nrows();
-    let cost = schur_cost(n).plus_bytes(4.0 * (n * n) as f64 * 8.0);
-    let cost = Cost {
-        flops: cost.flops + 4.0 * (n as f64).powi(3),
-        ..cost
-    };
+    let cost = schur_cost(n).then(Cost::of(4.0 * (n as f64).powi(3), 4.0, n));
     let x = compute(py, cost, || solve_lyapunov_core(a, q))?;
     let mut outputs = Outputs::new(py);
     let out = outputs.matrix("X", x.as_ref())?;

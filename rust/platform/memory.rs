@@ -24,6 +24,7 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use std::cell::Cell;
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Requests `bytes` of memory and releases them at once; `Err(Error::OutOfMemory)` if the system
 /// refuses.
@@ -87,17 +88,28 @@ fn parse_cache_size(text: &str) -> Option<usize> {
 }
 
 /// The bytes to reserve for the product kernel's buffer: twice its cache estimate (at least
-/// 2 MiB, as the kernel assumes), plus a margin for the kernel's rounding to pages.
+/// 2 MiB, as the kernel assumes), plus a margin for what the system and the allocators map
+/// between the reservation and the buffer (a new thread's malloc arena, say).
 pub fn product_workspace_bytes() -> usize {
     static BYTES: OnceLock<usize> = OnceLock::new();
     *BYTES.get_or_init(|| {
         let cache = last_level_cache_bytes().max(2 << 20);
-        cache.saturating_mul(2).saturating_add(1 << 20)
+        cache
+            .saturating_mul(2)
+            .saturating_add(PRODUCT_WORKSPACE_MARGIN)
     })
 }
 
+/// See [`product_workspace_bytes`].
+const PRODUCT_WORKSPACE_MARGIN: usize = 16 << 20;
+
 thread_local! {
     static PRODUCT_WORKSPACE_READY: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Whether this thread holds faer's product workspace.
+pub fn has_product_workspace() -> bool {
+    PRODUCT_WORKSPACE_READY.get()
 }
 
 /// Makes sure this thread holds faer's product workspace (see the module documentation), or
@@ -106,12 +118,13 @@ pub fn ensure_product_workspace() -> Result<(), Error> {
     if PRODUCT_WORKSPACE_READY.get() {
         return Ok(());
     }
-    reserve(product_workspace_bytes())?;
-    // A product just above faer's small-product threshold: the kernel allocates its buffer now,
-    // while the address space is known to be there.
+    // A product just above faer's small-product threshold, whose operands are made first: the
+    // kernel allocates its buffer right after the reservation, while the address space is known
+    // to be there.
     const ORDER: usize = 17;
     let a = Mat::<f64>::zeros(ORDER, ORDER);
     let mut c = Mat::<f64>::zeros(ORDER, ORDER);
+    reserve(product_workspace_bytes())?;
     matmul(
         c.as_mut(),
         Accum::Replace,
@@ -124,38 +137,26 @@ pub fn ensure_product_workspace() -> Result<(), Error> {
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+/// Whether every thread of rayon's global pool holds faer's product workspace (once true, true
+/// for the life of the pool).
+static POOL_PRODUCT_WORKSPACE: AtomicBool = AtomicBool::new(false);
 
-    #[test]
-    fn cache_sizes_as_sysfs_writes_them() {
-        assert_eq!(parse_cache_size("32K"), Some(32 << 10));
-        assert_eq!(parse_cache_size("260M"), Some(260 << 20));
-        assert_eq!(parse_cache_size("1G"), Some(1 << 30));
-        assert_eq!(parse_cache_size("512"), Some(512));
-        assert_eq!(parse_cache_size(""), None);
-        assert_eq!(parse_cache_size("K"), None);
-        assert_eq!(parse_cache_size("x12K"), None);
-        assert!(product_workspace_bytes() >= 4 << 20);
+/// [`ensure_product_workspace`] on every thread of rayon's global pool, for a computation whose
+/// faer kernels may run in parallel. Call it from outside the pool.
+pub fn ensure_pool_product_workspace() -> Result<(), Error> {
+    if POOL_PRODUCT_WORKSPACE.load(Ordering::Acquire) {
+        return Ok(());
     }
+    rayon::broadcast(|_| ensure_product_workspace())
+        .into_iter()
+        .collect::<Result<Vec<()>, Error>>()?;
+    POOL_PRODUCT_WORKSPACE.store(true, Ordering::Release);
+    Ok(())
+}
 
-    #[test]
-    fn impossible_requests_are_errors() {
-        let bytes = usize::MAX / 2;
-        assert_eq!(reserve(bytes), Err(Error::OutOfMemory { bytes }));
-        assert!(matches!(
-            try_vec(usize::MAX / 16, 0.0f64),
-            Err(Error::OutOfMemory { .. })
-        ));
-        assert_eq!(reserve(1 << 20), Ok(()));
-        assert_eq!(try_vec(3, 1.5), Ok(vec![1.5; 3]));
-    }
-
-    #[test]
-    fn the_product_workspace_is_made_once_per_thread() {
-        assert_eq!(ensure_product_workspace(), Ok(()));
-        assert!(PRODUCT_WORKSPACE_READY.get());
-        assert_eq!(ensure_product_workspace(), Ok(()));
-    }
+/// Whether faer's kernels may run in parallel on the pool: only once every thread of the pool
+/// holds its product workspace ([`ensure_pool_product_workspace`]); otherwise they run on the
+/// computing thread alone.
+pub fn parallel_products_allowed() -> bool {
+    POOL_PRODUCT_WORKSPACE.load(Ordering::Acquire)
 }
