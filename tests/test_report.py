@@ -59,7 +59,12 @@ def test_the_folder_has_the_report_and_every_figure(written: tuple[Path, list[st
     path, _ = written
     folder = path.parent
     assert path.name == "report.html"
-    assert sorted(p.name for p in folder.iterdir()) == ["figures", "report.html", "report.md"]
+    assert sorted(p.name for p in folder.iterdir()) == [
+        ".aerocontrol-report.json",
+        "figures",
+        "report.html",
+        "report.md",
+    ]
     assert {p.name for p in (folder / "figures").iterdir()} == FIGURES | EXAMPLES
     for figure in (folder / "figures").iterdir():
         assert figure.read_bytes().startswith(PNG_SIGNATURE)
@@ -220,22 +225,29 @@ def test_rendering_escapes_html_and_markdown(
     assert "| 1 | x\\|y |" in (tmp_path / "tiny" / "report.md").read_text(encoding="utf-8")
 
 
-def test_rewriting_a_folder_replaces_the_report(
+def test_rewriting_a_folder_keeps_the_users_files(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
+    """Files the report did not write are never removed (see test_report_folder.py for the
+    rules): with --force into a folder of the user's, then again into it as an earlier report."""
     monkeypatch.setattr(report_module, "build_report", _tiny)
     out = tmp_path / "out"
     (out / "figures").mkdir(parents=True)
     (out / "figures" / "stale.png").write_bytes(b"old")
     (out / "notes.txt").write_text("mine")
+    with pytest.raises(aerocontrol.OutputFolderError, match="it is not empty and holds no"):
+        write_report(out=out)
+    write_report(out=out, force=True)
     write_report(out=out)
     assert sorted(p.name for p in out.iterdir()) == [
+        ".aerocontrol-report.json",
         "figures",
         "notes.txt",
         "report.html",
         "report.md",
     ]
-    assert [p.name for p in (out / "figures").iterdir()] == ["one.png"]
+    assert sorted(p.name for p in (out / "figures").iterdir()) == ["one.png", "stale.png"]
+    assert (out / "figures" / "stale.png").read_bytes() == b"old"
 
 
 @pytest.mark.parametrize("existing", [False, True])
@@ -251,7 +263,7 @@ def test_a_failure_leaves_nothing_half_written(
         out.mkdir()
         (out / "notes.txt").write_text("mine")
     with pytest.raises(aerocontrol.ConvergenceError, match="the regulator failed"):
-        write_report(out=out)
+        write_report(out=out, force=True)
     if existing:
         assert [p.name for p in out.iterdir()] == ["notes.txt"]
     else:
