@@ -665,3 +665,23 @@ def test_a_signal_during_the_final_moves_waits_until_they_are_done(
     files = _assert_complete_report(out)
     assert set(files) == {"report.html", "report.md", "figures/one.png", "figures/two.png"}
     assert "v2" in (out / "report.md").read_text(encoding="utf-8")
+
+
+def test_the_readme_documents_the_rules_and_the_promises() -> None:
+    readme = Path(__file__).resolve().parents[1] / "README.md"
+    if not readme.is_file():  # pragma: no cover - tests run from an sdist without README
+        pytest.skip("README.md not found beside the tests")
+    text = " ".join(readme.read_text(encoding="utf-8").split())
+    report = text.split("## The report", 1)[1].split("## What aerocontrol promises", 1)[0]
+    for rule in (
+        "never deletes, renames or overwrites a file it did not write itself",
+        "`DIR/.aerocontrol-report.json`",
+        "running the same command twice, as in the setup above, just works",
+        "is never touched",
+        "`--force`",
+        "symbolic links inside `DIR` are never written through",
+        "no staging folder, no half-written report",
+    ):
+        assert rule in report, rule
+    promises = text.split("### Files and input files", 1)[1]
+    assert promises.lstrip().startswith("- A command never deletes")
