@@ -711,3 +711,28 @@ def test_at_refuses_implausible_conditions_by_name() -> None:
     ):
         with pytest.raises(AircraftDataError, match=re.escape(message)):
             b747.at(**arguments)
+
+
+def test_a_singular_model_is_a_named_error_not_a_division_by_zero(tmp_path: Path) -> None:
+    """CL_alphadot chosen (within its range) so that 1 - Zẇ is exactly zero: the α equation
+    loses dα/dt. Once a ZeroDivisionError; now an AircraftDataError naming the cause."""
+    b747 = aircraft.load()
+    factor = b747.density * b747.S * b747.cbar / (4 * b747.mass)
+    exact = next(
+        value
+        for step in range(-8, 9)
+        for value in [-1.0 / factor + step * math.ulp(1.0 / factor)]
+        if 1.0 - (-factor * value) == 0.0
+    )
+    plane = aircraft.load(_edited(tmp_path, "CL_alphadot = 6.7", f"CL_alphadot = {exact!r}"))
+    with pytest.raises(AircraftDataError, match=r"the longitudinal model is singular: 1 - Zẇ = 0"):
+        plane.longitudinal()
+
+
+def test_at_a_file_at_zero_lift_holds_the_drag() -> None:
+    """CL = 0 has no parabolic polar through the file's point with a slope (once a
+    ZeroDivisionError): the drag coefficient is held."""
+    b747 = aircraft.load()
+    level = dataclasses.replace(b747, derivatives={**b747.derivatives, "CL": 0.0})
+    moved = level.at(altitude=5_000.0)
+    assert moved.derivatives["CL"] == 0.0 and moved.derivatives["CD"] == b747.derivatives["CD"]

@@ -405,6 +405,11 @@ class Aircraft:
         d = self.dimensional_longitudinal()
         u0, g, theta0 = self.speed, self.gravity, self.theta0
         surge = [d["Xu"], d["Xw"], 0.0, -g * math.cos(theta0) / u0]
+        if d["Zwdot"] == 1.0:  # (1 - Zẇ) dα/dt: the α equation would have no dα/dt
+            raise AircraftDataError(
+                f"{self.name}: the longitudinal model is singular: 1 - Zẇ = 0 with "
+                f"CL_alphadot = {self.derivatives['CL_alphadot']:g}"
+            )
         scale = 1.0 / (1.0 - d["Zwdot"])
         heave = [
             d["Zu"] * scale,
@@ -432,6 +437,10 @@ class Aircraft:
         u0, g, theta0 = self.speed, self.gravity, self.theta0
         ix, iz = d["ix"], d["iz"]
         coupling = 1.0 - ix * iz
+        if not coupling > 0.0:  # Ix Iz > Ixz^2, checked by the loader, lost to rounding
+            raise AircraftDataError(
+                f"{self.name}: the lateral model is singular: 1 - Ixz^2/(Ix Iz) = {coupling:g}"
+            )
         roll = [u0 * d["Lv"], d["Lp"], 0.0, d["Lr"]]
         yaw = [u0 * d["Nv"], d["Np"], 0.0, d["Nr"]]
         roll_control = [d["Ldr"], d["Lda"]]
@@ -532,7 +541,12 @@ class Aircraft:
         # CL ∝ W / q̄ at a fixed Θ0; scaling the file's CL reproduces the file at its own
         # condition exactly.
         lift = c["CL"] * (mass / self.mass) * (self.density * self.speed**2) / (density * speed**2)
-        k = max(c["CD_alpha"] / (2.0 * c["CL"] * c["CL_alpha"]), 0.0) if c["CL_alpha"] else 0.0
+        # (A file at CL = 0 has no polar through its point with that slope: CD is held.)
+        k = (
+            max(c["CD_alpha"] / (2.0 * c["CL"] * c["CL_alpha"]), 0.0)
+            if c["CL_alpha"] and c["CL"]
+            else 0.0
+        )
         drag_zero = c["CD"] - k * c["CL"] ** 2
         c["CL"], c["CD"] = lift, drag_zero + k * lift**2
         names = _UNIT_NAMES[self.units]
@@ -595,7 +609,7 @@ def body_to_stability(
 _NAME_LIMIT = 200
 _DESCRIPTION_LIMIT = 2_000
 _SOURCE_LIMIT = 20_000
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u200e\u200f\u2028-\u202e\u2066-\u2069]")
 _PLAIN_KEY = re.compile(r"[A-Za-z0-9_\-]{1,40}")
 
 
