@@ -339,8 +339,8 @@ def test_debug_prints_the_traceback_instead(
          "by zero); run 'aerocontrol --debug ...' for the traceback"),
         (RecursionError("maximum recursion depth exceeded"), "unexpected error (RecursionError: "
          "maximum recursion depth exceeded); run 'aerocontrol --debug ...' for the traceback"),
-        (MemoryError(), "unexpected error (MemoryError); run 'aerocontrol --debug ...' for the "
-         "traceback"),
+        (MemoryError(), "out of memory (no detail)"),
+        (MemoryError("Unable to allocate 149. GiB"), "out of memory (Unable to allocate 149. GiB)"),
         (KeyError("x\ny"), "unexpected error (KeyError: 'x\\ny'); run 'aerocontrol --debug ...' "
          "for the traceback"),
         (aerocontrol.ConvergenceError("no convergence\nafter 30 steps"), "no convergence\\nafter "

@@ -395,20 +395,24 @@ def test_the_folder_itself_may_be_a_link_to_a_folder(
     _assert_complete_report(real)
 
 
-@pytest.mark.parametrize("kind", ["file", "broken-link", "file-parent", "fifo"])
+@pytest.mark.parametrize("kind", ["file", "broken-link", "file-parent", "fifo", "link-to-file"])
 def test_a_folder_that_is_not_one_is_one_clear_error(
     tiny: Callable[..., None], tmp_path: Path, kind: str
 ) -> None:
     out = tmp_path / "out"
     if kind == "file":
         out.write_text("a file")
-        expected = "it is a file, not a folder"
+        expected = "it exists and is not a folder"
     elif kind == "broken-link":
         out.symlink_to(tmp_path / "absent")
         expected = "it is a symbolic link to nothing (a broken link)"
     elif kind == "fifo":
         os.mkfifo(out)
-        expected = "it is a file, not a folder"
+        expected = "it exists and is not a folder"
+    elif kind == "link-to-file":
+        (tmp_path / "file").write_text("a file")
+        out.symlink_to(tmp_path / "file")
+        expected = "it exists and is not a folder"
     else:
         (tmp_path / "file").write_text("a file")
         out = tmp_path / "file" / "out"

@@ -401,9 +401,9 @@ class ReportFolder:
         if os.path.lexists(out):
             if os.path.isdir(out):
                 return
-            if os.path.islink(out):
+            if os.path.islink(out) and not os.path.exists(out):
                 raise self._fail("it is a symbolic link to nothing (a broken link)")
-            raise self._fail("it is a file, not a folder")
+            raise self._fail("it exists and is not a folder")
         missing: list[str] = []
         path = os.path.abspath(out)
         while not os.path.lexists(path):

@@ -236,7 +236,7 @@ class _Terminated(BaseException):
 
 
 _COMMANDS = {"report": _report, "aircraft": _aircraft, "modes": _modes, "lqr": _lqr}
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u200e\u200f\u2028-\u202e\u2066-\u2069]")
 
 
 def _one_line(text: str) -> str:
@@ -248,8 +248,10 @@ def _message(error: BaseException) -> str:
     """The one-line message of an error: its own text for the errors aerocontrol expects
     (its exceptions, the operating system's), the type and a pointer to --debug for the rest."""
     text = _one_line(str(error))
-    if isinstance(error, (AerocontrolError, OSError)) and text:
+    if isinstance(error, (AerocontrolError, OSError, Warning)) and text:
         return text
+    if isinstance(error, MemoryError):
+        return f"out of memory ({text or 'no detail'})"
     kind = type(error).__name__
     detail = f"{kind}: {text}" if text else kind
     return f"unexpected error ({detail}); run 'aerocontrol --debug ...' for the traceback"

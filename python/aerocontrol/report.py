@@ -80,6 +80,8 @@ DAMPER_SIDESLIP = math.radians(5.0)
 DAMPER_ZETA = 0.30
 
 ONE_DEGREE = math.pi / 180.0
+#: The most samples of a time response in the report.
+_MAX_SAMPLES = 200_001
 
 
 # --- The document -----------------------------------------------------------------------------
@@ -401,7 +403,10 @@ def _section_responses(ctx: _Context) -> str:
     report, sys = ctx.report, ctx.longitudinal
     report.heading("Responses")
     short, long = _time_scales(ctx)
-    grid = np.linspace(0.0, long, round(long / min(short / 400.0, 0.05)) + 1)
+    # 400 steps per short scale, at most 0.05 s, and at most _MAX_SAMPLES samples (an aircraft
+    # with a very fast short period over a long phugoid scale would need billions).
+    spacing = max(min(short / 400.0, 0.05), long / (_MAX_SAMPLES - 1))
+    grid = np.linspace(0.0, long, round(long / spacing) + 1)
     impulse = impulse_response(sys, T=grid)
     figure, axes = _new_figure(2)
     plotting.plot_time_scales(impulse, short, axes=axes[0])
@@ -1096,7 +1101,7 @@ def write_report(
             report = build_report(aircraft, say)
             earlier = " (replacing the earlier report)" if folder.replacing else ""
             say(f"writing {len(report.figures)} figures and the report{earlier}")
-            folder.write(_render(report))
+            folder.write(_render(report, say))
         except BaseException as error:
             problems = folder.rollback()
             if problems and isinstance(error, Exception):
@@ -1107,17 +1112,37 @@ def write_report(
     return Path(out) / "report.html"
 
 
-def _render(report: Report) -> dict[str, bytes]:
-    """The report's files by name: ``figures/*.png``, ``report.md``, ``report.html``."""
+def _render(report: Report, say: Callable[[str], None]) -> dict[str, bytes]:
+    """The report's files by name: ``figures/*.png``, ``report.md``, ``report.html``.
+
+    A figure that matplotlib cannot draw (the responses of an aircraft whose numbers are each
+    plausible but together absurd can overflow to values no axis can hold) is replaced by a
+    picture that says so, and the rest of the report goes on."""
     images = {}
     for name, figure in report.figures:
         buffer = io.BytesIO()
-        figure.savefig(buffer, format="png", dpi=100)
+        try:
+            figure.savefig(buffer, format="png", dpi=100)
+        except (ArithmeticError, ValueError, RuntimeError) as error:
+            reason = " ".join(f"{type(error).__name__}: {error}".split())
+            say(f"figure {name} could not be drawn ({reason})")
+            buffer = io.BytesIO()
+            _undrawable(name, reason).savefig(buffer, format="png", dpi=100)
         images[name] = buffer.getvalue()
     files = {f"figures/{name}": data for name, data in images.items()}
     files["report.md"] = report.markdown().encode("utf-8")
     files["report.html"] = report.html(images).encode("utf-8")
     return files
+
+
+def _undrawable(name: str, reason: str) -> Any:
+    """A small figure that says why the figure ``name`` could not be drawn."""
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(6.0, 1.5))
+    text = f"{name}: this figure could not be drawn\n({reason[:200]})"
+    figure.text(0.5, 0.5, text, ha="center", va="center", wrap=True, fontsize=9)
+    return figure
 
 
 def _version() -> str:
