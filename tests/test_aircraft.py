@@ -6,6 +6,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import re
+import subprocess
 import sys
 from pathlib import Path
 
@@ -447,3 +450,289 @@ def test_si_file_matches_the_english_one(tmp_path: Path) -> None:
     # The models differ only through g (9.80665 m/s^2 against 32.174 ft/s^2: 3e-6 relative).
     np.testing.assert_allclose(si.lateral().A, english.lateral().A, rtol=1e-5, atol=1e-12)
     np.testing.assert_allclose(si.longitudinal().B, english.longitudinal().B, rtol=1e-5)
+
+
+# --------------------------------------------------------------------------------------------
+# Hostile files: one AircraftDataError (a ValueError) with one line naming the file and the
+# key, never another exception, never a hang, never an unbounded read
+# --------------------------------------------------------------------------------------------
+
+
+def _one_line_error(path: Path | str) -> str:
+    """The message of the AircraftDataError that loading ``path`` raises (one line)."""
+    with pytest.raises(AircraftDataError) as caught:
+        aircraft.load(path)
+    message = str(caught.value)
+    assert "\n" not in message and len(message) < 400, message
+    return message
+
+
+def test_a_fifo_is_refused_without_blocking(tmp_path: Path) -> None:
+    """A FIFO named like an aircraft file would block a plain open() forever; the loader
+    refuses it at once. Run in a child process with a timeout, so a regression fails the
+    test instead of hanging the suite."""
+    fifo = tmp_path / "pipe.toml"
+    os.mkfifo(fifo)
+    code = (
+        "import sys\nfrom aerocontrol import aircraft\n"
+        "try:\n    aircraft.load(sys.argv[1])\n"
+        "except aircraft.AircraftDataError as error:\n    print(error)\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", code, str(fifo)], capture_output=True, text=True, timeout=60
+    )
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == (
+        f"cannot read the aircraft file {str(fifo)!r}: it is a FIFO (named pipe), not a regular "
+        "file\n"
+    )
+
+
+def test_devices_folders_and_links_to_them_are_refused(tmp_path: Path) -> None:
+    zero = tmp_path / "zero.toml"
+    zero.symlink_to("/dev/zero")  # an endless file: must not be read at all
+    assert _one_line_error(zero) == (
+        f"cannot read the aircraft file {str(zero)!r}: it is a device, not a regular file"
+    )
+    folder = tmp_path / "folder.toml"
+    folder.mkdir()
+    assert _one_line_error(folder).endswith("it is a folder, not a regular file")
+    dangling = tmp_path / "dangling.toml"
+    dangling.symlink_to(tmp_path / "absent.toml")
+    assert _one_line_error(dangling).endswith(": No such file or directory")
+    # A link to a regular file is followed.
+    link = tmp_path / "link.toml"
+    link.symlink_to(B747_FILE)
+    assert aircraft.load(link).name == aircraft.load().name
+
+
+def test_files_above_the_size_limit_are_refused(tmp_path: Path) -> None:
+    big = tmp_path / "big.toml"
+    big.write_bytes(B747_FILE.read_bytes() + b"#" * 2_000_000)  # 2 MB: valid TOML, too large
+    assert _one_line_error(big) == (
+        f"cannot read the aircraft file {str(big)!r}: it is larger than 1,048,576 bytes, the "
+        "limit of an aircraft file"
+    )
+    assert aircraft.AIRCRAFT_FILE_LIMIT == 1 << 20
+    # Just below the limit is read.
+    padded = tmp_path / "padded.toml"
+    text = B747_FILE.read_bytes()
+    padded.write_bytes(text + b"#" * (aircraft.AIRCRAFT_FILE_LIMIT - len(text)))
+    assert aircraft.load(padded).name == aircraft.load().name
+
+
+def test_a_file_that_is_not_utf8_names_the_byte(tmp_path: Path) -> None:
+    latin1 = tmp_path / "latin1.toml"
+    text = B747_FILE.read_text().replace("Boeing 747", "Boeing 747 \u00e9", 1)
+    encoded = text.encode("latin-1", errors="replace")
+    latin1.write_bytes(encoded)
+    offset = encoded.index(b"\xe9")
+    assert _one_line_error(latin1) == (
+        f"{latin1}: not UTF-8 text: byte 0xe9 at offset {offset} (invalid continuation byte); "
+        "save the file as UTF-8"
+    )
+
+
+@pytest.mark.parametrize(
+    "nesting",
+    [
+        "a = " + "[" * 3000 + "]" * 3000,
+        "a = " + "{ b = " * 3000 + "1" + " }" * 3000,
+    ],
+    ids=["arrays", "inline-tables"],
+)
+def test_nesting_too_deep_for_the_parser_is_one_error(tmp_path: Path, nesting: str) -> None:
+    deep = tmp_path / "deep.toml"
+    deep.write_text(nesting)
+    assert _one_line_error(deep) == (
+        f"{deep}: not valid TOML for an aircraft: arrays or tables nested too deeply"
+    )
+
+
+def test_integers_too_large_for_a_float_name_the_key(tmp_path: Path) -> None:
+    digits400 = _edited(tmp_path, "weight = 564032.0", "weight = 1" + "0" * 399)
+    assert _one_line_error(digits400).endswith(
+        "edited.toml: [mass] weight, an integer of about 400 digits, is outside the plausible "
+        "range 0.1 to 4.5e+06 lbf"
+    )
+    digits5000 = _edited(tmp_path, "Ixz = -2.23e6", "Ixz = -" + "9" * 5000)
+    line = B747_FILE.read_text().splitlines().index("Ixz = -2.23e6") + 1
+    assert _one_line_error(digits5000).endswith(
+        f"edited.toml: line {line}: Ixz = an integer of 5000 digits is outside the plausible "
+        "range of every quantity"
+    )
+    # An integer that is a float in range is taken.
+    whole = aircraft.load(_edited(tmp_path, "weight = 564032.0", "weight = 564032"))
+    assert whole.mass * whole.gravity == pytest.approx(564032.0)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        ("speed = 279.1", "speed = 1e300", "[flight] speed = 1e+300 ft/s is outside the "
+         "plausible range 1.5 to 11500 ft/s"),
+        ("weight = 564032.0", "weight = 1e300", "[mass] weight = 1e+300 lbf is outside the "
+         "plausible range 0.1 to 4.5e+06 lbf"),
+        ("Cm_q = -20.8", "Cm_q = -1e300", "[longitudinal] Cm_q = -1e+300 per rad is outside "
+         "the plausible range -1000 to 1000 per rad"),
+        ("Cn_beta = 0.15", "Cn_beta = 1e300", "[lateral] Cn_beta = 1e+300 per rad is outside "
+         "the plausible range -100 to 100 per rad"),
+        ("altitude = 0.0", "altitude = 1e300", "[flight] altitude = 1e+300 ft is outside the "
+         "plausible range -16400 to 282000 ft"),
+        ("density = 0.002377", "density = 1e300", "[flight] density = 1e+300 slug/ft^3 is "
+         "not plausible at 0 ft"),
+        ("Ix = 14.3e6", "Ix = 1e300", "[mass] Ix = 1e+300 slug ft^2 is outside the plausible "
+         "range 1e-06 to 1e+10 slug ft^2"),
+        ("Ixz = -2.23e6", "Ixz = -1e300", "[mass] Ixz = -1e+300 slug ft^2 is outside the "
+         "plausible range -1e+10 to 1e+10 slug ft^2"),
+        ("S = 5500.0", "S = 1e-300", "[geometry] S = 1e-300 ft^2 is outside the plausible "
+         "range 0.01 to 100000 ft^2"),
+        ("b = 195.7", "b = 1e300", "[geometry] b = 1e+300 ft is outside the plausible range "
+         "0.15 to 1600 ft"),
+        ("theta0_deg = 0.0", "theta0_deg = 90.0", "[flight] theta0_deg = 90 deg is outside "
+         "the plausible range -89 to 89 deg"),
+        ("speed = 279.1", "mach = 1e300", "[flight] mach = 1e+300 is outside the plausible "
+         "range 0.001 to 12"),
+        ("CD = 0.102", "CD = -0.5", "[longitudinal] CD = -0.5 is outside the plausible range "
+         "0 to 10"),
+        ("zeta = 0.1079 }", "zeta = 1e300 }", "[published.dutch_roll] zeta = 1e+300 is outside "
+         "the plausible range -10 to 10"),
+        ("tolerance = 1e-2 ", "tolerance = 1e300 ", "[published] tolerance = 1e+300 is outside "
+         "the plausible range 1e-12 to 1"),
+        ("weight = 564032.0", "weight = -1e300", "[mass] weight must be positive, got -1e+300"),
+        ("weight = 564032.0", "weight = nan", "[mass] weight must be a finite number, got nan"),
+        ("Cm_q = -20.8", "Cm_q = -inf", "[longitudinal] Cm_q must be a finite number, got -inf"),
+        ("Cm_q = -20.8", "Cm_q = [1.0]", "[longitudinal] Cm_q must be a finite number, got "
+         "[1.0]"),
+        ('name = "Boeing 747, powered approach"', 'name = "two\\nlines"', "[aircraft] name "
+         "contains the control character '\\n' at position 3"),
+        ('name = "Boeing 747, powered approach"', f'name = "{"x" * 300}"', "[aircraft] name has "
+         "300 characters, more than the 200 allowed"),
+        ('name = "Boeing 747, powered approach"', "name = 747", "[aircraft] name must be a "
+         "string, got 747"),
+        ("Cn_r = -0.30\n", "Cn_r = -0.30\n" + "".join(f"k{i} = 1\n" for i in range(9)),
+         "[lateral] has unknown key(s) k0, k1, k2, k3, k4 and 4 more; the keys are"),
+        ("Cn_r = -0.30\n", 'Cn_r = -0.30\n"a\\nb" = 1\n', "[lateral] has unknown key(s) "
+         "'a\\nb'; the keys are"),
+    ],
+)  # fmt: skip
+def test_every_quantity_is_checked_against_its_plausible_range(
+    tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    assert f"edited.toml: {message}" in _one_line_error(_edited(tmp_path, old, new))
+
+
+def test_the_range_table_covers_every_number_and_is_documented() -> None:
+    """Every number an aircraft file may give has a range, each range holds the values of every
+    shipped aircraft, and the loader's documentation lists the ranges it quotes."""
+    flight_mass_geometry = (
+        "speed", "mach", "altitude", "density", "theta0_deg", "alpha0_deg", "weight", "mass",
+        "Ix", "Iy", "Iz", "Ixz", "S", "cbar", "b",
+    )  # fmt: skip
+    published = ("omega_n", "zeta", "time_constant", "time_to_half", "time_to_double")
+    keys = (
+        *flight_mass_geometry,
+        *aircraft.LONGITUDINAL_DERIVATIVES,
+        *aircraft.LATERAL_DERIVATIVES,
+        *published,
+        "tolerance",
+    )
+    assert set(aircraft.PLAUSIBLE_RANGES) == set(keys)
+    for key, bounds in aircraft.PLAUSIBLE_RANGES.items():
+        for units in ("si", "english"):
+            low, high, _ = bounds.bounds(units)
+            assert low < high, key
+    schema_doc = aircraft.schema.__doc__ or ""
+    for key in keys:
+        assert key in schema_doc, key
+    load_doc = aircraft.load.__doc__ or ""
+    assert "1.5 to 11,500 ft/s" in load_doc and "-1,000 to 1,000 per rad" in load_doc
+    for identifier in aircraft.available():
+        data = tomllib.loads(
+            (Path(aircraft.__file__).parent / "data" / f"{identifier}.toml").read_text()
+        )
+        units = data["aircraft"]["units"]
+        for table in ("flight", "mass", "geometry", "longitudinal", "lateral"):
+            for key, value in data[table].items():
+                if key == "axes":
+                    continue
+                low, high, _ = aircraft.PLAUSIBLE_RANGES[key].bounds(units)
+                # Well inside, not at the edge: the ranges are generous.
+                assert low < value < high or value == 0.0, (identifier, key, value)
+
+
+def _aircraft_with(tmp_path: Path, values: dict[str, float | str], name: str) -> Path:
+    """The 747 file with some values replaced (key = value lines, units as given)."""
+    text = B747_FILE.read_text()
+    for key, value in values.items():
+        lines = text.splitlines(keepends=True)
+        index = next(i for i, line in enumerate(lines) if line.split("=")[0].strip() == key)
+        lines[index] = (
+            f"{key} = {value!r}\n" if not isinstance(value, str) else (f'{key} = "{value}"\n')
+        )
+        text = "".join(lines)
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("name", "values"),
+    [
+        # Orders of magnitude of public figures; the ranges must admit them all.
+        ("model-glider", {"units": "si", "speed": 12.0, "density": 1.225, "weight": 15.0,
+                          "Ix": 0.05, "Iy": 0.04, "Iz": 0.09, "Ixz": 0.0, "S": 0.4,
+                          "cbar": 0.2, "b": 2.0}),
+        ("light-single", {"speed": 180.0, "weight": 2400.0, "Ix": 950.0, "Iy": 1350.0,
+                          "Iz": 2000.0, "Ixz": 0.0, "S": 174.0, "cbar": 4.9, "b": 36.0}),
+        ("heavy-transport", {"speed": 290.0, "weight": 1.4e6, "Ix": 6.0e7, "Iy": 1.2e8,
+                             "Iz": 1.8e8, "Ixz": 5.0e6, "S": 9700.0, "cbar": 40.0,
+                             "b": 290.0}),
+        ("hypersonic", {"speed": 6600.0, "altitude": 100000.0, "weight": 15000.0,
+                        "Ix": 3650.0, "Iy": 80000.0, "Iz": 82000.0, "Ixz": 590.0,
+                        "S": 200.0, "cbar": 10.3, "b": 22.4, "Cm_q": -80.0, "Cl_p": -0.35}),
+    ],
+)  # fmt: skip
+def test_the_ranges_admit_real_aircraft_from_models_to_jumbos(
+    tmp_path: Path, name: str, values: dict[str, float | str]
+) -> None:
+    if "density" not in values:
+        values = {**values, "density": 0.002377 if "altitude" not in values else 0.0000331}
+    plane = aircraft.load(_aircraft_with(tmp_path, values, name))
+    assert plane.speed == values["speed"]
+
+
+def test_at_refuses_implausible_conditions_by_name() -> None:
+    b747 = aircraft.load()
+    for arguments, message in (
+        ({"mach": 1e300}, "mach = 1e+300 is outside the plausible range 0.001 to 12"),
+        ({"altitude": 1e300}, "altitude = 1e+300 ft is outside the plausible range"),
+        ({"weight": 1e300}, "weight = 1e+300 lbf is outside the plausible range 0.1 to"),
+    ):
+        with pytest.raises(AircraftDataError, match=re.escape(message)):
+            b747.at(**arguments)
+
+
+def test_a_singular_model_is_a_named_error_not_a_division_by_zero(tmp_path: Path) -> None:
+    """CL_alphadot chosen (within its range) so that 1 - Zẇ is exactly zero: the α equation
+    loses dα/dt. Once a ZeroDivisionError; now an AircraftDataError naming the cause."""
+    b747 = aircraft.load()
+    factor = b747.density * b747.S * b747.cbar / (4 * b747.mass)
+    exact = next(
+        value
+        for step in range(-8, 9)
+        for value in [-1.0 / factor + step * math.ulp(1.0 / factor)]
+        if 1.0 - (-factor * value) == 0.0
+    )
+    plane = aircraft.load(_edited(tmp_path, "CL_alphadot = 6.7", f"CL_alphadot = {exact!r}"))
+    with pytest.raises(AircraftDataError, match=r"the longitudinal model is singular: 1 - Zẇ = 0"):
+        plane.longitudinal()
+
+
+def test_at_a_file_at_zero_lift_holds_the_drag() -> None:
+    """CL = 0 has no parabolic polar through the file's point with a slope (once a
+    ZeroDivisionError): the drag coefficient is held."""
+    b747 = aircraft.load()
+    level = dataclasses.replace(b747, derivatives={**b747.derivatives, "CL": 0.0})
+    moved = level.at(altitude=5_000.0)
+    assert moved.derivatives["CL"] == 0.0 and moved.derivatives["CD"] == b747.derivatives["CD"]

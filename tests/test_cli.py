@@ -3,8 +3,10 @@ with a non-zero exit (never a traceback) for every kind of bad input."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +41,19 @@ def test_default_run_writes_the_report_of_the_747(tmp_path: Path) -> None:
     assert report.is_file() and (report.parent / "report.md").is_file()
     assert len(list((report.parent / "figures").glob("*.png"))) == 14
     assert result.stderr == ""
+    # README's command, run again into the same folder: the earlier report, untouched, is
+    # replaced without any option; a file of the user's beside it stays.
+    (tmp_path / "aerocontrol-report" / "notes.txt").write_text("mine")
+    again = subprocess.run(
+        [sys.executable, "-m", "aerocontrol", "report", "--out", "aerocontrol-report"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert again.returncode == 0, again.stderr
+    assert "writing 14 figures and the report (replacing the earlier report)" in again.stdout
+    assert (tmp_path / "aerocontrol-report" / "notes.txt").read_text() == "mine"
+    assert again.stderr == ""
 
 
 def test_aircraft_lists_the_shipped_aircraft(capsys: pytest.CaptureFixture[str]) -> None:
@@ -151,3 +166,267 @@ def test_report_on_an_aircraft_file(capsys: pytest.CaptureFixture[str], tmp_path
     assert status == 0
     assert out.splitlines()[-1] == f"report: {tmp_path / 'fin' / 'report.html'}"
     assert "chapter check" not in out  # the chapter's numbers are for the embedded 747 only
+
+
+# --- Every error is one line -------------------------------------------------------------------
+
+
+def _one_line(err: str) -> str:
+    """The single line of standard error, without its newline."""
+    assert err.endswith("\n") and err.count("\n") == 1, err
+    assert "Traceback" not in err
+    return err[:-1]
+
+
+def _hostile(tmp_path: Path, kind: str) -> tuple[Path, str]:
+    """A hostile aircraft file and the error message it must give."""
+    shipped = aerocontrol.aircraft.model.resources.files("aerocontrol.aircraft.data")
+    text = shipped.joinpath("b747-approach.toml").read_text(encoding="utf-8")
+    path = tmp_path / f"{kind}.toml"
+    if kind == "digits400":
+        path.write_text(text.replace("weight = 564032.0", "weight = 1" + "0" * 399))
+        return path, (
+            f"{path}: [mass] weight, an integer of about 400 digits, is outside the plausible "
+            "range 0.1 to 4.5e+06 lbf"
+        )
+    if kind == "digits5000":
+        path.write_text(text.replace("weight = 564032.0", "weight = " + "7" * 5000))
+        line = text.splitlines().index("weight = 564032.0          # lbf") + 1
+        return path, (
+            f"{path}: line {line}: weight = an integer of 5000 digits is outside the plausible "
+            "range of every quantity"
+        )
+    if kind == "speed":
+        path.write_text(text.replace("speed = 279.1", "speed = 1e300"))
+        return path, (
+            f"{path}: [flight] speed = 1e+300 ft/s is outside the plausible range 1.5 to 11500 ft/s"
+        )
+    if kind == "Cm_q":
+        path.write_text(text.replace("Cm_q = -20.8", "Cm_q = -1e300"))
+        return path, (
+            f"{path}: [longitudinal] Cm_q = -1e+300 per rad is outside the plausible range "
+            "-1000 to 1000 per rad"
+        )
+    if kind == "latin1":
+        path.write_bytes(b'[aircraft]\nname = "Caf\xe9"\n')
+        return path, (
+            f"{path}: not UTF-8 text: byte 0xe9 at offset 22 (invalid continuation byte); save "
+            "the file as UTF-8"
+        )
+    if kind == "deep":
+        path.write_text("a = " + "[" * 3000 + "]" * 3000)
+        return path, f"{path}: not valid TOML for an aircraft: arrays or tables nested too deeply"
+    if kind == "big":
+        path.write_text(text + "#" * 2_000_000)
+        return path, (
+            f"cannot read the aircraft file {str(path)!r}: it is larger than 1,048,576 bytes, "
+            "the limit of an aircraft file"
+        )
+    if kind == "zero":
+        path.symlink_to("/dev/zero")
+        return path, (
+            f"cannot read the aircraft file {str(path)!r}: it is a device, not a regular file"
+        )
+    if kind == "folder":
+        path.mkdir()
+        return path, (
+            f"cannot read the aircraft file {str(path)!r}: it is a folder, not a regular file"
+        )
+    raise AssertionError(kind)  # pragma: no cover
+
+
+HOSTILE = ["digits400", "digits5000", "speed", "Cm_q", "latin1", "deep", "big", "zero", "folder"]
+
+
+@pytest.mark.parametrize("kind", HOSTILE)
+@pytest.mark.parametrize("command", ["modes", "lqr", "report"])
+def test_hostile_aircraft_files_are_one_line_and_status_1(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, kind: str, command: str
+) -> None:
+    path, message = _hostile(tmp_path, kind)
+    out_folder = tmp_path / "report-out"
+    extra = ["--out", str(out_folder)] if command == "report" else []
+    status, out, err = _run(capsys, command, str(path), *extra)
+    assert (status, out) == (1, "")
+    assert _one_line(err) == f"aerocontrol: error: {message}"
+    assert not out_folder.exists()
+
+
+def test_a_fifo_does_not_block_the_command(tmp_path: Path) -> None:
+    fifo = tmp_path / "x.toml"
+    os.mkfifo(fifo)
+    result = subprocess.run(
+        [sys.executable, "-m", "aerocontrol", "modes", str(fifo)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (result.returncode, result.stdout) == (1, "")
+    assert _one_line(result.stderr) == (
+        f"aerocontrol: error: cannot read the aircraft file {str(fifo)!r}: it is a FIFO (named "
+        "pipe), not a regular file"
+    )
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        ("1e300", "--c must lie between 1e-08 and 1e+08 (R = I/c^2 within the range of double "
+         "precision of Q = I), got 1e+300"),
+        ("1e-300", "--c must lie between 1e-08 and 1e+08 (R = I/c^2 within the range of double "
+         "precision of Q = I), got 1e-300"),
+        ("inf", "--c must be a positive number, got inf"),
+        ("0", "--c must be a positive number, got 0"),
+        ("-0", "--c must be a positive number, got -0"),
+        ("1e400", "--c must be a positive number, got inf"),
+    ],
+)  # fmt: skip
+def test_lqr_weights_out_of_range_are_usage_errors(
+    capsys: pytest.CaptureFixture[str], value: str, message: str
+) -> None:
+    status, out, err = _run(capsys, "lqr", "--c", value)
+    assert (status, out) == (2, "")
+    assert _one_line(err) == f"aerocontrol: error: {message} (see aerocontrol --help)"
+
+
+def test_lqr_weights_at_the_ends_of_the_range_are_solved(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    for value in ("1e-8", "1e8"):
+        status, out, err = _run(capsys, "lqr", "--c", value)
+        assert status == 0 and err == "" and "Riccati relative residual" in out
+
+
+def test_an_unsolvable_regulator_is_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A directionally unstable 747 (Cn_beta < 0) with no lateral controls: no stabilising
+    Riccati solution exists, whatever c."""
+    shipped = aerocontrol.aircraft.model.resources.files("aerocontrol.aircraft.data")
+    text = shipped.joinpath("b747-approach.toml").read_text(encoding="utf-8")
+    text = text.replace("Cn_beta = 0.15", "Cn_beta = -0.15")
+    for key in ("Cy_dr = 0.175", "Cl_dr = 0.007", "Cn_dr = -0.109", "Cl_da = 0.0461",
+                "Cn_da = 0.0064"):  # fmt: skip
+        assert key in text
+        text = text.replace(key, key.split(" = ")[0] + " = 0.0")
+    path = tmp_path / "uncontrolled.toml"
+    path.write_text(text)
+    status, out, err = _run(capsys, "lqr", str(path))
+    assert (status, out) == (1, "")
+    lateral = aerocontrol.aircraft.load(path).lateral()
+    with pytest.raises(aerocontrol.AerocontrolLinAlgError) as caught:  # what the core says
+        aerocontrol.solve_care(lateral.A, lateral.B, np.eye(4), np.eye(2))
+    assert _one_line(err) == f"aerocontrol: error: {caught.value}"
+
+
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_debug_prints_the_traceback_instead(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, where: str
+) -> None:
+    path, message = _hostile(tmp_path, "speed")
+    argv = ["--debug", "modes", str(path)] if where == "before" else ["modes", str(path), "--debug"]
+    status, out, err = _run(capsys, *argv)
+    assert (status, out) == (1, "")
+    assert err.startswith("Traceback (most recent call last):\n")
+    assert err.endswith(f"aerocontrol.aircraft.schema.AircraftDataError: {message}\n")
+    assert "aerocontrol: error" not in err
+
+
+@pytest.mark.parametrize(
+    ("error", "line"),
+    [
+        (ZeroDivisionError("division by zero"), "unexpected error (ZeroDivisionError: division "
+         "by zero); run 'aerocontrol --debug ...' for the traceback"),
+        (RecursionError("maximum recursion depth exceeded"), "unexpected error (RecursionError: "
+         "maximum recursion depth exceeded); run 'aerocontrol --debug ...' for the traceback"),
+        (MemoryError(), "out of memory (no detail)"),
+        (MemoryError("Unable to allocate 149. GiB"), "out of memory (Unable to allocate 149. GiB)"),
+        (KeyError("x\ny"), "unexpected error (KeyError: 'x\\ny'); run 'aerocontrol --debug ...' "
+         "for the traceback"),
+        (aerocontrol.ConvergenceError("no convergence\nafter 30 steps"), "no convergence\\nafter "
+         "30 steps"),
+        (PermissionError(13, "Permission denied", "x"), "[Errno 13] Permission denied: 'x'"),
+    ],
+)  # fmt: skip
+def test_any_exception_is_one_line_and_status_1(
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    error: BaseException,
+    line: str,
+) -> None:
+    def fail(arguments: object) -> int:
+        raise error
+
+    for command in ("aircraft", "modes", "lqr", "report"):
+        monkeypatch.setitem(cli._COMMANDS, command, fail)
+        status, out, err = _run(capsys, command)
+        assert (status, out) == (1, "")
+        assert _one_line(err) == f"aerocontrol: error: {line}"
+    status, _, err = _run(capsys, "--debug", "aircraft")
+    assert status == 1 and err.startswith("Traceback (most recent call last):")
+
+
+def test_ctrl_c_is_one_line_and_status_130(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def interrupted(arguments: object) -> int:
+        raise KeyboardInterrupt
+
+    monkeypatch.setitem(cli._COMMANDS, "modes", interrupted)
+    status, out, err = _run(capsys, "modes")
+    assert (status, out, err) == (130, "", "aerocontrol: interrupted\n")
+
+
+def test_warnings_are_one_line(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def warns(arguments: object) -> int:
+        warnings.warn(
+            "ill-conditioned\nrcond 1e-17", aerocontrol.IllConditionedWarning, stacklevel=1
+        )
+        return 0
+
+    monkeypatch.setitem(cli._COMMANDS, "modes", warns)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        status, out, err = _run(capsys, "modes")
+    assert (status, out) == (0, "")
+    assert err == "aerocontrol: warning: ill-conditioned\\nrcond 1e-17\n"
+
+
+def test_a_refused_report_folder_is_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "report.md").write_text("my notes")
+    status, stdout, err = _run(capsys, "report", "--out", str(out))
+    assert (status, stdout) == (1, "")
+    assert _one_line(err) == (
+        f"aerocontrol: error: cannot write the report into {str(out)!r}: it is not empty and "
+        "holds no earlier report (no .aerocontrol-report.json); choose a new or empty folder, or "
+        "add --force to write the report beside its files (none of them is replaced)"
+    )
+    status, stdout, err = _run(capsys, "report", "--out", str(out), "--force")
+    assert (status, stdout) == (1, "")
+    assert _one_line(err).endswith("report.md is a file the report did not write; it is not "
+                                   "replaced: move it away or choose another --out")  # fmt: skip
+    assert [p.name for p in out.iterdir()] == ["report.md"]
+    assert (out / "report.md").read_text() == "my notes"
+
+
+def test_the_help_documents_the_folder_rules(capsys: pytest.CaptureFixture[str]) -> None:
+    status, out, _ = _run(capsys, "report", "--help")
+    assert status == 0
+    flat = " ".join(out.split())
+    for promise in (
+        "never deletes, renames or overwrites a file it did not write",
+        "a new or empty DIR is used",
+        "running the same command again just works",
+        "files the manifest does not list (your notes, your images in figures/) are never touched",
+        "a DIR that is not empty and holds no manifest is refused, unless --force",
+        "symbolic links inside DIR are never written through",
+        "on an error, Ctrl-C or SIGTERM the run is undone",
+        "--force also write into a non-empty folder",
+    ):
+        assert promise in flat, promise

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import matplotlib
 
@@ -133,3 +134,85 @@ def test_envelope_rejects_bad_grids() -> None:
         aircraft.envelope_sweep(B747, machs=[])
     with pytest.raises(aerocontrol.InvalidArgumentError, match="plane must be an Aircraft"):
         aircraft.envelope_sweep("b747-approach")  # type: ignore[arg-type]
+
+
+def test_nonsense_conditions_are_failures_and_the_sweep_goes_on() -> None:
+    """machs=[1e300] once stopped the whole sweep with an OverflowError; now each such
+    condition is a failure with its reason, and the others are assessed."""
+    env = aircraft.envelope_sweep(
+        B747, altitudes=[0.0, 1e300], machs=[B747.mach, 1e300, 1e-300], weights=[WEIGHT, 1e300]
+    )
+    assert env.shape == (2, 3, 2)
+    # The file's own condition is assessed as alone: Dutch roll Level 2.
+    assert env.levels["dutch roll"][0, 0, 0] == 2 and (0, 0, 0) not in env.failures
+    assert env.failures[(0, 1, 0)] == "mach = 1e+300 is outside the plausible range 0.001 to 12"
+    assert env.failures[(0, 2, 0)] == "mach = 1e-300 is outside the plausible range 0.001 to 12"
+    assert env.failures[(0, 0, 1)] == (
+        "weight = 1e+300 lbf is outside the plausible range 0.1 to 4.5e+06 lbf"
+    )
+    assert env.failures[(1, 0, 0)] == (
+        "altitude = 1e+300 ft is outside the plausible range -16400 to 282000 ft"
+    )
+    assert set(env.failures) == set(np.ndindex(env.shape)) - {(0, 0, 0)}
+    assert all(env.worst[index] == 0 for index in env.failures)
+
+
+@pytest.mark.parametrize(
+    ("failure", "reason"),
+    [
+        (lambda plane: 1e300**2, r"OverflowError: \(34, 'Numerical result out of range'\)"),
+        (lambda plane: np.float64(1.0) / np.float64(0.0), "FloatingPointError: divide by zero.*"),
+        (lambda plane: math.sqrt(-1.0), "ValueError: math domain error"),
+        (lambda plane: 1 / 0, "ZeroDivisionError: division by zero"),
+        (
+            lambda plane: dataclasses.replace(plane, speed=plane.speed * 1e200),
+            r"OverflowError: \(34, 'Numerical result out of range'\)",
+        ),
+        (lambda plane: dataclasses.replace(plane, Ix=0.0), "ZeroDivisionError: float division.*"),
+        (
+            lambda plane: dataclasses.replace(plane, Iy=1e-320),
+            r"A must be finite, but A\[2, \d\] is (NaN|-?inf)",
+        ),
+        (lambda plane: np.linalg.inv(np.zeros((2, 2))), "LinAlgError: Singular matrix"),
+    ],
+    ids=[
+        "overflow",
+        "floating-point",
+        "domain",
+        "zero-division",
+        "speed",
+        "no-inertia",
+        "core",
+        "linalg",
+    ],
+)
+def test_an_arithmetic_or_numerical_failure_of_one_condition_is_recorded(
+    failure: object, reason: str
+) -> None:
+    def derivatives(plane: aircraft.Aircraft) -> aircraft.Aircraft:
+        if plane.mach > 0.3:
+            with np.errstate(all="raise"):
+                return failure(plane)  # type: ignore[operator, no-any-return]
+        return plane
+
+    env = aircraft.envelope_sweep(B747, machs=[B747.mach, 0.4], derivatives=derivatives)
+    assert (0, 0, 0) not in env.failures and env.worst[0, 0, 0] == 2
+    assert list(env.failures) == [(0, 1, 0)]
+    assert re.fullmatch(reason, env.failures[(0, 1, 0)]), env.failures
+
+
+def test_what_is_wrong_with_the_call_as_a_whole_raises() -> None:
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="machs must be finite"):
+        aircraft.envelope_sweep(B747, machs=[0.2, math.nan])
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="altitudes must be finite"):
+        aircraft.envelope_sweep(B747, altitudes=[math.inf])
+    with pytest.raises(
+        aerocontrol.InvalidArgumentError, match="derivatives must return an Aircraft, got NoneType"
+    ):
+        aircraft.envelope_sweep(B747, derivatives=lambda plane: None)  # type: ignore[arg-type, return-value]
+
+    def buggy(plane: aircraft.Aircraft) -> aircraft.Aircraft:
+        return plane.derivatives["no such key"]  # type: ignore[return-value]
+
+    with pytest.raises(KeyError, match="no such key"):  # a bug in the callback is not hidden
+        aircraft.envelope_sweep(B747, derivatives=buggy)

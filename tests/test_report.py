@@ -59,7 +59,12 @@ def test_the_folder_has_the_report_and_every_figure(written: tuple[Path, list[st
     path, _ = written
     folder = path.parent
     assert path.name == "report.html"
-    assert sorted(p.name for p in folder.iterdir()) == ["figures", "report.html", "report.md"]
+    assert sorted(p.name for p in folder.iterdir()) == [
+        ".aerocontrol-report.json",
+        "figures",
+        "report.html",
+        "report.md",
+    ]
     assert {p.name for p in (folder / "figures").iterdir()} == FIGURES | EXAMPLES
     for figure in (folder / "figures").iterdir():
         assert figure.read_bytes().startswith(PNG_SIGNATURE)
@@ -220,22 +225,29 @@ def test_rendering_escapes_html_and_markdown(
     assert "| 1 | x\\|y |" in (tmp_path / "tiny" / "report.md").read_text(encoding="utf-8")
 
 
-def test_rewriting_a_folder_replaces_the_report(
+def test_rewriting_a_folder_keeps_the_users_files(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
+    """Files the report did not write are never removed (see test_report_folder.py for the
+    rules): with --force into a folder of the user's, then again into it as an earlier report."""
     monkeypatch.setattr(report_module, "build_report", _tiny)
     out = tmp_path / "out"
     (out / "figures").mkdir(parents=True)
     (out / "figures" / "stale.png").write_bytes(b"old")
     (out / "notes.txt").write_text("mine")
+    with pytest.raises(aerocontrol.OutputFolderError, match="it is not empty and holds no"):
+        write_report(out=out)
+    write_report(out=out, force=True)
     write_report(out=out)
     assert sorted(p.name for p in out.iterdir()) == [
+        ".aerocontrol-report.json",
         "figures",
         "notes.txt",
         "report.html",
         "report.md",
     ]
-    assert [p.name for p in (out / "figures").iterdir()] == ["one.png"]
+    assert sorted(p.name for p in (out / "figures").iterdir()) == ["one.png", "stale.png"]
+    assert (out / "figures" / "stale.png").read_bytes() == b"old"
 
 
 @pytest.mark.parametrize("existing", [False, True])
@@ -251,7 +263,7 @@ def test_a_failure_leaves_nothing_half_written(
         out.mkdir()
         (out / "notes.txt").write_text("mine")
     with pytest.raises(aerocontrol.ConvergenceError, match="the regulator failed"):
-        write_report(out=out)
+        write_report(out=out, force=True)
     if existing:
         assert [p.name for p in out.iterdir()] == ["notes.txt"]
     else:
@@ -263,3 +275,56 @@ def test_an_unwritable_folder_is_one_clear_error(tmp_path: Path) -> None:
     blocker.write_text("not a folder")
     with pytest.raises(OSError, match=r"cannot write the report into '.*file/out'"):
         write_report(out=blocker / "out")
+
+
+def test_a_figure_that_cannot_be_drawn_is_replaced_and_the_report_goes_on(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """matplotlib refuses data no axis can hold (the responses of an aircraft whose numbers
+    are each plausible but together absurd): that figure says so, the rest is written."""
+    from matplotlib.figure import Figure
+
+    class Undrawable(Figure):  # type: ignore[misc]
+        def savefig(self, *args: object, **kwargs: object) -> None:
+            raise ValueError("arange: cannot compute length")
+
+    def build(*args: object, **kwargs: object) -> Report:
+        built = _tiny()
+        built.figure("broken", "a figure that cannot be drawn", Undrawable(figsize=(1, 1)))
+        return built
+
+    monkeypatch.setattr(report_module, "build_report", build)
+    lines: list[str] = []
+    path = write_report(out=tmp_path / "out", progress=lines.append)
+    assert lines == [
+        "writing 2 figures and the report",
+        "figure broken.png could not be drawn (ValueError: arange: cannot compute length)",
+    ]
+    broken = (tmp_path / "out" / "figures" / "broken.png").read_bytes()
+    assert broken.startswith(PNG_SIGNATURE)
+    assert path.read_text(encoding="utf-8").count('src="data:image/png;base64,') == 2
+
+
+def test_the_response_grid_is_bounded_for_an_extreme_aircraft(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """A 747 file weighing 0.1 lbf (every number in range) has a short time scale of 0.1 ms over
+    a 5,000 s phugoid scale: 400 samples per short scale would be 2e10 samples (a MemoryError
+    once); the grid is capped at 200,001."""
+    text = (Path(aerocontrol.aircraft.__file__).parent / "data" / "b747-approach.toml").read_text()
+    path = tmp_path / "feather.toml"
+    path.write_text(text.replace("weight = 564032.0", "weight = 0.1"))
+    sizes: list[int] = []
+    real = report_module.impulse_response
+
+    def recording(sys: object, T: np.ndarray, **kwargs: object) -> object:
+        sizes.append(len(T))
+        return real(sys, T=T, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(report_module, "impulse_response", recording)
+    lines: list[str] = []
+    built = build_report(str(path), progress=lines.append)
+    assert sizes == [200_001]
+    assert lines[3].startswith("responses: elevator impulse and step over 0.0001 s and 5000 s")
+    for _, figure in built.figures:
+        figure.clear()

@@ -3,24 +3,38 @@
 =====================================  ======================================================
 ``aerocontrol``                        the report on the embedded 747 into ./aerocontrol-report
 ``aerocontrol report [AIRCRAFT]``      the report on a shipped aircraft or a TOML file
-``--out DIR``                          (default ./aerocontrol-report)
+``--out DIR [--force]``                (default ./aerocontrol-report; see ``report --help``)
 ``aerocontrol aircraft``               the shipped aircraft
 ``aerocontrol modes AIRCRAFT``         the modes and their MIL-F-8785C Levels
 ``aerocontrol lqr AIRCRAFT --c 1.0``   the lateral (or ``--axis longitudinal``) regulator
+``aerocontrol --debug COMMAND ...``    a traceback instead of the one-line error
 =====================================  ======================================================
 
-A bad argument, an unknown aircraft, a file that does not validate or an output folder that
-cannot be written gives one line on standard error and exit status 2 (usage) or 1 (the
-rest), never a traceback; a report that fails is not left half-written.
+Every error, whatever its kind, is one line on standard error, ``aerocontrol: error: ...``,
+and exit status 2 for a usage error (a bad option or option value) or 1 for the rest (an
+unknown aircraft, a file that cannot be read or does not validate, an output folder that
+cannot be used, a problem the mathematics cannot solve, and any unexpected error, which says
+so); ``--debug`` prints the traceback instead. Ctrl-C (SIGINT) ends the command with
+``aerocontrol: interrupted`` and status 130, SIGTERM and SIGHUP with ``aerocontrol:
+terminated`` and 128 + the signal number; a report in progress is undone first. Warnings are
+one line each, ``aerocontrol: warning: ...``.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
+import re
+import signal
 import sys
-from collections.abc import Sequence
-from typing import NoReturn
+import threading
+import traceback
+import warnings
+from collections.abc import Iterator, Sequence
+from types import FrameType
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -33,6 +47,29 @@ from .riccati import solve_care
 
 DEFAULT_AIRCRAFT = "b747-approach"
 DEFAULT_OUT = "aerocontrol-report"
+#: The weights c that ``lqr --c`` accepts: R = I/c^2 then lies within 1e-16 to 1e16 of Q = I,
+#: the range of double precision; beyond it the regulator has no meaning in floating point.
+C_RANGE = (1e-8, 1e8)
+
+REPORT_DESCRIPTION = """\
+The models, modes and handling-quality Levels, responses, the Dutch-roll damper, the lateral
+regulator with its root locus and critical c, and the Levels after augmentation, written into
+DIR as report.html (self-contained), report.md and figures/*.png, with the manifest
+.aerocontrol-report.json listing each of these files with its size and SHA-256.
+
+The report never deletes, renames or overwrites a file it did not write:
+  - a new or empty DIR is used (missing parent folders are created);
+  - a DIR holding an earlier report (its manifest) is replaced if every file the manifest
+    lists is unchanged or deleted, so running the same command again just works; files the
+    manifest does not list (your notes, your images in figures/) are never touched, and a
+    listed file you changed stops the run with its name (move it away first);
+  - a DIR that is not empty and holds no manifest is refused, unless --force: then the
+    report is written beside the files there, and a file in its way (your own report.md)
+    stops the run with its name;
+  - symbolic links inside DIR are never written through (DIR itself may be one);
+  - on an error, Ctrl-C or SIGTERM the run is undone: nothing half-written, the earlier
+    report as it was, no staging folder, no folders left that the run created.
+"""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -49,6 +86,11 @@ def _parser() -> argparse.ArgumentParser:
         "the course chapter's analyses on the embedded Boeing 747 into ./aerocontrol-report.",
     )
     parser.add_argument("--version", action="version", version=f"aerocontrol {__version__}")
+    debug_help = "on an error, print the traceback instead of the one-line message"
+    parser.add_argument("--debug", action="store_true", help=debug_help)
+    # --debug also after the command; SUPPRESS keeps the top level's value when it is absent.
+    common = _Parser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=debug_help)
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     aircraft_help = (
         f"a shipped aircraft (see 'aerocontrol aircraft') or a TOML file; "
@@ -57,24 +99,35 @@ def _parser() -> argparse.ArgumentParser:
 
     report = commands.add_parser(
         "report",
+        parents=[common],
         help="write the report of the chapter's analyses (HTML, Markdown, PNG figures)",
-        description="The models, modes and handling-quality Levels, responses, the Dutch-roll "
-        "damper, the lateral regulator with its root locus and critical c, and the Levels "
-        "after augmentation, written as report.html, report.md and figures/*.png.",
+        description=REPORT_DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     report.add_argument("aircraft", nargs="?", default=DEFAULT_AIRCRAFT, help=aircraft_help)
     report.add_argument(
-        "--out", default=DEFAULT_OUT, metavar="DIR", help=f"output folder (default {DEFAULT_OUT})"
+        "--out",
+        default=DEFAULT_OUT,
+        metavar="DIR",
+        help=f"output folder (default {DEFAULT_OUT}); run again to replace its report",
+    )
+    report.add_argument(
+        "--force",
+        action="store_true",
+        help="also write into a non-empty folder that holds no earlier report, beside its "
+        "files (none of them is ever replaced)",
     )
 
     commands.add_parser(
         "aircraft",
+        parents=[common],
         help="list the shipped aircraft",
         description="The shipped aircraft: identifier and description.",
     )
 
     modes_command = commands.add_parser(
         "modes",
+        parents=[common],
         help="the modes of an aircraft and their MIL-F-8785C Levels",
         description="The longitudinal and lateral-directional modes and their Levels.",
     )
@@ -82,13 +135,17 @@ def _parser() -> argparse.ArgumentParser:
 
     lqr = commands.add_parser(
         "lqr",
+        parents=[common],
         help="the optimal regulator of an aircraft for a weight c",
         description="LQR with Q = I and R = I/c^2 (the chapter's (6.224)-(6.227)): the gain, "
         "the closed-loop modes, the Riccati residual and the Levels.",
     )
     lqr.add_argument("aircraft", nargs="?", default=DEFAULT_AIRCRAFT, help=aircraft_help)
     lqr.add_argument(
-        "--c", type=float, default=1.0, help="control weight c > 0 (default 1.0): R = I/c^2"
+        "--c",
+        type=float,
+        default=1.0,
+        help=f"control weight c, from {C_RANGE[0]:g} to {C_RANGE[1]:g} (default 1.0): R = I/c^2",
     )
     lqr.add_argument(
         "--axis",
@@ -102,7 +159,7 @@ def _parser() -> argparse.ArgumentParser:
 def _report(arguments: argparse.Namespace) -> int:
     from .report import write_report
 
-    path = write_report(arguments.aircraft, arguments.out, progress=print)
+    path = write_report(arguments.aircraft, arguments.out, progress=print, force=arguments.force)
     print(f"report: {path}")
     return 0
 
@@ -139,9 +196,14 @@ def _lqr(arguments: argparse.Namespace) -> int:
     c = arguments.c
     if not (math.isfinite(c) and c > 0):
         raise _UsageError(f"--c must be a positive number, got {c:g}")
+    if not C_RANGE[0] <= c <= C_RANGE[1]:
+        raise _UsageError(
+            f"--c must lie between {C_RANGE[0]:g} and {C_RANGE[1]:g} (R = I/c^2 within the "
+            f"range of double precision of Q = I), got {c:g}"
+        )
     plane = load(arguments.aircraft)
     sys_ = plane.lateral() if arguments.axis == "lateral" else plane.longitudinal()
-    R = np.eye(sys_.n_inputs) / c**2
+    R = np.eye(sys_.n_inputs) / (c * c)
     solution = solve_care(sys_.A, sys_.B, np.eye(sys_.n_states), R)
     print(plane.summary())
     print(f"\n{arguments.axis} regulator: Q = I, R = I/c^2 with c = {c:g} (6.224)-(6.227)")
@@ -164,23 +226,115 @@ class _UsageError(Exception):
     """A bad option value found after parsing: reported like argparse's own errors."""
 
 
+class _Terminated(BaseException):
+    """SIGTERM or SIGHUP arrived: raised in the main thread so that work in progress (a report
+    being written) is undone before the command ends."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
 _COMMANDS = {"report": _report, "aircraft": _aircraft, "modes": _modes, "lqr": _lqr}
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u200e\u200f\u2028-\u202e\u2066-\u2069]")
+
+
+def _one_line(text: str) -> str:
+    """``text`` on one line: control characters (a newline in a file name, say) escaped."""
+    return _CONTROL.sub(lambda match: repr(match.group())[1:-1], text.strip())
+
+
+def _message(error: BaseException) -> str:
+    """The one-line message of an error: its own text for the errors aerocontrol expects
+    (its exceptions, the operating system's), the type and a pointer to --debug for the rest."""
+    text = _one_line(str(error))
+    if isinstance(error, (AerocontrolError, OSError, Warning)) and text:
+        return text
+    if isinstance(error, MemoryError):
+        return f"out of memory ({text or 'no detail'})"
+    kind = type(error).__name__
+    detail = f"{kind}: {text}" if text else kind
+    return f"unexpected error ({detail}); run 'aerocontrol --debug ...' for the traceback"
+
+
+def _on_signal(signum: int, frame: FrameType | None) -> None:
+    raise _Terminated(signum)
+
+
+@contextlib.contextmanager
+def _termination_raises() -> Iterator[None]:
+    """SIGTERM and SIGHUP raise _Terminated while the command runs (main thread only, and
+    only where the signal still has its default action: an ignored SIGHUP stays ignored)."""
+    installed: dict[int, Any] = {}
+    if threading.current_thread() is threading.main_thread():
+        for name in ("SIGTERM", "SIGHUP"):
+            number = getattr(signal, name, None)
+            if number is not None and signal.getsignal(number) == signal.SIG_DFL:
+                installed[number] = signal.signal(number, _on_signal)
+    try:
+        yield
+    finally:
+        for number, previous in installed.items():
+            signal.signal(number, previous)
+
+
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    print(f"aerocontrol: warning: {_one_line(str(message))}", file=sys.stderr)
+
+
+def _error(text: str) -> None:
+    with contextlib.suppress(OSError, ValueError):
+        print(f"aerocontrol: {text}", file=sys.stderr)
+        sys.stderr.flush()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``aerocontrol`` command; returns the exit status."""
-    parser = _parser()
-    arguments = parser.parse_args(argv)
-    if arguments.command is None:
-        arguments = parser.parse_args(["report"])
+    """Entry point of the ``aerocontrol`` command; returns the exit status.
+
+    Every exception ends in one line on standard error and a non-zero status (2 for usage
+    errors, 1 for the rest, 130 for Ctrl-C, 128 + n for signal n); with ``--debug``, the
+    traceback is printed instead of the line.
+    """
+    debug = False
     try:
-        return _COMMANDS[arguments.command](arguments)
-    except _UsageError as error:
-        print(f"aerocontrol: error: {error} (see aerocontrol --help)", file=sys.stderr)
-        return 2
-    except (AerocontrolError, OSError) as error:
-        print(f"aerocontrol: error: {error}", file=sys.stderr)
+        with _termination_raises(), warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            parser = _parser()
+            arguments = parser.parse_args(argv)
+            debug = arguments.debug
+            if arguments.command is None:
+                arguments = parser.parse_args(["report"])
+                arguments.debug = debug
+            return _COMMANDS[arguments.command](arguments)
+    except SystemExit:
+        raise  # argparse: --help, --version and usage errors (status 2, one line)
+    except BaseException as error:
+        if debug:
+            traceback.print_exc()
+        if isinstance(error, _UsageError):
+            if not debug:
+                _error(f"error: {_one_line(str(error))} (see aerocontrol --help)")
+            return 2
+        if isinstance(error, KeyboardInterrupt):
+            _error("interrupted")
+            return 130
+        if isinstance(error, _Terminated):
+            _error("terminated")
+            return 128 + error.signum
+        if isinstance(error, BrokenPipeError):
+            # The reader of standard output went away (``aerocontrol aircraft | head -1``):
+            # nothing more to say to it; keep Python from complaining at exit.
+            with contextlib.suppress(OSError, ValueError):
+                devnull = os.open(os.devnull, os.O_WRONLY)
+                os.dup2(devnull, sys.stdout.fileno())
+            return 1
+        if not debug:
+            _error(f"error: {_message(error)}")
         return 1
-    except KeyboardInterrupt:
-        print("aerocontrol: interrupted", file=sys.stderr)
-        return 130

@@ -42,6 +42,7 @@ __all__ = [
     "NotPositiveDefiniteError",
     "NotRealError",
     "NumericalOverflowWarning",
+    "OutputFolderError",
     "ShapeError",
     "SingularMatrixError",
     "UncontrollableError",
@@ -116,3 +117,10 @@ class IllConditionedWarning(AerocontrolWarning, RuntimeWarning):
 
 class NumericalOverflowWarning(AerocontrolWarning, RuntimeWarning):
     """A result overflowed double precision and contains infinite (or NaN) entries."""
+
+
+class OutputFolderError(AerocontrolError, OSError):
+    """An output folder cannot be written without touching files the command did not write
+    (an ``OSError``): it is not empty and holds no earlier report, a file of the earlier
+    report was changed since, a file is in the way, or another run is writing into it. The
+    message is one line and names the folder or the file; nothing in the folder was changed."""

@@ -46,8 +46,6 @@ import base64
 import html
 import io
 import math
-import shutil
-import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -56,12 +54,13 @@ from typing import Any
 import numpy as np
 
 from . import chapter, handling, plotting
+from ._report_folder import ReportFolder, termination_exits
 from .aircraft.envelope import envelope_sweep
 from .aircraft.model import Aircraft, load
 from .aircraft.naming import DISPLAY_NAMES, classify_modes
 from .controllability import controllability, ctrb
 from .design import critical_weight, dutch_roll_damper, lqr_root_locus
-from .exceptions import AerocontrolError, InvalidArgumentError
+from .exceptions import AerocontrolError, InvalidArgumentError, OutputFolderError
 from .frequency import bode
 from .modal import Modes, charpoly, modes
 from .placement import Placement, place_bass_gura
@@ -81,6 +80,8 @@ DAMPER_SIDESLIP = math.radians(5.0)
 DAMPER_ZETA = 0.30
 
 ONE_DEGREE = math.pi / 180.0
+#: The most samples of a time response in the report.
+_MAX_SAMPLES = 200_001
 
 
 # --- The document -----------------------------------------------------------------------------
@@ -402,7 +403,10 @@ def _section_responses(ctx: _Context) -> str:
     report, sys = ctx.report, ctx.longitudinal
     report.heading("Responses")
     short, long = _time_scales(ctx)
-    grid = np.linspace(0.0, long, round(long / min(short / 400.0, 0.05)) + 1)
+    # 400 steps per short scale, at most 0.05 s, and at most _MAX_SAMPLES samples (an aircraft
+    # with a very fast short period over a long phugoid scale would need billions).
+    spacing = max(min(short / 400.0, 0.05), long / (_MAX_SAMPLES - 1))
+    grid = np.linspace(0.0, long, round(long / spacing) + 1)
     impulse = impulse_response(sys, T=grid)
     figure, axes = _new_figure(2)
     plotting.plot_time_scales(impulse, short, axes=axes[0])
@@ -1042,59 +1046,103 @@ def write_report(
     plane: Aircraft | str = "b747-approach",
     out: str | Path = "aerocontrol-report",
     progress: Callable[[str], None] | None = None,
+    force: bool = False,
 ) -> Path:
     """Build the report of an aircraft and write it into the folder ``out``: ``report.html``
-    (self-contained), ``report.md`` and ``figures/*.png``. Returns the path of
+    (self-contained), ``report.md``, ``figures/*.png`` and the manifest
+    ``.aerocontrol-report.json`` (each file with its size and SHA-256). Returns the path of
     ``report.html``.
 
-    Nothing is left half-written: the files are rendered into a temporary folder inside
-    ``out`` and moved into place only when all of them are done.
+    The report never deletes, renames or overwrites a file it did not write itself:
+
+    - a new or empty ``out`` is used (missing parent folders are created);
+    - an ``out`` holding an earlier report (its manifest) is replaced if every file the
+      manifest lists is unchanged or deleted: only those files are replaced or removed, and
+      files it does not list (your notes, your images in ``figures/``) are never touched;
+      a listed file changed since stops the run, named (it is yours now);
+    - an ``out`` that is not empty and holds no manifest is refused, unless ``force``: then
+      the report is written beside the files there, and a file in its way (your own
+      ``report.md``, say) stops the run, named;
+    - a symbolic link inside ``out`` (``report.md``, ``figures``) is never written through;
+      ``out`` itself may be a link to a folder;
+    - a manifest that is not one this function wrote (not JSON, entries other than the
+      report's own file names, such as ``../x`` or absolute paths) refuses the run.
+
+    The aircraft is loaded and the folder checked before anything is built, so a refusal is
+    immediate. The files are rendered into a staging folder inside ``out`` and moved into
+    place at the end, with SIGINT, SIGTERM and SIGHUP held back for those moves. On any
+    failure, and on KeyboardInterrupt or SIGTERM (in the main thread, while SIGTERM has its
+    default action, it raises SystemExit(143) for the duration of the call), the run undoes
+    exactly what it did: the staging folder, its files, the folders it created (if empty);
+    the earlier report's files, kept as backups until the end, are put back. Another run
+    writing into the same folder at the same time is refused.
+
+    Raises
+    ------
+    AircraftDataError
+        The aircraft cannot be loaded (nothing is written).
+    OutputFolderError
+        An ``OSError``: ``out`` cannot be used (not empty and no earlier report, a changed
+        or unlisted file in the way, a bad manifest, another run, not a folder, not
+        writable, out of space); one line naming the folder and the file.
 
     Examples
     --------
     ``write_report("navion", "navion-report")`` writes the Navion's report into
-    ./navion-report; ``aerocontrol report navion --out navion-report`` does the same.
+    ./navion-report; ``aerocontrol report navion --out navion-report`` does the same, and
+    running either again replaces that report.
     """
-    target = Path(out)
+    aircraft = plane if isinstance(plane, Aircraft) else load(plane)
     say = progress if progress is not None else (lambda line: None)
-    created = not target.exists()
-    try:
-        target.mkdir(parents=True, exist_ok=True)
-        staging = Path(tempfile.mkdtemp(prefix=".aerocontrol-", dir=target))
-    except OSError as error:
-        raise OSError(
-            f"cannot write the report into {str(target)!r}: {error.strerror or error}"
-        ) from None
-    try:
-        report = build_report(plane, say)
-        say(f"writing {len(report.figures)} figures and the report")
-        images = _render(report, staging / "figures")
-        (staging / "report.md").write_text(report.markdown(), encoding="utf-8")
-        (staging / "report.html").write_text(report.html(images), encoding="utf-8")
-        figures = target / "figures"
-        if figures.exists():
-            shutil.rmtree(figures)
-        (staging / "figures").replace(figures)
-        for name in ("report.md", "report.html"):
-            (staging / name).replace(target / name)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        if created:
-            shutil.rmtree(target, ignore_errors=True)
-        raise
-    shutil.rmtree(staging, ignore_errors=True)
-    return target / "report.html"
+    folder = ReportFolder(Path(out), force=force)
+    with termination_exits():
+        folder.prepare()
+        try:
+            report = build_report(aircraft, say)
+            earlier = " (replacing the earlier report)" if folder.replacing else ""
+            say(f"writing {len(report.figures)} figures and the report{earlier}")
+            folder.write(_render(report, say))
+        except BaseException as error:
+            problems = folder.rollback()
+            if problems and isinstance(error, Exception):
+                raise OutputFolderError(f"{error}; moreover {'; '.join(problems)}") from error
+            raise
+        finally:
+            folder.release()
+    return Path(out) / "report.html"
 
 
-def _render(report: Report, folder: Path) -> dict[str, bytes]:
-    folder.mkdir()
+def _render(report: Report, say: Callable[[str], None]) -> dict[str, bytes]:
+    """The report's files by name: ``figures/*.png``, ``report.md``, ``report.html``.
+
+    A figure that matplotlib cannot draw (the responses of an aircraft whose numbers are each
+    plausible but together absurd can overflow to values no axis can hold) is replaced by a
+    picture that says so, and the rest of the report goes on."""
     images = {}
     for name, figure in report.figures:
         buffer = io.BytesIO()
-        figure.savefig(buffer, format="png", dpi=100)
+        try:
+            figure.savefig(buffer, format="png", dpi=100)
+        except (ArithmeticError, ValueError, RuntimeError) as error:
+            reason = " ".join(f"{type(error).__name__}: {error}".split())
+            say(f"figure {name} could not be drawn ({reason})")
+            buffer = io.BytesIO()
+            _undrawable(name, reason).savefig(buffer, format="png", dpi=100)
         images[name] = buffer.getvalue()
-        (folder / name).write_bytes(images[name])
-    return images
+    files = {f"figures/{name}": data for name, data in images.items()}
+    files["report.md"] = report.markdown().encode("utf-8")
+    files["report.html"] = report.html(images).encode("utf-8")
+    return files
+
+
+def _undrawable(name: str, reason: str) -> Any:
+    """A small figure that says why the figure ``name`` could not be drawn."""
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(6.0, 1.5))
+    text = f"{name}: this figure could not be drawn\n({reason[:200]})"
+    figure.text(0.5, 0.5, text, ha="center", va="center", wrap=True, fontsize=9)
+    return figure
 
 
 def _version() -> str:

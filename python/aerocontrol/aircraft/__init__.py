@@ -20,6 +20,7 @@ from .envelope import Envelope, envelope_sweep
 from .model import (
     LATERAL_DERIVATIVES,
     LONGITUDINAL_DERIVATIVES,
+    PLAUSIBLE_RANGES,
     Aircraft,
     AircraftDataError,
     available,
@@ -27,14 +28,18 @@ from .model import (
     load,
 )
 from .naming import classify_modes, name_modes
+from .schema import AIRCRAFT_FILE_LIMIT, PlausibleRange
 
 __all__ = [
+    "AIRCRAFT_FILE_LIMIT",
     "LATERAL_DERIVATIVES",
     "LONGITUDINAL_DERIVATIVES",
+    "PLAUSIBLE_RANGES",
     "Aircraft",
     "AircraftDataError",
     "Atmosphere",
     "Envelope",
+    "PlausibleRange",
     "available",
     "body_to_stability",
     "classify_modes",

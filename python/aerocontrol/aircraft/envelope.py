@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from .. import handling
 from .._validation import real_array
-from ..exceptions import AerocontrolError, InvalidArgumentError, ShapeError
+from ..exceptions import AerocontrolError, AerocontrolWarning, InvalidArgumentError, ShapeError
 from ..modal import modes
 from .model import Aircraft
 from .naming import classify_modes
@@ -26,6 +26,19 @@ __all__ = ["Envelope", "envelope_sweep"]
 
 #: What a condition's Level is when it could not be assessed (see ``Envelope.failures``).
 NOT_ASSESSED = 0
+
+#: The exceptions that make one condition a failure of the sweep rather than of the call: a
+#: condition outside the plausible ranges or the standard atmosphere (ValueError), arithmetic
+#: that overflows (OverflowError, FloatingPointError, ZeroDivisionError), and a model the core
+#: cannot analyse (AerocontrolError, numpy's LinAlgError; an AerocontrolWarning where the
+#: caller has turned warnings into errors).
+CONDITION_FAILURES: tuple[type[BaseException], ...] = (
+    ArithmeticError,
+    ValueError,
+    np.linalg.LinAlgError,
+    AerocontrolError,
+    AerocontrolWarning,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,6 +103,19 @@ class Envelope:
         return ax
 
 
+class _NotAnAircraft(InvalidArgumentError):
+    """``derivatives`` returned something other than an Aircraft: wrong for every condition."""
+
+
+def _reason(error: BaseException) -> str:
+    """The reason of a failed condition, on one line; the exception's type where it has no
+    message of its own (an OverflowError from arithmetic)."""
+    text = " ".join(str(error).split())
+    if isinstance(error, AerocontrolError) and text:
+        return text
+    return f"{type(error).__name__}: {text}" if text else type(error).__name__
+
+
 def _grid(values: Any, name: str, default: float) -> NDArray[np.float64]:
     if values is None:
         return np.array([default])
@@ -113,8 +139,19 @@ def envelope_sweep(
 
     ``derivatives``, if given, receives each condition's aircraft (from :meth:`Aircraft.at`)
     and returns the aircraft to analyse there, e.g. with Mach-dependent derivatives put in
-    with ``dataclasses.replace``. A condition whose model cannot be built or whose modes
-    cannot be named is recorded in ``failures`` (Level 0) and the sweep goes on.
+    with ``dataclasses.replace``.
+
+    A condition that fails is recorded in ``failures`` with its reason (Level 0) and the
+    sweep goes on: a Mach number, altitude or weight outside its plausible range
+    (:data:`~aerocontrol.aircraft.PLAUSIBLE_RANGES`, e.g. ``machs=[1e300]``) or outside the
+    standard atmosphere, arithmetic that overflows, a model whose modes cannot be computed or
+    named, or any of these raised by ``derivatives`` (the exceptions of
+    :data:`CONDITION_FAILURES`). What is wrong with the call as a whole raises at once:
+    ``plane`` not an Aircraft, a grid that is not a non-empty 1-D array of real numbers or
+    holds NaN or an infinity (a grid point that is not a number is no flight condition),
+    ``derivatives`` returning something other than an Aircraft, and any other exception of
+    ``derivatives`` (a TypeError or KeyError is a bug in it, not a property of the
+    condition).
 
     Examples
     --------
@@ -141,14 +178,20 @@ def envelope_sweep(
             condition = plane.at(altitude_grid[i], mach_grid[j], weight_grid[k])
             if derivatives is not None:
                 condition = derivatives(condition)
+                if not isinstance(condition, Aircraft):
+                    raise _NotAnAircraft(
+                        f"derivatives must return an Aircraft, got {type(condition).__name__}"
+                    )
             named = {
                 **classify_modes(modes(condition.longitudinal().A), "longitudinal"),
                 **classify_modes(modes(condition.lateral().A), "lateral"),
             }
             assessable = {key: value for key, value in named.items() if key in levels}
             assessed = handling.assess(assessable, plane.aircraft_class, plane.category)
-        except AerocontrolError as error:
-            failures[index] = str(error)
+        except _NotAnAircraft:
+            raise
+        except CONDITION_FAILURES as error:
+            failures[index] = _reason(error)
             continue
         for mode, level in assessed.levels.items():
             levels[mode][index] = level

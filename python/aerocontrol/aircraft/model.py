@@ -43,7 +43,7 @@ Iz' = Ix sin²α0 + Iz cos²α0 + Ixz sin 2α0, Ixz' = (Ix - Iz)/2 sin 2α0 + Ix
 from __future__ import annotations
 
 import math
-import sys
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from importlib import resources
@@ -58,15 +58,20 @@ from ..modal import Modes, modes
 from ..statespace import StateSpace
 from .atmosphere import standard_atmosphere
 from .naming import name_modes
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+from .schema import (
+    PLAUSIBLE_RANGES,
+    AircraftDataError,
+    check_range,
+    decode_text,
+    parse_toml,
+    read_aircraft_file,
+    shown,
+)
 
 __all__ = [
     "LATERAL_DERIVATIVES",
     "LONGITUDINAL_DERIVATIVES",
+    "PLAUSIBLE_RANGES",
     "Aircraft",
     "AircraftDataError",
     "available",
@@ -147,12 +152,6 @@ LONGITUDINAL_STATES = ("u/u0", "alpha", "q", "theta")
 LATERAL_STATES = ("beta", "p", "phi", "r")
 
 
-class AircraftDataError(InvalidArgumentError):
-    """An aircraft file or table is malformed: an unknown or missing key, a value of the wrong
-    type or sign, or numbers inconsistent with the declared units. The message names the file
-    and the key."""
-
-
 @dataclass(frozen=True)
 class Aircraft:
     """An aircraft at one flight condition: geometry, mass, the flight condition and the
@@ -219,11 +218,14 @@ class Aircraft:
         reader = _Reader(data, origin)
         info = reader.table("aircraft", required=("name", "class", "category", "units"))
         units = reader.choice(info, "aircraft", "units", ("english", "si"))
+        reader.units = units
         aircraft_class = reader.choice(info, "aircraft", "class", (*_CLASSES, "II"))
         if aircraft_class == "II":
             aircraft_class = "II-L"
         category = reader.choice(info, "aircraft", "category", _CATEGORIES)
         reader.only(info, "aircraft", ("name", "description", "class", "category", "units"))
+        name = reader.text(info, "aircraft", "name", _NAME_LIMIT)
+        description = reader.text(info, "aircraft", "description", _DESCRIPTION_LIMIT, "")
 
         flight = reader.table("flight", required=("altitude",))
         reader.only(flight, "flight", _FLIGHT_KEYS)
@@ -239,7 +241,7 @@ class Aircraft:
             speed = mach * atmosphere.speed_of_sound
         density = atmosphere.density
         if "density" in flight:
-            density = reader.positive(flight, "flight", "density")
+            density = reader.number(flight, "flight", "density", positive=True, bounded=False)
             if not 0.5 <= density / atmosphere.density <= 2.0:
                 names = _UNIT_NAMES[units]
                 raise AircraftDataError(
@@ -247,9 +249,8 @@ class Aircraft:
                     f"at {altitude:g} {names['length']} (the standard atmosphere gives "
                     f"{atmosphere.density:.5g} {names['density']}): are the units {units!r}?"
                 )
+            reader.number(flight, "flight", "density")
         theta0 = math.radians(reader.number(flight, "flight", "theta0_deg", default=0.0))
-        if abs(theta0) >= math.pi / 2:
-            raise AircraftDataError(f"{origin}: [flight] theta0_deg must lie in (-90, 90) degrees")
         gravity = _GRAVITY[units]
 
         mass_table = reader.table("mass", required=("Ix", "Iy", "Iz", "Ixz", "axes"))
@@ -292,12 +293,17 @@ class Aircraft:
             derivatives.update({key: reader.number(table, table_name, key) for key in keys})
 
         published = reader.published()
-        sources = reader.table("sources", required=("default",)) if "sources" in data else {}
+        sources: dict[str, str] = {}
+        if "sources" in data:
+            table = reader.table("sources", required=("default",))
+            sources = {
+                str(key): reader.text(table, "sources", str(key), _SOURCE_LIMIT) for key in table
+            }
         reader.only_tables(_TABLES)
         return cls(
-            name=str(info["name"]),
+            name=name,
             identifier=Path(origin).stem,
-            description=str(info.get("description", "")),
+            description=description,
             aircraft_class=aircraft_class,
             category=category,
             units=units,
@@ -317,7 +323,7 @@ class Aircraft:
             b=b,
             derivatives=derivatives,
             published=published,
-            sources={str(k): str(v) for k, v in sources.items()},
+            sources=sources,
         )
 
     # ------------------------------------------------------------------------------------
@@ -399,6 +405,11 @@ class Aircraft:
         d = self.dimensional_longitudinal()
         u0, g, theta0 = self.speed, self.gravity, self.theta0
         surge = [d["Xu"], d["Xw"], 0.0, -g * math.cos(theta0) / u0]
+        if d["Zwdot"] == 1.0:  # (1 - Zẇ) dα/dt: the α equation would have no dα/dt
+            raise AircraftDataError(
+                f"{self.name}: the longitudinal model is singular: 1 - Zẇ = 0 with "
+                f"CL_alphadot = {self.derivatives['CL_alphadot']:g}"
+            )
         scale = 1.0 / (1.0 - d["Zwdot"])
         heave = [
             d["Zu"] * scale,
@@ -426,6 +437,10 @@ class Aircraft:
         u0, g, theta0 = self.speed, self.gravity, self.theta0
         ix, iz = d["ix"], d["iz"]
         coupling = 1.0 - ix * iz
+        if not coupling > 0.0:  # Ix Iz > Ixz^2, checked by the loader, lost to rounding
+            raise AircraftDataError(
+                f"{self.name}: the lateral model is singular: 1 - Ixz^2/(Ix Iz) = {coupling:g}"
+            )
         roll = [u0 * d["Lv"], d["Lp"], 0.0, d["Lr"]]
         yaw = [u0 * d["Nv"], d["Np"], 0.0, d["Nr"]]
         roll_control = [d["Ldr"], d["Lda"]]
@@ -490,6 +505,9 @@ class Aircraft:
         near the file's condition; away from it (other Mach regime, other configuration)
         give the derivatives of that condition in a file of its own.
 
+        Each given value must lie in its plausible range (:data:`PLAUSIBLE_RANGES`, the
+        file's units), else InvalidArgumentError (an :class:`AircraftDataError`).
+
         Parameters
         ----------
         altitude : float, optional
@@ -508,18 +526,27 @@ class Aircraft:
         1.4539
         """
         density, speed_of_sound = self.density, self.speed / self.mach
-        new_altitude = self.altitude if altitude is None else _finite(altitude, "altitude")
+        new_altitude = self.altitude
+        if altitude is not None:
+            new_altitude = check_range(_finite(altitude, "altitude"), "altitude", self.units)
         if new_altitude != self.altitude:
             atmosphere = standard_atmosphere(new_altitude, self.units)
             density, speed_of_sound = atmosphere.density, atmosphere.speed_of_sound
-        new_mach = self.mach if mach is None else _positive(mach, "mach")
-        mass = self.mass if weight is None else _positive(weight, "weight") / self.gravity
+        new_mach = self.mach if mach is None else check_range(_positive(mach, "mach"), "mach")
+        mass = self.mass
+        if weight is not None:
+            mass = check_range(_positive(weight, "weight"), "weight", self.units) / self.gravity
         speed = new_mach * speed_of_sound
         c = dict(self.derivatives)
         # CL ∝ W / q̄ at a fixed Θ0; scaling the file's CL reproduces the file at its own
         # condition exactly.
         lift = c["CL"] * (mass / self.mass) * (self.density * self.speed**2) / (density * speed**2)
-        k = max(c["CD_alpha"] / (2.0 * c["CL"] * c["CL_alpha"]), 0.0) if c["CL_alpha"] else 0.0
+        # (A file at CL = 0 has no polar through its point with that slope: CD is held.)
+        k = (
+            max(c["CD_alpha"] / (2.0 * c["CL"] * c["CL_alpha"]), 0.0)
+            if c["CL_alpha"] and c["CL"]
+            else 0.0
+        )
         drag_zero = c["CD"] - k * c["CL"] ** 2
         c["CL"], c["CD"] = lift, drag_zero + k * lift**2
         names = _UNIT_NAMES[self.units]
@@ -579,13 +606,33 @@ def body_to_stability(
     )
 
 
+_NAME_LIMIT = 200
+_DESCRIPTION_LIMIT = 2_000
+_SOURCE_LIMIT = 20_000
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u200e\u200f\u2028-\u202e\u2066-\u2069]")
+_PLAIN_KEY = re.compile(r"[A-Za-z0-9_\-]{1,40}")
+
+
+def _keys(keys: list[str]) -> str:
+    """Keys read from a file, for a message: plain ones as they are, others quoted and
+    shortened, at most five of them."""
+    named = [key if _PLAIN_KEY.fullmatch(key) else shown(key) for key in keys[:5]]
+    more = f" and {len(keys) - 5} more" if len(keys) > 5 else ""
+    return ", ".join(named) + more
+
+
 class _Reader:
-    """Typed access to the tables of an aircraft file, raising AircraftDataError by name."""
+    """Typed access to the tables of an aircraft file, raising AircraftDataError by name.
+
+    Every number is checked against its plausible range (:data:`PLAUSIBLE_RANGES`) in the
+    file's units, which :meth:`Aircraft.from_dict` sets in ``units`` once it has read them.
+    """
 
     def __init__(self, data: Mapping[str, Any], origin: str) -> None:
         if not isinstance(data, Mapping):
             raise AircraftDataError(f"{origin}: an aircraft must be a table of tables")
         self.data, self.origin = data, origin
+        self.units = "si"
 
     def table(self, name: str, required: tuple[str, ...]) -> Mapping[str, Any]:
         table = self.data.get(name)
@@ -605,7 +652,7 @@ class _Reader:
         unknown = [key for key in table if key not in allowed]
         if unknown:
             raise AircraftDataError(
-                f"{self.origin}: [{name}] has unknown key(s) {', '.join(unknown)}; "
+                f"{self.origin}: [{name}] has unknown key(s) {_keys(unknown)}; "
                 f"the keys are {', '.join(allowed)}"
             )
 
@@ -613,28 +660,51 @@ class _Reader:
         unknown = [key for key in self.data if key not in allowed]
         if unknown:
             raise AircraftDataError(
-                f"{self.origin}: unknown table(s) {', '.join(unknown)}; the tables are "
+                f"{self.origin}: unknown table(s) {_keys(unknown)}; the tables are "
                 f"{', '.join(allowed)}"
             )
 
     def number(
-        self, table: Mapping[str, Any], name: str, key: str, default: float | None = None
+        self,
+        table: Mapping[str, Any],
+        name: str,
+        key: str,
+        default: float | None = None,
+        positive: bool = False,
+        bounded: bool = True,
     ) -> float:
+        """The number ``table[key]``, a finite real within the key's plausible range (only
+        finite, and positive if asked, with ``bounded=False``)."""
+        if key not in table and default is not None:
+            return default
+        where = f"{self.origin}: [{name}] "
+        return check_range(table[key], key, self.units, where, positive, bounded)
+
+    def positive(self, table: Mapping[str, Any], name: str, key: str) -> float:
+        return self.number(table, name, key, positive=True)
+
+    def text(
+        self, table: Mapping[str, Any], name: str, key: str, limit: int, default: str | None = None
+    ) -> str:
+        """The string ``table[key]``: at most ``limit`` characters, none of them a control
+        character (so that it prints on one line)."""
         if key not in table and default is not None:
             return default
         value = table[key]
-        number = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if not number or not math.isfinite(value):
+        if not isinstance(value, str):
             raise AircraftDataError(
-                f"{self.origin}: [{name}] {key} must be a finite number, got {value!r}"
+                f"{self.origin}: [{name}] {key} must be a string, got {shown(value)}"
             )
-        return float(value)
-
-    def positive(self, table: Mapping[str, Any], name: str, key: str) -> float:
-        value = self.number(table, name, key)
-        if value <= 0.0:
+        if len(value) > limit:
             raise AircraftDataError(
-                f"{self.origin}: [{name}] {key} must be positive, got {value!r}"
+                f"{self.origin}: [{name}] {key} has {len(value):,} characters, more than the "
+                f"{limit:,} allowed"
+            )
+        control = _CONTROL.search(value)
+        if control:
+            raise AircraftDataError(
+                f"{self.origin}: [{name}] {key} contains the control character "
+                f"{control.group()!r} at position {control.start()}"
             )
         return value
 
@@ -642,10 +712,10 @@ class _Reader:
         self, table: Mapping[str, Any], name: str, key: str, choices: tuple[str, ...]
     ) -> str:
         value = table.get(key)
-        if value not in choices:
+        if not isinstance(value, str) or value not in choices:
             listed = ", ".join(repr(c) for c in choices)
             raise AircraftDataError(
-                f"{self.origin}: [{name}] {key} must be one of {listed}, got {value!r}"
+                f"{self.origin}: [{name}] {key} must be one of {listed}, got {shown(value)}"
             )
         return str(value)
 
@@ -655,7 +725,9 @@ class _Reader:
         negative, an unstable oscillation, but not zero)."""
         table = self.data.get("published", {})
         if not isinstance(table, Mapping):
-            raise AircraftDataError(f"{self.origin}: [published] must be a table, got {table!r}")
+            raise AircraftDataError(
+                f"{self.origin}: [published] must be a table, got {shown(table)}"
+            )
         published: dict[str, Any] = {}
         for mode, entry in table.items():
             if mode == "tolerance":
@@ -663,20 +735,20 @@ class _Reader:
                 continue
             if mode not in _PUBLISHED_MODES:
                 raise AircraftDataError(
-                    f"{self.origin}: [published] has unknown mode {mode!r}; the modes are "
+                    f"{self.origin}: [published] has unknown mode {shown(mode)}; the modes are "
                     f"{', '.join(_PUBLISHED_MODES)} (and the file-level tolerance)"
                 )
             name = f"published.{mode}"
             if not isinstance(entry, Mapping):
                 raise AircraftDataError(
                     f"{self.origin}: [{name}] must be a table of quantities such as "
-                    f"{{ {_PUBLISHED_MODES[mode][0]} = ... }}, got {entry!r}"
+                    f"{{ {_PUBLISHED_MODES[mode][0]} = ... }}, got {shown(entry)}"
                 )
             allowed = (*_PUBLISHED_MODES[mode], "tolerance")
             unknown = [key for key in entry if key not in allowed]
             if unknown:
                 raise AircraftDataError(
-                    f"{self.origin}: [{name}] has unknown quantity {', '.join(unknown)}; "
+                    f"{self.origin}: [{name}] has unknown quantity {_keys(unknown)}; "
                     f"the quantities of the {mode} are {', '.join(allowed)}"
                 )
             if not any(key != "tolerance" for key in entry):
@@ -719,8 +791,31 @@ def available() -> tuple[str, ...]:
 def load(name_or_path: str | Path = "b747-approach") -> Aircraft:
     """A shipped aircraft by identifier (see :func:`available`), or an aircraft file by path.
 
-    Raises AircraftDataError for an unknown identifier, a missing or unreadable file, malformed
-    TOML, or a table that does not validate; the message names the file and the key.
+    The file is read only if it is a regular file (a symbolic link only to a regular file: a
+    FIFO, a device, a socket or a folder is refused without being read) of at most
+    :data:`~aerocontrol.aircraft.schema.AIRCRAFT_FILE_LIMIT` bytes (1 MiB), in UTF-8, and
+    valid TOML. Every number must be a finite real within its plausible range
+    (:data:`PLAUSIBLE_RANGES`, in the file's units; the table is in
+    :mod:`aerocontrol.aircraft.schema`), for example
+
+    ==================  ========================  ==========================
+    key                 SI                        English
+    ==================  ========================  ==========================
+    speed               0.5 to 3,500 m/s          1.5 to 11,500 ft/s
+    mach                0.001 to 12
+    altitude            -5,000 to 86,000 m        -16,400 to 282,000 ft
+    weight              0.5 to 2e7 N              0.1 to 4.5e6 lbf
+    Ix, Iy, Iz          1e-6 to 1e10 kg m^2       1e-6 to 1e10 slug ft^2
+    S                   0.001 to 10,000 m^2       0.01 to 100,000 ft^2
+    CL_alpha, Cm_de     -100 to 100 per rad
+    Cm_q, Cl_p          -1,000 to 1,000 per rad
+    ==================  ========================  ==========================
+
+    Raises AircraftDataError (a ``ValueError``) for an unknown identifier, a missing,
+    unreadable, oversized or non-UTF-8 file, malformed TOML (including nesting too deep for
+    the parser and integers of thousands of digits), or a table that does not validate; the
+    message is one line and names the file and the key (and, for a number out of range, the
+    value and the range).
 
     Examples
     --------
@@ -730,26 +825,23 @@ def load(name_or_path: str | Path = "b747-approach") -> Aircraft:
     -1.0994
     """
     text, origin = _read(name_or_path)
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise AircraftDataError(f"{origin}: not valid TOML: {error}") from None
-    return Aircraft.from_dict(data, origin)
+    return Aircraft.from_dict(parse_toml(text, origin), origin)
 
 
 def _read(name_or_path: str | Path) -> tuple[str, str]:
     if isinstance(name_or_path, str) and name_or_path in available():
         resource = resources.files(_DATA).joinpath(f"{name_or_path}.toml")
-        return resource.read_text(encoding="utf-8"), f"{name_or_path}.toml"
+        origin = f"{name_or_path}.toml"
+        return decode_text(resource.read_bytes(), origin), origin
+    if not isinstance(name_or_path, (str, Path)):
+        raise AircraftDataError(
+            f"an aircraft is a shipped identifier or the path of a .toml file, got "
+            f"{shown(name_or_path)}"
+        )
     path = Path(name_or_path)
     if path.suffix != ".toml":
         raise AircraftDataError(
-            f"unknown aircraft {str(name_or_path)!r}: give a file ending in .toml or one of "
+            f"unknown aircraft {shown(str(name_or_path))}: give a file ending in .toml or one of "
             f"{', '.join(available())}"
         )
-    try:
-        return path.read_text(encoding="utf-8"), str(path)
-    except OSError as error:
-        raise AircraftDataError(
-            f"cannot read the aircraft file {str(path)!r}: {error.strerror}"
-        ) from None
+    return read_aircraft_file(path), str(path)
