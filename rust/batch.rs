@@ -95,7 +95,7 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
     if n == 0 {
         return Ok(());
     }
-    let context = ParallelContext::capture();
+    let context = ParallelContext::capture(n);
     out.par_chunks_mut(n * n)
         .enumerate()
         .try_for_each(|(index, chunk)| {
@@ -210,7 +210,8 @@ pub fn care_batch(
         refine,
         ..CareOptions::default()
     };
-    let context = ParallelContext::capture();
+    // The Hamiltonian is of order 2n.
+    let context = ParallelContext::capture(2 * n);
     let failure = out
         .x
         .par_chunks_mut(n * n)
@@ -294,7 +295,7 @@ pub fn place_batch(
     check_output_len(out.achieved.len(), count * n)?;
     check_output_len(out.max_relative_error.len(), count)?;
     check_output_len(out.condition.len(), count)?;
-    let context = ParallelContext::capture();
+    let context = ParallelContext::capture(n.max(m));
     let failure = out
         .gain
         .par_chunks_mut(m * n)

@@ -1036,7 +1036,7 @@ fn transition_matrices_with<M: ExpmMatrix>(
         plan.prepare(choice);
     }
     let plan = &plan;
-    let context = ParallelContext::capture();
+    let context = ParallelContext::capture(n);
     let evaluate = |((&t, &choice), chunk): ((&f64, &PadeChoice), &mut [f64])| {
         context.run(|| {
             plan.exponential_into(t, choice, MatMut::from_row_major_slice_mut(chunk, n, n));

@@ -236,7 +236,7 @@ pub fn frequency_response_into(
     if p * m == 0 {
         return Ok(());
     }
-    let Hessenberg { h, q } = hessenberg(a);
+    let Hessenberg { h, q } = hessenberg(a)?;
     let (qb, cq) = (q.transpose() * b, c * &q);
     let row_major = |x: &Mat<f64>| -> Vec<f64> {
         (0..x.nrows())
@@ -261,7 +261,8 @@ pub fn frequency_response_into(
         x_re: vec![0.0; n * m],
         x_im: vec![0.0; n * m],
     };
-    let context = ParallelContext::capture();
+    // The evaluations multiply by their own kernels, not faer's.
+    let context = ParallelContext::capture(0);
     omega
         .par_iter()
         .zip(out.par_chunks_mut(p * m))

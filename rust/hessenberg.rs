@@ -5,6 +5,8 @@
 //! (sI - A) = Q (sI - H) Q^T, and sI - H is Hessenberg. The reduction is backward stable:
 //! Q H Q^T = A + E with ||E|| = O(u ||A||).
 
+use crate::error::Error;
+use crate::platform::interrupt;
 use crate::pool::scratch;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::evd::hessenberg::{hessenberg_in_place, hessenberg_in_place_scratch};
@@ -13,7 +15,7 @@ use faer::linalg::householder::{
     apply_block_householder_sequence_on_the_right_in_place_with_conj,
 };
 use faer::linalg::qr::no_pivoting::factor::recommended_block_size;
-use faer::{Conj, Mat, MatMut, MatRef, Par};
+use faer::{Conj, Mat, MatMut, MatRef};
 
 /// The Hessenberg form of a square matrix: A = Q H Q^T.
 #[derive(Debug, Clone)]
@@ -25,30 +27,33 @@ pub struct Hessenberg {
 }
 
 /// The Hessenberg form of a square matrix (the caller checks that it is square and finite).
-pub fn hessenberg(a: MatRef<'_, f64>) -> Hessenberg {
+/// Between the reduction and the forming of Q (two long steps at large orders) it stops if the
+/// computation was interrupted.
+pub fn hessenberg(a: MatRef<'_, f64>) -> Result<Hessenberg, Error> {
     let n = a.nrows();
     let mut h = a.to_owned();
     let mut q = Mat::<f64>::identity(n, n);
-    reduce(h.as_mut(), Some(q.as_mut()));
-    Hessenberg { h, q }
+    reduce(h.as_mut(), Some(q.as_mut()))?;
+    Ok(Hessenberg { h, q })
 }
 
 /// H alone, when the transformation is not needed (eigenvalues).
 pub fn hessenberg_matrix(a: MatRef<'_, f64>) -> Mat<f64> {
     let mut h = a.to_owned();
-    reduce(h.as_mut(), None);
+    // Without Q there is one step only: nothing to interrupt between.
+    let _ = reduce(h.as_mut(), None);
     h
 }
 
 /// Reduces `h` to Hessenberg form in place and, if given, overwrites `q` (the identity on
 /// entry) with the transformation.
-fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) {
+fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) -> Result<(), Error> {
     let n = h.nrows();
     if n <= 2 {
         // Already Hessenberg.
-        return;
+        return Ok(());
     }
-    let par = Par::Seq;
+    let par = crate::expm::parallelism_for_order(n);
     let block_size = recommended_block_size::<f64>(n - 1, n - 1);
     let mut householder = scratch(block_size, n - 1);
     let requirement = StackReq::any_of(&[
@@ -69,6 +74,7 @@ fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) {
         Default::default(),
     );
     if let Some(q) = q {
+        interrupt::check()?;
         // The reflectors act on rows and columns 1..n; Q = diag(1, Q1).
         apply_block_householder_sequence_on_the_right_in_place_with_conj(
             h.as_ref().submatrix(1, 0, n - 1, n - 1),
@@ -84,6 +90,7 @@ fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) {
             h[(i, j)] = 0.0;
         }
     }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -94,7 +101,7 @@ mod tests {
     fn reconstructs_and_is_orthogonal() {
         for n in [1usize, 2, 3, 5, 12, 40] {
             let a = Mat::from_fn(n, n, |i, j| ((i * 7 + j * 13) % 17) as f64 / 8.0 - 1.0);
-            let Hessenberg { h, q } = hessenberg(a.as_ref());
+            let Hessenberg { h, q } = hessenberg(a.as_ref()).unwrap();
             for j in 0..n {
                 for i in j + 2..n {
                     assert_eq!(h[(i, j)], 0.0);

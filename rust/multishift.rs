@@ -168,7 +168,8 @@ pub(crate) fn multishift_qr(
         if window + 1 < order && h[(top, top - 1)].abs() > h[(top - 1, top - 2)].abs() {
             window += 1;
         }
-        let deflation = aggressive_early_deflation(h, z.as_deref_mut(), full, (ktop, kbot), window);
+        let deflation =
+            aggressive_early_deflation(h, z.as_deref_mut(), full, (ktop, kbot), window)?;
         end -= deflation.deflated;
         if deflation.deflated > 0 {
             stalls = 0;
@@ -283,7 +284,7 @@ fn aggressive_early_deflation(
     full: bool,
     (ktop, kbot): (usize, usize),
     window: usize,
-) -> EarlyDeflation {
+) -> Result<EarlyDeflation, Error> {
     let n = h.n();
     let top = kbot + 1 - window;
     debug_assert!(
@@ -296,10 +297,10 @@ fn aggressive_early_deflation(
     if schur_of_hessenberg(&mut t, Some(&mut v), true, Spectrum::General).is_err() {
         // The window's iteration failed: no deflation this time (H is untouched), and the
         // shifts come from elsewhere.
-        return EarlyDeflation {
+        return Ok(EarlyDeflation {
             deflated: 0,
             shifts: Vec::new(),
-        };
+        });
     }
     let (mut t, mut v) = (t.to_mat(), v.to_mat());
     clear_upper_avx_state();
@@ -353,7 +354,7 @@ fn aggressive_early_deflation(
     let deflated = window - kept;
     let shifts = quasi_triangular_eigenvalues(t.as_ref().submatrix(0, 0, kept, kept));
     if deflated == 0 {
-        return EarlyDeflation { deflated, shifts };
+        return Ok(EarlyDeflation { deflated, shifts });
     }
 
     // The spike of the undeflated part, s = spike V[0, ..kept], folded into its first entry.
@@ -385,7 +386,7 @@ fn aggressive_early_deflation(
             }
         }
         if kept > 2 {
-            let reduced = hessenberg(t.as_ref().submatrix(0, 0, kept, kept));
+            let reduced = hessenberg(t.as_ref().submatrix(0, 0, kept, kept))?;
             let right = reduced.q.transpose() * t.as_ref().submatrix(0, kept, kept, window - kept);
             t.as_mut()
                 .submatrix_mut(0, 0, kept, kept)
@@ -411,7 +412,7 @@ fn aggressive_early_deflation(
     let mut scratch = Vec::new();
     apply_outside_window(h, z, outside, (top, kbot), v.as_ref(), &mut scratch);
     clear_upper_avx_state();
-    EarlyDeflation { deflated, shifts }
+    Ok(EarlyDeflation { deflated, shifts })
 }
 
 /// Completes an orthogonal similarity U^T H U whose U acts on rows and columns w0..=w1 and

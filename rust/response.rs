@@ -18,7 +18,7 @@
 //! 5001-sample response allocates nothing per step.
 
 use crate::discretize::{Discretization, Hold, discretize};
-use crate::error::{Error, check_finite, check_finite_values, check_output_len};
+use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_positive};
 use crate::freq::check_state_space;
 use crate::norm::{LinearOperator, one_norm_estimate};
 use crate::platform::interrupt;
@@ -98,7 +98,7 @@ fn row_major(m: MatRef<'_, f64>) -> Vec<f64> {
 /// From this order on the outputs of a response are one matrix product; below it the
 /// matrix-vector products per step are faster (the product of a long, 4-column X with a 4 x 4
 /// C^T runs far below the speed of a square one).
-const OUTPUT_PRODUCT_MIN_ORDER: usize = 16;
+pub const OUTPUT_PRODUCT_MIN_ORDER: usize = 16;
 
 /// Independent partial sums of [`dot`]: enough to hide the latency of the additions and to
 /// fill the vector registers (a single running sum is one dependent addition per entry).
@@ -297,10 +297,22 @@ pub fn simulate_into(
     }
     check_output_len(x.len(), responses * steps * n)?;
     check_output_len(y.len(), responses * steps * p)?;
+    check_positive(dt, "dt")?;
+    if x.is_empty() && y.is_empty() {
+        // Nothing to compute (no samples, or neither states nor outputs), however many steps.
+        return Ok(());
+    }
     let discretization = discretize(a, b, dt, hold)?;
     let recurrence = Recurrence::new(&discretization, c, d);
     let no_input: &[f64] = &[];
-    let context = ParallelContext::capture();
+    // The outputs of a response of order OUTPUT_PRODUCT_MIN_ORDER or more are one product of
+    // all its samples.
+    let product_order = if n >= OUTPUT_PRODUCT_MIN_ORDER {
+        steps.max(n)
+    } else {
+        0
+    };
+    let context = ParallelContext::capture(product_order);
     let run = |(r, (x_r, y_r)): (usize, (&mut [f64], &mut [f64]))| {
         let x0_r: Vec<f64> = (0..n).map(|j| x0[(r, j)]).collect();
         context.run(|| match input {
@@ -380,7 +392,8 @@ pub fn simulate_models_into(
             return Err(Error::in_batch(index, error));
         }
     }
-    let context = ParallelContext::capture();
+    // Each model is discretised (an exponential of order n + 2m) and simulated.
+    let context = ParallelContext::capture(n + 2 * m);
     par_chunks(x, steps * n, q)
         .zip(par_chunks(y, steps * p, q))
         .enumerate()

@@ -633,7 +633,7 @@ pub(crate) fn square_schur_form<O: Order>(
         Ok((SquareSchur { t: a, z, scale }, finished))
     } else {
         // (Above the fixed orders: O is Dynamic, and the copies back are O(n^2).)
-        let reduced = hessenberg(a.as_ref());
+        let reduced = hessenberg(a.as_ref())?;
         let (mut t, mut z) = (
             Square::from_mat(reduced.h.as_ref()),
             Square::from_mat(reduced.q.as_ref()),

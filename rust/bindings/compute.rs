@@ -1,8 +1,8 @@
 //! How a binding runs its computation: with the GIL held, released, or on rayon's pool and
 //! interruptible, by its cost; after the memory it needs has been requested.
 //!
-//! * Work below [`DETACH_MIN_FLOPS`] (a 12 x 12 exponential) runs with the GIL held: releasing
-//!   and re-acquiring it would cost more than other threads gain.
+//! * Work below [`DETACH_MIN_FLOPS`] (some tens of microseconds) runs with the GIL held:
+//!   releasing and re-acquiring it would cost more than other threads gain.
 //! * Work below [`INTERRUPTIBLE_MIN_FLOPS`] (a few milliseconds) runs on the calling thread with
 //!   the GIL released. It ends long before a Ctrl-C would be missed.
 //! * Longer work runs on a thread of rayon's pool while the calling thread waits with the GIL
@@ -23,23 +23,22 @@ use super::errors::to_py_err;
 use crate::error::Error;
 use crate::expm::PARALLEL_MIN_ORDER;
 use crate::platform::interrupt::{self, Token};
-use crate::platform::memory;
+use crate::platform::memory::{self, SMALL_PRODUCT_MAX_ORDER};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::Arc;
 use std::sync::mpsc::{RecvTimeoutError, sync_channel};
 use std::time::Duration;
 
 /// Work (in floating-point operations) below which the GIL is kept.
-pub const DETACH_MIN_FLOPS: f64 = 4e3;
+pub const DETACH_MIN_FLOPS: f64 = 2e5;
 /// Work above which the computation can be interrupted.
 pub const INTERRUPTIBLE_MIN_FLOPS: f64 = 1e7;
+/// Working memory below this is not requested beforehand (mimalloc's small blocks: if they
+/// cannot be had, neither can Python's own objects).
+pub const RESERVE_MIN_BYTES: usize = 1 << 16;
 /// How often a waiting caller runs Python's signal handlers.
 pub const SIGNAL_POLL: Duration = Duration::from_millis(20);
-/// Matrices of at most this order multiply through faer's small-product kernel (16^3
-/// multiply-adds at most), which needs no workspace.
-pub const SMALL_PRODUCT_MAX_ORDER: usize = 16;
 
 /// The cost of a computation: its floating-point operations, the bytes of working memory it
 /// will allocate (beyond its arguments and results), both estimates, and the largest order of
@@ -103,7 +102,9 @@ where
     } else {
         usize::MAX
     };
-    memory::reserve(bytes).map_err(|e| to_py_err(py, e))?;
+    if bytes >= RESERVE_MIN_BYTES {
+        memory::reserve(bytes).map_err(|e| to_py_err(py, e))?;
+    }
     let small_products = cost.order <= SMALL_PRODUCT_MAX_ORDER;
     // From a thread of the pool (Python code run by a computation, such as the `select` of a
     // Schur form) the work stays: a job of the pool must not wait for another.
@@ -149,10 +150,10 @@ where
     T: Send,
     F: FnOnce() -> Result<T, Error> + Send,
 {
-    let token = Arc::new(Token::default());
+    let token = Token::default();
     let (job, interruption) = py.detach(|| {
         let (sender, receiver) = sync_channel(1);
-        let job_token = token.clone();
+        let job_token = &token;
         let mut interruption: Option<PyErr> = None;
         let job = rayon::in_place_scope(|scope| {
             scope.spawn(move |_| {
@@ -162,7 +163,7 @@ where
                 };
                 let job = match job {
                     Some(error) => Job::NoWorkspace(f, error),
-                    None => Job::Done(guarded(|| interrupt::within(Some(job_token), f))),
+                    None => Job::Done(guarded(|| interrupt::within(job_token, f))),
                 };
                 // The receiver waits for this message; it cannot be gone.
                 let _ = sender.send(job);

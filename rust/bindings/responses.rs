@@ -8,8 +8,8 @@ use super::linalg::{discretize_cost, hold_from_method};
 use super::statespace::ModelArgs;
 use crate::error::Error;
 use crate::response::{
-    Input, Model, simulate_into, simulate_models_into, steady_state as steady_state_core,
-    uniform_grid_step,
+    Input, Model, OUTPUT_PRODUCT_MIN_ORDER, simulate_into, simulate_models_into,
+    steady_state as steady_state_core, uniform_grid_step,
 };
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -47,8 +47,15 @@ fn simulation_cost(responses: usize, steps: usize, n: usize, m: usize, p: usize)
     let per_step = 2.0 * ((n + p) * (n + m)) as f64 + 1.0;
     let recurrence = responses as f64 * steps as f64 * per_step;
     let discretization = discretize_cost(n, m);
+    // From order OUTPUT_PRODUCT_MIN_ORDER the outputs are one product over all samples.
+    let outputs_order = if n >= OUTPUT_PRODUCT_MIN_ORDER {
+        steps
+    } else {
+        0
+    };
     Cost {
         flops: discretization.flops + recurrence,
+        order: discretization.order.max(outputs_order),
         ..discretization
     }
 }

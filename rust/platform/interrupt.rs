@@ -2,15 +2,15 @@
 //!
 //! A caller that may want to stop a computation (the Python bindings, for Ctrl-C) runs it with a
 //! [`Token`] installed on the computing thread ([`within`]). The long loops of the core call
-//! [`check`] between units of work (a QR sweep, a product of the exponential, a problem of a
+//! [`check`] between units of work (a QR sweep, a block of the Lyapunov solve, a problem of a
 //! batch, a block of time steps), which returns [`Error::Interrupted`] once the token is
 //! cancelled, so that the computation unwinds through its ordinary error path within a fraction of
 //! a second. A parallel loop carries the token of the thread that started it to its items with
-//! [`crate::platform::parallel::ParallelContext`]. Without a token, [`check`] is one thread-local load.
+//! [`crate::platform::parallel::ParallelContext`]. Without a token, [`check`] is one
+//! thread-local load.
 
 use crate::error::Error;
-use std::cell::RefCell;
-use std::sync::Arc;
+use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The cancellation flag of one computation, shared between the caller and the threads that
@@ -30,39 +30,51 @@ impl Token {
     }
 }
 
+/// The token of a computation, as the threads that compute for it hold it: valid for as long as
+/// it is installed by [`within`], whose caller borrows the token for that long.
+#[derive(Debug, Clone, Copy)]
+pub struct TokenRef(*const Token);
+
+// SAFETY: a TokenRef points at a Token (Sync) that outlives every use of it: it is only read
+// while installed by `within`, which borrows the token, on threads that the borrowing scope
+// waits for (the items of a parallel loop inside that scope).
+unsafe impl Send for TokenRef {}
+// SAFETY: as above.
+unsafe impl Sync for TokenRef {}
+
 thread_local! {
-    static CURRENT: RefCell<Option<Arc<Token>>> = const { RefCell::new(None) };
+    static CURRENT: Cell<Option<TokenRef>> = const { Cell::new(None) };
 }
 
 /// `Err(Error::Interrupted)` if the token of this thread's computation was cancelled.
 #[inline]
 pub fn check() -> Result<(), Error> {
-    let cancelled = CURRENT
-        .try_with(|current| current.borrow().as_ref().is_some_and(|t| t.is_cancelled()))
-        .unwrap_or(false);
-    if cancelled {
-        Err(Error::Interrupted)
-    } else {
-        Ok(())
+    let current = CURRENT.try_with(Cell::get).ok().flatten();
+    // SAFETY: an installed TokenRef is valid (see `TokenRef`).
+    match current.map(|token| unsafe { &*token.0 }.is_cancelled()) {
+        Some(true) => Err(Error::Interrupted),
+        _ => Ok(()),
     }
 }
 
-/// The token of this thread's computation, if it has one.
-pub fn current() -> Option<Arc<Token>> {
-    CURRENT
-        .try_with(|current| current.borrow().clone())
-        .ok()
-        .flatten()
+/// The token of this thread's computation, if it has one, for the items of a parallel loop
+/// started within that computation (to be installed with [`within_ref`]).
+pub fn current() -> Option<TokenRef> {
+    CURRENT.try_with(Cell::get).ok().flatten()
 }
 
 /// Runs `f` with `token` as this thread's token, restoring the previous one afterwards (also
 /// when `f` panics).
-pub fn within<T>(token: Option<Arc<Token>>, f: impl FnOnce() -> T) -> T {
-    struct Restore(Option<Arc<Token>>);
+pub fn within<T>(token: &Token, f: impl FnOnce() -> T) -> T {
+    within_ref(Some(TokenRef(token)), f)
+}
+
+/// [`within`] for the token of an enclosing computation ([`current`]), or none.
+pub fn within_ref<T>(token: Option<TokenRef>, f: impl FnOnce() -> T) -> T {
+    struct Restore(Option<TokenRef>);
     impl Drop for Restore {
         fn drop(&mut self) {
-            let previous = self.0.take();
-            let _ = CURRENT.try_with(|current| *current.borrow_mut() = previous);
+            let _ = CURRENT.try_with(|current| current.set(self.0));
         }
     }
     let previous = CURRENT
@@ -80,8 +92,8 @@ mod tests {
     #[test]
     fn a_cancelled_token_stops_its_thread_only() {
         assert_eq!(check(), Ok(()));
-        let token = Arc::new(Token::default());
-        within(Some(token.clone()), || {
+        let token = Token::default();
+        within(&token, || {
             assert_eq!(check(), Ok(()));
             token.cancel();
             assert_eq!(check(), Err(Error::Interrupted));
@@ -94,13 +106,22 @@ mod tests {
 
     #[test]
     fn tokens_nest_and_are_restored() {
-        let outer = Arc::new(Token::default());
-        let inner = Arc::new(Token::default());
+        let outer = Token::default();
+        let inner = Token::default();
         inner.cancel();
-        within(Some(outer.clone()), || {
-            within(Some(inner), || assert_eq!(check(), Err(Error::Interrupted)));
+        within(&outer, || {
+            within(&inner, || assert_eq!(check(), Err(Error::Interrupted)));
             assert_eq!(check(), Ok(()));
-            assert!(Arc::ptr_eq(&current().expect("outer token"), &outer));
+            let carried = current();
+            std::thread::scope(|scope| {
+                scope.spawn(|| {
+                    within_ref(carried, || {
+                        assert_eq!(check(), Ok(()));
+                        outer.cancel();
+                        assert_eq!(check(), Err(Error::Interrupted));
+                    })
+                });
+            });
         });
         assert!(current().is_none());
     }

@@ -23,8 +23,8 @@ use crate::error::Error;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use std::cell::Cell;
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, OnceLock};
 
 /// Requests `bytes` of memory and releases them at once; `Err(Error::OutOfMemory)` if the system
 /// refuses.
@@ -103,9 +103,17 @@ pub fn product_workspace_bytes() -> usize {
 /// See [`product_workspace_bytes`].
 const PRODUCT_WORKSPACE_MARGIN: usize = 16 << 20;
 
+/// Matrices of at most this order multiply through faer's small-product kernel (16^3
+/// multiply-adds at most), which needs no workspace.
+pub const SMALL_PRODUCT_MAX_ORDER: usize = 16;
+
 thread_local! {
     static PRODUCT_WORKSPACE_READY: Cell<bool> = const { Cell::new(false) };
 }
+
+/// Held while a thread reserves the workspace and has the kernel allocate it, so that two
+/// threads do not both count on the same free address space.
+static PRODUCT_WORKSPACE_LOCK: Mutex<()> = Mutex::new(());
 
 /// Whether this thread holds faer's product workspace.
 pub fn has_product_workspace() -> bool {
@@ -124,6 +132,9 @@ pub fn ensure_product_workspace() -> Result<(), Error> {
     const ORDER: usize = 17;
     let a = Mat::<f64>::zeros(ORDER, ORDER);
     let mut c = Mat::<f64>::zeros(ORDER, ORDER);
+    let _lock = PRODUCT_WORKSPACE_LOCK
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
     reserve(product_workspace_bytes())?;
     matmul(
         c.as_mut(),

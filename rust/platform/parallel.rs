@@ -1,35 +1,40 @@
 //! Parallel loops over the problems of a batch: the context their items take from the thread
 //! that started them, and chunking that stays whole when the chunks are empty.
 
-use super::interrupt::{self, Token};
+use super::interrupt::{self, TokenRef};
 use super::memory;
 use crate::error::Error;
 use rayon::iter::Either;
 use rayon::prelude::*;
-use std::sync::Arc;
 
 /// What the items of a parallel loop take from the thread that started it: the interrupt token
-/// of its computation. Each item runs through [`ParallelContext::run`], which installs the token
-/// on the item's thread, stops if the computation was interrupted, and makes sure the thread
-/// holds faer's product workspace before the item multiplies.
+/// of its computation, and the largest order of the matrices they multiply. Each item runs
+/// through [`ParallelContext::run`], which installs the token on the item's thread, stops if the
+/// computation was interrupted, and, if the items multiply matrices too large for faer's
+/// small-product kernel, makes sure the thread holds faer's product workspace first.
 #[derive(Debug, Clone, Default)]
 pub struct ParallelContext {
-    token: Option<Arc<Token>>,
+    token: Option<TokenRef>,
+    product_order: usize,
 }
 
 impl ParallelContext {
-    /// The context of the calling thread's computation.
-    pub fn capture() -> Self {
+    /// The context of the calling thread's computation, for items that multiply matrices of
+    /// order at most `product_order`.
+    pub fn capture(product_order: usize) -> Self {
         Self {
             token: interrupt::current(),
+            product_order,
         }
     }
 
     /// Runs one item of the loop on the current thread.
     pub fn run<T>(&self, item: impl FnOnce() -> Result<T, Error>) -> Result<T, Error> {
-        interrupt::within(self.token.clone(), || {
+        interrupt::within_ref(self.token, || {
             interrupt::check()?;
-            memory::ensure_product_workspace()?;
+            if self.product_order > memory::SMALL_PRODUCT_MAX_ORDER {
+                memory::ensure_product_workspace()?;
+            }
             item()
         })
     }
@@ -84,10 +89,12 @@ mod tests {
 
     #[test]
     fn items_stop_once_interrupted() {
-        let token = Arc::new(Token::default());
-        let context = interrupt::within(Some(token.clone()), ParallelContext::capture);
-        assert_eq!(context.run(|| Ok(1)), Ok(1));
-        token.cancel();
-        assert_eq!(context.run(|| Ok(1)), Err(Error::Interrupted));
+        let token = interrupt::Token::default();
+        interrupt::within(&token, || {
+            let context = ParallelContext::capture(4);
+            assert_eq!(context.run(|| Ok(1)), Ok(1));
+            token.cancel();
+            assert_eq!(context.run(|| Ok(1)), Err(Error::Interrupted));
+        });
     }
 }
