@@ -193,6 +193,13 @@ def test_results_that_overflow_come_with_a_warning() -> None:
         aerocontrol.steady_state(sys_, [1e10])
     with pytest.warns(NumericalOverflowWarning):
         aerocontrol.ctrb(np.diag([1e200, 1.0]), [[1e200], [1.0]])
+    huge = aerocontrol.StateSpace(-1e-300 * np.eye(2), [[1e300], [1.0]], [[1e300, 0]], [[0.0]])
+    with pytest.warns(NumericalOverflowWarning, match="DC gain"):
+        assert np.isinf(aerocontrol.dc_gain(huge)[0, 0])
+    # The doublet starts from A B η0: refused when that overflows, before anything runs.
+    stiff = aerocontrol.StateSpace(-1e300 * np.eye(2), [[1e300], [1.0]], np.eye(2), [[0], [0]])
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="A B eta0"):
+        aerocontrol.doublet_response(stiff, T=np.linspace(0, 1, 3))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         aerocontrol.modes(np.diag([-1.0, 0.0]))  # infinite time constant: by definition

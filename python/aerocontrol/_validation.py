@@ -8,12 +8,13 @@ reads its inputs (copying them before it releases the GIL).
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .exceptions import InvalidArgumentError, NotRealError, ShapeError
+from .exceptions import InvalidArgumentError, NotRealError, NumericalOverflowWarning, ShapeError
 
 FloatArray = NDArray[np.float64]
 
@@ -50,6 +51,18 @@ def real_scalar(value: Any, name: str) -> float:
     if array.ndim != 0:
         raise ShapeError(f"{name} must be a scalar, got an array of shape {array.shape}")
     return float(array)
+
+
+def finite_or_warn(values: FloatArray, what: str) -> FloatArray:
+    """``values``, with a NumericalOverflowWarning naming ``what`` if any entry is not finite
+    (the warning the core issues for its own results, for results formed in Python)."""
+    if not np.all(np.isfinite(values)):
+        warnings.warn(
+            f"the result overflowed double precision: {what} has infinite or NaN entries",
+            NumericalOverflowWarning,
+            stacklevel=3,
+        )
+    return values
 
 
 def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:

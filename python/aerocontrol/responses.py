@@ -26,14 +26,14 @@ leading response axis, ``x.shape == (r, k, n)``.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 
 from . import _core
-from ._validation import FloatArray, check_choice, real_array
+from ._validation import FloatArray, check_choice, finite_or_warn, real_array
 from .exceptions import InvalidArgumentError, ShapeError
 from .statespace import StateSpace, as_state_space, is_system
 
@@ -255,7 +255,9 @@ def impulse_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
     models, _ = _systems(sys)
     weights, names = _input_weights(eta0, models[0].n_inputs)
     labels = names or models[0].input_names
-    return _free_responses("impulse", sys, T, lambda m: weights @ m.B.T, labels)
+    return _free_responses(
+        "impulse", sys, T, lambda m: _initial_state(lambda: weights @ m.B.T, "B eta0"), labels
+    )
 
 
 def doublet_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
@@ -266,7 +268,25 @@ def doublet_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
     models, _ = _systems(sys)
     weights, names = _input_weights(eta0, models[0].n_inputs)
     labels = names or models[0].input_names
-    return _free_responses("doublet", sys, T, lambda m: weights @ (m.A @ m.B).T, labels)
+    return _free_responses(
+        "doublet",
+        sys,
+        T,
+        lambda m: _initial_state(lambda: weights @ (m.A @ m.B).T, "A B eta0"),
+        labels,
+    )
+
+
+def _initial_state(form: Callable[[], FloatArray], what: str) -> FloatArray:
+    """The initial states of an impulse or doublet, refused if forming them overflowed."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        states = form()
+    if not np.all(np.isfinite(states)):
+        raise InvalidArgumentError(
+            f"the response starts from x(0) = {what}, which overflows double precision "
+            "(infinite entries): scale the model or the input weights eta0"
+        )
+    return states
 
 
 def initial_response(sys: Any, x0: Any, T: Any = None) -> TimeResponse:
@@ -449,9 +469,11 @@ def dc_gain(sys: Any) -> FloatArray:
     Raises SingularMatrixError naming the zero eigenvalue when A is singular.
     """
     model = as_state_space(sys)
-    columns = [
-        model.C @ _core.steady_state(model.A, model.B, np.eye(model.n_inputs)[j]) + model.D[:, j]
-        for j in range(model.n_inputs)
-    ]
+    with np.errstate(over="ignore", invalid="ignore"):
+        columns = [
+            model.C @ _core.steady_state(model.A, model.B, np.eye(model.n_inputs)[j])
+            + model.D[:, j]
+            for j in range(model.n_inputs)
+        ]
     gain: FloatArray = np.stack(columns, axis=1) if columns else np.zeros((model.n_outputs, 0))
-    return gain
+    return finite_or_warn(gain, "the DC gain")
