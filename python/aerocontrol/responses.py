@@ -26,6 +26,7 @@ leading response axis, ``x.shape == (r, k, n)``.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -34,7 +35,7 @@ import numpy as np
 
 from . import _core
 from ._validation import FloatArray, check_choice, finite_or_warn, real_array
-from .exceptions import InvalidArgumentError, ShapeError
+from .exceptions import InvalidArgumentError, NumericalOverflowWarning, ShapeError
 from .statespace import StateSpace, as_state_space, is_system
 
 __all__ = [
@@ -469,7 +470,9 @@ def dc_gain(sys: Any) -> FloatArray:
     Raises SingularMatrixError naming the zero eigenvalue when A is singular.
     """
     model = as_state_space(sys)
-    with np.errstate(over="ignore", invalid="ignore"):
+    # One warning for the gain, not one per column's steady state.
+    with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", NumericalOverflowWarning)
         columns = [
             model.C @ _core.steady_state(model.A, model.B, np.eye(model.n_inputs)[j])
             + model.D[:, j]
