@@ -256,6 +256,41 @@ def test_long_calls_release_the_gil(call: Callable[[np.ndarray, np.ndarray], Any
     assert during > 2000 * elapsed * 1000 * 0.1, (during, elapsed)
 
 
+def test_threads_give_bitwise_the_results_of_one_thread() -> None:
+    rng = np.random.default_rng(5)
+    problems = [
+        (rng.standard_normal((n, n)) / np.sqrt(n) - 2 * np.eye(n), rng.standard_normal((n, 2)))
+        for n in (4, 12, 40, 90)
+    ]
+
+    def solve(A: np.ndarray, B: np.ndarray) -> list[np.ndarray]:
+        n = len(A)
+        return [
+            aerocontrol.expm(A),
+            aerocontrol.solve_care(A, B, np.eye(n), np.eye(2)).X,
+            aerocontrol.modes(A).eigenvalues,
+            aerocontrol.step_response((A, B), T=np.linspace(0, 2, 21)).x,
+            aerocontrol.batch.lqr_sweep(A, B, weights=[0.5, 1.0, 2.0]).K,
+        ]
+
+    expected = [solve(A, B) for A, B in problems]
+    results: dict[int, list[list[np.ndarray]]] = {}
+
+    def work(thread: int) -> None:
+        results[thread] = [solve(A, B) for A, B in problems]
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(8)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert sorted(results) == list(range(8))
+    for got in results.values():
+        for mine, theirs in zip(got, expected, strict=True):
+            for a, b in zip(mine, theirs, strict=True):
+                assert np.array_equal(a, b)
+
+
 # ----- Ctrl-C -----------------------------------------------------------------------------------
 
 _INTERRUPT = """
