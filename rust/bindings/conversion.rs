@@ -161,6 +161,10 @@ impl Real {
         value.map(|v| Self::convert(py, v, name)).transpose()
     }
 
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
     pub fn shape(&self) -> &[usize] {
         &self.shape
     }

@@ -33,12 +33,39 @@ type SimulationOutput<'py> = (Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn
 
 /// The input of a simulation: sampled inputs `u` if given, else a constant `eta0` if given, else
 /// none.
-fn simulation_input<'a>(u: Option<&'a Real>, eta0: Option<&'a Real>) -> Input<'a> {
-    match (u, eta0) {
-        (Some(u), _) => Input::Sampled(u.values()),
-        (None, Some(eta)) => Input::Constant(eta.values()),
+///
+/// Each is checked against the simulation's own shape: `u` of shape (responses, steps, m) and
+/// `eta0` of shape `eta_shape` ((m,) for one model, (models, m) for a stack).
+fn simulation_input<'a>(
+    u: Option<&'a Real>,
+    eta0: Option<&'a Real>,
+    (responses, steps, m): (usize, usize, usize),
+    eta_shape: &[usize],
+) -> Result<Input<'a>, Error> {
+    let shaped = |argument: &'a Real, shape: &[usize], expected: &'static str| {
+        if argument.shape() == shape {
+            Ok(argument.values())
+        } else {
+            Err(Error::WrongDimensions {
+                arg: argument.name(),
+                expected,
+                shape: argument.shape().to_vec(),
+            })
+        }
+    };
+    Ok(match (u, eta0) {
+        (Some(u), _) => Input::Sampled(shaped(
+            u,
+            &[responses, steps, m],
+            "of shape (responses, times, inputs)",
+        )?),
+        (None, Some(eta)) => Input::Constant(shaped(
+            eta,
+            eta_shape,
+            "one value per input (for a stack of models, one row per model)",
+        )?),
         (None, None) => Input::Free,
-    }
+    })
 }
 
 /// The work of `responses` responses of `steps` samples of a model (n, m, p), after its
@@ -98,7 +125,8 @@ fn simulate<'py>(
         }
     };
     let responses = x0.nrows();
-    let input = simulation_input(u.as_ref(), eta0.as_ref());
+    let input = simulation_input(u.as_ref(), eta0.as_ref(), (responses, steps, m), &[m])
+        .map_err(|e| to_py_err(py, e))?;
     let x = new_array::<f64>(py, &[responses, steps, n])?;
     let y = new_array::<f64>(py, &[responses, steps, p])?;
     // SAFETY: both arrays are new and not visible to Python until returned.
@@ -181,7 +209,8 @@ fn simulate_models<'py>(
             d: stacks.3.get(i),
         })
         .collect();
-    let input = simulation_input(u.as_ref(), eta0.as_ref());
+    let input = simulation_input(u.as_ref(), eta0.as_ref(), (q, steps, m), &[q, m])
+        .map_err(|e| to_py_err(py, e))?;
     let x0 = match *x0.shape() {
         [models, states] if (models, states) == (q, n) => {
             x0.matrix().map_err(|e| to_py_err(py, e))?
