@@ -5,11 +5,11 @@
 //! at n = 4, 16, 64 and 256 (the companion form and the Riccati ODE stop where their peers do:
 //! 16 and 64).
 
-use aerocontrol::ctrb::{controllability_staircase, ctrb, obsv};
-use aerocontrol::modes::{charpoly, modal_analysis};
-use aerocontrol::place::companion_form;
-use aerocontrol::response::steady_state;
-use aerocontrol::riccati_ode::riccati_ode;
+use aerocontrol::control::controllability::{controllability_staircase, ctrb, obsv};
+use aerocontrol::control::modes::{charpoly, modal_analysis};
+use aerocontrol::control::placement::companion_form;
+use aerocontrol::control::responses::steady_state;
+use aerocontrol::control::riccati::ode::riccati_ode;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
 use std::hint::black_box;

@@ -4,10 +4,10 @@
 //! call. Rayon uses every core; `RAYON_NUM_THREADS=1 cargo bench --bench batch` gives the
 //! one-core time, and the ratio the parallel speed-up.
 
-use aerocontrol::batch::{
+use aerocontrol::control::batch::{
     CareBatchOutput, CareStacks, MatrixStack, PlaceBatchOutput, care_batch, place_batch,
 };
-use aerocontrol::place::{place, place_bass_gura};
+use aerocontrol::control::placement::{place, place_bass_gura};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::c64;
 use std::hint::black_box;
@@ -89,7 +89,7 @@ fn dampers(c: &mut Criterion) {
             "bass-gura rudder",
             &rudder[..],
             1,
-            place_bass_gura as aerocontrol::batch::Placer,
+            place_bass_gura as aerocontrol::control::batch::Placer,
         ),
         ("knv rudder + aileron", &B[..], 2, place),
     ] {

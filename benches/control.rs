@@ -7,8 +7,8 @@
 //! rudder), and Kautsky–Nichols–Van Dooren on the 747 with both inputs and on a seeded random
 //! 16-state, 2-input plant.
 
-use aerocontrol::ctrb::{controllability, controllability_staircase};
-use aerocontrol::place::{place, place_ackermann, place_bass_gura};
+use aerocontrol::control::controllability::{controllability, controllability_staircase};
+use aerocontrol::control::placement::{place, place_ackermann, place_bass_gura};
 use criterion::{Criterion, criterion_group, criterion_main};
 use faer::{Mat, c64, mat};
 use std::hint::black_box;

@@ -3,9 +3,9 @@
 //! Inputs are seeded random matrices scaled to 1-norm about 2 (degree 13 with a few squarings,
 //! the common case), the same family that `benches/compare_peers.py` uses against scipy.
 
-use aerocontrol::batch::{MatrixStack, expm_batch};
-use aerocontrol::discretize::{Hold, discretize};
-use aerocontrol::expm::{expm, transition_matrices};
+use aerocontrol::control::batch::{MatrixStack, expm_batch};
+use aerocontrol::control::discretize::{Hold, discretize};
+use aerocontrol::linalg::expm::{expm, transition_matrices};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
 use std::hint::black_box;

@@ -7,10 +7,10 @@
 //! Frequency responses: 1000 log-spaced frequencies for the 747 (n = 4, 4 outputs, 1 input) and
 //! a seeded random stable model (n = 64, 2 inputs, 2 outputs).
 
-use aerocontrol::discretize::Hold;
-use aerocontrol::freq::frequency_response_into;
-use aerocontrol::modes::eigen;
-use aerocontrol::response::{Input, Model, simulate_into};
+use aerocontrol::control::discretize::Hold;
+use aerocontrol::control::frequency::frequency_response_into;
+use aerocontrol::control::modes::eigen;
+use aerocontrol::control::responses::{Input, Model, simulate_into};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::{Mat, MatRef, c64, mat};
 use std::hint::black_box;

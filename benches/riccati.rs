@@ -3,10 +3,10 @@
 //! python-control). Seeded random matrices at n = 4, 16, 64 and 256; the CARE also on the
 //! chapter's 747 lateral regulator (6.224)-(6.227) with Q = I, R = I.
 
-use aerocontrol::care::{CareOptions, solve_care};
-use aerocontrol::lyapunov::solve_lyapunov;
-use aerocontrol::reorder::reorder_schur;
-use aerocontrol::schur::real_schur;
+use aerocontrol::control::riccati::care::{CareOptions, solve_care};
+use aerocontrol::linalg::lyapunov::solve_lyapunov;
+use aerocontrol::linalg::schur::real_schur;
+use aerocontrol::linalg::schur::reorder::reorder_schur;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
 use std::hint::black_box;

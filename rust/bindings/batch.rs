@@ -6,7 +6,7 @@ use super::conversion::{Complex, Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::placement::{placement_cost, placer_for};
 use super::riccati::care_cost;
-use crate::batch::{
+use crate::control::batch::{
     CareBatchOutput, CareStacks, PlaceBatchOutput, care_batch as care_batch_core,
     place_batch as place_batch_core,
 };
@@ -122,9 +122,12 @@ fn place_batch<'py>(
             return Err(to_py_err(py, error));
         }
     };
-    let count =
-        crate::batch::batch_count(&[("A", a_stack.len()), ("B", b_stack.len()), ("poles", rows)])
-            .map_err(|e| to_py_err(py, e))?;
+    let count = crate::control::batch::batch_count(&[
+        ("A", a_stack.len()),
+        ("B", b_stack.len()),
+        ("poles", rows),
+    ])
+    .map_err(|e| to_py_err(py, e))?;
     let gain = new_array::<f64>(py, &[count, m, n])?;
     let achieved = new_array::<c64>(py, &[count, n])?;
     let error = new_array::<f64>(py, &[count])?;

@@ -21,7 +21,7 @@
 
 use super::errors::to_py_err;
 use crate::error::Error;
-use crate::expm::PARALLEL_MIN_ORDER;
+use crate::linalg::expm::PARALLEL_MIN_ORDER;
 use crate::platform::interrupt::{self, Token};
 use crate::platform::memory::{self, SMALL_PRODUCT_MAX_ORDER};
 use pyo3::exceptions::PyRuntimeError;

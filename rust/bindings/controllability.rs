@@ -5,7 +5,7 @@ use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
 use super::modal::eigen_cost;
-use crate::ctrb::{
+use crate::control::controllability::{
     controllability as controllability_core, ctrb, observability as observability_core, obsv,
 };
 use numpy::PyArrayDyn;

@@ -20,7 +20,7 @@
 //! naming the results that overflowed.
 
 use super::errors::{to_py_err, warn};
-use crate::batch::MatrixStack;
+use crate::control::batch::MatrixStack;
 use crate::error::Error;
 use faer::{Mat, MatMut, MatRef, c64};
 use numpy::PyUntypedArrayMethods;

@@ -4,7 +4,7 @@ use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::statespace::ModelArgs;
-use crate::freq::frequency_response_into;
+use crate::control::frequency::frequency_response_into;
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;

@@ -4,10 +4,10 @@
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::{raise, to_py_err, warn};
-use crate::discretize::{Hold, discretize as discretize_core};
+use crate::control::discretize::{Hold, discretize as discretize_core};
 use crate::error::{Error, check_square};
-use crate::expm::{expm_into, pade_choice, transition_matrices_into};
-use crate::norm::one_norm;
+use crate::linalg::expm::{expm_into, pade_choice, transition_matrices_into};
+use crate::linalg::norm::one_norm;
 use faer::{MatMut, MatRef};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -80,7 +80,7 @@ fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
             let threads = rayon::current_num_threads() as f64;
             let cost =
                 Cost::of(expm_flops(rows), EXPM_TEMPORARIES * threads, rows).times(stack.len());
-            compute(py, cost, || crate::batch::expm_batch(stack, data))?;
+            compute(py, cost, || crate::control::batch::expm_batch(stack, data))?;
             // SAFETY: as above; the computation is over.
             let values = unsafe { new_array_data(&out) };
             let size = rows * rows;

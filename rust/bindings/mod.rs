@@ -43,14 +43,20 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     schur::register(m)?;
     riccati::register(m)?;
     batch::register(m)?;
-    m.add("EXACT_NORM_MAX_ORDER", crate::expm::EXACT_NORM_MAX_ORDER)?;
-    m.add("SMALL_MAX_ORDER", crate::expm::SMALL_MAX_ORDER)?;
-    m.add("FMA_KERNELS", crate::dispatch::fma_available())?;
+    m.add(
+        "EXACT_NORM_MAX_ORDER",
+        crate::linalg::expm::EXACT_NORM_MAX_ORDER,
+    )?;
+    m.add("SMALL_MAX_ORDER", crate::linalg::expm::SMALL_MAX_ORDER)?;
+    m.add("FMA_KERNELS", crate::platform::dispatch::fma_available())?;
     m.add(
         "ILL_CONDITIONED_CONTROLLABILITY",
-        crate::place::ILL_CONDITIONED_CONTROLLABILITY,
+        crate::control::placement::ILL_CONDITIONED_CONTROLLABILITY,
     )?;
-    m.add("POLE_ERROR_WARNING", crate::place::POLE_ERROR_WARNING)?;
+    m.add(
+        "POLE_ERROR_WARNING",
+        crate::control::placement::POLE_ERROR_WARNING,
+    )?;
     m.add(
         "PRODUCT_WORKSPACE_BYTES",
         crate::platform::memory::product_workspace_bytes(),

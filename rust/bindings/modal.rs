@@ -3,7 +3,9 @@
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
-use crate::modes::{Mode, charpoly as charpoly_core, modal_analysis as modal_analysis_core};
+use crate::control::modes::{
+    Mode, charpoly as charpoly_core, modal_analysis as modal_analysis_core,
+};
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;

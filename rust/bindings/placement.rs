@@ -3,12 +3,12 @@
 use super::compute::{Cost, compute};
 use super::conversion::{Complex, Outputs, Real};
 use super::errors::{raise, to_py_err, warn};
-use crate::batch::Placer;
-use crate::error::Error;
-use crate::place::{
+use crate::control::batch::Placer;
+use crate::control::placement::{
     ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING, companion_form as companion_form_core,
     place as place_core, place_ackermann, place_bass_gura,
 };
+use crate::error::Error;
 use faer::c64;
 use numpy::{PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -78,7 +78,7 @@ pub fn placer_for(py: Python<'_>, method: &str) -> PyResult<Placer> {
 
 /// A state-feedback design η = -K x (6.91).
 ///
-/// ``k`` is the gain vector of a single-input design (the chapter's k^T = K[0]).
+/// ``k`` is the gain vector of a single-input design (the chapter's k^T = `K[0]`).
 // Built here rather than as a Python dataclass: filling a ten-field dataclass cost 0.4 µs, a
 // sixth of a whole 4-state design called from Python, and this object costs a tenth of that.
 #[pyclass(frozen, module = "aerocontrol", name = "Placement")]

@@ -6,11 +6,11 @@ use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::linalg::{discretize_cost, hold_from_method};
 use super::statespace::ModelArgs;
-use crate::error::Error;
-use crate::response::{
+use crate::control::responses::{
     Input, Model, OUTPUT_PRODUCT_MIN_ORDER, simulate_into, simulate_models_into,
     steady_state as steady_state_core, uniform_grid_step,
 };
+use crate::error::Error;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 

@@ -4,9 +4,9 @@
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
-use crate::lyapunov::solve_lyapunov as solve_lyapunov_core;
-use crate::reorder::{OrderedSchur, reorder_schur};
-use crate::schur::{quasi_triangular_eigenvalues, real_schur};
+use crate::linalg::lyapunov::solve_lyapunov as solve_lyapunov_core;
+use crate::linalg::schur::reorder::{OrderedSchur, reorder_schur};
+use crate::linalg::schur::{quasi_triangular_eigenvalues, real_schur};
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;

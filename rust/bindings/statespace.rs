@@ -3,9 +3,9 @@
 
 use super::conversion::Real;
 use super::errors::to_py_err;
+use crate::control::frequency::check_state_space;
+use crate::control::responses::Model;
 use crate::error::Error;
-use crate::freq::check_state_space;
-use crate::response::Model;
 use pyo3::prelude::*;
 
 /// The converted A, B, C and D of a model.

@@ -1,6 +1,11 @@
-//! What the numerical code needs from the machine: interruption of long computations, memory
+//! What the numerical code needs from the machine: run-time choice of vectorised kernels, scratch
+//! matrices, the allocator of the Python extension, interruption of long computations, memory
 //! requested so that a shortage is an error, and the plumbing of parallel loops.
 
+#[cfg(feature = "small-block-allocator")]
+pub mod allocator;
+pub mod dispatch;
 pub mod interrupt;
 pub mod memory;
 pub mod parallel;
+pub mod pool;

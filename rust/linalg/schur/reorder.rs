@@ -12,7 +12,7 @@
 //!     [ 0    T22 ]
 //! ```
 //!
-//! If X solves the Sylvester equation T11 X - X T22 = T12 (`crate::sylvester`), then
+//! If X solves the Sylvester equation T11 X - X T22 = T12 (`crate::linalg::sylvester`), then
 //! D [-X; I] = [-X; I] T22, so the columns of [-X; I] span the invariant subspace of T22's
 //! eigenvalues. With the QR factorisation [-X; I] = Q R, the orthogonal Q gives
 //!
@@ -35,7 +35,7 @@
 //! inaccurate invariant subspace. Two 1 x 1 blocks are exchanged by the single plane rotation
 //! whose first column is the eigenvector [t12, t22 - t11] of t22, which is always stable.
 //!
-//! New 2 x 2 blocks are put back in standard form ([`crate::schur::standardize_block`]); a
+//! New 2 x 2 blocks are put back in standard form ([`crate::linalg::schur::standardize_block`]); a
 //! block whose eigenvalues the rounding errors have made real splits into two 1 x 1 blocks.
 //!
 //! # Ordering
@@ -44,11 +44,11 @@
 //! a time, to just below the selected ones already in place, as LAPACK's dtrsen does. A
 //! complex pair is selected by its member with positive imaginary part.
 
-use crate::dispatch::clear_upper_avx_state;
 use crate::error::Error;
+use crate::linalg::schur::{RealSchur, quasi_triangular_eigenvalues, reflector, standardize_block};
+use crate::linalg::sylvester::solve_small_sylvester;
+use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
-use crate::schur::{RealSchur, quasi_triangular_eigenvalues, reflector, standardize_block};
-use crate::sylvester::solve_small_sylvester;
 use faer::{Mat, c64};
 use std::ops::Range;
 
@@ -400,7 +400,7 @@ fn rotate(t: &mut Mat<f64>, z: &mut Mat<f64>, j: usize, cs: f64, sn: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::schur::real_schur;
+    use crate::linalg::schur::real_schur;
 
     use crate::test_matrices::seeded_square as seeded;
 

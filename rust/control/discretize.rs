@@ -32,7 +32,7 @@
 //! overflow or underflow at the edges of the range of doubles.
 
 use crate::error::{Error, check_finite, check_positive, check_rows, check_square};
-use crate::expm::expm;
+use crate::linalg::expm::expm;
 use faer::Mat;
 use faer::MatRef;
 
@@ -67,7 +67,7 @@ fn times_power_of_two(x: f64, exponent: f64) -> f64 {
 ///
 /// ```
 /// use faer::mat;
-/// use aerocontrol::discretize::{discretize, Hold};
+/// use aerocontrol::control::discretize::{discretize, Hold};
 /// // A double integrator: Φ = [[1, h], [0, 1]], Γ0 = [h^2/2, h]^T.
 /// let a = mat![[0.0, 1.0], [0.0, 0.0]];
 /// let b = mat![[0.0], [1.0]];
@@ -146,7 +146,7 @@ pub fn discretize(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lu::solve_in_place;
+    use crate::linalg::lu::solve_in_place;
     use faer::{Par, mat};
 
     fn max_abs_difference(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> f64 {

@@ -45,13 +45,13 @@
 //! requested pole, and the largest relative error |λ_achieved - λ| / |λ| (relative to
 //! ||A - BK||_F for a pole at 0).
 
-use crate::ctrb::{controllability, controllability_staircase, krylov_blocks};
+use crate::control::controllability::{controllability, controllability_staircase, krylov_blocks};
+use crate::control::modes::{charpoly, polynomial_from_roots};
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
-use crate::lu::solve_with_inverse;
-use crate::modes::{charpoly, polynomial_from_roots};
-use crate::norm::{frobenius_norm, one_norm};
+use crate::linalg::lu::solve_with_inverse;
+use crate::linalg::norm::{frobenius_norm, one_norm};
+use crate::linalg::schur::eigenvalues_near;
 use crate::platform::interrupt;
-use crate::schur::eigenvalues_near;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, c64};
 
@@ -643,7 +643,7 @@ fn condition_number(x: &Mat<c64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::schur::eigenvalues;
+    use crate::linalg::schur::eigenvalues;
     use faer::mat;
 
     fn real(values: &[f64]) -> Vec<c64> {

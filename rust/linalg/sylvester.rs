@@ -1,6 +1,6 @@
 //! The small Sylvester equation L X + X R = C with L of order p and R of order q, p, q in
-//! {1, 2}: the kernel of Schur reordering ([`crate::reorder`], with L = T11, R = -T22) and of
-//! the Bartels–Stewart Lyapunov solver ([`crate::lyapunov`], with L = T_ii, R = T_jj^T).
+//! {1, 2}: the kernel of Schur reordering ([`crate::linalg::schur::reorder`], with L = T11, R = -T22) and of
+//! the Bartels–Stewart Lyapunov solver ([`crate::linalg::lyapunov`], with L = T_ii, R = T_jj^T).
 //!
 //! The equation is solved in its Kronecker form
 //!

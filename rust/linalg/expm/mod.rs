@@ -58,13 +58,15 @@
 //! (the transition matrices of a response) reuses them: ||(tA)^k|| = |t|^k ||A^k||, so only the
 //! final Padé evaluation and squaring are repeated per time.
 
-use crate::dispatch::{add_scaled, scale_into};
-use crate::double_double::DoubleDoubleMatrix;
+pub mod double_double;
+
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
-use crate::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
+use crate::linalg::expm::double_double::DoubleDoubleMatrix;
+use crate::linalg::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
+use crate::linalg::small_matrix::SmallMatrix;
+use crate::platform::dispatch::{add_scaled, scale_into};
 use crate::platform::parallel::ParallelContext;
-use crate::pool::{Scratch, scratch};
-use crate::small_matrix::SmallMatrix;
+use crate::platform::pool::{Scratch, scratch};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
@@ -596,7 +598,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         choice(M13, squarings.saturating_add(self.prescale))
     }
 
-    /// Forms the powers that evaluating `choice` needs; call before [`Self::exponential`].
+    /// Forms the powers that evaluating `choice` needs; call before evaluating it.
     pub fn prepare(&mut self, choice: PadeChoice) {
         match choice.approximant {
             M3 => {}
@@ -741,7 +743,7 @@ impl PadeArithmetic for Scratch {
         for j in 0..n {
             add_scaled(even.col_as_slice_mut(j), -1.0, odd.col_as_slice(j));
         }
-        crate::lu::solve_in_place(even.as_mut(), odd.as_mut(), parallelism_for_order(n));
+        crate::linalg::lu::solve_in_place(even.as_mut(), odd.as_mut(), parallelism_for_order(n));
         for j in 0..n {
             let column = odd.col_as_slice_mut(j);
             for value in column.iter_mut() {
@@ -1000,7 +1002,7 @@ pub(crate) fn expm_into_validated(a: MatRef<'_, f64>, mut out: MatMut<'_, f64>) 
 /// ```
 /// use faer::mat;
 /// let a = mat![[0.0, 1.0], [-2.0, -3.0]];
-/// let phi = aerocontrol::expm::expm(a.as_ref()).unwrap();
+/// let phi = aerocontrol::linalg::expm::expm(a.as_ref()).unwrap();
 /// // e^A = [[2e^-1 - e^-2, e^-1 - e^-2], [-2e^-1 + 2e^-2, -e^-1 + 2e^-2]]
 /// let (e1, e2) = ((-1.0f64).exp(), (-2.0f64).exp());
 /// assert!((phi[(0, 0)] - (2.0 * e1 - e2)).abs() < 1e-15);

@@ -15,7 +15,7 @@
 //!   each iteration costs two applications of the operator to an n x t block, so estimating the
 //!   norm of a product of k n x n matrices costs O(k t n^2) instead of the O(k n^3) of forming it.
 
-use crate::pool::scratch;
+use crate::platform::pool::scratch;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 

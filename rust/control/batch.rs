@@ -5,11 +5,11 @@
 //! copy per matrix. Each problem runs on one rayon task (small problems sequentially inside),
 //! which is the efficient split for many small problems; an error names the index of the problem.
 
-use crate::care::{CareOptions, solve_care_dense};
-use crate::dense::Dense;
+use crate::control::placement::Placement;
+use crate::control::riccati::care::{CareOptions, solve_care_dense};
 use crate::error::{Error, check_finite, check_output_len};
-use crate::expm::expm_into_validated;
-use crate::place::Placement;
+use crate::linalg::dense::Dense;
+use crate::linalg::expm::expm_into_validated;
 use crate::platform::parallel::{ParallelContext, par_chunks};
 use faer::{MatMut, MatRef, c64};
 use rayon::prelude::*;
@@ -188,7 +188,7 @@ pub struct CareBatchOutput<'a> {
 }
 
 /// Solves every Riccati equation of a batch, in parallel (one problem per rayon task, each
-/// exactly as [`solve_care`] solves it alone, so the results are bitwise those of single
+/// exactly as [`crate::control::riccati::care::solve_care`] solves it alone, so the results are bitwise those of single
 /// calls). Every problem is attempted; if any fails, the error of the lowest index is
 /// returned, naming that index, and the outputs are unspecified.
 pub fn care_batch(
@@ -246,7 +246,7 @@ pub fn care_batch(
     lowest_failure(failure)
 }
 
-/// A pole-placement algorithm of [`crate::place`].
+/// A pole-placement algorithm of [`crate::control::placement`].
 pub type Placer = fn(MatRef<'_, f64>, MatRef<'_, f64>, &[c64]) -> Result<Placement, Error>;
 
 /// Where [`place_batch`] writes: for problem k, K (m x n) row-major at k m n, the achieved
@@ -334,8 +334,8 @@ pub fn place_batch(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::care::solve_care;
-    use crate::expm::expm;
+    use crate::control::riccati::care::solve_care;
+    use crate::linalg::expm::expm;
 
     #[test]
     fn batch_equals_one_at_a_time() {
@@ -527,7 +527,7 @@ mod tests {
 
     #[test]
     fn place_batch_equals_one_at_a_time_and_names_the_failing_index() {
-        use crate::place::{place, place_bass_gura};
+        use crate::control::placement::{place, place_bass_gura};
         let (a, b) = lateral();
         let rudder: Vec<f64> = b.chunks(2).map(|row| row[0]).collect();
         // Two designs per problem: move the Dutch roll to each damping ratio, keep the rest.

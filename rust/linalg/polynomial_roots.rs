@@ -1,7 +1,7 @@
 //! The roots of real monic polynomials of degree at most four, in closed form.
 //!
 //! The Riccati solver's QR iteration takes its shifts from the roots of the even characteristic
-//! polynomial of the Hamiltonian, det(λI - H) = q(λ²) ([`crate::schur`]); for 1- to 4-state
+//! polynomial of the Hamiltonian, det(λI - H) = q(λ²) ([`crate::linalg::schur`]); for 1- to 4-state
 //! models q has degree 1 to 4. The eigenvalues of q's companion matrix cost about five
 //! double-shift sweeps, a tenth of a 4-state Riccati solve; the closed forms below cost a few
 //! square and cube roots. Closed forms lose accuracy through cancellation (depressing the

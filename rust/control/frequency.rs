@@ -16,11 +16,11 @@
 //! A frequency at an eigenvalue of A on the imaginary axis (a pole of G) gives infinite or NaN
 //! entries, never an error: the caller decides how to report them.
 
-use crate::dispatch::{fma_dispatch, multiply_add};
 use crate::error::{
     Error, check_finite, check_finite_values, check_output_len, check_rows, check_square,
 };
-use crate::hessenberg::{Hessenberg, hessenberg};
+use crate::linalg::hessenberg::{Hessenberg, hessenberg};
+use crate::platform::dispatch::{fma_dispatch, multiply_add};
 use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
 use rayon::prelude::*;

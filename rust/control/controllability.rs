@@ -60,10 +60,10 @@
 //! Observability is the dual: (A, C) is observable if and only if (A^T, C^T) is controllable,
 //! and the unobservable eigenvalues of (A, C) are the uncontrollable ones of (A^T, C^T).
 
+use crate::control::modes::eigen;
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::modes::eigen;
-use crate::schur::{eigenvalues, reflector};
-use crate::small_matrix::product;
+use crate::linalg::schur::{eigenvalues, reflector};
+use crate::linalg::small_matrix::product;
 use faer::linalg::matmul::matmul;
 use faer::prelude::{IntoConst, Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par, c64};

@@ -13,7 +13,7 @@
 //!
 //! # Algorithm
 //!
-//! A is first reduced to upper Hessenberg form H = Q^T A Q ([`crate::hessenberg`], faer's blocked
+//! A is first reduced to upper Hessenberg form H = Q^T A Q ([`crate::linalg::hessenberg`], faer's blocked
 //! Householder reduction). The QR iteration then works on the active window H[l..=i, l..=i]
 //! between negligible subdiagonal entries (the deflation test of Ahues & Tisseur, as in LAPACK's
 //! small-matrix QR, which declares h_{k,k-1} negligible only when doing so perturbs the
@@ -39,7 +39,7 @@
 //!
 //! - A Hamiltonian matrix ([`Spectrum::Hamiltonian`], the Riccati solver's) has an even
 //!   characteristic polynomial, det(λI - H) = q(λ²), whose coefficients La Budde's recurrence
-//!   gives from the Hessenberg form in O(n^3) ([`crate::modes::charpoly`]); the roots μ of q
+//!   gives from the Hessenberg form in O(n^3) ([`crate::control::modes::charpoly`]); the roots μ of q
 //!   (of half the order: in closed form up to degree four, `polynomial_roots`, which costs a
 //!   tenth of the five or six sweeps of q's companion matrix; else, or where the closed form
 //!   fails its backward-error check, the eigenvalues of the companion matrix) give the
@@ -86,14 +86,17 @@
 //! the computed eigenvalues of badly scaled matrices such as models in mixed units. The Schur
 //! form itself is not balanced, since its Z must be orthogonal.
 
-use crate::dispatch::clear_upper_avx_state;
+pub(crate) mod multishift;
+pub mod reorder;
+
+use crate::control::modes::hessenberg_characteristic_polynomial;
 use crate::error::{Error, check_finite, check_square};
-use crate::hessenberg::{hessenberg, hessenberg_matrix};
-use crate::modes::hessenberg_characteristic_polynomial;
-use crate::multishift::multishift_qr;
-use crate::norm::max_abs;
+use crate::linalg::hessenberg::{hessenberg, hessenberg_matrix};
+use crate::linalg::norm::max_abs;
+use crate::linalg::polynomial_roots::monic_roots;
+use crate::linalg::schur::multishift::multishift_qr;
+use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
-use crate::polynomial_roots::monic_roots;
 use faer::{Mat, MatRef, c64};
 use std::ops::{Index, IndexMut, Range};
 
@@ -241,7 +244,7 @@ impl Mirrors {
 }
 
 /// From this order on the QR iteration is the small-bulge multishift iteration with aggressive
-/// early deflation ([`crate::multishift`]); below it, and on the active blocks below it that the
+/// early deflation ([`crate::linalg::schur::multishift`]); below it, and on the active blocks below it that the
 /// multishift iteration leaves, the double-shift iteration of this module, whose set-up is
 /// nothing. LAPACK's crossover is 75 (its NMIN); measured here, see the module docs.
 pub(crate) const MULTISHIFT_MIN_ORDER: usize = 75;
@@ -958,7 +961,7 @@ pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
 }
 
 /// The QR iteration on an upper Hessenberg `h`, in place: the double-shift iteration below
-/// [`MULTISHIFT_MIN_ORDER`], the small-bulge multishift iteration ([`crate::multishift`]) from
+/// [`MULTISHIFT_MIN_ORDER`], the small-bulge multishift iteration ([`crate::linalg::schur::multishift`]) from
 /// there.
 ///
 /// With `full` the whole of `h` is transformed into the Schur form T (and `z`, if given, is
@@ -1937,7 +1940,7 @@ mod tests {
         }) {
             let h = seeded_hamiltonian(n, seed);
             let what = format!("n={n} seed={seed} {spectrum:?}");
-            let margin = crate::care::AXIS_TOLERANCE * h.norm_l2();
+            let margin = crate::control::riccati::care::AXIS_TOLERANCE * h.norm_l2();
             let (schur, finished) = with_order!(2 * n, order => square_real_schur(
                 Square::from_mat_in(order, h.as_ref()),
                 spectrum,
@@ -1989,7 +1992,7 @@ mod tests {
     /// The Schur vectors of H with the stable eigenvalues first.
     fn reorder_stable_first(h: &Mat<f64>, spectrum: Spectrum) -> Mat<f64> {
         let schur = real_schur_with(h.as_ref(), spectrum).unwrap();
-        crate::reorder::reorder_schur(schur, |z| z.re < 0.0)
+        crate::linalg::schur::reorder::reorder_schur(schur, |z| z.re < 0.0)
             .unwrap()
             .z
     }

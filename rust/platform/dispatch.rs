@@ -67,7 +67,7 @@ macro_rules! fma_dispatch {
                 fn fused($($arg: $ty),*) $(-> $ret)? {
                     $kernel::<true>($($arg),*)
                 }
-                if $crate::dispatch::fma_available() {
+                if $crate::platform::dispatch::fma_available() {
                     // SAFETY: the CPU supports AVX2 and FMA, checked just above.
                     return unsafe { fused($($arg),*) };
                 }
@@ -84,7 +84,7 @@ macro_rules! fma_dispatch {
                 fn fused<const N: usize>($($arg: $ty),*) $(-> $ret)? {
                     $kernel::<N, true>($($arg),*)
                 }
-                if $crate::dispatch::fma_available() {
+                if $crate::platform::dispatch::fma_available() {
                     // SAFETY: the CPU supports AVX2 and FMA, checked just above.
                     return unsafe { fused::<N>($($arg),*) };
                 }

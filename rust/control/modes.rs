@@ -28,7 +28,7 @@
 //! arithmetic and without computing eigenvalues.
 
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::schur::{Dynamic, Fixed, Order, Square, with_order};
+use crate::linalg::schur::{Dynamic, Fixed, Order, Square, with_order};
 use faer::diag::Diag;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::{ComputeEigenvectors, evd_real, evd_scratch};
@@ -250,7 +250,7 @@ pub fn charpoly(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let (mut coefficients, scale) = with_order!(a.nrows(), order => {
-        let (h, scale) = crate::schur::balanced_hessenberg(Square::from_mat_in(order, a));
+        let (h, scale) = crate::linalg::schur::balanced_hessenberg(Square::from_mat_in(order, a));
         (hessenberg_characteristic_polynomial(&h), scale)
     });
     // H is similar to A / s: a_k(A) = s^k a_k(A / s), exactly for s a power of two.

@@ -17,7 +17,7 @@
 //! ```
 //!
 //! with no truncation error: the only errors are those of the matrix exponential
-//! ([`crate::expm`], accurate to a few units of u) and of one LU solve per step. Starting every
+//! ([`crate::linalg::expm`], accurate to a few units of u) and of one LU solve per step. Starting every
 //! step again from [I; S] (the modified Davison–Maki method; Kenney & Leipnik 1985) keeps X
 //! well conditioned, where the plain method, propagating [X; Y] over the whole horizon,
 //! lets the growing modes of e^{-Ht} swamp the others. A step is further divided so that
@@ -29,13 +29,13 @@
 //!
 //! For a uniform grid (the usual case) one exponential serves every step.
 
-use crate::care::check_problem;
+use crate::control::riccati::care::check_problem;
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::expm::expm;
-use crate::lu::solve_in_place;
-use crate::lyapunov::symmetrize;
+use crate::linalg::expm::expm;
+use crate::linalg::lu::solve_in_place;
+use crate::linalg::lyapunov::symmetrize;
+use crate::linalg::schur::eigenvalues;
 use crate::platform::interrupt;
-use crate::schur::eigenvalues;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };

@@ -1,7 +1,7 @@
 //! The continuous Lyapunov equation A X + X A^T + Q = 0, by the method of Bartels & Stewart
 //! (1972).
 //!
-//! With the real Schur form A = Z T Z^T ([`crate::schur`]) the equation becomes
+//! With the real Schur form A = Z T Z^T ([`crate::linalg::schur`]) the equation becomes
 //!
 //! ```text
 //! T Y + Y T^T = F,      F = -Z^T Q Z,      X = Z Y Z^T.
@@ -14,7 +14,7 @@
 //! ```
 //!
 //! so the blocks follow one another from the bottom right, each a Sylvester equation of order
-//! at most 4 (`crate::sylvester`). The solution exists and is unique exactly when no two
+//! at most 4 (`crate::linalg::sylvester`). The solution exists and is unique exactly when no two
 //! eigenvalues of A add up to zero (λ_i + λ_j ≠ 0); a stable A qualifies. Near that
 //! singularity a pivot of the small systems is perturbed and the solver refuses the result
 //! ([`Error::IllConditioned`]). The method is backward stable in the sense of Higham (1993):
@@ -29,13 +29,13 @@
 //! whose elimination costs O(n^6) flops but fewer than the Schur form's constant factor at
 //! these orders (the 4-state models of flight dynamics, and the Riccati solver's Newton steps).
 
-use crate::dense::Dense;
-use crate::dispatch::clear_upper_avx_state;
 use crate::error::{Error, check_finite, check_rows, check_square};
+use crate::linalg::dense::Dense;
+use crate::linalg::schur::real_schur;
+use crate::linalg::small_matrix::product;
+use crate::linalg::sylvester::solve_small_sylvester;
+use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
-use crate::schur::real_schur;
-use crate::small_matrix::product;
-use crate::sylvester::solve_small_sylvester;
 use faer::{Accum, Mat, MatRef, Par};
 
 /// The solution X of A X + X A^T + Q = 0 (symmetric when Q is).

@@ -1,7 +1,7 @@
 //! The small-bulge multishift QR iteration with aggressive early deflation, for the real Schur
 //! form of large upper Hessenberg matrices (from order [`MULTISHIFT_MIN_ORDER`]).
 //!
-//! The double-shift iteration of [`crate::schur`] chases one bulge at a time and applies each
+//! The double-shift iteration of [`crate::linalg::schur`] chases one bulge at a time and applies each
 //! 3 x 3 reflector as a rank-1 update of whole rows and columns: O(n^2) memory traffic per
 //! sweep for O(n^2) flops, so at orders of a few hundred it runs at the speed of memory, not of
 //! the arithmetic units. This module does what Braman, Byers & Mathias (2002) proposed and
@@ -51,16 +51,16 @@
 //! Maintaining well-focused shifts and level 3 performance; Part II: Aggressive early
 //! deflation. SIAM J. Matrix Anal. Appl. 23 (2002) 929-947 and 948-973.
 
-use crate::dispatch::{clear_upper_avx_state, fma_dispatch, multiply_add};
 use crate::error::Error;
-use crate::hessenberg::hessenberg;
-use crate::platform::interrupt;
-use crate::reorder::swap_blocks;
-use crate::schur::{
+use crate::linalg::hessenberg::hessenberg;
+use crate::linalg::schur::reorder::swap_blocks;
+use crate::linalg::schur::{
     MULTISHIFT_MIN_ORDER, Spectrum, Square, block_eigenvalues, double_shift, francis_qr,
     negligible_subdiagonal, quasi_triangular_eigenvalues, reflector, schur_of_hessenberg,
     shift_polynomial_column,
 };
+use crate::platform::dispatch::{clear_upper_avx_state, fma_dispatch, multiply_add};
+use crate::platform::interrupt;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par, c64};
 use std::ops::Range;

@@ -14,8 +14,8 @@
 //! the magnitudes of the terms, against 2^-53 for a double product. The exponential uses it where
 //! squaring amplifies rounding errors (see `expm.rs`).
 
-use crate::dispatch::fma_dispatch;
-use crate::small_matrix::SmallMatrix;
+use crate::linalg::small_matrix::SmallMatrix;
+use crate::platform::dispatch::fma_dispatch;
 
 /// (s, e) with s = fl(a + b) and s + e = a + b exactly (Knuth's branch-free two-sum).
 #[inline(always)]

@@ -17,7 +17,7 @@
 
 use faer::{Mat, MatRef};
 
-use crate::dispatch::{fma_dispatch, multiply_add};
+use crate::platform::dispatch::{fma_dispatch, multiply_add};
 
 type Rows<const N: usize> = [[f64; N]; N];
 
@@ -97,7 +97,7 @@ fn absolute_power_norm_kernel<const N: usize, const FMA: bool>(
 fma_dispatch!(fn absolute_power_norm<const N: usize>(a: &Rows<N>, scale: f64, p: usize) -> f64 => absolute_power_norm_kernel);
 
 /// Gaussian elimination with partial pivoting in place: the unit lower factor below the
-/// diagonal, the upper factor on and above it; row k was swapped with row pivots[k].
+/// diagonal, the upper factor on and above it; row k was swapped with row `pivots[k]`.
 #[inline(always)]
 fn lu_kernel<const N: usize, const FMA: bool>(a: &mut Rows<N>, pivots: &mut [usize; N]) {
     for k in 0..N {
@@ -324,7 +324,7 @@ impl<const N: usize> SmallMatrix<N> {
 pub struct SmallLu<const N: usize> {
     /// Unit lower factor below the diagonal, upper factor on and above it.
     factors: SmallMatrix<N>,
-    /// Row k was swapped with row pivots[k] at step k.
+    /// Row k was swapped with row `pivots[k]` at step k.
     pivots: [usize; N],
 }
 
@@ -339,7 +339,7 @@ impl<const N: usize> SmallLu<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::norm::one_norm;
+    use crate::linalg::norm::one_norm;
 
     fn sample<const N: usize>(seed: u64) -> SmallMatrix<N> {
         let mut state = seed;

@@ -17,10 +17,10 @@
 //! one discretisation; the outputs are written into caller-provided row-major buffers, so a
 //! 5001-sample response allocates nothing per step.
 
-use crate::discretize::{Discretization, Hold, discretize};
+use crate::control::discretize::{Discretization, Hold, discretize};
+use crate::control::frequency::check_state_space;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_positive};
-use crate::freq::check_state_space;
-use crate::norm::{LinearOperator, one_norm_estimate};
+use crate::linalg::norm::{LinearOperator, one_norm_estimate};
 use crate::platform::interrupt;
 use crate::platform::parallel::{ParallelContext, chunks, par_chunks};
 use faer::linalg::matmul::matmul;
@@ -81,7 +81,7 @@ struct Recurrence {
     m: usize,
     p: usize,
     phi: Vec<f64>,
-    /// Γ0 - Γ1, applied to η[k].
+    /// Γ0 - Γ1, applied to `η[k]`.
     gamma_now: Vec<f64>,
     /// Γ1, applied to η[k+1] (absent for a zero-order hold).
     gamma_next: Option<Vec<f64>>,
@@ -171,7 +171,7 @@ impl Recurrence {
     }
 
     /// Runs one response of `steps` samples: `x` (steps x n) and `y` (steps x p) row-major,
-    /// from `x0`, with `input(k)` the m values of η[k] (empty for a free response). Checks for
+    /// from `x0`, with `input(k)` the m values of `η[k]` (empty for a free response). Checks for
     /// an interruption every [`STEPS_PER_CHECK`] samples.
     fn run<'a>(
         &self,
@@ -455,7 +455,7 @@ pub fn steady_state(
     let inverse_norm = one_norm_estimate(&Inverse(&lu), 2);
     let cleared = x.is_all_finite() && 10.0 * (n as f64).sqrt() * inverse_norm * tolerance < 1.0;
     if !cleared {
-        let (eigenvalues, _) = crate::modes::eigen(a)?;
+        let (eigenvalues, _) = crate::control::modes::eigen(a)?;
         if let Some(lambda) = eigenvalues.iter().find(|l| l.norm() <= tolerance) {
             return Err(Error::Singular {
                 arg: "A",
@@ -591,7 +591,7 @@ mod tests {
             &mut y,
         )
         .unwrap();
-        let expected = crate::expm::expm((&a * faer::Scale(20.0)).as_ref()).unwrap() * &b;
+        let expected = crate::linalg::expm::expm((&a * faer::Scale(20.0)).as_ref()).unwrap() * &b;
         for i in 0..4 {
             assert!((x[200 * 4 + i] - expected[(i, 0)]).abs() < 1e-13);
         }

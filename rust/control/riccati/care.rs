@@ -28,11 +28,11 @@
 //! on it and the stable invariant subspace is spanned by the columns of [U11; U21] with U11
 //! nonsingular, Y = U21 U11^-1 is the stabilising solution and the stable eigenvalues of H are
 //! the closed-loop ones. The subspace comes from the real Schur form of H reordered to put
-//! Re λ < 0 first ([`crate::reorder`]); Y from U11^T Y = U21^T by an LU solve, then
+//! Re λ < 0 first ([`crate::linalg::schur::reorder`]); Y from U11^T Y = U21^T by an LU solve, then
 //! symmetrised. Up to order [`HAMILTONIAN_SHIFT_MAX_ORDER`] the QR iteration
-//! ([`crate::schur`]) estimates the eigenvalues of H from its even characteristic polynomial
+//! ([`crate::linalg::schur`]) estimates the eigenvalues of H from its even characteristic polynomial
 //! and takes the unstable ones as its first shifts, so that the unstable half deflates first.
-//! The iteration then stops ([`crate::schur`]'s `Until::UnstableHalf`): once the trailing n
+//! The iteration then stops ([`crate::linalg::schur`]'s `Until::UnstableHalf`): once the trailing n
 //! eigenvalues have deflated, all of them with Re λ beyond the axis tolerance, the leading n
 //! columns of Z span the stable subspace already, and the sweeps that would triangularise the
 //! leading block (two of six on the 747's regulator) are saved; the stable eigenvalues are
@@ -53,9 +53,9 @@
 //!
 //! The Schur method is backward stable for the Hamiltonian but not for the Riccati equation
 //! itself; Newton's method (Kleinman 1968) restores a small residual: with A_k = Ā - G Y_k,
-//! A_k^T Δ + Δ A_k = -Res(Y_k) ([`crate::lyapunov`]), Y_{k+1} = Y_k + Δ, repeated while the
+//! A_k^T Δ + Δ A_k = -Res(Y_k) ([`crate::linalg::lyapunov`]), Y_{k+1} = Y_k + Δ, repeated while the
 //! residual decreases and is above [`REFINEMENT_FLOOR`], a few units of rounding (at most
-//! [`MAX_REFINEMENT_STEPS`] times). Up to n = [`crate::lyapunov::KRONECKER_MAX_ORDER`] each step
+//! [`MAX_REFINEMENT_STEPS`] times). Up to n = [`crate::linalg::lyapunov::KRONECKER_MAX_ORDER`] each step
 //! is an exact step whose Lyapunov equation is solved directly in its vectorised form (10
 //! unknowns at n = 4: a fifth of the cost of the Schur route). Above, the first step needs no
 //! Schur form of A_0: the Hamiltonian's Schur form already factors the closed loop of the Schur
@@ -79,16 +79,16 @@
 //! a computed solution whose closed loop A - B K has an eigenvalue with Re λ >= 0 (the stable
 //! and unstable eigenvalues of H too ill-conditioned to be told apart).
 
-use crate::dense::{
+use crate::error::{Error, check_finite, check_rows, check_square};
+use crate::linalg::dense::{
     Dense, cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place,
     transposed_product,
 };
-use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::lu::{solve_in_place, solve_with_inverse};
-use crate::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity, symmetrize};
-use crate::norm::{frobenius_norm, max_abs, one_norm};
-use crate::reorder::reorder_schur;
-use crate::schur::{
+use crate::linalg::lu::{solve_in_place, solve_with_inverse};
+use crate::linalg::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity, symmetrize};
+use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
+use crate::linalg::schur::reorder::reorder_schur;
+use crate::linalg::schur::{
     Dynamic, Finished, Fixed, Order, RealSchur, Spectrum, Square, Until, balance, eigenvalues_near,
     quasi_triangular_eigenvalues, real_schur_with, square_schur_form, with_order,
 };

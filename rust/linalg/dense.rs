@@ -140,9 +140,9 @@ impl Dense {
     }
 
     /// sqrt(sum x_ij^2), by a plain sum of squares while it stays in the normal range, faer's
-    /// scaled sum otherwise (as [`crate::norm::frobenius_norm`]).
+    /// scaled sum otherwise (as [`crate::linalg::norm::frobenius_norm`]).
     pub(crate) fn frobenius_norm(&self) -> f64 {
-        crate::norm::frobenius_norm(self.as_ref())
+        crate::linalg::norm::frobenius_norm(self.as_ref())
     }
 }
 
@@ -164,11 +164,11 @@ impl IndexMut<(usize, usize)> for Dense {
 }
 
 /// Products of at most this many multiply-adds are plain loops, larger ones faer's blocked
-/// kernel (as [`crate::small_matrix::product`]).
+/// kernel (as [`crate::linalg::small_matrix::product`]).
 const LOOP_PRODUCT_MAX_WORK: usize = 16 * 16 * 16;
 
 /// lhs * rhs. Each entry of a small product is the sum over k, in order, of
-/// lhs[i, k] rhs[k, j], as [`crate::small_matrix::product`] forms it.
+/// lhs[i, k] rhs[k, j], as [`crate::linalg::small_matrix::product`] forms it.
 pub(crate) fn product(lhs: &Dense, rhs: &Dense) -> Dense {
     let (rows, inner, cols) = (lhs.rows, lhs.cols, rhs.cols);
     debug_assert_eq!(inner, rhs.rows);
@@ -433,7 +433,7 @@ mod tests {
     #[test]
     fn small_products_round_like_the_faer_matrix_product_loop() {
         let (a, b) = (seeded(4, 4, 3), seeded(4, 2, 4));
-        let expected = crate::small_matrix::product(a.as_ref(), b.as_ref());
+        let expected = crate::linalg::small_matrix::product(a.as_ref(), b.as_ref());
         let found = product(&Dense::from_ref(a.as_ref()), &Dense::from_ref(b.as_ref()));
         assert_eq!(found.to_mat(), expected);
         let found = transposed_product(

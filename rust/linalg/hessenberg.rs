@@ -7,7 +7,7 @@
 
 use crate::error::Error;
 use crate::platform::interrupt;
-use crate::pool::scratch;
+use crate::platform::pool::scratch;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::evd::hessenberg::{hessenberg_in_place, hessenberg_in_place_scratch};
 use faer::linalg::householder::{
@@ -53,7 +53,7 @@ fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) -> Result<(), Erro
         // Already Hessenberg.
         return Ok(());
     }
-    let par = crate::expm::parallelism_for_order(n);
+    let par = crate::linalg::expm::parallelism_for_order(n);
     let block_size = recommended_block_size::<f64>(n - 1, n - 1);
     let mut householder = scratch(block_size, n - 1);
     let requirement = StackReq::any_of(&[

@@ -1,0 +1,25 @@
+//! Numerical kernels, knowing nothing of control: they take matrices and return matrices.
+//!
+//! * [`small_matrix`], `dense`: matrices of the small orders of flight models, on the stack or
+//!   in plain vectors, for kernels whose arithmetic is cheaper than a general library's call.
+//! * [`lu`]: linear solves by LU with partial pivoting.
+//! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
+//! * [`hessenberg`]: the Hessenberg form and its transformation.
+//! * [`schur`]: the real Schur form (Francis double-shift QR, and small-bulge multishift QR with
+//!   aggressive early deflation at large orders), its eigenvalues, and reordering.
+//! * `polynomial_roots`: closed-form roots of polynomials of degree <= 4 (QR shifts).
+//! * `sylvester`: small Sylvester equations, the kernel of reordering and of Bartels–Stewart.
+//! * [`lyapunov`]: the continuous Lyapunov equation.
+//! * [`expm`]: the matrix exponential, with double-double arithmetic where squarings amplify
+//!   rounding.
+
+pub(crate) mod dense;
+pub mod expm;
+pub mod hessenberg;
+pub mod lu;
+pub mod lyapunov;
+pub mod norm;
+pub(crate) mod polynomial_roots;
+pub mod schur;
+pub mod small_matrix;
+pub(crate) mod sylvester;
