@@ -6,10 +6,11 @@
 //! 16 and 64).
 
 use aerocontrol::control::controllability::{controllability_staircase, ctrb, obsv};
-use aerocontrol::control::modes::{charpoly, modal_analysis};
+use aerocontrol::control::modes::modal_analysis;
 use aerocontrol::control::placement::companion_form;
 use aerocontrol::control::responses::steady_state;
 use aerocontrol::control::riccati::ode::riccati_ode;
+use aerocontrol::linalg::charpoly::charpoly;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
 use std::hint::black_box;

@@ -8,6 +8,7 @@ cannot take the test session with it.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -289,6 +290,31 @@ def test_threads_give_bitwise_the_results_of_one_thread() -> None:
         for mine, theirs in zip(got, expected, strict=True):
             for a, b in zip(mine, theirs, strict=True):
                 assert np.array_equal(a, b)
+
+
+def test_results_do_not_depend_on_the_number_of_threads() -> None:
+    # Large orders run faer's parallel kernels (products and LU of the exponential); the
+    # reductions whose rounding would depend on the number of threads run sequentially.
+    code = """
+        import hashlib, numpy as np, aerocontrol
+        rng = np.random.default_rng(1)
+        M = rng.standard_normal((450, 450)) / np.sqrt(450) - 0.5 * np.eye(450)
+        B = rng.standard_normal((450, 2))
+        results = [*aerocontrol.schur(M)[:2], aerocontrol.expm(M),
+                   aerocontrol.solve_lyapunov(M, np.eye(450)),
+                   aerocontrol.solve_care(M[:200, :200], B[:200], np.eye(200), np.eye(2)).X]
+        print([hashlib.sha256(r.tobytes()).hexdigest() for r in results])
+        """
+    one = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(code)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "RAYON_NUM_THREADS": "1"},
+    )
+    default = _child(code, timeout=300)
+    assert one.returncode == 0 and default.returncode == 0, one.stderr + default.stderr
+    assert one.stdout == default.stdout
 
 
 # ----- Ctrl-C -----------------------------------------------------------------------------------

@@ -21,9 +21,9 @@
 
 use super::errors::to_py_err;
 use crate::error::Error;
-use crate::linalg::expm::PARALLEL_MIN_ORDER;
 use crate::platform::interrupt::{self, Token};
 use crate::platform::memory::{self, SMALL_PRODUCT_MAX_ORDER};
+use crate::platform::parallel::PARALLEL_MIN_ORDER;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};

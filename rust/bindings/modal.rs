@@ -3,9 +3,8 @@
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
-use crate::control::modes::{
-    Mode, charpoly as charpoly_core, modal_analysis as modal_analysis_core,
-};
+use crate::control::modes::{Mode, modal_analysis as modal_analysis_core};
+use crate::linalg::charpoly::charpoly as charpoly_core;
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;

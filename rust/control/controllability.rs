@@ -62,7 +62,8 @@
 
 use crate::control::modes::eigen;
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::linalg::schur::{eigenvalues, reflector};
+use crate::linalg::householder::reflector;
+use crate::linalg::schur::eigenvalues;
 use crate::linalg::small_matrix::product;
 use faer::linalg::matmul::matmul;
 use faer::prelude::{IntoConst, Reborrow, ReborrowMut};

@@ -46,8 +46,9 @@
 //! ||A - BK||_F for a pole at 0).
 
 use crate::control::controllability::{controllability, controllability_staircase, krylov_blocks};
-use crate::control::modes::{charpoly, polynomial_from_roots};
+use crate::control::modes::polynomial_from_roots;
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
+use crate::linalg::charpoly::charpoly;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::{frobenius_norm, one_norm};
 use crate::linalg::schur::eigenvalues_near;

@@ -6,6 +6,10 @@
 //! Q H Q^T = A + E with ||E|| = O(u ||A||).
 
 use crate::error::Error;
+use crate::linalg::balance::{balance, range_scale};
+use crate::linalg::householder::reflector;
+use crate::linalg::square::{Order, Square};
+use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
 use crate::platform::pool::scratch;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -15,7 +19,7 @@ use faer::linalg::householder::{
     apply_block_householder_sequence_on_the_right_in_place_with_conj,
 };
 use faer::linalg::qr::no_pivoting::factor::recommended_block_size;
-use faer::{Conj, Mat, MatMut, MatRef};
+use faer::{Conj, Mat, MatMut, MatRef, Par};
 
 /// The Hessenberg form of a square matrix: A = Q H Q^T.
 #[derive(Debug, Clone)]
@@ -53,7 +57,9 @@ fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) -> Result<(), Erro
         // Already Hessenberg.
         return Ok(());
     }
-    let par = crate::linalg::expm::parallelism_for_order(n);
+    // Sequential at every order: faer's parallel reduction rounds differently with the
+    // number of threads, and the Schur forms and eigenvalues would depend on the machine.
+    let par = Par::Seq;
     let block_size = recommended_block_size::<f64>(n - 1, n - 1);
     let mut householder = scratch(block_size, n - 1);
     let requirement = StackReq::any_of(&[
@@ -91,6 +97,57 @@ fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) -> Result<(), Erro
         }
     }
     Ok(())
+}
+
+/// Up to this order the Hessenberg reduction is the plain Householder loop below; above it,
+/// faer's blocked reduction (whose set-up costs more than the whole reduction at n = 4).
+pub(crate) const UNBLOCKED_HESSENBERG_MAX_ORDER: usize = 32;
+
+/// The upper Hessenberg form H of the balanced D^-1 (A / s) D, with s the power of two that
+/// brings A's entries into range ([`range_scale`]): returns (H, s). H is similar to A / s, so
+/// it has the eigenvalues and the characteristic polynomial of A / s (the balancing is exact,
+/// the reduction backward stable). The caller checks that A is finite.
+pub(crate) fn balanced_hessenberg<O: Order>(mut h: Square<O>) -> (Square<O>, f64) {
+    let scale = range_scale(h.as_ref());
+    if scale != 1.0 {
+        h.data.as_mut().iter_mut().for_each(|x| *x /= scale);
+    }
+    let _ = balance(&mut h);
+    if h.n() <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+        reduce_to_hessenberg(&mut h, None);
+    } else {
+        h = Square::from_mat_in(h.order, hessenberg_matrix(h.to_mat().as_ref()).as_ref());
+    }
+    (h, scale)
+}
+
+/// Householder reduction to upper Hessenberg form in place, H = Q^T A Q; `q` (the identity on
+/// entry) becomes Q. Reflector k maps column k below the subdiagonal onto e_{k+1}.
+pub(crate) fn reduce_to_hessenberg<O: Order>(h: &mut Square<O>, mut q: Option<&mut Square<O>>) {
+    clear_upper_avx_state();
+    let n = h.n();
+    let mut w = [0.0; UNBLOCKED_HESSENBERG_MAX_ORDER];
+    for k in 0..n.saturating_sub(2) {
+        let length = n - k - 1;
+        let w = &mut w[..length];
+        for (r, x) in w.iter_mut().enumerate() {
+            *x = h[(k + 1 + r, k)];
+        }
+        let (beta, tau) = reflector(w);
+        if tau == 0.0 {
+            continue;
+        }
+        w[0] = 1.0;
+        h.reflect_rows(k + 1, w, tau, k + 1..n);
+        h.reflect_columns(k + 1, w, tau, 0..n);
+        h[(k + 1, k)] = beta;
+        for r in k + 2..n {
+            h[(r, k)] = 0.0;
+        }
+        if let Some(q) = q.as_deref_mut() {
+            q.reflect_columns(k + 1, w, tau, 0..n);
+        }
+    }
 }
 
 #[cfg(test)]

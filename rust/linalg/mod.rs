@@ -13,13 +13,17 @@
 //! * [`expm`]: the matrix exponential, with double-double arithmetic where squarings amplify
 //!   rounding.
 
+pub(crate) mod balance;
+pub mod charpoly;
 pub(crate) mod dense;
 pub mod expm;
 pub mod hessenberg;
+pub(crate) mod householder;
 pub mod lu;
 pub mod lyapunov;
 pub mod norm;
 pub(crate) mod polynomial_roots;
 pub mod schur;
 pub mod small_matrix;
+pub(crate) mod square;
 pub(crate) mod sylvester;

@@ -40,6 +40,21 @@ impl ParallelContext {
     }
 }
 
+/// Matrices of at least this order use faer's multithreaded kernels (products, LU, the
+/// Hessenberg reduction) within a single problem.
+pub const PARALLEL_MIN_ORDER: usize = 400;
+
+/// The threading of faer's kernels on matrices of order n: parallel from
+/// [`PARALLEL_MIN_ORDER`], once every thread of the pool holds faer's product workspace
+/// ([`memory::parallel_products_allowed`]).
+pub fn parallelism_for_order(n: usize) -> faer::Par {
+    if n >= PARALLEL_MIN_ORDER && memory::parallel_products_allowed() {
+        faer::Par::rayon(0)
+    } else {
+        faer::Par::Seq
+    }
+}
+
 /// The `count` consecutive chunks of `size` entries of `data` (which holds `count * size`), as
 /// an indexed parallel iterator: `count` empty slices when `size` is 0, where rayon's
 /// `par_chunks_mut` would yield none (and panics for a size of 0).

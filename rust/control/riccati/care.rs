@@ -80,6 +80,7 @@
 //! and unstable eigenvalues of H too ill-conditioned to be told apart).
 
 use crate::error::{Error, check_finite, check_rows, check_square};
+use crate::linalg::balance::balance;
 use crate::linalg::dense::{
     Dense, cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place,
     transposed_product,
@@ -89,9 +90,10 @@ use crate::linalg::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity, symmetrize
 use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
 use crate::linalg::schur::reorder::reorder_schur;
 use crate::linalg::schur::{
-    Dynamic, Finished, Fixed, Order, RealSchur, Spectrum, Square, Until, balance, eigenvalues_near,
-    quasi_triangular_eigenvalues, real_schur_with, square_schur_form, with_order,
+    Finished, RealSchur, Spectrum, Until, eigenvalues_near, quasi_triangular_eigenvalues,
+    real_schur_with, square_schur_form,
 };
+use crate::linalg::square::{Order, Square, with_order};
 use faer::{Mat, MatRef, Par, c64};
 
 /// Eigenvalues of H with |Re λ| <= AXIS_TOLERANCE ||H||_F count as on the imaginary axis.

@@ -65,19 +65,16 @@ use crate::linalg::expm::double_double::DoubleDoubleMatrix;
 use crate::linalg::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
 use crate::linalg::small_matrix::SmallMatrix;
 use crate::platform::dispatch::{add_scaled, scale_into};
-use crate::platform::parallel::ParallelContext;
+use crate::platform::parallel::{PARALLEL_MIN_ORDER, ParallelContext, parallelism_for_order};
 use crate::platform::pool::{Scratch, scratch};
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatMut, MatRef, Par};
+use faer::{Accum, Mat, MatMut, MatRef};
 use rayon::prelude::*;
 
 /// For n up to this order the norms ||A^8||_1 and ||A^10||_1 of the degree selection are exact
 /// (from formed products); above it they are estimated (Higham & Tisseur 2000), which costs
 /// O(n^2) instead of a matrix product.
 pub const EXACT_NORM_MAX_ORDER: usize = 150;
-
-/// Matrices of at least this order use multithreaded products and LU in a single exponential.
-pub const PARALLEL_MIN_ORDER: usize = 400;
 
 /// Orders up to this run on fixed-size stack matrices; larger ones on faer.
 pub const SMALL_MAX_ORDER: usize = 8;
@@ -686,15 +683,6 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 }
 
 // ----- faer matrices (any order), pooled ----------------------------------------------------
-
-/// The threading of the products of one exponential of order n.
-pub fn parallelism_for_order(n: usize) -> Par {
-    if n >= PARALLEL_MIN_ORDER && crate::platform::memory::parallel_products_allowed() {
-        Par::rayon(0)
-    } else {
-        Par::Seq
-    }
-}
 
 impl PadeArithmetic for Scratch {
     fn product(&self, rhs: &Self) -> Self {

@@ -53,17 +53,45 @@
 
 use crate::error::Error;
 use crate::linalg::hessenberg::hessenberg;
-use crate::linalg::schur::reorder::swap_blocks;
-use crate::linalg::schur::{
-    MULTISHIFT_MIN_ORDER, Spectrum, Square, block_eigenvalues, double_shift, francis_qr,
-    negligible_subdiagonal, quasi_triangular_eigenvalues, reflector, schur_of_hessenberg,
-    shift_polynomial_column,
+use crate::linalg::householder::reflector;
+use crate::linalg::schur::form::{block_eigenvalues, quasi_triangular_eigenvalues};
+use crate::linalg::schur::francis::{
+    Spectrum, double_shift, francis_qr, negligible_subdiagonal, shift_polynomial_column,
 };
+use crate::linalg::schur::reorder::swap_blocks;
+use crate::linalg::square::Square;
 use crate::platform::dispatch::{clear_upper_avx_state, fma_dispatch, multiply_add};
 use crate::platform::interrupt;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par, c64};
 use std::ops::Range;
+
+/// From this order on the QR iteration is the small-bulge multishift iteration with aggressive
+/// early deflation ([`crate::linalg::schur::multishift`]); below it, and on the active blocks below it that the
+/// multishift iteration leaves, the double-shift iteration of this module, whose set-up is
+/// nothing. LAPACK's crossover is 75 (its NMIN); measured here, see the module docs.
+pub(crate) const MULTISHIFT_MIN_ORDER: usize = 75;
+
+/// The QR iteration of an upper Hessenberg `h`, in place: the double-shift iteration below
+/// [`MULTISHIFT_MIN_ORDER`], the small-bulge multishift iteration ([`crate::linalg::schur::multishift`]) from
+/// there.
+///
+/// With `full` the whole of `h` is transformed into the Schur form T (and `z`, if given, is
+/// multiplied on the right by the orthogonal transformations); without it only the diagonal
+/// blocks are formed, which suffices for the eigenvalues. The known shifts of a Hamiltonian
+/// `spectrum` serve the double-shift iteration only.
+pub(crate) fn schur_of_hessenberg(
+    h: &mut Square,
+    z: Option<&mut Square>,
+    full: bool,
+    spectrum: Spectrum,
+) -> Result<(), Error> {
+    if h.n() < MULTISHIFT_MIN_ORDER {
+        francis_qr(h, z, (0, h.n().saturating_sub(1)), full, spectrum)
+    } else {
+        multishift_qr(h, z, full)
+    }
+}
 
 /// The iteration limit is this many iterations (deflation passes, each with at most one sweep)
 /// per row, as in the double-shift iteration and LAPACK.

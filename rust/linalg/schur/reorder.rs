@@ -45,7 +45,8 @@
 //! complex pair is selected by its member with positive imaginary part.
 
 use crate::error::Error;
-use crate::linalg::schur::{RealSchur, quasi_triangular_eigenvalues, reflector, standardize_block};
+use crate::linalg::householder::reflector;
+use crate::linalg::schur::form::{RealSchur, quasi_triangular_eigenvalues, standardize_block};
 use crate::linalg::sylvester::solve_small_sylvester;
 use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;

@@ -1,0 +1,77 @@
+//! Diagonal similarities that scale a matrix before its eigenvalues are computed: a power of
+//! two that brings its entries into range, and balancing (Parlett & Reinsch 1969), a diagonal
+//! of powers of two that equalises row and column norms. Both are exact in floating point.
+
+use crate::linalg::norm::max_abs;
+use crate::linalg::square::{Order, Square};
+use crate::platform::dispatch::clear_upper_avx_state;
+use faer::MatRef;
+
+/// Entries of the largest magnitude outside [`SMALL_ENTRY`], 1 / [`SMALL_ENTRY`] are brought
+/// to 1 first (as LAPACK's dgees scales): the deflation tests compare entries with the
+/// smallest normal number, so a matrix whose entries are all below about 1e-290 would
+/// otherwise count as negligible everywhere and come back as a wrong Schur form (residual
+/// 0.7), and one near the overflow threshold would overflow in the shifts.
+const SMALL_ENTRY: f64 = 1.0e-150;
+
+/// The power of two by which `a` is divided before its Schur form, 1 when its largest entry
+/// is in range (the scaling is exact, and A = Z (s T) Z^T with the same Z).
+pub(crate) fn range_scale(a: MatRef<'_, f64>) -> f64 {
+    let largest = max_abs(a);
+    if largest > 0.0 && !(SMALL_ENTRY..=1.0 / SMALL_ENTRY).contains(&largest) {
+        2f64.powi(largest.log2().round() as i32)
+    } else {
+        1.0
+    }
+}
+
+/// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
+/// row and column i are scaled until their off-diagonal 2-norms are within a factor of two, and
+/// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more. Returns
+/// the diagonal of D.
+pub(crate) fn balance<O: Order>(a: &mut Square<O>) -> Vec<f64> {
+    clear_upper_avx_state();
+    let n = a.n();
+    let mut scale = vec![1.0; n];
+    let mut changed = true;
+    let mut sweeps = 0;
+    while changed && sweeps < 100 {
+        changed = false;
+        sweeps += 1;
+        for i in 0..n {
+            let (mut column_squares, mut row_squares) = (0.0, 0.0);
+            for k in 0..n {
+                if k != i {
+                    column_squares += a[(k, i)] * a[(k, i)];
+                    row_squares += a[(i, k)] * a[(i, k)];
+                }
+            }
+            if column_squares == 0.0
+                || row_squares == 0.0
+                || !(column_squares + row_squares).is_finite()
+            {
+                continue;
+            }
+            // The scaling by powers of two works on the squared norms (exactly, by fours).
+            let (mut c, mut r, mut f) = (column_squares, row_squares, 1.0f64);
+            while c < r / 4.0 && f < 2f64.powi(500) {
+                (c, r, f) = (c * 4.0, r / 4.0, f * 2.0);
+            }
+            while c >= r * 4.0 && f > 2f64.powi(-500) {
+                (c, r, f) = (c / 4.0, r * 4.0, f / 2.0);
+            }
+            if f != 1.0 && c.sqrt() + r.sqrt() < 0.95 * (column_squares.sqrt() + row_squares.sqrt())
+            {
+                changed = true;
+                scale[i] *= f;
+                // f is a power of two: multiplying by 1 / f rounds as dividing by f.
+                let f_inverse = 1.0 / f;
+                for k in 0..n {
+                    a[(i, k)] *= f_inverse;
+                    a[(k, i)] *= f;
+                }
+            }
+        }
+    }
+    scale
+}
