@@ -6,7 +6,7 @@
 //! 16 and 64).
 
 use aerocontrol::control::controllability::{controllability_staircase, ctrb, obsv};
-use aerocontrol::control::modes::modal_analysis;
+use aerocontrol::control::modal::modal_analysis;
 use aerocontrol::control::placement::companion_form;
 use aerocontrol::control::responses::steady_state;
 use aerocontrol::control::riccati::ode::riccati_ode;

@@ -9,7 +9,7 @@
 
 use aerocontrol::control::discretize::Hold;
 use aerocontrol::control::frequency::frequency_response_into;
-use aerocontrol::control::modes::eigen;
+use aerocontrol::control::modal::eigen;
 use aerocontrol::control::responses::{Input, Model, simulate_into};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::{Mat, MatRef, c64, mat};

@@ -44,7 +44,7 @@ from .exceptions import (
     UncontrollableError,
 )
 from .frequency import FrequencyResponse, bode, default_frequency_grid, frequency_response
-from .linalg import Discretization, discretize, expm, transition_matrix
+from .linalg import Discretization, discretize, expm, schur, transition_matrix
 from .modal import Modes, charpoly, modes
 from .placement import (
     CompanionForm,
@@ -73,8 +73,8 @@ from .riccati import (
     lqr_finite,
     riccati_ode,
     solve_care,
+    solve_lyapunov,
 )
-from .schur import schur, solve_lyapunov
 from .statespace import StateSpace, as_state_space
 
 try:

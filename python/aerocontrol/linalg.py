@@ -1,4 +1,5 @@
-"""The matrix exponential, state transition matrices and exact discretisation.
+"""The matrix exponential, state transition matrices, exact discretisation, and the real Schur
+form with reordering.
 
 Chapter §6.1.2: the transition matrix of x' = Ax + Bη is Φ(t) = e^{At} (6.22), and the
 response to an input held over a step follows from Φ and two integrals of it (6.9).
@@ -6,14 +7,20 @@ response to an input held over a step follows from Φ and two integrals of it (6
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Literal
 
+import numpy as np
+from numpy.typing import NDArray
+
 from . import _core
 from ._validation import FloatArray, check_choice, real_array, real_scalar
-from .exceptions import ShapeError
+from .exceptions import InvalidArgumentError, ShapeError
 
-__all__ = ["Discretization", "discretize", "expm", "transition_matrix"]
+__all__ = ["Discretization", "discretize", "expm", "schur", "transition_matrix"]
+
+ComplexArray = NDArray[np.complex128]
 
 
 def expm(A: Any) -> FloatArray:
@@ -170,3 +177,68 @@ def discretize(A: Any, B: Any, dt: float, method: Literal["zoh", "foh"] = "zoh")
     )
     Phi, Gamma0, Gamma1 = _core.discretize(A, B, step, hold)
     return Discretization(Phi=Phi, Gamma0=Gamma0, Gamma1=Gamma1, dt=step, method=hold)
+
+
+#: The named selections of :func:`schur` (scipy.linalg.schur's ``sort`` names).
+SELECTIONS: dict[str, Callable[[complex], bool]] = {
+    "lhp": lambda z: z.real < 0.0,
+    "rhp": lambda z: z.real > 0.0,
+    "iuc": lambda z: abs(z) < 1.0,
+    "ouc": lambda z: abs(z) > 1.0,
+}
+
+
+def schur(
+    A: Any, select: str | Callable[[complex], bool] | None = None
+) -> tuple[FloatArray, FloatArray, ComplexArray]:
+    """The real Schur form A = Q T Q^T, optionally reordered.
+
+    Hessenberg reduction, then the Francis double-shift QR iteration with Ahues-Tisseur
+    deflation and exceptional shifts (an iteration bound turns a failure into
+    ``ConvergenceError``, never a hang). With ``select``, the diagonal blocks are exchanged
+    (Bai & Demmel's direct swap with its stability tests, as LAPACK's dtrsen) until every
+    selected eigenvalue comes first.
+
+    Parameters
+    ----------
+    A : array_like (n, n), real and finite
+    select : None, "lhp", "rhp", "iuc", "ouc", or a callable
+        The eigenvalues to put first: Re < 0, Re > 0, |λ| < 1, |λ| > 1, or those for which
+        ``select(λ)`` is true (called with the member of a complex pair that has Im > 0; the
+        pair moves together).
+
+    Returns
+    -------
+    T : ndarray (n, n)
+        Quasi-upper-triangular, exact zeros below the 1 x 1 and 2 x 2 diagonal blocks.
+    Q : ndarray (n, n)
+        Orthogonal.
+    eigenvalues : ndarray (n,) of complex128
+        In the order of T's diagonal, pairs adjacent with Im > 0 first.
+
+    Raises
+    ------
+    IllConditionedError
+        A swap was rejected: two blocks to exchange have nearly equal eigenvalues.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A = np.array([[1.0, 2.0, 0.0], [0.0, -1.0, 3.0], [0.0, 0.0, 2.0]])
+    >>> T, Q, w = aerocontrol.schur(A, "lhp")
+    >>> w.real
+    array([-1.,  1.,  2.])
+    >>> bool(np.allclose(Q @ T @ Q.T, A))
+    True
+    """
+    if isinstance(select, str):
+        if select not in SELECTIONS:
+            raise InvalidArgumentError(
+                f"select must be one of {', '.join(map(repr, SELECTIONS))} or a callable, "
+                f"got {select!r}"
+            )
+        select = SELECTIONS[select]
+    elif select is not None and not callable(select):
+        raise InvalidArgumentError(f"select must be a name or a callable, got {select!r}")
+    T, Q, eigenvalues, _ = _core.schur(A, select)
+    return T, Q, eigenvalues

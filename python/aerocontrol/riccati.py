@@ -1,4 +1,5 @@
-"""Optimal control: the algebraic and differential Riccati equations and LQR (chapter §6.6).
+"""Optimal control: the algebraic and differential Riccati equations and LQR (chapter §6.6),
+and the Lyapunov equation that Newton's method for the Riccati equation solves at each step.
 
 The regulator that minimises J = ∫ (x^T Q x + η^T R η) dt (6.190) is η = -K x with
 K = R^-1 B^T S (6.200), where S solves the Riccati differential equation (6.196) backward from
@@ -8,6 +9,7 @@ S(t_f) = S_f, or, for an infinite horizon, the algebraic equation (6.199).
   with a cross weight S and a descriptor matrix E, by the Hamiltonian ordered-Schur method
   (scaled, then refined by Newton's method), with its residual and conditioning;
 * :func:`lqr`: python-control's ``lqr`` call and return convention, (K, S, E);
+* :func:`solve_lyapunov`: A X + X A^T + Q = 0 by Bartels-Stewart;
 * :func:`riccati_ode` and :func:`lqr_finite`: the finite-horizon solution S(t) and gain K(t)
   on a time grid, exact up to rounding at any step (the Hamiltonian transition matrix,
   re-normalised every step).
@@ -34,6 +36,7 @@ __all__ = [
     "lqr_finite",
     "riccati_ode",
     "solve_care",
+    "solve_lyapunov",
 ]
 
 ComplexArray = NDArray[np.complex128]
@@ -293,3 +296,22 @@ def lqr_finite(
     (len(t), m, n); arguments as :func:`riccati_ode`."""
     gains: FloatArray = riccati_ode(A_or_sys, B, Q, R, t, Sf).K
     return gains
+
+
+def solve_lyapunov(A: Any, Q: Any) -> FloatArray:
+    """The solution X of the continuous Lyapunov equation A X + X A^T + Q = 0.
+
+    Bartels-Stewart: with A = U T U^T, T Y + Y T^T = -U^T Q U is solved block by block from
+    the bottom right, and X = U Y U^T (symmetric when Q is). The solution is unique unless two
+    eigenvalues of A add up to zero; that case raises ``IllConditionedError``. For a stable A
+    and Q = C^T C, X is the observability Gramian of (C, A^T).
+
+    Note the sign: scipy.linalg.solve_continuous_lyapunov(A, Q) solves A X + X A^T = Q.
+
+    >>> import numpy as np, aerocontrol
+    >>> aerocontrol.solve_lyapunov([[-1.0, 0.0], [0.0, -3.0]], [[2.0, 4.0], [4.0, 6.0]])
+    array([[1., 1.],
+           [1., 1.]])
+    """
+    X: FloatArray = _core.solve_lyapunov(A, Q)
+    return X

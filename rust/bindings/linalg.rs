@@ -1,5 +1,5 @@
-//! Bindings of `aerocontrol.linalg`: the matrix exponential, transition matrices and exact
-//! discretisation.
+//! Bindings of `aerocontrol.linalg`: the matrix exponential, transition matrices, exact
+//! discretisation, and the real Schur form with reordering.
 
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real, new_array, new_array_data};
@@ -8,9 +8,12 @@ use crate::control::discretize::{Hold, discretize as discretize_core};
 use crate::error::{Error, check_square};
 use crate::linalg::expm::{expm_into, pade_choice, transition_matrices_into};
 use crate::linalg::norm::one_norm;
-use faer::{MatMut, MatRef};
+use crate::linalg::schur::reorder::{OrderedSchur, reorder_schur};
+use crate::linalg::schur::{quasi_triangular_eigenvalues, real_schur};
+use faer::{MatMut, MatRef, c64};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
+use pyo3::types::PyComplex;
 
 /// Floating-point operations of one exponential of order n (a Padé evaluation of degree 13 and
 /// a few squarings: about ten products).
@@ -211,7 +214,81 @@ fn expm_pade_choice(py: Python<'_>, a: &Bound<'_, PyAny>) -> PyResult<(usize, u3
     compute(py, Cost::of(expm_flops(n) / 4.0, 8.0, n), || pade_choice(a))
 }
 
+/// The cost of the real Schur form of order n, with Z.
+pub fn schur_cost(n: usize) -> Cost {
+    Cost::of(25.0 * (n as f64).powi(3), 6.0, n)
+}
+
+type SchurOutput<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    usize,
+);
+
+/// The real Schur form A = Z T Z^T, reordered when `select` (a callable on an eigenvalue,
+/// called once per diagonal block) is given: (T, Z, eigenvalues, number selected).
+///
+/// `select` runs with the GIL taken for each call, while the Schur form itself is computed
+/// with the GIL released; the first exception it raises is re-raised after the reordering.
+#[pyfunction]
+#[pyo3(signature = (a, select, /))]
+fn schur<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    select: Option<&Bound<'py, PyAny>>,
+) -> PyResult<SchurOutput<'py>> {
+    let a = Real::convert(py, a, "A")?;
+    let a = a.matrix().map_err(|e| to_py_err(py, e))?;
+    let select: Option<Py<PyAny>> = select.map(|s| s.clone().unbind());
+    let (ordered, failure) = compute(py, schur_cost(a.nrows()), || {
+        let form = real_schur(a)?;
+        let Some(select) = select else {
+            let eigenvalues = quasi_triangular_eigenvalues(form.t.as_ref());
+            let selected = eigenvalues.len();
+            let ordered = OrderedSchur {
+                t: form.t,
+                z: form.z,
+                eigenvalues,
+                selected,
+            };
+            return Ok((ordered, None));
+        };
+        let mut failure: Option<PyErr> = None;
+        let chooser = |lambda: c64| -> bool {
+            if failure.is_some() {
+                return false;
+            }
+            Python::attach(|py| {
+                let value = PyComplex::from_doubles(py, lambda.re, lambda.im);
+                match select.bind(py).call1((value,)).and_then(|r| r.is_truthy()) {
+                    Ok(chosen) => chosen,
+                    Err(error) => {
+                        failure = Some(error);
+                        false
+                    }
+                }
+            })
+        };
+        let ordered = reorder_schur(form, chooser)?;
+        Ok((ordered, failure))
+    })?;
+    if let Some(error) = failure {
+        return Err(error);
+    }
+    let mut outputs = Outputs::new(py);
+    let n = ordered.eigenvalues.len();
+    Ok((
+        outputs.matrix("T", ordered.t.as_ref())?,
+        outputs.matrix("Z", ordered.z.as_ref())?,
+        outputs.complex("the eigenvalues", &[n], &ordered.eigenvalues)?,
+        ordered.selected,
+    ))
+    .and_then(|result| outputs.finish().map(|()| result))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(schur, m)?)?;
     m.add_function(wrap_pyfunction!(expm, m)?)?;
     m.add_function(wrap_pyfunction!(transition_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(discretize, m)?)?;

@@ -21,7 +21,6 @@ mod modal;
 mod placement;
 mod responses;
 mod riccati;
-mod schur;
 mod statespace;
 
 use pyo3::prelude::*;
@@ -40,7 +39,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     modal::register(m)?;
     controllability::register(m)?;
     placement::register(m)?;
-    schur::register(m)?;
     riccati::register(m)?;
     batch::register(m)?;
     m.add(

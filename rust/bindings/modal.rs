@@ -3,7 +3,7 @@
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
-use crate::control::modes::{Mode, modal_analysis as modal_analysis_core};
+use crate::control::modal::{Mode, modal_analysis as modal_analysis_core};
 use crate::linalg::charpoly::charpoly as charpoly_core;
 use faer::c64;
 use numpy::PyArrayDyn;

@@ -1,12 +1,13 @@
-//! Bindings of `aerocontrol.riccati`: the algebraic Riccati equation and the Riccati
-//! differential equation.
+//! Bindings of `aerocontrol.riccati`: the algebraic Riccati equation, the Riccati
+//! differential equation, and the Lyapunov equation.
 
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
-use super::linalg::expm_flops;
+use super::linalg::{expm_flops, schur_cost};
 use crate::control::riccati::care::{CareOptions, solve_care as solve_care_core};
 use crate::control::riccati::ode::riccati_ode as riccati_ode_core;
+use crate::linalg::lyapunov::solve_lyapunov as solve_lyapunov_core;
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -127,7 +128,27 @@ fn riccati_ode<'py>(
     Ok(result)
 }
 
+/// The solution X of A X + X A^T + Q = 0.
+#[pyfunction]
+#[pyo3(signature = (a, q, /))]
+fn solve_lyapunov<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let (a, q) = (Real::convert(py, a, "A")?, Real::convert(py, q, "Q")?);
+    let (a, q) = (|| Ok((a.matrix()?, q.matrix()?)))().map_err(|e| to_py_err(py, e))?;
+    let n = a.nrows();
+    let cost = schur_cost(n).then(Cost::of(4.0 * (n as f64).powi(3), 4.0, n));
+    let x = compute(py, cost, || solve_lyapunov_core(a, q))?;
+    let mut outputs = Outputs::new(py);
+    let out = outputs.matrix("X", x.as_ref())?;
+    outputs.finish()?;
+    Ok(out)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(solve_lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(solve_care, m)?)?;
     m.add_function(wrap_pyfunction!(riccati_ode, m)?)?;
     Ok(())

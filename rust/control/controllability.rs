@@ -60,7 +60,7 @@
 //! Observability is the dual: (A, C) is observable if and only if (A^T, C^T) is controllable,
 //! and the unobservable eigenvalues of (A, C) are the uncontrollable ones of (A^T, C^T).
 
-use crate::control::modes::eigen;
+use crate::control::modal::eigen;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::householder::reflector;
 use crate::linalg::schur::eigenvalues;

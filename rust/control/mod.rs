@@ -4,7 +4,7 @@
 //!   (Van Loan 1978), exact for singular A.
 //! * [`responses`]: time responses on a uniform grid, by one discretisation and a recurrence.
 //! * [`frequency`]: frequency responses through one Hessenberg reduction.
-//! * [`modes`]: eigenvalues, modes and their characteristics, the characteristic polynomial.
+//! * [`modal`]: eigenvalues, modes and their characteristics, the modal matrix.
 //! * [`controllability`]: controllability and observability matrices, the staircase and modal
 //!   verdicts.
 //! * [`placement`]: pole placement: Bass–Gura, Ackermann and the robust multi-input method.
@@ -15,7 +15,7 @@ pub mod batch;
 pub mod controllability;
 pub mod discretize;
 pub mod frequency;
-pub mod modes;
+pub mod modal;
 pub mod placement;
 pub mod responses;
 pub mod riccati;

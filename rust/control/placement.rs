@@ -46,7 +46,7 @@
 //! ||A - BK||_F for a pole at 0).
 
 use crate::control::controllability::{controllability, controllability_staircase, krylov_blocks};
-use crate::control::modes::polynomial_from_roots;
+use crate::control::modal::polynomial_from_roots;
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
 use crate::linalg::charpoly::charpoly;
 use crate::linalg::lu::solve_with_inverse;

@@ -455,7 +455,7 @@ pub fn steady_state(
     let inverse_norm = one_norm_estimate(&Inverse(&lu), 2);
     let cleared = x.is_all_finite() && 10.0 * (n as f64).sqrt() * inverse_norm * tolerance < 1.0;
     if !cleared {
-        let (eigenvalues, _) = crate::control::modes::eigen(a)?;
+        let (eigenvalues, _) = crate::control::modal::eigen(a)?;
         if let Some(lambda) = eigenvalues.iter().find(|l| l.norm() <= tolerance) {
             return Err(Error::Singular {
                 arg: "A",
