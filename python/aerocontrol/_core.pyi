@@ -23,6 +23,7 @@ __all__ = [
     "companion_form",
     "controllability",
     "discretize",
+    "exception_classes",
     "expm",
     "expm_pade_choice",
     "frequency_response",
@@ -48,6 +49,7 @@ ILL_CONDITIONED_CONTROLLABILITY: float
 POLE_ERROR_WARNING: float
 PRODUCT_WORKSPACE_BYTES: int
 
+def exception_classes() -> list[str]: ...
 def expm(a: ArrayLike, /) -> NDArray[np.float64]: ...
 def transition_matrices(a: ArrayLike, t: ArrayLike, /) -> NDArray[np.float64]: ...
 def discretize(

@@ -50,7 +50,22 @@ __all__ = [
 
 
 class AerocontrolError(Exception):
-    """Base class of every exception raised by aerocontrol."""
+    """Base class of every exception raised by aerocontrol.
+
+    Errors raised by the native core carry their data as attributes; an attribute that does
+    not apply is None.
+    """
+
+    argument: str | None = None
+    """The name of the argument at fault (``"B"``, ``"poles"``), if one is."""
+    batch_index: int | None = None
+    """For a batch function: the index of the first problem that failed."""
+    entry: list[int] | None = None
+    """For a NonFiniteError: the index of the first entry that is NaN or infinite."""
+    value: float | None = None
+    """The value at fault: the non-finite entry, or the scalar out of its domain."""
+    eigenvalues: list[complex] | None = None
+    """For an UncontrollableError: the eigenvalues that no feedback can move."""
 
 
 class InvalidArgumentError(AerocontrolError, ValueError):

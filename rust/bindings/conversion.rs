@@ -19,7 +19,7 @@
 //! non-finite value of a result that should be finite and issues one `NumericalOverflowWarning`
 //! naming the results that overflowed.
 
-use super::errors::{to_py_err, warn};
+use super::errors::{Class, to_py_err, warn};
 use crate::control::batch::MatrixStack;
 use crate::error::Error;
 use faer::{Mat, MatMut, MatRef, c64};
@@ -416,6 +416,6 @@ impl<'py> Outputs<'py> {
                 "have"
             }
         );
-        warn(self.py, "NumericalOverflowWarning", &message)
+        warn(self.py, Class::NumericalOverflowWarning, &message)
     }
 }

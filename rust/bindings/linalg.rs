@@ -3,7 +3,7 @@
 
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real, new_array, new_array_data};
-use super::errors::{raise, to_py_err, warn};
+use super::errors::{Class, raise, to_py_err, warn};
 use crate::control::discretize::{Hold, discretize as discretize_core};
 use crate::error::{Error, check_square};
 use crate::linalg::expm::{expm_into, pade_choice, transition_matrices_into};
@@ -37,7 +37,7 @@ fn warn_if_ill_conditioned(py: Python<'_>, a_norm: f64, t_max: f64) -> PyResult<
              number is at least ||tA||_2, so the rounding of the input alone can change every \
              digit of the result"
         );
-        warn(py, "IllConditionedWarning", &message)?;
+        warn(py, Class::IllConditionedWarning, &message)?;
     }
     Ok(())
 }
@@ -99,7 +99,7 @@ fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
                         "the matrix exponential overflowed double precision: the result has \
                          infinite or NaN entries (matrices {overflowed:?} of the stack)"
                     );
-                    warn(py, "NumericalOverflowWarning", &message)?;
+                    warn(py, Class::NumericalOverflowWarning, &message)?;
                 }
                 let largest_norm = a
                     .values()
@@ -161,7 +161,7 @@ pub fn hold_from_method(py: Python<'_>, method: &str) -> PyResult<Hold> {
         "foh" => Ok(Hold::First),
         other => Err(raise(
             py,
-            "InvalidArgumentError",
+            Class::InvalidArgumentError,
             format!("method must be \"zoh\" or \"foh\", got {other:?}"),
         )),
     }

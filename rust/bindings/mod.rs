@@ -32,6 +32,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // methods (small QR, LU and SVD in the placement code) follow the global setting, whose
     // default, rayon, costs more in dispatch than a 4 x 4 factorisation takes.
     faer::set_global_parallelism(faer::Par::Seq);
+    errors::load(m.py())?;
+    m.add_function(wrap_pyfunction!(errors::exception_classes, m)?)?;
     linalg::register(m)?;
     statespace::register(m)?;
     responses::register(m)?;

@@ -2,7 +2,7 @@
 
 use super::compute::{Cost, compute};
 use super::conversion::{Complex, Outputs, Real};
-use super::errors::{raise, to_py_err, warn};
+use super::errors::{Class, raise, to_py_err, warn};
 use crate::control::batch::Placer;
 use crate::control::placement::{
     ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING, companion_form as companion_form_core,
@@ -70,7 +70,7 @@ pub fn placer_for(py: Python<'_>, method: &str) -> PyResult<Placer> {
         "knv0" => Ok(place_core),
         other => Err(raise(
             py,
-            "InvalidArgumentError",
+            Class::InvalidArgumentError,
             format!("unknown placement method {other:?}"),
         )),
     }
@@ -148,7 +148,7 @@ impl PlacementResult {
         if !consistent {
             return Err(raise(
                 py,
-                "ShapeError",
+                Class::ShapeError,
                 format!(
                     "Placement needs K (m, n), closed_loop (n, n) and poles and \
                      achieved_poles (n,); got shapes {gain_shape:?}, {loop_shape:?}, \
@@ -178,7 +178,7 @@ impl PlacementResult {
         if inputs != 1 {
             return Err(raise(
                 py,
-                "ShapeError",
+                Class::ShapeError,
                 format!("k is defined for one input; this design has {inputs}"),
             ));
         }
@@ -337,7 +337,7 @@ fn place<'py>(
              poles that are repeated or close together are inherently sensitive (a k-fold pole \
              moves by about u^(1/k))"
         );
-        warn(py, "IllConditionedWarning", &message)?;
+        warn(py, Class::IllConditionedWarning, &message)?;
     }
     Bound::new(py, result)
 }

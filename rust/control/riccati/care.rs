@@ -435,7 +435,7 @@ fn remove_descriptor(
     let combined = solve_with_inverse(e.to_owned().as_mut(), plant.as_ref());
     let (solution, inverse) = combined.as_ref().split_at_col(n + m);
     let condition = one_norm(e) * one_norm(inverse);
-    // (one_norm skips NaN, so a solve that broke down is caught by the finiteness test.)
+    // (A solve that broke down gives a NaN condition number, which the finiteness test catches.)
     let singular = !inverse.is_all_finite() || condition * f64::EPSILON * n.max(1) as f64 > 1.0;
     if singular {
         return Err(Error::InvalidArgument {
