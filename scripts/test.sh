@@ -1,10 +1,16 @@
 #!/usr/bin/env bash
 # The one test command: builds aerocontrol from scratch into a fresh virtual environment, then
-# runs the Rust tests (cargo test) and the Python tests (pytest). Fails if either fails, if no
-# test ran, or if the package does not build as one abi3 wheel.
+# runs the style and type checks and the tests. Fails on the first failure, if no test ran, or
+# if the package does not build as one abi3 wheel.
 #
 #   bash scripts/test.sh            # from anywhere; uses python3 on PATH
 #   PYTHON=python3.12 bash scripts/test.sh
+#
+# Steps: a fresh venv with the package and its test dependencies; cargo fmt --check, ruff check,
+# ruff format --check; one abi3 wheel; cargo clippy --all-targets -D warnings
+# (with the Python bindings); cargo test without features (as the README's cargo test) and with
+# the extension's allocator; pytest (which also runs mypy --strict and stubtest on the package,
+# the doctests, and the property suite within its CI budget).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -20,6 +26,11 @@ rm -rf "$venv"
 echo "== build and install aerocontrol with its test dependencies"
 "$venv/bin/python" -m pip install --quiet ".[test]"
 
+echo "== style: cargo fmt, ruff"
+cargo fmt --all --check
+"$venv/bin/ruff" check python tests benches scripts
+"$venv/bin/ruff" format --check python tests benches scripts
+
 echo "== one abi3 wheel"
 rm -rf "$root/dist"
 "$venv/bin/python" -m pip wheel --quiet --no-deps --wheel-dir "$root/dist" .
@@ -30,12 +41,22 @@ if [ "${#wheels[@]}" -ne 1 ] || [[ "${wheels[0]}" != *abi3* ]]; then
 fi
 echo "${wheels[0]##*/}"
 
-echo "== cargo test"
-cargo_log=$(mktemp)
-# With the allocator of the Python extension, so the kernels are tested as Python runs them.
-cargo test --release --features small-block-allocator 2>&1 | tee "$cargo_log"
-cargo_passed=$(grep -Eo 'test result: ok\. [0-9]+ passed' "$cargo_log" | awk '{s += $4} END {print s + 0}')
-rm -f "$cargo_log"
+echo "== cargo clippy"
+# PYO3_PYTHON: the bindings' build script needs an interpreter.
+PYO3_PYTHON="$venv/bin/python" cargo clippy --release --features python --all-targets -- -D warnings
+
+cargo_passed=0
+run_cargo_test() {
+    local log
+    log=$(mktemp)
+    cargo test --release "$@" 2>&1 | tee "$log"
+    cargo_passed=$((cargo_passed + $(grep -Eo 'test result: ok\. [0-9]+ passed' "$log" | awk '{s += $4} END {print s + 0}')))
+    rm -f "$log"
+}
+echo "== cargo test (no features, as a Rust user runs it)"
+run_cargo_test
+echo "== cargo test (with the Python extension's allocator)"
+run_cargo_test --features small-block-allocator
 if [ "$cargo_passed" -eq 0 ]; then
     echo "cargo test ran no test" >&2
     exit 1
@@ -45,4 +66,4 @@ echo "== pytest"
 # Run from outside the source tree so that the installed package, not python/, is tested.
 (cd "$root/tests" && "$venv/bin/python" -m pytest -p no:cacheprovider "$root/tests")
 
-echo "== all tests passed (cargo: $cargo_passed)"
+echo "== all checks and tests passed (cargo: $cargo_passed)"

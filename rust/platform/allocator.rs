@@ -4,9 +4,8 @@
 //! A 4-state Riccati solve makes about fifty short-lived matrices of a few hundred bytes,
 //! aligned to 64 bytes as faer's matrices are. glibc's malloc serves aligned requests through
 //! its slow path (`_int_memalign`, with chunk splitting and consolidation): 17 % of the whole
-//! solve. mimalloc's thread-local size classes take a fraction of that (measured back to back
-//! on the 747's lateral regulator: 9.9 µs against 8.2 µs per solve), and serve rayon's worker
-//! threads in the batch kernels without contention.
+//! solve. mimalloc's thread-local size classes take a fraction of that, and serve rayon's
+//! worker threads in the batch kernels without contention.
 //!
 //! Blocks of [`LARGE_BLOCK`] bytes and more go to the system allocator, whose cost is
 //! negligible beside the O(n^3) work on a matrix that size, and which refuses an impossible

@@ -35,8 +35,8 @@ pub fn fma_available() -> bool {
 ///
 /// Some of faer's kernels return with those halves dirty. The crate itself is compiled for
 /// baseline x86-64 (legacy SSE encoding), and on such CPUs every SSE instruction executed in
-/// that state pays a transition penalty: the QR sweeps of an 88 x 88 Schur form ran six times
-/// slower after faer's Hessenberg reduction (110 µs per sweep against 19 µs). Each hot scalar
+/// that state pays a transition penalty (the QR sweeps that follow faer's Hessenberg reduction
+/// would run several times slower). Each hot scalar
 /// kernel that runs after faer calls starts with this; it costs about a cycle.
 #[inline]
 pub fn clear_upper_avx_state() {

@@ -101,14 +101,11 @@ pub const AXIS_TOLERANCE: f64 = 100.0 * f64::EPSILON;
 
 /// Up to this order of H the QR iteration uses the structure of its spectrum
 /// ([`Spectrum::Hamiltonian`]): estimates of the eigenvalues from the characteristic
-/// polynomial as shifts, unstable ones first. On the 747's order 8 over 200 weights this took
-/// 6 sweeps and no reordering swap per solve, where mirror images of deflated eigenvalues
-/// alone took 10 sweeps and 3.6 swaps; the solve took 17 % fewer instructions. At orders 24
-/// and 32 the estimates still saved 15 % of the time of random solves, but on graded ones
-/// (entries spread over 6 decades) the worst residual of 300 was 8 times larger, so the limit
-/// stays at 16. (On larger Hamiltonians whose stable eigenvalues cluster, the n = 64
-/// benchmark's around -1.5, mirror images were measured 13 % slower than the general shifts
-/// at order 128.)
+/// polynomial as shifts, unstable ones first, which saves sweeps and reordering swaps over
+/// the mirror images of deflated eigenvalues alone. Above this order the roots of the
+/// polynomial lose too much accuracy: on graded problems (entries spread over 6 decades) the
+/// worst residuals grow, and on Hamiltonians whose stable eigenvalues cluster the mirror
+/// images do no better than the general shifts.
 pub const HAMILTONIAN_SHIFT_MAX_ORDER: usize = 16;
 
 /// Newton steps at most; each costs one Lyapunov solve (about the price of the Schur form of

@@ -31,8 +31,7 @@
 //! first two sweeps after each deflation therefore use the known eigenvalue nearest to the
 //! trailing block's (two real ones, or a conjugate pair). The nearest, not the latest: an
 //! exact shift spent on an eigenvalue that has nearly split off higher up makes the sweep undo
-//! the split (forward instability; the 747's closed loop at c = 0.5 took 8 sweeps that way, and
-//! takes 2). A known eigenvalue matches a deflated one within a relative 1e-6 and is then
+//! the split (forward instability), and the iteration needs several sweeps more. A known eigenvalue matches a deflated one within a relative 1e-6 and is then
 //! dropped; a mismatch only costs a sweep with an ordinary shift, and the transformations stay
 //! orthogonal either way, so the form is as backward stable as without them. Known
 //! eigenvalues come from three places:
@@ -49,9 +48,8 @@
 //!   stays a candidate, chosen only if the trailing block comes near it). The unstable half
 //!   thus deflates at the bottom first, and
 //!   the form usually comes out already ordered with the stable eigenvalues leading, as the
-//!   Riccati solver needs it: on the 747 lateral regulator's Hamiltonian of order 8 over
-//!   200 weights, 6 sweeps each and no reordering swap, where mirror images alone (below)
-//!   took 10 sweeps and 3.6 swaps. The estimates lose accuracy as the order grows (the roots of
+//!   Riccati solver needs it, in fewer sweeps than with mirror images alone (below) and
+//!   usually with no reordering swap. The estimates lose accuracy as the order grows (the roots of
 //!   a polynomial are more sensitive than the eigenvalues of a matrix); a poor one only costs
 //!   sweeps, and the Riccati solver's reordering puts right any eigenvalue left out of place.
 //! - Without estimates (a polynomial that is not finite or a companion matrix whose QR
@@ -60,7 +58,7 @@
 //!   eigenvalue of the part still active.
 //! - [`eigenvalues_near`] takes estimates the caller knows ([`Spectrum::Near`]): the requested
 //!   poles of a placement, or the Hamiltonian's stable eigenvalues for the closed loop of a
-//!   Riccati solution (the 747 regulator's closed-loop eigenvalues in 0.72 µs instead of 1.17).
+//!   Riccati solution, which then converge in fewer sweeps.
 //!
 //! The single-window, double-shift iteration is the right tool at the orders of flight-control
 //! models: at n = 4 it finds the eigenvalues in a fraction of the time of a general multishift
