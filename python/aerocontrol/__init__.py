@@ -44,7 +44,15 @@ from .exceptions import (
     UncontrollableError,
 )
 from .frequency import FrequencyResponse, bode, default_frequency_grid, frequency_response
-from .linalg import Discretization, discretize, expm, schur, transition_matrix
+from .linalg import (
+    Discretization,
+    GeneralizedSchur,
+    discretize,
+    expm,
+    qz,
+    schur,
+    transition_matrix,
+)
 from .modal import Modes, charpoly, modes
 from .placement import (
     CompanionForm,
@@ -91,6 +99,7 @@ __all__ = [
     "Controllability",
     "ConvergenceError",
     "Discretization",
+    "GeneralizedSchur",
     "FrequencyResponse",
     "IllConditionedError",
     "IllConditionedWarning",
@@ -146,6 +155,7 @@ __all__ = [
     "plotting",
     "report",
     "riccati_ode",
+    "qz",
     "schur",
     "solve_care",
     "solve_lyapunov",

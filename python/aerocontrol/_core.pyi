@@ -50,6 +50,18 @@ POLE_ERROR_WARNING: float
 PRODUCT_WORKSPACE_BYTES: int
 
 def exception_classes() -> list[str]: ...
+def eigenvalues(a: ArrayLike, /) -> NDArray[np.complex128]: ...
+def qz(
+    a: ArrayLike, b: ArrayLike, select: Callable[[complex, float], bool] | None, /
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.complex128],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.float64],
+    int,
+]: ...
 def expm(a: ArrayLike, /) -> NDArray[np.float64]: ...
 def transition_matrices(a: ArrayLike, t: ArrayLike, /) -> NDArray[np.float64]: ...
 def discretize(

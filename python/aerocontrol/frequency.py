@@ -106,7 +106,7 @@ def default_frequency_grid(sys: Any, count: int = DEFAULT_FREQUENCIES) -> FloatA
     """Log-spaced frequencies from a tenth of the slowest to ten times the fastest nonzero
     natural frequency of the modes (0.01 to 100 rad/s when every eigenvalue is zero)."""
     model = as_state_space(sys)
-    magnitudes = np.abs(np.linalg.eigvals(model.A)) if model.n_states else np.array([])
+    magnitudes = np.abs(_core.eigenvalues(model.A)) if model.n_states else np.array([])
     nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
     low, high = (nonzero.min() / 10, nonzero.max() * 10) if nonzero.size else (0.01, 100.0)
     return np.logspace(np.log10(low), np.log10(high), count)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -18,7 +18,15 @@ from . import _core
 from ._validation import FloatArray, check_choice, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
 
-__all__ = ["Discretization", "discretize", "expm", "schur", "transition_matrix"]
+__all__ = [
+    "Discretization",
+    "GeneralizedSchur",
+    "discretize",
+    "expm",
+    "qz",
+    "schur",
+    "transition_matrix",
+]
 
 ComplexArray = NDArray[np.complex128]
 
@@ -242,3 +250,113 @@ def schur(
         raise InvalidArgumentError(f"select must be a name or a callable, got {select!r}")
     T, Q, eigenvalues, _ = _core.schur(A, select)
     return T, Q, eigenvalues
+
+
+def eigenvalues(A: Any) -> ComplexArray:
+    """The eigenvalues of a real square matrix, by aerocontrol's own Schur form (never through
+    numpy's LAPACK, whose buffers may end the process when memory is short), pairs adjacent
+    with Im > 0 first."""
+    return _core.eigenvalues(A)
+
+
+class GeneralizedSchur(NamedTuple):
+    """The generalized real Schur form (A, B) = Q (AA, BB) Z^T, in the order of
+    ``scipy.linalg.ordqz``'s results: ``AA, BB, alpha, beta, Q, Z = qz(A, B)`` unpacks it."""
+
+    AA: FloatArray
+    """Quasi-upper-triangular: 1 x 1 blocks and 2 x 2 blocks for complex pairs."""
+    BB: FloatArray
+    """Upper triangular with a nonnegative diagonal, diagonal under AA's 2 x 2 blocks."""
+    alpha: ComplexArray
+    """The eigenvalues are alpha / beta, in the order of the diagonal."""
+    beta: FloatArray
+    """Nonnegative; 0 for an infinite eigenvalue (B singular)."""
+    Q: FloatArray
+    """Orthogonal."""
+    Z: FloatArray
+    """Orthogonal; with ``select``, its leading ``selected`` columns span the right deflating
+    subspace of the selected eigenvalues."""
+    selected: int
+    """The number of leading eigenvalues chosen by ``select`` (n without it)."""
+
+
+def _generalized_selection(name: str) -> Callable[[complex, float], bool]:
+    """scipy.linalg.ordqz's named sorts on (alpha, beta); an infinite eigenvalue (beta = 0)
+    is in neither half plane and outside the unit circle."""
+
+    def finite(alpha: complex, beta: float) -> complex | None:
+        return None if beta == 0.0 else alpha / beta
+
+    def lhp(alpha: complex, beta: float) -> bool:
+        value = finite(alpha, beta)
+        return value is not None and value.real < 0.0
+
+    def rhp(alpha: complex, beta: float) -> bool:
+        value = finite(alpha, beta)
+        return value is not None and value.real > 0.0
+
+    def iuc(alpha: complex, beta: float) -> bool:
+        return abs(alpha) < abs(beta)
+
+    def ouc(alpha: complex, beta: float) -> bool:
+        return abs(alpha) > abs(beta)
+
+    return {"lhp": lhp, "rhp": rhp, "iuc": iuc, "ouc": ouc}[name]
+
+
+def qz(
+    A: Any, B: Any, select: str | Callable[[complex, float], bool] | None = None
+) -> GeneralizedSchur:
+    """The generalized real Schur (QZ) form of the pencil A - λB, optionally reordered.
+
+    Hessenberg-triangular reduction, then the double-shift QZ iteration of Moler and Stewart
+    with deflation of infinite eigenvalues (B singular is allowed); 2 x 2 blocks in LAPACK's
+    standard form (BB's block diagonal and positive). With ``select``, adjacent blocks are
+    swapped (Kågström's direct method with its weak and strong stability tests, as LAPACK's
+    dtgsen) until every selected eigenvalue comes first. All transformations are orthogonal:
+    the result is the exact form of a pencil within a few units of rounding of (A, B).
+
+    Parameters
+    ----------
+    A, B : array_like (n, n), real and finite
+    select : None, "lhp", "rhp", "iuc", "ouc", or a callable
+        The eigenvalues to put first: Re λ < 0, Re λ > 0, |λ| < 1, |λ| > 1 (λ = α/β; an
+        infinite eigenvalue counts as outside the unit circle and in neither half plane), or
+        those for which ``select(alpha, beta)`` is true (as scipy.linalg.ordqz's ``sort``; for
+        a complex pair it is called with the member with Im > 0, and the pair moves together).
+
+    Returns
+    -------
+    GeneralizedSchur
+        ``(AA, BB, alpha, beta, Q, Z, selected)`` with A = Q AA Z^T and B = Q BB Z^T.
+
+    Raises
+    ------
+    ShapeError
+        A or B not square, or of different orders.
+    IllConditionedError
+        A swap was refused: two blocks to exchange have nearly equal eigenvalues.
+    ConvergenceError
+        The iteration did not converge (30 n steps).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A = np.array([[1.0, 2.0], [3.0, 4.0]])
+    >>> B = np.array([[2.0, 0.0], [0.0, 1.0]])
+    >>> AA, BB, alpha, beta, Q, Z, k = aerocontrol.qz(A, B, "lhp")
+    >>> k, np.round((alpha / beta).real, 6)
+    (1, array([-0.386001,  3.886001]))
+    >>> bool(np.allclose(Q @ AA @ Z.T, A) and np.allclose(Q @ BB @ Z.T, B))
+    True
+    """
+    if isinstance(select, str):
+        if select not in SELECTIONS:
+            raise InvalidArgumentError(
+                f"select must be one of {', '.join(map(repr, SELECTIONS))} or a callable, "
+                f"got {select!r}"
+            )
+        select = _generalized_selection(select)
+    elif select is not None and not callable(select):
+        raise InvalidArgumentError(f"select must be a name or a callable, got {select!r}")
+    return GeneralizedSchur(*_core.qz(A, B, select))

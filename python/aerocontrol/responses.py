@@ -134,7 +134,7 @@ def default_time_grid(sys: Any) -> FloatArray:
 
 
 def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
-    eigenvalues = np.concatenate([np.linalg.eigvals(m.A) for m in models])
+    eigenvalues = np.concatenate([_core.eigenvalues(m.A) for m in models])
     magnitudes = np.abs(eigenvalues)
     nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
     if nonzero.size == 0:

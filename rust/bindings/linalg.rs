@@ -8,8 +8,13 @@ use crate::control::discretize::{Hold, discretize as discretize_core};
 use crate::error::{Error, check_square};
 use crate::linalg::expm::{expm_into, pade_choice, transition_matrices_into};
 use crate::linalg::norm::one_norm;
+use crate::linalg::qz::{
+    GeneralizedEigenvalue, generalized_eigenvalues, qz as qz_core, reorder_qz,
+};
 use crate::linalg::schur::reorder::{OrderedSchur, reorder_schur};
-use crate::linalg::schur::{quasi_triangular_eigenvalues, real_schur};
+use crate::linalg::schur::{
+    eigenvalues as eigenvalues_core, quasi_triangular_eigenvalues, real_schur,
+};
 use faer::{MatMut, MatRef, c64};
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -287,7 +292,109 @@ fn schur<'py>(
     .and_then(|result| outputs.finish().map(|()| result))
 }
 
+/// The eigenvalues of a real square matrix (the Schur form without Z), in the order of the
+/// quasi-triangular form's diagonal.
+#[pyfunction]
+#[pyo3(signature = (a, /))]
+fn eigenvalues<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<c64>>> {
+    let a = Real::convert(py, a, "A")?;
+    let a = a.matrix().map_err(|e| to_py_err(py, e))?;
+    let values = compute(py, schur_cost(a.nrows()), || eigenvalues_core(a))?;
+    let mut outputs = Outputs::new(py);
+    let n = values.len();
+    let result = outputs.complex("the eigenvalues", &[n], &values)?;
+    outputs.finish()?;
+    Ok(result)
+}
+
+/// The cost of the generalized Schur form of order n, with Q and Z.
+pub fn qz_cost(n: usize) -> Cost {
+    Cost::of(66.0 * (n as f64).powi(3), 8.0, n)
+}
+
+type QzOutput<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    usize,
+);
+
+/// The generalized real Schur form (A, B) = Q (S, T) Z^T, reordered when `select` (a callable
+/// on (alpha, beta), called once per diagonal block) is given: (S, T, alpha, beta, Q, Z,
+/// number selected). As with `schur`, `select` runs with the GIL taken for each call and its
+/// first exception is re-raised after the reordering.
+#[pyfunction]
+#[pyo3(signature = (a, b, select, /))]
+fn qz<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    select: Option<&Bound<'py, PyAny>>,
+) -> PyResult<QzOutput<'py>> {
+    let a = Real::convert(py, a, "A")?;
+    let b = Real::convert(py, b, "B")?;
+    let a = a.matrix().map_err(|e| to_py_err(py, e))?;
+    let b = b.matrix().map_err(|e| to_py_err(py, e))?;
+    let select: Option<Py<PyAny>> = select.map(|s| s.clone().unbind());
+    let (form, selected, failure) = compute(py, qz_cost(a.nrows()), || {
+        let form = qz_core(a, b)?;
+        let Some(select) = select else {
+            let n = form.s.nrows();
+            return Ok((form, n, None));
+        };
+        let mut failure: Option<PyErr> = None;
+        let chooser = |value: GeneralizedEigenvalue| -> bool {
+            if failure.is_some() {
+                return false;
+            }
+            Python::attach(|py| {
+                let alpha = PyComplex::from_doubles(py, value.alpha.re, value.alpha.im);
+                match select
+                    .bind(py)
+                    .call1((alpha, value.beta))
+                    .and_then(|r| r.is_truthy())
+                {
+                    Ok(chosen) => chosen,
+                    Err(error) => {
+                        failure = Some(error);
+                        false
+                    }
+                }
+            })
+        };
+        let (form, selected) = reorder_qz(form, chooser)?;
+        Ok((form, selected, failure))
+    })?;
+    if let Some(error) = failure {
+        return Err(error);
+    }
+    let values = generalized_eigenvalues(form.s.as_ref(), form.t.as_ref());
+    let n = values.len();
+    let alpha: Vec<c64> = values.iter().map(|v| v.alpha).collect();
+    let beta: Vec<f64> = values.iter().map(|v| v.beta).collect();
+    let mut outputs = Outputs::new(py);
+    let result = (
+        outputs.matrix("S", form.s.as_ref())?,
+        outputs.matrix("T", form.t.as_ref())?,
+        outputs.complex("alpha", &[n], &alpha)?,
+        outputs.real("beta", &[n], &beta)?,
+        outputs.matrix("Q", form.q.as_ref())?,
+        outputs.matrix("Z", form.z.as_ref())?,
+        selected,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(eigenvalues, m)?)?;
+    m.add_function(wrap_pyfunction!(qz, m)?)?;
     m.add_function(wrap_pyfunction!(schur, m)?)?;
     m.add_function(wrap_pyfunction!(expm, m)?)?;
     m.add_function(wrap_pyfunction!(transition_matrices, m)?)?;

@@ -9,6 +9,7 @@
 //!   aggressive early deflation at large orders), its eigenvalues, and reordering.
 //! * `polynomial_roots`: closed-form roots of polynomials of degree <= 4 (QR shifts).
 //! * `sylvester`: small Sylvester equations, the kernel of reordering and of Bartels–Stewart.
+//! * [`qz`]: the generalized real Schur form of a pencil (QZ) and its reordering.
 //! * [`lyapunov`]: the continuous Lyapunov equation.
 //! * [`expm`]: the matrix exponential, with double-double arithmetic where squarings amplify
 //!   rounding.
@@ -23,6 +24,8 @@ pub mod lu;
 pub mod lyapunov;
 pub mod norm;
 pub(crate) mod polynomial_roots;
+pub mod qz;
+pub(crate) mod rotation;
 pub mod schur;
 pub mod small_matrix;
 pub(crate) mod square;

@@ -385,7 +385,7 @@ pub(crate) fn check_problem(
 }
 
 /// A square, finite, symmetric (to [`SYMMETRY_TOLERANCE`]) matrix, symmetrised.
-fn symmetric(
+pub(crate) fn symmetric(
     matrix: MatRef<'_, f64>,
     arg: &'static str,
     order: usize,

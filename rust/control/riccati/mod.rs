@@ -2,4 +2,5 @@
 //! the differential equation of the finite-horizon one ([`ode`]).
 
 pub mod care;
+pub mod dare;
 pub mod ode;

@@ -1,0 +1,454 @@
+//! The discrete-time algebraic Riccati equation, in its general form (MATLAB's
+//! dare(A, B, Q, R, S, E)):
+//!
+//! ```text
+//! A^T X A - E^T X E - (A^T X B + S)(R + B^T X B)^-1 (B^T X A + S^T) + Q = 0,
+//! K = (R + B^T X B)^-1 (B^T X A + S^T),     closed loop eig(A - B K, E),
+//! ```
+//!
+//! for the stabilising solution X = X^T (every closed-loop eigenvalue inside the unit circle),
+//! by the extended symplectic pencil and the QZ algorithm (Van Dooren 1981; Arnold & Laub
+//! 1984), which needs neither A nor R invertible.
+//!
+//! # The pencil
+//!
+//! The state, costate and input of the optimal sequence (x_{k+1} = A x_k + B u_k,
+//! E^T λ_k = Q x_k + A^T λ_{k+1} + S u_k, 0 = S^T x_k + B^T λ_{k+1} + R u_k) with x_{k+1} = z x_k
+//! are the generalized eigenvectors of the pencil of order 2n + m
+//!
+//! ```text
+//! M - z N = [ A   0    B ]  - z [ E  0    0 ]
+//!           [ -Q  E^T -S ]      [ 0  A^T  0 ]
+//!           [ S^T 0    R ]      [ 0  -B^T 0 ],
+//! ```
+//!
+//! whose finite eigenvalues come in pairs (z, 1/z). The last m columns are compressed away by
+//! the QR factorisation of M's last block column (orthogonal rows transformations of both
+//! matrices), leaving a 2n x 2n pencil with the same finite eigenvalues. Its generalized Schur
+//! form ([`crate::linalg::qz`]) reordered to put |z| < 1 first gives the stable deflating
+//! subspace [U11; U21]: X = U21 (E U11)^-1, symmetrised. Exactly n eigenvalues must lie inside
+//! the unit circle and none within 100 u of it; else the equation has no stabilising solution.
+//!
+//! # Checks and the reported numbers
+//!
+//! The gain's matrix R + B^T X B must be nonsingular; the closed loop A - B K (with E: the
+//! pencil) must have every eigenvalue with |λ| < 1 - 100 u max(1, ||A - B K||_F); the relative
+//! residual
+//!
+//! ```text
+//! ||Res||_F / (||Q||_F + ||A^T X A||_F + ||E^T X E||_F + ||M^T K||_F),   M = B^T X A + S^T,
+//! ```
+//!
+//! and the reciprocal 1-norm condition number of E U11 are reported.
+//!
+//! R need not be positive definite (only symmetric): indefinite weights, as the H-infinity
+//! equations have, are solved where a stabilising solution exists.
+
+use super::care::symmetric;
+use crate::error::{Error, check_finite, check_rows, check_square};
+use crate::linalg::householder::reflector;
+use crate::linalg::lu::solve_with_inverse;
+use crate::linalg::norm::{frobenius_norm, one_norm};
+use crate::linalg::qz::{GeneralizedSchur, generalized_eigenvalues, qz, reorder_qz};
+use crate::platform::interrupt;
+use faer::{Mat, MatRef, c64};
+
+/// Distance from the unit circle, relative, within which an eigenvalue counts as on it.
+pub const CIRCLE_TOLERANCE: f64 = 100.0 * f64::EPSILON;
+
+/// The solution of a DARE and its diagnostics.
+#[derive(Debug, Clone)]
+pub struct Dare {
+    /// The stabilising solution X = X^T.
+    pub x: Mat<f64>,
+    /// K = (R + B^T X B)^-1 (B^T X A + S^T), m x n.
+    pub gain: Mat<f64>,
+    /// The eigenvalues of (A - B K, E).
+    pub closed_loop_eigenvalues: Vec<c64>,
+    /// The relative residual (see the module documentation).
+    pub residual: f64,
+    /// The reciprocal 1-norm condition number of E U11.
+    pub rcond: f64,
+}
+
+/// The optional arguments of [`solve_dare`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DareOptions<'a> {
+    /// The cross weight S (n x m), the N of python-control's dlqr.
+    pub s: Option<MatRef<'a, f64>>,
+    /// The descriptor matrix E (n x n).
+    pub e: Option<MatRef<'a, f64>>,
+}
+
+/// Solves the DARE for its stabilising solution, verified (see the module documentation).
+pub fn solve_dare(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    options: DareOptions<'_>,
+) -> Result<Dare, Error> {
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    let n = a.nrows();
+    check_rows(b, "B", n, "A")?;
+    check_finite(b, "B")?;
+    let m = b.ncols();
+    let q = symmetric(q, "Q", n, "A")?.to_mat();
+    let r = symmetric(r, "R", m, "the columns of B")?.to_mat();
+    if let Some(s) = options.s {
+        check_rows(s, "S", n, "A")?;
+        check_finite(s, "S")?;
+        if s.ncols() != m {
+            return Err(Error::Mismatch {
+                arg: "S",
+                what: "columns",
+                expected: m,
+                other: "B",
+                got: s.ncols(),
+            });
+        }
+    }
+    let identity = Mat::<f64>::identity(n, n);
+    let e = match options.e {
+        Some(e) => {
+            check_square(e, "E")?;
+            check_rows(e, "E", n, "A")?;
+            check_finite(e, "E")?;
+            e
+        }
+        None => identity.as_ref(),
+    };
+    if n == 0 {
+        return Ok(Dare {
+            x: Mat::zeros(0, 0),
+            gain: Mat::zeros(m, 0),
+            closed_loop_eigenvalues: vec![],
+            residual: 0.0,
+            rcond: 1.0,
+        });
+    }
+    crate::platform::memory::reserve((2 * n + m).pow(2).saturating_mul(8 * 8))?;
+    let (pencil_m, pencil_n) = compressed_pencil(a, b, q.as_ref(), r.as_ref(), options.s, e);
+    interrupt::check()?;
+    let form = qz(pencil_m.as_ref(), pencil_n.as_ref())?;
+    let values = generalized_eigenvalues(form.s.as_ref(), form.t.as_ref());
+    check_separated(&values, n)?;
+    let (form, selected) = reorder_qz(form, |v| v.alpha.norm() < v.beta)?;
+    if selected != n {
+        return Err(no_solution(format!(
+            "{selected} of the 2n = {} finite eigenvalues of the symplectic pencil lie inside \
+             the unit circle, not n = {n}",
+            2 * n
+        )));
+    }
+    let (x, rcond) = solution(&form, e, n)?;
+    let (gain, closed_loop) = gain_and_closed_loop(a, b, &r, options.s, &x)?;
+    let closed_loop_eigenvalues = closed_loop_eigenvalues(closed_loop.as_ref(), options.e)?;
+    check_stabilising(
+        &closed_loop_eigenvalues,
+        frobenius_norm(closed_loop.as_ref()),
+    )?;
+    let residual = residual(a, b, q.as_ref(), options.s, e, &x, &gain);
+    Ok(Dare {
+        x,
+        gain,
+        closed_loop_eigenvalues,
+        residual,
+        rcond,
+    })
+}
+
+/// The pencil of order 2n + m (module documentation) with its last m columns compressed away:
+/// reflectors from the QR factorisation of M's last block column, applied to the rows of both
+/// matrices; the rows m.. and columns ..2n remain.
+fn compressed_pencil(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    s: Option<MatRef<'_, f64>>,
+    e: MatRef<'_, f64>,
+) -> (Mat<f64>, Mat<f64>) {
+    let (n, m) = (a.nrows(), b.ncols());
+    let size = 2 * n + m;
+    let mut big_m = Mat::<f64>::zeros(size, size);
+    let mut big_n = Mat::<f64>::zeros(size, size);
+    for j in 0..n {
+        for i in 0..n {
+            big_m[(i, j)] = a[(i, j)];
+            big_m[(n + i, j)] = -q[(i, j)];
+            big_m[(n + i, n + j)] = e[(j, i)];
+            big_n[(i, j)] = e[(i, j)];
+            big_n[(n + i, n + j)] = a[(j, i)];
+        }
+    }
+    for j in 0..m {
+        for i in 0..n {
+            big_m[(i, 2 * n + j)] = b[(i, j)];
+            big_n[(2 * n + j, n + i)] = -b[(i, j)];
+            let sij = s.map_or(0.0, |s| s[(i, j)]);
+            big_m[(n + i, 2 * n + j)] = -sij;
+            big_m[(2 * n + j, i)] = sij;
+        }
+        for i in 0..m {
+            big_m[(2 * n + i, 2 * n + j)] = r[(i, j)];
+        }
+    }
+    let mut v = Vec::with_capacity(size);
+    for c in 0..m {
+        let col = 2 * n + c;
+        v.clear();
+        v.extend((c..size).map(|i| big_m[(i, col)]));
+        let (_, tau) = reflector(&mut v);
+        v[0] = 1.0;
+        if tau == 0.0 {
+            continue;
+        }
+        for matrix in [&mut big_m, &mut big_n] {
+            for j in 0..size {
+                let w: f64 = v
+                    .iter()
+                    .enumerate()
+                    .map(|(k, vk)| vk * matrix[(c + k, j)])
+                    .sum();
+                for (k, vk) in v.iter().enumerate() {
+                    matrix[(c + k, j)] -= tau * w * vk;
+                }
+            }
+        }
+    }
+    let take = |matrix: &Mat<f64>| Mat::from_fn(2 * n, 2 * n, |i, j| matrix[(m + i, j)]);
+    (take(&big_m), take(&big_n))
+}
+
+/// The error when eigenvalues of the pencil lie on the unit circle to working precision.
+fn check_separated(
+    values: &[crate::linalg::qz::GeneralizedEigenvalue],
+    n: usize,
+) -> Result<(), Error> {
+    let on_circle: Vec<String> = values
+        .iter()
+        .filter(|v| v.beta > 0.0 && (v.alpha.norm() / v.beta - 1.0).abs() <= CIRCLE_TOLERANCE)
+        .map(|v| crate::error::format_complex(v.value()))
+        .collect();
+    if on_circle.is_empty() {
+        return Ok(());
+    }
+    Err(no_solution(format!(
+        "the symplectic pencil (order 2n = {}) has {} eigenvalue(s) on the unit circle to \
+         working precision ({}; ||z| - 1| <= {CIRCLE_TOLERANCE:.1e}), so some mode on the unit \
+         circle can be neither moved by B nor seen by Q",
+        2 * n,
+        on_circle.len(),
+        on_circle.join(", ")
+    )))
+}
+
+fn no_solution(evidence: String) -> Error {
+    Error::NoStabilizingSolution {
+        message: format!("the discrete Riccati equation has no stabilising solution: {evidence}"),
+    }
+}
+
+/// X = U21 (E U11)^-1 from the leading n columns of Z, symmetrised, and rcond(E U11).
+fn solution(
+    form: &GeneralizedSchur,
+    e: MatRef<'_, f64>,
+    n: usize,
+) -> Result<(Mat<f64>, f64), Error> {
+    let u11 = form.z.as_ref().submatrix(0, 0, n, n);
+    let u21 = form.z.as_ref().submatrix(n, 0, n, n);
+    // (E U11)^T X^T = U21^T.
+    let eu11 = e * u11;
+    let norm = one_norm(eu11.as_ref());
+    let mut factor = eu11.transpose().to_owned();
+    let combined = solve_with_inverse(factor.as_mut(), u21.transpose());
+    let (xt, inverse) = combined.as_ref().split_at_col(n);
+    // The inverse of (E U11)^T: its 1-norm is the infinity norm of (E U11)^-1; use the
+    // transpose's norm for the 1-norm condition number of E U11.
+    let rcond = 1.0 / (norm * crate::linalg::norm::one_norm(inverse.transpose()));
+    if !xt.is_all_finite() || !(rcond > f64::EPSILON) {
+        return Err(no_solution(format!(
+            "the stable deflating subspace is not a graph: E U11 is singular to working \
+             precision (reciprocal condition number {rcond:.1e})"
+        )));
+    }
+    let mut x = xt.transpose().to_owned();
+    for j in 0..n {
+        for i in 0..j {
+            let mean = 0.5 * (x[(i, j)] + x[(j, i)]);
+            x[(i, j)] = mean;
+            x[(j, i)] = mean;
+        }
+    }
+    Ok((x, rcond))
+}
+
+/// K = (R + B^T X B)^-1 (B^T X A + S^T) and A - B K; R + B^T X B must be nonsingular.
+fn gain_and_closed_loop(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    r: &Mat<f64>,
+    s: Option<MatRef<'_, f64>>,
+    x: &Mat<f64>,
+) -> Result<(Mat<f64>, Mat<f64>), Error> {
+    let m = b.ncols();
+    let xb = x * b;
+    let weight = r + b.transpose() * &xb;
+    let mut rhs = xb.transpose() * a;
+    if let Some(s) = s {
+        rhs += s.transpose();
+    }
+    let norm = one_norm(weight.as_ref());
+    let mut factor = weight.clone();
+    let combined = solve_with_inverse(factor.as_mut(), rhs.as_ref());
+    let (gain, inverse) = combined.as_ref().split_at_col(a.nrows());
+    let rcond = 1.0 / (norm * one_norm(inverse));
+    if m > 0 && (!gain.is_all_finite() || !(rcond > f64::EPSILON)) {
+        return Err(Error::Singular {
+            arg: "R + B^T X B",
+            eigenvalue_re: 0.0,
+            eigenvalue_im: 0.0,
+        });
+    }
+    let gain = gain.to_owned();
+    let closed_loop = a - b * &gain;
+    Ok((gain, closed_loop))
+}
+
+/// The eigenvalues of A - B K, or of the pencil (A - B K, E).
+fn closed_loop_eigenvalues(
+    closed_loop: MatRef<'_, f64>,
+    e: Option<MatRef<'_, f64>>,
+) -> Result<Vec<c64>, Error> {
+    match e {
+        None => crate::linalg::schur::eigenvalues(closed_loop),
+        Some(e) => {
+            let form = qz(closed_loop, e)?;
+            Ok(generalized_eigenvalues(form.s.as_ref(), form.t.as_ref())
+                .iter()
+                .map(|v| v.value())
+                .collect())
+        }
+    }
+}
+
+/// The error for a closed loop with an eigenvalue on or outside the unit circle to working
+/// precision.
+fn check_stabilising(eigenvalues: &[c64], closed_loop_norm: f64) -> Result<(), Error> {
+    let limit = 1.0 - CIRCLE_TOLERANCE * closed_loop_norm.max(1.0);
+    let unstable: Vec<String> = eigenvalues
+        .iter()
+        .filter(|z| !(z.norm() < limit))
+        .map(|z| crate::error::format_complex(*z))
+        .collect();
+    if unstable.is_empty() {
+        return Ok(());
+    }
+    Err(no_solution(format!(
+        "the computed solution leaves {} eigenvalue(s) of the closed loop A - B K on or \
+         outside the unit circle ({}; |z| >= {limit}), so some mode on or outside the unit \
+         circle can be neither moved by B nor separated from its mirror image",
+        unstable.len(),
+        unstable.join(", ")
+    )))
+}
+
+/// The relative residual of the general equation.
+fn residual(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    s: Option<MatRef<'_, f64>>,
+    e: MatRef<'_, f64>,
+    x: &Mat<f64>,
+    gain: &Mat<f64>,
+) -> f64 {
+    let axa = a.transpose() * x * a;
+    let exe = e.transpose() * x * e;
+    let mut mixed = b.transpose() * x * a;
+    if let Some(s) = s {
+        mixed += s.transpose();
+    }
+    let quadratic = mixed.transpose() * gain;
+    let res = &axa - &exe - &quadratic + q;
+    let scale = frobenius_norm(q)
+        + frobenius_norm(axa.as_ref())
+        + frobenius_norm(exe.as_ref())
+        + frobenius_norm(quadratic.as_ref());
+    let norm = frobenius_norm(res.as_ref());
+    if scale > 0.0 { norm / scale } else { norm }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mat(rows: &[&[f64]]) -> Mat<f64> {
+        Mat::from_fn(rows.len(), rows[0].len(), |i, j| rows[i][j])
+    }
+
+    #[test]
+    fn scalar_equation_has_its_closed_form() {
+        // a^2 x - x - a^2 b^2 x^2 / (r + b^2 x) + q = 0 with a = 2, b = 1, q = 1, r = 1:
+        // x^2 - 4x - 1 = 0 -> x = 2 + sqrt(5).
+        let (a, b, q, r) = (
+            mat(&[&[2.0]]),
+            mat(&[&[1.0]]),
+            mat(&[&[1.0]]),
+            mat(&[&[1.0]]),
+        );
+        let d = solve_dare(
+            a.as_ref(),
+            b.as_ref(),
+            q.as_ref(),
+            r.as_ref(),
+            DareOptions::default(),
+        )
+        .unwrap();
+        assert!((d.x[(0, 0)] - (2.0 + 5f64.sqrt())).abs() < 1e-14);
+        assert!(d.residual < 1e-15);
+        assert!(d.closed_loop_eigenvalues[0].norm() < 1.0);
+    }
+
+    #[test]
+    fn singular_a_is_solved() {
+        // A nilpotent: the pencil has infinite eigenvalues.
+        let a = mat(&[&[0.0, 1.0], &[0.0, 0.0]]);
+        let b = mat(&[&[0.0], &[1.0]]);
+        let q = mat(&[&[1.0, 0.0], &[0.0, 1.0]]);
+        let r = mat(&[&[1.0]]);
+        let d = solve_dare(
+            a.as_ref(),
+            b.as_ref(),
+            q.as_ref(),
+            r.as_ref(),
+            DareOptions::default(),
+        )
+        .unwrap();
+        assert!(d.residual < 1e-14, "{}", d.residual);
+        // X = diag(1, 2)? A^T X A = [[0,0],[0,x11]]: x12 = 0, x11 = 1, x22 = 1 + x11 - x11^2... check residual only.
+        assert!(d.closed_loop_eigenvalues.iter().all(|z| z.norm() < 1.0));
+    }
+
+    #[test]
+    fn an_uncontrollable_mode_on_the_unit_circle_is_refused() {
+        let a = mat(&[&[0.0, 1.0, 0.0], &[-1.0, 0.0, 0.0], &[0.0, 0.0, 0.5]]);
+        let b = mat(&[&[0.0], &[0.0], &[1.0]]);
+        let q = Mat::<f64>::identity(3, 3);
+        let r = mat(&[&[1.0]]);
+        let error = solve_dare(
+            a.as_ref(),
+            b.as_ref(),
+            q.as_ref(),
+            r.as_ref(),
+            DareOptions::default(),
+        )
+        .unwrap_err();
+        assert!(
+            matches!(error, Error::NoStabilizingSolution { .. }),
+            "{error:?}"
+        );
+    }
+}

@@ -1,0 +1,154 @@
+//! The generalized real Schur form (QZ) of a pencil A - λB and its reordering:
+//!
+//! ```text
+//! A = Q S Z^T,   B = Q T Z^T,   Q, Z orthogonal,
+//! ```
+//!
+//! S quasi-upper-triangular with 2 x 2 blocks for complex pairs, T upper triangular with
+//! t_kk >= 0 and diagonal 2 x 2 blocks under S's (LAPACK's dgges form). The eigenvalues are
+//! α_k / β_k: β_k = t_kk, α_k = s_kk for a 1 x 1 block, α = λ β for a pair; β = 0 is an
+//! infinite eigenvalue (B singular).
+//!
+//! The method: the Hessenberg-triangular reduction ([`reduction`]), the double-shift QZ
+//! iteration with deflation of infinite eigenvalues and standard 2 x 2 blocks ([`iteration`]),
+//! and reordering by adjacent swaps ([`reorder`]). All transformations are orthogonal, so the
+//! computed form is the exact form of a pencil within a small multiple of u ||(A, B)||_F; the
+//! tests check ||Q^T A Z - S||, ||Q^T B Z - T|| <= 10 n u ||(A, B)||_F. It is the base of the
+//! discrete Riccati solver ([`crate::control::riccati::dare`]).
+
+pub(crate) mod iteration;
+pub(crate) mod reduction;
+pub(crate) mod reorder;
+
+use crate::error::{Error, check_finite, check_square};
+use faer::{Mat, MatRef, c64};
+use iteration::Pencil;
+
+/// The generalized real Schur form (A, B) = Q (S, T) Z^T.
+#[derive(Debug, Clone)]
+pub struct GeneralizedSchur {
+    pub s: Mat<f64>,
+    pub t: Mat<f64>,
+    pub q: Mat<f64>,
+    pub z: Mat<f64>,
+}
+
+/// One generalized eigenvalue α / β: α complex, β >= 0 real (0 for an infinite eigenvalue).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeneralizedEigenvalue {
+    pub alpha: c64,
+    pub beta: f64,
+}
+
+impl GeneralizedEigenvalue {
+    /// α / β, with an infinite real part when β = 0 (and α is not).
+    pub fn value(self) -> c64 {
+        if self.beta == 0.0 {
+            c64::new(f64::INFINITY, 0.0)
+        } else {
+            self.alpha / self.beta
+        }
+    }
+}
+
+/// The generalized real Schur form of (A, B).
+pub fn qz(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<GeneralizedSchur, Error> {
+    check_square(a, "A")?;
+    check_square(b, "B")?;
+    if b.nrows() != a.nrows() {
+        return Err(Error::Mismatch {
+            arg: "B",
+            what: "order",
+            expected: a.nrows(),
+            other: "A",
+            got: b.nrows(),
+        });
+    }
+    check_finite(a, "A")?;
+    check_finite(b, "B")?;
+    let n = a.nrows();
+    // S, T, Q, Z and the temporaries of the reduction.
+    crate::platform::memory::reserve(n.saturating_mul(n).saturating_mul(6 * 8))?;
+    let mut s = a.to_owned();
+    let mut t = b.to_owned();
+    let mut q = Mat::<f64>::identity(n, n);
+    let mut z = Mat::<f64>::identity(n, n);
+    reduction::hessenberg_triangular(&mut s, &mut t, &mut q, &mut z)?;
+    iteration::qz_iteration(&mut Pencil {
+        h: &mut s,
+        t: &mut t,
+        q: &mut q,
+        z: &mut z,
+    })?;
+    Ok(GeneralizedSchur { s, t, q, z })
+}
+
+/// The eigenvalues of a generalized real Schur form, in the order of its diagonal (a pair with
+/// Im > 0 first).
+pub fn generalized_eigenvalues(
+    s: MatRef<'_, f64>,
+    t: MatRef<'_, f64>,
+) -> Vec<GeneralizedEigenvalue> {
+    let n = s.nrows();
+    let mut values = Vec::with_capacity(n);
+    let mut k = 0;
+    while k < n {
+        if k + 1 < n && s[(k + 1, k)] != 0.0 {
+            let (t11, t22) = (t[(k, k)], t[(k + 1, k + 1)]);
+            let m = [
+                [s[(k, k)] / t11, s[(k, k + 1)] / t22],
+                [s[(k + 1, k)] / t11, s[(k + 1, k + 1)] / t22],
+            ];
+            let block = crate::linalg::schur::standardize_block(m[0][0], m[0][1], m[1][0], m[1][1]);
+            let im = block.b.abs().sqrt() * block.c.abs().sqrt();
+            values.push(GeneralizedEigenvalue {
+                alpha: c64::new(block.a, im) * t11,
+                beta: t11,
+            });
+            values.push(GeneralizedEigenvalue {
+                alpha: c64::new(block.a, -im) * t22,
+                beta: t22,
+            });
+            k += 2;
+        } else {
+            values.push(GeneralizedEigenvalue {
+                alpha: c64::new(s[(k, k)], 0.0),
+                beta: t[(k, k)],
+            });
+            k += 1;
+        }
+    }
+    values
+}
+
+/// Reorders a generalized Schur form so that the eigenvalues for which `select` is true come
+/// first; returns the form and the number of selected eigenvalues. A complex pair is selected
+/// when its member with Im > 0 is.
+pub fn reorder_qz(
+    mut schur: GeneralizedSchur,
+    mut select: impl FnMut(GeneralizedEigenvalue) -> bool,
+) -> Result<(GeneralizedSchur, usize), Error> {
+    let values = generalized_eigenvalues(schur.s.as_ref(), schur.t.as_ref());
+    let n = values.len();
+    let mut selected = vec![false; n];
+    let mut k = 0;
+    while k < n {
+        let size = reorder::block_size(&schur.s, k);
+        let chosen = select(values[k]);
+        selected[k..k + size].fill(chosen);
+        k += size;
+    }
+    let count = reorder::reorder(
+        &mut Pencil {
+            h: &mut schur.s,
+            t: &mut schur.t,
+            q: &mut schur.q,
+            z: &mut schur.z,
+        },
+        &selected,
+    )?;
+    Ok((schur, count))
+}
+
+#[cfg(test)]
+mod tests;
