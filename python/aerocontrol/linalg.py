@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, check_choice, real_array, real_scalar
@@ -23,7 +23,7 @@ __all__ = ["Discretization", "discretize", "expm", "schur", "transition_matrix"]
 ComplexArray = NDArray[np.complex128]
 
 
-def expm(A: Any) -> FloatArray:
+def expm(A: ArrayLike) -> FloatArray:
     """The matrix exponential e^A of a real square matrix, or of each matrix of a stack.
 
     Padé scaling and squaring with the degree (3, 5, 7, 9 or 13) and scaling chosen as in
@@ -69,7 +69,7 @@ def expm(A: Any) -> FloatArray:
     return _core.expm(A)
 
 
-def transition_matrix(A: Any, t: Any) -> FloatArray:
+def transition_matrix(A: ArrayLike, t: ArrayLike) -> FloatArray:
     """The state transition matrix Φ(t) = e^{At} (6.22) at one time or at each of many.
 
     The powers of A and their norms are computed once for all times; each time then costs a
@@ -134,7 +134,9 @@ class Discretization:
     """The hold: ``"zoh"`` or ``"foh"``."""
 
 
-def discretize(A: Any, B: Any, dt: float, method: Literal["zoh", "foh"] = "zoh") -> Discretization:
+def discretize(
+    A: ArrayLike, B: ArrayLike, dt: float, method: Literal["zoh", "foh"] = "zoh"
+) -> Discretization:
     """Exact discretisation of x' = Ax + Bη over a step ``dt``.
 
     Φ, Γ0 and Γ1 come from one exponential of an augmented block matrix (Van Loan 1978), so
@@ -189,7 +191,7 @@ SELECTIONS: dict[str, Callable[[complex], bool]] = {
 
 
 def schur(
-    A: Any, select: str | Callable[[complex], bool] | None = None
+    A: ArrayLike, select: str | Callable[[complex], bool] | None = None
 ) -> tuple[FloatArray, FloatArray, ComplexArray]:
     """The real Schur form A = Q T Q^T, optionally reordered.
 
