@@ -9,7 +9,6 @@ reads its inputs (copying them before it releases the GIL).
 from __future__ import annotations
 
 import warnings
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,7 +18,7 @@ from .exceptions import InvalidArgumentError, NotRealError, NumericalOverflowWar
 FloatArray = NDArray[np.float64]
 
 
-def real_array(value: Any, name: str) -> FloatArray:
+def real_array(value: object, name: str) -> FloatArray:
     """``value`` as a float64 ndarray, or NotRealError naming ``name``.
 
     Accepts any real array-like: lists, integer, boolean and float32 arrays, Fortran-ordered
@@ -45,7 +44,7 @@ def real_array(value: Any, name: str) -> FloatArray:
     return array
 
 
-def real_scalar(value: Any, name: str) -> float:
+def real_scalar(value: object, name: str) -> float:
     """``value`` as a Python float, rejecting arrays, complex numbers and non-numbers by name."""
     array = real_array(value, name)
     if array.ndim != 0:
@@ -65,7 +64,7 @@ def finite_or_warn(values: FloatArray, what: str) -> FloatArray:
     return values
 
 
-def check_choice(value: Any, name: str, choices: tuple[str, ...]) -> str:
+def check_choice(value: object, name: str, choices: tuple[str, ...]) -> str:
     """``value`` if it is one of ``choices``, else InvalidArgumentError naming ``name``."""
     if not isinstance(value, str) or value not in choices:
         allowed = ", ".join(repr(c) for c in choices)

@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
@@ -31,6 +31,9 @@ from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
 from .placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
 from .riccati import RCOND_WARNING, RESIDUAL_WARNING
 from .statespace import as_state_space, is_system
+
+if TYPE_CHECKING:
+    from ._typing import SystemObject
 
 __all__ = ["CareBatch", "LqrSweep", "PlaceBatch", "lqr_sweep", "place_batch", "solve_care_batch"]
 
@@ -98,7 +101,7 @@ class PlaceBatch:
 _METHODS = {"bass-gura": "bass-gura", "ackermann": "ackermann", "knv": "knv0"}
 
 
-def place_batch(A: Any, B: Any, poles: Any, method: str = "knv") -> PlaceBatch:
+def place_batch(A: ArrayLike, B: ArrayLike, poles: ArrayLike, method: str = "knv") -> PlaceBatch:
     """Pole placement for every problem of a batch, in parallel, each exactly as the single
     function places it (:func:`aerocontrol.place_bass_gura`, :func:`aerocontrol.place_ackermann`
     or :func:`aerocontrol.place`).
@@ -162,7 +165,7 @@ def place_batch(A: Any, B: Any, poles: Any, method: str = "knv") -> PlaceBatch:
     return batch
 
 
-def _stack(value: Any, name: str) -> FloatArray:
+def _stack(value: object, name: str) -> FloatArray:
     array = real_array(value, name)
     if array.ndim == 2:
         return array[np.newaxis]
@@ -185,7 +188,9 @@ def _warn(flagged: NDArray[np.intp], what: str) -> None:
         )
 
 
-def solve_care_batch(A: Any, B: Any, Q: Any, R: Any, refine: bool = True) -> CareBatch:
+def solve_care_batch(
+    A: ArrayLike, B: ArrayLike, Q: ArrayLike, R: ArrayLike, refine: bool = True
+) -> CareBatch:
     """Solve A_i^T X_i + X_i A_i - X_i B_i R_i^-1 B_i^T X_i + Q_i = 0 for every problem i of a
     batch, in parallel.
 
@@ -234,7 +239,11 @@ def solve_care_batch(A: Any, B: Any, Q: Any, R: Any, refine: bool = True) -> Car
 
 
 def lqr_sweep(
-    sys_or_A: Any, B: Any = None, Q: Any = None, R: Any = None, weights: Any = None
+    sys_or_A: ArrayLike | SystemObject,
+    B: ArrayLike | None = None,
+    Q: ArrayLike | None = None,
+    R: ArrayLike | None = None,
+    weights: ArrayLike | None = None,
 ) -> LqrSweep:
     """The regulator of one model for each weight c: J = ∫ x^T Q x + (1/c²) η^T R η dt
     ((6.224)-(6.227); R/c² is the control weight), all solved in one parallel call.

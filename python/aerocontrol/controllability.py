@@ -22,14 +22,17 @@ the dual: (A, C) is observable if and only if (A^T, C^T) is controllable.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, check_choice, real_scalar
 from .statespace import plant_pair
+
+if TYPE_CHECKING:
+    from ._typing import System
 
 __all__ = [
     "Controllability",
@@ -45,7 +48,7 @@ ComplexArray = NDArray[np.complex128]
 _METHODS = ("full", "staircase")
 
 
-def ctrb(A: Any, B: Any) -> FloatArray:
+def ctrb(A: ArrayLike, B: ArrayLike) -> FloatArray:
     """The controllability matrix V = [B AB A^2B ... A^{n-1}B] (6.74), n x nm.
 
     For hand analysis and the companion form; decide controllability with
@@ -59,7 +62,7 @@ def ctrb(A: Any, B: Any) -> FloatArray:
     return _core.krylov_matrix(A, B, False)
 
 
-def obsv(A: Any, C: Any) -> FloatArray:
+def obsv(A: ArrayLike, C: ArrayLike) -> FloatArray:
     """The observability matrix [C; CA; ...; CA^{n-1}] (6.89), np x n.
 
     >>> import aerocontrol
@@ -111,7 +114,12 @@ class Controllability:
 
 
 def _analyse(
-    A: Any, second: Any, tol: float | None, method: str, dual: bool, transformation: bool = True
+    A: ArrayLike,
+    second: ArrayLike,
+    tol: float | None,
+    method: str,
+    dual: bool,
+    transformation: bool = True,
 ) -> Controllability:
     check_choice(method, "method", _METHODS)
     tolerance = None if tol is None else real_scalar(tol, "tol")
@@ -134,7 +142,11 @@ def _analyse(
 
 
 def controllability(
-    A_or_sys: Any, B: Any = None, *, tol: float | None = None, method: str = "full"
+    A_or_sys: ArrayLike | System,
+    B: ArrayLike | None = None,
+    *,
+    tol: float | None = None,
+    method: str = "full",
 ) -> Controllability:
     """The controllability of (A, B): verdict, unreachable modes, staircase form.
 
@@ -163,7 +175,11 @@ def controllability(
 
 
 def observability(
-    A_or_sys: Any, C: Any = None, *, tol: float | None = None, method: str = "full"
+    A_or_sys: ArrayLike | System,
+    C: ArrayLike | None = None,
+    *,
+    tol: float | None = None,
+    method: str = "full",
 ) -> Controllability:
     """The observability of (A, C), by duality with :func:`controllability`.
 
@@ -176,7 +192,11 @@ def observability(
 
 
 def is_controllable(
-    A_or_sys: Any, B: Any = None, *, tol: float | None = None, method: str = "full"
+    A_or_sys: ArrayLike | System,
+    B: ArrayLike | None = None,
+    *,
+    tol: float | None = None,
+    method: str = "full",
 ) -> bool:
     """Whether every mode of (A, B) can be moved by state feedback (see
     :func:`controllability`).
@@ -190,7 +210,11 @@ def is_controllable(
 
 
 def is_observable(
-    A_or_sys: Any, C: Any = None, *, tol: float | None = None, method: str = "full"
+    A_or_sys: ArrayLike | System,
+    C: ArrayLike | None = None,
+    *,
+    tol: float | None = None,
+    method: str = "full",
 ) -> bool:
     """Whether every mode of (A, C) shows in the output (see :func:`observability`).
 

@@ -9,10 +9,9 @@ small c makes control expensive (the closed loop stays near the open loop) and a
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ._validation import real_array, real_scalar
 from .aircraft.model import Aircraft
@@ -65,13 +64,17 @@ def dutch_roll_damper(
     return place_bass_gura(sys.A, sys.B[:, sys.input_names.index(surface)], poles)
 
 
-def _weights(n: int, m: int, Q: Any, R: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _weights(
+    n: int, m: int, Q: ArrayLike | None, R: ArrayLike | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     Q_matrix = np.eye(n) if Q is None else real_array(Q, "Q")
     R_matrix = np.eye(m) if R is None else real_array(R, "R")
     return Q_matrix, R_matrix
 
 
-def lqr_root_locus(sys: StateSpace, weights: Any, Q: Any = None, R: Any = None) -> ComplexArray:
+def lqr_root_locus(
+    sys: StateSpace, weights: ArrayLike, Q: ArrayLike | None = None, R: ArrayLike | None = None
+) -> ComplexArray:
     """The closed-loop eigenvalues of the regulator for each control weight c (Figure 6.12):
     an array (len(weights), n), each row as :func:`aerocontrol.lqr` returns its E.
 
@@ -94,8 +97,8 @@ def _split(poles: ComplexArray, mode: str) -> float:
 def critical_weight(
     sys: StateSpace,
     mode: str = "dutch roll",
-    Q: Any = None,
-    R: Any = None,
+    Q: ArrayLike | None = None,
+    R: ArrayLike | None = None,
     bounds: tuple[float, float] = (1e-3, 1e3),
 ) -> float:
     """The control weight c at which a lateral ``mode`` of the regulated aircraft becomes

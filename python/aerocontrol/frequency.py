@@ -7,16 +7,22 @@ frequencies from a tenth of the slowest to ten times the fastest natural frequen
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import ShapeError
 from .statespace import as_state_space
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ._typing import System
 
 __all__ = ["FrequencyResponse", "bode", "default_frequency_grid", "frequency_response"]
 
@@ -67,7 +73,9 @@ class FrequencyResponse:
                 )
         return "\n".join(lines)
 
-    def plot(self, ax: Any = None, output: int = 0, input: int = 0) -> Any:
+    def plot(
+        self, ax: Iterable[Axes] | None = None, output: int = 0, input: int = 0
+    ) -> tuple[Axes, Axes]:
         """Bode plot (magnitude in dB and phase in degrees) of one input-output pair;
         ``ax`` is a pair of axes."""
         from .plotting import plot_bode
@@ -75,7 +83,7 @@ class FrequencyResponse:
         return plot_bode(self, ax=ax, output=output, input=input)
 
 
-def frequency_response(sys: Any, omega: Any) -> FrequencyResponse:
+def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
     """G(jω) = C (jωI - A)^-1 B + D at each frequency of ``omega`` (rad/s).
 
     A frequency at an imaginary-axis pole gives infinite or NaN entries.
@@ -102,7 +110,7 @@ def frequency_response(sys: Any, omega: Any) -> FrequencyResponse:
     )
 
 
-def default_frequency_grid(sys: Any, count: int = DEFAULT_FREQUENCIES) -> FloatArray:
+def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> FloatArray:
     """Log-spaced frequencies from a tenth of the slowest to ten times the fastest nonzero
     natural frequency of the modes (0.01 to 100 rad/s when every eigenvalue is zero)."""
     model = as_state_space(sys)
@@ -112,7 +120,7 @@ def default_frequency_grid(sys: Any, count: int = DEFAULT_FREQUENCIES) -> FloatA
     return np.logspace(np.log10(low), np.log10(high), count)
 
 
-def bode(sys: Any, omega: Any = None) -> FrequencyResponse:
+def bode(sys: System, omega: ArrayLike | None = None) -> FrequencyResponse:
     """The frequency response for a Bode plot: ``.magnitude_db``, ``.phase_deg`` (unwrapped),
     ``.plot()``. Without ``omega``, the default grid of :func:`default_frequency_grid`.
 

@@ -79,9 +79,9 @@ import math
 import textwrap
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .exceptions import InvalidArgumentError, NonFiniteError, ShapeError
 
@@ -305,7 +305,9 @@ class HandlingQualities:
         return self.table()
 
 
-def assess(modes: Mapping[str, Any], aircraft_class: str, category: str) -> HandlingQualities:
+# object, not ArrayLike: a dict of eigenvalue lists of mixed kinds ([complex, complex] for one
+# mode, [float] for another) is inferred as dict[str, object]; each value is checked here.
+def assess(modes: Mapping[str, object], aircraft_class: str, category: str) -> HandlingQualities:
     """Judge the modes' eigenvalues against MIL-F-8785C for a Class and Flight Phase Category.
 
     For an oscillatory mode given as two roots λ1, λ2 (a conjugate pair, or two real roots
@@ -454,7 +456,7 @@ def _choices(values: tuple[str, ...]) -> str:
     return ", ".join(repr(v) for v in values)
 
 
-def _aircraft_class(value: Any) -> str:
+def _aircraft_class(value: object) -> str:
     if isinstance(value, str):
         key = value.strip().upper()
         key = _CLASS_ALIASES.get(key, key)
@@ -466,13 +468,13 @@ def _aircraft_class(value: Any) -> str:
     )
 
 
-def _category(value: Any) -> str:
+def _category(value: object) -> str:
     if isinstance(value, str) and value.strip().upper() in CATEGORIES:
         return value.strip().upper()
     raise InvalidArgumentError(f"category must be one of {_choices(CATEGORIES)}, got {value!r}")
 
 
-def _mode_name(key: Any, name: str) -> str:
+def _mode_name(key: object, name: str) -> str:
     if isinstance(key, str):
         normal = " ".join(key.lower().replace("-", " ").replace("_", " ").split())
         if normal in MODES:
@@ -480,7 +482,7 @@ def _mode_name(key: Any, name: str) -> str:
     raise InvalidArgumentError(f"{name} {key!r} is not a mode; the modes are {_choices(MODES)}")
 
 
-def _as_eigenvalues(value: Any, label: str) -> np.ndarray[Any, np.dtype[np.complex128]]:
+def _as_eigenvalues(value: object, label: str) -> NDArray[np.complex128]:
     """A 1-D complex array of the numbers in ``value`` (a tuple or list of Python or numpy
     scalars, as the mode namers return them, without numpy's dtype discovery)."""
     if isinstance(value, (tuple, list)) and all(
@@ -498,14 +500,14 @@ def _as_eigenvalues(value: Any, label: str) -> np.ndarray[Any, np.dtype[np.compl
     return np.atleast_1d(array.astype(np.complex128))
 
 
-def _eigenvalues(modes: Any) -> dict[str, np.ndarray[Any, np.dtype[np.complex128]]]:
+def _eigenvalues(modes: object) -> dict[str, NDArray[np.complex128]]:
     if not isinstance(modes, Mapping):
         raise InvalidArgumentError(
             f"modes must be a mapping from mode name to eigenvalues, got {type(modes).__name__}"
         )
     if not modes:
         raise InvalidArgumentError(f"modes is empty; give at least one of {_choices(MODES)}")
-    result: dict[str, np.ndarray[Any, np.dtype[np.complex128]]] = {}
+    result: dict[str, NDArray[np.complex128]] = {}
     for key, value in modes.items():
         mode = _mode_name(key, "modes key")
         label = f"modes[{key!r}]"
@@ -542,7 +544,7 @@ def _eigenvalues(modes: Any) -> dict[str, np.ndarray[Any, np.dtype[np.complex128
 # --- The modes -------------------------------------------------------------------------------
 
 
-def _pair(lam: np.ndarray[Any, np.dtype[np.complex128]]) -> tuple[float, float, float]:
+def _pair(lam: NDArray[np.complex128]) -> tuple[float, float, float]:
     """(ω_n, ζ, ζ ω_n) of two roots; ω_n and ζ NaN for real roots of opposite sign."""
     l1, l2 = complex(lam[0]), complex(lam[1])
     wn2 = (l1 * l2).real
@@ -590,9 +592,7 @@ def _requirement(
     )
 
 
-def _short_period(
-    lam: np.ndarray[Any, np.dtype[np.complex128]], category: str
-) -> list[Requirement]:
+def _short_period(lam: NDArray[np.complex128], category: str) -> list[Requirement]:
     _, zeta, _ = _pair(lam)
     checks: list[tuple[str | None, bool]] = []
     for low, high in SHORT_PERIOD_ZETA[category]:
@@ -603,7 +603,7 @@ def _short_period(
     return [_requirement("short period", "zeta", zeta, checks)]
 
 
-def _phugoid(lam: np.ndarray[Any, np.dtype[np.complex128]]) -> list[Requirement]:
+def _phugoid(lam: NDArray[np.complex128]) -> list[Requirement]:
     _, zeta, _ = _pair(lam)
     level1, level2 = PHUGOID_MIN_ZETA
     t2 = _time_to_double(float(np.max(lam.real)))
@@ -629,7 +629,7 @@ def _phugoid(lam: np.ndarray[Any, np.dtype[np.complex128]]) -> list[Requirement]
 
 
 def _dutch_roll(
-    lam: np.ndarray[Any, np.dtype[np.complex128]], aircraft_class: str, category: str
+    lam: NDArray[np.complex128], aircraft_class: str, category: str
 ) -> list[Requirement]:
     wn, zeta, zw = _pair(lam)
     rows = (DUTCH_ROLL_LEVEL1[category, aircraft_class], DUTCH_ROLL_LEVEL2, DUTCH_ROLL_LEVEL3)
@@ -654,16 +654,14 @@ def _dutch_roll(
     ]
 
 
-def _roll(
-    lam: np.ndarray[Any, np.dtype[np.complex128]], aircraft_class: str, category: str
-) -> Requirement:
+def _roll(lam: NDArray[np.complex128], aircraft_class: str, category: str) -> Requirement:
     root = float(lam[0].real)
     tau = -1.0 / root if root < 0 else math.inf
     limits = ROLL_MODE_MAX_TIME_CONSTANT[category, aircraft_class]
     return _requirement("roll", "time constant", tau, [(f"<= {m:g} s", tau <= m) for m in limits])
 
 
-def _spiral(lam: np.ndarray[Any, np.dtype[np.complex128]], category: str) -> Requirement:
+def _spiral(lam: NDArray[np.complex128], category: str) -> Requirement:
     t2 = _time_to_double(float(lam[0].real))
     limits = SPIRAL_MIN_TIME_TO_DOUBLE[category]
     return _requirement("spiral", "time to double", t2, [(f"> {m:g} s", t2 > m) for m in limits])

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal, NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, check_choice, real_array, real_scalar
@@ -31,7 +31,7 @@ __all__ = [
 ComplexArray = NDArray[np.complex128]
 
 
-def expm(A: Any) -> FloatArray:
+def expm(A: ArrayLike) -> FloatArray:
     """The matrix exponential e^A of a real square matrix, or of each matrix of a stack.
 
     Padé scaling and squaring with the degree (3, 5, 7, 9 or 13) and scaling chosen as in
@@ -77,7 +77,7 @@ def expm(A: Any) -> FloatArray:
     return _core.expm(A)
 
 
-def transition_matrix(A: Any, t: Any) -> FloatArray:
+def transition_matrix(A: ArrayLike, t: ArrayLike) -> FloatArray:
     """The state transition matrix Φ(t) = e^{At} (6.22) at one time or at each of many.
 
     The powers of A and their norms are computed once for all times; each time then costs a
@@ -142,7 +142,9 @@ class Discretization:
     """The hold: ``"zoh"`` or ``"foh"``."""
 
 
-def discretize(A: Any, B: Any, dt: float, method: Literal["zoh", "foh"] = "zoh") -> Discretization:
+def discretize(
+    A: ArrayLike, B: ArrayLike, dt: float, method: Literal["zoh", "foh"] = "zoh"
+) -> Discretization:
     """Exact discretisation of x' = Ax + Bη over a step ``dt``.
 
     Φ, Γ0 and Γ1 come from one exponential of an augmented block matrix (Van Loan 1978), so
@@ -197,7 +199,7 @@ SELECTIONS: dict[str, Callable[[complex], bool]] = {
 
 
 def schur(
-    A: Any, select: str | Callable[[complex], bool] | None = None
+    A: ArrayLike, select: str | Callable[[complex], bool] | None = None
 ) -> tuple[FloatArray, FloatArray, ComplexArray]:
     """The real Schur form A = Q T Q^T, optionally reordered.
 
@@ -252,7 +254,7 @@ def schur(
     return T, Q, eigenvalues
 
 
-def eigenvalues(A: Any) -> ComplexArray:
+def eigenvalues(A: ArrayLike) -> ComplexArray:
     """The eigenvalues of a real square matrix, by aerocontrol's own Schur form (never through
     numpy's LAPACK, whose buffers may end the process when memory is short), pairs adjacent
     with Im > 0 first."""
@@ -305,7 +307,7 @@ def _generalized_selection(name: str) -> Callable[[complex, float], bool]:
 
 
 def qz(
-    A: Any, B: Any, select: str | Callable[[complex, float], bool] | None = None
+    A: ArrayLike, B: ArrayLike, select: str | Callable[[complex, float], bool] | None = None
 ) -> GeneralizedSchur:
     """The generalized real Schur (QZ) form of the pencil A - λB, optionally reordered.
 

@@ -26,15 +26,20 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning
 from .statespace import as_state_space, is_system
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ._typing import System
 
 __all__ = ["Modes", "charpoly", "modes"]
 
@@ -110,14 +115,14 @@ class Modes:
     def __str__(self) -> str:
         return self.table()
 
-    def plot(self, ax: Any = None) -> Any:
+    def plot(self, ax: Axes | None = None) -> Axes:
         """The eigenvalues in the complex plane, labelled by mode (matplotlib)."""
         from .plotting import plot_modes
 
         return plot_modes(self, ax=ax)
 
 
-def _plant(A_or_sys: Any) -> tuple[FloatArray, FloatArray | None]:
+def _plant(A_or_sys: ArrayLike | System) -> tuple[FloatArray, FloatArray | None]:
     """(A, B or None) from a plant matrix or a system."""
     if is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
@@ -128,7 +133,7 @@ def _plant(A_or_sys: Any) -> tuple[FloatArray, FloatArray | None]:
     return real_array(A_or_sys, "A"), None
 
 
-def modes(A_or_sys: Any, mode_names: list[str] | None = None) -> Modes:
+def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> Modes:
     """The modes of A, or of a system's A (then with P^-1 B).
 
     Parameters
@@ -187,7 +192,7 @@ def modes(A_or_sys: Any, mode_names: list[str] | None = None) -> Modes:
     )
 
 
-def charpoly(A: Any) -> FloatArray:
+def charpoly(A: ArrayLike) -> FloatArray:
     """Coefficients of det(λI - A), highest power first ([1, a_1, ..., a_n], (6.106)).
 
     Computed by La Budde's method (Rehman & Ipsen 2011): the balanced A is reduced to upper

@@ -22,16 +22,19 @@ mode (the Dutch roll to ζ = 0.30 at its ω_n, say) and keeps every other pole.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
 from .modal import Modes, modes
 from .statespace import StateSpace, as_state_space, is_system, plant_pair
+
+if TYPE_CHECKING:
+    from ._typing import ModeKey, System
 
 __all__ = [
     "CompanionForm",
@@ -71,7 +74,7 @@ def _describe(design: Placement) -> str:
     return "\n".join(lines)
 
 
-def _poles(poles: Any) -> ComplexArray:
+def _poles(poles: object) -> ComplexArray:
     """Requested poles as a contiguous complex vector (the core calls this for anything that
     is not one already)."""
     try:
@@ -83,7 +86,9 @@ def _poles(poles: Any) -> ComplexArray:
     return np.ascontiguousarray(array)
 
 
-def place_bass_gura(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placement:
+def place_bass_gura(
+    A_or_sys: ArrayLike | System, b: ArrayLike | None = None, poles: ArrayLike | None = None
+) -> Placement:
     """Single-input pole placement by the Bass-Gura formula (6.145).
 
     k = ((VW)^-1)^T (ā - a), with V the controllability matrix (6.125), W the Toeplitz matrix of
@@ -113,10 +118,13 @@ def place_bass_gura(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placemen
     """
     if poles is None:
         A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
-    return _core.place(A_or_sys, b, poles, "bass-gura")
+    # Now the matrices; a system or None still here is refused by the core, by name.
+    return _core.place(cast("ArrayLike", A_or_sys), cast("ArrayLike", b), poles, "bass-gura")
 
 
-def place_ackermann(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placement:
+def place_ackermann(
+    A_or_sys: ArrayLike | System, b: ArrayLike | None = None, poles: ArrayLike | None = None
+) -> Placement:
     """Single-input pole placement by Ackermann's formula k^T = e_n^T V^-1 φ(A).
 
     φ is the desired characteristic polynomial; V^T w = e_n is solved by LU and φ(A)^T w is
@@ -130,10 +138,13 @@ def place_ackermann(A_or_sys: Any, b: Any = None, poles: Any = None) -> Placemen
     """
     if poles is None:
         A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
-    return _core.place(A_or_sys, b, poles, "ackermann")
+    # Now the matrices; a system or None still here is refused by the core, by name.
+    return _core.place(cast("ArrayLike", A_or_sys), cast("ArrayLike", b), poles, "ackermann")
 
 
-def place(A_or_sys: Any, B: Any = None, poles: Any = None) -> Placement:
+def place(
+    A_or_sys: ArrayLike | System, B: ArrayLike | None = None, poles: ArrayLike | None = None
+) -> Placement:
     """Pole placement for one or several inputs, by Kautsky-Nichols-Van Dooren method 0.
 
     The eigenvector of each pole is chosen in its admissible subspace to make the closed-loop
@@ -158,7 +169,8 @@ def place(A_or_sys: Any, B: Any = None, poles: Any = None) -> Placement:
     """
     if poles is None:
         A_or_sys, B, poles = *plant_pair(A_or_sys, None, "B"), B
-    return _core.place(A_or_sys, B, poles, "knv0")
+    # Now the matrices; a system or None still here is refused by the core, by name.
+    return _core.place(cast("ArrayLike", A_or_sys), cast("ArrayLike", B), poles, "knv0")
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,7 +189,7 @@ class CompanionForm:
     """[1, a_1, ..., a_n] of det(λI - A) (6.106)."""
 
 
-def companion_form(A_or_sys: Any, b: Any = None) -> CompanionForm:
+def companion_form(A_or_sys: ArrayLike | System, b: ArrayLike | None = None) -> CompanionForm:
     """The first companion form of a controllable single-input pair (6.116)-(6.145).
 
     >>> import aerocontrol
@@ -197,7 +209,7 @@ def companion_form(A_or_sys: Any, b: Any = None) -> CompanionForm:
     )
 
 
-def _select_mode(analysis: Modes, mode: Any) -> int:
+def _select_mode(analysis: Modes, mode: object) -> int:
     """The index of a mode given by index, name, or (approximate) eigenvalue."""
     count = len(analysis)
     if count == 0:
@@ -223,8 +235,8 @@ def _select_mode(analysis: Modes, mode: Any) -> int:
 
 
 def augment_mode(
-    sys_or_A: Any,
-    mode: Any,
+    sys_or_A: ArrayLike | System | Modes,
+    mode: ModeKey,
     zeta: float | None = None,
     omega_n: float | None = None,
 ) -> ComplexArray:
@@ -284,7 +296,7 @@ def augment_mode(
     return poles
 
 
-def _plant_matrix(sys_or_A: Any) -> FloatArray:
+def _plant_matrix(sys_or_A: ArrayLike | System) -> FloatArray:
     if isinstance(sys_or_A, (StateSpace, tuple, list)) and not _is_matrix(sys_or_A):
         return as_state_space(sys_or_A).A
     if is_system(sys_or_A):
@@ -292,7 +304,7 @@ def _plant_matrix(sys_or_A: Any) -> FloatArray:
     return real_array(sys_or_A, "A")
 
 
-def _is_matrix(value: Any) -> bool:
+def _is_matrix(value: object) -> bool:
     """Whether a list or tuple is a nested list of numbers (a matrix), not (A, B)."""
     try:
         return np.asarray(value, dtype=np.float64).ndim == 2

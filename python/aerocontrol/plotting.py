@@ -27,15 +27,19 @@ States, inputs and outputs with the names of the aircraft models (``u/u0``, ``al
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from collections.abc import Iterable, Sequence
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ._validation import FloatArray, real_array
 from .exceptions import InvalidArgumentError, ShapeError
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.legend import Legend
+
     from .frequency import FrequencyResponse
     from .modal import Modes
     from .responses import TimeResponse
@@ -92,6 +96,8 @@ def _axis_label(names: Sequence[str], what: str) -> str:
     return f"{what} ({', '.join(units)})" if units else what
 
 
+# Any: the options are matplotlib's subplots keywords, of any type; the result is one Axes or
+# an array of them by rows and columns (matplotlib's own stubs type it Any).
 def _new_axes(rows: int = 1, columns: int = 1, **options: Any) -> Any:
     import matplotlib.pyplot as plt
 
@@ -99,7 +105,7 @@ def _new_axes(rows: int = 1, columns: int = 1, **options: Any) -> Any:
     return axes
 
 
-def _finish(ax: Any, xlabel: str, ylabel: str, title: str | None = None) -> None:
+def _finish(ax: Axes, xlabel: str, ylabel: str, title: str | None = None) -> None:
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     if title:
@@ -108,7 +114,7 @@ def _finish(ax: Any, xlabel: str, ylabel: str, title: str | None = None) -> None
     ax.legend(loc="best", fontsize="small")
 
 
-def _pair(axes: Any, name: str) -> tuple[Any, Any]:
+def _pair(axes: Iterable[Axes], name: str) -> tuple[Axes, Axes]:
     try:
         first, second = axes
     except (TypeError, ValueError):
@@ -134,14 +140,14 @@ def _response_index(result: TimeResponse, response: int) -> int:
 
 def plot_time_response(
     result: TimeResponse,
-    ax: Any = None,
+    ax: Axes | None = None,
     signal: str = "states",
     response: int = 0,
     t_max: float | None = None,
     title: str | None = None,
     suffix: str = "",
     linestyle: str = "-",
-) -> Any:
+) -> Axes:
     """States (``signal="states"``) or outputs of one response against time, one named line
     each, up to ``t_max`` seconds (the whole grid when None). Returns the axes.
 
@@ -173,10 +179,10 @@ def plot_time_response(
 def plot_time_scales(
     result: TimeResponse,
     short: float,
-    axes: Any = None,
+    axes: Iterable[Axes] | None = None,
     signal: str = "states",
     response: int = 0,
-) -> tuple[Any, Any]:
+) -> tuple[Axes, Axes]:
     """One response at two time scales, as the chapter shows the longitudinal motions: the
     first ``short`` seconds (the short period) and the whole grid (the phugoid), Figures 6.1
     and 6.2. Returns the pair of axes.
@@ -192,17 +198,18 @@ def plot_time_scales(
     plot_time_response(result, first, signal, response, t_max=short, title="short period scale")
     plot_time_response(result, second, signal, response, title="phugoid scale")
     # One legend for both (the same lines): the long panel's oscillation leaves no corner free.
-    second.get_legend().remove()
+    # (plot_time_response gave each axes a legend, so there is one to remove.)
+    cast("Legend", second.get_legend()).remove()
     return first, second
 
 
 def plot_open_closed(
     open_loop: TimeResponse,
     closed_loop: TimeResponse,
-    axes: Any = None,
+    axes: Iterable[Axes] | None = None,
     titles: tuple[str, str] = ("(a) open loop", "(b) closed loop"),
     signal: str = "states",
-) -> tuple[Any, Any]:
+) -> tuple[Axes, Axes]:
     """The open-loop response beside the closed-loop one on a common scale (Figures 6.4-6.6).
     Returns the pair of axes."""
     first, second = _pair(
@@ -217,7 +224,7 @@ def plot_open_closed(
     return first, second
 
 
-def _gain(K: Any, result: TimeResponse) -> FloatArray:
+def _gain(K: ArrayLike, result: TimeResponse) -> FloatArray:
     gain = real_array(K, "K")
     gain = gain.reshape(1, -1) if gain.ndim == 1 else gain
     n = len(result.state_names)
@@ -233,11 +240,11 @@ def _control_names(result: TimeResponse, m: int) -> tuple[str, ...]:
 
 def plot_with_controls(
     result: TimeResponse,
-    K: Any,
-    ax: Any = None,
+    K: ArrayLike,
+    ax: Axes | None = None,
     response: int = 0,
     title: str | None = None,
-) -> Any:
+) -> Axes:
     """A regulated response with the control deflections η = -K x (6.230) that produce it,
     dashed, on the same axes (Figures 6.9, 6.10). ``result`` is a response of the closed loop
     A - B K whose input names (if it has one per row of K) name the controls. Returns the axes.
@@ -254,7 +261,7 @@ def plot_with_controls(
 
 
 def penalty_terms(
-    result: TimeResponse, K: Any, Q: Any, R: Any, response: int = 0
+    result: TimeResponse, K: ArrayLike, Q: ArrayLike, R: ArrayLike, response: int = 0
 ) -> tuple[FloatArray, FloatArray]:
     """The integrands of the performance index along a regulated response: x^T Q x and
     η^T R η with η = -K x (the terms of J, (6.198); R includes the weight 1/c²).
@@ -277,13 +284,13 @@ def penalty_terms(
 
 def plot_penalty(
     result: TimeResponse,
-    K: Any,
-    Q: Any,
-    R: Any,
-    ax: Any = None,
+    K: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike,
+    ax: Axes | None = None,
     name: str = "",
     response: int = 0,
-) -> Any:
+) -> Axes:
     """x^T Q x above the axis and -η^T R η below it along a regulated response, the area
     between them shaded: it is the performance index J (Figure 6.11). The legend gives J by
     the trapezoidal rule. Call once per design on the same axes to compare. Returns the axes.
@@ -301,7 +308,7 @@ def plot_penalty(
     return ax
 
 
-def _tracks(poles: np.ndarray[Any, Any]) -> np.ndarray[Any, Any]:
+def _tracks(poles: NDArray[np.generic]) -> NDArray[np.complex128]:
     """Reorder each row of ``poles`` so that column j follows one root from row to row:
     greedy nearest matching to the previous row."""
     tracked = np.array(poles, dtype=np.complex128, copy=True)
@@ -319,13 +326,13 @@ def _tracks(poles: np.ndarray[Any, Any]) -> np.ndarray[Any, Any]:
 
 
 def plot_root_locus(
-    weights: Any,
-    poles: Any,
-    ax: Any = None,
+    weights: ArrayLike,
+    poles: ArrayLike,
+    ax: Axes | None = None,
     marked: Sequence[float] | None = None,
     weight_name: str = "c",
     title: str = "closed-loop roots over the weight",
-) -> Any:
+) -> Axes:
     """The closed-loop roots as the weight varies (Figures 6.8, 6.12): one line per root
     through ``poles`` (shape (len(weights), n), e.g. from
     :func:`aerocontrol.design.lqr_root_locus`), a symbol per value in ``marked`` (at the
@@ -375,7 +382,9 @@ def plot_root_locus(
     return ax
 
 
-def plot_bode(result: FrequencyResponse, ax: Any = None, output: int = 0, input: int = 0) -> Any:
+def plot_bode(
+    result: FrequencyResponse, ax: Iterable[Axes] | None = None, output: int = 0, input: int = 0
+) -> tuple[Axes, Axes]:
     """Magnitude (dB) and phase (degrees) against frequency (rad/s, log scale) of one
     input-output pair, on a pair of axes. Returns the pair."""
     for value, names, argument in (
@@ -411,8 +420,12 @@ def _edges(centres: FloatArray) -> FloatArray:
 
 
 def plot_levels(
-    machs: Any, altitudes: Any, levels: Any, ax: Any = None, title: str = "Levels"
-) -> Any:
+    machs: ArrayLike,
+    altitudes: ArrayLike,
+    levels: ArrayLike,
+    ax: Axes | None = None,
+    title: str = "Levels",
+) -> Axes:
     """MIL-F-8785C Levels over a grid of flight conditions: one cell per (Mach, altitude),
     coloured and labelled by its Level (0: not assessed). ``levels`` is (len(altitudes),
     len(machs)). Returns the axes."""
@@ -443,7 +456,7 @@ def plot_levels(
     return ax
 
 
-def plot_modes(modes: Modes, ax: Any = None, marker: str = "x", suffix: str = "") -> Any:
+def plot_modes(modes: Modes, ax: Axes | None = None, marker: str = "x", suffix: str = "") -> Axes:
     """The eigenvalues in the complex plane (rad/s), one marker and label per mode; give
     ``marker`` and ``suffix`` (appended to the labels) to overlay two sets, e.g. open and
     closed loop."""

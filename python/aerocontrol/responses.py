@@ -29,14 +29,20 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Literal, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _core
 from ._validation import FloatArray, check_choice, finite_or_warn, real_array
 from .exceptions import InvalidArgumentError, NumericalOverflowWarning, ShapeError
 from .statespace import StateSpace, as_state_space, is_system
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ._typing import System, Systems
 
 __all__ = [
     "TimeResponse",
@@ -98,14 +104,14 @@ class TimeResponse:
                 lines.append(f"    {name:<14} {value:+.6g}   (peak |x| {peak:.4g})")
         return "\n".join(lines)
 
-    def plot(self, ax: Any = None, signal: str = "states", response: int = 0) -> Any:
+    def plot(self, ax: Axes | None = None, signal: str = "states", response: int = 0) -> Axes:
         """Plot the states (or ``signal="outputs"``) of one response against time."""
         from .plotting import plot_time_response
 
         return plot_time_response(self, ax=ax, signal=signal, response=response)
 
 
-def _systems(sys: Any) -> tuple[list[StateSpace], bool]:
+def _systems(sys: Systems) -> tuple[list[StateSpace], bool]:
     """The models, and whether several were given as a list."""
     if isinstance(sys, list) and sys and is_system(sys[0]):
         models = [as_state_space(s, f"sys[{k}]") for k, s in enumerate(sys)]
@@ -122,10 +128,11 @@ def _systems(sys: Any) -> tuple[list[StateSpace], bool]:
                     f"({model.n_states}, {model.n_inputs}, {model.n_outputs})"
                 )
         return models, True
-    return [as_state_space(sys)], False
+    # Not a list of models: one model, whose conversion refuses an empty list by name.
+    return [as_state_space(cast("System", sys))], False
 
 
-def default_time_grid(sys: Any) -> FloatArray:
+def default_time_grid(sys: Systems) -> FloatArray:
     """The default grid of the responses (see the module documentation)."""
     models, _ = _systems(sys)
     step, final = _default_step_and_final(models)
@@ -148,7 +155,7 @@ def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
     return step, final
 
 
-def _grid(T: Any, models: list[StateSpace]) -> tuple[FloatArray, float]:
+def _grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, float]:
     """(t, step) for the T given: a grid, a final time, or None."""
     if T is None:
         t = default_time_grid(models)
@@ -168,7 +175,7 @@ def _grid(T: Any, models: list[StateSpace]) -> tuple[FloatArray, float]:
     return np.array(times, dtype=np.float64), step
 
 
-def _input_weights(eta0: Any, m: int) -> tuple[FloatArray, tuple[str, ...] | None]:
+def _input_weights(eta0: ArrayLike | None, m: int) -> tuple[FloatArray, tuple[str, ...] | None]:
     """The η0 of each response (r, m) and, for the unit vectors, None (names from inputs)."""
     if eta0 is None:
         return np.eye(m), None
@@ -207,7 +214,11 @@ def _assemble(
 
 
 def _free_responses(
-    kind: str, sys: Any, T: Any, initial: Any, names: Sequence[str] | None = None
+    kind: str,
+    sys: Systems,
+    T: ArrayLike | None,
+    initial: Callable[[StateSpace], FloatArray],
+    names: Sequence[str] | None = None,
 ) -> TimeResponse:
     """Free responses from initial states computed per model by ``initial(model)`` (r, n)."""
     models, several_models = _systems(sys)
@@ -237,7 +248,9 @@ def _free_responses(
     return _assemble(kind, t, x, y, None, first, labels, len(x0) > 1)
 
 
-def impulse_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
+def impulse_response(
+    sys: Systems, T: ArrayLike | None = None, eta0: ArrayLike | None = None
+) -> TimeResponse:
     """Response to η = η0 δ(t): x(t) = e^{At} B η0, y = C x (chapter (6.36)).
 
     Equal to the free response from x(0) = B η0. Without ``eta0`` a multi-input system gives
@@ -261,7 +274,9 @@ def impulse_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
     )
 
 
-def doublet_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
+def doublet_response(
+    sys: Systems, T: ArrayLike | None = None, eta0: ArrayLike | None = None
+) -> TimeResponse:
     """Response to η = η0 δ'(t): x(t) = e^{At} A B η0, y = C x (chapter (6.38)).
 
     Equal to the free response from x(0) = A B η0.
@@ -290,7 +305,7 @@ def _initial_state(form: Callable[[], FloatArray], what: str) -> FloatArray:
     return states
 
 
-def initial_response(sys: Any, x0: Any, T: Any = None) -> TimeResponse:
+def initial_response(sys: Systems, x0: ArrayLike, T: ArrayLike | None = None) -> TimeResponse:
     """The free response x(t) = e^{At} x0 (6.31), y = C x.
 
     ``x0`` is one initial state (n,) or several (r, n), computed in one call.
@@ -308,7 +323,9 @@ def initial_response(sys: Any, x0: Any, T: Any = None) -> TimeResponse:
     return _free_responses("initial", sys, T, lambda m: states)
 
 
-def step_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
+def step_response(
+    sys: Systems, T: ArrayLike | None = None, eta0: ArrayLike | None = None
+) -> TimeResponse:
     """Response to η = η0 H(t) from rest (chapter (6.39)-(6.45)).
 
     Computed exactly through the augmented exponential, so it is right for singular A (an
@@ -360,10 +377,10 @@ def step_response(sys: Any, T: Any = None, eta0: Any = None) -> TimeResponse:
 
 
 def forced_response(
-    sys: Any,
-    T: Any,
-    u: Any,
-    x0: Any = None,
+    sys: System,
+    T: ArrayLike,
+    u: ArrayLike,
+    x0: ArrayLike | None = None,
     method: Literal["zoh", "foh"] = "zoh",
 ) -> TimeResponse:
     """Response to a sampled input u on the uniform grid T, from x0 (default rest).
@@ -443,7 +460,7 @@ def forced_response(
     return _assemble("forced", times, x, y, inputs, model, labels, responses > 1)
 
 
-def steady_state(sys: Any, eta0: Any) -> FloatArray:
+def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     """The state a step η0 settles to, x∞ = -A^-1 B η0 (6.45), for a stable system.
 
     Raises SingularMatrixError naming the zero eigenvalue when A is singular (an integrator
@@ -464,7 +481,7 @@ def steady_state(sys: Any, eta0: Any) -> FloatArray:
     return result
 
 
-def dc_gain(sys: Any) -> FloatArray:
+def dc_gain(sys: System) -> FloatArray:
     """The zero-frequency gain D - C A^-1 B (p, m): the steady output per unit step input.
 
     Raises SingularMatrixError naming the zero eigenvalue when A is singular.

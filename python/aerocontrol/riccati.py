@@ -19,15 +19,18 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError
 from .statespace import as_state_space, is_system
+
+if TYPE_CHECKING:
+    from ._typing import SystemObject
 
 __all__ = [
     "CareSolution",
@@ -72,12 +75,12 @@ class CareSolution:
 
 
 def solve_care(
-    A: Any,
-    B: Any,
-    Q: Any,
-    R: Any,
-    S: Any = None,
-    E: Any = None,
+    A: ArrayLike,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike,
+    S: ArrayLike | None = None,
+    E: ArrayLike | None = None,
     refine: bool = True,
 ) -> CareSolution:
     """The stabilising solution of the continuous algebraic Riccati equation (6.199, 6.228).
@@ -145,7 +148,13 @@ def solve_care(
 
 
 def _solve_care(
-    A: Any, B: Any, Q: Any, R: Any, S: Any, E: Any, refine: bool
+    A: ArrayLike,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike,
+    S: ArrayLike | None,
+    E: ArrayLike | None,
+    refine: bool,
 ) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
     """The native solve, as (X, K, poles, residual, rcond, steps), warning (at the caller of
     :func:`solve_care` or :func:`lqr`) when the solution may be inaccurate."""
@@ -176,13 +185,15 @@ def _solve_care(
     return result
 
 
-def _matrix(value: Any, name: str) -> FloatArray:
+def _matrix(value: object, name: str) -> FloatArray:
     """A weight as a 2-D array: a scalar becomes 1 x 1 (python-control accepts R = 1)."""
     array = real_array(value, name)
     return np.atleast_2d(array) if array.ndim < 2 else array
 
 
-def lqr(sys_or_A: Any, *args: Any, N: Any = None) -> tuple[FloatArray, FloatArray, ComplexArray]:
+def lqr(
+    sys_or_A: ArrayLike | SystemObject, *args: ArrayLike, N: ArrayLike | None = None
+) -> tuple[FloatArray, FloatArray, ComplexArray]:
     """The linear-quadratic regulator, called and returning as python-control's ``lqr``.
 
     ``lqr(sys, Q, R)``, ``lqr(A, B, Q, R)`` or ``lqr(A, B, Q, R, N)`` minimise
@@ -208,6 +219,8 @@ def lqr(sys_or_A: Any, *args: Any, N: Any = None) -> tuple[FloatArray, FloatArra
     """
     # Plain indexing, not star-unpacking: this wrapper's own cost is part of a 4-state lqr's.
     count = len(args)
+    A: ArrayLike  # the system's matrices or the caller's
+    B: ArrayLike
     if is_system(sys_or_A):
         if count not in (2, 3):
             raise InvalidArgumentError("lqr(sys, Q, R[, N]) takes a system and two weights")
@@ -243,7 +256,12 @@ class RiccatiSolution:
 
 
 def riccati_ode(
-    A_or_sys: Any, B: Any, Q: Any, R: Any = None, t: Any = None, Sf: Any = None
+    A_or_sys: ArrayLike | SystemObject,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike | None = None,
+    t: ArrayLike | None = None,
+    Sf: ArrayLike | None = None,
 ) -> RiccatiSolution:
     """The Riccati differential equation -dS/dt = S A + A^T S - S B R^-1 B^T S + Q (6.196),
     integrated backward from S(t_f) = Sf (default 0, (6.197)) over the grid ``t``.
@@ -267,6 +285,7 @@ def riccati_ode(
     >>> np.round(sol.K[0], 6)            # the algebraic (steady-state) gain, t_f - t = 20
     array([[2.414214, 2.197368]])
     """
+    A: ArrayLike  # the system's plant matrix or the caller's
     if is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
         # riccati_ode(sys, Q, R, t, Sf): every argument shifts one place to the left.
@@ -290,7 +309,12 @@ def riccati_ode(
 
 
 def lqr_finite(
-    A_or_sys: Any, B: Any, Q: Any, R: Any = None, t: Any = None, Sf: Any = None
+    A_or_sys: ArrayLike | SystemObject,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike | None = None,
+    t: ArrayLike | None = None,
+    Sf: ArrayLike | None = None,
 ) -> FloatArray:
     """The time-varying gain K(t) = R^-1 B^T S(t) of the finite-horizon regulator (6.200), shape
     (len(t), m, n); arguments as :func:`riccati_ode`."""
@@ -298,7 +322,7 @@ def lqr_finite(
     return gains
 
 
-def solve_lyapunov(A: Any, Q: Any) -> FloatArray:
+def solve_lyapunov(A: ArrayLike, Q: ArrayLike) -> FloatArray:
     """The solution X of the continuous Lyapunov equation A X + X A^T + Q = 0.
 
     Bartels-Stewart: with A = U T U^T, T Y + Y T^T = -U^T Q U is solved block by block from

@@ -11,18 +11,24 @@ importing python-control); :func:`as_state_space` does the conversion.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import ShapeError
 
+if TYPE_CHECKING:
+    from typing_extensions import TypeIs
+
+    from ._typing import System, SystemObject
+
 __all__ = ["StateSpace", "as_state_space"]
 
 
-def _matrix(value: Any, name: str) -> FloatArray:
+def _matrix(value: object, name: str) -> FloatArray:
     array = real_array(value, name)
     if array.ndim == 1:
         raise ShapeError(
@@ -86,10 +92,10 @@ class StateSpace:
 
     def __init__(
         self,
-        A: Any,
-        B: Any,
-        C: Any = None,
-        D: Any = None,
+        A: ArrayLike,
+        B: ArrayLike,
+        C: ArrayLike | None = None,
+        D: ArrayLike | None = None,
         state_names: Sequence[str] | None = None,
         input_names: Sequence[str] | None = None,
         output_names: Sequence[str] | None = None,
@@ -135,7 +141,7 @@ class StateSpace:
         )
 
 
-def is_system(value: Any) -> bool:
+def is_system(value: object) -> TypeIs[SystemObject]:
     """Whether ``value`` is a model rather than a matrix: a :class:`StateSpace`, or an object
     with ``A``, ``B``, ``C`` and ``D`` attributes such as python-control's StateSpace. Arrays
     are matrices, ``numpy.matrix`` included (its ``.A`` is the plain array, not a plant)."""
@@ -146,7 +152,7 @@ def is_system(value: Any) -> bool:
     return all(hasattr(value, attribute) for attribute in "ABCD")
 
 
-def as_state_space(model: Any, name: str = "sys") -> StateSpace:
+def as_state_space(model: System, name: str = "sys") -> StateSpace:
     """``model`` as a :class:`StateSpace`.
 
     Accepts a StateSpace (returned as is), a tuple or list ``(A, B)`` or ``(A, B, C, D)``, or
@@ -162,7 +168,7 @@ def as_state_space(model: Any, name: str = "sys") -> StateSpace:
             )
         return StateSpace(*model)
     if is_system(model):
-        names: dict[str, Any] = {}
+        names: dict[str, list[str]] = {}
         for ours, theirs in [
             ("state_names", "state_labels"),
             ("input_names", "input_labels"),
@@ -184,11 +190,14 @@ def as_state_space(model: Any, name: str = "sys") -> StateSpace:
     )
 
 
-def plant_pair(A_or_sys: Any, second: Any, attribute: str) -> tuple[Any, Any]:
+def plant_pair(
+    A_or_sys: ArrayLike | System, second: ArrayLike | None, attribute: str
+) -> tuple[ArrayLike, ArrayLike]:
     """(A, B) or (A, C): the two matrices when ``second`` is given, else taken from a system,
     an (A, B) tuple or any object with the attributes (``attribute`` names the second one)."""
     if second is not None:
-        return A_or_sys, second
+        # With both given the first is the plant matrix; a system there is refused by the core.
+        return cast("ArrayLike", A_or_sys), second
     if isinstance(A_or_sys, (tuple, list)) or is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
         return sys.A, getattr(sys, attribute)
