@@ -76,11 +76,14 @@ from .responses import (
 )
 from .riccati import (
     CareSolution,
+    DareSolution,
     RiccatiSolution,
+    dlqr,
     lqr,
     lqr_finite,
     riccati_ode,
     solve_care,
+    solve_dare,
     solve_lyapunov,
 )
 from .statespace import StateSpace, as_state_space
@@ -95,6 +98,7 @@ __all__ = [
     "AerocontrolLinAlgError",
     "AerocontrolWarning",
     "CareSolution",
+    "DareSolution",
     "CompanionForm",
     "Controllability",
     "ConvergenceError",
@@ -134,6 +138,7 @@ __all__ = [
     "default_time_grid",
     "design",
     "discretize",
+    "dlqr",
     "doublet_response",
     "exceptions",
     "expm",
@@ -158,6 +163,7 @@ __all__ = [
     "qz",
     "schur",
     "solve_care",
+    "solve_dare",
     "solve_lyapunov",
     "steady_state",
     "step_response",

@@ -159,6 +159,15 @@ def schur(
     a: ArrayLike, select: Callable[[complex], bool] | None, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], int]: ...
 def solve_lyapunov(a: ArrayLike, q: ArrayLike, /) -> NDArray[np.float64]: ...
+def solve_dare(
+    a: ArrayLike,
+    b: ArrayLike,
+    q: ArrayLike,
+    r: ArrayLike,
+    s: ArrayLike | None,
+    e: ArrayLike | None,
+    /,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], float, float, int]: ...
 def solve_care(
     a: ArrayLike,
     b: ArrayLike,

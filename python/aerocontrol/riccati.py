@@ -9,6 +9,8 @@ S(t_f) = S_f, or, for an infinite horizon, the algebraic equation (6.199).
   with a cross weight S and a descriptor matrix E, by the Hamiltonian ordered-Schur method
   (scaled, then refined by Newton's method), with its residual and conditioning;
 * :func:`lqr`: python-control's ``lqr`` call and return convention, (K, S, E);
+* :func:`solve_dare` and :func:`dlqr`: the discrete-time equation and regulator, by the
+  extended symplectic pencil and the QZ algorithm;
 * :func:`solve_lyapunov`: A X + X A^T + Q = 0 by Bartels-Stewart;
 * :func:`riccati_ode` and :func:`lqr_finite`: the finite-horizon solution S(t) and gain K(t)
   on a time grid, exact up to rounding at any step (the Hamiltonian transition matrix,
@@ -34,11 +36,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     "CareSolution",
+    "DareSolution",
     "RiccatiSolution",
+    "dlqr",
     "lqr",
     "lqr_finite",
     "riccati_ode",
     "solve_care",
+    "solve_dare",
     "solve_lyapunov",
 ]
 
@@ -238,6 +243,165 @@ def lqr(
         N = args[weights_given]
     result = _solve_care(A, B, Q, R, N, None, True)
     return result[1], result[0], result[2]
+
+
+@dataclass(frozen=True, eq=False)
+class DareSolution:
+    """The stabilising solution of a discrete algebraic Riccati equation.
+
+    The equation is A^T X A - E^T X E - (A^T X B + S)(R + B^T X B)^-1 (B^T X A + S^T) + Q = 0,
+    with E = I and S = 0 by default.
+    """
+
+    X: FloatArray
+    """The stabilising solution, symmetric, n x n."""
+    K: FloatArray
+    """The optimal gain (R + B^T X B)^-1 (B^T X A + S^T), m x n."""
+    closed_loop_poles: ComplexArray
+    """The eigenvalues of (A - B K, E), all with |z| < 1."""
+    residual: float
+    """||Res||_F / (||Q||_F + ||A^T X A||_F + ||E^T X E||_F + ||(B^T X A + S^T)^T K||_F)."""
+    rcond: float
+    """Reciprocal 1-norm condition number of E U11 (U11 the top half of the stable deflating
+    subspace's basis): small means X is sensitive."""
+    refinement_steps: int
+    """Newton steps taken after the pencil's solution (up to n = 16)."""
+
+
+def solve_dare(
+    A: ArrayLike,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike,
+    S: ArrayLike | None = None,
+    E: ArrayLike | None = None,
+) -> DareSolution:
+    """The stabilising solution of the discrete algebraic Riccati equation.
+
+    Solves A^T X A - E^T X E - (A^T X B + S)(R + B^T X B)^-1 (B^T X A + S^T) + Q = 0 for the X
+    that puts every eigenvalue of (A - B K, E) inside the unit circle,
+    K = (R + B^T X B)^-1 (B^T X A + S^T) (MATLAB's dare; scipy's solve_discrete_are).
+
+    Method: the extended symplectic pencil of order 2n + m (Van Dooren 1981), its last m
+    columns compressed away by a QR factorisation, then aerocontrol's own QZ algorithm
+    (:func:`~aerocontrol.qz`) reordered to put the eigenvalues inside the unit circle first;
+    X = U21 (E U11)^-1 from that deflating subspace, then up to n = 16 Newton steps (Hewer
+    1971; each a Stein equation) while the residual decreases. Neither A nor R need be invertible, and R
+    need not be definite (only R + B^T X B nonsingular). Before it is returned the solution is
+    verified: no eigenvalue of the pencil on the unit circle, exactly n inside, E U11
+    nonsingular, and every closed-loop eigenvalue inside the unit circle.
+
+    Parameters
+    ----------
+    A, Q : array_like (n, n)
+    B : array_like (n, m)
+    R : array_like (m, m), symmetric
+    S : array_like (n, m), optional; the cross weight (python-control's N)
+    E : array_like (n, n), optional
+
+    Raises
+    ------
+    NoStabilizingSolutionError
+        The pencil has eigenvalues on the unit circle (a mode on it is neither controllable
+        nor penalised), its stable subspace is not a graph, or the computed closed loop is not
+        inside the unit circle.
+    SingularMatrixError
+        R + B^T X B is singular.
+
+    Warns
+    -----
+    IllConditionedWarning
+        rcond(E U11) < 1e-8 or relative residual > 1e-8.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.solve_dare([[2.0]], [[1.0]], [[1.0]], [[1.0]])
+    >>> round(float(sol.X[0, 0]), 12), round(2 + 5 ** 0.5, 12)     # x^2 - 4x - 1 = 0
+    (4.2360679775, 4.2360679775)
+    >>> bool(np.all(abs(sol.closed_loop_poles) < 1))
+    True
+    """
+    return DareSolution(*_solve_dare(A, B, Q, R, S, E))
+
+
+def _solve_dare(
+    A: ArrayLike,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike,
+    S: ArrayLike | None,
+    E: ArrayLike | None,
+) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
+    """The native solve, warning (at the caller of :func:`solve_dare` or :func:`dlqr`) when
+    the solution may be inaccurate."""
+    result = _core.solve_dare(
+        A,
+        B,
+        _matrix(Q, "Q"),
+        _matrix(R, "R"),
+        None if S is None else _matrix(S, "S"),
+        None if E is None else _matrix(E, "E"),
+    )
+    residual, rcond = result[3], result[4]
+    if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
+        warnings.warn(
+            f"the discrete Riccati solution may be inaccurate: rcond(E U11) = {rcond:.2e}, "
+            f"relative residual {residual:.2e}",
+            IllConditionedWarning,
+            stacklevel=3,
+        )
+    return result
+
+
+def dlqr(
+    sys_or_A: ArrayLike | SystemObject, *args: ArrayLike, N: ArrayLike | None = None
+) -> tuple[FloatArray, FloatArray, ComplexArray]:
+    """The discrete-time linear-quadratic regulator, called and returning as python-control's
+    ``dlqr``.
+
+    ``dlqr(sys, Q, R)``, ``dlqr(A, B, Q, R)`` or ``dlqr(A, B, Q, R, N)`` minimise
+    J = Σ (x_k^T Q x_k + u_k^T R u_k + 2 x_k^T N u_k) for x_{k+1} = A x_k + B u_k.
+
+    Returns
+    -------
+    K : ndarray (m, n)
+        The gain of u_k = -K x_k.
+    S : ndarray (n, n)
+        The solution of the discrete Riccati equation.
+    E : ndarray (n,) of complex128
+        The closed-loop eigenvalues, eig(A - B K), inside the unit circle.
+
+    See :func:`solve_dare` for the method, the errors and the diagnostics.
+
+    >>> import numpy as np, aerocontrol
+    >>> A = np.array([[1.0, 0.1], [0.0, 1.0]]); B = np.array([[0.005], [0.1]])
+    >>> K, S, E = aerocontrol.dlqr(A, B, np.eye(2), [[1.0]])
+    >>> bool(np.all(abs(E) < 1)), K.shape
+    (True, (1, 2))
+    """
+    count = len(args)
+    if is_system(sys_or_A):
+        if getattr(sys_or_A, "dt", None) == 0:
+            raise InvalidArgumentError(
+                "dlqr needs a discrete-time system, got a continuous one (dt = 0); use lqr"
+            )
+        if count not in (2, 3):
+            raise InvalidArgumentError("dlqr(sys, Q, R[, N]) takes a system and two weights")
+        sys = as_state_space(sys_or_A)
+        A, B, Q, R = sys.A, sys.B, args[0], args[1]
+        weights_given = 2
+    else:
+        if count not in (3, 4):
+            raise InvalidArgumentError("dlqr(A, B, Q, R[, N]) takes four or five matrices")
+        A, B, Q, R = sys_or_A, args[0], args[1], args[2]
+        weights_given = 3
+    if count > weights_given:
+        if N is not None:
+            raise InvalidArgumentError("N given both by position and by keyword")
+        N = args[weights_given]
+    X, K, poles, *_ = _solve_dare(A, B, Q, R, N, None)
+    return K, X, poles
 
 
 @dataclass(frozen=True, eq=False)

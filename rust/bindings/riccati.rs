@@ -6,6 +6,7 @@ use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
 use super::linalg::{expm_flops, schur_cost};
 use crate::control::riccati::care::{CareOptions, solve_care as solve_care_core};
+use crate::control::riccati::dare::{DareOptions, solve_dare as solve_dare_core};
 use crate::control::riccati::ode::riccati_ode as riccati_ode_core;
 use crate::linalg::lyapunov::solve_lyapunov as solve_lyapunov_core;
 use faer::c64;
@@ -58,6 +59,72 @@ fn solve_care<'py>(
     .map_err(|e| to_py_err(py, e))?;
     let solution = compute(py, care_cost(a.nrows()), || {
         solve_care_core(a, b, q, r, options)
+    })?;
+    let mut outputs = Outputs::new(py);
+    let n = solution.closed_loop_eigenvalues.len();
+    let result = (
+        outputs.matrix("X", solution.x.as_ref())?,
+        outputs.matrix("K", solution.gain.as_ref())?,
+        outputs.complex(
+            "the closed-loop eigenvalues",
+            &[n],
+            &solution.closed_loop_eigenvalues,
+        )?,
+        solution.residual,
+        solution.rcond,
+        solution.refinement_steps,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
+
+/// The cost of one DARE of n states and m inputs: the QZ form of the compressed pencil (order
+/// 2n) and its reordering.
+pub fn dare_cost(n: usize, m: usize) -> Cost {
+    let order = 2 * n;
+    Cost::of(
+        80.0 * (order as f64).powi(3) + 4.0 * ((order + m) as f64).powi(3),
+        12.0,
+        order + m,
+    )
+}
+
+type DareOutput<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<c64>>,
+    f64,
+    f64,
+    usize,
+);
+
+/// The stabilising solution of the DARE: (X, K, closed-loop eigenvalues, relative residual,
+/// rcond(E U11), Newton steps).
+#[pyfunction]
+#[pyo3(signature = (a, b, q, r, s, e, /))]
+fn solve_dare<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+    s: Option<&Bound<'py, PyAny>>,
+    e: Option<&Bound<'py, PyAny>>,
+) -> PyResult<DareOutput<'py>> {
+    let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
+    let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
+    let s = Real::convert_optional(py, s, "S")?;
+    let e = Real::convert_optional(py, e, "E")?;
+    let (a, b, q, r, options) = (|| {
+        let options = DareOptions {
+            s: s.as_ref().map(|s| s.matrix()).transpose()?,
+            e: e.as_ref().map(|e| e.matrix()).transpose()?,
+        };
+        Ok((a.matrix()?, b.matrix()?, q.matrix()?, r.matrix()?, options))
+    })()
+    .map_err(|e| to_py_err(py, e))?;
+    let solution = compute(py, dare_cost(a.nrows(), b.ncols()), || {
+        solve_dare_core(a, b, q, r, options)
     })?;
     let mut outputs = Outputs::new(py);
     let n = solution.closed_loop_eigenvalues.len();
@@ -150,6 +217,7 @@ fn solve_lyapunov<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve_lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(solve_care, m)?)?;
+    m.add_function(wrap_pyfunction!(solve_dare, m)?)?;
     m.add_function(wrap_pyfunction!(riccati_ode, m)?)?;
     Ok(())
 }

@@ -10,6 +10,7 @@
 //! * `polynomial_roots`: closed-form roots of polynomials of degree <= 4 (QR shifts).
 //! * `sylvester`: small Sylvester equations, the kernel of reordering and of Bartels–Stewart.
 //! * [`qz`]: the generalized real Schur form of a pencil (QZ) and its reordering.
+//! * [`stein`]: the symmetric Stein (discrete Lyapunov) equation at small orders.
 //! * [`lyapunov`]: the continuous Lyapunov equation.
 //! * [`expm`]: the matrix exponential, with double-double arithmetic where squarings amplify
 //!   rounding.
@@ -29,4 +30,5 @@ pub(crate) mod rotation;
 pub mod schur;
 pub mod small_matrix;
 pub(crate) mod square;
+pub mod stein;
 pub(crate) mod sylvester;
