@@ -120,7 +120,7 @@ def test_bad_input_is_one_line_and_a_nonzero_exit(
 
 
 def _aircraft_file(tmp_path: Path, replace: tuple[str, str]) -> Path:
-    shipped = aerocontrol.aircraft.model.resources.files("aerocontrol.aircraft.data")
+    shipped = aerocontrol.aircraft.reader.resources.files("aerocontrol.aircraft.data")
     text = shipped.joinpath("b747-approach.toml").read_text(encoding="utf-8")
     assert replace[0] in text
     path = tmp_path / "plane.toml"
@@ -180,7 +180,7 @@ def _one_line(err: str) -> str:
 
 def _hostile(tmp_path: Path, kind: str) -> tuple[Path, str]:
     """A hostile aircraft file and the error message it must give."""
-    shipped = aerocontrol.aircraft.model.resources.files("aerocontrol.aircraft.data")
+    shipped = aerocontrol.aircraft.reader.resources.files("aerocontrol.aircraft.data")
     text = shipped.joinpath("b747-approach.toml").read_text(encoding="utf-8")
     path = tmp_path / f"{kind}.toml"
     if kind == "digits400":
@@ -302,7 +302,7 @@ def test_an_unsolvable_regulator_is_one_line(
 ) -> None:
     """A directionally unstable 747 (Cn_beta < 0) with no lateral controls: no stabilising
     Riccati solution exists, whatever c."""
-    shipped = aerocontrol.aircraft.model.resources.files("aerocontrol.aircraft.data")
+    shipped = aerocontrol.aircraft.reader.resources.files("aerocontrol.aircraft.data")
     text = shipped.joinpath("b747-approach.toml").read_text(encoding="utf-8")
     text = text.replace("Cn_beta = 0.15", "Cn_beta = -0.15")
     for key in ("Cy_dr = 0.175", "Cl_dr = 0.007", "Cn_dr = -0.109", "Cl_da = 0.0461",

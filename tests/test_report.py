@@ -15,8 +15,11 @@ import numpy as np
 import pytest
 
 import aerocontrol
-from aerocontrol import report as report_module
 from aerocontrol.report import Report, build_report, write_report
+from aerocontrol.report import build as report_module
+from aerocontrol.report import damper as report_damper
+from aerocontrol.report import regulator as report_regulator
+from aerocontrol.report import responses as report_responses
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 FIGURES = {
@@ -194,7 +197,7 @@ def test_a_design_that_does_not_apply_is_reported_and_the_rest_goes_on(
     def refuse(*args: object, **kwargs: object) -> None:
         raise aerocontrol.UncontrollableError("the Dutch roll is not controllable from here")
 
-    monkeypatch.setattr(report_module, "dutch_roll_damper", refuse)
+    monkeypatch.setattr(report_damper, "dutch_roll_damper", refuse)
     lines: list[str] = []
     built = build_report(progress=lines.append)
     markdown = built.markdown()
@@ -257,7 +260,7 @@ def test_a_failure_leaves_nothing_half_written(
     def fail(ctx: object) -> str:
         raise aerocontrol.ConvergenceError("the regulator failed")
 
-    monkeypatch.setattr(report_module, "_section_regulator", fail)
+    monkeypatch.setattr(report_regulator, "section", fail)
     out = tmp_path / "out"
     if existing:
         out.mkdir()
@@ -315,13 +318,13 @@ def test_the_response_grid_is_bounded_for_an_extreme_aircraft(
     path = tmp_path / "feather.toml"
     path.write_text(text.replace("weight = 564032.0", "weight = 0.1"))
     sizes: list[int] = []
-    real = report_module.impulse_response
+    real = report_responses.impulse_response
 
     def recording(sys: object, T: np.ndarray, **kwargs: object) -> object:
         sizes.append(len(T))
         return real(sys, T=T, **kwargs)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(report_module, "impulse_response", recording)
+    monkeypatch.setattr(report_responses, "impulse_response", recording)
     lines: list[str] = []
     built = build_report(str(path), progress=lines.append)
     assert sizes == [200_001]

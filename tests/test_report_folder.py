@@ -29,9 +29,9 @@ import pytest
 from matplotlib.figure import Figure
 
 import aerocontrol
-from aerocontrol import _report_folder
-from aerocontrol import report as report_module
 from aerocontrol.report import Report, write_report
+from aerocontrol.report import build as report_module
+from aerocontrol.report import folder as _report_folder
 
 MANIFEST = ".aerocontrol-report.json"
 
@@ -481,13 +481,13 @@ def test_a_failure_while_building_leaves_no_trace(
 
 def _count_moves(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     calls = [0]
-    real = _report_folder._link_new
+    real = _report_folder.link_new
 
     def counting(*args: object) -> None:
         calls[0] += 1
         real(*args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(_report_folder, "_link_new", counting)
+    monkeypatch.setattr(_report_folder, "link_new", counting)
     return calls
 
 
@@ -521,7 +521,7 @@ def test_a_failure_at_any_of_the_final_moves_is_undone(
     # The earlier report's 4 files and manifest out of the way; the 5 new files and manifest in.
     assert total == (5 if earlier else 0) + 6
     before = _snapshot(tmp_path)
-    real = _report_folder._link_new
+    real = _report_folder.link_new
     for failing in range(1, total + 1):
         count = itertools.count(1)
 
@@ -533,7 +533,7 @@ def test_a_failure_at_any_of_the_final_moves_is_undone(
             real(*args)  # type: ignore[arg-type]
 
         with monkeypatch.context() as patch:
-            patch.setattr(_report_folder, "_link_new", failing_move)
+            patch.setattr(_report_folder, "link_new", failing_move)
             with pytest.raises(type(error)):
                 write_report(out=out)
         assert _snapshot(tmp_path) == before, failing
@@ -654,7 +654,7 @@ def test_a_signal_during_the_final_moves_waits_until_they_are_done(
     tiny(("one", "stale"), "v1")
     write_report(out=out)
     tiny(("one", "two"), "v2")
-    real = _report_folder._link_new
+    real = _report_folder.link_new
     count = itertools.count(1)
 
     def interrupted_move(*args: object) -> None:
@@ -662,7 +662,7 @@ def test_a_signal_during_the_final_moves_waits_until_they_are_done(
             os.kill(os.getpid(), signal.SIGINT)
         real(*args)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(_report_folder, "_link_new", interrupted_move)
+    monkeypatch.setattr(_report_folder, "link_new", interrupted_move)
     with pytest.raises(KeyboardInterrupt):
         write_report(out=out)
     assert next(count) == 5 + 5 + 1  # every move was made (4 out, 5 in), then the signal

@@ -24,11 +24,12 @@ from .model import (
     Aircraft,
     AircraftDataError,
     available,
-    body_to_stability,
     load,
 )
 from .naming import classify_modes, name_modes
-from .schema import AIRCRAFT_FILE_LIMIT, PlausibleRange
+from .reader import AIRCRAFT_FILE_LIMIT
+from .schema import PlausibleRange
+from .tables import body_to_stability
 
 __all__ = [
     "AIRCRAFT_FILE_LIMIT",

@@ -1,10 +1,7 @@
-"""Reading aircraft files safely, and the plausible range of every quantity they give.
-
-An aircraft file is read only if it is a regular file (a symbolic link is followed only to a
-regular file; a FIFO, a device, a socket or a folder is refused without being read) of at most
-:data:`AIRCRAFT_FILE_LIMIT` bytes (1 MiB; the shipped files are under 15 kB), in UTF-8, and valid
-TOML. Every failure is an :class:`AircraftDataError` (a ``ValueError``) whose one-line message
-names the file and, where there is one, the table and the key.
+"""The plausible range of every quantity an aircraft file gives, and the error of a malformed
+file: :class:`AircraftDataError` (a ``ValueError``), whose one-line message names the file and,
+where there is one, the table and the key. Reading the file is
+:mod:`~aerocontrol.aircraft.reader`'s.
 
 Every number of a file is checked against :data:`PLAUSIBLE_RANGES`, generous bounds that admit
 any real airplane from a model aircraft to the largest transport and the fastest research
@@ -59,38 +56,28 @@ and weight), so an envelope sweep records an implausible condition as a failure.
 from __future__ import annotations
 
 import math
-import os
-import re
 import reprlib
-import stat
-import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from ..exceptions import InvalidArgumentError
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
-
 __all__ = [
-    "AIRCRAFT_FILE_LIMIT",
     "PLAUSIBLE_RANGES",
+    "UNIT_NAMES",
     "AircraftDataError",
     "PlausibleRange",
     "check_range",
-    "decode_text",
-    "parse_toml",
-    "read_aircraft_file",
-    "read_toml",
     "shown",
 ]
 
-AIRCRAFT_FILE_LIMIT = 1 << 20
-"""The largest aircraft file read, in bytes (1 MiB)."""
+UNIT_NAMES = {
+    "english": {"length": "ft", "speed": "ft/s", "density": "slug/ft^3", "force": "lbf"},
+    "si": {"length": "m", "speed": "m/s", "density": "kg/m^3", "force": "N"},
+}
+"""The unit of a length, a speed, a density and a force in each unit system of a file, for
+messages and summaries."""
 
 
 class AircraftDataError(InvalidArgumentError):
@@ -215,126 +202,3 @@ def check_range(
     if bounded and not low <= number <= high:
         raise AircraftDataError(f"{where}{key} = {number:g}{suffix} is outside {span}")
     return number
-
-
-# --- Reading the file ---------------------------------------------------------------------------
-
-
-def _kind(mode: int) -> str:
-    if stat.S_ISDIR(mode):
-        return "a folder"
-    if stat.S_ISFIFO(mode):
-        return "a FIFO (named pipe)"
-    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
-        return "a device"
-    if stat.S_ISSOCK(mode):
-        return "a socket"
-    return "not a regular file"
-
-
-def read_aircraft_file(path: str | os.PathLike[str]) -> str:
-    """The text of the aircraft file at ``path``: a regular file (a symbolic link is followed
-    only to a regular file) of at most :data:`AIRCRAFT_FILE_LIMIT` bytes, decoded as UTF-8.
-
-    A FIFO, a device, a socket or a folder is refused without being read (the file is opened
-    non-blocking and checked again after opening, so a FIFO cannot block and a file swapped
-    after the first check is still refused). Raises AircraftDataError naming the file.
-    """
-    name = str(path)
-    where = f"cannot read the aircraft file {name!r}"
-    try:
-        before = os.stat(path)
-    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the path
-        raise AircraftDataError(f"{where}: {_reason(error)}") from None
-    if not stat.S_ISREG(before.st_mode):
-        raise AircraftDataError(f"{where}: it is {_kind(before.st_mode)}, not a regular file")
-    flags = os.O_RDONLY
-    for flag in ("O_NONBLOCK", "O_NOCTTY", "O_CLOEXEC", "O_BINARY"):
-        flags |= getattr(os, flag, 0)
-    try:
-        descriptor = os.open(path, flags)
-    except OSError as error:
-        raise AircraftDataError(f"{where}: {_reason(error)}") from None
-    try:
-        after = os.fstat(descriptor)
-        if not stat.S_ISREG(after.st_mode):
-            raise AircraftDataError(f"{where}: it is {_kind(after.st_mode)}, not a regular file")
-        limit = f"it is larger than {AIRCRAFT_FILE_LIMIT:,} bytes, the limit of an aircraft file"
-        if after.st_size > AIRCRAFT_FILE_LIMIT:
-            raise AircraftDataError(f"{where}: {limit}")
-        chunks, size = [], 0
-        while size <= AIRCRAFT_FILE_LIMIT:
-            chunk = os.read(descriptor, AIRCRAFT_FILE_LIMIT + 1 - size)
-            if not chunk:
-                break
-            chunks.append(chunk)
-            size += len(chunk)
-        if size > AIRCRAFT_FILE_LIMIT:  # grew while being read
-            raise AircraftDataError(f"{where}: {limit}")
-    except OSError as error:
-        raise AircraftDataError(f"{where}: {_reason(error)}") from None
-    finally:
-        os.close(descriptor)
-    return decode_text(b"".join(chunks), name)
-
-
-def _reason(error: BaseException) -> str:
-    if isinstance(error, OSError) and error.strerror:
-        return error.strerror
-    return str(error) or type(error).__name__
-
-
-def decode_text(data: bytes, origin: str) -> str:
-    """``data`` decoded as UTF-8, or AircraftDataError naming the first bad byte's offset."""
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        raise AircraftDataError(
-            f"{origin}: not UTF-8 text: byte 0x{data[error.start]:02x} at offset {error.start} "
-            f"({error.reason}); save the file as UTF-8"
-        ) from None
-
-
-_INTEGER = re.compile(r"[0-9][0-9_]*")
-_KEY_BEFORE = re.compile(r"([A-Za-z0-9_\-]+)\s*=\s*[+-]?$")
-
-
-def parse_toml(text: str, origin: str) -> dict[str, Any]:
-    """The tables of a TOML document, or AircraftDataError with one line saying why not
-    (the parser's message and position, nesting too deep for the parser, a number with more
-    digits than Python converts)."""
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        message = " ".join(str(error).split())
-        raise AircraftDataError(f"{origin}: not valid TOML: {message}") from None
-    except RecursionError:
-        raise AircraftDataError(
-            f"{origin}: not valid TOML for an aircraft: arrays or tables nested too deeply"
-        ) from None
-    except ValueError:
-        # The parser's int() refused an integer of more digits than Python converts
-        # (sys.get_int_max_str_digits(), 4300 by default).
-        raise AircraftDataError(f"{origin}: {_longest_integer(text)}") from None
-
-
-def _longest_integer(text: str) -> str:
-    """Where the longest run of digits is, for the message about an integer too long."""
-    longest = max(_INTEGER.finditer(text), key=lambda m: len(m.group()), default=None)
-    if longest is None:  # pragma: no cover - the parser fails only on a long integer
-        return "not valid TOML: a number Python cannot read"
-    start = longest.start()
-    line_start = text.rfind("\n", 0, start) + 1
-    line = text.count("\n", 0, start) + 1
-    key = _KEY_BEFORE.search(text[line_start:start])
-    digits = len(longest.group().replace("_", ""))
-    named = f"{key.group(1)} = " if key else ""
-    return (
-        f"line {line}: {named}an integer of {digits} digits is outside the plausible range "
-        "of every quantity"
-    )
-
-
-def read_toml(path: str | os.PathLike[str] | Path) -> dict[str, Any]:
-    """:func:`read_aircraft_file` then :func:`parse_toml`: the tables of a TOML file."""
-    return parse_toml(read_aircraft_file(path), str(path))

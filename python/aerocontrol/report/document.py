@@ -1,0 +1,46 @@
+"""The report as a document: a title and a list of blocks, which the sections append and
+:mod:`~aerocontrol.report.render` writes as Markdown and HTML."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from . import render
+from .render import Figure, Heading, Paragraph, Table
+
+__all__ = ["Report"]
+
+
+@dataclass
+class Report:
+    """A report as a list of blocks, rendered to Markdown and to self-contained HTML."""
+
+    title: str
+    blocks: list[Any] = field(default_factory=list)
+
+    def heading(self, text: str, level: int = 2) -> None:
+        self.blocks.append(Heading(text, level))
+
+    def paragraph(self, text: str) -> None:
+        self.blocks.append(Paragraph(text))
+
+    def table(self, header: Sequence[str], rows: Sequence[Sequence[str]]) -> None:
+        self.blocks.append(Table(tuple(header), [tuple(row) for row in rows]))
+
+    def figure(self, name: str, caption: str, figure: Any) -> None:
+        self.blocks.append(Figure(name, caption, figure))
+
+    @property
+    def figures(self) -> list[tuple[str, Any]]:
+        """(file name, matplotlib figure) of every figure, in order."""
+        return [(f"{b.name}.png", b.figure) for b in self.blocks if isinstance(b, Figure)]
+
+    def markdown(self, figure_folder: str = "figures") -> str:
+        """The report in Markdown, the figures linked from ``figure_folder``."""
+        return render.markdown(self.title, self.blocks, figure_folder)
+
+    def html(self, images: dict[str, bytes]) -> str:
+        """The report as one HTML page; ``images`` maps file names to PNG bytes, embedded."""
+        return render.html(self.title, self.blocks, images)
