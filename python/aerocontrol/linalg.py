@@ -348,7 +348,7 @@ def qz(
     >>> B = np.array([[2.0, 0.0], [0.0, 1.0]])
     >>> AA, BB, alpha, beta, Q, Z, k = aerocontrol.qz(A, B, "lhp")
     >>> k, np.round((alpha / beta).real, 6)
-    (1, array([-0.386001,  3.886001]))
+    (1, array([-0.212214,  4.712214]))
     >>> bool(np.allclose(Q @ AA @ Z.T, A) and np.allclose(Q @ BB @ Z.T, B))
     True
     """

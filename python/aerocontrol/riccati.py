@@ -222,25 +222,7 @@ def lqr(
     >>> bool(np.all(E.real < 0))
     True
     """
-    # Plain indexing, not star-unpacking: this wrapper's own cost is part of a 4-state lqr's.
-    count = len(args)
-    A: ArrayLike  # the system's matrices or the caller's
-    B: ArrayLike
-    if is_system(sys_or_A):
-        if count not in (2, 3):
-            raise InvalidArgumentError("lqr(sys, Q, R[, N]) takes a system and two weights")
-        sys = as_state_space(sys_or_A)
-        A, B, Q, R = sys.A, sys.B, args[0], args[1]
-        weights_given = 2
-    else:
-        if count not in (3, 4):
-            raise InvalidArgumentError("lqr(A, B, Q, R[, N]) takes four or five matrices")
-        A, B, Q, R = sys_or_A, args[0], args[1], args[2]
-        weights_given = 3
-    if count > weights_given:
-        if N is not None:
-            raise InvalidArgumentError("N given both by position and by keyword")
-        N = args[weights_given]
+    A, B, Q, R, N = _regulator_arguments("lqr", sys_or_A, args, N)
     result = _solve_care(A, B, Q, R, N, None, True)
     return result[1], result[0], result[2]
 
@@ -286,10 +268,11 @@ def solve_dare(
     columns compressed away by a QR factorisation, then aerocontrol's own QZ algorithm
     (:func:`~aerocontrol.qz`) reordered to put the eigenvalues inside the unit circle first;
     X = U21 (E U11)^-1 from that deflating subspace, then up to n = 16 Newton steps (Hewer
-    1971; each a Stein equation) while the residual decreases. Neither A nor R need be invertible, and R
-    need not be definite (only R + B^T X B nonsingular). Before it is returned the solution is
-    verified: no eigenvalue of the pencil on the unit circle, exactly n inside, E U11
-    nonsingular, and every closed-loop eigenvalue inside the unit circle.
+    1971; each a Stein equation) while the residual decreases. Neither A nor R need be
+    invertible, and R need not be definite (only R + B^T X B nonsingular). Before it is
+    returned the solution is verified: no eigenvalue of the pencil on the unit circle,
+    exactly n inside, E U11 nonsingular, and every closed-loop eigenvalue inside the unit
+    circle.
 
     Parameters
     ----------
@@ -380,28 +363,40 @@ def dlqr(
     >>> bool(np.all(abs(E) < 1)), K.shape
     (True, (1, 2))
     """
+    if is_system(sys_or_A) and getattr(sys_or_A, "dt", None) == 0:
+        raise InvalidArgumentError(
+            "dlqr needs a discrete-time system, got a continuous one (dt = 0); use lqr"
+        )
+    A, B, Q, R, N = _regulator_arguments("dlqr", sys_or_A, args, N)
+    X, K, poles, *_ = _solve_dare(A, B, Q, R, N, None)
+    return K, X, poles
+
+
+def _regulator_arguments(
+    name: str, sys_or_A: ArrayLike | SystemObject, args: tuple[ArrayLike, ...], N: ArrayLike | None
+) -> tuple[ArrayLike, ArrayLike, ArrayLike, ArrayLike, ArrayLike | None]:
+    """(A, B, Q, R, N) from python-control's ``name(sys, Q, R[, N])`` or
+    ``name(A, B, Q, R[, N])``."""
+    # Plain indexing, not star-unpacking: this wrapper's own cost is part of a 4-state lqr's.
     count = len(args)
+    A: ArrayLike  # the system's matrices or the caller's
+    B: ArrayLike
     if is_system(sys_or_A):
-        if getattr(sys_or_A, "dt", None) == 0:
-            raise InvalidArgumentError(
-                "dlqr needs a discrete-time system, got a continuous one (dt = 0); use lqr"
-            )
         if count not in (2, 3):
-            raise InvalidArgumentError("dlqr(sys, Q, R[, N]) takes a system and two weights")
+            raise InvalidArgumentError(f"{name}(sys, Q, R[, N]) takes a system and two weights")
         sys = as_state_space(sys_or_A)
         A, B, Q, R = sys.A, sys.B, args[0], args[1]
         weights_given = 2
     else:
         if count not in (3, 4):
-            raise InvalidArgumentError("dlqr(A, B, Q, R[, N]) takes four or five matrices")
+            raise InvalidArgumentError(f"{name}(A, B, Q, R[, N]) takes four or five matrices")
         A, B, Q, R = sys_or_A, args[0], args[1], args[2]
         weights_given = 3
     if count > weights_given:
         if N is not None:
             raise InvalidArgumentError("N given both by position and by keyword")
         N = args[weights_given]
-    X, K, poles, *_ = _solve_dare(A, B, Q, R, N, None)
-    return K, X, poles
+    return A, B, Q, R, N
 
 
 @dataclass(frozen=True, eq=False)

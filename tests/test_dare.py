@@ -1,0 +1,228 @@
+"""The discrete algebraic Riccati equation and dlqr against closed forms, scipy,
+python-control, SLICOT (SB02OD through slycot) and the DAREX benchmark collection.
+
+DAREX: P. Benner, A. J. Laub, V. Mehrmann, "A collection of benchmark examples for the
+numerical solution of algebraic Riccati equations II: discrete-time case", Tech. Report
+SPC 95_23, TU Chemnitz-Zwickau, 1995. The 19 cases (default parameters) are read from scipy's
+own test file scipy/linalg/tests/test_solvers.py (class TestSolveDiscreteAre), as installed
+with scipy; case 2 has a complex B, which aerocontrol (real matrices only) refuses by name.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from typing import Any
+
+import control
+import numpy as np
+import pytest
+import scipy
+import scipy.linalg as sl
+
+import aerocontrol
+from aerocontrol.exceptions import (
+    InvalidArgumentError,
+    NoStabilizingSolutionError,
+    ShapeError,
+)
+
+EPS = np.finfo(float).eps
+
+
+def _darex_cases() -> list[tuple[Any, ...]]:
+    """(A, B, Q, R) of the 19 DAREX cases, from scipy's installed test module."""
+    tests = os.path.join(os.path.dirname(scipy.__file__), "linalg", "tests")
+    source = open(os.path.join(tests, "test_solvers.py"), encoding="utf-8").read()
+    start = source.index("class TestSolveDiscreteAre")
+    end = source.index("    # Makes the minimum precision", start)
+    namespace: dict[str, Any] = {
+        "np": np,
+        "block_diag": sl.block_diag,
+        "_load_data": lambda name: np.load(os.path.join(tests, "data", name)),
+    }
+    exec(source[start:end].replace("class TestSolveDiscreteAre:", "if True:"), namespace)
+    cases = [tuple(np.atleast_2d(np.asarray(m)) for m in case[:4]) for case in namespace["cases"]]
+    assert len(cases) == 19
+    return cases
+
+
+DAREX = _darex_cases()
+
+
+def relative_residual(
+    A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray, X: np.ndarray
+) -> float:
+    """||A'XA - X - (A'XB)(R + B'XB)^-1 (B'XA) + Q||_F over the size of its terms."""
+    axa = A.T @ X @ A
+    mixed = B.T @ X @ A
+    quadratic = mixed.T @ np.linalg.solve(R + B.T @ X @ B, mixed)
+    residual = axa - X - quadratic + Q
+    scale = sum(np.linalg.norm(m) for m in (Q, axa, X, quadratic))
+    return float(np.linalg.norm(residual) / scale)
+
+
+@pytest.mark.parametrize("index", range(19))
+def test_darex_residual_at_or_below_scipy(index: int) -> None:
+    A, B, Q, R = DAREX[index]
+    if np.any(np.imag(B) != 0):
+        with pytest.raises(aerocontrol.exceptions.AerocontrolError, match="B must be real"):
+            aerocontrol.solve_dare(A, B, Q, R)
+        return
+    A, B, Q, R = (np.real(m).astype(float) for m in (A, B, Q, R))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        solution = aerocontrol.solve_dare(A, B, Q, R)
+    # Warned exactly when the subspace basis is ill-conditioned (case 16: X = diag(1, 1e12)).
+    assert bool(caught) == (solution.rcond < 1e-8), [str(w.message) for w in caught]
+    ours = relative_residual(A, B, Q, R, solution.X)
+    theirs = relative_residual(A, B, Q, R, sl.solve_discrete_are(A, B, Q, R))
+    # At or below scipy's, or below half a unit of rounding (where both are exact to
+    # rounding and the comparison is noise).
+    assert ours <= max(theirs, EPS / 2), (ours, theirs)
+    assert ours < 1e-13
+    assert np.all(np.abs(solution.closed_loop_poles) < 1)
+    np.testing.assert_allclose(solution.X, solution.X.T, rtol=0, atol=0)
+
+
+def test_scalar_closed_form() -> None:
+    # a = 2, b = q = r = 1: x^2 - 4x - 1 = 0, x = 2 + sqrt(5), k = a b x / (r + b^2 x).
+    solution = aerocontrol.solve_dare([[2.0]], [[1.0]], [[1.0]], [[1.0]])
+    x = 2 + np.sqrt(5)
+    assert solution.X[0, 0] == pytest.approx(x, rel=4 * EPS)
+    assert solution.K[0, 0] == pytest.approx(2 * x / (1 + x), rel=4 * EPS)
+    assert solution.closed_loop_poles[0] == pytest.approx(2 - 2 * x / (1 + x), rel=1e-14)
+
+
+def _random_stabilisable(rng: np.random.Generator, n: int, m: int) -> tuple[np.ndarray, ...]:
+    A = rng.standard_normal((n, n)) / np.sqrt(n) * 1.3
+    B = rng.standard_normal((n, m))
+    C = rng.standard_normal((n, n))
+    return A, B, C @ C.T + 0.1 * np.eye(n), np.eye(m) + 0.1 * np.ones((m, m))
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_dlqr_matches_python_control(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n, m = int(rng.integers(1, 13)), int(rng.integers(1, 4))
+    A, B, Q, R = _random_stabilisable(rng, n, m)
+    N = 0.1 * rng.standard_normal((n, m))
+    K, S, E = aerocontrol.dlqr(A, B, Q, R, N)
+    K2, S2, E2 = control.dlqr(A, B, Q, R, N)
+    assert K.shape == (m, n) and S.shape == (n, n) and E.dtype == np.complex128
+    np.testing.assert_allclose(S, S2, rtol=1e-10, atol=1e-10 * np.linalg.norm(S2))
+    np.testing.assert_allclose(K, K2, rtol=1e-10, atol=1e-10 * np.linalg.norm(K2))
+    np.testing.assert_allclose(np.sort_complex(E), np.sort_complex(E2), atol=1e-10)
+
+
+def test_dlqr_accepts_a_system_and_refuses_a_continuous_one() -> None:
+    A = np.array([[1.0, 0.1], [0.0, 1.0]])
+    B = np.array([[0.005], [0.1]])
+    K, _, _ = aerocontrol.dlqr(A, B, np.eye(2), 1.0)
+    K2, _, _ = aerocontrol.dlqr(
+        aerocontrol.StateSpace(A, B, np.eye(2), np.zeros((2, 1))), np.eye(2), 1.0
+    )
+    np.testing.assert_array_equal(K, K2)
+    with pytest.raises(InvalidArgumentError, match="discrete-time"):
+        aerocontrol.dlqr(control.ss(A, B, np.eye(2), 0), np.eye(2), 1.0)
+    with pytest.raises(InvalidArgumentError, match="four or five"):
+        aerocontrol.dlqr(A, B, np.eye(2))
+
+
+def test_cross_weight_and_descriptor_match_scipy() -> None:
+    # The generalized equation with E nonsingular is the standard one for A E^-1, E^-T Q E^-1
+    # and E^-T S (the bracket that E^T ... E encloses); scipy solves that one (its own E path
+    # refuses this well-conditioned problem as "too close to the unit circle").
+    rng = np.random.default_rng(7)
+    A, B, Q, R = _random_stabilisable(rng, 5, 2)
+    S = 0.1 * rng.standard_normal((5, 2))
+    E = np.eye(5) + 0.1 * rng.standard_normal((5, 5))
+    solution = aerocontrol.solve_dare(A, B, Q, R, S=S, E=E)
+    Ei = np.linalg.inv(E)
+    reference = sl.solve_discrete_are(A @ Ei, B, Ei.T @ Q @ Ei, R, s=Ei.T @ S)
+    np.testing.assert_allclose(
+        solution.X, reference, rtol=0, atol=1e-10 * np.linalg.norm(reference)
+    )
+    poles = sl.eigvals(A - B @ solution.K, E)
+    np.testing.assert_allclose(
+        np.sort_complex(solution.closed_loop_poles), np.sort_complex(poles), atol=1e-12
+    )
+    assert np.all(np.abs(poles) < 1)
+    with_s = aerocontrol.solve_dare(A, B, Q, R, S=S).X
+    np.testing.assert_allclose(with_s, sl.solve_discrete_are(A, B, Q, R, s=S), rtol=1e-11)
+
+
+def test_singular_a_is_solved() -> None:
+    # A deadbeat-like plant: A nilpotent, so the symplectic pencil has infinite eigenvalues.
+    A = np.diag([1.0, 1.0], 1)
+    B = np.array([[0.0], [0.0], [1.0]])
+    solution = aerocontrol.solve_dare(A, B, np.eye(3), [[1.0]])
+    reference = sl.solve_discrete_are(A, B, np.eye(3), [[1.0]])
+    np.testing.assert_allclose(solution.X, reference, rtol=0, atol=1e-13)
+    assert solution.residual < 1e-15
+
+
+def test_indefinite_r_where_a_stabilising_solution_exists() -> None:
+    # a = 2, b = q = 1, r = -5: x = a^2 x r / (r + x) + q, i.e. x^2 + 14 x + 5 = 0; the root
+    # -7 - sqrt(44) leaves the closed loop a - a x / (r + x) = 0.537 inside the unit circle.
+    solution = aerocontrol.solve_dare([[2.0]], [[1.0]], [[1.0]], [[-5.0]])
+    assert solution.X[0, 0] == pytest.approx(-7 - np.sqrt(44), rel=1e-14)
+    assert abs(solution.closed_loop_poles[0]) < 1
+
+
+def test_indefinite_r_without_a_real_solution_is_refused() -> None:
+    # a = 1.5, r = -0.2: x^2 - 0.75 x + 0.2 = 0 has no real root. scipy returns X = -16.56,
+    # whose residual is O(1); aerocontrol refuses.
+    A, B, Q, R = (np.array([[v]]) for v in (1.5, 1.0, 1.0, -0.2))
+    scipy_x = sl.solve_discrete_are(A, B, Q, R)
+    assert relative_residual(A, B, Q, R, scipy_x) > 0.01
+    with pytest.raises(NoStabilizingSolutionError):
+        aerocontrol.solve_dare(A, B, Q, R)
+
+
+def test_an_uncontrollable_mode_on_the_unit_circle_has_no_stabilising_solution() -> None:
+    # A rotation by 90 degrees that B cannot touch; with and without a cross weight.
+    A = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 0.5]])
+    B = np.array([[0.0], [0.0], [1.0]])
+    for S in (None, np.array([[0.1], [0.0], [0.2]])):
+        with pytest.raises(NoStabilizingSolutionError, match="unit circle"):
+            aerocontrol.solve_dare(A, B, np.eye(3), [[1.0]], S=S)
+
+
+def test_an_unstabilisable_plant_is_refused() -> None:
+    A = np.diag([2.0, 0.5])
+    B = np.array([[0.0], [1.0]])
+    with pytest.raises(NoStabilizingSolutionError):
+        aerocontrol.solve_dare(A, B, np.eye(2), [[1.0]])
+
+
+def test_bad_arguments_are_named() -> None:
+    A = np.eye(2) * 0.5
+    with pytest.raises(ShapeError, match="B"):
+        aerocontrol.solve_dare(A, np.ones((3, 1)), np.eye(2), [[1.0]])
+    with pytest.raises(ShapeError, match="R"):
+        aerocontrol.solve_dare(A, np.ones((2, 1)), np.eye(2), np.eye(2))
+    with pytest.raises(InvalidArgumentError, match="Q must be symmetric"):
+        aerocontrol.solve_dare(A, np.ones((2, 1)), [[1.0, 1.0], [0.0, 1.0]], [[1.0]])
+    with pytest.raises(aerocontrol.exceptions.AerocontrolError, match="A"):
+        aerocontrol.solve_dare([[np.nan]], [[1.0]], [[1.0]], [[1.0]])
+
+
+def test_layouts_and_inputs_left_alone() -> None:
+    rng = np.random.default_rng(3)
+    A, B, Q, R = _random_stabilisable(rng, 4, 2)
+    reference = aerocontrol.solve_dare(A, B, Q, R).X
+    copies = [m.copy() for m in (A, B, Q, R)]
+    F = [np.asfortranarray(m) for m in (A, B, Q, R)]
+    np.testing.assert_array_equal(aerocontrol.solve_dare(*F).X, reference)
+    big = np.zeros((8, 8))
+    big[::2, ::2] = A
+    np.testing.assert_array_equal(aerocontrol.solve_dare(big[::2, ::2], B, Q, R).X, reference)
+    for m, c in zip((A, B, Q, R), copies, strict=True):
+        np.testing.assert_array_equal(m, c)
+
+
+def test_no_warning_on_a_well_conditioned_problem() -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        aerocontrol.solve_dare(np.eye(2) * 0.9, np.eye(2), np.eye(2), np.eye(2))
