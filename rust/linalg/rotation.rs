@@ -21,7 +21,13 @@ impl Rotation {
     /// The rotation that maps (f, g) to (r, 0), r = hypot(f, g) >= 0; the identity when both
     /// are zero.
     pub fn zeroing(f: f64, g: f64) -> (Rotation, f64) {
-        let r = f.hypot(g);
+        // The plain square root unless the squares leave the normal range (hypot is slow).
+        let squares = f * f + g * g;
+        let r = if (f64::MIN_POSITIVE..f64::MAX).contains(&squares) {
+            squares.sqrt()
+        } else {
+            f.hypot(g)
+        };
         if r == 0.0 {
             (Rotation { c: 1.0, s: 0.0 }, 0.0)
         } else {
@@ -38,20 +44,48 @@ impl Rotation {
     /// Rows i and k of `m`, over `columns`.
     #[inline]
     pub fn rows(self, m: &mut Mat<f64>, i: usize, k: usize, columns: Range<usize>) {
+        assert!(i < m.nrows() && k < m.nrows() && columns.end <= m.ncols());
+        let stride = m.col_stride();
+        let base = m.as_ptr_mut();
         for j in columns {
-            let (x, y) = (m[(i, j)], m[(k, j)]);
-            m[(i, j)] = self.c * x + self.s * y;
-            m[(k, j)] = -self.s * x + self.c * y;
+            // SAFETY: i, k < nrows and j < ncols (asserted above), so both entries are inside
+            // the matrix, and they are distinct when i != k.
+            unsafe {
+                let pi = base.offset(i as isize + j as isize * stride);
+                let pk = base.offset(k as isize + j as isize * stride);
+                let (x, y) = (*pi, *pk);
+                *pi = self.c * x + self.s * y;
+                *pk = -self.s * x + self.c * y;
+            }
         }
     }
 
     /// Columns i and k of `m`, over `rows`.
     #[inline]
     pub fn columns(self, m: &mut Mat<f64>, i: usize, k: usize, rows: Range<usize>) {
-        for r in rows {
-            let (x, y) = (m[(r, i)], m[(r, k)]);
-            m[(r, i)] = self.c * x + self.s * y;
-            m[(r, k)] = -self.s * x + self.c * y;
+        assert!(i < m.ncols() && k < m.ncols() && rows.end <= m.nrows() && i != k);
+        let (ci, ck) = if i < k {
+            let (left, right) = m.as_mut().split_at_col_mut(k);
+            (
+                left.col_mut(i).try_as_col_major_mut(),
+                right.col_mut(0).try_as_col_major_mut(),
+            )
+        } else {
+            let (left, right) = m.as_mut().split_at_col_mut(i);
+            (
+                right.col_mut(0).try_as_col_major_mut(),
+                left.col_mut(k).try_as_col_major_mut(),
+            )
+        };
+        let (ci, ck) = (
+            ci.expect("a Mat's columns are contiguous"),
+            ck.expect("contiguous"),
+        );
+        let (ci, ck) = (ci.as_slice_mut(), ck.as_slice_mut());
+        for (x, y) in ci[rows.clone()].iter_mut().zip(&mut ck[rows]) {
+            let (a, b) = (*x, *y);
+            *x = self.c * a + self.s * b;
+            *y = -self.s * a + self.c * b;
         }
     }
 }
@@ -107,16 +141,24 @@ impl SmallReflector {
         if self.tau == 0.0 {
             return;
         }
-        let u = &self.u[..self.len];
+        assert!(first + self.len <= m.nrows() && columns.end <= m.ncols());
+        let stride = m.col_stride();
+        let base = m.as_ptr_mut();
+        let u = self.u;
         for j in columns {
-            let w: f64 = u
-                .iter()
-                .enumerate()
-                .map(|(k, uk)| uk * m[(first + k, j)])
-                .sum();
-            let w = self.tau * w;
-            for (k, uk) in u.iter().enumerate() {
-                m[(first + k, j)] -= w * uk;
+            // SAFETY: rows first..first + len and column j are inside the matrix (asserted).
+            unsafe {
+                let p = base.offset(first as isize + j as isize * stride);
+                if self.len == 3 {
+                    let w = self.tau * (u[0] * *p + u[1] * *p.add(1) + u[2] * *p.add(2));
+                    *p -= w * u[0];
+                    *p.add(1) -= w * u[1];
+                    *p.add(2) -= w * u[2];
+                } else {
+                    let w = self.tau * (u[0] * *p + u[1] * *p.add(1));
+                    *p -= w * u[0];
+                    *p.add(1) -= w * u[1];
+                }
             }
         }
     }
@@ -127,16 +169,25 @@ impl SmallReflector {
         if self.tau == 0.0 {
             return;
         }
-        let u = &self.u[..self.len];
+        assert!(first + self.len <= m.ncols() && rows.end <= m.nrows());
+        let stride = m.col_stride() as usize;
+        let base = m.as_ptr_mut();
+        let u = self.u;
         for r in rows {
-            let w: f64 = u
-                .iter()
-                .enumerate()
-                .map(|(k, uk)| uk * m[(r, first + k)])
-                .sum();
-            let w = self.tau * w;
-            for (k, uk) in u.iter().enumerate() {
-                m[(r, first + k)] -= w * uk;
+            // SAFETY: row r and columns first..first + len are inside the matrix (asserted).
+            unsafe {
+                let p = base.add(r + first * stride);
+                if self.len == 3 {
+                    let w =
+                        self.tau * (u[0] * *p + u[1] * *p.add(stride) + u[2] * *p.add(2 * stride));
+                    *p -= w * u[0];
+                    *p.add(stride) -= w * u[1];
+                    *p.add(2 * stride) -= w * u[2];
+                } else {
+                    let w = self.tau * (u[0] * *p + u[1] * *p.add(stride));
+                    *p -= w * u[0];
+                    *p.add(stride) -= w * u[1];
+                }
             }
         }
     }

@@ -56,7 +56,7 @@ pub fn solve_stein_kronecker(
     }
     let scale = crate::linalg::norm::max_abs(system.as_ref());
     solve_in_place(system.as_mut(), rhs.as_mut(), Par::Seq);
-    if !rhs.is_all_finite() || !(scale > 0.0) {
+    if !rhs.is_all_finite() || scale.is_nan() || scale <= 0.0 {
         return Ok(None);
     }
     Ok(Some(Mat::from_fn(n, n, |i, j| rhs[(index(i, j), 0)])))

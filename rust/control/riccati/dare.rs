@@ -221,7 +221,7 @@ impl Problem<'_> {
         let combined = solve_with_inverse(factor.as_mut(), mixed.as_ref());
         let (gain, inverse) = combined.as_ref().split_at_col(a.nrows());
         let rcond = 1.0 / (norm * one_norm(inverse));
-        if m > 0 && (!gain.is_all_finite() || !(rcond > f64::EPSILON)) {
+        if m > 0 && (!gain.is_all_finite() || rcond.is_nan() || rcond <= f64::EPSILON) {
             return Err(Error::Singular {
                 arg: "R + B^T X B",
                 eigenvalue_re: 0.0,
@@ -272,7 +272,9 @@ fn refine(
         let Ok(candidate_evaluation) = problem.evaluate(&candidate) else {
             break;
         };
-        if !(candidate_evaluation.relative < evaluation.relative) {
+        if candidate_evaluation.relative.is_nan()
+            || candidate_evaluation.relative >= evaluation.relative
+        {
             break;
         }
         *x = candidate;
@@ -391,7 +393,7 @@ fn solution(
     // The inverse of (E U11)^T: its 1-norm is the infinity norm of (E U11)^-1; use the
     // transpose's norm for the 1-norm condition number of E U11.
     let rcond = 1.0 / (norm * crate::linalg::norm::one_norm(inverse.transpose()));
-    if !xt.is_all_finite() || !(rcond > f64::EPSILON) {
+    if !xt.is_all_finite() || rcond.is_nan() || rcond <= f64::EPSILON {
         return Err(no_solution(format!(
             "the stable deflating subspace is not a graph: E U11 is singular to working \
              precision (reciprocal condition number {rcond:.1e})"
@@ -431,7 +433,7 @@ fn check_stabilising(eigenvalues: &[c64], closed_loop_norm: f64) -> Result<(), E
     let limit = 1.0 - CIRCLE_TOLERANCE * closed_loop_norm.max(1.0);
     let unstable: Vec<String> = eigenvalues
         .iter()
-        .filter(|z| !(z.norm() < limit))
+        .filter(|z| z.norm().is_nan() || z.norm() >= limit)
         .map(|z| crate::error::format_complex(*z))
         .collect();
     if unstable.is_empty() {

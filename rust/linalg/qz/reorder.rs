@@ -88,6 +88,76 @@ pub(crate) fn reorder(p: &mut Pencil<'_>, selected: &[bool]) -> Result<usize, Er
     Ok(position)
 }
 
+/// A matrix of order <= 4 on the stack (the swapped blocks and their transformations).
+type Small = [[f64; 4]; 4];
+
+/// x^T y z for matrices of order m.
+fn congruence(x: &Small, y: &Small, z: &Small, m: usize) -> Small {
+    let mut yz = [[0.0; 4]; 4];
+    for i in 0..m {
+        for j in 0..m {
+            yz[i][j] = (0..m).map(|k| y[i][k] * z[k][j]).sum();
+        }
+    }
+    let mut out = [[0.0; 4]; 4];
+    for i in 0..m {
+        for j in 0..m {
+            out[i][j] = (0..m).map(|k| x[k][i] * yz[k][j]).sum();
+        }
+    }
+    out
+}
+
+/// Sum of squares of x - q y z^T over order m.
+fn back_error(q: &Small, y: &Small, z: &Small, original: &Small, m: usize) -> f64 {
+    let mut yz = [[0.0; 4]; 4];
+    for i in 0..m {
+        for j in 0..m {
+            yz[i][j] = (0..m).map(|k| y[i][k] * z[j][k]).sum();
+        }
+    }
+    let mut sum = 0.0;
+    for i in 0..m {
+        for j in 0..m {
+            let v: f64 = (0..m).map(|k| q[i][k] * yz[k][j]).sum();
+            sum += (v - original[i][j]).powi(2);
+        }
+    }
+    sum
+}
+
+/// Rows first..first + m of `x` over `columns`, replaced by f^T times them.
+fn rows_times(
+    x: &mut Mat<f64>,
+    f: &Small,
+    m: usize,
+    first: usize,
+    columns: std::ops::Range<usize>,
+) {
+    for c in columns {
+        let old: [f64; 4] = std::array::from_fn(|r| if r < m { x[(first + r, c)] } else { 0.0 });
+        for r in 0..m {
+            x[(first + r, c)] = (0..m).map(|k| f[k][r] * old[k]).sum();
+        }
+    }
+}
+
+/// Columns first..first + m of `x` over `rows`, replaced by them times f.
+fn columns_times(
+    x: &mut Mat<f64>,
+    f: &Small,
+    m: usize,
+    first: usize,
+    rows: std::ops::Range<usize>,
+) {
+    for r in rows {
+        let old: [f64; 4] = std::array::from_fn(|c| if c < m { x[(r, first + c)] } else { 0.0 });
+        for c in 0..m {
+            x[(r, first + c)] = (0..m).map(|k| old[k] * f[k][c]).sum();
+        }
+    }
+}
+
 /// Swaps the adjacent blocks at j (order p1) and j + p1 (order p2).
 pub(crate) fn swap_blocks(
     pencil: &mut Pencil<'_>,
@@ -97,12 +167,22 @@ pub(crate) fn swap_blocks(
 ) -> Result<(), Error> {
     let n = pencil.n();
     let m = p1 + p2;
-    let block = |x: &Mat<f64>| Mat::from_fn(m, m, |r, c| x[(j + r, j + c)]);
+    let block = |x: &Mat<f64>| -> Small {
+        std::array::from_fn(|r| {
+            std::array::from_fn(|c| {
+                if r < m && c < m {
+                    x[(j + r, j + c)]
+                } else {
+                    0.0
+                }
+            })
+        })
+    };
     let (a, b) = (block(pencil.h), block(pencil.t));
     let norm = a
-        .col_iter()
-        .chain(b.col_iter())
-        .flat_map(|c| c.iter().copied().collect::<Vec<_>>())
+        .iter()
+        .chain(b.iter())
+        .flatten()
         .map(|x| x * x)
         .sum::<f64>()
         .sqrt();
@@ -110,50 +190,36 @@ pub(crate) fn swap_blocks(
 
     let (l, r) = solve_coupled_sylvester(&a, &b, p1, p2)?;
     // [R; I] and [L; I] (m x p2), their full orthogonal QR factors.
-    let basis = |x: &[[f64; 2]; 2]| {
-        Mat::from_fn(m, p2, |row, col| {
-            if row < p1 {
-                x[row][col]
-            } else if row - p1 == col {
-                1.0
-            } else {
-                0.0
-            }
+    let basis = |x: &[[f64; 2]; 2]| -> Small {
+        std::array::from_fn(|row| {
+            std::array::from_fn(|col| {
+                if col >= p2 || row >= m {
+                    0.0
+                } else if row < p1 {
+                    x[row][col]
+                } else if row - p1 == col {
+                    1.0
+                } else {
+                    0.0
+                }
+            })
         })
     };
-    let zs = orthogonal_factor(basis(&r));
-    let qs = orthogonal_factor(basis(&l));
-    let a_new = qs.transpose() * &a * &zs;
-    let b_new = qs.transpose() * &b * &zs;
-    // Weak test: the block below the new leading one.
-    let lower = |x: &Mat<f64>| {
-        let mut s = 0.0;
-        for row in p2..m {
-            for col in 0..p2 {
-                s += x[(row, col)] * x[(row, col)];
-            }
+    let zs = orthogonal_factor(basis(&r), m, p2);
+    let qs = orthogonal_factor(basis(&l), m, p2);
+    let mut a_new = congruence(&qs, &a, &zs, m);
+    let mut b_new = congruence(&qs, &b, &zs, m);
+    // Weak test: the block below the new leading one; then it is set to zero.
+    let mut weak = 0.0;
+    for row in p2..m {
+        for col in 0..p2 {
+            weak += a_new[row][col].powi(2) + b_new[row][col].powi(2);
+            a_new[row][col] = 0.0;
+            b_new[row][col] = 0.0;
         }
-        s
-    };
-    let weak = (lower(&a_new) + lower(&b_new)).sqrt();
-    let zeroed = |x: &Mat<f64>| {
-        Mat::from_fn(m, m, |row, col| {
-            if row >= p2 && col < p2 {
-                0.0
-            } else {
-                x[(row, col)]
-            }
-        })
-    };
-    let (a_new, b_new) = (zeroed(&a_new), zeroed(&b_new));
-    let back = |x: &Mat<f64>, original: &Mat<f64>| {
-        let d = &qs * x * zs.transpose() - original;
-        d.col_iter()
-            .flat_map(|c| c.iter().copied().collect::<Vec<_>>())
-            .map(|v| v * v)
-            .sum::<f64>()
-    };
-    let strong = (back(&a_new, &a) + back(&b_new, &b)).sqrt();
+    }
+    let weak = weak.sqrt();
+    let strong = (back_error(&qs, &a_new, &zs, &a, m) + back_error(&qs, &b_new, &zs, &b, m)).sqrt();
     if !(weak <= threshold && strong <= threshold) {
         return Err(Error::IllConditioned {
             message: format!(
@@ -166,36 +232,16 @@ pub(crate) fn swap_blocks(
     // Apply: the block itself, the rows to its right, the columns above it, Q and Z.
     for r in 0..m {
         for c in 0..m {
-            pencil.h[(j + r, j + c)] = a_new[(r, c)];
-            pencil.t[(j + r, j + c)] = b_new[(r, c)];
+            pencil.h[(j + r, j + c)] = a_new[r][c];
+            pencil.t[(j + r, j + c)] = b_new[r][c];
         }
     }
-    let right = j + m..n;
     for x in [&mut *pencil.h, &mut *pencil.t] {
-        let rows = Mat::from_fn(m, right.len(), |r, c| x[(j + r, right.start + c)]);
-        let rows = qs.transpose() * rows;
-        for r in 0..m {
-            for c in 0..right.len() {
-                x[(j + r, right.start + c)] = rows[(r, c)];
-            }
-        }
-        let columns = Mat::from_fn(j, m, |r, c| x[(r, j + c)]);
-        let columns = columns * &zs;
-        for r in 0..j {
-            for c in 0..m {
-                x[(r, j + c)] = columns[(r, c)];
-            }
-        }
+        rows_times(x, &qs, m, j, j + m..n);
+        columns_times(x, &zs, m, j, 0..j);
     }
-    for (x, factor) in [(&mut *pencil.q, &qs), (&mut *pencil.z, &zs)] {
-        let columns = Mat::from_fn(n, m, |r, c| x[(r, j + c)]);
-        let columns = columns * factor;
-        for r in 0..n {
-            for c in 0..m {
-                x[(r, j + c)] = columns[(r, c)];
-            }
-        }
-    }
+    columns_times(pencil.q, &qs, m, j, 0..n);
+    columns_times(pencil.z, &zs, m, j, 0..n);
     // The new blocks in standard form: (A22, B22)'s at j, (A11, B11)'s at j + p2.
     for (start, size) in [(j, p2), (j + p2, p1)] {
         if size == 2 {
@@ -208,30 +254,32 @@ pub(crate) fn swap_blocks(
 }
 
 /// The orthogonal factor Q of the full QR factorisation of x (m x k, m <= 4), by reflectors.
-fn orthogonal_factor(mut x: Mat<f64>) -> Mat<f64> {
-    let (m, k) = (x.nrows(), x.ncols());
-    let mut q = Mat::<f64>::identity(m, m);
+fn orthogonal_factor(mut x: Small, m: usize, k: usize) -> Small {
+    let mut q: Small =
+        std::array::from_fn(|i| std::array::from_fn(|j| if i == j { 1.0 } else { 0.0 }));
     for c in 0..k.min(m - 1) {
-        let mut v: Vec<f64> = (c..m).map(|r| x[(r, c)]).collect();
-        let (_, tau) = reflector(&mut v);
+        let mut v = [0.0; 4];
+        for r in c..m {
+            v[r - c] = x[r][c];
+        }
+        let (_, tau) = reflector(&mut v[..m - c]);
         v[0] = 1.0;
-        let reflect_rows = |y: &mut Mat<f64>, columns: std::ops::Range<usize>| {
-            for col in columns {
-                let s: f64 = v
-                    .iter()
-                    .enumerate()
-                    .map(|(i, vi)| vi * y[(c + i, col)])
-                    .sum();
-                for (i, vi) in v.iter().enumerate() {
-                    y[(c + i, col)] -= tau * s * vi;
-                }
+        let v = &v[..m - c];
+        // x <- H x (columns c..k); q <- q H.
+        // Gaussian-elimination-like updates of a 4 x 4 array read most clearly with indices.
+        #[allow(clippy::needless_range_loop)]
+        for col in c..k {
+            let s: f64 = v.iter().enumerate().map(|(i, vi)| vi * x[c + i][col]).sum();
+            for (i, vi) in v.iter().enumerate() {
+                x[c + i][col] -= tau * s * vi;
             }
-        };
-        reflect_rows(&mut x, c..k);
-        // Q = H_0 H_1 ...: accumulate Q <- Q H_c by applying H_c to Q^T's rows.
-        let mut qt = q.transpose().to_owned();
-        reflect_rows(&mut qt, 0..m);
-        q = qt.transpose().to_owned();
+        }
+        for row in q.iter_mut().take(m) {
+            let s: f64 = v.iter().enumerate().map(|(i, vi)| vi * row[c + i]).sum();
+            for (i, vi) in v.iter().enumerate() {
+                row[c + i] -= tau * s * vi;
+            }
+        }
     }
     q
 }
@@ -242,8 +290,8 @@ fn orthogonal_factor(mut x: Mat<f64>) -> Mat<f64> {
 // Gaussian elimination on an 8 x 8 array reads most clearly with indices.
 #[allow(clippy::needless_range_loop, clippy::type_complexity)]
 fn solve_coupled_sylvester(
-    a: &Mat<f64>,
-    b: &Mat<f64>,
+    a: &Small,
+    b: &Small,
     p1: usize,
     p2: usize,
 ) -> Result<([[f64; 2]; 2], [[f64; 2]; 2]), Error> {
@@ -256,12 +304,12 @@ fn solve_coupled_sylvester(
         for c in 0..p2 {
             for i in 0..p1 {
                 let row = offset + i + p1 * c;
-                rhs[row] = -x[(i, p1 + c)];
+                rhs[row] = -x[i][p1 + c];
                 for s in 0..p1 {
-                    m[row][s + p1 * c] += x[(i, s)];
+                    m[row][s + p1 * c] += x[i][s];
                 }
                 for s in 0..p2 {
-                    m[row][half + i + p1 * s] -= x[(p1 + s, p1 + c)];
+                    m[row][half + i + p1 * s] -= x[p1 + s][p1 + c];
                 }
             }
         }
