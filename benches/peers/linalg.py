@@ -283,11 +283,51 @@ def schur_cases() -> list[Case]:
     return cases
 
 
+def _compare_deflating_subspace(ours: Any, peer: Any) -> Pairs:
+    """The count of eigenvalues selected and the projector onto their right deflating
+    subspace (unique, unlike the basis)."""
+    k = ours.selected
+    Z = peer[5]
+    alpha, beta = peer[2], peer[3]
+    sdim = int(np.count_nonzero(np.abs(alpha) < np.abs(beta)))
+    return [
+        (np.array([k]), np.array([sdim])),
+        (ours.Z[:, :k] @ ours.Z[:, :k].T, Z[:, :sdim] @ Z[:, :sdim].T),
+    ]
+
+
+def qz_cases() -> list[Case]:
+    """The generalized Schur form reordered to put the eigenvalues inside the unit circle first
+    (against scipy.linalg.ordqz(sort="iuc"); agreement on the number selected and the projector
+    onto their deflating subspace) of standard normal pencils at n = 4, 16, 64 and 256."""
+    target = Target("qz n=4..256: faster than scipy.linalg.ordqz", 1.0)
+    return [
+        Case(
+            op="qz iuc",
+            size=f"n={n}",
+            seed=n,
+            setup=lambda rng, n=n: (rng.standard_normal((n, n)), rng.standard_normal((n, n))),
+            ours=lambda A, B: aerocontrol.qz(A, B, "iuc"),
+            peers=[
+                Peer(
+                    "scipy.linalg.ordqz iuc",
+                    lambda A, B: scipy.linalg.ordqz(A, B, sort="iuc", output="real"),
+                    compare=_compare_deflating_subspace,
+                    target=target,
+                )
+            ],
+            repeat=1 if n > 64 else None,
+        )
+        for n in (4, *SIZES)
+    ]
+
+
 GROUPS = (
     expm_cases,
     expm_batch_cases,
     transition_matrix_cases,
     discretize_cases,
     schur_cases,
+    qz_cases,
 )
 """The case builders of this file, in the order they run."""

@@ -268,5 +268,66 @@ def lyapunov_cases() -> list[Case]:
     return cases
 
 
-GROUPS = (lqr_cases, care_general_cases, riccati_ode_cases, lyapunov_cases)
+def _dlqr_problem(rng: np.random.Generator, n: int) -> tuple[Any, ...]:
+    """A random n-state, 2-input discrete plant with Q = I, R = I: A = 0.9 G / sqrt(n), its
+    spectrum in a disc of radius about 0.9 (a sampled stable plant, as a flight computer sees
+    one)."""
+    A = 0.9 * rng.standard_normal((n, n)) / np.sqrt(n)
+    return A, rng.standard_normal((n, 2)), np.eye(n), np.eye(2)
+
+
+def _dlqr_747(rng: np.random.Generator) -> tuple[Any, ...]:
+    """The chapter's lateral regulator at c = 1, sampled at 50 Hz (zero-order hold)."""
+    A, B = aerocontrol.chapter.boeing747_lateral()
+    d = aerocontrol.discretize(A, B, 0.02)
+    return d.Phi, d.Gamma0, np.eye(4), np.eye(2)
+
+
+def _dlqr_scipy(A: Any, B: Any, Q: Any, R: Any) -> Any:
+    X = scipy.linalg.solve_discrete_are(A, B, Q, R)
+    return np.linalg.solve(R + B.T @ X @ B, B.T @ X @ A)
+
+
+def dlqr_cases() -> list[Case]:
+    """The discrete LQR (DARE + gain): ours against python-control's dlqr (slycot SB02OD) and
+    scipy.linalg.solve_discrete_are plus the gain, agreement on K."""
+    small_control = Target("dlqr n=4: >= 10x control.dlqr", 10.0)
+    small_scipy = Target("dlqr n=4: >= 50x scipy", 50.0)
+    large = Target("dlqr n=64/256: faster", 1.0)
+    cases = [
+        Case(
+            op="dlqr",
+            size="n=4 747 lateral 50 Hz",
+            seed=0,
+            setup=_dlqr_747,
+            ours=lambda A, B, Q, R: aerocontrol.dlqr(A, B, Q, R)[0],
+            peers=[
+                Peer("control.dlqr", lambda *a: control.dlqr(*a)[0], target=small_control),
+                Peer("scipy DARE + gain", _dlqr_scipy, target=small_scipy),
+            ],
+        )
+    ]
+    for n in SIZES:
+        cases.append(
+            Case(
+                op="dlqr",
+                size=f"n={n} m=2",
+                seed=n,
+                setup=functools.partial(_dlqr_problem, n=n),
+                ours=lambda A, B, Q, R: aerocontrol.dlqr(A, B, Q, R)[0],
+                peers=[
+                    Peer(
+                        "control.dlqr",
+                        lambda *a: control.dlqr(*a)[0],
+                        target=large if n > 16 else None,
+                    ),
+                    Peer("scipy DARE + gain", _dlqr_scipy, target=large if n > 16 else None),
+                ],
+                repeat=1 if n > 16 else None,
+            )
+        )
+    return cases
+
+
+GROUPS = (lqr_cases, care_general_cases, dlqr_cases, riccati_ode_cases, lyapunov_cases)
 """The case builders of this file, in the order they run."""
