@@ -247,7 +247,7 @@ class DareSolution:
     """Reciprocal 1-norm condition number of E U11 (U11 the top half of the stable deflating
     subspace's basis): small means X is sensitive."""
     refinement_steps: int
-    """Newton steps taken after the pencil's solution (up to n = 16)."""
+    """Newton steps taken after the pencil's solution."""
 
 
 def solve_dare(
@@ -267,8 +267,8 @@ def solve_dare(
     Method: the extended symplectic pencil of order 2n + m (Van Dooren 1981), its last m
     columns compressed away by a QR factorisation, then aerocontrol's own QZ algorithm
     (:func:`~aerocontrol.qz`) reordered to put the eigenvalues inside the unit circle first;
-    X = U21 (E U11)^-1 from that deflating subspace, then up to n = 16 Newton steps (Hewer
-    1971; each a Stein equation) while the residual decreases. Neither A nor R need be
+    X = U21 (E U11)^-1 from that deflating subspace, then Newton steps (Hewer 1971; each a
+    Stein equation; with E only up to n = 16) while the residual decreases. Neither A nor R need be
     invertible, and R need not be definite (only R + B^T X B nonsingular). Before it is
     returned the solution is verified: no eigenvalue of the pencil on the unit circle,
     exactly n inside, E U11 nonsingular, and every closed-loop eigenvalue inside the unit

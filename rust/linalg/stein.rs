@@ -12,6 +12,11 @@
 //! step of Newton's method for the discrete Riccati equation
 //! ([`crate::control::riccati::dare`]); the cost, (n^2 / 2)^3 / 3 flops, limits it to
 //! [`KRONECKER_MAX_ORDER`].
+//!
+//! Above it, for E = I and A with spectral radius below one, [`solve_stein_smith`] sums the
+//! series X = Σ (A^T)^k C A^k (for X - A^T X A = C) by Smith's doubling (Smith 1968):
+//! X_{k+1} = X_k + A_k^T X_k A_k, A_{k+1} = A_k^2, which after k steps has summed 2^k terms;
+//! three products of order n per step, until A_k is negligible.
 
 use crate::error::Error;
 use crate::linalg::lu::solve_in_place;
@@ -62,6 +67,35 @@ pub fn solve_stein_kronecker(
     Ok(Some(Mat::from_fn(n, n, |i, j| rhs[(index(i, j), 0)])))
 }
 
+/// Doubling steps at most: 2^40 terms of the series, enough for a spectral radius up to
+/// 1 - 3e-11.
+const SMITH_MAX_STEPS: usize = 40;
+
+/// Solves X - A^T X A = C (C symmetric) by Smith's doubling. Returns `None` when A^(2^k) does
+/// not become negligible within [`SMITH_MAX_STEPS`] steps (spectral radius too close to one,
+/// or above) or the sum overflows.
+pub fn solve_stein_smith(
+    a: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+) -> Result<Option<Mat<f64>>, Error> {
+    let mut x = c.to_owned();
+    let mut power = a.to_owned();
+    for _ in 0..SMITH_MAX_STEPS {
+        crate::platform::interrupt::check()?;
+        let update = power.transpose() * &x * &power;
+        x += &update;
+        let power_norm = crate::linalg::norm::frobenius_norm(power.as_ref());
+        if !x.is_all_finite() || !power_norm.is_finite() {
+            return Ok(None);
+        }
+        if power_norm * power_norm <= f64::EPSILON * 1e-3 {
+            return Ok(Some(x));
+        }
+        power = &power * &power;
+    }
+    Ok(None)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -78,5 +112,18 @@ mod tests {
             .unwrap();
         let error = &solved - &x;
         assert!(crate::linalg::norm::max_abs(error.as_ref()) < 1e-14);
+        // The same by doubling: X - A^T X A = -C.
+        let doubled = solve_stein_smith(a.as_ref(), (-&c).as_ref())
+            .unwrap()
+            .unwrap();
+        let error = &doubled - &x;
+        assert!(crate::linalg::norm::max_abs(error.as_ref()) < 1e-14);
+        // Spectral radius one: no convergence, no answer.
+        let rotation = Mat::from_fn(2, 2, |i, j| [[0.0, 1.0], [-1.0, 0.0]][i][j]);
+        assert!(
+            solve_stein_smith(rotation.as_ref(), c.as_ref())
+                .unwrap()
+                .is_none()
+        );
     }
 }

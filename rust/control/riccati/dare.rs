@@ -41,10 +41,10 @@
 //!
 //! and the reciprocal 1-norm condition number of E U11 are reported.
 //!
-//! The pencil method is backward stable for the pencil, not for the equation; up to order
-//! [`crate::linalg::stein::KRONECKER_MAX_ORDER`] Newton steps (Hewer 1971) restore a residual of
-//! a few units of rounding where the pencil's solution lost digits to a badly conditioned
-//! subspace basis.
+//! The pencil method is backward stable for the pencil, not for the equation; Newton steps
+//! (Hewer 1971; each a Stein equation, [`crate::linalg::stein`]) restore a residual of a few
+//! units of rounding where the pencil's solution lost digits to a badly conditioned subspace
+//! basis (with a descriptor E, only up to order [`crate::linalg::stein::KRONECKER_MAX_ORDER`]).
 //!
 //! R need not be positive definite (only symmetric): indefinite weights, as the H-infinity
 //! equations have, are solved where a stabilising solution exists.
@@ -55,7 +55,7 @@ use crate::linalg::householder::reflector;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::{frobenius_norm, one_norm};
 use crate::linalg::qz::{GeneralizedSchur, generalized_eigenvalues, qz, reorder_qz};
-use crate::linalg::stein::solve_stein_kronecker;
+use crate::linalg::stein::{KRONECKER_MAX_ORDER, solve_stein_kronecker, solve_stein_smith};
 use crate::platform::interrupt;
 use faer::{Mat, MatRef, c64};
 
@@ -166,6 +166,7 @@ pub fn solve_dare(
         r: r.as_ref(),
         s: options.s,
         e,
+        identity_e: options.e.is_none(),
     };
     let mut evaluation = problem.evaluate(&x)?;
     let refinement_steps = refine(&problem, &mut x, &mut evaluation)?;
@@ -193,6 +194,8 @@ struct Problem<'a> {
     r: MatRef<'a, f64>,
     s: Option<MatRef<'a, f64>>,
     e: MatRef<'a, f64>,
+    /// No descriptor matrix was given (E = I).
+    identity_e: bool,
 }
 
 /// The gain, closed loop and residual of a candidate X.
@@ -252,7 +255,8 @@ impl Problem<'_> {
 /// Newton steps (Hewer 1971) after the pencil's solution: with A_c = A - B K the closed loop of
 /// X, the correction solves A_c^T Δ A_c - E^T Δ E = -Res(X) (the derivative of the Riccati
 /// operator at X applied to Δ), in vectorised form up to order
-/// [`crate::linalg::stein::KRONECKER_MAX_ORDER`]; taken while the residual decreases and is
+/// [`crate::linalg::stein::KRONECKER_MAX_ORDER`] and above it (E = I) by Smith's doubling; taken
+/// while the residual decreases and is
 /// above [`REFINEMENT_FLOOR`], at most [`MAX_REFINEMENT_STEPS`] times. Returns the steps taken.
 fn refine(
     problem: &Problem<'_>,
@@ -263,9 +267,18 @@ fn refine(
     while steps < MAX_REFINEMENT_STEPS && evaluation.relative > REFINEMENT_FLOOR {
         interrupt::check()?;
         let rhs = -&evaluation.residual;
-        let Some(delta) =
+        let delta = if x.nrows() <= KRONECKER_MAX_ORDER {
             solve_stein_kronecker(evaluation.closed_loop.as_ref(), problem.e, rhs.as_ref())?
-        else {
+        } else if problem.identity_e {
+            // A_c^T Δ A_c - Δ = -Res  <=>  Δ - A_c^T Δ A_c = Res.
+            solve_stein_smith(
+                evaluation.closed_loop.as_ref(),
+                evaluation.residual.as_ref(),
+            )?
+        } else {
+            None
+        };
+        let Some(delta) = delta else {
             break;
         };
         let candidate = &*x + &delta;
