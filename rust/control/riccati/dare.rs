@@ -69,6 +69,10 @@ pub const REFINEMENT_FLOOR: f64 = f64::EPSILON;
 /// Newton steps at most.
 pub const MAX_REFINEMENT_STEPS: usize = 3;
 
+/// Above this order (and E = I) a Newton step solves its Stein equation by Smith's doubling:
+/// the vectorised system's (n^2 / 2)^3 / 3 flops outgrow the doubling's few dozen products.
+const SMITH_MIN_ORDER: usize = 8;
+
 /// The solution of a DARE and its diagnostics.
 #[derive(Debug, Clone)]
 pub struct Dare {
@@ -254,9 +258,9 @@ impl Problem<'_> {
 
 /// Newton steps (Hewer 1971) after the pencil's solution: with A_c = A - B K the closed loop of
 /// X, the correction solves A_c^T Δ A_c - E^T Δ E = -Res(X) (the derivative of the Riccati
-/// operator at X applied to Δ), in vectorised form up to order
-/// [`crate::linalg::stein::KRONECKER_MAX_ORDER`] and above it (E = I) by Smith's doubling; taken
-/// while the residual decreases and is
+/// operator at X applied to Δ), in vectorised form up to order [`SMITH_MIN_ORDER`] (with a
+/// descriptor E up to [`crate::linalg::stein::KRONECKER_MAX_ORDER`]) and above it (E = I) by
+/// Smith's doubling; taken while the residual decreases and is
 /// above [`REFINEMENT_FLOOR`], at most [`MAX_REFINEMENT_STEPS`] times. Returns the steps taken.
 fn refine(
     problem: &Problem<'_>,
@@ -267,7 +271,8 @@ fn refine(
     while steps < MAX_REFINEMENT_STEPS && evaluation.relative > REFINEMENT_FLOOR {
         interrupt::check()?;
         let rhs = -&evaluation.residual;
-        let delta = if x.nrows() <= KRONECKER_MAX_ORDER {
+        let n = x.nrows();
+        let delta = if n <= SMITH_MIN_ORDER || (!problem.identity_e && n <= KRONECKER_MAX_ORDER) {
             solve_stein_kronecker(evaluation.closed_loop.as_ref(), problem.e, rhs.as_ref())?
         } else if problem.identity_e {
             // A_c^T Δ A_c - Δ = -Res  <=>  Δ - A_c^T Δ A_c = Res.
