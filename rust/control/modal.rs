@@ -128,10 +128,24 @@ impl ModalAnalysis {
 
 /// The eigenvalues and unit eigenvectors of a real square matrix, conjugate pairs adjacent with
 /// Im > 0 first.
+///
+/// A matrix whose largest entry is outside [1e-150, 1e150] is first divided by the power of
+/// two nearest to it ([`crate::linalg::balance::range_scale`], exact; the eigenvectors are
+/// those of A, the eigenvalues are multiplied back): faer's eigensolver compares entries with
+/// the smallest normal number and squares them, so a matrix of entries near 1e-301 came back
+/// with its diagonal as its eigenvalues.
 pub fn eigen(a: MatRef<'_, f64>) -> Result<(Vec<c64>, Mat<c64>), Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let n = a.nrows();
+    let scale = crate::linalg::balance::range_scale(a);
+    let scaled;
+    let a = if scale == 1.0 {
+        a
+    } else {
+        scaled = Mat::from_fn(n, n, |i, j| a[(i, j)] / scale);
+        scaled.as_ref()
+    };
     let mut real_vectors = Mat::<f64>::zeros(n, n);
     let mut re = Diag::<f64>::zeros(n);
     let mut im = Diag::<f64>::zeros(n);
@@ -161,7 +175,7 @@ pub fn eigen(a: MatRef<'_, f64>) -> Result<(Vec<c64>, Mat<c64>), Error> {
     let mut j = 0;
     while j < n {
         if im[j] == 0.0 {
-            values.push(c64::new(re[j], 0.0));
+            values.push(c64::new(re[j] * scale, 0.0));
             for i in 0..n {
                 vectors[(i, j)] = c64::new(real_vectors[(i, j)], 0.0);
             }
@@ -170,8 +184,8 @@ pub fn eigen(a: MatRef<'_, f64>) -> Result<(Vec<c64>, Mat<c64>), Error> {
             // Columns j and j + 1 hold the real and imaginary parts of the eigenvector of
             // re + i im; its conjugate belongs to re - i im.
             let sign = if im[j] > 0.0 { 1.0 } else { -1.0 };
-            values.push(c64::new(re[j], im[j].abs()));
-            values.push(c64::new(re[j], -im[j].abs()));
+            values.push(c64::new(re[j] * scale, im[j].abs() * scale));
+            values.push(c64::new(re[j] * scale, -im[j].abs() * scale));
             for i in 0..n {
                 let v = c64::new(real_vectors[(i, j)], sign * real_vectors[(i, j + 1)]);
                 vectors[(i, j)] = v;
@@ -407,5 +421,28 @@ mod tests {
                 .to_string(),
             "B must have as many rows as A (2), got 3"
         );
+    }
+}
+
+#[cfg(test)]
+mod scaling_tests {
+    use super::*;
+
+    #[test]
+    fn eigenvalues_of_tiny_and_huge_matrices_scale() {
+        // 1e-301 [[1.26, -1.32], [6.40, 1.05]]: eigenvalues 1e-301 (1.155 ± 2.9045 i).
+        for factor in [1e-301, 1e-160, 1e160, 1e300] {
+            let a = Mat::from_fn(2, 2, |i, j| [[1.26, -1.32], [6.40, 1.05]][i][j] * factor);
+            let (values, _) = eigen(a.as_ref()).unwrap();
+            let re = 0.5 * (1.26 + 1.05);
+            let im = (1.32 * 6.40 - 0.25 * (1.26f64 - 1.05).powi(2)).sqrt();
+            for v in &values {
+                assert!((v.re / factor - re).abs() < 1e-13, "{factor}: {values:?}");
+                assert!(
+                    (v.im.abs() / factor - im).abs() < 1e-13,
+                    "{factor}: {values:?}"
+                );
+            }
+        }
     }
 }
