@@ -25,6 +25,7 @@ from .controllability import (
     observability,
     obsv,
 )
+from .estimation import KalmanFilter, LqgDesign, dlqe, kalman, lqe, lqg, place_observer
 from .exceptions import (
     AerocontrolError,
     AerocontrolLinAlgError,
@@ -108,6 +109,8 @@ __all__ = [
     "IllConditionedError",
     "IllConditionedWarning",
     "InvalidArgumentError",
+    "KalmanFilter",
+    "LqgDesign",
     "Modes",
     "NoStabilizingSolutionError",
     "NonFiniteError",
@@ -138,6 +141,7 @@ __all__ = [
     "default_time_grid",
     "design",
     "discretize",
+    "dlqe",
     "dlqr",
     "doublet_response",
     "exceptions",
@@ -149,6 +153,9 @@ __all__ = [
     "initial_response",
     "is_controllable",
     "is_observable",
+    "kalman",
+    "lqe",
+    "lqg",
     "lqr",
     "lqr_finite",
     "modes",
@@ -157,6 +164,7 @@ __all__ = [
     "place",
     "place_ackermann",
     "place_bass_gura",
+    "place_observer",
     "plotting",
     "qz",
     "report",
