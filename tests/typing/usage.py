@@ -162,6 +162,48 @@ assert_type(aerocontrol.lqr_finite(small, np.eye(2), [[1.0]], [0.0, 1.0, 2.0]), 
 X = aerocontrol.solve_lyapunov([[-1.0, 0.0], [0.0, -3.0]], [[2.0, 4.0], [4.0, 6.0]])
 assert_type(X, Floats)
 
+# --- Estimation: Kalman filters, observers, LQG -----------------------------------------------
+
+C_prp = np.eye(4)[[1, 3, 2]]  # the 747 lateral model measured by p, r, φ
+Lk, Pk, Ek = aerocontrol.lqe(A_lat, B_lat, C_prp, np.eye(2), 1e-2 * np.eye(3))
+assert_type(Lk, Floats)
+assert_type(Ek, Complexes)
+aerocontrol.lqe(
+    aerocontrol.StateSpace(A_lat, B_lat, C_prp),
+    np.eye(2),
+    [[1e-2, 0, 0], [0, 1e-2, 0], [0, 0, 1e-2]],
+)
+aerocontrol.lqe(A_lat, B_lat, C_prp, np.eye(2), np.eye(3), NN=np.zeros((2, 3)))
+aerocontrol.lqe([[0.7]], [[1]], [[1]], 2.0, 0.5)
+sampled = aerocontrol.discretize(A_lat, B_lat, dt=0.02)
+assert_type(aerocontrol.dlqe(sampled.Phi, sampled.Gamma0, C_prp, np.eye(2), np.eye(3))[1], Floats)
+aerocontrol.dlqe([[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], np.zeros((1, 1)))
+kf = aerocontrol.kalman((sampled.Phi, sampled.Gamma0, C_prp), np.eye(2), 1e-4 * np.eye(3), dt=0.02)
+assert_type(kf, aerocontrol.KalmanFilter)
+assert_type(kf.filter_gain, Floats)
+assert_type(kf.predictor_gain, Floats)
+assert_type(kf.posterior_covariance, Floats)
+assert_type(kf.closed_loop_poles, Complexes)
+assert_type(kf.dt, float | None)
+continuous_kf = aerocontrol.kalman(
+    (A_lat, B_lat, C_prp, np.zeros((3, 2))), np.eye(4), np.eye(3), G=np.eye(4)
+)
+assert_type(continuous_kf.gain, Floats)
+assert_type(continuous_kf.estimator_B, Floats)
+aerocontrol.kalman(aerocontrol.StateSpace(A_lat, B_lat, C_prp), np.eye(2), np.eye(3))
+aerocontrol.kalman(Foreign(A_lat, B_lat, C_prp, np.zeros((3, 2))), np.eye(2), np.eye(3), None)
+observer = aerocontrol.place_observer(A_lat, C_prp, [-2.0 + 1.0j, -2.0 - 1.0j, -3.0, -4.0])
+assert_type(observer, Floats)
+aerocontrol.place_observer(aerocontrol.StateSpace(A_lat, B_lat, C_prp), (-2, -3, -4, -5))
+measured = aerocontrol.StateSpace(A_lat, B_lat, C_prp)
+lqg = aerocontrol.lqg(measured, np.eye(4), np.eye(2), np.eye(2), 1e-2 * np.eye(3))
+assert_type(lqg, aerocontrol.LqgDesign)
+assert_type(lqg.compensator, aerocontrol.StateSpace)
+assert_type(lqg.closed_loop_poles, Complexes)
+aerocontrol.lqg(
+    (A_lat, B_lat, C_prp, np.zeros((3, 2))), np.eye(4), np.eye(2), np.eye(4), np.eye(3), G=np.eye(4)
+)
+
 # --- Batches and the design studies ----------------------------------------------------------
 
 b747 = aircraft.load("b747-approach")
@@ -231,4 +273,7 @@ def _misuse() -> None:
     plotting.plot_modes(modes, ax=figure)  # type: ignore[arg-type]  # a figure is not axes
     exponential: Complexes = aerocontrol.expm(A)  # type: ignore[assignment]  # real result
     gains: Complexes = aerocontrol.lqr(sys, np.eye(4), 1.0)[0]  # type: ignore[assignment]
-    del exponential, gains
+    aerocontrol.kalman(measured, np.eye(2), np.eye(3), dt="0.02")  # type: ignore[arg-type]
+    aerocontrol.lqg(measured, np.eye(4), np.eye(2), np.eye(2))  # type: ignore[call-arg]
+    estimate: Complexes = aerocontrol.lqe(measured, np.eye(2), np.eye(3))[0]  # type: ignore[assignment]
+    del exponential, gains, estimate
