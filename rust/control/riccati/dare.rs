@@ -286,7 +286,8 @@ fn refine(
         let Some(delta) = delta else {
             break;
         };
-        let candidate = &*x + &delta;
+        let mut candidate = &*x + &delta;
+        symmetrize(&mut candidate);
         let Ok(candidate_evaluation) = problem.evaluate(&candidate) else {
             break;
         };
@@ -418,14 +419,19 @@ fn solution(
         )));
     }
     let mut x = xt.transpose().to_owned();
-    for j in 0..n {
+    symmetrize(&mut x);
+    Ok((x, rcond))
+}
+
+/// X <- (X + X^T) / 2.
+fn symmetrize(x: &mut Mat<f64>) {
+    for j in 0..x.ncols() {
         for i in 0..j {
             let mean = 0.5 * (x[(i, j)] + x[(j, i)]);
             x[(i, j)] = mean;
             x[(j, i)] = mean;
         }
     }
-    Ok((x, rcond))
 }
 
 /// The eigenvalues of A - B K, or of the pencil (A - B K, E).
