@@ -460,15 +460,6 @@ def _check_zoh_logarithm(A: FloatArray) -> None:
             )
 
 
-def _polynomial(roots: ComplexArray) -> FloatArray:
-    """The real coefficients of prod (x - r), highest power first, for roots closed under
-    conjugation."""
-    coefficients = np.array([1.0 + 0.0j])
-    for root in roots:
-        coefficients = np.convolve(coefficients, np.array([1.0, -root]))
-    return np.asarray(coefficients.real, dtype=np.float64)
-
-
 def _roots(coefficients: FloatArray) -> ComplexArray:
     """The roots of a polynomial (highest power first, leading coefficient nonzero): the
     eigenvalues of its companion matrix, by aerocontrol's own Schur form."""
@@ -516,34 +507,122 @@ def _matched(model: StateSpace, dt: float) -> StateSpace:
     tiny = 1e-12 * max(1.0, float(np.abs(poles).max(initial=0.0)))
     nonzero_poles, nonzero_zeros = poles[np.abs(poles) > tiny], zeros[np.abs(zeros) > tiny]
     excess = (len(zeros) - len(nonzero_zeros)) - (len(poles) - len(nonzero_poles))
-    z_poles, z_zeros = np.exp(poles * dt), np.exp(zeros * dt)
     continuous_gain = numerator[0] * np.prod(-nonzero_zeros) / np.prod(-nonzero_poles)
-    discrete_gain = np.prod(1.0 - np.exp(nonzero_zeros * dt)) / np.prod(
-        1.0 - np.exp(nonzero_poles * dt)
+    discrete_gain = np.prod(_one_minus_exp(nonzero_zeros * dt)) / np.prod(
+        _one_minus_exp(nonzero_poles * dt)
     )
     gain = float((continuous_gain / discrete_gain).real) / dt**excess
-    den = _polynomial(z_poles)
-    num = gain * _polynomial(z_zeros)
-    num = np.concatenate([np.zeros(len(den) - len(num)), num])
-    # Controllable canonical form (scipy.signal.tf2ss's).
-    Ad = np.zeros((n, n))
-    if n:
-        Ad[0, :] = -den[1:]
-        Ad[1:, :-1] = np.eye(n - 1)
-    Bd = np.zeros((n, 1))
-    if n:
-        Bd[0, 0] = 1.0
-    Cd = (num[1:] - num[0] * den[1:]).reshape(1, n)
-    Dd = [[num[0]]]
+    # A cascade of first- and second-order sections, each a factor (z - e^{z_i dt}) ... over
+    # (z - e^{p_i dt}) ...: the poles sit exactly in the sections' matrices, where the
+    # coefficients of one polynomial of degree n would lose digits as the poles crowd towards
+    # z = 1 (small dt).
+    numerators = _real_factors(zeros, dt)
+    quadratic = [f for f in numerators if len(f) == 3]
+    linear = [f for f in numerators if len(f) == 2]
+    Ad, Bd, Cd, Dd = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1))
+    for A_k, B_k, denominator in _pole_sections(poles, dt):
+        order = len(denominator) - 1
+        factor = np.ones(1)
+        if order == 2 and quadratic:
+            factor = quadratic.pop()
+        elif linear:
+            factor = linear.pop()
+        if order == 2 and len(factor) == 2 and linear:
+            factor = np.convolve(factor, linear.pop())
+        # A zero far outside the unit circle (e^{z dt} of a right-half-plane zero) makes its
+        # factor's coefficients huge: scaled to unit size, its size goes into the gain.
+        size = float(np.abs(factor).max())
+        factor, gain = factor / size, gain * size
+        num = np.concatenate([np.zeros(order + 1 - len(factor)), factor])
+        remainder = num[1:] - num[0] * denominator[1:]  # of the strictly proper part
+        C_k = _output_row(A_k, B_k, remainder)
+        D_k = num[:1].reshape(1, 1)
+        # The section after the cascade so far: its input is the cascade's output.
+        size_so_far = Ad.shape[0]
+        Ad = np.block([[Ad, np.zeros((size_so_far, order))], [B_k @ Cd, A_k]])
+        Bd = np.vstack([Bd, B_k @ Dd])
+        Cd = np.hstack([D_k @ Cd, C_k])
+        Dd = D_k @ Dd
+    if quadratic or linear:  # pragma: no cover - a proper G has no more zeros than poles
+        raise AssertionError("matched: zeros left over after the sections")
     return StateSpace(
         Ad,
-        Bd,
+        gain * Bd,
         Cd,
-        Dd,
+        gain * Dd,
         input_names=model.input_names,
         output_names=model.output_names,
         dt=dt,
     )
+
+
+def _pole_sections(
+    poles: ComplexArray, dt: float
+) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
+    """(A_k, B_k, denominator) of each section with poles e^{p dt}: [[α, -β], [β, α]] and
+    B = [0, 1] for a pair α ± jβ, [[p1, 0], [1, p2]] and B = [1, 0] for two real poles, [[p]]
+    and B = [1] for the last real one; second-order sections first."""
+    sections = []
+    for r in poles[poles.imag > 0]:
+        z = np.exp(r.real * dt) * np.array([np.cos(r.imag * dt), np.sin(r.imag * dt)])
+        alpha, beta = float(z[0]), float(z[1])
+        sections.append(
+            (
+                np.array([[alpha, -beta], [beta, alpha]]),
+                np.array([[0.0], [1.0]]),
+                np.array([1.0, -2.0 * alpha, alpha * alpha + beta * beta]),
+            )
+        )
+    reals = [float(np.exp(r.real * dt)) for r in poles if r.imag == 0]
+    for first, second in zip(reals[0::2], reals[1::2], strict=False):
+        sections.append(
+            (
+                np.array([[first, 0.0], [1.0, second]]),
+                np.array([[1.0], [0.0]]),
+                np.array([1.0, -(first + second), first * second]),
+            )
+        )
+    if len(reals) % 2:
+        sections.append((np.array([[reals[-1]]]), np.ones((1, 1)), np.array([1.0, -reals[-1]])))
+    return sections
+
+
+def _output_row(A: FloatArray, B: FloatArray, remainder: FloatArray) -> FloatArray:
+    """The row C with C (zI - A)^-1 B = (remainder as a polynomial in z) / det(zI - A), for a
+    section of order 1 or 2: adj(zI - A) B = z B + (A - tr(A) I) B, so C B and
+    C (A - tr(A) I) B are the coefficients (Cramer's rule on the 2 x 2 system)."""
+    if A.shape[0] == 1:
+        return np.asarray(remainder.reshape(1, 1) / B[0, 0], dtype=np.float64)
+    V = (A - np.trace(A) * np.eye(2)) @ B
+    b0, b1, v0, v1 = B[0, 0], B[1, 0], V[0, 0], V[1, 0]
+    n1, n0 = remainder
+    determinant = b0 * v1 - b1 * v0
+    return np.array([[(n1 * v1 - b1 * n0) / determinant, (b0 * n0 - v0 * n1) / determinant]])
+
+
+def _one_minus_exp(s: ComplexArray) -> ComplexArray:
+    """1 - e^s without cancellation for small |s|: -(expm1(a) cos b - 2 sin²(b/2)) - j e^a sin b
+    for s = a + jb."""
+    a, b = s.real, s.imag
+    real = np.expm1(a) * np.cos(b) - 2.0 * np.sin(b / 2.0) ** 2
+    return np.asarray(-(real + 1j * np.exp(a) * np.sin(b)), dtype=np.complex128)
+
+
+def _real_factors(roots: ComplexArray, dt: float) -> list[FloatArray]:
+    """The monic real factors of prod (z - e^{r dt}) over the roots r (conjugate pairs exact):
+    z^2 - 2 e^{σ dt} cos(ω dt) z + e^{2σ dt} for each pair σ ± jω, real roots two to a
+    quadratic, and at most one linear factor z - e^{r dt} left."""
+    factors = [
+        np.array([1.0, -2.0 * np.exp(r.real * dt) * np.cos(r.imag * dt), np.exp(2 * r.real * dt)])
+        for r in roots
+        if r.imag > 0
+    ]
+    reals = [float(np.exp(r.real * dt)) for r in roots if r.imag == 0]
+    for first, second in zip(reals[0::2], reals[1::2], strict=False):
+        factors.append(np.array([1.0, -(first + second), first * second]))
+    if len(reals) % 2:
+        factors.append(np.array([1.0, -reals[-1]]))
+    return factors
 
 
 #: The named selections of :func:`schur` (scipy.linalg.schur's ``sort`` names).

@@ -247,14 +247,24 @@ def _discrete_grid(
 
 def _every_qth(model: StateSpace, q: int) -> tuple[FloatArray, FloatArray]:
     """(A^q, Σ_{i<q} A^i B): the recurrence of a discrete model between every q-th sample, the
-    blocks of [[A, B], [0, I]]^q."""
+    blocks of M^q for M = [[A, B], [0, I]].
+
+    Binary powering on E_k = M^k - I (E_{j+k} = E_j E_k + E_j + E_k), not on M^k: a slow mode
+    has A^q close to I, and M^k itself would carry its difference from I, which sets the
+    steady state, with an absolute error of q u instead of u."""
     if q == 1:
         return model.A, model.B
     n, m = model.n_states, model.n_inputs
-    augmented = np.zeros((n + m, n + m))
-    augmented[:n, :n], augmented[:n, n:], augmented[n:, n:] = model.A, model.B, np.eye(m)
-    power = np.linalg.matrix_power(augmented, q)
-    return power[:n, :n], power[:n, n:]
+    base = np.zeros((n + m, n + m))
+    base[:n, :n], base[:n, n:] = model.A - np.eye(n), model.B
+    power = np.zeros_like(base)
+    while q:
+        if q & 1:
+            power = power @ base + power + base
+        q >>= 1
+        if q:
+            base = base @ base + 2.0 * base
+    return np.eye(n) + power[:n, :n], power[:n, n:]
 
 
 def _simulate(
