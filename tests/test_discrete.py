@@ -79,9 +79,9 @@ def _matrices(sys: StateSpace) -> tuple[np.ndarray, ...]:
 
 def test_dt_sets_a_discrete_model() -> None:
     continuous = StateSpace(A_LON, B_LON)
-    assert continuous.dt == 0.0 and not continuous.is_discrete
-    for unset in (None, 0, 0.0, False):
-        model = StateSpace(A_LON, B_LON, dt=unset)  # type: ignore[arg-type]
+    assert continuous.dt is None and not continuous.is_discrete
+    for unset in (0, 0.0, False):
+        model = StateSpace(A_LON, B_LON, dt=unset)
         assert model.dt == 0.0 and not model.is_discrete
         assert repr(model) == repr(continuous)
     sampled = StateSpace(A_LON, B_LON, dt=0.05)
@@ -114,7 +114,27 @@ def test_python_control_models_keep_their_sampling_period() -> None:
     assert aerocontrol.as_state_space(control.ss(A_LON, B_LON, C, D)).dt == 0.0
     with pytest.raises(InvalidArgumentError, match=r"sys\.dt=True"):
         aerocontrol.as_state_space(control.ss(A_LON, B_LON, C, D, True))
-    assert aerocontrol.as_state_space((A_LON, B_LON)).dt == 0.0
+    assert aerocontrol.as_state_space((A_LON, B_LON)).dt is None
+    unset = control.ss(A_LON, B_LON, C, D, None)
+    assert aerocontrol.as_state_space(unset).dt is None
+
+
+def test_an_unsaid_time_base_is_continuous_but_not_refused_by_dlqr() -> None:
+    # As python-control: dt=None leaves the time base open, dt=0 says continuous.
+    A, B = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]])
+    K, _, _ = aerocontrol.dlqr(A, B, np.eye(2), 1.0)
+    unsaid = StateSpace(A, B)
+    assert np.array_equal(aerocontrol.dlqr(unsaid, np.eye(2), 1.0)[0], K)
+    with pytest.raises(InvalidArgumentError, match="discrete-time"):
+        aerocontrol.dlqr(StateSpace(A, B, dt=0), np.eye(2), 1.0)
+    assert np.array_equal(aerocontrol.dlqr(StateSpace(A, B, dt=0.1), np.eye(2), 1.0)[0], K)
+    t = np.linspace(0.0, 1.0, 11)
+    assert np.array_equal(
+        aerocontrol.step_response(unsaid, T=t).y,
+        aerocontrol.step_response(StateSpace(A, B, dt=0), T=t).y,
+    )
+    # d2c marks its result continuous.
+    assert aerocontrol.d2c(aerocontrol.c2d(StateSpace(A_LON, B_LON), 0.1)).dt == 0.0
 
 
 # ----- c2d against scipy and python-control ---------------------------------------------------
@@ -675,4 +695,4 @@ def test_inputs_are_not_modified() -> None:
     for array, copy in zip((A, B, C, D), before, strict=True):
         assert np.array_equal(array, copy)
     assert A.flags.f_contiguous
-    assert not sys.A.flags.writeable and sys.dt == 0.0
+    assert not sys.A.flags.writeable and sys.dt is None

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import ShapeError
-from .statespace import as_state_space, continuous_eigenvalues
+from .statespace import as_state_space, continuous_eigenvalues, period
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -113,7 +113,12 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
     if frequencies.ndim != 1:
         raise ShapeError(f"omega must be a 1-D array of frequencies, got {frequencies.shape}")
     response = _core.frequency_response(
-        model.A, model.B, model.C, model.D, frequencies, model.dt if model.is_discrete else None
+        model.A,
+        model.B,
+        model.C,
+        model.D,
+        frequencies,
+        period(model) if model.is_discrete else None,
     )
     return FrequencyResponse(
         omega=np.array(frequencies, dtype=np.float64),
@@ -130,7 +135,7 @@ def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> Flo
     thousandth of the Nyquist frequency, if lower) to the Nyquist frequency π/dt."""
     model = as_state_space(sys)
     if model.is_discrete:
-        nyquist = np.pi / model.dt
+        nyquist = np.pi / period(model)
         s = continuous_eigenvalues(model)
         magnitudes = np.abs(s[np.isfinite(s)])
         nonzero = magnitudes[magnitudes > 1e-12 * nyquist]

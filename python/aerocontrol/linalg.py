@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, check_choice, real_array, real_scalar
 from .exceptions import InvalidArgumentError, NoContinuousEquivalentError, ShapeError
-from .statespace import StateSpace, as_state_space, sampling_period
+from .statespace import StateSpace, as_state_space, period, sampling_period
 
 if TYPE_CHECKING:
     from ._typing import System
@@ -174,6 +174,8 @@ def discretize(
     -------
     Discretization
         ``Phi``, ``Gamma0`` and, for ``"foh"``, ``Gamma1`` (see :class:`Discretization`).
+        :func:`c2d` turns them into a discrete :class:`~aerocontrol.StateSpace` (and has the
+        bilinear and matched methods).
 
     Examples
     --------
@@ -321,7 +323,7 @@ def c2d(
     model = as_state_space(sys)
     if model.is_discrete:
         raise InvalidArgumentError(
-            f"sys must be a continuous model, got a discrete one (dt = {model.dt:g}); "
+            f"sys must be a continuous model, got a discrete one (dt = {period(model):g}); "
             "use d2c to undo a discretisation"
         )
     step = sampling_period(dt)
@@ -404,17 +406,22 @@ def d2c(
                 "prewarp and alpha apply to the bilinear methods, not to method='zoh'"
             )
         _check_zoh_logarithm(model.A)
-        A, B = _core.undiscretize_zoh(model.A, model.B, model.dt)
-        return _named_like(model, A, B, model.C, model.D, None)
+        try:
+            A, B = _core.undiscretize_zoh(model.A, model.B, period(model))
+        except InvalidArgumentError as error:
+            if error.argument != "A":
+                raise
+            raise NoContinuousEquivalentError(str(error)) from None
+        return _named_like(model, A, B, model.C, model.D, 0.0)
     weight = _bilinear_weight(chosen, alpha)
-    warped = _warped_step(chosen, weight, model.dt, prewarp)
+    warped = _warped_step(chosen, weight, period(model), prewarp)
     try:
         A, B, C, D = _core.inverse_bilinear(model.A, model.B, model.C, model.D, warped, weight)
     except InvalidArgumentError as error:
         if error.argument != "A":
             raise
         raise NoContinuousEquivalentError(str(error)) from None
-    return _named_like(model, A, B, C, D, None)
+    return _named_like(model, A, B, C, D, 0.0)
 
 
 def _named_like(

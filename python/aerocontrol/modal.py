@@ -41,7 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning
-from .statespace import as_state_space, is_system
+from .statespace import as_state_space, is_system, period
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -143,7 +143,7 @@ def _plant(A_or_sys: ArrayLike | System) -> tuple[FloatArray, FloatArray | None]
 def _plant_period(A_or_sys: ArrayLike | System) -> float:
     """The sampling period of a discrete system; 0.0 for a continuous one or a matrix."""
     if is_system(A_or_sys) or isinstance(A_or_sys, tuple):
-        return as_state_space(A_or_sys).dt
+        return period(as_state_space(A_or_sys))
     return 0.0
 
 

@@ -52,7 +52,7 @@ from .exceptions import (
     ShapeError,
     SingularMatrixError,
 )
-from .statespace import StateSpace, as_state_space, continuous_eigenvalues, is_system
+from .statespace import StateSpace, as_state_space, continuous_eigenvalues, is_system, period
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -160,16 +160,16 @@ def default_time_grid(sys: Systems) -> FloatArray:
 
 def _sampling_period(models: list[StateSpace]) -> float:
     """The sampling period the models share (0.0 for continuous models); mixing is refused."""
-    dt = models[0].dt
+    dt = period(models[0])
 
     def describe(period: float) -> str:
         return f"dt = {period:g} s" if period > 0 else "continuous"
 
     for k, model in enumerate(models[1:], start=1):
-        if model.dt != dt:
+        if period(model) != dt:
             raise InvalidArgumentError(
                 f"sys[{k}] must have the sampling period of sys[0] ({describe(dt)}), "
-                f"got {describe(model.dt)}"
+                f"got {describe(period(model))}"
             )
     return dt
 
@@ -282,7 +282,7 @@ def _simulate(
     (q = 0), or discrete, every q-th sample."""
     if q:
         pairs = [_every_qth(model, q) for model in models]
-        method, step = "discrete", models[0].dt
+        method, step = "discrete", period(models[0])
     else:
         pairs = [(model.A, model.B) for model in models]
     if several:
@@ -418,7 +418,7 @@ def _discrete_impulse(
 ) -> TimeResponse:
     """The response of discrete models to the pulse η[0] = η0/dt: x[0] = 0, y[0] = D η0/dt,
     then the free response from x[q] = A^(q-1) B η0/dt."""
-    dt = models[0].dt
+    dt = period(models[0])
     t, q = _discrete_grid(T, models, dt)
     pulses = weights[:1] if several else weights
 
@@ -587,9 +587,10 @@ def forced_response(
     if times.ndim != 1:
         raise ShapeError(f"T must be a 1-D grid of times, got shape {times.shape}")
     step = _core.grid_step(times)
-    if model.is_discrete and abs(step - model.dt) > GRID_MULTIPLE_TOLERANCE * model.dt:
+    dt = period(model)
+    if model.is_discrete and abs(step - dt) > GRID_MULTIPLE_TOLERANCE * dt:
         raise InvalidArgumentError(
-            f"T must step by the sampling period dt = {model.dt:g} s of the discrete model "
+            f"T must step by the sampling period dt = {dt:g} s of the discrete model "
             f"(one input per sample, t = k dt), got a step of {step:g} s"
         )
     k, m, n = len(times), model.n_inputs, model.n_states

@@ -88,10 +88,13 @@ class StateSpace:
         Names used in tables, plots and legends (defaults x0..., u0..., y0...; the outputs take
         the state names when C is the default identity).
     dt : float, optional
-        None or 0 (the default): a continuous model. A positive, finite number: a discrete
+        None (the default) or 0: a continuous model. A positive, finite number: a discrete
         model sampled every ``dt`` seconds, whose responses are taken at t = k dt and whose
         frequency response is G(e^{jω dt}). A negative or non-finite ``dt``, and
         python-control's ``dt=True`` (a discrete model of unspecified period), are refused.
+        As in python-control, ``dt=None`` leaves the time base unsaid (every analysis treats
+        the model as continuous, but the discrete designs such as :func:`~aerocontrol.dlqr`
+        accept it) while ``dt=0`` marks it continuous.
 
     Every matrix is checked at construction, by name: shapes that disagree or entries that
     are not finite raise ShapeError or NonFiniteError. The matrices are read-only copies:
@@ -118,8 +121,8 @@ class StateSpace:
     state_names: tuple[str, ...]
     input_names: tuple[str, ...]
     output_names: tuple[str, ...]
-    dt: float
-    """The sampling period in seconds; 0.0 for a continuous model."""
+    dt: float | None
+    """The sampling period in seconds; None or 0.0 for a continuous model."""
 
     def __init__(
         self,
@@ -132,7 +135,7 @@ class StateSpace:
         output_names: Sequence[str] | None = None,
         dt: float | None = None,
     ) -> None:
-        self.dt = sampling_period(dt)
+        self.dt = None if dt is None else sampling_period(dt)
         A = _matrix(A, "A")
         B_array = real_array(B, "B")
         B = _matrix(B_array.reshape(-1, 1) if B_array.ndim == 1 else B_array, "B")
@@ -154,7 +157,7 @@ class StateSpace:
     @property
     def is_discrete(self) -> bool:
         """Whether the model is discrete (sampled every ``dt`` > 0 seconds)."""
-        return self.dt > 0.0
+        return period(self) > 0.0
 
     @property
     def n_states(self) -> int:
@@ -175,8 +178,19 @@ class StateSpace:
         return (
             f"StateSpace(n_states={self.n_states}, n_inputs={self.n_inputs}, "
             f"n_outputs={self.n_outputs}, states={list(self.state_names)}, "
-            f"inputs={list(self.input_names)}" + (f", dt={self.dt:g})" if self.is_discrete else ")")
+            f"inputs={list(self.input_names)}"
+            + (f", dt={period(self):g})" if self.is_discrete else ")")
         )
+
+
+def period(model: StateSpace) -> float:
+    """The sampling period of a model in seconds: 0.0 for a continuous one (dt None or 0)."""
+    return model.dt or 0.0
+
+
+def _foreign_period(dt: object, name: str) -> float | None:
+    """A foreign model's ``dt`` checked under its own name; None stays None."""
+    return None if dt is None else sampling_period(dt, name)
 
 
 def continuous_eigenvalues(model: StateSpace) -> NDArray[np.complex128]:
@@ -188,7 +202,7 @@ def continuous_eigenvalues(model: StateSpace) -> NDArray[np.complex128]:
         return eigenvalues
     s = np.full(eigenvalues.shape, complex(-np.inf, 0.0), dtype=np.complex128)
     nonzero = eigenvalues != 0
-    s[nonzero] = np.log(eigenvalues[nonzero]) / model.dt
+    s[nonzero] = np.log(eigenvalues[nonzero]) / period(model)
     return s
 
 
@@ -235,7 +249,7 @@ def as_state_space(model: System, name: str = "sys") -> StateSpace:
             np.asarray(model.C),
             np.asarray(model.D),
             **names,
-            dt=sampling_period(getattr(model, "dt", None), f"{name}.dt"),
+            dt=_foreign_period(getattr(model, "dt", None), f"{name}.dt"),
         )
     raise TypeError(
         f"{name} must be a StateSpace, a tuple (A, B) or (A, B, C, D), or an object with A, B, "

@@ -67,10 +67,10 @@ if d.Gamma1 is not None:
 assert_type(aerocontrol.discretize([[-3.0, 8.0], [0.0, 0.0]], (0.0, 4.0), 0.1).Gamma0, Floats)
 sampled = aerocontrol.c2d(sys, 0.05)
 assert_type(sampled, aerocontrol.StateSpace)
-assert_type(sampled.dt, float)
+assert_type(sampled.dt, float | None)
 assert_type(sampled.is_discrete, bool)
 assert_type(aerocontrol.c2d((A, B), 0.05, "tustin", prewarp=1.0).A, Floats)
-assert_type(aerocontrol.c2d(small, 0.1, "matched").dt, float)
+assert_type(aerocontrol.c2d(small, 0.1, "matched").dt, float | None)
 assert_type(
     aerocontrol.c2d(Foreign(A, B, np.eye(4), np.zeros((4, 1))), 0.1, "gbt", alpha=0.3),
     aerocontrol.StateSpace,
