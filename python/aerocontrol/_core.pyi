@@ -17,6 +17,7 @@ __all__ = [
     "PRODUCT_WORKSPACE_BYTES",
     "SMALL_MAX_ORDER",
     "Placement",
+    "bilinear",
     "care_batch",
     "charpoly",
     "check_model",
@@ -29,6 +30,7 @@ __all__ = [
     "expm_pade_choice",
     "frequency_response",
     "grid_step",
+    "inverse_bilinear",
     "krylov_matrix",
     "modal_analysis",
     "place",
@@ -43,6 +45,7 @@ __all__ = [
     "solve_lyapunov",
     "steady_state",
     "transition_matrices",
+    "undiscretize_zoh",
 ]
 
 EXACT_NORM_MAX_ORDER: int
@@ -70,6 +73,15 @@ def transition_matrices(a: ArrayLike, t: ArrayLike, /) -> NDArray[np.float64]: .
 def discretize(
     a: ArrayLike, b: ArrayLike, dt: float, method: str, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64] | None]: ...
+def bilinear(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, dt: float, alpha: float, /
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
+def inverse_bilinear(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, dt: float, alpha: float, /
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
+def undiscretize_zoh(
+    phi: ArrayLike, gamma: ArrayLike, dt: float, /
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
 def expm_pade_choice(a: ArrayLike, /) -> tuple[int, int]: ...
 def check_model(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /) -> None: ...
 def grid_step(t: ArrayLike, /) -> float: ...
@@ -101,7 +113,13 @@ def simulate_models(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
 def steady_state(a: ArrayLike, b: ArrayLike, eta0: ArrayLike, /) -> NDArray[np.float64]: ...
 def frequency_response(
-    a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, omega: ArrayLike, /
+    a: ArrayLike,
+    b: ArrayLike,
+    c: ArrayLike,
+    d: ArrayLike,
+    omega: ArrayLike,
+    dt: float | None = None,
+    /,
 ) -> NDArray[np.complex128]: ...
 def modal_analysis(a: ArrayLike, b: ArrayLike | None, /) -> dict[str, Any]: ...
 def krylov_matrix(a: ArrayLike, b: ArrayLike, dual: bool, /) -> NDArray[np.float64]: ...

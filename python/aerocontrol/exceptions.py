@@ -17,6 +17,8 @@ class                         raised when
 ``UncontrollableError``       a pair (A, B) has a mode that no feedback can move (likewise)
 ``NoStabilizingSolutionError``  a Riccati equation has no stabilising solution (likewise)
 ``IllConditionedError``       a step would lose every digit and was refused (likewise)
+``NoContinuousEquivalentError``  a discrete model has no real continuous model behind it under
+                              the method asked (likewise)
 ``NotPositiveDefiniteError``  a weight such as R is not symmetric positive definite
                               (an ``InvalidArgumentError``)
 ============================  ===========================================================
@@ -37,6 +39,7 @@ __all__ = [
     "IllConditionedError",
     "IllConditionedWarning",
     "InvalidArgumentError",
+    "NoContinuousEquivalentError",
     "NoStabilizingSolutionError",
     "NonFiniteError",
     "NotPositiveDefiniteError",
@@ -114,6 +117,13 @@ class NoStabilizingSolutionError(AerocontrolLinAlgError):
 class IllConditionedError(AerocontrolLinAlgError):
     """A step would lose every digit to ill-conditioning and was refused, for example the
     exchange of two Schur blocks with nearly equal eigenvalues."""
+
+
+class NoContinuousEquivalentError(AerocontrolLinAlgError):
+    """A discrete model has no real continuous model that the method asked maps to it: for the
+    zero-order hold, A has an eigenvalue on the closed negative real axis (e^{A dt} never has
+    one, and such an A has no real logarithm); for the bilinear transformation, A has an
+    eigenvalue at the image of s = ∞ (-1 for Tustin's). The message names the eigenvalue."""
 
 
 class ConvergenceError(AerocontrolLinAlgError):

@@ -3,6 +3,11 @@
 The Rust core reduces A to Hessenberg form once and solves each frequency in O(n^2) (see
 ``rust/freq.rs``). :func:`bode` chooses a default grid from the modes: 1000 log-spaced
 frequencies from a tenth of the slowest to ten times the fastest natural frequency.
+
+A discrete model sampled every dt has the frequency response G(e^{jω dt}) =
+C (e^{jω dt} I - A)^-1 B + D, periodic in ω with period 2π/dt; its default grid runs from a
+tenth of the slowest natural frequency of the equivalent continuous model s = ln(z)/dt to the
+Nyquist frequency π/dt.
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import ShapeError
-from .statespace import as_state_space
+from .statespace import as_state_space, continuous_eigenvalues, period
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -84,9 +89,11 @@ class FrequencyResponse:
 
 
 def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
-    """G(jω) = C (jωI - A)^-1 B + D at each frequency of ``omega`` (rad/s).
+    """G(jω) = C (jωI - A)^-1 B + D at each frequency of ``omega`` (rad/s); for a discrete
+    model, G(e^{jω dt}) = C (e^{jω dt} I - A)^-1 B + D.
 
-    A frequency at an imaginary-axis pole gives infinite or NaN entries.
+    A frequency at an imaginary-axis pole (a pole on the unit circle, for a discrete model)
+    gives infinite or NaN entries.
 
     Examples
     --------
@@ -94,6 +101,10 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
     >>> g = aerocontrol.frequency_response(([[-2.0]], [[1.0]]), [0.0, 2.0])
     >>> np.round(g.response[:, 0, 0], 4)            # 1 / (jω + 2)
     array([0.5 +0.j  , 0.25-0.25j])
+    >>> d = aerocontrol.StateSpace([[0.5]], [[1.0]], [[1.0]], [[0.0]], dt=0.1)
+    >>> g = aerocontrol.frequency_response(d, [0.0, np.pi / 0.1])   # z = 1 and z = -1
+    >>> np.round(g.response[:, 0, 0].real, 4)                        # 1 / (z - 0.5)
+    array([ 2.    , -0.6667])
     """
     model = as_state_space(sys)
     frequencies = real_array(omega, "omega")
@@ -101,7 +112,14 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
         frequencies = frequencies.reshape(1)
     if frequencies.ndim != 1:
         raise ShapeError(f"omega must be a 1-D array of frequencies, got {frequencies.shape}")
-    response = _core.frequency_response(model.A, model.B, model.C, model.D, frequencies)
+    response = _core.frequency_response(
+        model.A,
+        model.B,
+        model.C,
+        model.D,
+        frequencies,
+        period(model) if model.is_discrete else None,
+    )
     return FrequencyResponse(
         omega=np.array(frequencies, dtype=np.float64),
         response=response,
@@ -112,8 +130,17 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
 
 def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> FloatArray:
     """Log-spaced frequencies from a tenth of the slowest to ten times the fastest nonzero
-    natural frequency of the modes (0.01 to 100 rad/s when every eigenvalue is zero)."""
+    natural frequency of the modes (0.01 to 100 rad/s when every eigenvalue is zero). For a
+    discrete model: from a tenth of the slowest natural frequency of s = ln(z)/dt (or a
+    thousandth of the Nyquist frequency, if lower) to the Nyquist frequency π/dt."""
     model = as_state_space(sys)
+    if model.is_discrete:
+        nyquist = np.pi / period(model)
+        s = continuous_eigenvalues(model)
+        magnitudes = np.abs(s[np.isfinite(s)])
+        nonzero = magnitudes[magnitudes > 1e-12 * nyquist]
+        low = min(nonzero.min() / 10, nyquist / 1000) if nonzero.size else nyquist / 1000
+        return np.logspace(np.log10(low), np.log10(nyquist), count)
     magnitudes = np.abs(_core.eigenvalues(model.A)) if model.n_states else np.array([])
     nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
     low, high = (nonzero.min() / 10, nonzero.max() * 10) if nonzero.size else (0.01, 100.0)

@@ -1,5 +1,5 @@
-"""The matrix exponential, state transition matrices, exact discretisation, and the real Schur
-form with reordering.
+"""The matrix exponential, state transition matrices, exact discretisation, discrete models of
+continuous ones and back (:func:`c2d`, :func:`d2c`), and the real Schur form with reordering.
 
 Chapter §6.1.2: the transition matrix of x' = Ax + Bη is Φ(t) = e^{At} (6.22), and the
 response to an input held over a step follows from Φ and two integrals of it (6.9).
@@ -9,18 +9,24 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import TYPE_CHECKING, Literal, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, check_choice, real_array, real_scalar
-from .exceptions import InvalidArgumentError, ShapeError
+from .exceptions import InvalidArgumentError, NoContinuousEquivalentError, ShapeError
+from .statespace import StateSpace, as_state_space, period, sampling_period
+
+if TYPE_CHECKING:
+    from ._typing import System
 
 __all__ = [
     "Discretization",
     "GeneralizedSchur",
+    "c2d",
+    "d2c",
     "discretize",
     "expm",
     "qz",
@@ -168,6 +174,8 @@ def discretize(
     -------
     Discretization
         ``Phi``, ``Gamma0`` and, for ``"foh"``, ``Gamma1`` (see :class:`Discretization`).
+        :func:`c2d` turns them into a discrete :class:`~aerocontrol.StateSpace` (and has the
+        bilinear and matched methods).
 
     Examples
     --------
@@ -182,11 +190,446 @@ def discretize(
     if B.ndim == 1:
         B = B.reshape(-1, 1)
     step = real_scalar(dt, "dt")
+    if isinstance(method, str) and method in C2D_METHODS and method not in ("zoh", "foh"):
+        raise InvalidArgumentError(
+            f"method must be one of 'zoh', 'foh', got {method!r}: discretize gives the "
+            f"matrices of a hold, and method={method!r} changes C and D as well; use "
+            "aerocontrol.c2d(sys, dt, method=...) for it"
+        )
     hold: Literal["zoh", "foh"] = (
         "zoh" if check_choice(method, "method", ("zoh", "foh")) == "zoh" else "foh"
     )
     Phi, Gamma0, Gamma1 = _core.discretize(A, B, step, hold)
     return Discretization(Phi=Phi, Gamma0=Gamma0, Gamma1=Gamma1, dt=step, method=hold)
+
+
+#: The methods of :func:`c2d`.
+C2D_METHODS = ("zoh", "foh", "tustin", "bilinear", "gbt", "euler", "backward_diff", "matched")
+
+#: The methods of :func:`d2c`.
+D2C_METHODS = ("zoh", "tustin", "bilinear", "gbt", "euler", "backward_diff")
+
+#: The weight α of each named generalized bilinear transformation.
+_BILINEAR_WEIGHTS = {"tustin": 0.5, "bilinear": 0.5, "euler": 0.0, "backward_diff": 1.0}
+
+
+def _bilinear_weight(method: str, alpha: float | None) -> float:
+    """α of a bilinear method: fixed by its name, or given (between 0 and 1) for "gbt"."""
+    if method == "gbt":
+        if alpha is None:
+            raise InvalidArgumentError("method='gbt' needs the weight alpha, between 0 and 1")
+        weight = real_scalar(alpha, "alpha")
+        if not 0.0 <= weight <= 1.0:
+            raise InvalidArgumentError(f"alpha must be between 0 and 1, got {weight}")
+        return weight
+    if alpha is not None:
+        raise InvalidArgumentError(
+            f"alpha is the weight of method='gbt'; method={method!r} has its own "
+            f"({_BILINEAR_WEIGHTS.get(method, 'none')})"
+        )
+    return _BILINEAR_WEIGHTS[method]
+
+
+def _warped_step(method: str, weight: float, dt: float, prewarp: float | None) -> float:
+    """The step of the bilinear transformation: dt, or 2 tan(ω dt / 2) / ω with frequency
+    prewarping at ω, so that the discrete model's response at ω equals the continuous one's."""
+    if prewarp is None:
+        return dt
+    if method not in ("tustin", "bilinear", "gbt") or weight != 0.5:
+        raise InvalidArgumentError(
+            f"prewarp applies to Tustin's transformation (method='tustin', or 'gbt' with "
+            f"alpha=0.5), not to method={method!r}"
+        )
+    omega = real_scalar(prewarp, "prewarp")
+    nyquist = np.pi / dt
+    if not (np.isfinite(omega) and 0.0 < omega < nyquist):
+        raise InvalidArgumentError(
+            f"prewarp must be a frequency in rad/s between 0 and the Nyquist frequency "
+            f"pi/dt = {nyquist:g}, got {omega}"
+        )
+    return float(2.0 * np.tan(omega * dt / 2.0) / omega)
+
+
+def c2d(
+    sys: System,
+    dt: float,
+    method: str = "zoh",
+    prewarp: float | None = None,
+    alpha: float | None = None,
+) -> StateSpace:
+    """The discrete model of a continuous one, sampled every ``dt`` seconds (MATLAB's ``c2d``,
+    python-control's ``sample_system``).
+
+    Methods (the realizations are scipy.signal.cont2discrete's, so the matrices agree with
+    scipy and python-control, not only the transfer functions):
+
+    ``"zoh"``
+        Zero-order hold, exact for inputs constant over each step: Ad = e^{A dt},
+        Bd = ∫_0^dt e^{Aτ} dτ B, C and D unchanged (:func:`discretize`, exact for singular A).
+    ``"foh"``
+        First-order (triangle) hold, exact for inputs linear between samples: with Φ, Γ0, Γ1
+        of :func:`discretize`, Ad = Φ, Bd = Γ0 - Γ1 + Φ Γ1, Cd = C, Dd = D + C Γ1 (the state
+        is x - Γ1 η, so that the model is causal).
+    ``"tustin"`` (or ``"bilinear"``), ``"euler"``, ``"backward_diff"``, ``"gbt"``
+        The generalized bilinear transformation s ← (z - 1) / (dt (α z + 1 - α)) with α = 1/2,
+        0, 1, or ``alpha``: Ad = M^-1 (I + (1 - α) dt A), Bd = M^-1 dt B, Cd = C M^-1,
+        Dd = D + α C Bd with M = I - α dt A. ``prewarp`` (rad/s, below π/dt) replaces dt by
+        2 tan(ω dt/2)/ω in Tustin's map, so that the frequency responses agree at ω.
+    ``"matched"``
+        Matched pole-zero (single input, single output): each pole and finite zero s maps to
+        e^{s dt}, and the gain matches the continuous one at low frequency (the DC gain when
+        there is no pole or zero at s = 0), as python-control's ``sample_system``. The result
+        is a controllable canonical realization, with new state names.
+
+    Parameters
+    ----------
+    sys : system
+        A continuous model (a discrete one is refused).
+    dt : float
+        Sampling period in seconds, positive and finite.
+    method : str
+        One of the above; default ``"zoh"``.
+    prewarp : float, optional
+        Frequency in rad/s at which Tustin's map is exact.
+    alpha : float, optional
+        The weight of ``method="gbt"``, between 0 and 1.
+
+    Returns
+    -------
+    StateSpace
+        The discrete model (``dt`` set), with the names of ``sys`` (except for
+        ``"matched"``, whose states are new).
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``sys`` is already discrete, ``dt`` is not positive, an unknown method, ``prewarp`` or
+        ``alpha`` given to a method that has none, or a bilinear step that sends an eigenvalue
+        of A to infinity (A has the eigenvalue 1 / (α dt)).
+    ShapeError
+        ``method="matched"`` on a model with more than one input or output.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> lag = aerocontrol.StateSpace([[-2.0]], [[2.0]], [[1.0]], [[0.0]])     # 2 / (s + 2)
+    >>> d = aerocontrol.c2d(lag, 0.1)
+    >>> round(float(d.A[0, 0]), 6), round(float(d.B[0, 0]), 6), d.dt
+    (0.818731, 0.181269, 0.1)
+    >>> t = aerocontrol.c2d(lag, 0.1, "tustin")
+    >>> round(float(t.A[0, 0]), 6)                                    # (1 - 0.1) / (1 + 0.1)
+    0.818182
+    """
+    model = as_state_space(sys)
+    if model.is_discrete:
+        raise InvalidArgumentError(
+            f"sys must be a continuous model, got a discrete one (dt = {period(model):g}); "
+            "use d2c to undo a discretisation"
+        )
+    step = sampling_period(dt)
+    if step == 0.0:
+        raise InvalidArgumentError("dt must be a positive sampling period in seconds, got 0")
+    chosen = check_choice(method, "method", C2D_METHODS)
+    if chosen in ("zoh", "foh", "matched") and (prewarp is not None or alpha is not None):
+        raise InvalidArgumentError(
+            f"prewarp and alpha apply to the bilinear methods, not to method={chosen!r}"
+        )
+    if chosen == "matched":
+        return _matched(model, step)
+    if chosen in ("zoh", "foh"):
+        Phi, Gamma0, Gamma1 = _core.discretize(model.A, model.B, step, chosen)
+        if Gamma1 is None:
+            return _named_like(model, Phi, Gamma0, model.C, model.D, step)
+        return _named_like(
+            model, Phi, Gamma0 - Gamma1 + Phi @ Gamma1, model.C, model.D + model.C @ Gamma1, step
+        )
+    weight = _bilinear_weight(chosen, alpha)
+    warped = _warped_step(chosen, weight, step, prewarp)
+    Ad, Bd, Cd, Dd = _core.bilinear(model.A, model.B, model.C, model.D, warped, weight)
+    return _named_like(model, Ad, Bd, Cd, Dd, step)
+
+
+def d2c(
+    sys: System,
+    method: str = "zoh",
+    prewarp: float | None = None,
+    alpha: float | None = None,
+) -> StateSpace:
+    """The continuous model whose discretisation by ``method`` is the discrete model ``sys``
+    (MATLAB's ``d2c``): the inverse of :func:`c2d`, so ``d2c(c2d(sys, dt, m), m)`` is ``sys``
+    to rounding.
+
+    ``"zoh"``
+        A dt and B dt are the blocks of the principal logarithm of [[Ad, Bd], [0, I]]
+        (inverse scaling and squaring on the real Schur form, in the core); C and D are
+        unchanged. The logarithm is real only if Ad has no eigenvalue on the closed negative
+        real axis: e^{A dt} never has one, so such a model (a pole at z <= 0, such as a
+        one-step delay z = 0) has no continuous equivalent.
+    ``"tustin"`` (``"bilinear"``), ``"euler"``, ``"backward_diff"``, ``"gbt"``
+        The inverse of the generalized bilinear transformation of :func:`c2d`, with the same
+        ``prewarp`` and ``alpha``; it needs Ad free of the eigenvalue -(1 - α)/α (-1 for
+        Tustin's), the image of s = ∞.
+
+    First-order hold and matched pole-zero have no inverse here.
+
+    Raises
+    ------
+    NoContinuousEquivalentError
+        No real continuous model maps to ``sys`` (the message names the eigenvalue).
+    InvalidArgumentError
+        ``sys`` is continuous, an unknown method, or ``prewarp``/``alpha`` where they do not
+        apply.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_longitudinal()
+    >>> sys = aerocontrol.StateSpace(A, B)
+    >>> back = aerocontrol.d2c(aerocontrol.c2d(sys, 0.05))
+    >>> bool(np.allclose(back.A, A, rtol=1e-12, atol=1e-14)), back.dt
+    (True, 0.0)
+    """
+    model = as_state_space(sys)
+    if not model.is_discrete:
+        raise InvalidArgumentError(
+            "sys must be a discrete model (a StateSpace with dt > 0), got a continuous one"
+        )
+    if isinstance(method, str) and method in ("foh", "matched"):
+        raise InvalidArgumentError(
+            f"d2c has no inverse of method={method!r}; it undoes 'zoh' and the bilinear "
+            "methods ('tustin', 'euler', 'backward_diff', 'gbt')"
+        )
+    chosen = check_choice(method, "method", D2C_METHODS)
+    if chosen == "zoh":
+        if prewarp is not None or alpha is not None:
+            raise InvalidArgumentError(
+                "prewarp and alpha apply to the bilinear methods, not to method='zoh'"
+            )
+        _check_zoh_logarithm(model.A)
+        try:
+            A, B = _core.undiscretize_zoh(model.A, model.B, period(model))
+        except InvalidArgumentError as error:
+            if error.argument != "A":
+                raise
+            raise NoContinuousEquivalentError(str(error)) from None
+        return _named_like(model, A, B, model.C, model.D, 0.0)
+    weight = _bilinear_weight(chosen, alpha)
+    warped = _warped_step(chosen, weight, period(model), prewarp)
+    try:
+        A, B, C, D = _core.inverse_bilinear(model.A, model.B, model.C, model.D, warped, weight)
+    except InvalidArgumentError as error:
+        if error.argument != "A":
+            raise
+        raise NoContinuousEquivalentError(str(error)) from None
+    return _named_like(model, A, B, C, D, 0.0)
+
+
+def _named_like(
+    model: StateSpace,
+    A: ArrayLike,
+    B: ArrayLike,
+    C: ArrayLike,
+    D: ArrayLike,
+    dt: float | None,
+) -> StateSpace:
+    """A model with the matrices given and the names of ``model``."""
+    return StateSpace(
+        A,
+        B,
+        C,
+        D,
+        state_names=model.state_names,
+        input_names=model.input_names,
+        output_names=model.output_names,
+        dt=dt,
+    )
+
+
+def _check_zoh_logarithm(A: FloatArray) -> None:
+    """Refuses an A with an eigenvalue on the closed negative real axis (or at 0 to working
+    precision), which no e^{A_c dt} has."""
+    eigenvalues = _core.eigenvalues(A)
+    if eigenvalues.size == 0:
+        return
+    zero = A.shape[0] * np.finfo(float).eps * float(np.abs(A).max())
+    for value in eigenvalues:
+        if abs(value) <= zero:
+            raise NoContinuousEquivalentError(
+                f"A has the eigenvalue 0 (computed as {complex(value):.3g}), a pole at z = 0 "
+                "(a pure delay or a deadbeat mode): e^(A_c dt) is never singular, so no "
+                "continuous model has these zero-order-hold samples"
+            )
+        if value.imag == 0.0 and value.real < 0.0:
+            raise NoContinuousEquivalentError(
+                f"A has the eigenvalue {value.real:.6g} on the negative real axis: e^(A_c dt) "
+                "never has one (A has no real logarithm), so no real continuous model has "
+                "these zero-order-hold samples"
+            )
+
+
+def _roots(coefficients: FloatArray) -> ComplexArray:
+    """The roots of a polynomial (highest power first, leading coefficient nonzero): the
+    eigenvalues of its companion matrix, by aerocontrol's own Schur form."""
+    degree = len(coefficients) - 1
+    if degree < 1:
+        return np.zeros(0, dtype=np.complex128)
+    companion = np.zeros((degree, degree))
+    companion[0, :] = -coefficients[1:] / coefficients[0]
+    companion[1:, :-1] = np.eye(degree - 1)
+    return _core.eigenvalues(companion)
+
+
+def _matched(model: StateSpace, dt: float) -> StateSpace:
+    """Matched pole-zero discretisation of a single-input, single-output model."""
+    if (model.n_inputs, model.n_outputs) != (1, 1):
+        raise ShapeError(
+            "method='matched' needs a single-input, single-output model, got "
+            f"{model.n_inputs} input(s) and {model.n_outputs} output(s); discretise each "
+            "input-output pair, or use another method"
+        )
+    A, b, c, d = model.A, model.B[:, 0], model.C[0], float(model.D[0, 0])
+    n = model.n_states
+    poles = _core.eigenvalues(A) if n else np.zeros(0, dtype=np.complex128)
+    # G(s) = N(s) / P(s) with P = det(sI - A) and, by the matrix determinant lemma,
+    # N = d P + det(sI - A + b c) - P. Without feedthrough the leading coefficients of N are
+    # the Markov parameters c A^(k-1) b, zero below the relative degree.
+    P = _core.charpoly(A) if n else np.ones(1)
+    numerator = d * P + ((_core.charpoly(A - np.outer(b, c)) - P) if n else np.zeros(1))
+    if d == 0.0:
+        eps = np.finfo(float).eps
+        scale = float(np.linalg.norm(c) * np.linalg.norm(b))
+        norm_A = max(float(np.abs(A).sum(axis=0).max()) if n else 0.0, 1.0)
+        relative_degree, power = None, b.copy()
+        for k in range(1, n + 1):
+            if abs(float(c @ power)) > 1e3 * n * eps * scale * norm_A ** (k - 1):
+                relative_degree = k
+                break
+            power = A @ power
+        if relative_degree is None:  # G = 0
+            return StateSpace(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[0.0]], dt=dt)
+        numerator = numerator[relative_degree:]
+    zeros = _roots(numerator)
+    # Poles and zeros at s = 0 map to z = 1; the gain is matched on the rest (their low
+    # frequency asymptotes agree, with z - 1 ≈ s dt).
+    tiny = 1e-12 * max(1.0, float(np.abs(poles).max(initial=0.0)))
+    nonzero_poles, nonzero_zeros = poles[np.abs(poles) > tiny], zeros[np.abs(zeros) > tiny]
+    excess = (len(zeros) - len(nonzero_zeros)) - (len(poles) - len(nonzero_poles))
+    continuous_gain = numerator[0] * np.prod(-nonzero_zeros) / np.prod(-nonzero_poles)
+    discrete_gain = np.prod(_one_minus_exp(nonzero_zeros * dt)) / np.prod(
+        _one_minus_exp(nonzero_poles * dt)
+    )
+    gain = float((continuous_gain / discrete_gain).real) / dt**excess
+    # A cascade of first- and second-order sections, each a factor (z - e^{z_i dt}) ... over
+    # (z - e^{p_i dt}) ...: the poles sit exactly in the sections' matrices, where the
+    # coefficients of one polynomial of degree n would lose digits as the poles crowd towards
+    # z = 1 (small dt).
+    numerators = _real_factors(zeros, dt)
+    quadratic = [f for f in numerators if len(f) == 3]
+    linear = [f for f in numerators if len(f) == 2]
+    Ad, Bd, Cd, Dd = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1))
+    for A_k, B_k, denominator in _pole_sections(poles, dt):
+        order = len(denominator) - 1
+        factor = np.ones(1)
+        if order == 2 and quadratic:
+            factor = quadratic.pop()
+        elif linear:
+            factor = linear.pop()
+        if order == 2 and len(factor) == 2 and linear:
+            factor = np.convolve(factor, linear.pop())
+        # A zero far outside the unit circle (e^{z dt} of a right-half-plane zero) makes its
+        # factor's coefficients huge: scaled to unit size, its size goes into the gain.
+        size = float(np.abs(factor).max())
+        factor, gain = factor / size, gain * size
+        num = np.concatenate([np.zeros(order + 1 - len(factor)), factor])
+        remainder = num[1:] - num[0] * denominator[1:]  # of the strictly proper part
+        C_k = _output_row(A_k, B_k, remainder)
+        D_k = num[:1].reshape(1, 1)
+        # The section after the cascade so far: its input is the cascade's output.
+        size_so_far = Ad.shape[0]
+        Ad = np.block([[Ad, np.zeros((size_so_far, order))], [B_k @ Cd, A_k]])
+        Bd = np.vstack([Bd, B_k @ Dd])
+        Cd = np.hstack([D_k @ Cd, C_k])
+        Dd = D_k @ Dd
+    if quadratic or linear:  # pragma: no cover - a proper G has no more zeros than poles
+        raise AssertionError("matched: zeros left over after the sections")
+    return StateSpace(
+        Ad,
+        gain * Bd,
+        Cd,
+        gain * Dd,
+        input_names=model.input_names,
+        output_names=model.output_names,
+        dt=dt,
+    )
+
+
+def _pole_sections(
+    poles: ComplexArray, dt: float
+) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
+    """(A_k, B_k, denominator) of each section with poles e^{p dt}: [[α, -β], [β, α]] and
+    B = [0, 1] for a pair α ± jβ, [[p1, 0], [1, p2]] and B = [1, 0] for two real poles, [[p]]
+    and B = [1] for the last real one; second-order sections first."""
+    sections = []
+    for r in poles[poles.imag > 0]:
+        z = np.exp(r.real * dt) * np.array([np.cos(r.imag * dt), np.sin(r.imag * dt)])
+        alpha, beta = float(z[0]), float(z[1])
+        sections.append(
+            (
+                np.array([[alpha, -beta], [beta, alpha]]),
+                np.array([[0.0], [1.0]]),
+                np.array([1.0, -2.0 * alpha, alpha * alpha + beta * beta]),
+            )
+        )
+    reals = [float(np.exp(r.real * dt)) for r in poles if r.imag == 0]
+    for first, second in zip(reals[0::2], reals[1::2], strict=False):
+        sections.append(
+            (
+                np.array([[first, 0.0], [1.0, second]]),
+                np.array([[1.0], [0.0]]),
+                np.array([1.0, -(first + second), first * second]),
+            )
+        )
+    if len(reals) % 2:
+        sections.append((np.array([[reals[-1]]]), np.ones((1, 1)), np.array([1.0, -reals[-1]])))
+    return sections
+
+
+def _output_row(A: FloatArray, B: FloatArray, remainder: FloatArray) -> FloatArray:
+    """The row C with C (zI - A)^-1 B = (remainder as a polynomial in z) / det(zI - A), for a
+    section of order 1 or 2: adj(zI - A) B = z B + (A - tr(A) I) B, so C B and
+    C (A - tr(A) I) B are the coefficients (Cramer's rule on the 2 x 2 system)."""
+    if A.shape[0] == 1:
+        return np.asarray(remainder.reshape(1, 1) / B[0, 0], dtype=np.float64)
+    V = (A - np.trace(A) * np.eye(2)) @ B
+    b0, b1, v0, v1 = B[0, 0], B[1, 0], V[0, 0], V[1, 0]
+    n1, n0 = remainder
+    determinant = b0 * v1 - b1 * v0
+    return np.array([[(n1 * v1 - b1 * n0) / determinant, (b0 * n0 - v0 * n1) / determinant]])
+
+
+def _one_minus_exp(s: ComplexArray) -> ComplexArray:
+    """1 - e^s without cancellation for small |s|: -(expm1(a) cos b - 2 sin²(b/2)) - j e^a sin b
+    for s = a + jb."""
+    a, b = s.real, s.imag
+    real = np.expm1(a) * np.cos(b) - 2.0 * np.sin(b / 2.0) ** 2
+    return np.asarray(-(real + 1j * np.exp(a) * np.sin(b)), dtype=np.complex128)
+
+
+def _real_factors(roots: ComplexArray, dt: float) -> list[FloatArray]:
+    """The monic real factors of prod (z - e^{r dt}) over the roots r (conjugate pairs exact):
+    z^2 - 2 e^{σ dt} cos(ω dt) z + e^{2σ dt} for each pair σ ± jω, real roots two to a
+    quadratic, and at most one linear factor z - e^{r dt} left."""
+    factors = [
+        np.array([1.0, -2.0 * np.exp(r.real * dt) * np.cos(r.imag * dt), np.exp(2 * r.real * dt)])
+        for r in roots
+        if r.imag > 0
+    ]
+    reals = [float(np.exp(r.real * dt)) for r in roots if r.imag == 0]
+    for first, second in zip(reals[0::2], reals[1::2], strict=False):
+        factors.append(np.array([1.0, -(first + second), first * second]))
+    if len(reals) % 2:
+        factors.append(np.array([1.0, -reals[-1]]))
+    return factors
 
 
 #: The named selections of :func:`schur` (scipy.linalg.schur's ``sort`` names).

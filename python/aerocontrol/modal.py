@@ -15,6 +15,13 @@ cycles to half      N½ = t½ / T                             (oscillations)
 time constant       τ = 1 / |λ|                             s (real modes)
 ==================  ======================================  =================================
 
+For a discrete model (a StateSpace with ``dt`` > 0) the eigenvalues z of A are reported as
+they are, and the characteristics are those of the equivalent continuous mode s = ln(z)/dt
+(principal logarithm): ω_n = |s|, ζ = -Re s/|s|, and so on, with the modes ordered by that
+ω_n. A real z < 0 is an oscillation at the Nyquist frequency π/dt (period 2 dt) on its own; z
+= 0 (a pure delay, a deadbeat mode) has s = -inf: infinite ω_n, ζ = 1, and a time to half and
+a time constant of 0.
+
 The modal matrix P (unit eigenvectors as columns) diagonalises A, P^-1 A P = Λ (6.59), and
 P^-1 B (6.61) shows which modes each input reaches: a zero row is a mode no input excites. A
 defective A (a repeated eigenvalue without a full set of eigenvectors, such as a double
@@ -26,7 +33,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,7 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning
-from .statespace import as_state_space, is_system
+from .statespace import as_state_space, is_system, period
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -91,7 +98,7 @@ class Modes:
         lines = [header, "-" * len(header)]
         for k in range(len(self)):
             lam = self.eigenvalue[k]
-            if self.oscillatory[k]:
+            if self.oscillatory[k] and lam.imag != 0:
                 pole = f"{lam.real:.5g} ± {abs(lam.imag):.5g}j"
             else:
                 pole = f"{lam.real:.5g}"
@@ -133,8 +140,58 @@ def _plant(A_or_sys: ArrayLike | System) -> tuple[FloatArray, FloatArray | None]
     return real_array(A_or_sys, "A"), None
 
 
+def _plant_period(A_or_sys: ArrayLike | System) -> float:
+    """The sampling period of a discrete system; 0.0 for a continuous one or a matrix."""
+    if is_system(A_or_sys) or isinstance(A_or_sys, tuple):
+        return period(as_state_space(A_or_sys))
+    return 0.0
+
+
+def _equivalent_continuous(result: dict[str, Any], dt: float) -> dict[str, Any]:
+    """The modal analysis of a discrete A (eigenvalues z) with the characteristics of the
+    equivalent continuous modes s = ln(z)/dt, reordered by their natural frequency (then by
+    decreasing damping), eigenvalues, modal matrix columns and modal input rows alike."""
+    eigenvalues = result["eigenvalues"]
+    groups = [list(range(first, last + 1)) for first, last in result["mode_indices"]]
+    z = np.array([eigenvalues[group[0]] for group in groups], dtype=np.complex128)
+    s = np.full(z.shape, complex(-np.inf, 0.0), dtype=np.complex128)
+    s[z != 0] = np.log(z[z != 0]) / dt
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sigma, omega_d = s.real, np.abs(s.imag)
+        natural = np.abs(s)
+        oscillatory = omega_d > 0
+        damping = np.where(np.isinf(sigma), 1.0, -sigma / natural)
+        damping = np.where(natural == 0, np.nan, damping)
+        period = np.where(oscillatory, 2 * np.pi / np.where(oscillatory, omega_d, 1.0), np.inf)
+        half = np.where(sigma < 0, np.log(2) / -sigma, np.nan)
+        double = np.where(sigma > 0, np.log(2) / sigma, np.nan)
+        cycles = np.where(oscillatory, half / period, np.nan)
+        constant = np.where(oscillatory | (natural == 0), np.nan, 1.0 / natural)
+    order = np.lexsort((-np.nan_to_num(damping, nan=-np.inf), natural))
+    columns = [index for k in order for index in groups[k]]
+    modal_input = result["modal_input"]
+    return {
+        **result,
+        "eigenvalues": eigenvalues[columns],
+        "mode_eigenvalue": z[order],
+        "oscillatory": oscillatory[order],
+        "natural_frequency": natural[order],
+        "damping_ratio": damping[order],
+        "damped_frequency": omega_d[order],
+        "period": period[order],
+        "time_to_half": half[order],
+        "time_to_double": double[order],
+        "cycles_to_half": cycles[order],
+        "time_constant": constant[order],
+        "modal_matrix": result["modal_matrix"][:, columns],
+        "modal_input": None if modal_input is None else modal_input[columns],
+    }
+
+
 def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> Modes:
-    """The modes of A, or of a system's A (then with P^-1 B).
+    """The modes of A, or of a system's A (then with P^-1 B). For a discrete system, the
+    eigenvalues z of A with the characteristics of the equivalent continuous modes
+    s = ln(z)/dt (see the module documentation).
 
     Parameters
     ----------
@@ -152,9 +209,15 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
     [0.0464, 0.7477, 1.2308]
     >>> round(float(m.damping_ratio[1]), 4)                      # Dutch roll, (6.153)
     0.1079
+    >>> lateral = aerocontrol.c2d(aerocontrol.StateSpace(A, B), 0.05)   # sampled at 20 Hz
+    >>> [round(float(w), 4) for w in aerocontrol.modes(lateral).natural_frequency]
+    [0.0464, 0.7477, 1.2308]
     """
     A, B = _plant(A_or_sys)
     result = _core.modal_analysis(A, B)
+    dt = _plant_period(A_or_sys)
+    if dt > 0.0:
+        result = _equivalent_continuous(result, dt)
     count = len(result["mode_eigenvalue"])
     if mode_names is None:
         names = tuple(f"mode {k + 1}" for k in range(count))

@@ -22,6 +22,16 @@ amplitude), or 10/|λ|min when no mode decays; at most 100,001 samples (the step
 Several responses come in one call: several initial states x0 (r, n), several input histories
 u (r, k, m), or a list of models of one size (``[sys1, sys2, ...]``); the result then has a
 leading response axis, ``x.shape == (r, k, n)``.
+
+A discrete model (a :class:`~aerocontrol.StateSpace` with ``dt`` > 0) is its own recurrence,
+x[k+1] = A x[k] + B η[k], y[k] = C x[k] + D η[k], on t = k dt; every time of a grid must be
+a multiple of dt (a step of q dt gives every q-th sample, from the powers A^q and
+Σ_{i<q} A^i B). The default grid then steps by dt up to the final time above (for the modes
+of the equivalent continuous model s = ln(z)/dt), every q-th sample beyond 100,001. The
+impulse of a discrete model is the unit-area pulse η[0] = η0/dt, η[k] = 0 after (as MATLAB's
+and python-control's, so that it tends to the continuous impulse response as dt → 0; y[0]
+holds D η0/dt). A doublet has no sampled equivalent and is refused. A list of models must
+share their sampling period.
 """
 
 from __future__ import annotations
@@ -36,8 +46,13 @@ from numpy.typing import ArrayLike
 
 from . import _core
 from ._validation import FloatArray, check_choice, finite_or_warn, real_array
-from .exceptions import InvalidArgumentError, NumericalOverflowWarning, ShapeError
-from .statespace import StateSpace, as_state_space, is_system
+from .exceptions import (
+    InvalidArgumentError,
+    NumericalOverflowWarning,
+    ShapeError,
+    SingularMatrixError,
+)
+from .statespace import StateSpace, as_state_space, continuous_eigenvalues, is_system, period
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -135,13 +150,33 @@ def _systems(sys: Systems) -> tuple[list[StateSpace], bool]:
 def default_time_grid(sys: Systems) -> FloatArray:
     """The default grid of the responses (see the module documentation)."""
     models, _ = _systems(sys)
+    dt = _sampling_period(models)
+    if dt > 0.0:
+        return _discrete_grid(None, models, dt)[0]
     step, final = _default_step_and_final(models)
     samples = int(np.ceil(final / step)) + 1
     return np.linspace(0.0, (samples - 1) * step, samples)
 
 
+def _sampling_period(models: list[StateSpace]) -> float:
+    """The sampling period the models share (0.0 for continuous models); mixing is refused."""
+    dt = period(models[0])
+
+    def describe(period: float) -> str:
+        return f"dt = {period:g} s" if period > 0 else "continuous"
+
+    for k, model in enumerate(models[1:], start=1):
+        if period(model) != dt:
+            raise InvalidArgumentError(
+                f"sys[{k}] must have the sampling period of sys[0] ({describe(dt)}), "
+                f"got {describe(period(model))}"
+            )
+    return dt
+
+
 def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
-    eigenvalues = np.concatenate([_core.eigenvalues(m.A) for m in models])
+    eigenvalues = np.concatenate([continuous_eigenvalues(m) for m in models])
+    eigenvalues = eigenvalues[np.isfinite(eigenvalues)]  # z = 0 of a discrete model
     magnitudes = np.abs(eigenvalues)
     nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
     if nonzero.size == 0:
@@ -173,6 +208,109 @@ def _grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, fl
         return t, float(t[1] - t[0])
     step = _core.grid_step(times)
     return np.array(times, dtype=np.float64), step
+
+
+#: A grid step within this relative distance of q dt is q dt.
+GRID_MULTIPLE_TOLERANCE = 1e-9
+
+
+def _discrete_grid(
+    T: ArrayLike | None, models: list[StateSpace], dt: float
+) -> tuple[FloatArray, int]:
+    """(t, q) for discrete models sampled every dt: the times, q dt apart."""
+    if T is None:
+        _, final = _default_step_and_final(models)
+        steps = max(int(np.ceil(final / dt - GRID_MULTIPLE_TOLERANCE)), 100)
+    else:
+        times = real_array(T, "T")
+        if times.ndim == 0:
+            final = float(times)
+            if not (np.isfinite(final) and final >= dt * (1.0 - GRID_MULTIPLE_TOLERANCE)):
+                raise InvalidArgumentError(
+                    f"T as a final time must be finite and at least the sampling period "
+                    f"dt = {dt:g} s, got {final}"
+                )
+            steps = int(np.floor(final / dt + GRID_MULTIPLE_TOLERANCE))
+        else:
+            step = _core.grid_step(times)
+            q = round(step / dt)
+            if q < 1 or abs(step - q * dt) > GRID_MULTIPLE_TOLERANCE * step:
+                raise InvalidArgumentError(
+                    f"T must be a grid of multiples of the sampling period dt = {dt:g} s "
+                    f"(t = k dt), got a step of {step:g} s"
+                )
+            return np.array(times, dtype=np.float64), q
+    q = max(1, int(np.ceil(steps / (MAX_DEFAULT_SAMPLES - 1))))
+    samples = steps // q + 1
+    return np.arange(samples, dtype=np.float64) * (q * dt), q
+
+
+def _every_qth(model: StateSpace, q: int) -> tuple[FloatArray, FloatArray]:
+    """(A^q, Σ_{i<q} A^i B): the recurrence of a discrete model between every q-th sample, the
+    blocks of M^q for M = [[A, B], [0, I]].
+
+    Binary powering on E_k = M^k - I (E_{j+k} = E_j E_k + E_j + E_k), not on M^k: a slow mode
+    has A^q close to I, and M^k itself would carry its difference from I, which sets the
+    steady state, with an absolute error of q u instead of u."""
+    if q == 1:
+        return model.A, model.B
+    n, m = model.n_states, model.n_inputs
+    base = np.zeros((n + m, n + m))
+    base[:n, :n], base[:n, n:] = model.A - np.eye(n), model.B
+    power = np.zeros_like(base)
+    while q:
+        if q & 1:
+            power = power @ base + power + base
+        q >>= 1
+        if q:
+            base = base @ base + 2.0 * base
+    return np.eye(n) + power[:n, :n], power[:n, n:]
+
+
+def _simulate(
+    models: list[StateSpace],
+    several: bool,
+    x0: FloatArray,
+    u: FloatArray | None,
+    eta0: FloatArray | None,
+    step: float,
+    samples: int,
+    q: int,
+    method: str = "zoh",
+) -> tuple[FloatArray, FloatArray]:
+    """The core's simulation of one model or of a stack: continuous with the hold ``method``
+    (q = 0), or discrete, every q-th sample."""
+    if q:
+        pairs = [_every_qth(model, q) for model in models]
+        method, step = "discrete", period(models[0])
+    else:
+        pairs = [(model.A, model.B) for model in models]
+    if several:
+        return _core.simulate_models(
+            np.stack([a for a, _ in pairs]),
+            np.stack([b for _, b in pairs]),
+            np.stack([m.C for m in models]),
+            np.stack([m.D for m in models]),
+            x0,
+            u,
+            eta0,
+            step,
+            samples,
+            method,
+        )
+    (A, B), model = pairs[0], models[0]
+    return _core.simulate(A, B, model.C, model.D, x0, u, eta0, step, samples, method)
+
+
+def _time_grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, float, int]:
+    """(t, step, q): the times and, for continuous models, the step (q = 0); for discrete
+    ones, the number q of recurrence steps per sample (step = q dt)."""
+    dt = _sampling_period(models)
+    if dt > 0.0:
+        t, q = _discrete_grid(T, models, dt)
+        return t, q * dt, q
+    t, step = _grid(T, models)
+    return t, step, 0
 
 
 def _input_weights(eta0: ArrayLike | None, m: int) -> tuple[FloatArray, tuple[str, ...] | None]:
@@ -222,26 +360,15 @@ def _free_responses(
 ) -> TimeResponse:
     """Free responses from initial states computed per model by ``initial(model)`` (r, n)."""
     models, several_models = _systems(sys)
-    t, step = _grid(T, models)
+    t, step, q = _time_grid(T, models)
     first = models[0]
     if several_models:
         x0 = np.stack([initial(m)[0] for m in models])
-        x, y = _core.simulate_models(
-            np.stack([m.A for m in models]),
-            np.stack([m.B for m in models]),
-            np.stack([m.C for m in models]),
-            np.stack([m.D for m in models]),
-            x0,
-            None,
-            None,
-            step,
-            len(t),
-            "zoh",
-        )
+        x, y = _simulate(models, True, x0, None, None, step, len(t), q)
         model_labels = [f"model {k}" for k in range(len(models))]
         return _assemble(kind, t, x, y, None, first, model_labels, True)
     x0 = initial(first)
-    x, y = _core.simulate(first.A, first.B, first.C, first.D, x0, None, None, step, len(t), "zoh")
+    x, y = _simulate(models, False, x0, None, None, step, len(t), q)
     labels: Sequence[str] = (
         names if names is not None else [f"response {k}" for k in range(len(x0))]
     )
@@ -265,13 +392,49 @@ def impulse_response(
     (201, 4)
     >>> np.allclose(r.x[0], B[:, 0])
     True
+
+    A discrete model gets the unit-area pulse η[0] = η0/dt (see the module documentation):
+
+    >>> d = aerocontrol.StateSpace([[0.5]], [[1.0]], [[1.0]], [[0.0]], dt=0.1)
+    >>> aerocontrol.impulse_response(d, T=0.3).y[:, 0]
+    array([ 0. , 10. ,  5. ,  2.5])
     """
-    models, _ = _systems(sys)
+    models, several_models = _systems(sys)
     weights, names = _input_weights(eta0, models[0].n_inputs)
     labels = names or models[0].input_names
+    if _sampling_period(models) > 0.0:
+        return _discrete_impulse(models, several_models, T, weights, labels)
     return _free_responses(
         "impulse", sys, T, lambda m: _initial_state(lambda: weights @ m.B.T, "B eta0"), labels
     )
+
+
+def _discrete_impulse(
+    models: list[StateSpace],
+    several: bool,
+    T: ArrayLike | None,
+    weights: FloatArray,
+    labels: Sequence[str],
+) -> TimeResponse:
+    """The response of discrete models to the pulse η[0] = η0/dt: x[0] = 0, y[0] = D η0/dt,
+    then the free response from x[q] = A^(q-1) B η0/dt."""
+    dt = period(models[0])
+    t, q = _discrete_grid(T, models, dt)
+    pulses = weights[:1] if several else weights
+
+    def start(model: StateSpace) -> FloatArray:
+        reach = np.linalg.matrix_power(model.A, q - 1) @ model.B
+        return _initial_state(lambda: pulses @ reach.T / dt, "A^(q-1) B eta0 / dt")
+
+    x0 = np.stack([start(m)[0] for m in models]) if several else start(models[0])
+    x, y = _simulate(models, several, x0, None, None, q * dt, len(t) - 1, q)
+    with np.errstate(over="ignore", invalid="ignore"):
+        first_outputs = np.stack([pulses @ m.D.T / dt for m in models])
+    first_outputs = first_outputs[:, 0] if several else first_outputs[0]
+    x = np.concatenate([np.zeros((x.shape[0], 1, x.shape[2])), x], axis=1)
+    y = np.concatenate([first_outputs[:, None, :], y], axis=1)
+    names = [f"model {k}" for k in range(len(models))] if several else labels
+    return _assemble("impulse", t, x, y, None, models[0], names, several or len(pulses) > 1)
 
 
 def doublet_response(
@@ -279,9 +442,16 @@ def doublet_response(
 ) -> TimeResponse:
     """Response to η = η0 δ'(t): x(t) = e^{At} A B η0, y = C x (chapter (6.38)).
 
-    Equal to the free response from x(0) = A B η0.
+    Equal to the free response from x(0) = A B η0. Continuous models only: a doublet has no
+    sampled equivalent.
     """
     models, _ = _systems(sys)
+    if _sampling_period(models) > 0.0:
+        raise InvalidArgumentError(
+            "a doublet (the derivative of an impulse) has no sampled equivalent: "
+            "doublet_response takes continuous models; give a discrete model its input "
+            "sequence with forced_response"
+        )
     weights, names = _input_weights(eta0, models[0].n_inputs)
     labels = names or models[0].input_names
     return _free_responses(
@@ -306,7 +476,8 @@ def _initial_state(form: Callable[[], FloatArray], what: str) -> FloatArray:
 
 
 def initial_response(sys: Systems, x0: ArrayLike, T: ArrayLike | None = None) -> TimeResponse:
-    """The free response x(t) = e^{At} x0 (6.31), y = C x.
+    """The free response x(t) = e^{At} x0 (6.31), y = C x; for a discrete model
+    x[k] = A^k x0.
 
     ``x0`` is one initial state (n,) or several (r, n), computed in one call.
     """
@@ -329,7 +500,8 @@ def step_response(
     """Response to η = η0 H(t) from rest (chapter (6.39)-(6.45)).
 
     Computed exactly through the augmented exponential, so it is right for singular A (an
-    integrator), where the chapter's x(t) = (e^{At} - I) A^-1 B η0 (6.43) cannot be used.
+    integrator), where the chapter's x(t) = (e^{At} - I) A^-1 B η0 (6.43) cannot be used. A
+    discrete model steps x[k+1] = A x[k] + B η0 from x[0] = 0 (scipy.signal.dstep's).
 
     Examples
     --------
@@ -341,20 +513,18 @@ def step_response(
     """
     models, several_models = _systems(sys)
     first = models[0]
-    t, step = _grid(T, models)
+    t, step, q = _time_grid(T, models)
     weights, names = _input_weights(eta0, first.n_inputs)
     if several_models:
-        x, y = _core.simulate_models(
-            np.stack([m.A for m in models]),
-            np.stack([m.B for m in models]),
-            np.stack([m.C for m in models]),
-            np.stack([m.D for m in models]),
+        x, y = _simulate(
+            models,
+            True,
             np.zeros((len(models), first.n_states)),
             None,
             np.repeat(weights[:1], len(models), axis=0),
             step,
             len(t),
-            "zoh",
+            q,
         )
         u = np.broadcast_to(weights[:1], (len(models), len(t), first.n_inputs))
         return _assemble(
@@ -363,14 +533,10 @@ def step_response(
     responses = weights.shape[0]
     x0 = np.zeros((responses, first.n_states))
     if responses == 1:
-        x, y = _core.simulate(
-            first.A, first.B, first.C, first.D, x0, None, weights[0], step, len(t), "zoh"
-        )
+        x, y = _simulate(models, False, x0, None, weights[0], step, len(t), q)
     else:
         u_all = np.repeat(weights[:, None, :], len(t), axis=1)
-        x, y = _core.simulate(
-            first.A, first.B, first.C, first.D, x0, u_all, None, step, len(t), "zoh"
-        )
+        x, y = _simulate(models, False, x0, u_all, None, step, len(t), q)
     u = np.repeat(weights[:, None, :], len(t), axis=1)
     labels: Sequence[str] = names or first.input_names
     return _assemble("step", t, x, y, u, first, labels, responses > 1)
@@ -395,7 +561,8 @@ def forced_response(
     x0 : array_like, shape (n,) or (r, n), optional
     method : {"zoh", "foh"}
         Input held constant between samples (zero-order hold) or linear between them
-        (first-order hold, as scipy.signal.lsim's default interpolation).
+        (first-order hold, as scipy.signal.lsim's default interpolation). A discrete model
+        takes one input per sample, T steps by its dt, and "foh" is refused.
 
     Examples
     --------
@@ -411,10 +578,21 @@ def forced_response(
         raise ShapeError("forced_response takes one model; call it per model for several")
     model = models[0]
     hold = check_choice(method, "method", ("zoh", "foh"))
+    if model.is_discrete and hold != "zoh":
+        raise InvalidArgumentError(
+            f"method={hold!r} is a hold between samples of a continuous model; a discrete "
+            "model takes one input per sample (leave method at 'zoh')"
+        )
     times = real_array(T, "T")
     if times.ndim != 1:
         raise ShapeError(f"T must be a 1-D grid of times, got shape {times.shape}")
     step = _core.grid_step(times)
+    dt = period(model)
+    if model.is_discrete and abs(step - dt) > GRID_MULTIPLE_TOLERANCE * dt:
+        raise InvalidArgumentError(
+            f"T must step by the sampling period dt = {dt:g} s of the discrete model "
+            f"(one input per sample, t = k dt), got a step of {step:g} s"
+        )
     k, m, n = len(times), model.n_inputs, model.n_states
     inputs = real_array(u, "u")
     if inputs.ndim == 1 and m == 1:
@@ -444,16 +622,15 @@ def forced_response(
     if inputs.shape[0] == 1 and states.shape[0] > 1:
         inputs = np.repeat(inputs, states.shape[0], axis=0)
         responses = states.shape[0]
-    x, y = _core.simulate(
-        model.A,
-        model.B,
-        model.C,
-        model.D,
+    x, y = _simulate(
+        models,
+        False,
         states,
         np.ascontiguousarray(inputs),
         None,
         step,
         k,
+        1 if model.is_discrete else 0,
         hold,
     )
     labels = [f"response {r}" for r in range(responses)]
@@ -461,10 +638,11 @@ def forced_response(
 
 
 def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
-    """The state a step η0 settles to, x∞ = -A^-1 B η0 (6.45), for a stable system.
+    """The state a step η0 settles to, x∞ = -A^-1 B η0 (6.45), for a stable system; for a
+    discrete model, x∞ = (I - A)^-1 B η0.
 
     Raises SingularMatrixError naming the zero eigenvalue when A is singular (an integrator
-    has no steady state).
+    has no steady state); for a discrete model, the eigenvalue 1 of A.
 
     Examples
     --------
@@ -477,22 +655,37 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     weights = real_array(eta0, "eta0")
     if weights.ndim == 0 and model.n_inputs == 1:  # a number for the one input
         weights = weights.reshape(1)
-    result: FloatArray = _core.steady_state(model.A, model.B, weights)
+    result: FloatArray = _steady_state(model, weights)
     return result
 
 
-def dc_gain(sys: System) -> FloatArray:
-    """The zero-frequency gain D - C A^-1 B (p, m): the steady output per unit step input.
+def _steady_state(model: StateSpace, weights: ArrayLike) -> FloatArray:
+    """-A^-1 B η0 for a continuous model; for a discrete one, -(A - I)^-1 B η0, with the
+    error of a singular A - I naming the eigenvalue 1 of A."""
+    if not model.is_discrete:
+        return _core.steady_state(model.A, model.B, weights)
+    try:
+        return _core.steady_state(model.A - np.eye(model.n_states), model.B, weights)
+    except SingularMatrixError as error:
+        raise SingularMatrixError(
+            "A - I is singular: A has the eigenvalue 1 (a discrete integrator or neutral "
+            "mode), so the discrete model has no steady state"
+        ) from error
 
-    Raises SingularMatrixError naming the zero eigenvalue when A is singular.
+
+def dc_gain(sys: System) -> FloatArray:
+    """The zero-frequency gain D - C A^-1 B (p, m): the steady output per unit step input;
+    for a discrete model, G(z = 1) = D + C (I - A)^-1 B.
+
+    Raises SingularMatrixError naming the zero eigenvalue when A is singular (the eigenvalue
+    1 for a discrete model).
     """
     model = as_state_space(sys)
     # One warning for the gain, not one per column's steady state.
     with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", NumericalOverflowWarning)
         columns = [
-            model.C @ _core.steady_state(model.A, model.B, np.eye(model.n_inputs)[j])
-            + model.D[:, j]
+            model.C @ _steady_state(model, np.eye(model.n_inputs)[j]) + model.D[:, j]
             for j in range(model.n_inputs)
         ]
     gain: FloatArray = np.stack(columns, axis=1) if columns else np.zeros((model.n_outputs, 0))

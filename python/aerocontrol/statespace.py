@@ -1,8 +1,10 @@
 """Linear time-invariant models in state-space form (chapter (6.3), (6.30)).
 
-    x' = A x + B η,     y = C x + D η
+    x' = A x + B η,     y = C x + D η                         (continuous, dt = 0)
+    x[k+1] = A x[k] + B η[k],     y[k] = C x[k] + D η[k]       (discrete, sampled every dt)
 
-:class:`StateSpace` holds the four matrices and the names of the states, inputs and outputs.
+:class:`StateSpace` holds the four matrices, the sampling period and the names of the states,
+inputs and outputs.
 Every analysis function takes a StateSpace, a tuple ``(A, B)`` or ``(A, B, C, D)``, or any
 object with ``A``, ``B``, ``C`` and ``D`` attributes (python-control's StateSpace works without
 importing python-control); :func:`as_state_space` does the conversion.
@@ -14,11 +16,11 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._validation import FloatArray, real_array
-from .exceptions import ShapeError
+from ._validation import FloatArray, real_array, real_scalar
+from .exceptions import InvalidArgumentError, ShapeError
 
 if TYPE_CHECKING:
     from typing_extensions import TypeIs
@@ -49,8 +51,28 @@ def _names(given: Sequence[str] | None, count: int, prefix: str, argument: str) 
     return names
 
 
+def sampling_period(dt: object, name: str = "dt") -> float:
+    """``dt`` as a sampling period: 0.0 for a continuous model (None, 0 or False), else a
+    positive, finite number of seconds; anything else is refused by name."""
+    if dt is None or dt is False:
+        return 0.0
+    if dt is True:
+        raise InvalidArgumentError(
+            f"{name}=True (a discrete model of unspecified sampling period, as python-control "
+            "writes it) is not supported: give the sampling period in seconds"
+        )
+    period = real_scalar(dt, name)
+    if not (np.isfinite(period) and period >= 0.0):
+        raise InvalidArgumentError(
+            f"{name} must be None or 0 for a continuous model, or a positive, finite sampling "
+            f"period in seconds, got {period}"
+        )
+    return period
+
+
 class StateSpace:
-    """x' = A x + B η, y = C x + D η, with names for the states, inputs and outputs.
+    """x' = A x + B η, y = C x + D η, with names for the states, inputs and outputs; or, with
+    a sampling period ``dt``, the discrete x[k+1] = A x[k] + B η[k], y[k] = C x[k] + D η[k].
 
     Parameters
     ----------
@@ -65,6 +87,14 @@ class StateSpace:
     state_names, input_names, output_names : sequence of str, optional
         Names used in tables, plots and legends (defaults x0..., u0..., y0...; the outputs take
         the state names when C is the default identity).
+    dt : float, optional
+        None (the default) or 0: a continuous model. A positive, finite number: a discrete
+        model sampled every ``dt`` seconds, whose responses are taken at t = k dt and whose
+        frequency response is G(e^{jω dt}). A negative or non-finite ``dt``, and
+        python-control's ``dt=True`` (a discrete model of unspecified period), are refused.
+        As in python-control, ``dt=None`` leaves the time base unsaid (every analysis treats
+        the model as continuous, but the discrete designs such as :func:`~aerocontrol.dlqr`
+        accept it) while ``dt=0`` marks it continuous.
 
     Every matrix is checked at construction, by name: shapes that disagree or entries that
     are not finite raise ShapeError or NonFiniteError. The matrices are read-only copies:
@@ -80,6 +110,8 @@ class StateSpace:
     (4, 1, 4)
     >>> sys.output_names
     ('u/u0', 'alpha', 'q', 'theta')
+    >>> aerocontrol.StateSpace([[0.9]], [[0.1]], dt=0.05)
+    StateSpace(n_states=1, n_inputs=1, n_outputs=1, states=['x0'], inputs=['u0'], dt=0.05)
     """
 
     A: FloatArray
@@ -89,6 +121,8 @@ class StateSpace:
     state_names: tuple[str, ...]
     input_names: tuple[str, ...]
     output_names: tuple[str, ...]
+    dt: float | None
+    """The sampling period in seconds; None or 0.0 for a continuous model."""
 
     def __init__(
         self,
@@ -99,7 +133,9 @@ class StateSpace:
         state_names: Sequence[str] | None = None,
         input_names: Sequence[str] | None = None,
         output_names: Sequence[str] | None = None,
+        dt: float | None = None,
     ) -> None:
+        self.dt = None if dt is None else sampling_period(dt)
         A = _matrix(A, "A")
         B_array = real_array(B, "B")
         B = _matrix(B_array.reshape(-1, 1) if B_array.ndim == 1 else B_array, "B")
@@ -117,6 +153,11 @@ class StateSpace:
             self.output_names = self.state_names
         else:
             self.output_names = _names(output_names, C.shape[0], "y", "output_names")
+
+    @property
+    def is_discrete(self) -> bool:
+        """Whether the model is discrete (sampled every ``dt`` > 0 seconds)."""
+        return period(self) > 0.0
 
     @property
     def n_states(self) -> int:
@@ -137,8 +178,32 @@ class StateSpace:
         return (
             f"StateSpace(n_states={self.n_states}, n_inputs={self.n_inputs}, "
             f"n_outputs={self.n_outputs}, states={list(self.state_names)}, "
-            f"inputs={list(self.input_names)})"
+            f"inputs={list(self.input_names)}"
+            + (f", dt={period(self):g})" if self.is_discrete else ")")
         )
+
+
+def period(model: StateSpace) -> float:
+    """The sampling period of a model in seconds: 0.0 for a continuous one (dt None or 0)."""
+    return model.dt or 0.0
+
+
+def _foreign_period(dt: object, name: str) -> float | None:
+    """A foreign model's ``dt`` checked under its own name; None stays None."""
+    return None if dt is None else sampling_period(dt, name)
+
+
+def continuous_eigenvalues(model: StateSpace) -> NDArray[np.complex128]:
+    """The eigenvalues of A for a continuous model; for a discrete one, those of the equivalent
+    continuous model, s = ln(z) / dt (principal logarithm: a real z < 0 gives the Nyquist
+    frequency π/dt, and z = 0 gives s = -inf)."""
+    eigenvalues = _core.eigenvalues(model.A) if model.n_states else np.zeros(0, np.complex128)
+    if not model.is_discrete:
+        return eigenvalues
+    s = np.full(eigenvalues.shape, complex(-np.inf, 0.0), dtype=np.complex128)
+    nonzero = eigenvalues != 0
+    s[nonzero] = np.log(eigenvalues[nonzero]) / period(model)
+    return s
 
 
 def is_system(value: object) -> TypeIs[SystemObject]:
@@ -155,9 +220,10 @@ def is_system(value: object) -> TypeIs[SystemObject]:
 def as_state_space(model: System, name: str = "sys") -> StateSpace:
     """``model`` as a :class:`StateSpace`.
 
-    Accepts a StateSpace (returned as is), a tuple or list ``(A, B)`` or ``(A, B, C, D)``, or
-    any object with ``A``, ``B``, ``C``, ``D`` attributes, such as python-control's StateSpace
-    (its names are taken too when it has them).
+    Accepts a StateSpace (returned as is), a tuple or list ``(A, B)`` or ``(A, B, C, D)``
+    (continuous), or any object with ``A``, ``B``, ``C``, ``D`` attributes, such as
+    python-control's StateSpace (its names and its sampling period ``dt`` are taken too when it
+    has them; python-control's ``dt=True``, an unspecified period, is refused).
     """
     if isinstance(model, StateSpace):
         return model
@@ -183,6 +249,7 @@ def as_state_space(model: System, name: str = "sys") -> StateSpace:
             np.asarray(model.C),
             np.asarray(model.D),
             **names,
+            dt=_foreign_period(getattr(model, "dt", None), f"{name}.dt"),
         )
     raise TypeError(
         f"{name} must be a StateSpace, a tuple (A, B) or (A, B, C, D), or an object with A, B, "

@@ -4,14 +4,15 @@ use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::statespace::ModelArgs;
-use crate::control::frequency::frequency_response_into;
+use crate::control::frequency::{discrete_frequency_response_into, frequency_response_into};
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 
-/// G(jω_k) = C (jω_k I - A)^-1 B + D, as a complex (len(omega), p, m) array.
+/// G(jω_k) = C (jω_k I - A)^-1 B + D, as a complex (len(omega), p, m) array; for a discrete
+/// model sampled every `dt`, G(e^{jω_k dt}) = C (e^{jω_k dt} I - A)^-1 B + D.
 #[pyfunction]
-#[pyo3(signature = (a, b, c, d, omega, /))]
+#[pyo3(signature = (a, b, c, d, omega, dt=None, /))]
 fn frequency_response<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
@@ -19,6 +20,7 @@ fn frequency_response<'py>(
     c: &Bound<'py, PyAny>,
     d: &Bound<'py, PyAny>,
     omega: &Bound<'py, PyAny>,
+    dt: Option<f64>,
 ) -> PyResult<Bound<'py, PyArrayDyn<c64>>> {
     let args = ModelArgs::convert(py, a, b, c, d)?;
     let omega = Real::convert(py, omega, "omega")?;
@@ -39,8 +41,11 @@ fn frequency_response<'py>(
         bytes: (8.0 + 4.0 * threads) * (n * n.max(m)) as f64 * 8.0,
         order: n.max(m).max(p),
     };
-    compute(py, cost, || {
-        frequency_response_into(model.a, model.b, model.c, model.d, omega, data)
+    compute(py, cost, || match dt {
+        None => frequency_response_into(model.a, model.b, model.c, model.d, omega, data),
+        Some(dt) => {
+            discrete_frequency_response_into(model.a, model.b, model.c, model.d, omega, dt, data)
+        }
     })?;
     let mut outputs = Outputs::new(py);
     // SAFETY: as above; the computation is over.

@@ -4,7 +4,10 @@
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::{Class, raise, to_py_err, warn};
-use crate::control::discretize::{Hold, discretize as discretize_core};
+use crate::control::discretize::{
+    Hold, StateSpaceMatrices, bilinear as bilinear_core, discretize as discretize_core,
+    inverse_bilinear as inverse_bilinear_core, undiscretize_zoh as undiscretize_zoh_core,
+};
 use crate::error::{Error, check_square};
 use crate::linalg::expm::{expm_into, pade_choice, transition_matrices_into};
 use crate::linalg::norm::one_norm;
@@ -207,6 +210,111 @@ fn discretize<'py>(
     Ok((phi, gamma0, gamma1))
 }
 
+type Matrices<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+);
+
+/// The four matrices of a model as arrays, warning if any overflowed.
+fn matrices_out<'py>(py: Python<'py>, model: &StateSpaceMatrices) -> PyResult<Matrices<'py>> {
+    let mut outputs = Outputs::new(py);
+    let result = (
+        outputs.matrix("A", model.a.as_ref())?,
+        outputs.matrix("B", model.b.as_ref())?,
+        outputs.matrix("C", model.c.as_ref())?,
+        outputs.matrix("D", model.d.as_ref())?,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
+
+/// The cost of a bilinear transformation of a model (n, m, p): an LU of order n and solves
+/// with 2n + m right-hand sides.
+fn bilinear_cost(n: usize, m: usize, p: usize) -> Cost {
+    let flops = (n as f64).powi(2) * (4.0 * n as f64 + 2.0 * (m + p) as f64);
+    Cost::of(flops, 6.0, n.max(m).max(p))
+}
+
+/// (Ad, Bd, Cd, Dd): the generalized bilinear transformation of (A, B, C, D) with step dt and
+/// weight alpha (1/2: Tustin's).
+#[pyfunction]
+#[pyo3(signature = (a, b, c, d, dt, alpha, /))]
+#[allow(clippy::too_many_arguments)]
+fn bilinear<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    d: &Bound<'py, PyAny>,
+    dt: f64,
+    alpha: f64,
+) -> PyResult<Matrices<'py>> {
+    let args = super::statespace::ModelArgs::convert(py, a, b, c, d)?;
+    let model = args.model().map_err(|e| to_py_err(py, e))?;
+    let cost = bilinear_cost(model.a.nrows(), model.b.ncols(), model.c.nrows());
+    let result = compute(py, cost, || {
+        bilinear_core(model.a, model.b, model.c, model.d, dt, alpha)
+    })?;
+    matrices_out(py, &result)
+}
+
+/// (A, B, C, D): the continuous model whose generalized bilinear transformation with step dt
+/// and weight alpha is the discrete model (a, b, c, d).
+#[pyfunction]
+#[pyo3(signature = (a, b, c, d, dt, alpha, /))]
+#[allow(clippy::too_many_arguments)]
+fn inverse_bilinear<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    d: &Bound<'py, PyAny>,
+    dt: f64,
+    alpha: f64,
+) -> PyResult<Matrices<'py>> {
+    let args = super::statespace::ModelArgs::convert(py, a, b, c, d)?;
+    let model = args.model().map_err(|e| to_py_err(py, e))?;
+    let cost = bilinear_cost(model.a.nrows(), model.b.ncols(), model.c.nrows());
+    let result = compute(py, cost, || {
+        inverse_bilinear_core(model.a, model.b, model.c, model.d, dt, alpha)
+    })?;
+    matrices_out(py, &result)
+}
+
+type PlantPair<'py> = (Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>);
+
+/// (A, B): the continuous model whose zero-order-hold discretisation over dt is (phi, gamma),
+/// by the principal logarithm of [[phi, gamma], [0, I]].
+#[pyfunction]
+#[pyo3(signature = (phi, gamma, dt, /))]
+fn undiscretize_zoh<'py>(
+    py: Python<'py>,
+    phi: &Bound<'py, PyAny>,
+    gamma: &Bound<'py, PyAny>,
+    dt: f64,
+) -> PyResult<PlantPair<'py>> {
+    let (phi, gamma) = (Real::convert(py, phi, "A")?, Real::convert(py, gamma, "B")?);
+    let phi = phi.matrix().map_err(|e| to_py_err(py, e))?;
+    let gamma = gamma.matrix().map_err(|e| to_py_err(py, e))?;
+    let order = phi.nrows() + gamma.ncols();
+    // A Schur form, a few square roots and eight solves, and the exponential of the check.
+    let cost = Cost::of(
+        schur_cost(order).flops + 30.0 * (order as f64).powi(3) + expm_flops(order),
+        EXPM_TEMPORARIES,
+        order,
+    );
+    let (a, b) = compute(py, cost, || undiscretize_zoh_core(phi, gamma, dt))?;
+    let mut outputs = Outputs::new(py);
+    let result = (
+        outputs.matrix("A", a.as_ref())?,
+        outputs.matrix("B", b.as_ref())?,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
+
 /// The Padé degree m and the number of squarings s that the exponential of A uses: a
 /// diagnostic for tests and for users comparing algorithms.
 #[pyfunction]
@@ -399,6 +507,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(expm, m)?)?;
     m.add_function(wrap_pyfunction!(transition_matrices, m)?)?;
     m.add_function(wrap_pyfunction!(discretize, m)?)?;
+    m.add_function(wrap_pyfunction!(bilinear, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse_bilinear, m)?)?;
+    m.add_function(wrap_pyfunction!(undiscretize_zoh, m)?)?;
     m.add_function(wrap_pyfunction!(expm_pade_choice, m)?)?;
     Ok(())
 }

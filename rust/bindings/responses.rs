@@ -7,8 +7,8 @@ use super::errors::to_py_err;
 use super::linalg::{discretize_cost, hold_from_method};
 use super::statespace::ModelArgs;
 use crate::control::responses::{
-    Input, Model, OUTPUT_PRODUCT_MIN_ORDER, simulate_into, simulate_models_into,
-    steady_state as steady_state_core, uniform_grid_step,
+    Input, Model, OUTPUT_PRODUCT_MIN_ORDER, Sampling, simulate_models_sampled_into,
+    simulate_sampled_into, steady_state as steady_state_core, uniform_grid_step,
 };
 use crate::error::Error;
 use numpy::PyArrayDyn;
@@ -30,6 +30,16 @@ fn grid_step(py: Python<'_>, t: &Bound<'_, PyAny>) -> PyResult<f64> {
 }
 
 type SimulationOutput<'py> = (Bound<'py, PyArrayDyn<f64>>, Bound<'py, PyArrayDyn<f64>>);
+
+/// The sampling named by `method`: "zoh" or "foh" for a continuous model sampled every `dt`,
+/// "discrete" for a discrete model (its own recurrence; `dt` is not used).
+fn sampling_from_method(py: Python<'_>, method: &str, dt: f64) -> PyResult<Sampling> {
+    if method == "discrete" {
+        return Ok(Sampling::Discrete);
+    }
+    let hold = hold_from_method(py, method)?;
+    Ok(Sampling::Continuous { dt, hold })
+}
 
 /// The input of a simulation: sampled inputs `u` if given, else a constant `eta0` if given, else
 /// none.
@@ -89,7 +99,8 @@ fn simulation_cost(responses: usize, steps: usize, n: usize, m: usize, p: usize)
 
 /// States (r, steps, n) and outputs (r, steps, p) of r responses from the initial states
 /// x0 (r, n): free (u and eta0 None), a constant input eta0 (m), or sampled inputs u
-/// (r, steps, m) with a zero- or first-order hold.
+/// (r, steps, m) with a zero- or first-order hold ("zoh", "foh"), or of a discrete model
+/// ("discrete", dt unused).
 #[pyfunction]
 #[pyo3(signature = (a, b, c, d, x0, u, eta0, dt, steps, method, /))]
 #[allow(clippy::too_many_arguments)]
@@ -106,7 +117,7 @@ fn simulate<'py>(
     steps: usize,
     method: &str,
 ) -> PyResult<SimulationOutput<'py>> {
-    let hold = hold_from_method(py, method)?;
+    let sampling = sampling_from_method(py, method, dt)?;
     let args = ModelArgs::convert(py, a, b, c, d)?;
     let x0 = Real::convert(py, x0, "x0")?;
     let u = Real::convert_optional(py, u, "u")?;
@@ -133,7 +144,7 @@ fn simulate<'py>(
     let (x_data, y_data) = unsafe { (new_array_data(&x), new_array_data(&y)) };
     let cost = simulation_cost(responses, steps, n, m, p);
     compute(py, cost, || {
-        simulate_into(model, x0, input, dt, steps, hold, x_data, y_data)
+        simulate_sampled_into(model, x0, input, sampling, steps, x_data, y_data)
     })?;
     finish_simulation(py, &x, &y)?;
     Ok((x, y))
@@ -174,7 +185,7 @@ fn simulate_models<'py>(
     steps: usize,
     method: &str,
 ) -> PyResult<SimulationOutput<'py>> {
-    let hold = hold_from_method(py, method)?;
+    let sampling = sampling_from_method(py, method, dt)?;
     let a = Real::convert(py, a, "A")?;
     let b = Real::convert(py, b, "B")?;
     let c = Real::convert(py, c, "C")?;
@@ -230,7 +241,7 @@ fn simulate_models<'py>(
     let (x_data, y_data) = unsafe { (new_array_data(&x), new_array_data(&y)) };
     let cost = simulation_cost(1, steps, n, m, p).times(q);
     compute(py, cost, || {
-        simulate_models_into(&models, x0, input, dt, steps, hold, x_data, y_data)
+        simulate_models_sampled_into(&models, x0, input, sampling, steps, x_data, y_data)
     })?;
     finish_simulation(py, &x, &y)?;
     Ok((x, y))

@@ -30,11 +30,48 @@
 //! comparable with Ah before the exponential and the blocks are scaled back: a B much larger
 //! than Ah would otherwise force extra squarings on the whole augmented matrix, and B h could
 //! overflow or underflow at the edges of the range of doubles.
+//!
+//! # The generalized bilinear transformation
+//!
+//! [`bilinear`] replaces s by (z - 1) / (h (α z + 1 - α)) (Zhang, Chen & Ye, "The generalized
+//! bilinear transformation", Int. J. Control 82(4), 2009): α = 1/2 is Tustin's transformation,
+//! α = 0 the forward and α = 1 the backward difference. With M = I - α h A, the realization is
+//! that of scipy.signal.cont2discrete's "gbt":
+//!
+//! ```text
+//! Ad = M^-1 (I + (1 - α) h A),   Bd = M^-1 h B,   Cd = C M^-1,   Dd = D + α C Bd,
+//! ```
+//!
+//! and [`inverse_bilinear`] undoes it exactly: with W = α Ad + (1 - α) I, which equals M^-1,
+//!
+//! ```text
+//! A = (Ad - I) W^-1 / h,   B = W^-1 Bd / h,   C = Cd W^-1,   D = Dd - α C Bd.
+//! ```
+//!
+//! # Undoing the zero-order hold
+//!
+//! [`undiscretize_zoh`] recovers A and B from Φ = e^{Ah} and Γ0 as the principal logarithm of
+//! the block matrix of the exponential above: log [[Φ, Γ0], [0, I]] = [[Ah, Bh], [0, 0]]. The
+//! logarithm is real exactly when Φ has no eigenvalue on the closed negative real axis; it is
+//! computed by the inverse scaling and squaring method on the real Schur form (Higham,
+//! *Functions of Matrices*, SIAM 2008, §11.5, Algorithm 11.10, with the real square root of a
+//! quasi-triangular matrix of Higham, "Computing real square roots of a real matrix", Linear
+//! Algebra Appl. 88/89, 1987): square roots until ||T^(1/2^s) - I||_1 <= θ_8 = 0.34, then the
+//! [8/8] Padé approximant of log(I + X) as 8-point Gauss–Legendre quadrature of
+//! ∫_0^1 X (I + tX)^-1 dt, whose error is below u for ||X|| <= θ_8 (Kenney & Laub's bound,
+//! SIAM J. Matrix Anal. Appl. 10(2), 1989). The diagonal blocks of T^(1/2^s) - I and of the
+//! logarithm are formed from closed forms (expm1 and ln of the eigenvalues), not by
+//! subtraction, so the slow modes keep their relative accuracy.
 
+use crate::control::frequency::check_state_space;
 use crate::error::{Error, check_finite, check_positive, check_rows, check_square};
 use crate::linalg::expm::expm;
+use crate::linalg::norm::one_norm;
+use crate::linalg::schur::real_schur;
+use crate::linalg::sylvester::solve_small_sylvester;
 use faer::Mat;
 use faer::MatRef;
+use faer::linalg::solvers::Solve;
 
 /// How the input is reconstructed between samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,6 +178,467 @@ pub fn discretize(
         gamma0: block(n),
         gamma1: (hold == Hold::First).then(|| block(n + m)),
     })
+}
+
+/// The matrices A, B, C, D of a state-space model (continuous or discrete).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StateSpaceMatrices {
+    pub a: Mat<f64>,
+    pub b: Mat<f64>,
+    pub c: Mat<f64>,
+    pub d: Mat<f64>,
+}
+
+/// Checks the weight α of the generalized bilinear transformation.
+fn check_alpha(alpha: f64) -> Result<(), Error> {
+    if (0.0..=1.0).contains(&alpha) {
+        Ok(())
+    } else {
+        Err(Error::InvalidValue {
+            arg: "alpha",
+            value: alpha,
+            requirement: "between 0 and 1",
+        })
+    }
+}
+
+/// The inverse of a square matrix by LU with partial pivoting, or None when its reciprocal
+/// condition number 1 / (||M||_1 ||M^-1||_1) is below n u (singular to working precision).
+fn checked_inverse(m: MatRef<'_, f64>) -> Option<Mat<f64>> {
+    let n = m.nrows();
+    let inverse = m.partial_piv_lu().solve(Mat::<f64>::identity(n, n));
+    let condition = one_norm(m) * one_norm(inverse.as_ref());
+    (inverse.is_all_finite() && condition.is_finite() && condition * n as f64 * f64::EPSILON < 1.0)
+        .then_some(inverse)
+}
+
+/// The generalized bilinear transformation of x' = Ax + Bη, y = Cx + Dη with step `dt` and
+/// weight `alpha` (see the module docs; 1/2 is Tustin's). Refuses a step for which I - α dt A
+/// is singular to working precision (A has an eigenvalue at or near 1 / (α dt), which the
+/// transformation sends to infinity).
+pub fn bilinear(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    d: MatRef<'_, f64>,
+    dt: f64,
+    alpha: f64,
+) -> Result<StateSpaceMatrices, Error> {
+    check_state_space(a, b, c, d)?;
+    check_positive(dt, "dt")?;
+    check_alpha(alpha)?;
+    let n = a.nrows();
+    let identity = Mat::<f64>::identity(n, n);
+    let m = &identity - faer::Scale(alpha * dt) * a;
+    if !m.is_all_finite() {
+        return Err(Error::InvalidValue {
+            arg: "dt",
+            value: dt,
+            requirement: "small enough that A dt is finite",
+        });
+    }
+    let Some(inverse) = checked_inverse(m.as_ref()) else {
+        return Err(Error::InvalidArgument {
+            arg: "dt",
+            message: format!(
+                "I - alpha dt A is singular to working precision for dt = {dt} and alpha = \
+                 {alpha}: A has an eigenvalue at or near 1 / (alpha dt) = {}, which the \
+                 bilinear transformation sends to infinity; choose another dt",
+                1.0 / (alpha * dt)
+            ),
+        });
+    };
+    let lu = m.partial_piv_lu();
+    let ad = lu.solve(&identity + faer::Scale((1.0 - alpha) * dt) * a);
+    let bd = lu.solve(faer::Scale(dt) * b);
+    let cd = c * &inverse;
+    let dd = d + faer::Scale(alpha) * (c * &bd);
+    Ok(StateSpaceMatrices {
+        a: ad,
+        b: bd,
+        c: cd,
+        d: dd,
+    })
+}
+
+/// The continuous model whose generalized bilinear transformation with step `dt` and weight
+/// `alpha` is the discrete model (Ad, Bd, Cd, Dd): the exact inverse of [`bilinear`]. Refuses a
+/// model for which α Ad + (1 - α) I is singular to working precision (Ad has an eigenvalue at
+/// or near -(1 - α) / α, the image of s = ∞: -1 for Tustin's).
+pub fn inverse_bilinear(
+    ad: MatRef<'_, f64>,
+    bd: MatRef<'_, f64>,
+    cd: MatRef<'_, f64>,
+    dd: MatRef<'_, f64>,
+    dt: f64,
+    alpha: f64,
+) -> Result<StateSpaceMatrices, Error> {
+    check_state_space(ad, bd, cd, dd)?;
+    check_positive(dt, "dt")?;
+    check_alpha(alpha)?;
+    let n = ad.nrows();
+    let identity = Mat::<f64>::identity(n, n);
+    let w = faer::Scale(alpha) * ad + faer::Scale(1.0 - alpha) * &identity;
+    let Some(w_inverse) = checked_inverse(w.as_ref()) else {
+        return Err(Error::InvalidArgument {
+            arg: "A",
+            message: format!(
+                "alpha A + (1 - alpha) I is singular to working precision for alpha = {alpha}: \
+                 the discrete A has an eigenvalue at or near -(1 - alpha) / alpha = {}, the \
+                 image of s = infinity, so no continuous model maps to it",
+                -(1.0 - alpha) / alpha
+            ),
+        });
+    };
+    let lu = w.partial_piv_lu();
+    let a = faer::Scale(1.0 / dt) * lu.solve(ad - &identity);
+    let b = faer::Scale(1.0 / dt) * lu.solve(bd);
+    let c = cd * &w_inverse;
+    let d = dd - faer::Scale(alpha) * (&c * bd);
+    if !(a.is_all_finite() && b.is_all_finite()) {
+        return Err(Error::InvalidValue {
+            arg: "dt",
+            value: dt,
+            requirement: "large enough that A / dt and B / dt are finite",
+        });
+    }
+    Ok(StateSpaceMatrices { a, b, c, d })
+}
+
+/// The continuous A and B whose zero-order-hold discretisation over `dt` is (Φ, Γ0): the
+/// principal real logarithm of [[Φ, Γ0], [0, I]] divided by dt (see the module docs).
+///
+/// Refuses a Φ with an eigenvalue on the closed negative real axis (no real logarithm: no real
+/// continuous model has these samples), and verifies e^{[[A, B], [0, 0]] dt} against the block
+/// matrix before returning.
+pub fn undiscretize_zoh(
+    phi: MatRef<'_, f64>,
+    gamma: MatRef<'_, f64>,
+    dt: f64,
+) -> Result<(Mat<f64>, Mat<f64>), Error> {
+    check_square(phi, "A")?;
+    check_finite(phi, "A")?;
+    check_rows(gamma, "B", phi.nrows(), "A")?;
+    check_finite(gamma, "B")?;
+    check_positive(dt, "dt")?;
+    let (n, m) = (phi.nrows(), gamma.ncols());
+    // Γ0 scaled by a power of two (exactly) to the size of Φ: the logarithm's (1, 2) block is
+    // linear in Γ0, and the blocks then weigh alike in the Schur form and the norms.
+    let gamma_max = gamma.norm_max();
+    let phi_max = phi.norm_max().max(f64::MIN_POSITIVE);
+    let input_scale = if gamma_max > 0.0 {
+        (phi_max.log2() - gamma_max.log2()).round()
+    } else {
+        0.0
+    };
+    let size = n + m;
+    let block = Mat::from_fn(size, size, |i, j| match (i < n, j < n) {
+        (true, true) => phi[(i, j)],
+        (true, false) => times_power_of_two(gamma[(i, j - n)], input_scale),
+        (false, false) => f64::from(u8::from(i == j)),
+        (false, true) => 0.0,
+    });
+    let logarithm = real_logarithm(block.as_ref())?;
+    // The check: e^{log M} = M to a tolerance far above rounding (a failure is gross).
+    let back = expm(logarithm.as_ref())?;
+    let residual = (&back - &block).norm_max() / block.norm_max().max(f64::MIN_POSITIVE);
+    if residual.is_nan() || residual > LOGARITHM_RESIDUAL {
+        return Err(Error::IllConditioned {
+            message: format!(
+                "the logarithm of [[A, B], [0, I]] failed its check: e^(log M) differs from M \
+                 by {residual:.2e} relatively, so the zero-order hold cannot be undone \
+                 accurately"
+            ),
+        });
+    }
+    let a = Mat::from_fn(n, n, |i, j| logarithm[(i, j)] / dt);
+    let b = Mat::from_fn(n, m, |i, j| {
+        times_power_of_two(logarithm[(i, n + j)], -input_scale) / dt
+    });
+    if !(a.is_all_finite() && b.is_all_finite()) {
+        return Err(Error::InvalidValue {
+            arg: "dt",
+            value: dt,
+            requirement: "large enough that A / dt and B / dt are finite",
+        });
+    }
+    Ok((a, b))
+}
+
+/// The largest relative residual ||e^(log M) - M||_max / ||M||_max that [`undiscretize_zoh`]
+/// accepts.
+const LOGARITHM_RESIDUAL: f64 = 1e-8;
+
+/// θ_8: for ||X||_1 <= θ_8 the [8/8] Padé approximant of log(I + X) errs by less than u = 2^-53
+/// (Kenney & Laub's bound |r_8(-||X||) - log(1 - ||X||)|, evaluated at 50 digits; Higham 2008,
+/// Table 11.1 gives 3.40e-1).
+const LOG_PADE_THETA: f64 = 0.340_217_233_198_529_9;
+
+/// The nodes of 8-point Gauss–Legendre quadrature on [0, 1] (computed at 40 digits).
+const LOG_PADE_NODES: [f64; 8] = [
+    0.019_855_071_751_231_884,
+    0.101_666_761_293_186_64,
+    0.237_233_795_041_835_5,
+    0.408_282_678_752_175_1,
+    0.591_717_321_247_825,
+    0.762_766_204_958_164_5,
+    0.898_333_238_706_813_4,
+    0.980_144_928_248_768_1,
+];
+
+/// The weights of 8-point Gauss–Legendre quadrature on [0, 1].
+const LOG_PADE_WEIGHTS: [f64; 8] = [
+    0.050_614_268_145_188_13,
+    0.111_190_517_226_687_24,
+    0.156_853_322_938_943_63,
+    0.181_341_891_689_181,
+    0.181_341_891_689_181,
+    0.156_853_322_938_943_63,
+    0.111_190_517_226_687_24,
+    0.050_614_268_145_188_13,
+];
+
+/// The square roots [`real_logarithm`] takes at most: each halves the argument of the
+/// eigenvalues and takes their moduli towards 1, so ||T^(1/2^s) - I|| falls below θ_8 within
+/// about log2(|log λ|max / θ_8) roots; more means the iteration is going nowhere.
+const MAX_SQUARE_ROOTS: u32 = 100;
+
+/// A diagonal block of a quasi-triangular matrix: 1 x 1 (a real eigenvalue) or 2 x 2 in
+/// standard form (a complex pair θ ± iμ).
+#[derive(Debug, Clone, Copy)]
+struct DiagonalBlock {
+    start: usize,
+    size: usize,
+    /// θ, the real part of the eigenvalue(s).
+    theta: f64,
+    /// μ > 0 for a complex pair, 0 for a real eigenvalue.
+    mu: f64,
+}
+
+fn diagonal_blocks(t: MatRef<'_, f64>) -> Vec<DiagonalBlock> {
+    let n = t.nrows();
+    let mut blocks = Vec::new();
+    let mut k = 0;
+    while k < n {
+        if k + 1 < n && t[(k + 1, k)] != 0.0 {
+            let (theta, mu) = pair_of(t, k);
+            blocks.push(DiagonalBlock {
+                start: k,
+                size: 2,
+                theta,
+                mu,
+            });
+            k += 2;
+        } else {
+            blocks.push(DiagonalBlock {
+                start: k,
+                size: 1,
+                theta: t[(k, k)],
+                mu: 0.0,
+            });
+            k += 1;
+        }
+    }
+    blocks
+}
+
+/// ln |θ + iμ|, accurate relative to its (small) size when the modulus is near 1.
+fn log_modulus(theta: f64, mu: f64) -> f64 {
+    let modulus = theta.hypot(mu);
+    if (0.5..=2.0).contains(&modulus) {
+        0.5 * ((theta - 1.0) * (theta + 1.0) + mu * mu).ln_1p()
+    } else {
+        modulus.ln()
+    }
+}
+
+/// The principal square root of the quasi-triangular T by the block recurrence of Higham
+/// (1987): R_jj = sqrt(T_jj) on the diagonal blocks, then R_ii R_ij + R_ij R_jj = T_ij -
+/// Σ_k R_ik R_kj (a Sylvester equation of order <= 4) up each block column. Every eigenvalue of
+/// R has a positive real part, so the Sylvester equations are nonsingular.
+fn quasi_triangular_sqrt(t: MatRef<'_, f64>, blocks: &[DiagonalBlock]) -> Result<Mat<f64>, Error> {
+    let n = t.nrows();
+    let mut r = Mat::<f64>::zeros(n, n);
+    for (column, &diagonal) in blocks.iter().enumerate() {
+        let DiagonalBlock {
+            start: j0, size: q, ..
+        } = diagonal;
+        if q == 1 {
+            r[(j0, j0)] = t[(j0, j0)].sqrt();
+        } else {
+            // T_jj = θ I + N with N^2 = -μ^2 I; sqrt(θ + iμ) = α + iβ with α > 0 gives
+            // R_jj = α I + N / (2α) (R_jj^2 = (α^2 - μ^2/(4α^2)) I + N = T_jj).
+            let (theta, mu) = pair_of(t, j0);
+            let modulus = theta.hypot(mu);
+            let alpha = if theta >= 0.0 {
+                ((theta + modulus) / 2.0).sqrt()
+            } else {
+                mu / (2.0 * (modulus - theta)).sqrt()
+            };
+            for i in 0..2 {
+                for j in 0..2 {
+                    let identity = if i == j { theta } else { 0.0 };
+                    r[(j0 + i, j0 + j)] = (t[(j0 + i, j0 + j)] - identity) / (2.0 * alpha)
+                        + if i == j { alpha } else { 0.0 };
+                }
+            }
+        }
+        for &row_block in blocks[..column].iter().rev() {
+            let DiagonalBlock {
+                start: i0, size: p, ..
+            } = row_block;
+            let mut rhs = [[0.0; 2]; 2];
+            for (a, rhs_row) in rhs.iter_mut().enumerate().take(p) {
+                for (b, value) in rhs_row.iter_mut().enumerate().take(q) {
+                    let mut sum = t[(i0 + a, j0 + b)];
+                    for k in i0 + p..j0 {
+                        sum -= r[(i0 + a, k)] * r[(k, j0 + b)];
+                    }
+                    *value = sum;
+                }
+            }
+            let small = |start: usize, size: usize| {
+                let mut m = [[0.0; 2]; 2];
+                for (a, row) in m.iter_mut().enumerate().take(size) {
+                    for (b, value) in row.iter_mut().enumerate().take(size) {
+                        *value = r[(start + a, start + b)];
+                    }
+                }
+                m
+            };
+            let solution = solve_small_sylvester(&small(i0, p), p, &small(j0, q), q, &rhs);
+            if solution.perturbed {
+                return Err(Error::IllConditioned {
+                    message: "the square root of the Schur form met a nearly singular Sylvester \
+                              equation: A has eigenvalues too near 0 for a logarithm"
+                        .to_string(),
+                });
+            }
+            for a in 0..p {
+                for b in 0..q {
+                    r[(i0 + a, j0 + b)] = solution.x[a][b];
+                }
+            }
+        }
+    }
+    Ok(r)
+}
+
+/// (θ, μ) of the complex pair θ ± iμ of the 2 x 2 block [[a, b], [c, d]] of T at `k`:
+/// θ = (a + d)/2, μ^2 = -((a - d)^2/4 + b c).
+fn pair_of(t: MatRef<'_, f64>, k: usize) -> (f64, f64) {
+    let (a, b, c, d) = (t[(k, k)], t[(k, k + 1)], t[(k + 1, k)], t[(k + 1, k + 1)]);
+    let half_difference = (a - d) / 2.0;
+    let mu = (-(half_difference * half_difference + b * c))
+        .max(0.0)
+        .sqrt();
+    ((a + d) / 2.0, mu)
+}
+
+/// Writes into `out` (at the block's place) the diagonal block of T^(1/2^s) - I, from the
+/// eigenvalues of the block of the original T (`original`, with its N = T_jj - θ I):
+/// λ^(1/2^s) - 1 = expm1(ln λ / 2^s) for a real λ > 0, and for a pair
+/// e^ρ (cos ψ I + sin ψ N / μ) - I with ρ = ln|λ| / 2^s, ψ = arg λ / 2^s.
+fn root_minus_identity(t: MatRef<'_, f64>, block: DiagonalBlock, s: u32, out: &mut Mat<f64>) {
+    let scale = (-f64::from(s)).exp2();
+    let k = block.start;
+    if block.size == 1 {
+        out[(k, k)] = (t[(k, k)].ln() * scale).exp_m1();
+        return;
+    }
+    let (rho, psi) = (
+        log_modulus(block.theta, block.mu) * scale,
+        block.mu.atan2(block.theta) * scale,
+    );
+    let half_sine = (psi / 2.0).sin();
+    let diagonal = rho.exp_m1() * psi.cos() - 2.0 * half_sine * half_sine;
+    let off = rho.exp() * psi.sin() / block.mu;
+    for i in 0..2 {
+        for j in 0..2 {
+            out[(k + i, k + j)] = if i == j {
+                diagonal + off * (t[(k + i, k + i)] - block.theta)
+            } else {
+                off * t[(k + i, k + j)]
+            };
+        }
+    }
+}
+
+/// Writes into `out` the diagonal block of log T: ln λ for a real λ, and
+/// ln|λ| I + (arg λ / μ) N for a pair.
+fn block_logarithm(t: MatRef<'_, f64>, block: DiagonalBlock, out: &mut Mat<f64>) {
+    let k = block.start;
+    if block.size == 1 {
+        out[(k, k)] = t[(k, k)].ln();
+        return;
+    }
+    let (log_modulus, angle) = (
+        log_modulus(block.theta, block.mu),
+        block.mu.atan2(block.theta) / block.mu,
+    );
+    for i in 0..2 {
+        for j in 0..2 {
+            out[(k + i, k + j)] = if i == j {
+                log_modulus + angle * (t[(k + i, k + i)] - block.theta)
+            } else {
+                angle * t[(k + i, k + j)]
+            };
+        }
+    }
+}
+
+/// The principal logarithm of a real square matrix, real when no eigenvalue lies on the closed
+/// negative real axis (else an error naming the eigenvalue): inverse scaling and squaring on
+/// the real Schur form (see the module docs).
+fn real_logarithm(m: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+    let n = m.nrows();
+    let schur = real_schur(m)?;
+    let t = schur.t;
+    let blocks = diagonal_blocks(t.as_ref());
+    if let Some(block) = blocks.iter().find(|b| b.size == 1 && b.theta <= 0.0) {
+        return Err(Error::InvalidArgument {
+            arg: "A",
+            message: format!(
+                "A has the eigenvalue {} on the closed negative real axis: it has no real \
+                 logarithm, so no real continuous model has these zero-order-hold samples",
+                block.theta
+            ),
+        });
+    }
+    // X = T^(1/2^s) - I: off the diagonal blocks from the computed roots, on them from the
+    // closed forms.
+    let mut root = t.clone();
+    let mut roots = 0u32;
+    let mut x = Mat::<f64>::zeros(n, n);
+    loop {
+        x.copy_from(&root);
+        for &block in &blocks {
+            root_minus_identity(t.as_ref(), block, roots, &mut x);
+        }
+        if one_norm(x.as_ref()) <= LOG_PADE_THETA {
+            break;
+        }
+        if roots == MAX_SQUARE_ROOTS {
+            return Err(Error::NoConvergence {
+                algorithm: "the square roots of the matrix logarithm",
+            });
+        }
+        root = quasi_triangular_sqrt(root.as_ref(), &blocks)?;
+        roots += 1;
+    }
+    // log(I + X) = Σ_k w_k X (I + t_k X)^-1 = Σ_k w_k (I + t_k X)^-1 X (the factors commute).
+    let identity = Mat::<f64>::identity(n, n);
+    let mut logarithm = Mat::<f64>::zeros(n, n);
+    for (&node, &weight) in LOG_PADE_NODES.iter().zip(&LOG_PADE_WEIGHTS) {
+        let shifted = &identity + faer::Scale(node) * &x;
+        let term = shifted.partial_piv_lu().solve(&x);
+        logarithm += faer::Scale(weight) * term;
+    }
+    logarithm *= faer::Scale(f64::from(roots).exp2());
+    for &block in &blocks {
+        block_logarithm(t.as_ref(), block, &mut logarithm);
+    }
+    Ok(&schur.z * logarithm * schur.z.transpose())
 }
 
 #[cfg(test)]
@@ -254,6 +752,176 @@ mod tests {
         )
         .unwrap_err();
         assert!(matches!(err, Error::InvalidValue { arg: "dt", .. }));
+    }
+
+    /// A seeded random matrix with entries in [-1, 1).
+    fn random(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
+        let mut state = seed;
+        Mat::from_fn(rows, cols, |_, _| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        })
+    }
+
+    fn relative_difference(x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> f64 {
+        (x - y).norm_max() / y.norm_max().max(f64::MIN_POSITIVE)
+    }
+
+    #[test]
+    fn tustin_of_a_first_order_lag() {
+        // x' = -a x + u, y = x: Tustin gives Ad = (1 - ah/2) / (1 + ah/2), Bd = h / (1 + ah/2),
+        // Cd = 1 / (1 + ah/2), Dd = (h/2) / (1 + ah/2) (scipy's realization).
+        let (a, h) = (3.0, 0.1);
+        let model = bilinear(
+            mat![[-a]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[0.0]].as_ref(),
+            h,
+            0.5,
+        )
+        .unwrap();
+        let denominator = 1.0 + a * h / 2.0;
+        assert!((model.a[(0, 0)] - (1.0 - a * h / 2.0) / denominator).abs() < 1e-16);
+        assert!((model.b[(0, 0)] - h / denominator).abs() < 1e-16);
+        assert!((model.c[(0, 0)] - 1.0 / denominator).abs() < 1e-16);
+        assert!((model.d[(0, 0)] - h / 2.0 / denominator).abs() < 1e-16);
+    }
+
+    #[test]
+    fn inverse_bilinear_undoes_bilinear() {
+        for (n, seed) in [(1usize, 1u64), (4, 2), (9, 3)] {
+            let a = random(n, n, seed) - Mat::<f64>::identity(n, n);
+            let (b, c, d) = (
+                random(n, 2, seed + 10),
+                random(3, n, seed + 20),
+                random(3, 2, 7),
+            );
+            for alpha in [0.0, 0.3, 0.5, 1.0] {
+                let h = 0.05;
+                let discrete =
+                    bilinear(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), h, alpha).unwrap();
+                let back = inverse_bilinear(
+                    discrete.a.as_ref(),
+                    discrete.b.as_ref(),
+                    discrete.c.as_ref(),
+                    discrete.d.as_ref(),
+                    h,
+                    alpha,
+                )
+                .unwrap();
+                for (x, y) in [(&back.a, &a), (&back.b, &b), (&back.c, &c), (&back.d, &d)] {
+                    let error = relative_difference(x.as_ref(), y.as_ref());
+                    assert!(error < 1e-12, "n={n} alpha={alpha}: {error}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bilinear_refuses_a_pole_sent_to_infinity() {
+        // A = 2/h: Tustin maps s = 2/h to z = infinity.
+        let h = 0.5;
+        let err = bilinear(
+            mat![[2.0 / h]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[0.0]].as_ref(),
+            h,
+            0.5,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(err, Error::InvalidArgument { arg: "dt", .. }),
+            "{err}"
+        );
+        let err = inverse_bilinear(
+            mat![[-1.0]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[0.0]].as_ref(),
+            h,
+            0.5,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(err, Error::InvalidArgument { arg: "A", .. }),
+            "{err}"
+        );
+        let err = bilinear(
+            mat![[1.0]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[0.0]].as_ref(),
+            h,
+            1.5,
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::InvalidValue { arg: "alpha", .. }));
+    }
+
+    #[test]
+    fn logarithm_of_the_zero_order_hold_recovers_a_and_b() {
+        // The 747's longitudinal model (an oscillatory pair, a real mode) and random models,
+        // including a singular A (an integrator), over steps of different sizes.
+        let lon = mat![
+            [-0.0212, 0.0466, 0.0, -0.1153],
+            [-0.2229, -0.5839, 0.9404, 0.0],
+            [0.0150, -0.5031, -0.5015, 0.0],
+            [0.0, 0.0, 1.0, 0.0]
+        ];
+        let lon_b = mat![[0.0], [-0.0340], [-0.5746], [0.0]];
+        let singular = mat![[-3.0, 8.0], [0.0, 0.0]];
+        let singular_b = mat![[0.0], [4.0]];
+        let mut cases = vec![(lon, lon_b), (singular, singular_b)];
+        for (n, seed) in [(3usize, 4u64), (6, 5), (10, 6)] {
+            cases.push((random(n, n, seed), random(n, 2, seed + 1)));
+        }
+        for (a, b) in &cases {
+            for h in [0.01, 0.3, 2.0] {
+                let d = discretize(a.as_ref(), b.as_ref(), h, Hold::Zero).unwrap();
+                let (a_back, b_back) =
+                    undiscretize_zoh(d.phi.as_ref(), d.gamma0.as_ref(), h).unwrap();
+                let error_a = relative_difference(a_back.as_ref(), a.as_ref());
+                let error_b = relative_difference(b_back.as_ref(), b.as_ref());
+                assert!(
+                    error_a < 1e-11 && error_b < 1e-11,
+                    "h={h}: {error_a} {error_b}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn logarithm_of_a_rotation_and_of_a_large_spread() {
+        // Φ a rotation by 3 rad (near the negative axis, still principal) and eigenvalues from
+        // 1e-8 to 1e3: log Φ is known in closed form.
+        let angle = 3.0f64;
+        let phi = mat![[angle.cos(), -angle.sin()], [angle.sin(), angle.cos()]];
+        let gamma = Mat::<f64>::zeros(2, 0);
+        let (a, _) = undiscretize_zoh(phi.as_ref(), gamma.as_ref(), 1.0).unwrap();
+        let expected = mat![[0.0, -angle], [angle, 0.0]];
+        assert!(relative_difference(a.as_ref(), expected.as_ref()) < 1e-14);
+        let phi = mat![[1e-8, 1.0, 0.0], [0.0, 1.0, 1.0], [0.0, 0.0, 1e3]];
+        let (a, _) = undiscretize_zoh(phi.as_ref(), Mat::<f64>::zeros(3, 0).as_ref(), 1.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let back = expm(a.as_ref()).unwrap();
+        assert!(relative_difference(back.as_ref(), phi.as_ref()) < 1e-12);
+        assert!((a[(0, 0)] - 1e-8f64.ln()).abs() < 1e-14 * 1e-8f64.ln().abs());
+    }
+
+    #[test]
+    fn no_real_logarithm_is_refused() {
+        let gamma = mat![[1.0], [0.0]];
+        for phi in [mat![[-0.5, 0.0], [0.0, 0.9]], mat![[0.0, 1.0], [0.0, 0.5]]] {
+            let err = undiscretize_zoh(phi.as_ref(), gamma.as_ref(), 0.1).unwrap_err();
+            assert!(
+                err.to_string().contains("closed negative real axis"),
+                "{err}"
+            );
+        }
     }
 
     #[test]

@@ -15,9 +15,15 @@
 //!
 //! A frequency at an eigenvalue of A on the imaginary axis (a pole of G) gives infinite or NaN
 //! entries, never an error: the caller decides how to report them.
+//!
+//! A discrete model x[k+1] = A x[k] + B η[k] sampled every h seconds has the frequency response
+//! G(e^{jωh}) = C (e^{jωh} I - A)^-1 B + D ([`discrete_frequency_response_into`]): the same
+//! kernel at the point z = cos ωh + j sin ωh of the unit circle instead of jω, periodic in ω
+//! with period 2π/h (a pole on the unit circle gives infinite or NaN entries likewise).
 
 use crate::error::{
-    Error, check_finite, check_finite_values, check_output_len, check_rows, check_square,
+    Error, check_finite, check_finite_values, check_output_len, check_positive, check_rows,
+    check_square,
 };
 use crate::linalg::hessenberg::{Hessenberg, hessenberg};
 use crate::platform::dispatch::{fma_dispatch, multiply_add};
@@ -114,26 +120,31 @@ fn complex_dot<const FMA: bool>(ur: &[f64], ui: &[f64], vr: &[f64], vi: &[f64]) 
     (sum_re, sum_im)
 }
 
-/// G(jω) into `g` (p x m row-major): fill jωI - H, eliminate its subdiagonal with pivoting
-/// between the two rows involved, back-substitute each right-hand side, and form C Q X + D.
+/// G(s) into `g` (p x m row-major) at the complex point s (jω, or e^{jωh} for a discrete
+/// model): fill sI - H, eliminate its subdiagonal with pivoting between the two rows
+/// involved, back-substitute each right-hand side, and form C Q X + D.
 #[inline(always)]
 fn evaluate_kernel<const FMA: bool>(
     model: &HessenbergModel,
-    omega: f64,
+    point: c64,
     ws: &mut Workspace,
     g: &mut [c64],
 ) {
     let (n, m, p) = (model.n, model.m, model.p);
     let Workspace { re, im, x_re, x_im } = ws;
-    // jωI - H; entries left of the subdiagonal are never read.
+    // sI - H; entries left of the subdiagonal are never read. A zero real part (s = jω) is not
+    // added, so that -h keeps its sign of zero.
     for i in 0..n {
         let start = i * n + i.saturating_sub(1);
         let end = (i + 1) * n;
         for (r, &h) in re[start..end].iter_mut().zip(&model.h[start..end]) {
             *r = -h;
         }
+        if point.re != 0.0 {
+            re[i * n + i] += point.re;
+        }
         im[start..end].fill(0.0);
-        im[i * n + i] = omega;
+        im[i * n + i] = point.im;
     }
     x_re.copy_from_slice(&model.b);
     x_im.fill(0.0);
@@ -217,7 +228,7 @@ fn evaluate_kernel<const FMA: bool>(
     }
 }
 
-fma_dispatch!(fn evaluate_frequency(model: &HessenbergModel, omega: f64, ws: &mut Workspace, g: &mut [c64]) => evaluate_kernel);
+fma_dispatch!(fn evaluate_frequency(model: &HessenbergModel, point: c64, ws: &mut Workspace, g: &mut [c64]) => evaluate_kernel);
 
 /// Writes G(jω_k) = C (jω_k I - A)^-1 B + D for every ω_k into `out`, a row-major
 /// len(omega) x p x m stack.
@@ -227,6 +238,54 @@ pub fn frequency_response_into(
     c: MatRef<'_, f64>,
     d: MatRef<'_, f64>,
     omega: &[f64],
+    out: &mut [c64],
+) -> Result<(), Error> {
+    transfer_function_into(a, b, c, d, omega, |w| c64::new(0.0, w), out)
+}
+
+/// Writes G(e^{jω_k dt}) = C (e^{jω_k dt} I - A)^-1 B + D for every ω_k into `out`, a
+/// row-major len(omega) x p x m stack: the frequency response of the discrete model
+/// x[k+1] = A x[k] + B η[k], y[k] = C x[k] + D η[k] sampled every `dt`.
+pub fn discrete_frequency_response_into(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    d: MatRef<'_, f64>,
+    omega: &[f64],
+    dt: f64,
+    out: &mut [c64],
+) -> Result<(), Error> {
+    check_positive(dt, "dt")?;
+    check_finite_values(omega, "omega")?;
+    if let Some(k) = omega.iter().position(|w| !(w * dt).is_finite()) {
+        return Err(Error::InvalidValue {
+            arg: "omega",
+            value: omega[k],
+            requirement: "small enough that omega dt is finite",
+        });
+    }
+    transfer_function_into(
+        a,
+        b,
+        c,
+        d,
+        omega,
+        |w| {
+            let (sine, cosine) = (w * dt).sin_cos();
+            c64::new(cosine, sine)
+        },
+        out,
+    )
+}
+
+/// G(s_k) = C (s_k I - A)^-1 B + D at the points s_k = point(ω_k), into `out`.
+fn transfer_function_into(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    d: MatRef<'_, f64>,
+    omega: &[f64],
+    point: impl Fn(f64) -> c64 + Sync,
     out: &mut [c64],
 ) -> Result<(), Error> {
     check_state_space(a, b, c, d)?;
@@ -269,7 +328,7 @@ pub fn frequency_response_into(
         .with_min_len(32)
         .try_for_each_init(workspace, |ws, (&w, g)| {
             context.run(|| {
-                evaluate_frequency(&model, w, ws, g);
+                evaluate_frequency(&model, point(w), ws, g);
                 Ok(())
             })
         })
@@ -348,6 +407,76 @@ mod tests {
         let value = g[0][(0, 0)];
         assert!((value.norm() - 1.0 / 8f64.sqrt()).abs() < 1e-16);
         assert!((value.arg().to_degrees() + 45.0).abs() < 1e-13);
+    }
+
+    #[test]
+    fn discrete_response_is_taken_on_the_unit_circle() {
+        // G(z) at z = e^{jωh} against a dense solve at that point, and the discrete first-order
+        // lag 1 / (z - a) by hand.
+        let n = 5;
+        let mut state = 11u64;
+        let a = Mat::from_fn(n, n, |_, _| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        });
+        let b = Mat::from_fn(n, 2, |i, j| (i + 2 * j) as f64 / n as f64 - 0.5);
+        let c = Mat::from_fn(2, n, |i, j| ((i * j) % 3) as f64 - 1.0);
+        let d = Mat::from_fn(2, 2, |i, j| (i + j) as f64);
+        let h = 0.05;
+        let omega = [0.0, 1.0, 30.0, std::f64::consts::PI / h, 200.0];
+        let mut out = vec![c64::new(0.0, 0.0); omega.len() * 4];
+        discrete_frequency_response_into(
+            a.as_ref(),
+            b.as_ref(),
+            c.as_ref(),
+            d.as_ref(),
+            &omega,
+            h,
+            &mut out,
+        )
+        .unwrap();
+        for (k, &w) in omega.iter().enumerate() {
+            let z = c64::new((w * h).cos(), (w * h).sin());
+            let shifted = Mat::from_fn(n, n, |i, j| {
+                c64::new(
+                    if i == j { z.re } else { 0.0 } - a[(i, j)],
+                    if i == j { z.im } else { 0.0 },
+                )
+            });
+            let rhs = Mat::from_fn(n, 2, |i, j| c64::new(b[(i, j)], 0.0));
+            let x = shifted.partial_piv_lu().solve(&rhs);
+            let cc = Mat::from_fn(2, n, |i, j| c64::new(c[(i, j)], 0.0));
+            let dd = Mat::from_fn(2, 2, |i, j| c64::new(d[(i, j)], 0.0));
+            let expected = cc * x + dd;
+            let got = Mat::from_fn(2, 2, |i, j| out[k * 4 + i * 2 + j]);
+            let err = (&got - &expected).norm_l2() / expected.norm_l2();
+            assert!(err < 1e-13, "w={w}: {err}");
+        }
+        let mut lag = [c64::new(0.0, 0.0)];
+        discrete_frequency_response_into(
+            mat![[0.5]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[0.0]].as_ref(),
+            &[0.0],
+            h,
+            &mut lag,
+        )
+        .unwrap();
+        assert!((lag[0] - c64::new(2.0, 0.0)).norm() < 1e-15);
+        let err = discrete_frequency_response_into(
+            mat![[0.5]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[0.0]].as_ref(),
+            &[0.0],
+            -1.0,
+            &mut lag,
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::InvalidValue { arg: "dt", .. }));
     }
 
     #[test]

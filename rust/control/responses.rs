@@ -16,6 +16,9 @@
 //! Several responses of one model (initial conditions or input histories) run in parallel after
 //! one discretisation; the outputs are written into caller-provided row-major buffers, so a
 //! 5001-sample response allocates nothing per step.
+//!
+//! A discrete model ([`Sampling::Discrete`]) is its own recurrence: x[k+1] = A x[k] + B η[k],
+//! y[k] = C x[k] + D η[k], with Φ = A and Γ0 = B and nothing to discretise.
 
 use crate::control::discretize::{Discretization, Hold, discretize};
 use crate::control::frequency::check_state_space;
@@ -239,6 +242,16 @@ pub struct Model<'a> {
     pub d: MatRef<'a, f64>,
 }
 
+/// How the samples of a response follow from the model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sampling {
+    /// A continuous model x' = Ax + Bη sampled every `dt`, the input reconstructed between
+    /// samples by `hold`.
+    Continuous { dt: f64, hold: Hold },
+    /// A discrete model x[k+1] = A x[k] + B η[k]: one sample per step of the recurrence.
+    Discrete,
+}
+
 /// Simulates one response per row of `x0` (responses x n initial states) of one model over
 /// `steps` samples of step `dt`, with the input and the hold between input samples. Writes the
 /// states into `x` (responses x steps x n) and the outputs into `y` (responses x steps x p),
@@ -251,6 +264,20 @@ pub fn simulate_into(
     dt: f64,
     steps: usize,
     hold: Hold,
+    x: &mut [f64],
+    y: &mut [f64],
+) -> Result<(), Error> {
+    let sampling = Sampling::Continuous { dt, hold };
+    simulate_sampled_into(model, x0, input, sampling, steps, x, y)
+}
+
+/// [`simulate_into`] for a continuous or a discrete model ([`Sampling`]).
+pub fn simulate_sampled_into(
+    model: Model<'_>,
+    x0: MatRef<'_, f64>,
+    input: Input<'_>,
+    sampling: Sampling,
+    steps: usize,
     x: &mut [f64],
     y: &mut [f64],
 ) -> Result<(), Error> {
@@ -297,12 +324,21 @@ pub fn simulate_into(
     }
     check_output_len(x.len(), responses * steps * n)?;
     check_output_len(y.len(), responses * steps * p)?;
-    check_positive(dt, "dt")?;
+    if let Sampling::Continuous { dt, .. } = sampling {
+        check_positive(dt, "dt")?;
+    }
     if x.is_empty() && y.is_empty() {
         // Nothing to compute (no samples, or neither states nor outputs), however many steps.
         return Ok(());
     }
-    let discretization = discretize(a, b, dt, hold)?;
+    let discretization = match sampling {
+        Sampling::Continuous { dt, hold } => discretize(a, b, dt, hold)?,
+        Sampling::Discrete => Discretization {
+            phi: a.to_owned(),
+            gamma0: b.to_owned(),
+            gamma1: None,
+        },
+    };
     let recurrence = Recurrence::new(&discretization, c, d);
     let no_input: &[f64] = &[];
     // The outputs of a response of order OUTPUT_PRODUCT_MIN_ORDER or more are one product of
@@ -349,6 +385,20 @@ pub fn simulate_models_into(
     dt: f64,
     steps: usize,
     hold: Hold,
+    x: &mut [f64],
+    y: &mut [f64],
+) -> Result<(), Error> {
+    let sampling = Sampling::Continuous { dt, hold };
+    simulate_models_sampled_into(models, x0, input, sampling, steps, x, y)
+}
+
+/// [`simulate_models_into`] for continuous or discrete models ([`Sampling`]).
+pub fn simulate_models_sampled_into(
+    models: &[Model<'_>],
+    x0: MatRef<'_, f64>,
+    input: Input<'_>,
+    sampling: Sampling,
+    steps: usize,
     x: &mut [f64],
     y: &mut [f64],
 ) -> Result<(), Error> {
@@ -406,13 +456,12 @@ pub fn simulate_models_into(
             };
             context
                 .run(|| {
-                    simulate_into(
+                    simulate_sampled_into(
                         models[i],
                         x0.subrows(i, 1),
                         input_i,
-                        dt,
+                        sampling,
                         steps,
-                        hold,
                         x_i,
                         y_i,
                     )
@@ -520,6 +569,58 @@ mod tests {
             ],
             mat![[0.0000], [-0.0340], [-0.5746], [0.0000]],
         )
+    }
+
+    #[test]
+    fn discrete_models_step_their_own_recurrence() {
+        // x[k+1] = A x[k] + B u[k], y[k] = C x[k] + D u[k], by hand, for sampled inputs and a
+        // constant input, one model and a stack of two.
+        let a = mat![[0.9, 0.2], [-0.1, 0.7]];
+        let b = mat![[0.0], [1.0]];
+        let c = mat![[1.0, -1.0]];
+        let d = mat![[0.5]];
+        let steps = 6;
+        let u: Vec<f64> = (0..steps).map(|k| (k as f64).sin()).collect();
+        let (mut x, mut y) = (vec![0.0; steps * 2], vec![0.0; steps]);
+        let x0 = [1.0, -2.0];
+        simulate_sampled_into(
+            model(&a, &b, &c, &d),
+            states(&x0, 2),
+            Input::Sampled(&u),
+            Sampling::Discrete,
+            steps,
+            &mut x,
+            &mut y,
+        )
+        .unwrap();
+        let mut state = x0;
+        for k in 0..steps {
+            assert_eq!(&x[2 * k..2 * k + 2], &state);
+            let output = state[0] - state[1] + 0.5 * u[k];
+            assert!((y[k] - output).abs() < 1e-15);
+            state = [
+                0.9 * state[0] + 0.2 * state[1],
+                -0.1 * state[0] + 0.7 * state[1] + u[k],
+            ];
+        }
+        let models = [model(&a, &b, &c, &d), model(&a, &b, &c, &d)];
+        let (mut xs, mut ys) = (vec![0.0; 2 * steps * 2], vec![0.0; 2 * steps]);
+        simulate_models_sampled_into(
+            &models,
+            states(&[0.0; 4], 2),
+            Input::Constant(&[1.0, 2.0]),
+            Sampling::Discrete,
+            steps,
+            &mut xs,
+            &mut ys,
+        )
+        .unwrap();
+        // The step of the second model is twice the first's; x[1] = B, y[0] = D.
+        assert_eq!(&xs[2..4], &[0.0, 1.0]);
+        assert_eq!(ys[0], 0.5);
+        for k in 0..steps {
+            assert!((ys[steps + k] - 2.0 * ys[k]).abs() < 1e-14);
+        }
     }
 
     #[test]

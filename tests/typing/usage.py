@@ -65,6 +65,23 @@ assert_type(d.Phi, Floats)
 if d.Gamma1 is not None:
     x_next = d.Phi @ np.zeros(4) + (d.Gamma0 - d.Gamma1) @ [0.0] + d.Gamma1 @ [np.pi / 180]
 assert_type(aerocontrol.discretize([[-3.0, 8.0], [0.0, 0.0]], (0.0, 4.0), 0.1).Gamma0, Floats)
+sampled = aerocontrol.c2d(sys, 0.05)
+assert_type(sampled, aerocontrol.StateSpace)
+assert_type(sampled.dt, float | None)
+assert_type(sampled.is_discrete, bool)
+assert_type(aerocontrol.c2d((A, B), 0.05, "tustin", prewarp=1.0).A, Floats)
+assert_type(aerocontrol.c2d(small, 0.1, "matched").dt, float | None)
+assert_type(
+    aerocontrol.c2d(Foreign(A, B, np.eye(4), np.zeros((4, 1))), 0.1, "gbt", alpha=0.3),
+    aerocontrol.StateSpace,
+)
+assert_type(aerocontrol.d2c(sampled).B, Floats)
+assert_type(
+    aerocontrol.d2c(aerocontrol.StateSpace([[0.5]], [1.0], dt=0.1), "tustin"),
+    aerocontrol.StateSpace,
+)
+assert_type(aerocontrol.step_response(sampled, T=np.arange(10) * 0.05).y, Floats)
+assert_type(aerocontrol.frequency_response(sampled, [0.1, 1.0]).response, Complexes)
 T, Q, w = aerocontrol.schur([[1.0, 2.0, 0.0], [0.0, -1.0, 3.0], [0.0, 0.0, 2.0]], "lhp")
 assert_type(w, Complexes)
 assert_type(aerocontrol.schur(A, lambda z: abs(z) < 1.0)[0], Floats)
