@@ -696,3 +696,20 @@ def test_inputs_are_not_modified() -> None:
         assert np.array_equal(array, copy)
     assert A.flags.f_contiguous
     assert not sys.A.flags.writeable and sys.dt is None
+
+
+def test_continuous_designs_refuse_a_discrete_system() -> None:
+    # lqr on a sampled model would solve the continuous problem for its matrices, silently.
+    A, B = aerocontrol.chapter.boeing747_lateral()
+    sampled = aerocontrol.c2d(aerocontrol.StateSpace(A, B), 0.02)
+    Q, R = np.eye(4), np.eye(2)
+    for call in (
+        lambda: aerocontrol.lqr(sampled, Q, R),
+        lambda: aerocontrol.riccati_ode(sampled, Q, R, np.linspace(0, 1, 3)),
+        lambda: aerocontrol.batch.lqr_sweep(sampled, Q=Q, R=R, weights=[1.0]),
+        lambda: aerocontrol.augment_mode(sampled, 1, zeta=0.3),
+    ):
+        with pytest.raises(InvalidArgumentError, match="discrete"):
+            call()
+    _, _, poles = aerocontrol.dlqr(sampled, Q, R)
+    assert np.all(np.abs(poles) < 1)

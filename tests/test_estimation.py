@@ -347,12 +347,14 @@ def test_kalman_discrete_names_both_gains() -> None:
     with pytest.raises(AttributeError, match=r"filter_gain .* predictor_gain"):
         _ = kf.gain
     assert "dt=0.02" in repr(kf)
-    # A python-control model brings its dt; True is discrete with an unknown period.
-    for dt, expected in ((0.02, 0.02), (True, None)):
-        sys = control.ss(plant.Phi, plant.Gamma0, C_PRP, 0, dt=dt)
-        other = aerocontrol.kalman(sys, QN, RN)
-        assert other.discrete and other.dt == expected
-        np.testing.assert_array_equal(other.predictor_gain, kf.predictor_gain)
+    # A python-control model brings its dt; True (discrete, period unknown) is refused by
+    # name, as every aerocontrol model needs its sampling period.
+    sys = control.ss(plant.Phi, plant.Gamma0, C_PRP, 0, dt=0.02)
+    other = aerocontrol.kalman(sys, QN, RN)
+    assert other.discrete and other.dt == 0.02
+    np.testing.assert_array_equal(other.predictor_gain, kf.predictor_gain)
+    with pytest.raises(InvalidArgumentError, match="dt=True"):
+        aerocontrol.kalman(control.ss(plant.Phi, plant.Gamma0, C_PRP, 0, dt=True), QN, RN)
 
 
 def test_the_discrete_estimator_tracks_the_plant() -> None:

@@ -30,7 +30,7 @@ from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
 from .placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
 from .riccati import RCOND_WARNING, RESIDUAL_WARNING
-from .statespace import as_state_space, is_system
+from .statespace import as_state_space, is_system, require_continuous
 
 if TYPE_CHECKING:
     from ._typing import SystemObject
@@ -265,6 +265,7 @@ def lqr_sweep(
         if B is not None:
             raise InvalidArgumentError("lqr_sweep(sys, Q=..., R=..., weights=...) takes no B")
         sys = as_state_space(sys_or_A)
+        require_continuous(sys, "lqr_sweep", "a discrete sweep is not available yet")
         A_matrix, B_matrix = sys.A, sys.B
     else:
         if B is None:

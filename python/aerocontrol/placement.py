@@ -31,7 +31,7 @@ from . import _core
 from ._validation import FloatArray, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
 from .modal import Modes, modes
-from .statespace import StateSpace, as_state_space, is_system, plant_pair
+from .statespace import StateSpace, as_state_space, is_system, plant_pair, require_continuous
 
 if TYPE_CHECKING:
     from ._typing import ModeKey, System
@@ -297,10 +297,14 @@ def augment_mode(
 
 
 def _plant_matrix(sys_or_A: ArrayLike | System) -> FloatArray:
-    if isinstance(sys_or_A, (StateSpace, tuple, list)) and not _is_matrix(sys_or_A):
-        return as_state_space(sys_or_A).A
-    if is_system(sys_or_A):
-        return as_state_space(sys_or_A).A
+    """A of a continuous system, or the matrix given (augment_mode's new poles are in the s
+    plane)."""
+    if (isinstance(sys_or_A, (StateSpace, tuple, list)) and not _is_matrix(sys_or_A)) or (
+        is_system(sys_or_A)
+    ):
+        model = as_state_space(sys_or_A)
+        require_continuous(model, "augment_mode", "place the poles z = e^{s dt} instead")
+        return model.A
     return real_array(sys_or_A, "A")
 
 

@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError
-from .statespace import as_state_space, is_system
+from .statespace import as_state_space, is_system, require_continuous
 
 if TYPE_CHECKING:
     from ._typing import SystemObject
@@ -385,6 +385,8 @@ def _regulator_arguments(
         if count not in (2, 3):
             raise InvalidArgumentError(f"{name}(sys, Q, R[, N]) takes a system and two weights")
         sys = as_state_space(sys_or_A)
+        if name == "lqr":
+            require_continuous(sys, "lqr", "use dlqr for the discrete regulator")
         A, B, Q, R = sys.A, sys.B, args[0], args[1]
         weights_given = 2
     else:
@@ -447,6 +449,7 @@ def riccati_ode(
     A: ArrayLike  # the system's plant matrix or the caller's
     if is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
+        require_continuous(sys, "riccati_ode", "the discrete finite horizon is not available yet")
         # riccati_ode(sys, Q, R, t, Sf): every argument shifts one place to the left.
         A, B, Q, R, t, Sf = sys.A, sys.B, B, Q, R, (t if t is not None else Sf)
     else:

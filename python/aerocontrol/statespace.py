@@ -193,6 +193,16 @@ def _foreign_period(dt: object, name: str) -> float | None:
     return None if dt is None else sampling_period(dt, name)
 
 
+def require_continuous(model: StateSpace, function: str, instead: str) -> None:
+    """Refuses a discrete model in a continuous-time design function, which would otherwise
+    solve the continuous problem for the matrices of the sampled one without a word."""
+    if model.is_discrete:
+        raise InvalidArgumentError(
+            f"{function} designs in continuous time, but the system is discrete (sampled every "
+            f"{period(model):g} s); {instead}"
+        )
+
+
 def continuous_eigenvalues(model: StateSpace) -> NDArray[np.complex128]:
     """The eigenvalues of A for a continuous model; for a discrete one, those of the equivalent
     continuous model, s = ln(z) / dt (principal logarithm: a real z < 0 gives the Nyquist

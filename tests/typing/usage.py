@@ -192,10 +192,14 @@ aerocontrol.lqe(
 )
 aerocontrol.lqe(A_lat, B_lat, C_prp, np.eye(2), np.eye(3), NN=np.zeros((2, 3)))
 aerocontrol.lqe([[0.7]], [[1]], [[1]], 2.0, 0.5)
-sampled = aerocontrol.discretize(A_lat, B_lat, dt=0.02)
-assert_type(aerocontrol.dlqe(sampled.Phi, sampled.Gamma0, C_prp, np.eye(2), np.eye(3))[1], Floats)
+sampled_lat = aerocontrol.discretize(A_lat, B_lat, dt=0.02)
+assert_type(
+    aerocontrol.dlqe(sampled_lat.Phi, sampled_lat.Gamma0, C_prp, np.eye(2), np.eye(3))[1], Floats
+)
 aerocontrol.dlqe([[1.0]], [[1.0]], [[1.0]], [[1.0]], [[1.0]], np.zeros((1, 1)))
-kf = aerocontrol.kalman((sampled.Phi, sampled.Gamma0, C_prp), np.eye(2), 1e-4 * np.eye(3), dt=0.02)
+kf = aerocontrol.kalman(
+    (sampled_lat.Phi, sampled_lat.Gamma0, C_prp), np.eye(2), 1e-4 * np.eye(3), dt=0.02
+)
 assert_type(kf, aerocontrol.KalmanFilter)
 assert_type(kf.filter_gain, Floats)
 assert_type(kf.predictor_gain, Floats)
