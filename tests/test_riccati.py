@@ -333,12 +333,35 @@ def test_undamped_mode_unseen_and_unmoved_has_no_stabilising_solution() -> None:
         aerocontrol.solve_care([[0.0, 1.0], [-1.0, 0.0]], [[0.0], [1.0]], np.zeros((2, 2)), [[1.0]])
 
 
-def test_R_must_be_symmetric_positive_definite() -> None:
-    A, B, Q = np.eye(2), np.eye(2), np.eye(2)
-    with pytest.raises(NotPositiveDefiniteError, match="R must be symmetric positive definite"):
-        aerocontrol.solve_care(A, B, Q, [[1.0, 0.0], [0.0, -1.0]])
+def test_R_must_be_symmetric_and_nonsingular() -> None:
+    A, B, Q = -np.eye(2), np.eye(2), np.eye(2)
     with pytest.raises(NotPositiveDefiniteError, match="R must be symmetric"):
         aerocontrol.solve_care(A, B, Q, [[1.0, 0.5], [0.0, 1.0]])
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="R must be nonsingular"):
+        aerocontrol.solve_care(A, B, Q, [[1.0, 0.0], [0.0, 0.0]])
+
+
+def test_indefinite_R_by_the_extended_pencil() -> None:
+    # scipy's example: A = -1, B = 1, Q = 0.5, R = -1: x^2 - 2x + 0.5 = 0, x = 1 - sqrt(0.5).
+    solution = aerocontrol.solve_care([[-1.0]], [[1.0]], [[0.5]], [[-1.0]])
+    assert solution.X[0, 0] == pytest.approx(1 - np.sqrt(0.5), rel=4 * EPS)
+    assert solution.closed_loop_poles[0].real < 0
+    # An H-infinity-like weight diag(1, -gamma^2) on random plants, with S and E, against
+    # scipy's own extended pencil.
+    rng = np.random.default_rng(5)
+    for n in (2, 4, 8):
+        A = rng.standard_normal((n, n)) - 2 * np.eye(n)
+        B = rng.standard_normal((n, 2))
+        R = np.diag([1.0, -25.0])
+        S = 0.1 * rng.standard_normal((n, 2))
+        E = np.eye(n) + 0.05 * rng.standard_normal((n, n))
+        ours = aerocontrol.solve_care(A, B, np.eye(n), R, S=S, E=E)
+        reference = sl.solve_continuous_are(A, B, np.eye(n), R, e=E, s=S)
+        np.testing.assert_allclose(
+            ours.X, reference, rtol=0, atol=1e-10 * np.linalg.norm(reference)
+        )
+        assert ours.residual < 1e-13
+        assert np.all(ours.closed_loop_poles.real < 0)
 
 
 def test_unstabilisable_pair_is_refused() -> None:

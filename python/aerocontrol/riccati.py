@@ -108,7 +108,11 @@ def solve_care(
     ----------
     A, Q : array_like (n, n)
     B : array_like (n, m)
-    R : array_like (m, m), symmetric positive definite
+    R : array_like (m, m), symmetric and nonsingular
+        Positive definite: the Hamiltonian method above. Indefinite (as the H-infinity
+        equations have): the extended Hamiltonian pencil of order 2n + m, compressed and
+        reduced by aerocontrol's QZ algorithm (:func:`~aerocontrol.qz`), X = U21 (E U11)^-1
+        from its stable deflating subspace, with the same checks (no refinement).
     S : array_like (n, m), optional; the cross weight (python-control's N)
     E : array_like (n, n), optional; nonsingular
     refine : bool
@@ -117,7 +121,9 @@ def solve_care(
     Raises
     ------
     NotPositiveDefiniteError
-        R is not symmetric positive definite.
+        R is not symmetric.
+    InvalidArgumentError
+        R is singular to working precision.
     NoStabilizingSolutionError
         The Hamiltonian has eigenvalues on the imaginary axis to working precision: some
         undamped mode is neither controllable nor penalised; or the computed solution leaves

@@ -237,7 +237,8 @@ impl Evaluation {
     }
 }
 
-/// Solves the CARE for its stabilising solution.
+/// Solves the CARE for its stabilising solution; an R that is symmetric and nonsingular but
+/// not positive definite goes to the extended pencil ([`super::care_pencil`]).
 pub fn solve_care(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -245,6 +246,17 @@ pub fn solve_care(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<Care, Error> {
+    // An R that is symmetric but not positive definite: the extended pencil, which needs no
+    // Cholesky factor (an asymmetric R is refused by the same check in both paths).
+    if r.nrows() == r.ncols()
+        && r.nrows() == b.ncols()
+        && r.is_all_finite()
+        && symmetric(r, "R", b.ncols(), "the columns of B")
+            .map(|r| cholesky(&r).is_none())
+            .unwrap_or(false)
+    {
+        return super::care_pencil::solve_care_indefinite(a, b, q, r, options);
+    }
     solve_care_dense(a, b, q, r, options).map(|care| Care {
         x: care.x.to_mat(),
         gain: care.gain.to_mat(),

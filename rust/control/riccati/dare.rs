@@ -50,11 +50,11 @@
 //! equations have, are solved where a stabilising solution exists.
 
 use super::care::symmetric;
+use super::pencil::{compress, graph_solution, symmetrize};
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::linalg::householder::reflector;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::{frobenius_norm, one_norm};
-use crate::linalg::qz::{GeneralizedSchur, generalized_eigenvalues, qz, reorder_qz};
+use crate::linalg::qz::{generalized_eigenvalues, qz, reorder_qz};
 use crate::linalg::stein::{KRONECKER_MAX_ORDER, solve_stein_kronecker, solve_stein_smith};
 use crate::platform::interrupt;
 use faer::{Mat, MatRef, c64};
@@ -162,7 +162,13 @@ pub fn solve_dare(
             2 * n
         )));
     }
-    let (mut x, rcond) = solution(&form, e, n)?;
+    let (mut x, rcond) = graph_solution(&form, e, n).ok_or_else(|| {
+        no_solution(
+            "the stable deflating subspace is not a graph: E U11 is singular to working \
+             precision"
+                .into(),
+        )
+    })?;
     let problem = Problem {
         a,
         b,
@@ -339,31 +345,7 @@ fn compressed_pencil(
             big_m[(2 * n + i, 2 * n + j)] = r[(i, j)];
         }
     }
-    let mut v = Vec::with_capacity(size);
-    for c in 0..m {
-        let col = 2 * n + c;
-        v.clear();
-        v.extend((c..size).map(|i| big_m[(i, col)]));
-        let (_, tau) = reflector(&mut v);
-        v[0] = 1.0;
-        if tau == 0.0 {
-            continue;
-        }
-        for matrix in [&mut big_m, &mut big_n] {
-            for j in 0..size {
-                let w: f64 = v
-                    .iter()
-                    .enumerate()
-                    .map(|(k, vk)| vk * matrix[(c + k, j)])
-                    .sum();
-                for (k, vk) in v.iter().enumerate() {
-                    matrix[(c + k, j)] -= tau * w * vk;
-                }
-            }
-        }
-    }
-    let take = |matrix: &Mat<f64>| Mat::from_fn(2 * n, 2 * n, |i, j| matrix[(m + i, j)]);
-    (take(&big_m), take(&big_n))
+    compress(big_m, big_n, 2 * n)
 }
 
 /// The error when eigenvalues of the pencil lie on the unit circle to working precision.
@@ -392,45 +374,6 @@ fn check_separated(
 fn no_solution(evidence: String) -> Error {
     Error::NoStabilizingSolution {
         message: format!("the discrete Riccati equation has no stabilising solution: {evidence}"),
-    }
-}
-
-/// X = U21 (E U11)^-1 from the leading n columns of Z, symmetrised, and rcond(E U11).
-fn solution(
-    form: &GeneralizedSchur,
-    e: MatRef<'_, f64>,
-    n: usize,
-) -> Result<(Mat<f64>, f64), Error> {
-    let u11 = form.z.as_ref().submatrix(0, 0, n, n);
-    let u21 = form.z.as_ref().submatrix(n, 0, n, n);
-    // (E U11)^T X^T = U21^T.
-    let eu11 = e * u11;
-    let norm = one_norm(eu11.as_ref());
-    let mut factor = eu11.transpose().to_owned();
-    let combined = solve_with_inverse(factor.as_mut(), u21.transpose());
-    let (xt, inverse) = combined.as_ref().split_at_col(n);
-    // The inverse of (E U11)^T: its 1-norm is the infinity norm of (E U11)^-1; use the
-    // transpose's norm for the 1-norm condition number of E U11.
-    let rcond = 1.0 / (norm * crate::linalg::norm::one_norm(inverse.transpose()));
-    if !xt.is_all_finite() || rcond.is_nan() || rcond <= f64::EPSILON {
-        return Err(no_solution(format!(
-            "the stable deflating subspace is not a graph: E U11 is singular to working \
-             precision (reciprocal condition number {rcond:.1e})"
-        )));
-    }
-    let mut x = xt.transpose().to_owned();
-    symmetrize(&mut x);
-    Ok((x, rcond))
-}
-
-/// X <- (X + X^T) / 2.
-fn symmetrize(x: &mut Mat<f64>) {
-    for j in 0..x.ncols() {
-        for i in 0..j {
-            let mean = 0.5 * (x[(i, j)] + x[(j, i)]);
-            x[(i, j)] = mean;
-            x[(j, i)] = mean;
-        }
     }
 }
 
