@@ -231,3 +231,38 @@ def test_no_warning_on_a_well_conditioned_problem() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         aerocontrol.solve_dare(np.eye(2) * 0.9, np.eye(2), np.eye(2), np.eye(2))
+
+
+def test_batch_is_bitwise_the_single_solves_and_names_the_failing_problem() -> None:
+    rng = np.random.default_rng(11)
+    A = rng.standard_normal((40, 4, 4)) / 3
+    B = rng.standard_normal((4, 2))
+    batch = aerocontrol.batch.solve_dare_batch(A, B, np.eye(4), np.eye(2))
+    for i in range(40):
+        single = aerocontrol.solve_dare(A[i], B, np.eye(4), np.eye(2))
+        np.testing.assert_array_equal(batch.X[i], single.X)
+        np.testing.assert_array_equal(batch.K[i], single.K)
+    assert np.all(np.abs(batch.closed_loop_poles) < 1)
+    # Problem 1 cannot be stabilised (the mode 2 is not reachable).
+    stack = np.stack([0.5 * np.eye(2), np.diag([2.0, 0.5])])
+    with pytest.raises(NoStabilizingSolutionError) as caught:
+        aerocontrol.batch.solve_dare_batch(stack, np.array([[0.0], [1.0]]), np.eye(2), [[1.0]])
+    assert caught.value.batch_index == 1
+    empty = aerocontrol.batch.solve_dare_batch(
+        np.zeros((0, 2, 2)), np.ones((2, 1)), np.eye(2), [[1.0]]
+    )
+    assert empty.X.shape == (0, 2, 2)
+
+
+def test_dlqr_sweep_matches_dlqr_per_weight() -> None:
+    A, B = aerocontrol.chapter.boeing747_lateral()
+    sampled = aerocontrol.c2d(aerocontrol.StateSpace(A, B), 0.1)
+    weights = np.geomspace(1e-2, 10, 7)
+    sweep = aerocontrol.batch.dlqr_sweep(sampled, weights=weights)
+    for k, c in enumerate(weights):
+        K, _, _ = aerocontrol.dlqr(sampled.A, sampled.B, np.eye(4), np.eye(2) / c**2)
+        np.testing.assert_array_equal(sweep.K[k], K)
+    with pytest.raises(InvalidArgumentError, match="continuous"):
+        aerocontrol.batch.dlqr_sweep(aerocontrol.StateSpace(A, B, dt=0), weights=weights)
+    with pytest.raises(InvalidArgumentError, match="discrete"):
+        aerocontrol.batch.lqr_sweep(sampled, weights=weights)

@@ -23,6 +23,7 @@ __all__ = [
     "check_model",
     "companion_form",
     "controllability",
+    "dare_batch",
     "discretize",
     "eigenvalues",
     "exception_classes",
@@ -205,6 +206,19 @@ def care_batch(
     q: ArrayLike,
     r: ArrayLike,
     refine: bool,
+    /,
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.complex128],
+    NDArray[np.float64],
+    NDArray[np.float64],
+]: ...
+def dare_batch(
+    a: ArrayLike,
+    b: ArrayLike,
+    q: ArrayLike,
+    r: ArrayLike,
     /,
 ) -> tuple[
     NDArray[np.float64],

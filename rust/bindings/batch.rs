@@ -1,14 +1,15 @@
 //! Bindings of `aerocontrol.batch`: Riccati equations and pole placement over stacks of
 //! problems, in parallel with the GIL released.
 
+use super::compute::Cost;
 use super::compute::compute;
 use super::conversion::{Complex, Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::placement::{placement_cost, placer_for};
-use super::riccati::care_cost;
+use super::riccati::{care_cost, dare_cost};
 use crate::control::batch::{
-    CareBatchOutput, CareStacks, PlaceBatchOutput, care_batch as care_batch_core,
-    place_batch as place_batch_core,
+    CareBatchOutput, CareStacks, PlaceBatchOutput, RiccatiKind, place_batch as place_batch_core,
+    riccati_batch,
 };
 use crate::error::Error;
 use faer::c64;
@@ -38,6 +39,31 @@ fn care_batch<'py>(
     q: &Bound<'py, PyAny>,
     r: &Bound<'py, PyAny>,
     refine: bool,
+) -> PyResult<CareBatchArrays<'py>> {
+    riccati_batch_arrays(py, [a, b, q, r], RiccatiKind::Continuous { refine })
+}
+
+/// A batch of discrete Riccati equations solved in parallel with the GIL released, as
+/// [`care_batch`]: X, K, the closed-loop eigenvalues (inside the unit circle), the relative
+/// residuals, rcond(E U11).
+#[pyfunction]
+#[pyo3(signature = (a, b, q, r, /))]
+fn dare_batch<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+) -> PyResult<CareBatchArrays<'py>> {
+    riccati_batch_arrays(py, [a, b, q, r], RiccatiKind::Discrete)
+}
+
+/// The batch of either kind: arguments converted, outputs allocated, the work done with the
+/// GIL released, overflow reported.
+fn riccati_batch_arrays<'py>(
+    py: Python<'py>,
+    [a, b, q, r]: [&Bound<'py, PyAny>; 4],
+    kind: RiccatiKind,
 ) -> PyResult<CareBatchArrays<'py>> {
     let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
     let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
@@ -69,12 +95,16 @@ fn care_batch<'py>(
         }
     };
     let threads = rayon::current_num_threads();
-    let cost = care_cost(n).times(count);
-    let cost = super::compute::Cost {
+    let cost = match kind {
+        RiccatiKind::Continuous { .. } => care_cost(n),
+        RiccatiKind::Discrete => dare_cost(n, m),
+    }
+    .times(count);
+    let cost = Cost {
         bytes: cost.bytes * threads as f64,
         ..cost
     };
-    compute(py, cost, || care_batch_core(stacks, refine, out))?;
+    compute(py, cost, || riccati_batch(stacks, kind, out))?;
     let mut outputs = Outputs::new(py);
     // SAFETY: the computation is over and the arrays are not yet visible to Python.
     unsafe {
@@ -155,6 +185,7 @@ fn place_batch<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(care_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(dare_batch, m)?)?;
     m.add_function(wrap_pyfunction!(place_batch, m)?)?;
     Ok(())
 }

@@ -7,6 +7,7 @@
 
 use crate::control::placement::Placement;
 use crate::control::riccati::care::{CareOptions, solve_care_dense};
+use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
 use crate::linalg::dense::Dense;
 use crate::linalg::expm::expm_into_validated;
@@ -187,6 +188,16 @@ pub struct CareBatchOutput<'a> {
     pub rcond: &'a mut [f64],
 }
 
+/// Which algebraic Riccati equation a batch solves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RiccatiKind {
+    /// The continuous equation (6.199) by [`solve_care_dense`], refined by Newton's method or
+    /// not.
+    Continuous { refine: bool },
+    /// The discrete equation by [`solve_dare`].
+    Discrete,
+}
+
 /// Solves every Riccati equation of a batch, in parallel (one problem per rayon task, each
 /// exactly as [`crate::control::riccati::care::solve_care`] solves it alone, so the results are bitwise those of single
 /// calls). Every problem is attempted; if any fails, the error of the lowest index is
@@ -194,6 +205,16 @@ pub struct CareBatchOutput<'a> {
 pub fn care_batch(
     stacks: CareStacks<'_>,
     refine: bool,
+    out: CareBatchOutput<'_>,
+) -> Result<(), Error> {
+    riccati_batch(stacks, RiccatiKind::Continuous { refine }, out)
+}
+
+/// [`care_batch`] for either equation: the discrete one solved as
+/// [`crate::control::riccati::dare::solve_dare`] solves it alone.
+pub fn riccati_batch(
+    stacks: CareStacks<'_>,
+    kind: RiccatiKind,
     out: CareBatchOutput<'_>,
 ) -> Result<(), Error> {
     let count = stacks.count()?;
@@ -206,11 +227,7 @@ pub fn care_batch(
     if count == 0 || n == 0 {
         return Ok(());
     }
-    let options = CareOptions {
-        refine,
-        ..CareOptions::default()
-    };
-    // The Hamiltonian is of order 2n.
+    // The Hamiltonian (or the compressed symplectic pencil) is of order 2n.
     let context = ParallelContext::capture(2 * n);
     let failure = out
         .x
@@ -221,22 +238,38 @@ pub fn care_batch(
         .zip(out.rcond.par_iter_mut())
         .enumerate()
         .filter_map(|(index, ((((x, gain), poles), residual), rcond))| {
-            let solved = context.run(|| {
-                solve_care_dense(
-                    member(&stacks.a, index),
-                    member(&stacks.b, index),
-                    member(&stacks.q, index),
-                    member(&stacks.r, index),
-                    options,
-                )
+            let (a, b, q, r) = (
+                member(&stacks.a, index),
+                member(&stacks.b, index),
+                member(&stacks.q, index),
+                member(&stacks.r, index),
+            );
+            let solved = context.run(|| match kind {
+                RiccatiKind::Continuous { refine } => {
+                    let options = CareOptions {
+                        refine,
+                        ..CareOptions::default()
+                    };
+                    solve_care_dense(a, b, q, r, options).map(|care| {
+                        write_row_major(&care.x, x);
+                        write_row_major(&care.gain, gain);
+                        poles.copy_from_slice(&care.closed_loop_eigenvalues);
+                        (care.residual, care.rcond)
+                    })
+                }
+                RiccatiKind::Discrete => {
+                    solve_dare(a, b, q, r, DareOptions::default()).map(|dare| {
+                        MatMut::from_row_major_slice_mut(x, n, n).copy_from(&dare.x);
+                        MatMut::from_row_major_slice_mut(gain, m, n).copy_from(&dare.gain);
+                        poles.copy_from_slice(&dare.closed_loop_eigenvalues);
+                        (dare.residual, dare.rcond)
+                    })
+                }
             });
             match solved {
-                Ok(care) => {
-                    write_row_major(&care.x, x);
-                    write_row_major(&care.gain, gain);
-                    poles.copy_from_slice(&care.closed_loop_eigenvalues);
-                    *residual = care.residual;
-                    *rcond = care.rcond;
+                Ok((res, cond)) => {
+                    *residual = res;
+                    *rcond = cond;
                     None
                 }
                 Err(error) => Some((index, error)),
