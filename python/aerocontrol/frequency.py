@@ -15,8 +15,8 @@ from numpy.typing import NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
-from .exceptions import ShapeError
-from .statespace import as_state_space
+from .exceptions import InvalidArgumentError, ShapeError
+from .statespace import as_state_space, grid_frequencies
 
 __all__ = ["FrequencyResponse", "bode", "default_frequency_grid", "frequency_response"]
 
@@ -103,13 +103,18 @@ def frequency_response(sys: Any, omega: Any) -> FrequencyResponse:
 
 
 def default_frequency_grid(sys: Any, count: int = DEFAULT_FREQUENCIES) -> FloatArray:
-    """Log-spaced frequencies from a tenth of the slowest to ten times the fastest nonzero
-    natural frequency of the modes (0.01 to 100 rad/s when every eigenvalue is zero)."""
+    """``count`` (at least 1) log-spaced frequencies from a tenth of the slowest to ten times
+    the fastest nonzero natural frequency of the modes (0.01 to 100 rad/s when every
+    eigenvalue is zero; at most 1e308)."""
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+        raise InvalidArgumentError(f"count must be a positive integer, got {count!r}")
     model = as_state_space(sys)
-    magnitudes = np.abs(np.linalg.eigvals(model.A)) if model.n_states else np.array([])
-    nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
-    low, high = (nonzero.min() / 10, nonzero.max() * 10) if nonzero.size else (0.01, 100.0)
-    return np.logspace(np.log10(low), np.log10(high), count)
+    _, nonzero = grid_frequencies([model], "the default frequency grid")
+    if nonzero.size == 0:
+        return np.logspace(-2.0, 2.0, int(count))
+    return np.logspace(
+        np.log10(nonzero.min()) - 1, min(np.log10(nonzero.max()) + 1, 308.0), int(count)
+    )
 
 
 def bode(sys: Any, omega: Any = None) -> FrequencyResponse:

@@ -14,10 +14,11 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
-from .exceptions import ShapeError
+from .exceptions import ConvergenceError, InvalidArgumentError, NotRealError, ShapeError
 
 __all__ = ["StateSpace", "as_state_space"]
 
@@ -178,7 +179,7 @@ def as_state_space(model: Any, name: str = "sys") -> StateSpace:
             np.asarray(model.D),
             **names,
         )
-    raise TypeError(
+    raise NotRealError(
         f"{name} must be a StateSpace, a tuple (A, B) or (A, B, C, D), or an object with A, B, "
         f"C and D attributes, got {type(model).__name__}"
     )
@@ -192,4 +193,30 @@ def plant_pair(A_or_sys: Any, second: Any, attribute: str) -> tuple[Any, Any]:
     if isinstance(A_or_sys, (tuple, list)) or is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
         return sys.A, getattr(sys, attribute)
-    raise TypeError(f"give a system or both A and {attribute}")
+    raise NotRealError(f"give a system or both A and {attribute}")
+
+
+def grid_frequencies(
+    models: Sequence[StateSpace], what: str
+) -> tuple[NDArray[np.complex128], FloatArray]:
+    """(eigenvalues, nonzero natural frequencies |λ|) of the models' A, from which the
+    default time and frequency grids are chosen; |λ| within 1e-12 max(1, |λ|max) of zero
+    counts as zero.
+
+    An eigenvalue whose magnitude overflows double precision gives InvalidArgumentError
+    naming ``what``: no grid of doubles resolves it, and the caller must give the grid."""
+    try:
+        eigenvalues = np.concatenate(
+            [np.linalg.eigvals(m.A) for m in models] + [np.zeros(0, dtype=np.complex128)]
+        )
+    except np.linalg.LinAlgError as error:
+        raise ConvergenceError(f"{what}: the eigenvalues of A did not converge ({error})") from None
+    with np.errstate(over="ignore"):
+        magnitudes = np.abs(eigenvalues)
+    if not np.all(np.isfinite(magnitudes)):
+        raise InvalidArgumentError(
+            f"{what}: an eigenvalue of A overflows double precision, so no default grid can "
+            "resolve it; give the grid"
+        )
+    largest = float(magnitudes.max(initial=0.0))
+    return eigenvalues, magnitudes[magnitudes > 1e-12 * max(1.0, largest)]
