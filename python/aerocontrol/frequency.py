@@ -54,6 +54,8 @@ class FrequencyResponse:
         return np.degrees(self.phase)
 
     def __str__(self) -> str:
+        if len(self.omega) == 0:
+            return "frequency response: no frequencies"
         lines = [
             f"frequency response: {len(self.omega)} frequencies, "
             f"{self.omega.min():.4g} ... {self.omega.max():.4g} rad/s"
