@@ -104,7 +104,7 @@ def test_frequency_response(data: st.DataObject) -> None:
 def _bode_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
     omega = args["omega"]
     if omega is None:
-        omega = aerocontrol.default_frequency_grid(args["sys"])
+        omega = quietly(aerocontrol.default_frequency_grid, args["sys"])
     direct = quietly(aerocontrol.frequency_response, args["sys"], omega)
     assert np.array_equal(result.omega, direct.omega)
     assert np.array_equal(result.response, direct.response, equal_nan=True)
