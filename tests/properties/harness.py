@@ -9,7 +9,8 @@ their canonical form: the same numbers as C-ordered float64 arrays. The call mus
    Anything else (a ``TypeError`` from inside numpy, a ``ZeroDivisionError``, an
    ``IndexError``, a bare ``ValueError``) is a failure;
 2. refuse what it must: an argument that is not real (complex, object, text), one that
-   contains NaN or an infinity, one whose ``__array__`` raises;
+   contains NaN or an infinity, one whose ``__array__`` raises; and blame no argument wrongly
+   (a ``NonFiniteError`` when every argument is finite);
 3. leave every argument as it was: values, dtype, shape, strides and writeability;
 4. issue no warning but aerocontrol's (a numpy ``RuntimeWarning`` is an overflow nobody
    handled);
@@ -43,7 +44,12 @@ import numpy as np
 from hypothesis import note
 
 import aerocontrol
-from aerocontrol.exceptions import AerocontrolError, AerocontrolWarning, NumericalOverflowWarning
+from aerocontrol.exceptions import (
+    AerocontrolError,
+    AerocontrolWarning,
+    NonFiniteError,
+    NumericalOverflowWarning,
+)
 
 Warned = tuple[type[Warning], ...]
 """The classes of aerocontrol's warnings that a call issued, in order."""
@@ -252,6 +258,8 @@ class Defect:
     summary: str
     applies: Callable[[dict[str, Any]], bool]
     """Whether the canonical arguments of a call are inputs the defect concerns."""
+    symptom: str | None = None
+    """Text the failure's message must contain, where the defect has one clear symptom."""
     active: bool = True
     """False while its reproduction runs, so that the failure shows."""
 
@@ -269,19 +277,25 @@ KNOWN_DEFECTS: list[Defect] = []
 
 
 def known_defect(
-    key: str, functions: set[str], summary: str, applies: Callable[[dict[str, Any]], bool]
+    key: str,
+    functions: set[str],
+    summary: str,
+    applies: Callable[[dict[str, Any]], bool],
+    symptom: str | None = None,
 ) -> Defect:
     """Register a known defect of the core."""
-    defect = Defect(key, frozenset(functions), summary, applies)
+    defect = Defect(key, frozenset(functions), summary, applies, symptom)
     KNOWN_DEFECTS.append(defect)
     return defect
 
 
-def _known_defect(name: str, arguments: dict[str, Arg]) -> Defect | None:
+def _known_defect(name: str, arguments: dict[str, Arg], failure: str) -> Defect | None:
     if any(arg.expect not in (SAME, CALLBACK) for arg in arguments.values()):
         return None
     canonical = {key: arg.canonical for key, arg in arguments.items()}
     for defect in KNOWN_DEFECTS:
+        if defect.symptom is not None and defect.symptom not in failure:
+            continue
         if defect.active and name in defect.functions:
             try:
                 if defect.applies(canonical):
@@ -346,8 +360,8 @@ def exercise(
     made: list[Outcome] = []
     try:
         outcome = _exercise(name, function, arguments, oracle, nonfinite_by_definition, made)
-    except AssertionError:
-        defect = _known_defect(name, arguments)
+    except AssertionError as failure:
+        defect = _known_defect(name, arguments, str(failure))
         if defect is None:
             TALLY[name]["FAILED"] += 1
             raise
@@ -399,6 +413,10 @@ def _exercise(
                 f"{outcome.error!r}"
             )
         return outcome
+    if isinstance(outcome.error, NonFiniteError):
+        assert any(nonfinite(arg.canonical) for arg in arguments.values()), (
+            f"{name} raised NonFiniteError, but every argument is finite: {outcome.error}"
+        )
     callbacks = any(arg.expect == CALLBACK for arg in arguments.values())
     if isinstance(outcome.error, CallerError) and not callbacks:
         raise AssertionError(f"{name} raised a CallerError no argument raised: {outcome.error}")

@@ -143,3 +143,17 @@ def _pair(args: dict[str, Any]) -> tuple[Any, Any]:
         model = _model(args["A_or_sys"])
         return model[0], np.concatenate([np.ravel(m) for m in model[1:]])
     return args["A_or_sys"], second
+
+
+PLACEMENT_OVERFLOW_BLAMES_A: Defect = known_defect(
+    "placement-overflow-blames-A",
+    {"place", "place_ackermann", "place_bass_gura"},
+    "When a placement overflows inside (the desired polynomial's coefficients for poles "
+    "-1e160 and -2e160; a gain of 1/b for b = [[1e-301]]; A and B with entries near 1e150 "
+    "for place), it raises NonFiniteError 'A must be finite, but A[0, 0] is -inf' (or NaN), "
+    "although A is finite. place_bass_gura says instead 'the controllability matrix of (A, b) "
+    "is numerically singular (condition number 5.21e0)'. The error should name the cause "
+    "(the poles' coefficients or the gain overflow).",
+    lambda args: True,
+    symptom="raised NonFiniteError, but every argument is finite",
+)

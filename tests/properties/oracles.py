@@ -205,11 +205,11 @@ def eigenvalue_backward_error(A: np.ndarray, eigenvalue: complex) -> float:
 
 
 def characteristic_tolerance(A: np.ndarray) -> np.ndarray:
-    """Per coefficient a_k of det(lambda I - A): SLACK n u C(n, k) k ||A||_2^k. a_k is the sum
+    """Per coefficient a_k of det(lambda I - A): SLACK n u C(n, k) k ||A||_F^k. a_k is the sum
     of the C(n, k) principal minors of order k, and a perturbation E of A changes a minor of
     order k by at most k ||A||^(k-1) ||E||; the eigenvalue solvers' E is about n u ||A||."""
     n = A.shape[0]
-    size = np.float64(np.linalg.norm(A, 2)) if n else np.float64(0.0)
+    size = np.float64(norm(A))  # the Frobenius norm bounds the 2-norm
     with np.errstate(over="ignore"):
         return np.array([SLACK * n * U * comb(n, k) * max(k, 1) * size**k for k in range(n + 1)])
 
@@ -271,6 +271,18 @@ def assert_stable(A: np.ndarray, what: str) -> None:
         f"{what}: eigenvalue {values[worst]} is not in the left half plane "
         f"(sensitivity margin {margin[worst]:.2e})"
     )
+
+
+def condition(M: np.ndarray) -> float:
+    """The 2-norm condition number of M (numpy's), inf where it cannot be computed."""
+    if M.shape[0] == 0:
+        return 1.0
+    with silenced():
+        try:
+            value = float(np.linalg.cond(M))
+        except np.linalg.LinAlgError:
+            return np.inf
+    return value if np.isfinite(value) else np.inf
 
 
 def relative_residual(residual: np.ndarray, *terms: Any) -> float:
