@@ -85,3 +85,11 @@ def test_bad_arguments() -> None:
         aerocontrol.frequency_response((A_LON, B_LON), [1.0, np.nan])
     with pytest.raises(ShapeError, match="omega must be a 1-D array"):
         aerocontrol.frequency_response((A_LON, B_LON), np.ones((2, 2)))
+
+
+def test_the_count_of_the_default_grid_is_checked() -> None:
+    # Found by the property suite: a negative count was numpy's bare ValueError.
+    for count in (0, -1, 2.5, True, "10"):
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="count must be a positive"):
+            aerocontrol.default_frequency_grid((A_LON, B_LON), count)  # type: ignore[arg-type]
+    assert len(aerocontrol.default_frequency_grid((A_LON, B_LON), np.int64(3))) == 3

@@ -88,3 +88,9 @@ def test_mode_characteristics_in_closed_form() -> None:
 def test_charpoly_of_the_state_feedback_example() -> None:
     A, _ = aerocontrol.chapter.state_feedback_example()
     np.testing.assert_array_equal(aerocontrol.charpoly(A), [1.0, 3.0, 0.0])
+
+
+def test_mode_names_of_the_wrong_count_are_a_shape_error() -> None:
+    # Found by the property suite: a bare ValueError, not one of aerocontrol's.
+    with pytest.raises(aerocontrol.ShapeError, match="mode_names must name 3 modes, got 1"):
+        aerocontrol.modes(A_LAT, mode_names=["spiral"])

@@ -250,3 +250,79 @@ def test_inputs_are_not_modified() -> None:
     aerocontrol.step_response((A, B), T=1.0)
     for now, then in zip((A, B, u), before, strict=True):
         np.testing.assert_array_equal(now, then)
+
+
+# ----- found by the property suite (tests/properties/test_responses.py) --------------------------
+
+
+def test_models_without_inputs_have_no_impulse_or_step_responses() -> None:
+    # The defect: one response per input, of which there were none, was taken for a single
+    # response and indexed (an IndexError).
+    free = aerocontrol.StateSpace(-np.eye(2), np.zeros((2, 0)))
+    t = np.linspace(0.0, 1.0, 3)
+    for response in (
+        aerocontrol.impulse_response(free, T=t),
+        aerocontrol.doublet_response(free, T=t),
+        aerocontrol.step_response(free, T=t),
+        aerocontrol.initial_response(free, np.zeros((0, 2)), T=t),
+    ):
+        assert response.x.shape == (0, 3, 2) and response.y.shape == (0, 3, 2)
+        assert response.n_responses == 0 and str(response)
+    # A list of models has one response each, to the first input: refused, by name.
+    for function in (
+        aerocontrol.impulse_response,
+        aerocontrol.doublet_response,
+        aerocontrol.step_response,
+    ):
+        with pytest.raises(ShapeError, match=r"one .* response per model"):
+            function([free, free], T=t)
+    with pytest.raises(ShapeError, match="one initial response per model"):
+        aerocontrol.initial_response([free, free], np.zeros((0, 2)), T=t)
+
+
+def test_input_weights_are_checked_even_where_nothing_uses_them() -> None:
+    # The defect: a model without states never read eta0, and a NaN weight was accepted.
+    empty = aerocontrol.StateSpace(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[1.0]])
+    for function in (aerocontrol.impulse_response, aerocontrol.doublet_response):
+        with pytest.raises(NonFiniteError, match=r"eta0\[0\] is NaN") as error:
+            function(empty, T=[0.0, 1.0], eta0=np.nan)
+        assert error.value.argument == "eta0" and error.value.entry == [0]
+
+
+def test_results_do_not_share_memory_with_the_arguments() -> None:
+    # The defect: forced_response returned the caller's T (and a view of u) as its t and u,
+    # so that changing one changed the other.
+    t = np.linspace(0.0, 1.0, 11)
+    u = np.ones((11, 1))
+    response = aerocontrol.forced_response(LON, t, u)
+    assert not np.shares_memory(response.t, t) and not np.shares_memory(response.u, u)
+    response.t[0] = 5.0
+    assert t[0] == 0.0
+
+
+def test_default_grids_refuse_eigenvalues_beyond_double_precision() -> None:
+    # The defect: an eigenvalue that overflowed gave a grid for a model with no modes (0.01 s
+    # steps, or 0.01 to 100 rad/s); 1e308 gave 100,002 samples (one over the limit) of a
+    # subnormal step with numpy overflow warnings, and a frequency grid of NaN and inf.
+    overflowing = aerocontrol.StateSpace(np.full((2, 2), 1e308), np.zeros((2, 1)))
+    huge = aerocontrol.StateSpace(np.diag([-1e308, -1.0]), np.zeros((2, 1)))
+    for sys in (overflowing, huge):
+        with pytest.raises(InvalidArgumentError, match="default time grid"):
+            aerocontrol.default_time_grid(sys)
+        with pytest.raises(InvalidArgumentError, match="default time grid"):
+            aerocontrol.step_response(sys)
+    with pytest.raises(InvalidArgumentError, match="default frequency grid"):
+        aerocontrol.default_frequency_grid(overflowing)
+    omega = aerocontrol.default_frequency_grid(huge)
+    assert np.all(np.isfinite(omega)) and omega[0] == pytest.approx(1e307) and omega[-1] == 1e308
+    # Just below the limit the grid keeps its 100,001 samples at most.
+    t = aerocontrol.default_time_grid(aerocontrol.StateSpace(np.diag([-1e300, -1e-11]), [[0], [0]]))
+    assert len(t) <= aerocontrol.responses.MAX_DEFAULT_SAMPLES
+
+
+def test_a_number_is_not_a_model() -> None:
+    # The defect: a bare TypeError, not one of aerocontrol's (NotRealError is a TypeError).
+    with pytest.raises(aerocontrol.NotRealError, match="sys must be a StateSpace"):
+        aerocontrol.as_state_space(3.0)
+    with pytest.raises(aerocontrol.NotRealError, match="both A and B"):
+        aerocontrol.controllability(np.eye(2))

@@ -13,7 +13,13 @@ import warnings
 import numpy as np
 from numpy.typing import NDArray
 
-from .exceptions import InvalidArgumentError, NotRealError, NumericalOverflowWarning, ShapeError
+from .exceptions import (
+    InvalidArgumentError,
+    NonFiniteError,
+    NotRealError,
+    NumericalOverflowWarning,
+    ShapeError,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -50,6 +56,21 @@ def real_scalar(value: object, name: str) -> float:
     if array.ndim != 0:
         raise ShapeError(f"{name} must be a scalar, got an array of shape {array.shape}")
     return float(array)
+
+
+def check_finite(values: FloatArray, name: str) -> FloatArray:
+    """``values``, or NonFiniteError naming ``name`` and its first NaN or infinite entry (the
+    check the core makes of its own arguments, for arguments used only in Python)."""
+    bad = np.argwhere(~np.isfinite(values))
+    if bad.size:
+        entry = [int(k) for k in bad[0]]
+        value = float(values[tuple(entry)])
+        where = f"{name}[{', '.join(map(str, entry))}]" if entry else name
+        shown = "NaN" if np.isnan(value) else str(value)
+        error = NonFiniteError(f"{name} must be finite, but {where} is {shown}")
+        error.argument, error.entry, error.value = name, entry, value
+        raise error
+    return values
 
 
 def finite_or_warn(values: FloatArray, what: str) -> FloatArray:

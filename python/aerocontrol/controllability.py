@@ -14,7 +14,7 @@ verdict of :func:`controllability` comes from two tests that cover each other's 
   (a zero row of P^-1 B). This catches a planted uncontrollable mode that dominates the
   others, which rounding errors amplified by A make look controllable to the staircase.
 
-Both use the tolerance ``tol = n u max(||A||_F, ||B||_F)`` (u = 2^-53) unless given: a mode
+Both use the tolerance ``tol = n ε max(||A||_F, ||B||_F)`` (ε = 2^-52) unless given: a mode
 declared uncontrollable is within about tol of being exactly uncontrollable. Observability is
 the dual: (A, C) is observable if and only if (A^T, C^T) is controllable.
 """
@@ -155,7 +155,7 @@ def controllability(
     A_or_sys : array_like (n, n), StateSpace, (A, B) tuple, or object with A and B
     B : array_like (n, m), optional (required with a plain A)
     tol : float, optional
-        Rank tolerance; default n u max(||A||_F, ||B||_F).
+        Rank tolerance; default n ε max(||A||_F, ||B||_F), ε = 2^-52.
     method : "full" (default) or "staircase"
         "full" runs the staircase form and the modal PBH test; "staircase" only the first,
         about 5x faster at n = 64 but blind to an uncontrollable mode that dominates the

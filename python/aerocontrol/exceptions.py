@@ -90,7 +90,8 @@ class NotPositiveDefiniteError(InvalidArgumentError):
 
 
 class NotRealError(AerocontrolError, TypeError):
-    """An argument is complex or not numeric; aerocontrol works with real matrices only."""
+    """An argument is complex or not numeric; aerocontrol works with real matrices only. Also
+    raised where a model is expected and the argument is none (a number, a bare matrix)."""
 
 
 class AerocontrolLinAlgError(AerocontrolError, np.linalg.LinAlgError):

@@ -21,8 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
-from .exceptions import ShapeError
-from .statespace import as_state_space, continuous_eigenvalues, period
+from .exceptions import InvalidArgumentError, ShapeError
+from .statespace import as_state_space, continuous_eigenvalues, grid_frequencies, period
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -65,6 +65,8 @@ class FrequencyResponse:
         return np.degrees(self.phase)
 
     def __str__(self) -> str:
+        if len(self.omega) == 0:
+            return "frequency response: no frequencies"
         lines = [
             f"frequency response: {len(self.omega)} frequencies, "
             f"{self.omega.min():.4g} ... {self.omega.max():.4g} rad/s"
@@ -129,10 +131,13 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
 
 
 def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> FloatArray:
-    """Log-spaced frequencies from a tenth of the slowest to ten times the fastest nonzero
-    natural frequency of the modes (0.01 to 100 rad/s when every eigenvalue is zero). For a
-    discrete model: from a tenth of the slowest natural frequency of s = ln(z)/dt (or a
-    thousandth of the Nyquist frequency, if lower) to the Nyquist frequency π/dt."""
+    """``count`` (at least 1) log-spaced frequencies from a tenth of the slowest to ten times
+    the fastest nonzero natural frequency of the modes (0.01 to 100 rad/s when every
+    eigenvalue is zero; at most 1e308). For a discrete model: from a tenth of the slowest
+    natural frequency of s = ln(z)/dt (or a thousandth of the Nyquist frequency, if lower) to
+    the Nyquist frequency π/dt."""
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+        raise InvalidArgumentError(f"count must be a positive integer, got {count!r}")
     model = as_state_space(sys)
     if model.is_discrete:
         nyquist = np.pi / period(model)
@@ -140,11 +145,13 @@ def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> Flo
         magnitudes = np.abs(s[np.isfinite(s)])
         nonzero = magnitudes[magnitudes > 1e-12 * nyquist]
         low = min(nonzero.min() / 10, nyquist / 1000) if nonzero.size else nyquist / 1000
-        return np.logspace(np.log10(low), np.log10(nyquist), count)
-    magnitudes = np.abs(_core.eigenvalues(model.A)) if model.n_states else np.array([])
-    nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
-    low, high = (nonzero.min() / 10, nonzero.max() * 10) if nonzero.size else (0.01, 100.0)
-    return np.logspace(np.log10(low), np.log10(high), count)
+        return np.logspace(np.log10(low), np.log10(nyquist), int(count))
+    _, nonzero = grid_frequencies([model], "the default frequency grid")
+    if nonzero.size == 0:
+        return np.logspace(-2.0, 2.0, int(count))
+    return np.logspace(
+        np.log10(nonzero.min()) - 1, min(np.log10(nonzero.max()) + 1, 308.0), int(count)
+    )
 
 
 def bode(sys: System, omega: ArrayLike | None = None) -> FrequencyResponse:

@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
-from .exceptions import IllConditionedWarning
+from .exceptions import IllConditionedWarning, ShapeError
 from .statespace import as_state_space, is_system, period
 
 if TYPE_CHECKING:
@@ -223,7 +223,7 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
         names = tuple(f"mode {k + 1}" for k in range(count))
     else:
         if len(mode_names) != count:
-            raise ValueError(f"mode_names must name {count} modes, got {len(mode_names)}")
+            raise ShapeError(f"mode_names must name {count} modes, got {len(mode_names)}")
         names = tuple(mode_names)
     singular = bool(result["modal_matrix_is_singular"])
     if singular:

@@ -45,14 +45,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core
-from ._validation import FloatArray, check_choice, finite_or_warn, real_array
+from ._validation import FloatArray, check_choice, check_finite, finite_or_warn, real_array
 from .exceptions import (
     InvalidArgumentError,
     NumericalOverflowWarning,
     ShapeError,
     SingularMatrixError,
 )
-from .statespace import StateSpace, as_state_space, continuous_eigenvalues, is_system, period
+from .statespace import StateSpace, as_state_space, grid_frequencies, is_system, period
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -79,7 +79,8 @@ class TimeResponse:
     """States, outputs and inputs of one or several responses on a uniform time grid.
 
     With a single response ``x`` is (len(t), n); with several, (r, len(t), n), and likewise
-    ``y`` and ``u``. ``u`` is None for free, impulse and doublet responses.
+    ``y`` and ``u`` (r is 0 for the impulse or step responses of a model without inputs).
+    ``u`` is None for free, impulse and doublet responses.
     """
 
     t: FloatArray
@@ -148,13 +149,16 @@ def _systems(sys: Systems) -> tuple[list[StateSpace], bool]:
 
 
 def default_time_grid(sys: Systems) -> FloatArray:
-    """The default grid of the responses (see the module documentation)."""
+    """The default grid of the responses (see the module documentation).
+
+    Raises InvalidArgumentError when an eigenvalue is so large (|λ| > 2e306) that the step
+    1/(20 |λ|) would not be a normal double: give the grid T instead."""
     models, _ = _systems(sys)
     dt = _sampling_period(models)
     if dt > 0.0:
         return _discrete_grid(None, models, dt)[0]
     step, final = _default_step_and_final(models)
-    samples = int(np.ceil(final / step)) + 1
+    samples = min(int(np.ceil(final / step)) + 1, MAX_DEFAULT_SAMPLES)
     return np.linspace(0.0, (samples - 1) * step, samples)
 
 
@@ -175,14 +179,17 @@ def _sampling_period(models: list[StateSpace]) -> float:
 
 
 def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
-    eigenvalues = np.concatenate([continuous_eigenvalues(m) for m in models])
-    eigenvalues = eigenvalues[np.isfinite(eigenvalues)]  # z = 0 of a discrete model
-    magnitudes = np.abs(eigenvalues)
-    nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, float(magnitudes.max(initial=0.0)))]
+    eigenvalues, nonzero = grid_frequencies(models, "the default time grid")
     if nonzero.size == 0:
         return 0.01, 10.0
-    step = 1.0 / (20.0 * nonzero.max())
-    decaying = -eigenvalues.real[eigenvalues.real < -1e-12 * nonzero.max()]
+    fastest = float(nonzero.max())
+    step = 0.05 / fastest  # 1/(20 |λ|max), without overflow in 20 |λ|max
+    if step < np.finfo(np.float64).tiny:
+        raise InvalidArgumentError(
+            f"the default time grid: the fastest mode (|λ| = {fastest:.3g}) needs a step "
+            f"of {step:.3g}, below the normal doubles; give the grid T"
+        )
+    decaying = -eigenvalues.real[eigenvalues.real < -1e-12 * fastest]
     final = 7.0 / decaying.min() if decaying.size else 10.0 / nonzero.min()
     final = max(final, 100 * step)
     if final / step > MAX_DEFAULT_SAMPLES - 1:
@@ -207,7 +214,7 @@ def _grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, fl
         t = np.linspace(0.0, final, samples)
         return t, float(t[1] - t[0])
     step = _core.grid_step(times)
-    return np.array(times, dtype=np.float64), step
+    return times, step
 
 
 #: A grid step within this relative distance of q dt is q dt.
@@ -322,7 +329,7 @@ def _input_weights(eta0: ArrayLike | None, m: int) -> tuple[FloatArray, tuple[st
         weights = weights.reshape(1)
     if weights.ndim != 1 or weights.shape[0] != m:
         raise ShapeError(f"eta0 must have one weight per input ({m}), got shape {weights.shape}")
-    return weights.reshape(1, m), ("eta0",)
+    return check_finite(weights, "eta0").reshape(1, m), ("eta0",)
 
 
 def _assemble(
@@ -335,14 +342,18 @@ def _assemble(
     names: Sequence[str],
     several: bool,
 ) -> TimeResponse:
-    if not several:
+    """The result; x, y and u are (r, len(t), ...) stacks, given as one response unless
+    ``several`` was asked for or there is not exactly one (r = 0: a model without inputs has
+    no impulse or step responses). The result owns its arrays: t and u are copied, since
+    they may be the caller's."""
+    if not several and x.shape[0] == 1:
         x, y = x[0], y[0]
         u = None if u is None else u[0]
     return TimeResponse(
-        t=t,
+        t=np.array(t, dtype=np.float64),
         x=x,
         y=y,
-        u=u,
+        u=None if u is None else np.array(u, dtype=np.float64),
         kind=kind,
         state_names=model.state_names,
         input_names=model.input_names,
@@ -363,7 +374,7 @@ def _free_responses(
     t, step, q = _time_grid(T, models)
     first = models[0]
     if several_models:
-        x0 = np.stack([initial(m)[0] for m in models])
+        x0 = np.stack([_first(initial(m), kind) for m in models])
         x, y = _simulate(models, True, x0, None, None, step, len(t), q)
         model_labels = [f"model {k}" for k in range(len(models))]
         return _assemble(kind, t, x, y, None, first, model_labels, True)
@@ -373,6 +384,19 @@ def _free_responses(
         names if names is not None else [f"response {k}" for k in range(len(x0))]
     )
     return _assemble(kind, t, x, y, None, first, labels, len(x0) > 1)
+
+
+def _first(rows: FloatArray, kind: str) -> FloatArray:
+    """The first row: a list of models has one response per model, from the first input
+    weight (or initial state); there is none for a model without inputs."""
+    if rows.shape[0] == 0:
+        raise ShapeError(
+            f"a list of models has one {kind} response per model, to its first input (or "
+            "from the first initial state); there is none: the models have no inputs, or x0 "
+            "no rows"
+        )
+    first: FloatArray = rows[0]
+    return first
 
 
 def impulse_response(
@@ -521,7 +545,7 @@ def step_response(
             True,
             np.zeros((len(models), first.n_states)),
             None,
-            np.repeat(weights[:1], len(models), axis=0),
+            np.repeat(_first(weights, "step")[np.newaxis], len(models), axis=0),
             step,
             len(t),
             q,

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array, real_scalar
-from .exceptions import InvalidArgumentError, ShapeError
+from .exceptions import InvalidArgumentError, NotRealError, ShapeError
 
 if TYPE_CHECKING:
     from typing_extensions import TypeIs
@@ -261,7 +261,7 @@ def as_state_space(model: System, name: str = "sys") -> StateSpace:
             **names,
             dt=_foreign_period(getattr(model, "dt", None), f"{name}.dt"),
         )
-    raise TypeError(
+    raise NotRealError(
         f"{name} must be a StateSpace, a tuple (A, B) or (A, B, C, D), or an object with A, B, "
         f"C and D attributes, got {type(model).__name__}"
     )
@@ -278,4 +278,30 @@ def plant_pair(
     if isinstance(A_or_sys, (tuple, list)) or is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
         return sys.A, getattr(sys, attribute)
-    raise TypeError(f"give a system or both A and {attribute}")
+    raise NotRealError(f"give a system or both A and {attribute}")
+
+
+def grid_frequencies(
+    models: Sequence[StateSpace], what: str
+) -> tuple[NDArray[np.complex128], FloatArray]:
+    """(eigenvalues, nonzero natural frequencies |λ|) of the models' A (for a discrete model,
+    of its continuous equivalent, s = ln(z)/dt), by aerocontrol's own eigensolver, from which the
+    default time and frequency grids are chosen; |λ| within 1e-12 max(1, |λ|max) of zero
+    counts as zero.
+
+    An eigenvalue whose magnitude overflows double precision gives InvalidArgumentError
+    naming ``what``: no grid of doubles resolves it, and the caller must give the grid."""
+    eigenvalues = np.concatenate(
+        [continuous_eigenvalues(m) for m in models] + [np.zeros(0, dtype=np.complex128)]
+    )
+    # z = 0 of a discrete model (s = -inf) sets no time scale.
+    eigenvalues = eigenvalues[~np.isneginf(eigenvalues.real)]
+    with np.errstate(over="ignore"):
+        magnitudes = np.abs(eigenvalues)
+    if not np.all(np.isfinite(magnitudes)):
+        raise InvalidArgumentError(
+            f"{what}: an eigenvalue of A overflows double precision, so no default grid can "
+            "resolve it; give the grid"
+        )
+    largest = float(magnitudes.max(initial=0.0))
+    return eigenvalues, magnitudes[magnitudes > 1e-12 * max(1.0, largest)]

@@ -1,0 +1,159 @@
+"""Defects of the native core that the property suite found, kept until the Rust is fixed.
+
+Each defect names the public functions it affects and the inputs it concerns: a predicate on
+the canonical arguments, as narrow as the measurements allowed. While it is known, a failed
+check on such an input is counted as ``known defect <key>`` and does not fail the property, so
+that the rest of the property keeps running in CI and in long campaigns. Each defect also has
+a reproduction, a test marked ``xfail(strict=True)`` beside the property that found it
+(``test_known_defect_*``), which runs the minimal input with the allowance switched off: when
+the core is fixed it passes, the strict xfail fails, and the entry here is to be removed.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .harness import Defect, known_defect
+
+
+def _largest(value: Any) -> float:
+    """The largest magnitude in a canonical array argument, 0 if it is none or empty."""
+    array = np.asarray(value, dtype=float) if value is not None else np.zeros(0)
+    return float(np.max(np.abs(array), initial=0.0)) if np.all(np.isfinite(array)) else 0.0
+
+
+def _one_norm(value: Any) -> float:
+    array = np.asarray(value, dtype=float)
+    with np.errstate(over="ignore"):
+        return float(np.max(np.sum(np.abs(array), axis=0), initial=0.0))
+
+
+def _extreme_entries(value: Any) -> bool:
+    """Whether an entry's square overflows (|a| > 1.3e154) or a nonzero entry is below 1e-150
+    (where squares and products of entries leave the normal range)."""
+    array = np.abs(np.asarray(value, dtype=float))
+    if not np.all(np.isfinite(array)):
+        return False
+    return bool(np.any(array > 1.3e154) or np.any((array > 0) & (array < 1e-150)))
+
+
+SCHUR_EXTREME_ENTRIES: Defect = known_defect(
+    "schur-extreme-entries",
+    {"schur", "modes"},
+    "schur(A) mishandles entries whose squares leave the normal range, as if norms were "
+    "formed from unscaled sums of squares: with an entry above about 1.3e154 it returns "
+    "T = A unreduced (not quasi-triangular, Q = I, the diagonal as eigenvalues: wrong from "
+    "about 1e300) without a warning; a nonzero entry below about 2e-162 under the subdiagonal "
+    "is left in T (documented: exact zeros); a matrix of subnormal entries ([[1e-310]]) gives "
+    "NaN with a NumericalOverflowWarning; entries near 1e-151 lose accuracy (backward error "
+    "880 u at n = 5). modes inherits it: for A = 1e-301 [[1.26, -1.32], [6.40, 1.05]] it "
+    "returns the diagonal as the eigenvalues, silently. It should scale, as LAPACK's dnrm2 "
+    "and dlahqr do.",
+    lambda args: _extreme_entries(_plant(args)),
+)
+
+
+def _plant(args: dict[str, Any]) -> Any:
+    """The plant matrix A of a call: the argument A, or the A of a model."""
+    if "A" in args:
+        return args["A"]
+    given = args.get("A_or_sys", args.get("sys"))
+    if isinstance(given, np.ndarray):
+        return given
+    return _model(given)[0]
+
+
+TRANSITION_HUGE_TIMES: Defect = known_defect(
+    "transition-huge-times",
+    {"transition_matrix"},
+    "transition_matrix(A, t) with |t| >= about 1e50 and ||A t|| moderate gives NaN entries "
+    "(with a NumericalOverflowWarning): for A = 0 (n >= 3) and t = 1e155, Φ(t) = I exactly, "
+    "but Φ[0, 2] is NaN; likewise A = -I/t for t = 1e100. The powers of A and of t seem to "
+    "be formed apart, so that 0 * inf appears. It should scale A t as one matrix.",
+    lambda args: _largest(args["t"]) >= 1e50,
+)
+
+
+def _exponent_norm(args: dict[str, Any]) -> float:
+    """max ||A t||_1 over the matrices of A and the times t (or dt; 1 for expm)."""
+    A = np.abs(np.asarray(args["A"], dtype=float))
+    times = np.abs(np.asarray(args.get("t", args.get("dt", 1.0)), dtype=float))
+    with np.errstate(all="ignore"):
+        column_sums = np.sum(A, axis=-2) if A.ndim >= 2 else np.zeros(0)
+        return float(np.max(column_sums, initial=0.0) * np.max(times, initial=0.0))
+
+
+EXPONENTIAL_HUGE_NORM: Defect = known_defect(
+    "exponential-huge-norm",
+    {"expm", "transition_matrix", "discretize"},
+    "Beyond ||A t||_1 >= 2^53, where an IllConditionedWarning says that the rounding of the "
+    "input alone can change every digit, the exponential can be NaN although its exact value "
+    "is finite: expm([[0, 1e50], [-1e50, 0]]) (a rotation, e^A orthogonal) is all NaN, and "
+    "transition_matrix likewise; discretize gives no IllConditionedWarning at all and returns "
+    "Phi = 0 for the rotation [[0, 2e300], [-2e300, 0]] with dt = 0.1, or NaN where the exact "
+    "value is finite (a nilpotent A with entries 1e149, dt = 0.1: -2.39e295). It should not "
+    "produce NaN where nothing overflows, and discretize should warn as expm does.",
+    lambda args: _exponent_norm(args) >= 2.0**52,
+)
+
+
+FREQUENCY_EXTREME_SCALE: Defect = known_defect(
+    "frequency-extreme-scale",
+    {"frequency_response", "bode"},
+    "frequency_response is wrong where squares of the model's entries or of ω leave the "
+    "normal range: for A = [[0.1257]], B = [[1]], G(jω) is 0 from ω = 1e155 on (exact: -1e-155j), "
+    "silently; for A = [[a]] with a >= 1e155 G(0) = 0 (exact -1/a), silently; for A = a "
+    "[[-1, 2], [0, -3]] with a = 1e-160, a G(0) = 1.66669 (exact 5/3), silently, and NaN from "
+    "a = 1e-200; A = [[1e308]] gives NaN with a NumericalOverflowWarning where G(0) = "
+    "-1.26e-306, and B = [[2e300]] with A = [[-1.87e8]], C = [[0.126]] NaN where G is 1.3e291. "
+    "Frequencies below 1e-150 likewise: A = [[0]], B = [[0.126]] gives NaN at ω = 1e-300 "
+    "(exact: -1.26e299j). It should scale the Hessenberg solve (as LAPACK's dlatrs) instead "
+    "of squaring entries.",
+    lambda args: (
+        any(_extreme_entries(matrix) for matrix in _model(args["sys"]))
+        or _extreme_entries(args.get("omega", 1.0))
+    ),
+)
+
+
+def _model(sys: Any) -> tuple[Any, ...]:
+    return (sys.A, sys.B, sys.C, sys.D) if hasattr(sys, "A") else tuple(sys)
+
+
+CONTROLLABILITY_EXTREME_ENTRIES: Defect = known_defect(
+    "controllability-extreme-entries",
+    {"controllability", "observability", "is_controllable", "is_observable"},
+    "The controllability analysis forms norms from unscaled sums of squares. With an entry "
+    "above about 1.3e154 the default tolerance n eps max(||A||_F, ||B||_F) is inf (2.2e292 "
+    "for B = [[1e308]]) and every mode is declared uncontrollable, silently: (A, B) = "
+    "([[0.125]], [[1e308]]) is controllable, and is reported not to be, with tolerance and "
+    "modal_measure inf. With entries below about 1e-160 the norms underflow to 0: "
+    "([[1]], [[1e-170]]) with tol = 0 is reported uncontrollable (modal_measure 0), and "
+    "([[1e-301]], [[1e-301]]) with the default tolerance 2.8e-317 likewise, silently. It "
+    "should scale the norms (as LAPACK's dnrm2).",
+    lambda args: any(_extreme_entries(m) for m in _pair(args)),
+)
+
+
+def _pair(args: dict[str, Any]) -> tuple[Any, Any]:
+    second = args.get("B", args.get("C"))
+    if second is None:
+        model = _model(args["A_or_sys"])
+        return model[0], np.concatenate([np.ravel(m) for m in model[1:]])
+    return args["A_or_sys"], second
+
+
+PLACEMENT_OVERFLOW_BLAMES_A: Defect = known_defect(
+    "placement-overflow-blames-A",
+    {"place", "place_ackermann", "place_bass_gura"},
+    "When a placement overflows inside (the desired polynomial's coefficients for poles "
+    "-1e160 and -2e160; a gain of 1/b for b = [[1e-301]]; A and B with entries near 1e150 "
+    "for place), it raises NonFiniteError 'A must be finite, but A[0, 0] is -inf' (or NaN), "
+    "although A is finite. place_bass_gura says instead 'the controllability matrix of (A, b) "
+    "is numerically singular (condition number 5.21e0)'. The error should name the cause "
+    "(the poles' coefficients or the gain overflow).",
+    lambda args: True,
+    symptom="raised NonFiniteError, but every argument is finite",
+)

@@ -1,0 +1,272 @@
+"""Properties of the controllability and observability matrices and tests
+(aerocontrol.controllability).
+
+Oracles: the Krylov blocks A V_k against numpy's products; the staircase form by its
+definition (Z orthogonal, Z^T A Z and Z^T B, nothing below the staircase but what the rank
+decisions judged negligible, within the tolerance); each mode
+declared uncontrollable by the Popov-Belevitch-Hautus test, sigma_min([A - λI, B]) within the
+tolerance the verdict used; pairs planted exactly uncontrollable declared so; the verdict of
+is_controllable and is_observable equal to that of the full analysis; observability as the
+dual.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import aerocontrol
+
+from . import known_defects
+from .harness import Warned, exercise, plain
+from .oracles import SLACK, TINY, U, assert_spectrum, finite, norm, quietly, silenced
+from .strategies import (
+    canonical,
+    model_matrices,
+    orders,
+    planted_uncontrollable,
+    presented,
+    presented_system,
+    rectangular,
+    scalar,
+    square,
+)
+
+COVERED = {"ctrb", "obsv", "controllability", "observability", "is_controllable", "is_observable"}
+
+TOLERANCES = st.sampled_from((None, None, None, 0.0, 1e-8, 1e-3, 1e300, -1.0, np.nan))
+METHODS = st.sampled_from(("full", "full", "staircase", "modal"))
+
+
+def _pair(args: dict[str, Any], second: str) -> tuple[np.ndarray, np.ndarray]:
+    """(A, B) or (A, C) from A_or_sys and the second matrix, canonical."""
+    given_ = args["A_or_sys"]
+    other = args.get(second)
+    if other is None:  # a model (a tuple)
+        A, other = given_[0], given_[1]
+    else:
+        A = given_
+    A, other = np.asarray(A, float), np.asarray(other, float)
+    return A, other.reshape(-1, 1) if other.ndim == 1 and second == "B" else other
+
+
+def _krylov_oracle(dual: bool) -> Any:
+    def oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        A = np.asarray(args["A"], float)
+        X = np.asarray(args["C" if dual else "B"], float)
+        if dual:  # [C; CA; ...] is the transpose of the controllability matrix of (A^T, C^T)
+            A, X, result = A.T, X.T, result.T
+        n, m = X.shape
+        assert result.shape == (n, n * m)
+        if n:
+            assert np.array_equal(result[:, :m], X), "the first block is B (C)"
+        for k in range(1, n):
+            previous, block = result[:, (k - 1) * m : k * m], result[:, k * m : (k + 1) * m]
+            with silenced():
+                expected = A @ previous
+                bound = SLACK * n * (U * norm(A) * norm(previous) + TINY)
+            if finite(expected, block) and np.isfinite(bound):
+                assert norm(block - expected) <= bound, f"block {k} is not A times block {k - 1}"
+
+    return oracle
+
+
+@given(st.data())
+def test_ctrb_and_obsv(data: st.DataObject) -> None:
+    n, m = data.draw(orders()), data.draw(st.integers(0, 3))
+    A = data.draw(square(n))
+    dual = data.draw(st.booleans())
+    X = data.draw(rectangular(m, n) if dual else rectangular(n, m))
+    name, key = ("obsv", "C") if dual else ("ctrb", "B")
+    exercise(
+        name,
+        getattr(aerocontrol, name),
+        {"A": data.draw(presented(A)), key: data.draw(presented(X))},
+        _krylov_oracle(dual),
+    )
+
+
+def _pbh_distance(A: np.ndarray, X: np.ndarray, eigenvalue: complex) -> float:
+    """sigma_min([A - λI, X]): how far (A, X) is from having λ as an uncontrollable mode."""
+    n = A.shape[0]
+    stacked = np.hstack([A - eigenvalue * np.eye(n), X]).astype(complex)
+    return float(np.linalg.svd(stacked, compute_uv=False)[-1]) if n else 0.0
+
+
+def _analysis_oracle(dual: bool, planted: bool) -> Any:
+    def oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        A, X = _pair(args, "C" if dual else "B")
+        if dual:
+            A, X = A.T, X.T
+        n = A.shape[0]
+        assert result.kind == ("observability" if dual else "controllability")
+        assert result.controllable == (len(result.uncontrollable_eigenvalues) == 0)
+        tol = result.tolerance
+        if args["tol"] is None:  # n ε max(||A||_F, ||B||_F), ε = 2u
+            with silenced():
+                default = n * 2 * U * max(norm(A), norm(X))
+            assert abs(tol - default) <= 8 * U * default, f"tolerance {tol}, not {default}"
+        else:
+            assert tol == float(args["tol"])
+        # The staircase: Z orthogonal, Z^T A Z and Z^T B (transposed for observability), exact
+        # zeros below the steps and under the controllable part.
+        SA, SB, Z = result.staircase_A, result.staircase_B, result.Z
+        if dual:
+            SA, SB = SA.T, SB.T
+        order = result.controllable_order
+        assert sum(result.block_sizes) == order <= n
+        assert Z.shape == (n, n) and SA.shape == (n, n) and SB.shape == X.shape
+        if finite(A, X, Z, SA, SB):
+            with silenced():
+                size = norm(A) + norm(X)
+            assert norm(Z.T @ Z - np.eye(n)) <= SLACK * n * U, "Z is not orthogonal"
+            assert norm(Z.T @ A @ Z - SA) <= SLACK * n * (U * size + TINY), "Z^T A Z"
+            assert norm(Z.T @ X - SB) <= SLACK * n * (U * size + TINY), "Z^T B"
+        # Below the steps: only what the rank decisions judged negligible (norm <= tol).
+        first = result.block_sizes[0] if result.block_sizes else 0
+        negligible = tol * (1 + SLACK * U) + SLACK * n * TINY
+        if finite(SB, SA):
+            assert norm(SB[first:]) <= negligible, "Z^T B is not zero below its first block"
+            assert norm(SA[order:, :order]) <= negligible, "the uncontrollable part is coupled"
+        offsets = np.concatenate([[0], np.cumsum(result.block_sizes)]).astype(int)
+        for j, size_j in enumerate(result.block_sizes):
+            below = offsets[min(j + 2, len(offsets) - 1)]
+            block = SA[below:order, offsets[j] : offsets[j] + size_j]
+            if finite(block):
+                assert norm(block) <= negligible, f"not a staircase under block {j}"
+        # Each mode declared unreachable is within about tol of being exactly so (PBH).
+        for eigenvalue in result.uncontrollable_eigenvalues:
+            if finite(A, X):
+                distance = _pbh_distance(A, X, complex(eigenvalue))
+                bound = SLACK * max(n, 1) * (tol + U * (norm(A) + norm(X)) + TINY)
+                assert distance <= bound, f"{eigenvalue} is reachable: PBH distance {distance:.2e}"
+        assert len(result.uncontrollable_eigenvalues) >= n - order
+        if args["method"] == "full":
+            assert_spectrum(A, result.eigenvalues, "the eigenvalues of the modal test")
+            assert result.modal_measure.shape == (n,)
+            if planted and finite(A, X) and args["tol"] is None:
+                assert not result.controllable, "an exactly uncontrollable pair was passed"
+        # The verdict alone is the same.
+        alone = quietly(
+            getattr(aerocontrol, "is_observable" if dual else "is_controllable"),
+            args["A_or_sys"],
+            args.get("C" if dual else "B"),
+            tol=args["tol"],
+            method=args["method"],
+        )
+        assert alone == result.controllable, "is_controllable disagrees with controllability"
+        assert isinstance(str(result), str)
+
+    return oracle
+
+
+def _verdict_oracle(dual: bool, planted: bool) -> Any:
+    def oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        assert type(result) is bool
+        full = quietly(
+            getattr(aerocontrol, "observability" if dual else "controllability"),
+            args["A_or_sys"],
+            args.get("C" if dual else "B"),
+            tol=args["tol"],
+            method=args["method"],
+        )
+        assert result == full.controllable
+        if planted and args["method"] == "full" and args["tol"] is None:
+            A, X = _pair(args, "C" if dual else "B")
+            if finite(A, X):
+                assert not result, "an exactly uncontrollable pair was passed"
+
+    return oracle
+
+
+@given(st.data())
+def test_controllability_and_observability(data: st.DataObject) -> None:
+    n, m = data.draw(orders()), data.draw(st.integers(0, 3))
+    planted = data.draw(st.booleans())
+    if planted:
+        A, X, _ = data.draw(planted_uncontrollable(n, m))
+        n = A.shape[0]
+    else:
+        A, X = data.draw(square(n)), data.draw(rectangular(n, m))
+    dual = data.draw(st.booleans())
+    if dual:
+        A, X = A.T.copy(), X.T.copy()
+    verdict_only = data.draw(st.booleans())
+    name = {
+        (False, False): "controllability",
+        (True, False): "observability",
+        (False, True): "is_controllable",
+        (True, True): "is_observable",
+    }[(dual, verdict_only)]
+    key = "C" if dual else "B"
+    if data.draw(st.sampled_from((False, False, True))):
+        arguments = {
+            "A_or_sys": data.draw(presented_system((A, X.T if dual else X))),
+            key: plain(None),
+        }
+        if dual:  # a model (A, B) gives C = I to observability; pass (A, B, C, D) instead
+            p = X.shape[0]
+            model = (A, np.zeros((A.shape[0], 1)), X, np.zeros((p, 1)))
+            arguments = {"A_or_sys": data.draw(presented_system(model)), key: plain(None)}
+    else:
+        arguments = {"A_or_sys": data.draw(presented(A)), key: data.draw(presented(X))}
+    tol = data.draw(TOLERANCES)
+    arguments["tol"] = plain(tol, finite=False) if tol is None else data.draw(scalar(tol))
+    arguments["method"] = plain(data.draw(METHODS))
+    oracle = (_verdict_oracle if verdict_only else _analysis_oracle)(dual, planted)
+    outcome = exercise(
+        name,
+        getattr(aerocontrol, name),
+        arguments,
+        _through_models(oracle, key),
+        nonfinite_by_definition=("smallest_pivot",),  # inf when no pivot was accepted
+    )
+    if arguments["method"].value == "modal" or (tol is not None and not tol >= 0):
+        assert outcome.error is not None, f"method {arguments['method'].value}, tol {tol}"
+
+
+def _through_models(oracle: Any, key: str) -> Any:
+    """The oracle, with a model argument unpacked into A and B (or A and C)."""
+
+    def unpacked(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        if args.get(key) is None:
+            A, B, C, _ = model_matrices(args["A_or_sys"])
+            args = {**args, "A_or_sys": A, key: C if key == "C" else B}
+        oracle(result, args, warned)
+
+    return unpacked
+
+
+# ----- known defects of the core (see known_defects.py) ------------------------------------------
+
+
+CONTROLLABLE_EXTREME_PAIRS = {
+    "huge": (np.array([[0.125]]), np.array([[1e308]]), None),
+    "tiny": (np.array([[1.0]]), np.array([[1e-170]]), 0.0),
+}
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.CONTROLLABILITY_EXTREME_ENTRIES.summary)
+@pytest.mark.parametrize("example", CONTROLLABLE_EXTREME_PAIRS)
+def test_known_defect_controllability_extreme_entries(example: str) -> None:
+    A, B, tol = CONTROLLABLE_EXTREME_PAIRS[example]
+    with known_defects.CONTROLLABILITY_EXTREME_ENTRIES.reproducing():
+        outcome = exercise(
+            "controllability",
+            aerocontrol.controllability,
+            {
+                "A_or_sys": canonical(A),
+                "B": canonical(B),
+                "tol": plain(tol),
+                "method": plain("full"),
+            },
+            _through_models(_analysis_oracle(False, False), "B"),
+            nonfinite_by_definition=("smallest_pivot",),
+        )
+        # Both pairs are controllable in exact arithmetic and far from any uncontrollable one
+        # relative to their tolerance.
+        assert outcome.result.controllable, "a controllable pair was declared uncontrollable"

@@ -1,0 +1,176 @@
+"""Properties of the frequency response (aerocontrol.frequency).
+
+Oracles: G(jω) = C (jωI - A)^-1 B + D by numpy's complex solve at each frequency, within the
+solve's conditioning; bode as frequency_response on the default grid, bitwise; the default
+grid's definition.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import aerocontrol
+
+from . import known_defects
+from .harness import Arg, Warned, exercise, plain
+from .oracles import SLACK, TINY, U, finite, norm, quietly, silenced
+from .oracles import condition as condition_number
+from .strategies import (
+    ALL_PRESENTATIONS,
+    model_matrices,
+    orders,
+    presented,
+    presented_system,
+    system,
+)
+
+COVERED = {"frequency_response", "bode", "default_frequency_grid"}
+
+#: Frequencies, with the imaginary-axis poles of the "imaginary axis" plants (1, 2, 3 rad/s).
+FREQUENCIES = (0.0, 0.1, 1.0, 2.0, 3.0, 0.5, 10.0, 1e3, 1e-300, 1e300, -1.0, np.inf, np.nan)
+
+
+def _check_response(
+    result: Any, A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray
+) -> None:
+    """G(jω) against a complex solve: the computed response is that of a model within
+    n u ||jωI - A|| of the given one, so it may differ from the exact by
+    cond(jωI - A) n u ||C|| ||X|| (X = (jωI - A)^-1 B); frequencies nearer a pole than that
+    are skipped."""
+    n = A.shape[0]
+    omega = result.omega
+    assert result.response.shape == (len(omega), C.shape[0], B.shape[1])
+    assert result.response.dtype == np.complex128
+    for k, w in enumerate(omega):
+        M = 1j * w * np.eye(n) - A
+        condition = condition_number(M)
+        if not np.isfinite(condition) or condition * U > 1e-3:
+            continue
+        with silenced():
+            X = np.linalg.solve(M, B.astype(complex)) if n else np.zeros((0, B.shape[1]))
+            expected = C @ X + D
+        if not finite(expected) or np.max(np.abs(expected), initial=0.0) > 1e300:
+            continue  # near or beyond overflow: the harness checks the warning
+        got = result.response[k]
+        assert finite(got), f"NaN or Inf at ω = {w}, where G is finite (cond {condition:.2e})"
+        with silenced():
+            bound = SLACK * max(n, 1) * (U * (condition * norm(C) * norm(X) + norm(D)) + TINY)
+        if not np.isfinite(bound):
+            continue  # C X overflows in the reference: no measure of the error
+        error = norm(got - expected)
+        assert error <= bound, f"G(j{w}): error {error:.3e} exceeds {bound:.3e}"
+    # The derived quantities exist for any response.
+    with silenced():
+        assert result.magnitude_db.shape == result.phase_deg.shape == result.response.shape
+    assert isinstance(str(result), str)
+
+
+def _frequency_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    omega = np.atleast_1d(np.asarray(args["omega"], float))
+    assert np.array_equal(result.omega, omega), "omega is not the frequencies given"
+    _check_response(result, *model_matrices(args["sys"]))
+
+
+@st.composite
+def frequencies(draw: st.DrawFn) -> Arg:
+    shape = draw(st.sampled_from(("vector", "vector", "vector", "scalar", "empty", "2-D")))
+    values = np.array([draw(st.sampled_from(FREQUENCIES)) for _ in range(4)])
+    if shape == "scalar":
+        return plain(float(values[0]))
+    array = {"vector": values, "empty": values[:0], "2-D": values.reshape(2, 2)}[shape]
+    return draw(presented(array))
+
+
+@given(st.data())
+def test_frequency_response(data: st.DataObject) -> None:
+    n, m, p = data.draw(orders()), data.draw(st.integers(0, 3)), data.draw(st.integers(0, 3))
+    matrices = data.draw(system(n, m, p))
+    pair = data.draw(st.sampled_from((False, False, True)))
+    exercise(
+        "frequency_response",
+        aerocontrol.frequency_response,
+        {
+            "sys": data.draw(presented_system(matrices[:2] if pair else matrices)),
+            "omega": data.draw(frequencies()),
+        },
+        _frequency_oracle,
+    )
+
+
+def _bode_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    omega = args["omega"]
+    if omega is None:
+        omega = quietly(aerocontrol.default_frequency_grid, args["sys"])
+    direct = quietly(aerocontrol.frequency_response, args["sys"], omega)
+    assert np.array_equal(result.omega, direct.omega)
+    assert np.array_equal(result.response, direct.response, equal_nan=True)
+    _check_response(result, *model_matrices(args["sys"]))
+
+
+@given(st.data())
+def test_bode(data: st.DataObject) -> None:
+    n, m, p = data.draw(orders()), data.draw(st.integers(0, 2)), data.draw(st.integers(0, 2))
+    matrices = data.draw(system(n, m, p))
+    omega = plain(None) if data.draw(st.booleans()) else data.draw(frequencies())
+    exercise(
+        "bode",
+        aerocontrol.bode,
+        {"sys": data.draw(presented_system(matrices)), "omega": omega},
+        _bode_oracle,
+    )
+
+
+def _grid_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    A = model_matrices(args["sys"])[0]
+    count = args["count"]
+    assert result.shape == (count,) and finite(result) and np.all(result > 0)
+    assert np.all(np.diff(result) >= 0), "not increasing"
+    with silenced():
+        magnitudes = np.abs(np.linalg.eigvals(A)) if len(A) else np.zeros(0)
+        nonzero = magnitudes[magnitudes > 1e-12 * max(1.0, magnitudes.max(initial=0.0))]
+        low, high = (nonzero.min() / 10, nonzero.max() * 10) if nonzero.size else (0.01, 100.0)
+    # numpy's and the grid's eigenvalues agree to their backward error, far within 1e-6.
+    assert abs(result[0] / low - 1) < 1e-6, f"starts at {result[0]}, not {low}"
+    if count > 1:
+        assert abs(result[-1] / min(high, 1e308) - 1) < 1e-6, f"ends at {result[-1]}"
+
+
+@given(st.data())
+def test_default_frequency_grid(data: st.DataObject) -> None:
+    matrices = data.draw(system(data.draw(orders()), 1, 1))
+    count = data.draw(st.sampled_from((1000, 1, 2, 17, 0, -3, 2.5, True)))
+    outcome = exercise(
+        "default_frequency_grid",
+        aerocontrol.default_frequency_grid,
+        {"sys": data.draw(presented_system(matrices, ALL_PRESENTATIONS)), "count": plain(count)},
+        _grid_oracle,
+    )
+    if count in (0, -3, 2.5) or count is True:
+        assert outcome.error is not None, f"count={count!r} was accepted"
+
+
+# ----- known defects of the core (see known_defects.py) ------------------------------------------
+
+FREQUENCY_EXAMPLES = {
+    "huge frequency": ((np.array([[0.1257]]), np.array([[1.0]])), [1e200]),
+    "huge A": ((np.array([[1e200]]), np.array([[1.0]])), [0.0]),
+    "tiny A": ((1e-160 * np.array([[-1.0, 2.0], [0.0, -3.0]]), np.ones((2, 1))), [0.0]),
+}
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.FREQUENCY_EXTREME_SCALE.summary)
+@pytest.mark.parametrize("example", FREQUENCY_EXAMPLES)
+def test_known_defect_frequency_extreme_scale(example: str) -> None:
+    sys, omega = FREQUENCY_EXAMPLES[example]
+    with known_defects.FREQUENCY_EXTREME_SCALE.reproducing():
+        exercise(
+            "frequency_response",
+            aerocontrol.frequency_response,
+            {"sys": plain(sys), "omega": plain(omega)},
+            _frequency_oracle,
+        )
