@@ -12,6 +12,7 @@ importing python-control); :func:`as_state_space` does the conversion.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, cast
 
@@ -20,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array, real_scalar
-from .exceptions import InvalidArgumentError, NotRealError, ShapeError
+from .exceptions import InvalidArgumentError, NotRealError, NumericalOverflowWarning, ShapeError
 
 if TYPE_CHECKING:
     from typing_extensions import TypeIs
@@ -291,9 +292,12 @@ def grid_frequencies(
 
     An eigenvalue whose magnitude overflows double precision gives InvalidArgumentError
     naming ``what``: no grid of doubles resolves it, and the caller must give the grid."""
-    eigenvalues = np.concatenate(
-        [continuous_eigenvalues(m) for m in models] + [np.zeros(0, dtype=np.complex128)]
-    )
+    with warnings.catch_warnings():
+        # An eigenvalue that overflows is refused below, by name.
+        warnings.simplefilter("ignore", NumericalOverflowWarning)
+        eigenvalues = np.concatenate(
+            [continuous_eigenvalues(m) for m in models] + [np.zeros(0, dtype=np.complex128)]
+        )
     # z = 0 of a discrete model (s = -inf) sets no time scale.
     eigenvalues = eigenvalues[~np.isneginf(eigenvalues.real)]
     with np.errstate(over="ignore"):
