@@ -19,7 +19,9 @@ const SMALL_ENTRY: f64 = 1.0e-150;
 pub(crate) fn range_scale(a: MatRef<'_, f64>) -> f64 {
     let largest = max_abs(a);
     if largest > 0.0 && !(SMALL_ENTRY..=1.0 / SMALL_ENTRY).contains(&largest) {
-        2f64.powi(largest.log2().round() as i32)
+        // 2^±1000 at most: 2^-1074 (the smallest subnormal) would be 1 / 2^1074 = 1 / inf = 0,
+        // and a division by it NaN everywhere; 2^1000 brings any entry into range.
+        2f64.powi((largest.log2().round() as i32).clamp(-1000, 1000))
     } else {
         1.0
     }

@@ -13,10 +13,12 @@ pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
     if x[1..].iter().all(|v| *v == 0.0) {
         return (alpha, 0.0);
     }
-    let largest = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if !largest.is_finite() {
+    // A NaN or infinite entry has no reflector (and max would skip a NaN): the identity, and
+    // the caller's own checks see the non-finite entry.
+    if !x.iter().all(|v| v.is_finite()) {
         return (alpha, 0.0);
     }
+    let largest = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if !(RANGE_LOW..=RANGE_HIGH).contains(&largest) {
         // The reflector depends only on the direction of x: compute it for x times a power of
         // two (exact; 2^±1000 at most, so that one step brings any finite x into range) and
@@ -49,6 +51,18 @@ const RANGE_HIGH: f64 = 3.273390607896142e150; // 2^500
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn non_finite_vectors_give_the_identity() {
+        for x in [
+            [f64::NAN, 1e-320, 0.0],
+            [0.0, f64::NAN, 0.0],
+            [1.0, f64::INFINITY, 1.0],
+        ] {
+            let mut y = x;
+            assert_eq!(reflector(&mut y).1, 0.0);
+        }
+    }
 
     #[test]
     fn tiny_and_huge_tails_are_annihilated() {
