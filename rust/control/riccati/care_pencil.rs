@@ -19,9 +19,9 @@
 //! closed loop (A - B K, E) with K = R^-1 (B^T X E + S^T) stable to working precision; the
 //! relative residual and rcond(E U11) are reported.
 
-use super::care::{AXIS_TOLERANCE, Care, CareOptions, symmetric};
-use super::pencil::{compress, graph_solution};
-use crate::error::{Error, check_finite, check_rows, check_square};
+use super::care::{AXIS_TOLERANCE, Care, CareOptions};
+use super::pencil::{checked_weights, compress, graph_solution};
+use crate::error::Error;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::{frobenius_norm, one_norm};
 use crate::linalg::qz::{generalized_eigenvalues, qz, reorder_qz};
@@ -35,18 +35,8 @@ pub(crate) fn solve_care_indefinite(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<Care, Error> {
-    check_square(a, "A")?;
-    check_finite(a, "A")?;
-    let n = a.nrows();
-    check_rows(b, "B", n, "A")?;
-    check_finite(b, "B")?;
-    let m = b.ncols();
-    let q = symmetric(q, "Q", n, "A")?.to_mat();
-    let r = symmetric(r, "R", m, "the columns of B")?.to_mat();
-    if let Some(s) = options.s {
-        check_rows(s, "S", n, "A")?;
-        check_finite(s, "S")?;
-    }
+    let (q, r) = checked_weights(a, b, q, r, options.s, options.e)?;
+    let (n, m) = (a.nrows(), b.ncols());
     // R must be invertible (the gain is R^-1 (B^T X E + S^T)).
     let r_norm = one_norm(r.as_ref());
     let r_inverse = solve_with_inverse(r.clone().as_mut(), Mat::<f64>::zeros(m, 0).as_ref());
@@ -61,15 +51,7 @@ pub(crate) fn solve_care_indefinite(
         });
     }
     let identity = Mat::<f64>::identity(n, n);
-    let e = match options.e {
-        Some(e) => {
-            check_square(e, "E")?;
-            check_rows(e, "E", n, "A")?;
-            check_finite(e, "E")?;
-            e
-        }
-        None => identity.as_ref(),
-    };
+    let e = options.e.unwrap_or(identity.as_ref());
     crate::platform::memory::reserve((2 * n + m).pow(2).saturating_mul(8 * 8))?;
     let size = 2 * n + m;
     let mut big_m = Mat::<f64>::zeros(size, size);

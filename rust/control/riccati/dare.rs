@@ -49,9 +49,8 @@
 //! R need not be positive definite (only symmetric): indefinite weights, as the H-infinity
 //! equations have, are solved where a stabilising solution exists.
 
-use super::care::symmetric;
-use super::pencil::{compress, graph_solution, symmetrize};
-use crate::error::{Error, check_finite, check_rows, check_square};
+use super::pencil::{checked_weights, compress, graph_solution, symmetrize};
+use crate::error::Error;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::{frobenius_norm, one_norm};
 use crate::linalg::qz::{generalized_eigenvalues, qz, reorder_qz};
@@ -107,37 +106,10 @@ pub fn solve_dare(
     r: MatRef<'_, f64>,
     options: DareOptions<'_>,
 ) -> Result<Dare, Error> {
-    check_square(a, "A")?;
-    check_finite(a, "A")?;
-    let n = a.nrows();
-    check_rows(b, "B", n, "A")?;
-    check_finite(b, "B")?;
-    let m = b.ncols();
-    let q = symmetric(q, "Q", n, "A")?.to_mat();
-    let r = symmetric(r, "R", m, "the columns of B")?.to_mat();
-    if let Some(s) = options.s {
-        check_rows(s, "S", n, "A")?;
-        check_finite(s, "S")?;
-        if s.ncols() != m {
-            return Err(Error::Mismatch {
-                arg: "S",
-                what: "columns",
-                expected: m,
-                other: "B",
-                got: s.ncols(),
-            });
-        }
-    }
+    let (q, r) = checked_weights(a, b, q, r, options.s, options.e)?;
+    let (n, m) = (a.nrows(), b.ncols());
     let identity = Mat::<f64>::identity(n, n);
-    let e = match options.e {
-        Some(e) => {
-            check_square(e, "E")?;
-            check_rows(e, "E", n, "A")?;
-            check_finite(e, "E")?;
-            e
-        }
-        None => identity.as_ref(),
-    };
+    let e = options.e.unwrap_or(identity.as_ref());
     if n == 0 {
         return Ok(Dare {
             x: Mat::zeros(0, 0),

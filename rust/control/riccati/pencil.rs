@@ -1,6 +1,6 @@
 //! The pieces of the extended-pencil Riccati solvers ([`super::dare`], and [`super::care`] with
-//! an indefinite R): the compression of a pencil's input columns, and the solution X from a
-//! deflating subspace.
+//! an indefinite R): their argument checks, the compression of a pencil's input columns, and
+//! the solution X from a deflating subspace.
 //!
 //! An extended pencil M - λ N of order 2n + m whose last m columns belong to the input u is
 //! compressed to order 2n by the QR factorisation of M's last m columns, M_u = W [R_u; 0]:
@@ -8,6 +8,8 @@
 //! pencil with the same finite eigenvalues and the same deflating subspaces in (x, λ) (Van
 //! Dooren 1981). It needs no inverse of R, so R may be indefinite or ill-conditioned.
 
+use super::care::symmetric;
+use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::householder::reflector;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::one_norm;
@@ -74,6 +76,46 @@ pub(crate) fn graph_solution(
     let mut x = xt.transpose().to_owned();
     symmetrize(&mut x);
     Some((x, rcond))
+}
+
+/// The checks shared by the pencil solvers: A square and finite, B finite with n rows, Q and R
+/// finite and symmetric (to [`super::care::SYMMETRY_TOLERANCE`]), S finite n x m and E finite
+/// n x n when given. Returns Q and R symmetrised.
+pub(crate) fn checked_weights(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    s: Option<MatRef<'_, f64>>,
+    e: Option<MatRef<'_, f64>>,
+) -> Result<(Mat<f64>, Mat<f64>), Error> {
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    let n = a.nrows();
+    check_rows(b, "B", n, "A")?;
+    check_finite(b, "B")?;
+    let m = b.ncols();
+    let q = symmetric(q, "Q", n, "A")?.to_mat();
+    let r = symmetric(r, "R", m, "the columns of B")?.to_mat();
+    if let Some(s) = s {
+        check_rows(s, "S", n, "A")?;
+        check_finite(s, "S")?;
+        if s.ncols() != m {
+            return Err(Error::Mismatch {
+                arg: "S",
+                what: "columns",
+                expected: m,
+                other: "B",
+                got: s.ncols(),
+            });
+        }
+    }
+    if let Some(e) = e {
+        check_square(e, "E")?;
+        check_rows(e, "E", n, "A")?;
+        check_finite(e, "E")?;
+    }
+    Ok((q, r))
 }
 
 /// X <- (X + X^T) / 2.
