@@ -69,6 +69,10 @@ def expm(A: ArrayLike) -> FloatArray:
         ``A`` contains NaN or an infinity (the message names the entry).
     NotRealError
         ``A`` is complex.
+    IllConditionedError
+        e^A could not be computed in double precision although it does not overflow: the
+        squarings that a norm beyond 2^53 needs amplified rounding until it overflowed (a
+        rotation by 1e50 rad). NaN is never returned for such a matrix.
 
     Examples
     --------
@@ -100,6 +104,12 @@ def transition_matrix(A: ArrayLike, t: ArrayLike) -> FloatArray:
     Returns
     -------
     ndarray of float64, shape (n, n) for a scalar ``t``, else (k, n, n)
+        Overflow and ill-conditioning are reported as by :func:`expm`.
+
+    Raises
+    ------
+    IllConditionedError
+        As :func:`expm`, for a time at which e^{At} could not be computed.
 
     Examples
     --------

@@ -9,7 +9,7 @@ use crate::control::discretize::{
     inverse_bilinear as inverse_bilinear_core, undiscretize_zoh as undiscretize_zoh_core,
 };
 use crate::error::{Error, check_square};
-use crate::linalg::expm::{expm_into, pade_choice, transition_matrices_into};
+use crate::linalg::expm::{ILL_CONDITIONED_NORM, expm_into, pade_choice, transition_matrices_into};
 use crate::linalg::norm::one_norm;
 use crate::linalg::qz::{
     GeneralizedEigenvalue, generalized_eigenvalues, qz as qz_core, reorder_qz,
@@ -31,10 +31,6 @@ pub fn expm_flops(n: usize) -> f64 {
 
 /// Temporaries of one exponential: the powers, the Padé terms, the LU factors.
 const EXPM_TEMPORARIES: f64 = 24.0;
-
-/// 2^53 = 1/u: at ||tA|| beyond it the exponential's relative condition number (at least
-/// ||tA||_2) times u exceeds 1, so the rounding of the input alone can change every digit.
-const ILL_CONDITIONED_NORM: f64 = 9_007_199_254_740_992.0;
 
 /// Warns when ||A||_1 max|t| makes e^{At} meaningless in double precision.
 fn warn_if_ill_conditioned(py: Python<'_>, a_norm: f64, t_max: f64) -> PyResult<()> {

@@ -105,8 +105,8 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
                 expm_into_validated(
                     stack.get(index),
                     MatMut::from_row_major_slice_mut(chunk, n, n),
-                );
-                Ok(())
+                )
+                .map_err(|e| Error::in_batch(index, e))
             })
         })
 }

@@ -9,10 +9,12 @@ use faer::MatRef;
 
 /// Entries of the largest magnitude outside [`SMALL_ENTRY`], 1 / [`SMALL_ENTRY`] are brought
 /// to 1 first (as LAPACK's dgees scales): the deflation tests compare entries with the
-/// smallest normal number, so a matrix whose entries are all below about 1e-290 would
-/// otherwise count as negligible everywhere and come back as a wrong Schur form (residual
-/// 0.7), and one near the overflow threshold would overflow in the shifts.
-const SMALL_ENTRY: f64 = 1.0e-150;
+/// smallest normal number and the eigensolvers square entries and multiply pairs of them, so
+/// a matrix whose entries are all below about 1e-146 (where a product of two entries, times
+/// 1 / u, is no longer a normal number) would count as negligible in places and come back
+/// with wrong eigenvalues or eigenvectors, and one whose squares overflow would overflow in
+/// the shifts. 2^-100 leaves a margin of 2^100 on both sides for the n-term sums of products.
+const SMALL_ENTRY: f64 = 7.888_609_052_210_118e-31; // 2^-100
 
 /// The power of two by which `a` is divided before its Schur form, 1 when its largest entry
 /// is in range (the scaling is exact, and A = Z (s T) Z^T with the same Z).

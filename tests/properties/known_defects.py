@@ -18,12 +18,6 @@ import numpy as np
 from .harness import Defect, known_defect
 
 
-def _largest(value: Any) -> float:
-    """The largest magnitude in a canonical array argument, 0 if it is none or empty."""
-    array = np.asarray(value, dtype=float) if value is not None else np.zeros(0)
-    return float(np.max(np.abs(array), initial=0.0)) if np.all(np.isfinite(array)) else 0.0
-
-
 def _one_norm(value: Any) -> float:
     array = np.asarray(value, dtype=float)
     with np.errstate(over="ignore"):
@@ -37,66 +31,6 @@ def _extreme_entries(value: Any) -> bool:
     if not np.all(np.isfinite(array)):
         return False
     return bool(np.any(array > 1.3e154) or np.any((array > 0) & (array < 1e-150)))
-
-
-SCHUR_EXTREME_ENTRIES: Defect = known_defect(
-    "schur-extreme-entries",
-    {"schur", "modes"},
-    "schur(A) mishandles entries whose squares leave the normal range, as if norms were "
-    "formed from unscaled sums of squares: with an entry above about 1.3e154 it returns "
-    "T = A unreduced (not quasi-triangular, Q = I, the diagonal as eigenvalues: wrong from "
-    "about 1e300) without a warning; a nonzero entry below about 2e-162 under the subdiagonal "
-    "is left in T (documented: exact zeros); a matrix of subnormal entries ([[1e-310]]) gives "
-    "NaN with a NumericalOverflowWarning; entries near 1e-151 lose accuracy (backward error "
-    "880 u at n = 5). modes inherits it: for A = 1e-301 [[1.26, -1.32], [6.40, 1.05]] it "
-    "returns the diagonal as the eigenvalues, silently. It should scale, as LAPACK's dnrm2 "
-    "and dlahqr do.",
-    lambda args: _extreme_entries(_plant(args)),
-)
-
-
-def _plant(args: dict[str, Any]) -> Any:
-    """The plant matrix A of a call: the argument A, or the A of a model."""
-    if "A" in args:
-        return args["A"]
-    given = args.get("A_or_sys", args.get("sys"))
-    if isinstance(given, np.ndarray):
-        return given
-    return _model(given)[0]
-
-
-TRANSITION_HUGE_TIMES: Defect = known_defect(
-    "transition-huge-times",
-    {"transition_matrix"},
-    "transition_matrix(A, t) with |t| >= about 1e50 and ||A t|| moderate gives NaN entries "
-    "(with a NumericalOverflowWarning): for A = 0 (n >= 3) and t = 1e155, Φ(t) = I exactly, "
-    "but Φ[0, 2] is NaN; likewise A = -I/t for t = 1e100. The powers of A and of t seem to "
-    "be formed apart, so that 0 * inf appears. It should scale A t as one matrix.",
-    lambda args: _largest(args["t"]) >= 1e50,
-)
-
-
-def _exponent_norm(args: dict[str, Any]) -> float:
-    """max ||A t||_1 over the matrices of A and the times t (or dt; 1 for expm)."""
-    A = np.abs(np.asarray(args["A"], dtype=float))
-    times = np.abs(np.asarray(args.get("t", args.get("dt", 1.0)), dtype=float))
-    with np.errstate(all="ignore"):
-        column_sums = np.sum(A, axis=-2) if A.ndim >= 2 else np.zeros(0)
-        return float(np.max(column_sums, initial=0.0) * np.max(times, initial=0.0))
-
-
-EXPONENTIAL_HUGE_NORM: Defect = known_defect(
-    "exponential-huge-norm",
-    {"expm", "transition_matrix", "discretize"},
-    "Beyond ||A t||_1 >= 2^53, where an IllConditionedWarning says that the rounding of the "
-    "input alone can change every digit, the exponential can be NaN although its exact value "
-    "is finite: expm([[0, 1e50], [-1e50, 0]]) (a rotation, e^A orthogonal) is all NaN, and "
-    "transition_matrix likewise; discretize gives no IllConditionedWarning at all and returns "
-    "Phi = 0 for the rotation [[0, 2e300], [-2e300, 0]] with dt = 0.1, or NaN where the exact "
-    "value is finite (a nilpotent A with entries 1e149, dt = 0.1: -2.39e295). It should not "
-    "produce NaN where nothing overflows, and discretize should warn as expm does.",
-    lambda args: _exponent_norm(args) >= 2.0**52,
-)
 
 
 FREQUENCY_EXTREME_SCALE: Defect = known_defect(

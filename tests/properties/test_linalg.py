@@ -17,9 +17,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import aerocontrol
-from aerocontrol.exceptions import IllConditionedWarning
+from aerocontrol.exceptions import IllConditionedError, IllConditionedWarning
 
-from . import known_defects
 from .harness import CALLBACK, Arg, CallerError, Warned, exercise, plain
 from .oracles import (
     SLACK,
@@ -274,43 +273,41 @@ SCHUR_EXTREME_EXAMPLES = {
 }
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.SCHUR_EXTREME_ENTRIES.summary)
 @pytest.mark.parametrize("example", SCHUR_EXTREME_EXAMPLES)
-def test_known_defect_schur_extreme_entries(example: str) -> None:
+def test_schur_extreme_entries(example: str) -> None:
+    """Entries whose squares leave the normal range (once returned unreduced or NaN)."""
     A = SCHUR_EXTREME_EXAMPLES[example]
-    with known_defects.SCHUR_EXTREME_ENTRIES.reproducing():
-        exercise(
-            "schur", aerocontrol.schur, {"A": canonical(A), "select": plain(None)}, _schur_oracle
-        )
+    exercise("schur", aerocontrol.schur, {"A": canonical(A), "select": plain(None)}, _schur_oracle)
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.TRANSITION_HUGE_TIMES.summary)
-def test_known_defect_transition_huge_times() -> None:
-    with known_defects.TRANSITION_HUGE_TIMES.reproducing():
-        exercise(
-            "transition_matrix",
-            aerocontrol.transition_matrix,
-            {"A": canonical(np.zeros((3, 3))), "t": plain(1e155)},
-            _transition_oracle,
-        )
+def test_transition_huge_times() -> None:
+    """Φ(1e155) of A = 0 is I (the powers of A and of t, formed apart, once gave 0 · inf)."""
+    exercise(
+        "transition_matrix",
+        aerocontrol.transition_matrix,
+        {"A": canonical(np.zeros((3, 3))), "t": plain(1e155)},
+        _transition_oracle,
+    )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.EXPONENTIAL_HUGE_NORM.summary)
-@pytest.mark.parametrize("function", ["expm", "discretize"])
-def test_known_defect_exponential_huge_norm(function: str) -> None:
-    with known_defects.EXPONENTIAL_HUGE_NORM.reproducing():
-        if function == "expm":
-            rotation = np.array([[0.0, 1e50], [-1e50, 0.0]])
-            exercise("expm", aerocontrol.expm, {"A": canonical(rotation)}, _expm_oracle)
-        rotation = np.array([[0.0, 2e300], [-2e300, 0.0]])
-        exercise(
-            "discretize",
-            aerocontrol.discretize,
-            {
-                "A": canonical(rotation),
-                "B": canonical(np.zeros((2, 1))),
-                "dt": plain(0.1),
-                "method": plain("zoh"),
-            },
-            _discretize_oracle,
-        )
+def test_exponential_huge_norm() -> None:
+    """e^A of a rotation by 1e50 rad: refused as ill-conditioned (was all NaN)."""
+    rotation = np.array([[0.0, 1e50], [-1e50, 0.0]])
+    outcome = exercise("expm", aerocontrol.expm, {"A": canonical(rotation)}, _expm_oracle)
+    assert isinstance(outcome.error, IllConditionedError), outcome
+
+
+def test_discretize_huge_rotation() -> None:
+    """A rotation by 2e299 rad per step (Phi was once 0), with the IllConditionedWarning."""
+    rotation = np.array([[0.0, 2e300], [-2e300, 0.0]])
+    exercise(
+        "discretize",
+        aerocontrol.discretize,
+        {
+            "A": canonical(rotation),
+            "B": canonical(np.zeros((2, 1))),
+            "dt": plain(0.1),
+            "method": plain("zoh"),
+        },
+        _discretize_oracle,
+    )

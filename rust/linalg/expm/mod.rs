@@ -88,6 +88,16 @@ pub const DOUBLE_DOUBLE_MIN_SQUARINGS: u32 = 2;
 /// A^2 ... A^12 of the degree selection can overflow.
 const MAX_UNSCALED_NORM_LOG2: f64 = 64.0;
 
+/// Matrices whose largest entry is below 2^-64 are first scaled up to it, with the difference
+/// moved into the time: e^{tA} = e^{(t 2^e) (2^-e A)}. Otherwise the powers of a tiny A
+/// underflow while the powers of the scalar (t 2^-s) that multiply them overflow, and their
+/// product (0 · inf) is NaN: A = -I / t at t = 1e100 gave NaN for e^{-I}.
+const MIN_UNSCALED_ENTRY_LOG2: f64 = -64.0;
+
+/// ln of the largest double (about 709.78), less a margin: e^{tA} with ||e^{tA}||_2 below
+/// e^this has finite entries.
+const LOG_FINITE_BOUND: f64 = 700.0;
+
 /// Squarings are capped here: 2^-2200 underflows every double, so more can only repeat inf.
 const MAX_SQUARINGS: u32 = 2200;
 
@@ -313,6 +323,83 @@ fn square_repeatedly<M: PadeArithmetic>(
     x
 }
 
+/// c^k P for P = A^k, given `factor` = c^k: when c^k overflows (a large c, which only a matrix
+/// whose powers vanish or are small allows, a nilpotent A), c is applied k times instead, so
+/// that a zero entry stays zero instead of becoming 0 · inf = NaN.
+fn scaled_power<M: PadeArithmetic>(power: &M, c: f64, k: usize, factor: f64) -> M {
+    if factor.is_finite() {
+        return M::combination(0.0, &[(factor, power)]);
+    }
+    let mut scaled = M::combination(0.0, &[(c, power)]);
+    for _ in 1..k {
+        scaled = M::combination(0.0, &[(c, &scaled)]);
+    }
+    scaled
+}
+
+/// Whether e^{tA} is certainly finite, by the logarithmic norm: ||e^{tA}||_2 <= e^{|t| μ},
+/// μ = λ_max(sign(t) (A + A^T) / 2) (Dahlquist 1958; Higham 2008, Theorem 10.11), bounded by
+/// the Gershgorin discs of the symmetric part. A rotation, however fast, has μ = 0.
+fn exponential_is_finite(a: MatRef<'_, f64>, t: f64) -> bool {
+    let n = a.nrows();
+    let sign = t.signum();
+    let mu = (0..n)
+        .map(|i| {
+            let radius: f64 = (0..n)
+                .filter(|&j| j != i)
+                .map(|j| (0.5 * a[(i, j)] + 0.5 * a[(j, i)]).abs())
+                .sum();
+            sign * a[(i, i)] + radius
+        })
+        .fold(f64::NEG_INFINITY, f64::max);
+    t.abs() * mu.max(0.0) <= LOG_FINITE_BOUND
+}
+
+/// ||tA||_1 from which the rounding of the input alone can change every digit of e^{tA}:
+/// 2^53 = 1/u (the exponential's relative condition number is at least ||tA||_2).
+pub const ILL_CONDITIONED_NORM: f64 = 9_007_199_254_740_992.0;
+
+/// Refuses a computed e^{tA} with infinite or NaN entries that cannot be its value: where the
+/// exact value is certainly finite ([`exponential_is_finite`]), or NaN where ||tA||_1 is
+/// beyond [`ILL_CONDITIONED_NORM`] while e^{tA} need not overflow. There the squarings of the scaled matrix amplify rounding
+/// until it overflows (a rotation by 1e50 rad came back all NaN). An exponential that does
+/// overflow is returned as it is, for the caller to warn.
+fn check_computed_exponential(
+    a: MatRef<'_, f64>,
+    t: f64,
+    out: MatRef<'_, f64>,
+) -> Result<(), Error> {
+    let entries = || (0..out.ncols()).flat_map(move |j| (0..out.nrows()).map(move |i| out[(i, j)]));
+    if entries().all(f64::is_finite) {
+        return Ok(());
+    }
+    let scaled_norm = t.abs() * one_norm(a);
+    let cause = "the squarings that the scaling of ||tA|| needs amplified rounding errors until \
+                 they overflowed";
+    if exponential_is_finite(a, t) {
+        return Err(Error::IllConditioned {
+            message: format!(
+                "e^(tA) at t = {t:e} is finite (its logarithmic norm bounds it), but could not \
+                 be computed in double precision: ||tA||_1 = {scaled_norm:.3e}, and {cause}"
+            ),
+        });
+    }
+    // The spectral radius, e^{t max Re λ} >= e^{t tr(A) / n}, shows where e^{tA} overflows.
+    let n = a.nrows() as f64;
+    let mean_growth = t * (0..a.nrows()).map(|i| a[(i, i)] / n).sum::<f64>();
+    let overflows = mean_growth > f64::MAX.ln();
+    if scaled_norm >= ILL_CONDITIONED_NORM && !overflows && entries().any(f64::is_nan) {
+        return Err(Error::IllConditioned {
+            message: format!(
+                "e^(tA) at t = {t:e} could not be computed in double precision: ||tA||_1 = \
+                 {scaled_norm:.3e} exceeds 1/u = 2^53, where the rounding of the input alone \
+                 changes every digit, and {cause} into NaN"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// (e^b - e^a) / (b - a), the exponential's divided difference, without cancellation or
 /// inf - inf: for close arguments e^((a+b)/2) sinh(δ)/δ, δ = (b - a)/2; otherwise
 /// e^max(a,b) (1 - e^-|b-a|) / |b - a|, which overflows only when the value does.
@@ -365,6 +452,9 @@ pub(crate) struct ExponentialPlan<M> {
     diagonals: Option<(Vec<f64>, Vec<f64>)>,
     /// Extra squarings that undo the pre-scaling of a matrix of huge norm.
     prescale: u32,
+    /// 2^e for a matrix of tiny entries stored as 2^-e A ([`MIN_UNSCALED_ENTRY_LOG2`]): times
+    /// are multiplied by it. 1 otherwise.
+    time_scale: f64,
     a_norm: f64,
     exact_norms: bool,
     a2: M,
@@ -393,11 +483,19 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             (diagonal, superdiagonal)
         });
         // ||A||_1 <= n max|a_ij|, a bound that cannot overflow (the column sums can).
-        let log2_norm_bound = a.max_abs().log2() + (n as f64).log2();
-        let mut prescale = 0;
+        let largest = a.max_abs();
+        let log2_norm_bound = largest.log2() + (n as f64).log2();
+        let (mut prescale, mut time_scale) = (0, 1.0);
         if log2_norm_bound > MAX_UNSCALED_NORM_LOG2 {
             prescale = (log2_norm_bound - MAX_UNSCALED_NORM_LOG2).ceil() as u32;
             a = M::combination(0.0, &[((-(prescale as f64)).exp2(), &a)]);
+        } else if largest > 0.0 && largest.log2() < MIN_UNSCALED_ENTRY_LOG2 {
+            // largest in [2^e, 2^(e+1)); 2^-e is applied in two halves, as 2^1074 overflows.
+            let exponent = largest.log2().floor();
+            let half = (-exponent / 2.0).floor();
+            a = M::combination(0.0, &[(half.exp2(), &a)]);
+            a = M::combination(0.0, &[((-exponent - half).exp2(), &a)]);
+            time_scale = exponent.exp2();
         }
         let a_norm = a.one_norm();
         let a2 = a.product(&a);
@@ -406,6 +504,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             transposed,
             diagonals,
             prescale,
+            time_scale,
             a_norm,
             exact_norms: n <= EXACT_NORM_MAX_ORDER,
             a2,
@@ -555,7 +654,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             approximant,
             squarings: squarings.min(MAX_SQUARINGS),
         };
-        let tau = t.abs();
+        let tau = t.abs() * self.time_scale;
         if tau == 0.0 || self.a_norm == 0.0 {
             return choice(M3, self.prescale);
         }
@@ -617,7 +716,8 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             return;
         }
         // r_m is evaluated at c * (pre-scaled A); the squarings undo both scalings.
-        let c = t * (-(choice.squarings.saturating_sub(self.prescale) as f64)).exp2();
+        let c =
+            t * self.time_scale * (-(choice.squarings.saturating_sub(self.prescale) as f64)).exp2();
         let accurate = choice.squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS;
         let x = accurate
             .then(|| {
@@ -652,14 +752,14 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         } else {
             // The powers of cA: c^k A^k.
             let c2 = c * c;
-            let scaled = |power: &Option<M>, factor: f64| {
-                power.as_ref().map(|p| M::combination(0.0, &[(factor, p)]))
+            let scaled = |power: &Option<M>, factor: f64, k: usize| {
+                power.as_ref().map(|p| scaled_power(p, c, k, factor))
             };
             let a = M::combination(0.0, &[(c, &self.a)]);
-            let a2 = M::combination(0.0, &[(c2, &self.a2)]);
-            let a4 = scaled(&self.a4, c2 * c2);
-            let a6 = scaled(&self.a6, c2 * c2 * c2);
-            let a8 = scaled(&self.a8, (c2 * c2) * (c2 * c2));
+            let a2 = scaled_power(&self.a2, c, 2, c2);
+            let a4 = scaled(&self.a4, c2 * c2, 4);
+            let a6 = scaled(&self.a6, c2 * c2 * c2, 6);
+            let a8 = scaled(&self.a8, (c2 * c2) * (c2 * c2), 8);
             pade_approximant(choice.approximant, &a, &[&a2], [&a4, &a6, &a8])
         };
         square_repeatedly(x, choice.squarings, |x, i| {
@@ -969,23 +1069,28 @@ pub fn expm_into(a: MatRef<'_, f64>, out: MatMut<'_, f64>) -> Result<(), Error> 
     check_square_finite(a, "A")?;
     check_output_len(out.nrows() * out.ncols(), a.nrows() * a.nrows())?;
     check_output_len(out.nrows(), a.nrows())?;
-    expm_into_validated(a, out);
-    Ok(())
+    expm_into_validated(a, out)
 }
 
 /// [`expm_into`] for an A already known to be square and finite, with `out` of its order.
-pub(crate) fn expm_into_validated(a: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+pub(crate) fn expm_into_validated(
+    a: MatRef<'_, f64>,
+    mut out: MatMut<'_, f64>,
+) -> Result<(), Error> {
     match a.nrows() {
         0 => {}
         1 => out[(0, 0)] = a[(0, 0)].exp(),
-        n => with_matrix_type!(n, M => single_exponential::<M>(a, out)),
+        n => with_matrix_type!(n, M => single_exponential::<M>(a, out.as_mut())),
     }
+    check_computed_exponential(a, 1.0, out.as_ref())
 }
 
 /// The matrix exponential e^A (6.19) of a square matrix of finite entries.
 ///
 /// A result that overflows double precision has infinite (or NaN) entries; the caller decides
-/// how to report it.
+/// how to report it. Infinite or NaN entries where the exact value is finite (a matrix of
+/// norm beyond 2^53, whose squarings amplify rounding until it overflows) are
+/// [`Error::IllConditioned`].
 ///
 /// ```
 /// use faer::mat;
@@ -1030,7 +1135,7 @@ fn transition_matrices_with<M: ExpmMatrix>(
     let evaluate = |((&t, &choice), chunk): ((&f64, &PadeChoice), &mut [f64])| {
         context.run(|| {
             plan.exponential_into(t, choice, MatMut::from_row_major_slice_mut(chunk, n, n));
-            Ok(())
+            check_computed_exponential(a, t, MatRef::from_row_major_slice(chunk, n, n))
         })
     };
     if n < PARALLEL_MIN_ORDER && times.len() > 1 {
@@ -1450,5 +1555,54 @@ mod tests {
             };
             assert!((got - expected).abs() <= 1e-13 * expected.abs(), "{a} {b}");
         }
+    }
+
+    /// Times far beyond 1 / ||A||: the powers of A and of the time are not formed apart, so a
+    /// zero or tiny A gives the exact exponential, not 0 · inf = NaN.
+    #[test]
+    fn huge_times_of_zero_tiny_and_nilpotent_matrices() {
+        let identity = Mat::<f64>::identity(3, 3);
+        let zero = Mat::<f64>::zeros(3, 3);
+        let phi = transition_matrices(zero.as_ref(), &[1e155, -1e300]).unwrap();
+        for p in &phi {
+            assert_eq!(p, &identity);
+        }
+        for t in [1e100, 1e200, 1e300] {
+            let a = &identity * faer::Scale(-1.0 / t);
+            let phi = &transition_matrices(a.as_ref(), &[t]).unwrap()[0];
+            let expected = &identity * faer::Scale((-1.0f64).exp());
+            assert!(
+                (phi - &expected).norm_max() <= 4.0 * f64::EPSILON,
+                "t = {t:e}: {phi:?}"
+            );
+        }
+        // A^3 = 0 and |A|^3 = 0: no squarings, and e^{tA} = I + tA + t^2 A^2 / 2 from the Padé
+        // approximant at c = t, whose scalars c^4 ... c^8 overflow while A^4 = 0.
+        let nilpotent = mat![[0.0, 1.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 0.0]];
+        for t in [1e3, 1e60, 1e100] {
+            let phi = &transition_matrices(nilpotent.as_ref(), &[t]).unwrap()[0];
+            let expected = mat![[1.0, t, t + 0.5 * t * t], [0.0, 1.0, t], [0.0, 0.0, 1.0]];
+            let error = (phi - &expected).norm_max() / expected.norm_max();
+            assert!(error <= 4.0 * f64::EPSILON, "t = {t:e}: {phi:?}");
+        }
+    }
+
+    /// A rotation by 1e50 rad: e^A is orthogonal, but the squarings overflow; refused as
+    /// ill-conditioned instead of returned as NaN, alone, in a stack and as a transition matrix.
+    #[test]
+    fn exponentials_that_cannot_be_computed_are_refused() {
+        let rotation = mat![[0.0, 1e50], [-1e50, 0.0]];
+        assert!(matches!(
+            expm(rotation.as_ref()),
+            Err(Error::IllConditioned { .. })
+        ));
+        assert!(matches!(
+            transition_matrices(rotation.as_ref(), &[0.5, 1.0]),
+            Err(Error::IllConditioned { .. })
+        ));
+        // An exponential that does overflow is returned, with its infinities.
+        let growth = mat![[800.0, 0.0], [1.0, 800.0]];
+        let phi = expm(growth.as_ref()).unwrap();
+        assert!(phi[(0, 0)].is_infinite());
     }
 }
