@@ -19,6 +19,7 @@ from typing import Any
 import control
 import numpy as np
 import pytest
+import scipy.integrate
 import scipy.linalg
 import scipy.signal
 from hypothesis import given, settings
@@ -824,3 +825,65 @@ def test_continuous_designs_refuse_a_discrete_system() -> None:
             call()
     _, _, poles = aerocontrol.dlqr(sampled, Q, R)
     assert np.all(np.abs(poles) < 1)
+
+
+# ----- sampled-data regulator (design.sampled_weights, design.sampled_data_lqr) -----------------
+
+
+def _quadrature_weights(sys: StateSpace, dt: float, Q: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """The oracle: W = ∫_0^dt e^{F^T t} diag(Q, R) e^{F t} dt by scipy's adaptive quadrature."""
+    n, m = sys.n_states, sys.n_inputs
+    F = np.zeros((n + m, n + m))
+    F[:n, :n], F[:n, n:] = sys.A, sys.B
+    H = scipy.linalg.block_diag(Q, R)
+
+    def integrand(t: float) -> np.ndarray:
+        E = scipy.linalg.expm(F * t)
+        return E.T @ H @ E
+
+    W, _ = scipy.integrate.quad_vec(integrand, 0.0, dt, epsabs=1e-15, epsrel=1e-13)
+    return 0.5 * (W + W.T)
+
+
+@pytest.mark.parametrize("name", ["747 lateral", "747 longitudinal", "random n=6"])
+@pytest.mark.parametrize("dt", [0.02, 0.1, 1.0])
+def test_sampled_weights_equal_the_quadrature_of_the_continuous_cost(name: str, dt: float) -> None:
+    sys = MODELS[name]
+    n, m = sys.n_states, sys.n_inputs
+    rng = np.random.default_rng(3)
+    root = rng.standard_normal((n, n))
+    Q, R = root @ root.T, np.diag(rng.uniform(0.5, 2.0, m))
+    w = aerocontrol.design.sampled_weights(sys, dt, Q, R)
+    W = _quadrature_weights(sys, dt, Q, R)
+    assert _relative(w.Q, W[:n, :n]) < 1e-11
+    assert _relative(w.R, W[n:, n:]) < 1e-11
+    assert _relative(w.N, W[:n, n:]) < 1e-11
+
+
+def test_sampled_data_lqr_is_python_controls_dlqr_and_tends_to_lqr() -> None:
+    sys = MODELS["747 lateral"]
+    Kc = np.asarray(control.lqr(sys.A, sys.B, np.eye(4), np.eye(2))[0])
+    previous = np.inf
+    for dt in (0.1, 0.02, 0.004):
+        K, S, E = aerocontrol.design.sampled_data_lqr(sys, dt)
+        W = _quadrature_weights(sys, dt, np.eye(4), np.eye(2))
+        Phi, Gamma, *_ = scipy.signal.cont2discrete((sys.A, sys.B, sys.C, sys.D), dt)
+        K_ref, S_ref, _ = control.dlqr(Phi, Gamma, W[:4, :4], W[4:, 4:], W[:4, 4:])
+        assert _relative(K, np.asarray(K_ref)) < 1e-9
+        assert _relative(S, np.asarray(S_ref)) < 1e-9
+        assert np.all(np.abs(E) < 1)
+        # O(dt): the difference from the continuous gain shrinks with the period.
+        difference = float(np.linalg.norm(K - Kc) / np.linalg.norm(Kc))
+        assert difference < previous
+        previous = difference
+    assert previous < 2e-3
+
+
+def test_sampled_weights_of_a_stiff_plant_do_not_overflow() -> None:
+    # A mode at -1e4 rad/s held for 0.02 s: e^{+200} in one Van Loan step; by doublings, the
+    # closed form ∫ e^{-2e4 t} dt = 1/2e4 (to e^{-400}) for the state weight.
+    sys = StateSpace([[-1e4]], [[1.0]])
+    w = aerocontrol.design.sampled_weights(sys, 0.02, [[1.0]], [[0.0]])
+    assert w.Q[0, 0] == pytest.approx(1.0 / 2e4, rel=1e-12)
+    with pytest.raises(InvalidArgumentError, match="sampled_weights designs in continuous time"):
+        aerocontrol.design.sampled_weights(aerocontrol.c2d(sys, 0.1), 0.1)
