@@ -39,7 +39,7 @@ def test_default_run_writes_the_report_of_the_747(tmp_path: Path) -> None:
     report = tmp_path / "aerocontrol-report" / "report.html"
     assert lines[-1] == f"report: {Path('aerocontrol-report') / 'report.html'}"
     assert report.is_file() and (report.parent / "report.md").is_file()
-    assert len(list((report.parent / "figures").glob("*.png"))) == 14
+    assert len(list((report.parent / "figures").glob("*.png"))) == 16
     assert result.stderr == ""
     # README's command, run again into the same folder: the earlier report, untouched, is
     # replaced without any option; a file of the user's beside it stays.
@@ -51,7 +51,7 @@ def test_default_run_writes_the_report_of_the_747(tmp_path: Path) -> None:
         cwd=tmp_path,
     )
     assert again.returncode == 0, again.stderr
-    assert "writing 14 figures and the report (replacing the earlier report)" in again.stdout
+    assert "writing 16 figures and the report (replacing the earlier report)" in again.stdout
     assert (tmp_path / "aerocontrol-report" / "notes.txt").read_text() == "mine"
     assert again.stderr == ""
 

@@ -19,6 +19,7 @@ from typing import Any
 import control
 import numpy as np
 import pytest
+import scipy.integrate
 import scipy.linalg
 import scipy.signal
 from hypothesis import given, settings
@@ -374,6 +375,117 @@ def test_d2c_refuses_models_without_a_continuous_equivalent() -> None:
     assert not aerocontrol.d2c(negative, "tustin").is_discrete
 
 
+def _rotation(radius: float, angle: float) -> np.ndarray:
+    """radius times the rotation by ``angle``: the discrete pair radius e^{±j angle}."""
+    c, s = np.cos(angle), np.sin(angle)
+    return radius * np.array([[c, -s], [s, c]])
+
+
+@pytest.mark.parametrize("a", [-0.5, -1.0, -3.0, -1e-300, 0.0])
+def test_d2c_zoh_refuses_a_scalar_pole_on_the_closed_negative_axis_naming_sys(a: float) -> None:
+    # Closed form: ln(a) = ln|a| + jπ for a < 0 and ln(0) = -∞: no real logarithm, as scipy's
+    # logm (the oracle) confirms with its imaginary part π.
+    if -1e3 < a < -1e-3:  # (scipy's logm warns of its own accuracy at a = -1e-300)
+        assert scipy.linalg.logm(np.array([[a]]))[0, 0].imag == pytest.approx(np.pi, rel=1e-15)
+    with pytest.raises(InvalidArgumentError, match=r"^sys\.A has the eigenvalue") as error:
+        aerocontrol.d2c(StateSpace([[a]], [[1.0]], [[1.0]], [[0.0]], dt=0.1))
+    assert isinstance(error.value, NoContinuousEquivalentError)
+    assert isinstance(error.value, np.linalg.LinAlgError)
+    assert error.value.argument == "sys"
+    assert error.value.eigenvalues == [complex(a, 0.0)]
+
+
+def test_d2c_zoh_refuses_negative_real_pairs_and_a_delay_in_a_larger_model() -> None:
+    # Two distinct negative eigenvalues (no real logarithm at all, Culver 1966), a repeated one
+    # (a real logarithm ln 0.5 I + π J exists, but no principal one: an oscillation at exactly
+    # the Nyquist frequency, whose sign is undecidable), a one-step delay inside a stable model.
+    B = np.eye(2)
+    for A, eigenvalue in (
+        (np.diag([-0.5, -0.3]), -0.5),
+        (-0.5 * np.eye(2), -0.5),
+        (np.array([[0.9, 1.0], [0.0, 0.0]]), 0.0),
+    ):
+        with pytest.raises(NoContinuousEquivalentError) as error:
+            aerocontrol.d2c(StateSpace(A, B, dt=0.02))
+        assert error.value.argument == "sys"
+        assert error.value.eigenvalues is not None
+        assert error.value.eigenvalues[0] == pytest.approx(eigenvalue, abs=1e-15)
+
+
+@pytest.mark.parametrize("fraction", [0.5, 0.85, 0.89])
+def test_d2c_zoh_of_a_rotation_below_the_warning_angle_is_the_closed_form(fraction: float) -> None:
+    # Closed form: the real logarithm of r R(θ) is ln r I + θ J, J = [[0, -1], [1, 0]]; scipy's
+    # logm is the second oracle. No warning (the suite makes aerocontrol's warnings errors).
+    dt, radius, angle = 0.1, 0.9, fraction * np.pi
+    back = aerocontrol.d2c(StateSpace(_rotation(radius, angle), np.eye(2), dt=dt))
+    closed_form = (np.log(radius) * np.eye(2) + angle * np.array([[0.0, -1.0], [1.0, 0.0]])) / dt
+    assert _relative(back.A, closed_form) < 1e-14
+    assert _relative(back.A, np.real(scipy.linalg.logm(_rotation(radius, angle))) / dt) < 1e-13
+
+
+@pytest.mark.parametrize("gap", [0.05 * np.pi, 1e-3, 1e-8])
+def test_d2c_zoh_warns_near_the_nyquist_angle_and_still_returns_the_principal_logarithm(
+    gap: float,
+) -> None:
+    # A pole at the angle π - gap: the continuous frequency is (π - gap)/dt, the alias
+    # (π + gap)/dt. The result is still the closed form ln r I + θ J, to the logarithm's
+    # sensitivity θ / sin θ (about π / gap) times the rounding of A.
+    dt, radius, angle = 0.02, 0.95, np.pi - gap
+    sensitivity = angle / np.sin(angle)
+    with pytest.warns(aerocontrol.IllConditionedWarning, match=r"near the Nyquist") as record:
+        back = aerocontrol.d2c(StateSpace(_rotation(radius, angle), np.eye(2), dt=dt))
+    message = str(record[0].message)
+    assert f"at the angle {angle / np.pi:.4f} pi" in message
+    assert f"{(np.pi + gap) / dt:.6g} rad/s (aliasing)" in message
+    assert f"theta/sin(theta) is {sensitivity:.3g}" in message
+    closed_form = (np.log(radius) * np.eye(2) + angle * np.array([[0.0, -1.0], [1.0, 0.0]])) / dt
+    assert _relative(back.A, closed_form) < 10 * sensitivity * np.finfo(float).eps
+
+
+def test_d2c_zoh_cannot_tell_a_mode_above_nyquist_from_its_alias() -> None:
+    # Round trips: a mode at 0.95 Nyquist comes back (with the warning); one at 1.05 Nyquist
+    # comes back as its alias: e^{j 1.05 π} = e^{-j 0.95 π}, the mode at 0.95 Nyquist turning
+    # the other way (A transposed), whose samples are the same (c2d of both agree).
+    dt = 0.1
+    nyquist = np.pi / dt
+    below = StateSpace([[-0.3, -0.95 * nyquist], [0.95 * nyquist, -0.3]], [[1.0], [0.0]])
+    above = StateSpace([[-0.3, -1.05 * nyquist], [1.05 * nyquist, -0.3]], [[1.0], [0.0]])
+    with pytest.warns(aerocontrol.IllConditionedWarning, match=r"0\.9500 pi"):
+        back = aerocontrol.d2c(aerocontrol.c2d(below, dt))
+    assert _relative(back.A, below.A) < 1e-12
+    sampled = aerocontrol.c2d(above, dt)
+    with pytest.warns(aerocontrol.IllConditionedWarning, match=r"0\.9500 pi"):
+        alias = aerocontrol.d2c(sampled)
+    assert _relative(alias.A, below.A.T) < 1e-12  # not above.A: the samples cannot tell
+    assert _relative(aerocontrol.c2d(alias, dt).A, sampled.A) < 1e-12
+
+
+def test_d2c_bilinear_refuses_the_image_of_infinity_and_warns_near_it() -> None:
+    B = np.array([[1.0], [1.0]])
+    # Tustin's: z = -1 is the image of s = ∞; the generalized weights' image is -(1 - α)/α.
+    for method, alpha, image in (("tustin", None, -1.0), ("gbt", 0.25, -3.0)):
+        with pytest.raises(
+            InvalidArgumentError, match=r"^sys\.A: .*image of s = infinity"
+        ) as error:
+            aerocontrol.d2c(StateSpace(np.diag([image, 0.5]), B, dt=0.1), method, alpha=alpha)
+        assert isinstance(error.value, NoContinuousEquivalentError)
+        assert error.value.argument == "sys"
+        assert error.value.eigenvalues == [complex(image)]
+    # Near -1: Tustin's inverse s = (2/dt)(z - 1)/(z + 1) has a pole near infinity. The closed
+    # form is exact in floating point (z + 1 is exact for z in [-2, -1/2], Sterbenz).
+    dt = 0.1
+    for gap in (1e-9, 1e-12):
+        z = -1.0 + gap
+        with pytest.warns(aerocontrol.IllConditionedWarning, match=r"reciprocal condition"):
+            back = aerocontrol.d2c(StateSpace([[z]], [[1.0]], [[1.0]], [[0.0]], dt=dt), "tustin")
+        exact = (2.0 / dt) * (z - 1.0) / (z + 1.0)
+        assert back.A[0, 0] == pytest.approx(exact, rel=1e4 * np.finfo(float).eps / gap)
+    # Far from it: no warning, and the round trip holds.
+    sys = StateSpace([[-0.9, 0.2], [0.0, 0.3]], B, dt=dt)
+    again = aerocontrol.c2d(aerocontrol.d2c(sys, "tustin"), dt, "tustin")
+    assert _relative(again.A, sys.A) < 1e-13
+
+
 def test_c2d_and_d2c_arguments_are_checked_by_name() -> None:
     sys, discrete = MODELS["747 longitudinal"], aerocontrol.c2d(MODELS["747 longitudinal"], 0.1)
     with pytest.raises(InvalidArgumentError, match="sys must be a continuous model"):
@@ -713,3 +825,65 @@ def test_continuous_designs_refuse_a_discrete_system() -> None:
             call()
     _, _, poles = aerocontrol.dlqr(sampled, Q, R)
     assert np.all(np.abs(poles) < 1)
+
+
+# ----- sampled-data regulator (design.sampled_weights, design.sampled_data_lqr) -----------------
+
+
+def _quadrature_weights(sys: StateSpace, dt: float, Q: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """The oracle: W = ∫_0^dt e^{F^T t} diag(Q, R) e^{F t} dt by scipy's adaptive quadrature."""
+    n, m = sys.n_states, sys.n_inputs
+    F = np.zeros((n + m, n + m))
+    F[:n, :n], F[:n, n:] = sys.A, sys.B
+    H = scipy.linalg.block_diag(Q, R)
+
+    def integrand(t: float) -> np.ndarray:
+        E = scipy.linalg.expm(F * t)
+        return E.T @ H @ E
+
+    W, _ = scipy.integrate.quad_vec(integrand, 0.0, dt, epsabs=1e-15, epsrel=1e-13)
+    return 0.5 * (W + W.T)
+
+
+@pytest.mark.parametrize("name", ["747 lateral", "747 longitudinal", "random n=6"])
+@pytest.mark.parametrize("dt", [0.02, 0.1, 1.0])
+def test_sampled_weights_equal_the_quadrature_of_the_continuous_cost(name: str, dt: float) -> None:
+    sys = MODELS[name]
+    n, m = sys.n_states, sys.n_inputs
+    rng = np.random.default_rng(3)
+    root = rng.standard_normal((n, n))
+    Q, R = root @ root.T, np.diag(rng.uniform(0.5, 2.0, m))
+    w = aerocontrol.design.sampled_weights(sys, dt, Q, R)
+    W = _quadrature_weights(sys, dt, Q, R)
+    assert _relative(w.Q, W[:n, :n]) < 1e-11
+    assert _relative(w.R, W[n:, n:]) < 1e-11
+    assert _relative(w.N, W[:n, n:]) < 1e-11
+
+
+def test_sampled_data_lqr_is_python_controls_dlqr_and_tends_to_lqr() -> None:
+    sys = MODELS["747 lateral"]
+    Kc = np.asarray(control.lqr(sys.A, sys.B, np.eye(4), np.eye(2))[0])
+    previous = np.inf
+    for dt in (0.1, 0.02, 0.004):
+        K, S, E = aerocontrol.design.sampled_data_lqr(sys, dt)
+        W = _quadrature_weights(sys, dt, np.eye(4), np.eye(2))
+        Phi, Gamma, *_ = scipy.signal.cont2discrete((sys.A, sys.B, sys.C, sys.D), dt)
+        K_ref, S_ref, _ = control.dlqr(Phi, Gamma, W[:4, :4], W[4:, 4:], W[:4, 4:])
+        assert _relative(K, np.asarray(K_ref)) < 1e-9
+        assert _relative(S, np.asarray(S_ref)) < 1e-9
+        assert np.all(np.abs(E) < 1)
+        # O(dt): the difference from the continuous gain shrinks with the period.
+        difference = float(np.linalg.norm(K - Kc) / np.linalg.norm(Kc))
+        assert difference < previous
+        previous = difference
+    assert previous < 2e-3
+
+
+def test_sampled_weights_of_a_stiff_plant_do_not_overflow() -> None:
+    # A mode at -1e4 rad/s held for 0.02 s: e^{+200} in one Van Loan step; by doublings, the
+    # closed form ∫ e^{-2e4 t} dt = 1/2e4 (to e^{-400}) for the state weight.
+    sys = StateSpace([[-1e4]], [[1.0]])
+    w = aerocontrol.design.sampled_weights(sys, 0.02, [[1.0]], [[0.0]])
+    assert w.Q[0, 0] == pytest.approx(1.0 / 2e4, rel=1e-12)
+    with pytest.raises(InvalidArgumentError, match="sampled_weights designs in continuous time"):
+        aerocontrol.design.sampled_weights(aerocontrol.c2d(sys, 0.1), 0.1)

@@ -193,3 +193,21 @@ def test_plots_do_not_modify_the_results() -> None:
     np.testing.assert_array_equal(response.x, before[0])
     np.testing.assert_array_equal(K, before[1])
     assert scipy.linalg.norm(K) > 0
+
+
+def test_compared_draws_held_samples_as_steps() -> None:
+    lag = aerocontrol.StateSpace([[-1.0]], [[1.0]], state_names=["beta"])
+    t = np.arange(0.0, 3.0, 0.5)
+    continuous = aerocontrol.initial_response(lag, [1.0], T=t)
+    sampled = aerocontrol.initial_response(aerocontrol.c2d(lag, 0.5), [1.0], T=t)
+    ax = plotting.plot_compared(
+        {"continuous": (continuous, "beta"), "2 Hz": (sampled, "beta")}, held=["2 Hz"]
+    )
+    lines = ax.get_lines()
+    assert [line.get_drawstyle() for line in lines] == ["default", "steps-post"]
+    assert [line.get_label() for line in lines] == ["continuous", "2 Hz"]
+    # The samples of e^{-t}, exactly (the zero-order hold of a free response).
+    assert np.allclose(lines[1].get_ydata(), np.exp(-t), rtol=1e-14)
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="neither a state nor an output"):
+        plotting.plot_compared({"x": (continuous, "phi")})
+    plt.close("all")

@@ -11,13 +11,18 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+import control
 import numpy as np
 import pytest
+import scipy.integrate
+import scipy.linalg
+import scipy.signal
 
 import aerocontrol
 from aerocontrol.report import Report, build_report, write_report
 from aerocontrol.report import build as report_module
 from aerocontrol.report import damper as report_damper
+from aerocontrol.report import digital as report_digital
 from aerocontrol.report import regulator as report_regulator
 from aerocontrol.report import responses as report_responses
 
@@ -34,6 +39,8 @@ FIGURES = {
     "lqr-responses.png",
     "lqr-penalty.png",
     "root-locus.png",
+    "digital-regulator.png",
+    "digital-lqg.png",
     "envelope.png",
 }
 #: The chapter's two small examples, in the embedded 747's report only.
@@ -91,13 +98,16 @@ def test_progress_is_one_line_per_step(written: tuple[Path, list[str]]) -> None:
         "Dutch-roll damper",
         "LQR",
         "root locus",
+        "digital regulator",
+        "digital damper",
+        "LQG",
         "levels after augmentation",
         "envelope",
         "chapter check",
-        "writing 14 figures and the report",
+        "writing 16 figures and the report",
     ]
     assert "critically damped at c = 9.772714" in lines[6]
-    assert "dutch roll 2 -> damper (rudder) 1, damper (aileron) 1" in lines[7]
+    assert "dutch roll 2 -> damper (rudder) 1, damper (aileron) 1" in lines[10]
 
 
 def test_the_report_has_the_chapters_results(written: tuple[Path, list[str]]) -> None:
@@ -154,6 +164,225 @@ def test_the_report_has_the_chapters_results(written: tuple[Path, list[str]]) ->
     assert pendulum[1] == pendulum[2] == "[2.414213562, 2.197368227]"
     steady = _table_row(markdown, "steady state (6.51)")[2].strip("[]").split(", ")
     assert [round(float(v), 4) for v in steady] == [0.0459, -0.0186, 0.0, -0.0160]  # as printed
+
+
+# ----- the digital section -------------------------------------------------------------------
+#
+# Oracles, independent of aerocontrol: the zero-order-hold plant by scipy.signal.cont2discrete,
+# the sampled weights by adaptive quadrature (scipy.integrate.quad_vec of
+# e^{F^T t} diag(Q, R) e^{F t} with scipy.linalg.expm), the regulators by python-control's lqr
+# and dlqr, the damper by scipy.signal.place_poles, the Kalman filter by python-control's dlqe,
+# the costs by scipy.linalg.solve_discrete_lyapunov, the roots by numpy's eigvals. The report
+# prints ζ and ω_n to 5 decimals, gains to 5 (M to 6), J to 6 significant digits and the gain
+# differences to 4: each is compared with the oracle to half a unit of its last printed digit
+# plus 1e-9 (the oracles' own error, far smaller).
+
+LATERAL_747 = aerocontrol.aircraft.load().lateral()
+
+
+def _section(markdown: str, start: str, end: str | None = None) -> str:
+    after = markdown.split(start, 1)[1]
+    return after.split(end, 1)[0] if end else after
+
+
+def _zoh(period: float) -> tuple[np.ndarray, np.ndarray]:
+    sys = LATERAL_747
+    Phi, Gamma, *_ = scipy.signal.cont2discrete((sys.A, sys.B, np.eye(4), np.zeros((4, 2))), period)
+    return Phi, Gamma
+
+
+def _oracle_weights(period: float) -> np.ndarray:
+    """W = ∫_0^T e^{F^T t} diag(Q, R) e^{F t} dt by adaptive quadrature, Q = I, R = I."""
+    F = np.zeros((6, 6))
+    F[:4, :4], F[:4, 4:] = LATERAL_747.A, LATERAL_747.B
+
+    def integrand(t: float) -> np.ndarray:
+        E = scipy.linalg.expm(F * t)
+        return E.T @ E
+
+    W, _ = scipy.integrate.quad_vec(integrand, 0.0, period, epsabs=1e-15, epsrel=1e-13)
+    return 0.5 * (W + W.T)
+
+
+def _oracle_regulator(period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(K, S, W) of python-control's dlqr with the quadrature's sampled weights."""
+    Phi, Gamma = _zoh(period)
+    W = _oracle_weights(period)
+    K, S, _ = control.dlqr(Phi, Gamma, W[:4, :4], W[4:, 4:], W[:4, 4:])
+    return np.asarray(K), np.asarray(S), W
+
+
+def _oracle_cost(closed: np.ndarray, stage: np.ndarray, x0: np.ndarray) -> float:
+    P = scipy.linalg.solve_discrete_lyapunov(closed.T, stage)
+    return float(x0 @ P @ x0)
+
+
+def _dutch_roll_of(closed: np.ndarray, period: float | None) -> complex:
+    """The one complex root (Im > 0) of a 747 lateral loop, mapped by ln(z)/T if sampled."""
+    values = np.linalg.eigvals(closed)
+    (root,) = [v for v in values if v.imag > 1e-12]
+    return complex(np.log(root) / period) if period else complex(root)
+
+
+def _printed(
+    cell: str, value: float, decimals: int | None = None, digits: int | None = None
+) -> None:
+    """The printed ``cell`` equals ``value`` to half a unit of its last printed place."""
+    if decimals is not None:
+        tolerance = 0.5 * 10.0**-decimals
+    else:
+        assert digits is not None
+        tolerance = 0.5 * 10.0 ** (np.floor(np.log10(abs(value))) - digits + 1)
+    assert abs(float(cell) - value) <= tolerance + 1e-9, (cell, value)
+
+
+def test_the_digital_section_is_in_the_report(written: tuple[Path, list[str]]) -> None:
+    markdown = (written[0].parent / "report.md").read_text(encoding="utf-8")
+    for heading in (
+        "## Digital flight control",
+        "### The lateral regulator at a flight computer's rate",
+        "### The Dutch-roll damper at a flight computer's rate",
+        "### LQG at 50 Hz with sideslip not measured",
+    ):
+        assert heading in markdown
+    # Between the regulator and the Levels, in the order of the report.
+    assert markdown.index("## Optimal regulator") < markdown.index("## Digital flight control")
+    assert markdown.index("## Digital flight control") < markdown.index("(figures/envelope.png)")
+    lines = written[1]
+    assert lines[7].startswith("digital regulator (c = 1): 50 Hz: ‖K - K_c‖/‖K_c‖ = 6.377e-03")
+    assert lines[9].startswith("LQG (50 Hz, p, r, phi measured): filter poles")
+
+
+def test_the_digital_regulator_matches_python_control_and_quadrature(
+    written: tuple[Path, list[str]],
+) -> None:
+    markdown = (written[0].parent / "report.md").read_text(encoding="utf-8")
+    sys = LATERAL_747
+    x0 = np.array([1.0, 0.0, 0.0, 0.0])
+    Kc, Sc, _ = control.lqr(sys.A, sys.B, np.eye(4), np.eye(2))
+    Kc, Sc = np.asarray(Kc), np.asarray(Sc)
+    row = _table_row(markdown, "LQR continuous")
+    dutch = _dutch_roll_of(sys.A - sys.B @ Kc, None)
+    _printed(row[2], -dutch.real / abs(dutch), decimals=5)
+    _printed(row[3], abs(dutch), decimals=5)
+    assert row[4] == "0"
+    _printed(row[5], float(x0 @ Sc @ x0), digits=6)
+    gains = _section(markdown, "The gains, K (rows")
+    costs = {}
+    for rate in report_digital.DIGITAL_RATES:
+        period = 1.0 / rate
+        Phi, Gamma = _zoh(period)
+        K, S, W = _oracle_regulator(period)
+        for name, gain in ((f"LQR dlqr {rate:g} Hz", K), (f"LQR held {rate:g} Hz", Kc)):
+            closed = Phi - Gamma @ gain
+            assert np.all(np.abs(np.linalg.eigvals(closed)) < 1), name  # stable
+            row = _table_row(markdown, name)
+            dutch = _dutch_roll_of(closed, period)
+            _printed(row[2], -dutch.real / abs(dutch), decimals=5)
+            _printed(row[3], abs(dutch), decimals=5)
+            difference = np.linalg.norm(gain - Kc) / np.linalg.norm(Kc)
+            if gain is Kc:
+                assert row[4] == "0"
+            else:
+                _printed(row[4], difference, digits=4)
+            stage = np.vstack([np.eye(4), -gain])
+            costs[name] = _oracle_cost(closed, stage.T @ W @ stage, x0)
+            _printed(row[5], costs[name], digits=6)
+            printed_gain = [float(v) for v in _table_row(gains, name)[1:]]
+            assert np.max(np.abs(np.array(printed_gain) - gain.ravel())) <= 0.5e-5 + 1e-9
+        # The dlqr cost is x0^T S x0, and no held gain does better; the continuous design,
+        # free to change its command between samples, does better still.
+        assert costs[f"LQR dlqr {rate:g} Hz"] == pytest.approx(float(x0 @ S @ x0), rel=1e-10)
+        assert float(x0 @ Sc @ x0) < costs[f"LQR dlqr {rate:g} Hz"] < costs[f"LQR held {rate:g} Hz"]
+    # Measured: at 50 Hz the dlqr design is the continuous one to 0.64 %, at 10 Hz to 3.2 %.
+    assert _table_row(markdown, "LQR dlqr 50 Hz")[4] == "6.377e-03"
+    assert _table_row(markdown, "LQR dlqr 10 Hz")[4] == "3.164e-02"
+
+
+def test_the_digital_damper_matches_scipys_placement(written: tuple[Path, list[str]]) -> None:
+    markdown = (written[0].parent / "report.md").read_text(encoding="utf-8")
+    sys = LATERAL_747
+    # The continuous target (6.156) from numpy's eigenvalues: the Dutch roll at ζ = 0.3 and the
+    # same ω_n, the roll and spiral kept.
+    values = np.linalg.eigvals(sys.A)
+    (dutch,) = [v for v in values if v.imag > 0]
+    omega = abs(dutch)
+    target = [v for v in values if v.imag == 0] + [
+        complex(-0.3 * omega, s * omega * np.sqrt(1 - 0.09)) for s in (1, -1)
+    ]
+    k_continuous = scipy.signal.place_poles(sys.A, sys.B[:, :1], target).gain_matrix.ravel()
+    row = _table_row(markdown, "damper continuous")
+    assert np.max(np.abs([float(v) for v in row[1:5]] - k_continuous)) <= 0.5e-5 + 1e-9
+    _printed(row[6], 0.3, decimals=5)
+    _printed(row[7], omega, decimals=5)
+    for rate in report_digital.DIGITAL_RATES:
+        period = 1.0 / rate
+        Phi, Gamma = _zoh(period)
+        mapped = np.exp(np.array(target) * period)
+        k = scipy.signal.place_poles(Phi, Gamma[:, :1], mapped).gain_matrix.ravel()
+        row = _table_row(markdown, f"damper placed {rate:g} Hz")
+        assert np.max(np.abs([float(v) for v in row[1:5]] - k)) <= 0.5e-5 + 1e-9
+        _printed(row[6], 0.3, decimals=5)  # the mapped roots are the continuous ones
+        _printed(row[7], omega, decimals=5)
+        _printed(row[8], np.linalg.norm(k - k_continuous) / np.linalg.norm(k_continuous), digits=4)
+        held = _table_row(markdown, f"damper held {rate:g} Hz")
+        closed = Phi - np.outer(Gamma[:, 0], k_continuous)
+        assert np.all(np.abs(np.linalg.eigvals(closed)) < 1)
+        root = _dutch_roll_of(closed, period)
+        _printed(held[6], -root.real / abs(root), decimals=5)
+        _printed(held[7], abs(root), decimals=5)
+    # Measured: holding the continuous damper's gain at 10 Hz gives ζ = 0.30202, not 0.30.
+    assert _table_row(markdown, "damper held 10 Hz")[6] == "0.30202"
+
+
+def test_the_lqg_regulator_matches_python_control_and_its_loop_is_stable(
+    written: tuple[Path, list[str]],
+) -> None:
+    markdown = (written[0].parent / "report.md").read_text(encoding="utf-8")
+    lqg = _section(markdown, "### LQG at 50 Hz with sideslip not measured")
+    period = 1.0 / report_digital.LQG_RATE
+    Phi, Gamma = _zoh(period)
+    K, S, W = _oracle_regulator(period)
+    C = np.eye(4)[[1, 3, 2]]  # p, r, φ of (β, p, φ, r)
+    QN = np.radians(1.0) ** 2 * np.eye(2)
+    RN = np.diag(np.radians([0.1, 0.1, 0.2]) ** 2)
+    L, P, E = control.dlqe(Phi, Gamma, C, QN, RN)
+    L, P = np.asarray(L), np.asarray(P)
+    M = P @ C.T @ np.linalg.inv(C @ P @ C.T + RN)
+    assert np.allclose(L, Phi @ M, rtol=1e-9)  # L = Φ M (no cross covariance)
+    for state, gains in zip(("beta", "p", "phi", "r"), M, strict=True):
+        printed = [float(v) for v in _table_row(lqg, state)[1:]]
+        assert np.max(np.abs(np.array(printed) - gains)) <= 0.5e-6 + 1e-9
+    # The poles: the table's |z| and ω_n of the filter against dlqe's E.
+    rows = [line for line in lqg.splitlines() if line.startswith("| Kalman filter")]
+    expected = sorted((v for v in np.asarray(E) if v.imag >= 0), key=lambda v: abs(np.log(v)))
+    assert len(rows) == len(expected)
+    for line, z in zip(rows, expected, strict=True):
+        cells = [cell.strip() for cell in line.strip().strip("|").split("|")]
+        _printed(cells[3], abs(z), decimals=6)
+        _printed(cells[5], abs(np.log(z) / period), decimals=5)
+    # The closed loop, built here from the current-estimate compensator: x̂ = x̄ + M C (x - x̄),
+    # η = -K x̂, x̄⁺ = Φ x̂ + Γ η. Stable, and its poles are the regulator's and the filter's.
+    estimate = np.hstack([M @ C, np.eye(4) - M @ C])
+    command = -K @ estimate
+    closed = np.vstack(
+        [np.hstack([Phi, np.zeros((4, 4))]) + Gamma @ command, Phi @ estimate + Gamma @ command]
+    )
+    computed = np.linalg.eigvals(closed)
+    assert np.all(np.abs(computed) < 1)
+    union = np.concatenate([np.linalg.eigvals(Phi - Gamma @ K), np.asarray(E)])
+    assert max(np.min(np.abs(union - value)) for value in computed) < 1e-9
+    # The costs from a unit sideslip, the estimate starting at zero.
+    x0 = np.r_[1.0, np.zeros(7)]
+    stage = np.vstack([np.hstack([np.eye(4), np.zeros((4, 4))]), command])
+    lqg_cost = _oracle_cost(closed, stage.T @ W @ stage, x0)
+    found = re.search(r"J = ([0-9.]+) \(full-state feedback: J = ([0-9.]+), \+([0-9.]+) %\)", lqg)
+    assert found is not None
+    _printed(found.group(1), lqg_cost, digits=6)
+    _printed(found.group(2), float(S[0, 0]), digits=6)
+    assert "The closed loop (order 8) is stable" in lqg
+    # Measured: not measuring the sideslip costs 40 % more from this start.
+    assert found.group(3) == "39.7"
 
 
 def test_the_loci_name_their_modes_and_mark_the_critical_weight() -> None:

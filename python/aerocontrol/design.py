@@ -1,6 +1,7 @@
 """The chapter's design studies on an aircraft model: the Dutch-roll damper by pole placement
 (§6.5.1, (6.156)-(6.165)) and the lateral regulator over the control weight c (§6.6,
-(6.224)-(6.227), Figure 6.12).
+(6.224)-(6.227), Figure 6.12); and the regulator designed for a flight computer that samples
+the state and holds its command (:func:`sampled_weights`, :func:`sampled_data_lqr`).
 
 The regulator minimises J = ∫ x^T Q x + (1/c²) η^T R η dt: R/c² is the control weight, so a
 small c makes control expensive (the closed loop stays near the open loop) and a large c cheap.
@@ -9,6 +10,7 @@ small c makes control expensive (the closed loop stays near the open loop) and a
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -18,12 +20,20 @@ from .aircraft.model import Aircraft
 from .aircraft.naming import classify_modes
 from .batch import lqr_sweep
 from .exceptions import InvalidArgumentError
+from .linalg import c2d, expm
 from .modal import modes
 from .placement import Placement, augment_mode, place_bass_gura
-from .riccati import lqr
-from .statespace import StateSpace
+from .riccati import dlqr, lqr
+from .statespace import StateSpace, require_continuous, sampling_period
 
-__all__ = ["critical_weight", "dutch_roll_damper", "lqr_root_locus"]
+__all__ = [
+    "SampledWeights",
+    "critical_weight",
+    "dutch_roll_damper",
+    "lqr_root_locus",
+    "sampled_data_lqr",
+    "sampled_weights",
+]
 
 ComplexArray = NDArray[np.complex128]
 
@@ -141,3 +151,135 @@ def critical_weight(
     raise InvalidArgumentError(
         f"the {mode} does not become critically damped for c in [{low:g}, {high:g}]"
     )
+
+
+class SampledWeights(NamedTuple):
+    """The weights of the discrete regulator whose cost is the continuous one, from
+    :func:`sampled_weights`."""
+
+    Q: NDArray[np.float64]
+    """n x n, the weight of x_k."""
+    R: NDArray[np.float64]
+    """m x m, the weight of the held command η_k."""
+    N: NDArray[np.float64]
+    """n x m, the cross weight of x_k and η_k."""
+
+
+def sampled_weights(
+    sys: StateSpace, dt: float, Q: ArrayLike | None = None, R: ArrayLike | None = None
+) -> SampledWeights:
+    """The weights (Q_d, R_d, N_d) of the discrete cost that equals the continuous cost
+    J = ∫ x^T Q x + η^T R η dt of the plant driven by commands held over each period ``dt``
+    (zero-order hold), as MATLAB's ``lqrd`` forms them.
+
+    Between samples, [x(t_k + τ); η_k] = e^{F τ} [x_k; η_k] with F = [[A, B], [0, 0]], so the
+    cost over one period is [x_k; η_k]^T W [x_k; η_k] with
+
+        W = ∫_0^dt e^{F^T τ} diag(Q, R) e^{F τ} dτ = [[Q_d, N_d], [N_d^T, R_d]],
+
+    computed by Van Loan's method (1978) from one exponential of order 2 (n + m):
+    e^{[[-F^T, H], [0, F]] h} = [[., G12], [0, G22]] gives W(h) = G22^T G12, H = diag(Q, R),
+    over a step h = dt / 2^k short enough that ||F|| h <= 1 (over a long step the block
+    e^{-F^T h} of a fast stable mode overflows), then doubled k times,
+    W(2h) = W(h) + e^{F^T h} W(h) e^{F h}: sums of positive semidefinite terms, without
+    cancellation.
+    ``dlqr(c2d(sys, dt), Q_d, R_d, N=N_d)`` then minimises the continuous cost exactly over
+    held commands (:func:`sampled_data_lqr`), and tends to the continuous design as dt -> 0.
+
+    Parameters
+    ----------
+    sys : StateSpace
+        The continuous plant.
+    dt : float
+        The sampling period in seconds.
+    Q, R : array_like, optional
+        The continuous weights, identities by default (the chapter's (6.225)-(6.226)).
+
+    Returns
+    -------
+    SampledWeights
+        (Q, R, N), W symmetrised.
+
+    Examples
+    --------
+    A double integrator with the velocity weighted, v(t_k + τ) = v_k + η_k τ: the cost of one
+    period, ∫ (v_k + η_k τ)² + η_k² dτ, gives Q_d = diag(0, dt), N_d = (0, dt²/2) and
+    R_d = dt + dt³/3 in closed form:
+
+    >>> import numpy as np, aerocontrol
+    >>> from aerocontrol import design
+    >>> sys = aerocontrol.StateSpace([[0.0, 1.0], [0.0, 0.0]], [[0.0], [1.0]])
+    >>> w = design.sampled_weights(sys, 0.5, Q=np.diag([0.0, 1.0]), R=[[1.0]])
+    >>> np.round(w.Q, 12), np.round(w.N.ravel(), 12), np.round(w.R, 12)
+    (array([[0. , 0. ],
+           [0. , 0.5]]), array([0.   , 0.125]), array([[0.54166667]]))
+    """
+    require_continuous(sys, "sampled_weights", "its weights are those of a continuous cost")
+    period = sampling_period(dt)
+    if period == 0.0:
+        raise InvalidArgumentError(f"dt must be a positive sampling period, got {dt}")
+    n, m = sys.n_states, sys.n_inputs
+    Q_matrix, R_matrix = _weights(n, m, Q, R)
+    if Q_matrix.shape != (n, n) or R_matrix.shape != (m, m):
+        raise InvalidArgumentError(
+            f"Q must be {n} x {n} and R {m} x {m}, got {Q_matrix.shape} and {R_matrix.shape}"
+        )
+    size = n + m
+    F = np.zeros((size, size))
+    F[:n, :n], F[:n, n:] = sys.A, sys.B
+    H = np.zeros((size, size))
+    H[:n, :n], H[n:, n:] = Q_matrix, R_matrix
+    norm = float(np.abs(F).sum(axis=0).max()) * period
+    doublings = max(0, math.ceil(math.log2(norm))) if norm > 1.0 else 0
+    step = period / 2.0**doublings
+    block = np.block([[-F.T, H], [np.zeros((size, size)), F]])
+    exponential = expm(block * step)
+    transition = exponential[size:, size:]
+    W = transition.T @ exponential[:size, size:]
+    for _ in range(doublings):
+        W = W + transition.T @ W @ transition
+        transition = transition @ transition
+    W = 0.5 * (W + W.T)
+    return SampledWeights(
+        np.ascontiguousarray(W[:n, :n]),
+        np.ascontiguousarray(W[n:, n:]),
+        np.ascontiguousarray(W[:n, n:]),
+    )
+
+
+def sampled_data_lqr(
+    sys: StateSpace, dt: float, Q: ArrayLike | None = None, R: ArrayLike | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], ComplexArray]:
+    """The regulator of a flight computer sampling every ``dt`` seconds that minimises the
+    continuous cost J = ∫ x^T Q x + η^T R η dt over commands η_k = -K x_k held between samples
+    (MATLAB's ``lqrd``): :func:`~aerocontrol.dlqr` of the zero-order-hold plant
+    (:func:`~aerocontrol.c2d`) with the weights of :func:`sampled_weights`.
+
+    Returns
+    -------
+    K : ndarray (m, n)
+        The gain of η_k = -K x_k.
+    S : ndarray (n, n)
+        The discrete Riccati solution: x_0^T S x_0 is the continuous cost J of the sampled-data
+        loop from x_0 (between the samples included).
+    E : ndarray (n,) of complex128
+        The closed-loop eigenvalues z, inside the unit circle; ln(z)/dt are the continuous
+        roots they sample.
+
+    Examples
+    --------
+    The lateral regulator of (6.224) (c = 1) at 50 Hz is the continuous one to 0.7 %:
+
+    >>> import numpy as np, aerocontrol
+    >>> from aerocontrol import design
+    >>> lateral = aerocontrol.aircraft.load().lateral()
+    >>> K, S, E = design.sampled_data_lqr(lateral, 0.02)
+    >>> Kc, Sc, _ = aerocontrol.lqr(lateral.A, lateral.B, np.eye(4), np.eye(2))
+    >>> round(float(np.linalg.norm(K - Kc) / np.linalg.norm(Kc)), 4)
+    0.0064
+    >>> bool(np.all(abs(E) < 1))
+    True
+    """
+    weights = sampled_weights(sys, dt, Q, R)
+    plant = c2d(sys, dt)
+    return dlqr(plant.A, plant.B, weights.Q, weights.R, N=weights.N)

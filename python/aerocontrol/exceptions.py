@@ -18,7 +18,8 @@ class                         raised when
 ``NoStabilizingSolutionError``  a Riccati equation has no stabilising solution (likewise)
 ``IllConditionedError``       a step would lose every digit and was refused (likewise)
 ``NoContinuousEquivalentError``  a discrete model has no real continuous model behind it under
-                              the method asked (likewise)
+                              the method asked (likewise, and an ``InvalidArgumentError``
+                              naming the model: the argument is outside ``d2c``'s domain)
 ``NotPositiveDefiniteError``  a weight such as R is not symmetric positive definite
                               (an ``InvalidArgumentError``)
 ============================  ===========================================================
@@ -120,11 +121,15 @@ class IllConditionedError(AerocontrolLinAlgError):
     exchange of two Schur blocks with nearly equal eigenvalues."""
 
 
-class NoContinuousEquivalentError(AerocontrolLinAlgError):
+class NoContinuousEquivalentError(AerocontrolLinAlgError, InvalidArgumentError):
     """A discrete model has no real continuous model that the method asked maps to it: for the
     zero-order hold, A has an eigenvalue on the closed negative real axis (e^{A dt} never has
     one, and such an A has no real logarithm); for the bilinear transformation, A has an
-    eigenvalue at the image of s = ∞ (-1 for Tustin's). The message names the eigenvalue."""
+    eigenvalue at the image of s = ∞ (-1 for Tustin's). The message names the eigenvalue.
+
+    Both a ``LinAlgError`` (the matrix condition that fails) and an
+    :class:`InvalidArgumentError` (the model is outside the domain of ``d2c``): ``argument``
+    names the model (``"sys"``) and ``eigenvalues`` holds the eigenvalue at fault."""
 
 
 class ConvergenceError(AerocontrolLinAlgError):

@@ -7,6 +7,7 @@ response to an input held over a step follows from Φ and two integrals of it (6
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal, NamedTuple
@@ -16,7 +17,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, check_choice, real_array, real_scalar
-from .exceptions import InvalidArgumentError, NoContinuousEquivalentError, ShapeError
+from .exceptions import (
+    IllConditionedWarning,
+    InvalidArgumentError,
+    NoContinuousEquivalentError,
+    ShapeError,
+)
 from .statespace import StateSpace, as_state_space, period, sampling_period
 
 if TYPE_CHECKING:
@@ -35,6 +41,13 @@ __all__ = [
 ]
 
 ComplexArray = NDArray[np.complex128]
+
+#: :func:`d2c` with ``method="zoh"`` warns when a pole's angle exceeds this fraction of π: its
+#: continuous frequency is above 90 % of the Nyquist frequency π/dt, near its alias.
+NYQUIST_FRACTION_WARNING = 0.9
+#: :func:`d2c` with a bilinear method warns when α Ad + (1 - α) I has a reciprocal condition
+#: number (relative to its terms) below this: a pole near the image of s = ∞.
+BILINEAR_RCOND_WARNING = 1e-8
 
 
 def expm(A: ArrayLike) -> FloatArray:
@@ -374,21 +387,41 @@ def d2c(
         (inverse scaling and squaring on the real Schur form, in the core); C and D are
         unchanged. The logarithm is real only if Ad has no eigenvalue on the closed negative
         real axis: e^{A dt} never has one, so such a model (a pole at z <= 0, such as a
-        one-step delay z = 0) has no continuous equivalent.
+        one-step delay z = 0) has no continuous equivalent and is refused. Each pole
+        z = |z| e^{jθ} becomes s = (ln|z| + jθ)/dt with |θ| < π: the samples are equally
+        those of s + 2πjk/dt for every integer k (aliasing), and the principal one is chosen.
+        When |θ| > 0.9 π (:data:`NYQUIST_FRACTION_WARNING`: a continuous frequency above 90 %
+        of the Nyquist frequency π/dt) the choice is doubtful: the alias (2π - |θ|)/dt is
+        near, and the real logarithm of the pair z, z̄ is sensitive to A by the factor
+        θ / sin θ, which grows without bound as θ → π. It is computed, with a warning.
     ``"tustin"`` (``"bilinear"``), ``"euler"``, ``"backward_diff"``, ``"gbt"``
         The inverse of the generalized bilinear transformation of :func:`c2d`, with the same
-        ``prewarp`` and ``alpha``; it needs Ad free of the eigenvalue -(1 - α)/α (-1 for
-        Tustin's), the image of s = ∞.
+        ``prewarp`` and ``alpha``: A = (Ad - I)(α Ad + (1 - α) I)^-1 / dt (and B, C, D
+        likewise). It needs Ad free of the eigenvalue -(1 - α)/α (-1 for Tustin's), the
+        image of s = ∞: such a model is refused, and one whose α Ad + (1 - α) I has a
+        reciprocal condition number below 1e-8 relative to its terms,
+        σ_min / (α ||Ad|| + 1 - α) (an eigenvalue near -1 for Tustin's, a pole near s = ∞),
+        is computed with a warning.
 
     First-order hold and matched pole-zero have no inverse here.
 
     Raises
     ------
     NoContinuousEquivalentError
-        No real continuous model maps to ``sys`` (the message names the eigenvalue).
+        No real continuous model maps to ``sys``: an eigenvalue of its A at z = 0 or on the
+        negative real axis (``"zoh"``), or at -(1 - α)/α (the bilinear methods). An
+        :class:`~aerocontrol.exceptions.InvalidArgumentError` as well, with ``argument``
+        ``"sys"`` and the eigenvalue in ``eigenvalues``; the message names both.
     InvalidArgumentError
         ``sys`` is continuous, an unknown method, or ``prewarp``/``alpha`` where they do not
         apply.
+
+    Warns
+    -----
+    IllConditionedWarning
+        ``"zoh"``: a pole's angle is within 0.1 π of ±π (near the Nyquist frequency, where
+        the continuous frequency is ambiguous); the bilinear methods: α Ad + (1 - α) I is
+        nearly singular. The message gives the pole and the measure.
 
     Examples
     --------
@@ -398,6 +431,14 @@ def d2c(
     >>> back = aerocontrol.d2c(aerocontrol.c2d(sys, 0.05))
     >>> bool(np.allclose(back.A, A, rtol=1e-12, atol=1e-14)), back.dt
     (True, 0.0)
+
+    A sampled mode that alternates in sign (z = -0.5) has no continuous model behind it:
+
+    >>> try:
+    ...     aerocontrol.d2c(aerocontrol.StateSpace([[-0.5]], [[1.0]], dt=0.1))
+    ... except aerocontrol.InvalidArgumentError as error:
+    ...     print(error.argument, error.eigenvalues)
+    sys [(-0.5+0j)]
     """
     model = as_state_space(sys)
     if not model.is_discrete:
@@ -415,13 +456,13 @@ def d2c(
             raise InvalidArgumentError(
                 "prewarp and alpha apply to the bilinear methods, not to method='zoh'"
             )
-        _check_zoh_logarithm(model.A)
+        _check_zoh_logarithm(model.A, period(model))
         try:
             A, B = _core.undiscretize_zoh(model.A, model.B, period(model))
         except InvalidArgumentError as error:
             if error.argument != "A":
                 raise
-            raise NoContinuousEquivalentError(str(error)) from None
+            raise _no_equivalent(f"sys.A: {error}", None) from None
         return _named_like(model, A, B, model.C, model.D, 0.0)
     weight = _bilinear_weight(chosen, alpha)
     warped = _warped_step(chosen, weight, period(model), prewarp)
@@ -430,7 +471,9 @@ def d2c(
     except InvalidArgumentError as error:
         if error.argument != "A":
             raise
-        raise NoContinuousEquivalentError(str(error)) from None
+        infinity = -(1.0 - weight) / weight if weight else None
+        raise _no_equivalent(f"sys.A: {error}", infinity) from None
+    _check_bilinear_condition(model.A, weight, chosen)
     return _named_like(model, A, B, C, D, 0.0)
 
 
@@ -455,26 +498,77 @@ def _named_like(
     )
 
 
-def _check_zoh_logarithm(A: FloatArray) -> None:
+def _no_equivalent(message: str, eigenvalue: complex | None) -> NoContinuousEquivalentError:
+    """The refusal of a discrete model without a continuous equivalent, naming ``sys``."""
+    error = NoContinuousEquivalentError(message)
+    error.argument = "sys"
+    error.eigenvalues = None if eigenvalue is None else [complex(eigenvalue)]
+    return error
+
+
+def _check_zoh_logarithm(A: FloatArray, dt: float) -> None:
     """Refuses an A with an eigenvalue on the closed negative real axis (or at 0 to working
-    precision), which no e^{A_c dt} has."""
+    precision), which no e^{A_c dt} has; warns of a pole whose angle is near ±π (see
+    :func:`d2c`)."""
     eigenvalues = _core.eigenvalues(A)
     if eigenvalues.size == 0:
         return
     zero = A.shape[0] * np.finfo(float).eps * float(np.abs(A).max())
     for value in eigenvalues:
         if abs(value) <= zero:
-            raise NoContinuousEquivalentError(
-                f"A has the eigenvalue 0 (computed as {complex(value):.3g}), a pole at z = 0 "
+            raise _no_equivalent(
+                f"sys.A has the eigenvalue 0 (computed as {complex(value):.3g}), a pole at z = 0 "
                 "(a pure delay or a deadbeat mode): e^(A_c dt) is never singular, so no "
-                "continuous model has these zero-order-hold samples"
+                "continuous model has these zero-order-hold samples",
+                0.0,
             )
         if value.imag == 0.0 and value.real < 0.0:
-            raise NoContinuousEquivalentError(
-                f"A has the eigenvalue {value.real:.6g} on the negative real axis: e^(A_c dt) "
-                "never has one (A has no real logarithm), so no real continuous model has "
-                "these zero-order-hold samples"
+            raise _no_equivalent(
+                f"sys.A has the eigenvalue {value.real:.6g} on the negative real axis: "
+                "e^(A_c dt) never has one (A has no real logarithm), so no real continuous "
+                "model has these zero-order-hold samples",
+                complex(value.real, 0.0),
             )
+    angles = np.abs(np.angle(eigenvalues))
+    worst = int(np.argmax(angles))
+    theta = float(angles[worst])
+    if theta > NYQUIST_FRACTION_WARNING * np.pi:
+        nyquist = np.pi / dt
+        warnings.warn(
+            f"sys.A has the pole {complex(eigenvalues[worst]):.6g} at the angle "
+            f"{theta / np.pi:.4f} pi, near the Nyquist frequency: its continuous frequency "
+            f"{theta / dt:.6g} rad/s is {theta / np.pi:.1%} of pi/dt = {nyquist:.6g} rad/s, "
+            f"and the samples are equally those of {(2 * np.pi - theta) / dt:.6g} rad/s "
+            f"(aliasing); the real logarithm's sensitivity theta/sin(theta) is "
+            f"{theta / np.sin(theta):.3g}",
+            IllConditionedWarning,
+            stacklevel=3,
+        )
+
+
+def _check_bilinear_condition(A: FloatArray, weight: float, method: str) -> None:
+    """Warns when α A + (1 - α) I, inverted by the bilinear inverse, is nearly singular
+    relative to its terms: σ_min(α A + (1 - α) I) / (α ||A||_2 + 1 - α) below
+    :data:`BILINEAR_RCOND_WARNING`. (Relative to the terms, not to the sum's own norm: the sum
+    of a scalar -1 + 1e-10 and 1 is well conditioned but has lost ten digits in the sum.)"""
+    if A.shape[0] == 0 or weight == 0.0:
+        return
+    denominator = weight * A + (1.0 - weight) * np.eye(A.shape[0])
+    smallest = float(np.linalg.svd(denominator, compute_uv=False)[-1])
+    largest = float(np.linalg.svd(A, compute_uv=False)[0])
+    rcond = smallest / (weight * largest + 1.0 - weight)
+    if rcond < BILINEAR_RCOND_WARNING:
+        eigenvalues = _core.eigenvalues(A)
+        infinity = -(1.0 - weight) / weight
+        nearest = complex(eigenvalues[int(np.argmin(np.abs(eigenvalues - infinity)))])
+        warnings.warn(
+            f"sys.A has the eigenvalue {nearest:.12g} near {infinity:g}, the image of "
+            f"s = infinity under method={method!r}: alpha A + (1 - alpha) I has the reciprocal "
+            f"condition number {rcond:.2e}, so the continuous model may carry few correct "
+            "digits (its pole is near infinity)",
+            IllConditionedWarning,
+            stacklevel=3,
+        )
 
 
 def _roots(coefficients: FloatArray) -> ComplexArray:

@@ -16,6 +16,8 @@ function                       the chapter's figure
                                (6.230; Figures 6.9, 6.10)
 :func:`plot_penalty`           x^T Q x and -η^T R η against time; the area between is J
                                (Figure 6.11)
+:func:`plot_compared`          one variable of several designs on the same axes, sampled ones
+                               as held samples (the report's digital designs)
 :func:`plot_root_locus`        closed-loop roots over a weight c (Figures 6.8, 6.12)
 :func:`plot_bode`              magnitude and phase of one input-output pair
 :func:`plot_modes`             the eigenvalues in the complex plane, by mode
@@ -27,7 +29,7 @@ States, inputs and outputs with the names of the aircraft models (``u/u0``, ``al
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
@@ -48,6 +50,7 @@ __all__ = [
     "label",
     "penalty_terms",
     "plot_bode",
+    "plot_compared",
     "plot_levels",
     "plot_modes",
     "plot_open_closed",
@@ -257,6 +260,53 @@ def plot_with_controls(
     for column, name in zip(controls.T, names, strict=True):
         ax.plot(result.t, column, "--", label=label(name))
     _finish(ax, "time (s)", _axis_label((*result.state_names, *names), "states and controls"))
+    return ax
+
+
+def plot_compared(
+    curves: Mapping[str, tuple[TimeResponse, str]],
+    ax: Axes | None = None,
+    held: Iterable[str] = (),
+    title: str | None = None,
+) -> Axes:
+    """One variable of several responses on the same axes, as the designs of a flight
+    computer are compared with the continuous one. ``curves`` maps each legend label to a
+    response and the name of the state or output to draw (states first); the labels in
+    ``held`` are drawn as a staircase (the samples of a discrete model, held until the next).
+    The y label is the first variable's. Returns the axes.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> from aerocontrol import StateSpace, c2d, initial_response, plotting
+    >>> lag = StateSpace([[-1.0]], [[1.0]], state_names=["beta"])
+    >>> t = np.arange(0.0, 5.0, 0.5)
+    >>> ax = plotting.plot_compared(
+    ...     {"continuous": (initial_response(lag, [1.0], T=t), "beta"),
+    ...      "2 Hz": (initial_response(c2d(lag, 0.5), [1.0], T=t), "beta")},
+    ...     held=["2 Hz"])
+    >>> [line.get_drawstyle() for line in ax.get_lines()], ax.get_ylabel()
+    (['default', 'steps-post'], 'sideslip β (rad)')
+    """
+    ax = _new_axes() if ax is None else ax
+    staircase = set(held)
+    first = None
+    for name, (result, variable) in curves.items():
+        if variable in result.state_names:
+            values = result.states()[:, result.state_names.index(variable)]
+        elif variable in result.output_names:
+            values = result.outputs()[:, result.output_names.index(variable)]
+        else:
+            raise InvalidArgumentError(
+                f"curves[{name!r}] names {variable!r}, which is neither a state nor an output "
+                f"of its response (states {result.state_names})"
+            )
+        style = "steps-post" if name in staircase else "default"
+        ax.plot(result.t, values, label=name, drawstyle=style)
+        first = variable if first is None else first
+    _finish(ax, "time (s)", label(first) if first is not None else "", title)
     return ax
 
 

@@ -14,9 +14,15 @@ contained: the figures are embedded) and ``report.md`` with ``figures/*.png``. T
    6.6);
 5. the lateral regulator at the chapter's weights c (6.224-6.227, Figures 6.9-6.11), its root
    locus over c with the weight at which the Dutch roll becomes critically damped (Figure 6.12);
-6. the Levels after augmentation, and the open-loop Levels over Mach and altitude around the
+6. the lateral designs on a flight computer: the regulator (c = 1) by dlqr with the sampled
+   weights and the rudder damper placed at the mapped roots, at 50 Hz and 10 Hz, beside the
+   continuous designs and their gains held (roots s = ln(z)/T, the Dutch roll's ζ and ω_n, the
+   gain difference, the continuous cost); an LQG regulator at 50 Hz with sideslip not
+   measured (a Kalman filter from p, r, φ), its closed-loop poles and its response beside
+   full-state feedback;
+7. the Levels after augmentation, and the open-loop Levels over Mach and altitude around the
    file's condition;
-7. for the embedded 747, the chapter's small examples (controllability (6.75-6.88), Figures 6.4
+8. for the embedded 747, the chapter's small examples (controllability (6.75-6.88), Figures 6.4
    and 6.8) and its printed numbers beside ours, among them the static check (6.52-6.55).
 
 A design that does not apply to an aircraft (for example a lateral model without an
@@ -28,7 +34,8 @@ document and its Markdown, HTML and PNG forms), :mod:`~aerocontrol.report.contex
 :mod:`~aerocontrol.report.formatting` (what the sections share), one module per section
 (:mod:`~aerocontrol.report.models`, :mod:`~aerocontrol.report.modes`,
 :mod:`~aerocontrol.report.responses`, :mod:`~aerocontrol.report.damper`,
-:mod:`~aerocontrol.report.regulator`, :mod:`~aerocontrol.report.levels`,
+:mod:`~aerocontrol.report.regulator`, :mod:`~aerocontrol.report.digital`,
+:mod:`~aerocontrol.report.levels`,
 :mod:`~aerocontrol.report.envelope`, :mod:`~aerocontrol.report.chapter_check`), and the output
 folder: :mod:`~aerocontrol.report.folder` (the rules and ``ReportFolder``),
 :mod:`~aerocontrol.report.manifest`, :mod:`~aerocontrol.report.staging`,
@@ -46,11 +53,14 @@ responses: elevator impulse and step over 20 s and 500 s (Figures 6.1, 6.2), ...
 Dutch-roll damper (Bass-Gura): rudder k = [0.1383, 0.09435, 0.125, -1.133], ...
 LQR (Figures 6.9-6.11): c = 0.001: J∞ = 16.57; c = 0.5: J∞ = 10.56; c = 1: J∞ = 7.088; ...
 root locus (Figure 6.12): The Dutch roll becomes critically damped at c = 9.772714 ...
+digital regulator (c = 1): 50 Hz: ‖K - K_c‖/‖K_c‖ = 6.377e-03, Dutch roll ζ = 0.35955; ...
+digital damper (rudder): 50 Hz: k = [0.1316, 0.09474, 0.1248, -1.128], ...
+LQG (50 Hz, p, r, phi measured): filter poles 0.9902 + 0.00251j, 0.9337, 0.9553; J = 9.902 ...
 levels after augmentation: dutch roll 2 -> damper (rudder) 1, damper (aileron) 1, ...
 envelope: 63 conditions around the file's (Level 2: 41, Level 3: 20, Level 4: 2)
 chapter check: Figures 6.4 and 6.8, 16 results beside the printed values
 >>> len(report.figures)
-14
+16
 """
 
 from __future__ import annotations

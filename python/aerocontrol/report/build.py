@@ -10,7 +10,17 @@ from pathlib import Path
 
 from ..aircraft.model import Aircraft, load
 from ..exceptions import OutputFolderError
-from . import chapter_check, damper, envelope, levels, models, modes, regulator, responses
+from . import (
+    chapter_check,
+    damper,
+    digital,
+    envelope,
+    levels,
+    models,
+    modes,
+    regulator,
+    responses,
+)
 from .context import Context
 from .document import Report
 from .folder import ReportFolder
@@ -37,6 +47,7 @@ def build_report(
         responses.section,
         damper.section,
         regulator.section,
+        digital.section,
         levels.section,
         envelope.section,
     ]
