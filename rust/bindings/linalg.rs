@@ -203,6 +203,7 @@ fn discretize<'py>(
         .map(|g| outputs.matrix("Gamma1", g.as_ref()))
         .transpose()?;
     outputs.finish()?;
+    warn_if_ill_conditioned(py, one_norm(a), dt)?;
     Ok((phi, gamma0, gamma1))
 }
 

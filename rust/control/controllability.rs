@@ -62,7 +62,9 @@
 
 use crate::control::modal::eigen;
 use crate::error::{Error, check_finite, check_rows, check_square};
+use crate::linalg::balance::{range_scale, scale_for_largest};
 use crate::linalg::householder::reflector;
+use crate::linalg::norm::{frobenius_norm, max_abs, vector_norm};
 use crate::linalg::schur::eigenvalues;
 use crate::linalg::small_matrix::product;
 use faer::linalg::matmul::matmul;
@@ -244,16 +246,21 @@ fn combine_with_modal_test(
     let (mut eigenvalues, mut modal_measure) = (Vec::new(), Vec::new());
     if modal_test {
         let (values, vectors) = eigen(a_dual)?;
+        // ||w^T B|| = s ||w^T (B / s)|| for the power of two s of B's largest entry, with the
+        // norm scaled, so that neither the products nor their squares leave the range.
+        let scale = range_scale(coupling_dual);
         for (k, &lambda) in values.iter().enumerate() {
             let vector = vectors.col(k);
-            let measure = (0..coupling_dual.nrows())
+            let products: Vec<c64> = (0..coupling_dual.nrows())
                 .map(|r| {
                     let row = coupling_dual.row(r);
-                    let product: c64 = row.iter().zip(vector.iter()).map(|(&x, v)| v * x).sum();
-                    product.norm_sqr()
+                    row.iter()
+                        .zip(vector.iter())
+                        .map(|(&x, v)| v * (x / scale))
+                        .sum()
                 })
-                .sum::<f64>()
-                .sqrt();
+                .collect();
+            let measure = vector_norm(products.iter().flat_map(|p| [p.re, p.im])) * scale;
             modal_measure.push(measure);
             // Add what the staircase missed (at most once per computed eigenvalue).
             let near = |mu: &c64| (mu - lambda).norm() <= 1e-6 * lambda.norm().max(1.0);
@@ -292,12 +299,20 @@ pub(crate) fn staircase(
     with_transformation: bool,
 ) -> Result<Staircase, Error> {
     let (n, m) = (a.nrows(), b.ncols());
-    let default = n as f64 * f64::EPSILON * a.norm_l2().max(b.norm_l2());
-    let tolerance = checked_tolerance(tolerance, default)?;
+    let tolerance = checked_tolerance(tolerance, 0.0).map(|_| tolerance)?;
+    // (A, B) / s for the power of two s that brings the largest entry near 1 (exact, and the
+    // same staircase with the tolerance divided by s): the reflections' products of entries
+    // neither overflow nor underflow. Results are multiplied back.
+    let scale = scale_for_largest(max_abs(a).max(max_abs(b)));
+    let scaled = |m: MatRef<'_, f64>| Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] / scale);
+    let (a, b) = (scaled(a), scaled(b));
+    let default =
+        n as f64 * f64::EPSILON * frobenius_norm(a.as_ref()).max(frobenius_norm(b.as_ref()));
+    let tolerance = tolerance.map_or(default, |t| t / scale);
     let z_order = if with_transformation { n } else { 0 };
     let mut reduction = Reduction {
-        a: a.to_owned(),
-        b: b.to_owned(),
+        a,
+        b,
         z: Mat::identity(z_order, z_order),
         w: Mat::zeros(n, 1),
         row_work: Mat::zeros(1, n.max(m)),
@@ -322,16 +337,26 @@ pub(crate) fn staircase(
         start,
         n - start,
         n - start,
-    ))?;
+    ))?
+    .into_iter()
+    .map(|lambda| lambda * scale)
+    .collect();
+    let unscaled = |m: Mat<f64>| {
+        if scale == 1.0 {
+            m
+        } else {
+            &m * faer::Scale(scale)
+        }
+    };
     Ok(Staircase {
-        a: reduction.a,
-        b: reduction.b,
+        a: unscaled(reduction.a),
+        b: unscaled(reduction.b),
         z: reduction.z,
         block_sizes,
         controllable_order: start,
         uncontrollable_eigenvalues,
-        tolerance,
-        smallest_pivot: reduction.smallest_pivot,
+        tolerance: tolerance * scale,
+        smallest_pivot: reduction.smallest_pivot * scale,
     })
 }
 
@@ -370,15 +395,11 @@ impl Reduction {
             let row = start + rank;
             let block = if in_b { &self.b } else { &self.a };
             // The pivot: the column with the largest norm in rows row.. .
-            let (position, squares) = unused
+            let (position, norm) = unused
                 .iter()
                 .enumerate()
-                .map(|(p, &j)| {
-                    let tail = &block.col_as_slice(j)[row..];
-                    (p, tail.iter().map(|x| x * x).sum::<f64>())
-                })
+                .map(|(p, &j)| (p, vector_norm(block.col_as_slice(j)[row..].iter().copied())))
                 .fold((0, -1.0), |best, c| if c.1 > best.1 { c } else { best });
-            let norm = squares.sqrt();
             if norm <= self.tolerance {
                 break;
             }

@@ -19,7 +19,11 @@ const SMALL_ENTRY: f64 = 7.888_609_052_210_118e-31; // 2^-100
 /// The power of two by which `a` is divided before its Schur form, 1 when its largest entry
 /// is in range (the scaling is exact, and A = Z (s T) Z^T with the same Z).
 pub(crate) fn range_scale(a: MatRef<'_, f64>) -> f64 {
-    let largest = max_abs(a);
+    scale_for_largest(max_abs(a))
+}
+
+/// The power of two of [`range_scale`] for a matrix whose largest magnitude is `largest`.
+pub(crate) fn scale_for_largest(largest: f64) -> f64 {
     if largest > 0.0 && !(SMALL_ENTRY..=1.0 / SMALL_ENTRY).contains(&largest) {
         // 2^±1000 at most: 2^-1074 (the smallest subnormal) would be 1 / 2^1074 = 1 / inf = 0,
         // and a division by it NaN everywhere; 2^1000 brings any entry into range.

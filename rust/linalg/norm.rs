@@ -42,6 +42,26 @@ pub fn frobenius_norm(a: MatRef<'_, f64>) -> f64 {
     a.norm_l2()
 }
 
+/// The Euclidean norm of a vector of finite entries, without overflow or underflow in its
+/// squares (as LAPACK's dnrm2): a plain sum of squares when the largest entry is within
+/// 2^±500, where no square overflows and those that underflow are below u times the largest;
+/// otherwise the sum for the entries divided by the power of two nearest the largest (exact),
+/// multiplied back. A vector of entries near 1e-170 has its norm, not 0.
+pub fn vector_norm(x: impl Iterator<Item = f64> + Clone) -> f64 {
+    let largest = x.clone().fold(0.0f64, |m, v| m.max(v.abs()));
+    if largest == 0.0 || (VECTOR_RANGE_LOW..=VECTOR_RANGE_HIGH).contains(&largest) {
+        return x.map(|v| v * v).sum::<f64>().sqrt();
+    }
+    // 2^±1000 at most: 1 / 2^-1074 would overflow.
+    let exponent = largest.log2().round().clamp(-1000.0, 1000.0);
+    let (down, up) = ((-exponent).exp2(), exponent.exp2());
+    x.map(|v| (v * down) * (v * down)).sum::<f64>().sqrt() * up
+}
+
+/// The range of the largest entry in which [`vector_norm`] sums squares unscaled.
+const VECTOR_RANGE_LOW: f64 = 3.054936363499605e-151; // 2^-500
+const VECTOR_RANGE_HIGH: f64 = 3.273390607896142e150; // 2^500
+
 /// The larger of a and b, NaN if either is: a norm of a matrix with a NaN entry is NaN, not
 /// the norm of its other entries (`f64::max` drops NaN).
 fn max_or_nan(a: f64, b: f64) -> f64 {
@@ -519,5 +539,26 @@ mod tests {
             one_norm_estimate(&MatrixProduct::new(vec![a.as_ref(), identity.as_ref()]), 2);
         let expected = u.iter().map(|x| x.abs()).sum::<f64>() * 5.0;
         assert!((estimate - expected).abs() <= 1e-12 * expected);
+    }
+
+    #[test]
+    fn vector_norms_of_any_magnitude() {
+        for scale in [1e-320, 1e-300, 1e-170, 1e-150, 1.0, 1e150, 1e170, 1e300] {
+            let x = [3.0 * scale, -4.0 * scale, 0.0];
+            let norm = vector_norm(x.iter().copied());
+            let expected = 5.0 * scale;
+            let tolerance = if scale < f64::MIN_POSITIVE {
+                1e-3
+            } else {
+                4.0 * f64::EPSILON
+            };
+            assert!(
+                (norm - expected).abs() <= tolerance * expected,
+                "{scale:e}: {norm:e}"
+            );
+        }
+        assert_eq!(vector_norm([1e308, 1e308].into_iter()), 1e308 * 2f64.sqrt());
+        assert_eq!(vector_norm([0.0, 0.0].into_iter()), 0.0);
+        assert_eq!(vector_norm([1.0, 1e-170].into_iter()), 1.0);
     }
 }

@@ -56,29 +56,6 @@ def _model(sys: Any) -> tuple[Any, ...]:
     return (sys.A, sys.B, sys.C, sys.D) if hasattr(sys, "A") else tuple(sys)
 
 
-CONTROLLABILITY_EXTREME_ENTRIES: Defect = known_defect(
-    "controllability-extreme-entries",
-    {"controllability", "observability", "is_controllable", "is_observable"},
-    "The controllability analysis forms norms from unscaled sums of squares. With an entry "
-    "above about 1.3e154 the default tolerance n eps max(||A||_F, ||B||_F) is inf (2.2e292 "
-    "for B = [[1e308]]) and every mode is declared uncontrollable, silently: (A, B) = "
-    "([[0.125]], [[1e308]]) is controllable, and is reported not to be, with tolerance and "
-    "modal_measure inf. With entries below about 1e-160 the norms underflow to 0: "
-    "([[1]], [[1e-170]]) with tol = 0 is reported uncontrollable (modal_measure 0), and "
-    "([[1e-301]], [[1e-301]]) with the default tolerance 2.8e-317 likewise, silently. It "
-    "should scale the norms (as LAPACK's dnrm2).",
-    lambda args: any(_extreme_entries(m) for m in _pair(args)),
-)
-
-
-def _pair(args: dict[str, Any]) -> tuple[Any, Any]:
-    second = args.get("B", args.get("C"))
-    if second is None:
-        model = _model(args["A_or_sys"])
-        return model[0], np.concatenate([np.ravel(m) for m in model[1:]])
-    return args["A_or_sys"], second
-
-
 PLACEMENT_OVERFLOW_BLAMES_A: Defect = known_defect(
     "placement-overflow-blames-A",
     {"place", "place_ackermann", "place_bass_gura"},

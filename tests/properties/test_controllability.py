@@ -21,7 +21,6 @@ from hypothesis import strategies as st
 
 import aerocontrol
 
-from . import known_defects
 from .harness import Warned, exercise, plain
 from .oracles import SLACK, TINY, U, assert_spectrum, finite, norm, quietly, silenced
 from .strategies import (
@@ -241,32 +240,34 @@ def _through_models(oracle: Any, key: str) -> Any:
     return unpacked
 
 
-# ----- known defects of the core (see known_defects.py) ------------------------------------------
+# ----- inputs a campaign found (regressions) -----------------------------------------------------
 
 
 CONTROLLABLE_EXTREME_PAIRS = {
     "huge": (np.array([[0.125]]), np.array([[1e308]]), None),
     "tiny": (np.array([[1.0]]), np.array([[1e-170]]), 0.0),
+    "all tiny": (np.array([[1e-301]]), np.array([[1e-301]]), None),
+    "huge A": (np.array([[1e300, 1e300], [0.0, 2e300]]), np.array([[0.0], [1e300]]), None),
 }
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.CONTROLLABILITY_EXTREME_ENTRIES.summary)
 @pytest.mark.parametrize("example", CONTROLLABLE_EXTREME_PAIRS)
-def test_known_defect_controllability_extreme_entries(example: str) -> None:
+def test_controllability_extreme_entries(example: str) -> None:
+    """Pairs whose squares leave the normal range (once declared uncontrollable: the norms
+    were formed from unscaled sums of squares)."""
     A, B, tol = CONTROLLABLE_EXTREME_PAIRS[example]
-    with known_defects.CONTROLLABILITY_EXTREME_ENTRIES.reproducing():
-        outcome = exercise(
-            "controllability",
-            aerocontrol.controllability,
-            {
-                "A_or_sys": canonical(A),
-                "B": canonical(B),
-                "tol": plain(tol),
-                "method": plain("full"),
-            },
-            _through_models(_analysis_oracle(False, False), "B"),
-            nonfinite_by_definition=("smallest_pivot",),
-        )
-        # Both pairs are controllable in exact arithmetic and far from any uncontrollable one
-        # relative to their tolerance.
-        assert outcome.result.controllable, "a controllable pair was declared uncontrollable"
+    outcome = exercise(
+        "controllability",
+        aerocontrol.controllability,
+        {
+            "A_or_sys": canonical(A),
+            "B": canonical(B),
+            "tol": plain(tol),
+            "method": plain("full"),
+        },
+        _through_models(_analysis_oracle(False, False), "B"),
+        nonfinite_by_definition=("smallest_pivot",),
+    )
+    # Both pairs are controllable in exact arithmetic and far from any uncontrollable one
+    # relative to their tolerance.
+    assert outcome.result.controllable, "a controllable pair was declared uncontrollable"

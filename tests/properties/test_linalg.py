@@ -280,6 +280,37 @@ def test_schur_extreme_entries(example: str) -> None:
     exercise("schur", aerocontrol.schur, {"A": canonical(A), "select": plain(None)}, _schur_oracle)
 
 
+def test_schur_reordering_of_tiny_entries() -> None:
+    """The reordering of a Schur form of entries near 1e-300 (its swaps compared with absolute
+    thresholds: residual 6.5e-301 for a matrix of norm 2e-300)."""
+    A = 1e-301 * np.array(
+        [[4.0313, 8.5368, -10.546], [11.535, -9.0528, -0.13459], [5.5115, 1.1740, 3.6542]]
+    )
+    select = _selector("rhp")
+    exercise(
+        "schur",
+        aerocontrol.schur,
+        {"A": canonical(A), "select": Arg(select, select, "rhp", "same")},
+        _schur_oracle,
+    )
+
+
+def test_discretize_warns_beyond_2_to_53() -> None:
+    """||A dt|| = 1.4e149 (n = 1, m = 0): the IllConditionedWarning of expm, once missing."""
+    outcome = exercise(
+        "discretize",
+        aerocontrol.discretize,
+        {
+            "A": canonical(np.array([[-1.4308730228590872e150]])),
+            "B": canonical(np.zeros((1, 0))),
+            "dt": plain(0.1),
+            "method": plain("zoh"),
+        },
+        _discretize_oracle,
+    )
+    assert IllConditionedWarning in outcome.warned
+
+
 def test_transition_huge_times() -> None:
     """Φ(1e155) of A = 0 is I (the powers of A and of t, formed apart, once gave 0 · inf)."""
     exercise(

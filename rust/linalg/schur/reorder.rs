@@ -45,6 +45,7 @@
 //! complex pair is selected by its member with positive imaginary part.
 
 use crate::error::Error;
+use crate::linalg::balance::range_scale;
 use crate::linalg::householder::reflector;
 use crate::linalg::schur::form::{RealSchur, quasi_triangular_eigenvalues, standardize_block};
 use crate::linalg::sylvester::solve_small_sylvester;
@@ -72,14 +73,22 @@ pub fn reorder_schur(
     clear_upper_avx_state();
     let RealSchur { t, mut z } = schur;
     let n = t.nrows();
+    // T / s for the power of two s that brings its largest entry near 1 (exact): the swaps'
+    // small Sylvester equations and their tests compare with absolute thresholds, so a form
+    // of entries near 1e-300 came back with a residual of its own size. `select` sees the
+    // eigenvalues of T itself.
+    let scale = range_scale(t.as_ref());
     let mut t = with_padded_columns(t);
+    if scale != 1.0 {
+        t /= faer::Scale(scale);
+    }
     // Rows and columns above `position` hold selected blocks only.
     let mut position = 0;
     let mut k = 0;
     while k < n {
         interrupt::check()?;
         let size = block_size(&t, k);
-        if !select(block_eigenvalue(&t, k, size)) {
+        if !select(block_eigenvalue(&t, k, size) * scale) {
             k += size;
             continue;
         }
@@ -107,6 +116,9 @@ pub fn reorder_schur(
         position += size;
         k += size;
     }
+    if scale != 1.0 {
+        t *= faer::Scale(scale);
+    }
     let eigenvalues = quasi_triangular_eigenvalues(t.as_ref());
     Ok(OrderedSchur {
         t,
@@ -127,8 +139,7 @@ const PADDED_MIN_ORDER: usize = 256;
 /// stride of a multiple of 512 bytes, consecutive columns fall into a handful of the L1 cache's
 /// sets and each sweep misses the cache on every column; one extra cache line per column
 /// spreads them over all the sets, so the rows a sweep touches stay in L1 for the next swap
-/// (reordering the Schur form of a Hamiltonian of order 512 by the stable eigenvalues: 73 ->
-/// 33 ms; order 256: 7.7 -> 5.1 ms; at orders 128 to 200 it gained nothing).
+/// (the bench "schur + reorder lhp" in `benches/riccati.rs` measures it).
 fn with_padded_columns(t: Mat<f64>) -> Mat<f64> {
     let n = t.nrows();
     if n < PADDED_MIN_ORDER || n != t.ncols() {
@@ -432,6 +443,25 @@ mod tests {
             );
             assert!(eigenvalues[..selected].iter().all(|z| z.re < 0.0), "n={n}");
             assert_eq!(eigenvalues, quasi_triangular_eigenvalues(t.as_ref()));
+        }
+    }
+
+    /// Matrices near the ends of the range reorder with the same relative residual as at 1
+    /// (the swaps work on T scaled to its largest entry).
+    #[test]
+    fn tiny_and_huge_forms_reorder_with_a_relative_residual() {
+        let base = seeded(6, 3);
+        for factor in [1e-300, 1e-200, 1e200, 1e300] {
+            let a = &base * faer::Scale(factor);
+            let ordered = reorder_schur(real_schur(a.as_ref()).unwrap(), |z| z.re > 0.0).unwrap();
+            let (t, z) = (&ordered.t, &ordered.z);
+            let residual = (z * t * z.transpose() - &a).norm_l2() / a.norm_l2();
+            assert!(residual < 1e-14, "{factor:e}: residual {residual:e}");
+            assert!(
+                ordered.eigenvalues[..ordered.selected]
+                    .iter()
+                    .all(|z| z.re > 0.0)
+            );
         }
     }
 }
