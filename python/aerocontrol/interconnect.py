@@ -40,6 +40,7 @@ from ._validation import FloatArray, check_finite, finite_or_warn, real_array, r
 from .exceptions import (
     IllConditionedWarning,
     InvalidArgumentError,
+    NonFiniteError,
     NotRealError,
     ShapeError,
     SingularMatrixError,
@@ -79,10 +80,19 @@ ILL_CONDITIONED = 1e8
 # ----- arguments --------------------------------------------------------------------------------
 
 
+def _finite(value: object, name: str) -> float:
+    """``value`` as a finite float, or the package's error naming ``name``."""
+    number = real_scalar(value, name)
+    if not np.isfinite(number):
+        error = NonFiniteError(f"{name} must be finite, got {number}")
+        error.argument, error.value = name, number
+        raise error
+    return number
+
+
 def _positive(value: object, name: str) -> float:
     """``value`` as a positive, finite float, or the package's error naming ``name``."""
-    number = real_scalar(value, name)
-    check_finite(np.array(number), name)
+    number = _finite(value, name)
     if number <= 0.0:
         raise InvalidArgumentError(f"{name} must be positive, got {number}")
     return number
@@ -178,22 +188,29 @@ def _block_diagonal(matrices: Sequence[FloatArray]) -> FloatArray:
     return result
 
 
-def _solve_loop(M: FloatArray, right: FloatArray, what: str, function: str) -> FloatArray:
-    """M^-1 right for the loop matrix M (named ``what``): SingularMatrixError for an algebraic
-    loop, IllConditionedWarning with the condition number when digits are lost."""
-    if M.shape[0] == 0:
+def _solve_loop(loop: FloatArray, right: FloatArray, what: str, function: str) -> FloatArray:
+    """(I - loop)^-1 right, for the loop matrix M = I - loop named ``what``.
+
+    Its conditioning is measured relative to the terms it is formed from,
+    κ = (1 + ||loop||) ||M^-1|| (2-norms): M singular (an algebraic loop) or κ beyond
+    1/(size·u) is SingularMatrixError; κ above 1e8 warns IllConditionedWarning with κ."""
+    size = loop.shape[0]
+    if size == 0:
         return right
-    condition = float(np.linalg.cond(M))
-    if not np.isfinite(condition) or condition * np.finfo(float).eps * M.shape[0] >= 1.0:
+    M = np.eye(size) - loop
+    smallest = float(np.linalg.svd(M, compute_uv=False)[-1])
+    size_of_terms = 1.0 + float(np.linalg.norm(loop, 2))
+    condition = size_of_terms / smallest if smallest > 0.0 else np.inf
+    if not np.isfinite(condition) or condition * np.finfo(float).eps * size >= 1.0:
         raise SingularMatrixError(
-            f"{function}: algebraic loop: {what} is singular (condition number {condition:.3g}), "
-            "so the loop of direct feedthrough has no solution; add dynamics (an actuator, a "
-            "filter) or change a gain in the loop"
+            f"{function}: algebraic loop: {what} is singular (relative condition number "
+            f"{condition:.3g}), so the loop of direct feedthrough has no solution; add dynamics "
+            "(an actuator, a filter) or change a gain in the loop"
         )
     if condition > ILL_CONDITIONED:
         warnings.warn(
-            f"{function}: {what} has condition number {condition:.3g}: the algebraic loop is "
-            "nearly singular and the closed loop may have lost that many digits",
+            f"{function}: {what} has relative condition number {condition:.3g}: the algebraic "
+            "loop is nearly singular and the closed loop may have lost that many digits",
             IllConditionedWarning,
             stacklevel=3,
         )
@@ -379,10 +396,11 @@ def feedback(sys1: System, sys2: System | None = None, sign: float = -1) -> Stat
     A1, B1, C1, D1 = forward.A, forward.B, forward.C, forward.D
     A2, B2, C2, D2 = back.A, back.B, back.C, back.D
     n1, n2, m1 = forward.n_states, back.n_states, forward.n_inputs
-    F = np.eye(m1) - s * D2 @ D1
-    # u1 = U_x x + U_r r, from one solve with F.
+    # u1 = U_x x + U_r r, from one solve with F = I - sign·D2·D1.
     loop_state = s * np.hstack([D2 @ C1, C2])
-    solved = _solve_loop(F, np.hstack([loop_state, np.eye(m1)]), "I - sign·D2·D1", "feedback")
+    solved = _solve_loop(
+        s * D2 @ D1, np.hstack([loop_state, np.eye(m1)]), "I - sign·D2·D1", "feedback"
+    )
     U_x, U_r = solved[:, : n1 + n2], solved[:, n1 + n2 :]
     B_u = np.vstack([B1, B2 @ D1])
     A = np.block([[A1, np.zeros((n1, n2))], [B2 @ C1, A2]]) + B_u @ U_x
@@ -446,9 +464,7 @@ def _source(spec: object, where: str) -> tuple[str, float]:
             return spec[1:], -1.0
         return spec, 1.0
     if isinstance(spec, tuple) and len(spec) == 2 and isinstance(spec[0], str):
-        factor = real_scalar(spec[1], f"the gain of {spec[0]!r} in {where}")
-        check_finite(np.array(factor), f"the gain of {spec[0]!r} in {where}")
-        return spec[0], factor
+        return spec[0], _finite(spec[1], f"the gain of {spec[0]!r} in {where}")
     raise InvalidArgumentError(
         f"{where}: a signal must be 'name', '-name' or ('name', gain), got {spec!r}"
     )
@@ -674,7 +690,7 @@ def connect(
             )
 
     n = A.shape[0]
-    solved = _solve_loop(np.eye(mu) - K @ D, np.hstack([K @ C, E]), "I - K·D", "connect")
+    solved = _solve_loop(K @ D, np.hstack([K @ C, E]), "I - K·D", "connect")
     U_x, U_w = solved[:, :n], solved[:, n:]
     result = StateSpace(
         finite_or_warn(A + B @ U_x, "the interconnection's A"),
@@ -723,17 +739,26 @@ def _observable_form(
     numerator: FloatArray, denominator: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """The observable canonical form of numerator/denominator (coefficients from the highest
-    power, denominator monic, numerator of the same length), balanced."""
+    power, denominator monic, numerator of the same length), balanced.
+
+    With den = s^n + a1 s^(n-1) + ... + an and num = b0 s^n + ... + bn, the states in the
+    order that makes A upper Hessenberg (ones on the subdiagonal, -an ... -a1 in the last
+    column), B = (bn - b0 an, ..., b1 - b0 a1), C = (0, ..., 0, 1), D = b0. An A already in
+    Hessenberg form is kept as it is by the frequency response's own Hessenberg reduction, so
+    the response is computed from the coefficients without mixing them: at high frequency,
+    where the response of a model of high relative degree is tiny, this keeps its relative
+    accuracy (a full first column lost 5 digits at 50 times the fastest pole of a fifth-order
+    lag)."""
     n = len(denominator) - 1
     a = denominator[1:]
     D = np.array([[numerator[0]]])
     A = np.zeros((n, n))
-    A[:, 0] = -a
-    A[np.arange(n - 1), np.arange(1, n)] = 1.0
-    B = (numerator[1:] - numerator[0] * a).reshape(n, 1)
+    A[np.arange(1, n), np.arange(n - 1)] = 1.0
+    B = (numerator[1:] - numerator[0] * a)[::-1].reshape(n, 1)
     C = np.zeros((1, n))
     if n:
-        C[0, 0] = 1.0
+        A[:, -1] = -a[::-1]
+        C[0, -1] = 1.0
     A, B, C = _balance(A, B, C)
     return A, B, C, D
 
@@ -891,8 +916,7 @@ def zpk(
     """
     zeros = _roots(z, "z")
     poles = _roots(p, "p")
-    factor = real_scalar(k, "k")
-    check_finite(np.array(factor), "k")
+    factor = _finite(k, "k")
     if zeros.size > poles.size:
         raise InvalidArgumentError(
             f"zpk: {zeros.size} zeros over {poles.size} poles is improper: it has no state-space "
@@ -920,9 +944,10 @@ def zpk(
     for numerator, denominator in zip(numerators, pole_factors, strict=True):
         padded = np.concatenate([np.zeros(denominator.size - numerator.size), numerator])
         A2, B2, C2, D2 = _observable_form(padded, denominator)
-        A = np.block([[A, np.zeros((A.shape[0], A2.shape[0]))], [B2 @ C, A2]])
-        B = np.vstack([B, B2 @ D])
-        C = np.hstack([D2 @ C, C2])
+        # The new section's states first: A stays upper Hessenberg (see _observable_form).
+        A = np.block([[A2, B2 @ C], [np.zeros((A.shape[0], A2.shape[0])), A]])
+        B = np.vstack([B2 @ D, B])
+        C = np.hstack([C2, D2 @ C])
         D = D2 @ D
     C, D = factor * C, factor * D
     A, B, C = _balance(A, B, C)
@@ -997,8 +1022,7 @@ def first_order_lag(
     (array([[-2.]]), array([[1.]]))
     """
     time_constant = _positive(tau, "tau")
-    k = real_scalar(gain, "gain")
-    check_finite(np.array(k), "gain")
+    k = _finite(gain, "gain")
     return _model(
         np.array([[-1.0 / time_constant]]),
         np.array([[1.0 / time_constant]]),
@@ -1100,8 +1124,7 @@ def second_order(
     (array([30., 30.]), array([0.7, 0.7]))
     """
     omega = _positive(omega_n, "omega_n")
-    damping = real_scalar(zeta, "zeta")
-    check_finite(np.array(damping), "zeta")
+    damping = _finite(zeta, "zeta")
     if damping < 0.0:
         raise InvalidArgumentError(f"zeta must be non-negative, got {damping}")
     return _model(
