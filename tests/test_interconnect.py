@@ -14,8 +14,11 @@ from __future__ import annotations
 import warnings
 
 import control
+import mpmath
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import aerocontrol
 from aerocontrol import (
@@ -38,9 +41,9 @@ def _random(n: int, m: int, p: int, seed: int, dt: float | None = None) -> State
     """A seeded random model with distinct, stable poles (inside the unit circle if discrete)."""
     rng = np.random.default_rng(seed)
     A = rng.standard_normal((n, n))
-    if dt is None:
+    if n and dt is None:
         A -= (np.abs(np.linalg.eigvals(A).real).max() + 0.5) * np.eye(n)
-    else:
+    elif n:
         A *= 0.9 / np.abs(np.linalg.eigvals(A)).max()
     return StateSpace(
         A,
@@ -706,3 +709,72 @@ def test_no_warnings_for_ordinary_use() -> None:
         aerocontrol.connect(_yaw_damper_blocks(), inputs="rudder command", outputs="r")
         aerocontrol.pade_delay(0.2, 6)
         aerocontrol.feedback(aerocontrol.tf([1.0], [1.0, 1.0]))
+
+
+# ----- identities and high-precision references --------------------------------------------------
+
+
+@settings(max_examples=40, deadline=None, derandomize=True, database=None)
+@given(
+    n1=st.integers(0, 5),
+    n2=st.integers(0, 5),
+    m=st.integers(1, 3),
+    p=st.integers(1, 3),
+    seed=st.integers(0, 2**32 - 1),
+    discrete=st.booleans(),
+    sign=st.sampled_from([-1, 1]),
+)
+def test_interconnections_multiply_add_and_invert_frequency_responses(
+    n1: int, n2: int, m: int, p: int, seed: int, discrete: bool, sign: int
+) -> None:
+    """G_series = G2 G1, G_parallel = G1 + G3 and G_feedback = (I - sign G1 G2)^-1 G1 at every
+    frequency, from the parts' own responses (an oracle independent of the realisation)."""
+    dt = 0.1 if discrete else None
+    g1 = _random(n1, m, p, seed=seed % 1000, dt=dt)
+    g2 = _random(n2, p, m, seed=seed % 997 + 1, dt=dt)
+    g3 = _random(n2, m, p, seed=seed % 991 + 2, dt=dt)
+    omega = np.logspace(-2, np.log10(np.pi / 0.1) if discrete else 2, 30)
+
+    def response(sys: StateSpace) -> np.ndarray:
+        return aerocontrol.frequency_response(sys, omega).response
+
+    G1, G2, G3 = response(g1), response(g2), response(g3)
+    loop = np.eye(p) - sign * G1 @ G2
+    if np.min(np.linalg.svd(loop, compute_uv=False)) < 1e-6:
+        return  # a closed-loop pole within 1e-6 of the grid: the comparison loses its digits
+    expected = [G2 @ G1, G1 + G3, np.linalg.solve(loop, G1)]
+    try:
+        closed = aerocontrol.feedback(g1, g2, sign=sign)
+    except SingularMatrixError:
+        return  # I - sign D2 D1 singular: refused, as it must be
+    actual = [response(aerocontrol.series(g1, g2)), response(aerocontrol.parallel(g1, g3))]
+    actual.append(response(closed))
+    for got, want in zip(actual, expected, strict=True):
+        error = np.linalg.norm(got - want, axis=(1, 2)) / np.linalg.norm(want, axis=(1, 2))
+        assert np.max(error) <= 1e-9
+
+
+@pytest.mark.parametrize("order", [2, 6, 10, 14])
+def test_pade_delay_against_the_approximant_in_high_precision(order: int) -> None:
+    # P(-x)/P(x), P(x) = sum c_k x^k, c_k = (2n - k)! n! / ((2n)! k! (n - k)!), at 50 digits.
+    T = 0.3
+    n = order
+    c = [
+        mpmath.factorial(2 * n - k)
+        * mpmath.factorial(n)
+        / (mpmath.factorial(2 * n) * mpmath.factorial(k) * mpmath.factorial(n - k))
+        for k in range(n + 1)
+    ]
+    with mpmath.workdps(50):
+        exact = []
+        for w in FREQUENCIES:
+            x = mpmath.mpc(0, w) * mpmath.mpf(T)
+            exact.append(
+                complex(
+                    sum(ck * (-x) ** k for k, ck in enumerate(c))
+                    / sum(ck * x**k for k, ck in enumerate(c))
+                )
+            )
+    ours = aerocontrol.frequency_response(aerocontrol.pade_delay(T, order), FREQUENCIES).response
+    error = np.abs(ours[:, 0, 0] - np.array(exact))  # |G| = 1
+    assert np.max(error) <= 1e-12, np.max(error)

@@ -64,4 +64,4 @@ Systems: TypeAlias = System | Sequence[SystemObject]
 ModeKey: TypeAlias = int | str | complex | np.number[Any]
 
 #: Inputs or outputs of a model: a name, an index, a slice, or a list of names and indices.
-SignalSelection: TypeAlias = str | int | slice | Sequence[str | int]
+SignalSelection: TypeAlias = str | int | np.integer[Any] | slice | Sequence[str | int]
