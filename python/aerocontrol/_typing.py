@@ -13,6 +13,7 @@ run time and name the argument in their errors.
   call. It says ``Sequence``, not ``list``, because a list is invariant (a ``list[Foreign]``
   is not a ``list[StateSpaceLike]``); at run time the models must come as a list.
 * :data:`ModeKey` names a mode of :func:`~aerocontrol.augment_mode`.
+* :data:`SignalSelection` picks inputs or outputs of a model (``sys[outputs, inputs]``).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from numpy.typing import ArrayLike
 if TYPE_CHECKING:
     from .statespace import StateSpace
 
-__all__ = ["ModeKey", "StateSpaceLike", "System", "SystemObject", "Systems"]
+__all__ = ["ModeKey", "SignalSelection", "StateSpaceLike", "System", "SystemObject", "Systems"]
 
 
 class StateSpaceLike(Protocol):
@@ -61,3 +62,6 @@ Systems: TypeAlias = System | Sequence[SystemObject]
 #: A mode of :func:`~aerocontrol.augment_mode`: its index in mode order, its name, or an
 #: eigenvalue near it (Python or numpy numbers; ``Any`` is numpy's precision parameter).
 ModeKey: TypeAlias = int | str | complex | np.number[Any]
+
+#: Inputs or outputs of a model: a name, an index, a slice, or a list of names and indices.
+SignalSelection: TypeAlias = str | int | np.integer[Any] | slice | Sequence[str | int]

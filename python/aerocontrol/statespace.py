@@ -12,6 +12,7 @@ importing python-control); :func:`as_state_space` does the conversion.
 
 from __future__ import annotations
 
+import operator
 import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, cast
@@ -26,7 +27,7 @@ from .exceptions import InvalidArgumentError, NotRealError, NumericalOverflowWar
 if TYPE_CHECKING:
     from typing_extensions import TypeIs
 
-    from ._typing import System, SystemObject
+    from ._typing import SignalSelection, System, SystemObject
 
 __all__ = ["StateSpace", "as_state_space"]
 
@@ -155,6 +156,46 @@ class StateSpace:
         else:
             self.output_names = _names(output_names, C.shape[0], "y", "output_names")
 
+    def __getitem__(self, key: tuple[SignalSelection, SignalSelection]) -> StateSpace:
+        """The model from some inputs to some outputs: ``sys[outputs, inputs]``.
+
+        Each of the two is a signal name, an index, a slice, or a list of names and indices;
+        the states are kept (no reduction), and so are the names and ``dt``. A name must
+        belong to exactly one signal, and an index must be in range.
+
+        Examples
+        --------
+        >>> import aerocontrol
+        >>> lateral = aerocontrol.aircraft.load("b747-approach").lateral()
+        >>> lateral.output_names, lateral.input_names
+        (('beta', 'p', 'phi', 'r'), ('rudder', 'aileron'))
+        >>> yaw = lateral["r", "rudder"]
+        >>> yaw
+        StateSpace(n_states=4, n_inputs=1, n_outputs=1, states=['beta', 'p', 'phi', 'r'],
+                   inputs=['rudder'])
+        >>> yaw.output_names
+        ('r',)
+        >>> lateral[["p", 3], :].output_names
+        ('p', 'r')
+        """
+        if not (isinstance(key, tuple) and len(key) == 2):
+            raise InvalidArgumentError(
+                "select signals as sys[outputs, inputs] (each a name, an index, a slice or a "
+                f"list of them; sys[name, :] keeps every input), got sys[{key!r}]"
+            )
+        rows = signal_indices(key[0], self.output_names, "output")
+        columns = signal_indices(key[1], self.input_names, "input")
+        return StateSpace(
+            self.A,
+            self.B[:, columns],
+            self.C[rows, :],
+            self.D[np.ix_(rows, columns)],
+            state_names=self.state_names,
+            input_names=[self.input_names[j] for j in columns],
+            output_names=[self.output_names[i] for i in rows],
+            dt=self.dt,
+        )
+
     @property
     def is_discrete(self) -> bool:
         """Whether the model is discrete (sampled every ``dt`` > 0 seconds)."""
@@ -182,6 +223,46 @@ class StateSpace:
             f"inputs={list(self.input_names)}"
             + (f", dt={period(self):g})" if self.is_discrete else ")")
         )
+
+
+def signal_indices(key: object, names: Sequence[str], what: str) -> list[int]:
+    """The positions in ``names`` (a model's ``what`` names: "input", "output") that ``key``
+    selects: a name, an index (negative counts from the end), a slice, or a list of names and
+    indices. An unknown or ambiguous name, an index out of range and anything else are
+    refused by name."""
+    if isinstance(key, slice):
+        return list(range(len(names)))[key]
+    if isinstance(key, (str, int, np.integer)):
+        return [_signal_index(key, names, what)]
+    if isinstance(key, (list, tuple, np.ndarray)):
+        return [_signal_index(item, names, what) for item in key]
+    raise InvalidArgumentError(
+        f"an {what} selection must be a name, an index, a slice or a list of them, "
+        f"got {type(key).__name__}"
+    )
+
+
+def _signal_index(item: object, names: Sequence[str], what: str) -> int:
+    if isinstance(item, (str, np.str_)):
+        found = [i for i, name in enumerate(names) if name == item]
+        if not found:
+            known = ", ".join(repr(name) for name in names) or "none"
+            raise InvalidArgumentError(f"no {what} is named {str(item)!r}; the {what}s are {known}")
+        if len(found) > 1:
+            raise InvalidArgumentError(
+                f"{len(found)} {what}s are named {str(item)!r} (positions {found}); select by index"
+            )
+        return found[0]
+    if isinstance(item, (bool, np.bool_)) or not isinstance(item, (int, np.integer)):
+        raise InvalidArgumentError(
+            f"an {what} must be selected by name or by integer index, got {item!r}"
+        )
+    index = operator.index(item)
+    if not -len(names) <= index < len(names):
+        raise InvalidArgumentError(
+            f"{what} index {index} is out of range for a model with {len(names)} {what}s"
+        )
+    return index % len(names)
 
 
 def period(model: StateSpace) -> float:

@@ -115,6 +115,47 @@ assert_type(bode.magnitude_db, Floats)
 aerocontrol.bode(foreign, omega=np.logspace(-2, 1, 50))
 assert_type(aerocontrol.default_frequency_grid((A, B), count=100), Floats)
 
+# --- Systems as building blocks --------------------------------------------------------------
+
+plant = aircraft.load("b747-approach").lateral()
+yaw = plant["r", "rudder"]
+assert_type(yaw, aerocontrol.StateSpace)
+plant[["p", 3], :]
+plant[np.int64(3), 0:1]
+servo = aerocontrol.actuator(20.0, input_names="rudder command", output_names="rudder")
+filt = aerocontrol.washout(2, input_names=["r"], output_names="r washed", state_names=["lag"])
+assert_type(aerocontrol.series(servo, yaw), aerocontrol.StateSpace)
+aerocontrol.series(servo, (-np.eye(1), np.ones((1, 1)), [[1.0]], [[0.0]]), yaw)
+aerocontrol.parallel(aerocontrol.gain(1.0), aerocontrol.first_order_lag(2.0, gain=-1.0))
+aerocontrol.append(servo, foreign)
+assert_type(aerocontrol.feedback(yaw), aerocontrol.StateSpace)
+aerocontrol.feedback(yaw, filt, sign=+1)
+aerocontrol.feedback(yaw, aerocontrol.gain([[0.5]]), -1.0)
+yaw_loop = aerocontrol.connect(
+    [
+        yaw,
+        filt,
+        aerocontrol.gain(1.5, input_names="r washed", output_names="u"),
+        aerocontrol.summing_junction(["rudder command", "u"], "servo input"),
+        aerocontrol.actuator(20.0, input_names="servo input", output_names="rudder"),
+    ],
+    inputs="rudder command",
+    outputs=["r", "rudder"],
+)
+assert_type(yaw_loop, aerocontrol.StateSpace)
+aerocontrol.connect(
+    [yaw, filt, servo],
+    [["r", "r"], ["rudder command", "external", ("r washed", -0.5)], ["rudder", "rudder"]],
+    ["external"],
+    "r",
+)
+aerocontrol.connect([yaw, servo], None, None, None)
+assert_type(aerocontrol.second_order(30.0, 0.7), aerocontrol.StateSpace)
+assert_type(aerocontrol.pade_delay(0.1, 3, output_names="delayed"), aerocontrol.StateSpace)
+assert_type(aerocontrol.tf([1, 2], np.array([1.0, 3.0, 2.0]), dt=0.1), aerocontrol.StateSpace)
+assert_type(aerocontrol.zpk([-1 + 1j, -1 - 1j], (-2.0, -3.0, -4.0), 2), aerocontrol.StateSpace)
+aerocontrol.zpk(np.array([]), [-1.0], np.float64(1.5), input_names="e")
+
 # --- Modes, controllability, pole placement --------------------------------------------------
 
 A_lat, B_lat = aerocontrol.chapter.boeing747_lateral()
@@ -297,4 +338,9 @@ def _misuse() -> None:
     aerocontrol.kalman(measured, np.eye(2), np.eye(3), dt="0.02")  # type: ignore[arg-type]
     aerocontrol.lqg(measured, np.eye(4), np.eye(2), np.eye(2))  # type: ignore[call-arg]
     estimate: Complexes = aerocontrol.lqe(measured, np.eye(2), np.eye(3))[0]  # type: ignore[assignment]
+    aerocontrol.washout("2.0")  # type: ignore[arg-type]  # a number, not a string
+    aerocontrol.pade_delay(0.1, 2.5)  # type: ignore[arg-type]  # the order is an integer
+    aerocontrol.feedback(sys, sign="-")  # type: ignore[arg-type]
+    sys["r"]  # type: ignore[index]  # outputs and inputs, both
+    aerocontrol.connect(sys, inputs="r")  # type: ignore[arg-type]  # a list of models
     del exponential, gains, estimate

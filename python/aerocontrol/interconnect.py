@@ -1,0 +1,1208 @@
+"""Systems as building blocks: the elements of a flight-control loop and their interconnection.
+
+Every element is a :class:`~aerocontrol.StateSpace` with named inputs and outputs, and every
+interconnection is formed from the four matrices of its parts, never through polynomials (whose
+coefficients lose the roots of a loop of any order to rounding):
+
+* :func:`series` (``sys2`` after ``sys1``), :func:`parallel`, :func:`feedback` and
+  :func:`append` combine models by position, like python-control's functions of those names;
+* :func:`connect` wires models by signal name, like python-control's ``interconnect``: an
+  output feeds every input of the same name, outputs of one name are summed, and explicit
+  connections may add signs and gains; :func:`summing_junction` is the usual comparator;
+* :func:`washout`, :func:`first_order_lag`, :func:`actuator`, :func:`second_order`,
+  :func:`pade_delay` and :func:`gain` are the elements of a stability augmentation system, and
+  :func:`tf` and :func:`zpk` turn a transfer function, given by polynomial coefficients or by
+  zeros, poles and gain, into a state-space model.
+
+With the interconnection's signals stacked, u the inputs of the blocks, y their outputs, w the
+external inputs and z the external outputs,
+
+    x' = A x + B u,   y = C x + D u,   u = K y + E w,   z = F y + G u + H w,
+
+eliminating u gives u = M^-1 (K C x + E w) with M = I - K D. M singular is an algebraic loop
+(a loop of feedthrough with no dynamics whose gain is one): it has no solution and is refused
+by name. Continuous and discrete models combine alike; the sampling periods must agree (a
+static model, with no states, goes with either).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from fractions import Fraction
+from math import comb
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
+from .exceptions import (
+    IllConditionedWarning,
+    InvalidArgumentError,
+    NonFiniteError,
+    NotRealError,
+    ShapeError,
+    SingularMatrixError,
+)
+from .statespace import StateSpace, as_state_space, period
+
+if TYPE_CHECKING:
+    from ._typing import System
+
+__all__ = [
+    "actuator",
+    "append",
+    "connect",
+    "feedback",
+    "first_order_lag",
+    "gain",
+    "pade_delay",
+    "parallel",
+    "second_order",
+    "series",
+    "summing_junction",
+    "tf",
+    "washout",
+    "zpk",
+]
+
+Names = str | Sequence[str] | None
+"""Signal names of a constructor: one name as a string, or a sequence of names."""
+
+Source = str | tuple[str, float]
+"""A signal feeding an input in :func:`connect`: ``"name"``, ``"-name"`` or ``("name", gain)``."""
+
+#: A loop whose M = I - K D has a condition number above this warns that it lost digits.
+ILL_CONDITIONED = 1e8
+
+#: The highest order of :func:`pade_delay`: at 20 its response is within 1.2e-12 of the
+#: approximant's (computed at 50 digits) from 1e-3 to 1e3 rad/s for T = 0.3 s.
+MAX_PADE_ORDER = 20
+
+
+# ----- arguments --------------------------------------------------------------------------------
+
+
+def _finite(value: object, name: str) -> float:
+    """``value`` as a finite float, or the package's error naming ``name``."""
+    number = real_scalar(value, name)
+    if not np.isfinite(number):
+        error = NonFiniteError(f"{name} must be finite, got {number}")
+        error.argument, error.value = name, number
+        raise error
+    return number
+
+
+def _positive(value: object, name: str) -> float:
+    """``value`` as a positive, finite float, or the package's error naming ``name``."""
+    number = _finite(value, name)
+    if number <= 0.0:
+        raise InvalidArgumentError(f"{name} must be positive, got {number}")
+    return number
+
+
+def _signal_names(given: Names, count: int, default: str, argument: str) -> tuple[str, ...]:
+    """Constructor names: a string is one name; None gives ``default`` numbered (``u0``, ...)
+    or, for a single signal, ``default`` followed by 0."""
+    if given is None:
+        return tuple(f"{default}{i}" for i in range(count))
+    names = (given,) if isinstance(given, str) else tuple(given)
+    for name in names:
+        if not isinstance(name, str):
+            raise InvalidArgumentError(
+                f"{argument} must be a name or a sequence of names, got {name!r} in it"
+            )
+    if len(names) != count:
+        raise ShapeError(f"{argument} must have {count} names, got {len(names)}")
+    return names
+
+
+def _model(
+    A: FloatArray,
+    B: FloatArray,
+    C: FloatArray,
+    D: FloatArray,
+    *,
+    input_names: Names,
+    output_names: Names,
+    state_names: Names,
+    states: str | Sequence[str] = "x{k}",
+    dt: float | None = None,
+) -> StateSpace:
+    """The model with its names; without ``state_names``, the states are named by
+    ``states``: one template for each (or one for all), formatted with the element's
+    ``input`` and ``output`` names (single-input, single-output) and the state's index ``k``."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    inputs = _signal_names(input_names, m, "u", "input_names")
+    outputs = _signal_names(output_names, p, "y", "output_names")
+    if state_names is None and m == 1 and p == 1:
+        templates = [states] * n if isinstance(states, str) else list(states)
+        state_names = [
+            template.format(input=inputs[0], output=outputs[0], k=k)
+            for k, template in enumerate(templates)
+        ]
+    return StateSpace(
+        A,
+        B,
+        C,
+        D,
+        state_names=_signal_names(state_names, n, "x", "state_names"),
+        input_names=inputs,
+        output_names=outputs,
+        dt=dt,
+    )
+
+
+def _models(systems: Sequence[System], function: str) -> list[StateSpace]:
+    return [as_state_space(s, f"{function}: sys{k + 1}") for k, s in enumerate(systems)]
+
+
+def _time_base(models: Sequence[StateSpace], labels: Sequence[str], function: str) -> float | None:
+    """The common ``dt`` of ``models``: their sampling period if discrete, else 0.0 if any is
+    marked continuous (dt = 0), else None. A model without states fits any time base; the
+    others must agree, or InvalidArgumentError names the two that differ."""
+    dynamic = [(m, label) for m, label in zip(models, labels, strict=True) if m.n_states] or list(
+        zip(models, labels, strict=True)
+    )
+    first, first_label = dynamic[0]
+    for model, label in dynamic[1:]:
+        if period(model) != period(first):
+
+            def describe(m: StateSpace) -> str:
+                return f"discrete (dt = {period(m):g} s)" if m.is_discrete else "continuous"
+
+            raise InvalidArgumentError(
+                f"{function}: {first_label} is {describe(first)} but {label} is "
+                f"{describe(model)}; bring them to one time base first (c2d, d2c)"
+            )
+    if first.is_discrete:
+        return period(first)
+    return 0.0 if any(m.dt == 0.0 for m in models) else None
+
+
+def _block_diagonal(matrices: Sequence[FloatArray]) -> FloatArray:
+    rows = sum(m.shape[0] for m in matrices)
+    columns = sum(m.shape[1] for m in matrices)
+    result = np.zeros((rows, columns))
+    i = j = 0
+    for m in matrices:
+        result[i : i + m.shape[0], j : j + m.shape[1]] = m
+        i, j = i + m.shape[0], j + m.shape[1]
+    return result
+
+
+def _solve_loop(loop: FloatArray, right: FloatArray, what: str, function: str) -> FloatArray:
+    """(I - loop)^-1 right, for the loop matrix M = I - loop named ``what``.
+
+    Its conditioning is measured relative to the terms it is formed from,
+    κ = (1 + ||loop||) ||M^-1|| (2-norms): M singular (an algebraic loop) or κ beyond
+    1/(size·u) is SingularMatrixError; κ above 1e8 warns IllConditionedWarning with κ."""
+    size = loop.shape[0]
+    if size == 0:
+        return right
+    M = np.eye(size) - loop
+    smallest = float(np.linalg.svd(M, compute_uv=False)[-1])
+    size_of_terms = 1.0 + float(np.linalg.norm(loop, 2))
+    condition = size_of_terms / smallest if smallest > 0.0 else np.inf
+    if not np.isfinite(condition) or condition * np.finfo(float).eps * size >= 1.0:
+        raise SingularMatrixError(
+            f"{function}: algebraic loop: {what} is singular (relative condition number "
+            f"{condition:.3g}), so the loop of direct feedthrough has no solution; add dynamics "
+            "(an actuator, a filter) or change a gain in the loop"
+        )
+    if condition > ILL_CONDITIONED:
+        warnings.warn(
+            f"{function}: {what} has relative condition number {condition:.3g}: the algebraic "
+            "loop is nearly singular and the closed loop may have lost that many digits",
+            IllConditionedWarning,
+            stacklevel=3,
+        )
+    solution = np.asarray(np.linalg.solve(M, right), dtype=np.float64)
+    return solution
+
+
+# ----- interconnections by position -------------------------------------------------------------
+
+
+def series(sys1: System, sys2: System, *systems: System) -> StateSpace:
+    """``sys2`` after ``sys1`` (and so on along ``systems``): the outputs of each feed the
+    inputs of the next, by position.
+
+    With x = (x1, x2):
+
+        A = [[A1, 0], [B2 C1, A2]],  B = [[B1], [B2 D1]],  C = [D2 C1, C2],  D = D2 D1.
+
+    The model has the inputs of the first, the outputs of the last and the states of all, with
+    their names. The same as python-control's ``series(sys1, sys2)`` (``sys2 * sys1``).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> servo = aerocontrol.actuator(20.0, input_names="rudder command", output_names="rudder")
+    >>> plant = aerocontrol.aircraft.load("b747-approach").lateral()["r", "rudder"]
+    >>> loop = aerocontrol.series(servo, plant)
+    >>> loop.input_names, loop.output_names, loop.n_states
+    (('rudder command',), ('r',), 5)
+    """
+    models = _models([sys1, sys2, *systems], "series")
+    labels = [f"sys{k + 1}" for k in range(len(models))]
+    dt = _time_base(models, labels, "series")
+    result = models[0]
+    for k in range(1, len(models)):
+        second = models[k]
+        if second.n_inputs != result.n_outputs:
+            raise ShapeError(
+                f"series: {labels[k]} has {second.n_inputs} inputs but the model before it has "
+                f"{result.n_outputs} outputs"
+            )
+        n1, n2 = result.n_states, second.n_states
+        A = np.block(
+            [[result.A, np.zeros((n1, n2))], [second.B @ result.C, second.A]],
+        )
+        result = StateSpace(
+            A,
+            np.vstack([result.B, second.B @ result.D]),
+            np.hstack([second.D @ result.C, second.C]),
+            second.D @ result.D,
+            state_names=result.state_names + second.state_names,
+            input_names=result.input_names,
+            output_names=second.output_names,
+            dt=dt,
+        )
+    return result
+
+
+def parallel(sys1: System, sys2: System, *systems: System) -> StateSpace:
+    """The sum of models driven by the same inputs: y = y1 + y2 (+ ...).
+
+    With x = (x1, x2): A = diag(A1, A2), B = [[B1], [B2]], C = [C1, C2], D = D1 + D2. The
+    names of the inputs and outputs are those of ``sys1``. The same as python-control's
+    ``parallel``.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> # A washout is one minus a first-order lag of the same time constant.
+    >>> lag = aerocontrol.first_order_lag(2.0, gain=-1.0)
+    >>> difference = aerocontrol.parallel(aerocontrol.gain(1.0), lag)
+    >>> w = [0.0, 0.5, 10.0]
+    >>> g1 = aerocontrol.frequency_response(difference, w).response
+    >>> g2 = aerocontrol.frequency_response(aerocontrol.washout(2.0), w).response
+    >>> bool(np.allclose(g1, g2, rtol=1e-14, atol=1e-15))
+    True
+    """
+    models = _models([sys1, sys2, *systems], "parallel")
+    labels = [f"sys{k + 1}" for k in range(len(models))]
+    dt = _time_base(models, labels, "parallel")
+    first = models[0]
+    for model, label in zip(models[1:], labels[1:], strict=True):
+        if (model.n_outputs, model.n_inputs) != (first.n_outputs, first.n_inputs):
+            raise ShapeError(
+                f"parallel: {label} has {model.n_outputs} outputs and {model.n_inputs} inputs "
+                f"but sys1 has {first.n_outputs} and {first.n_inputs}"
+            )
+    return StateSpace(
+        _block_diagonal([m.A for m in models]),
+        np.vstack([m.B for m in models]),
+        np.hstack([m.C for m in models]),
+        np.sum([m.D for m in models], axis=0),
+        state_names=sum((m.state_names for m in models), ()),
+        input_names=first.input_names,
+        output_names=first.output_names,
+        dt=dt,
+    )
+
+
+def append(*systems: System) -> StateSpace:
+    """The models side by side, unconnected: inputs, outputs and states stacked in order,
+    A, B, C, D block diagonal, the names kept. The same as python-control's ``append``.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> both = aerocontrol.append(
+    ...     aerocontrol.actuator(20.0, input_names="rudder command", output_names="rudder"),
+    ...     aerocontrol.actuator(15.0, input_names="aileron command", output_names="aileron"),
+    ... )
+    >>> both.input_names, both.output_names
+    (('rudder command', 'aileron command'), ('rudder', 'aileron'))
+    """
+    if not systems:
+        raise InvalidArgumentError("append needs at least one model")
+    models = _models(systems, "append")
+    dt = _time_base(models, [f"sys{k + 1}" for k in range(len(models))], "append")
+    return StateSpace(
+        _block_diagonal([m.A for m in models]),
+        _block_diagonal([m.B for m in models]),
+        _block_diagonal([m.C for m in models]),
+        _block_diagonal([m.D for m in models]),
+        state_names=sum((m.state_names for m in models), ()),
+        input_names=sum((m.input_names for m in models), ()),
+        output_names=sum((m.output_names for m in models), ()),
+        dt=dt,
+    )
+
+
+def feedback(sys1: System, sys2: System | None = None, sign: float = -1) -> StateSpace:
+    """The loop of ``sys1`` (forward) closed through ``sys2`` (return), by position: u1 = r +
+    sign·y2, u2 = y1, from the reference r to y1.
+
+    ``sys2`` defaults to unity feedback (y2 = y1, which needs as many outputs as inputs), and
+    ``sign`` is -1 (negative feedback) or +1. Eliminating u1 with F = I - sign·D2·D1:
+
+        u1 = F^-1 (r + sign·D2·C1 x1 + sign·C2 x2),
+
+    and the closed loop has the states (x1, x2), the inputs and outputs of ``sys1`` and their
+    names. A singular F (an algebraic loop, such as unity positive feedback around a unit
+    gain) is refused with SingularMatrixError naming it; a nearly singular one warns
+    IllConditionedWarning with its condition number. The same as python-control's
+    ``feedback``.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> # k/(s + a) in a negative unity loop: one pole at -(a + k).
+    >>> closed = aerocontrol.feedback(aerocontrol.tf([3.0], [1.0, 2.0]))
+    >>> np.linalg.eigvals(closed.A)
+    array([-5.])
+    >>> aerocontrol.feedback(aerocontrol.gain(1.0), sign=+1)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aerocontrol.exceptions.SingularMatrixError: feedback: algebraic loop: I - sign·D2·D1 ...
+    """
+    s = None if isinstance(sign, bool) else real_scalar(sign, "sign")
+    if s not in (-1.0, 1.0):
+        raise InvalidArgumentError(f"sign must be -1 (negative feedback) or +1, got {sign!r}")
+    forward = as_state_space(sys1, "feedback: sys1")
+    if sys2 is None:
+        if forward.n_inputs != forward.n_outputs:
+            raise ShapeError(
+                f"feedback: unity feedback needs as many outputs as inputs, but sys1 has "
+                f"{forward.n_outputs} outputs and {forward.n_inputs} inputs; give sys2"
+            )
+        back = StateSpace(
+            np.zeros((0, 0)),
+            np.zeros((0, forward.n_outputs)),
+            np.zeros((forward.n_inputs, 0)),
+            np.eye(forward.n_inputs),
+            dt=forward.dt,
+        )
+    else:
+        back = as_state_space(sys2, "feedback: sys2")
+    dt = _time_base([forward, back], ["sys1", "sys2"], "feedback")
+    if back.n_inputs != forward.n_outputs or back.n_outputs != forward.n_inputs:
+        raise ShapeError(
+            f"feedback: sys2 must have as many inputs as sys1 has outputs ({forward.n_outputs}) "
+            f"and as many outputs as sys1 has inputs ({forward.n_inputs}), got "
+            f"{back.n_inputs} inputs and {back.n_outputs} outputs"
+        )
+    A1, B1, C1, D1 = forward.A, forward.B, forward.C, forward.D
+    A2, B2, C2, D2 = back.A, back.B, back.C, back.D
+    n1, n2, m1 = forward.n_states, back.n_states, forward.n_inputs
+    # u1 = U_x x + U_r r, from one solve with F = I - sign·D2·D1.
+    loop_state = s * np.hstack([D2 @ C1, C2])
+    solved = _solve_loop(
+        s * D2 @ D1, np.hstack([loop_state, np.eye(m1)]), "I - sign·D2·D1", "feedback"
+    )
+    U_x, U_r = solved[:, : n1 + n2], solved[:, n1 + n2 :]
+    B_u = np.vstack([B1, B2 @ D1])
+    A = np.block([[A1, np.zeros((n1, n2))], [B2 @ C1, A2]]) + B_u @ U_x
+    C = np.hstack([C1, np.zeros((C1.shape[0], n2))]) + D1 @ U_x
+    result = StateSpace(
+        finite_or_warn(A, "the closed loop's A"),
+        B_u @ U_r,
+        C,
+        D1 @ U_r,
+        state_names=forward.state_names + back.state_names,
+        input_names=forward.input_names,
+        output_names=forward.output_names,
+        dt=dt,
+    )
+    return result
+
+
+# ----- interconnection by name ------------------------------------------------------------------
+
+
+def summing_junction(
+    inputs: str | Sequence[str], output: str, *, dt: float | None = None
+) -> StateSpace:
+    """A static comparator: ``output`` = the sum of ``inputs``, a name written ``"-name"``
+    entering with a minus sign (as python-control's ``summing_junction``). The inputs are named
+    without their signs.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> error = aerocontrol.summing_junction(["r command", "-r washed"], "e")
+    >>> error.input_names, error.output_names, error.D
+    (('r command', 'r washed'), ('e',), array([[ 1., -1.]]))
+    """
+    specs = (inputs,) if isinstance(inputs, str) else tuple(inputs)
+    if not specs:
+        raise InvalidArgumentError("summing_junction needs at least one input")
+    names, signs = [], []
+    for spec in specs:
+        if not isinstance(spec, str) or spec in ("", "-"):
+            raise InvalidArgumentError(f"inputs must be signal names, got {spec!r}")
+        negative = spec.startswith("-")
+        names.append(spec[1:] if negative else spec)
+        signs.append(-1.0 if negative else 1.0)
+    if not isinstance(output, str):
+        raise InvalidArgumentError(f"output must be a signal name, got {output!r}")
+    return StateSpace(
+        np.zeros((0, 0)),
+        np.zeros((0, len(names))),
+        np.zeros((1, 0)),
+        np.array([signs]),
+        input_names=names,
+        output_names=[output],
+        dt=dt,
+    )
+
+
+def _source(spec: object, where: str) -> tuple[str, float]:
+    if isinstance(spec, str):
+        if spec.startswith("-") and len(spec) > 1:
+            return spec[1:], -1.0
+        return spec, 1.0
+    if isinstance(spec, tuple) and len(spec) == 2 and isinstance(spec[0], str):
+        return spec[0], _finite(spec[1], f"the gain of {spec[0]!r} in {where}")
+    raise InvalidArgumentError(
+        f"{where}: a signal must be 'name', '-name' or ('name', gain), got {spec!r}"
+    )
+
+
+def _name_list(value: str | Sequence[str], argument: str) -> list[str]:
+    names = [value] if isinstance(value, str) else list(value)
+    for name in names:
+        if not isinstance(name, str):
+            raise InvalidArgumentError(f"{argument} must be signal names, got {name!r}")
+    duplicates = sorted({name for name in names if names.count(name) > 1})
+    if duplicates:
+        raise InvalidArgumentError(f"{argument} names {duplicates[0]!r} more than once")
+    return names
+
+
+def connect(
+    systems: Sequence[System],
+    connections: Sequence[Sequence[Source]] | None = None,
+    inputs: str | Sequence[str] | None = None,
+    outputs: str | Sequence[str] | None = None,
+) -> StateSpace:
+    """The block diagram of ``systems`` wired by signal name, as one model (python-control's
+    ``interconnect`` for linear systems, with signals named as aerocontrol names them).
+
+    Signals are names: every input of the blocks with a given name receives the same signal,
+    and outputs of one name are summed.
+
+    Parameters
+    ----------
+    systems : sequence of models
+        The blocks, with named inputs and outputs (constructors take ``input_names`` and
+        ``output_names``; ``sys[outputs, inputs]`` selects signals of a plant).
+    connections : sequence of sequences, optional
+        None (the default): every block input is fed by the sum of the block outputs of the
+        same name, as python-control does when it is given no connections. Otherwise only the
+        connections listed are made, each ``[input, source, source, ...]``: the block inputs
+        named ``input`` receive the sum of the sources, each a block output name (outputs of
+        that name summed) or an external input name, written ``"name"``, ``"-name"`` (times
+        -1) or ``("name", gain)``.
+    inputs : str or sequence of str, optional
+        The external inputs, by name: each is added to the block inputs of its name (and may
+        be a source of a connection). None: every block input that nothing feeds, in order.
+        When given, a block input that nothing feeds is an error.
+    outputs : str or sequence of str, optional
+        The external outputs: a block output name (outputs of that name summed), or else a
+        block input name (the signal entering it) or an external input; ``"-name"`` negates.
+        None: every block output name, in order.
+
+    Returns
+    -------
+    StateSpace
+        The states of every block in order (with their names), the external inputs and
+        outputs with their names, and the common ``dt``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        A name that matches no signal, a block input that nothing feeds (with ``inputs``
+        given), an external input that feeds nothing, a name listed twice, time bases that
+        differ.
+    SingularMatrixError
+        An algebraic loop: I - K·D singular (see the module's documentation).
+
+    Examples
+    --------
+    A yaw damper: the yaw rate, washed out, drives the rudder through its actuator.
+
+    >>> import numpy as np, aerocontrol
+    >>> plant = aerocontrol.aircraft.load("b747-approach").lateral()
+    >>> damper = aerocontrol.connect(
+    ...     [
+    ...         plant["r", "rudder"],
+    ...         aerocontrol.washout(2.0, input_names="r", output_names="r washed"),
+    ...         aerocontrol.gain(1.5, input_names="r washed", output_names="u"),
+    ...         aerocontrol.summing_junction(["rudder command", "u"], "servo input"),
+    ...         aerocontrol.actuator(20.0, input_names="servo input", output_names="rudder"),
+    ...     ],
+    ...     inputs="rudder command",
+    ...     outputs=["r", "rudder"],
+    ... )
+    >>> damper.state_names
+    ('beta', 'p', 'phi', 'r', 'r lagged', 'rudder')
+    >>> damper.input_names, damper.output_names
+    (('rudder command',), ('r', 'rudder'))
+
+    The same loop with explicit connections and the gain written into them:
+
+    >>> same = aerocontrol.connect(
+    ...     [
+    ...         plant["r", "rudder"],
+    ...         aerocontrol.washout(2.0, input_names="r", output_names="r washed"),
+    ...         aerocontrol.actuator(20.0, input_names="servo input", output_names="rudder"),
+    ...     ],
+    ...     [
+    ...         ["r", "r"],
+    ...         ["servo input", "rudder command", ("r washed", 1.5)],
+    ...         ["rudder", "rudder"],
+    ...     ],
+    ...     inputs="rudder command",
+    ...     outputs=["r", "rudder"],
+    ... )
+    >>> w = np.linspace(0.1, 3.0, 5)
+    >>> g1 = aerocontrol.frequency_response(damper, w).response
+    >>> g2 = aerocontrol.frequency_response(same, w).response
+    >>> bool(np.allclose(g1, g2, rtol=1e-12, atol=0.0))
+    True
+    """
+    if isinstance(systems, (str, bytes)) or not isinstance(systems, Sequence) or not systems:
+        raise InvalidArgumentError("systems must be a non-empty list of models")
+    models = [as_state_space(s, f"connect: systems[{k}]") for k, s in enumerate(systems)]
+    labels = [f"systems[{k}]" for k in range(len(models))]
+    dt = _time_base(models, labels, "connect")
+    stacked = append(*models)
+    A, B, C, D = stacked.A, stacked.B, stacked.C, stacked.D
+    block_inputs, block_outputs = stacked.input_names, stacked.output_names
+    mu, py = len(block_inputs), len(block_outputs)
+
+    def where(names: Sequence[str], name: str) -> list[int]:
+        return [i for i, n in enumerate(names) if n == name]
+
+    # u = K y + E w: first the internal feeds, in columns of y and of the named sources.
+    K = np.zeros((mu, py))
+    external: list[str] = [] if inputs is None else _name_list(inputs, "inputs")
+    explicit_sources: dict[int, list[tuple[int, float]]] = {}  # input row -> (w index, gain)
+    fed = np.zeros(mu, dtype=bool)
+    if connections is None:
+        for j, name in enumerate(block_inputs):
+            sources = where(block_outputs, name)
+            K[j, sources] = 1.0
+            fed[j] = bool(sources)
+    else:
+        if isinstance(connections, str) or not isinstance(connections, Sequence):
+            raise InvalidArgumentError(
+                "connections must be a list of [input, source, ...] lists, or None"
+            )
+        seen: set[str] = set()
+        for k, connection in enumerate(connections):
+            label = f"connections[{k}]"
+            if isinstance(connection, str) or not isinstance(connection, Sequence):
+                raise InvalidArgumentError(
+                    f"{label} must be a list [input, source, ...], got {connection!r}"
+                )
+            if len(connection) < 2 or not isinstance(connection[0], str):
+                raise InvalidArgumentError(
+                    f"{label} must be [input, source, ...]: an input name and at least one "
+                    f"source, got {connection!r}"
+                )
+            destination = connection[0]
+            rows = where(block_inputs, destination)
+            if not rows:
+                raise InvalidArgumentError(
+                    f"{label}: no block has an input named {destination!r}; the inputs are "
+                    + ", ".join(repr(n) for n in dict.fromkeys(block_inputs))
+                )
+            if destination in seen:
+                raise InvalidArgumentError(
+                    f"{label}: the input {destination!r} is fed by an earlier connection too; "
+                    "list all its sources in one"
+                )
+            seen.add(destination)
+            for spec in connection[1:]:
+                name, factor = _source(spec, label)
+                columns = where(block_outputs, name)
+                if columns and name in external:
+                    raise InvalidArgumentError(
+                        f"{label}: {name!r} is both a block output and an external input; "
+                        "rename one"
+                    )
+                if columns:
+                    for j in rows:
+                        K[j, columns] += factor
+                elif name in external:
+                    for j in rows:
+                        explicit_sources.setdefault(j, []).append((external.index(name), factor))
+                else:
+                    raise InvalidArgumentError(
+                        f"{label}: no block output and no external input is named {name!r}"
+                    )
+            fed[rows] = True
+
+    if inputs is None:
+        external = list(dict.fromkeys(n for j, n in enumerate(block_inputs) if not fed[j]))
+    E = np.zeros((mu, len(external)))
+    for row, entries in explicit_sources.items():
+        for column, weight in entries:
+            E[row, column] += weight
+    for index, name in enumerate(external):
+        rows = where(block_inputs, name)
+        E[rows, index] += 1.0
+        fed[rows] = True
+        if not rows and not any(index == i for e in explicit_sources.values() for i, _ in e):
+            raise InvalidArgumentError(
+                f"connect: the external input {name!r} feeds nothing: no block input has its "
+                "name" + ("" if connections is None else " and no connection uses it")
+            )
+    if not np.all(fed):
+        unfed = list(dict.fromkeys(n for j, n in enumerate(block_inputs) if not fed[j]))
+        raise InvalidArgumentError(
+            "connect: nothing feeds the block input(s) "
+            + ", ".join(repr(n) for n in unfed)
+            + "; connect them, list them in inputs, or leave inputs=None to make them external"
+        )
+
+    # z = F y + G u + H w.
+    wanted = (
+        list(dict.fromkeys(block_outputs)) if outputs is None else _name_list(outputs, "outputs")
+    )
+    F = np.zeros((len(wanted), py))
+    G = np.zeros((len(wanted), mu))
+    H = np.zeros((len(wanted), len(external)))
+    for row, spec in enumerate(wanted):
+        name, factor = (spec[1:], -1.0) if spec.startswith("-") and len(spec) > 1 else (spec, 1.0)
+        if where(block_outputs, name):
+            F[row, where(block_outputs, name)] = factor
+        elif where(block_inputs, name):
+            G[row, where(block_inputs, name)[0]] = factor
+        elif name in external:
+            H[row, external.index(name)] = factor
+        else:
+            raise InvalidArgumentError(
+                f"connect: the output {spec!r} names no block output, block input or external input"
+            )
+
+    n = A.shape[0]
+    solved = _solve_loop(K @ D, np.hstack([K @ C, E]), "I - K·D", "connect")
+    U_x, U_w = solved[:, :n], solved[:, n:]
+    result = StateSpace(
+        finite_or_warn(A + B @ U_x, "the interconnection's A"),
+        B @ U_w,
+        F @ (C + D @ U_x) + G @ U_x,
+        F @ D @ U_w + G @ U_w + H,
+        state_names=stacked.state_names,
+        input_names=external,
+        output_names=wanted,
+        dt=dt,
+    )
+    return result
+
+
+# ----- realisations -----------------------------------------------------------------------------
+
+
+def _balance(A: FloatArray, B: FloatArray, C: FloatArray) -> tuple[FloatArray, ...]:
+    """A diagonal similarity by powers of two (exact in floating point) that makes each state's
+    row of [A B] and column of [A; C] of similar size, as SLICOT's TB01ID does: the
+    companion forms of polynomial coefficients spread over many orders of magnitude."""
+    A, B, C = A.copy(), B.copy(), C.copy()
+    n = A.shape[0]
+    for _ in range(100):
+        changed = False
+        for i in range(n):
+            column = np.abs(A[:, i]).sum() - abs(A[i, i]) + np.abs(C[:, i]).sum()
+            row = np.abs(A[i, :]).sum() - abs(A[i, i]) + np.abs(B[i, :]).sum()
+            if column == 0.0 or row == 0.0:
+                continue
+            exponent = int(np.round(0.5 * np.log2(row / column)))
+            if exponent == 0:
+                continue
+            factor = 2.0**exponent
+            A[:, i] *= factor
+            C[:, i] *= factor
+            A[i, :] /= factor
+            B[i, :] /= factor
+            changed = True
+        if not changed:
+            break
+    return A, B, C
+
+
+def _observable_form(
+    numerator: FloatArray, denominator: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The observable canonical form of numerator/denominator (coefficients from the highest
+    power, denominator monic, numerator of the same length), balanced.
+
+    With den = s^n + a1 s^(n-1) + ... + an and num = b0 s^n + ... + bn, the states in the
+    order that makes A upper Hessenberg (ones on the subdiagonal, -an ... -a1 in the last
+    column), B = (bn - b0 an, ..., b1 - b0 a1), C = (0, ..., 0, 1), D = b0. An A already in
+    Hessenberg form is kept as it is by the frequency response's own Hessenberg reduction, so
+    the response is computed from the coefficients without mixing them: at high frequency,
+    where the response of a model of high relative degree is tiny, this keeps its relative
+    accuracy (a full first column lost 5 digits at 50 times the fastest pole of a fifth-order
+    lag)."""
+    n = len(denominator) - 1
+    a = denominator[1:]
+    D = np.array([[numerator[0]]])
+    A = np.zeros((n, n))
+    A[np.arange(1, n), np.arange(n - 1)] = 1.0
+    B = (numerator[1:] - numerator[0] * a)[::-1].reshape(n, 1)
+    C = np.zeros((1, n))
+    if n:
+        A[:, -1] = -a[::-1]
+        C[0, -1] = 1.0
+    A, B, C = _balance(A, B, C)
+    return A, B, C, D
+
+
+def _coefficients(value: object, name: str) -> FloatArray:
+    array = real_array(value, name)
+    if array.ndim == 0:
+        array = array.reshape(1)
+    if array.ndim != 1:
+        raise ShapeError(
+            f"{name} must be a 1-D array of polynomial coefficients (highest power first), "
+            f"got shape {array.shape}"
+        )
+    check_finite(array, name)
+    nonzero = np.flatnonzero(array)
+    return array[nonzero[0] :] if nonzero.size else np.zeros(0)
+
+
+def tf(
+    num: ArrayLike,
+    den: ArrayLike,
+    *,
+    dt: float | None = None,
+    input_names: Names = None,
+    output_names: Names = None,
+    state_names: Names = None,
+) -> StateSpace:
+    """The single-input, single-output model num(s)/den(s) (num(z)/den(z) with ``dt``), as a
+    state-space model.
+
+    The coefficients come highest power first, as numpy's and python-control's (leading zeros
+    are dropped). The realisation is the observable canonical form of the monic denominator,
+    balanced by a diagonal similarity in powers of two; its order is the degree of ``den``:
+    a factor common to num and den is kept, as a mode that the input does not reach. An
+    improper num/den (degree of num above that of den) has no state-space model and is
+    refused.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> g = aerocontrol.tf([2.0, 1.0], [1.0, 3.0, 2.0], input_names="e", output_names="u")
+    >>> g.n_states, g.input_names, g.output_names
+    (2, ('e',), ('u',))
+    >>> np.sort(np.linalg.eigvals(g.A))
+    array([-2., -1.])
+    >>> aerocontrol.dc_gain(g)
+    array([[0.5]])
+    >>> aerocontrol.tf([1.0, 0.0, 0.0], [1.0, 1.0])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aerocontrol.exceptions.InvalidArgumentError: tf: num/den is improper ...
+    """
+    numerator = _coefficients(num, "num")
+    denominator = _coefficients(den, "den")
+    if denominator.size == 0:
+        raise InvalidArgumentError("den must have a nonzero coefficient")
+    if numerator.size > denominator.size:
+        raise InvalidArgumentError(
+            f"tf: num/den is improper (num of degree {numerator.size - 1} over den of degree "
+            f"{denominator.size - 1}): it has no state-space model; add poles (a first-order "
+            "lag) to make it proper"
+        )
+    with np.errstate(over="ignore"):
+        numerator = np.concatenate([np.zeros(denominator.size - numerator.size), numerator])
+        leading = denominator[0]
+        A, B, C, D = _observable_form(numerator / leading, denominator / leading)
+    for matrix, what in ((A, "A"), (B, "B"), (D, "D")):
+        finite_or_warn(matrix, f"the realisation's {what}")
+    return _model(
+        A,
+        B,
+        C,
+        D,
+        input_names=input_names,
+        output_names=output_names,
+        state_names=state_names,
+        states="{output} x{k}",
+        dt=dt,
+    )
+
+
+def _roots(value: object, name: str) -> np.ndarray:
+    try:
+        array = np.asarray(value)
+    except ValueError as error:
+        raise ShapeError(f"{name} must be a 1-D array of numbers: {error}") from None
+    if array.dtype.kind not in "biufc":
+        raise NotRealError(f"{name} must be an array of numbers, got dtype {array.dtype}")
+    array = array.astype(np.complex128).reshape(-1) if array.ndim == 0 else array
+    if array.ndim != 1:
+        raise ShapeError(f"{name} must be a 1-D array of roots, got shape {array.shape}")
+    array = array.astype(np.complex128)
+    check_finite(np.concatenate([array.real, array.imag]), name)
+    return array
+
+
+def _real_factors(roots: np.ndarray, name: str) -> list[FloatArray]:
+    """The roots as real monic factors, highest power first: one quadratic per complex pair
+    (each complex root must come with its conjugate, to 1e-10 relative), then quadratics of
+    two real roots, then at most one linear factor."""
+    real = sorted(float(r.real) for r in roots if r.imag == 0.0)
+    upper = sorted((r for r in roots if r.imag > 0.0), key=lambda r: (r.real, r.imag))
+    lower = [r for r in roots if r.imag < 0.0]
+    factors: list[FloatArray] = []
+    for r in upper:
+        match = [k for k, q in enumerate(lower) if abs(q - r.conjugate()) <= 1e-10 * abs(r)]
+        if not match:
+            raise InvalidArgumentError(
+                f"{name} has the complex root {complex(r)} without its conjugate: a real model "
+                "has complex roots in conjugate pairs"
+            )
+        lower.pop(match[0])
+        factors.append(np.array([1.0, -2.0 * r.real, abs(r) ** 2]))
+    if lower:
+        raise InvalidArgumentError(
+            f"{name} has the complex root {complex(lower[0])} without its conjugate: a real "
+            "model has complex roots in conjugate pairs"
+        )
+    for k in range(0, len(real) - 1, 2):
+        factors.append(np.array([1.0, -(real[k] + real[k + 1]), real[k] * real[k + 1]]))
+    if len(real) % 2:
+        factors.append(np.array([1.0, -real[-1]]))
+    return factors
+
+
+def zpk(
+    z: ArrayLike,
+    p: ArrayLike,
+    k: float,
+    *,
+    dt: float | None = None,
+    input_names: Names = None,
+    output_names: Names = None,
+    state_names: Names = None,
+) -> StateSpace:
+    """The single-input, single-output model k·Π(s - z_i)/Π(s - p_i) (in z with ``dt``), as
+    a state-space model.
+
+    Complex zeros and poles come in conjugate pairs. The model is a cascade of first- and
+    second-order sections (each pole pair, or pair of real poles, with up to two zeros), each
+    in balanced observable form, so that no polynomial of high degree is ever formed. More
+    zeros than poles (an improper model) is refused.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> # A yaw damper's filter: washout zero at 0, poles of the washout and of a lag.
+    >>> g = aerocontrol.zpk([0.0], [-0.5, -10.0], 10.0)
+    >>> np.sort(np.linalg.eigvals(g.A).real)
+    array([-10. ,  -0.5])
+    >>> aerocontrol.zpk([1 + 2j], [-1.0, -2.0], 1.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aerocontrol.exceptions.InvalidArgumentError: z has the complex root (1+2j) without ...
+    """
+    zeros = _roots(z, "z")
+    poles = _roots(p, "p")
+    factor = _finite(k, "k")
+    if zeros.size > poles.size:
+        raise InvalidArgumentError(
+            f"zpk: {zeros.size} zeros over {poles.size} poles is improper: it has no state-space "
+            "model; add poles to make it proper"
+        )
+    pole_factors = _real_factors(poles, "p")
+    zero_factors = _real_factors(zeros, "z")
+    # Quadratic zero factors go with quadratic pole factors; a linear zero factor with a
+    # quadratic one left over, else with the linear pole factor (there is one when the
+    # quadratics are used up, since there are no more zeros than poles).
+    numerators: list[FloatArray] = [np.array([1.0]) for _ in pole_factors]
+    quadratic = [i for i, f in enumerate(pole_factors) if f.size == 3]
+    linear = [i for i, f in enumerate(pole_factors) if f.size == 2]
+    zero_quadratics = [f for f in zero_factors if f.size == 3]
+    zero_linear = [f for f in zero_factors if f.size == 2]
+    for f in zero_quadratics:
+        numerators[quadratic.pop(0)] = f
+    for f in zero_linear:
+        numerators[(quadratic or linear).pop(0)] = f
+    n = poles.size
+    A = np.zeros((0, 0))
+    B = np.zeros((0, 1))
+    C = np.zeros((1, 0))
+    D = np.array([[1.0]])
+    for numerator, denominator in zip(numerators, pole_factors, strict=True):
+        padded = np.concatenate([np.zeros(denominator.size - numerator.size), numerator])
+        A2, B2, C2, D2 = _observable_form(padded, denominator)
+        # The new section's states first: A stays upper Hessenberg (see _observable_form).
+        A = np.block([[A2, B2 @ C], [np.zeros((A.shape[0], A2.shape[0])), A]])
+        B = np.vstack([B2 @ D, B])
+        C = np.hstack([C2, D2 @ C])
+        D = D2 @ D
+    C, D = factor * C, factor * D
+    A, B, C = _balance(A, B, C)
+    assert A.shape == (n, n)
+    return _model(
+        A,
+        B,
+        C,
+        D,
+        input_names=input_names,
+        output_names=output_names,
+        state_names=state_names,
+        states="{output} x{k}",
+        dt=dt,
+    )
+
+
+# ----- elements ---------------------------------------------------------------------------------
+
+
+def gain(
+    K: ArrayLike, *, input_names: Names = None, output_names: Names = None, dt: float | None = None
+) -> StateSpace:
+    """A static gain y = K u (a scalar, or a p x m matrix), with no states.
+
+    A model without states fits any time base in an interconnection; ``dt`` marks it all the
+    same.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> k = aerocontrol.gain(-1.5, input_names="r", output_names="rudder command")
+    >>> k.D, k.n_states
+    (array([[-1.5]]), 0)
+    """
+    matrix = real_array(K, "K")
+    if matrix.ndim == 0:
+        matrix = matrix.reshape(1, 1)
+    if matrix.ndim != 2:
+        raise ShapeError(f"K must be a scalar or a 2-D matrix, got shape {matrix.shape}")
+    check_finite(matrix, "K")
+    p, m = matrix.shape
+    return _model(
+        np.zeros((0, 0)),
+        np.zeros((0, m)),
+        np.zeros((p, 0)),
+        matrix,
+        input_names=input_names,
+        output_names=output_names,
+        state_names=None,
+        dt=dt,
+    )
+
+
+def first_order_lag(
+    tau: float,
+    *,
+    gain: float = 1.0,
+    input_names: Names = None,
+    output_names: Names = None,
+    state_names: Names = None,
+) -> StateSpace:
+    """gain/(tau s + 1): a first-order lag of time constant ``tau`` seconds (positive).
+
+    The state is the output divided by ``gain`` (x' = (u - x)/tau, y = gain·x).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> lag = aerocontrol.first_order_lag(0.5)
+    >>> lag.A, aerocontrol.dc_gain(lag)
+    (array([[-2.]]), array([[1.]]))
+    """
+    time_constant = _positive(tau, "tau")
+    k = _finite(gain, "gain")
+    return _model(
+        np.array([[-1.0 / time_constant]]),
+        np.array([[1.0 / time_constant]]),
+        np.array([[k]]),
+        np.zeros((1, 1)),
+        input_names=input_names,
+        output_names=output_names,
+        state_names=state_names,
+        states="{input} lagged",
+    )
+
+
+def actuator(
+    bandwidth: float,
+    *,
+    input_names: Names = None,
+    output_names: Names = None,
+    state_names: Names = None,
+) -> StateSpace:
+    """A first-order actuator of ``bandwidth`` rad/s (positive): bandwidth/(s + bandwidth),
+    unit gain at rest; its state is the surface deflection.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> servo = aerocontrol.actuator(20.0, input_names="rudder command", output_names="rudder")
+    >>> servo.A, servo.input_names, servo.output_names
+    (array([[-20.]]), ('rudder command',), ('rudder',))
+    """
+    omega = _positive(bandwidth, "bandwidth")
+    return _model(
+        np.array([[-omega]]),
+        np.array([[omega]]),
+        np.ones((1, 1)),
+        np.zeros((1, 1)),
+        input_names=input_names,
+        output_names=output_names,
+        state_names=state_names,
+        states="{output}",
+    )
+
+
+def washout(
+    tau: float,
+    *,
+    input_names: Names = None,
+    output_names: Names = None,
+    state_names: Names = None,
+) -> StateSpace:
+    """tau s/(tau s + 1): a washout filter of time constant ``tau`` seconds (positive), which
+    passes changes and blocks a steady signal (so that a yaw damper does not oppose a steady
+    turn): gain 0 at rest and 1 at high frequency.
+
+    The state is the input lagged by ``tau`` and the output is the input minus it
+    (x' = (u - x)/tau, y = u - x).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> filt = aerocontrol.washout(2.0, input_names="r", output_names="r washed")
+    >>> g = aerocontrol.frequency_response(filt, [0.0, 0.5, 1e6]).response[:, 0, 0]
+    >>> np.round(np.abs(g), 6)
+    array([0.      , 0.707107, 1.      ])
+    """
+    time_constant = _positive(tau, "tau")
+    return _model(
+        np.array([[-1.0 / time_constant]]),
+        np.array([[1.0 / time_constant]]),
+        -np.ones((1, 1)),
+        np.ones((1, 1)),
+        input_names=input_names,
+        output_names=output_names,
+        state_names=state_names,
+        states="{input} lagged",
+    )
+
+
+def second_order(
+    omega_n: float,
+    zeta: float,
+    *,
+    input_names: Names = None,
+    output_names: Names = None,
+    state_names: Names = None,
+) -> StateSpace:
+    """ω_n²/(s² + 2ζω_n s + ω_n²): a second-order element (an actuator, a sensor, a structural
+    filter) of natural frequency ``omega_n`` rad/s (positive) and damping ratio ``zeta``
+    (non-negative), unit gain at rest.
+
+    The states are the output y and its rate divided by ω_n (x1' = ω_n x2,
+    x2' = ω_n (u - x1) - 2ζω_n x2), which keeps the matrices of size ω_n.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> servo = aerocontrol.second_order(30.0, 0.7)
+    >>> poles = np.linalg.eigvals(servo.A)
+    >>> np.round(np.abs(poles), 12), np.round(-poles.real / np.abs(poles), 12)
+    (array([30., 30.]), array([0.7, 0.7]))
+    """
+    omega = _positive(omega_n, "omega_n")
+    damping = _finite(zeta, "zeta")
+    if damping < 0.0:
+        raise InvalidArgumentError(f"zeta must be non-negative, got {damping}")
+    return _model(
+        np.array([[0.0, omega], [-omega, -2.0 * damping * omega]]),
+        np.array([[0.0], [omega]]),
+        np.array([[1.0, 0.0]]),
+        np.zeros((1, 1)),
+        input_names=input_names,
+        output_names=output_names,
+        state_names=state_names,
+        states=["{output}", "{output} rate/omega_n"],
+    )
+
+
+def pade_delay(
+    T: float,
+    order: int = 1,
+    *,
+    input_names: Names = None,
+    output_names: Names = None,
+    state_names: Names = None,
+) -> StateSpace:
+    """The Padé approximant of order ``order`` (numerator and denominator degree, 1 to 20) of
+    a time delay e^{-sT} of ``T`` seconds (positive), as a state-space model; python-control's
+    ``pade(T, order)`` in state space.
+
+    With x = sT the approximant is P(-x)/P(x), P(x) = Σ_k c_k x^k,
+    c_k = (2n - k)! n! / ((2n)! k! (n - k)!) (Golub and Van Loan, §9.3.1), computed exactly in
+    rational arithmetic; its balanced observable form in x is then scaled to seconds. An
+    all-pass: |G(jω)| = 1 at every frequency, with the phase -ωT at low frequency.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> delay = aerocontrol.pade_delay(0.1, 3)
+    >>> g = aerocontrol.frequency_response(delay, [1.0, 10.0]).response[:, 0, 0]
+    >>> np.round(np.abs(g), 12), np.round(np.angle(g), 6)     # e^{-jωT}: -0.1, then -1 rad
+    (array([1., 1.]), array([-0.1    , -0.99999]))
+    """
+    delay = _positive(T, "T")
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 1:
+        raise InvalidArgumentError(f"order must be a positive integer, got {order!r}")
+    if order > MAX_PADE_ORDER:
+        raise InvalidArgumentError(
+            f"order must be at most {MAX_PADE_ORDER}, got {order}: beyond it the realisation "
+            "from the approximant's coefficients loses digits (the all-pass magnitude is off by "
+            "4e-11 at order 30, 4e-9 at order 40)"
+        )
+    n = int(order)
+    exact = [
+        Fraction(comb(n, k) * _falling(2 * n - k, n - k), _falling(2 * n, n)) for k in range(n + 1)
+    ]
+    # Highest power first, monic: P(x) / c_n and P(-x) / c_n.
+    denominator = np.array([float(c / exact[n]) for c in reversed(exact)])
+    numerator = np.array(
+        [float((-1) ** k * c / exact[n]) for k, c in reversed(list(enumerate(exact)))]
+    )
+    A, B, C, D = _observable_form(numerator, denominator)
+    A, B, C = _balance(A / delay, B / delay, C)
+    return _model(
+        A,
+        B,
+        C,
+        D,
+        input_names=input_names,
+        output_names=output_names,
+        state_names=state_names,
+        states="{input} delay x{k}",
+    )
+
+
+def _falling(top: int, count: int) -> int:
+    """top! / (top - count)!."""
+    result = 1
+    for factor in range(top - count + 1, top + 1):
+        result *= factor
+    return result
