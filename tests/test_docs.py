@@ -6,6 +6,7 @@ import doctest
 import importlib
 import pkgutil
 
+import numpy as np
 import pytest
 
 import aerocontrol
@@ -20,7 +21,10 @@ MODULES = sorted(
 @pytest.mark.parametrize("name", ["aerocontrol", *MODULES])
 def test_docstring_examples(name: str) -> None:
     module = importlib.import_module(name)
-    failures, _ = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
+    # numpy's default print options, whatever another test left.
+    defaults = dict(precision=8, floatmode="maxprec", suppress=False, linewidth=75, sign="-")
+    with np.printoptions(threshold=1000, edgeitems=3, legacy=False, **defaults):
+        failures, _ = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert failures == 0
 
 

@@ -65,6 +65,7 @@
 
 use crate::control::frequency::check_state_space;
 use crate::error::{Error, check_finite, check_positive, check_rows, check_square};
+use crate::linalg::balance::times_power_of_two;
 use crate::linalg::expm::expm;
 use crate::linalg::norm::one_norm;
 use crate::linalg::schur::real_schur;
@@ -91,13 +92,6 @@ pub struct Discretization {
     pub gamma0: Mat<f64>,
     /// Γ1 = (1/h) ∫_0^h e^{Aτ} (h - τ) dτ B, n x m; present for [`Hold::First`].
     pub gamma1: Option<Mat<f64>>,
-}
-
-/// x 2^e for an integer e of any size, in two exact steps where one power would leave the range
-/// of doubles.
-fn times_power_of_two(x: f64, exponent: f64) -> f64 {
-    let half = (exponent / 2.0).trunc();
-    x * half.exp2() * (exponent - half).exp2()
 }
 
 /// Discretises x' = Ax + Bη over the step `dt` with the given hold (see the module docs).

@@ -13,6 +13,11 @@
 //! dense solve. The elimination is backward stable for each frequency, as Gaussian elimination
 //! with partial pivoting is. Frequencies run in parallel.
 //!
+//! Entries and frequencies of any magnitude: A, B and C are divided by the powers of two of
+//! their largest entries (exact; the point s by A's, G - D multiplied back at the end), pivots
+//! are chosen by |re| + |im| and complex divisions are Smith's (1962), so no square of an
+//! entry is formed: G(jω) of 1 / (s - 0.1257) at ω = 1e155 is -1e-155j, not 0.
+//!
 //! A frequency at an eigenvalue of A on the imaginary axis (a pole of G) gives infinite or NaN
 //! entries, never an error: the caller decides how to report them.
 //!
@@ -25,6 +30,7 @@ use crate::error::{
     Error, check_finite, check_finite_values, check_output_len, check_positive, check_rows,
     check_square,
 };
+use crate::linalg::balance::{range_scale, times_power_of_two};
 use crate::linalg::hessenberg::{Hessenberg, hessenberg};
 use crate::platform::dispatch::{fma_dispatch, multiply_add};
 use crate::platform::parallel::ParallelContext;
@@ -76,6 +82,25 @@ struct HessenbergModel {
     b: Vec<f64>,
     c: Vec<f64>,
     d: Vec<f64>,
+    /// A / σ, B / β and C / γ are held (the point s is divided by σ): C (sI - A)^-1 B is
+    /// multiplied by 2^`exponent` = γ β / σ.
+    exponent: f64,
+}
+
+/// (a + jb) / (c + jd) by Smith's algorithm (Smith 1962): the ratio of the smaller to the
+/// larger part of the divisor scales it, so that no square is formed and nothing overflows
+/// or underflows unless the quotient does.
+#[inline(always)]
+fn complex_divide(a: f64, b: f64, c: f64, d: f64) -> (f64, f64) {
+    if d.abs() <= c.abs() {
+        let r = d / c;
+        let denominator = c + d * r;
+        ((a + b * r) / denominator, (b - a * r) / denominator)
+    } else {
+        let r = c / d;
+        let denominator = c * r + d;
+        ((a * r + b) / denominator, (b * r - a) / denominator)
+    }
 }
 
 /// One frequency's scratch: the real and imaginary planes of the eliminated jωI - H
@@ -150,9 +175,7 @@ fn evaluate_kernel<const FMA: bool>(
     x_im.fill(0.0);
     for k in 0..n.saturating_sub(1) {
         let (this, next) = (k * n, (k + 1) * n);
-        let magnitude = |row: usize, re: &[f64], im: &[f64]| {
-            re[row + k] * re[row + k] + im[row + k] * im[row + k]
-        };
+        let magnitude = |row: usize, re: &[f64], im: &[f64]| re[row + k].abs() + im[row + k].abs();
         if magnitude(next, re, im) > magnitude(this, re, im) {
             for j in k..n {
                 re.swap(this + j, next + j);
@@ -168,12 +191,8 @@ fn evaluate_kernel<const FMA: bool>(
         if sr == 0.0 && si == 0.0 {
             continue;
         }
-        // factor = sub / pivot.
-        let denominator = pr * pr + pi * pi;
-        let (fr, fi) = (
-            (sr * pr + si * pi) / denominator,
-            (si * pr - sr * pi) / denominator,
-        );
+        // factor = sub / pivot (the pivot is not zero: it is the larger of the two).
+        let (fr, fi) = complex_divide(sr, si, pr, pi);
         let (upper_re, lower_re) = re.split_at_mut(next);
         let (upper_im, lower_im) = im.split_at_mut(next);
         let (row_re, row_im) = (&upper_re[this + k + 1..], &upper_im[this + k + 1..]);
@@ -198,7 +217,6 @@ fn evaluate_kernel<const FMA: bool>(
             &im[k * n + k + 1..(k + 1) * n],
         );
         let (pr, pi) = (re[k * n + k], im[k * n + k]);
-        let denominator = pr * pr + pi * pi;
         for column in 0..m {
             let (xr, xi) = (
                 &mut x_re[column * n..(column + 1) * n],
@@ -206,8 +224,7 @@ fn evaluate_kernel<const FMA: bool>(
             );
             let (dr, di) = complex_dot::<FMA>(row_re, row_im, &xr[k + 1..], &xi[k + 1..]);
             let (sr, si) = (xr[k] - dr, xi[k] - di);
-            xr[k] = (sr * pr + si * pi) / denominator;
-            xi[k] = (si * pr - sr * pi) / denominator;
+            (xr[k], xi[k]) = complex_divide(sr, si, pr, pi);
         }
     }
     // G = C Q X + D.
@@ -218,12 +235,16 @@ fn evaluate_kernel<const FMA: bool>(
                 &x_re[column * n..(column + 1) * n],
                 &x_im[column * n..(column + 1) * n],
             );
-            let (mut gr, mut gi) = (model.d[i * m + column], 0.0);
+            let (mut gr, mut gi) = (0.0, 0.0);
             for ((&c, &vr), &vi) in c_row.iter().zip(xr).zip(xi) {
                 gr = multiply_add::<FMA>(c, vr, gr);
                 gi = multiply_add::<FMA>(c, vi, gi);
             }
-            g[i * m + column] = c64::new(gr, gi);
+            if model.exponent != 0.0 {
+                gr = times_power_of_two(gr, model.exponent);
+                gi = times_power_of_two(gi, model.exponent);
+            }
+            g[i * m + column] = c64::new(gr + model.d[i * m + column], gi);
         }
     }
 }
@@ -295,8 +316,12 @@ fn transfer_function_into(
     if p * m == 0 {
         return Ok(());
     }
-    let Hessenberg { h, q } = hessenberg(a)?;
-    let (qb, cq) = (q.transpose() * b, c * &q);
+    let (sigma, beta, gamma) = (range_scale(a), range_scale(b), range_scale(c));
+    let scaled =
+        |x: MatRef<'_, f64>, s: f64| Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)] / s);
+    let (a, b, c) = (scaled(a, sigma), scaled(b, beta), scaled(c, gamma));
+    let Hessenberg { h, q } = hessenberg(a.as_ref())?;
+    let (qb, cq) = (q.transpose() * &b, &c * &q);
     let row_major = |x: &Mat<f64>| -> Vec<f64> {
         (0..x.nrows())
             .flat_map(|i| (0..x.ncols()).map(move |j| x[(i, j)]))
@@ -313,6 +338,7 @@ fn transfer_function_into(
             .collect(),
         c: row_major(&cq),
         d: row_major(&d.to_owned()),
+        exponent: gamma.log2() + beta.log2() - sigma.log2(),
     };
     let workspace = || Workspace {
         re: vec![0.0; n * n],
@@ -328,7 +354,9 @@ fn transfer_function_into(
         .with_min_len(32)
         .try_for_each_init(workspace, |ws, (&w, g)| {
             context.run(|| {
-                evaluate_frequency(&model, point(w), ws, g);
+                let s = point(w);
+                let s = if sigma == 1.0 { s } else { s / sigma };
+                evaluate_frequency(&model, s, ws, g);
                 Ok(())
             })
         })

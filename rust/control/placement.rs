@@ -48,9 +48,10 @@
 use crate::control::controllability::{controllability, controllability_staircase, krylov_blocks};
 use crate::control::modal::polynomial_from_roots;
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
+use crate::linalg::balance::{range_scale, scale_for_largest};
 use crate::linalg::charpoly::charpoly;
 use crate::linalg::lu::solve_with_inverse;
-use crate::linalg::norm::{frobenius_norm, one_norm};
+use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
 use crate::linalg::schur::eigenvalues_near;
 use crate::platform::interrupt;
 use faer::linalg::solvers::Solve;
@@ -280,7 +281,24 @@ fn place_single_input(
             true,
         );
     }
+    if let Some(scaled) = ScaledPlant::of(a, b, &poles, false) {
+        let design =
+            place_single_input(scaled.a.as_ref(), scaled.b.as_ref(), &scaled.poles, method)?;
+        return scaled.unscale(a, b, poles, design);
+    }
     let desired = polynomial_from_roots(&poles);
+    if let Some(k) = desired.iter().position(|c| !c.is_finite()) {
+        return Err(Error::InvalidArgument {
+            arg: "poles",
+            message: format!(
+                "the characteristic polynomial of the poles overflows double precision (the \
+                 coefficient of s^{} is {}): the poles are too large for a polynomial-based \
+                 method; place() works without one",
+                n - k,
+                desired[k]
+            ),
+        });
+    }
     let v = krylov_blocks(a, b);
     // One LU solve with V^T for the right-hand side and I: the first gives the gains, the
     // second V^-T, whose norm (and nothing else) gives κ_1(V).
@@ -348,6 +366,59 @@ fn place_single_input(
 /// rounding error in forming it explains.
 const SCREEN_CONDITION: f64 = 1e6;
 
+/// A plant whose largest entry (or pole) is outside [2^-100, 2^100], divided by the power of two s that
+/// brings it near 1, with the poles likewise: A - B K has the eigenvalues p exactly when
+/// A / s - (B / s) K has p / s, so the gain is the same, and the methods' products of entries
+/// (A^k b, X Λ X^-1, U0^T (A - M)) stay in range. Plants in range are designed as they are.
+struct ScaledPlant {
+    a: Mat<f64>,
+    b: Mat<f64>,
+    poles: Vec<c64>,
+}
+
+impl ScaledPlant {
+    /// The scaled plant, if it needs scaling; by the poles too when `by_poles` (for the robust
+    /// method: the polynomial methods form A^k b, which a plant scaled to poles far from its
+    /// eigenvalues would underflow, and check the poles' polynomial instead).
+    fn of(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64], by_poles: bool) -> Option<Self> {
+        let largest_pole = poles
+            .iter()
+            .fold(0.0f64, |m, p| m.max(p.re.abs()).max(p.im.abs()));
+        let largest = max_abs(a).max(max_abs(b));
+        let scale = scale_for_largest(if by_poles {
+            largest.max(largest_pole)
+        } else {
+            largest
+        });
+        (scale != 1.0).then(|| Self {
+            a: Mat::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] / scale),
+            b: Mat::from_fn(b.nrows(), b.ncols(), |i, j| b[(i, j)] / scale),
+            poles: poles.iter().map(|p| p / scale).collect(),
+        })
+    }
+
+    /// The design of the scaled plant as a design of (A, B): the same gain, verified on A - B K.
+    fn unscale(
+        &self,
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        poles: Vec<c64>,
+        design: Placement,
+    ) -> Result<Placement, Error> {
+        finish(
+            a,
+            b,
+            design.gain,
+            poles,
+            design.method,
+            design.controllability_condition,
+            design.eigenvector_condition,
+            design.iterations,
+            design.converged,
+        )
+    }
+}
+
 /// The closed loop, its poles matched to the requested ones, and the result.
 #[allow(clippy::too_many_arguments)]
 fn finish(
@@ -361,6 +432,9 @@ fn finish(
     iterations: usize,
     converged: bool,
 ) -> Result<Placement, Error> {
+    if !gain.is_all_finite() {
+        return Err(gain_overflow("the gain K"));
+    }
     // A - B K entry by entry: at these sizes a general product costs more to dispatch than to
     // compute.
     let closed_loop = Mat::from_fn(a.nrows(), a.ncols(), |i, j| {
@@ -369,6 +443,9 @@ fn finish(
                 .map(|k| b[(i, k)] * gain[(k, j)])
                 .sum::<f64>()
     });
+    if !closed_loop.is_all_finite() {
+        return Err(gain_overflow("the closed loop A - B K"));
+    }
     // The requested poles as the QR iteration's shifts: near the eigenvalues when the design
     // succeeded, it then converges in fewer sweeps (and finds them as accurately either way).
     let computed = eigenvalues_near(closed_loop.as_ref(), &poles)?;
@@ -410,6 +487,16 @@ fn finish(
     })
 }
 
+/// The error of a design whose gain or closed loop overflows double precision.
+fn gain_overflow(what: &str) -> Error {
+    Error::IllConditioned {
+        message: format!(
+            "{what} overflows double precision: the poles are too far from A's eigenvalues for \
+             inputs as weak as B's (a gain beyond 1.8e308 would be needed)"
+        ),
+    }
+}
+
 /// Multi-input pole placement by the robust method of Kautsky, Nichols & Van Dooren.
 pub fn place(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64]) -> Result<Placement, Error> {
     check_plant(a, b)?;
@@ -428,6 +515,10 @@ pub fn place(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64]) -> Result<Pl
             0,
             true,
         );
+    }
+    if let Some(scaled) = ScaledPlant::of(a, b, &poles, true) {
+        let design = place(scaled.a.as_ref(), scaled.b.as_ref(), &scaled.poles)?;
+        return scaled.unscale(a, b, poles, design);
     }
     let InputBasis { u0, u1, z } = input_basis(b)?;
     check_multiplicities(&poles, m)?;
@@ -499,10 +590,14 @@ fn input_basis(b: MatRef<'_, f64>) -> Result<InputBasis, Error> {
             message: format!("column {j} of B is zero: that input acts on no state; remove it"),
         });
     }
-    let qr = b.qr();
+    // The QR factors of B / s for the power of two s of B's largest entry (exact: the same Q,
+    // and R times s), so that faer's reflectors see entries near 1 (a B of 1e-310 had rank 0).
+    let scale = range_scale(b);
+    let scaled = Mat::from_fn(n, m, |i, j| b[(i, j)] / scale);
+    let qr = scaled.qr();
     let q = qr.compute_Q();
-    let r = qr.R();
-    let tolerance = n.max(m) as f64 * f64::EPSILON * b.norm_l2();
+    let r = qr.R() * faer::Scale(scale);
+    let tolerance = n.max(m) as f64 * f64::EPSILON * frobenius_norm(scaled.as_ref()) * scale;
     let rank = (0..m.min(n))
         .filter(|&k| r[(k, k)].abs() > tolerance)
         .count();

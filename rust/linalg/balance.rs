@@ -33,6 +33,13 @@ pub(crate) fn scale_for_largest(largest: f64) -> f64 {
     }
 }
 
+/// x 2^e for an integer e of any size, in two exact steps where one power would leave the range
+/// of doubles.
+pub(crate) fn times_power_of_two(x: f64, exponent: f64) -> f64 {
+    let half = (exponent / 2.0).trunc();
+    x * half.exp2() * (exponent - half).exp2()
+}
+
 /// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
 /// row and column i are scaled until their off-diagonal 2-norms are within a factor of two, and
 /// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more. Returns

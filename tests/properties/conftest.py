@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -50,8 +51,14 @@ settings.register_profile(
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
 )
 
-# Failing examples are printed with every digit, so that they can be reproduced.
-np.set_printoptions(precision=17)
+
+@pytest.fixture(autouse=True)
+def _every_digit() -> Iterator[None]:
+    """Failing examples are printed with every digit, so that they can be reproduced (within
+    the property tests only: the doctests elsewhere print with numpy's defaults)."""
+    with np.printoptions(precision=17):
+        yield
+
 
 settings.load_profile(
     os.environ.get(

@@ -22,7 +22,6 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning
 from aerocontrol.placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
 
-from . import known_defects
 from .harness import REFUSE, SAME, Arg, Warned, exercise, plain
 from .oracles import (
     SLACK,
@@ -313,19 +312,34 @@ def test_augment_mode(data: st.DataObject) -> None:
     )
 
 
-# ----- known defects of the core (see known_defects.py) ------------------------------------------
+# ----- inputs a campaign found (regressions) -----------------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.PLACEMENT_OVERFLOW_BLAMES_A.summary)
-def test_known_defect_placement_overflow_blames_a() -> None:
+@pytest.mark.parametrize("function", ["place_ackermann", "place_bass_gura"])
+def test_placement_overflow_names_the_poles(function: str) -> None:
+    """Poles whose characteristic polynomial overflows: the error names the poles (it blamed
+    A, which is finite, or the controllability matrix)."""
     A = np.array([[0.1257, -0.132], [0.64, 0.105]])
     b = np.array([0.1257, -0.132])
-    with known_defects.PLACEMENT_OVERFLOW_BLAMES_A.reproducing():
-        outcome = exercise(
-            "place_ackermann",
-            aerocontrol.place_ackermann,
-            {"A_or_sys": canonical(A), "b": canonical(b), "poles": plain([-1e160, -2e160])},
-            _placement_oracle(True),
-            nonfinite_by_definition=NOT_APPLICABLE,
-        )
+    outcome = exercise(
+        function,
+        getattr(aerocontrol, function),
+        {"A_or_sys": canonical(A), "b": canonical(b), "poles": plain([-1e160, -2e160])},
+        _placement_oracle(True),
+        nonfinite_by_definition=NOT_APPLICABLE,
+    )
     assert "poles" in str(outcome.error), f"the error blames another argument: {outcome.error}"
+
+
+@pytest.mark.parametrize("factor", [1e-200, 1e150, 1e200])
+def test_placement_of_plants_at_extreme_scales(factor: float) -> None:
+    """(A, B) and the poles scaled together: the gain is the same, computed from the scaled
+    plant (entries near 1e150 overflowed inside the methods)."""
+    A = np.array([[0.1257, -0.132], [0.64, 0.105]])
+    b = np.array([[0.1257], [-0.132]])
+    poles = [-1.0, -2.0]
+    reference = aerocontrol.place(A, b, poles).K
+    for function in ("place", "place_ackermann", "place_bass_gura"):
+        design = getattr(aerocontrol, function)(A * factor, b * factor, [p * factor for p in poles])
+        assert np.allclose(design.K, reference, rtol=1e-12, atol=0), function
+        assert np.allclose(np.sort(design.achieved_poles.real), [-2 * factor, -factor], rtol=1e-12)
