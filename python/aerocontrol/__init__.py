@@ -107,6 +107,7 @@ from .riccati import (
     solve_lyapunov,
 )
 from .statespace import StateSpace, as_state_space
+from .transfer import Factor, TransferFunction, transfer_function, transmission_zeros
 
 try:
     __version__ = version("aerocontrol")
@@ -123,6 +124,7 @@ __all__ = [
     "ConvergenceError",
     "DareSolution",
     "Discretization",
+    "Factor",
     "FrequencyResponse",
     "GeneralizedSchur",
     "IllConditionedError",
@@ -144,6 +146,7 @@ __all__ = [
     "SingularMatrixError",
     "StateSpace",
     "TimeResponse",
+    "TransferFunction",
     "UncontrollableError",
     "__version__",
     "actuator",
@@ -209,7 +212,9 @@ __all__ = [
     "step_response",
     "summing_junction",
     "tf",
+    "transfer_function",
     "transition_matrix",
+    "transmission_zeros",
     "washout",
     "zpk",
 ]
