@@ -440,9 +440,15 @@ def stability_margins(loop: System) -> StabilityMargins:
         if response.one(w).real < 0:
             phase_w.append(float(w))
     ends = [0.0] + ([math.pi / period(model)] if discrete else [])
+    largest = float(np.abs(values).max(initial=0.0))
     for w in ends:
         value = response.one(w)
-        if np.isfinite(value) and value.real < 0 and abs(value.imag) <= 1e-12 * abs(value):
+        # Not where L vanishes (a zero at the origin, a washout): no crossing there.
+        if (
+            np.isfinite(value)
+            and value.real < -1e-10 * largest
+            and abs(value.imag) <= 1e-12 * abs(value)
+        ):
             phase_w.append(float(w))
     phase_w = sorted(set(phase_w))
     gains = np.array([1.0 / abs(response.one(w)) for w in phase_w])
@@ -726,7 +732,10 @@ class _Objective:
         return _damping(pole, self.dt), pole, poles
 
     def __call__(self, k: float) -> float:
-        return self.pole(k)[0]
+        zeta, _, poles = self.pole(k)
+        if np.any(_unstable(poles, bool(self.dt))):
+            return -1.0  # a gain that leaves the closed loop unstable is never the best
+        return zeta
 
 
 def _default_gains(model: StateSpace) -> FloatArray:
@@ -772,7 +781,8 @@ def best_damping_gain(
 
     The damping is computed on a grid of gains (``gains``, or 0 and 400 gains over six
     decades about 1/|L| at the loop's modes), then refined by golden-section search between
-    the best grid gain's neighbours.
+    the best grid gain's neighbours. A gain at which a closed-loop pole is unstable is never
+    chosen (its damping counts as -1).
 
     Examples
     --------
