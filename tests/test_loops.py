@@ -286,3 +286,29 @@ def test_root_locus_arguments() -> None:
         best_damping_gain(loop, mode="dutch roll")  # type: ignore[arg-type]
     with pytest.raises(ShapeError, match="gains must be a non-empty"):
         root_locus(loop, [])
+
+
+def test_yaw_damper_closed_loop_is_the_locus_at_its_gain() -> None:
+    """The damper's closed loop (built with feedback()) has the poles of 1 + k L = 0 that
+    numpy finds for the loop's matrices; the washout keeps a slow real (spiral) root that
+    the damper without it turns into an oscillation."""
+    plane = aerocontrol.aircraft.load("b747-cruise")
+    damper = aerocontrol.design.yaw_damper(plane)
+    loop, k = damper.loop, damper.design.gain
+    expected = np.linalg.eigvals(loop.A - k * loop.B @ loop.C / (1 + k * loop.D[0, 0]))
+    ours = np.linalg.eigvals(damper.closed_loop.A)
+    assert _matched(ours, expected) < 1e-9
+    assert damper.margins.closed_loop_stable and damper.check.passed == {"yaw damper": True}
+    slow = ours[np.argmin(np.abs(ours))]
+    assert slow.imag == 0 and -0.01 < slow.real < 0
+    bare = aerocontrol.design.yaw_damper(plane, washout_tau=None)
+    roots = np.linalg.eigvals(bare.closed_loop.A)
+    assert np.all(np.abs(roots[np.abs(roots) < 0.5].imag) > 0)  # no slow real root left
+
+
+def _matched(a: np.ndarray, b: np.ndarray) -> float:
+    from scipy.optimize import linear_sum_assignment
+
+    distance = np.abs(a[:, None] - b[None, :])
+    rows, columns = linear_sum_assignment(distance)
+    return float(np.max(distance[rows, columns]))

@@ -448,14 +448,15 @@ def plot_gain_root_locus(
     (arcs, labelled ω_n). A discrete locus is drawn in the z-plane with the unit circle.
     Returns the axes.
     """
-    ax = plot_root_locus(
-        locus.gains,
-        locus.poles,
-        ax=ax,
-        marked=marked,
-        weight_name="k",
-        title=title,
-    )
+    with np.errstate(divide="ignore"):  # k = 0 is marked by its nearest gain
+        ax = plot_root_locus(
+            locus.gains,
+            locus.poles,
+            ax=ax,
+            marked=marked,
+            weight_name="k",
+            title=title,
+        )
     ax.plot(
         locus.open_loop_poles.real,
         locus.open_loop_poles.imag,

@@ -150,6 +150,7 @@ def _pencil_zeros(model: StateSpace, tol: float | None) -> _Reduced:
     scale = np.maximum(np.abs(np.diag(form.AA)), np.abs(np.diag(form.BB))).max(initial=0.0)
     finite = beta > tolerance * max(scale, 1.0) * 1e-3
     zeros = np.asarray(alpha[finite] / beta[finite], dtype=np.complex128)
+    zeros[np.abs(zeros) <= tolerance] = 0.0  # a zero at the origin, to rounding (a washout)
     return _Reduced(_conjugate_clean(zeros), rank)
 
 
