@@ -39,7 +39,7 @@ def test_default_run_writes_the_report_of_the_747(tmp_path: Path) -> None:
     report = tmp_path / "aerocontrol-report" / "report.html"
     assert lines[-1] == f"report: {Path('aerocontrol-report') / 'report.html'}"
     assert report.is_file() and (report.parent / "report.md").is_file()
-    assert len(list((report.parent / "figures").glob("*.png"))) == 16
+    assert len(list((report.parent / "figures").glob("*.png"))) == 17
     assert result.stderr == ""
     # README's command, run again into the same folder: the earlier report, untouched, is
     # replaced without any option; a file of the user's beside it stays.
@@ -51,7 +51,7 @@ def test_default_run_writes_the_report_of_the_747(tmp_path: Path) -> None:
         cwd=tmp_path,
     )
     assert again.returncode == 0, again.stderr
-    assert "writing 16 figures and the report (replacing the earlier report)" in again.stdout
+    assert "writing 17 figures and the report (replacing the earlier report)" in again.stdout
     assert (tmp_path / "aerocontrol-report" / "notes.txt").read_text() == "mine"
     assert again.stderr == ""
 
@@ -430,3 +430,31 @@ def test_the_help_documents_the_folder_rules(capsys: pytest.CaptureFixture[str])
         "--force also write into a non-empty folder",
     ):
         assert promise in flat, promise
+
+
+def test_damper_command() -> None:
+    """``aerocontrol damper``: the yaw damper's gain, margins and MIL-F-9490D check; a bad
+    option value is one line and status 2."""
+    result = subprocess.run(
+        [sys.executable, "-m", "aerocontrol", "damper", "b747-cruise", "--loop", "yaw"],
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 0, result.stderr
+    assert "yaw damper, washout 3 s: gain k = 1.4873" in result.stdout
+    assert "MIL-F-9490D 3.1.3.6 margins" in result.stdout and "UNVERIFIED" in result.stdout
+    pitch = subprocess.run(
+        [sys.executable, "-m", "aerocontrol", "damper", "b747-cruise", "--loop", "pitch"],
+        capture_output=True,
+        text=True,
+    )
+    assert pitch.returncode == 0 and "pitch damper: gain k =" in pitch.stdout
+    bad = subprocess.run(
+        [sys.executable, "-m", "aerocontrol", "damper", "--loop", "pitch", "--washout", "2"],
+        capture_output=True,
+        text=True,
+    )
+    assert bad.returncode == 2
+    assert bad.stderr.splitlines() == [
+        "aerocontrol: error: --washout applies to the yaw damper only (see aerocontrol --help)"
+    ]

@@ -41,6 +41,7 @@ FIGURES = {
     "root-locus.png",
     "digital-regulator.png",
     "digital-lqg.png",
+    "yaw-damper.png",
     "envelope.png",
 }
 #: The chapter's two small examples, in the embedded 747's report only.
@@ -101,13 +102,14 @@ def test_progress_is_one_line_per_step(written: tuple[Path, list[str]]) -> None:
         "digital regulator",
         "digital damper",
         "LQG",
+        "output-feedback dampers",
         "levels after augmentation",
         "envelope",
         "chapter check",
-        "writing 16 figures and the report",
+        "writing 17 figures and the report",
     ]
     assert "critically damped at c = 9.772714" in lines[6]
-    assert "dutch roll 2 -> damper (rudder) 1, damper (aileron) 1" in lines[10]
+    assert "dutch roll 2 -> damper (rudder) 1, damper (aileron) 1" in lines[11]
 
 
 def test_the_report_has_the_chapters_results(written: tuple[Path, list[str]]) -> None:

@@ -73,6 +73,17 @@ from .linalg import (
     schur,
     transition_matrix,
 )
+from .loops import (
+    DampingDesign,
+    RootLocus,
+    StabilityMargins,
+    best_damping_gain,
+    complementary_sensitivity,
+    gain_for_damping,
+    root_locus,
+    sensitivity,
+    stability_margins,
+)
 from .modal import Modes, charpoly, modes
 from .placement import (
     CompanionForm,
@@ -107,6 +118,7 @@ from .riccati import (
     solve_lyapunov,
 )
 from .statespace import StateSpace, as_state_space
+from .transfer import Factor, TransferFunction, transfer_function, transmission_zeros
 
 try:
     __version__ = version("aerocontrol")
@@ -121,8 +133,10 @@ __all__ = [
     "CompanionForm",
     "Controllability",
     "ConvergenceError",
+    "DampingDesign",
     "DareSolution",
     "Discretization",
+    "Factor",
     "FrequencyResponse",
     "GeneralizedSchur",
     "IllConditionedError",
@@ -140,10 +154,13 @@ __all__ = [
     "OutputFolderError",
     "Placement",
     "RiccatiSolution",
+    "RootLocus",
     "ShapeError",
     "SingularMatrixError",
+    "StabilityMargins",
     "StateSpace",
     "TimeResponse",
+    "TransferFunction",
     "UncontrollableError",
     "__version__",
     "actuator",
@@ -152,11 +169,13 @@ __all__ = [
     "as_state_space",
     "augment_mode",
     "batch",
+    "best_damping_gain",
     "bode",
     "c2d",
     "chapter",
     "charpoly",
     "companion_form",
+    "complementary_sensitivity",
     "connect",
     "controllability",
     "ctrb",
@@ -176,6 +195,7 @@ __all__ = [
     "forced_response",
     "frequency_response",
     "gain",
+    "gain_for_damping",
     "handling",
     "impulse_response",
     "initial_response",
@@ -199,17 +219,22 @@ __all__ = [
     "qz",
     "report",
     "riccati_ode",
+    "root_locus",
     "schur",
     "second_order",
+    "sensitivity",
     "series",
     "solve_care",
     "solve_dare",
     "solve_lyapunov",
+    "stability_margins",
     "steady_state",
     "step_response",
     "summing_junction",
     "tf",
+    "transfer_function",
     "transition_matrix",
+    "transmission_zeros",
     "washout",
     "zpk",
 ]

@@ -7,6 +7,7 @@
 ``aerocontrol aircraft``               the shipped aircraft
 ``aerocontrol modes AIRCRAFT``         the modes and their MIL-F-8785C Levels
 ``aerocontrol lqr AIRCRAFT --c 1.0``   the lateral (or ``--axis longitudinal``) regulator
+``aerocontrol damper AIRCRAFT``        a yaw (or ``--loop pitch``) damper and its margins
 ``aerocontrol --debug COMMAND ...``    a traceback instead of the one-line error
 =====================================  ======================================================
 
@@ -153,7 +154,58 @@ def _parser() -> argparse.ArgumentParser:
         default="lateral",
         help="which model (default lateral, with rudder and aileron)",
     )
+
+    damper = commands.add_parser(
+        "damper",
+        parents=[common],
+        help="a yaw or pitch damper designed on the root locus, and its margins",
+        description="A rate damper through a first-order actuator (and, for yaw, a washout) "
+        "at the gain of best damping; its loop's transfer function, margins against "
+        "MIL-F-9490D (Table I values as widely quoted, unverified) and closed-loop modes.",
+    )
+    damper.add_argument("aircraft", nargs="?", default=DEFAULT_AIRCRAFT, help=aircraft_help)
+    damper.add_argument(
+        "--loop",
+        choices=("yaw", "pitch"),
+        default="yaw",
+        help="yaw: yaw rate to rudder with a washout; pitch: pitch rate to elevator",
+    )
+    damper.add_argument(
+        "--washout",
+        type=float,
+        default=None,
+        metavar="TAU",
+        help="the yaw damper's washout time constant in seconds (default 3; 0 for none)",
+    )
     return parser
+
+
+def _damper(arguments: argparse.Namespace) -> int:
+    from .design import DAMPER_WASHOUT, pitch_damper, yaw_damper
+    from .transfer import transfer_function
+
+    tau = arguments.washout
+    if tau is not None and not (math.isfinite(tau) and tau >= 0):
+        raise _UsageError(f"--washout must be a non-negative number of seconds, got {tau:g}")
+    if tau is not None and arguments.loop == "pitch":
+        raise _UsageError("--washout applies to the yaw damper only")
+    plane = load(arguments.aircraft)
+    if arguments.loop == "yaw":
+        washout_tau = DAMPER_WASHOUT if tau is None else (tau or None)
+        design = yaw_damper(plane, washout_tau=washout_tau)
+    else:
+        design = pitch_damper(plane)
+    print(plane.summary())
+    filters = f", washout {design.washout:g} s" if design.washout else ""
+    print(f"\n{design.name}{filters}: gain k = {design.design.gain:.5g}")
+    print(f"loop L(s) at k = 1: {transfer_function(design.loop).aircraft_form()}")
+    print(f"\nmargins of k L (negative feedback)\n{design.margins.table()}")
+    print(f"\n{design.check.table()}")
+    print("\nopen-loop modes (with the actuator)")
+    print(modes(design.open_loop).table())
+    print("\nclosed-loop modes")
+    print(modes(design.closed_loop).table())
+    return 0
 
 
 def _report(arguments: argparse.Namespace) -> int:
@@ -235,7 +287,13 @@ class _Terminated(BaseException):
         self.signum = signum
 
 
-_COMMANDS = {"report": _report, "aircraft": _aircraft, "modes": _modes, "lqr": _lqr}
+_COMMANDS = {
+    "report": _report,
+    "aircraft": _aircraft,
+    "modes": _modes,
+    "lqr": _lqr,
+    "damper": _damper,
+}
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u200e\u200f\u2028-\u202e\u2066-\u2069]")
 
 

@@ -10,6 +10,7 @@ small c makes control expensive (the closed loop stays near the open loop) and a
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -19,20 +20,28 @@ from ._validation import real_array, real_scalar
 from .aircraft.model import Aircraft
 from .aircraft.naming import classify_modes
 from .batch import lqr_sweep
-from .exceptions import InvalidArgumentError
+from .exceptions import AerocontrolLinAlgError, InvalidArgumentError
+from .handling import MarginsCheck, margins_check
+from .interconnect import actuator, feedback, gain, series, washout
 from .linalg import c2d, expm
+from .loops import DampingDesign, StabilityMargins, best_damping_gain, stability_margins
 from .modal import modes
 from .placement import Placement, augment_mode, place_bass_gura
 from .riccati import dlqr, lqr
 from .statespace import StateSpace, require_continuous, sampling_period
 
 __all__ = [
+    "DAMPER_ACTUATOR_BANDWIDTH",
+    "DAMPER_WASHOUT",
+    "Damper",
     "SampledWeights",
     "critical_weight",
     "dutch_roll_damper",
     "lqr_root_locus",
+    "pitch_damper",
     "sampled_data_lqr",
     "sampled_weights",
+    "yaw_damper",
 ]
 
 ComplexArray = NDArray[np.complex128]
@@ -283,3 +292,145 @@ def sampled_data_lqr(
     weights = sampled_weights(sys, dt, Q, R)
     plant = c2d(sys, dt)
     return dlqr(plant.A, plant.B, weights.Q, weights.R, N=weights.N)
+
+
+# ----- classical dampers: output feedback through an actuator and a washout --------------------
+
+#: The bandwidth of the first-order surface actuators of the dampers (rad/s).
+DAMPER_ACTUATOR_BANDWIDTH = 10.0
+#: The yaw damper's washout time constant (s).
+DAMPER_WASHOUT = 3.0
+
+
+@dataclass(frozen=True, eq=False)
+class Damper:
+    """A rate damper designed on the root locus: the loop, the gain, its margins against
+    MIL-F-9490D and the closed loop.
+
+    The feedback is surface command = sign·k·filter(rate) + pilot command, with the loop
+    L = -sign·filter·(rate/surface)·actuator broken at the surface command (negative feedback
+    1 + k L = 0)."""
+
+    name: str
+    loop: StateSpace
+    """L for k = 1 (actuator, plant channel, sign, washout)."""
+    design: DampingDesign
+    """The gain k and the damping it gives the mode."""
+    margins: StabilityMargins
+    """The margins of k·L."""
+    check: MarginsCheck
+    open_loop: StateSpace
+    """Actuator and aircraft, from the surface command to every state."""
+    closed_loop: StateSpace
+    """The same with the damper engaged."""
+    washout: float | None
+    """The washout's time constant (s), None without one."""
+
+
+def _damper(
+    name: str,
+    sys: StateSpace,
+    rate: str,
+    surface: str,
+    mode: complex | None,
+    washout_tau: float | None,
+    bandwidth: float,
+) -> Damper:
+    servo = actuator(bandwidth, input_names=f"{surface} command", output_names=surface)
+    open_loop = series(servo, sys[:, surface])
+    channel = series(servo, sys[rate, surface])
+    filters = [] if washout_tau is None else [washout(washout_tau)]
+    best: tuple[DampingDesign, float] | None = None
+    for sign in (1.0, -1.0):  # the sign that damps the mode
+        loop = series(channel, gain(-sign), *filters)
+        design = best_damping_gain(loop, mode=mode)
+        if best is None or design.damping_ratio > best[0].damping_ratio:
+            best = (design, sign)
+    assert best is not None
+    design, sign = best
+    loop = series(channel, gain(-sign), *filters)
+    loop = StateSpace(
+        loop.A,
+        loop.B,
+        loop.C,
+        loop.D,
+        state_names=loop.state_names,
+        input_names=[f"{surface} command"],
+        output_names=[f"{rate} fed back"],
+    )
+    margins = stability_margins(series(loop, gain(design.gain)))
+    if not margins.closed_loop_stable:
+        raise AerocontrolLinAlgError(
+            f"{name}: the loop closed with the best gain {design.gain:.4g} is unstable"
+        )
+    check = margins_check({name: margins})
+    selector = gain(
+        [[1.0 if out == rate else 0.0 for out in open_loop.output_names]],
+        output_names=rate,
+    )
+    feedback_path = series(selector, *filters, gain(sign * design.gain))
+    closed = feedback(open_loop, feedback_path, sign=+1)
+    return Damper(name, loop, design, margins, check, open_loop, closed, washout_tau)
+
+
+def yaw_damper(
+    plane_or_sys: Aircraft | StateSpace,
+    washout_tau: float | None = DAMPER_WASHOUT,
+    bandwidth: float = DAMPER_ACTUATOR_BANDWIDTH,
+) -> Damper:
+    """A yaw damper: yaw rate r fed back to the rudder through a first-order actuator of
+    ``bandwidth`` rad/s and a washout of ``washout_tau`` seconds (None: without one), at the
+    gain that gives the least-damped oscillatory mode (the Dutch roll, at first) its best
+    damping (:func:`~aerocontrol.best_damping_gain`: no gain that makes a new, less damped
+    oscillation of two other roots), with its margins against MIL-F-9490D.
+
+    The washout passes the Dutch roll's yaw rate and blocks a steady one, so the damper
+    does not oppose a steady turn and leaves the spiral mode nearly where it was; without
+    it the feedback of r moves the spiral root.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft, design
+    >>> damper = design.yaw_damper(aircraft.load("b747-cruise"))
+    >>> round(damper.design.gain, 2), round(damper.design.damping_ratio, 3)
+    (1.49, 0.291)
+    >>> damper.check.passed
+    {'yaw damper': True}
+    """
+    sys = _lateral(plane_or_sys)
+    tau = None if washout_tau is None else real_scalar(washout_tau, "washout_tau")
+    if tau is not None and not (math.isfinite(tau) and tau > 0):
+        raise InvalidArgumentError(f"washout_tau must be positive or None, got {tau}")
+    # The least-damped oscillation, not the Dutch roll tracked: without a washout the roll
+    # and spiral roots join in an oscillation that the tracked design would leave lightly
+    # damped.
+    return _damper("yaw damper", sys, "r", "rudder", None, tau, bandwidth)
+
+
+def pitch_damper(
+    plane_or_sys: Aircraft | StateSpace, bandwidth: float = DAMPER_ACTUATOR_BANDWIDTH
+) -> Damper:
+    """A pitch damper: pitch rate q fed back to the elevator through a first-order actuator,
+    at the gain that gives the short period, tracked along the locus, its best damping (the
+    phugoid is left to the pilot), with its margins against MIL-F-9490D.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft, design
+    >>> damper = design.pitch_damper(aircraft.load("b747-cruise"))
+    >>> damper.design.damping_ratio > 0.5
+    True
+    """
+    if isinstance(plane_or_sys, Aircraft):
+        sys = plane_or_sys.longitudinal()
+    elif isinstance(plane_or_sys, StateSpace):
+        sys = plane_or_sys
+    else:
+        raise InvalidArgumentError(
+            f"expected an Aircraft or a longitudinal StateSpace, got {type(plane_or_sys).__name__}"
+        )
+    named = classify_modes(modes(sys.A), "longitudinal")
+    short = [p for p in named.get("short period", ()) if p.imag > 0]
+    return _damper(
+        "pitch damper", sys, "q", "elevator", short[0] if short else None, None, bandwidth
+    )

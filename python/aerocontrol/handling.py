@@ -87,12 +87,17 @@ from .exceptions import InvalidArgumentError, NonFiniteError, ShapeError
 
 __all__ = [
     "AIRCRAFT_CLASSES",
+    "AIRSPEEDS",
     "CATEGORIES",
+    "MARGIN_TABLE",
     "MODES",
     "HandlingQualities",
+    "MarginsCheck",
     "Requirement",
     "assess",
     "compare",
+    "margin_requirement",
+    "margins_check",
 ]
 
 SPECIFICATION = "MIL-F-8785C"
@@ -726,3 +731,157 @@ def _columns(
         if index == 0:
             lines.append("  ".join("-" * width for width in widths))
     return lines
+
+
+# ----- MIL-F-9490D: stability margins of the flight control system ---------------------------
+
+MARGIN_SPECIFICATION = "MIL-F-9490D"
+
+#: The airspeed columns of the margin table: below V_Omin, from V_Omin to V_Omax (the
+#: operational envelope), at the limit airspeed V_L, and at 1.15 V_L.
+AIRSPEEDS: tuple[str, ...] = ("below Vo_min", "Vo_min to Vo_max", "at V_L", "at 1.15 V_L")
+
+#: (gain margin dB, phase margin degrees) by mode frequency band and airspeed: the bands are
+#: f_M < 0.06 Hz, 0.06 Hz <= f_M < the first aeroelastic mode, and f_M at or beyond it.
+#: UNVERIFIED: the text of MIL-F-9490D (6 June 1975) paragraph 3.1.3.6 and its Table I could
+#: not be read while this was written; these are the values widely quoted from it (flight
+#: control texts and course notes), not read from the specification. "Below Vo_min" asks a
+#: 6 dB gain margin and no phase margin in every band; "at 1.15 V_L" asks only that the loop
+#: be stable at its nominal gain and phase (0 dB, 0 degrees). Check them against the
+#: specification before relying on a verdict.
+MARGIN_TABLE: dict[str, tuple[tuple[float, float], tuple[float, float], tuple[float, float]]] = {
+    "below Vo_min": ((6.0, 0.0), (6.0, 0.0), (6.0, 0.0)),
+    "Vo_min to Vo_max": ((4.5, 30.0), (6.0, 45.0), (8.0, 60.0)),
+    "at V_L": ((3.0, 20.0), (4.5, 30.0), (6.0, 45.0)),
+    "at 1.15 V_L": ((0.0, 0.0), (0.0, 0.0), (0.0, 0.0)),
+}
+_BANDS = ("f < 0.06 Hz", "0.06 Hz <= f < first aeroelastic mode", "f >= first aeroelastic mode")
+
+
+def margin_requirement(
+    frequency_hz: float, airspeed: str = "Vo_min to Vo_max", aeroelastic_hz: float = math.inf
+) -> tuple[float, float, str]:
+    """(gain margin dB, phase margin degrees, band) required of a loop mode at
+    ``frequency_hz`` (MIL-F-9490D 3.1.3.6, Table I; see :data:`MARGIN_TABLE`, UNVERIFIED).
+
+    Examples
+    --------
+    >>> from aerocontrol.handling import margin_requirement
+    >>> margin_requirement(0.2)
+    (6.0, 45.0, '0.06 Hz <= f < first aeroelastic mode')
+    >>> margin_requirement(0.02, "at V_L")
+    (3.0, 20.0, 'f < 0.06 Hz')
+    """
+    if airspeed not in MARGIN_TABLE:
+        allowed = ", ".join(repr(a) for a in AIRSPEEDS)
+        raise InvalidArgumentError(f"airspeed must be one of {allowed}, got {airspeed!r}")
+    f = float(frequency_hz)
+    band = 0 if f < 0.06 else (1 if f < aeroelastic_hz else 2)
+    gm, pm = MARGIN_TABLE[airspeed][band]
+    return gm, pm, _BANDS[band]
+
+
+@dataclass(frozen=True)
+class MarginsCheck:
+    """A pass/fail table of loop margins against MIL-F-9490D; ``print`` shows it."""
+
+    airspeed: str
+    rows: tuple[tuple[str, str, str, str, str, bool], ...]
+    """(loop, quantity, value, at frequency, required, passed)."""
+
+    @property
+    def passed(self) -> dict[str, bool]:
+        """Whether each loop meets every requirement."""
+        result: dict[str, bool] = {}
+        for row in self.rows:
+            result[row[0]] = result.get(row[0], True) and row[5]
+        return result
+
+    def table(self) -> str:
+        header = ("loop", "quantity", "value", "at", "required", "verdict")
+        rows = [(*row[:5], "pass" if row[5] else "FAIL") for row in self.rows]
+        title = (
+            f"{MARGIN_SPECIFICATION} 3.1.3.6 margins, airspeed {self.airspeed} "
+            "(Table I values as widely quoted: UNVERIFIED against the specification)"
+        )
+        return "\n".join([title, *_columns(header, rows)])
+
+    def __str__(self) -> str:
+        return self.table()
+
+
+def margins_check(
+    loops: Mapping[str, object],
+    airspeed: str = "Vo_min to Vo_max",
+    aeroelastic_hz: float = math.inf,
+) -> MarginsCheck:
+    """Each loop's margins against MIL-F-9490D 3.1.3.6 (Table I, UNVERIFIED values: see
+    :data:`MARGIN_TABLE`).
+
+    ``loops`` maps a name to the loop (its open-loop transfer at the break point, negative
+    feedback, as for :func:`~aerocontrol.stability_margins`) or to its
+    :class:`~aerocontrol.StabilityMargins`. The mode frequency f_M of each requirement is
+    taken as the frequency of the crossover where the margin is measured (the phase
+    crossover of a gain margin, the gain crossover of a phase margin), and its band is
+    chosen by it. Every gain margin must be at least the requirement in its direction (a gain
+    margin below 1, a gain reduction margin, at least that many dB of reduction); every phase
+    margin at least the requirement in magnitude (Table I's ±: a phase margin of -58° is a
+    lead of 58° that destabilises); and the closed loop must be stable (from its poles). A
+    loop without crossovers has infinite margins and passes them.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> from aerocontrol.handling import margins_check
+    >>> check = margins_check({"k/s(s+1)(s+2), k=1": aerocontrol.zpk([], [0, -1, -2], 1.0),
+    ...                        "k = 4": aerocontrol.zpk([], [0, -1, -2], 4.0)})
+    >>> check.passed
+    {'k/s(s+1)(s+2), k=1': True, 'k = 4': False}
+    """
+    from .loops import StabilityMargins, stability_margins
+
+    if airspeed not in MARGIN_TABLE:
+        allowed = ", ".join(repr(a) for a in AIRSPEEDS)
+        raise InvalidArgumentError(f"airspeed must be one of {allowed}, got {airspeed!r}")
+    if not isinstance(loops, Mapping) or not loops:
+        raise InvalidArgumentError("loops must be a non-empty mapping of names to loops")
+    rows: list[tuple[str, str, str, str, str, bool]] = []
+    for name, loop in loops.items():
+        m = loop if isinstance(loop, StabilityMargins) else stability_margins(loop)  # type: ignore[arg-type]
+        rows.append(
+            (
+                name,
+                "closed loop",
+                "stable" if m.closed_loop_stable else "unstable",
+                "-",
+                "stable",
+                m.closed_loop_stable,
+            )
+        )
+        for gm, w in zip(m.gain_margins, m.phase_crossovers, strict=True):
+            required, _, band = margin_requirement(w / (2 * math.pi), airspeed, aeroelastic_hz)
+            db = 20 * math.log10(gm) if gm > 0 else -math.inf
+            ok = (db >= required) if gm >= 1 else (-db >= required)
+            rows.append(
+                (
+                    name,
+                    "gain margin",
+                    f"{db:+.2f} dB",
+                    f"{w / (2 * math.pi):.4g} Hz",
+                    f"{'+' if gm >= 1 else '-'}{required:g} dB ({band})",
+                    bool(ok),
+                )
+            )
+        for pm, w in zip(m.phase_margins, m.gain_crossovers, strict=True):
+            _, required_pm, band = margin_requirement(w / (2 * math.pi), airspeed, aeroelastic_hz)
+            rows.append(
+                (
+                    name,
+                    "phase margin",
+                    f"{pm:+.1f} deg",
+                    f"{w / (2 * math.pi):.4g} Hz",
+                    f"{required_pm:g} deg ({band})",
+                    bool(abs(pm) >= required_pm),
+                )
+            )
+    return MarginsCheck(airspeed, tuple(rows))

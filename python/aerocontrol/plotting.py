@@ -43,6 +43,7 @@ if TYPE_CHECKING:
     from matplotlib.legend import Legend
 
     from .frequency import FrequencyResponse
+    from .loops import RootLocus
     from .modal import Modes
     from .responses import TimeResponse
 
@@ -51,6 +52,7 @@ __all__ = [
     "penalty_terms",
     "plot_bode",
     "plot_compared",
+    "plot_gain_root_locus",
     "plot_levels",
     "plot_modes",
     "plot_open_closed",
@@ -429,6 +431,71 @@ def plot_root_locus(
     ax.axvline(0.0, color="black", linewidth=0.8)
     ax.axhline(0.0, color="black", linewidth=0.8)
     _finish(ax, "real part (1/s)", "imaginary part (rad/s)", title)
+    return ax
+
+
+def plot_gain_root_locus(
+    locus: RootLocus,
+    ax: Axes | None = None,
+    marked: Sequence[float] | None = None,
+    zetas: Sequence[float] = (0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 0.9),
+    title: str = "root locus over the loop gain k",
+) -> Axes:
+    """The closed-loop poles of 1 + k L(s) = 0 over the gains of a
+    :class:`~aerocontrol.loops.RootLocus` (like the chapter's Figure 6.8, for a classical
+    loop): one line per root, the open-loop poles (x) and zeros (o), a symbol per gain in
+    ``marked``, and a grid of constant damping ratio (rays, labelled ζ) and natural frequency
+    (arcs, labelled ω_n). A discrete locus is drawn in the z-plane with the unit circle.
+    Returns the axes.
+    """
+    with np.errstate(divide="ignore"):  # k = 0 is marked by its nearest gain
+        ax = plot_root_locus(
+            locus.gains,
+            locus.poles,
+            ax=ax,
+            marked=marked,
+            weight_name="k",
+            title=title,
+        )
+    ax.plot(
+        locus.open_loop_poles.real,
+        locus.open_loop_poles.imag,
+        "x",
+        color="black",
+        label="open-loop poles",
+    )
+    if locus.open_loop_zeros.size:
+        ax.plot(
+            locus.open_loop_zeros.real,
+            locus.open_loop_zeros.imag,
+            "o",
+            mfc="none",
+            color="black",
+            label="zeros",
+        )
+    if locus.dt:
+        t = np.linspace(0.0, 2.0 * np.pi, 361)
+        ax.plot(np.cos(t), np.sin(t), color="0.7", linewidth=0.8)
+        ax.legend(fontsize=8)
+        return ax
+    x_low, x_high = ax.get_xlim()
+    y_low, y_high = ax.get_ylim()
+    reach = max(abs(x_low), abs(x_high), abs(y_low), abs(y_high))
+    for zeta in zetas:
+        angle = np.arccos(zeta)
+        x, y = -reach * np.cos(angle), reach * np.sin(angle)
+        ax.plot([0.0, x], [0.0, y], ":", color="0.6", linewidth=0.7)
+        ax.plot([0.0, x], [0.0, -y], ":", color="0.6", linewidth=0.7)
+        if x_low <= 0.9 * x and 0.9 * y <= y_high:
+            ax.annotate(f"ζ={zeta:g}", (0.9 * x, 0.9 * y), fontsize=7, color="0.4")
+    ticks = [v for v in ax.get_yticks() if 0 < v <= reach]
+    t = np.linspace(np.pi / 2, 3 * np.pi / 2, 91)
+    for radius in ticks:
+        ax.plot(radius * np.cos(t), radius * np.sin(t), ":", color="0.6", linewidth=0.7)
+        ax.annotate(f"ω_n={radius:g}", (-radius, 0.0), fontsize=7, color="0.4")
+    ax.set_xlim(x_low, x_high)
+    ax.set_ylim(y_low, y_high)
+    ax.legend(fontsize=8)
     return ax
 
 

@@ -322,6 +322,31 @@ plotting.plot_levels([0.2, 0.25], [0, 5000], [[1, 2], [2, 3]], ax=ax, title="Lev
 assert_type(plotting.plot_modes(modes, ax=ax, marker="o", suffix=" (open loop)"), Axes)
 assert_type(modes.plot(ax=ax), Axes)
 
+# Transfer functions, zeros, loop analysis (issue 25).
+yaw_plant = aircraft.load("b747-cruise").lateral()
+channel = aerocontrol.transfer_function(yaw_plant, "r", "rudder")
+assert_type(channel, aerocontrol.TransferFunction)
+assert_type(channel.zeros, Complexes)
+assert_type(channel.aircraft_form(), str)
+assert_type(aerocontrol.transmission_zeros(yaw_plant, tol=1e-12), Complexes)
+yaw_loop = aerocontrol.series(
+    aerocontrol.actuator(10.0), yaw_plant["r", "rudder"], aerocontrol.gain(-1.0)
+)
+margins = aerocontrol.stability_margins(yaw_loop)
+assert_type(margins, aerocontrol.StabilityMargins)
+assert_type(margins.gain_margins, Floats)
+assert_type(margins.disk_gain_margin, tuple[float, float])
+assert_type(aerocontrol.sensitivity(yaw_loop), aerocontrol.StateSpace)
+assert_type(aerocontrol.complementary_sensitivity(yaw_loop), aerocontrol.StateSpace)
+locus = aerocontrol.root_locus(yaw_loop, [0.0, 1.0, 2.0])
+assert_type(locus, aerocontrol.RootLocus)
+assert_type(aerocontrol.best_damping_gain(yaw_loop), aerocontrol.DampingDesign)
+assert_type(aerocontrol.gain_for_damping(yaw_loop, 0.2, gains=np.linspace(0, 5, 50)).gain, float)
+assert_type(plotting.plot_gain_root_locus(locus, ax=Figure().subplots(), marked=[1.0]), Axes)
+assert_type(handling.margins_check({"yaw": yaw_loop, "again": margins}), handling.MarginsCheck)
+assert_type(design.yaw_damper(aircraft.load("b747-cruise"), washout_tau=None), design.Damper)
+assert_type(design.pitch_damper(aircraft.load("b747-cruise")).margins, aerocontrol.StabilityMargins)
+
 
 def _misuse() -> None:
     """Calls the annotations refuse (never run: each would raise)."""
@@ -343,4 +368,5 @@ def _misuse() -> None:
     aerocontrol.feedback(sys, sign="-")  # type: ignore[arg-type]
     sys["r"]  # type: ignore[index]  # outputs and inputs, both
     aerocontrol.connect(sys, inputs="r")  # type: ignore[arg-type]  # a list of models
+    aerocontrol.stability_margins(yaw_loop, 1.0)  # type: ignore[call-arg]  # no frequencies
     del exponential, gains, estimate

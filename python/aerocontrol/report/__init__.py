@@ -20,6 +20,10 @@ contained: the figures are embedded) and ``report.md`` with ``figures/*.png``. T
    gain difference, the continuous cost); an LQG regulator at 50 Hz with sideslip not
    measured (a Kalman filter from p, r, φ), its closed-loop poles and its response beside
    full-state feedback;
+6a. stability augmentation by output feedback: a yaw damper (yaw rate to rudder through an
+   actuator, with and without a washout) and a pitch damper designed on the root locus, their
+   margins against MIL-F-9490D (Table I as widely quoted, unverified), the root locus and the
+   response to a rudder pulse beside the open loop's;
 7. the Levels after augmentation, and the open-loop Levels over Mach and altitude around the
    file's condition;
 8. for the embedded 747, the chapter's small examples (controllability (6.75-6.88), Figures 6.4
@@ -35,7 +39,7 @@ document and its Markdown, HTML and PNG forms), :mod:`~aerocontrol.report.contex
 (:mod:`~aerocontrol.report.models`, :mod:`~aerocontrol.report.modes`,
 :mod:`~aerocontrol.report.responses`, :mod:`~aerocontrol.report.damper`,
 :mod:`~aerocontrol.report.regulator`, :mod:`~aerocontrol.report.digital`,
-:mod:`~aerocontrol.report.levels`,
+:mod:`~aerocontrol.report.sas`, :mod:`~aerocontrol.report.levels`,
 :mod:`~aerocontrol.report.envelope`, :mod:`~aerocontrol.report.chapter_check`), and the output
 folder: :mod:`~aerocontrol.report.folder` (the rules and ``ReportFolder``),
 :mod:`~aerocontrol.report.manifest`, :mod:`~aerocontrol.report.staging`,
@@ -56,11 +60,12 @@ root locus (Figure 6.12): The Dutch roll becomes critically damped at c = 9.7727
 digital regulator (c = 1): 50 Hz: ‖K - K_c‖/‖K_c‖ = 6.377e-03, Dutch roll ζ = 0.35955; ...
 digital damper (rudder): 50 Hz: k = [0.1316, 0.09474, 0.1248, -1.128], ...
 LQG (50 Hz, p, r, phi measured): filter poles 0.9902 + 0.00251j, 0.9337, 0.9553; J = 9.902 ...
+output-feedback dampers: yaw damper, washout 3 s: k = 2.413, ζ = 0.256; ...
 levels after augmentation: dutch roll 2 -> damper (rudder) 1, damper (aileron) 1, ...
 envelope: 63 conditions around the file's (Level 2: 41, Level 3: 20, Level 4: 2)
 chapter check: Figures 6.4 and 6.8, 16 results beside the printed values
 >>> len(report.figures)
-16
+17
 """
 
 from __future__ import annotations

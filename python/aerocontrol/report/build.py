@@ -20,6 +20,7 @@ from . import (
     modes,
     regulator,
     responses,
+    sas,
 )
 from .context import Context
 from .document import Report
@@ -48,6 +49,7 @@ def build_report(
         damper.section,
         regulator.section,
         digital.section,
+        sas.section,
         levels.section,
         envelope.section,
     ]

@@ -1,0 +1,865 @@
+"""Loop analysis of a single-input, single-output loop: stability margins, sensitivities and
+the root locus over a scalar gain.
+
+The loop L(s) is the open-loop transfer around the loop break point, in the negative feedback
+convention: the loop is closed as u = -y, the closed loop's characteristic equation is
+1 + L(s) = 0, and over a gain k it is 1 + k L(s) = 0. (A loop whose feedback is positive is
+given as -L.) Every frequency response is the Rust core's G(jω) = C (jωI - A)⁻¹ B + D
+(:func:`~aerocontrol.frequency_response`; G(e^{jω dt}) for a discrete loop).
+
+Margins (:func:`stability_margins`)
+    ================  =====================================================================
+    gain margins      1/|L(jω)| at each phase crossover, where L(jω) is real and negative
+                      (ω = 0 and the Nyquist frequency included); the factor by which the
+                      loop gain may grow (> 1) or shrink (< 1) before the closed loop has a
+                      pole at jω. The one reported is the closest to 0 dB.
+    phase margins     180° + ∠L(jω) at each gain crossover |L(jω)| = 1, wrapped to
+                      (-180°, 180°]: the phase lag that brings L(jω) to -1 (negative: a
+                      lead). The one reported has the least magnitude.
+    delay margin      min over the gain crossovers ω > 0 of (PM in rad, taken in [0, 2π))/ω:
+                      the smallest pure delay that destabilises the loop; 0 when the closed
+                      loop is unstable, ∞ without a crossover.
+    disk margin       the balanced (σ = 0) disk margin of Seiler, Packard and Gahinet:
+                      α = 1/max_ω |S(jω) - T(jω)|/2 = 1/max_ω |1 - L|/(2|1 + L|): the loop
+                      stays stable for every simultaneous gain and phase change f in the disk
+                      D(α) = {(1 + δα/2)/(1 - δα/2) : |δ| < 1}, i.e. gains in
+                      [(2 - α)/(2 + α), (2 + α)/(2 - α)] with no phase change, or phase
+                      changes up to ±2 arctan(α/2) at unit gain. 0 when the closed loop is
+                      unstable.
+    ================  =====================================================================
+
+Crossovers are located on a dense logarithmic grid (spanning the loop's poles and zeros, the
+asymptotic crossovers of its integrators and of its high-frequency roll-off, and clustered
+around lightly damped poles and zeros), then refined by Brent's method on the exact L(jω):
+no interpolation error. The disk margin's and the stability margin's extrema are refined by
+golden-section search. A crossover "at infinity" is not reported: a loop with no gain
+crossover has phase margin ∞ and delay margin ∞, and one with no phase crossover has gain
+margin ∞ (python-control reports 0 in some such cases).
+
+Closed-loop stability is decided from the closed-loop poles, the eigenvalues of
+A - B (1 + D)⁻¹ C, never from the plot; the number of counterclockwise encirclements of -1 by
+the Nyquist plot follows from the principle of the argument: N = P - Z, with P and Z the open-
+and closed-loop poles in the open right half plane (outside the unit circle).
+
+Root locus (:func:`root_locus`, :func:`best_damping_gain`, :func:`gain_for_damping`)
+    The closed-loop poles of 1 + k L(s) = 0 are the eigenvalues of A - k B (1 + k D)⁻¹ C.
+
+References
+----------
+P. Seiler, A. Packard and P. Gahinet, "An introduction to disk margins", IEEE Control Systems
+Magazine 40(5), 78-95, 2020 (the disk margin, eqs. (9)-(12)). R. P. Brent, *Algorithms for
+Minimization without Derivatives*, 1973 (the root finder).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _core
+from ._validation import FloatArray, check_finite, real_array, real_scalar
+from .exceptions import (
+    AerocontrolLinAlgError,
+    IllConditionedWarning,
+    InvalidArgumentError,
+    NumericalOverflowWarning,
+    ShapeError,
+    SingularMatrixError,
+)
+from .interconnect import feedback, gain
+from .statespace import StateSpace, as_state_space, period
+from .transfer import transfer_function
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from ._typing import System
+
+__all__ = [
+    "DampingDesign",
+    "RootLocus",
+    "StabilityMargins",
+    "best_damping_gain",
+    "complementary_sensitivity",
+    "gain_for_damping",
+    "root_locus",
+    "sensitivity",
+    "stability_margins",
+]
+
+ComplexArray = NDArray[np.complex128]
+
+#: Grid points per decade of frequency before refinement.
+POINTS_PER_DECADE = 120
+_EPS = float(np.finfo(float).eps)
+
+
+# ----- the loop -----------------------------------------------------------------------------
+
+
+def _siso(loop: System, name: str = "loop") -> StateSpace:
+    model = as_state_space(loop, name)
+    if (model.n_inputs, model.n_outputs) != (1, 1):
+        raise ShapeError(
+            f"{name} must have one input and one output (a loop broken at one point), got "
+            f"{model.n_outputs} outputs and {model.n_inputs} inputs; select the channel with "
+            f"{name}[output, input]"
+        )
+    return model
+
+
+def _closed_loop_matrix(model: StateSpace, k: float = 1.0) -> FloatArray:
+    """A - k B (1 + k D)⁻¹ C, or SingularMatrixError for 1 + k D = 0 (an algebraic loop)."""
+    d = float(model.D[0, 0])
+    denominator = 1.0 + k * d
+    if abs(denominator) <= 8 * _EPS * max(1.0, abs(k * d)):
+        raise SingularMatrixError(
+            f"the loop closed with gain {k:g} is an algebraic loop: 1 + k D = 0 (D = {d:g}), "
+            "so it has no solution"
+        )
+    return np.asarray(model.A - (k / denominator) * (model.B @ model.C), dtype=np.float64)
+
+
+def _unstable(roots: ComplexArray, discrete: bool) -> NDArray[np.bool_]:
+    return np.abs(roots) > 1.0 if discrete else roots.real > 0.0
+
+
+def _stable(roots: ComplexArray, discrete: bool) -> bool:
+    return bool(np.all(np.abs(roots) < 1.0) if discrete else np.all(roots.real < 0.0))
+
+
+def _eigenvalues(A: FloatArray) -> ComplexArray:
+    return _core.eigenvalues(A) if A.shape[0] else np.zeros(0, np.complex128)
+
+
+# ----- one-dimensional searches -------------------------------------------------------------
+
+
+def _brent(
+    f: Callable[[float], float], a: float, b: float, fa: float, fb: float, xtol: float
+) -> float:
+    """A root of f in [a, b] (f(a), f(b) of opposite signs), by Brent's method (zeroin)."""
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    c, fc = a, fa
+    d = e = b - a
+    for _ in range(200):
+        if (fb > 0) == (fc > 0):
+            c, fc = a, fa
+            d = e = b - a
+        if abs(fc) < abs(fb):
+            a, b, c = b, c, b
+            fa, fb, fc = fb, fc, fb
+        tol = 2 * _EPS * abs(b) + 0.5 * xtol
+        m = 0.5 * (c - b)
+        if abs(m) <= tol or fb == 0.0:
+            return b
+        if abs(e) >= tol and abs(fa) > abs(fb):
+            s = fb / fa
+            if a == c:
+                p, q = 2 * m * s, 1 - s
+            else:
+                q, r = fa / fc, fb / fc
+                p = s * (2 * m * q * (q - r) - (b - a) * (r - 1))
+                q = (q - 1) * (r - 1) * (s - 1)
+            if p > 0:
+                q = -q
+            p = abs(p)
+            if 2 * p < min(3 * m * q - abs(tol * q), abs(e * q)):
+                e, d = d, p / q
+            else:
+                d = e = m
+        else:
+            d = e = m
+        a, fa = b, fb
+        b += d if abs(d) > tol else math.copysign(tol, m)
+        fb = f(b)
+    return b  # pragma: no cover - Brent's method converges in far fewer steps
+
+
+def _golden_max(f: Callable[[float], float], a: float, b: float) -> tuple[float, float]:
+    """(x, f(x)) at a maximum of f on [a, b] by golden-section search (to 1e-12 relative)."""
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(200):
+        if abs(b - a) <= 1e-12 * max(abs(a), abs(b), 1e-300):
+            break
+        if fc >= fd:
+            b, d, fd = d, c, fc
+            c = b - ratio * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + ratio * (b - a)
+            fd = f(d)
+    return (c, fc) if fc >= fd else (d, fd)
+
+
+# ----- the frequency grid -------------------------------------------------------------------
+
+
+class _Response:
+    """L(jω) of a SISO model through the core, one frequency or many."""
+
+    def __init__(self, model: StateSpace) -> None:
+        self.model = model
+        self.dt = period(model) if model.is_discrete else None
+
+    def many(self, omega: FloatArray) -> ComplexArray:
+        """L at each frequency; infinite at a pole on the axis (not a warning here: the
+        searches drop such points)."""
+        m = self.model
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", NumericalOverflowWarning)
+            return _core.frequency_response(m.A, m.B, m.C, m.D, omega, self.dt)[:, 0, 0]
+
+    def one(self, omega: float) -> complex:
+        return complex(self.many(np.array([omega]))[0])
+
+
+def _grid(model: StateSpace) -> FloatArray:
+    """Frequencies from below the slowest to beyond the fastest pole or zero of the loop and
+    beyond its asymptotic crossovers, with points clustered at lightly damped roots."""
+    g = transfer_function(model)
+    dt = period(model) if model.is_discrete else 0.0
+    roots = np.concatenate([g.poles, g.zeros])
+    if dt:
+        nonzero = roots[roots != 0]
+        s = np.log(nonzero.astype(np.complex128)) / dt
+    else:
+        s = roots
+    sizes = np.abs(s[np.isfinite(s)])
+    scale = float(sizes.max()) if sizes.size else 1.0
+    origin = sizes <= 1e-12 * max(scale, 1.0)
+    nonzero_sizes = sizes[~origin]
+    if nonzero_sizes.size:
+        low, high = float(nonzero_sizes.min()) / 100.0, float(nonzero_sizes.max()) * 100.0
+    else:
+        low, high = 1e-2, 1e2
+    if not dt and g.gain != 0.0:
+        # High frequency: L ~ K s^-r; low frequency: L ~ K0 s^-q (q integrators net).
+        r = len(g.poles) - len(g.zeros)
+        if r > 0:
+            high = max(high, 100.0 * abs(g.gain) ** (1.0 / r))
+        at_origin_poles = int(np.sum(np.abs(g.poles) <= 1e-12 * max(scale, 1.0)))
+        at_origin_zeros = int(np.sum(np.abs(g.zeros) <= 1e-12 * max(scale, 1.0)))
+        q = at_origin_poles - at_origin_zeros
+        if q > 0:
+            far_poles = g.poles[np.abs(g.poles) > 1e-12 * max(scale, 1.0)]
+            far_zeros = g.zeros[np.abs(g.zeros) > 1e-12 * max(scale, 1.0)]
+            k0 = abs(g.gain * np.prod(-far_zeros) / np.prod(-far_poles))
+            if k0 > 0:
+                low = min(low, k0 ** (1.0 / q) / 100.0)
+    nyquist = math.pi / dt if dt else math.inf
+    high = min(high, nyquist, 1e300)
+    low = min(low, high / 10.0)
+    decades = math.log10(high / low)
+    grid = [np.logspace(math.log10(low), math.log10(high), int(decades * POINTS_PER_DECADE) + 2)]
+    for root in s[np.isfinite(s)]:
+        omega_n = abs(root)
+        if omega_n == 0 or abs(root.imag) <= 1e-12 * omega_n:
+            continue
+        zeta = min(abs(root.real) / omega_n, 1.0)
+        spread = np.linspace(-10.0, 10.0, 81) * max(zeta, 1e-6)
+        grid.append(abs(root.imag) * (1.0 + spread))
+        grid.append(omega_n * (1.0 + spread))
+    omega = np.unique(np.concatenate(grid))
+    omega = omega[(omega > 0) & (omega <= high)]
+    if dt:
+        omega = np.unique(np.concatenate([omega, [nyquist]]))
+    return np.asarray(omega, dtype=np.float64)
+
+
+# ----- margins ------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class StabilityMargins:
+    """The margins of a SISO loop, negative feedback (1 + L = 0); ``print`` shows a table.
+
+    Single values are the critical ones (as python-control's ``stability_margins``): the gain
+    margin closest to 0 dB, the phase margin of least magnitude; the arrays hold every
+    crossover, by increasing frequency.
+    """
+
+    gain_margin: float
+    """The critical gain margin (factor; ∞ without a phase crossover)."""
+    phase_crossover: float
+    """Its frequency (rad/s; NaN without one)."""
+    phase_margin: float
+    """The critical phase margin (degrees, signed; ∞ without a gain crossover)."""
+    gain_crossover: float
+    """Its frequency (rad/s; NaN without one)."""
+    delay_margin: float
+    """Seconds; 0 if the closed loop is unstable, ∞ without a gain crossover above 0."""
+    disk_margin: float
+    """α of the balanced disk margin (σ = 0); 0 if the closed loop is unstable."""
+    disk_frequency: float
+    """Where |S - T|/2 peaks (rad/s)."""
+    stability_margin: float
+    """min |1 + L(jω)|, the distance from the Nyquist plot to -1 (1/||S||∞)."""
+    stability_frequency: float
+    gain_margins: FloatArray
+    phase_crossovers: FloatArray
+    phase_margins: FloatArray
+    gain_crossovers: FloatArray
+    delay_margins: FloatArray
+    """(PM_i in rad, in [0, 2π))/ω_i at each gain crossover above 0."""
+    closed_loop_poles: ComplexArray
+    closed_loop_stable: bool
+    open_loop_unstable_poles: int
+    """P: open-loop poles in the open right half plane (outside the unit circle)."""
+    encirclements: int
+    """Counterclockwise encirclements of -1 by the Nyquist plot: P - Z."""
+
+    @property
+    def gain_margin_db(self) -> float:
+        """The critical gain margin in dB (negative: a gain reduction margin)."""
+        return _db(self.gain_margin)
+
+    @property
+    def disk_gain_margin(self) -> tuple[float, float]:
+        """The gain range [(2 - α)/(2 + α), (2 + α)/(2 - α)] of the disk margin."""
+        a = self.disk_margin
+        return ((2 - a) / (2 + a), (2 + a) / (2 - a) if a < 2 else math.inf)
+
+    @property
+    def disk_phase_margin(self) -> float:
+        """±2 arctan(α/2) in degrees: the phase change at unit gain the disk allows."""
+        return math.degrees(2.0 * math.atan(self.disk_margin / 2.0))
+
+    def table(self) -> str:
+        """The margins and the closed loop, one line each."""
+        status = "stable" if self.closed_loop_stable else "UNSTABLE"
+        lines = [
+            f"closed loop {status}: {self.open_loop_unstable_poles} unstable open-loop poles, "
+            f"{self.encirclements} counterclockwise encirclements of -1",
+        ]
+        for gm, w in zip(self.gain_margins, self.phase_crossovers, strict=True):
+            lines.append(f"gain margin   {_db(gm):+9.3f} dB  at {w:.5g} rad/s")
+        for pm, w in zip(self.phase_margins, self.gain_crossovers, strict=True):
+            lines.append(f"phase margin  {pm:+9.3f} deg at {w:.5g} rad/s")
+        lines.append(f"delay margin  {self.delay_margin:.5g} s")
+        low, high = self.disk_gain_margin
+        lines.append(
+            f"disk margin   alpha = {self.disk_margin:.4g}: gain {_db(low):+.2f}/{_db(high):+.2f} "
+            f"dB, phase ±{self.disk_phase_margin:.2f} deg (at {self.disk_frequency:.4g} rad/s)"
+        )
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.table()
+
+
+def _db(factor: float) -> float:
+    if factor == 0.0:
+        return -math.inf
+    return 20.0 * math.log10(factor) if math.isfinite(factor) else math.inf
+
+
+def _wrap_degrees(angle: float) -> float:
+    """``angle`` in (-180, 180]."""
+    wrapped = math.remainder(angle, 360.0)
+    return 180.0 if wrapped == -180.0 else wrapped
+
+
+def stability_margins(loop: System) -> StabilityMargins:
+    """Gain, phase, delay and disk margins of a SISO loop, with every crossover, and the
+    closed loop's stability from its poles (negative feedback: 1 + L(s) = 0).
+
+    See the module's documentation for the definitions. Integrators (poles at 0) are
+    allowed; an unstable open loop is allowed (the encirclement count and closed-loop
+    stability are reported, and a stable closed loop needs P counterclockwise
+    encirclements); discrete loops are evaluated on the unit circle up to the Nyquist
+    frequency.
+
+    Parameters
+    ----------
+    loop : StateSpace or (A, B, C, D)
+        The open-loop transfer L, one input and one output.
+
+    Returns
+    -------
+    StabilityMargins
+
+    Raises
+    ------
+    ShapeError
+        The loop is not single-input, single-output.
+    SingularMatrixError
+        1 + D = 0: closing the loop is an algebraic loop.
+    AerocontrolLinAlgError
+        A gain margin failed its check: the loop closed with that gain has no pole at the
+        phase crossover.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> # k/(s(s + 1)(s + 2)) with k = 2: GM = 6/k = 3 at ω = √2 (a closed form).
+    >>> m = aerocontrol.stability_margins(aerocontrol.zpk([], [0.0, -1.0, -2.0], 2.0))
+    >>> round(m.gain_margin, 12), round(m.phase_crossover**2, 12)
+    (3.0, 2.0)
+    >>> round(m.phase_margin, 4), m.closed_loop_stable
+    (32.6131, True)
+    >>> aerocontrol.stability_margins(aerocontrol.tf([1.0], [1.0, 0.0])).gain_margin  # 1/s
+    inf
+    """
+    model = _siso(loop)
+    discrete = model.is_discrete
+    closed = _eigenvalues(_closed_loop_matrix(model))
+    open_poles = _eigenvalues(model.A)
+    stable = _stable(closed, discrete)
+    unstable_open = int(np.sum(_unstable(open_poles, discrete)))
+    unstable_closed = int(np.sum(_unstable(closed, discrete)))
+
+    response = _Response(model)
+    omega = _grid(model)
+    values = response.many(omega)
+    finite = np.isfinite(values) & (values != 0)
+    omega, values = omega[finite], values[finite]
+
+    # Phase crossovers: angle(-L) changes sign where L crosses the negative real axis.
+    def minus_angle(w: float) -> float:
+        return float(np.angle(-response.one(w)))
+
+    phase_w: list[float] = []
+    angles = np.angle(-values)
+    for i in np.nonzero(np.sign(angles[:-1]) != np.sign(angles[1:]))[0]:
+        if abs(angles[i]) > math.pi / 2 or abs(angles[i + 1]) > math.pi / 2:
+            continue  # a crossing of the positive real axis (angle jumps by 2π)
+        w = _brent(minus_angle, omega[i], omega[i + 1], angles[i], angles[i + 1], 0.0)
+        if response.one(w).real < 0:
+            phase_w.append(float(w))
+    ends = [0.0] + ([math.pi / period(model)] if discrete else [])
+    largest = float(np.abs(values).max(initial=0.0))
+    for w in ends:
+        value = response.one(w)
+        # Not where L vanishes (a zero at the origin, a washout): no crossing there.
+        if (
+            np.isfinite(value)
+            and value.real < -1e-10 * largest
+            and abs(value.imag) <= 1e-12 * abs(value)
+        ):
+            phase_w.append(float(w))
+    phase_w = sorted(set(phase_w))
+    gains = np.array([1.0 / abs(response.one(w)) for w in phase_w])
+
+    # Gain crossovers: log|L| changes sign.
+    def log_magnitude(w: float) -> float:
+        return math.log(abs(response.one(w)))
+
+    logs = np.log(np.abs(values))
+    gain_w: list[float] = []
+    for i in np.nonzero(np.sign(logs[:-1]) != np.sign(logs[1:]))[0]:
+        gain_w.append(
+            float(_brent(log_magnitude, omega[i], omega[i + 1], logs[i], logs[i + 1], 0.0))
+        )
+    gain_w = sorted(set(gain_w))
+    phases = np.array(
+        [_wrap_degrees(180.0 + math.degrees(float(np.angle(response.one(w))))) for w in gain_w]
+    )
+    delays = np.array(
+        [math.radians(pm % 360.0) / w for pm, w in zip(phases, gain_w, strict=True) if w > 0]
+    )
+
+    # |S - T|/2 = |1 - L|/(2|1 + L|) and |1 + L|, peak and minimum refined.
+    def half_difference(w: FloatArray) -> FloatArray:
+        value = response.many(w)
+        return np.asarray(np.abs(1 - value) / (2 * np.abs(1 + value)), dtype=np.float64)
+
+    def distance(w: FloatArray) -> FloatArray:
+        return np.asarray(-np.abs(1 + response.many(w)), dtype=np.float64)
+
+    # ω = 0 too, where L is finite (the grid starts above it).
+    at_zero = response.one(0.0)
+    if np.isfinite(at_zero) and omega.size:
+        omega, values = np.concatenate([[0.0], omega]), np.concatenate([[at_zero], values])
+    disk_w, disk_peak = _extremum(
+        omega, np.abs(1 - values) / (2 * np.abs(1 + values)), half_difference
+    )
+    if not discrete:  # the supremum may be approached as ω → ∞, where L = D
+        d = float(model.D[0, 0])
+        at_infinity = abs(1 - d) / (2 * abs(1 + d))
+        if at_infinity > disk_peak:
+            disk_w, disk_peak = math.inf, at_infinity
+    stab_w, stab_peak = _extremum(omega, -np.abs(1 + values), distance)
+
+    if gains.size:
+        critical = int(np.argmin(np.abs(np.log(gains))))
+        gm, w_gm = float(gains[critical]), phase_w[critical]
+    else:
+        gm, w_gm = math.inf, math.nan
+    if phases.size:
+        critical = int(np.argmin(np.abs(phases)))
+        pm, w_pm = float(phases[critical]), gain_w[critical]
+    else:
+        pm, w_pm = math.inf, math.nan
+    if not stable:
+        delay, disk = 0.0, 0.0
+    else:
+        delay = float(delays.min()) if delays.size else math.inf
+        disk = 1.0 / disk_peak if disk_peak > 0 else math.inf
+    result = StabilityMargins(
+        gain_margin=gm,
+        phase_crossover=w_gm,
+        phase_margin=pm,
+        gain_crossover=w_pm,
+        delay_margin=delay,
+        disk_margin=disk,
+        disk_frequency=disk_w,
+        stability_margin=-stab_peak,
+        stability_frequency=stab_w,
+        gain_margins=gains,
+        phase_crossovers=np.array(phase_w),
+        phase_margins=phases,
+        gain_crossovers=np.array(gain_w),
+        delay_margins=delays,
+        closed_loop_poles=np.sort_complex(closed),
+        closed_loop_stable=stable,
+        open_loop_unstable_poles=unstable_open,
+        encirclements=unstable_open - unstable_closed,
+    )
+    _verify_gain_margins(model, result)
+    return result
+
+
+def _extremum(
+    omega: FloatArray, values: FloatArray, f: Callable[[FloatArray], FloatArray]
+) -> tuple[float, float]:
+    """(ω, f(ω)) at the grid's maximum of ``values``, refined between its neighbours by
+    zooming: 64 points in one call of the core, then again about the best of them, until the
+    bracket is 1e-9 of ω wide (near a smooth maximum f is then within about 1e-16 of it)."""
+    if omega.size == 0:
+        return math.nan, math.nan
+    i = int(np.argmax(values))
+    best_w, best_value = float(omega[i]), float(values[i])
+    low, high = float(omega[max(i - 1, 0)]), float(omega[min(i + 1, omega.size - 1)])
+    while high - low > 1e-9 * max(best_w, 1e-300):
+        points = np.linspace(low, high, 65)
+        found = f(points)
+        j = int(np.nanargmax(found)) if np.any(np.isfinite(found)) else 0
+        if not found[j] > best_value:
+            break
+        best_w, best_value = float(points[j]), float(found[j])
+        step = (high - low) / 64
+        low, high = max(best_w - step, low), min(best_w + step, high)
+    return best_w, best_value
+
+
+def _verify_gain_margins(model: StateSpace, margins: StabilityMargins) -> None:
+    """Each gain margin k must put a closed-loop pole of 1 + k L = 0 at the phase crossover
+    (jω, or e^{jω dt}); a miss beyond 1e-6 of the pole's size is an error."""
+    dt = period(model) if model.is_discrete else 0.0
+    scale = 1.0 + float(np.abs(model.A).max(initial=0.0))
+    for k, w in zip(margins.gain_margins, margins.phase_crossovers, strict=True):
+        if not math.isfinite(k):
+            continue
+        point = np.exp(1j * w * dt) if dt else 1j * w
+        poles = _eigenvalues(_closed_loop_matrix(model, float(k)))
+        miss = float(np.min(np.abs(poles - point))) if poles.size else 0.0
+        if poles.size and miss > 1e-6 * max(scale, abs(point)):
+            raise AerocontrolLinAlgError(
+                f"stability_margins: the loop closed with its gain margin {k:.6g} has no pole "
+                f"at the phase crossover {w:.6g} rad/s (nearest at distance {miss:.3g})"
+            )
+
+
+def sensitivity(loop: System) -> StateSpace:
+    """S = 1/(1 + L): from a disturbance at the loop's output to the output, negative
+    feedback; the state space of :func:`~aerocontrol.feedback` (unity forward, L in the
+    return path).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> S = aerocontrol.sensitivity(aerocontrol.tf([2.0], [1.0, 1.0]))   # (s + 1)/(s + 3)
+    >>> round(float(aerocontrol.dc_gain(S)[0, 0]), 12)
+    0.333333333333
+    """
+    model = _siso(loop)
+    dt = model.dt
+    return feedback(gain(1.0, dt=dt), model)
+
+
+def complementary_sensitivity(loop: System) -> StateSpace:
+    """T = L/(1 + L): the closed loop from the reference to the output, negative feedback
+    (:func:`~aerocontrol.feedback` with unity return). S + T = 1.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> T = aerocontrol.complementary_sensitivity(aerocontrol.tf([2.0], [1.0, 1.0]))
+    >>> round(float(aerocontrol.dc_gain(T)[0, 0]), 12)                   # 2/(s + 3)
+    0.666666666667
+    """
+    model = _siso(loop)
+    return feedback(model, gain(1.0, dt=model.dt))
+
+
+# ----- root locus ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class RootLocus:
+    """The closed-loop poles of 1 + k L(s) = 0 over the gains k."""
+
+    gains: FloatArray
+    poles: ComplexArray
+    """Shape (len(gains), n): the eigenvalues of A - k B (1 + k D)⁻¹ C, each row sorted."""
+    open_loop_poles: ComplexArray
+    open_loop_zeros: ComplexArray
+    dt: float
+
+    def plot(self, ax: Axes | None = None, marked: list[float] | None = None) -> Axes:
+        """The locus with a ζ/ω_n grid (matplotlib); see
+        :func:`~aerocontrol.plotting.plot_gain_root_locus`."""
+        from .plotting import plot_gain_root_locus
+
+        return plot_gain_root_locus(self, ax=ax, marked=marked)
+
+
+def _gains(gains: ArrayLike, name: str = "gains") -> FloatArray:
+    values = real_array(gains, name)
+    if values.ndim == 0:
+        values = values.reshape(1)
+    if values.ndim != 1 or values.size == 0:
+        raise ShapeError(f"{name} must be a non-empty 1-D array of gains, got shape {values.shape}")
+    check_finite(values, name)
+    return np.asarray(values, dtype=np.float64)
+
+
+def _closed_poles(model: StateSpace, k: float) -> ComplexArray:
+    return np.sort_complex(_eigenvalues(_closed_loop_matrix(model, k)))
+
+
+def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
+    """The closed-loop poles of 1 + k L(s) = 0 for each gain k of ``gains`` (negative
+    feedback for k > 0), as the eigenvalues of A - k B (1 + k D)⁻¹ C.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> # k/(s(s + 2)): poles -1 ± j√(k - 1) beyond k = 1.
+    >>> locus = aerocontrol.root_locus(aerocontrol.zpk([], [0.0, -2.0], 1.0), [0.0, 1.0, 5.0])
+    >>> np.round(locus.poles[2], 12)
+    array([-1.-2.j, -1.+2.j])
+    """
+    model = _siso(loop)
+    k = _gains(gains)
+    poles = np.array([_closed_poles(model, float(value)) for value in k]).reshape(
+        k.size, model.n_states
+    )
+    g = transfer_function(model)
+    return RootLocus(
+        gains=k,
+        poles=poles.astype(np.complex128),
+        open_loop_poles=g.poles,
+        open_loop_zeros=g.zeros,
+        dt=period(model) if model.is_discrete else 0.0,
+    )
+
+
+@dataclass(frozen=True)
+class DampingDesign:
+    """A gain of a root-locus design and the mode it sets."""
+
+    gain: float
+    damping_ratio: float
+    """ζ of the mode (of s = ln(z)/dt for a discrete loop); 1 when no pole oscillates."""
+    pole: complex
+    """The mode's pole (Im ≥ 0); NaN when no pole oscillates."""
+    closed_loop_poles: ComplexArray
+
+
+def _continuous(poles: ComplexArray, dt: float) -> ComplexArray:
+    if not dt:
+        return poles
+    s = np.full(poles.shape, complex(-np.inf, 0.0), dtype=np.complex128)
+    nonzero = poles != 0
+    s[nonzero] = np.log(poles[nonzero]) / dt
+    return s
+
+
+def _least_damped(poles: ComplexArray, dt: float) -> tuple[float, complex]:
+    s = _continuous(poles, dt)
+    oscillatory = np.isfinite(s) & (s.imag > 1e-9 * np.abs(s))
+    if not np.any(oscillatory):
+        return 1.0, complex(math.nan, math.nan)
+    candidates = s[oscillatory]
+    zetas = -candidates.real / np.abs(candidates)
+    i = int(np.argmin(zetas))
+    return float(zetas[i]), complex(poles[oscillatory][i])
+
+
+def _damping(pole: complex, dt: float) -> float:
+    s = complex(np.log(pole)) / dt if dt else pole
+    return -s.real / abs(s) if abs(s.imag) > 1e-9 * abs(s) else 1.0
+
+
+class _Objective:
+    """ζ(k) of the least-damped oscillatory mode, or of the mode tracked from ``mode``."""
+
+    def __init__(self, model: StateSpace, mode: complex | None, gains: FloatArray) -> None:
+        self.model = model
+        self.dt = period(model) if model.is_discrete else 0.0
+        self.gains = gains
+        self.track: list[complex] = []
+        if mode is not None:
+            current = complex(mode)
+            for k in gains:
+                poles = _closed_poles(model, float(k))
+                current = complex(poles[int(np.argmin(np.abs(poles - current)))])
+                current = complex(current.real, abs(current.imag))
+                self.track.append(current)
+
+    def pole(self, k: float) -> tuple[float, complex, ComplexArray]:
+        poles = _closed_poles(self.model, k)
+        if not self.track:
+            zeta, pole = _least_damped(poles, self.dt)
+            return zeta, pole, poles
+        nearest = self.track[int(np.argmin(np.abs(self.gains - k)))]
+        pole = complex(poles[int(np.argmin(np.abs(poles - nearest)))])
+        pole = complex(pole.real, abs(pole.imag))
+        return _damping(pole, self.dt), pole, poles
+
+    def __call__(self, k: float) -> float:
+        zeta, _, poles = self.pole(k)
+        if np.any(_unstable(poles, bool(self.dt))):
+            return -1.0  # a gain that leaves the closed loop unstable is never the best
+        return zeta
+
+
+def _default_gains(model: StateSpace) -> FloatArray:
+    """0, then 400 gains log-spaced over six decades about 1/|L| at the loop's modes."""
+    poles = _continuous(_eigenvalues(model.A), period(model) if model.is_discrete else 0.0)
+    sizes = np.abs(poles[np.isfinite(poles) & (np.abs(poles) > 0)])
+    omega = sizes if sizes.size else np.array([1.0])
+    magnitude = np.abs(_Response(model).many(omega))
+    magnitude = magnitude[np.isfinite(magnitude) & (magnitude > 0)]
+    reference = 1.0 / float(np.median(magnitude)) if magnitude.size else 1.0
+    return np.concatenate([[0.0], reference * np.logspace(-3.0, 3.0, 400)])
+
+
+def _mode(mode: complex | None) -> complex | None:
+    if mode is None:
+        return None
+    try:
+        value = complex(mode)
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(
+            f"mode must be an open-loop pole (a complex number) or None, got {mode!r}"
+        ) from None
+    if not (math.isfinite(value.real) and math.isfinite(value.imag)):
+        raise InvalidArgumentError(f"mode must be finite, got {value}")
+    return value
+
+
+def _search_gains(model: StateSpace, gains: ArrayLike | None) -> FloatArray:
+    if gains is None:
+        return _default_gains(model)
+    values = np.sort(_gains(gains))
+    if values[0] < 0:
+        raise InvalidArgumentError(f"gains must be non-negative, got {values[0]:g}")
+    return values
+
+
+def best_damping_gain(
+    loop: System, mode: complex | None = None, gains: ArrayLike | None = None
+) -> DampingDesign:
+    """The gain k ≥ 0 of 1 + k L(s) = 0 that maximises the damping ratio of the least-damped
+    oscillatory closed-loop mode or, with ``mode`` (an open-loop pole), of that mode tracked
+    by continuity along the locus.
+
+    The damping is computed on a grid of gains (``gains``, or 0 and 400 gains over six
+    decades about 1/|L| at the loop's modes), then refined by golden-section search between
+    the best grid gain's neighbours. A gain at which a closed-loop pole is unstable is never
+    chosen (its damping counts as -1).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> # k (s + 1)/(s² (s + 10))... here simply k/(s² + 0.2 s + 1) with a lead (s + 2):
+    >>> loop = aerocontrol.zpk([-2.0], [-0.1 + 1j, -0.1 - 1j, -20.0], 20.0)
+    >>> best = aerocontrol.best_damping_gain(loop, mode=-0.1 + 1j)
+    >>> best.damping_ratio > 0.7
+    True
+    """
+    model = _siso(loop)
+    tracked = _mode(mode)
+    k = _search_gains(model, gains)
+    objective = _Objective(model, tracked, k)
+    values = np.array([objective(float(g)) for g in k])
+    i = int(np.argmax(values))
+    best_k, best_zeta = float(k[i]), float(values[i])
+    if k.size > 2:
+        a, b = float(k[max(i - 1, 0)]), float(k[min(i + 1, k.size - 1)])
+        refined_k, refined_zeta = _golden_max(objective, a, b)
+        if refined_zeta >= best_zeta:
+            best_k, best_zeta = refined_k, refined_zeta
+    zeta, pole, poles = objective.pole(best_k)
+    return DampingDesign(best_k, zeta, pole, poles)
+
+
+def gain_for_damping(
+    loop: System, zeta: float, mode: complex | None = None, gains: ArrayLike | None = None
+) -> DampingDesign:
+    """The smallest gain k ≥ 0 of 1 + k L(s) = 0 at which the least-damped oscillatory mode
+    (or the mode tracked from the open-loop pole ``mode``) has damping ratio ``zeta``.
+
+    The damping ratio counts as 1 where no pole oscillates. The first grid interval where the
+    damping crosses ``zeta`` (rising, as a damper's, or falling, as a high-gain loop's) is
+    refined by Brent's method. A damping that no gain of the grid reaches is refused, naming
+    the nearest one.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> # k/(s(s + 2)): ζ = 1/√k beyond k = 1, so ζ = 0.5 at k = 4 (a closed form).
+    >>> design = aerocontrol.gain_for_damping(aerocontrol.zpk([], [0.0, -2.0], 1.0), 0.5)
+    >>> round(design.gain, 10), round(design.damping_ratio, 10)
+    (4.0, 0.5)
+    """
+    model = _siso(loop)
+    target = real_scalar(zeta, "zeta")
+    if not (math.isfinite(target) and -1.0 < target < 1.0):
+        raise InvalidArgumentError(f"zeta must lie in (-1, 1), got {target}")
+    tracked = _mode(mode)
+    k = _search_gains(model, gains)
+    objective = _Objective(model, tracked, k)
+    values = np.array([objective(float(g)) for g in k]) - target
+    if values[0] == 0:
+        z, pole, poles = objective.pole(float(k[0]))
+        return DampingDesign(float(k[0]), z, pole, poles)
+    crossed = np.nonzero(np.sign(values[1:]) != np.sign(values[0]))[0]
+    if crossed.size == 0:
+        best = int(np.argmin(np.abs(values)))
+        raise InvalidArgumentError(
+            f"zeta = {target:g} is not reached for gains up to {k[-1]:.4g}: the nearest is "
+            f"zeta = {values[best] + target:.4g} at k = {k[best]:.4g}"
+        )
+    j = int(crossed[0]) + 1
+
+    def shifted(g: float) -> float:
+        return objective(g) - target
+
+    found = _brent(
+        shifted, float(k[j - 1]), float(k[j]), float(values[j - 1]), float(values[j]), 0.0
+    )
+    z, pole, poles = objective.pole(found)
+    if abs(z - target) > 1e-6:
+        warnings.warn(
+            f"gain_for_damping: the damping ratio jumps at k = {found:.6g} (from one mode to "
+            f"another): it is {z:.6g} there, not {target:g}",
+            IllConditionedWarning,
+            stacklevel=2,
+        )
+    return DampingDesign(found, z, pole, poles)

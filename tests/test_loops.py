@@ -1,0 +1,314 @@
+"""Loop analysis against closed forms, python-control's stability_margins and disk_margins,
+and numpy evaluations of the same formulas."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import control
+import numpy as np
+import pytest
+from scipy.optimize import minimize_scalar
+
+import aerocontrol
+from aerocontrol import (
+    InvalidArgumentError,
+    ShapeError,
+    SingularMatrixError,
+    best_damping_gain,
+    complementary_sensitivity,
+    gain_for_damping,
+    root_locus,
+    sensitivity,
+    stability_margins,
+)
+
+
+def _third_order(k: float) -> aerocontrol.StateSpace:
+    """k/(s(s + 1)(s + 2))."""
+    return aerocontrol.zpk([], [0.0, -1.0, -2.0], k)
+
+
+def _numpy_response(sys: aerocontrol.StateSpace, w: np.ndarray) -> np.ndarray:
+    """C (jωI - A)^-1 B + D by numpy.linalg.solve: an evaluation independent of the core."""
+    n = sys.n_states
+    return np.array(
+        [(sys.C @ np.linalg.solve(1j * x * np.eye(n) - sys.A, sys.B) + sys.D)[0, 0] for x in w]
+    )
+
+
+def _yaw_loop(tau: float | None = 3.0) -> aerocontrol.StateSpace:
+    """The 747 cruise yaw damper's loop: actuator, -r/rudder, washout."""
+    plane = aerocontrol.aircraft.load("b747-cruise").lateral()
+    parts = [aerocontrol.actuator(10.0), plane["r", "rudder"], aerocontrol.gain(-1.0)]
+    if tau is not None:
+        parts.append(aerocontrol.washout(tau))
+    return aerocontrol.series(*parts)
+
+
+# ----- closed forms ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("k", [0.5, 2.0, 5.0, 10.0, 30.0])
+def test_third_order_loop_closed_form(k: float) -> None:
+    m = stability_margins(_third_order(k))
+    # Phase crossover: Im of jω(jω + 1)(jω + 2) = ω(2 - ω²) = 0 at ω = √2, where L = -k/6.
+    assert m.gain_margin == pytest.approx(6.0 / k, rel=1e-13)
+    assert m.phase_crossover == pytest.approx(math.sqrt(2.0), rel=1e-13)
+    # Gain crossover: ω²(ω² + 1)(ω² + 4) = k², a cubic in ω² (numpy.roots).
+    x = np.roots([1.0, 5.0, 4.0, -(k**2)])
+    w = math.sqrt(float(x[np.abs(x.imag) < 1e-12].real.max()))
+    assert m.gain_crossover == pytest.approx(w, rel=1e-12)
+    phase = -90.0 - math.degrees(math.atan(w) + math.atan(w / 2.0))
+    assert m.phase_margin == pytest.approx(180.0 + phase, abs=1e-9)
+    stable = k < 6.0  # Routh: s³ + 3s² + 2s + k
+    assert m.closed_loop_stable is stable
+    assert m.encirclements == (0 if stable else -2)
+    if stable:
+        assert m.phase_margin > 0
+        assert m.delay_margin == pytest.approx(math.radians(m.phase_margin) / w, rel=1e-12)
+    else:  # a negative phase margin, with its sign, and no delay or disk margin
+        assert m.phase_margin < 0
+        assert m.delay_margin == 0.0 and m.disk_margin == 0.0
+
+
+@pytest.mark.parametrize("k", [0.1, 1.0, 50.0])
+def test_pure_integrator(k: float) -> None:
+    m = stability_margins(aerocontrol.tf([k], [1.0, 0.0]))
+    assert m.gain_margin == math.inf and math.isnan(m.phase_crossover)
+    assert m.phase_margin == pytest.approx(90.0, abs=1e-12)
+    assert m.gain_crossover == pytest.approx(k, rel=1e-13)
+    assert m.delay_margin == pytest.approx(math.pi / 2 / k, rel=1e-13)
+    # |1 - k/jω| = |1 + k/jω|: |S - T|/2 = 1/2 at every frequency, so α = 2.
+    assert m.disk_margin == pytest.approx(2.0, rel=1e-12)
+    assert m.disk_gain_margin[1] == math.inf
+    assert m.disk_phase_margin == pytest.approx(90.0, rel=1e-12)
+
+
+def test_no_crossover_is_infinite_not_zero() -> None:
+    # 0.5/(s + 1): |L| < 1 and ∠L > -90° everywhere.
+    m = stability_margins(aerocontrol.tf([0.5], [1.0, 1.0]))
+    assert m.gain_margin == math.inf and m.phase_margin == math.inf
+    assert m.delay_margin == math.inf
+    assert m.gain_margins.size == 0 and m.phase_margins.size == 0
+    # α: |1 - L|/(2|1 + L|) is 1/6 at ω = 0 and rises to its supremum 1/2 as L → 0.
+    assert m.disk_margin == pytest.approx(2.0, rel=1e-14) and m.disk_frequency == math.inf
+    # A lag 2/(s + 1)^2 nears -180° only as ω → ∞, where |L| → 0: no phase crossover.
+    lag = stability_margins(aerocontrol.zpk([], [-1.0, -1.0], 2.0))
+    assert lag.gain_margin == math.inf
+    assert lag.phase_margin == pytest.approx(180.0 - 2 * math.degrees(math.atan(1.0)), abs=1e-9)
+
+
+def test_unstable_open_loop() -> None:
+    # 2/(s - 1): closed-loop pole at -1; L(0) = -2, so GM = 1/2 at ω = 0 (a gain reduction
+    # margin); |L| = 1 at ω = √3 with ∠L = -120°: PM = 60°.
+    m = stability_margins(aerocontrol.tf([2.0], [1.0, -1.0]))
+    assert m.open_loop_unstable_poles == 1
+    assert m.closed_loop_stable and m.encirclements == 1
+    np.testing.assert_allclose(m.closed_loop_poles, [-1.0], rtol=1e-14)
+    assert m.gain_margin == pytest.approx(0.5, rel=1e-14) and m.phase_crossover == 0.0
+    assert m.gain_margin_db == pytest.approx(-20 * math.log10(2.0), rel=1e-13)
+    assert m.gain_crossover == pytest.approx(math.sqrt(3.0), rel=1e-13)
+    assert m.phase_margin == pytest.approx(60.0, abs=1e-10)
+    assert m.delay_margin == pytest.approx(math.pi / 3 / math.sqrt(3.0), rel=1e-12)
+    # The same plant at gain 0.5: closed loop unstable, no encirclement.
+    weak = stability_margins(aerocontrol.tf([0.5], [1.0, -1.0]))
+    assert not weak.closed_loop_stable and weak.encirclements == 0 and weak.disk_margin == 0
+
+
+def test_algebraic_loop_and_shapes_are_refused() -> None:
+    with pytest.raises(SingularMatrixError, match="algebraic loop"):
+        stability_margins(aerocontrol.gain(-1.0))
+    lateral = aerocontrol.aircraft.load("b747-cruise").lateral()
+    with pytest.raises(ShapeError, match="loop must have one input and one output"):
+        stability_margins(lateral)
+    with pytest.raises(ShapeError, match="loop must have one input"):
+        root_locus(lateral, [1.0])
+
+
+# ----- python-control -------------------------------------------------------------------------
+
+
+def _control_all(sys: aerocontrol.StateSpace) -> tuple[np.ndarray, ...]:
+    theirs = control.ss(sys.A, sys.B, sys.C, sys.D, sys.dt or 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return control.stability_margins(theirs, returnall=True)
+
+
+@pytest.mark.parametrize(
+    "loop",
+    [
+        _third_order(2.0),
+        aerocontrol.zpk([-0.5], [0.0, -5.0, -0.2 + 2j, -0.2 - 2j], 8.0),
+        aerocontrol.series(_yaw_loop(3.0), aerocontrol.gain(2.5)),
+        aerocontrol.series(_yaw_loop(None), aerocontrol.gain(2.5)),
+        aerocontrol.series(_yaw_loop(1.0), aerocontrol.gain(8.0)),
+    ],
+    ids=["third-order", "resonant", "yaw-washout-3s", "yaw-no-washout", "yaw-washout-1s"],
+)
+def test_every_crossover_against_python_control(loop: aerocontrol.StateSpace) -> None:
+    m = stability_margins(loop)
+    gm, pm, _, w180, wc, _ = _control_all(loop)
+    # python-control counts ω = 0 as a phase crossover where a washout makes L(0) = 0 (its
+    # "gain margin" there is inf): not a crossing of the negative real axis, so not ours.
+    real = np.asarray(gm) < 1e10
+    w180, gm = np.asarray(w180)[real], np.asarray(gm)[real]
+    # python-control's polynomial crossings (ss2tf, then roots): agree to 1e-7.
+    order = np.argsort(w180)
+    np.testing.assert_allclose(m.phase_crossovers, np.asarray(w180)[order], rtol=1e-7)
+    np.testing.assert_allclose(m.gain_margins, np.asarray(gm)[order], rtol=1e-7)
+    order = np.argsort(wc)
+    np.testing.assert_allclose(m.gain_crossovers, np.asarray(wc)[order], rtol=1e-7)
+    np.testing.assert_allclose(m.phase_margins, np.asarray(pm)[order], atol=1e-6)
+
+
+def test_discrete_loop_against_python_control() -> None:
+    loop = aerocontrol.c2d(_third_order(2.0), 0.1)
+    m = stability_margins(loop)
+    gm, pm, _, w180, wc, _ = _control_all(loop)
+    np.testing.assert_allclose(m.gain_margins, gm, rtol=1e-7)
+    np.testing.assert_allclose(m.phase_crossovers, w180, rtol=1e-7)
+    np.testing.assert_allclose(m.phase_margins, pm, atol=1e-6)
+    np.testing.assert_allclose(m.gain_crossovers, wc, rtol=1e-7)
+    assert m.closed_loop_stable
+
+
+@pytest.mark.parametrize(
+    "loop", [_third_order(2.0), aerocontrol.series(_yaw_loop(3.0), aerocontrol.gain(2.5))]
+)
+def test_disk_margin_against_python_control(loop: aerocontrol.StateSpace) -> None:
+    m = stability_margins(loop)
+    theirs = control.ss(loop.A, loop.B, loop.C, loop.D)
+    w = np.logspace(-4, 3, 20001)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        alpha = control.disk_margins(theirs, w, skew=0.0, returnall=False)[0]
+    # python-control's value is on its grid: ours is the refined maximum, never below it.
+    assert m.disk_margin == pytest.approx(float(alpha), rel=1e-5)
+    assert m.disk_margin <= float(alpha) * (1 + 1e-12)
+
+    # The refined peak against scipy's bounded search on a numpy evaluation.
+    def peak(x: float) -> float:
+        value = _numpy_response(loop, np.array([x]))[0]
+        return -abs(1 - value) / (2 * abs(1 + value))
+
+    best = minimize_scalar(
+        peak,
+        bounds=(m.disk_frequency * 0.8, m.disk_frequency * 1.25),
+        method="bounded",
+        options={"xatol": 1e-12},
+    )
+    assert m.disk_margin == pytest.approx(-1.0 / best.fun, rel=1e-9)
+
+
+def test_sensitivities_against_numpy() -> None:
+    loop = _third_order(2.0)
+    w = np.logspace(-2, 2, 30)
+    L = _numpy_response(loop, w)
+    S = aerocontrol.frequency_response(sensitivity(loop), w).response[:, 0, 0]
+    T = aerocontrol.frequency_response(complementary_sensitivity(loop), w).response[:, 0, 0]
+    np.testing.assert_allclose(S, 1 / (1 + L), rtol=1e-12)
+    np.testing.assert_allclose(T, L / (1 + L), rtol=1e-12)
+    np.testing.assert_allclose(S + T, 1.0, rtol=1e-12)
+
+
+# ----- root locus -----------------------------------------------------------------------------
+
+
+def test_root_locus_closed_form_and_numpy() -> None:
+    loop = aerocontrol.zpk([], [0.0, -2.0], 1.0)  # k/(s(s + 2)): -1 ± j√(k - 1)
+    gains = np.array([0.0, 0.5, 1.0, 2.0, 10.0])
+    locus = root_locus(loop, gains)
+    for k, poles in zip(gains, locus.poles, strict=True):
+        expected = np.roots([1.0, 2.0, k])
+        np.testing.assert_allclose(np.sort_complex(poles), np.sort_complex(expected), atol=1e-7)
+    yaw = _yaw_loop(3.0)
+    k = np.linspace(0, 5, 7)
+    locus = root_locus(yaw, k)
+    for value, poles in zip(k, locus.poles, strict=True):
+        A = yaw.A - value * yaw.B @ yaw.C / (1 + value * yaw.D[0, 0])
+        np.testing.assert_allclose(
+            np.sort_complex(poles), np.sort_complex(np.linalg.eigvals(A)), rtol=1e-10, atol=1e-12
+        )
+
+
+def test_gain_for_damping_closed_forms() -> None:
+    design = gain_for_damping(aerocontrol.zpk([], [0.0, -2.0], 1.0), 0.5)
+    assert design.gain == pytest.approx(4.0, rel=1e-10)  # ζ = 1/√k
+    # Rate feedback k s/(s² + 2ζ0 ω s + ω²): ζ = ζ0 + k/(2ω), for the tracked mode.
+    omega, zeta0 = 2.0, 0.05
+    pole = complex(-zeta0 * omega, omega * math.sqrt(1 - zeta0**2))
+    loop = aerocontrol.tf([1.0, 0.0], [1.0, 2 * zeta0 * omega, omega**2])
+    design = gain_for_damping(loop, 0.4, mode=pole)
+    assert design.gain == pytest.approx(2 * omega * (0.4 - zeta0), rel=1e-10)
+    assert design.damping_ratio == pytest.approx(0.4, abs=1e-12)
+    with pytest.raises(InvalidArgumentError, match="zeta must lie in"):
+        gain_for_damping(loop, 1.5)
+    with pytest.raises(InvalidArgumentError, match="not reached"):
+        gain_for_damping(loop, 0.9, mode=pole, gains=[0.0, 0.1, 0.2])  # ζ at most 0.1
+
+
+def test_best_damping_gain_against_dense_search() -> None:
+    loop = _yaw_loop(3.0)
+    plane = aerocontrol.aircraft.load("b747-cruise").lateral()
+    dutch = next(p for p in np.linalg.eigvals(plane.A) if p.imag > 0)
+    design = best_damping_gain(loop, mode=dutch)
+
+    # The oracle: numpy eigenvalues on 20,001 gains, then scipy's bounded search.
+    def zeta(k: float) -> float:
+        A = loop.A - k * loop.B @ loop.C
+        poles = np.linalg.eigvals(A)
+        near = poles[np.argmin(np.abs(poles - dutch))] if k < 1e-9 else None
+        candidates = poles[poles.imag > 1e-9]
+        near = candidates[np.argmin(np.abs(candidates - design.pole))]
+        return float(-near.real / abs(near))
+
+    ks = np.linspace(0, 10, 2001)
+    best_k = ks[int(np.argmax([zeta(k) for k in ks]))]
+    refined = minimize_scalar(
+        lambda k: -zeta(k),
+        bounds=(best_k - 0.01, best_k + 0.01),
+        method="bounded",
+        options={"xatol": 1e-10},
+    )
+    assert design.damping_ratio == pytest.approx(-refined.fun, abs=1e-8)
+    assert design.gain == pytest.approx(refined.x, rel=1e-4)
+    assert design.damping_ratio > 0.25
+
+
+def test_root_locus_arguments() -> None:
+    loop = _third_order(1.0)
+    with pytest.raises(InvalidArgumentError, match="gains must be non-negative"):
+        best_damping_gain(loop, gains=[-1.0, 1.0])
+    with pytest.raises(InvalidArgumentError, match="mode must be"):
+        best_damping_gain(loop, mode="dutch roll")  # type: ignore[arg-type]
+    with pytest.raises(ShapeError, match="gains must be a non-empty"):
+        root_locus(loop, [])
+
+
+def test_yaw_damper_closed_loop_is_the_locus_at_its_gain() -> None:
+    """The damper's closed loop (built with feedback()) has the poles of 1 + k L = 0 that
+    numpy finds for the loop's matrices; the washout keeps a slow real (spiral) root that
+    the damper without it turns into an oscillation."""
+    plane = aerocontrol.aircraft.load("b747-cruise")
+    damper = aerocontrol.design.yaw_damper(plane)
+    loop, k = damper.loop, damper.design.gain
+    expected = np.linalg.eigvals(loop.A - k * loop.B @ loop.C / (1 + k * loop.D[0, 0]))
+    ours = np.linalg.eigvals(damper.closed_loop.A)
+    assert _matched(ours, expected) < 1e-9
+    assert damper.margins.closed_loop_stable and damper.check.passed == {"yaw damper": True}
+    slow = ours[np.argmin(np.abs(ours))]
+    assert slow.imag == 0 and -0.01 < slow.real < 0
+    bare = aerocontrol.design.yaw_damper(plane, washout_tau=None)
+    roots = np.linalg.eigvals(bare.closed_loop.A)
+    assert np.all(np.abs(roots[np.abs(roots) < 0.5].imag) > 0)  # no slow real root left
+
+
+def _matched(a: np.ndarray, b: np.ndarray) -> float:
+    from scipy.optimize import linear_sum_assignment
+
+    distance = np.abs(a[:, None] - b[None, :])
+    rows, columns = linear_sum_assignment(distance)
+    return float(np.max(distance[rows, columns]))

@@ -1,0 +1,159 @@
+"""Transfer functions and transmission zeros against python-control (with slycot), scipy's
+generalized eigenvalues of the Rosenbrock pencil, and hand-derived examples."""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+import scipy.linalg
+from scipy.optimize import linear_sum_assignment
+
+import aerocontrol
+from aerocontrol import InvalidArgumentError, transfer_function, transmission_zeros
+
+
+def _matched_error(ours: np.ndarray, theirs: np.ndarray) -> float:
+    """The largest relative distance between the two sets of roots, best matched."""
+    assert len(ours) == len(theirs)
+    if len(ours) == 0:
+        return 0.0
+    distance = np.abs(ours[:, None] - theirs[None, :])
+    rows, columns = linear_sum_assignment(distance)
+    return float(np.max(distance[rows, columns] / np.maximum(1.0, np.abs(ours[rows]))))
+
+
+# ----- hand-derived -----------------------------------------------------------------------------
+
+
+def test_two_lags_in_parallel() -> None:
+    # 1/(s + 1) + 1/(s + 2) = (2s + 3)/((s + 1)(s + 2)): zero -1.5, gain 2 (by hand).
+    sys = aerocontrol.StateSpace(np.diag([-1.0, -2.0]), [[1.0], [1.0]], [[1.0, 1.0]], [[0.0]])
+    g = transfer_function(sys)
+    np.testing.assert_allclose(g.zeros, [-1.5], rtol=1e-14)
+    assert g.gain == pytest.approx(2.0, rel=1e-14)
+    np.testing.assert_allclose(g.numerator, [2.0, 3.0], rtol=1e-14)
+    np.testing.assert_allclose(g.denominator, [1.0, 3.0, 2.0], rtol=1e-14)
+    np.testing.assert_allclose(np.sort(g.poles.real), [-2.0, -1.0], rtol=1e-14)
+
+
+def test_feedthrough_and_zero_channel() -> None:
+    # 2 + 1/(s + 1) = (2s + 3)/(s + 1): zero -1.5, gain 2.
+    g = transfer_function(([[-1.0]], [[1.0]], [[1.0]], [[2.0]]))
+    np.testing.assert_allclose(g.zeros, [-1.5], rtol=1e-14)
+    assert g.gain == pytest.approx(2.0, rel=1e-14)
+    # An output that the input does not reach: G = 0.
+    zero = transfer_function((np.diag([-1.0, -2.0]), [[1.0], [0.0]], [[0.0, 1.0]], [[0.0]]))
+    assert zero.gain == 0.0 and zero.zeros.size == 0
+    np.testing.assert_array_equal(zero.numerator, [0.0])
+
+
+def test_aircraft_form_prints_time_constants_and_quadratics() -> None:
+    # 5 (s + 2)/(s (s² + 2·0.5·2 s + 4)): zero at -1/T with T = 0.5, pole pair ζ = 0.5, ω = 2.
+    g = transfer_function(
+        aerocontrol.zpk([-2.0], [0.0, -1 + np.sqrt(3) * 1j, -1 - np.sqrt(3) * 1j], 5.0)
+    )
+    assert g.aircraft_form() == "5 (s + 2) / s(s² + 2(0.5)(2)s + (2)²)"
+    pair = g.pole_factors[-1]
+    assert pair.zeta == pytest.approx(0.5, rel=1e-13) and pair.omega == pytest.approx(
+        2.0, rel=1e-13
+    )
+    assert g.zero_factors[0].time_constant == pytest.approx(0.5, rel=1e-13)
+    assert "T = 0.5 s" in str(g)
+
+
+# ----- python-control ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("identifier", ["b747-approach", "b747-cruise", "navion"])
+def test_every_channel_against_ss2tf(identifier: str) -> None:
+    plane = aerocontrol.aircraft.load(identifier)
+    for sys in (plane.lateral(), plane.longitudinal()):
+        theirs_ss = control.ss(sys.A, sys.B, sys.C, sys.D)
+        for i, output in enumerate(sys.output_names):
+            for j, input_ in enumerate(sys.input_names):
+                g = transfer_function(sys, output, input_)
+                theirs = control.ss2tf(theirs_ss[i, j])
+                num = np.trim_zeros(np.asarray(theirs.num[0][0], float), "f")
+                den = np.asarray(theirs.den[0][0], float)
+                # Coefficients to 1e-10 of the largest (slycot's TB04AD forms them directly).
+                np.testing.assert_allclose(g.denominator, den, atol=1e-10 * np.abs(den).max())
+                scale = np.abs(g.numerator).max()
+                np.testing.assert_allclose(g.numerator[-len(num) :], num, atol=1e-9 * scale)
+                assert _matched_error(g.zeros, control.zeros(theirs_ss[i, j])) < 1e-8
+
+
+def test_discrete_channel_against_python_control() -> None:
+    lateral = aerocontrol.aircraft.load("b747-cruise").lateral()
+    d = aerocontrol.c2d(lateral, 0.1)
+    g = transfer_function(d, "r", "rudder")
+    assert g.variable == "z"
+    theirs = control.ss2tf(control.ss(d.A, d.B, d.C, d.D, 0.1)[3, 0])
+    np.testing.assert_allclose(g.numerator, theirs.num[0][0], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(g.denominator, theirs.den[0][0], rtol=1e-12, atol=1e-14)
+    # G(z) from the factored form equals the state-space response at z = e^{jω dt}.
+    w = np.array([0.1, 1.0, 10.0])
+    response = aerocontrol.frequency_response(d[["r"], ["rudder"]], w).response[:, 0, 0]
+    np.testing.assert_allclose(g(np.exp(1j * w * 0.1)), response, rtol=1e-10)
+
+
+def test_factored_form_reproduces_frequency_response() -> None:
+    lateral = aerocontrol.aircraft.load("b747-approach").lateral()
+    w = np.logspace(-2, 2, 50)
+    for output in lateral.output_names:
+        g = transfer_function(lateral, output, "aileron")
+        response = aerocontrol.frequency_response(lateral[output, "aileron"], w).response
+        np.testing.assert_allclose(g(1j * w), response[:, 0, 0], rtol=1e-10)
+
+
+# ----- transmission zeros ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_square_random_systems_against_scipy_pencil(seed: int) -> None:
+    """Square systems with a regular pencil: the zeros are scipy's finite generalized
+    eigenvalues of [[A, B], [C, D]] - λ diag(I, 0), matched to 1e-8 relative."""
+    rng = np.random.default_rng(seed)
+    for _ in range(15):
+        n, m = int(rng.integers(1, 21)), int(rng.integers(1, 5))
+        A, B = rng.standard_normal((n, n)), rng.standard_normal((n, m))
+        C = rng.standard_normal((m, n))
+        D = rng.standard_normal((m, m)) if rng.random() < 0.5 or m > n else np.zeros((m, m))
+        ours = transmission_zeros((A, B, C, D))
+        S = np.block([[A, B], [C, D]])
+        E = scipy.linalg.block_diag(np.eye(n), np.zeros((m, m)))
+        theirs = scipy.linalg.eig(S, E, right=False)
+        # LAPACK returns an infinite eigenvalue as a huge finite one now and then.
+        theirs = theirs[np.abs(theirs) < 1e8 * np.linalg.norm(S)]
+        assert _matched_error(ours, theirs) < 1e-8
+
+
+@pytest.mark.parametrize("shape", [(6, 3, 2), (6, 2, 3), (8, 1, 3), (12, 4, 2), (5, 2, 4)])
+def test_non_square_systems_against_slycot(shape: tuple[int, int, int]) -> None:
+    n, m, p = shape
+    rng = np.random.default_rng(n * 100 + m * 10 + p)
+    A, B, C = rng.standard_normal((n, n)), rng.standard_normal((n, m)), rng.standard_normal((p, n))
+    # A structured non-square system with zeros: the same column repeated in B.
+    B[:, 1:] = B[:, :1] * np.arange(2, m + 1) if m > 1 else B
+    D = np.zeros((p, m))
+    ours = transmission_zeros((A, B, C, D))
+    theirs = control.zeros(control.ss(A, B, C, D))
+    assert _matched_error(ours, theirs) < 1e-8
+
+
+def test_decoupling_zeros_are_invariant_zeros() -> None:
+    # An uncontrollable mode at -3 is an input-decoupling zero (as SLICOT counts them).
+    sys = (np.diag([-1.0, -3.0]), [[1.0], [0.0]], [[1.0, 1.0]], [[0.0]])
+    np.testing.assert_allclose(transmission_zeros(sys), [-3.0], rtol=1e-14)
+
+
+def test_bad_arguments_are_named() -> None:
+    lateral = aerocontrol.aircraft.load("b747-approach").lateral()
+    with pytest.raises(InvalidArgumentError, match="name the output"):
+        transfer_function(lateral)
+    with pytest.raises(InvalidArgumentError, match="no output is named 'q'"):
+        transfer_function(lateral, "q", "rudder")
+    with pytest.raises(InvalidArgumentError, match="output must select one output"):
+        transfer_function(lateral, ["r", "p"], "rudder")
+    with pytest.raises(InvalidArgumentError, match="tol"):
+        transmission_zeros(lateral, tol=-1.0)
