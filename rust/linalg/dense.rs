@@ -6,9 +6,9 @@
 //! than the arithmetic. [`Dense`] is a plain column-major `Vec<f64>` with its shape: one
 //! unaligned small allocation (the fast path of the extension's allocator), contiguous columns
 //! as slices, and [`Dense::as_ref`] and [`Dense::as_mut`] to lend it to faer as a view (no copy)
-//! for the factorisations and the blocked products of large orders. (Storing the entries inline
-//! up to 8 x 8 was measured 10 % slower on the 4-state Riccati solve: moving the 528-byte
-//! values between functions cost more than the allocations it saved.)
+//! for the factorisations and the blocked products of large orders. (Entries are not stored
+//! inline for small orders: moving such values between functions costs more than the
+//! allocations it saves, on the Riccati benches.)
 
 use faer::{Mat, MatMut, MatRef};
 use std::ops::{Index, IndexMut};
