@@ -375,7 +375,7 @@ def _sweep(
             B_matrix = B_matrix.reshape(-1, 1)
     if weights is None:
         raise InvalidArgumentError("weights must be given: a 1-D array of positive numbers c")
-    c = np.atleast_1d(real_array(weights, "weights"))
+    c = np.atleast_1d(real_array(weights, "weights")).copy()  # the result's own
     if c.ndim != 1:
         raise ShapeError(f"weights must be a 1-D array, got shape {c.shape}")
     bad = np.flatnonzero(~(np.isfinite(c) & (c > 0)))

@@ -301,13 +301,39 @@ class _FilterSolution:
 _USER_FRAME_VIA_SOLVE_FILTER = 4
 
 
+_Formed = TypeVar("_Formed")
+
+
+def _formed(what: str, arguments: str, compute: Callable[[], _Formed]) -> _Formed:
+    """A product of the caller's matrices, refused by name if it overflows double precision
+    (numpy's own overflow warning never reaches the caller)."""
+    with np.errstate(over="raise", invalid="raise"):
+        try:
+            return compute()
+        except FloatingPointError:
+            error = InvalidArgumentError(
+                f"{what} overflows double precision: the entries of {arguments} are too large "
+                "together (scale the model's units)"
+            )
+            error.argument = arguments.split(",")[0]
+            raise error from None
+
+
+def _symmetric_part(M: FloatArray) -> FloatArray:
+    """(M + M^T) / 2, halved before the sum so that it overflows only if M does."""
+    half: FloatArray = 0.5 * M
+    symmetric: FloatArray = half + half.T
+    return symmetric
+
+
 def _solve_filter(model: _NoiseModel, discrete: bool) -> _FilterSolution:
     """The stationary Kalman filter of ``model`` by the dual Riccati equation. Only call it
     directly from a public function (its warnings are re-issued at that function's caller)."""
     A, G, C, RN = model.A, model.G, model.C, model.RN
-    process = G @ model.QN @ G.T
-    process = 0.5 * (process + process.T)  # exactly symmetric, as the solvers require
-    cross = None if model.NN is None else G @ model.NN
+    # Exactly symmetric, as the solvers require.
+    process = _formed("G QN G^T", "G, QN", lambda: _symmetric_part(G @ model.QN @ G.T))
+    NN = model.NN
+    cross = None if NN is None else _formed("G NN", "G, NN", lambda: G @ NN)
     if not discrete:
         _positive_definite(RN, "RN")
     try:
@@ -328,9 +354,8 @@ def _solve_filter(model: _NoiseModel, discrete: bool) -> _FilterSolution:
     L = np.ascontiguousarray(solution.K.T)
     if not discrete:
         return _FilterSolution(L, X, poles, None, None)
-    CP = C @ X
-    innovation = CP @ C.T + RN
-    innovation = 0.5 * (innovation + innovation.T)
+    CP = _formed("C P", "C", lambda: C @ X)
+    innovation = _formed("C P C^T + RN", "C, RN", lambda: _symmetric_part(CP @ C.T + RN))
     try:
         M = np.ascontiguousarray(np.linalg.solve(innovation, CP).T)
     except np.linalg.LinAlgError:
@@ -338,8 +363,8 @@ def _solve_filter(model: _NoiseModel, discrete: bool) -> _FilterSolution:
             "C P C^T + RN, the covariance of the innovation y - C x̂, is singular: some "
             "measurement is noise-free and repeats what P already knows exactly"
         ) from None
-    posterior = X - M @ CP
-    return _FilterSolution(L, X, poles, M, 0.5 * (posterior + posterior.T))
+    posterior = _formed("(I - M C) P", "C", lambda: _symmetric_part(X - M @ CP))
+    return _FilterSolution(L, X, poles, M, posterior)
 
 
 # --- lqe, dlqe -------------------------------------------------------------------------------
@@ -902,8 +927,11 @@ def lqg(
     estimator = _solve_filter(model, False)
     K, L = regulator.K, estimator.L
     hats = [f"{name}_hat" for name in plant.state_names]
+    compensator_A = _formed(
+        "the compensator's A - B K - L C + L D K", "sys", lambda: A - B @ K - L @ C + L @ D @ K
+    )
     compensator = StateSpace(
-        A - B @ K - L @ C + L @ D @ K,
+        compensator_A,
         L,
         -K,
         np.zeros((m, p)),
@@ -911,10 +939,17 @@ def lqg(
         input_names=plant.output_names,
         output_names=plant.input_names,
     )
+    loop_matrices = _formed(
+        "the closed loop's matrices",
+        "sys",
+        lambda: (
+            np.block([[A, -B @ K], [L @ C, A - B @ K - L @ C]]),
+            np.vstack([B, L @ D]),
+            np.block([[C, -D @ K], [np.zeros((m, n)), -K]]),
+        ),
+    )
     closed_loop = StateSpace(
-        np.block([[A, -B @ K], [L @ C, A - B @ K - L @ C]]),
-        np.vstack([B, L @ D]),
-        np.block([[C, -D @ K], [np.zeros((m, n)), -K]]),
+        *loop_matrices,
         np.vstack([D, np.eye(m)]),
         state_names=[*plant.state_names, *hats],
         input_names=plant.input_names,

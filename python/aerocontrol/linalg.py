@@ -362,14 +362,35 @@ def c2d(
     if chosen in ("zoh", "foh"):
         Phi, Gamma0, Gamma1 = _core.discretize(model.A, model.B, step, chosen)
         if Gamma1 is None:
-            return _named_like(model, Phi, Gamma0, model.C, model.D, step)
-        return _named_like(
-            model, Phi, Gamma0 - Gamma1 + Phi @ Gamma1, model.C, model.D + model.C @ Gamma1, step
-        )
+            return _discrete_like(model, (Phi, Gamma0, model.C, model.D), step)
+        with np.errstate(all="ignore"):  # an overflow is refused by name below
+            matrices = (Phi, Gamma0 - Gamma1 + Phi @ Gamma1, model.C, model.D + model.C @ Gamma1)
+        return _discrete_like(model, matrices, step)
     weight = _bilinear_weight(chosen, alpha)
     warped = _warped_step(chosen, weight, step, prewarp)
     Ad, Bd, Cd, Dd = _core.bilinear(model.A, model.B, model.C, model.D, warped, weight)
-    return _named_like(model, Ad, Bd, Cd, Dd, step)
+    return _discrete_like(model, (Ad, Bd, Cd, Dd), step)
+
+
+def _discrete_like(model: StateSpace, matrices: tuple[FloatArray, ...], dt: float) -> StateSpace:
+    """The sampled model of :func:`c2d`, with the names of ``model``."""
+    _refuse_overflow(matrices, dt)
+    A, B, C, D = matrices
+    return _named_like(model, A, B, C, D, dt)
+
+
+def _refuse_overflow(matrices: tuple[FloatArray, ...], dt: float) -> None:
+    """Refuses a sampled model whose matrix overflowed double precision, naming dt (instead
+    of a NonFiniteError from StateSpace blaming the model the caller gave)."""
+    for name, matrix in zip("ABCD", matrices, strict=True):
+        if not np.all(np.isfinite(matrix)):
+            error = InvalidArgumentError(
+                f"the sampled model's {name} overflows double precision: dt = {dt:g} is too "
+                "long for this model (e^(A dt) or its integral leaves the range of doubles), "
+                "or its entries are too large"
+            )
+            error.argument = "dt"
+            raise error
 
 
 def d2c(
@@ -656,11 +677,11 @@ def _matched(model: StateSpace, dt: float) -> StateSpace:
         Dd = D_k @ Dd
     if quadratic or linear:  # pragma: no cover - a proper G has no more zeros than poles
         raise AssertionError("matched: zeros left over after the sections")
+    with np.errstate(all="ignore"):  # an overflow is refused by name below
+        matrices = (Ad, gain * Bd, Cd, gain * Dd)
+    _refuse_overflow(matrices, dt)
     return StateSpace(
-        Ad,
-        gain * Bd,
-        Cd,
-        gain * Dd,
+        *matrices,
         input_names=model.input_names,
         output_names=model.output_names,
         dt=dt,
