@@ -25,8 +25,8 @@ const PLAIN_FROBENIUS_MAX_ENTRIES: usize = 256;
 /// The Frobenius norm ||A||_F = sqrt(sum a_ij^2). Small matrices (the 4-state Riccati solve
 /// takes seven such norms) use a plain sum of squares when it stays in the normal range:
 /// relative error at most about (mn/2 + 1) u, which is all a scale or a residual needs, where
-/// faer's scaled pairwise sum costs more to set up than the arithmetic. Larger matrices, and
-/// sums that overflow or underflow, use faer's `norm_l2`.
+/// faer's pairwise sum costs more to set up than the arithmetic. Larger matrices use faer's
+/// `norm_l2`, and matrices whose squares leave the range [`vector_norm`].
 pub fn frobenius_norm(a: MatRef<'_, f64>) -> f64 {
     if a.nrows() * a.ncols() <= PLAIN_FROBENIUS_MAX_ENTRIES {
         let mut squares = 0.0;
@@ -39,7 +39,14 @@ pub fn frobenius_norm(a: MatRef<'_, f64>) -> f64 {
             return squares.sqrt();
         }
     }
-    a.norm_l2()
+    // faer's sum for entries whose squares stay in range; otherwise the scaled sum (faer's
+    // overflowed to inf for entries near 1e154, and a Hamiltonian's axis margin with it).
+    let largest = max_abs(a);
+    if (VECTOR_RANGE_LOW..=VECTOR_RANGE_HIGH).contains(&largest) {
+        return a.norm_l2();
+    }
+    let (rows, cols) = (a.nrows(), a.ncols());
+    vector_norm((0..rows * cols).map(move |k| a[(k % rows, k / rows)]))
 }
 
 /// The Euclidean norm of a vector of finite entries, without overflow or underflow in its
