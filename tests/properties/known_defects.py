@@ -157,3 +157,58 @@ PLACEMENT_OVERFLOW_BLAMES_A: Defect = known_defect(
     lambda args: True,
     symptom="raised NonFiniteError, but every argument is finite",
 )
+
+
+def _definite(value: Any) -> bool:
+    """Whether a canonical weight is symmetric positive definite (by numpy's Cholesky)."""
+    array = np.asarray(value, dtype=float)
+    if array.ndim != 2 or array.shape[0] != array.shape[1] or not np.all(np.isfinite(array)):
+        return True
+    try:
+        np.linalg.cholesky(0.5 * (array + array.T))
+    except np.linalg.LinAlgError:
+        return False
+    return True
+
+
+CARE_EMPTY_INDEFINITE_RCOND: Defect = known_defect(
+    "care-empty-indefinite-rcond",
+    {"solve_care"},
+    "solve_care of an empty problem (n = 0) with an indefinite R (the extended-pencil path) "
+    "reports rcond = inf, without a NumericalOverflowWarning: "
+    "solve_care(zeros((0, 0)), zeros((0, 2)), zeros((0, 0)), diag([1.0, -1.0])).rcond is inf, "
+    "where the definite path (R = I) and solve_dare report 1.0. It should report 1.0 (E U11 "
+    "of order 0 is perfectly conditioned), as the other paths do.",
+    lambda args: np.asarray(args["A"]).size == 0 and not _definite(args["R"]),
+    symptom="NaN or Inf in ['.rcond']",
+)
+
+
+def _hamiltonian_work(args: dict[str, Any]) -> float:
+    """||H||_1 (t_f - t_0) of a riccati_ode call, H = [[A, -B R^-1 B^T], [-Q, -A^T]]: an
+    upper bound of the growth rate of its modes times the horizon."""
+    if "sys" in args:
+        (A, B), Q, R = _model(args["sys"])[:2], args["Q"], args["R"]
+    else:
+        A, B, Q, R = args["A_or_sys"], args["B"], args["Q"], args["R"]
+    A, B, Q, R = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, B, Q, R))
+    t = np.atleast_1d(np.asarray(args["t"], dtype=float))
+    with np.errstate(all="ignore"):
+        G = B @ np.linalg.solve(R, B.T)
+        H = np.block([[A, -G], [-Q, -A.T]])
+        return float(_one_norm(H) * abs(t[-1] - t[0])) if t.size else 0.0
+
+
+RICCATI_ODE_UNBOUNDED_SUBSTEPS: Defect = known_defect(
+    "riccati-ode-unbounded-substeps",
+    {"riccati_ode", "lqr_finite"},
+    "riccati_ode divides the horizon into steps across which the Hamiltonian's modes grow by "
+    "at most e, with no bound on their number: its time is proportional to "
+    "rho(H) (t_f - t_0). riccati_ode([[1e6]], [[1]], [[1]], [[1]], [0, 1]) takes 1.4e6 "
+    "substeps (0.5 s), A = [[1e8]] takes about 35 s, A = [[1e300]] (or a horizon of 1e300) "
+    "would run for ever, uninterruptibly, and returns a solution that converged to the "
+    "algebraic one after the first few time constants. It should double the step once the "
+    "modes have decayed (or refuse the horizon by name) so that the work stays bounded.",
+    lambda args: _hamiltonian_work(args) >= 5e4,
+    symptom="substeps",
+)
