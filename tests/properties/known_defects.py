@@ -212,3 +212,92 @@ RICCATI_ODE_UNBOUNDED_SUBSTEPS: Defect = known_defect(
     lambda args: _hamiltonian_work(args) >= 5e4,
     symptom="substeps",
 )
+
+
+def _any_indefinite(value: Any) -> bool:
+    """Whether some member of a canonical weight (one matrix or a stack) is not positive
+    definite."""
+    array = np.asarray(value, dtype=float)
+    members = array if array.ndim == 3 else array[np.newaxis]
+    return any(not _definite(member) for member in members)
+
+
+BATCH_REFUSES_INDEFINITE_R: Defect = known_defect(
+    "batch-refuses-indefinite-R",
+    {"batch.solve_care_batch", "batch.lqr_sweep"},
+    "solve_care_batch (and lqr_sweep, through it) refuses a symmetric indefinite R with "
+    "NotPositiveDefiniteError ('problem i of the batch: R must be symmetric positive "
+    "definite'), although solve_care solves it since issue 24 (the extended Hamiltonian "
+    "pencil) and the batch promises each problem 'solved exactly as solve_care solves it "
+    "alone': solve_care([[-5]], [[1]], [[1]], [[-1]]) returns X = 5 - sqrt(24) (closed loop "
+    "-4.899), solve_care_batch of the same numbers raises. (tests/test_batch.py pins the "
+    "refusal; rust/control/batch.rs calls the Cholesky path directly.) It should dispatch as "
+    "solve_care does.",
+    lambda args: _any_indefinite(args["R"]),
+    symptom="in the batch but",
+)
+
+
+def _order(args: dict[str, Any]) -> int:
+    """The order n of a batch or sweep call's plant (the last axis of A)."""
+    if "sys" in args:
+        return int(np.asarray(_model(args["sys"])[0]).shape[-1])
+    A = args.get("A", args.get("sys_or_A"))
+    return int(np.asarray(A, dtype=float).shape[-1])
+
+
+BATCH_EMPTY_RCOND: Defect = known_defect(
+    "batch-empty-rcond",
+    {"batch.solve_care_batch", "batch.solve_dare_batch", "batch.lqr_sweep", "batch.dlqr_sweep"},
+    "The Riccati batches report rcond = 0 for a problem of order n = 0, and then an "
+    "IllConditionedWarning ('1 of the 1 Riccati solutions may be inaccurate ... problems 0'), "
+    "where solve_care and solve_dare report rcond = 1.0 without a warning: "
+    "solve_care_batch(zeros((0, 0)), zeros((0, 2)), zeros((0, 0)), eye(2)).rcond is [0.]; "
+    "likewise solve_dare_batch, lqr_sweep and dlqr_sweep. The batch should fill rcond as the "
+    "single solve does (it promises the single results bitwise).",
+    lambda args: _order(args) == 0,
+    symptom="rcond",
+)
+
+
+def _any_extreme(args: dict[str, Any]) -> bool:
+    """Whether a matrix argument (or a model's matrix) has an entry whose square leaves the
+    normal range."""
+    for value in args.values():
+        matrices = _model(value) if hasattr(value, "A") else (value,)
+        for matrix in matrices:
+            try:
+                if _extreme_entries(matrix):
+                    return True
+            except (TypeError, ValueError):
+                continue
+    return False
+
+
+RICCATI_OVERFLOW_BLAMES_A: Defect = known_defect(
+    "riccati-overflow-blames-A",
+    {"solve_care", "lqr", "riccati_ode", "lqr_finite", "lqe", "kalman", "lqg"},
+    "When B R^-1 B^T (or another product forming the Hamiltonian) overflows, solve_care and "
+    "riccati_ode raise NonFiniteError 'A must be finite, but A[0, 1] is -inf', blaming A, "
+    "which is finite: solve_care([[0.0]], [[1e200]], [[1.0]], [[1.0]]) has the solution "
+    "X = 1e-200, K = 1 (representable, and found after scaling B), and "
+    "riccati_ode([[0.0]], [[1e200]], [[1.0]], [[1.0]], [0.0, 0.1]) likewise (also with "
+    "R = [[1e-310]] and B = [[1]]). (solve_dare refuses the same numbers with "
+    "IllConditionedError.) The solvers should scale B (or R) before forming G, or at least "
+    "name the overflow instead of A.",
+    _any_extreme,
+    symptom="raised NonFiniteError, but every argument is finite",
+)
+
+
+SWEEP_WEIGHTS_ALIAS: Defect = known_defect(
+    "sweep-weights-alias",
+    {"batch.lqr_sweep", "batch.dlqr_sweep"},
+    "lqr_sweep and dlqr_sweep return the caller's own weights array as LqrSweep.weights when "
+    "it is an aligned float64 array (python/aerocontrol/batch.py, _sweep: "
+    "np.atleast_1d(real_array(weights, 'weights')) is the argument itself): "
+    "c = np.array([1.0, 2.0]); s = lqr_sweep(A, B, weights=c); c[0] = 5.0 changes "
+    "s.weights[0] to 5.0. Every other result is a fresh array; the weights should be copied.",
+    lambda args: True,
+    symptom="share memory with the arguments",
+)

@@ -522,13 +522,14 @@ def riccati_problem(
     descriptor_matrix: bool = True,
     n: int | None = None,
     m: int | None = None,
+    kinds: Sequence[str] = RICCATI_KINDS,
 ) -> dict[str, np.ndarray | None]:
     """The canonical numbers of a Riccati problem: A, B, Q, R, and S and E (each None when
     not drawn). Kinds: "regulator" (a random plant with definite weights, mostly solvable),
     "drawn" (every matrix from the general strategies: any structure, scale and special
     value), "planted" (an exactly uncontrollable pair, stabilisable or not), "imaginary axis"
     (undamped modes with semidefinite Q: no stabilising solution when unexcited)."""
-    kind = draw(st.sampled_from(RICCATI_KINDS))
+    kind = draw(st.sampled_from(tuple(kinds)))
     n = draw(orders()) if n is None else n
     m = draw(st.integers(1, 3)) if m is None else m
     rng = _rng(draw)
