@@ -233,8 +233,7 @@ BATCH_REFUSES_INDEFINITE_R: Defect = known_defect(
     "-4.899), solve_care_batch of the same numbers raises. (tests/test_batch.py pins the "
     "refusal; rust/control/batch.rs calls the Cholesky path directly.) It should dispatch as "
     "solve_care does.",
-    lambda args: _any_indefinite(args["R"]),
-    symptom="in the batch but",
+    lambda args: args["R"] is not None and _any_indefinite(args["R"]),
 )
 
 
@@ -247,16 +246,18 @@ def _order(args: dict[str, Any]) -> int:
 
 
 BATCH_EMPTY_RCOND: Defect = known_defect(
-    "batch-empty-rcond",
+    "batch-empty-problem",
     {"batch.solve_care_batch", "batch.solve_dare_batch", "batch.lqr_sweep", "batch.dlqr_sweep"},
-    "The Riccati batches report rcond = 0 for a problem of order n = 0, and then an "
-    "IllConditionedWarning ('1 of the 1 Riccati solutions may be inaccurate ... problems 0'), "
-    "where solve_care and solve_dare report rcond = 1.0 without a warning: "
-    "solve_care_batch(zeros((0, 0)), zeros((0, 2)), zeros((0, 0)), eye(2)).rcond is [0.]; "
-    "likewise solve_dare_batch, lqr_sweep and dlqr_sweep. The batch should fill rcond as the "
-    "single solve does (it promises the single results bitwise).",
+    "The Riccati batches skip a problem of order n = 0 entirely: they report rcond = 0 and "
+    "then an IllConditionedWarning ('1 of the 1 Riccati solutions may be inaccurate ... "
+    "problems 0'), where solve_care and solve_dare report rcond = 1.0 without a warning "
+    "(solve_care_batch(zeros((0, 0)), zeros((0, 2)), zeros((0, 0)), eye(2)).rcond is [0.]), "
+    "and they do not check R: R = [[nan]] or [[inf]] is returned from (solve_care and "
+    "solve_dare raise NonFiniteError naming R), R = [[0.0]] too (solve_care raises "
+    "InvalidArgumentError: R singular). Likewise lqr_sweep and dlqr_sweep. The batch should "
+    "check and fill each problem as the single solve does (it promises the single results "
+    "bitwise).",
     lambda args: _order(args) == 0,
-    symptom="rcond",
 )
 
 
