@@ -186,7 +186,10 @@ def _assert_gain(problem: Problem, X: np.ndarray, K: np.ndarray, discrete: bool)
         sizes += norm(S) if S is not None else 0.0
     kappa = 1.0 if E is None else condition(E)
     if np.isfinite(sizes) and np.isfinite(kappa):
-        assert_within_(error, SLACK * (n + m) * U * kappa * sizes + TINY, "the gain's equation")
+        # K may underflow (R = 1e150, B^T X A = 1e-304: K = 1e-454): an absolute error of
+        # TINY in K, ||R|| TINY in the equation.
+        floor = SLACK * (norm(np.asarray(lhs, np.float64)) + 1) * TINY
+        assert_within_(error, SLACK * (n + m) * U * kappa * sizes + floor, "the gain's equation")
 
 
 def _assert_closed_loop(problem: Problem, K: np.ndarray, poles: np.ndarray, discrete: bool) -> None:
