@@ -261,12 +261,20 @@ BATCH_EMPTY_RCOND: Defect = known_defect(
 )
 
 
+def _matrices_of(value: Any) -> list[Any]:
+    """The arrays of an argument: itself, a model's A, B, C, D, or a tuple's members."""
+    if hasattr(value, "A") and not isinstance(value, np.ndarray):
+        return list(_model(value))
+    if isinstance(value, (tuple, list)) and value and not np.isscalar(value[0]):
+        return [m for item in value for m in _matrices_of(item)]
+    return [value]
+
+
 def _any_extreme(args: dict[str, Any]) -> bool:
     """Whether a matrix argument (or a model's matrix) has an entry whose square leaves the
     normal range."""
     for value in args.values():
-        matrices = _model(value) if hasattr(value, "A") else (value,)
-        for matrix in matrices:
+        for matrix in _matrices_of(value):
             try:
                 if _extreme_entries(matrix):
                     return True
@@ -301,4 +309,60 @@ SWEEP_WEIGHTS_ALIAS: Defect = known_defect(
     "s.weights[0] to 5.0. Every other result is a fresh array; the weights should be copied.",
     lambda args: True,
     symptom="share memory with the arguments",
+)
+
+
+ESTIMATION_OVERFLOW: Defect = known_defect(
+    "estimation-overflow",
+    {"lqe", "dlqe", "kalman", "lqg"},
+    "python/aerocontrol/estimation.py forms G QN G^T, its symmetric part 0.5 (P + P^T) and "
+    "the LQG compensator's A - B K - L C + L D K with numpy without handling overflow: "
+    "numpy's RuntimeWarning 'overflow encountered in matmul' (estimation.py:308, :906) or "
+    "'in add' (:309) reaches the caller, and the filter is then refused as NonFiniteError "
+    "'Q must be finite, but Q[0, 0] is inf', naming a Q that lqe does not take. "
+    "lqe([[-1.0]], [[1e200]], [[1.0]], [[1.0]], [[1.0]]) and, with a representable G QN G^T, "
+    "lqe([[-1.0]], [[1.0]], [[1.0]], [[1e308]], [[1.0]]) (P + P^T = 2e308 overflows where "
+    "0.5 P + 0.5 P^T would not); likewise dlqe, kalman and lqg. It should scale (or halve "
+    "before adding) and name the argument or the overflow.",
+    _any_extreme,
+    symptom="estimation.py",
+)
+
+
+def _c2d_overflows(args: dict[str, Any]) -> bool:
+    """Whether a c2d call's discretisation can overflow: ||A dt||_1 >= 700 (e^{A dt}), or an
+    entry of the model or of A dt whose square leaves the normal range."""
+    A = np.asarray(_model(args["sys"])[0], dtype=float)
+    dt = abs(float(args["dt"]))
+    with np.errstate(all="ignore"):
+        return bool(_one_norm(A) * dt >= 700 or _any_extreme(args) or _extreme_entries(A * dt))
+
+
+C2D_OVERFLOW_BLAMES_MODEL: Defect = known_defect(
+    "c2d-overflow-blames-model",
+    {"c2d"},
+    "When the discretisation overflows, c2d issues a NumericalOverflowWarning and then raises "
+    "NonFiniteError 'A must be finite, but A[0, 0] is inf', blaming the model's finite A "
+    "(the StateSpace it builds from the overflowed Phi refuses it): "
+    "c2d(([[1.0]], [[1.0]], [[1.0]], [[0.0]]), 1000.0) (e^1000 overflows); with "
+    "method='foh' numpy's RuntimeWarning 'invalid value encountered in subtract' "
+    "(linalg.py:344) leaks too, and c2d(([[-1.0]], [[1e300]], [[1e300]], [[0.0]]), 0.1, "
+    "'foh') says 'D must be finite, but D[0, 0] is inf'. It should raise an error that names "
+    "the overflow (dt too long for the model, or entries too large).",
+    _c2d_overflows,
+)
+
+
+QZ_REAL_TWO_BY_TWO_BLOCK: Defect = known_defect(
+    "qz-real-2x2-block",
+    {"qz"},
+    "qz can leave a negligible subdiagonal entry of AA standing, so that AA has a 2 x 2 "
+    "block whose eigenvalues are real (alpha with imaginary part +-0): for the pencil (M, M), "
+    "M = [[-0.06, -0.29, 0.04], [-0.95, 2.71, 0.9], [-0.8, -0.21, 0.04]] (every eigenvalue "
+    "1), AA[1, 0] = 3.07e-16 and alpha = [1.254+0j, 0.109-0j, 2.008+0j]; 2 of 300 random "
+    "pencils (M, M) of orders 2 to 6 did so. The documented form has 2 x 2 blocks for "
+    "complex pairs only (LAPACK's dlagv2 splits a real pair into two 1 x 1 blocks with an "
+    "exact zero below).",
+    lambda args: True,
+    symptom="holds real eigenvalues",
 )

@@ -60,7 +60,7 @@ def member(stack: np.ndarray, i: int, name: str) -> np.ndarray:
     array = np.asarray(stack, dtype=np.float64)
     if name == "B" and array.ndim == 1:
         return array.reshape(-1, 1)
-    return array if array.ndim == 2 else array[i]
+    return array if array.ndim == 2 else array[i if array.shape[0] > 1 else 0]
 
 
 def batch_count(args: dict[str, Any], names: tuple[str, ...], rows: int = 1) -> int:
@@ -162,14 +162,16 @@ def stacked(members: list[np.ndarray], how: str) -> np.ndarray:
     return np.stack(members) if members else np.zeros((0, 0, 0))
 
 
-def _wrong(a: np.ndarray, how: str, name: str) -> np.ndarray:
-    """``a`` (a stack of k, or one matrix) made of the wrong count or shape."""
+def _wrong(a: np.ndarray, how: str, name: str, others: list[Any]) -> np.ndarray:
+    """``a`` (a stack of k, or one matrix) made of the wrong count or shape; ``others`` are
+    the other stacked arguments, whose counts the wrong count must contradict."""
     stack = a if a.ndim == 3 else a[np.newaxis]
-    if how == "count":
-        if not stack.shape[0]:
-            return np.zeros((2, *stack.shape[1:]))
-        return np.concatenate([stack, stack[:1], stack[:1]])
-    if how == "order":
+    counts = {np.asarray(o).shape[0] for o in others if np.asarray(o).ndim == 3} - {1}
+    if how == "count" and counts:
+        # Neither one (shared) nor the other stacks' count.
+        wrong = max(counts) + 1
+        return np.concatenate([stack[:1]] * wrong) if stack.shape[0] else np.zeros((wrong, 1, 1))
+    if how in ("count", "order"):
         return np.pad(stack, ((0, 0), (0, 1), (0, 1)))
     if how == "4-D":
         return stack[np.newaxis]
@@ -201,7 +203,8 @@ def riccati_batch(draw: st.DrawFn) -> tuple[dict[str, Arg], str | None]:
     wrong = None
     if draw(st.sampled_from((False,) * 6 + (True,))):
         wrong = draw(st.sampled_from(("B", "Q", "R")))
-        arrays[wrong] = _wrong(arrays[wrong], draw(st.sampled_from(WRONG)), wrong)
+        others = [a for name, a in arrays.items() if name != wrong]
+        arrays[wrong] = _wrong(arrays[wrong], draw(st.sampled_from(WRONG)), wrong, others)
     if m == 1 and arrays["B"].ndim == 2 and draw(st.booleans()):
         arrays["B"] = arrays["B"][:, 0]  # one input as a vector, shared
     return {name: draw(presented(a)) for name, a in arrays.items()}, wrong
@@ -343,7 +346,7 @@ def test_place_batch(data: st.DataObject) -> None:
     if data.draw(st.sampled_from((False,) * 6 + (True,))):
         wrong = data.draw(st.sampled_from(("B", "poles")))
         if wrong == "B":
-            B = _wrong(B, data.draw(st.sampled_from(WRONG)), "B")
+            B = _wrong(B, data.draw(st.sampled_from(WRONG)), "B", [A, np.atleast_2d(P)[:, None, :]])
         else:
             P = np.pad(np.atleast_2d(P), ((0, 0), (0, 1)), constant_values=-1.0)
     if m == 1 and B.ndim == 2 and data.draw(st.booleans()):
@@ -510,4 +513,22 @@ def test_known_defect_batch_empty_rcond() -> None:
                 "R": canonical(np.eye(2)),
             },
             _riccati_batch_oracle(False),
+        )
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.SWEEP_WEIGHTS_ALIAS.summary)
+def test_known_defect_sweep_weights_alias() -> None:
+    A, B = aerocontrol.chapter.boeing747_lateral()
+    with known_defects.SWEEP_WEIGHTS_ALIAS.reproducing():
+        exercise(
+            "batch.lqr_sweep",
+            batch.lqr_sweep,
+            {
+                "sys_or_A": canonical(A),
+                "B": canonical(B),
+                "Q": plain(None),
+                "R": plain(None),
+                "weights": canonical(np.array([1.0, 2.0])),
+            },
+            _sweep_oracle(False),
         )

@@ -21,6 +21,7 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+import pytest
 import scipy.linalg as sl
 import scipy.signal as ss
 from hypothesis import given
@@ -29,6 +30,7 @@ from hypothesis import strategies as st
 import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning
 
+from . import known_defects
 from .harness import CALLBACK, SAME, Arg, CallerError, Warned, exercise, plain
 from .oracles import (
     SLACK,
@@ -42,6 +44,7 @@ from .oracles import (
     silenced,
 )
 from .strategies import (
+    canonical,
     model_matrices,
     orders,
     presented,
@@ -119,7 +122,9 @@ def _qz_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
             assert BB[k, k + 1] == 0, f"BB is not diagonal under AA's block {k}"
             # A complex pair, the member with Im > 0 first; as LAPACK's dgges, alpha and beta
             # of the two members may be scaled apart (only their ratios are conjugate).
-            assert alpha[k].imag > 0 and alpha[k + 1].imag < 0, f"block {k}: {alpha[k : k + 2]}"
+            assert alpha[k].imag > 0 and alpha[k + 1].imag < 0, (
+                f"2 x 2 block {k} holds real eigenvalues: alpha {alpha[k : k + 2]}"
+            )
             assert (
                 abs(alpha[k] * beta[k + 1] - np.conj(alpha[k + 1]) * beta[k])
                 <= scale * (abs(alpha[k]) * beta[k + 1] + abs(alpha[k + 1]) * beta[k]) + TINY
@@ -254,8 +259,13 @@ def _c2d_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
 
 
 def _round_trip(discrete: Any, A: np.ndarray, B: np.ndarray, dt: float) -> None:
-    """d2c(c2d(sys)) = sys for the zero-order hold, without aliasing: ||A dt||_1 <= 1."""
-    n = A.shape[0]
+    """d2c(c2d(sys)) = sys for the zero-order hold, without aliasing (||A dt||_1 <= 1).
+
+    The logarithm of M = [[Ad, Bd], [0, I]] is accurate to u ||M|| ||M^-1|| absolutely (its
+    derivative is of the size of M^-1), and A = log(M)_11 / dt: the error allowed is
+    SLACK (n + m) u κ_exp(A dt)² ||M|| ||M^-1|| / dt, κ_exp for the rounding of Ad and Bd by
+    c2d as well."""
+    n, m = B.shape
     if n == 0 or not finite(A, B) or not 1e-100 < dt < 1e100:
         return
     with silenced():
@@ -264,8 +274,10 @@ def _round_trip(discrete: Any, A: np.ndarray, B: np.ndarray, dt: float) -> None:
         if not (1e-100 < size <= 1.0) or norm(B) * dt > 1e100:
             return
         kappa = expm_condition(X)
+        M = np.block([[discrete.A, discrete.B], [np.zeros((m, n)), np.eye(m)]])
+        spread = norm(M) * norm(np.linalg.inv(M))
         back = aerocontrol.d2c(discrete)
-    bound = SLACK * n * U * kappa**2 * (norm(A) + norm(B)) + SLACK * TINY / dt
+    bound = SLACK * (n + m) * U * kappa**2 * spread / dt + SLACK * TINY / dt
     assert norm(back.A - A) <= bound, f"d2c(c2d(sys)).A != A: {norm(back.A - A):.3e} > {bound:.3e}"
     assert norm(back.B - B) <= bound, "d2c(c2d(sys)).B != B"
 
@@ -368,3 +380,37 @@ def test_d2c(data: st.DataObject) -> None:
     exercise(
         "d2c", aerocontrol.d2c, {"sys": sys, "method": plain(method), "alpha": alpha}, _d2c_oracle
     )
+
+
+# ----- known defects of the core (see known_defects.py) ------------------------------------------
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.QZ_REAL_TWO_BY_TWO_BLOCK.summary)
+def test_known_defect_qz_real_2x2_block() -> None:
+    M = np.array([[-0.06, -0.29, 0.04], [-0.95, 2.71, 0.9], [-0.8, -0.21, 0.04]])
+    with known_defects.QZ_REAL_TWO_BY_TWO_BLOCK.reproducing():
+        exercise(
+            "qz",
+            aerocontrol.qz,
+            {"A": canonical(M), "B": canonical(M.copy()), "select": plain(None)},
+            _qz_oracle,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.C2D_OVERFLOW_BLAMES_MODEL.summary)
+@pytest.mark.parametrize("method", ["zoh", "foh"])
+def test_known_defect_c2d_overflow_blames_model(method: str) -> None:
+    model = tuple(np.array([[value]]) for value in (1.0, 1.0, 1.0, 0.0))
+    with known_defects.C2D_OVERFLOW_BLAMES_MODEL.reproducing():
+        exercise(
+            "c2d",
+            aerocontrol.c2d,
+            {
+                "sys": Arg(model, model, "tuple", SAME),
+                "dt": plain(1000.0),
+                "method": plain(method),
+                "prewarp": plain(None),
+                "alpha": plain(None),
+            },
+            _c2d_oracle,
+        )

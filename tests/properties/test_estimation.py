@@ -20,6 +20,7 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -27,9 +28,11 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning
 from aerocontrol.placement import POLE_ERROR_WARNING
 
+from . import known_defects
 from .harness import SAME, Arg, Warned, exercise, plain
 from .oracles import SLACK, TINY, U, assert_stable, condition, finite, norm, quietly, silenced
 from .strategies import (
+    canonical,
     model_matrices,
     presented,
     presented_system,
@@ -376,3 +379,25 @@ def test_lqg(data: st.DataObject) -> None:
         return aerocontrol.lqg(sys, Q, R, QN, RN, N=N, G=G, NN=NN)
 
     exercise("lqg", call, arguments, _lqg_oracle)
+
+
+# ----- known defects of the core (see known_defects.py) ------------------------------------------
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.ESTIMATION_OVERFLOW.summary)
+@pytest.mark.parametrize("covariance", [1.0, 1e308])
+def test_known_defect_estimation_overflow(covariance: float) -> None:
+    G = 1e200 if covariance == 1.0 else 1.0
+    with known_defects.ESTIMATION_OVERFLOW.reproducing():
+        exercise(
+            "lqe",
+            _filter_call("lqe", "A, G, C, QN, RN"),
+            {
+                "A": canonical(np.array([[-1.0]])),
+                "G": canonical(np.array([[G]])),
+                "C": canonical(np.eye(1)),
+                "QN": canonical(np.array([[covariance]])),
+                "RN": canonical(np.eye(1)),
+            },
+            _filter_oracle(False),
+        )

@@ -747,3 +747,19 @@ def test_known_defect_riccati_ode_unbounded_substeps() -> None:
             },
             _ode_oracle,
         )
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.RICCATI_OVERFLOW_BLAMES_A.summary)
+def test_known_defect_riccati_overflow_blames_a() -> None:
+    with known_defects.RICCATI_OVERFLOW_BLAMES_A.reproducing():
+        exercise(
+            "solve_care",
+            aerocontrol.solve_care,
+            {
+                "A": canonical(np.zeros((1, 1))),
+                "B": canonical(np.array([[1e200]])),
+                "Q": canonical(np.eye(1)),
+                "R": canonical(np.eye(1)),
+            },
+            _solution_oracle(False),
+        )
