@@ -147,7 +147,7 @@ def _pair(args: dict[str, Any]) -> tuple[Any, Any]:
 
 PLACEMENT_OVERFLOW_BLAMES_A: Defect = known_defect(
     "placement-overflow-blames-A",
-    {"place", "place_ackermann", "place_bass_gura"},
+    {"place", "place_ackermann", "place_bass_gura", "batch.place_batch"},
     "When a placement overflows inside (the desired polynomial's coefficients for poles "
     "-1e160 and -2e160; a gain of 1/b for b = [[1e-301]]; A and B with entries near 1e150 "
     "for place), it raises NonFiniteError 'A must be finite, but A[0, 0] is -inf' (or NaN), "
@@ -365,4 +365,49 @@ QZ_REAL_TWO_BY_TWO_BLOCK: Defect = known_defect(
     "exact zero below).",
     lambda args: True,
     symptom="holds real eigenvalues",
+)
+
+
+def _norm_ratio(args: dict[str, Any]) -> float:
+    """max(||A||_F / ||B||_F, ||B||_F / ||A||_F) of a qz call (inf when one is zero)."""
+    with np.errstate(all="ignore"):
+        a = float(np.linalg.norm(np.asarray(args["A"], dtype=float)))
+        b = float(np.linalg.norm(np.asarray(args["B"], dtype=float)))
+        if a == 0 or b == 0:
+            return 1.0 if a == b else np.inf
+        return max(a / b, b / a)
+
+
+QZ_UNBALANCED_PENCIL: Defect = known_defect(
+    "qz-unbalanced-pencil",
+    {"qz"},
+    "qz is not backward stable for each matrix of a pencil whose two matrices differ much in "
+    "size: Q BB Z^T differs from B by far more than u ||B|| when ||B|| << ||A||. For "
+    "A = [[-0.1, -0.5], [-1.7e-4, -1.2]], B = [[4e-11, -4e-11], [1.3e-10, -1.3e-10]] "
+    "(B singular: one infinite eigenvalue) ||Q BB Z^T - B|| is 1 % of ||B|| (1e14 u; scipy: "
+    "2 u), and the eigenvalues come out as 4.2955e9 and -9.08e11 where scipy gives 3.998e9 "
+    "and inf; for A = [[-0.132, 640.4], [1.05e-4, -0.536]] and a random B of size 1e-8 the "
+    "error is 3.9e4 u (B of size 1e-6: 1.3 u). With entries near 1e-300 in A and 1e-3 in B, "
+    "Q and Z lose orthogonality (3e8 u) and B's error is 1e8 u. Deflation and the "
+    "convergence tests seem to compare B's entries with a norm of the whole pencil (or of "
+    "A); LAPACK's dhgeqz tests each matrix against its own norm. solve_dare and the "
+    "indefinite CARE use this QZ.",
+    lambda args: _norm_ratio(args) >= 1e6 or _any_extreme(args),
+)
+
+
+C2D_MATCHED_SCALE: Defect = known_defect(
+    "c2d-matched-scale",
+    {"c2d"},
+    "c2d(method='matched') is not invariant to the scale of the model's gain: with "
+    "A = [[0.1257, -0.1321], [0.6404, 0.1049]], B = [[1e-4], [-1.3e-4]], "
+    "C = c [[1, -1.05]], D = 0, dt = 0.1, G_d(e^{0.3j}) / c is -9.50e-6 - 7.97e-5j for "
+    "c = 1 and 1e10 but -1.79e-5 - 7.77e-5j for c = 1e50 to 1e140 (another zero, silently), "
+    "1.9e124 for c = 1e149, and for c = 1e100 and 1e120 numpy's RuntimeWarnings (overflow in "
+    "expm1 and exp, linalg.py:614-627) leak and NonFiniteError 'B must be finite, but "
+    "B[0, 0] is NaN' blames the finite B. The zeros seem to be found with a tolerance that is "
+    "not relative to the numerator's scale.",
+    lambda args: (
+        args["method"] == "matched" and max(_largest(m) for m in _model(args["sys"])) >= 1e40
+    ),
 )

@@ -169,7 +169,7 @@ def _wrong(a: np.ndarray, how: str, name: str, others: list[Any]) -> np.ndarray:
     counts = {np.asarray(o).shape[0] for o in others if np.asarray(o).ndim == 3} - {1}
     if how == "count" and counts:
         # Neither one (shared) nor the other stacks' count.
-        wrong = max(counts) + 1
+        wrong = max(max(counts) + 1, 2)
         return np.concatenate([stack[:1]] * wrong) if stack.shape[0] else np.zeros((wrong, 1, 1))
     if how in ("count", "order"):
         return np.pad(stack, ((0, 0), (0, 1), (0, 1)))

@@ -158,18 +158,20 @@ def _qz_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
 
 
 def _side(select: Any, alpha: complex, beta: float, A: np.ndarray, B: np.ndarray) -> str:
-    radius = SLACK * A.shape[0] * U * (norm(A) + norm(B) + 1.0)
-    scale = abs(alpha) + abs(beta)
+    """ "in" or "out" of the selection, or "edge" if perturbing alpha by SLACK n u ||A|| or
+    beta by SLACK n u ||B|| (their backward errors) changes it."""
+    n = A.shape[0]
+    d_alpha, d_beta = SLACK * n * U * (norm(A) + TINY), SLACK * n * U * (norm(B) + TINY)
     verdicts = set()
-    for d_alpha, d_beta in (
+    for da, db in (
         (0, 0),
-        (radius, 0),
-        (-radius, 0),
-        (1j * radius, 0),
-        (0, radius),
-        (0, -radius),
+        (d_alpha, 0),
+        (-d_alpha, 0),
+        (1j * d_alpha, 0),
+        (0, d_beta),
+        (0, -d_beta),
     ):
-        verdicts.add(_selected(select, alpha + d_alpha * scale, max(beta + d_beta * scale, 0.0)))
+        verdicts.add(_selected(select, alpha + da, max(beta + db, 0.0)))
     return "edge" if len(verdicts) == 2 else "in" if verdicts == {True} else "out"
 
 
@@ -409,6 +411,40 @@ def test_known_defect_c2d_overflow_blames_model(method: str) -> None:
                 "sys": Arg(model, model, "tuple", SAME),
                 "dt": plain(1000.0),
                 "method": plain(method),
+                "prewarp": plain(None),
+                "alpha": plain(None),
+            },
+            _c2d_oracle,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.QZ_UNBALANCED_PENCIL.summary)
+def test_known_defect_qz_unbalanced_pencil() -> None:
+    A = np.array([[-0.1, -0.5], [-1.7e-4, -1.2]])
+    B = np.array([[4e-11, -4e-11], [1.3e-10, -1.3e-10]])
+    with known_defects.QZ_UNBALANCED_PENCIL.reproducing():
+        exercise(
+            "qz",
+            aerocontrol.qz,
+            {"A": canonical(A), "B": canonical(B), "select": plain(None)},
+            _qz_oracle,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.C2D_MATCHED_SCALE.summary)
+def test_known_defect_c2d_matched_scale() -> None:
+    A = np.array(
+        [[0.1257302210933933, -0.1321048632913019], [0.6404226504432821, 0.1049001171530397]]
+    )
+    model = (A, np.array([[1e-4], [-1.3e-4]]), np.array([[1e100, -1.05e100]]), np.zeros((1, 1)))
+    with known_defects.C2D_MATCHED_SCALE.reproducing():
+        exercise(
+            "c2d",
+            aerocontrol.c2d,
+            {
+                "sys": Arg(model, model, "tuple", SAME),
+                "dt": plain(0.1),
+                "method": plain("matched"),
                 "prewarp": plain(None),
                 "alpha": plain(None),
             },
