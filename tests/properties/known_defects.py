@@ -165,7 +165,8 @@ def _definite(value: Any) -> bool:
     if array.ndim != 2 or array.shape[0] != array.shape[1] or not np.all(np.isfinite(array)):
         return True
     try:
-        np.linalg.cholesky(0.5 * (array + array.T))
+        with np.errstate(all="ignore"):
+            np.linalg.cholesky(0.5 * array + 0.5 * array.T)
     except np.linalg.LinAlgError:
         return False
     return True
@@ -410,4 +411,30 @@ C2D_MATCHED_SCALE: Defect = known_defect(
     lambda args: (
         args["method"] == "matched" and max(_largest(m) for m in _model(args["sys"])) >= 1e40
     ),
+)
+
+
+LYAPUNOV_TINY_REFUSED: Defect = known_defect(
+    "lyapunov-tiny-refused",
+    {"solve_lyapunov"},
+    "solve_lyapunov refuses a well-conditioned equation whose A is tiny, as if its test of "
+    "the eigenvalue sums were absolute: solve_lyapunov([[-1e-295]], [[1e-295]]) raises "
+    "IllConditionedError ('A has two eigenvalues whose sum is (nearly) zero') although "
+    "X = 0.5 exactly; A = -1e-290 is solved, A = -1e-300 I (any n) refused. The test should "
+    "be relative to ||A||.",
+    lambda args: 0 < _largest(args["A"]) < 1e-280,
+    symptom="solve_lyapunov refused",
+)
+
+
+SWEEP_WEIGHT_OVERFLOW: Defect = known_defect(
+    "sweep-weight-overflow",
+    {"batch.lqr_sweep", "batch.dlqr_sweep"},
+    "lqr_sweep and dlqr_sweep form R / c^2 with numpy (python/aerocontrol/batch.py:392) "
+    "without handling overflow: for a small weight c and a large R numpy's RuntimeWarning "
+    "'overflow encountered in divide' reaches the caller (then the infinite R is refused by "
+    "name, though the caller's R is finite): lqr_sweep([[-1.0]], [[1.0]], R=[[1e10]], "
+    "weights=[1e-150]). It should refuse the weight by name (or scale).",
+    lambda args: True,
+    symptom="batch.py",
 )
