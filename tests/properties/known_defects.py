@@ -313,6 +313,18 @@ SWEEP_WEIGHTS_ALIAS: Defect = known_defect(
 )
 
 
+def _largest_entry(args: dict[str, Any]) -> float:
+    """The largest magnitude in any matrix argument (or a model's matrix)."""
+    largest = 0.0
+    for value in args.values():
+        for matrix in _matrices_of(value):
+            try:
+                largest = max(largest, _largest(matrix))
+            except (TypeError, ValueError):
+                continue
+    return largest
+
+
 ESTIMATION_OVERFLOW: Defect = known_defect(
     "estimation-overflow",
     {"lqe", "dlqe", "kalman", "lqg"},
@@ -323,9 +335,10 @@ ESTIMATION_OVERFLOW: Defect = known_defect(
     "'Q must be finite, but Q[0, 0] is inf', naming a Q that lqe does not take. "
     "lqe([[-1.0]], [[1e200]], [[1.0]], [[1.0]], [[1.0]]) and, with a representable G QN G^T, "
     "lqe([[-1.0]], [[1.0]], [[1.0]], [[1e308]], [[1.0]]) (P + P^T = 2e308 overflows where "
-    "0.5 P + 0.5 P^T would not); likewise dlqe, kalman and lqg. It should scale (or halve "
+    "0.5 P + 0.5 P^T would not); likewise dlqe, kalman (G = 2e150, QN = 1e8) and lqg. It "
+    "should scale (or halve "
     "before adding) and name the argument or the overflow.",
-    _any_extreme,
+    lambda args: _any_extreme(args) or _largest_entry(args) >= 1e100,
     symptom="estimation.py",
 )
 
