@@ -257,9 +257,24 @@ BATCH_EMPTY_RCOND: Defect = known_defect(
     "solve_dare raise NonFiniteError naming R), R = [[0.0]] too (solve_care raises "
     "InvalidArgumentError: R singular). Likewise lqr_sweep and dlqr_sweep. The batch should "
     "check and fill each problem as the single solve does (it promises the single results "
-    "bitwise).",
-    lambda args: _order(args) == 0,
+    "bitwise). An empty batch (k = 0, or lqr_sweep with weights=[]) or a problem of order "
+    "0 is not checked at all: lqr_sweep([[0.126]], [[0.126]], Q=[[inf]], weights=[]) "
+    "returns, and solve_dare_batch(zeros((0, 0)), [[[0.0, 0.0]]], zeros((0, 0)), [[1.0]]) "
+    "accepts a B of one row for an A of none.",
+    lambda args: _order(args) == 0 or _batch_size(args) == 0,
 )
+
+
+def _batch_size(args: dict[str, Any]) -> int:
+    """The number of problems of a batch call (the weights of a sweep), -1 if unknown."""
+    if "weights" in args:
+        return int(np.atleast_1d(np.asarray(args["weights"], dtype=float)).size)
+    sizes = [
+        np.asarray(args[key], dtype=float).shape[0]
+        for key in ("A", "B", "Q", "R")
+        if key in args and np.asarray(args[key], dtype=float).ndim == 3
+    ]
+    return min(sizes) if sizes else -1
 
 
 def _matrices_of(value: Any) -> list[Any]:

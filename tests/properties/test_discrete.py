@@ -36,7 +36,6 @@ from .oracles import (
     SLACK,
     TINY,
     U,
-    condition,
     expm_condition,
     finite,
     norm,
@@ -213,6 +212,17 @@ def _model(args: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np
     return model_matrices(args["sys"])
 
 
+def _inverse_condition(M: np.ndarray, size: float) -> float:
+    """||M^-1|| (1 + size): the amplification of the rounding of M = I + X, ||X|| = size,
+    in M^-1 (at least κ(M) / 2; inf where M is singular)."""
+    if M.shape[0] == 0:
+        return 1.0
+    try:
+        return float(np.linalg.norm(np.linalg.inv(M), 2) * (1 + size))
+    except np.linalg.LinAlgError:
+        return np.inf
+
+
 def _c2d_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
     A, B, C, D = _model(args)
     dt, method = float(args["dt"]), args["method"]
@@ -241,8 +251,9 @@ def _c2d_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
     if n == 0:
         return
     with silenced():
+        # Forming M = I - α dt A rounds by u (1 + ||α dt A||), which M^-1 amplifies.
         M = np.eye(n) - weight * step * A
-        kappa = condition(M)
+        kappa = _inverse_condition(M, weight * step * norm(A))
         try:
             theirs = ss.cont2discrete((A, B, C, D), step, "gbt", alpha=weight)
         except (ValueError, np.linalg.LinAlgError):
@@ -341,9 +352,9 @@ def _d2c_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
         return
     weight = BILINEAR.get(method, args["alpha"])
     with silenced():
-        kappa = condition(np.eye(n) + (1 - weight) * Ad) * condition(
-            np.eye(n) - weight * dt * result.A
-        )
+        kappa = _inverse_condition(
+            np.eye(n) + (1 - weight) * Ad, (1 - weight) * norm(Ad)
+        ) * _inverse_condition(np.eye(n) - weight * dt * result.A, weight * dt * norm(result.A))
         size = norm(Ad) + norm(Bd) + norm(Cd) + norm(Dd) + 1
     if np.isfinite(kappa) and kappa * U < 1e-3:
         error = sum(

@@ -277,6 +277,22 @@ def well_posed(problem: Problem, discrete: bool) -> bool:
         return False
     if any(not 1e-20 <= norm(M) <= 1e20 for M in (A, B, Q, R)):
         return False
+    try:
+        return _clearly_solvable(A, B, Q, R, S, E, discrete)
+    except (ValueError, np.linalg.LinAlgError):
+        return False  # numpy cannot tell: not clearly well posed
+
+
+def _clearly_solvable(
+    A: np.ndarray,
+    B: np.ndarray,
+    Q: np.ndarray,
+    R: np.ndarray,
+    S: np.ndarray | None,
+    E: np.ndarray | None,
+    discrete: bool,
+) -> bool:
+    n = A.shape[0]
     with silenced():
         if max(np.max(np.abs(Q - Q.T)), np.max(np.abs(R - R.T))) > 0:
             return False
