@@ -355,7 +355,10 @@ def _d2c_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
         kappa = _inverse_condition(
             np.eye(n) + (1 - weight) * Ad, (1 - weight) * norm(Ad)
         ) * _inverse_condition(np.eye(n) - weight * dt * result.A, weight * dt * norm(result.A))
+        # The continuous model may be far larger than the discrete one (Ad near the image of
+        # s = ∞): Dd = D + α C Bd then cancels, to u ||D||.
         size = norm(Ad) + norm(Bd) + norm(Cd) + norm(Dd) + 1
+        size += norm(result.D) + norm(result.C) * norm(result.B) * dt
     if np.isfinite(kappa) and kappa * U < 1e-3:
         error = sum(
             norm(x - y)
