@@ -147,7 +147,7 @@ def _pair(args: dict[str, Any]) -> tuple[Any, Any]:
 
 PLACEMENT_OVERFLOW_BLAMES_A: Defect = known_defect(
     "placement-overflow-blames-A",
-    {"place", "place_ackermann", "place_bass_gura", "batch.place_batch"},
+    {"place", "place_ackermann", "place_bass_gura", "batch.place_batch", "place_observer"},
     "When a placement overflows inside (the desired polynomial's coefficients for poles "
     "-1e160 and -2e160; a gain of 1/b for b = [[1e-301]]; A and B with entries near 1e150 "
     "for place), it raises NonFiniteError 'A must be finite, but A[0, 0] is -inf' (or NaN), "
@@ -248,7 +248,13 @@ def _order(args: dict[str, Any]) -> int:
 
 BATCH_EMPTY_RCOND: Defect = known_defect(
     "batch-empty-problem",
-    {"batch.solve_care_batch", "batch.solve_dare_batch", "batch.lqr_sweep", "batch.dlqr_sweep"},
+    {
+        "batch.solve_care_batch",
+        "batch.solve_dare_batch",
+        "batch.lqr_sweep",
+        "batch.dlqr_sweep",
+        "batch.place_batch",
+    },
     "The Riccati batches skip a problem of order n = 0 entirely: they report rcond = 0 and "
     "then an IllConditionedWarning ('1 of the 1 Riccati solutions may be inaccurate ... "
     "problems 0'), where solve_care and solve_dare report rcond = 1.0 without a warning "
@@ -260,7 +266,8 @@ BATCH_EMPTY_RCOND: Defect = known_defect(
     "bitwise). An empty batch (k = 0, or lqr_sweep with weights=[]) or a problem of order "
     "0 is not checked at all: lqr_sweep([[0.126]], [[0.126]], Q=[[inf]], weights=[]) "
     "returns, and solve_dare_batch(zeros((0, 0)), [[[0.0, 0.0]]], zeros((0, 0)), [[1.0]]) "
-    "accepts a B of one row for an A of none.",
+    "accepts a B of one row for an A of none; place_batch(zeros((0, 1, 1)), zeros((1, 2, 2)), "
+    "[-1.0]) accepts a B of order 2 for an empty stack of order-1 plants.",
     lambda args: _order(args) == 0 or _batch_size(args) == 0,
 )
 
@@ -299,18 +306,38 @@ def _any_extreme(args: dict[str, Any]) -> bool:
     return False
 
 
+def _extreme_weights(args: dict[str, Any]) -> bool:
+    """Whether a sweep's weights c leave [1e-100, 1e100] (R / c^2 then near the range's
+    ends)."""
+    if args.get("weights") is None:
+        return False
+    c = np.abs(np.atleast_1d(np.asarray(args["weights"], dtype=float)))
+    return bool(np.any((c > 1e100) | (c < 1e-100)))
+
+
 RICCATI_OVERFLOW_BLAMES_A: Defect = known_defect(
     "riccati-overflow-blames-A",
-    {"solve_care", "lqr", "riccati_ode", "lqr_finite", "lqe", "kalman", "lqg"},
+    {
+        "solve_care",
+        "lqr",
+        "riccati_ode",
+        "lqr_finite",
+        "lqe",
+        "kalman",
+        "lqg",
+        "batch.solve_care_batch",
+        "batch.lqr_sweep",
+    },
     "When B R^-1 B^T (or another product forming the Hamiltonian) overflows, solve_care and "
     "riccati_ode raise NonFiniteError 'A must be finite, but A[0, 1] is -inf', blaming A, "
     "which is finite: solve_care([[0.0]], [[1e200]], [[1.0]], [[1.0]]) has the solution "
     "X = 1e-200, K = 1 (representable, and found after scaling B), and "
     "riccati_ode([[0.0]], [[1e200]], [[1.0]], [[1.0]], [0.0, 0.1]) likewise (also with "
     "R = [[1e-310]] and B = [[1]]). (solve_dare refuses the same numbers with "
-    "IllConditionedError.) The solvers should scale B (or R) before forming G, or at least "
-    "name the overflow instead of A.",
-    _any_extreme,
+    "IllConditionedError.) The batches and sweeps likewise (lqr_sweep with B = [[3.5e149]], "
+    "R = [[1e-8]], weights [0.01, 0.1, 1, 10]). The solvers should scale B (or R) before "
+    "forming G, or at least name the overflow instead of A.",
+    lambda args: _any_extreme(args) or _extreme_weights(args) or _largest_entry(args) >= 1e100,
     symptom="raised NonFiniteError, but every argument is finite",
 )
 
