@@ -10,3 +10,397 @@ the core is fixed it passes, the strict xfail fails, and the entry here is to be
 """
 
 from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .harness import Defect, known_defect
+
+
+def _largest(value: Any) -> float:
+    """The largest magnitude in a canonical array argument, 0 if it is none or empty."""
+    array = np.asarray(value, dtype=float) if value is not None else np.zeros(0)
+    return float(np.max(np.abs(array), initial=0.0)) if np.all(np.isfinite(array)) else 0.0
+
+
+def _one_norm(value: Any) -> float:
+    array = np.asarray(value, dtype=float)
+    with np.errstate(over="ignore"):
+        return float(np.max(np.sum(np.abs(array), axis=0), initial=0.0))
+
+
+def _extreme_entries(value: Any) -> bool:
+    """Whether an entry's square overflows (|a| > 1.3e154) or a nonzero entry is below 1e-150
+    (where squares and products of entries leave the normal range)."""
+    array = np.abs(np.asarray(value, dtype=float))
+    if not np.all(np.isfinite(array)):
+        return False
+    return bool(np.any(array > 1.3e154) or np.any((array > 0) & (array < 1e-150)))
+
+
+def _plant(args: dict[str, Any]) -> Any:
+    """The plant matrix A of a call: the argument A, or the A of a model."""
+    if "A" in args:
+        return args["A"]
+    given = args.get("A_or_sys", args.get("sys"))
+    if isinstance(given, np.ndarray):
+        return given
+    return _model(given)[0]
+
+
+def _exponent_norm(args: dict[str, Any]) -> float:
+    """max ||A t||_1 over the matrices of A and the times t (or dt; 1 for expm)."""
+    A = np.abs(np.asarray(args["A"], dtype=float))
+    times = np.abs(np.asarray(args.get("t", args.get("dt", 1.0)), dtype=float))
+    with np.errstate(all="ignore"):
+        column_sums = np.sum(A, axis=-2) if A.ndim >= 2 else np.zeros(0)
+        return float(np.max(column_sums, initial=0.0) * np.max(times, initial=0.0))
+
+
+def _model(sys: Any) -> tuple[Any, ...]:
+    return (sys.A, sys.B, sys.C, sys.D) if hasattr(sys, "A") else tuple(sys)
+
+
+def _pair(args: dict[str, Any]) -> tuple[Any, Any]:
+    second = args.get("B", args.get("C"))
+    if second is None:
+        model = _model(args["A_or_sys"])
+        return model[0], np.concatenate([np.ravel(m) for m in model[1:]])
+    return args["A_or_sys"], second
+
+
+def _definite(value: Any) -> bool:
+    """Whether a canonical weight is symmetric positive definite (by numpy's Cholesky)."""
+    array = np.asarray(value, dtype=float)
+    if array.ndim != 2 or array.shape[0] != array.shape[1] or not np.all(np.isfinite(array)):
+        return True
+    try:
+        with np.errstate(all="ignore"):
+            np.linalg.cholesky(0.5 * array + 0.5 * array.T)
+    except np.linalg.LinAlgError:
+        return False
+    return True
+
+
+CARE_EMPTY_INDEFINITE_RCOND: Defect = known_defect(
+    "care-empty-indefinite-rcond",
+    {"solve_care"},
+    "solve_care of an empty problem (n = 0) with an indefinite R (the extended-pencil path) "
+    "reports rcond = inf, without a NumericalOverflowWarning: "
+    "solve_care(zeros((0, 0)), zeros((0, 2)), zeros((0, 0)), diag([1.0, -1.0])).rcond is inf, "
+    "where the definite path (R = I) and solve_dare report 1.0. It should report 1.0 (E U11 "
+    "of order 0 is perfectly conditioned), as the other paths do.",
+    lambda args: np.asarray(args["A"]).size == 0 and not _definite(args["R"]),
+    symptom="NaN or Inf in ['.rcond']",
+)
+
+
+def _hamiltonian_work(args: dict[str, Any]) -> float:
+    """||H||_1 (t_f - t_0) of a riccati_ode call, H = [[A, -B R^-1 B^T], [-Q, -A^T]]: an
+    upper bound of the growth rate of its modes times the horizon."""
+    if "sys" in args:
+        (A, B), Q, R = _model(args["sys"])[:2], args["Q"], args["R"]
+    else:
+        A, B, Q, R = args["A_or_sys"], args["B"], args["Q"], args["R"]
+    A, B, Q, R = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, B, Q, R))
+    t = np.atleast_1d(np.asarray(args["t"], dtype=float))
+    with np.errstate(all="ignore"):
+        G = B @ np.linalg.solve(R, B.T)
+        H = np.block([[A, -G], [-Q, -A.T]])
+        return float(_one_norm(H) * abs(t[-1] - t[0])) if t.size else 0.0
+
+
+RICCATI_ODE_UNBOUNDED_SUBSTEPS: Defect = known_defect(
+    "riccati-ode-unbounded-substeps",
+    {"riccati_ode", "lqr_finite"},
+    "riccati_ode divides the horizon into steps across which the Hamiltonian's modes grow by "
+    "at most e, with no bound on their number: its time is proportional to "
+    "rho(H) (t_f - t_0). riccati_ode([[1e6]], [[1]], [[1]], [[1]], [0, 1]) takes 1.4e6 "
+    "substeps (0.5 s), A = [[1e8]] takes about 35 s, A = [[1e300]] (or a horizon of 1e300) "
+    "would run for ever, uninterruptibly, and returns a solution that converged to the "
+    "algebraic one after the first few time constants. It should double the step once the "
+    "modes have decayed (or refuse the horizon by name) so that the work stays bounded.",
+    lambda args: _hamiltonian_work(args) >= 5e4,
+    symptom="substeps",
+)
+
+
+def _any_indefinite(value: Any) -> bool:
+    """Whether some member of a canonical weight (one matrix or a stack) is not positive
+    definite."""
+    array = np.asarray(value, dtype=float)
+    members = array if array.ndim == 3 else array[np.newaxis]
+    return any(not _definite(member) for member in members)
+
+
+BATCH_REFUSES_INDEFINITE_R: Defect = known_defect(
+    "batch-refuses-indefinite-R",
+    {"batch.solve_care_batch", "batch.lqr_sweep"},
+    "solve_care_batch (and lqr_sweep, through it) refuses a symmetric indefinite R with "
+    "NotPositiveDefiniteError ('problem i of the batch: R must be symmetric positive "
+    "definite'), although solve_care solves it since issue 24 (the extended Hamiltonian "
+    "pencil) and the batch promises each problem 'solved exactly as solve_care solves it "
+    "alone': solve_care([[-5]], [[1]], [[1]], [[-1]]) returns X = 5 - sqrt(24) (closed loop "
+    "-4.899), solve_care_batch of the same numbers raises. (tests/test_batch.py pins the "
+    "refusal; rust/control/batch.rs calls the Cholesky path directly.) It should dispatch as "
+    "solve_care does.",
+    lambda args: args["R"] is not None and _any_indefinite(args["R"]),
+)
+
+
+def _order(args: dict[str, Any]) -> int:
+    """The order n of a batch or sweep call's plant (the last axis of A)."""
+    if "sys" in args:
+        return int(np.asarray(_model(args["sys"])[0]).shape[-1])
+    A = args.get("A", args.get("sys_or_A"))
+    return int(np.asarray(A, dtype=float).shape[-1])
+
+
+BATCH_EMPTY_RCOND: Defect = known_defect(
+    "batch-empty-problem",
+    {
+        "batch.solve_care_batch",
+        "batch.solve_dare_batch",
+        "batch.lqr_sweep",
+        "batch.dlqr_sweep",
+        "batch.place_batch",
+    },
+    "The Riccati batches skip a problem of order n = 0 entirely: they report rcond = 0 and "
+    "then an IllConditionedWarning ('1 of the 1 Riccati solutions may be inaccurate ... "
+    "problems 0'), where solve_care and solve_dare report rcond = 1.0 without a warning "
+    "(solve_care_batch(zeros((0, 0)), zeros((0, 2)), zeros((0, 0)), eye(2)).rcond is [0.]), "
+    "and they do not check R: R = [[nan]] or [[inf]] is returned from (solve_care and "
+    "solve_dare raise NonFiniteError naming R), R = [[0.0]] too (solve_care raises "
+    "InvalidArgumentError: R singular). Likewise lqr_sweep and dlqr_sweep. The batch should "
+    "check and fill each problem as the single solve does (it promises the single results "
+    "bitwise). An empty batch (k = 0, or lqr_sweep with weights=[]) or a problem of order "
+    "0 is not checked at all: lqr_sweep([[0.126]], [[0.126]], Q=[[inf]], weights=[]) "
+    "returns, and solve_dare_batch(zeros((0, 0)), [[[0.0, 0.0]]], zeros((0, 0)), [[1.0]]) "
+    "accepts a B of one row for an A of none; place_batch(zeros((0, 1, 1)), zeros((1, 2, 2)), "
+    "[-1.0]) accepts a B of order 2 for an empty stack of order-1 plants.",
+    lambda args: _order(args) == 0 or _batch_size(args) == 0,
+)
+
+
+def _batch_size(args: dict[str, Any]) -> int:
+    """The number of problems of a batch call (the weights of a sweep), -1 if unknown."""
+    if "weights" in args:
+        return int(np.atleast_1d(np.asarray(args["weights"], dtype=float)).size)
+    sizes = [
+        np.asarray(args[key], dtype=float).shape[0]
+        for key in ("A", "B", "Q", "R")
+        if key in args and np.asarray(args[key], dtype=float).ndim == 3
+    ]
+    return min(sizes) if sizes else -1
+
+
+def _matrices_of(value: Any) -> list[Any]:
+    """The arrays of an argument: itself, a model's A, B, C, D, or a tuple's members."""
+    if hasattr(value, "A") and not isinstance(value, np.ndarray):
+        return list(_model(value))
+    if isinstance(value, (tuple, list)) and value and not np.isscalar(value[0]):
+        return [m for item in value for m in _matrices_of(item)]
+    return [value]
+
+
+def _any_extreme(args: dict[str, Any]) -> bool:
+    """Whether a matrix argument (or a model's matrix) has an entry whose square leaves the
+    normal range."""
+    for value in args.values():
+        for matrix in _matrices_of(value):
+            try:
+                if _extreme_entries(matrix):
+                    return True
+            except (TypeError, ValueError):
+                continue
+    return False
+
+
+def _extreme_weights(args: dict[str, Any]) -> bool:
+    """Whether a sweep's weights c leave [1e-100, 1e100] (R / c^2 then near the range's
+    ends)."""
+    if args.get("weights") is None:
+        return False
+    c = np.abs(np.atleast_1d(np.asarray(args["weights"], dtype=float)))
+    return bool(np.any((c > 1e100) | (c < 1e-100)))
+
+
+RICCATI_OVERFLOW_BLAMES_A: Defect = known_defect(
+    "riccati-overflow-blames-A",
+    {
+        "solve_care",
+        "lqr",
+        "riccati_ode",
+        "lqr_finite",
+        "lqe",
+        "kalman",
+        "lqg",
+        "batch.solve_care_batch",
+        "batch.lqr_sweep",
+    },
+    "When B R^-1 B^T (or another product forming the Hamiltonian) overflows, solve_care and "
+    "riccati_ode raise NonFiniteError 'A must be finite, but A[0, 1] is -inf', blaming A, "
+    "which is finite: solve_care([[0.0]], [[1e200]], [[1.0]], [[1.0]]) has the solution "
+    "X = 1e-200, K = 1 (representable, and found after scaling B), and "
+    "riccati_ode([[0.0]], [[1e200]], [[1.0]], [[1.0]], [0.0, 0.1]) likewise (also with "
+    "R = [[1e-310]] and B = [[1]]). (solve_dare refuses the same numbers with "
+    "IllConditionedError.) The batches and sweeps likewise (lqr_sweep with B = [[3.5e149]], "
+    "R = [[1e-8]], weights [0.01, 0.1, 1, 10]). The solvers should scale B (or R) before "
+    "forming G, or at least name the overflow instead of A.",
+    lambda args: _any_extreme(args) or _extreme_weights(args) or _largest_entry(args) >= 1e100,
+    symptom="raised NonFiniteError, but every argument is finite",
+)
+
+
+SWEEP_WEIGHTS_ALIAS: Defect = known_defect(
+    "sweep-weights-alias",
+    {"batch.lqr_sweep", "batch.dlqr_sweep"},
+    "lqr_sweep and dlqr_sweep return the caller's own weights array as LqrSweep.weights when "
+    "it is an aligned float64 array (python/aerocontrol/batch.py, _sweep: "
+    "np.atleast_1d(real_array(weights, 'weights')) is the argument itself): "
+    "c = np.array([1.0, 2.0]); s = lqr_sweep(A, B, weights=c); c[0] = 5.0 changes "
+    "s.weights[0] to 5.0. Every other result is a fresh array; the weights should be copied.",
+    lambda args: True,
+    symptom="share memory with the arguments",
+)
+
+
+def _largest_entry(args: dict[str, Any]) -> float:
+    """The largest magnitude in any matrix argument (or a model's matrix)."""
+    largest = 0.0
+    for value in args.values():
+        for matrix in _matrices_of(value):
+            try:
+                largest = max(largest, _largest(matrix))
+            except (TypeError, ValueError):
+                continue
+    return largest
+
+
+ESTIMATION_OVERFLOW: Defect = known_defect(
+    "estimation-overflow",
+    {"lqe", "dlqe", "kalman", "lqg"},
+    "python/aerocontrol/estimation.py forms G QN G^T, its symmetric part 0.5 (P + P^T) and "
+    "the LQG compensator's A - B K - L C + L D K with numpy without handling overflow: "
+    "numpy's RuntimeWarning 'overflow encountered in matmul' (estimation.py:308, :906) or "
+    "'in add' (:309) reaches the caller, and the filter is then refused as NonFiniteError "
+    "'Q must be finite, but Q[0, 0] is inf', naming a Q that lqe does not take. "
+    "lqe([[-1.0]], [[1e200]], [[1.0]], [[1.0]], [[1.0]]) and, with a representable G QN G^T, "
+    "lqe([[-1.0]], [[1.0]], [[1.0]], [[1e308]], [[1.0]]) (P + P^T = 2e308 overflows where "
+    "0.5 P + 0.5 P^T would not); likewise dlqe, kalman (G = 2e150, QN = 1e8) and lqg. It "
+    "should scale (or halve "
+    "before adding) and name the argument or the overflow.",
+    lambda args: _any_extreme(args) or _largest_entry(args) >= 1e100,
+    symptom="estimation.py",
+)
+
+
+def _c2d_overflows(args: dict[str, Any]) -> bool:
+    """Whether a c2d call's discretisation can overflow: ||A dt||_1 >= 700 (e^{A dt}), or an
+    entry of the model or of A dt whose square leaves the normal range."""
+    A = np.asarray(_model(args["sys"])[0], dtype=float)
+    dt = abs(float(args["dt"]))
+    with np.errstate(all="ignore"):
+        return bool(_one_norm(A) * dt >= 700 or _any_extreme(args) or _extreme_entries(A * dt))
+
+
+C2D_OVERFLOW_BLAMES_MODEL: Defect = known_defect(
+    "c2d-overflow-blames-model",
+    {"c2d"},
+    "When the discretisation overflows, c2d issues a NumericalOverflowWarning and then raises "
+    "NonFiniteError 'A must be finite, but A[0, 0] is inf', blaming the model's finite A "
+    "(the StateSpace it builds from the overflowed Phi refuses it): "
+    "c2d(([[1.0]], [[1.0]], [[1.0]], [[0.0]]), 1000.0) (e^1000 overflows); with "
+    "method='foh' numpy's RuntimeWarning 'invalid value encountered in subtract' "
+    "(linalg.py:344) leaks too, and c2d(([[-1.0]], [[1e300]], [[1e300]], [[0.0]]), 0.1, "
+    "'foh') says 'D must be finite, but D[0, 0] is inf'. It should raise an error that names "
+    "the overflow (dt too long for the model, or entries too large).",
+    _c2d_overflows,
+)
+
+
+QZ_REAL_TWO_BY_TWO_BLOCK: Defect = known_defect(
+    "qz-real-2x2-block",
+    {"qz"},
+    "qz can leave a negligible subdiagonal entry of AA standing, so that AA has a 2 x 2 "
+    "block whose eigenvalues are real (alpha with imaginary part +-0): for the pencil (M, M), "
+    "M = [[-0.06, -0.29, 0.04], [-0.95, 2.71, 0.9], [-0.8, -0.21, 0.04]] (every eigenvalue "
+    "1), AA[1, 0] = 3.07e-16 and alpha = [1.254+0j, 0.109-0j, 2.008+0j]; 2 of 300 random "
+    "pencils (M, M) of orders 2 to 6 did so. The documented form has 2 x 2 blocks for "
+    "complex pairs only (LAPACK's dlagv2 splits a real pair into two 1 x 1 blocks with an "
+    "exact zero below).",
+    lambda args: True,
+    symptom="holds real eigenvalues",
+)
+
+
+def _norm_ratio(args: dict[str, Any]) -> float:
+    """max(||A||_F / ||B||_F, ||B||_F / ||A||_F) of a qz call (inf when one is zero)."""
+    with np.errstate(all="ignore"):
+        a = float(np.linalg.norm(np.asarray(args["A"], dtype=float)))
+        b = float(np.linalg.norm(np.asarray(args["B"], dtype=float)))
+        if a == 0 or b == 0:
+            return 1.0 if a == b else np.inf
+        return max(a / b, b / a)
+
+
+QZ_UNBALANCED_PENCIL: Defect = known_defect(
+    "qz-unbalanced-pencil",
+    {"qz"},
+    "qz is not backward stable for each matrix of a pencil whose two matrices differ much in "
+    "size: Q BB Z^T differs from B by far more than u ||B|| when ||B|| << ||A||. For "
+    "A = [[-0.1, -0.5], [-1.7e-4, -1.2]], B = [[4e-11, -4e-11], [1.3e-10, -1.3e-10]] "
+    "(B singular: one infinite eigenvalue) ||Q BB Z^T - B|| is 1 % of ||B|| (1e14 u; scipy: "
+    "2 u), and the eigenvalues come out as 4.2955e9 and -9.08e11 where scipy gives 3.998e9 "
+    "and inf; for A = [[-0.132, 640.4], [1.05e-4, -0.536]] and a random B of size 1e-8 the "
+    "error is 3.9e4 u (B of size 1e-6: 1.3 u). With entries near 1e-300 in A and 1e-3 in B, "
+    "Q and Z lose orthogonality (3e8 u) and B's error is 1e8 u. Deflation and the "
+    "convergence tests seem to compare B's entries with a norm of the whole pencil (or of "
+    "A); LAPACK's dhgeqz tests each matrix against its own norm. solve_dare and the "
+    "indefinite CARE use this QZ.",
+    lambda args: _norm_ratio(args) >= 1e6 or _any_extreme(args),
+)
+
+
+C2D_MATCHED_SCALE: Defect = known_defect(
+    "c2d-matched-scale",
+    {"c2d"},
+    "c2d(method='matched') is not invariant to the scale of the model's gain: with "
+    "A = [[0.1257, -0.1321], [0.6404, 0.1049]], B = [[1e-4], [-1.3e-4]], "
+    "C = c [[1, -1.05]], D = 0, dt = 0.1, G_d(e^{0.3j}) / c is -9.50e-6 - 7.97e-5j for "
+    "c = 1 and 1e10 but -1.79e-5 - 7.77e-5j for c = 1e50 to 1e140 (another zero, silently), "
+    "1.9e124 for c = 1e149, and for c = 1e100 and 1e120 numpy's RuntimeWarnings (overflow in "
+    "expm1 and exp, linalg.py:614-627) leak and NonFiniteError 'B must be finite, but "
+    "B[0, 0] is NaN' blames the finite B. The zeros seem to be found with a tolerance that is "
+    "not relative to the numerator's scale.",
+    lambda args: (
+        args["method"] == "matched" and max(_largest(m) for m in _model(args["sys"])) >= 1e40
+    ),
+)
+
+
+LYAPUNOV_TINY_REFUSED: Defect = known_defect(
+    "lyapunov-tiny-refused",
+    {"solve_lyapunov"},
+    "solve_lyapunov refuses a well-conditioned equation whose A is tiny, as if its test of "
+    "the eigenvalue sums were absolute: solve_lyapunov([[-1e-295]], [[1e-295]]) raises "
+    "IllConditionedError ('A has two eigenvalues whose sum is (nearly) zero') although "
+    "X = 0.5 exactly; A = -1e-290 is solved, A = -1e-300 I (any n) refused. The test should "
+    "be relative to ||A||.",
+    lambda args: 0 < _largest(args["A"]) < 1e-280,
+    symptom="solve_lyapunov refused",
+)
+
+
+SWEEP_WEIGHT_OVERFLOW: Defect = known_defect(
+    "sweep-weight-overflow",
+    {"batch.lqr_sweep", "batch.dlqr_sweep"},
+    "lqr_sweep and dlqr_sweep form R / c^2 with numpy (python/aerocontrol/batch.py:392) "
+    "without handling overflow: for a small weight c and a large R numpy's RuntimeWarning "
+    "'overflow encountered in divide' reaches the caller (then the infinite R is refused by "
+    "name, though the caller's R is finite): lqr_sweep([[-1.0]], [[1.0]], R=[[1e10]], "
+    "weights=[1e-150]). It should refuse the weight by name (or scale).",
+    lambda args: True,
+    symptom="batch.py",
+)

@@ -372,3 +372,221 @@ def exact_response(
             + rate * deviation
         )
     return x64, tolerance
+
+
+# ----- Riccati and Lyapunov equations -----------------------------------------------------------
+#
+# A returned solution is checked by its residual, evaluated in long double from the returned X
+# and K (so that the evaluation adds nothing of its own), relative to the size of the
+# equation's terms as the solvers report it; by the residual of its gain; by the stability of
+# its closed loop; and, where scipy solves the same equation, against scipy's solution within
+# the first-order forward error bound ||X - X_s||_F <= (||Res(X)||_F + ||Res(X_s)||_F) / sep,
+# sep = sigma_min of the Lyapunov (continuous) or Stein (discrete) operator of the closed loop:
+# Res(X* + D) = Omega(D) + O(||D||^2), so each solution is within ||Res|| / sep of X*. The
+# comparison is made only where that bound is below 1e-6 ||X|| and the second-order term is
+# negligible, so that it holds whatever the problem's conditioning.
+
+
+def symmetric_part(M: np.ndarray) -> np.ndarray:
+    return 0.5 * (M + M.T)
+
+
+def longdouble(M: Any) -> np.ndarray:
+    return np.asarray(M, dtype=np.float64).astype(np.longdouble)
+
+
+def care_residual(
+    A: np.ndarray,
+    B: np.ndarray,
+    Q: np.ndarray,
+    S: np.ndarray | None,
+    E: np.ndarray | None,
+    X: np.ndarray,
+    K: np.ndarray,
+) -> tuple[float, float]:
+    """(||Res||_F, ||Q||_F + 2 ||A^T X E||_F + ||M^T K||_F) of
+    Res = A^T X E + E^T X A - M^T K + Q, M = B^T X E + S^T, in long double (the solvers'
+    reported residual is the first divided by the second)."""
+    n, m = B.shape
+    a, b, q, x, k = (longdouble(M) for M in (A, B, symmetric_part(Q), X, K))
+    e = np.eye(n, dtype=np.longdouble) if E is None else longdouble(E)
+    s = np.zeros((n, m), dtype=np.longdouble) if S is None else longdouble(S)
+    with silenced():
+        axe = a.T @ x @ e
+        M = b.T @ x @ e + s.T
+        quadratic = M.T @ k
+        residual = axe + axe.T - quadratic + q
+        sizes = [norm(np.asarray(t, dtype=np.float64)) for t in (residual, q, axe, quadratic)]
+    return sizes[0], sizes[1] + 2 * sizes[2] + sizes[3]
+
+
+def dare_residual(
+    A: np.ndarray,
+    B: np.ndarray,
+    Q: np.ndarray,
+    S: np.ndarray | None,
+    E: np.ndarray | None,
+    X: np.ndarray,
+    K: np.ndarray,
+) -> tuple[float, float]:
+    """(||Res||_F, ||Q||_F + ||A^T X A||_F + ||E^T X E||_F + ||M^T K||_F) of
+    Res = A^T X A - E^T X E - M^T K + Q, M = B^T X A + S^T, in long double."""
+    n, m = B.shape
+    a, b, q, x, k = (longdouble(M) for M in (A, B, symmetric_part(Q), X, K))
+    e = np.eye(n, dtype=np.longdouble) if E is None else longdouble(E)
+    s = np.zeros((n, m), dtype=np.longdouble) if S is None else longdouble(S)
+    with silenced():
+        axa = a.T @ x @ a
+        exe = e.T @ x @ e
+        M = b.T @ x @ a + s.T
+        quadratic = M.T @ k
+        residual = axa - exe - quadratic + q
+        sizes = [norm(np.asarray(t, dtype=np.float64)) for t in (residual, q, axa, exe, quadratic)]
+    return sizes[0], sizes[1] + sizes[2] + sizes[3] + sizes[4]
+
+
+def riccati_gain(
+    A: np.ndarray,
+    B: np.ndarray,
+    R: np.ndarray,
+    S: np.ndarray | None,
+    E: np.ndarray | None,
+    X: np.ndarray,
+    discrete: bool,
+) -> np.ndarray:
+    """The gain of a solution X: R^-1 (B^T X E + S^T) (continuous) or
+    (R + B^T X B)^-1 (B^T X A + S^T) (discrete), by numpy's solve and one step of refinement
+    with the residual in long double."""
+    n, m = B.shape
+    e = np.eye(n) if E is None else E
+    s = np.zeros((n, m)) if S is None else S
+    with silenced():
+        if discrete:
+            lhs = longdouble(symmetric_part(R)) + longdouble(B).T @ longdouble(X) @ longdouble(B)
+            rhs = longdouble(B).T @ longdouble(X) @ longdouble(A) + longdouble(s).T
+        else:
+            lhs = longdouble(symmetric_part(R))
+            rhs = longdouble(B).T @ longdouble(X) @ longdouble(e) + longdouble(s).T
+        lhs64 = np.asarray(lhs, dtype=np.float64)
+        K = np.linalg.solve(lhs64, np.asarray(rhs, dtype=np.float64))
+        correction = np.asarray(rhs - lhs @ longdouble(K), dtype=np.float64)
+        return np.asarray(K + np.linalg.solve(lhs64, correction), dtype=np.float64)
+
+
+def closed_loop_separation(Acl: np.ndarray, E: np.ndarray | None, discrete: bool) -> float:
+    """sigma_min of the operator D -> Acl^T D E + E^T D Acl (continuous) or
+    Acl^T D Acl - E^T D E (discrete), by its Kronecker matrix: 1 / ||Omega^-1||_2 (n <= 12)."""
+    n = Acl.shape[0]
+    if n == 0:
+        return np.inf
+    e = np.eye(n) if E is None else E
+    with silenced():
+        if discrete:
+            operator = np.kron(Acl.T, Acl.T) - np.kron(e.T, e.T)
+        else:
+            operator = np.kron(e.T, Acl.T) + np.kron(Acl.T, e.T)
+        try:
+            return float(np.linalg.svd(operator, compute_uv=False)[-1])
+        except np.linalg.LinAlgError:
+            return 0.0
+
+
+def pencil_eigenvalues(
+    A: np.ndarray,
+    B: np.ndarray,
+    Q: np.ndarray,
+    R: np.ndarray,
+    S: np.ndarray | None,
+    E: np.ndarray | None,
+    discrete: bool,
+) -> np.ndarray:
+    """The finite eigenvalues of the extended Hamiltonian (continuous) or symplectic
+    (discrete) pencil of order 2n + m (scipy's construction), by scipy's QZ: n of them are the
+    closed-loop poles of the stabilising solution when it exists."""
+    n, m = B.shape
+    e = np.eye(n) if E is None else E
+    s = np.zeros((n, m)) if S is None else S
+    q, r = symmetric_part(Q), symmetric_part(R)
+    zero = np.zeros((n, n))
+    if discrete:
+        M = np.block([[A, zero, B], [-q, e.T, -s], [s.T, np.zeros((m, n)), r]])
+        N = np.block(
+            [
+                [e, zero, np.zeros((n, m))],
+                [zero, A.T, np.zeros((n, m))],
+                [np.zeros((m, n)), -B.T, np.zeros((m, m))],
+            ]
+        )
+    else:
+        M = np.block([[A, zero, B], [-q, -A.T, -s], [s.T, B.T, r]])
+        N = np.zeros((2 * n + m, 2 * n + m))
+        N[:n, :n], N[n : 2 * n, n : 2 * n] = e, e.T
+    with silenced():
+        try:
+            alpha, beta = sl.eig(M, N, right=False, homogeneous_eigvals=True)
+        except (ValueError, np.linalg.LinAlgError):
+            return np.full(2 * n, np.nan + 0j)
+    size = np.abs(alpha) + np.abs(beta)
+    finite_ones = np.abs(beta) > 1e3 * U * size
+    with silenced():
+        return np.asarray(alpha[finite_ones] / beta[finite_ones])
+
+
+def stabilizability_margin(
+    A: np.ndarray, B: np.ndarray, E: np.ndarray | None, discrete: bool
+) -> float:
+    """min over the eigenvalues lambda of (A, E) that are not stable of
+    sigma_min([A - lambda E, B]) / (||A||_F + ||B||_F + |lambda| ||E||_F) (the PBH test, by
+    distance): 0 when (A, B) is not stabilisable, inf when A is stable; NaN where it cannot
+    be computed."""
+    n = A.shape[0]
+    if n == 0:
+        return np.inf
+    e = np.eye(n) if E is None else E
+    with silenced():
+        try:
+            eigenvalues = sl.eigvals(A, e)
+        except (ValueError, np.linalg.LinAlgError):
+            return np.nan
+        worst = np.inf
+        for value in eigenvalues:
+            if not np.isfinite(value):
+                continue
+            unstable = abs(value) >= 1 - 1e-8 if discrete else value.real >= -1e-8 * abs(value)
+            if not unstable:
+                continue
+            pencil = np.hstack([A.astype(complex) - value * e, B.astype(complex)])
+            smallest = np.linalg.svd(pencil, compute_uv=False)[-1] if n else np.inf
+            worst = min(worst, smallest / (norm(A) + norm(B) + abs(value) * norm(e)))
+    return float(worst)
+
+
+def riccati_defect(
+    A: np.ndarray,
+    B: np.ndarray,
+    Q: np.ndarray,
+    R: np.ndarray,
+    S: np.ndarray | None,
+    E: np.ndarray | None,
+    X: np.ndarray,
+    K: np.ndarray,
+    discrete: bool,
+) -> float:
+    """||Res(X)||_F in the form that is stationary in the gain, in long double:
+    (A - B K)^T X E + E^T X (A - B K) (continuous) or (A - B K)^T X (A - B K) - E^T X E
+    (discrete), plus Q - S K - K^T S^T + K^T R K. At the optimal gain of X it is the Riccati
+    residual; an error dK in K changes it by O(||dK||^2) only, so that it measures X."""
+    n, m = B.shape
+    a, b, q, r, x, k = (longdouble(M) for M in (A, B, symmetric_part(Q), symmetric_part(R), X, K))
+    e = np.eye(n, dtype=np.longdouble) if E is None else longdouble(E)
+    s = np.zeros((n, m), dtype=np.longdouble) if S is None else longdouble(S)
+    with silenced():
+        closed = a - b @ k
+        if discrete:
+            loop = closed.T @ x @ closed - e.T @ x @ e
+        else:
+            half = closed.T @ x @ e
+            loop = half + half.T
+        cross = s @ k
+        residual = loop + q - cross - cross.T + k.T @ r @ k
+        return norm(np.asarray(residual, dtype=np.float64))

@@ -422,3 +422,142 @@ def model_matrices(model: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
     C = np.asarray(model[2], float) if len(model) == 4 else np.eye(A.shape[0])
     D = np.asarray(model[3], float) if len(model) == 4 else np.zeros((C.shape[0], B.shape[1]))
     return A, B, C, D
+
+
+# ----- weights and Riccati problems --------------------------------------------------------------
+
+WEIGHT_KINDS = (
+    "identity",
+    "definite",
+    "definite",
+    "semidefinite",
+    "diagonal",
+    "zero",
+    "indefinite",
+    "graded",
+    "nonsymmetric",
+    "entries",
+)
+
+
+@st.composite
+def symmetric_weight(
+    draw: st.DrawFn, n: int, kinds: Sequence[str] = WEIGHT_KINDS, scaled: bool = True
+) -> np.ndarray:
+    """An n x n weight or covariance: the identity, definite, semidefinite of rank one,
+    diagonal with zeros, zero, indefinite, graded (entries from 1e-6 to 1e6), slightly
+    nonsymmetric (beyond the solvers' 1e-12, to be refused), or any entries symmetrised;
+    scaled, maybe with a special value (which breaks the symmetry too)."""
+    kind = draw(st.sampled_from(tuple(kinds)))
+    rng = _rng(draw)
+    if kind == "identity":
+        w = np.eye(n)
+    elif kind == "definite":
+        f = rng.standard_normal((n, n))
+        w = f @ f.T + 0.1 * np.eye(n)
+    elif kind == "semidefinite":
+        f = rng.standard_normal((1, n))
+        w = f.T @ f
+    elif kind == "diagonal":
+        w = np.diag(rng.integers(0, 3, n).astype(float))
+    elif kind == "zero":
+        w = np.zeros((n, n))
+    elif kind == "indefinite":
+        q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+        signs = np.where(np.arange(n) % 2 == 0, 1.0, -1.0) * rng.uniform(0.5, 2.0, n)
+        w = q @ np.diag(signs) @ q.T
+    elif kind == "graded":
+        d = 10.0 ** rng.integers(-6, 7, n)
+        f = rng.standard_normal((n, n))
+        w = d[:, None] * (f @ f.T + np.eye(n)) * d[None, :]
+    elif kind == "nonsymmetric":
+        w = np.eye(n) + (1e-6 * np.triu(np.ones((n, n)), 1) if n > 1 else 0.0)
+    else:
+        f = draw(hnp.arrays(np.float64, (n, n), elements=ENTRIES))
+        with np.errstate(all="ignore"):
+            w = 0.5 * (f + f.T)
+    w = symmetrised(w)
+    if kind == "nonsymmetric" and n > 1:
+        w[0, -1] += 1e-6 * max(1.0, float(np.max(np.abs(w))))
+    if scaled:
+        w = _scaled(w, draw(st.sampled_from(SCALES)))
+    return draw(with_specials(np.ascontiguousarray(w, dtype=np.float64)))
+
+
+def symmetrised(w: np.ndarray) -> np.ndarray:
+    """The matrix with its lower triangle copied from the upper: exactly symmetric."""
+    return np.triu(w) + np.triu(w, 1).T
+
+
+DESCRIPTOR_KINDS = ("near identity", "near identity", "diagonal", "singular", "gaussian")
+
+
+@st.composite
+def descriptor(draw: st.DrawFn, n: int) -> np.ndarray:
+    """An n x n descriptor matrix E: near the identity, a diagonal scaling, a gaussian one
+    (well or badly conditioned), or singular (to be refused or handled)."""
+    kind = draw(st.sampled_from(DESCRIPTOR_KINDS))
+    rng = _rng(draw)
+    if kind == "near identity":
+        e = np.eye(n) + 0.2 * rng.standard_normal((n, n))
+    elif kind == "diagonal":
+        e = np.diag(2.0 ** rng.integers(-3, 4, n))
+    elif kind == "singular":
+        e = np.eye(n)
+        if n:
+            e[-1, -1] = 0.0
+    else:
+        e = rng.standard_normal((n, n))
+    return draw(with_specials(np.ascontiguousarray(e, dtype=np.float64)))
+
+
+RICCATI_KINDS = ("regulator", "regulator", "regulator", "drawn", "planted", "imaginary axis")
+
+
+@st.composite
+def riccati_problem(
+    draw: st.DrawFn,
+    *,
+    cross: bool = True,
+    descriptor_matrix: bool = True,
+    n: int | None = None,
+    m: int | None = None,
+    kinds: Sequence[str] = RICCATI_KINDS,
+) -> dict[str, np.ndarray | None]:
+    """The canonical numbers of a Riccati problem: A, B, Q, R, and S and E (each None when
+    not drawn). Kinds: "regulator" (a random plant with definite weights, mostly solvable),
+    "drawn" (every matrix from the general strategies: any structure, scale and special
+    value), "planted" (an exactly uncontrollable pair, stabilisable or not), "imaginary axis"
+    (undamped modes with semidefinite Q: no stabilising solution when unexcited)."""
+    kind = draw(st.sampled_from(tuple(kinds)))
+    n = draw(orders()) if n is None else n
+    m = draw(st.integers(1, 3)) if m is None else m
+    rng = _rng(draw)
+    if kind == "regulator":
+        A = draw(square(n, ("gaussian", "stable", "companion", "integers", "imaginary axis")))
+        B = rng.standard_normal((n, m))
+        Q = draw(symmetric_weight(n, ("identity", "definite", "graded"), scaled=False))
+        R = draw(symmetric_weight(m, ("identity", "definite", "indefinite"), scaled=False))
+    elif kind == "planted":
+        A, B, _ = draw(planted_uncontrollable(n, m))
+        n = A.shape[0]
+        Q = draw(symmetric_weight(n, ("identity", "definite", "semidefinite", "zero"), False))
+        R = np.eye(m)
+    elif kind == "imaginary axis":
+        A = draw(square(n, ("imaginary axis", "zero", "jordan")))
+        B = draw(rectangular(n, m, ("zero column", "unit", "gaussian", "zero")))
+        Q = draw(symmetric_weight(n, ("semidefinite", "zero", "diagonal"), scaled=False))
+        R = np.eye(m)
+    else:
+        A = draw(square(n))
+        B = draw(rectangular(n, m))
+        Q = draw(symmetric_weight(n))
+        R = draw(symmetric_weight(m))
+    S = None
+    if cross and draw(st.sampled_from((False, False, True))):
+        S = draw(rectangular(n, m, ("gaussian", "zero", "integers")))
+        S = S * draw(st.sampled_from((0.1, 0.1, 1.0)))
+    E = None
+    if descriptor_matrix and draw(st.sampled_from((False, False, False, True))):
+        E = draw(descriptor(n))
+    return {"A": A, "B": B, "Q": Q, "R": R, "S": S, "E": E}

@@ -1,0 +1,466 @@
+"""Properties of the generalized Schur form and of sampled models (aerocontrol.linalg: qz, c2d,
+d2c).
+
+Oracles: qz by its definition, Q and Z orthogonal and Q AA Z^T = A, Q BB Z^T = B to a
+backward error of SLACK n u times the norms, AA quasi-triangular with 2 x 2 blocks holding
+complex pairs, BB upper triangular with a nonnegative diagonal (diagonal under AA's blocks),
+each eigenvalue alpha / beta of its block with a small backward error; with ``select`` the
+selected eigenvalues first and as many of them as scipy.linalg.ordqz selects (eigenvalues
+within their backward error of the boundary excepted). c2d: zero- and first-order holds
+bitwise from aerocontrol.discretize (whose own property compares it with Van Loan's exponential
+in long double); the bilinear methods against scipy.signal.cont2discrete within
+SLACK n u κ(I - α dt A) (prewarping as scipy's step 2 tan(ω dt / 2) / ω); the zero-order
+hold's round trip d2c(c2d(sys)) = sys without aliasing (||A dt||_1 <= 1), within
+SLACK n u κ_exp(A dt)² ||A||. d2c: c2d of its result gives the model back, within
+SLACK n u κ_exp ||M|| (zero-order hold, M = [[Ad, Bd], [0, I]]) or κ(M) (bilinear).
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+import scipy.linalg as sl
+import scipy.signal as ss
+from hypothesis import given
+from hypothesis import strategies as st
+
+import aerocontrol
+from aerocontrol.exceptions import IllConditionedWarning
+
+from . import known_defects
+from .harness import CALLBACK, CALLER, REFUSE, SAME, Arg, CallerError, Warned, exercise, plain
+from .oracles import (
+    SLACK,
+    TINY,
+    U,
+    expm_condition,
+    finite,
+    norm,
+    quietly,
+    silenced,
+)
+from .strategies import (
+    canonical,
+    model_matrices,
+    orders,
+    presented,
+    presented_system,
+    rectangular,
+    scalar,
+    square,
+    system,
+)
+
+COVERED = {"qz", "c2d", "d2c"}
+
+
+# ----- qz ---------------------------------------------------------------------------------------
+
+NAMED = {
+    "lhp": lambda a, b: b != 0 and (a / b).real < 0,
+    "rhp": lambda a, b: b != 0 and (a / b).real > 0,
+    "iuc": lambda a, b: abs(a) < abs(b),
+    "ouc": lambda a, b: abs(a) > abs(b),
+}
+
+
+def _select(kind: str) -> Any:
+    if kind == "raises":
+
+        def select(alpha: complex, beta: float) -> bool:
+            raise CallerError("raised by the caller's select")
+
+        return select
+    if kind == "complex only":
+        return lambda alpha, beta: np.bool_(alpha.imag != 0)
+    if kind == "not callable":
+        return 42
+    if kind == "bad":
+        return "left"
+    return None if kind == "none" else kind
+
+
+SELECTS = ("none", "none", "lhp", "rhp", "iuc", "ouc", "complex only", "raises")
+REFUSED_SELECTS = ("bad", "not callable")
+
+
+def _selected(select: Any, alpha: complex, beta: float) -> bool:
+    function = NAMED[select] if isinstance(select, str) else select
+    return bool(function(complex(alpha.real, abs(alpha.imag)), float(beta)))
+
+
+def _qz_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    A, B, select = np.asarray(args["A"], float), np.asarray(args["B"], float), args["select"]
+    AA, BB, alpha, beta, Q, Z, selected = result
+    n = A.shape[0]
+    assert AA.shape == BB.shape == Q.shape == Z.shape == (n, n)
+    assert alpha.shape == beta.shape == (n,) and alpha.dtype == np.complex128
+    assert isinstance(selected, int) and 0 <= selected <= n
+    if select is None:
+        assert selected == n, "without select, every eigenvalue counts as selected"
+    if not finite(A, B) or max(norm(A), norm(B)) >= 1e300:
+        return
+    assert finite(AA, BB, Q, Z, alpha, beta), f"NaN or Inf in the QZ form of finite A, B {warned}"
+    scale = SLACK * n * U
+    assert norm(Q.T @ Q - np.eye(n)) <= scale, "Q is not orthogonal"
+    assert norm(Z.T @ Z - np.eye(n)) <= scale, "Z is not orthogonal"
+    assert norm(Q @ AA @ Z.T - A) <= scale * norm(A) + SLACK * n * TINY, "Q AA Z^T != A"
+    assert norm(Q @ BB @ Z.T - B) <= scale * norm(B) + SLACK * n * TINY, "Q BB Z^T != B"
+    assert not np.any(np.tril(AA, -2)), "AA has entries below its subdiagonal"
+    assert not np.any(np.tril(BB, -1)), "BB is not upper triangular"
+    sub = np.diag(AA, -1)
+    assert not np.any((sub[:-1] != 0) & (sub[1:] != 0)), "AA has a 3 x 3 block"
+    assert np.all(np.diag(BB) >= 0) and np.all(beta >= 0), "BB's diagonal or beta is negative"
+    blocks = set(np.flatnonzero(sub).tolist())
+    k = 0
+    while k < n:
+        if k in blocks:
+            assert BB[k, k + 1] == 0, f"BB is not diagonal under AA's block {k}"
+            # A complex pair, the member with Im > 0 first; as LAPACK's dgges, alpha and beta
+            # of the two members may be scaled apart (only their ratios are conjugate).
+            assert alpha[k].imag > 0 and alpha[k + 1].imag < 0, (
+                f"2 x 2 block {k} holds real eigenvalues: alpha {alpha[k : k + 2]}"
+            )
+            assert (
+                abs(alpha[k] * beta[k + 1] - np.conj(alpha[k + 1]) * beta[k])
+                <= scale * (abs(alpha[k]) * beta[k + 1] + abs(alpha[k + 1]) * beta[k]) + TINY
+            ), f"block {k}: the eigenvalues are not conjugate"
+            a_blk, b_blk = AA[k : k + 2, k : k + 2], BB[k : k + 2, k : k + 2]
+            for j in (0, 1):
+                pencil = beta[k + j] * a_blk - alpha[k + j] * b_blk
+                backward = np.linalg.svd(pencil, compute_uv=False)[-1]
+                size = abs(beta[k + j]) * norm(a_blk) + abs(alpha[k + j]) * norm(b_blk)
+                assert backward <= scale * size + TINY, f"eigenvalue of block {k}"
+            k += 2
+        else:
+            assert alpha[k] == AA[k, k] and beta[k] == BB[k, k], f"1 x 1 block {k}"
+            k += 1
+    if select is None:
+        return
+    # The selected eigenvalues first, as many as the selection holds; an eigenvalue that a
+    # perturbation of its backward error moves across the boundary may count as either.
+    sides = [_side(select, alpha[j], beta[j], A, B) for j in range(n)]
+    for j in range(n):
+        if sides[j] != "edge":
+            assert (j < selected) == (sides[j] == "in"), (
+                f"eigenvalue {j} ({alpha[j]}/{beta[j]}) is {sides[j]}, {selected} selected"
+            )
+    if isinstance(select, str) and "edge" not in sides and n:
+        theirs = quietly(sl.ordqz, A, B, sort=select, output="real")
+        their_count = int(
+            np.sum([_selected(select, a, b) for a, b in zip(theirs[2], theirs[3], strict=True)])
+        )
+        assert selected == their_count, f"{selected} selected, scipy.linalg.ordqz {their_count}"
+
+
+def _side(select: Any, alpha: complex, beta: float, A: np.ndarray, B: np.ndarray) -> str:
+    """ "in" or "out" of the selection, or "edge" if perturbing alpha by SLACK n u ||A|| or
+    beta by SLACK n u ||B|| (their backward errors) changes it."""
+    n = A.shape[0]
+    d_alpha, d_beta = SLACK * n * U * (norm(A) + TINY), SLACK * n * U * (norm(B) + TINY)
+    verdicts = set()
+    for da, db in (
+        (0, 0),
+        (d_alpha, 0),
+        (-d_alpha, 0),
+        (1j * d_alpha, 0),
+        (0, d_beta),
+        (0, -d_beta),
+    ):
+        verdicts.add(_selected(select, alpha + da, max(beta + db, 0.0)))
+    return "edge" if len(verdicts) == 2 else "in" if verdicts == {True} else "out"
+
+
+@given(st.data())
+def test_qz(data: st.DataObject) -> None:
+    n = data.draw(orders())
+    A = data.draw(square(n))
+    B = data.draw(
+        square(
+            n, ("gaussian", "diagonal", "zero", "integers", "nilpotent", "orthogonal similarity")
+        )
+    )
+    if data.draw(st.sampled_from((False,) * 6 + (True,))):
+        B = np.eye(n + 1)  # of another order
+    kind = data.draw(st.sampled_from(SELECTS + REFUSED_SELECTS))
+    select = _select(kind)
+    outcome = exercise(
+        "qz",
+        aerocontrol.qz,
+        {
+            "A": data.draw(presented(A)),
+            "B": data.draw(presented(B)),
+            "select": Arg(select, select, kind, CALLBACK if kind == "raises" else SAME),
+        },
+        _qz_oracle,
+    )
+    if kind in REFUSED_SELECTS:
+        assert outcome.error is not None, f"select={kind} was accepted"
+
+
+# ----- c2d --------------------------------------------------------------------------------------
+
+STEPS = (0.1, 0.02, 1.0, 0.5, 1e-300, 1e300, 0.0, -0.1, np.inf, np.nan)
+C2D = ("zoh", "zoh", "foh", "tustin", "bilinear", "euler", "backward_diff", "gbt", "matched")
+BILINEAR = {"tustin": 0.5, "bilinear": 0.5, "euler": 0.0, "backward_diff": 1.0}
+
+
+def _model(args: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    return model_matrices(args["sys"])
+
+
+def _inverse_condition(M: np.ndarray, size: float) -> float:
+    """||M^-1|| (1 + size): the amplification of the rounding of M = I + X, ||X|| = size,
+    in M^-1 (at least κ(M) / 2; inf where M is singular)."""
+    if M.shape[0] == 0:
+        return 1.0
+    try:
+        return float(np.linalg.norm(np.linalg.inv(M), 2) * (1 + size))
+    except np.linalg.LinAlgError:
+        return np.inf
+
+
+def _c2d_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    A, B, C, D = _model(args)
+    dt, method = float(args["dt"]), args["method"]
+    prewarp, alpha = args["prewarp"], args["alpha"]
+    n = A.shape[0]
+    assert isinstance(result, aerocontrol.StateSpace) and result.dt == dt
+    if method in ("zoh", "foh"):
+        exact = quietly(aerocontrol.discretize, A, B, dt, method)
+        Phi, Gamma0, Gamma1 = exact.Phi, exact.Gamma0, exact.Gamma1
+        assert np.array_equal(result.A, Phi), "Ad is not discretize's Phi"
+        if method == "zoh":
+            assert np.array_equal(result.B, Gamma0), "Bd is not discretize's Gamma0"
+            assert np.array_equal(result.C, C) and np.array_equal(result.D, D)
+            _round_trip(result, A, B, dt)
+        else:
+            assert np.array_equal(result.B, Gamma0 - Gamma1 + Phi @ Gamma1), "foh Bd"
+            assert np.array_equal(result.C, C) and np.array_equal(result.D, D + C @ Gamma1)
+        return
+    if method == "matched":
+        assert result.n_inputs == 1 and result.n_outputs == 1
+        return
+    weight = BILINEAR.get(method, alpha)
+    step = dt if prewarp is None else 2 * np.tan(prewarp * dt / 2) / prewarp
+    if not finite(A, B, C, D) or not np.isfinite(step):
+        return
+    if n == 0:
+        return
+    with silenced():
+        # Forming M = I - α dt A rounds by u (1 + ||α dt A||), which M^-1 amplifies.
+        M = np.eye(n) - weight * step * A
+        kappa = _inverse_condition(M, weight * step * norm(A))
+        try:
+            theirs = ss.cont2discrete((A, B, C, D), step, "gbt", alpha=weight)
+        except (ValueError, np.linalg.LinAlgError):
+            return
+    if not (np.isfinite(kappa) and finite(*theirs[:4])) or kappa * U > 1e-3:
+        return
+    for name, ours, their in zip(
+        "ABCD", (result.A, result.B, result.C, result.D), theirs[:4], strict=False
+    ):
+        with silenced():
+            size = norm(their) + (norm(A) * step + 1) * (norm(B) + norm(C)) * step + norm(D) + 1
+            bound = SLACK * max(n, 1) * U * kappa * size * (1 + norm(A) * step)
+        assert norm(ours - their) <= bound + TINY, (
+            f"{method}: {name}d against scipy's cont2discrete"
+        )
+
+
+def _round_trip(discrete: Any, A: np.ndarray, B: np.ndarray, dt: float) -> None:
+    """d2c(c2d(sys)) = sys for the zero-order hold, without aliasing (||A dt||_1 <= 1).
+
+    The logarithm of M = [[Ad, Bd], [0, I]] is accurate to u ||M|| ||M^-1|| absolutely (its
+    derivative is of the size of M^-1), and A = log(M)_11 / dt: the error allowed is
+    SLACK (n + m) u κ_exp(A dt)² ||M|| ||M^-1|| / dt, κ_exp for the rounding of Ad and Bd by
+    c2d as well."""
+    n, m = B.shape
+    if n == 0 or not finite(A, B) or not 1e-100 < dt < 1e100:
+        return
+    with silenced():
+        X = A * dt
+        size = float(np.max(np.sum(np.abs(X), axis=0)))
+        if not (1e-100 < size <= 1.0) or norm(B) * dt > 1e100:
+            return
+        kappa = expm_condition(X)
+        M = np.block([[discrete.A, discrete.B], [np.zeros((m, n)), np.eye(m)]])
+        spread = norm(M) * norm(np.linalg.inv(M))
+        back = aerocontrol.d2c(discrete)
+    bound = SLACK * (n + m) * U * kappa**2 * spread / dt + SLACK * TINY / dt
+    assert norm(back.A - A) <= bound, f"d2c(c2d(sys)).A != A: {norm(back.A - A):.3e} > {bound:.3e}"
+    assert norm(back.B - B) <= bound, "d2c(c2d(sys)).B != B"
+
+
+@given(st.data())
+def test_c2d(data: st.DataObject) -> None:
+    A, B, C, D = data.draw(system())
+    method = data.draw(st.sampled_from((*C2D, "ZOH", 3)))
+    if method == "matched" and data.draw(st.booleans()):
+        n = A.shape[0]
+        B, C, D = data.draw(rectangular(n, 1)), data.draw(rectangular(1, n)), np.zeros((1, 1))
+    dt = data.draw(st.sampled_from(STEPS))
+    prewarp: Arg = plain(None)
+    alpha: Arg = plain(None)
+    if method == "gbt" or data.draw(st.sampled_from((False,) * 5 + (True,))):
+        alpha = data.draw(scalar(data.draw(st.sampled_from((0.0, 0.3, 0.5, 1.0, 1.5)))))
+    if method in ("tustin", "bilinear") and data.draw(st.booleans()):
+        prewarp = data.draw(scalar(data.draw(st.sampled_from((1.0, 3.0, 100.0, -1.0)))))
+    arguments = {
+        "sys": data.draw(presented_system((A, B, C, D))),
+        "dt": data.draw(scalar(dt)),
+        "method": plain(method),
+        "prewarp": prewarp,
+        "alpha": alpha,
+    }
+    exercise("c2d", aerocontrol.c2d, arguments, _c2d_oracle)
+
+
+# ----- d2c --------------------------------------------------------------------------------------
+
+D2C = ("zoh", "zoh", "tustin", "bilinear", "euler", "backward_diff", "gbt")
+
+
+def _d2c_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    sys = args["sys"]
+    Ad, Bd, Cd, Dd = (np.asarray(getattr(sys, x), float) for x in "ABCD")
+    dt, method = float(sys.dt), args["method"]
+    n, m = Bd.shape
+    assert isinstance(result, aerocontrol.StateSpace) and not result.is_discrete
+    if n == 0 or not finite(result.A, result.B, result.C, result.D):
+        return
+    if IllConditionedWarning in warned:
+        return
+    with silenced():
+        again = aerocontrol.c2d(
+            result, dt, method, alpha=args["alpha"] if method == "gbt" else None
+        )
+    if method == "zoh":
+        assert np.array_equal(result.C, Cd) and np.array_equal(result.D, Dd)
+        with silenced():
+            X = np.zeros((n + m, n + m))
+            X[:n, :n], X[:n, n:] = result.A * dt, result.B * dt
+            kappa = expm_condition(X)
+            M = np.block([[Ad, Bd], [np.zeros((m, n)), np.eye(m)]])
+        bound = SLACK * (n + m) * U * kappa * norm(M) + SLACK * TINY
+        if np.isfinite(bound):
+            error = norm(again.A - Ad) + norm(again.B - Bd)
+            assert error <= bound, f"c2d(d2c(sys)) != sys: {error:.3e} > {bound:.3e}"
+        return
+    weight = BILINEAR.get(method, args["alpha"])
+    with silenced():
+        kappa = _inverse_condition(
+            np.eye(n) + (1 - weight) * Ad, (1 - weight) * norm(Ad)
+        ) * _inverse_condition(np.eye(n) - weight * dt * result.A, weight * dt * norm(result.A))
+        # The continuous model may be far larger than the discrete one (Ad near the image of
+        # s = ∞): Dd = D + α C Bd then cancels, to u ||D||.
+        size = norm(Ad) + norm(Bd) + norm(Cd) + norm(Dd) + 1
+        size += norm(result.D) + norm(result.C) * norm(result.B) * dt
+    if np.isfinite(kappa) and kappa * U < 1e-3:
+        error = sum(
+            norm(x - y)
+            for x, y in zip((again.A, again.B, again.C, again.D), (Ad, Bd, Cd, Dd), strict=True)
+        )
+        bound = SLACK * (n + m) * U * kappa * size
+        assert error <= bound, f"{method}: c2d(d2c(sys)) != sys: {error:.3e} > {bound:.3e}"
+
+
+@given(st.data())
+def test_d2c(data: st.DataObject) -> None:
+    method = data.draw(st.sampled_from((*D2C, "foh", "matched", "nope")))
+    dt = data.draw(st.sampled_from((0.1, 0.02, 1.0)))
+    A, B, C, D = data.draw(system())
+    if data.draw(st.booleans()) and finite(A, B, C, D):
+        # The discretisation of a continuous model, which has a continuous equivalent.
+        chosen = method if method in D2C else "zoh"
+        alpha = 0.3 if chosen == "gbt" else None
+        try:
+            sampled = quietly(aerocontrol.c2d, (A, B, C, D), dt, chosen, alpha=alpha)
+            A, B, C, D = sampled.A, sampled.B, sampled.C, sampled.D
+        except aerocontrol.AerocontrolError:
+            pass
+    parts = [data.draw(presented(M)) for M in (A, B, C, D)]
+    expect = next((e for e in (CALLER, REFUSE) if any(p.expect == e for p in parts)), SAME)
+    sys = Arg(
+        SimpleNamespace(**dict(zip("ABCD", (p.value for p in parts), strict=True)), dt=dt),
+        SimpleNamespace(**dict(zip("ABCD", (p.canonical for p in parts), strict=True)), dt=dt)
+        if expect == SAME
+        else None,
+        "attributes with dt of (" + ", ".join(p.label for p in parts) + ")",
+        expect,
+    )
+    alpha = plain(0.3) if method == "gbt" else plain(None)
+    exercise(
+        "d2c", aerocontrol.d2c, {"sys": sys, "method": plain(method), "alpha": alpha}, _d2c_oracle
+    )
+
+
+# ----- known defects of the core (see known_defects.py) ------------------------------------------
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.QZ_REAL_TWO_BY_TWO_BLOCK.summary)
+def test_known_defect_qz_real_2x2_block() -> None:
+    M = np.array([[-0.06, -0.29, 0.04], [-0.95, 2.71, 0.9], [-0.8, -0.21, 0.04]])
+    with known_defects.QZ_REAL_TWO_BY_TWO_BLOCK.reproducing():
+        exercise(
+            "qz",
+            aerocontrol.qz,
+            {"A": canonical(M), "B": canonical(M.copy()), "select": plain(None)},
+            _qz_oracle,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.C2D_OVERFLOW_BLAMES_MODEL.summary)
+@pytest.mark.parametrize("method", ["zoh", "foh"])
+def test_known_defect_c2d_overflow_blames_model(method: str) -> None:
+    model = tuple(np.array([[value]]) for value in (1.0, 1.0, 1.0, 0.0))
+    with known_defects.C2D_OVERFLOW_BLAMES_MODEL.reproducing():
+        exercise(
+            "c2d",
+            aerocontrol.c2d,
+            {
+                "sys": Arg(model, model, "tuple", SAME),
+                "dt": plain(1000.0),
+                "method": plain(method),
+                "prewarp": plain(None),
+                "alpha": plain(None),
+            },
+            _c2d_oracle,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.QZ_UNBALANCED_PENCIL.summary)
+def test_known_defect_qz_unbalanced_pencil() -> None:
+    A = np.array([[-0.1, -0.5], [-1.7e-4, -1.2]])
+    B = np.array([[4e-11, -4e-11], [1.3e-10, -1.3e-10]])
+    with known_defects.QZ_UNBALANCED_PENCIL.reproducing():
+        exercise(
+            "qz",
+            aerocontrol.qz,
+            {"A": canonical(A), "B": canonical(B), "select": plain(None)},
+            _qz_oracle,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason=known_defects.C2D_MATCHED_SCALE.summary)
+def test_known_defect_c2d_matched_scale() -> None:
+    A = np.array(
+        [[0.1257302210933933, -0.1321048632913019], [0.6404226504432821, 0.1049001171530397]]
+    )
+    model = (A, np.array([[1e-4], [-1.3e-4]]), np.array([[1e100, -1.05e100]]), np.zeros((1, 1)))
+    with known_defects.C2D_MATCHED_SCALE.reproducing():
+        exercise(
+            "c2d",
+            aerocontrol.c2d,
+            {
+                "sys": Arg(model, model, "tuple", SAME),
+                "dt": plain(0.1),
+                "method": plain("matched"),
+                "prewarp": plain(None),
+                "alpha": plain(None),
+            },
+            _c2d_oracle,
+        )
