@@ -604,6 +604,13 @@ def _roots(coefficients: FloatArray) -> ComplexArray:
     return _core.eigenvalues(companion)
 
 
+def _power_of_two(value: float) -> float:
+    """The power of two nearest ``value`` (1 for 0 or a non-finite value)."""
+    if value > 0.0 and np.isfinite(value):
+        return float(2.0 ** round(np.log2(value)))
+    return 1.0
+
+
 def _matched(model: StateSpace, dt: float) -> StateSpace:
     """Matched pole-zero discretisation of a single-input, single-output model."""
     if (model.n_inputs, model.n_outputs) != (1, 1):
@@ -615,11 +622,19 @@ def _matched(model: StateSpace, dt: float) -> StateSpace:
     A, b, c, d = model.A, model.B[:, 0], model.C[0], float(model.D[0, 0])
     n = model.n_states
     poles = _core.eigenvalues(A) if n else np.zeros(0, dtype=np.complex128)
+    # b / beta and c / gamma for the powers of two that give each the norm sqrt(||A||):
+    # det(sI - A + b c) - P cancels least when b c is as large as A, and the zeros do not
+    # depend on the scale of b or c (a C of 1e50 moved a zero). N = beta gamma N-hat.
+    size = float(np.sqrt(max(float(np.abs(A).max(initial=0.0)), np.finfo(float).tiny)))
+    beta, gamma = (_power_of_two(float(np.linalg.norm(v)) / size) for v in (b, c))
+    b, c = b / beta, c / gamma
     # G(s) = N(s) / P(s) with P = det(sI - A) and, by the matrix determinant lemma,
     # N = d P + det(sI - A + b c) - P. Without feedthrough the leading coefficients of N are
     # the Markov parameters c A^(k-1) b, zero below the relative degree.
     P = _core.charpoly(A) if n else np.ones(1)
-    numerator = d * P + ((_core.charpoly(A - np.outer(b, c)) - P) if n else np.zeros(1))
+    with np.errstate(over="ignore", under="ignore"):
+        hat_d = d / beta / gamma
+    numerator = hat_d * P + ((_core.charpoly(A - np.outer(b, c)) - P) if n else np.zeros(1))
     if d == 0.0:
         eps = np.finfo(float).eps
         scale = float(np.linalg.norm(c) * np.linalg.norm(b))
@@ -643,7 +658,8 @@ def _matched(model: StateSpace, dt: float) -> StateSpace:
     discrete_gain = np.prod(_one_minus_exp(nonzero_zeros * dt)) / np.prod(
         _one_minus_exp(nonzero_poles * dt)
     )
-    gain = float((continuous_gain / discrete_gain).real) / dt**excess
+    with np.errstate(over="ignore"):  # an overflow is refused by name below
+        gain = float((continuous_gain / discrete_gain).real) / dt**excess * beta * gamma
     # A cascade of first- and second-order sections, each a factor (z - e^{z_i dt}) ... over
     # (z - e^{p_i dt}) ...: the poles sit exactly in the sections' matrices, where the
     # coefficients of one polynomial of degree n would lose digits as the poles crowd towards

@@ -253,19 +253,6 @@ RICCATI_OVERFLOW_BLAMES_A: Defect = known_defect(
 )
 
 
-SWEEP_WEIGHTS_ALIAS: Defect = known_defect(
-    "sweep-weights-alias",
-    {"batch.lqr_sweep", "batch.dlqr_sweep"},
-    "lqr_sweep and dlqr_sweep return the caller's own weights array as LqrSweep.weights when "
-    "it is an aligned float64 array (python/aerocontrol/batch.py, _sweep: "
-    "np.atleast_1d(real_array(weights, 'weights')) is the argument itself): "
-    "c = np.array([1.0, 2.0]); s = lqr_sweep(A, B, weights=c); c[0] = 5.0 changes "
-    "s.weights[0] to 5.0. Every other result is a fresh array; the weights should be copied.",
-    lambda args: True,
-    symptom="share memory with the arguments",
-)
-
-
 def _largest_entry(args: dict[str, Any]) -> float:
     """The largest magnitude in any matrix argument (or a model's matrix)."""
     largest = 0.0
@@ -278,24 +265,6 @@ def _largest_entry(args: dict[str, Any]) -> float:
     return largest
 
 
-ESTIMATION_OVERFLOW: Defect = known_defect(
-    "estimation-overflow",
-    {"lqe", "dlqe", "kalman", "lqg"},
-    "python/aerocontrol/estimation.py forms G QN G^T, its symmetric part 0.5 (P + P^T) and "
-    "the LQG compensator's A - B K - L C + L D K with numpy without handling overflow: "
-    "numpy's RuntimeWarning 'overflow encountered in matmul' (estimation.py:308, :906) or "
-    "'in add' (:309) reaches the caller, and the filter is then refused as NonFiniteError "
-    "'Q must be finite, but Q[0, 0] is inf', naming a Q that lqe does not take. "
-    "lqe([[-1.0]], [[1e200]], [[1.0]], [[1.0]], [[1.0]]) and, with a representable G QN G^T, "
-    "lqe([[-1.0]], [[1.0]], [[1.0]], [[1e308]], [[1.0]]) (P + P^T = 2e308 overflows where "
-    "0.5 P + 0.5 P^T would not); likewise dlqe, kalman (G = 2e150, QN = 1e8) and lqg. It "
-    "should scale (or halve "
-    "before adding) and name the argument or the overflow.",
-    lambda args: _any_extreme(args) or _largest_entry(args) >= 1e100,
-    symptom="estimation.py",
-)
-
-
 def _c2d_overflows(args: dict[str, Any]) -> bool:
     """Whether a c2d call's discretisation can overflow: ||A dt||_1 >= 700 (e^{A dt}), or an
     entry of the model or of A dt whose square leaves the normal range."""
@@ -303,21 +272,6 @@ def _c2d_overflows(args: dict[str, Any]) -> bool:
     dt = abs(float(args["dt"]))
     with np.errstate(all="ignore"):
         return bool(_one_norm(A) * dt >= 700 or _any_extreme(args) or _extreme_entries(A * dt))
-
-
-C2D_OVERFLOW_BLAMES_MODEL: Defect = known_defect(
-    "c2d-overflow-blames-model",
-    {"c2d"},
-    "When the discretisation overflows, c2d issues a NumericalOverflowWarning and then raises "
-    "NonFiniteError 'A must be finite, but A[0, 0] is inf', blaming the model's finite A "
-    "(the StateSpace it builds from the overflowed Phi refuses it): "
-    "c2d(([[1.0]], [[1.0]], [[1.0]], [[0.0]]), 1000.0) (e^1000 overflows); with "
-    "method='foh' numpy's RuntimeWarning 'invalid value encountered in subtract' "
-    "(linalg.py:344) leaks too, and c2d(([[-1.0]], [[1e300]], [[1e300]], [[0.0]]), 0.1, "
-    "'foh') says 'D must be finite, but D[0, 0] is inf'. It should raise an error that names "
-    "the overflow (dt too long for the model, or entries too large).",
-    _c2d_overflows,
-)
 
 
 QZ_REAL_TWO_BY_TWO_BLOCK: Defect = known_defect(
@@ -343,41 +297,6 @@ def _norm_ratio(args: dict[str, Any]) -> float:
         if a == 0 or b == 0:
             return 1.0 if a == b else np.inf
         return max(a / b, b / a)
-
-
-QZ_UNBALANCED_PENCIL: Defect = known_defect(
-    "qz-unbalanced-pencil",
-    {"qz"},
-    "qz is not backward stable for each matrix of a pencil whose two matrices differ much in "
-    "size: Q BB Z^T differs from B by far more than u ||B|| when ||B|| << ||A||. For "
-    "A = [[-0.1, -0.5], [-1.7e-4, -1.2]], B = [[4e-11, -4e-11], [1.3e-10, -1.3e-10]] "
-    "(B singular: one infinite eigenvalue) ||Q BB Z^T - B|| is 1 % of ||B|| (1e14 u; scipy: "
-    "2 u), and the eigenvalues come out as 4.2955e9 and -9.08e11 where scipy gives 3.998e9 "
-    "and inf; for A = [[-0.132, 640.4], [1.05e-4, -0.536]] and a random B of size 1e-8 the "
-    "error is 3.9e4 u (B of size 1e-6: 1.3 u). With entries near 1e-300 in A and 1e-3 in B, "
-    "Q and Z lose orthogonality (3e8 u) and B's error is 1e8 u. Deflation and the "
-    "convergence tests seem to compare B's entries with a norm of the whole pencil (or of "
-    "A); LAPACK's dhgeqz tests each matrix against its own norm. solve_dare and the "
-    "indefinite CARE use this QZ.",
-    lambda args: _norm_ratio(args) >= 1e6 or _any_extreme(args),
-)
-
-
-C2D_MATCHED_SCALE: Defect = known_defect(
-    "c2d-matched-scale",
-    {"c2d"},
-    "c2d(method='matched') is not invariant to the scale of the model's gain: with "
-    "A = [[0.1257, -0.1321], [0.6404, 0.1049]], B = [[1e-4], [-1.3e-4]], "
-    "C = c [[1, -1.05]], D = 0, dt = 0.1, G_d(e^{0.3j}) / c is -9.50e-6 - 7.97e-5j for "
-    "c = 1 and 1e10 but -1.79e-5 - 7.77e-5j for c = 1e50 to 1e140 (another zero, silently), "
-    "1.9e124 for c = 1e149, and for c = 1e100 and 1e120 numpy's RuntimeWarnings (overflow in "
-    "expm1 and exp, linalg.py:614-627) leak and NonFiniteError 'B must be finite, but "
-    "B[0, 0] is NaN' blames the finite B. The zeros seem to be found with a tolerance that is "
-    "not relative to the numerator's scale.",
-    lambda args: (
-        args["method"] == "matched" and max(_largest(m) for m in _model(args["sys"])) >= 1e40
-    ),
-)
 
 
 LYAPUNOV_TINY_REFUSED: Defect = known_defect(

@@ -523,22 +523,20 @@ def test_known_defect_batch_empty_rcond() -> None:
         )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.SWEEP_WEIGHTS_ALIAS.summary)
-def test_known_defect_sweep_weights_alias() -> None:
+def test_regression_sweep_weights_alias() -> None:
     A, B = aerocontrol.chapter.boeing747_lateral()
-    with known_defects.SWEEP_WEIGHTS_ALIAS.reproducing():
-        exercise(
-            "batch.lqr_sweep",
-            batch.lqr_sweep,
-            {
-                "sys_or_A": canonical(A),
-                "B": canonical(B),
-                "Q": plain(None),
-                "R": plain(None),
-                "weights": canonical(np.array([1.0, 2.0])),
-            },
-            _sweep_oracle(False),
-        )
+    exercise(
+        "batch.lqr_sweep",
+        batch.lqr_sweep,
+        {
+            "sys_or_A": canonical(A),
+            "B": canonical(B),
+            "Q": plain(None),
+            "R": plain(None),
+            "weights": canonical(np.array([1.0, 2.0])),
+        },
+        _sweep_oracle(False),
+    )
 
 
 @pytest.mark.xfail(strict=True, reason=known_defects.SWEEP_WEIGHT_OVERFLOW.summary)

@@ -413,54 +413,65 @@ def test_known_defect_qz_real_2x2_block() -> None:
         )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.C2D_OVERFLOW_BLAMES_MODEL.summary)
 @pytest.mark.parametrize("method", ["zoh", "foh"])
-def test_known_defect_c2d_overflow_blames_model(method: str) -> None:
+def test_regression_c2d_overflow_blames_model(method: str) -> None:
     model = tuple(np.array([[value]]) for value in (1.0, 1.0, 1.0, 0.0))
-    with known_defects.C2D_OVERFLOW_BLAMES_MODEL.reproducing():
-        exercise(
-            "c2d",
-            aerocontrol.c2d,
-            {
-                "sys": Arg(model, model, "tuple", SAME),
-                "dt": plain(1000.0),
-                "method": plain(method),
-                "prewarp": plain(None),
-                "alpha": plain(None),
-            },
-            _c2d_oracle,
-        )
+    exercise(
+        "c2d",
+        aerocontrol.c2d,
+        {
+            "sys": Arg(model, model, "tuple", SAME),
+            "dt": plain(1000.0),
+            "method": plain(method),
+            "prewarp": plain(None),
+            "alpha": plain(None),
+        },
+        _c2d_oracle,
+    )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.QZ_UNBALANCED_PENCIL.summary)
-def test_known_defect_qz_unbalanced_pencil() -> None:
+def test_regression_qz_unbalanced_pencil() -> None:
     A = np.array([[-0.1, -0.5], [-1.7e-4, -1.2]])
     B = np.array([[4e-11, -4e-11], [1.3e-10, -1.3e-10]])
-    with known_defects.QZ_UNBALANCED_PENCIL.reproducing():
-        exercise(
-            "qz",
-            aerocontrol.qz,
-            {"A": canonical(A), "B": canonical(B), "select": plain(None)},
-            _qz_oracle,
-        )
+    exercise(
+        "qz",
+        aerocontrol.qz,
+        {"A": canonical(A), "B": canonical(B), "select": plain(None)},
+        _qz_oracle,
+    )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.C2D_MATCHED_SCALE.summary)
-def test_known_defect_c2d_matched_scale() -> None:
+def test_regression_c2d_matched_scale() -> None:
     A = np.array(
         [[0.1257302210933933, -0.1321048632913019], [0.6404226504432821, 0.1049001171530397]]
     )
     model = (A, np.array([[1e-4], [-1.3e-4]]), np.array([[1e100, -1.05e100]]), np.zeros((1, 1)))
-    with known_defects.C2D_MATCHED_SCALE.reproducing():
-        exercise(
-            "c2d",
-            aerocontrol.c2d,
-            {
-                "sys": Arg(model, model, "tuple", SAME),
-                "dt": plain(0.1),
-                "method": plain("matched"),
-                "prewarp": plain(None),
-                "alpha": plain(None),
-            },
-            _c2d_oracle,
-        )
+    exercise(
+        "c2d",
+        aerocontrol.c2d,
+        {
+            "sys": Arg(model, model, "tuple", SAME),
+            "dt": plain(0.1),
+            "method": plain("matched"),
+            "prewarp": plain(None),
+            "alpha": plain(None),
+        },
+        _c2d_oracle,
+    )
+
+
+@pytest.mark.parametrize("scale", [1e-100, 1e10, 1e50, 1e100, 1e149])
+def test_matched_zero_does_not_depend_on_the_output_scale(scale: float) -> None:
+    """G_d / c of the matched model of (A, B, c C) is the same for every c (a C of 1e50 once
+    moved the zero silently: -1.79e-5 - 7.77e-5j instead of -9.50e-6 - 7.97e-5j at 3 rad/s)."""
+    A = np.array([[0.1257, -0.1321], [0.6404, 0.1049]])
+    B, C = np.array([[1e-4], [-1.3e-4]]), np.array([[1.0, -1.05]])
+    reference = aerocontrol.frequency_response(
+        aerocontrol.c2d((A, B, C, np.zeros((1, 1))), 0.1, method="matched"), [3.0]
+    )
+    scaled = aerocontrol.frequency_response(
+        aerocontrol.c2d((A, B, scale * C, np.zeros((1, 1))), 0.1, method="matched"), [3.0]
+    )
+    expected = complex(reference.response[0, 0, 0])
+    got = complex(scaled.response[0, 0, 0]) / scale
+    assert abs(got - expected) <= 1e-12 * abs(expected)
