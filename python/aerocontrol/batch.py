@@ -389,7 +389,21 @@ def _sweep(
     R_matrix = np.eye(m) if R is None else np.atleast_2d(real_array(R, "R"))
     if R_matrix.ndim != 2:
         raise ShapeError(f"R must be one m x m matrix, got shape {R_matrix.shape}")
-    R_stack = R_matrix[np.newaxis] / (c * c)[:, np.newaxis, np.newaxis]
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        R_stack = R_matrix[np.newaxis] / (c * c)[:, np.newaxis, np.newaxis]
+    if np.all(np.isfinite(R_matrix)):
+        # R / c^2 overflowed, or a nonzero entry of R underflowed to zero.
+        lost = ~np.all(np.isfinite(R_stack), axis=(1, 2)) | np.any(
+            (R_stack == 0) & (R_matrix != 0), axis=(1, 2)
+        )
+        if np.any(lost):
+            k = int(np.flatnonzero(lost)[0])
+            error = InvalidArgumentError(
+                f"weights[{k}] = {c[k]:g} is out of range for R: R / c^2 leaves the range of "
+                "double precision (scale R or the weights)"
+            )
+            error.argument = "weights"
+            raise error
     solve = solve_dare_batch if discrete else solve_care_batch
     batch = solve(A_matrix, B_matrix, Q_matrix, R_stack)
     return LqrSweep(c, batch.K, batch.closed_loop_poles, batch.X, batch.residual, batch.rcond)

@@ -310,16 +310,3 @@ LYAPUNOV_TINY_REFUSED: Defect = known_defect(
     lambda args: 0 < _largest(args["A"]) < 1e-280,
     symptom="solve_lyapunov refused",
 )
-
-
-SWEEP_WEIGHT_OVERFLOW: Defect = known_defect(
-    "sweep-weight-overflow",
-    {"batch.lqr_sweep", "batch.dlqr_sweep"},
-    "lqr_sweep and dlqr_sweep form R / c^2 with numpy (python/aerocontrol/batch.py:392) "
-    "without handling overflow: for a small weight c and a large R numpy's RuntimeWarning "
-    "'overflow encountered in divide' reaches the caller (then the infinite R is refused by "
-    "name, though the caller's R is finite): lqr_sweep([[-1.0]], [[1.0]], R=[[1e10]], "
-    "weights=[1e-150]). It should refuse the weight by name (or scale).",
-    lambda args: True,
-    symptom="batch.py",
-)

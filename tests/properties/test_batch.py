@@ -539,18 +539,16 @@ def test_regression_sweep_weights_alias() -> None:
     )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.SWEEP_WEIGHT_OVERFLOW.summary)
-def test_known_defect_sweep_weight_overflow() -> None:
-    with known_defects.SWEEP_WEIGHT_OVERFLOW.reproducing():
-        exercise(
-            "batch.lqr_sweep",
-            batch.lqr_sweep,
-            {
-                "sys_or_A": canonical(np.array([[-1.0]])),
-                "B": canonical(np.eye(1)),
-                "Q": plain(None),
-                "R": canonical(np.array([[1e10]])),
-                "weights": plain([1e-150]),
-            },
-            _sweep_oracle(False),
-        )
+def test_regression_sweep_weight_overflow() -> None:
+    exercise(
+        "batch.lqr_sweep",
+        batch.lqr_sweep,
+        {
+            "sys_or_A": canonical(np.array([[-1.0]])),
+            "B": canonical(np.eye(1)),
+            "Q": plain(None),
+            "R": canonical(np.array([[1e10]])),
+            "weights": plain([1e-150]),
+        },
+        _sweep_oracle(False),
+    )
