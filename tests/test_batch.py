@@ -66,13 +66,17 @@ def test_single_input_and_empty_sweeps() -> None:
 
 
 def test_an_error_names_the_lowest_failing_index() -> None:
+    # A singular R (problem 2) is refused as solve_care refuses it; an indefinite one
+    # (problem 4) is solved by the extended pencil, as solve_care solves it.
     R = np.repeat(np.eye(2)[np.newaxis], 6, axis=0)
     R[4, 0, 0] = -1.0
     R[2, 1, 1] = 0.0
     with pytest.raises(
-        aerocontrol.NotPositiveDefiniteError, match=r"^problem 2 of the batch: R must be"
+        aerocontrol.InvalidArgumentError, match=r"^problem 2 of the batch: R must be"
     ):
         solve_care_batch(LATERAL.A, LATERAL.B, np.eye(4), R)
+    with pytest.raises(aerocontrol.InvalidArgumentError, match=r"^R must be nonsingular"):
+        aerocontrol.solve_care(LATERAL.A, LATERAL.B, np.eye(4), R[2])
     # No stabilising solution in problem 1 only (the chapter's undamped example, (6.5)).
     A = np.array([[[-1.0, 0.0], [0.0, -2.0]], [[0.0, 1.0], [-1.0, 0.0]]])
     with pytest.raises(aerocontrol.NoStabilizingSolutionError, match=r"^problem 1 of the batch"):

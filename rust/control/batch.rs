@@ -6,13 +6,13 @@
 //! which is the efficient split for many small problems; an error names the index of the problem.
 
 use crate::control::placement::Placement;
-use crate::control::riccati::care::{CareOptions, solve_care_dense};
+use crate::control::riccati::care::{CareOptions, solve_care, solve_care_dense};
 use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
 use crate::linalg::dense::Dense;
 use crate::linalg::expm::expm_into_validated;
 use crate::platform::parallel::{ParallelContext, par_chunks};
-use faer::{MatMut, MatRef, c64};
+use faer::{Mat, MatMut, MatRef, c64};
 use rayon::prelude::*;
 
 /// A read-only stack of `count` matrices of shape `rows` x `cols`, row-major and contiguous.
@@ -123,6 +123,44 @@ pub struct CareStacks<'a> {
 }
 
 impl CareStacks<'_> {
+    /// B with n rows, Q n x n and R m x m, for A n x n and B n x m: checked before any problem
+    /// (an empty batch or a problem of order 0 has no member that would check them).
+    fn check_shapes(&self) -> Result<(), Error> {
+        let (n, m) = (self.a.rows, self.b.cols);
+        if self.a.cols != n {
+            return Err(Error::NotSquare {
+                arg: "A",
+                rows: n,
+                cols: self.a.cols,
+            });
+        }
+        for (arg, stack, order, other) in [
+            ("B", &self.b, n, "A"),
+            ("Q", &self.q, n, "A"),
+            ("R", &self.r, m, "the columns of B"),
+        ] {
+            if stack.rows != order {
+                return Err(Error::Mismatch {
+                    arg,
+                    what: "as many rows as",
+                    expected: order,
+                    other,
+                    got: stack.rows,
+                });
+            }
+        }
+        for (arg, stack) in [("Q", &self.q), ("R", &self.r)] {
+            if stack.cols != stack.rows {
+                return Err(Error::NotSquare {
+                    arg,
+                    rows: stack.rows,
+                    cols: stack.cols,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The number of problems k: the stacks that do not hold one matrix must all hold k (an
     /// empty stack makes an empty batch); k = 1 when every stack holds one.
     pub fn count(&self) -> Result<usize, Error> {
@@ -224,8 +262,40 @@ pub fn riccati_batch(
     check_output_len(out.poles.len(), count * n)?;
     check_output_len(out.residual.len(), count)?;
     check_output_len(out.rcond.len(), count)?;
-    if count == 0 || n == 0 {
+    stacks.check_shapes()?;
+    if count == 0 {
+        // No problem to solve, but shared members are still the caller's arguments.
+        for (arg, stack) in [
+            ("A", &stacks.a),
+            ("B", &stacks.b),
+            ("Q", &stacks.q),
+            ("R", &stacks.r),
+        ] {
+            for index in 0..stack.len() {
+                check_finite(stack.get(index), arg)?;
+            }
+        }
         return Ok(());
+    }
+    if n == 0 {
+        // Nothing to write but the diagnostics; each problem still checked (R above all) and
+        // reported as the single solver reports it.
+        let failure = (0..count).find_map(|index| {
+            let problem = (
+                member(&stacks.a, index),
+                member(&stacks.b, index),
+                member(&stacks.q, index),
+                member(&stacks.r, index),
+            );
+            match solve_one(problem, kind) {
+                Ok(solved) => {
+                    (out.residual[index], out.rcond[index]) = (solved.residual, solved.rcond);
+                    None
+                }
+                Err(error) => Some((index, error)),
+            }
+        });
+        return lowest_failure(failure);
     }
     // The Hamiltonian (or the compressed symplectic pencil) is of order 2n.
     let context = ParallelContext::capture(2 * n);
@@ -244,32 +314,12 @@ pub fn riccati_batch(
                 member(&stacks.q, index),
                 member(&stacks.r, index),
             );
-            let solved = context.run(|| match kind {
-                RiccatiKind::Continuous { refine } => {
-                    let options = CareOptions {
-                        refine,
-                        ..CareOptions::default()
-                    };
-                    solve_care_dense(a, b, q, r, options).map(|care| {
-                        write_row_major(&care.x, x);
-                        write_row_major(&care.gain, gain);
-                        poles.copy_from_slice(&care.closed_loop_eigenvalues);
-                        (care.residual, care.rcond)
-                    })
-                }
-                RiccatiKind::Discrete => {
-                    solve_dare(a, b, q, r, DareOptions::default()).map(|dare| {
-                        MatMut::from_row_major_slice_mut(x, n, n).copy_from(&dare.x);
-                        MatMut::from_row_major_slice_mut(gain, m, n).copy_from(&dare.gain);
-                        poles.copy_from_slice(&dare.closed_loop_eigenvalues);
-                        (dare.residual, dare.rcond)
-                    })
-                }
-            });
+            let solved = context.run(|| solve_one((a, b, q, r), kind));
             match solved {
-                Ok((res, cond)) => {
-                    *residual = res;
-                    *rcond = cond;
+                Ok(solved) => {
+                    solved.write(x, gain, n, m);
+                    poles.copy_from_slice(&solved.poles);
+                    (*residual, *rcond) = (solved.residual, solved.rcond);
                     None
                 }
                 Err(error) => Some((index, error)),
@@ -277,6 +327,96 @@ pub fn riccati_batch(
         })
         .min_by_key(|(index, _)| *index);
     lowest_failure(failure)
+}
+
+/// One problem's solution as a batch writes it.
+struct Solved {
+    solution: Solution,
+    poles: Vec<c64>,
+    residual: f64,
+    rcond: f64,
+}
+
+/// X and K as the solver that found them holds them.
+enum Solution {
+    Dense { x: Dense, gain: Dense },
+    Faer { x: Mat<f64>, gain: Mat<f64> },
+}
+
+impl Solved {
+    /// X (n x n) and K (m x n), row-major, into `x` and `gain`.
+    fn write(&self, x: &mut [f64], gain: &mut [f64], n: usize, m: usize) {
+        match &self.solution {
+            Solution::Dense { x: xd, gain: kd } => {
+                write_row_major(xd, x);
+                write_row_major(kd, gain);
+            }
+            Solution::Faer { x: xm, gain: km } => {
+                MatMut::from_row_major_slice_mut(x, n, n).copy_from(xm);
+                MatMut::from_row_major_slice_mut(gain, m, n).copy_from(km);
+            }
+        }
+    }
+}
+
+/// One problem of a batch, solved exactly as the single solver solves it: the continuous
+/// equation by the Cholesky path, or (an R symmetric but not positive definite) by
+/// [`solve_care`]'s extended pencil; the discrete one by [`solve_dare`].
+fn solve_one(
+    (a, b, q, r): (
+        MatRef<'_, f64>,
+        MatRef<'_, f64>,
+        MatRef<'_, f64>,
+        MatRef<'_, f64>,
+    ),
+    kind: RiccatiKind,
+) -> Result<Solved, Error> {
+    match kind {
+        RiccatiKind::Continuous { refine } => {
+            let options = CareOptions {
+                refine,
+                ..CareOptions::default()
+            };
+            match solve_care_dense(a, b, q, r, options) {
+                Ok(care) => Ok(Solved {
+                    solution: Solution::Dense {
+                        x: care.x,
+                        gain: care.gain,
+                    },
+                    poles: care.closed_loop_eigenvalues,
+                    residual: care.residual,
+                    rcond: care.rcond,
+                }),
+                // solve_care routes such an R to the extended pencil (or refuses it as the
+                // single call does).
+                Err(Error::NotPositiveDefinite { arg: "R", .. }) => {
+                    let care = solve_care(a, b, q, r, options)?;
+                    Ok(Solved {
+                        solution: Solution::Faer {
+                            x: care.x,
+                            gain: care.gain,
+                        },
+                        poles: care.closed_loop_eigenvalues,
+                        residual: care.residual,
+                        rcond: care.rcond,
+                    })
+                }
+                Err(error) => Err(error),
+            }
+        }
+        RiccatiKind::Discrete => {
+            let dare = solve_dare(a, b, q, r, DareOptions::default())?;
+            Ok(Solved {
+                solution: Solution::Faer {
+                    x: dare.x,
+                    gain: dare.gain,
+                },
+                poles: dare.closed_loop_eigenvalues,
+                residual: dare.residual,
+                rcond: dare.rcond,
+            })
+        }
+    }
 }
 
 /// A pole-placement algorithm of [`crate::control::placement`].

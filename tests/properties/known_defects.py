@@ -83,19 +83,6 @@ def _definite(value: Any) -> bool:
     return True
 
 
-CARE_EMPTY_INDEFINITE_RCOND: Defect = known_defect(
-    "care-empty-indefinite-rcond",
-    {"solve_care"},
-    "solve_care of an empty problem (n = 0) with an indefinite R (the extended-pencil path) "
-    "reports rcond = inf, without a NumericalOverflowWarning: "
-    "solve_care(zeros((0, 0)), zeros((0, 2)), zeros((0, 0)), diag([1.0, -1.0])).rcond is inf, "
-    "where the definite path (R = I) and solve_dare report 1.0. It should report 1.0 (E U11 "
-    "of order 0 is perfectly conditioned), as the other paths do.",
-    lambda args: np.asarray(args["A"]).size == 0 and not _definite(args["R"]),
-    symptom="NaN or Inf in ['.rcond']",
-)
-
-
 def _hamiltonian_work(args: dict[str, Any]) -> float:
     """||H||_1 (t_f - t_0) of a riccati_ode call, H = [[A, -B R^-1 B^T], [-Q, -A^T]]: an
     upper bound of the growth rate of its modes times the horizon."""
@@ -134,53 +121,12 @@ def _any_indefinite(value: Any) -> bool:
     return any(not _definite(member) for member in members)
 
 
-BATCH_REFUSES_INDEFINITE_R: Defect = known_defect(
-    "batch-refuses-indefinite-R",
-    {"batch.solve_care_batch", "batch.lqr_sweep"},
-    "solve_care_batch (and lqr_sweep, through it) refuses a symmetric indefinite R with "
-    "NotPositiveDefiniteError ('problem i of the batch: R must be symmetric positive "
-    "definite'), although solve_care solves it since issue 24 (the extended Hamiltonian "
-    "pencil) and the batch promises each problem 'solved exactly as solve_care solves it "
-    "alone': solve_care([[-5]], [[1]], [[1]], [[-1]]) returns X = 5 - sqrt(24) (closed loop "
-    "-4.899), solve_care_batch of the same numbers raises. (tests/test_batch.py pins the "
-    "refusal; rust/control/batch.rs calls the Cholesky path directly.) It should dispatch as "
-    "solve_care does.",
-    lambda args: args["R"] is not None and _any_indefinite(args["R"]),
-)
-
-
 def _order(args: dict[str, Any]) -> int:
     """The order n of a batch or sweep call's plant (the last axis of A)."""
     if "sys" in args:
         return int(np.asarray(_model(args["sys"])[0]).shape[-1])
     A = args.get("A", args.get("sys_or_A"))
     return int(np.asarray(A, dtype=float).shape[-1])
-
-
-BATCH_EMPTY_RCOND: Defect = known_defect(
-    "batch-empty-problem",
-    {
-        "batch.solve_care_batch",
-        "batch.solve_dare_batch",
-        "batch.lqr_sweep",
-        "batch.dlqr_sweep",
-        "batch.place_batch",
-    },
-    "The Riccati batches skip a problem of order n = 0 entirely: they report rcond = 0 and "
-    "then an IllConditionedWarning ('1 of the 1 Riccati solutions may be inaccurate ... "
-    "problems 0'), where solve_care and solve_dare report rcond = 1.0 without a warning "
-    "(solve_care_batch(zeros((0, 0)), zeros((0, 2)), zeros((0, 0)), eye(2)).rcond is [0.]), "
-    "and they do not check R: R = [[nan]] or [[inf]] is returned from (solve_care and "
-    "solve_dare raise NonFiniteError naming R), R = [[0.0]] too (solve_care raises "
-    "InvalidArgumentError: R singular). Likewise lqr_sweep and dlqr_sweep. The batch should "
-    "check and fill each problem as the single solve does (it promises the single results "
-    "bitwise). An empty batch (k = 0, or lqr_sweep with weights=[]) or a problem of order "
-    "0 is not checked at all: lqr_sweep([[0.126]], [[0.126]], Q=[[inf]], weights=[]) "
-    "returns, and solve_dare_batch(zeros((0, 0)), [[[0.0, 0.0]]], zeros((0, 0)), [[1.0]]) "
-    "accepts a B of one row for an A of none; place_batch(zeros((0, 1, 1)), zeros((1, 2, 2)), "
-    "[-1.0]) accepts a B of order 2 for an empty stack of order-1 plants.",
-    lambda args: _order(args) == 0 or _batch_size(args) == 0,
-)
 
 
 def _batch_size(args: dict[str, Any]) -> int:

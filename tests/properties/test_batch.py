@@ -16,7 +16,6 @@ import re
 from typing import Any
 
 import numpy as np
-import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -24,7 +23,6 @@ import aerocontrol
 from aerocontrol import batch
 from aerocontrol.exceptions import AerocontrolError, IllConditionedWarning, ShapeError
 
-from . import known_defects
 from .harness import SAME, TALLY, Arg, Outcome, Warned, _known_defect, exercise, plain
 from .oracles import finite, silenced
 from .strategies import (
@@ -261,13 +259,12 @@ def failure_check(
     try:
         assert_batch_failure(name, outcome, singles)
     except AssertionError as failure:
-        for defect in (known_defects.BATCH_REFUSES_INDEFINITE_R,):
-            symptom = defect.symptom or ""
-            if defect.active and name in defect.functions and symptom in str(failure):
-                if defect.applies(values):
-                    # Counted as the defect, not as the exception the call raised.
-                    _recount(name, outcome.label, f"known defect: {defect.key}")
-                    return
+        arguments = {key: Arg(value, value, "canonical", SAME) for key, value in values.items()}
+        defect = _known_defect(name, arguments, str(failure))
+        if defect is not None:
+            # Counted as the defect, not as the exception the call raised.
+            _recount(name, outcome.label, f"known defect: {defect.key}")
+            return
         _recount(name, outcome.label, "FAILED")
         raise
 
@@ -490,37 +487,31 @@ def test_sweeps(data: st.DataObject) -> None:
 # ----- known defects of the core (see known_defects.py) ------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.BATCH_REFUSES_INDEFINITE_R.summary)
-def test_known_defect_batch_refuses_indefinite_r() -> None:
+def test_regression_batch_refuses_indefinite_r() -> None:
     A, B, Q, R = np.array([[-5.0]]), np.array([[1.0]]), np.array([[1.0]]), np.array([[-1.0]])
     values = {"A": A, "B": B, "Q": Q, "R": R}
-    with known_defects.BATCH_REFUSES_INDEFINITE_R.reproducing():
-        outcome = exercise(
-            "batch.solve_care_batch",
-            batch.solve_care_batch,
-            {key: canonical(value) for key, value in values.items()},
-            _riccati_batch_oracle(False),
-        )
-        if outcome.error is not None:
-            failure_check(
-                "batch.solve_care_batch", outcome, values, _riccati_singles(values, False)
-            )
+    outcome = exercise(
+        "batch.solve_care_batch",
+        batch.solve_care_batch,
+        {key: canonical(value) for key, value in values.items()},
+        _riccati_batch_oracle(False),
+    )
+    if outcome.error is not None:
+        failure_check("batch.solve_care_batch", outcome, values, _riccati_singles(values, False))
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.BATCH_EMPTY_RCOND.summary)
-def test_known_defect_batch_empty_rcond() -> None:
-    with known_defects.BATCH_EMPTY_RCOND.reproducing():
-        exercise(
-            "batch.solve_care_batch",
-            batch.solve_care_batch,
-            {
-                "A": canonical(np.zeros((0, 0))),
-                "B": canonical(np.zeros((0, 2))),
-                "Q": canonical(np.zeros((0, 0))),
-                "R": canonical(np.eye(2)),
-            },
-            _riccati_batch_oracle(False),
-        )
+def test_regression_batch_empty_rcond() -> None:
+    exercise(
+        "batch.solve_care_batch",
+        batch.solve_care_batch,
+        {
+            "A": canonical(np.zeros((0, 0))),
+            "B": canonical(np.zeros((0, 2))),
+            "Q": canonical(np.zeros((0, 0))),
+            "R": canonical(np.eye(2)),
+        },
+        _riccati_batch_oracle(False),
+    )
 
 
 def test_regression_sweep_weights_alias() -> None:

@@ -735,20 +735,18 @@ def test_riccati_ode(data: st.DataObject) -> None:
 # ----- known defects of the core (see known_defects.py) ------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.CARE_EMPTY_INDEFINITE_RCOND.summary)
-def test_known_defect_care_empty_indefinite_rcond() -> None:
-    with known_defects.CARE_EMPTY_INDEFINITE_RCOND.reproducing():
-        exercise(
-            "solve_care",
-            aerocontrol.solve_care,
-            {
-                "A": canonical(np.zeros((0, 0))),
-                "B": canonical(np.zeros((0, 2))),
-                "Q": canonical(np.zeros((0, 0))),
-                "R": canonical(np.diag([1.0, -1.0])),
-            },
-            _solution_oracle(False),
-        )
+def test_regression_care_empty_indefinite_rcond() -> None:
+    exercise(
+        "solve_care",
+        aerocontrol.solve_care,
+        {
+            "A": canonical(np.zeros((0, 0))),
+            "B": canonical(np.zeros((0, 2))),
+            "Q": canonical(np.zeros((0, 0))),
+            "R": canonical(np.diag([1.0, -1.0])),
+        },
+        _solution_oracle(False),
+    )
 
 
 @pytest.mark.xfail(strict=True, reason=known_defects.RICCATI_ODE_UNBOUNDED_SUBSTEPS.summary)

@@ -60,6 +60,10 @@ pub(crate) fn graph_solution(
     e: MatRef<'_, f64>,
     n: usize,
 ) -> Option<(Mat<f64>, f64)> {
+    if n == 0 {
+        // E U11 of order 0 is perfectly conditioned (1 / (0 * 0) would say inf).
+        return Some((Mat::zeros(0, 0), 1.0));
+    }
     let u11 = form.z.as_ref().submatrix(0, 0, n, n);
     let u21 = form.z.as_ref().submatrix(n, 0, n, n);
     // (E U11)^T X^T = U21^T.
