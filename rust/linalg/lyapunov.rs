@@ -30,6 +30,7 @@
 //! these orders (the 4-state models of flight dynamics, and the Riccati solver's Newton steps).
 
 use crate::error::{Error, check_finite, check_rows, check_square};
+use crate::linalg::balance::range_scale;
 use crate::linalg::dense::Dense;
 use crate::linalg::schur::real_schur;
 use crate::linalg::small_matrix::product;
@@ -66,6 +67,23 @@ pub(crate) fn solve(
     check_square(q, "Q")?;
     check_rows(q, "Q", a.nrows(), "A")?;
     check_finite(q, "Q")?;
+    // A / s and Q / s for the power of two s of A's largest entry give the same X (exactly),
+    // and keep the pivots' test relative to A: A = [[-1e-295]] was refused as singular, its
+    // pivot below the smallest normal number over u.
+    let scale = range_scale(a);
+    if scale != 1.0 {
+        let a = Mat::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] / scale);
+        let q = Mat::from_fn(q.nrows(), q.ncols(), |i, j| q[(i, j)] / scale);
+        if !q.is_all_finite() {
+            return Err(Error::InvalidArgument {
+                arg: "Q",
+                message: "the solution X overflows double precision: Q is too large for a \
+                          matrix A this small (||Q|| / ||A|| beyond the largest double)"
+                    .into(),
+            });
+        }
+        return solve(a.as_ref(), q.as_ref(), singularity);
+    }
     if a.nrows() <= KRONECKER_MAX_ORDER && is_symmetric(q) {
         let x = solve_kronecker(&Dense::from_ref(a), &Dense::from_ref(q), singularity)?;
         return Ok(x.to_mat());

@@ -172,33 +172,6 @@ def _extreme_weights(args: dict[str, Any]) -> bool:
     return bool(np.any((c > 1e100) | (c < 1e-100)))
 
 
-RICCATI_OVERFLOW_BLAMES_A: Defect = known_defect(
-    "riccati-overflow-blames-A",
-    {
-        "solve_care",
-        "lqr",
-        "riccati_ode",
-        "lqr_finite",
-        "lqe",
-        "kalman",
-        "lqg",
-        "batch.solve_care_batch",
-        "batch.lqr_sweep",
-    },
-    "When B R^-1 B^T (or another product forming the Hamiltonian) overflows, solve_care and "
-    "riccati_ode raise NonFiniteError 'A must be finite, but A[0, 1] is -inf', blaming A, "
-    "which is finite: solve_care([[0.0]], [[1e200]], [[1.0]], [[1.0]]) has the solution "
-    "X = 1e-200, K = 1 (representable, and found after scaling B), and "
-    "riccati_ode([[0.0]], [[1e200]], [[1.0]], [[1.0]], [0.0, 0.1]) likewise (also with "
-    "R = [[1e-310]] and B = [[1]]). (solve_dare refuses the same numbers with "
-    "IllConditionedError.) The batches and sweeps likewise (lqr_sweep with B = [[3.5e149]], "
-    "R = [[1e-8]], weights [0.01, 0.1, 1, 10]). The solvers should scale B (or R) before "
-    "forming G, or at least name the overflow instead of A.",
-    lambda args: _any_extreme(args) or _extreme_weights(args) or _largest_entry(args) >= 1e100,
-    symptom="raised NonFiniteError, but every argument is finite",
-)
-
-
 def _largest_entry(args: dict[str, Any]) -> float:
     """The largest magnitude in any matrix argument (or a model's matrix)."""
     largest = 0.0
@@ -243,16 +216,3 @@ def _norm_ratio(args: dict[str, Any]) -> float:
         if a == 0 or b == 0:
             return 1.0 if a == b else np.inf
         return max(a / b, b / a)
-
-
-LYAPUNOV_TINY_REFUSED: Defect = known_defect(
-    "lyapunov-tiny-refused",
-    {"solve_lyapunov"},
-    "solve_lyapunov refuses a well-conditioned equation whose A is tiny, as if its test of "
-    "the eigenvalue sums were absolute: solve_lyapunov([[-1e-295]], [[1e-295]]) raises "
-    "IllConditionedError ('A has two eigenvalues whose sum is (nearly) zero') although "
-    "X = 0.5 exactly; A = -1e-290 is solved, A = -1e-300 I (any n) refused. The test should "
-    "be relative to ||A||.",
-    lambda args: 0 < _largest(args["A"]) < 1e-280,
-    symptom="solve_lyapunov refused",
-)

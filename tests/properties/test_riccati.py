@@ -767,28 +767,22 @@ def test_known_defect_riccati_ode_unbounded_substeps() -> None:
         )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.RICCATI_OVERFLOW_BLAMES_A.summary)
-def test_known_defect_riccati_overflow_blames_a() -> None:
-    with known_defects.RICCATI_OVERFLOW_BLAMES_A.reproducing():
-        exercise(
-            "solve_care",
-            aerocontrol.solve_care,
-            {
-                "A": canonical(np.zeros((1, 1))),
-                "B": canonical(np.array([[1e200]])),
-                "Q": canonical(np.eye(1)),
-                "R": canonical(np.eye(1)),
-            },
-            _solution_oracle(False),
-        )
+def test_regression_riccati_overflow_blames_a() -> None:
+    exercise(
+        "solve_care",
+        aerocontrol.solve_care,
+        {
+            "A": canonical(np.zeros((1, 1))),
+            "B": canonical(np.array([[1e200]])),
+            "Q": canonical(np.eye(1)),
+            "R": canonical(np.eye(1)),
+        },
+        _solution_oracle(False),
+    )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.LYAPUNOV_TINY_REFUSED.summary)
-def test_known_defect_lyapunov_tiny_refused() -> None:
+def test_regression_lyapunov_tiny_refused() -> None:
     A, Q = np.array([[-1e-295]]), np.array([[1e-295]])
     arguments = {"A": canonical(A), "Q": canonical(Q)}
-    with known_defects.LYAPUNOV_TINY_REFUSED.reproducing():
-        outcome = exercise(
-            "solve_lyapunov", aerocontrol.solve_lyapunov, arguments, _lyapunov_oracle
-        )
+    outcome = exercise("solve_lyapunov", aerocontrol.solve_lyapunov, arguments, _lyapunov_oracle)
     assert outcome.error is None, f"X = 0.5 exactly, but: {outcome.error!r}"

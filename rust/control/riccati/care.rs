@@ -278,8 +278,64 @@ pub(crate) struct CareDense {
     pub(crate) refinement_steps: usize,
 }
 
+/// log2 of the size below which (and of its reciprocal, above which) the weights are scaled
+/// before the Hamiltonian is formed ([`solve_care_dense`]).
+const WEIGHT_RANGE_LOG2: f64 = 500.0;
+
 /// [`solve_care`], returning [`CareDense`].
+///
+/// When B R^-1 B^T or Q would overflow (||B||^2 / ||R|| or ||Q|| beyond 2^500), or both are
+/// below 2^-500, the equation is solved for the weights (Q / σ, R / σ, S / σ) with a power of two σ
+/// that balances the two terms: A^T X' + X' A - X' (σ G) X' + Q / σ = 0 has X' = X / σ and the
+/// same gain K, so X = σ X' exactly. (B = 1e200 made G overflow, and the error blamed A.)
 pub(crate) fn solve_care_dense(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    options: CareOptions<'_>,
+) -> Result<CareDense, Error> {
+    let log2 = |x: f64| if x > 0.0 && x.is_finite() { x.log2() } else { 0.0 };
+    let (b_log, r_log, q_log) = (
+        log2(frobenius_norm(b)),
+        log2(frobenius_norm(r)),
+        log2(frobenius_norm(q)),
+    );
+    let g_log = 2.0 * b_log - r_log;
+    let finite = [a, b, q, r].iter().all(|m| m.is_all_finite())
+        && options.s.is_none_or(|s| s.is_all_finite());
+    // Scaled when G or Q is huge (forming them or H overflows), or both are tiny; a tiny G
+    // beside a normal Q is a negligible quadratic term, solved as it is (scaling would make
+    // the gain underflow).
+    let huge = g_log > WEIGHT_RANGE_LOG2 || q_log > WEIGHT_RANGE_LOG2;
+    let tiny = g_log < -WEIGHT_RANGE_LOG2 && q_log < -WEIGHT_RANGE_LOG2;
+    if !finite || !(huge || tiny) {
+        return solve_care_balanced(a, b, q, r, options);
+    }
+    // σ G and Q / σ of the same size: log2 σ = (log2 ||Q|| - log2 ||G||) / 2 (for Q = 0,
+    // σ G of the size of A).
+    let target = if frobenius_norm(q) > 0.0 {
+        (q_log - g_log) / 2.0
+    } else {
+        log2(frobenius_norm(a)) - g_log
+    };
+    let sigma = target.round().clamp(-1000.0, 1000.0).exp2();
+    let divided = |m: MatRef<'_, f64>| Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] / sigma);
+    let (q_scaled, r_scaled) = (divided(q), divided(r));
+    let s_scaled = options.s.map(divided);
+    let scaled_options = CareOptions {
+        s: s_scaled.as_ref().map(|s| s.as_ref()),
+        ..options
+    };
+    let mut care = solve_care_balanced(a, b, q_scaled.as_ref(), r_scaled.as_ref(), scaled_options)?;
+    for x in care.x.as_mut_slice() {
+        *x *= sigma;
+    }
+    Ok(care)
+}
+
+/// [`solve_care_dense`] for weights that need no scaling.
+fn solve_care_balanced(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
