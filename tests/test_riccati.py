@@ -527,3 +527,14 @@ def test_riccati_ode_rejects_a_bad_grid() -> None:
         aerocontrol.riccati_ode(A, B, np.eye(4), np.eye(2), [0.0, 2.0, 1.0])
     with pytest.raises(aerocontrol.NonFiniteError, match="t"):
         aerocontrol.riccati_ode(A, B, np.eye(4), np.eye(2), [0.0, np.inf])
+
+
+@pytest.mark.parametrize("a", [1e6, 1e8, 1e12])
+def test_riccati_ode_work_is_bounded_by_the_transient(a: float) -> None:
+    """A plant fast against the horizon: S(t) settles on the algebraic solution after a few
+    dozen substeps, and the rest of the horizon costs nothing (A = [[1e8]] over one second
+    once took 1.4e8 substeps). S(0) = 2a + 1/(2a) to first order, the ARE's solution."""
+    solution = aerocontrol.riccati_ode([[a]], [[1.0]], [[1.0]], [[1.0]], [0.0, 1.0])
+    assert solution.substeps < 200
+    exact = a + np.sqrt(a * a + 1.0)
+    assert abs(solution.S[0][0, 0] - exact) <= 4e-16 * exact

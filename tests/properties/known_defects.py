@@ -98,21 +98,6 @@ def _hamiltonian_work(args: dict[str, Any]) -> float:
         return float(_one_norm(H) * abs(t[-1] - t[0])) if t.size else 0.0
 
 
-RICCATI_ODE_UNBOUNDED_SUBSTEPS: Defect = known_defect(
-    "riccati-ode-unbounded-substeps",
-    {"riccati_ode", "lqr_finite"},
-    "riccati_ode divides the horizon into steps across which the Hamiltonian's modes grow by "
-    "at most e, with no bound on their number: its time is proportional to "
-    "rho(H) (t_f - t_0). riccati_ode([[1e6]], [[1]], [[1]], [[1]], [0, 1]) takes 1.4e6 "
-    "substeps (0.5 s), A = [[1e8]] takes about 35 s, A = [[1e300]] (or a horizon of 1e300) "
-    "would run for ever, uninterruptibly, and returns a solution that converged to the "
-    "algebraic one after the first few time constants. It should double the step once the "
-    "modes have decayed (or refuse the horizon by name) so that the work stays bounded.",
-    lambda args: _hamiltonian_work(args) >= 5e4,
-    symptom="substeps",
-)
-
-
 def _any_indefinite(value: Any) -> bool:
     """Whether some member of a canonical weight (one matrix or a stack) is not positive
     definite."""

@@ -32,7 +32,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import pytest
 import scipy.linalg as sl
 from hypothesis import given
 from hypothesis import strategies as st
@@ -41,7 +40,6 @@ import aerocontrol
 from aerocontrol.exceptions import AerocontrolError, IllConditionedWarning
 from aerocontrol.riccati import RCOND_WARNING, RESIDUAL_WARNING
 
-from . import known_defects
 from .harness import SAME, Arg, Outcome, Warned, _known_defect, exercise, plain
 from .oracles import (
     SLACK,
@@ -749,22 +747,20 @@ def test_regression_care_empty_indefinite_rcond() -> None:
     )
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.RICCATI_ODE_UNBOUNDED_SUBSTEPS.summary)
-def test_known_defect_riccati_ode_unbounded_substeps() -> None:
-    with known_defects.RICCATI_ODE_UNBOUNDED_SUBSTEPS.reproducing():
-        exercise(
-            "riccati_ode",
-            _ode_call("riccati_ode", "matrices"),
-            {
-                "A_or_sys": canonical(np.array([[1e6]])),
-                "B": canonical(np.eye(1)),
-                "Q": canonical(np.eye(1)),
-                "R": canonical(np.eye(1)),
-                "t": canonical(np.array([0.0, 1.0])),
-                "Sf": plain(None),
-            },
-            _ode_oracle,
-        )
+def test_regression_riccati_ode_unbounded_substeps() -> None:
+    exercise(
+        "riccati_ode",
+        _ode_call("riccati_ode", "matrices"),
+        {
+            "A_or_sys": canonical(np.array([[1e6]])),
+            "B": canonical(np.eye(1)),
+            "Q": canonical(np.eye(1)),
+            "R": canonical(np.eye(1)),
+            "t": canonical(np.array([0.0, 1.0])),
+            "Sf": plain(None),
+        },
+        _ode_oracle,
+    )
 
 
 def test_regression_riccati_overflow_blames_a() -> None:

@@ -295,7 +295,13 @@ pub(crate) fn solve_care_dense(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<CareDense, Error> {
-    let log2 = |x: f64| if x > 0.0 && x.is_finite() { x.log2() } else { 0.0 };
+    let log2 = |x: f64| {
+        if x > 0.0 && x.is_finite() {
+            x.log2()
+        } else {
+            0.0
+        }
+    };
     let (b_log, r_log, q_log) = (
         log2(frobenius_norm(b)),
         log2(frobenius_norm(r)),

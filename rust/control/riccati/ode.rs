@@ -28,6 +28,12 @@
 //! algebraic solution; here the accuracy is that of double precision whatever the step.
 //!
 //! For a uniform grid (the usual case) one exponential serves every step.
+//!
+//! The work is bounded: once a substep leaves S unchanged to rounding ([`STATIONARY`]), S has
+//! reached the fixed point of the step, the algebraic solution, and every earlier time has
+//! the same S (a plant whose modes are fast against the horizon, A = [[1e8]] over one second,
+//! needs a few dozen substeps instead of 1.4e8). A horizon that would take more than
+//! [`MAX_SUBSTEPS`] substeps without settling is refused, naming t.
 
 use crate::control::riccati::care::check_problem;
 use crate::error::{Error, check_finite, check_rows, check_square};
@@ -43,6 +49,15 @@ use faer::{Mat, MatRef, Par};
 
 /// The largest h max|Re λ(H)| of one substep.
 pub const MAX_GROWTH_EXPONENT: f64 = 1.0;
+
+/// A substep that changes no entry of S by more than this times max|S| leaves it stationary.
+pub const STATIONARY: f64 = 4.0 * f64::EPSILON;
+
+/// The most substeps of one integration that has not become stationary.
+pub const MAX_SUBSTEPS: usize = 1_000_000;
+
+/// Substeps between two checks for an interrupt.
+const INTERRUPT_INTERVAL: usize = 4096;
 
 /// S(t) and K(t) at every time of the grid.
 #[derive(Debug, Clone)]
@@ -111,20 +126,36 @@ pub fn riccati_ode(
     // The transition matrix of the last substep length, reused while it repeats.
     let mut cached: Option<(f64, Mat<f64>)> = None;
     let mut substeps = 0;
+    let mut stationary = false;
     for k in (0..count - 1).rev() {
         interrupt::check()?;
-        let interval = times[k + 1] - times[k];
-        let pieces = ((interval * growth_rate / MAX_GROWTH_EXPONENT).ceil() as usize).max(1);
-        let h = interval / pieces as f64;
-        if cached.as_ref().is_none_or(|(length, _)| *length != h) {
-            let scaled = Mat::from_fn(2 * n, 2 * n, |i, j| h * minus_h[(i, j)]);
-            cached = Some((h, expm(scaled.as_ref())?));
+        if !stationary {
+            let interval = times[k + 1] - times[k];
+            // (The float-to-integer conversion saturates: a horizon of 1e300 gives usize::MAX
+            // pieces, of which only those before S settles are taken.)
+            let pieces = ((interval * growth_rate / MAX_GROWTH_EXPONENT).ceil() as usize).max(1);
+            let h = interval / pieces as f64;
+            if cached.as_ref().is_none_or(|(length, _)| *length != h) {
+                let scaled = Mat::from_fn(2 * n, 2 * n, |i, j| h * minus_h[(i, j)]);
+                cached = Some((h, expm(scaled.as_ref())?));
+            }
+            let phi = &cached.as_ref().expect("just set").1;
+            for piece in 0..pieces {
+                let next = step(phi.as_ref(), &s)?;
+                substeps += 1;
+                stationary = is_stationary(&next, &s);
+                s = next;
+                if stationary {
+                    break;
+                }
+                if substeps >= MAX_SUBSTEPS {
+                    return Err(too_many_substeps(times, growth_rate));
+                }
+                if piece % INTERRUPT_INTERVAL == INTERRUPT_INTERVAL - 1 {
+                    interrupt::check()?;
+                }
+            }
         }
-        let phi = &cached.as_ref().expect("just set").1;
-        for _ in 0..pieces {
-            s = step(phi.as_ref(), &s)?;
-        }
-        substeps += pieces;
         gains[k] = gain(&s);
         solutions[k] = s.clone();
     }
@@ -136,6 +167,26 @@ pub fn riccati_ode(
 }
 
 /// One step: [X; Y] = Φ [I; S], S <- Y X^-1 (by X^T S'^T = Y^T), symmetrised.
+/// Whether a substep from `previous` to `next` changed no entry by more than
+/// [`STATIONARY`] max|S|.
+fn is_stationary(next: &Mat<f64>, previous: &Mat<f64>) -> bool {
+    let size = next.norm_max().max(previous.norm_max());
+    (next - previous).norm_max() <= STATIONARY * size
+}
+
+/// The refusal of a horizon whose substeps exceed [`MAX_SUBSTEPS`] before S settles.
+fn too_many_substeps(times: &[f64], growth_rate: f64) -> Error {
+    let horizon = times[times.len() - 1] - times[0];
+    Error::InvalidArgument {
+        arg: "t",
+        message: format!(
+            "the horizon {horizon:.3e} s is too long for the Hamiltonian's fastest modes \
+             (growth rate {growth_rate:.3e} 1/s): S(t) had not settled after {MAX_SUBSTEPS} \
+             substeps; shorten t, or use lqr for the stationary solution"
+        ),
+    }
+}
+
 fn step(phi: MatRef<'_, f64>, s: &Mat<f64>) -> Result<Mat<f64>, Error> {
     let n = s.nrows();
     let x = phi.submatrix(0, 0, n, n) + phi.submatrix(0, n, n, n) * s;
@@ -145,8 +196,9 @@ fn step(phi: MatRef<'_, f64>, s: &Mat<f64>) -> Result<Mat<f64>, Error> {
     solve_in_place(factors.as_mut(), next.as_mut(), Par::Seq);
     if !next.is_all_finite() {
         return Err(Error::IllConditioned {
-            message: "the Riccati differential equation's solution escaped to infinity \
-                      (S(t) has a finite escape time: Q or Sf is probably indefinite)"
+            message: "the Riccati differential equation's solution could not be continued: \
+                      a step left S(t) infinite or X singular (a finite escape time, when Q \
+                      or Sf is indefinite, or S beyond the range of doubles)"
                 .into(),
         });
     }
