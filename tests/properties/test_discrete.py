@@ -30,7 +30,6 @@ from hypothesis import strategies as st
 import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning
 
-from . import known_defects
 from .harness import CALLBACK, CALLER, REFUSE, SAME, Arg, CallerError, Warned, exercise, plain
 from .oracles import (
     SLACK,
@@ -401,16 +400,14 @@ def test_d2c(data: st.DataObject) -> None:
 # ----- known defects of the core (see known_defects.py) ------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason=known_defects.QZ_REAL_TWO_BY_TWO_BLOCK.summary)
-def test_known_defect_qz_real_2x2_block() -> None:
+def test_regression_qz_real_2x2_block() -> None:
     M = np.array([[-0.06, -0.29, 0.04], [-0.95, 2.71, 0.9], [-0.8, -0.21, 0.04]])
-    with known_defects.QZ_REAL_TWO_BY_TWO_BLOCK.reproducing():
-        exercise(
-            "qz",
-            aerocontrol.qz,
-            {"A": canonical(M), "B": canonical(M.copy()), "select": plain(None)},
-            _qz_oracle,
-        )
+    exercise(
+        "qz",
+        aerocontrol.qz,
+        {"A": canonical(M), "B": canonical(M.copy()), "select": plain(None)},
+        _qz_oracle,
+    )
 
 
 @pytest.mark.parametrize("method", ["zoh", "foh"])

@@ -297,35 +297,7 @@ pub(crate) fn standardize_pair(p: &mut Pencil<'_>, k: usize) -> Result<bool, Err
     }
     let block = standardize_block(m[0][0], m[0][1], m[1][0], m[1][1]);
     if block.c == 0.0 {
-        // Real: split through the right eigenvector of λ = block.a.
-        let lambda = block.a;
-        let rows = [
-            [h11 - lambda * t11, h12 - lambda * t12],
-            [h21, h22 - lambda * t22],
-        ];
-        let norm = |r: &[f64; 2]| r[0].hypot(r[1]);
-        let row = if norm(&rows[0]) >= norm(&rows[1]) {
-            rows[0]
-        } else {
-            rows[1]
-        };
-        // z ⟂ row: the right eigenvector; the column rotation's first column is z.
-        let (g, _) = if row == [0.0, 0.0] {
-            Rotation::zeroing(1.0, 0.0)
-        } else {
-            Rotation::zeroing(row[1], -row[0])
-        };
-        p.rotate_columns(g, k, l, l + 1, l + 1);
-        // Q's first column along H z or T z, whichever is larger.
-        let hz = [p.h[(k, k)], p.h[(l, k)]];
-        let tz = [p.t[(k, k)], p.t[(l, k)]];
-        let w = if norm(&hz) >= norm(&tz) { hz } else { tz };
-        let (g, _) = Rotation::zeroing(w[0], w[1]);
-        p.rotate_rows(g, k, l, k);
-        p.h[(l, k)] = 0.0;
-        p.t[(l, k)] = 0.0;
-        p.make_positive(k);
-        p.make_positive(l);
+        split_real_pair(p, k, block.a);
         return Ok(false);
     }
     // Complex: T's block diagonal and positive. Columns of T's block made orthogonal
@@ -357,5 +329,56 @@ pub(crate) fn standardize_pair(p: &mut Pencil<'_>, k: usize) -> Result<bool, Err
             }
         }
     }
+    // The rotations can leave a pair whose eigenvalues, formed again from the final blocks
+    // (as generalized_eigenvalues forms them), are real: a nearly defective real pair, such
+    // as a double eigenvalue of (M, M). Split it, so that 2 x 2 blocks hold complex pairs only
+    // (LAPACK's dlagv2 likewise).
+    let (t11, t22) = (p.t[(k, k)], p.t[(l, l)]);
+    let block = standardize_block(
+        p.h[(k, k)] / t11,
+        p.h[(k, l)] / t22,
+        p.h[(l, k)] / t11,
+        p.h[(l, l)] / t22,
+    );
+    if block.c == 0.0 {
+        split_real_pair(p, k, block.a);
+        return Ok(false);
+    }
     Ok(true)
+}
+
+/// Splits the 2 x 2 block at (k, k+1) with the real eigenvalue λ (T's block upper
+/// triangular): a column rotation through the right eigenvector of λ and a row rotation
+/// that annihilates below, leaving h_{k+1,k} = t_{k+1,k} = 0.
+fn split_real_pair(p: &mut Pencil<'_>, k: usize, lambda: f64) {
+    let l = k + 1;
+    let (t11, t12, t22) = (p.t[(k, k)], p.t[(k, l)], p.t[(l, l)]);
+    let (h11, h12, h21, h22) = (p.h[(k, k)], p.h[(k, l)], p.h[(l, k)], p.h[(l, l)]);
+    let rows = [
+        [h11 - lambda * t11, h12 - lambda * t12],
+        [h21, h22 - lambda * t22],
+    ];
+    let norm = |r: &[f64; 2]| r[0].hypot(r[1]);
+    let row = if norm(&rows[0]) >= norm(&rows[1]) {
+        rows[0]
+    } else {
+        rows[1]
+    };
+    // z ⟂ row: the right eigenvector; the column rotation's first column is z.
+    let (g, _) = if row == [0.0, 0.0] {
+        Rotation::zeroing(1.0, 0.0)
+    } else {
+        Rotation::zeroing(row[1], -row[0])
+    };
+    p.rotate_columns(g, k, l, l + 1, l + 1);
+    // Q's first column along H z or T z, whichever is larger.
+    let hz = [p.h[(k, k)], p.h[(l, k)]];
+    let tz = [p.t[(k, k)], p.t[(l, k)]];
+    let w = if norm(&hz) >= norm(&tz) { hz } else { tz };
+    let (g, _) = Rotation::zeroing(w[0], w[1]);
+    p.rotate_rows(g, k, l, k);
+    p.h[(l, k)] = 0.0;
+    p.t[(l, k)] = 0.0;
+    p.make_positive(k);
+    p.make_positive(l);
 }
