@@ -648,7 +648,7 @@ mod tests {
         let (a, b) = lateral();
         let q = identity(4);
         let mut r = weights(&[1.0, 1.0, 1.0, 1.0, 1.0]);
-        r[3 * 4] = -1.0; // R of problem 3 is indefinite
+        r[3 * 4] = 0.0; // R of problem 3 is singular (an indefinite one is solved)
         r[4 * 4 + 1] = 0.5; // R of problem 4 is not symmetric
         let stacks = CareStacks {
             a: MatrixStack::new(&a, 1, 4, 4).unwrap(),
@@ -661,7 +661,7 @@ mod tests {
         assert!(
             error
                 .to_string()
-                .starts_with("problem 3 of the batch: R must be symmetric positive definite")
+                .starts_with("problem 3 of the batch: R must be nonsingular")
         );
     }
 

@@ -285,9 +285,9 @@ const WEIGHT_RANGE_LOG2: f64 = 500.0;
 /// [`solve_care`], returning [`CareDense`].
 ///
 /// When B R^-1 B^T or Q would overflow (||B||^2 / ||R|| or ||Q|| beyond 2^500), or both are
-/// below 2^-500, the equation is solved for the weights (Q / σ, R / σ, S / σ) with a power of two σ
-/// that balances the two terms: A^T X' + X' A - X' (σ G) X' + Q / σ = 0 has X' = X / σ and the
-/// same gain K, so X = σ X' exactly. (B = 1e200 made G overflow, and the error blamed A.)
+/// below 2^-500, the equation is solved for (β B, Q / β², S / β) with a power of two β that
+/// balances the two terms: A^T X' + X' A - X' (β² G) X' + Q / β² = 0 has X' = X / β² and
+/// K' = K / β, multiplied back exactly. (B = 1e200 made G overflow, and the error blamed A.)
 pub(crate) fn solve_care_dense(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -318,26 +318,46 @@ pub(crate) fn solve_care_dense(
     if !finite || !(huge || tiny) {
         return solve_care_balanced(a, b, q, r, options);
     }
-    // σ G and Q / σ of the same size: log2 σ = (log2 ||Q|| - log2 ||G||) / 2 (for Q = 0,
-    // σ G of the size of A).
+    // B' = β B, Q' = Q / β², S' = S / β (β a power of two) give X' = X / β² and K' = K / β:
+    // G' = β² G and Q' of the same size, β = (||Q|| / ||G||)^(1/4) (for Q = 0, G' of the size
+    // of A). B is scaled rather than R, which is often the larger (R = 1e308 beside
+    // B = 1e299 would overflow as R / σ).
     let target = if frobenius_norm(q) > 0.0 {
-        (q_log - g_log) / 2.0
+        (q_log - g_log) / 4.0
     } else {
-        log2(frobenius_norm(a)) - g_log
+        (log2(frobenius_norm(a)) - g_log) / 2.0
     };
-    let sigma = target.round().clamp(-1000.0, 1000.0).exp2();
-    let divided = |m: MatRef<'_, f64>| Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] / sigma);
-    let (q_scaled, r_scaled) = (divided(q), divided(r));
-    let s_scaled = options.s.map(divided);
+    let beta = target.round().clamp(-500.0, 500.0).exp2();
+    let scaled = |m: MatRef<'_, f64>, factor: f64| {
+        Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] * factor)
+    };
+    let (b_scaled, q_scaled) = (scaled(b, beta), scaled(q, 1.0 / (beta * beta)));
+    let s_scaled = options.s.map(|s| scaled(s, 1.0 / beta));
+    if !(q_scaled.is_all_finite() && s_scaled.as_ref().is_none_or(|s| s.is_all_finite())) {
+        return Err(weights_out_of_range());
+    }
     let scaled_options = CareOptions {
         s: s_scaled.as_ref().map(|s| s.as_ref()),
         ..options
     };
-    let mut care = solve_care_balanced(a, b, q_scaled.as_ref(), r_scaled.as_ref(), scaled_options)?;
+    let mut care = solve_care_balanced(a, b_scaled.as_ref(), q_scaled.as_ref(), r, scaled_options)?;
     for x in care.x.as_mut_slice() {
-        *x *= sigma;
+        *x *= beta * beta;
+    }
+    for k in care.gain.as_mut_slice() {
+        *k *= beta;
     }
     Ok(care)
+}
+
+/// The refusal of weights whose Hamiltonian leaves the range of doubles even when balanced.
+fn weights_out_of_range() -> Error {
+    Error::InvalidArgument {
+        arg: "B, R",
+        message: "B R^-1 B^T and Q are too far apart in size for double precision (their \
+                  balanced Hamiltonian overflows): scale the model's units"
+            .into(),
+    }
 }
 
 /// [`solve_care_dense`] for weights that need no scaling.
@@ -369,6 +389,10 @@ fn solve_care_balanced(
     };
     let s = options.s.map(Dense::from_ref);
     let standard = standardize(&a_tilde, &b_tilde, &q, &l, s.as_ref());
+    let finite = |m: &Dense| m.as_slice().iter().all(|x| x.is_finite());
+    if !(finite(&standard.a) && finite(&standard.g) && finite(&standard.q)) {
+        return Err(weights_out_of_range());
+    }
     let reduced = Reduced {
         a: a_tilde,
         b: b_tilde,

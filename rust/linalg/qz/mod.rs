@@ -69,8 +69,13 @@ pub fn qz(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<GeneralizedSchur, Er
     let n = a.nrows();
     // S, T, Q, Z and the temporaries of the reduction.
     crate::platform::memory::reserve(n.saturating_mul(n).saturating_mul(6 * 8))?;
-    let mut s = a.to_owned();
-    let mut t = b.to_owned();
+    // A / α and B / β for the powers of two of their largest entries (exact: the same Q and
+    // Z, S = α S', T = β T', the eigenvalues α/β times those of the scaled pencil): the
+    // iteration's decisions compare entries of the two matrices and their tests are
+    // relative to each, so a B of 1e-11 beside an A of 1 lost B's backward error (1e14 u).
+    let (alpha, beta) = (unit_scale(a), unit_scale(b));
+    let mut s = Mat::from_fn(n, n, |i, j| a[(i, j)] / alpha);
+    let mut t = Mat::from_fn(n, n, |i, j| b[(i, j)] / beta);
     let mut q = Mat::<f64>::identity(n, n);
     let mut z = Mat::<f64>::identity(n, n);
     reduction::hessenberg_triangular(&mut s, &mut t, &mut q, &mut z)?;
@@ -80,7 +85,20 @@ pub fn qz(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<GeneralizedSchur, Er
         q: &mut q,
         z: &mut z,
     })?;
+    s *= faer::Scale(alpha);
+    t *= faer::Scale(beta);
     Ok(GeneralizedSchur { s, t, q, z })
+}
+
+/// The power of two nearest the largest magnitude of `m` (1 for a zero matrix), at most
+/// 2^±1000 so that its reciprocal is finite.
+fn unit_scale(m: MatRef<'_, f64>) -> f64 {
+    let largest = crate::linalg::norm::max_abs(m);
+    if largest > 0.0 {
+        largest.log2().round().clamp(-1000.0, 1000.0).exp2()
+    } else {
+        1.0
+    }
 }
 
 /// The eigenvalues of a generalized real Schur form, in the order of its diagonal (a pair with
@@ -138,6 +156,10 @@ pub fn reorder_qz(
         selected[k..k + size].fill(chosen);
         k += size;
     }
+    // The swaps on the pencil scaled as in [`qz`], for the same reasons.
+    let (alpha, beta) = (unit_scale(schur.s.as_ref()), unit_scale(schur.t.as_ref()));
+    schur.s *= faer::Scale(1.0 / alpha);
+    schur.t *= faer::Scale(1.0 / beta);
     let count = reorder::reorder(
         &mut Pencil {
             h: &mut schur.s,
@@ -146,8 +168,10 @@ pub fn reorder_qz(
             z: &mut schur.z,
         },
         &selected,
-    )?;
-    Ok((schur, count))
+    );
+    schur.s *= faer::Scale(alpha);
+    schur.t *= faer::Scale(beta);
+    Ok((schur, count?))
 }
 
 #[cfg(test)]

@@ -213,6 +213,14 @@ fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c6
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let n = a.nrows();
+    // A triangular matrix (an integrator chain, a cascade) has its diagonal as eigenvalues,
+    // exactly; the QR iteration would split a repeated one by sqrt(u) ||A|| (a double
+    // integrator's zeros came back as +-5e-9j).
+    let upper = (0..n).all(|j| (j + 1..n).all(|i| a[(i, j)] == 0.0));
+    let lower = upper || (0..n).all(|j| (0..j).all(|i| a[(i, j)] == 0.0));
+    if upper || lower {
+        return Ok((0..n).map(|k| c64::new(a[(k, k)], 0.0)).collect());
+    }
     // Estimates are of the unscaled matrix's eigenvalues (and scaling is rare): dropped.
     let unscaled = |scale: f64| {
         if scale == 1.0 {
