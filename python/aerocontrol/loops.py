@@ -28,13 +28,18 @@ Margins (:func:`stability_margins`)
                       unstable.
     ================  =====================================================================
 
-Crossovers are located on a dense logarithmic grid (spanning the loop's poles and zeros, the
-asymptotic crossovers of its integrators and of its high-frequency roll-off, and clustered
-around lightly damped poles and zeros), then refined by Brent's method on the exact L(jω):
-no interpolation error. The disk margin's and the stability margin's extrema are refined by
-golden-section search. A crossover "at infinity" is not reported: a loop with no gain
-crossover has phase margin ∞ and delay margin ∞, and one with no phase crossover has gain
-margin ∞ (python-control reports 0 in some such cases).
+Crossovers are computed by eigenvalue methods in the Rust core, in one call
+(``rust/control/margins.rs``): the gain crossovers are the imaginary-axis eigenvalues of the
+Hamiltonian of 1 - L(-s) L(s), the phase crossovers the imaginary-axis zeros of
+L(s) - L(-s); each candidate is polished by the secant method on the exact L(jω) and kept only
+if |L| = 1, respectively Im L = 0, holds to 1e-8. The disk margin's and the stability margin's
+extrema are L∞ norms, computed by the Boyd-Balakrishnan/Bruinsma-Steinbuch Hamiltonian
+iteration. A crossover "at infinity" is not reported: a loop with no gain crossover has phase
+margin ∞ and delay margin ∞, and one with no phase crossover has gain margin ∞ (python-control
+reports 0 in some such cases). A discrete loop, and a loop real on the whole imaginary axis
+(for which L(s) - L(-s) vanishes identically), are analysed on a dense logarithmic grid instead
+(spanning the loop's poles and zeros and its asymptotic crossovers, clustered around lightly
+damped roots) refined by Brent's method on the exact L(jω).
 
 Closed-loop stability is decided from the closed-loop poles, the eigenvalues of
 A - B (1 + D)⁻¹ C, never from the plot; the number of counterclockwise encirclements of -1 by
@@ -42,13 +47,17 @@ the Nyquist plot follows from the principle of the argument: N = P - Z, with P a
 and closed-loop poles in the open right half plane (outside the unit circle).
 
 Root locus (:func:`root_locus`, :func:`best_damping_gain`, :func:`gain_for_damping`)
-    The closed-loop poles of 1 + k L(s) = 0 are the eigenvalues of A - k B (1 + k D)⁻¹ C.
+    The closed-loop poles of 1 + k L(s) = 0 are the eigenvalues of A - k B (1 + k D)⁻¹ C; the
+    matrices of every gain are formed as one (k, n, n) stack and their eigenvalues computed in
+    one parallel call of the core.
 
 References
 ----------
 P. Seiler, A. Packard and P. Gahinet, "An introduction to disk margins", IEEE Control Systems
 Magazine 40(5), 78-95, 2020 (the disk margin, eqs. (9)-(12)). R. P. Brent, *Algorithms for
-Minimization without Derivatives*, 1973 (the root finder).
+Minimization without Derivatives*, 1973 (the root finder). S. Boyd and V. Balakrishnan,
+Systems & Control Letters 15, 1990, and N. A. Bruinsma and M. Steinbuch, Systems & Control
+Letters 14, 1990 (the L∞ iteration).
 """
 
 from __future__ import annotations
@@ -579,12 +588,12 @@ def _assemble(
     disk_w, disk_peak = disk
     if gains.size:
         critical = int(np.argmin(np.abs(np.log(gains))))
-        gm, w_gm = float(gains[critical]), phase_w[critical]
+        gm, w_gm = float(gains[critical]), float(phase_w[critical])
     else:
         gm, w_gm = math.inf, math.nan
     if phases.size:
         critical = int(np.argmin(np.abs(phases)))
-        pm, w_pm = float(phases[critical]), gain_w[critical]
+        pm, w_pm = float(phases[critical]), float(gain_w[critical])
     else:
         pm, w_pm = math.inf, math.nan
     if not stable:

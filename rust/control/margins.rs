@@ -45,7 +45,8 @@
 //! Boyd-Balakrishnan / Bruinsma-Steinbuch iteration: a lower bound γ from ω = 0, ω = ∞ and the
 //! frequencies of the poles; the imaginary eigenvalues jω_i of the Hamiltonian of G/γ' with
 //! γ' = (1 + 2ε) γ (ε = 1e-8); in the interval [ω_i, ω_i+1] whose midpoint is highest, the
-//! maximum by golden-section search (to 1e-12 in ω) is the new γ; until no imaginary
+//! maximum by Brent's method (golden section and parabolic interpolation, to 1e-12 in ω)
+//! is the new γ; until no imaginary
 //! eigenvalue remains (usually the second Hamiltonian). The disk margin's transfer is
 //! (1 - L)/(2 (1 + L)) = S - 1/2, with S = 1/(1 + L) realised as
 //! (A - B C/(1 + d), B/(1 + d), -C/(1 + d), 1/(1 + d)); the stability margin min |1 + L| is
@@ -68,6 +69,7 @@
 use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::error::Error;
 use crate::linalg::schur::eigenvalues;
+use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
 
 /// A crossover: the frequency and the loop's value there.
@@ -411,26 +413,80 @@ impl Loop<'_> {
     }
 }
 
-/// (ω, f(ω)) at a maximum of f on [lo, hi], by golden-section search to 1e-12 (relative).
+/// (ω, f(ω)) at a maximum of f on [lo, hi] by Brent's method (golden section with
+/// successive parabolic interpolation; Brent 1973, ch. 5, procedure localmin), to 1e-12 of ω.
 fn golden_maximum(f: &mut impl FnMut(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
-    let ratio = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut x1, mut x2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..200 {
-        if hi - lo <= 1e-12 * hi.abs().max(f64::MIN_POSITIVE) {
+    let golden = (3.0 - 5f64.sqrt()) / 2.0;
+    let mut g = |x: f64| {
+        let v = f(x);
+        if v.is_nan() { f64::INFINITY } else { -v }
+    };
+    let mut x = lo + golden * (hi - lo);
+    let (mut w, mut v) = (x, x);
+    let mut fx = g(x);
+    let (mut fw, mut fv) = (fx, fx);
+    let (mut d, mut e) = (0.0f64, 0.0f64);
+    for _ in 0..100 {
+        let middle = 0.5 * (lo + hi);
+        let tol = 1e-12 * x.abs() + 1e-300;
+        let tol2 = 2.0 * tol;
+        if (x - middle).abs() <= tol2 - 0.5 * (hi - lo) {
             break;
         }
-        if f1 >= f2 {
-            (hi, x2, f2) = (x2, x1, f1);
-            x1 = hi - ratio * (hi - lo);
-            f1 = f(x1);
+        let mut golden_step = true;
+        if e.abs() > tol {
+            let r = (x - w) * (fx - fv);
+            let mut q = (x - v) * (fx - fw);
+            let mut p = (x - v) * q - (x - w) * r;
+            q = 2.0 * (q - r);
+            if q > 0.0 {
+                p = -p;
+            }
+            q = q.abs();
+            let previous = e;
+            e = d;
+            if p.abs() < (0.5 * q * previous).abs() && p > q * (lo - x) && p < q * (hi - x) {
+                d = p / q;
+                let u = x + d;
+                if u - lo < tol2 || hi - u < tol2 {
+                    d = if x < middle { tol } else { -tol };
+                }
+                golden_step = false;
+            }
+        }
+        if golden_step {
+            e = if x < middle { hi - x } else { lo - x };
+            d = golden * e;
+        }
+        let u = if d.abs() >= tol {
+            x + d
+        } else if d > 0.0 {
+            x + tol
         } else {
-            (lo, x1, f1) = (x1, x2, f2);
-            x2 = lo + ratio * (hi - lo);
-            f2 = f(x2);
+            x - tol
+        };
+        let fu = g(u);
+        if fu <= fx {
+            if u < x {
+                hi = x;
+            } else {
+                lo = x;
+            }
+            (v, fv, w, fw, x, fx) = (w, fw, x, fx, u, fu);
+        } else {
+            if u < x {
+                lo = u;
+            } else {
+                hi = u;
+            }
+            if fu <= fw || w == x {
+                (v, fv, w, fw) = (w, fw, u, fu);
+            } else if fu <= fv || v == x || v == w {
+                (v, fv) = (u, fu);
+            }
         }
     }
-    if f1 >= f2 { (x1, f1) } else { (x2, f2) }
+    (x, -fx)
 }
 
 /// The L∞ norm over ω in [0, ∞] of the SISO G = (A, B, C, d) (see the module's
@@ -549,26 +605,42 @@ pub fn loop_margins(
         d: d0,
         evaluator: FrequencyEvaluator::new(a, b, c, d)?,
     };
-    let gain_crossovers = this.gain_crossovers()?;
-    let (phase_crossovers, degenerate) = this.phase_crossovers(&open_loop_poles)?;
-
     // S = 1/(1 + L) and (1 - L)/(2 (1 + L)) = S - 1/2 share the closed loop's realisation.
     let bs: Vec<f64> = bv.iter().map(|v| v / denominator).collect();
     let cs: Vec<f64> = cv.iter().map(|v| -v / denominator).collect();
-    let sensitivity = peak_gain(
-        closed.as_ref(),
-        &bs,
-        &cs,
-        1.0 / denominator,
-        &closed_loop_poles,
-    )?;
-    let disk = peak_gain(
-        closed.as_ref(),
-        &bs,
-        &cs,
-        1.0 / denominator - 0.5,
-        &closed_loop_poles,
-    )?;
+    // The crossovers and the two peaks are independent: two tasks (a few tens of µs each at
+    // n = 6, well above rayon's cost of a join).
+    let context = ParallelContext::capture(0);
+    let (crossovers, peaks) = rayon::join(
+        || {
+            context.run(|| {
+                let gain = this.gain_crossovers()?;
+                let phase = this.phase_crossovers(&open_loop_poles)?;
+                Ok((gain, phase))
+            })
+        },
+        || {
+            context.run(|| {
+                let sensitivity = peak_gain(
+                    closed.as_ref(),
+                    &bs,
+                    &cs,
+                    1.0 / denominator,
+                    &closed_loop_poles,
+                )?;
+                let disk = peak_gain(
+                    closed.as_ref(),
+                    &bs,
+                    &cs,
+                    1.0 / denominator - 0.5,
+                    &closed_loop_poles,
+                )?;
+                Ok((sensitivity, disk))
+            })
+        },
+    );
+    let ((gain_crossovers, (phase_crossovers, degenerate)), (sensitivity, disk)) =
+        (crossovers?, peaks?);
 
     // Each gain margin k puts a closed-loop pole at its crossover.
     let size = 1.0 + max_abs(a);
