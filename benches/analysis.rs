@@ -3,9 +3,10 @@
 //! controllability and observability matrices and the staircase verdict, the companion form,
 //! the steady state of a step, and the Riccati differential equation. Seeded random matrices
 //! at n = 4, 16, 64 and 256 (the companion form and the Riccati ODE stop where their peers do:
-//! 16 and 64).
+//! 16 and 64), and the crossovers and peaks of a SISO loop (loop_margins) at n = 4, 8 and 16.
 
 use aerocontrol::control::controllability::{controllability_staircase, ctrb, obsv};
+use aerocontrol::control::margins::loop_margins;
 use aerocontrol::control::modal::modal_analysis;
 use aerocontrol::control::placement::companion_form;
 use aerocontrol::control::responses::steady_state;
@@ -81,5 +82,31 @@ fn spectra(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, spectra);
+/// The crossovers and peaks of a SISO loop (control/margins.rs): seeded random stable loops of
+/// the orders of flight-control loops (4 and 8) and beyond (16), D = 0.
+fn margins(c: &mut Criterion) {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut group = c.benchmark_group("analysis");
+    group.sample_size(20);
+    for n in [4, 8, 16] {
+        let a = stable(n, 10 + n as u64);
+        let (b, c_out) = (seeded_matrix(n, 1, 11), seeded_matrix(1, n, 12));
+        // A loop gain that puts the crossovers among the poles.
+        let c_out = Mat::from_fn(1, n, |_, j| 4.0 * (n as f64).sqrt() * c_out[(0, j)]);
+        let d = Mat::<f64>::zeros(1, 1);
+        group.bench_with_input(BenchmarkId::new("loop_margins", n), &a, |bench, a| {
+            bench.iter(|| {
+                loop_margins(
+                    black_box(a.as_ref()),
+                    b.as_ref(),
+                    c_out.as_ref(),
+                    d.as_ref(),
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, spectra, margins);
 criterion_main!(benches);

@@ -203,6 +203,41 @@ def test_disk_margin_against_python_control(loop: aerocontrol.StateSpace) -> Non
     assert m.disk_margin == pytest.approx(-1.0 / best.fun, rel=1e-9)
 
 
+def test_unit_feedthrough_and_even_loops() -> None:
+    # d² = 1 (the Hamiltonian does not exist; the core takes the pencil of 1 - L(-s)L(s)):
+    # L = (s² + 0.5 s + 2)/(s² + 1.5 s + 1), |num|² - |den|² = 3 - 4ω²: a crossover at √3/2.
+    loop = aerocontrol.tf([1.0, 0.5, 2.0], [1.0, 1.5, 1.0])
+    m = stability_margins(loop)
+    np.testing.assert_allclose(m.gain_crossovers, [math.sqrt(0.75)], rtol=1e-13)
+    L = _numpy_response(loop, m.gain_crossovers)
+    np.testing.assert_allclose(np.abs(L), 1.0, rtol=1e-13)
+    # An even loop, real on the whole axis (L(s) - L(-s) ≡ 0: the grid method decides):
+    # L = -2/(s² - 1), L(jω) = 2/(ω² + 1) > 0: no phase crossover, |L| = 1 at ω = 1 with
+    # ∠L = 0 (PM = 180°); the closed loop s² - 1 - 2 = 0 has a pole at +√3.
+    even = stability_margins(aerocontrol.tf([-2.0], [1.0, 0.0, -1.0]))
+    assert even.gain_margin == math.inf
+    np.testing.assert_allclose(even.gain_crossovers, [1.0], rtol=1e-9)
+    assert even.phase_margin == pytest.approx(180.0, abs=1e-9)
+    assert not even.closed_loop_stable
+
+
+def test_eigenvalues_of_a_stack_match_one_by_one() -> None:
+    rng = np.random.default_rng(25)
+    stack = rng.standard_normal((40, 5, 5))
+    together = aerocontrol._core.eigenvalues(stack)
+    assert together.shape == (40, 5)
+    for matrix, values in zip(stack, together, strict=True):
+        np.testing.assert_array_equal(values, aerocontrol._core.eigenvalues(matrix))
+        np.testing.assert_allclose(
+            np.sort_complex(values), np.sort_complex(np.linalg.eigvals(matrix)), rtol=1e-10
+        )
+    assert aerocontrol._core.eigenvalues(np.zeros((3, 0, 0))).shape == (3, 0)
+    with pytest.raises(ShapeError):
+        aerocontrol._core.eigenvalues(np.zeros((2, 3, 4)))
+    with pytest.raises(aerocontrol.NonFiniteError):
+        aerocontrol._core.eigenvalues(np.full((2, 3, 3), np.nan))
+
+
 def test_sensitivities_against_numpy() -> None:
     loop = _third_order(2.0)
     w = np.logspace(-2, 2, 30)

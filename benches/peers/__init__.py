@@ -3,24 +3,24 @@
 ``benches/compare_peers.py`` is the command line. This package holds :mod:`peers.harness`
 (what a case is, agreement, timing, thread settings, the text, JSON and Markdown reports),
 :mod:`peers.inputs` (input builders several case files share) and one case file per
-aerocontrol module: ``linalg``, ``responses``, ``frequency``, ``modal``, ``placement``,
+aerocontrol module: ``linalg``, ``responses``, ``frequency``, ``loops``, ``modal``, ``placement``,
 ``controllability``, ``riccati`` and ``batch``.
 
 Coverage
 --------
-Every public numerical operation that has a peer in scipy, python-control (with slycot) or
-numpy, at n = 4 (the 747 where it is natural), 16, 64 and 256 (expm also 8 and 1024; the
-batch API on 1000 problems): expm (one matrix and a stack), transition_matrix, discretize,
-schur (plain and reordered) [linalg]; the step, impulse, doublet, initial-condition and forced
-responses, steady_state, dc_gain [responses]; frequency_response [frequency]; modes, charpoly
-[modal]; place_bass_gura, place_ackermann, place, companion_form [placement]; is_controllable,
-is_observable, controllability, ctrb, obsv [controllability]; lqr, solve_care (with S and E),
-riccati_ode, lqr_finite, solve_lyapunov [riccati]; batch.lqr_sweep, batch.solve_care_batch
-[batch]. Where a size is capped (single-input placement and the companion form: conditioning;
-KNV0 placement and the Riccati ODE: the peer's time and accuracy) the group's docstring says
-why. Not here, having no peer: bode (frequency_response on a default grid),
-default_time_grid, default_frequency_grid, augment_mode, the design module (compositions of
-the above), the aircraft module (atmosphere, models; envelope_sweep is timed by
+Every public numerical operation that has a peer in scipy, python-control (with slycot) or numpy, at
+n = 4 (the 747 where it is natural), 16, 64 and 256 (expm also 8 and 1024; the batch API on 1000
+problems): expm (one matrix and a stack), transition_matrix, discretize, schur (plain and reordered)
+[linalg]; the step, impulse, doublet, initial-condition and forced responses, steady_state, dc_gain
+[responses]; frequency_response [frequency]; stability_margins of the 747 dampers' loops and
+root_locus over 1000 gains [loops]; modes, charpoly [modal]; place_bass_gura, place_ackermann,
+place, companion_form [placement]; is_controllable, is_observable, controllability, ctrb, obsv
+[controllability]; lqr, solve_care (with S and E), riccati_ode, lqr_finite, solve_lyapunov
+[riccati]; batch.lqr_sweep, batch.solve_care_batch [batch]. Where a size is capped (single-input
+placement and the companion form: conditioning; KNV0 placement and the Riccati ODE: the peer's time
+and accuracy) the group's docstring says why. Not here, having no peer: bode (frequency_response on
+a default grid), default_time_grid, default_frequency_grid, augment_mode, the design module
+(compositions of the above), the aircraft module (atmosphere, models; envelope_sweep is timed by
 benches/batch_scaling.py), handling and the report.
 
 Adding a case
@@ -46,6 +46,7 @@ MODULES = (
     "linalg",
     "responses",
     "frequency",
+    "loops",
     "modal",
     "placement",
     "controllability",

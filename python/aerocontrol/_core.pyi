@@ -33,6 +33,7 @@ __all__ = [
     "grid_step",
     "inverse_bilinear",
     "krylov_matrix",
+    "loop_margins",
     "modal_analysis",
     "place",
     "place_batch",
@@ -113,6 +114,19 @@ def simulate_models(
     /,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
 def steady_state(a: ArrayLike, b: ArrayLike, eta0: ArrayLike, /) -> NDArray[np.float64]: ...
+def loop_margins(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.complex128],
+    NDArray[np.float64],
+    NDArray[np.complex128],
+    tuple[float, float],
+    tuple[float, float],
+    NDArray[np.complex128],
+    NDArray[np.complex128],
+    bool,
+]: ...
 def frequency_response(
     a: ArrayLike,
     b: ArrayLike,

@@ -28,13 +28,18 @@ Margins (:func:`stability_margins`)
                       unstable.
     ================  =====================================================================
 
-Crossovers are located on a dense logarithmic grid (spanning the loop's poles and zeros, the
-asymptotic crossovers of its integrators and of its high-frequency roll-off, and clustered
-around lightly damped poles and zeros), then refined by Brent's method on the exact L(jω):
-no interpolation error. The disk margin's and the stability margin's extrema are refined by
-golden-section search. A crossover "at infinity" is not reported: a loop with no gain
-crossover has phase margin ∞ and delay margin ∞, and one with no phase crossover has gain
-margin ∞ (python-control reports 0 in some such cases).
+Crossovers are computed by eigenvalue methods in the Rust core, in one call
+(``rust/control/margins.rs``): the gain crossovers are the imaginary-axis eigenvalues of the
+Hamiltonian of 1 - L(-s) L(s), the phase crossovers the imaginary-axis zeros of
+L(s) - L(-s); each candidate is polished by the secant method on the exact L(jω) and kept only
+if |L| = 1, respectively Im L = 0, holds to 1e-8. The disk margin's and the stability margin's
+extrema are L∞ norms, computed by the Boyd-Balakrishnan/Bruinsma-Steinbuch Hamiltonian
+iteration. A crossover "at infinity" is not reported: a loop with no gain crossover has phase
+margin ∞ and delay margin ∞, and one with no phase crossover has gain margin ∞ (python-control
+reports 0 in some such cases). A discrete loop, and a loop real on the whole imaginary axis
+(for which L(s) - L(-s) vanishes identically), are analysed on a dense logarithmic grid instead
+(spanning the loop's poles and zeros and its asymptotic crossovers, clustered around lightly
+damped roots) refined by Brent's method on the exact L(jω).
 
 Closed-loop stability is decided from the closed-loop poles, the eigenvalues of
 A - B (1 + D)⁻¹ C, never from the plot; the number of counterclockwise encirclements of -1 by
@@ -42,13 +47,17 @@ the Nyquist plot follows from the principle of the argument: N = P - Z, with P a
 and closed-loop poles in the open right half plane (outside the unit circle).
 
 Root locus (:func:`root_locus`, :func:`best_damping_gain`, :func:`gain_for_damping`)
-    The closed-loop poles of 1 + k L(s) = 0 are the eigenvalues of A - k B (1 + k D)⁻¹ C.
+    The closed-loop poles of 1 + k L(s) = 0 are the eigenvalues of A - k B (1 + k D)⁻¹ C; the
+    matrices of every gain are formed as one (k, n, n) stack and their eigenvalues computed in
+    one parallel call of the core.
 
 References
 ----------
 P. Seiler, A. Packard and P. Gahinet, "An introduction to disk margins", IEEE Control Systems
 Magazine 40(5), 78-95, 2020 (the disk margin, eqs. (9)-(12)). R. P. Brent, *Algorithms for
-Minimization without Derivatives*, 1973 (the root finder).
+Minimization without Derivatives*, 1973 (the root finder). S. Boyd and V. Balakrishnan,
+Systems & Control Letters 15, 1990, and N. A. Bruinsma and M. Steinbuch, Systems & Control
+Letters 14, 1990 (the L∞ iteration).
 """
 
 from __future__ import annotations
@@ -56,7 +65,8 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -74,7 +84,7 @@ from .exceptions import (
 )
 from .interconnect import feedback, gain
 from .statespace import StateSpace, as_state_space, period
-from .transfer import transfer_function
+from .transfer import TransferFunction, transfer_function
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -414,6 +424,56 @@ def stability_margins(loop: System) -> StabilityMargins:
     inf
     """
     model = _siso(loop)
+    if model.is_discrete:
+        return _grid_margins(model)
+    d = float(model.D[0, 0])
+    if abs(1.0 + d) <= 8 * _EPS * max(1.0, abs(d)):
+        _closed_loop_matrix(model)  # raises the algebraic loop's SingularMatrixError
+    (
+        gain_w,
+        gain_values,
+        phase_w,
+        phase_values,
+        (disk_w, disk_peak),
+        (stab_w, sensitivity_peak),
+        closed,
+        open_poles,
+        degenerate,
+    ) = _core.loop_margins(model.A, model.B, model.C, model.D)
+    if degenerate:
+        # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
+        # the phase crossovers, so the grid search decides.
+        return _grid_margins(model)
+    stable = bool(np.all(closed.real < 0.0))
+    unstable_open = int(np.sum(open_poles.real > 0.0))
+    unstable_closed = int(np.sum(closed.real > 0.0))
+    negative = phase_values.real < 0.0
+    gains = 1.0 / np.abs(phase_values[negative])
+    phase_w = phase_w[negative]
+    shifted = 180.0 + np.degrees(np.angle(gain_values))
+    phases = shifted - 360.0 * np.round(shifted / 360.0)
+    phases[phases == -180.0] = 180.0
+    positive = gain_w > 0
+    delays = np.radians(phases[positive] % 360.0) / gain_w[positive]
+    return _assemble(
+        gains,
+        phase_w,
+        phases,
+        gain_w,
+        delays,
+        disk=(float(disk_w), float(disk_peak)),
+        stability=(float(stab_w), 1.0 / float(sensitivity_peak)),
+        closed=closed,
+        stable=stable,
+        unstable_open=unstable_open,
+        unstable_closed=unstable_closed,
+    )
+
+
+def _grid_margins(model: StateSpace) -> StabilityMargins:
+    """:func:`stability_margins` on a dense frequency grid refined by Brent's method: the
+    method for discrete loops (the eigenvalue method of the core is continuous only) and for
+    a loop real on the whole imaginary axis (its phase-crossover pencil is singular)."""
     discrete = model.is_discrete
     closed = _eigenvalues(_closed_loop_matrix(model))
     open_poles = _eigenvalues(model.A)
@@ -493,43 +553,74 @@ def stability_margins(loop: System) -> StabilityMargins:
             disk_w, disk_peak = math.inf, at_infinity
     stab_w, stab_peak = _extremum(omega, -np.abs(1 + values), distance)
 
+    result = _assemble(
+        gains,
+        np.array(phase_w),
+        phases,
+        np.array(gain_w),
+        delays,
+        disk=(disk_w, disk_peak),
+        stability=(stab_w, -stab_peak),
+        closed=closed,
+        stable=stable,
+        unstable_open=unstable_open,
+        unstable_closed=unstable_closed,
+    )
+    _verify_gain_margins(model, result)
+    return result
+
+
+def _assemble(
+    gains: FloatArray,
+    phase_w: FloatArray,
+    phases: FloatArray,
+    gain_w: FloatArray,
+    delays: FloatArray,
+    *,
+    disk: tuple[float, float],
+    stability: tuple[float, float],
+    closed: ComplexArray,
+    stable: bool,
+    unstable_open: int,
+    unstable_closed: int,
+) -> StabilityMargins:
+    """The result object: the critical margins picked from every crossover's."""
+    disk_w, disk_peak = disk
     if gains.size:
         critical = int(np.argmin(np.abs(np.log(gains))))
-        gm, w_gm = float(gains[critical]), phase_w[critical]
+        gm, w_gm = float(gains[critical]), float(phase_w[critical])
     else:
         gm, w_gm = math.inf, math.nan
     if phases.size:
         critical = int(np.argmin(np.abs(phases)))
-        pm, w_pm = float(phases[critical]), gain_w[critical]
+        pm, w_pm = float(phases[critical]), float(gain_w[critical])
     else:
         pm, w_pm = math.inf, math.nan
     if not stable:
-        delay, disk = 0.0, 0.0
+        delay, alpha = 0.0, 0.0
     else:
         delay = float(delays.min()) if delays.size else math.inf
-        disk = 1.0 / disk_peak if disk_peak > 0 else math.inf
-    result = StabilityMargins(
+        alpha = 1.0 / disk_peak if disk_peak > 0 else math.inf
+    return StabilityMargins(
         gain_margin=gm,
         phase_crossover=w_gm,
         phase_margin=pm,
         gain_crossover=w_pm,
         delay_margin=delay,
-        disk_margin=disk,
+        disk_margin=alpha,
         disk_frequency=disk_w,
-        stability_margin=-stab_peak,
-        stability_frequency=stab_w,
+        stability_margin=stability[1],
+        stability_frequency=stability[0],
         gain_margins=gains,
-        phase_crossovers=np.array(phase_w),
+        phase_crossovers=phase_w,
         phase_margins=phases,
-        gain_crossovers=np.array(gain_w),
+        gain_crossovers=gain_w,
         delay_margins=delays,
         closed_loop_poles=np.sort_complex(closed),
         closed_loop_stable=stable,
         open_loop_unstable_poles=unstable_open,
         encirclements=unstable_open - unstable_closed,
     )
-    _verify_gain_margins(model, result)
-    return result
 
 
 def _extremum(
@@ -615,9 +706,24 @@ class RootLocus:
     gains: FloatArray
     poles: ComplexArray
     """Shape (len(gains), n): the eigenvalues of A - k B (1 + k D)⁻¹ C, each row sorted."""
-    open_loop_poles: ComplexArray
-    open_loop_zeros: ComplexArray
     dt: float
+    loop: StateSpace = field(repr=False)
+    """The open loop L."""
+
+    @cached_property
+    def _transfer(self) -> TransferFunction:
+        return transfer_function(self.loop)
+
+    @property
+    def open_loop_poles(self) -> ComplexArray:
+        """The poles of L's transfer function (computed on first use: the locus itself needs
+        only the closed-loop eigenvalues)."""
+        return self._transfer.poles
+
+    @property
+    def open_loop_zeros(self) -> ComplexArray:
+        """The zeros of L's transfer function (computed on first use)."""
+        return self._transfer.zeros
 
     def plot(self, ax: Axes | None = None, marked: list[float] | None = None) -> Axes:
         """The locus with a ζ/ω_n grid (matplotlib); see
@@ -655,16 +761,23 @@ def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
     """
     model = _siso(loop)
     k = _gains(gains)
-    poles = np.array([_closed_poles(model, float(value)) for value in k]).reshape(
-        k.size, model.n_states
-    )
-    g = transfer_function(model)
+    d = float(model.D[0, 0])
+    denominators = 1.0 + k * d
+    algebraic = np.abs(denominators) <= 8 * _EPS * np.maximum(1.0, np.abs(k * d))
+    if np.any(algebraic):
+        _closed_loop_matrix(model, float(k[np.argmax(algebraic)]))  # raises, naming the gain
+    n = model.n_states
+    if n:
+        # Every closed-loop matrix A - k B (1 + k D)⁻¹ C as one stack, one parallel call.
+        stack = model.A - (k / denominators)[:, None, None] * (model.B @ model.C)
+        poles = np.sort_complex(_core.eigenvalues(stack))
+    else:
+        poles = np.zeros((k.size, 0), np.complex128)
     return RootLocus(
         gains=k,
         poles=poles.astype(np.complex128),
-        open_loop_poles=g.poles,
-        open_loop_zeros=g.zeros,
         dt=period(model) if model.is_discrete else 0.0,
+        loop=model,
     )
 
 

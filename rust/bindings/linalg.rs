@@ -398,7 +398,7 @@ fn schur<'py>(
 }
 
 /// The eigenvalues of a real square matrix (the Schur form without Z), in the order of the
-/// quasi-triangular form's diagonal.
+/// quasi-triangular form's diagonal; of a 3-D stack (k, n, n), a (k, n) array, in parallel.
 #[pyfunction]
 #[pyo3(signature = (a, /))]
 fn eigenvalues<'py>(
@@ -406,13 +406,56 @@ fn eigenvalues<'py>(
     a: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArrayDyn<c64>>> {
     let a = Real::convert(py, a, "A")?;
-    let a = a.matrix().map_err(|e| to_py_err(py, e))?;
-    let values = compute(py, schur_cost(a.nrows()), || eigenvalues_core(a))?;
-    let mut outputs = Outputs::new(py);
-    let n = values.len();
-    let result = outputs.complex("the eigenvalues", &[n], &values)?;
-    outputs.finish()?;
-    Ok(result)
+    match *a.shape() {
+        [_, _] => {
+            let a = a.matrix().map_err(|e| to_py_err(py, e))?;
+            let values = compute(py, schur_cost(a.nrows()), || eigenvalues_core(a))?;
+            let mut outputs = Outputs::new(py);
+            let n = values.len();
+            let result = outputs.complex("the eigenvalues", &[n], &values)?;
+            outputs.finish()?;
+            Ok(result)
+        }
+        [count, rows, cols] => {
+            let stack = a.stack().map_err(|e| to_py_err(py, e))?;
+            if rows != cols {
+                return Err(to_py_err(
+                    py,
+                    Error::NotSquare {
+                        arg: "A",
+                        rows,
+                        cols,
+                    },
+                ));
+            }
+            let out = new_array::<c64>(py, &[count, rows])?;
+            // SAFETY: `out` is new and not visible to Python until returned.
+            let data = unsafe { new_array_data(&out) };
+            let threads = rayon::current_num_threads() as f64;
+            let single = schur_cost(rows);
+            let cost = Cost {
+                bytes: single.bytes * threads,
+                ..single
+            }
+            .times(count);
+            compute(py, cost, || {
+                crate::control::batch::eigenvalues_batch(stack, data)
+            })?;
+            let mut outputs = Outputs::new(py);
+            // SAFETY: as above; the computation is over.
+            outputs.check_complex("the eigenvalues", unsafe { new_array_data(&out) });
+            outputs.finish()?;
+            Ok(out)
+        }
+        _ => Err(to_py_err(
+            py,
+            Error::WrongDimensions {
+                arg: "A",
+                expected: "a 2-D square matrix or a 3-D stack of square matrices",
+                shape: a.shape().to_vec(),
+            },
+        )),
+    }
 }
 
 /// The cost of the generalized Schur form of order n, with Q and Z.

@@ -17,6 +17,7 @@ mod conversion;
 mod errors;
 mod frequency;
 mod linalg;
+mod loops;
 mod modal;
 mod placement;
 mod responses;
@@ -38,6 +39,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     statespace::register(m)?;
     responses::register(m)?;
     frequency::register(m)?;
+    loops::register(m)?;
     modal::register(m)?;
     controllability::register(m)?;
     placement::register(m)?;

@@ -111,6 +111,45 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
         })
 }
 
+/// The eigenvalues of every matrix of a stack of square matrices, written into `out` (length
+/// k n, n per matrix in the order of its Schur form's diagonal, each conjugate pair adjacent
+/// with Im > 0 first), in parallel. A non-finite entry is reported with the index of its
+/// matrix before anything is computed.
+pub fn eigenvalues_batch(stack: MatrixStack<'_>, out: &mut [c64]) -> Result<(), Error> {
+    let n = stack.rows;
+    if stack.rows != stack.cols {
+        return Err(Error::NotSquare {
+            arg: "A",
+            rows: stack.rows,
+            cols: stack.cols,
+        });
+    }
+    check_output_len(out.len(), stack.len() * n)?;
+    if !stack
+        .data
+        .iter()
+        .fold(true, |finite, v| finite & v.is_finite())
+    {
+        for index in 0..stack.len() {
+            check_finite(stack.get(index), "A").map_err(|e| Error::in_batch(index, e))?;
+        }
+    }
+    if n == 0 {
+        return Ok(());
+    }
+    let context = ParallelContext::capture(n);
+    out.par_chunks_mut(n)
+        .enumerate()
+        .try_for_each(|(index, chunk)| {
+            context.run(|| {
+                let values = crate::linalg::schur::eigenvalues(stack.get(index))
+                    .map_err(|e| Error::in_batch(index, e))?;
+                chunk.copy_from_slice(&values);
+                Ok(())
+            })
+        })
+}
+
 /// The data of a batch of Riccati equations A^T X + X A - X B R^-1 B^T X + Q = 0 (6.199).
 /// Each stack holds either one matrix, shared by every problem, or one per problem; so a
 /// sweep of one model over k weights is A, B, Q of one matrix each and a stack of k R's.

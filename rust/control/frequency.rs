@@ -85,6 +85,100 @@ struct HessenbergModel {
     /// A / σ, B / β and C / γ are held (the point s is divided by σ): C (sI - A)^-1 B is
     /// multiplied by 2^`exponent` = γ β / σ.
     exponent: f64,
+    /// σ, the power of two the point s is divided by.
+    sigma: f64,
+}
+
+impl HessenbergModel {
+    /// The model of a checked (A, B, C, D), scaled and reduced once.
+    fn new(
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        c: MatRef<'_, f64>,
+        d: MatRef<'_, f64>,
+    ) -> Result<Self, Error> {
+        let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
+        let (sigma, beta, gamma) = (range_scale(a), range_scale(b), range_scale(c));
+        let scaled =
+            |x: MatRef<'_, f64>, s: f64| Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)] / s);
+        let (a, b, c) = (scaled(a, sigma), scaled(b, beta), scaled(c, gamma));
+        let Hessenberg { h, q } = hessenberg(a.as_ref())?;
+        let (qb, cq) = (q.transpose() * &b, &c * &q);
+        let row_major = |x: &Mat<f64>| -> Vec<f64> {
+            (0..x.nrows())
+                .flat_map(|i| (0..x.ncols()).map(move |j| x[(i, j)]))
+                .collect()
+        };
+        Ok(HessenbergModel {
+            n,
+            m,
+            p,
+            h: row_major(&h),
+            b: (0..m)
+                .flat_map(|j| (0..n).map(move |i| (j, i)))
+                .map(|(j, i)| qb[(i, j)])
+                .collect(),
+            c: row_major(&cq),
+            d: row_major(&d.to_owned()),
+            exponent: gamma.log2() + beta.log2() - sigma.log2(),
+            sigma,
+        })
+    }
+
+    /// Scratch for one evaluation at a time.
+    fn workspace(&self) -> Workspace {
+        let (n, m) = (self.n, self.m);
+        Workspace {
+            re: vec![0.0; n * n],
+            im: vec![0.0; n * n],
+            x_re: vec![0.0; n * m],
+            x_im: vec![0.0; n * m],
+        }
+    }
+}
+
+/// G(s) of one model at many points one at a time (a root finder's evaluations): the
+/// Hessenberg reduction is made once, each point costs O(n^2 m + p n m).
+pub struct FrequencyEvaluator {
+    model: HessenbergModel,
+    workspace: Workspace,
+    g: Vec<c64>,
+}
+
+impl FrequencyEvaluator {
+    /// Checks and reduces (A, B, C, D) once.
+    pub fn new(
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        c: MatRef<'_, f64>,
+        d: MatRef<'_, f64>,
+    ) -> Result<Self, Error> {
+        check_state_space(a, b, c, d)?;
+        let model = HessenbergModel::new(a, b, c, d)?;
+        let workspace = model.workspace();
+        let g = vec![c64::new(0.0, 0.0); model.p * model.m];
+        Ok(Self {
+            model,
+            workspace,
+            g,
+        })
+    }
+
+    /// G(s) (p x m, row-major) at the complex point s: infinite or NaN entries at a pole.
+    pub fn at(&mut self, point: c64) -> &[c64] {
+        let s = if self.model.sigma == 1.0 {
+            point
+        } else {
+            point / self.model.sigma
+        };
+        evaluate_frequency(&self.model, s, &mut self.workspace, &mut self.g);
+        &self.g
+    }
+
+    /// The (0, 0) entry of G(jω): the loop L(jω) of a SISO model.
+    pub fn siso(&mut self, omega: f64) -> c64 {
+        self.at(c64::new(0.0, omega))[0]
+    }
 }
 
 /// (a + jb) / (c + jd) by Smith's algorithm (Smith 1962): the ratio of the smaller to the
@@ -311,41 +405,14 @@ fn transfer_function_into(
 ) -> Result<(), Error> {
     check_state_space(a, b, c, d)?;
     check_finite_values(omega, "omega")?;
-    let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
+    let (m, p) = (b.ncols(), c.nrows());
     check_output_len(out.len(), omega.len() * p * m)?;
     if p * m == 0 {
         return Ok(());
     }
-    let (sigma, beta, gamma) = (range_scale(a), range_scale(b), range_scale(c));
-    let scaled =
-        |x: MatRef<'_, f64>, s: f64| Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)] / s);
-    let (a, b, c) = (scaled(a, sigma), scaled(b, beta), scaled(c, gamma));
-    let Hessenberg { h, q } = hessenberg(a.as_ref())?;
-    let (qb, cq) = (q.transpose() * &b, &c * &q);
-    let row_major = |x: &Mat<f64>| -> Vec<f64> {
-        (0..x.nrows())
-            .flat_map(|i| (0..x.ncols()).map(move |j| x[(i, j)]))
-            .collect()
-    };
-    let model = HessenbergModel {
-        n,
-        m,
-        p,
-        h: row_major(&h),
-        b: (0..m)
-            .flat_map(|j| (0..n).map(move |i| (j, i)))
-            .map(|(j, i)| qb[(i, j)])
-            .collect(),
-        c: row_major(&cq),
-        d: row_major(&d.to_owned()),
-        exponent: gamma.log2() + beta.log2() - sigma.log2(),
-    };
-    let workspace = || Workspace {
-        re: vec![0.0; n * n],
-        im: vec![0.0; n * n],
-        x_re: vec![0.0; n * m],
-        x_im: vec![0.0; n * m],
-    };
+    let model = HessenbergModel::new(a, b, c, d)?;
+    let sigma = model.sigma;
+    let workspace = || model.workspace();
     // The evaluations multiply by their own kernels, not faer's.
     let context = ParallelContext::capture(0);
     omega

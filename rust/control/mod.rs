@@ -15,6 +15,7 @@ pub mod batch;
 pub mod controllability;
 pub mod discretize;
 pub mod frequency;
+pub mod margins;
 pub mod modal;
 pub mod placement;
 pub mod responses;

@@ -1,0 +1,135 @@
+"""Peer cases of aerocontrol.loops: stability margins of the 747 dampers' loops against
+python-control, and the root locus over 1000 gains against a Python loop over numpy."""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import control
+import numpy as np
+
+import aerocontrol
+
+from .harness import Case, Pairs, Peer, Target
+
+
+def _yaw_loop(rng: np.random.Generator) -> tuple[Any, ...]:
+    """The 747 cruise yaw damper's loop (design.yaw_damper: actuator, r/rudder, washout),
+    n = 6."""
+    return (aerocontrol.design.yaw_damper(aerocontrol.aircraft.load("b747-cruise")).loop,)
+
+
+def _pitch_loop(rng: np.random.Generator) -> tuple[Any, ...]:
+    """The 747 cruise pitch damper's loop (design.pitch_damper: actuator, q/elevator), n = 5."""
+    return (aerocontrol.design.pitch_damper(aerocontrol.aircraft.load("b747-cruise")).loop,)
+
+
+def _margins_ours(loop: Any) -> Any:
+    return aerocontrol.stability_margins(loop)
+
+
+def _margins_control(loop: Any) -> Any:
+    """python-control's stability_margins(returnall=True): every crossover, from the
+    polynomial numerator and denominator (their roots, then a check on the frequency
+    response)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return control.stability_margins(control.ss(loop.A, loop.B, loop.C, loop.D), returnall=True)
+
+
+def _compare_margins(ours: Any, peer: Any) -> Pairs:
+    """Phase margins and their frequencies; gain margins at the phase crossovers with ω > 0
+    (python-control also reports L(0) = 1e-13 of the washout's zero at the origin as a phase
+    crossover with gain margin 1e13: not a crossover, as L vanishes there)."""
+    gm, pm, _, wpc, wgc, _ = (np.atleast_1d(np.asarray(x, dtype=float)) for x in peer)
+    kept = wpc > 0
+    pairs = [
+        (ours.phase_margins, pm),
+        (ours.gain_crossovers, wgc),
+        (ours.gain_margins, gm[kept]),
+        (ours.phase_crossovers, wpc[kept]),
+    ]
+    # Empty on both sides (no phase crossover above 0) agrees; a shape mismatch still fails.
+    return [(a, b) for a, b in pairs if a.size or b.size]
+
+
+def margins_cases() -> list[Case]:
+    """stability_margins of the 747 cruise yaw damper's loop (n = 6) and pitch damper's loop
+    (n = 5). The issue's target: 20x python-control.
+
+    Peer: python-control's stability_margins(returnall=True).
+    """
+    target = Target("stability_margins vs control: ratio >= 20", min_ratio=20.0)
+    return [
+        Case(
+            op="stability_margins",
+            size=size,
+            seed=0,
+            setup=setup,
+            ours=_margins_ours,
+            peers=[
+                Peer(
+                    "control.stability_margins",
+                    _margins_control,
+                    compare=_compare_margins,
+                    target=target,
+                    rtol=1e-7,
+                )
+            ],
+        )
+        for size, setup in [("n=6 747 yaw", _yaw_loop), ("n=5 747 pitch", _pitch_loop)]
+    ]
+
+
+def _locus_inputs(rng: np.random.Generator) -> tuple[Any, ...]:
+    """The yaw damper's loop and 1000 gains from 0 to 5 (past the best damping)."""
+    return (*_yaw_loop(rng), np.linspace(0.0, 5.0, 1000))
+
+
+def _locus_ours(loop: Any, gains: np.ndarray) -> Any:
+    return aerocontrol.root_locus(loop, gains).poles
+
+
+def _locus_numpy(loop: Any, gains: np.ndarray) -> Any:
+    """numpy.linalg.eigvals of A - k B (1 + k D)^-1 C, one call per gain, each row sorted."""
+    A, B, C, D = loop.A, loop.B, loop.C, loop.D
+    BC = B @ C
+    return np.array(
+        [np.sort_complex(np.linalg.eigvals(A - (k / (1.0 + k * D[0, 0])) * BC)) for k in gains]
+    )
+
+
+def _compare_poles(ours: Any, peer: Any) -> Pairs:
+    """Real and imaginary parts of the sorted closed-loop poles, gain by gain."""
+    return [(ours.real, peer.real), (ours.imag, peer.imag)]
+
+
+def root_locus_cases() -> list[Case]:
+    """root_locus of the 747 yaw damper's loop (n = 6) over 1000 gains: one parallel call
+    against a Python loop over numpy.linalg.eigvals. The issue's target: 50x.
+
+    Peer: numpy.linalg.eigvals (LAPACK dgeev) in a Python loop.
+    """
+    return [
+        Case(
+            op="root_locus 1000 gains",
+            size="n=6 747 yaw",
+            seed=0,
+            setup=_locus_inputs,
+            ours=_locus_ours,
+            peers=[
+                Peer(
+                    "numpy.linalg.eigvals loop",
+                    _locus_numpy,
+                    compare=_compare_poles,
+                    target=Target("root locus vs numpy loop: ratio >= 50", min_ratio=50.0),
+                    rtol=1e-9,
+                )
+            ],
+        )
+    ]
+
+
+GROUPS = (margins_cases, root_locus_cases)
+"""The case builders of this file, in the order they run."""

@@ -1,0 +1,866 @@
+//! Crossovers and margins of a continuous SISO loop L(s) = C (sI - A)^-1 B + d, by eigenvalue
+//! methods (no frequency grid).
+//!
+//! **Gain crossovers** (|L(jω)| = 1) are the imaginary-axis eigenvalues jω of the Hamiltonian
+//! of 1 - L(-s) L(s) (Boyd, Balakrishnan and Kabamba 1989, Theorem 1 with γ = 1): with
+//! r = 1 - d^2 != 0,
+//!
+//! ```text
+//!     H = [ A + (d/r) B C        (1/r) B B^T         ]
+//!         [ -(1/r) C^T C        -(A + (d/r) B C)^T   ],
+//! ```
+//!
+//! whose eigenvalues are the zeros of 1 - L(-s) L(s) (plus any uncontrollable or unobservable
+//! modes). When d^2 = 1 to rounding (r = 0, the Hamiltonian does not exist) the zeros are the
+//! finite generalized eigenvalues of the system pencil of 1 - L(-s) L(s), the realisation
+//! A_f = [[A, 0], [B C, -A]], B_f = [B; d B], C_f = [-d C, C], D_f = 1 - d^2 (the series
+//! connection of L(s) and L(-s) = d - C (sI + A)^-1 B).
+//!
+//! **Phase crossovers** (L(jω) real, ω >= 0) are the imaginary-axis zeros of the odd function
+//! L(s) - L(-s) = C (sI - A)^-1 B + C (sI + A)^-1 B (for a real loop L(-jω) = conj L(jω), so
+//! L(jω) - L(-jω) = 2j Im L(jω)): the finite generalized eigenvalues of the system pencil
+//!
+//! ```text
+//!     [ diag(A, -A)  [B; B] ]       [ I  0 ]
+//!     [ [C, C]        0     ]  - s  [ 0  0 ]
+//! ```
+//!
+//! of Emami-Naeini and Van Dooren, reduced for one input and one output to an ordinary
+//! eigenvalue problem of order at most 2n - 1 ([`siso_zeros`]: orthogonal reflections that
+//! peel off the relative degree, the equivalent of QZ on the deflated pencil, at a fraction of
+//! its cost). ω = 0 is always a candidate (the odd function vanishes there when L(0)
+//! is finite). A pencil that is singular (L(s) - L(-s) vanishing identically: L even, real on
+//! the whole axis) is reported as [`LoopMargins::degenerate`] and no phase crossover is given.
+//! A phase crossover beyond 1e8 times the largest pole's modulus counts as at infinity (a zero
+//! pushed there by the reduction's division, where L is its feedthrough).
+//!
+//! **Acceptance.** An eigenvalue λ with |Re λ| <= 1e-6 |λ| (and Im λ >= 0) is a candidate; it
+//! is polished by the secant method on the exact L(jω) (f = ln|L| or f = Im L / |L|, evaluated
+//! by `control/frequency.rs`'s Hessenberg kernel on a model reduced once), and kept only if
+//! it then satisfies | |L| - 1 | <= 1e-8, respectively |Im L| <= 1e-8 |L|; candidates within
+//! 1e-9 of each other (relative) are merged. A phase crossover where L vanishes (|L| below
+//! 1e-10 of the loop's scale, a zero on the axis or at the origin) is not one.
+//!
+//! **Peaks** (the disk margin and the stability margin) are L∞ norms of SISO transfers, by the
+//! Boyd-Balakrishnan / Bruinsma-Steinbuch iteration: a lower bound γ from ω = 0, ω = ∞ and the
+//! frequencies of the poles; the imaginary eigenvalues jω_i of the Hamiltonian of G/γ' with
+//! γ' = (1 + 2ε) γ (ε = 1e-8); in the interval [ω_i, ω_i+1] whose midpoint is highest, the
+//! maximum by Brent's method (golden section and parabolic interpolation, to 1e-12 in ω)
+//! is the new γ; until no imaginary
+//! eigenvalue remains (usually the second Hamiltonian). The disk margin's transfer is
+//! (1 - L)/(2 (1 + L)) = S - 1/2, with S = 1/(1 + L) realised as
+//! (A - B C/(1 + d), B/(1 + d), -C/(1 + d), 1/(1 + d)); the stability margin min |1 + L| is
+//! 1/max |S|.
+//!
+//! **Verification.** Every phase crossover with L(jω) < 0 gives a gain margin k = 1/|L(jω)|;
+//! the loop closed with k must have a pole at jω (the eigenvalues of A - k B (1 + k d)^-1 C,
+//! within 1e-6 of max(1 + max|A|, ω)), else [`Error::IllConditioned`].
+//!
+//! References: S. Boyd, V. Balakrishnan and P. Kabamba, "A bisection method for computing the
+//! H∞ norm of a transfer matrix and related problems", Math. Control Signals Systems 2, 1989;
+//! S. Boyd and V. Balakrishnan, "A regularity result for the singular values of a transfer
+//! matrix and a quadratically convergent algorithm for computing its L∞-norm", Systems &
+//! Control Letters 15, 1990; N. A. Bruinsma and M. Steinbuch, "A fast algorithm to compute the
+//! H∞-norm of a transfer function matrix", Systems & Control Letters 14, 1990; A. Emami-Naeini
+//! and P. Van Dooren, "Computation of zeros of linear multivariable systems", Automatica 18,
+//! 1982 (zeros as generalized eigenvalues of the system pencil); P. Seiler, A. Packard and
+//! P. Gahinet, "An introduction to disk margins", IEEE Control Systems 40(5), 2020.
+
+use crate::control::frequency::{FrequencyEvaluator, check_state_space};
+use crate::error::Error;
+use crate::linalg::schur::eigenvalues;
+use crate::platform::parallel::ParallelContext;
+use faer::{Mat, MatRef, c64};
+
+/// A crossover: the frequency and the loop's value there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Crossover {
+    pub omega: f64,
+    pub value: c64,
+}
+
+/// The supremum over ω in [0, ∞] of |G(jω)| and where it is attained (∞ for the limit
+/// ω -> ∞; NaN with an infinite value when G has a pole on the axis).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Peak {
+    pub omega: f64,
+    pub value: f64,
+}
+
+/// Crossovers, peaks and poles of a SISO loop (see the module's documentation).
+#[derive(Debug, Clone)]
+pub struct LoopMargins {
+    /// |L(jω)| = 1, by increasing ω.
+    pub gain_crossovers: Vec<Crossover>,
+    /// L(jω) real and not vanishing, by increasing ω (both signs of L).
+    pub phase_crossovers: Vec<Crossover>,
+    /// max |1 - L|/(2 |1 + L|).
+    pub disk: Peak,
+    /// max |S| = 1/min |1 + L|.
+    pub sensitivity: Peak,
+    /// Eigenvalues of A - B (1 + d)^-1 C.
+    pub closed_loop_poles: Vec<c64>,
+    /// Eigenvalues of A.
+    pub open_loop_poles: Vec<c64>,
+    /// L(s) - L(-s) vanishes identically (or its pencil is singular): the phase crossovers
+    /// could not be located by the pencil.
+    pub degenerate: bool,
+}
+
+/// Relative distance from the imaginary axis within which an eigenvalue is a candidate.
+const AXIS_TOLERANCE: f64 = 1e-6;
+/// Relative residual a polished crossover must reach.
+const CROSSOVER_TOLERANCE: f64 = 1e-8;
+/// ε of the L∞ iteration: γ' = (1 + 2ε) γ.
+const PEAK_TOLERANCE: f64 = 1e-8;
+
+fn max_abs(x: MatRef<'_, f64>) -> f64 {
+    let mut m = 0.0f64;
+    for j in 0..x.ncols() {
+        for i in 0..x.nrows() {
+            m = m.max(x[(i, j)].abs());
+        }
+    }
+    m
+}
+
+/// The power of two nearest to x > 0 (1 for 0 or non-finite x): an exact scale factor.
+fn power_of_two(x: f64) -> f64 {
+    if x > 0.0 && x.is_finite() {
+        2f64.powi(x.log2().round() as i32)
+    } else {
+        1.0
+    }
+}
+
+/// The eigenvalues of the Hamiltonian of 1 - G(-s) G(s) for G = (A, B, C, d), r = 1 - d^2 != 0.
+fn hamiltonian_eigenvalues(
+    a: MatRef<'_, f64>,
+    b: &[f64],
+    c: &[f64],
+    d: f64,
+) -> Result<Vec<c64>, Error> {
+    let n = a.nrows();
+    let r = 1.0 - d * d;
+    // B β and C / β leave G unchanged; β balances B B^T against C^T C.
+    let (nb, nc) = (
+        b.iter().fold(0.0f64, |m, v| m.max(v.abs())),
+        c.iter().fold(0.0f64, |m, v| m.max(v.abs())),
+    );
+    let beta = if nb > 0.0 && nc > 0.0 {
+        power_of_two((nc / nb).sqrt())
+    } else {
+        1.0
+    };
+    let h = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+        (true, true) => a[(i, j)] + (d / r) * b[i] * c[j],
+        (true, false) => (b[i] * beta) * (b[j - n] * beta) / r,
+        (false, true) => -(c[i - n] / beta) * (c[j] / beta) / r,
+        (false, false) => -(a[(j - n, i - n)] + (d / r) * b[j - n] * c[i - n]),
+    });
+    eigenvalues(h.as_ref())
+}
+
+/// The finite zeros of the strictly proper SISO realisation (A, b, c, 0), or None when its
+/// transfer vanishes identically (the system pencil is singular).
+///
+/// The reduction of Emami-Naeini and Van Dooren (1982) for one input and one output: a
+/// Householder reflection H with H b = β e_N brings the input onto the last state; the last
+/// state equation then only determines u. If c̃_N = (c H)_N is not zero (to 1e-10 of |c|,
+/// the relative degree is reached), x_N = -c̃_1 x_1 / c̃_N and the zeros are the eigenvalues of
+/// Ã_11 - ã_12 c̃_1 / c̃_N (order N - 1); otherwise x_N is the input of the system
+/// (Ã_11, ã_12, c̃_1, 0) of order N - 1, which has the same zeros, and the step repeats. The
+/// reflections are orthogonal; the one division is by the largest Markov parameter direction
+/// left, and a zero it makes large is a candidate the caller verifies like any other.
+fn siso_zeros(a: MatRef<'_, f64>, b: &[f64], c: &[f64]) -> Result<Option<Vec<c64>>, Error> {
+    let norm = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let a_scale = max_abs(a).max(f64::MIN_POSITIVE);
+    let c_scale = norm(c);
+    let b_scale = norm(b);
+    let mut a = a.to_owned();
+    let mut b = b.to_vec();
+    let mut c = c.to_vec();
+    // The first input is b itself; later ones are columns of A, measured against A.
+    let mut input_scale = b_scale;
+    loop {
+        let n = a.nrows();
+        if n == 0 {
+            return Ok(None); // every Markov parameter vanishes: the transfer is 0
+        }
+        let (nb, nc) = (norm(&b), norm(&c));
+        if nb <= 1e-13 * input_scale || nc <= 1e-13 * c_scale || nb == 0.0 || nc == 0.0 {
+            return Ok(None);
+        }
+        // v = b + sign(b_N) |b| e_N; H = I - 2 v v^T / v^T v maps b to -sign(b_N) |b| e_N.
+        let mut v = b.clone();
+        let sign = if b[n - 1] >= 0.0 { 1.0 } else { -1.0 };
+        v[n - 1] += sign * nb;
+        let vv: f64 = v.iter().map(|x| x * x).sum();
+        // A <- H A H, c <- c H.
+        for j in 0..n {
+            let dot: f64 = (0..n).map(|i| v[i] * a[(i, j)]).sum();
+            let f = 2.0 * dot / vv;
+            for i in 0..n {
+                a[(i, j)] -= f * v[i];
+            }
+        }
+        for i in 0..n {
+            let dot: f64 = (0..n).map(|j| a[(i, j)] * v[j]).sum();
+            let f = 2.0 * dot / vv;
+            for j in 0..n {
+                a[(i, j)] -= f * v[j];
+            }
+        }
+        let dot: f64 = c.iter().zip(&v).map(|(x, y)| x * y).sum();
+        let f = 2.0 * dot / vv;
+        for (x, y) in c.iter_mut().zip(&v) {
+            *x -= f * y;
+        }
+        let last = c[n - 1];
+        let m = n - 1;
+        if last.abs() > 1e-10 * nc {
+            let reduced = Mat::from_fn(m, m, |i, j| a[(i, j)] - a[(i, m)] * c[j] / last);
+            return Ok(Some(eigenvalues(reduced.as_ref())?));
+        }
+        b = (0..m).map(|i| a[(i, m)]).collect();
+        c.truncate(m);
+        a = Mat::from_fn(m, m, |i, j| a[(i, j)]);
+        input_scale = a_scale;
+    }
+}
+
+/// The frequencies ω >= 0 of the eigenvalues within [`AXIS_TOLERANCE`] of the imaginary axis.
+fn axis_candidates(values: &[c64]) -> Vec<f64> {
+    values
+        .iter()
+        .filter(|v| v.im >= 0.0 && v.re.abs() <= AXIS_TOLERANCE * v.norm())
+        .map(|v| v.im)
+        .collect()
+}
+
+/// The secant method on f from ω0, at most 12 steps, staying within 1e-3 of ω0 (relative);
+/// returns the point of smallest |f| met.
+fn secant(mut f: impl FnMut(f64) -> f64, omega: f64) -> f64 {
+    let step = if omega > 0.0 { 1e-7 * omega } else { 1e-7 };
+    let (mut x0, mut f0) = (omega, f(omega));
+    let (mut x1, mut f1) = (omega + step, f(omega + step));
+    let (mut best, mut best_f) = if f1.abs() < f0.abs() {
+        (x1, f1)
+    } else {
+        (x0, f0)
+    };
+    if !best_f.is_finite() {
+        return omega;
+    }
+    for _ in 0..12 {
+        if f1 == f0 || best_f == 0.0 {
+            break;
+        }
+        let x2 = x1 - f1 * (x1 - x0) / (f1 - f0);
+        if !x2.is_finite() || (x2 - omega).abs() > 1e-3 * omega.max(1e-300) + step {
+            break;
+        }
+        let f2 = f(x2);
+        if !f2.is_finite() {
+            break;
+        }
+        if f2.abs() < best_f.abs() {
+            (best, best_f) = (x2, f2);
+        }
+        if (x2 - x1).abs() <= 4.0 * f64::EPSILON * x2.abs() {
+            break;
+        }
+        (x0, f0, x1, f1) = (x1, f1, x2, f2);
+    }
+    best.max(0.0)
+}
+
+/// Sorted, with crossovers within 1e-9 of each other (relative) merged.
+fn merged(mut found: Vec<Crossover>) -> Vec<Crossover> {
+    found.sort_by(|x, y| x.omega.total_cmp(&y.omega));
+    let mut out: Vec<Crossover> = Vec::with_capacity(found.len());
+    for x in found {
+        match out.last() {
+            Some(last) if (x.omega - last.omega).abs() <= 1e-9 * x.omega.max(1e-300) => {}
+            _ => out.push(x),
+        }
+    }
+    out
+}
+
+/// The SISO loop's vectors and its evaluator.
+struct Loop<'a> {
+    a: MatRef<'a, f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+    d: f64,
+    evaluator: FrequencyEvaluator,
+}
+
+impl Loop<'_> {
+    fn at(&mut self, omega: f64) -> c64 {
+        self.evaluator.siso(omega)
+    }
+
+    fn gain_crossovers(&mut self) -> Result<Vec<Crossover>, Error> {
+        let n = self.a.nrows();
+        let d = self.d;
+        let candidates = if (1.0 - d * d).abs() > 1e-12 {
+            axis_candidates(&hamiltonian_eigenvalues(self.a, &self.b, &self.c, d)?)
+        } else {
+            // d^2 = 1: the system pencil of 1 - L(-s) L(s).
+            let a2 = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+                (true, true) => self.a[(i, j)],
+                (true, false) => 0.0,
+                (false, true) => self.b[i - n] * self.c[j],
+                (false, false) => -self.a[(i - n, j - n)],
+            });
+            let b2: Vec<f64> = (0..2 * n)
+                .map(|i| if i < n { self.b[i] } else { d * self.b[i - n] })
+                .collect();
+            let c2: Vec<f64> = (0..2 * n)
+                .map(|j| if j < n { -d * self.c[j] } else { self.c[j - n] })
+                .collect();
+            match siso_zeros(a2.as_ref(), &b2, &c2)? {
+                Some(zeros) => axis_candidates(&zeros),
+                None => Vec::new(),
+            }
+        };
+        let mut found = Vec::with_capacity(candidates.len());
+        for omega in candidates {
+            let w = secant(|w| self.at(w).norm().ln(), omega);
+            let value = self.at(w);
+            if (value.norm() - 1.0).abs() <= CROSSOVER_TOLERANCE {
+                found.push(Crossover { omega: w, value });
+            }
+        }
+        Ok(merged(found))
+    }
+
+    /// The loop's magnitude scale: |d| and |L| between and beyond the poles' frequencies
+    /// (geometric means of consecutive moduli above 1e-10 of the largest, half the smallest, twice the largest;
+    /// ω = 1 without a nonzero pole), never at a pole.
+    fn scale(&mut self, poles: &[c64]) -> f64 {
+        let largest = poles.iter().fold(0.0f64, |m, p| m.max(p.norm()));
+        let mut moduli: Vec<f64> = poles
+            .iter()
+            .map(|p| p.norm())
+            .filter(|&m| m > 1e-10 * largest)
+            .collect();
+        moduli.sort_by(f64::total_cmp);
+        let mut points: Vec<f64> = moduli.windows(2).map(|w| (w[0] * w[1]).sqrt()).collect();
+        match (moduli.first(), moduli.last()) {
+            (Some(&low), Some(&high)) => points.extend([0.5 * low, 2.0 * high]),
+            _ => points.push(1.0),
+        }
+        let mut scale = self.d.abs();
+        for omega in points {
+            let value = self.at(omega).norm();
+            if value.is_finite() {
+                scale = scale.max(value);
+            }
+        }
+        scale
+    }
+
+    fn phase_crossovers(&mut self, poles: &[c64]) -> Result<(Vec<Crossover>, bool), Error> {
+        let n = self.a.nrows();
+        let a2 = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+            (true, true) => self.a[(i, j)],
+            (false, false) => -self.a[(i - n, j - n)],
+            _ => 0.0,
+        });
+        let b2: Vec<f64> = (0..2 * n).map(|i| self.b[i % n.max(1)]).collect();
+        let c2: Vec<f64> = (0..2 * n).map(|j| self.c[j % n.max(1)]).collect();
+        let (zeros, degenerate) = match siso_zeros(a2.as_ref(), &b2, &c2)? {
+            Some(zeros) => (zeros, false),
+            None => (Vec::new(), true),
+        };
+        let frequency_scale = poles.iter().fold(max_abs(self.a), |m, p| m.max(p.norm()));
+        let mut candidates = vec![0.0];
+        candidates.extend(
+            axis_candidates(&zeros)
+                .into_iter()
+                .filter(|&w| w > 1e-10 * frequency_scale && w < 1e8 * frequency_scale),
+        );
+        let vanishing = 1e-10 * self.scale(poles);
+        let mut found = Vec::with_capacity(candidates.len());
+        for omega in candidates {
+            let w = if omega == 0.0 {
+                0.0
+            } else {
+                secant(
+                    |w| {
+                        let v = self.at(w);
+                        v.im / v.norm()
+                    },
+                    omega,
+                )
+            };
+            let value = self.at(w);
+            if value.re.is_finite()
+                && value.im.is_finite()
+                && value.norm() > vanishing
+                && value.im.abs() <= CROSSOVER_TOLERANCE * value.norm()
+            {
+                found.push(Crossover {
+                    omega: w,
+                    value: c64::new(value.re, if w == 0.0 { 0.0 } else { value.im }),
+                });
+            }
+        }
+        Ok((merged(found), degenerate))
+    }
+}
+
+/// (ω, f(ω)) at a maximum of f on [lo, hi] by Brent's method (golden section with
+/// successive parabolic interpolation; Brent 1973, ch. 5, procedure localmin), to 1e-12 of ω.
+fn golden_maximum(f: &mut impl FnMut(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
+    let golden = (3.0 - 5f64.sqrt()) / 2.0;
+    let mut g = |x: f64| {
+        let v = f(x);
+        if v.is_nan() { f64::INFINITY } else { -v }
+    };
+    let mut x = lo + golden * (hi - lo);
+    let (mut w, mut v) = (x, x);
+    let mut fx = g(x);
+    let (mut fw, mut fv) = (fx, fx);
+    let (mut d, mut e) = (0.0f64, 0.0f64);
+    for _ in 0..100 {
+        let middle = 0.5 * (lo + hi);
+        let tol = 1e-12 * x.abs() + 1e-300;
+        let tol2 = 2.0 * tol;
+        if (x - middle).abs() <= tol2 - 0.5 * (hi - lo) {
+            break;
+        }
+        let mut golden_step = true;
+        if e.abs() > tol {
+            let r = (x - w) * (fx - fv);
+            let mut q = (x - v) * (fx - fw);
+            let mut p = (x - v) * q - (x - w) * r;
+            q = 2.0 * (q - r);
+            if q > 0.0 {
+                p = -p;
+            }
+            q = q.abs();
+            let previous = e;
+            e = d;
+            if p.abs() < (0.5 * q * previous).abs() && p > q * (lo - x) && p < q * (hi - x) {
+                d = p / q;
+                let u = x + d;
+                if u - lo < tol2 || hi - u < tol2 {
+                    d = if x < middle { tol } else { -tol };
+                }
+                golden_step = false;
+            }
+        }
+        if golden_step {
+            e = if x < middle { hi - x } else { lo - x };
+            d = golden * e;
+        }
+        let u = if d.abs() >= tol {
+            x + d
+        } else if d > 0.0 {
+            x + tol
+        } else {
+            x - tol
+        };
+        let fu = g(u);
+        if fu <= fx {
+            if u < x {
+                hi = x;
+            } else {
+                lo = x;
+            }
+            (v, fv, w, fw, x, fx) = (w, fw, x, fx, u, fu);
+        } else {
+            if u < x {
+                lo = u;
+            } else {
+                hi = u;
+            }
+            if fu <= fw || w == x {
+                (v, fv, w, fw) = (w, fw, u, fu);
+            } else if fu <= fv || v == x || v == w {
+                (v, fv) = (u, fu);
+            }
+        }
+    }
+    (x, -fx)
+}
+
+/// The L∞ norm over ω in [0, ∞] of the SISO G = (A, B, C, d) (see the module's
+/// documentation), with `poles` the eigenvalues of A.
+pub fn peak_gain(
+    a: MatRef<'_, f64>,
+    b: &[f64],
+    c: &[f64],
+    d: f64,
+    poles: &[c64],
+) -> Result<Peak, Error> {
+    let n = a.nrows();
+    let scale = poles.iter().fold(max_abs(a), |m, p| m.max(p.norm()));
+    if let Some(p) = poles
+        .iter()
+        .find(|p| p.re.abs() <= 1e-14 * scale.max(f64::MIN_POSITIVE) && n > 0)
+    {
+        return Ok(Peak {
+            omega: p.im.abs(),
+            value: f64::INFINITY,
+        });
+    }
+    let bm = Mat::from_fn(n, 1, |i, _| b[i]);
+    let cm = Mat::from_fn(1, n, |_, j| c[j]);
+    let dm = Mat::from_fn(1, 1, |_, _| d);
+    let mut evaluator = FrequencyEvaluator::new(a, bm.as_ref(), cm.as_ref(), dm.as_ref())?;
+    let mut magnitude = |w: f64| evaluator.siso(w).norm();
+    // The lower bound: ∞ first (ties keep it), then 0, then the poles' frequencies.
+    let mut best = Peak {
+        omega: f64::INFINITY,
+        value: d.abs(),
+    };
+    let tests = std::iter::once(0.0)
+        .chain(poles.iter().flat_map(|p| [p.im.abs(), p.norm()]))
+        .collect::<Vec<_>>();
+    for w in tests {
+        let value = magnitude(w);
+        if value > best.value * (1.0 + 1e-12) {
+            best = Peak { omega: w, value };
+        }
+    }
+    if best.value == 0.0 {
+        return Ok(best);
+    }
+    for _ in 0..60 {
+        crate::platform::interrupt::check()?;
+        let gamma = (1.0 + 2.0 * PEAK_TOLERANCE) * best.value;
+        let scaled: Vec<f64> = c.iter().map(|v| v / gamma).collect();
+        let values = hamiltonian_eigenvalues(a, b, &scaled, d / gamma)?;
+        let mut omegas = axis_candidates(&values);
+        if omegas.is_empty() {
+            break;
+        }
+        omegas.sort_by(f64::total_cmp);
+        if omegas.len() % 2 == 1 {
+            omegas.insert(0, 0.0);
+        }
+        // The interval whose midpoint is highest, then its maximum by golden section.
+        let mut chosen: Option<(f64, f64, f64)> = None;
+        for pair in omegas.windows(2) {
+            let value = magnitude(0.5 * (pair[0] + pair[1]));
+            if chosen.is_none_or(|(_, _, v)| value > v) {
+                chosen = Some((pair[0], pair[1], value));
+            }
+        }
+        let Some((lo, hi, _)) = chosen else { break };
+        let (w, value) = golden_maximum(&mut magnitude, lo, hi);
+        if value.is_nan() || value <= best.value {
+            break;
+        }
+        best = Peak { omega: w, value };
+    }
+    Ok(best)
+}
+
+/// Crossovers, disk and stability peaks, and poles of the continuous SISO loop
+/// L(s) = C (sI - A)^-1 B + D (A n x n, B n x 1, C 1 x n, D 1 x 1), with every gain margin
+/// verified by a closed-loop pole (see the module's documentation). 1 + D = 0 (an algebraic
+/// loop) is [`Error::Singular`].
+pub fn loop_margins(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    d: MatRef<'_, f64>,
+) -> Result<LoopMargins, Error> {
+    check_state_space(a, b, c, d)?;
+    if b.ncols() != 1 || c.nrows() != 1 {
+        return Err(Error::InvalidArgument {
+            arg: "loop",
+            message: format!(
+                "must have one input and one output, got {} outputs and {} inputs",
+                c.nrows(),
+                b.ncols()
+            ),
+        });
+    }
+    let n = a.nrows();
+    let d0 = d[(0, 0)];
+    let denominator = 1.0 + d0;
+    if denominator.abs() <= 8.0 * f64::EPSILON * d0.abs().max(1.0) {
+        return Err(Error::Singular {
+            arg: "1 + D (the closed loop is an algebraic loop)",
+            eigenvalue_re: denominator,
+            eigenvalue_im: 0.0,
+        });
+    }
+    let bv: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
+    let cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
+    let open_loop_poles = eigenvalues(a)?;
+    let closed = Mat::from_fn(n, n, |i, j| a[(i, j)] - bv[i] * cv[j] / denominator);
+    let closed_loop_poles = eigenvalues(closed.as_ref())?;
+    let mut this = Loop {
+        a,
+        b: bv.clone(),
+        c: cv.clone(),
+        d: d0,
+        evaluator: FrequencyEvaluator::new(a, b, c, d)?,
+    };
+    // S = 1/(1 + L) and (1 - L)/(2 (1 + L)) = S - 1/2 share the closed loop's realisation.
+    let bs: Vec<f64> = bv.iter().map(|v| v / denominator).collect();
+    let cs: Vec<f64> = cv.iter().map(|v| -v / denominator).collect();
+    // The crossovers and the two peaks are independent: two tasks (a few tens of µs each at
+    // n = 6, well above rayon's cost of a join).
+    let context = ParallelContext::capture(0);
+    let (crossovers, peaks) = rayon::join(
+        || {
+            context.run(|| {
+                let gain = this.gain_crossovers()?;
+                let phase = this.phase_crossovers(&open_loop_poles)?;
+                Ok((gain, phase))
+            })
+        },
+        || {
+            context.run(|| {
+                let sensitivity = peak_gain(
+                    closed.as_ref(),
+                    &bs,
+                    &cs,
+                    1.0 / denominator,
+                    &closed_loop_poles,
+                )?;
+                let disk = peak_gain(
+                    closed.as_ref(),
+                    &bs,
+                    &cs,
+                    1.0 / denominator - 0.5,
+                    &closed_loop_poles,
+                )?;
+                Ok((sensitivity, disk))
+            })
+        },
+    );
+    let ((gain_crossovers, (phase_crossovers, degenerate)), (sensitivity, disk)) =
+        (crossovers?, peaks?);
+
+    // Each gain margin k puts a closed-loop pole at its crossover.
+    let size = 1.0 + max_abs(a);
+    for crossover in phase_crossovers.iter().filter(|x| x.value.re < 0.0) {
+        let k = 1.0 / crossover.value.norm();
+        let shifted = 1.0 + k * d0;
+        if shifted.abs() <= 8.0 * f64::EPSILON * (k * d0).abs().max(1.0) || n == 0 {
+            continue;
+        }
+        let closed_k = Mat::from_fn(n, n, |i, j| a[(i, j)] - k * bv[i] * cv[j] / shifted);
+        let point = c64::new(0.0, crossover.omega);
+        let miss = eigenvalues(closed_k.as_ref())?
+            .iter()
+            .map(|p| (p - point).norm())
+            .fold(f64::INFINITY, f64::min);
+        if miss.is_nan() || miss > 1e-6 * size.max(crossover.omega) {
+            return Err(Error::IllConditioned {
+                message: format!(
+                    "stability_margins: the loop closed with its gain margin {k:.6} has no pole \
+                     at the phase crossover {:.6} rad/s (nearest at distance {miss:.3e})",
+                    crossover.omega
+                ),
+            });
+        }
+    }
+    Ok(LoopMargins {
+        gain_crossovers,
+        phase_crossovers,
+        disk,
+        sensitivity,
+        closed_loop_poles,
+        open_loop_poles,
+        degenerate,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// (A, B, C, D) of the controllable canonical form of num/den (den monic, deg num < deg den).
+    fn canonical(num: &[f64], den: &[f64], d: f64) -> (Mat<f64>, Mat<f64>, Mat<f64>, Mat<f64>) {
+        let n = den.len() - 1;
+        let a = Mat::from_fn(n, n, |i, j| {
+            if i == 0 {
+                -den[j + 1]
+            } else if i == j + 1 {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let b = Mat::from_fn(n, 1, |i, _| if i == 0 { 1.0 } else { 0.0 });
+        // num padded on the left to n coefficients (s^(n-1) ... s^0).
+        let mut padded = vec![0.0; n - num.len()];
+        padded.extend_from_slice(num);
+        let c = Mat::from_fn(1, n, |_, j| padded[j]);
+        (a, b, c, Mat::from_fn(1, 1, |_, _| d))
+    }
+
+    fn margins(num: &[f64], den: &[f64], d: f64) -> LoopMargins {
+        let (a, b, c, dd) = canonical(num, den, d);
+        loop_margins(a.as_ref(), b.as_ref(), c.as_ref(), dd.as_ref()).unwrap()
+    }
+
+    fn close(x: f64, y: f64, tol: f64) {
+        assert!((x - y).abs() <= tol * y.abs().max(1e-300), "{x} vs {y}");
+    }
+
+    #[test]
+    fn third_order_loop() {
+        // k/(s(s + 1)(s + 2)) = k/(s^3 + 3 s^2 + 2 s): phase crossover at √2, L = -k/6.
+        for k in [0.5, 2.0, 5.0, 10.0, 30.0] {
+            let m = margins(&[k], &[1.0, 3.0, 2.0, 0.0], 0.0);
+            let negative: Vec<_> = m
+                .phase_crossovers
+                .iter()
+                .filter(|x| x.value.re < 0.0)
+                .collect();
+            assert_eq!(negative.len(), 1);
+            close(negative[0].omega, 2f64.sqrt(), 1e-13);
+            close(1.0 / negative[0].value.norm(), 6.0 / k, 1e-13);
+            // ω^2 (ω^2 + 1)(ω^2 + 4) = k^2 at the gain crossover.
+            assert_eq!(m.gain_crossovers.len(), 1);
+            let w2 = m.gain_crossovers[0].omega.powi(2);
+            close(w2 * (w2 + 1.0) * (w2 + 4.0), k * k, 1e-12);
+        }
+    }
+
+    #[test]
+    fn integrator() {
+        // k/s: |L| = 1 at ω = k, never real; |S - T|/2 = 1/2 everywhere (peak kept at ∞).
+        for k in [0.1, 1.0, 50.0] {
+            let m = margins(&[k], &[1.0, 0.0], 0.0);
+            assert!(m.phase_crossovers.is_empty());
+            assert_eq!(m.gain_crossovers.len(), 1);
+            close(m.gain_crossovers[0].omega, k, 1e-13);
+            close(m.disk.value, 0.5, 1e-12);
+            assert_eq!(m.disk.omega, f64::INFINITY);
+        }
+    }
+
+    #[test]
+    fn unstable_first_order() {
+        // 2/(s - 1): L(0) = -2 (GM 1/2 at ω = 0), |L| = 1 at √3 with ∠L = -120°.
+        let m = margins(&[2.0], &[1.0, -1.0], 0.0);
+        assert_eq!(m.phase_crossovers.len(), 1);
+        assert_eq!(m.phase_crossovers[0].omega, 0.0);
+        close(m.phase_crossovers[0].value.re, -2.0, 1e-14);
+        assert_eq!(m.gain_crossovers.len(), 1);
+        close(m.gain_crossovers[0].omega, 3f64.sqrt(), 1e-13);
+        let phase = m.gain_crossovers[0].value.arg().to_degrees();
+        close(phase, -120.0, 1e-12);
+        close(m.closed_loop_poles[0].re, -1.0, 1e-14);
+    }
+
+    #[test]
+    fn no_crossover() {
+        // 0.5/(s + 1): |L| < 1, L real only at ω = 0 (positive); disk peak 1/2 at ∞.
+        let m = margins(&[0.5], &[1.0, 1.0], 0.0);
+        assert!(m.gain_crossovers.is_empty());
+        assert!(m.phase_crossovers.iter().all(|x| x.value.re > 0.0));
+        assert_eq!(m.disk.omega, f64::INFINITY);
+        close(m.disk.value, 0.5, 1e-14);
+        // min |1 + L| = 1 as ω -> ∞ (|1 + L(jω)|^2 = 1 + (1 + ω^2)^-1 (1.25 - ... ) > 1).
+        close(m.sensitivity.value, 1.0, 1e-12);
+    }
+
+    #[test]
+    fn lightly_damped_second_order() {
+        // L = 0.5/(s^2 + 0.02 s + 1): L(jω) = 0.5/(1 - ω^2 + 0.02 jω); |L| = 1 where
+        // (1 - ω^2)^2 + 0.0004 ω^2 = 0.25; L real at ω = 0 (positive) only, ∞ excluded.
+        let m = margins(&[0.5], &[1.0, 0.02, 1.0], 0.0);
+        assert_eq!(m.gain_crossovers.len(), 2);
+        for x in &m.gain_crossovers {
+            let w2 = x.omega * x.omega;
+            close((1.0 - w2).powi(2) + 0.0004 * w2, 0.25, 1e-12);
+        }
+        assert!(m.phase_crossovers.iter().all(|x| x.value.re > 0.0));
+        // The peak of |S| = |s^2 + 0.02 s + 1| / |s^2 + 0.02 s + 1.5| at ω ≈ √1.5 (a closed
+        // form by dense evaluation).
+        let mut best = 0.0f64;
+        for i in 0..200_001 {
+            let w = 1.0 + 0.5 * i as f64 / 200_000.0;
+            let s = c64::new(0.0, w);
+            let v = ((s * s + s * 0.02 + 1.0) / (s * s + s * 0.02 + 1.5)).norm();
+            best = best.max(v);
+        }
+        close(m.sensitivity.value, best, 1e-8);
+    }
+
+    #[test]
+    fn unit_feedthrough_uses_the_pencil() {
+        // d^2 = 1: L = 1 + (1 - s)/(s^2 + 1.5 s + 1) = (s^2 + 0.5 s + 2)/(s^2 + 1.5 s + 1);
+        // |num|^2 - |den|^2 = 3 - 4 ω^2 vanishes at ω = √3/2.
+        let m = margins(&[-1.0, 1.0], &[1.0, 1.5, 1.0], 1.0);
+        assert_eq!(m.gain_crossovers.len(), 1);
+        close(m.gain_crossovers[0].omega, 0.75f64.sqrt(), 1e-13);
+    }
+
+    /// The 747 cruise yaw damper's loop (design.yaw_damper): n = 6.
+    fn yaw_loop() -> (Mat<f64>, Mat<f64>, Mat<f64>, Mat<f64>) {
+        let rows = |r: &[&[f64]]| Mat::from_fn(r.len(), r[0].len(), |i, j| r[i][j]);
+        (
+            rows(&[
+                &[-10.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                &[
+                    0.0072901450026690105,
+                    -0.055813198525633184,
+                    0.0,
+                    0.041568475452196385,
+                    -1.0,
+                    0.0,
+                ],
+                &[
+                    0.11435968546764091,
+                    -2.9925363785056502,
+                    -0.4342638422254207,
+                    0.0,
+                    0.413658731720881,
+                    0.0,
+                ],
+                &[0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+                &[
+                    -0.4855530880759152,
+                    0.8406324424627803,
+                    -0.00591530768795045,
+                    0.0,
+                    -0.14574121621033306,
+                    0.0,
+                ],
+                &[0.0, 0.0, 0.0, 0.0, -0.3333333333333333, -0.3333333333333333],
+            ]),
+            rows(&[&[10.0], &[0.0], &[0.0], &[0.0], &[0.0], &[0.0]]),
+            rows(&[&[0.0, 0.0, 0.0, 0.0, -1.0, -1.0]]),
+            rows(&[&[0.0]]),
+        )
+    }
+
+    #[test]
+    fn yaw_damper_loop_matches_python_control() {
+        // python-control 0.10 stability_margins(returnall=True) on the same matrices: GM
+        // 6.35517022 at 0.46389296 rad/s; PM -66.10486781° at 0.78037584, 114.65090329° at
+        // 1.18732058 (printed to 9 digits). Its extra GM 1.25e13 at ω = 0 is L(0) = 8e-14, the
+        // washout's zero at the origin, which is not a crossover.
+        let (a, b, c, d) = yaw_loop();
+        let m = loop_margins(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()).unwrap();
+        let negative: Vec<_> = m
+            .phase_crossovers
+            .iter()
+            .filter(|x| x.value.re < 0.0)
+            .collect();
+        assert_eq!(negative.len(), 1);
+        close(1.0 / negative[0].value.norm(), 6.35517022, 1e-8);
+        close(negative[0].omega, 0.46389296, 1e-7);
+        assert_eq!(m.gain_crossovers.len(), 2);
+        close(m.gain_crossovers[0].omega, 0.78037584, 1e-7);
+        close(m.gain_crossovers[1].omega, 1.18732058, 1e-7);
+        let pm = |x: &Crossover| 180.0 + x.value.arg().to_degrees();
+        close(pm(&m.gain_crossovers[0]), -66.10486781 + 360.0, 1e-9);
+        close(pm(&m.gain_crossovers[1]), 114.65090329, 1e-9);
+    }
+}
