@@ -54,8 +54,8 @@ def test_batch_errors_carry_the_index_of_the_problem() -> None:
         aerocontrol.expm(A)
     assert error.value.batch_index == 2
     assert error.value.argument == "A" and error.value.entry == [1, 1]
-    R = np.stack([np.eye(1), -np.eye(1), np.eye(1)])
-    with pytest.raises(exceptions.NotPositiveDefiniteError) as weight:
+    R = np.stack([np.eye(1), np.zeros((1, 1)), np.eye(1)])  # a singular R in problem 1
+    with pytest.raises(exceptions.InvalidArgumentError) as weight:
         aerocontrol.batch.solve_care_batch(-np.eye(2), np.ones((2, 1)), np.eye(2), R)
     assert weight.value.batch_index == 1 and weight.value.argument == "R"
 
