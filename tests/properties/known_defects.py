@@ -87,14 +87,23 @@ PENCIL_TOLERANCE_OVERFLOW = known_defect(
     symptom="overflow encountered in multiply",
 )
 
-TRANSFER_DENOMINATOR_OVERFLOW = known_defect(
-    "transfer-denominator-overflow",
-    {"transfer_function", "root_locus"},
-    "transfer_function returns a denominator poly(eig(A)) with inf (|A| ~ 1e103, n = 3) and no "
-    "NumericalOverflowWarning",
-    lambda args: _spectral_scale(args) > 300,
-    symptom="without a NumericalOverflowWarning",
+
+def _feedthrough_log(args: dict[str, Any]) -> float:
+    D = _models_of(args)[0][3]
+    largest = float(np.max(np.abs(D), initial=0.0))
+    return float(np.log10(largest)) if largest > 0 else -np.inf
+
+
+TRANSFER_SCALE_OVERFLOW = known_defect(
+    "transfer-scale-overflow",
+    {"transfer_function", "root_locus", "stability_margins"},
+    "transfer_function overflows silently with large poles: the denominator poly(eig(A)) "
+    "holds inf with no NumericalOverflowWarning (|A| ~ 1e103, n = 3), and the gain's "
+    "G(point) prod(point - poles) overflows with numpy's 'overflow encountered in scalar "
+    "multiply' RuntimeWarning (|A| = |D| ~ 1e149, n = 2)",
+    lambda args: _spectral_scale(args) + max(_feedthrough_log(args), 0.0) > 300,
 )
+
 
 TRANSFER_GAIN_UNDERFLOW = known_defect(
     "transfer-gain-underflow",
@@ -147,4 +156,55 @@ MARGINS_TABLE_DISK = known_defect(
     "(2 - alpha)/(2 + alpha) is negative and _db takes its log10",
     _disk_margin_beyond_two,
     symptom="math domain error",
+)
+
+
+def _block_spread(args: dict[str, Any]) -> float:
+    """The ratio of the largest to the smallest nonzero of ||A||, ||B||, ||C||, ||D||."""
+    sizes = [float(np.linalg.norm(M)) for M in _models_of(args)[0] if M.size]
+    sizes = [x for x in sizes if x > 0]
+    return max(sizes) / min(sizes) if sizes else 1.0
+
+
+ZEROS_DROPPED = known_defect(
+    "zeros-dropped-badly-scaled",
+    {"transmission_zeros", "transfer_function"},
+    "transmission_zeros of a model whose blocks differ in size by 1e8 or more loses a finite "
+    "zero: A = diag(-1, -2), B = [1, 1]^T, C = [1e9, -2e9], D = 1 has zeros 1e9 and 2e-9 "
+    "(s^2 + (3 - 1e9) s + 2), but [0] is returned (scipy's QZ of the Rosenbrock pencil finds "
+    "both); transfer_function then drops the factor, and G(inf) is 0 instead of D",
+    lambda args: _block_spread(args) > 1e6 and _largest_entry(args) < 1e100,
+)
+
+
+def _closed_loop_overflow(args: dict[str, Any]) -> bool:
+    gains = args.get("gains")
+    k = float(np.max(np.abs(gains), initial=1.0)) if isinstance(gains, np.ndarray) else 1.0
+    largest = _largest_entry(args)
+    with np.errstate(all="ignore"):
+        return bool(np.float64(largest) * largest * max(k, 1.0) > 1e300)
+
+
+CLOSED_LOOP_OVERFLOW = known_defect(
+    "closed-loop-overflow",
+    {"root_locus", "stability_margins", "best_damping_gain", "gain_for_damping"},
+    "loops._closed_loop_matrix forms A - k B (1 + k D)^-1 C with numpy: where B C overflows "
+    "(B = 1e308) numpy's 'overflow encountered in matmul' RuntimeWarning reaches the caller",
+    _closed_loop_overflow,
+    symptom="overflow encountered in matmul",
+)
+
+
+def _mode_without_poles(args: dict[str, Any]) -> bool:
+    return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
+
+
+DAMPING_MODE_WITHOUT_POLES = known_defect(
+    "damping-mode-without-poles",
+    {"best_damping_gain", "gain_for_damping"},
+    "best_damping_gain / gain_for_damping with a mode to track and a loop without states "
+    "(a static gain) raise numpy's ValueError 'attempt to get argmin of an empty sequence' "
+    "instead of an aerocontrol error",
+    _mode_without_poles,
+    symptom="argmin of an empty sequence",
 )

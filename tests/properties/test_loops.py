@@ -27,7 +27,13 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning
 
 from .harness import Arg, Warned, exercise, plain
-from .known_defects import MARGINS_TABLE_DISK, ROOT_LOCUS_GAINS_ALIAS, TRANSFER_GAIN_UNDERFLOW
+from .known_defects import (
+    CLOSED_LOOP_OVERFLOW,
+    DAMPING_MODE_WITHOUT_POLES,
+    MARGINS_TABLE_DISK,
+    ROOT_LOCUS_GAINS_ALIAS,
+    TRANSFER_GAIN_UNDERFLOW,
+)
 from .oracles import (
     SLACK,
     TINY,
@@ -327,8 +333,8 @@ def _design_oracle(name: str) -> Any:
         assert formed is not None
         assert_poles(formed[0], formed[1], result.closed_loop_poles, "the design's poles")
         pole = result.pole
-        if np.isnan(pole.real):
-            assert result.damping_ratio == 1.0
+        if np.isnan(pole.real) or abs(pole.imag) <= 1e-9 * abs(pole):
+            assert result.damping_ratio == 1.0, "ζ is 1 where the pole does not oscillate"
         else:
             assert pole.imag >= 0
             assert abs(result.damping_ratio - (-pole.real / abs(pole))) <= 1e-12
@@ -421,4 +427,26 @@ def test_known_defect_margins_of_a_tiny_loop() -> None:
             {"loop": plain(model)},
             _margins_oracle,
             nonfinite_by_definition=UNBOUNDED,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="closed-loop-overflow: numpy's overflow in B C")
+def test_known_defect_closed_loop_overflow() -> None:
+    model = (-np.eye(1), np.array([[1e308]]), np.array([[2.0]]), np.zeros((1, 1)))
+    with CLOSED_LOOP_OVERFLOW.reproducing():
+        exercise(
+            "root_locus",
+            lambda loop, gains: aerocontrol.root_locus(loop, gains),
+            {"loop": plain(model), "gains": plain([1.0])},
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="damping-mode-without-poles: numpy's ValueError")
+def test_known_defect_damping_mode_without_poles() -> None:
+    static = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.zeros((1, 1)))
+    with DAMPING_MODE_WITHOUT_POLES.reproducing():
+        exercise(
+            "best_damping_gain",
+            lambda loop, mode: aerocontrol.best_damping_gain(loop, mode),
+            {"loop": plain(static), "mode": plain(-0.1 + 1j)},
         )
