@@ -44,8 +44,9 @@ def _products_overflow(args: dict[str, Any]) -> bool:
 
 INTERCONNECT_OVERFLOW = known_defect(
     "interconnect-overflow",
-    {"series", "feedback", "connect"},
-    "series/feedback/connect of finite models whose products B2 C1 (D2 C1, ...) overflow: "
+    {"series", "feedback", "connect", "sensitivity", "complementary_sensitivity"},
+    "series/feedback/connect (and sensitivity, complementary_sensitivity, which close the "
+    "loop with feedback) of finite models whose products B2 C1 (D2 C1, ...) overflow: "
     "numpy's 'overflow encountered in matmul' RuntimeWarning reaches the caller, then "
     "NonFiniteError blames A (which the caller gave finite) instead of a NumericalOverflowWarning "
     "or an error naming the overflow",
