@@ -113,8 +113,9 @@ TRANSFER_GAIN_UNDERFLOW = known_defect(
     "evaluation point underflows to 0, the gain comes out -0.0 and the numerator [-0, -0, -0] "
     "for a channel that is 3/s there (no error, no warning); where prod(point - zeros) "
     "underflows too, 0/0 gives numpy's 'invalid value encountered in scalar divide' "
-    "(stability_margins and root_locus call transfer_function)",
-    lambda args: -np.inf < _spectral_scale(args) < -290,
+    "(stability_margins and root_locus call transfer_function). Likewise a model of entries "
+    "near 1e-301 (A = 0, B = C = D = 1.26e-301: gain 0, numerator [0, 0] for G ~ D)",
+    lambda args: -np.inf < _spectral_scale(args) < -290 or 0 < _largest_entry(args) < 1e-150,
 )
 
 NAMES_NOT_ITERABLE = known_defect(
