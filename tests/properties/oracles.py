@@ -590,3 +590,47 @@ def riccati_defect(
         cross = s @ k
         residual = loop + q - cross - cross.T + k.T @ r @ k
         return norm(np.asarray(residual, dtype=np.float64))
+
+
+# ----- transfer functions -----------------------------------------------------------------------
+
+
+def response_at(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, s: complex
+) -> tuple[np.ndarray, float] | None:
+    """(G(s), size): G(s) = C (sI - A)^-1 B + D by a complex solve, and the size of its terms
+    ||C R|| ||R B|| ||A|| + ||C R|| ||B|| + ||C|| ||R B|| + ||D|| (R = (sI - A)^-1, Frobenius
+    norms): the change of G under perturbations of every matrix by u times its norm is at most
+    u times that size. None where sI - A is too close to singular (κ u > 1e-6) or where the
+    numbers overflow: there is nothing to compare."""
+    n = A.shape[0]
+    with silenced():
+        if not finite(A, B, C, D):
+            return None
+        M = s * np.eye(n) - A
+        if n and condition(M) * U > 1e-6:
+            return None
+        try:
+            RB = np.linalg.solve(M, B.astype(complex)) if n else np.zeros((0, B.shape[1]))
+            CR = np.linalg.solve(M.T, C.T.astype(complex)).T if n else np.zeros((C.shape[0], 0))
+        except np.linalg.LinAlgError:
+            return None
+        G = C @ RB + D
+        size = norm(CR) * norm(RB) * norm(A) + norm(CR) * norm(B) + norm(C) * norm(RB) + norm(D)
+    if not (finite(G) and np.isfinite(size)) or size > 1e250:
+        return None
+    return G, size
+
+
+def assert_response(
+    model: Any, expected: np.ndarray, s: complex, allowed: float, what: str
+) -> None:
+    """The model's G(s) is ``expected`` within SLACK n u (its own size) + ``allowed``."""
+    got = response_at(model.A, model.B, model.C, model.D, s)
+    if got is None or not np.isfinite(allowed) or not finite(expected):
+        return
+    G, size = got
+    n = max(model.A.shape[0], 1)
+    bound = SLACK * n * (U * size + TINY) + allowed
+    assert G.shape == expected.shape, f"{what}: G has shape {G.shape}, expected {expected.shape}"
+    assert_within(norm(G - expected), bound, f"{what} at s = {s}")

@@ -1,0 +1,452 @@
+"""Properties of loop analysis (aerocontrol.loops): margins, sensitivities, root locus.
+
+Oracles: the closed-loop poles as the spectrum of A - B (1 + D)^-1 C formed here (backward
+errors relative to ||A|| + ||B|| ||C|| / |1 + D|) and the stability flag against their real
+parts wherever an eigenvalue's sensitivity (its condition number times n u ||·||) cannot move
+it across the axis; at every reported gain crossover |L(jω)| = 1 and at every phase crossover
+Im L(jω) = 0 with Re L < 0, to the accuracy of the evaluation (oracles.response_at) plus the
+frequency's own rounding (|ω L'(jω)| u); each gain margin 1/|L| and phase margin 180° + ∠L
+at its crossover; the encirclements P - Z from the poles. S = 1/(1 + L) and T = L/(1 + L)
+against L evaluated directly, within |1 + L|^-2 times L's error. The root locus: each row the
+spectrum of A - k B (1 + k D)^-1 C. The damping designs: their closed-loop poles at the gain
+they return, their damping ratio that of their pole, ζ reached within 1e-6 (gain_for_damping,
+unless it warns), and no grid gain with a stable, better damped loop (best_damping_gain).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import aerocontrol
+from aerocontrol.exceptions import IllConditionedWarning
+
+from .harness import Arg, Warned, exercise, plain
+from .known_defects import (
+    CLOSED_LOOP_OVERFLOW,
+    DAMPING_MODE_WITHOUT_POLES,
+    MARGINS_TABLE_DISK,
+    ROOT_LOCUS_GAINS_ALIAS,
+    TRANSFER_GAIN_UNDERFLOW,
+)
+from .oracles import (
+    SLACK,
+    TINY,
+    U,
+    assert_response,
+    assert_within,
+    eigenvalue_backward_error,
+    eigenvalue_conditions,
+    finite,
+    norm,
+    response_at,
+    silenced,
+)
+from .strategies import (
+    SQUARE_KINDS,
+    model_matrices,
+    presented,
+    presented_system,
+    scalar,
+    system,
+)
+
+COVERED = {
+    "stability_margins",
+    "sensitivity",
+    "complementary_sensitivity",
+    "root_locus",
+    "best_damping_gain",
+    "gain_for_damping",
+}
+
+TAME = ("stable", "gaussian", "companion", "integers", "imaginary axis", "diagonal")
+POINTS = (0.31j, 1.7j, 11.0j)
+
+
+@st.composite
+def loop(draw: st.DrawFn) -> Arg:
+    """A SISO loop: a classic k/(s (s + a)(s + b)) or a lightly damped pair (as a StateSpace
+    from zpk), or a drawn plant; now and then one with two inputs (to be refused)."""
+    kind = draw(st.sampled_from(("classic", "classic", "drawn", "drawn", "drawn", "wide")))
+    if kind == "classic":
+        rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+        poles = [0.0, -rng.uniform(0.2, 5.0), -rng.uniform(0.2, 5.0)]
+        if draw(st.booleans()):
+            pair = complex(-rng.uniform(0.01, 0.3), rng.uniform(0.5, 3.0))
+            poles[1:] = [pair, pair.conjugate()]
+        if draw(st.booleans()):
+            poles[0] = rng.uniform(0.1, 1.0)  # an unstable open loop
+        k = float(rng.uniform(0.1, 20.0)) * draw(st.sampled_from((1.0, -1.0)))
+        zeros = [-rng.uniform(0.5, 4.0)] if draw(st.booleans()) else []
+        model = aerocontrol.zpk(zeros, poles, k)
+        matrices = (model.A, model.B, model.C, model.D)
+        return draw(presented_system(matrices))
+    n = draw(st.sampled_from((0, 1, 2, 3, 4, 5)))
+    kinds = draw(st.sampled_from((TAME, TAME, SQUARE_KINDS)))
+    return draw(presented_system(draw(system(n, 2 if kind == "wide" else 1, 1, kinds))))
+
+
+def closed_matrix(A: np.ndarray, B: np.ndarray, C: np.ndarray, d: float, k: float) -> Any:
+    """(A - k B (1 + k d)^-1 C, the size of its terms) or None for an algebraic loop."""
+    with silenced():
+        denominator = 1.0 + k * d
+        if denominator == 0:
+            return None
+        c = k / denominator
+        return A - c * (B @ C), norm(A) + abs(c) * norm(B) * norm(C)
+
+
+def assert_poles(A: np.ndarray, size: float, poles: np.ndarray, what: str) -> None:
+    n = A.shape[0]
+    assert poles.shape == (n,), f"{what}: {poles.shape} poles of order {n}"
+    if n == 0 or not finite(A, poles) or not np.isfinite(size):
+        return
+    bound = SLACK * n * (U * size + TINY)
+    for value in poles:
+        error = eigenvalue_backward_error(A, complex(value))
+        assert_within(error, bound, f"{what}: backward error of the pole {value}")
+
+
+def clearly(A: np.ndarray, size: float) -> bool | None:
+    """Whether every eigenvalue of A has Re < 0, where no eigenvalue is within its
+    sensitivity of the axis; None where that cannot be told."""
+    if A.shape[0] == 0:
+        return True
+    if not finite(A):
+        return None
+    values, conditions = eigenvalue_conditions(A)
+    margin = SLACK * A.shape[0] * U * size * conditions
+    if np.any(np.abs(values.real) <= margin) or not np.all(np.isfinite(margin)):
+        return None
+    return bool(np.all(values.real < 0))
+
+
+def derivative(A: np.ndarray, B: np.ndarray, C: np.ndarray, s: complex) -> float:
+    """|L'(s)| = |C (sI - A)^-2 B|."""
+    with silenced():
+        M = s * np.eye(A.shape[0]) - A
+        X = np.linalg.solve(M, np.linalg.solve(M, B.astype(complex)))
+        return float(abs((C @ X)[0, 0])) if A.shape[0] else 0.0
+
+
+def _margins_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    A, B, C, D = model_matrices(args["loop"])
+    n, d = A.shape[0], float(D[0, 0])
+    formed = closed_matrix(A, B, C, d, 1.0)
+    assert formed is not None
+    closed, size = formed
+    assert_poles(closed, size, result.closed_loop_poles, "the closed-loop poles")
+    verdict = clearly(closed, size)
+    if verdict is not None:
+        assert result.closed_loop_stable == verdict, (
+            f"closed_loop_stable = {result.closed_loop_stable}, but the poles of "
+            f"A - B (1 + D)^-1 C say {verdict}"
+        )
+    open_verdict = clearly(A, norm(A))
+    if open_verdict is not None and n:
+        values = np.linalg.eigvals(A)
+        assert result.open_loop_unstable_poles == int(np.sum(values.real > 0))
+    unstable_closed = int(np.sum(result.closed_loop_poles.real > 0))
+    assert result.encirclements == result.open_loop_unstable_poles - unstable_closed
+    if not result.closed_loop_stable:
+        assert result.delay_margin == 0 and result.disk_margin == 0
+    for crossovers, margins, kind in (
+        (result.gain_crossovers, result.phase_margins, "gain"),
+        (result.phase_crossovers, result.gain_margins, "phase"),
+    ):
+        assert len(crossovers) == len(margins)
+        assert np.all(np.diff(crossovers) > 0), f"the {kind} crossovers are not increasing"
+        for w, margin in zip(crossovers, margins, strict=True):
+            value = response_at(A, B, C, D, 1j * w)
+            if value is None:
+                continue
+            G, evaluation = value
+            L = complex(G[0, 0])
+            with silenced():
+                rounding = 8 * U * w * derivative(A, B, C, 1j * w)
+                tolerance = SLACK * max(n, 1) * (U * evaluation + rounding) + TINY
+            if not np.isfinite(tolerance) or tolerance > 1e-3:
+                continue
+            if kind == "gain":
+                assert_within(abs(abs(L) - 1), tolerance, f"|L(j{w})| at a gain crossover")
+                phase = math.radians(float(margin))
+                gap = abs(np.exp(1j * phase) - (-L / abs(L)))
+                assert_within(gap, 2 * tolerance, f"the phase margin {margin} at ω = {w}")
+            else:
+                assert_within(abs(L.imag), tolerance * max(abs(L), 1), f"Im L(j{w})")
+                assert L.real < 0, f"L(j{w}) = {L} at a phase crossover is not negative"
+                assert_within(
+                    abs(margin * abs(L) - 1), 2 * tolerance / abs(L), f"gain margin at ω = {w}"
+                )
+    if len(result.gain_margins):
+        critical = int(np.argmin(np.abs(np.log(result.gain_margins))))
+        assert result.gain_margin == result.gain_margins[critical]
+    else:
+        assert result.gain_margin == math.inf
+    if len(result.phase_margins):
+        assert result.phase_margin == result.phase_margins[np.argmin(np.abs(result.phase_margins))]
+    else:
+        assert result.phase_margin == math.inf
+    try:
+        text = str(result)
+    except Exception as error:
+        raise AssertionError(f"str(margins) raised {type(error).__name__}: {error}") from error
+    assert isinstance(text, str)
+
+
+#: Fields that are NaN or infinite by definition (no crossover, no margin).
+UNBOUNDED = (
+    "gain_margin",
+    "phase_crossover",
+    "phase_margin",
+    "gain_crossover",
+    "delay_margin",
+    "delay_margins",
+    "gain_margins",
+    "disk_frequency",
+    "stability_frequency",
+    "disk_margin",
+    "stability_margin",
+)
+
+
+@given(st.data())
+def test_stability_margins(data: st.DataObject) -> None:
+    exercise(
+        "stability_margins",
+        lambda loop: aerocontrol.stability_margins(loop),
+        {"loop": data.draw(loop())},
+        _margins_oracle,
+        nonfinite_by_definition=UNBOUNDED,
+    )
+
+
+# ----- sensitivities ----------------------------------------------------------------------------
+
+
+def _sensitivity_oracle(complementary: bool) -> Any:
+    def oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        A, B, C, D = model_matrices(args["loop"])
+        n, d = A.shape[0], float(D[0, 0])
+        assert result.A.shape == (n, n) and (result.n_inputs, result.n_outputs) == (1, 1)
+        with silenced():
+            kappa0 = (1 + abs(d)) / abs(1 + d)
+        for s in POINTS:
+            value = response_at(A, B, C, D, s)
+            if value is None:
+                continue
+            G, size = value
+            L = np.complex128(G[0, 0])  # numpy's arithmetic: an overflow is inf, not an error
+            with silenced():
+                expected = L / (1 + L) if complementary else 1 / (1 + L)
+                allowed = (
+                    SLACK
+                    * max(n, 1)
+                    * U
+                    * (size / abs(1 + L) ** 2)
+                    * kappa0
+                    * (1 + norm(B) * norm(C) / max(norm(A), TINY))
+                )
+            if not np.isfinite(allowed) or not np.isfinite(expected):
+                continue
+            what = "T = L/(1 + L)" if complementary else "S = 1/(1 + L)"
+            assert_response(result, np.array([[expected]]), s, allowed, what)
+
+    return oracle
+
+
+@given(st.data())
+def test_sensitivities(data: st.DataObject) -> None:
+    name = data.draw(st.sampled_from(("sensitivity", "complementary_sensitivity")))
+    exercise(
+        name,
+        getattr(aerocontrol, name),
+        {"loop": data.draw(loop())},
+        _sensitivity_oracle(name == "complementary_sensitivity"),
+    )
+
+
+# ----- root locus -------------------------------------------------------------------------------
+
+
+def _locus_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    A, B, C, D = model_matrices(args["loop"])
+    n, d = A.shape[0], float(D[0, 0])
+    gains = np.atleast_1d(np.asarray(args["gains"], float))
+    assert np.array_equal(result.gains, gains)
+    assert result.poles.shape == (gains.size, n) and result.poles.dtype == np.complex128
+    for k, row in zip(gains, result.poles, strict=True):
+        assert np.array_equal(row, np.sort_complex(row)), "a row of poles is not sorted"
+        formed = closed_matrix(A, B, C, d, float(k))
+        if formed is not None:
+            assert_poles(formed[0], formed[1], row, f"the poles at k = {k}")
+    assert_poles(A, norm(A), result.open_loop_poles, "the open-loop poles")
+
+
+GAINS = (
+    np.array([0.0, 1.0, 5.0]),
+    np.array([0.5]),
+    np.logspace(-2, 2, 7),
+    np.array([-1.0, 2.0]),
+    np.array([1e300, 1.0]),
+    np.zeros(0),
+    np.array([1.0, np.nan]),
+    np.ones((2, 2)),
+)
+
+
+@given(st.data())
+def test_root_locus(data: st.DataObject) -> None:
+    gains = GAINS[data.draw(st.integers(0, len(GAINS) - 1))]
+    outcome = exercise(
+        "root_locus",
+        lambda loop, gains: aerocontrol.root_locus(loop, gains),
+        {"loop": data.draw(loop()), "gains": data.draw(presented(gains))},
+        _locus_oracle,
+    )
+    if gains.ndim != 1 or gains.size == 0:
+        assert outcome.error is not None, f"root_locus accepted gains of shape {gains.shape}"
+
+
+# ----- damping designs --------------------------------------------------------------------------
+
+
+def least_damping(poles: np.ndarray) -> float:
+    oscillatory = poles[poles.imag > 1e-9 * np.abs(poles)]
+    if oscillatory.size == 0:
+        return 1.0
+    return float(np.min(-oscillatory.real / np.abs(oscillatory)))
+
+
+def _design_oracle(name: str) -> Any:
+    def oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        A, B, C, D = model_matrices(args["loop"])
+        d = float(D[0, 0])
+        assert result.gain >= 0 and np.isfinite(result.gain)
+        formed = closed_matrix(A, B, C, d, result.gain)
+        assert formed is not None
+        assert_poles(formed[0], formed[1], result.closed_loop_poles, "the design's poles")
+        pole = result.pole
+        if np.isnan(pole.real) or abs(pole.imag) <= 1e-9 * abs(pole):
+            assert result.damping_ratio == 1.0, "ζ is 1 where the pole does not oscillate"
+        else:
+            assert pole.imag >= 0
+            assert abs(result.damping_ratio - (-pole.real / abs(pole))) <= 1e-12
+        if name == "gain_for_damping":
+            if IllConditionedWarning not in warned:
+                assert_within(
+                    abs(result.damping_ratio - float(args["zeta"])), 1e-6, "ζ at the gain found"
+                )
+        elif args["mode"] is None and args["gains"] is not None:
+            achieved = result.damping_ratio
+            for k in np.asarray(args["gains"], float):
+                formed = closed_matrix(A, B, C, d, float(k))
+                if formed is None or not finite(formed[0]):
+                    continue
+                poles = np.linalg.eigvals(formed[0])
+                if np.all(poles.real < -1e-6 * (1 + np.abs(poles))):
+                    assert least_damping(poles) <= achieved + 1e-6, (
+                        f"k = {k} damps the loop better ({least_damping(poles)}) than the "
+                        f"best gain {result.gain} ({achieved})"
+                    )
+
+    return oracle
+
+
+@given(st.data())
+def test_damping_designs(data: st.DataObject) -> None:
+    name = data.draw(st.sampled_from(("best_damping_gain", "gain_for_damping")))
+    mode = data.draw(st.sampled_from((None, None, None, -0.1 + 1j, "x", complex(np.nan, 1))))
+    gains = data.draw(
+        st.sampled_from((None, None, np.linspace(0.0, 10.0, 21), np.array([-1.0, 1.0])))
+    )
+    arguments = {
+        "loop": data.draw(loop()),
+        "mode": plain(mode),
+        "gains": plain(None) if gains is None else data.draw(presented(gains)),
+    }
+    if name == "gain_for_damping":
+        arguments["zeta"] = data.draw(
+            scalar(data.draw(st.sampled_from((0.5, 0.3, 0.7, 1.0, -2.0))))
+        )
+
+    def call(**kwargs: Any) -> Any:
+        return getattr(aerocontrol, name)(**kwargs)
+
+    outcome = exercise(
+        name, call, arguments, _design_oracle(name), nonfinite_by_definition=("pole",)
+    )
+    if (mode is not None and not isinstance(mode, complex)) or (
+        isinstance(mode, complex) and np.isnan(mode.real)
+    ):
+        assert outcome.error is not None, f"{name} accepted mode = {mode!r}"
+
+
+# ----- known defects of the core (see known_defects.py) ------------------------------------------
+
+
+@pytest.mark.xfail(strict=True, reason="root-locus-gains-alias: RootLocus.gains is the argument")
+def test_known_defect_root_locus_gains_alias() -> None:
+    model = (np.array([[-1.0]]), np.eye(1), np.eye(1), np.zeros((1, 1)))
+    with ROOT_LOCUS_GAINS_ALIAS.reproducing():
+        exercise(
+            "root_locus",
+            lambda loop, gains: aerocontrol.root_locus(loop, gains),
+            {"loop": plain(model), "gains": plain(np.array([0.0, 1.0]))},
+            _locus_oracle,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="margins-table-disk-beyond-2: str() raises ValueError")
+def test_known_defect_margins_table_disk_beyond_two() -> None:
+    static = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[0.5]]))
+    with MARGINS_TABLE_DISK.reproducing():
+        exercise(
+            "stability_margins",
+            lambda loop: aerocontrol.stability_margins(loop),
+            {"loop": plain(static)},
+            _margins_oracle,
+            nonfinite_by_definition=UNBOUNDED,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="transfer-gain-underflow: 0/0 inside stability_margins")
+def test_known_defect_margins_of_a_tiny_loop() -> None:
+    A = np.array([[-2.3e-300, -1.3e-301], [6.4e-301, -2.3e-300]])
+    model = (A, np.array([[0.13], [-0.13]]), np.zeros((1, 2)), np.array([[0.13]]))
+    with TRANSFER_GAIN_UNDERFLOW.reproducing():
+        exercise(
+            "stability_margins",
+            lambda loop: aerocontrol.stability_margins(loop),
+            {"loop": plain(model)},
+            _margins_oracle,
+            nonfinite_by_definition=UNBOUNDED,
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="closed-loop-overflow: numpy's overflow in B C")
+def test_known_defect_closed_loop_overflow() -> None:
+    model = (-np.eye(1), np.array([[1e308]]), np.array([[2.0]]), np.zeros((1, 1)))
+    with CLOSED_LOOP_OVERFLOW.reproducing():
+        exercise(
+            "root_locus",
+            lambda loop, gains: aerocontrol.root_locus(loop, gains),
+            {"loop": plain(model), "gains": plain([1.0])},
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="damping-mode-without-poles: numpy's ValueError")
+def test_known_defect_damping_mode_without_poles() -> None:
+    static = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.zeros((1, 1)))
+    with DAMPING_MODE_WITHOUT_POLES.reproducing():
+        exercise(
+            "best_damping_gain",
+            lambda loop, mode: aerocontrol.best_damping_gain(loop, mode),
+            {"loop": plain(static), "mode": plain(-0.1 + 1j)},
+        )

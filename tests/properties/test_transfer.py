@@ -1,0 +1,326 @@
+"""Properties of transfer functions and transmission zeros (aerocontrol.transfer).
+
+Oracles: the transmission zeros by their backward error (the smallest singular value of the
+system matrix [[A - zI, B], [C, D]] at each zero, relative to its size), and, for square
+systems in general position, against scipy's finite generalized eigenvalues of the Rosenbrock
+pencil ([[A, B], [C, D]], [[I, 0], [0, 0]]) within each eigenvalue's condition number times
+n u ||S|| (from scipy's left and right vectors); the zeros are invariant under an orthogonal
+change of state coordinates, to the same tolerance. A transfer function's denominator is the
+characteristic polynomial of A (oracles.characteristic_tolerance), its poles the spectrum of A
+(oracles.assert_spectrum), its zeros the channel's transmission zeros (bitwise), and
+numerator(s) / denominator(s) is G(s) = C (sI - A)^-1 B + D evaluated directly, within the
+sensitivity of the factored form to the errors of its roots (sum_r δr / |s - r|, δr the root's
+condition times n u ||·||) and of the polynomials' evaluation.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+import scipy.linalg as sl
+from hypothesis import given
+from hypothesis import strategies as st
+
+import aerocontrol
+
+from .harness import Warned, exercise, plain
+from .known_defects import (
+    PENCIL_TOLERANCE_OVERFLOW,
+    TRANSFER_GAIN_UNDERFLOW,
+    TRANSFER_SCALE_OVERFLOW,
+    ZEROS_DROPPED,
+)
+from .oracles import (
+    SLACK,
+    TINY,
+    U,
+    assert_coefficients,
+    assert_spectrum,
+    assert_within,
+    characteristic_tolerance,
+    eigenvalue_conditions,
+    finite,
+    norm,
+    quietly,
+    response_at,
+    silenced,
+)
+from .strategies import (
+    SQUARE_KINDS,
+    model_matrices,
+    orders,
+    presented_system,
+    rectangular,
+    square,
+    system,
+)
+
+COVERED = {"transmission_zeros", "transfer_function"}
+
+GENERAL = ("gaussian", "stable")
+POINTS = (0.23j, 1.3j, 7.0j, 0.5 + 2.0j)
+
+
+def rosenbrock(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray) -> tuple[Any, ...]:
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    M = np.block([[A, B], [C, D]])
+    N = np.zeros((n + p, n + m))
+    N[:n, :n] = np.eye(n)
+    return M, N
+
+
+def pencil_zeros(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray) -> Any:
+    """(finite eigenvalues, their tolerances) of the Rosenbrock pencil of a square system, by
+    scipy's QZ; None where scipy fails or the pencil is singular (det(M - λN) ≡ 0)."""
+    M, N = rosenbrock(A, B, C, D)
+    size = norm(M)
+    with silenced():
+        try:
+            values, left, right = sl.eig(M, N, left=True, right=True, homogeneous_eigvals=True)
+        except (ValueError, np.linalg.LinAlgError):
+            return None
+        alpha, beta = values
+        if np.any((np.abs(alpha) < 1e3 * U * size) & (np.abs(beta) < 1e3 * U)):
+            return None  # a singular pencil: no comparison
+        finite_ones = np.abs(beta) * (size + 1) > 1e-8 * np.abs(alpha)
+        lam = alpha[finite_ones] / beta[finite_ones]
+        x, y = right[:, finite_ones], left[:, finite_ones]
+        denominators = np.abs(np.sum(y.conj() * (N @ x), axis=0))
+        conditions = np.linalg.norm(x, axis=0) * np.linalg.norm(y, axis=0) / denominators
+        n = M.shape[0]
+        tolerance = SLACK * n * U * (size + np.abs(lam)) * conditions
+    return lam, tolerance
+
+
+def match(got: np.ndarray, expected: np.ndarray, tolerance: np.ndarray, what: str) -> None:
+    """The same multiset of values: each expected value has its own got value within its
+    tolerance (greedily, tightest first)."""
+    assert len(got) == len(expected), f"{what}: {len(got)} zeros, scipy finds {len(expected)}"
+    remaining = list(got)
+    for k in np.argsort(tolerance):
+        distances = [abs(z - expected[k]) for z in remaining]
+        nearest = int(np.argmin(distances))
+        assert_within(distances[nearest], tolerance[k], f"{what}: zero {expected[k]}")
+        remaining.pop(nearest)
+
+
+def backward_errors(A: Any, B: Any, C: Any, D: Any, zeros: np.ndarray, what: str) -> None:
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    M, _ = rosenbrock(A, B, C, D)
+    for z in zeros:
+        shifted = M.astype(complex)
+        shifted[:n, :n] -= z * np.eye(n)
+        if min(shifted.shape) == 0:
+            continue
+        smallest = np.linalg.svd(shifted, compute_uv=False)[min(n + m, n + p) - 1]
+        bound = SLACK * (n + max(m, p)) * (U * (norm(M) + abs(z) * np.sqrt(n)) + TINY)
+        assert_within(smallest, bound, f"{what}: backward error of the zero {z}")
+
+
+def _zeros_oracle(general: bool) -> Any:
+    def oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        A, B, C, D = model_matrices(args["sys"])
+        assert result.dtype == np.complex128 and result.ndim == 1
+        assert np.all(np.diff(result.real) >= 0), "the zeros are not sorted by real part"
+        if not finite(A, B, C, D, result) or norm(np.block([[A, B], [C, D]])) > 1e150:
+            return
+        backward_errors(A, B, C, D, result, "transmission_zeros")
+        if not general or B.shape[1] != C.shape[0]:
+            return
+        reference = pencil_zeros(A, B, C, D)
+        if reference is None or not np.all(np.isfinite(reference[1])):
+            return
+        match(result, *reference, "transmission_zeros against scipy's Rosenbrock pencil")
+        # Invariant under an orthogonal change of state coordinates.
+        rng = np.random.default_rng(len(result))
+        Q, _ = np.linalg.qr(rng.standard_normal((A.shape[0], A.shape[0])))
+        moved = quietly(aerocontrol.transmission_zeros, (Q @ A @ Q.T, Q @ B, C @ Q.T, D))
+        match(moved, reference[0], 2 * reference[1], "transmission_zeros of T A T^-1, ...")
+
+    return oracle
+
+
+@given(st.data())
+def test_transmission_zeros(data: st.DataObject) -> None:
+    general = data.draw(st.sampled_from((True, True, False)))
+    n = data.draw(st.sampled_from((0, 1, 2, 3, 4, 5, 6))) if general else data.draw(orders())
+    m = data.draw(st.integers(1, 3))
+    p = m if general or data.draw(st.booleans()) else data.draw(st.integers(0, 3))
+    if general:
+        A = data.draw(square(n, GENERAL))
+        B = data.draw(rectangular(n, m, ("gaussian",)))
+        C = data.draw(rectangular(p, n, ("gaussian",)))
+        D = data.draw(rectangular(p, m, ("zero", "gaussian")))
+        matrices = (A, B, C, D)
+    else:
+        matrices = data.draw(system(n, m, p, SQUARE_KINDS))
+    tol = data.draw(st.sampled_from((None, None, None, 1e-10, 0.0, -1.0, np.nan)))
+    exercise(
+        "transmission_zeros",
+        lambda sys, tol: aerocontrol.transmission_zeros(sys, tol),
+        {"sys": data.draw(presented_system(matrices)), "tol": plain(tol)},
+        _zeros_oracle(general and tol is None),
+    )
+
+
+# ----- transfer_function ------------------------------------------------------------------------
+
+
+def _index(key: Any, count: int, prefix: str) -> int:
+    if key is None:
+        return 0
+    if isinstance(key, str):
+        return int(key[len(prefix) :])
+    if isinstance(key, list):
+        return int(key[0]) % count
+    return int(key) % count
+
+
+def _transfer_oracle(general: bool) -> Any:
+    def oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        A, B, C, D = model_matrices(args["sys"])
+        i = _index(args["output"], C.shape[0], "y")
+        j = _index(args["input"], B.shape[1], "u")
+        b, c, d = B[:, [j]], C[[i], :], D[[i]][:, [j]]
+        n = A.shape[0]
+        assert result.denominator.shape == (n + 1,) and result.denominator[0] == 1.0
+        assert result.dt == 0.0 and result.variable == "s"
+        assert result.output_name == f"y{i}" and result.input_name == f"u{j}"
+        zeros = quietly(aerocontrol.transmission_zeros, (A, b, c, d))
+        if result.gain != 0:
+            assert np.array_equal(result.zeros, zeros), "the zeros are not the channel's"
+            assert result.numerator[0] == result.gain
+        else:
+            assert np.array_equal(result.numerator, [0.0])
+        if not finite(A, b, c, d, result.poles, result.numerator, result.denominator):
+            return
+        assert_spectrum(A, result.poles, "the poles")
+        assert_coefficients(
+            result.denominator,
+            np.real(quietly(np.poly, A)) if n else np.ones(1),
+            characteristic_tolerance(A),
+            "the denominator against det(sI - A)",
+        )
+        if not general or result.gain == 0:
+            return
+        reference = pencil_zeros(A, b, c, d)
+        if reference is None or len(reference[0]) != len(result.zeros):
+            return
+        zero_tolerance = reference[1]
+        _, pole_conditions = eigenvalue_conditions(A) if n else (None, np.zeros(0))
+        pole_tolerance = SLACK * n * U * norm(A) * np.sort(pole_conditions)
+        roots = np.concatenate([result.zeros, result.poles])
+        errors = np.concatenate([np.sort(zero_tolerance)[::-1], pole_tolerance[::-1]])
+        for s in POINTS:
+            value = response_at(A, b, c, d, s)
+            if value is None:
+                continue
+            G, size = value
+            with silenced():
+                got = np.polyval(result.numerator, s) / np.polyval(result.denominator, s)
+                relative = 2 * np.max(errors, initial=0.0) * np.sum(1 / np.abs(s - roots))
+                evaluation = sum(
+                    np.dot(np.abs(p), np.abs(s) ** np.arange(len(p))[::-1]) / abs(np.polyval(p, s))
+                    for p in (result.numerator, result.denominator)
+                )
+                bound = abs(G[0, 0]) * (relative + SLACK * (n + 1) * U * evaluation) + (
+                    SLACK * max(n, 1) * U * size
+                )
+            if not np.isfinite(bound) or relative > 1e-3:
+                continue
+            assert_within(abs(got - G[0, 0]), 2 * bound + TINY, f"N(s)/D(s) against G(s = {s})")
+
+    return oracle
+
+
+CHANNELS = (None, None, 0, -1, 1, "y0", "u0", "y1", 9, 1.5, [0])
+
+
+@given(st.data())
+def test_transfer_function(data: st.DataObject) -> None:
+    general = data.draw(st.booleans())
+    n = data.draw(st.sampled_from((0, 1, 2, 3, 4, 5, 6))) if general else data.draw(orders())
+    m, p = data.draw(st.integers(1, 2)), data.draw(st.integers(1, 2))
+    if general:
+        A = data.draw(square(n, GENERAL))
+        B = data.draw(rectangular(n, m, ("gaussian",)))
+        C = data.draw(rectangular(p, n, ("gaussian",)))
+        D = data.draw(rectangular(p, m, ("zero", "gaussian")))
+        matrices = (A, B, C, D)
+    else:
+        matrices = data.draw(system(n, m, p))
+    output, input_ = data.draw(st.sampled_from(CHANNELS)), data.draw(st.sampled_from(CHANNELS))
+    if isinstance(output, str) and output.startswith("u"):
+        output = "y0"
+    if isinstance(input_, str) and input_.startswith("y"):
+        input_ = "u0"
+    outcome = exercise(
+        "transfer_function",
+        lambda sys, output, input: aerocontrol.transfer_function(sys, output, input),
+        {
+            "sys": data.draw(presented_system(matrices)),
+            "output": plain(output),
+            "input": plain(input_),
+        },
+        _transfer_oracle(general),
+    )
+    if outcome.error is None and outcome.result is not None:
+        assert isinstance(str(outcome.result), str)
+        assert isinstance(outcome.result.aircraft_form(3), str)
+
+
+# ----- known defects of the core (see known_defects.py) ------------------------------------------
+
+
+def _diagonal_channel(scale: float) -> tuple[np.ndarray, ...]:
+    """sum_k 1/(s + k scale), k = 1, 2, 3: poles -scale, -2 scale, -3 scale, gain 3."""
+    return (np.diag([-1.0, -2.0, -3.0]) * scale, np.ones((3, 1)), np.ones((1, 3)), np.zeros((1, 1)))
+
+
+@pytest.mark.xfail(strict=True, reason="pencil-tolerance-overflow: M * M overflows")
+def test_known_defect_pencil_tolerance_overflow() -> None:
+    model = (np.array([[-1e155]]), np.eye(1), np.eye(1), np.zeros((1, 1)))
+    with PENCIL_TOLERANCE_OVERFLOW.reproducing():
+        exercise(
+            "transmission_zeros",
+            lambda sys: aerocontrol.transmission_zeros(sys),
+            {"sys": plain(model)},
+            _zeros_oracle(False),
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="transfer-scale-overflow: inf without a warning")
+def test_known_defect_transfer_scale_overflow() -> None:
+    with TRANSFER_SCALE_OVERFLOW.reproducing():
+        exercise(
+            "transfer_function",
+            lambda sys, output, input: aerocontrol.transfer_function(sys, output, input),
+            {"sys": plain(_diagonal_channel(1e103)), "output": plain(None), "input": plain(None)},
+            _transfer_oracle(False),
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="transfer-gain-underflow: gain -0.0 for 3/s")
+def test_known_defect_transfer_gain_underflow() -> None:
+    with TRANSFER_GAIN_UNDERFLOW.reproducing():
+        outcome = exercise(
+            "transfer_function",
+            lambda sys, output, input: aerocontrol.transfer_function(sys, output, input),
+            {"sys": plain(_diagonal_channel(1e-151)), "output": plain(None), "input": plain(None)},
+            _transfer_oracle(False),
+        )
+    assert outcome.result.gain == pytest.approx(3.0), f"gain {outcome.result.gain}, not 3"
+
+
+@pytest.mark.xfail(strict=True, reason="zeros-dropped-badly-scaled: the zero at 1e9 is lost")
+def test_known_defect_zeros_dropped() -> None:
+    model = (np.diag([-1.0, -2.0]), np.ones((2, 1)), np.array([[1e9, -2e9]]), np.eye(1))
+    with ZEROS_DROPPED.reproducing():
+        exercise(
+            "transmission_zeros",
+            lambda sys: aerocontrol.transmission_zeros(sys),
+            {"sys": plain(model)},
+            _zeros_oracle(True),
+        )
