@@ -107,12 +107,7 @@ def _signal_names(given: Names, count: int, default: str, argument: str) -> tupl
     or, for a single signal, ``default`` followed by 0."""
     if given is None:
         return tuple(f"{default}{i}" for i in range(count))
-    names = (given,) if isinstance(given, str) else tuple(given)
-    for name in names:
-        if not isinstance(name, str):
-            raise InvalidArgumentError(
-                f"{argument} must be a name or a sequence of names, got {name!r} in it"
-            )
+    names = tuple(_name_list(given, argument, unique=False))
     if len(names) != count:
         raise ShapeError(f"{argument} must have {count} names, got {len(names)}")
     return names
@@ -474,13 +469,19 @@ def _source(spec: object, where: str) -> tuple[str, float]:
     )
 
 
-def _name_list(value: str | Sequence[str], argument: str) -> list[str]:
-    names = [value] if isinstance(value, str) else list(value)
+def _name_list(value: str | Sequence[str], argument: str, unique: bool = True) -> list[str]:
+    """A name or a sequence of names as a list, each a string (and, if ``unique``, once)."""
+    try:
+        names = [value] if isinstance(value, str) else list(value)
+    except TypeError:
+        names = [value]  # type: ignore[list-item]  # refused just below, by name
     for name in names:
         if not isinstance(name, str):
-            raise InvalidArgumentError(f"{argument} must be signal names, got {name!r}")
+            raise InvalidArgumentError(
+                f"{argument} must be a name or a sequence of names, got {name!r}"
+            )
     duplicates = sorted({name for name in names if names.count(name) > 1})
-    if duplicates:
+    if unique and duplicates:
         raise InvalidArgumentError(f"{argument} names {duplicates[0]!r} more than once")
     return names
 

@@ -338,9 +338,12 @@ class StabilityMargins:
 
     @property
     def disk_gain_margin(self) -> tuple[float, float]:
-        """The gain range [(2 - α)/(2 + α), (2 + α)/(2 - α)] of the disk margin."""
+        """The gain range [(2 - α)/(2 + α), (2 + α)/(2 - α)] of the disk margin; from α >= 2
+        every positive gain: [0, ∞]."""
         a = self.disk_margin
-        return ((2 - a) / (2 + a), (2 + a) / (2 - a) if a < 2 else math.inf)
+        if a >= 2:
+            return (0.0, math.inf)
+        return ((2 - a) / (2 + a), (2 + a) / (2 - a))
 
     @property
     def disk_phase_margin(self) -> float:
@@ -740,7 +743,7 @@ def _gains(gains: ArrayLike, name: str = "gains") -> FloatArray:
     if values.ndim != 1 or values.size == 0:
         raise ShapeError(f"{name} must be a non-empty 1-D array of gains, got shape {values.shape}")
     check_finite(values, name)
-    return np.asarray(values, dtype=np.float64)
+    return np.array(values, dtype=np.float64)  # the result's own copy
 
 
 def _closed_poles(model: StateSpace, k: float) -> ComplexArray:
@@ -827,6 +830,10 @@ class _Objective:
         self.gains = gains
         self.track: list[complex] = []
         if mode is not None:
+            if model.n_states == 0:
+                raise InvalidArgumentError(
+                    "mode: the loop has no states, so no closed-loop mode to track"
+                )
             current = complex(mode)
             for k in gains:
                 poles = _closed_poles(model, float(k))

@@ -47,7 +47,14 @@ def _matrix(value: object, name: str) -> FloatArray:
 def _names(given: Sequence[str] | None, count: int, prefix: str, argument: str) -> tuple[str, ...]:
     if given is None:
         return tuple(f"{prefix}{i}" for i in range(count))
-    names = tuple(str(name) for name in given)
+    if isinstance(given, str):
+        given = [given]
+    try:
+        names = tuple(str(name) for name in given)
+    except TypeError:
+        raise InvalidArgumentError(
+            f"{argument} must be a string or a sequence of strings, got {type(given).__name__}"
+        ) from None
     if len(names) != count:
         raise ShapeError(f"{argument} must have {count} names, got {len(names)}")
     return names

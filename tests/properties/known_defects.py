@@ -118,26 +118,6 @@ TRANSFER_GAIN_UNDERFLOW = known_defect(
     lambda args: -np.inf < _spectral_scale(args) < -290 or 0 < _largest_entry(args) < 1e-150,
 )
 
-NAMES_NOT_ITERABLE = known_defect(
-    "names-not-iterable",
-    {"washout", "first_order_lag", "actuator", "second_order", "StateSpace"},
-    "a signal name argument that is neither a string nor a sequence (input_names=3) raises "
-    "TypeError ('int' object is not iterable) from tuple(given), not InvalidArgumentError",
-    lambda args: isinstance(args.get("input_names"), (int, float)),
-    symptom="TypeError",
-)
-
-
-ROOT_LOCUS_GAINS_ALIAS = known_defect(
-    "root-locus-gains-alias",
-    {"root_locus"},
-    "root_locus returns gains given as a C-ordered float64 1-D array as they are: "
-    "RootLocus.gains is the caller's array (np.shares_memory), so that changing one changes "
-    "the other",
-    lambda args: np.asarray(args["gains"]).dtype == np.float64,
-    symptom="share memory",
-)
-
 
 def _disk_margin_beyond_two(args: dict[str, Any]) -> bool:
     import warnings
@@ -148,17 +128,6 @@ def _disk_margin_beyond_two(args: dict[str, Any]) -> bool:
         warnings.simplefilter("ignore")
         alpha = aerocontrol.stability_margins(args["loop"]).disk_margin
     return 2.0 < alpha < np.inf
-
-
-MARGINS_TABLE_DISK = known_defect(
-    "margins-table-disk-beyond-2",
-    {"stability_margins"},
-    "str(StabilityMargins) raises ValueError (math domain error) when the disk margin alpha "
-    "is above 2 and finite (the static loop L = 0.5: alpha = 6): disk_gain_margin's lower end "
-    "(2 - alpha)/(2 + alpha) is negative and _db takes its log10",
-    _disk_margin_beyond_two,
-    symptom="math domain error",
-)
 
 
 def _block_spread(args: dict[str, Any]) -> float:
@@ -199,14 +168,3 @@ CLOSED_LOOP_OVERFLOW = known_defect(
 
 def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
-
-
-DAMPING_MODE_WITHOUT_POLES = known_defect(
-    "damping-mode-without-poles",
-    {"best_damping_gain", "gain_for_damping"},
-    "best_damping_gain / gain_for_damping with a mode to track and a loop without states "
-    "(a static gain) raise numpy's ValueError 'attempt to get argmin of an empty sequence' "
-    "instead of an aerocontrol error",
-    _mode_without_poles,
-    symptom="argmin of an empty sequence",
-)

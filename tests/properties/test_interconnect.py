@@ -27,7 +27,7 @@ from hypothesis import strategies as st
 import aerocontrol
 
 from .harness import SAME, Arg, Warned, exercise, plain
-from .known_defects import INTERCONNECT_OVERFLOW, NAMES_NOT_ITERABLE
+from .known_defects import INTERCONNECT_OVERFLOW
 from .oracles import (
     SLACK,
     TINY,
@@ -717,11 +717,9 @@ def test_known_defect_interconnect_overflow(function: str) -> None:
         )
 
 
-@pytest.mark.xfail(strict=True, reason="names-not-iterable: TypeError from tuple(3)")
-def test_known_defect_names_not_iterable() -> None:
-    with NAMES_NOT_ITERABLE.reproducing():
-        exercise(
-            "actuator",
-            lambda bandwidth, input_names: aerocontrol.actuator(bandwidth, input_names=input_names),
-            {"bandwidth": plain(1.0), "input_names": plain(3)},
-        )
+def test_regression_names_not_iterable() -> None:
+    exercise(
+        "actuator",
+        lambda bandwidth, input_names: aerocontrol.actuator(bandwidth, input_names=input_names),
+        {"bandwidth": plain(1.0), "input_names": plain(3)},
+    )

@@ -29,9 +29,6 @@ from aerocontrol.exceptions import IllConditionedWarning
 from .harness import Arg, Warned, exercise, plain
 from .known_defects import (
     CLOSED_LOOP_OVERFLOW,
-    DAMPING_MODE_WITHOUT_POLES,
-    MARGINS_TABLE_DISK,
-    ROOT_LOCUS_GAINS_ALIAS,
     TRANSFER_GAIN_UNDERFLOW,
 )
 from .oracles import (
@@ -391,29 +388,25 @@ def test_damping_designs(data: st.DataObject) -> None:
 # ----- known defects of the core (see known_defects.py) ------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason="root-locus-gains-alias: RootLocus.gains is the argument")
-def test_known_defect_root_locus_gains_alias() -> None:
+def test_regression_root_locus_gains_alias() -> None:
     model = (np.array([[-1.0]]), np.eye(1), np.eye(1), np.zeros((1, 1)))
-    with ROOT_LOCUS_GAINS_ALIAS.reproducing():
-        exercise(
-            "root_locus",
-            lambda loop, gains: aerocontrol.root_locus(loop, gains),
-            {"loop": plain(model), "gains": plain(np.array([0.0, 1.0]))},
-            _locus_oracle,
-        )
+    exercise(
+        "root_locus",
+        lambda loop, gains: aerocontrol.root_locus(loop, gains),
+        {"loop": plain(model), "gains": plain(np.array([0.0, 1.0]))},
+        _locus_oracle,
+    )
 
 
-@pytest.mark.xfail(strict=True, reason="margins-table-disk-beyond-2: str() raises ValueError")
-def test_known_defect_margins_table_disk_beyond_two() -> None:
+def test_regression_margins_table_disk_beyond_two() -> None:
     static = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[0.5]]))
-    with MARGINS_TABLE_DISK.reproducing():
-        exercise(
-            "stability_margins",
-            lambda loop: aerocontrol.stability_margins(loop),
-            {"loop": plain(static)},
-            _margins_oracle,
-            nonfinite_by_definition=UNBOUNDED,
-        )
+    exercise(
+        "stability_margins",
+        lambda loop: aerocontrol.stability_margins(loop),
+        {"loop": plain(static)},
+        _margins_oracle,
+        nonfinite_by_definition=UNBOUNDED,
+    )
 
 
 @pytest.mark.xfail(strict=True, reason="transfer-gain-underflow: 0/0 inside stability_margins")
@@ -441,12 +434,10 @@ def test_known_defect_closed_loop_overflow() -> None:
         )
 
 
-@pytest.mark.xfail(strict=True, reason="damping-mode-without-poles: numpy's ValueError")
-def test_known_defect_damping_mode_without_poles() -> None:
+def test_regression_damping_mode_without_poles() -> None:
     static = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.zeros((1, 1)))
-    with DAMPING_MODE_WITHOUT_POLES.reproducing():
-        exercise(
-            "best_damping_gain",
-            lambda loop, mode: aerocontrol.best_damping_gain(loop, mode),
-            {"loop": plain(static), "mode": plain(-0.1 + 1j)},
-        )
+    exercise(
+        "best_damping_gain",
+        lambda loop, mode: aerocontrol.best_damping_gain(loop, mode),
+        {"loop": plain(static), "mode": plain(-0.1 + 1j)},
+    )
