@@ -190,3 +190,10 @@ def test_batches_warn_naming_the_doubtful_problems() -> None:
     with pytest.warns(aerocontrol.IllConditionedWarning) as single:
         aerocontrol.place_bass_gura(A, b[1], [-5.0, -6.0, -7.0, -8.0])
     assert len(single) == 1
+
+
+def test_place_batch_checks_shapes_of_an_empty_batch() -> None:
+    """No problem to solve, but B must still have A's rows (an empty stack of A accepted any
+    B)."""
+    with pytest.raises(aerocontrol.ShapeError, match="B must have as many rows as A"):
+        aerocontrol.batch.place_batch(np.zeros((0, 1, 1)), np.zeros((1, 2, 2)), [[-1.0]])

@@ -485,6 +485,22 @@ pub fn place_batch(
     out: PlaceBatchOutput<'_>,
 ) -> Result<(), Error> {
     let (n, m) = (a.rows, b.cols);
+    if a.cols != n {
+        return Err(Error::NotSquare {
+            arg: "A",
+            rows: n,
+            cols: a.cols,
+        });
+    }
+    if b.rows != n {
+        return Err(Error::Mismatch {
+            arg: "B",
+            what: "as many rows as",
+            expected: n,
+            other: "A",
+            got: b.rows,
+        });
+    }
     if n == 0 || m == 0 {
         return Err(Error::InvalidArgument {
             arg: "A, B",

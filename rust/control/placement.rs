@@ -464,7 +464,10 @@ fn finish(
             .expect("as many eigenvalues as poles");
         taken[nearest] = true;
         achieved_poles.push(computed[nearest]);
-        let reference = if pole.norm() > 0.0 {
+        // Relative to the pole; a pole below u ||A - B K||_F (which no design places more
+        // accurately) relative to ||A - B K||_F, as a zero pole is (a pole of 1e-301 beside a
+        // closed loop of 1e149 made the relative error overflow).
+        let reference = if pole.norm() > f64::EPSILON * scale {
             pole.norm()
         } else if scale > 0.0 {
             scale

@@ -343,3 +343,14 @@ def test_placement_of_plants_at_extreme_scales(factor: float) -> None:
         design = getattr(aerocontrol, function)(A * factor, b * factor, [p * factor for p in poles])
         assert np.allclose(design.K, reference, rtol=1e-12, atol=0), function
         assert np.allclose(np.sort(design.achieved_poles.real), [-2 * factor, -factor], rtol=1e-12)
+
+
+def test_placement_of_poles_below_rounding() -> None:
+    """Poles of 1e-301 for a plant of 1e149: the relative pole error is judged against
+    ||A - B K|| below u ||A - B K|| (it overflowed to inf without a NumericalOverflowWarning)."""
+    A = np.array([[1.2573e149, -1.3210e149], [6.404e148, 1.049e149]])
+    b = np.array([[0.1257], [-0.1321]])
+    poles = [-2.19e-301 + 1.48e-301j, -2.19e-301 - 1.48e-301j]
+    for function in ("place_bass_gura", "place_ackermann"):
+        design = getattr(aerocontrol, function)(A, b, poles)
+        assert np.isfinite(design.max_relative_error), function
