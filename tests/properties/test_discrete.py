@@ -478,3 +478,22 @@ def test_matched_zero_does_not_depend_on_the_output_scale(scale: float) -> None:
     expected = complex(reference.response[0, 0, 0])
     got = complex(scaled.response[0, 0, 0]) / scale
     assert abs(got - expected) <= 1e-12 * abs(expected)
+
+
+def test_regression_qz_of_a_tiny_b() -> None:
+    """A = -I beside B of entries near 1e-300 (eigenvalues near 1e300): the complex pairs'
+    alpha and beta were NaN (the pair's block S T^-1 overflowed when standardised)."""
+    B = 1e-300 * np.array(
+        [
+            [8.244, -3.434, 1.2, 0.5],
+            [3.775, -0.076, -2.1, 0.3],
+            [-3.581, 1.118, 0.4, -1.7],
+            [1.583, -3.295, 0.9, 2.2],
+        ]
+    )
+    exercise(
+        "qz",
+        aerocontrol.qz,
+        {"A": canonical(-np.eye(4)), "B": canonical(B), "select": plain(None)},
+        _qz_oracle,
+    )

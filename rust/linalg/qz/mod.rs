@@ -108,24 +108,29 @@ pub fn generalized_eigenvalues(
     t: MatRef<'_, f64>,
 ) -> Vec<GeneralizedEigenvalue> {
     let n = s.nrows();
+    // The pairs from S / σ and T / τ (the powers of two of their largest entries), α and β
+    // multiplied back: a pair's block S_kk T_kk^-1 of a pencil with T near 1e-300 beside S
+    // near 1 overflowed when it was standardised.
+    let (sigma, tau) = (unit_scale(s), unit_scale(t));
     let mut values = Vec::with_capacity(n);
     let mut k = 0;
     while k < n {
         if k + 1 < n && s[(k + 1, k)] != 0.0 {
-            let (t11, t22) = (t[(k, k)], t[(k + 1, k + 1)]);
+            let (t11, t22) = (t[(k, k)] / tau, t[(k + 1, k + 1)] / tau);
+            let entry = |i: usize, j: usize| s[(i, j)] / sigma;
             let m = [
-                [s[(k, k)] / t11, s[(k, k + 1)] / t22],
-                [s[(k + 1, k)] / t11, s[(k + 1, k + 1)] / t22],
+                [entry(k, k) / t11, entry(k, k + 1) / t22],
+                [entry(k + 1, k) / t11, entry(k + 1, k + 1) / t22],
             ];
             let block = crate::linalg::schur::standardize_block(m[0][0], m[0][1], m[1][0], m[1][1]);
             let im = block.b.abs().sqrt() * block.c.abs().sqrt();
             values.push(GeneralizedEigenvalue {
-                alpha: c64::new(block.a, im) * t11,
-                beta: t11,
+                alpha: c64::new(block.a, im) * t11 * sigma,
+                beta: t11 * tau,
             });
             values.push(GeneralizedEigenvalue {
-                alpha: c64::new(block.a, -im) * t22,
-                beta: t22,
+                alpha: c64::new(block.a, -im) * t22 * sigma,
+                beta: t22 * tau,
             });
             k += 2;
         } else {
