@@ -129,7 +129,9 @@ def _placement_oracle(single_input: bool) -> Any:
         # The reported error is the error of the achieved poles matched to the requested ones.
         # Relative to each pole, or to ||A - B K||_F for a pole below u times it (zero included).
         with silenced():
-            closed_norm = float(np.linalg.norm(closed))
+            largest = float(np.max(np.abs(closed), initial=0.0))
+            # Scaled, as the core's: numpy's sum of squares underflows for entries near 1e-160.
+            closed_norm = largest * float(np.linalg.norm(closed / largest)) if largest else 0.0
             small = np.abs(result.poles) <= np.finfo(float).eps * closed_norm
             reference = np.where(
                 small, closed_norm if closed_norm > 0 else 1.0, np.abs(result.poles)
