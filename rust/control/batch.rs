@@ -54,6 +54,23 @@ impl<'a> MatrixStack<'a> {
     }
 
     /// True when the stack holds no matrix.
+    /// Every member finite, or the NonFinite error of the first one that is not, naming its
+    /// index in the batch: one branch-free pass over the whole stack (vectorised), the member
+    /// at fault found only when there is one.
+    pub fn check_finite(&self, arg: &'static str) -> Result<(), Error> {
+        if self
+            .data
+            .iter()
+            .fold(true, |finite, v| finite & v.is_finite())
+        {
+            return Ok(());
+        }
+        for index in 0..self.len() {
+            check_finite(self.get(index), arg).map_err(|e| Error::in_batch(index, e))?;
+        }
+        Ok(())
+    }
+
     pub fn is_empty(&self) -> bool {
         self.count == 0
     }
@@ -82,17 +99,7 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
         });
     }
     check_output_len(out.len(), stack.len() * n * n)?;
-    // One branch-free pass over the whole stack (vectorised); the matrix at fault is found
-    // only when there is one.
-    if !stack
-        .data
-        .iter()
-        .fold(true, |finite, v| finite & v.is_finite())
-    {
-        for index in 0..stack.len() {
-            check_finite(stack.get(index), "A").map_err(|e| Error::in_batch(index, e))?;
-        }
-    }
+    stack.check_finite("A")?;
     if n == 0 {
         return Ok(());
     }
@@ -125,15 +132,7 @@ pub fn eigenvalues_batch(stack: MatrixStack<'_>, out: &mut [c64]) -> Result<(), 
         });
     }
     check_output_len(out.len(), stack.len() * n)?;
-    if !stack
-        .data
-        .iter()
-        .fold(true, |finite, v| finite & v.is_finite())
-    {
-        for index in 0..stack.len() {
-            check_finite(stack.get(index), "A").map_err(|e| Error::in_batch(index, e))?;
-        }
-    }
+    stack.check_finite("A")?;
     if n == 0 {
         return Ok(());
     }
