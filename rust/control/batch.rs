@@ -9,10 +9,10 @@ use crate::control::placement::Placement;
 use crate::control::riccati::care::{CareOptions, solve_care, solve_care_dense};
 use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
-use crate::linalg::dense::Dense;
 use crate::linalg::expm::expm_into_validated;
 use crate::platform::parallel::{ParallelContext, par_chunks};
 use faer::{Mat, MatMut, MatRef, c64};
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 
 /// A read-only stack of `count` matrices of shape `rows` x `cols`, row-major and contiguous.
@@ -233,7 +233,7 @@ pub fn batch_count(lengths: &[(&'static str, usize)]) -> Result<usize, Error> {
 }
 
 /// A matrix's entries, row by row.
-fn write_row_major(matrix: &Dense, out: &mut [f64]) {
+fn write_row_major(matrix: &DMatrix<f64>, out: &mut [f64]) {
     let cols = matrix.ncols();
     for (index, x) in out.iter_mut().enumerate() {
         *x = matrix[(index / cols, index % cols)];
@@ -377,7 +377,7 @@ struct Solved {
 
 /// X and K as the solver that found them holds them.
 enum Solution {
-    Dense { x: Dense, gain: Dense },
+    Small { x: DMatrix<f64>, gain: DMatrix<f64> },
     Faer { x: Mat<f64>, gain: Mat<f64> },
 }
 
@@ -385,7 +385,7 @@ impl Solved {
     /// X (n x n) and K (m x n), row-major, into `x` and `gain`.
     fn write(&self, x: &mut [f64], gain: &mut [f64], n: usize, m: usize) {
         match &self.solution {
-            Solution::Dense { x: xd, gain: kd } => {
+            Solution::Small { x: xd, gain: kd } => {
                 write_row_major(xd, x);
                 write_row_major(kd, gain);
             }
@@ -417,7 +417,7 @@ fn solve_one(
             };
             match solve_care_dense(a, b, q, r, options) {
                 Ok(care) => Ok(Solved {
-                    solution: Solution::Dense {
+                    solution: Solution::Small {
                         x: care.x,
                         gain: care.gain,
                     },

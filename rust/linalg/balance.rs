@@ -2,8 +2,8 @@
 //! two that brings its entries into range, and balancing (Parlett & Reinsch 1969), a diagonal
 //! of powers of two that equalises row and column norms. Both are exact in floating point.
 
+use crate::linalg::matrix::{Order, Square};
 use crate::linalg::norm::max_abs;
-use crate::linalg::square::{Order, Square};
 use crate::platform::dispatch::clear_upper_avx_state;
 use faer::MatRef;
 
@@ -46,7 +46,7 @@ pub(crate) fn times_power_of_two(x: f64, exponent: f64) -> f64 {
 /// the diagonal of D.
 pub(crate) fn balance<O: Order>(a: &mut Square<O>) -> Vec<f64> {
     clear_upper_avx_state();
-    let n = a.n();
+    let n = a.nrows();
     let mut scale = vec![1.0; n];
     let mut changed = true;
     let mut sweeps = 0;

@@ -3,7 +3,7 @@
 
 use crate::error::{Error, check_finite, check_square};
 use crate::linalg::hessenberg::balanced_hessenberg;
-use crate::linalg::square::{Order, Square, with_order};
+use crate::linalg::matrix::{Order, Square, from_faer_in, with_order};
 use faer::MatRef;
 
 /// The coefficients [1, a_1, ..., a_n] of det(λI - A) (6.106), highest power first, by La
@@ -32,7 +32,7 @@ pub fn charpoly(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let (mut coefficients, scale) = with_order!(a.nrows(), order => {
-        let (h, scale) = balanced_hessenberg(Square::from_mat_in(order, a));
+        let (h, scale) = balanced_hessenberg(from_faer_in(order, a));
         (hessenberg_characteristic_polynomial(&h), scale)
     });
     // H is similar to A / s: a_k(A) = s^k a_k(A / s), exactly for s a power of two.
@@ -47,7 +47,7 @@ pub fn charpoly(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
 /// det(λI - H) of an upper Hessenberg H by La Budde's recurrence (see [`charpoly`]),
 /// highest power first.
 pub(crate) fn hessenberg_characteristic_polynomial<O: Order>(h: &Square<O>) -> Vec<f64> {
-    let n = h.n();
+    let n = h.nrows();
     // p_i's coefficients, lowest power first, at p[start(i)..start(i) + i + 1].
     let start = |i: usize| i * (i + 1) / 2;
     let mut p = vec![0.0; start(n + 1)];
@@ -78,6 +78,7 @@ pub(crate) fn hessenberg_characteristic_polynomial<O: Order>(h: &Square<O>) -> V
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::matrix::from_faer;
     use faer::{Mat, mat};
 
     #[test]
@@ -85,7 +86,7 @@ mod tests {
         // det(λI - H) for H = [[a, b, c], [d, e, f], [0, g, h]], expanded by hand:
         // λ^3 - (a + e + h) λ^2 + (ae + ah + eh - bd - fg) λ - (aeh - afg - bdh + cdg).
         let (a, b, c, d, e, f, g, h) = (2.0, -1.0, 3.0, 0.5, -4.0, 1.5, 2.5, 1.0);
-        let hessenberg = Square::from_mat(mat![[a, b, c], [d, e, f], [0.0, g, h]].as_ref());
+        let hessenberg = from_faer(mat![[a, b, c], [d, e, f], [0.0, g, h]].as_ref());
         let expected = [
             1.0,
             -(a + e + h),
@@ -100,8 +101,7 @@ mod tests {
             );
         }
         // A zero subdiagonal splits the polynomial: (λ - 2)(λ^2 - λ - 6) for a reducible H.
-        let reducible =
-            Square::from_mat(mat![[2.0, 7.0, 9.0], [0.0, 1.0, 2.0], [0.0, 3.0, 0.0]].as_ref());
+        let reducible = from_faer(mat![[2.0, 7.0, 9.0], [0.0, 1.0, 2.0], [0.0, 3.0, 0.0]].as_ref());
         assert_eq!(
             hessenberg_characteristic_polynomial(&reducible),
             vec![1.0, -3.0, -4.0, 12.0]

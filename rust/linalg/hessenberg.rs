@@ -8,7 +8,7 @@
 use crate::error::Error;
 use crate::linalg::balance::{balance, range_scale};
 use crate::linalg::householder::reflector;
-use crate::linalg::square::{Order, Square};
+use crate::linalg::matrix::{FaerView, Order, Square, Transformations, from_faer_in};
 use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
 use crate::platform::pool::scratch;
@@ -108,15 +108,18 @@ pub(crate) const UNBLOCKED_HESSENBERG_MAX_ORDER: usize = 32;
 /// it has the eigenvalues and the characteristic polynomial of A / s (the balancing is exact,
 /// the reduction backward stable). The caller checks that A is finite.
 pub(crate) fn balanced_hessenberg<O: Order>(mut h: Square<O>) -> (Square<O>, f64) {
-    let scale = range_scale(h.as_ref());
+    let scale = range_scale(h.as_faer());
     if scale != 1.0 {
-        h.data.as_mut().iter_mut().for_each(|x| *x /= scale);
+        h.as_mut_slice().iter_mut().for_each(|x| *x /= scale);
     }
     let _ = balance(&mut h);
-    if h.n() <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+    if h.nrows() <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         reduce_to_hessenberg(&mut h, None);
     } else {
-        h = Square::from_mat_in(h.order, hessenberg_matrix(h.to_mat().as_ref()).as_ref());
+        h = from_faer_in(
+            h.shape_generic().0,
+            hessenberg_matrix(h.to_faer().as_ref()).as_ref(),
+        );
     }
     (h, scale)
 }
@@ -125,7 +128,7 @@ pub(crate) fn balanced_hessenberg<O: Order>(mut h: Square<O>) -> (Square<O>, f64
 /// entry) becomes Q. Reflector k maps column k below the subdiagonal onto e_{k+1}.
 pub(crate) fn reduce_to_hessenberg<O: Order>(h: &mut Square<O>, mut q: Option<&mut Square<O>>) {
     clear_upper_avx_state();
-    let n = h.n();
+    let n = h.nrows();
     let mut w = [0.0; UNBLOCKED_HESSENBERG_MAX_ORDER];
     for k in 0..n.saturating_sub(2) {
         let length = n - k - 1;

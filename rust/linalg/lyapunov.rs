@@ -31,13 +31,14 @@
 
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::range_scale;
-use crate::linalg::dense::Dense;
+use crate::linalg::matrix::{FaerView, Symmetrize, from_faer};
 use crate::linalg::schur::real_schur;
 use crate::linalg::small_matrix::product;
 use crate::linalg::sylvester::solve_small_sylvester;
 use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
 use faer::{Accum, Mat, MatRef, Par};
+use nalgebra::DMatrix;
 
 /// The solution X of A X + X A^T + Q = 0 (symmetric when Q is).
 pub fn solve_lyapunov(a: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
@@ -85,19 +86,19 @@ pub(crate) fn solve(
         return solve(a.as_ref(), q.as_ref(), singularity);
     }
     if a.nrows() <= KRONECKER_MAX_ORDER && is_symmetric(q) {
-        let x = solve_kronecker(&Dense::from_ref(a), &Dense::from_ref(q), singularity)?;
-        return Ok(x.to_mat());
+        let x = solve_kronecker(&from_faer(a), &from_faer(q), singularity)?;
+        return Ok(x.to_faer());
     }
     let schur = real_schur(a)?;
     let (t, z) = (schur.t.as_ref(), schur.z.as_ref());
-    let mut f = Dense::from_ref(product(product(z.transpose(), q).as_ref(), z).as_ref());
+    let mut f = from_faer(product(product(z.transpose(), q).as_ref(), z).as_ref());
     for x in f.as_mut_slice() {
         *x = -*x;
     }
-    let y = solve_quasi_triangular(&Dense::from_ref(t), f, singularity)?;
-    let mut x = product(product(z, y.as_ref()).as_ref(), z.transpose());
+    let y = solve_quasi_triangular(&from_faer(t), f, singularity)?;
+    let mut x = product(product(z, y.as_faer()).as_ref(), z.transpose());
     if is_symmetric(q) {
-        symmetrize(&mut x);
+        x.symmetrize();
     }
     Ok(x)
 }
@@ -123,14 +124,14 @@ pub const KRONECKER_MAX_ORDER: usize = 5;
 /// [`Singularity::Perturb`] replaces it by `smin`, as the small Sylvester systems of
 /// Bartels–Stewart do.
 pub(crate) fn solve_kronecker(
-    a: &Dense,
-    q: &Dense,
+    a: &DMatrix<f64>,
+    q: &DMatrix<f64>,
     singularity: Singularity,
-) -> Result<Dense, Error> {
+) -> Result<DMatrix<f64>, Error> {
     // The order N and the system's order S = N(N+1)/2 as constants: the loops over rows of S
     // entries unroll, and the system takes no more stack than it needs.
     match a.nrows() {
-        0 => Ok(Dense::zeros(0, 0)),
+        0 => Ok(DMatrix::zeros(0, 0)),
         1 => solve_kronecker_in::<1, 1>(a, q, singularity),
         2 => solve_kronecker_in::<2, 3>(a, q, singularity),
         3 => solve_kronecker_in::<3, 6>(a, q, singularity),
@@ -144,10 +145,10 @@ pub(crate) fn solve_kronecker(
 // The system's rows and columns are indexed by unknowns: indices read most clearly.
 #[allow(clippy::needless_range_loop)]
 fn solve_kronecker_in<const N: usize, const S: usize>(
-    a: &Dense,
-    q: &Dense,
+    a: &DMatrix<f64>,
+    q: &DMatrix<f64>,
     singularity: Singularity,
-) -> Result<Dense, Error> {
+) -> Result<DMatrix<f64>, Error> {
     const { assert!(S == N * (N + 1) / 2) };
     let n = N;
     debug_assert_eq!(a.nrows(), N);
@@ -215,7 +216,7 @@ fn solve_kronecker_in<const N: usize, const S: usize>(
         }
         solution[i] = value / m[i][i];
     }
-    Ok(Dense::from_fn(n, n, |i, j| solution[unknown[i][j]]))
+    Ok(DMatrix::from_fn(n, n, |i, j| solution[unknown[i][j]]))
 }
 
 /// Up to this order the quasi-triangular solve updates the right-hand side by plain column
@@ -224,10 +225,10 @@ const SMALL_UPDATE_MAX_ORDER: usize = 16;
 
 /// Solves T Y + Y T^T = F for quasi-upper-triangular T (2 x 2 blocks in standard form).
 pub(crate) fn solve_quasi_triangular(
-    t: &Dense,
-    mut f: Dense,
+    t: &DMatrix<f64>,
+    mut f: DMatrix<f64>,
     singularity: Singularity,
-) -> Result<Dense, Error> {
+) -> Result<DMatrix<f64>, Error> {
     clear_upper_avx_state();
     let n = t.nrows();
     let mut blocks = Vec::with_capacity(n);
@@ -241,17 +242,17 @@ pub(crate) fn solve_quasi_triangular(
         blocks.push((k, size));
         k += size;
     }
-    let mut y = Dense::zeros(n, n);
+    let mut y = DMatrix::zeros(n, n);
     for &(j0, q) in blocks.iter().rev() {
         interrupt::check()?;
         let after = j0 + q;
         // F[:, J] -= Y[:, after..] T[J, after..]^T (the columns of Y already known): column
         // updates for small orders, where faer's product costs more to set up than it saves.
         if after < n && n > SMALL_UPDATE_MAX_ORDER {
-            let known = y.as_ref().subcols(after, n - after);
-            let coupling = t.as_ref().submatrix(j0, after, q, n - after);
+            let known = y.as_faer().subcols(after, n - after);
+            let coupling = t.as_faer().submatrix(j0, after, q, n - after);
             faer::linalg::matmul::matmul(
-                f.as_mut().subcols_mut(j0, q),
+                f.as_faer_mut().subcols_mut(j0, q),
                 Accum::Add,
                 known,
                 coupling.transpose(),
@@ -262,7 +263,7 @@ pub(crate) fn solve_quasi_triangular(
             for c in j0..after {
                 for s in after..n {
                     let coefficient = t[(c, s)];
-                    for (x, &known) in f.col_mut(c).iter_mut().zip(y.col(s)) {
+                    for (x, &known) in f.column_slice_mut(c).iter_mut().zip(y.column_slice(s)) {
                         *x -= known * coefficient;
                     }
                 }
@@ -300,8 +301,8 @@ pub(crate) fn solve_quasi_triangular(
                     let value = solved.x[a][c];
                     y[(i0 + a, j0 + c)] = value;
                     if value != 0.0 {
-                        let column = &t.col(i0 + a)[..i0];
-                        let target = &mut f.col_mut(j0 + c)[..i0];
+                        let column = &t.column_slice(i0 + a)[..i0];
+                        let target = &mut f.column_slice_mut(j0 + c)[..i0];
                         for (x, &t_entry) in target.iter_mut().zip(column) {
                             *x -= value * t_entry;
                         }
@@ -315,18 +316,6 @@ pub(crate) fn solve_quasi_triangular(
 
 fn is_symmetric(q: MatRef<'_, f64>) -> bool {
     (0..q.nrows()).all(|i| (0..i).all(|j| q[(i, j)] == q[(j, i)]))
-}
-
-/// X <- (X + X^T) / 2.
-pub(crate) fn symmetrize(x: &mut Mat<f64>) {
-    let n = x.nrows();
-    for i in 0..n {
-        for j in 0..i {
-            let mean = 0.5 * (x[(i, j)] + x[(j, i)]);
-            x[(i, j)] = mean;
-            x[(j, i)] = mean;
-        }
-    }
 }
 
 #[cfg(test)]
@@ -382,22 +371,21 @@ mod tests {
                 let h = crate::test_matrices::seeded(n, n, 90 + seed);
                 let q = &h * h.transpose();
                 let direct = solve_kronecker(
-                    &Dense::from_ref(a.as_ref()),
-                    &Dense::from_ref(q.as_ref()),
+                    &from_faer(a.as_ref()),
+                    &from_faer(q.as_ref()),
                     Singularity::Refuse,
                 )
                 .unwrap()
-                .to_mat();
+                .to_faer();
                 // The Schur route: real_schur, then the quasi-triangular solve.
                 let schur = real_schur(a.as_ref()).unwrap();
                 let (t, z) = (schur.t.as_ref(), schur.z.as_ref());
-                let mut f = Dense::from_ref((z.transpose() * &q * z).as_ref());
+                let mut f = from_faer((z.transpose() * &q * z).as_ref());
                 for x in f.as_mut_slice() {
                     *x = -*x;
                 }
-                let y =
-                    solve_quasi_triangular(&Dense::from_ref(t), f, Singularity::Refuse).unwrap();
-                let schur_route = z * y.to_mat() * z.transpose();
+                let y = solve_quasi_triangular(&from_faer(t), f, Singularity::Refuse).unwrap();
+                let schur_route = z * y.to_faer() * z.transpose();
                 let scale = direct.norm_max();
                 assert!(
                     (&direct - &schur_route).norm_max() <= 1e-12 * scale,
@@ -409,10 +397,7 @@ mod tests {
         }
         let rotation = mat![[0.0, 1.0], [-1.0, 0.0]];
         let q = Mat::<f64>::identity(2, 2);
-        let (a, q) = (
-            Dense::from_ref(rotation.as_ref()),
-            Dense::from_ref(q.as_ref()),
-        );
+        let (a, q) = (from_faer(rotation.as_ref()), from_faer(q.as_ref()));
         assert!(matches!(
             solve_kronecker(&a, &q, Singularity::Refuse),
             Err(Error::IllConditioned { .. })

@@ -23,12 +23,13 @@ pub mod hessenberg;
 pub(crate) mod householder;
 pub mod lu;
 pub mod lyapunov;
+pub(crate) mod matrix;
 pub mod norm;
 pub(crate) mod polynomial_roots;
 pub mod qz;
 pub(crate) mod rotation;
 pub mod schur;
 pub mod small_matrix;
-pub(crate) mod square;
+
 pub mod stein;
 pub(crate) mod sylvester;

@@ -82,19 +82,19 @@
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::balance;
 use crate::linalg::dense::{
-    Dense, cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place,
-    transposed_product,
+    cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place, transposed_product,
 };
 use crate::linalg::lu::{solve_in_place, solve_with_inverse};
-use crate::linalg::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity, symmetrize};
+use crate::linalg::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity};
+use crate::linalg::matrix::{FaerView, Order, Symmetrize, from_faer, with_order};
 use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
 use crate::linalg::schur::reorder::reorder_schur;
 use crate::linalg::schur::{
     Finished, RealSchur, Spectrum, Until, eigenvalues_near, quasi_triangular_eigenvalues,
     real_schur_with, square_schur_form,
 };
-use crate::linalg::square::{Order, Square, with_order};
 use faer::{Mat, MatRef, Par, c64};
+use nalgebra::DMatrix;
 
 /// Eigenvalues of H with |Re λ| <= AXIS_TOLERANCE ||H||_F count as on the imaginary axis.
 pub const AXIS_TOLERANCE: f64 = 100.0 * f64::EPSILON;
@@ -156,9 +156,9 @@ pub struct CareOptions<'a> {
 
 /// The data of the Hamiltonian: Ā, G and Q̄.
 struct Standard {
-    a: Dense,
-    g: Dense,
-    q: Dense,
+    a: DMatrix<f64>,
+    g: DMatrix<f64>,
+    q: DMatrix<f64>,
 }
 
 /// The equation with E removed, Ã^T Y + Y Ã - (Y B̃ + S) R^-1 (B̃^T Y + S^T) + Q = 0, in which
@@ -166,19 +166,19 @@ struct Standard {
 /// with the Cholesky factor, keeps its accuracy when R is ill-conditioned, where
 /// Y B̂ B̂^T Y (B̂ = B̃ L^-T, entries of size ||B|| / σ_min(L)) loses digits to cancellation.
 struct Reduced<'a> {
-    a: Dense,
-    b: Dense,
-    q: &'a Dense,
+    a: DMatrix<f64>,
+    b: DMatrix<f64>,
+    q: &'a DMatrix<f64>,
     /// ||Q||_F.
     q_norm: f64,
-    s: Option<&'a Dense>,
-    l: &'a Dense,
+    s: Option<&'a DMatrix<f64>>,
+    l: &'a DMatrix<f64>,
 }
 
 impl Reduced<'_> {
     /// The residual of Y (symmetric) and its gain K = R^-1 (B̃^T Y + S^T) = L^-T L^-1 M^T, with
     /// M = Y B̃ + S the coupling of the quadratic term, (Y B̃ + S) K.
-    fn evaluate(&self, y: &Dense) -> Evaluation {
+    fn evaluate(&self, y: &DMatrix<f64>) -> Evaluation {
         let mut gain = transposed_product(&self.b, y);
         if let Some(s) = self.s {
             for j in 0..gain.ncols() {
@@ -193,10 +193,11 @@ impl Reduced<'_> {
         solve_lower_transposed_in_place(self.l, &mut gain);
         let ay = transposed_product(&self.a, y);
         let quadratic = product(&coupling, &gain);
-        let scale = self.q_norm + 2.0 * ay.frobenius_norm() + quadratic.frobenius_norm();
+        let scale =
+            self.q_norm + 2.0 * frobenius_norm(ay.as_faer()) + frobenius_norm(quadratic.as_faer());
         let n = y.nrows();
         let ay_transposed = ay.transpose();
-        let mut residual = Dense::zeros(n, n);
+        let mut residual = DMatrix::zeros(n, n);
         let terms = ay.as_slice().iter().zip(ay_transposed.as_slice());
         let terms = terms.zip(quadratic.as_slice()).zip(self.q.as_slice());
         for (x, (((&ay, &ya), &quadratic), &q)) in residual.as_mut_slice().iter_mut().zip(terms) {
@@ -204,7 +205,7 @@ impl Reduced<'_> {
         }
         residual.symmetrize();
         Evaluation {
-            residual_norm: residual.frobenius_norm(),
+            residual_norm: frobenius_norm(residual.as_faer()),
             residual,
             gain,
             scale,
@@ -212,7 +213,7 @@ impl Reduced<'_> {
     }
 
     /// Ã - B̃ K.
-    fn closed_loop(&self, gain: &Dense) -> Dense {
+    fn closed_loop(&self, gain: &DMatrix<f64>) -> DMatrix<f64> {
         let mut closed_loop = product(&self.b, gain);
         for (x, &a) in closed_loop.as_mut_slice().iter_mut().zip(self.a.as_slice()) {
             *x = a - *x;
@@ -225,9 +226,9 @@ impl Reduced<'_> {
 /// size of the terms, ||Q||_F + 2 ||Ã^T Y||_F + ||(Y B̃ + S) K||_F, against which it is judged.
 /// Without E this is the residual of the caller's equation and is reported as it is.
 struct Evaluation {
-    residual: Dense,
+    residual: DMatrix<f64>,
     residual_norm: f64,
-    gain: Dense,
+    gain: DMatrix<f64>,
     scale: f64,
 }
 
@@ -258,8 +259,8 @@ pub fn solve_care(
         return super::care_pencil::solve_care_indefinite(a, b, q, r, options);
     }
     solve_care_dense(a, b, q, r, options).map(|care| Care {
-        x: care.x.to_mat(),
-        gain: care.gain.to_mat(),
+        x: care.x.to_faer(),
+        gain: care.gain.to_faer(),
         closed_loop_eigenvalues: care.closed_loop_eigenvalues,
         residual: care.residual,
         rcond: care.rcond,
@@ -270,8 +271,8 @@ pub fn solve_care(
 /// [`Care`] with X and K as the solver forms them, for callers that copy them on (the batch
 /// kernels), sparing the conversion.
 pub(crate) struct CareDense {
-    pub(crate) x: Dense,
-    pub(crate) gain: Dense,
+    pub(crate) x: DMatrix<f64>,
+    pub(crate) gain: DMatrix<f64>,
     pub(crate) closed_loop_eigenvalues: Vec<c64>,
     pub(crate) residual: f64,
     pub(crate) rcond: f64,
@@ -385,26 +386,26 @@ fn solve_care_balanced(
     }
     let (a_tilde, b_tilde) = match options.e {
         Some(e) => remove_descriptor(a, b, e)?,
-        None => (Dense::from_ref(a), Dense::from_ref(b)),
+        None => (from_faer(a), from_faer(b)),
     };
-    let s = options.s.map(Dense::from_ref);
+    let s = options.s.map(from_faer);
     let standard = standardize(&a_tilde, &b_tilde, &q, &l, s.as_ref());
-    let finite = |m: &Dense| m.as_slice().iter().all(|x| x.is_finite());
+    let finite = |m: &DMatrix<f64>| m.as_slice().iter().all(|x| x.is_finite());
     if !(finite(&standard.a) && finite(&standard.g) && finite(&standard.q)) {
         return Err(weights_out_of_range());
     }
     let reduced = Reduced {
         a: a_tilde,
         b: b_tilde,
-        q_norm: q.frobenius_norm(),
+        q_norm: frobenius_norm(q.as_faer()),
         q: &q,
         s: s.as_ref(),
         l: &l,
     };
     if n == 0 {
         return Ok(CareDense {
-            x: Dense::zeros(0, 0),
-            gain: Dense::zeros(m, 0),
+            x: DMatrix::zeros(0, 0),
+            gain: DMatrix::zeros(m, 0),
             closed_loop_eigenvalues: Vec::new(),
             residual: 0.0,
             rcond: 1.0,
@@ -428,22 +429,25 @@ fn solve_care_balanced(
     let closed_loop = reduced.closed_loop(&gain);
     // The stable eigenvalues of H are those of the closed loop of the exact solution: as
     // shifts they make the QR iteration converge in fewer sweeps.
-    let closed_loop_eigenvalues = eigenvalues_near(closed_loop.as_ref(), &stable_eigenvalues)?;
-    check_stabilising(&closed_loop_eigenvalues, closed_loop.frobenius_norm())?;
+    let closed_loop_eigenvalues = eigenvalues_near(closed_loop.as_faer(), &stable_eigenvalues)?;
+    check_stabilising(
+        &closed_loop_eigenvalues,
+        frobenius_norm(closed_loop.as_faer()),
+    )?;
     // X = E^-T Y E^-1.
     let (x, residual) = match options.e {
         Some(e) => {
-            let mut x = y.to_mat();
+            let mut x = y.to_faer();
             let mut factors = e.transpose().to_owned();
             solve_in_place(factors.as_mut(), x.as_mut(), Par::Seq);
             let mut xt = x.transpose().to_owned();
             let mut factors = e.transpose().to_owned();
             solve_in_place(factors.as_mut(), xt.as_mut(), Par::Seq);
             let mut x = xt.transpose().to_owned();
-            symmetrize(&mut x);
-            let gain = gain.to_mat();
-            let residual = general_residual(a, b, q.as_ref(), options.s, e, &x, &gain);
-            (Dense::from_ref(x.as_ref()), residual)
+            x.symmetrize();
+            let gain = gain.to_faer();
+            let residual = general_residual(a, b, q.as_faer(), options.s, e, &x, &gain);
+            (from_faer(x.as_ref()), residual)
         }
         None => (y, reduced_residual),
     };
@@ -465,7 +469,7 @@ pub(crate) fn check_problem(
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
-) -> Result<(Dense, Dense), Error> {
+) -> Result<(DMatrix<f64>, DMatrix<f64>), Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let n = a.nrows();
@@ -488,12 +492,12 @@ pub(crate) fn symmetric(
     arg: &'static str,
     order: usize,
     other: &'static str,
-) -> Result<Dense, Error> {
+) -> Result<DMatrix<f64>, Error> {
     check_square(matrix, arg)?;
     check_rows(matrix, arg, order, other)?;
     check_finite(matrix, arg)?;
-    let mut symmetric = Dense::from_ref(matrix);
-    let largest = max_abs(symmetric.as_ref());
+    let mut symmetric = from_faer(matrix);
+    let largest = max_abs(symmetric.as_faer());
     let asymmetry = (0..order)
         .flat_map(|j| (0..j).map(move |i| (i, j)))
         .map(|(i, j)| (symmetric[(i, j)] - symmetric[(j, i)]).abs())
@@ -518,7 +522,7 @@ fn remove_descriptor(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     e: MatRef<'_, f64>,
-) -> Result<(Dense, Dense), Error> {
+) -> Result<(DMatrix<f64>, DMatrix<f64>), Error> {
     let n = a.nrows();
     check_square(e, "E")?;
     check_rows(e, "E", n, "A")?;
@@ -542,21 +546,21 @@ fn remove_descriptor(
         });
     }
     Ok((
-        Dense::from_ref(solution.subcols(0, n)),
-        Dense::from_ref(solution.subcols(n, m)),
+        from_faer(solution.subcols(0, n)),
+        from_faer(solution.subcols(n, m)),
     ))
 }
 
 /// Ā = Ã - B̂ Ŝ^T, G = B̂ B̂^T, Q̄ = Q - Ŝ Ŝ^T with B̂ = B̃ L^-T, Ŝ = S L^-T.
 fn standardize(
-    a_tilde: &Dense,
-    b_tilde: &Dense,
-    q: &Dense,
-    l: &Dense,
-    s: Option<&Dense>,
+    a_tilde: &DMatrix<f64>,
+    b_tilde: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    l: &DMatrix<f64>,
+    s: Option<&DMatrix<f64>>,
 ) -> Standard {
     // X L^T = Y  <=>  L X^T = Y^T: returns X^T.
-    let right_divide_transposed = |y: &Dense| {
+    let right_divide_transposed = |y: &DMatrix<f64>| {
         let mut transposed = y.transpose();
         solve_lower_in_place(l, &mut transposed);
         transposed
@@ -589,7 +593,7 @@ fn standardize(
 /// above [`KRONECKER_MAX_ORDER`] the closed loop's Schur-like factorisation for the first
 /// Newton step (up to that order an exact step, solved directly, costs less).
 struct HamiltonianSolution {
-    y: Dense,
+    y: DMatrix<f64>,
     rcond: f64,
     stable_eigenvalues: Vec<c64>,
     closed_loop: Option<ClosedLoopFactors>,
@@ -615,27 +619,27 @@ struct HamiltonianSolution {
 struct ClosedLoopFactors {
     /// T11, the leading n x n block of the reordered Schur form of the scaled Hamiltonian, or
     /// of its partial Schur form ([`Until::UnstableHalf`]), where it is upper Hessenberg.
-    t11: Dense,
+    t11: DMatrix<f64>,
     /// For a Hessenberg T11, estimates of its eigenvalues (shifts for its Schur form).
     hessenberg: Option<Vec<c64>>,
     /// V = D U11.
-    v: Dense,
+    v: DMatrix<f64>,
     /// U11^-T (formed anyway for rcond(U11)).
-    inverse_transposed: Dense,
+    inverse_transposed: DMatrix<f64>,
     d: Vec<f64>,
 }
 
 impl ClosedLoopFactors {
     /// Δ solving (Ā - G Y)^T Δ + Δ (Ā - G Y) = -Res for the Schur solution's Y.
-    fn newton_step(&self, residual: &Dense) -> Result<Dense, Error> {
+    fn newton_step(&self, residual: &DMatrix<f64>) -> Result<DMatrix<f64>, Error> {
         let (n, d) = (self.d.len(), &self.d);
         // A Hessenberg T11 = Q S Q^T: V T11 V^-1 = (V Q) S (V Q)^-1, and (V Q)^-T = V^-T Q.
         let triangularised = match &self.hessenberg {
             Some(estimates) => {
-                let schur = real_schur_with(self.t11.as_ref(), Spectrum::Near(estimates))?;
-                let q = Dense::from_ref(schur.z.as_ref());
+                let schur = real_schur_with(self.t11.as_faer(), Spectrum::Near(estimates))?;
+                let q = from_faer(schur.z.as_ref());
                 Some((
-                    Dense::from_ref(schur.t.as_ref()),
+                    from_faer(schur.t.as_ref()),
                     product(&self.v, &q),
                     product(&self.inverse_transposed, &q),
                 ))
@@ -650,16 +654,16 @@ impl ClosedLoopFactors {
         // T11^T W + W T11 = F is T W' + W' T^T = F' for T = P T11^T P and W' = P W P, F' = P F P
         // with P the reversal permutation: T is quasi-upper-triangular with standard blocks.
         let reverse = |i: usize| n - 1 - i;
-        let t = Dense::from_fn(n, n, |i, j| t11[(reverse(j), reverse(i))]);
-        let f_reversed = Dense::from_fn(n, n, |i, j| -f[(reverse(i), reverse(j))]);
+        let t = DMatrix::from_fn(n, n, |i, j| t11[(reverse(j), reverse(i))]);
+        let f_reversed = DMatrix::from_fn(n, n, |i, j| -f[(reverse(i), reverse(j))]);
         let w_reversed = lyapunov::solve_quasi_triangular(&t, f_reversed, Singularity::Perturb)?;
-        let w = Dense::from_fn(n, n, |i, j| w_reversed[(reverse(i), reverse(j))]);
+        let w = DMatrix::from_fn(n, n, |i, j| w_reversed[(reverse(i), reverse(j))]);
         // Δ = V^-T W V^-1 = D^-1 U11^-T W U11^-1 D^-1.
         let m = product(
             &product(inverse_transposed, &w),
             &inverse_transposed.transpose(),
         );
-        let mut delta = Dense::from_fn(n, n, |i, j| m[(i, j)] / (d[i] * d[j]));
+        let mut delta = DMatrix::from_fn(n, n, |i, j| m[(i, j)] / (d[i] * d[j]));
         delta.symmetrize();
         Ok(delta)
     }
@@ -676,9 +680,12 @@ fn hamiltonian_solution_in<O: Order>(
 ) -> Result<HamiltonianSolution, Error> {
     // n from the order type: a constant at the fixed orders, so that the loops over the
     // blocks of H unroll.
-    let n = order.get() / 2;
+    let n = order.value() / 2;
     debug_assert_eq!(n, standard.a.nrows());
-    let (g_norm, q_norm) = (standard.g.frobenius_norm(), standard.q.frobenius_norm());
+    let (g_norm, q_norm) = (
+        frobenius_norm(standard.g.as_faer()),
+        frobenius_norm(standard.q.as_faer()),
+    );
     let rho = if g_norm > 0.0 && q_norm > 0.0 {
         nearest_power_of_two((q_norm / g_norm).sqrt())
     } else {
@@ -686,7 +693,7 @@ fn hamiltonian_solution_in<O: Order>(
     };
     // Powers of two: their reciprocals are exact, and multiplying by them rounds as dividing.
     let rho_inverse = 1.0 / rho;
-    let mut h = Square::zeros_in(order);
+    let mut h = order.zeros();
     for j in 0..n {
         for i in 0..n {
             h[(i, j)] = standard.a[(i, j)];
@@ -709,7 +716,7 @@ fn hamiltonian_solution_in<O: Order>(
             h[(n + i, n + j)] *= d[i] * d_inverse[j];
         }
     }
-    let h_norm = frobenius_norm(h.as_ref());
+    let h_norm = frobenius_norm(h.as_faer());
     let spectrum = if 2 * n <= HAMILTONIAN_SHIFT_MAX_ORDER {
         Spectrum::Hamiltonian
     } else {
@@ -725,17 +732,17 @@ fn hamiltonian_solution_in<O: Order>(
         // the leading Hessenberg block the stable ones: by the symmetry of the spectrum their
         // mirror images -λ̄.
         Finished::UnstableHalf => {
-            let unstable = quasi_triangular_eigenvalues(schur.t.as_ref().submatrix(n, n, n, n));
+            let unstable = quasi_triangular_eigenvalues(schur.t.as_faer().submatrix(n, n, n, n));
             let stable = unstable
                 .iter()
                 .map(|z| c64::new(-z.re, z.im) * schur.scale)
                 .collect();
-            (schur.t.as_ref(), schur.z.as_ref(), schur.scale, stable)
+            (schur.t.as_faer(), schur.z.as_faer(), schur.scale, stable)
         }
         Finished::Complete => {
             let complete = RealSchur {
-                t: schur.t.to_mat_scaled(schur.scale),
-                z: schur.z.to_mat(),
+                t: schur.t.to_faer_scaled(schur.scale),
+                z: schur.z.to_faer(),
             };
             ordered = reorder_schur(complete, |lambda| lambda.re < 0.0)?;
             check_separated(&ordered.eigenvalues, ordered.selected, n, margin)?;
@@ -744,18 +751,19 @@ fn hamiltonian_solution_in<O: Order>(
         }
     };
     // U11^T Y'^T = U21^T, with U11^-T for rcond(U11): the right-hand sides [U21^T | I].
-    let u11 = Dense::from_ref(z.submatrix(0, 0, n, n));
+    let u11 = from_faer(z.submatrix(0, 0, n, n));
     let mut factors = u11.transpose();
-    let mut combined = Dense::zeros(n, 2 * n);
+    let mut combined = DMatrix::zeros(n, 2 * n);
     for j in 0..n {
         for i in 0..n {
             combined[(i, j)] = z[(n + j, i)];
         }
         combined[(j, n + j)] = 1.0;
     }
-    solve_in_place(factors.as_mut(), combined.as_mut(), Par::Seq);
-    let inverse_transposed = Dense::from_fn(n, n, |i, j| combined[(i, n + j)]);
-    let rcond = 1.0 / (one_norm(u11.as_ref()) * one_norm(inverse_transposed.as_ref().transpose()));
+    solve_in_place(factors.as_faer_mut(), combined.as_faer_mut(), Par::Seq);
+    let inverse_transposed = DMatrix::from_fn(n, n, |i, j| combined[(i, n + j)]);
+    let rcond =
+        1.0 / (one_norm(u11.as_faer()) * one_norm(inverse_transposed.as_faer().transpose()));
     let broke_down = !combined.as_slice().iter().all(|x| x.is_finite());
     if broke_down || rcond.is_nan() || rcond <= n as f64 * f64::EPSILON {
         return Err(Error::IllConditioned {
@@ -767,14 +775,14 @@ fn hamiltonian_solution_in<O: Order>(
         });
     }
     // Undo the scalings: Y = rho D^-1 Y' D^-1, Y' the transpose of the solve's first n columns.
-    let mut y = Dense::from_fn(n, n, |i, j| {
+    let mut y = DMatrix::from_fn(n, n, |i, j| {
         rho * combined[(j, i)] * (d_inverse[i] * d_inverse[j])
     });
     y.symmetrize();
     let closed_loop = (n > KRONECKER_MAX_ORDER).then(|| ClosedLoopFactors {
-        t11: Dense::from_fn(n, n, |i, j| t[(i, j)] * t_scale),
+        t11: DMatrix::from_fn(n, n, |i, j| t[(i, j)] * t_scale),
         hessenberg: (finished == Finished::UnstableHalf).then(|| stable_eigenvalues.clone()),
-        v: Dense::from_fn(n, n, |i, j| d[i] * u11[(i, j)]),
+        v: DMatrix::from_fn(n, n, |i, j| d[i] * u11[(i, j)]),
         inverse_transposed,
         d,
     });
@@ -869,7 +877,7 @@ fn nearest_power_of_two(value: f64) -> f64 {
 /// the residual, an exact one follows.
 fn refine(
     reduced: &Reduced<'_>,
-    y: &mut Dense,
+    y: &mut DMatrix<f64>,
     evaluation: &mut Evaluation,
     mut factors: Option<ClosedLoopFactors>,
 ) -> usize {
@@ -882,11 +890,11 @@ fn refine(
             None => {
                 let closed_loop = reduced.closed_loop(&evaluation.gain);
                 lyapunov::solve(
-                    closed_loop.as_ref().transpose(),
-                    evaluation.residual.as_ref(),
+                    closed_loop.as_faer().transpose(),
+                    evaluation.residual.as_faer(),
                     Singularity::Perturb,
                 )
-                .map(|delta| Dense::from_ref(delta.as_ref()))
+                .map(|delta| from_faer(delta.as_ref()))
             }
         };
         let improved = step.ok().and_then(|delta| {
@@ -1076,15 +1084,15 @@ mod tests {
             let q = Mat::<f64>::identity(n, n);
             let r = Mat::from_fn(2, 2, |i, j| if i == j { 2.0 } else { 0.5 });
             let s = seeded(n, 2, 13) * faer::Scale(0.1);
-            let s = with_cross_term.then(|| Dense::from_ref(s.as_ref()));
+            let s = with_cross_term.then(|| from_faer(s.as_ref()));
             let (q, l) = check_problem(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref()).unwrap();
-            let (a_tilde, b_tilde) = (Dense::from_ref(a.as_ref()), Dense::from_ref(b.as_ref()));
+            let (a_tilde, b_tilde) = (from_faer(a.as_ref()), from_faer(b.as_ref()));
             let standard = standardize(&a_tilde, &b_tilde, &q, &l, s.as_ref());
             let reduced = Reduced {
                 a: a_tilde,
                 b: b_tilde,
                 q: &q,
-                q_norm: q.frobenius_norm(),
+                q_norm: frobenius_norm(q.as_faer()),
                 s: s.as_ref(),
                 l: &l,
             };
@@ -1095,10 +1103,10 @@ mod tests {
                 .expect("factors above KRONECKER_MAX_ORDER")
                 .newton_step(&evaluation.residual)
                 .unwrap()
-                .to_mat();
+                .to_faer();
             let exact = lyapunov::solve(
-                reduced.closed_loop(&evaluation.gain).as_ref().transpose(),
-                evaluation.residual.as_ref(),
+                reduced.closed_loop(&evaluation.gain).as_faer().transpose(),
+                evaluation.residual.as_faer(),
                 Singularity::Perturb,
             )
             .unwrap();

@@ -49,9 +49,10 @@
 //! R need not be positive definite (only symmetric): indefinite weights, as the H-infinity
 //! equations have, are solved where a stabilising solution exists.
 
-use super::pencil::{checked_weights, compress, graph_solution, symmetrize};
+use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
 use crate::linalg::lu::solve_with_inverse;
+use crate::linalg::matrix::Symmetrize;
 use crate::linalg::norm::{frobenius_norm, one_norm};
 use crate::linalg::qz::{generalized_eigenvalues, qz, reorder_qz};
 use crate::linalg::stein::{KRONECKER_MAX_ORDER, solve_stein_kronecker, solve_stein_smith};
@@ -265,7 +266,7 @@ fn refine(
             break;
         };
         let mut candidate = &*x + &delta;
-        symmetrize(&mut candidate);
+        candidate.symmetrize();
         let Ok(candidate_evaluation) = problem.evaluate(&candidate) else {
             break;
         };

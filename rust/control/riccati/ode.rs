@@ -39,7 +39,7 @@ use crate::control::riccati::care::check_problem;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::expm::expm;
 use crate::linalg::lu::solve_in_place;
-use crate::linalg::lyapunov::symmetrize;
+use crate::linalg::matrix::{FaerView, Symmetrize};
 use crate::linalg::schur::eigenvalues;
 use crate::platform::interrupt;
 use faer::linalg::triangular_solve::{
@@ -91,13 +91,13 @@ pub fn riccati_ode(
         }
         None => Mat::zeros(n, n),
     };
-    symmetrize(&mut s);
-    let l = l.as_ref();
+    s.symmetrize();
+    let l = l.as_faer();
     // G = B R^-1 B^T = B̂ B̂^T with B̂^T = L^-1 B^T.
     let mut b_hat_t = b.transpose().to_owned();
     solve_lower_triangular_in_place(l, b_hat_t.as_mut(), Par::Seq);
     let mut g = b_hat_t.transpose() * &b_hat_t;
-    symmetrize(&mut g);
+    g.symmetrize();
     let mut minus_h = Mat::<f64>::zeros(2 * n, 2 * n);
     for j in 0..n {
         for i in 0..n {
@@ -203,7 +203,7 @@ fn step(phi: MatRef<'_, f64>, s: &Mat<f64>) -> Result<Mat<f64>, Error> {
         });
     }
     let mut next = next.transpose().to_owned();
-    symmetrize(&mut next);
+    next.symmetrize();
     Ok(next)
 }
 

@@ -12,6 +12,7 @@ use super::care::symmetric;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::householder::reflector;
 use crate::linalg::lu::solve_with_inverse;
+use crate::linalg::matrix::{FaerView, Symmetrize};
 use crate::linalg::norm::one_norm;
 use crate::linalg::qz::GeneralizedSchur;
 use faer::{Mat, MatRef};
@@ -78,7 +79,7 @@ pub(crate) fn graph_solution(
         return None;
     }
     let mut x = xt.transpose().to_owned();
-    symmetrize(&mut x);
+    x.symmetrize();
     Some((x, rcond))
 }
 
@@ -99,8 +100,8 @@ pub(crate) fn checked_weights(
     check_rows(b, "B", n, "A")?;
     check_finite(b, "B")?;
     let m = b.ncols();
-    let q = symmetric(q, "Q", n, "A")?.to_mat();
-    let r = symmetric(r, "R", m, "the columns of B")?.to_mat();
+    let q = symmetric(q, "Q", n, "A")?.to_faer();
+    let r = symmetric(r, "R", m, "the columns of B")?.to_faer();
     if let Some(s) = s {
         check_rows(s, "S", n, "A")?;
         check_finite(s, "S")?;
@@ -120,15 +121,4 @@ pub(crate) fn checked_weights(
         check_finite(e, "E")?;
     }
     Ok((q, r))
-}
-
-/// X <- (X + X^T) / 2.
-pub(crate) fn symmetrize(x: &mut Mat<f64>) {
-    for j in 0..x.ncols() {
-        for i in 0..j {
-            let mean = 0.5 * (x[(i, j)] + x[(j, i)]);
-            x[(i, j)] = mean;
-            x[(j, i)] = mean;
-        }
-    }
 }

@@ -7,9 +7,9 @@ use crate::error::Error;
 use crate::linalg::charpoly::hessenberg_characteristic_polynomial;
 use crate::linalg::hessenberg::balanced_hessenberg;
 use crate::linalg::householder::reflector;
+use crate::linalg::matrix::{Order, Square, Transformations, with_order};
 use crate::linalg::polynomial_roots::monic_roots;
 use crate::linalg::schur::form::{block_eigenvalues, standardize_block};
-use crate::linalg::square::{Order, Square, with_order};
 use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
 use faer::c64;
@@ -200,7 +200,7 @@ pub(crate) fn francis_qr_until<O: Order>(
 ) -> Result<Finished, Error> {
     clear_upper_avx_state();
 
-    let n = h.n();
+    let n = h.nrows();
     if n == 0 {
         return Ok(Finished::Complete);
     }
@@ -458,8 +458,8 @@ pub(crate) fn shift_polynomial_column<O: Order>(
 /// order, or if the polynomial is not finite or the companion matrix's QR iteration fails.
 /// A root μ < 0 gives an estimate on the imaginary axis (Re = -0).
 pub(super) fn hamiltonian_estimates<O: Order>(h: &Square<O>) -> Vec<c64> {
-    let order = h.n() / 2;
-    if order == 0 || !h.n().is_multiple_of(2) {
+    let order = h.nrows() / 2;
+    if order == 0 || !h.nrows().is_multiple_of(2) {
         return Vec::new();
     }
     let p = hessenberg_characteristic_polynomial(h);
@@ -473,7 +473,7 @@ pub(super) fn hamiltonian_estimates<O: Order>(h: &Square<O>) -> Vec<c64> {
     let roots = match monic_roots(&q) {
         Some(roots) => Ok(roots.as_slice().to_vec()),
         None => with_order!(order, companion_order => {
-            let mut companion = Square::zeros_in(companion_order);
+            let mut companion = companion_order.zeros();
             for j in 0..order {
                 companion[(0, j)] = -q[j];
                 if j + 1 < order {

@@ -98,7 +98,9 @@ use crate::linalg::balance::range_scale;
 use crate::linalg::hessenberg::{
     UNBLOCKED_HESSENBERG_MAX_ORDER, balanced_hessenberg, hessenberg, reduce_to_hessenberg,
 };
-use crate::linalg::square::{Order, Square, with_order};
+use crate::linalg::matrix::{
+    FaerView, Order, Square, from_faer, from_faer_in, identity_in, with_order,
+};
 use faer::{MatRef, c64};
 use form::block_eigenvalues;
 use multishift::{MULTISHIFT_MIN_ORDER, schur_of_hessenberg};
@@ -115,7 +117,7 @@ pub fn real_schur(a: MatRef<'_, f64>) -> Result<RealSchur, Error> {
 pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSchur, Error> {
     check_square(a, "A")?;
     with_order!(a.nrows(), order => {
-        square_real_schur(Square::from_mat_in(order, a), spectrum, Until::Complete)
+        square_real_schur(from_faer_in(order, a), spectrum, Until::Complete)
             .map(|(schur, _)| schur)
     })
 }
@@ -132,8 +134,8 @@ pub(crate) fn square_real_schur<O: Order>(
 ) -> Result<(RealSchur, Finished), Error> {
     square_schur_form(a, spectrum, until).map(|(schur, finished)| {
         let real_schur = RealSchur {
-            t: schur.t.to_mat_scaled(schur.scale),
-            z: schur.z.to_mat(),
+            t: schur.t.to_faer_scaled(schur.scale),
+            z: schur.z.to_faer(),
         };
         (real_schur, finished)
     })
@@ -156,14 +158,14 @@ pub(crate) fn square_schur_form<O: Order>(
     spectrum: Spectrum,
     until: Until,
 ) -> Result<(SquareSchur<O>, Finished), Error> {
-    check_finite(a.as_ref(), "A")?;
-    let n = a.n();
-    let scale = range_scale(a.as_ref());
+    check_finite(a.as_faer(), "A")?;
+    let n = a.nrows();
+    let scale = range_scale(a.as_faer());
     if scale != 1.0 {
-        a.data.as_mut().iter_mut().for_each(|x| *x /= scale);
+        a.as_mut_slice().iter_mut().for_each(|x| *x /= scale);
     }
     if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
-        let mut z = Square::identity_in(a.order);
+        let mut z = identity_in(a.shape_generic().0);
         reduce_to_hessenberg(&mut a, Some(&mut z));
         // The iteration works on A / scale.
         let until = match until {
@@ -182,16 +184,13 @@ pub(crate) fn square_schur_form<O: Order>(
         )?;
         Ok((SquareSchur { t: a, z, scale }, finished))
     } else {
-        // (Above the fixed orders: O is Dynamic, and the copies back are O(n^2).)
-        let reduced = hessenberg(a.as_ref())?;
-        let (mut t, mut z) = (
-            Square::from_mat(reduced.h.as_ref()),
-            Square::from_mat(reduced.q.as_ref()),
-        );
+        // (Above the fixed orders: O is Dyn, and the copies back are O(n^2).)
+        let reduced = hessenberg(a.as_faer())?;
+        let (mut t, mut z) = (from_faer(reduced.h.as_ref()), from_faer(reduced.q.as_ref()));
         schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
         let (t, z) = (
-            Square::from_mat_in(a.order, t.as_ref()),
-            Square::from_mat_in(a.order, z.as_ref()),
+            from_faer_in(a.shape_generic().0, t.as_faer()),
+            from_faer_in(a.shape_generic().0, z.as_faer()),
         );
         Ok((SquareSchur { t, z, scale }, Finished::Complete))
     }
@@ -231,12 +230,12 @@ fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c6
     };
     if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         with_order!(n, order => {
-            let (mut h, scale) = balanced_hessenberg(Square::from_mat_in(order, a));
+            let (mut h, scale) = balanced_hessenberg(from_faer_in(order, a));
             francis_qr(&mut h, None, (0, n.saturating_sub(1)), false, unscaled(scale))?;
             Ok(block_eigenvalues(n, |i, j| h[(i, j)] * scale))
         })
     } else {
-        let (mut h, scale) = balanced_hessenberg(Square::from_mat(a));
+        let (mut h, scale) = balanced_hessenberg(from_faer(a));
         schur_of_hessenberg(&mut h, None, false, unscaled(scale))?;
         Ok(block_eigenvalues(n, |i, j| h[(i, j)] * scale))
     }
@@ -247,11 +246,11 @@ mod tests {
     use super::francis::{Mirrors, hamiltonian_estimates};
     use super::*;
     use crate::linalg::hessenberg::hessenberg_matrix;
-    use crate::linalg::square::Dynamic;
     use crate::test_matrices::{lateral_747, lateral_747_inputs};
     use faer::Mat;
     use faer::linalg::solvers::DenseSolveCore;
     use faer::mat;
+    use nalgebra::Dyn;
 
     use crate::test_matrices::seeded_square as seeded;
 
@@ -307,7 +306,7 @@ mod tests {
     /// for the multishift iteration.
     fn double_shift_eigenvalues(a: &Mat<f64>) -> Vec<c64> {
         let n = a.nrows();
-        let mut h = Square::from_mat(hessenberg_matrix(a.as_ref()).as_ref());
+        let mut h = from_faer(hessenberg_matrix(a.as_ref()).as_ref());
         francis_qr(&mut h, None, (0, n - 1), false, Spectrum::General).unwrap();
         block_eigenvalues(n, |i, j| h[(i, j)])
     }
@@ -670,7 +669,7 @@ mod tests {
         for n in [1usize, 2, 3, 4, 6] {
             for seed in 0..6 {
                 let h = seeded_hamiltonian(n, seed);
-                let mut hessenberg = Square::from_mat(h.as_ref());
+                let mut hessenberg = from_faer(h.as_ref());
                 reduce_to_hessenberg(&mut hessenberg, None);
                 let estimates = hamiltonian_estimates(&hessenberg);
                 let stable: Vec<c64> = eigenvalues(h.as_ref())
@@ -687,7 +686,7 @@ mod tests {
         }
         // Odd orders are not Hamiltonian (the polynomial of I_3 is not even; read as one it
         // would give an estimate).
-        assert!(hamiltonian_estimates(&Square::identity(3)).is_empty());
+        assert!(hamiltonian_estimates(&nalgebra::DMatrix::<f64>::identity(3, 3)).is_empty());
     }
 
     /// The Hamiltonian [[A, G], [Q, -A^T]] of order 2n from its blocks.
@@ -724,7 +723,7 @@ mod tests {
             _ => 0.0,
         });
         let h = rotation.transpose() * hamiltonian(&a, &g, &q) * &rotation;
-        let mut hessenberg = Square::from_mat(h.as_ref());
+        let mut hessenberg = from_faer(h.as_ref());
         reduce_to_hessenberg(&mut hessenberg, None);
         let mirrors = Mirrors::for_spectrum(Spectrum::Hamiltonian, Some(&hessenberg)).unwrap();
         assert_eq!(mirrors.pending.len(), 2, "{:?}", mirrors.pending);
@@ -818,7 +817,7 @@ mod tests {
             let what = format!("n={n} seed={seed} {spectrum:?}");
             let margin = crate::control::riccati::care::AXIS_TOLERANCE * h.norm_l2();
             let (schur, finished) = with_order!(2 * n, order => square_real_schur(
-                Square::from_mat_in(order, h.as_ref()),
+                from_faer_in(order, h.as_ref()),
                 spectrum,
                 Until::UnstableHalf { margin },
             ))
@@ -964,7 +963,7 @@ mod tests {
 
     #[test]
     fn mirror_images_are_paired_off() {
-        let mut mirrors = Mirrors::for_spectrum::<Dynamic>(Spectrum::Hamiltonian, None).unwrap();
+        let mut mirrors = Mirrors::for_spectrum::<Dyn>(Spectrum::Hamiltonian, None).unwrap();
         let trailing = |a: f64, b: f64| [c64::new(a, b), c64::new(a, -b)];
         mirrors.found(c64::new(0.5, 0.0));
         mirrors.found(c64::new(-0.3, 0.8));

@@ -54,12 +54,12 @@
 use crate::error::Error;
 use crate::linalg::hessenberg::hessenberg;
 use crate::linalg::householder::reflector;
+use crate::linalg::matrix::{FaerView, Square};
 use crate::linalg::schur::form::{block_eigenvalues, quasi_triangular_eigenvalues};
 use crate::linalg::schur::francis::{
     Spectrum, double_shift, francis_qr, negligible_subdiagonal, shift_polynomial_column,
 };
 use crate::linalg::schur::reorder::swap_blocks;
-use crate::linalg::square::Square;
 use crate::platform::dispatch::{clear_upper_avx_state, fma_dispatch, multiply_add};
 use crate::platform::interrupt;
 use faer::linalg::matmul::matmul;
@@ -86,8 +86,8 @@ pub(crate) fn schur_of_hessenberg(
     full: bool,
     spectrum: Spectrum,
 ) -> Result<(), Error> {
-    if h.n() < MULTISHIFT_MIN_ORDER {
-        francis_qr(h, z, (0, h.n().saturating_sub(1)), full, spectrum)
+    if h.nrows() < MULTISHIFT_MIN_ORDER {
+        francis_qr(h, z, (0, h.nrows().saturating_sub(1)), full, spectrum)
     } else {
         multishift_qr(h, z, full)
     }
@@ -143,7 +143,7 @@ pub(crate) fn multishift_qr(
     mut z: Option<&mut Square>,
     full: bool,
 ) -> Result<(), Error> {
-    let n = h.n();
+    let n = h.nrows();
     let small = f64::MIN_POSITIVE * (n as f64 / f64::EPSILON);
     let nominal_shifts = shift_count(n);
     // The deflation window has as many rows as the sweep has shifts. (LAPACK's iparmq makes it
@@ -249,13 +249,13 @@ fn finish_small_block(
     full: bool,
     (ktop, kbot): (usize, usize),
 ) -> Result<(), Error> {
-    let n = h.n();
+    let n = h.nrows();
     let order = kbot + 1 - ktop;
     if !full || order == n {
         return francis_qr(h, z, (ktop, kbot), full, Spectrum::General);
     }
     let mut block = hessenberg_block(h, ktop, order);
-    let mut v = Square::identity(order);
+    let mut v = nalgebra::DMatrix::<f64>::identity(order, order);
     francis_qr(
         &mut block,
         Some(&mut v),
@@ -268,7 +268,7 @@ fn finish_small_block(
             h[(ktop + r, ktop + c)] = block[(r, c)];
         }
     }
-    let v = MatRef::from_column_major_slice(&v.data, order, order);
+    let v = MatRef::from_column_major_slice(v.as_slice(), order, order);
     apply_outside_window(h, z, (0, n - 1), (ktop, kbot), v, &mut Vec::new());
     clear_upper_avx_state();
     Ok(())
@@ -277,7 +277,7 @@ fn finish_small_block(
 /// A copy of the diagonal block of `h` of the given order from row and column `top`, with the
 /// entries below its subdiagonal zero.
 fn hessenberg_block(h: &Square, top: usize, order: usize) -> Square {
-    let mut block = Square::identity(order);
+    let mut block = nalgebra::DMatrix::<f64>::identity(order, order);
     for c in 0..order {
         block[(c, c)] = 0.0;
         for r in 0..=(c + 1).min(order - 1) {
@@ -313,7 +313,7 @@ fn aggressive_early_deflation(
     (ktop, kbot): (usize, usize),
     window: usize,
 ) -> Result<EarlyDeflation, Error> {
-    let n = h.n();
+    let n = h.nrows();
     let top = kbot + 1 - window;
     debug_assert!(
         top > ktop,
@@ -321,7 +321,7 @@ fn aggressive_early_deflation(
     );
     let spike = h[(top, top - 1)];
     let mut t = hessenberg_block(h, top, window);
-    let mut v = Square::identity(window);
+    let mut v = nalgebra::DMatrix::<f64>::identity(window, window);
     if schur_of_hessenberg(&mut t, Some(&mut v), true, Spectrum::General).is_err() {
         // The window's iteration failed: no deflation this time (H is untouched), and the
         // shifts come from elsewhere.
@@ -330,7 +330,7 @@ fn aggressive_early_deflation(
             shifts: Vec::new(),
         });
     }
-    let (mut t, mut v) = (t.to_mat(), v.to_mat());
+    let (mut t, mut v) = (t.to_faer(), v.to_faer());
     clear_upper_avx_state();
 
     // The scan from the bottom: t[..unjudged] is not yet judged, and of it t[..undeflated]
@@ -456,9 +456,9 @@ fn apply_outside_window(
     u: MatRef<'_, f64>,
     scratch: &mut Vec<f64>,
 ) {
-    let n = h.n();
+    let n = h.nrows();
     let w = w1 + 1 - w0;
-    let mut full_h = MatMut::from_column_major_slice_mut(&mut h.data, n, n);
+    let mut full_h = MatMut::from_column_major_slice_mut(h.as_mut_slice(), n, n);
     if w0 > first {
         multiply_on_the_right(
             full_h.as_mut().submatrix_mut(first, w0, w0 - first, w),
@@ -483,8 +483,8 @@ fn apply_outside_window(
         );
     }
     if let Some(z) = z {
-        let rows = z.n();
-        let mut full_z = MatMut::from_column_major_slice_mut(&mut z.data, rows, rows);
+        let rows = z.nrows();
+        let mut full_z = MatMut::from_column_major_slice_mut(z.as_mut_slice(), rows, rows);
         multiply_on_the_right(full_z.as_mut().submatrix_mut(0, w0, rows, w), u, scratch);
     }
 }
@@ -515,7 +515,7 @@ fn small_bulge_sweep(
     (ktop, kbot): (usize, usize),
     shifts: &[(c64, c64)],
 ) {
-    let n = h.n();
+    let n = h.nrows();
     if shifts.is_empty() || kbot < ktop + 2 {
         return;
     }
@@ -539,9 +539,9 @@ fn small_bulge_sweep(
         let w0 = if p_top > ktop { p_top - 1 } else { ktop };
         let w1 = (p_bottom + 3).min(kbot);
         let w = w1 + 1 - w0;
-        let mut u = Square::identity(w);
+        let mut u = nalgebra::DMatrix::<f64>::identity(w, w);
         chase_slab(h, &mut u, &chain, (t0, t1), (w0, w1), &mut reflectors);
-        let u = MatRef::from_column_major_slice(&u.data, w, w);
+        let u = MatRef::from_column_major_slice(u.as_slice(), w, w);
         apply_outside_window(h, z.as_deref_mut(), outside, (w0, w1), u, &mut scratch);
         t0 = t1 + 1;
     }
@@ -610,8 +610,8 @@ fn chase_slab_kernel<const FMA: bool>(
     reflectors: &mut Vec<StepReflector>,
 ) {
     let (ktop, kbot) = (chain.ktop, chain.kbot);
-    let n = h.n();
-    let w = u.n();
+    let n = h.nrows();
+    let w = u.nrows();
     // The rows of U below this one are still those of the identity.
     let mut u_rows_end = 0;
     for t in t0..=t1 {
@@ -659,7 +659,7 @@ fn chase_slab_kernel<const FMA: bool>(
         };
         // From the left, column by column: the reflectors with p <= j, the highest first.
         for j in top.p..=w1 {
-            let column = &mut h.data[j * n..(j + 1) * n];
+            let column = &mut h.as_mut_slice()[j * n..(j + 1) * n];
             for r in reflectors.iter().rev().take_while(|r| r.p <= j) {
                 reflect_entries::<FMA>(column, r);
             }
@@ -668,8 +668,14 @@ fn chase_slab_kernel<const FMA: bool>(
         u_rows_end = u_rows_end.max((bottom.p + 3 - w0).min(w));
         for r in reflectors.iter() {
             let rows = w0..(r.p + 3).min(kbot) + 1;
-            reflect_columns::<FMA>(&mut h.data, n, r.p, r, rows);
-            reflect_columns::<FMA>(&mut u.data, w, r.p - w0, r, r.first_row_of_u..u_rows_end);
+            reflect_columns::<FMA>(h.as_mut_slice(), n, r.p, r, rows);
+            reflect_columns::<FMA>(
+                u.as_mut_slice(),
+                w,
+                r.p - w0,
+                r,
+                r.first_row_of_u..u_rows_end,
+            );
         }
     }
 }
