@@ -63,10 +63,10 @@
 use crate::control::modal::eigen;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::{range_scale, scale_for_largest};
+use crate::linalg::dense::view_product;
 use crate::linalg::householder::reflector;
 use crate::linalg::norm::{frobenius_norm, max_abs, vector_norm};
 use crate::linalg::schur::eigenvalues;
-use crate::linalg::small_matrix::product;
 use faer::linalg::matmul::matmul;
 use faer::prelude::{IntoConst, Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par, c64};
@@ -117,7 +117,7 @@ pub(crate) fn krylov_blocks(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> 
         let previous = previous.into_const().subcols((k - 1) * m, m);
         next.as_mut()
             .subcols_mut(0, m)
-            .copy_from(product(a, previous));
+            .copy_from(view_product(a, previous));
     }
     v
 }

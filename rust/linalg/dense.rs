@@ -8,16 +8,49 @@
 //! column lengths known at compile time where [`with_order!`] finds one; large ones lend the
 //! matrices to faer as views (no copy) for its blocked kernels.
 
+use faer::{Mat, MatRef};
 use nalgebra::DMatrix;
 
 use crate::linalg::matrix::{FaerView, from_faer, with_order};
 
 /// Products of at most this many multiply-adds are plain loops, larger ones faer's blocked
-/// kernel (as [`crate::linalg::small_matrix::product`]).
+/// kernel (as [`view_product`]).
 const LOOP_PRODUCT_MAX_WORK: usize = 16 * 16 * 16;
 
+/// lhs * rhs for matrices of any (conforming) shapes and strides: a plain column-by-column
+/// loop when the product is small (the Riccati and Lyapunov solvers form a dozen products of
+/// order n and m at n = 4), faer's blocked kernel otherwise.
+pub fn view_product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
+    let (rows, inner, cols) = (lhs.nrows(), lhs.ncols(), rhs.ncols());
+    debug_assert_eq!(inner, rhs.nrows());
+    if rows * inner * cols > LOOP_PRODUCT_MAX_WORK {
+        return lhs * rhs;
+    }
+    let mut out = Mat::<f64>::zeros(rows, cols);
+    for j in 0..cols {
+        let column = out.col_as_slice_mut(j);
+        for k in 0..inner {
+            let coefficient = rhs[(k, j)];
+            // Contiguous columns (faer's own matrices) as slices: no per-entry index checks.
+            match lhs.col(k).try_as_col_major() {
+                Some(lhs_column) => {
+                    for (entry, x) in column.iter_mut().zip(lhs_column.as_slice()) {
+                        *entry += x * coefficient;
+                    }
+                }
+                None => {
+                    for (i, entry) in column.iter_mut().enumerate() {
+                        *entry += lhs[(i, k)] * coefficient;
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
 /// lhs * rhs. Each entry of a small product is the sum over k, in order, of
-/// lhs[i, k] rhs[k, j], as [`crate::linalg::small_matrix::product`] forms it.
+/// lhs[i, k] rhs[k, j], as [`view_product`] forms it.
 pub(crate) fn product(lhs: &DMatrix<f64>, rhs: &DMatrix<f64>) -> DMatrix<f64> {
     let (rows, inner, cols) = (lhs.nrows(), lhs.ncols(), rhs.ncols());
     debug_assert_eq!(inner, rhs.nrows());
@@ -281,7 +314,7 @@ mod tests {
     #[test]
     fn small_products_round_like_the_faer_matrix_product_loop() {
         let (a, b) = (seeded(4, 4, 3), seeded(4, 2, 4));
-        let expected = crate::linalg::small_matrix::product(a.as_ref(), b.as_ref());
+        let expected = view_product(a.as_ref(), b.as_ref());
         let found = product(&from_faer(a.as_ref()), &from_faer(b.as_ref()));
         assert_eq!(found.to_faer(), expected);
         let found = transposed_product(&from_faer(a.transpose()), &from_faer(b.as_ref()));

@@ -31,9 +31,9 @@
 
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::range_scale;
+use crate::linalg::dense::view_product;
 use crate::linalg::matrix::{FaerView, Symmetrize, from_faer};
 use crate::linalg::schur::real_schur;
-use crate::linalg::small_matrix::product;
 use crate::linalg::sylvester::solve_small_sylvester;
 use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
@@ -91,12 +91,12 @@ pub(crate) fn solve(
     }
     let schur = real_schur(a)?;
     let (t, z) = (schur.t.as_ref(), schur.z.as_ref());
-    let mut f = from_faer(product(product(z.transpose(), q).as_ref(), z).as_ref());
+    let mut f = from_faer(view_product(view_product(z.transpose(), q).as_ref(), z).as_ref());
     for x in f.as_mut_slice() {
         *x = -*x;
     }
     let y = solve_quasi_triangular(&from_faer(t), f, singularity)?;
-    let mut x = product(product(z, y.as_faer()).as_ref(), z.transpose());
+    let mut x = view_product(view_product(z, y.as_faer()).as_ref(), z.transpose());
     if is_symmetric(q) {
         x.symmetrize();
     }

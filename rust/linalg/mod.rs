@@ -1,7 +1,9 @@
 //! Numerical kernels, knowing nothing of control: they take matrices and return matrices.
 //!
-//! * [`small_matrix`], `dense`: matrices of the small orders of flight models, on the stack or
-//!   in plain vectors, for kernels whose arithmetic is cheaper than a general library's call.
+//! * `matrix`: the one matrix type of the small-order kernels (nalgebra's, with the order a
+//!   compile-time constant or known at run time) and the one dispatch between them;
+//!   `small_matrix` and `dense`: products, solves and factorisations on it, for kernels whose
+//!   arithmetic is cheaper than a general library's call.
 //! * [`lu`]: linear solves by LU with partial pivoting.
 //! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
 //! * [`hessenberg`]: the Hessenberg form and its transformation.
@@ -29,7 +31,7 @@ pub(crate) mod polynomial_roots;
 pub mod qz;
 pub(crate) mod rotation;
 pub mod schur;
-pub mod small_matrix;
+pub(crate) mod small_matrix;
 
 pub mod stein;
 pub(crate) mod sylvester;

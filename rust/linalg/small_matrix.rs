@@ -1,91 +1,115 @@
-//! Square matrices of a fixed small order N, on the stack.
+//! Kernels on nalgebra's `SMatrix<f64, N, N>` (a [`crate::linalg::matrix::Square`] of a
+//! fixed order, on the stack): products, linear combinations, an LU solve and norms, for the
+//! matrix exponential's Padé evaluation at the orders of flight models.
 //!
 //! Flight-dynamics models are small (4 states for each of the longitudinal and lateral motions,
-//! 8 to 12 for coupled or augmented models), and many algorithms here run thousands of them in
-//! a sweep. At these orders the cost of a general-order library call (dispatch, allocation,
-//! blocking decisions) exceeds the arithmetic: a 4 x 4 product costs 23 ns through faer and
-//! 7 ns as a fixed-size loop. This type gives the compiler constant trip counts, so its loops
-//! unroll and vectorise, and it allocates nothing. Larger orders use faer.
+//! 8 to 12 for coupled or augmented models), and the exponential runs thousands of them in a
+//! sweep. At these orders the cost of a general-order library call (dispatch, allocation,
+//! blocking decisions) exceeds the arithmetic; with the order a constant the loops unroll and
+//! vectorise, and nothing is allocated. Larger orders use faer.
 //!
-//! Each kernel is compiled twice: for the baseline target and, on x86-64, for AVX2 with fused
-//! multiply-add, chosen at run time by the CPU's features (see `dispatch.rs`), so that one
-//! portable wheel runs at full speed on current CPUs. (Fused multiply-adds round once instead of
-//! twice, so the two variants can differ in the last bit.)
+//! The kernels are free functions, not methods, so that none is confused with nalgebra's own
+//! `product` (of the entries) or `lu`. They read the storage as its N columns of N entries
+//! (`columns[j][i]` = a_ij). Each is compiled twice: for the baseline target and, on x86-64,
+//! for AVX2 with fused multiply-add, chosen at run time by the CPU's features (see
+//! `dispatch.rs`), so that one portable wheel runs at full speed on current CPUs. (Fused
+//! multiply-adds round once instead of twice, so the two variants can differ in the last bit.)
 //!
-//! Storage is row-major, `rows[i][j]` = a_ij. The LU solve uses partial pivoting and divides
-//! by the pivots (as LAPACK's dgetrs does) rather than multiplying by reciprocals.
+//! The LU solve uses partial pivoting and divides by the pivots (as LAPACK's dgetrs does)
+//! rather than multiplying by reciprocals.
 
-use faer::{Mat, MatRef};
+use nalgebra::SMatrix;
 
 use crate::platform::dispatch::{fma_dispatch, multiply_add};
 
-type Rows<const N: usize> = [[f64; N]; N];
+/// The storage of an N x N matrix: N columns of N entries.
+type Columns<const N: usize> = [[f64; N]; N];
 
-/// out += lhs * rhs, each row of the result a sum of scaled rows of rhs.
+/// The columns of `m`.
+#[inline(always)]
+pub(crate) fn columns<const N: usize>(m: &SMatrix<f64, N, N>) -> &Columns<N> {
+    &m.data.0
+}
+
+/// The columns of `m`, mutably.
+#[inline(always)]
+pub(crate) fn columns_mut<const N: usize>(m: &mut SMatrix<f64, N, N>) -> &mut Columns<N> {
+    &mut m.data.0
+}
+
+/// The matrix whose columns are `columns`.
+#[inline(always)]
+pub(crate) fn from_columns<const N: usize>(columns: Columns<N>) -> SMatrix<f64, N, N> {
+    SMatrix::from_data(nalgebra::ArrayStorage(columns))
+}
+
+/// out += lhs * rhs: column j of the result gains rhs_kj times column k of lhs, k in order
+/// (each entry the sum over k, in order, of lhs_ik rhs_kj).
 #[inline(always)]
 fn add_product_kernel<const N: usize, const FMA: bool>(
-    lhs: &Rows<N>,
-    rhs: &Rows<N>,
-    out: &mut Rows<N>,
+    lhs: &Columns<N>,
+    rhs: &Columns<N>,
+    out: &mut Columns<N>,
 ) {
-    for (out_row, lhs_row) in out.iter_mut().zip(lhs) {
-        for (&coefficient, rhs_row) in lhs_row.iter().zip(rhs) {
-            for (o, &r) in out_row.iter_mut().zip(rhs_row) {
-                *o = multiply_add::<FMA>(coefficient, r, *o);
+    for (out_column, rhs_column) in out.iter_mut().zip(rhs) {
+        for (&coefficient, lhs_column) in rhs_column.iter().zip(lhs) {
+            for (o, &x) in out_column.iter_mut().zip(lhs_column) {
+                *o = multiply_add::<FMA>(x, coefficient, *o);
             }
         }
     }
 }
 
-fma_dispatch!(fn add_product<const N: usize>(lhs: &Rows<N>, rhs: &Rows<N>, out: &mut Rows<N>) => add_product_kernel);
+fma_dispatch!(fn add_product_columns<const N: usize>(lhs: &Columns<N>, rhs: &Columns<N>, out: &mut Columns<N>) => add_product_kernel);
 
 /// identity * I + sum_k coefficient_k * M_k.
 #[inline(always)]
 fn combination_kernel<const N: usize, const FMA: bool>(
     identity: f64,
-    terms: &[(f64, &SmallMatrix<N>)],
-) -> Rows<N> {
+    terms: &[(f64, &SMatrix<f64, N, N>)],
+) -> Columns<N> {
     let (&(first_coefficient, first), rest) = terms.split_first().expect("at least one term");
     let mut out = [[0.0; N]; N];
-    for (out_row, row) in out.iter_mut().zip(&first.rows) {
-        for (o, &v) in out_row.iter_mut().zip(row) {
+    for (out_column, column) in out.iter_mut().zip(columns(first)) {
+        for (o, &v) in out_column.iter_mut().zip(column) {
             *o = first_coefficient * v;
         }
     }
     for &(coefficient, m) in rest {
-        for (out_row, row) in out.iter_mut().zip(&m.rows) {
-            for (o, &v) in out_row.iter_mut().zip(row) {
+        for (out_column, column) in out.iter_mut().zip(columns(m)) {
+            for (o, &v) in out_column.iter_mut().zip(column) {
                 *o = multiply_add::<FMA>(coefficient, v, *o);
             }
         }
     }
-    for (i, row) in out.iter_mut().enumerate() {
-        row[i] += identity;
+    for (i, column) in out.iter_mut().enumerate() {
+        column[i] += identity;
     }
     out
 }
 
-fma_dispatch!(fn combination<const N: usize>(identity: f64, terms: &[(f64, &SmallMatrix<N>)]) -> Rows<N> => combination_kernel);
+fma_dispatch!(fn combination_columns<const N: usize>(identity: f64, terms: &[(f64, &SMatrix<f64, N, N>)]) -> Columns<N> => combination_kernel);
 
-/// ||(|A| / scale)^p||_1 by p row-vector products (for B >= 0, ||B^p||_1 = max 1^T B^p).
+/// ||(|A| / scale)^p||_1 by p row-vector products (for B >= 0, ||B^p||_1 = max 1^T B^p):
+/// entry j of the next row vector is the sum over i, in order, of v_i b_ij.
 #[inline(always)]
 fn absolute_power_norm_kernel<const N: usize, const FMA: bool>(
-    a: &Rows<N>,
+    a: &Columns<N>,
     scale: f64,
     p: usize,
 ) -> f64 {
     let inverse = 1.0 / scale;
     let mut b = [[0.0; N]; N];
-    for (b_row, row) in b.iter_mut().zip(a) {
-        for (x, value) in b_row.iter_mut().zip(row) {
+    for (b_column, column) in b.iter_mut().zip(a) {
+        for (x, value) in b_column.iter_mut().zip(column) {
             *x = value.abs() * inverse;
         }
     }
     let mut vector = [1.0; N];
     for _ in 0..p {
         let mut next = [0.0; N];
-        for (&weight, b_row) in vector.iter().zip(&b) {
-            for (n, &x) in next.iter_mut().zip(b_row) {
+        for (n, b_column) in next.iter_mut().zip(&b) {
+            for (&weight, &x) in vector.iter().zip(b_column) {
                 *n = multiply_add::<FMA>(weight, x, *n);
             }
         }
@@ -94,293 +118,207 @@ fn absolute_power_norm_kernel<const N: usize, const FMA: bool>(
     vector.into_iter().fold(0.0, f64::max)
 }
 
-fma_dispatch!(fn absolute_power_norm<const N: usize>(a: &Rows<N>, scale: f64, p: usize) -> f64 => absolute_power_norm_kernel);
+fma_dispatch!(fn absolute_power_norm_columns<const N: usize>(a: &Columns<N>, scale: f64, p: usize) -> f64 => absolute_power_norm_kernel);
 
 /// Gaussian elimination with partial pivoting in place: the unit lower factor below the
 /// diagonal, the upper factor on and above it; row k was swapped with row `pivots[k]`.
 #[inline(always)]
-fn lu_kernel<const N: usize, const FMA: bool>(a: &mut Rows<N>, pivots: &mut [usize; N]) {
+fn lu_kernel<const N: usize, const FMA: bool>(a: &mut Columns<N>, pivots: &mut [usize; N]) {
     for k in 0..N {
         let mut pivot_row = k;
         for i in k + 1..N {
-            if a[i][k].abs() > a[pivot_row][k].abs() {
+            if a[k][i].abs() > a[k][pivot_row].abs() {
                 pivot_row = i;
             }
         }
         pivots[k] = pivot_row;
-        a.swap(k, pivot_row);
-        let pivot = a[k][k];
-        let (upper, lower) = a.split_at_mut(k + 1);
-        let pivot_row_values = &upper[k];
-        for row in lower.iter_mut() {
-            let factor = row[k] / pivot;
-            row[k] = factor;
-            for j in k + 1..N {
-                row[j] = multiply_add::<FMA>(-factor, pivot_row_values[j], row[j]);
+        for column in a.iter_mut() {
+            column.swap(k, pivot_row);
+        }
+        let (done, rest) = a.split_at_mut(k + 1);
+        let pivot_column = &mut done[k];
+        let pivot = pivot_column[k];
+        for factor in &mut pivot_column[k + 1..] {
+            *factor /= pivot;
+        }
+        for column in rest.iter_mut() {
+            let pivot_row_value = column[k];
+            for (x, &factor) in column[k + 1..].iter_mut().zip(&pivot_column[k + 1..]) {
+                *x = multiply_add::<FMA>(-factor, pivot_row_value, *x);
             }
         }
     }
 }
 
-fma_dispatch!(fn lu_in_place<const N: usize>(a: &mut Rows<N>, pivots: &mut [usize; N]) => lu_kernel);
+fma_dispatch!(fn lu_in_place<const N: usize>(a: &mut Columns<N>, pivots: &mut [usize; N]) => lu_kernel);
 
-/// Solves with the factors of [`lu_kernel`] for N right-hand sides in place.
+/// Solves with the factors of [`lu_kernel`] for N right-hand sides in place, column by column.
 #[inline(always)]
 fn lu_solve_kernel<const N: usize, const FMA: bool>(
-    lu: &Rows<N>,
+    lu: &Columns<N>,
     pivots: &[usize; N],
-    rhs: &mut Rows<N>,
+    rhs: &mut Columns<N>,
 ) {
-    for (k, &pivot_row) in pivots.iter().enumerate() {
-        rhs.swap(k, pivot_row);
-    }
-    // Forward substitution with the unit lower factor.
-    for k in 0..N {
-        let (done, rest) = rhs.split_at_mut(k + 1);
-        let solved = &done[k];
-        for (i, row) in rest.iter_mut().enumerate() {
-            let factor = lu[k + 1 + i][k];
-            for (x, &s) in row.iter_mut().zip(solved) {
-                *x = multiply_add::<FMA>(-factor, s, *x);
+    for x in rhs.iter_mut() {
+        for (k, &pivot_row) in pivots.iter().enumerate() {
+            x.swap(k, pivot_row);
+        }
+        // Forward substitution with the unit lower factor.
+        for k in 0..N {
+            let solved = x[k];
+            for (entry, &factor) in x[k + 1..].iter_mut().zip(&lu[k][k + 1..]) {
+                *entry = multiply_add::<FMA>(-factor, solved, *entry);
             }
         }
-    }
-    // Back substitution with the upper factor, dividing by each pivot.
-    for k in (0..N).rev() {
-        let pivot = lu[k][k];
-        for x in &mut rhs[k] {
-            *x /= pivot;
-        }
-        let (above, from_k) = rhs.split_at_mut(k);
-        let solved = &from_k[0];
-        for (i, row) in above.iter_mut().enumerate() {
-            let factor = lu[i][k];
-            for (x, &s) in row.iter_mut().zip(solved) {
-                *x = multiply_add::<FMA>(-factor, s, *x);
+        // Back substitution with the upper factor, dividing by each pivot.
+        for k in (0..N).rev() {
+            x[k] /= lu[k][k];
+            let solved = x[k];
+            for (entry, &factor) in x[..k].iter_mut().zip(&lu[k][..k]) {
+                *entry = multiply_add::<FMA>(-factor, solved, *entry);
             }
         }
     }
 }
 
-fma_dispatch!(fn lu_solve<const N: usize>(lu: &Rows<N>, pivots: &[usize; N], rhs: &mut Rows<N>) => lu_solve_kernel);
+fma_dispatch!(fn lu_solve_columns<const N: usize>(lu: &Columns<N>, pivots: &[usize; N], rhs: &mut Columns<N>) => lu_solve_kernel);
 
-/// Products of at most this many multiply-adds are formed by [`product`]'s plain loop: below
-/// it faer's dispatch and blocking decisions cost more than the arithmetic.
-const LOOP_PRODUCT_MAX_WORK: usize = 16 * 16 * 16;
-
-/// lhs * rhs for matrices of any (conforming) shapes and strides: a plain column-by-column
-/// loop when the product is small (the Riccati and Lyapunov solvers form a dozen products of
-/// order n and m at n = 4), faer's blocked kernel otherwise.
-pub fn product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
-    let (rows, inner, cols) = (lhs.nrows(), lhs.ncols(), rhs.ncols());
-    debug_assert_eq!(inner, rhs.nrows());
-    if rows * inner * cols > LOOP_PRODUCT_MAX_WORK {
-        return lhs * rhs;
-    }
-    let mut out = Mat::<f64>::zeros(rows, cols);
-    for j in 0..cols {
-        let column = out.col_as_slice_mut(j);
-        for k in 0..inner {
-            let coefficient = rhs[(k, j)];
-            // Contiguous columns (faer's own matrices) as slices: no per-entry index checks.
-            match lhs.col(k).try_as_col_major() {
-                Some(lhs_column) => {
-                    for (entry, x) in column.iter_mut().zip(lhs_column.as_slice()) {
-                        *entry += x * coefficient;
-                    }
-                }
-                None => {
-                    for (i, entry) in column.iter_mut().enumerate() {
-                        *entry += lhs[(i, k)] * coefficient;
-                    }
-                }
-            }
-        }
-    }
+/// lhs * rhs.
+pub(crate) fn product<const N: usize>(
+    lhs: &SMatrix<f64, N, N>,
+    rhs: &SMatrix<f64, N, N>,
+) -> SMatrix<f64, N, N> {
+    let mut out = SMatrix::zeros();
+    add_product(&mut out, lhs, rhs);
     out
 }
 
-/// An N x N matrix stored on the stack, row-major.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SmallMatrix<const N: usize> {
-    pub rows: [[f64; N]; N],
+/// out += lhs * rhs.
+pub(crate) fn add_product<const N: usize>(
+    out: &mut SMatrix<f64, N, N>,
+    lhs: &SMatrix<f64, N, N>,
+    rhs: &SMatrix<f64, N, N>,
+) {
+    add_product_columns(columns(lhs), columns(rhs), columns_mut(out));
 }
 
-impl<const N: usize> SmallMatrix<N> {
-    /// The zero matrix.
-    pub const fn zeros() -> Self {
-        Self {
-            rows: [[0.0; N]; N],
-        }
-    }
-
-    /// The identity matrix.
-    pub fn identity() -> Self {
-        let mut m = Self::zeros();
-        for i in 0..N {
-            m.rows[i][i] = 1.0;
-        }
-        m
-    }
-
-    /// Copies an N x N faer matrix (any strides).
-    pub fn from_ref(a: MatRef<'_, f64>) -> Self {
-        debug_assert_eq!((a.nrows(), a.ncols()), (N, N));
-        let mut m = Self::zeros();
-        for i in 0..N {
-            for j in 0..N {
-                m.rows[i][j] = a[(i, j)];
-            }
-        }
-        m
-    }
-
-    /// A new faer matrix holding the same values.
-    pub fn to_mat(&self) -> Mat<f64> {
-        Mat::from_fn(N, N, |i, j| self.rows[i][j])
-    }
-
-    /// self * rhs.
-    pub fn product(&self, rhs: &Self) -> Self {
-        let mut out = Self::zeros();
-        add_product(&self.rows, &rhs.rows, &mut out.rows);
-        out
-    }
-
-    /// self += lhs * rhs.
-    pub fn add_product(&mut self, lhs: &Self, rhs: &Self) {
-        add_product(&lhs.rows, &rhs.rows, &mut self.rows);
-    }
-
-    /// identity * I + sum_k coefficient_k * M_k, for at least one term.
-    pub fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
-        Self {
-            rows: combination(identity, terms),
-        }
-    }
-
-    /// Whether every entry below the diagonal is zero.
-    pub fn is_upper_triangular(&self) -> bool {
-        self.rows
-            .iter()
-            .enumerate()
-            .all(|(i, row)| row[..i].iter().all(|&v| v == 0.0))
-    }
-
-    /// Whether every entry above the diagonal is zero.
-    pub fn is_lower_triangular(&self) -> bool {
-        self.rows
-            .iter()
-            .enumerate()
-            .all(|(i, row)| row[i + 1..].iter().all(|&v| v == 0.0))
-    }
-
-    /// The transpose.
-    pub fn transpose(&self) -> Self {
-        let mut t = Self::zeros();
-        for (i, row) in self.rows.iter().enumerate() {
-            for (j, &value) in row.iter().enumerate() {
-                t.rows[j][i] = value;
-            }
-        }
-        t
-    }
-
-    /// The 1-norm, max_j sum_i |a_ij|.
-    pub fn one_norm(&self) -> f64 {
-        let mut sums = [0.0; N];
-        for row in &self.rows {
-            for (sum, value) in sums.iter_mut().zip(row) {
-                *sum += value.abs();
-            }
-        }
-        sums.into_iter().fold(0.0, f64::max)
-    }
-
-    /// ||(|A| / scale)^p||_1 by p row-vector products (for B >= 0, ||B^p||_1 = max 1^T B^p).
-    pub fn absolute_power_norm(&self, scale: f64, p: usize) -> f64 {
-        absolute_power_norm(&self.rows, scale, p)
-    }
-
-    /// Factors self = P^T L U by Gaussian elimination with partial pivoting. Exactly singular
-    /// pivots give infinities in later solves.
-    pub fn lu(mut self) -> SmallLu<N> {
-        let mut pivots = [0usize; N];
-        lu_in_place(&mut self.rows, &mut pivots);
-        SmallLu {
-            factors: self,
-            pivots,
-        }
-    }
-
-    /// Solves self * X = rhs by LU with partial pivoting.
-    pub fn solve(self, rhs: Self) -> Self {
-        self.lu().solve(rhs)
-    }
+/// identity * I + sum_k coefficient_k * M_k, for at least one term.
+pub(crate) fn combination<const N: usize>(
+    identity: f64,
+    terms: &[(f64, &SMatrix<f64, N, N>)],
+) -> SMatrix<f64, N, N> {
+    from_columns(combination_columns(identity, terms))
 }
 
-/// An LU factorisation with partial pivoting of a [`SmallMatrix`], for repeated solves.
+/// The 1-norm, max_j sum_i |a_ij|.
+pub(crate) fn one_norm<const N: usize>(a: &SMatrix<f64, N, N>) -> f64 {
+    columns(a)
+        .iter()
+        .map(|column| column.iter().fold(0.0, |sum, value| sum + value.abs()))
+        .fold(0.0, f64::max)
+}
+
+/// ||(|A| / scale)^p||_1 by p row-vector products (for B >= 0, ||B^p||_1 = max 1^T B^p).
+pub(crate) fn absolute_power_norm<const N: usize>(
+    a: &SMatrix<f64, N, N>,
+    scale: f64,
+    p: usize,
+) -> f64 {
+    absolute_power_norm_columns(columns(a), scale, p)
+}
+
+/// Whether every entry below the diagonal is zero.
+pub(crate) fn is_upper_triangular<const N: usize>(a: &SMatrix<f64, N, N>) -> bool {
+    columns(a)
+        .iter()
+        .enumerate()
+        .all(|(j, column)| column[j + 1..].iter().all(|&v| v == 0.0))
+}
+
+/// Whether every entry above the diagonal is zero.
+pub(crate) fn is_lower_triangular<const N: usize>(a: &SMatrix<f64, N, N>) -> bool {
+    columns(a)
+        .iter()
+        .enumerate()
+        .all(|(j, column)| column[..j].iter().all(|&v| v == 0.0))
+}
+
+/// An LU factorisation with partial pivoting of an N x N matrix, for repeated solves.
 #[derive(Clone, Copy, Debug)]
-pub struct SmallLu<const N: usize> {
+pub(crate) struct SmallLu<const N: usize> {
     /// Unit lower factor below the diagonal, upper factor on and above it.
-    factors: SmallMatrix<N>,
+    factors: SMatrix<f64, N, N>,
     /// Row k was swapped with row `pivots[k]` at step k.
     pivots: [usize; N],
 }
 
 impl<const N: usize> SmallLu<N> {
+    /// Factors a = P^T L U by Gaussian elimination with partial pivoting. Exactly singular
+    /// pivots give infinities in later solves.
+    pub(crate) fn new(mut a: SMatrix<f64, N, N>) -> Self {
+        let mut pivots = [0usize; N];
+        lu_in_place(columns_mut(&mut a), &mut pivots);
+        Self { factors: a, pivots }
+    }
+
     /// X with A X = rhs.
-    pub fn solve(&self, mut rhs: SmallMatrix<N>) -> SmallMatrix<N> {
-        lu_solve(&self.factors.rows, &self.pivots, &mut rhs.rows);
+    pub(crate) fn solve(&self, mut rhs: SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+        lu_solve_columns(columns(&self.factors), &self.pivots, columns_mut(&mut rhs));
         rhs
     }
+}
+
+/// X with a X = rhs, by LU with partial pivoting.
+pub(crate) fn solve<const N: usize>(
+    a: SMatrix<f64, N, N>,
+    rhs: SMatrix<f64, N, N>,
+) -> SMatrix<f64, N, N> {
+    SmallLu::new(a).solve(rhs)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linalg::norm::one_norm;
+    use crate::linalg::matrix::FaerView;
+    use crate::linalg::norm;
+    use faer::Mat;
 
-    fn sample<const N: usize>(seed: u64) -> SmallMatrix<N> {
+    fn sample<const N: usize>(seed: u64) -> SMatrix<f64, N, N> {
         let mut state = seed;
-        let mut m = SmallMatrix::<N>::zeros();
-        for row in &mut m.rows {
-            for value in row {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                *value = ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0;
-            }
-        }
-        m
+        SMatrix::from_fn(|_, _| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        })
     }
 
     fn check_order<const N: usize>() {
         let (a, b) = (sample::<N>(1), sample::<N>(2));
-        let expected = a.to_mat() * b.to_mat();
-        let got = a.product(&b).to_mat();
+        let expected = a.to_faer() * b.to_faer();
+        let got = product(&a, &b).to_faer();
         assert!((&got - &expected).norm_max() < 1e-14);
 
         let mut d = sample::<N>(3);
-        let before = d.to_mat();
-        d.add_product(&a, &b);
-        assert!((d.to_mat() - (&before + &expected)).norm_max() < 1e-14);
+        let before = d.to_faer();
+        add_product(&mut d, &a, &b);
+        assert!((d.to_faer() - (&before + &expected)).norm_max() < 1e-14);
 
-        let combined = SmallMatrix::combination(2.0, &[(3.0, &a), (-1.0, &b)]);
+        let combined = combination(2.0, &[(3.0, &a), (-1.0, &b)]);
         let expected = Mat::<f64>::identity(N, N) * faer::Scale(2.0)
-            + a.to_mat() * faer::Scale(3.0)
-            - b.to_mat();
-        assert!((combined.to_mat() - expected).norm_max() < 1e-14);
+            + a.to_faer() * faer::Scale(3.0)
+            - b.to_faer();
+        assert!((combined.to_faer() - expected).norm_max() < 1e-14);
 
-        assert!((a.one_norm() - one_norm(a.to_mat().as_ref())).abs() <= 1e-15 * a.one_norm());
+        let exact = norm::one_norm(a.to_faer().as_ref());
+        assert!((one_norm(&a) - exact).abs() <= 1e-15 * exact);
 
         // Reversing the rows of a random matrix makes pivoting necessary.
-        let mut system = sample::<N>(4);
-        system.rows.reverse();
+        let system = SMatrix::<f64, N, N>::from_fn(|i, j| sample::<N>(4)[(N - 1 - i, j)]);
         let x_true = sample::<N>(5);
-        let rhs = system.product(&x_true);
-        let x = system.solve(rhs);
-        assert!((x.to_mat() - x_true.to_mat()).norm_max() < 1e-10);
+        let rhs = product(&system, &x_true);
+        let x = solve(system, rhs);
+        assert!((x.to_faer() - x_true.to_faer()).norm_max() < 1e-10);
     }
 
     #[test]
@@ -399,10 +337,9 @@ mod tests {
         // one only where it is supported).
         let (a, b) = (sample::<6>(7), sample::<6>(8));
         let mut plain = [[0.0; 6]; 6];
-        add_product_kernel::<6, false>(&a.rows, &b.rows, &mut plain);
-        let mut dispatched = [[0.0; 6]; 6];
-        add_product(&a.rows, &b.rows, &mut dispatched);
-        for (p, d) in plain.as_flattened().iter().zip(dispatched.as_flattened()) {
+        add_product_kernel::<6, false>(columns(&a), columns(&b), &mut plain);
+        let dispatched = product(&a, &b);
+        for (p, d) in plain.as_flattened().iter().zip(dispatched.as_slice()) {
             assert!((p - d).abs() <= 1e-15);
         }
     }
@@ -410,30 +347,31 @@ mod tests {
     #[test]
     fn absolute_power_norm_equals_the_formed_power() {
         let a = sample::<5>(9);
-        let mut abs = SmallMatrix::<5>::zeros();
-        for i in 0..5 {
-            for j in 0..5 {
-                abs.rows[i][j] = a.rows[i][j].abs() / 2.0;
-            }
-        }
-        let mut power = SmallMatrix::<5>::identity();
+        let abs = a.map(|x| x.abs() / 2.0);
+        let mut power = SMatrix::<f64, 5, 5>::identity();
         for p in 0..10 {
-            let expected = power.one_norm();
-            assert!((a.absolute_power_norm(2.0, p) - expected).abs() <= 1e-14 * expected);
-            power = power.product(&abs);
+            let expected = one_norm(&power);
+            assert!((absolute_power_norm(&a, 2.0, p) - expected).abs() <= 1e-14 * expected);
+            power = product(&power, &abs);
         }
     }
 
     #[test]
+    fn triangular_structure() {
+        let upper = SMatrix::<f64, 3, 3>::new(1.0, 2.0, 3.0, 0.0, 4.0, 5.0, 0.0, 0.0, 6.0);
+        assert!(is_upper_triangular(&upper) && !is_lower_triangular(&upper));
+        let lower = upper.transpose();
+        assert!(is_lower_triangular(&lower) && !is_upper_triangular(&lower));
+    }
+
+    #[test]
     fn lu_solves_repeatedly_and_needs_pivoting() {
-        let a = SmallMatrix::<3> {
-            rows: [[0.0, 2.0, 1.0], [1.0, 1.0, 0.0], [3.0, 0.0, 1.0]],
-        };
-        let lu = a.lu();
+        let a = SMatrix::<f64, 3, 3>::new(0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 3.0, 0.0, 1.0);
+        let lu = SmallLu::new(a);
         for seed in 0..3 {
             let x_true = sample::<3>(seed);
-            let x = lu.solve(a.product(&x_true));
-            assert!((x.to_mat() - x_true.to_mat()).norm_max() < 1e-14);
+            let x = lu.solve(product(&a, &x_true));
+            assert!((x.to_faer() - x_true.to_faer()).norm_max() < 1e-14);
         }
     }
 }

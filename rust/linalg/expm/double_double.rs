@@ -14,8 +14,9 @@
 //! the magnitudes of the terms, against 2^-53 for a double product. The exponential uses it where
 //! squaring amplifies rounding errors (see `expm.rs`).
 
-use crate::linalg::small_matrix::SmallMatrix;
+use crate::linalg::small_matrix::{SmallLu, columns};
 use crate::platform::dispatch::fma_dispatch;
+use nalgebra::SMatrix;
 
 /// (s, e) with s = fl(a + b) and s + e = a + b exactly (Knuth's branch-free two-sum).
 #[inline(always)]
@@ -66,124 +67,133 @@ fn two_product_split(
     (p, e)
 }
 
-type Rows<const N: usize> = [[f64; N]; N];
+/// The storage of an N x N matrix: N columns of N entries (`columns[j][i]` = a_ij).
+type Columns<const N: usize> = [[f64; N]; N];
 
-/// The entries of a * b accumulated in double-double, not yet normalised.
+/// The entries of a * b accumulated in double-double, not yet normalised: column j of the
+/// result gains b_kj times column k of a, k in order (each entry the sum over k, in order).
 #[inline(always)]
 fn product_kernel<const N: usize, const FMA: bool>(
     a: &DoubleDoubleMatrix<N>,
     b: &DoubleDoubleMatrix<N>,
-) -> (Rows<N>, Rows<N>) {
+) -> (Columns<N>, Columns<N>) {
     let mut hi = [[0.0; N]; N];
     let mut lo = [[0.0; N]; N];
-    // Dekker's splits of b's high parts, once per product (unused with FMA).
+    let (a_hi, a_lo) = (columns(&a.hi), columns(&a.lo));
+    let (b_hi, b_lo) = (columns(&b.hi), columns(&b.lo));
+    // Dekker's splits of the high parts, once per product (unused with FMA).
+    let mut a_split = [[(0.0, 0.0); N]; N];
     let mut b_split = [[(0.0, 0.0); N]; N];
     if !FMA {
-        for (split_row, row) in b_split.iter_mut().zip(&b.hi.rows) {
-            for (x, &value) in split_row.iter_mut().zip(row) {
+        for (splits, column) in a_split
+            .iter_mut()
+            .zip(a_hi)
+            .chain(b_split.iter_mut().zip(b_hi))
+        {
+            for (x, &value) in splits.iter_mut().zip(column) {
                 *x = split(value);
             }
         }
     }
-    for i in 0..N {
-        let (acc_hi, acc_lo) = (&mut hi[i], &mut lo[i]);
-        for (k, b_split_row) in b_split.iter().enumerate() {
-            let (a_hi, a_lo) = (a.hi.rows[i][k], a.lo.rows[i][k]);
-            let a_split = split(a_hi);
-            let (b_hi, b_lo) = (&b.hi.rows[k], &b.lo.rows[k]);
-            for j in 0..N {
-                let p = a_hi * b_hi[j];
+    for j in 0..N {
+        let (acc_hi, acc_lo) = (&mut hi[j], &mut lo[j]);
+        for k in 0..N {
+            let (b_hi_kj, b_lo_kj, b_split_kj) = (b_hi[j][k], b_lo[j][k], b_split[j][k]);
+            let (a_hi_k, a_lo_k, a_split_k) = (&a_hi[k], &a_lo[k], &a_split[k]);
+            for i in 0..N {
+                let p = a_hi_k[i] * b_hi_kj;
                 let (p, mut e) = if FMA {
-                    (p, a_hi.mul_add(b_hi[j], -p))
+                    (p, a_hi_k[i].mul_add(b_hi_kj, -p))
                 } else {
-                    two_product_split(a_split, b_split_row[j], p)
+                    two_product_split(a_split_k[i], b_split_kj, p)
                 };
-                e += a_hi * b_lo[j] + a_lo * b_hi[j];
-                let (s, t) = two_sum(acc_hi[j], p);
-                acc_hi[j] = s;
-                acc_lo[j] += t + e;
+                e += a_hi_k[i] * b_lo_kj + a_lo_k[i] * b_hi_kj;
+                let (s, t) = two_sum(acc_hi[i], p);
+                acc_hi[i] = s;
+                acc_lo[i] += t + e;
             }
         }
     }
     (hi, lo)
 }
 
-fma_dispatch!(fn accumulate_product<const N: usize>(a: &DoubleDoubleMatrix<N>, b: &DoubleDoubleMatrix<N>) -> (Rows<N>, Rows<N>) => product_kernel);
+fma_dispatch!(fn accumulate_product<const N: usize>(a: &DoubleDoubleMatrix<N>, b: &DoubleDoubleMatrix<N>) -> (Columns<N>, Columns<N>) => product_kernel);
 
 /// identity * I + sum_k coefficient_k * M_k accumulated in double-double, not yet normalised.
 #[inline(always)]
 fn combination_kernel<const N: usize, const FMA: bool>(
     identity: f64,
     terms: &[(f64, &DoubleDoubleMatrix<N>)],
-) -> (Rows<N>, Rows<N>) {
+) -> (Columns<N>, Columns<N>) {
     let mut hi = [[0.0; N]; N];
     let mut lo = [[0.0; N]; N];
-    for (i, row) in hi.iter_mut().enumerate() {
-        row[i] = identity;
+    for (i, column) in hi.iter_mut().enumerate() {
+        column[i] = identity;
     }
     for &(coefficient, m) in terms {
-        for i in 0..N {
-            for j in 0..N {
-                let (p, e) = two_product::<FMA>(coefficient, m.hi.rows[i][j]);
-                let (s, t) = two_sum(hi[i][j], p);
-                hi[i][j] = s;
-                lo[i][j] += t + e + coefficient * m.lo.rows[i][j];
+        let (m_hi, m_lo) = (columns(&m.hi), columns(&m.lo));
+        for j in 0..N {
+            for i in 0..N {
+                let (p, e) = two_product::<FMA>(coefficient, m_hi[j][i]);
+                let (s, t) = two_sum(hi[j][i], p);
+                hi[j][i] = s;
+                lo[j][i] += t + e + coefficient * m_lo[j][i];
             }
         }
     }
     (hi, lo)
 }
 
-fma_dispatch!(fn accumulate_combination<const N: usize>(identity: f64, terms: &[(f64, &DoubleDoubleMatrix<N>)]) -> (Rows<N>, Rows<N>) => combination_kernel);
+fma_dispatch!(fn accumulate_combination<const N: usize>(identity: f64, terms: &[(f64, &DoubleDoubleMatrix<N>)]) -> (Columns<N>, Columns<N>) => combination_kernel);
 
-/// An N x N matrix of double-double numbers: entry (i, j) is `hi[i][j] + lo[i][j]`.
+/// An N x N matrix of double-double numbers: entry (i, j) is `hi[(i, j)] + lo[(i, j)]`.
 #[derive(Clone, Copy, Debug)]
 pub struct DoubleDoubleMatrix<const N: usize> {
-    pub hi: SmallMatrix<N>,
-    pub lo: SmallMatrix<N>,
+    pub hi: SMatrix<f64, N, N>,
+    pub lo: SMatrix<f64, N, N>,
 }
 
 impl<const N: usize> DoubleDoubleMatrix<N> {
     /// The exact double-double value of a double matrix.
-    pub fn from_double(a: &SmallMatrix<N>) -> Self {
+    pub fn from_double(a: &SMatrix<f64, N, N>) -> Self {
         Self {
             hi: *a,
-            lo: SmallMatrix::zeros(),
+            lo: SMatrix::zeros(),
         }
     }
 
     /// c A, exactly (each entry's product is error-free).
-    pub fn scaled(a: &SmallMatrix<N>, c: f64) -> Self {
-        let mut out = Self::from_double(&SmallMatrix::zeros());
+    pub fn scaled(a: &SMatrix<f64, N, N>, c: f64) -> Self {
+        let mut out = Self::from_double(&SMatrix::zeros());
         for i in 0..N {
             for j in 0..N {
-                let (p, e) = two_product::<false>(c, a.rows[i][j]);
-                out.hi.rows[i][j] = p;
-                out.lo.rows[i][j] = e;
+                let (p, e) = two_product::<false>(c, a[(i, j)]);
+                out.hi[(i, j)] = p;
+                out.lo[(i, j)] = e;
             }
         }
         out
     }
 
     /// The nearest double matrix (hi + lo rounded).
-    pub fn round(&self) -> SmallMatrix<N> {
-        let mut out = SmallMatrix::zeros();
+    pub fn round(&self) -> SMatrix<f64, N, N> {
+        let mut out = SMatrix::zeros();
         for i in 0..N {
             for j in 0..N {
-                out.rows[i][j] = self.hi.rows[i][j] + self.lo.rows[i][j];
+                out[(i, j)] = self.hi[(i, j)] + self.lo[(i, j)];
             }
         }
         out
     }
 
     /// Normalises accumulated (hi, lo) pairs so that |lo| <= ulp(hi)/2.
-    fn normalize(hi: [[f64; N]; N], lo: [[f64; N]; N]) -> Self {
-        let mut out = Self::from_double(&SmallMatrix::zeros());
+    fn normalize(hi: Columns<N>, lo: Columns<N>) -> Self {
+        let mut out = Self::from_double(&SMatrix::zeros());
         for i in 0..N {
             for j in 0..N {
-                let (h, l) = quick_two_sum(hi[i][j], lo[i][j]);
-                out.hi.rows[i][j] = h;
-                out.lo.rows[i][j] = l;
+                let (h, l) = quick_two_sum(hi[j][i], lo[j][i]);
+                out.hi[(i, j)] = h;
+                out.lo[(i, j)] = l;
             }
         }
         out
@@ -207,23 +217,23 @@ impl<const N: usize> DoubleDoubleMatrix<N> {
         let mut lo = [[0.0; N]; N];
         for i in 0..N {
             for j in 0..N {
-                let (s, t) = two_sum(self.hi.rows[i][j], -other.hi.rows[i][j]);
-                hi[i][j] = s;
-                lo[i][j] = t + (self.lo.rows[i][j] - other.lo.rows[i][j]);
+                let (s, t) = two_sum(self.hi[(i, j)], -other.hi[(i, j)]);
+                hi[j][i] = s;
+                lo[j][i] = t + (self.lo[(i, j)] - other.lo[(i, j)]);
             }
         }
         Self::normalize(hi, lo)
     }
 
     /// self + delta for a double matrix delta.
-    pub fn plus_double(&self, delta: &SmallMatrix<N>) -> Self {
+    pub fn plus_double(&self, delta: &SMatrix<f64, N, N>) -> Self {
         let mut hi = [[0.0; N]; N];
         let mut lo = [[0.0; N]; N];
         for i in 0..N {
             for j in 0..N {
-                let (s, t) = two_sum(self.hi.rows[i][j], delta.rows[i][j]);
-                hi[i][j] = s;
-                lo[i][j] = t + self.lo.rows[i][j];
+                let (s, t) = two_sum(self.hi[(i, j)], delta[(i, j)]);
+                hi[j][i] = s;
+                lo[j][i] = t + self.lo[(i, j)];
             }
         }
         Self::normalize(hi, lo)
@@ -233,7 +243,7 @@ impl<const N: usize> DoubleDoubleMatrix<N> {
     /// solve in double, then two steps of iterative refinement with residuals rhs - self X
     /// computed in double-double. Each step gains a factor of about κ(self) u.
     pub fn solve(&self, rhs: &Self) -> Self {
-        let lu = self.hi.lu();
+        let lu = SmallLu::new(self.hi);
         let mut x = Self::from_double(&lu.solve(rhs.round()));
         for _ in 0..2 {
             let residual = rhs.difference(&self.product(&x));
@@ -272,30 +282,32 @@ mod tests {
     fn products_are_accurate_beyond_double() {
         // The product of (1 + ε) I with (1 - ε) I is (1 - ε^2) I, below double resolution.
         let epsilon = 2f64.powi(-40);
-        let a = DoubleDoubleMatrix::<3>::scaled(&SmallMatrix::identity(), 1.0 + epsilon);
-        let b = DoubleDoubleMatrix::<3>::scaled(&SmallMatrix::identity(), 1.0 - epsilon);
+        let a = DoubleDoubleMatrix::<3>::scaled(&SMatrix::identity(), 1.0 + epsilon);
+        let b = DoubleDoubleMatrix::<3>::scaled(&SMatrix::identity(), 1.0 - epsilon);
         let p = a.product(&b);
         for i in 0..3 {
-            assert_eq!(p.hi.rows[i][i], 1.0);
-            assert_eq!(p.lo.rows[i][i], -epsilon * epsilon);
+            assert_eq!(p.hi[(i, i)], 1.0);
+            assert_eq!(p.lo[(i, i)], -epsilon * epsilon);
         }
     }
 
     #[test]
     fn refined_solve_reaches_double_double_accuracy() {
         // A = [[3, 1], [1, 3]] has the exactly representable inverse [[3/8, -1/8], [-1/8, 3/8]].
-        let a = DoubleDoubleMatrix::<2>::from_double(&SmallMatrix {
-            rows: [[3.0, 1.0], [1.0, 3.0]],
-        });
-        let x = a.solve(&DoubleDoubleMatrix::from_double(&SmallMatrix::identity()));
-        assert_eq!(x.hi.rows, [[0.375, -0.125], [-0.125, 0.375]]);
-        assert_eq!(x.lo.rows, [[0.0, 0.0], [0.0, 0.0]]);
+        let a =
+            DoubleDoubleMatrix::<2>::from_double(&SMatrix::from_row_slice(&[3.0, 1.0, 1.0, 3.0]));
+        let x = a.solve(&DoubleDoubleMatrix::from_double(&SMatrix::identity()));
+        assert_eq!(
+            x.hi,
+            SMatrix::<f64, 2, 2>::new(0.375, -0.125, -0.125, 0.375)
+        );
+        assert_eq!(x.lo, SMatrix::<f64, 2, 2>::zeros());
         // A 1/3 entry: 3 x = 1 has x = 1/3, whose double-double error is below 2^-105.
-        let three = DoubleDoubleMatrix::<1>::from_double(&SmallMatrix { rows: [[3.0]] });
-        let x = three.solve(&DoubleDoubleMatrix::from_double(&SmallMatrix {
-            rows: [[1.0]],
-        }));
-        let (h, l) = (x.hi.rows[0][0], x.lo.rows[0][0]);
+        let three = DoubleDoubleMatrix::<1>::from_double(&SMatrix::from_row_slice(&[3.0]));
+        let x = three.solve(&DoubleDoubleMatrix::from_double(&SMatrix::from_row_slice(
+            &[1.0],
+        )));
+        let (h, l) = (x.hi[(0, 0)], x.lo[(0, 0)]);
         // 3 (h + l) - 1 computed exactly: 3h = p + e exactly, then (p - 1) + e + 3l.
         let (p, e) = two_product::<false>(3.0, h);
         let residual = (p - 1.0) + e + 3.0 * l;
@@ -304,17 +316,15 @@ mod tests {
 
     #[test]
     fn combination_and_difference_cancel_exactly() {
-        let m = SmallMatrix::<2> {
-            rows: [[0.1, 0.2], [0.3, 0.7]],
-        };
+        let m = SMatrix::<f64, 2, 2>::from_row_slice(&[0.1, 0.2, 0.3, 0.7]);
         let d = DoubleDoubleMatrix::from_double(&m);
         let twice = DoubleDoubleMatrix::combination(0.0, &[(2.0, &d)]);
         let zero = twice.difference(&DoubleDoubleMatrix::combination(
             0.0,
             &[(1.0, &d), (1.0, &d)],
         ));
-        assert!(zero.round().one_norm() == 0.0);
+        assert!(crate::linalg::small_matrix::one_norm(&zero.round()) == 0.0);
         let shifted = d.plus_double(&m);
-        assert_eq!(shifted.round().rows, twice.round().rows);
+        assert_eq!(shifted.round(), twice.round());
     }
 }

@@ -43,7 +43,7 @@
 //!
 //! # Small orders, and accuracy beyond double precision
 //!
-//! Orders up to [`SMALL_MAX_ORDER`] run on stack matrices of constant size ([`SmallMatrix`]):
+//! Orders up to [`SMALL_MAX_ORDER`] run on stack matrices of constant size (nalgebra's `SMatrix`):
 //! flight models are that small, and at these orders a general-order library call costs more
 //! than its arithmetic. For them, an exponential that needs [`DOUBLE_DOUBLE_MIN_SQUARINGS`] or
 //! more squarings is evaluated in double-double arithmetic (`double_double.rs`). Measured against
@@ -62,13 +62,15 @@ pub mod double_double;
 
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
 use crate::linalg::expm::double_double::DoubleDoubleMatrix;
+use crate::linalg::matrix::{from_faer_in, with_order};
 use crate::linalg::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
-use crate::linalg::small_matrix::SmallMatrix;
+use crate::linalg::small_matrix;
 use crate::platform::dispatch::{add_scaled, scale_into};
 use crate::platform::parallel::{PARALLEL_MIN_ORDER, ParallelContext, parallelism_for_order};
 use crate::platform::pool::{Scratch, scratch};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef};
+use nalgebra::{Const, SMatrix};
 use rayon::prelude::*;
 
 /// For n up to this order the norms ||A^8||_1 and ||A^10||_1 of the degree selection are exact
@@ -904,22 +906,22 @@ impl ExpmMatrix for Scratch {
 
 // ----- stack matrices of a small order, with the double-double evaluation --------------------
 
-impl<const N: usize> PadeArithmetic for SmallMatrix<N> {
+impl<const N: usize> PadeArithmetic for SMatrix<f64, N, N> {
     fn product(&self, rhs: &Self) -> Self {
-        SmallMatrix::product(self, rhs)
+        small_matrix::product(self, rhs)
     }
 
     fn add_product(&mut self, lhs: &Self, rhs: &Self) {
-        SmallMatrix::add_product(self, lhs, rhs);
+        small_matrix::add_product(self, lhs, rhs);
     }
 
     fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
-        SmallMatrix::combination(identity, terms)
+        small_matrix::combination(identity, terms)
     }
 
     fn pade_quotient(even: Self, odd: Self) -> Self {
-        let denominator = SmallMatrix::combination(0.0, &[(1.0, &even), (-1.0, &odd)]);
-        SmallMatrix::combination(1.0, &[(2.0, &denominator.solve(odd))])
+        let denominator = small_matrix::combination(0.0, &[(1.0, &even), (-1.0, &odd)]);
+        small_matrix::combination(1.0, &[(2.0, &small_matrix::solve(denominator, odd))])
     }
 }
 
@@ -943,9 +945,9 @@ impl<const N: usize> PadeArithmetic for DoubleDoubleMatrix<N> {
     }
 }
 
-impl<const N: usize> ExpmMatrix for SmallMatrix<N> {
+impl<const N: usize> ExpmMatrix for SMatrix<f64, N, N> {
     fn from_ref(a: MatRef<'_, f64>) -> Self {
-        SmallMatrix::from_ref(a)
+        from_faer_in(Const::<N>, a)
     }
 
     fn order(&self) -> usize {
@@ -953,51 +955,50 @@ impl<const N: usize> ExpmMatrix for SmallMatrix<N> {
     }
 
     fn get(&self, i: usize, j: usize) -> f64 {
-        self.rows[i][j]
+        self[(i, j)]
     }
 
     fn is_upper_triangular(&self) -> bool {
-        SmallMatrix::is_upper_triangular(self)
+        small_matrix::is_upper_triangular(self)
     }
 
     fn is_lower_triangular(&self) -> bool {
-        SmallMatrix::is_lower_triangular(self)
+        small_matrix::is_lower_triangular(self)
     }
 
     fn transpose(&self) -> Self {
-        SmallMatrix::transpose(self)
+        SMatrix::transpose(self)
     }
 
     fn set(&mut self, i: usize, j: usize, value: f64) {
-        self.rows[i][j] = value;
+        self[(i, j)] = value;
     }
 
     fn one_norm(&self) -> f64 {
-        SmallMatrix::one_norm(self)
+        small_matrix::one_norm(self)
     }
 
     fn max_abs(&self) -> f64 {
-        self.rows
-            .as_flattened()
-            .iter()
-            .fold(0.0, |m, v| m.max(v.abs()))
+        self.as_slice().iter().fold(0.0, |m, v| m.max(v.abs()))
     }
 
     fn estimate_product_norm(factors: &[&Self]) -> f64 {
         // Small orders always use exact norms; the product is cheap.
         let (first, rest) = factors.split_first().expect("at least one factor");
         rest.iter()
-            .fold(**first, |product, factor| product.product(factor))
+            .fold(**first, |product, factor| {
+                small_matrix::product(&product, factor)
+            })
             .one_norm()
     }
 
     fn absolute_power_norm(&self, scale: f64, p: usize) -> f64 {
-        SmallMatrix::absolute_power_norm(self, scale, p)
+        small_matrix::absolute_power_norm(self, scale, p)
     }
 
     fn write_to(&self, mut out: MatMut<'_, f64>, transpose: bool) {
-        for (i, row) in self.rows.iter().enumerate() {
-            for (j, &value) in row.iter().enumerate() {
+        for (j, column) in small_matrix::columns(self).iter().enumerate() {
+            for (i, &value) in column.iter().enumerate() {
                 if transpose {
                     out[(j, i)] = value;
                 } else {
@@ -1025,7 +1026,7 @@ impl<const N: usize> ExpmMatrix for SmallMatrix<N> {
         });
         let x = pade_approximant(approximant, &b, &[&b2], [&b4, &b6, &b8]);
         let x = square_repeatedly(x, squarings, |_, _| {}).round();
-        x.rows.iter().flatten().all(|v| v.is_finite()).then_some(x)
+        x.as_slice().iter().all(|v| v.is_finite()).then_some(x)
     }
 }
 
@@ -1035,19 +1036,18 @@ impl<const N: usize> ExpmMatrix for SmallMatrix<N> {
 /// 2 to [`SMALL_MAX_ORDER`], a pooled faer matrix otherwise.
 macro_rules! with_matrix_type {
     ($n:expr, $m:ident => $body:expr) => {
-        with_matrix_type!(@orders $n, $m, $body, 2 3 4 5 6 7 8)
-    };
-    (@orders $n:expr, $m:ident, $body:expr, $($order:literal)*) => {
-        match $n {
-            $($order => {
-                type $m = SmallMatrix<$order>;
+        with_order!(
+            $n,
+            [2, 3, 4, 5, 6, 7, 8],
+            N => {
+                type $m = SMatrix<f64, N, N>;
                 $body
-            })*
+            },
             _ => {
                 type $m = Scratch;
                 $body
             }
-        }
+        )
     };
 }
 
@@ -1194,6 +1194,7 @@ pub fn transition_matrices(a: MatRef<'_, f64>, times: &[f64]) -> Result<Vec<Mat<
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::matrix::FaerView;
     use faer::mat;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
@@ -1393,7 +1394,7 @@ mod tests {
         for scale in [0.05, 1.0, 3.0] {
             let a = random_matrix(5, scale, &mut rng);
             let (mut small, mut general) = (Mat::zeros(5, 5), Mat::zeros(5, 5));
-            single_exponential::<SmallMatrix<5>>(a.as_ref(), small.as_mut());
+            single_exponential::<SMatrix<f64, 5, 5>>(a.as_ref(), small.as_mut());
             single_exponential::<Scratch>(a.as_ref(), general.as_mut());
             assert!(
                 relative_difference(&small, &general) < 1e-14,
@@ -1412,14 +1413,14 @@ mod tests {
             [3.0 * e17 - 2.0 * e1, -1.5 * e17 + 1.5 * e1],
             [4.0 * e17 - 4.0 * e1, -2.0 * e17 + 3.0 * e1]
         ];
-        let mut plan = ExponentialPlan::<SmallMatrix<2>>::new(a.as_ref());
+        let mut plan = ExponentialPlan::<SMatrix<f64, 2, 2>>::new(a.as_ref());
         let choice = plan.choose(1.0);
         assert!(choice.squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS);
         plan.prepare(choice);
         let mut accurate = Mat::zeros(2, 2);
         plan.exponential_into(1.0, choice, accurate.as_mut());
         let c = (-(choice.squarings as f64)).exp2();
-        let double = plan.double_exponential(1.0, c, choice).to_mat();
+        let double = plan.double_exponential(1.0, c, choice).to_faer();
         let (err_dd, err_double) = (
             relative_difference(&accurate, &expected),
             relative_difference(&double, &expected),
