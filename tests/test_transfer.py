@@ -157,3 +157,80 @@ def test_bad_arguments_are_named() -> None:
         transfer_function(lateral, ["r", "p"], "rudder")
     with pytest.raises(InvalidArgumentError, match="tol"):
         transmission_zeros(lateral, tol=-1.0)
+
+
+# ----- badly scaled blocks, tiny and huge poles -------------------------------------------------
+
+
+def _closed_form_zeros(c: float) -> np.ndarray:
+    """The roots of s² + (3 - c) s + 2, the zeros of A = diag(-1, -2), B = [1, 1]ᵀ,
+    C = [c, -2c], D = 1 (G = 1 + c/(s + 1) - 2c/(s + 2)), without cancellation: the larger
+    from the quadratic formula in the stable form, the other as 2 over it."""
+    b = 3.0 - c
+    large = -(b + np.sign(b) * np.sqrt(b * b - 8.0)) / 2.0 if b * b >= 8.0 else None
+    if large is None:
+        return np.sort_complex(np.roots([1.0, b, 2.0]))
+    return np.sort_complex(np.array([2.0 / large, large], dtype=complex))
+
+
+@pytest.mark.parametrize("c", [1e-12, 1e-6, 1e-3, 1e3, 1e6, 1e9, 1e12, -1e9])
+def test_zeros_of_a_badly_scaled_output_against_the_closed_form(c: float) -> None:
+    # The zeros lie at c and 2/c for a large c: both within a relative 1e3 u c of the closed
+    # form (the large one is determined to that by the pencil's normwise backward error).
+    zeros = transmission_zeros((np.diag([-1.0, -2.0]), [[1.0], [1.0]], [[c, -2.0 * c]], [[1.0]]))
+    expected = _closed_form_zeros(c)
+    assert len(zeros) == 2
+    tolerance = 1e3 * np.finfo(float).eps * max(1.0, abs(c))
+    for z, e in zip(sorted(zeros, key=abs), sorted(expected, key=abs), strict=True):
+        assert abs(z - e) <= tolerance * abs(e), (z, e)
+
+
+@pytest.mark.parametrize("scales", [(1, 1, 1e9, 1), (1, 1e-9, 1, 1), (1e-6, 1, 1, 1e-3)])
+def test_zeros_of_scaled_blocks_against_scipy_pencil(scales: tuple[float, ...]) -> None:
+    # A random 4-state, 2 x 2 model with blocks scaled apart; the reference is scipy's QZ of
+    # the Rosenbrock pencil of the model with the same blocks at unit scale, its zeros moved
+    # by the exact relation: scaling B, C, D by b, c, d is an input/output scaling (zeros
+    # unchanged) after A, B by a: the zeros of (aA, aB, C, D) are a times those of (A, B, C, D).
+    a, b, c, d = scales
+    rng = np.random.default_rng(7)
+    A, B = rng.standard_normal((4, 4)) - 3 * np.eye(4), rng.standard_normal((4, 2))
+    C, D = rng.standard_normal((2, 4)), rng.standard_normal((2, 2))
+    # (aA, bB, cC, dD): dividing the input by b/a and the output by c gives (aA, aB, C,
+    # (a d / (b c)) D), whose zeros are a times those of (A, B, C, (a d / (b c)) D).
+    reference_D = D * (a * d / (b * c))
+    M = np.block([[A, B], [C, reference_D]])
+    N = np.zeros((6, 6))
+    N[:4, :4] = np.eye(4)
+    values = scipy.linalg.eigvals(M, N)
+    expected = a * values[np.isfinite(values)]
+    ours = transmission_zeros((a * A, b * B, c * C, d * D))
+    # Zeros at two scales (those of A, and those of C B / D) are determined to a relative
+    # u times their ratio, here at most the spread of the blocks.
+    spread = max(scales) / min(scales)
+    assert _matched_error(ours / a, expected / a) < 1e3 * np.finfo(float).eps * spread
+
+
+def test_transfer_function_gain_of_tiny_poles() -> None:
+    # sum_k 1/(s + k 1e-151), k = 1, 2, 3: poles k 1e-151, zeros 1e-151 (-2 ± 1/√3), gain 3
+    # (the products of the gain's evaluation are 1e-302 and 1e-453 in size).
+    a = 1e-151
+    g = transfer_function((np.diag([-a, -2 * a, -3 * a]), np.ones((3, 1)), np.ones((1, 3)), [[0]]))
+    assert g.gain == pytest.approx(3.0, rel=1e-12)
+    np.testing.assert_allclose(
+        g.zeros.real, a * np.array([-2 - 1 / np.sqrt(3), -2 + 1 / np.sqrt(3)]), rtol=1e-10
+    )
+
+
+def test_transfer_function_of_huge_poles_warns_of_its_denominator() -> None:
+    # Poles near 1e103 (n = 3): det(sI - A) has the coefficient 6e309, beyond doubles; the
+    # gain (3) is computed, and the overflow is the library's warning, not numpy's.
+    A = np.diag([-1.0, -2.0, -3.0]) * 1e103
+    with pytest.warns(aerocontrol.NumericalOverflowWarning, match="denominator"):
+        g = transfer_function((A, np.ones((3, 1)), np.ones((1, 3)), [[0.0]]))
+    assert g.gain == pytest.approx(3.0, rel=1e-12)
+
+
+def test_transmission_zeros_of_entries_beyond_1e154() -> None:
+    # ||S||_F is formed scaled: 1/(s + 1e155) + 1 has its zero at -(1e155 + 1).
+    zeros = transmission_zeros(([[-1e155]], [[1.0]], [[1.0]], [[1.0]]))
+    np.testing.assert_allclose(zeros, [-1e155], rtol=1e-14)

@@ -35,6 +35,7 @@ structural invariants of generalized state-space systems", Automatica 30(12), 19
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -42,8 +43,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _core
-from ._validation import FloatArray, real_scalar
-from .exceptions import InvalidArgumentError
+from ._validation import FloatArray, finite_or_warn, real_scalar
+from .exceptions import ConvergenceError, InvalidArgumentError, NumericalOverflowWarning
 from .linalg import qz
 from .statespace import StateSpace, as_state_space, period, signal_indices
 
@@ -58,15 +59,118 @@ ComplexArray = NDArray[np.complex128]
 # ----- the reduction of the system pencil -------------------------------------------------------
 
 
+def _frobenius(*matrices: FloatArray) -> float:
+    """||[M1, M2, ...]||_F without overflow or underflow in the squares: each entry is divided
+    by the largest |entry| first (entries beyond 1e154 square to infinity, below 1e-154 to
+    zero)."""
+    largest = max((float(np.max(np.abs(M), initial=0.0)) for M in matrices), default=0.0)
+    if largest == 0.0:
+        return 0.0
+    total = sum(float(np.sum(np.square(M / largest))) for M in matrices)
+    return largest * math.sqrt(total)
+
+
 def _tolerance(A: FloatArray, B: FloatArray, C: FloatArray, D: FloatArray) -> float:
-    """The rank tolerance: (n + p)(n + m) ε ||S||_F (as SLICOT's AB08ND)."""
+    """The rank tolerance: (n + p)(n + m) ε ||S||_F (as SLICOT's AB08ND), of the balanced
+    system matrix S."""
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
-    size = math.sqrt(sum(float(np.sum(M * M)) for M in (A, B, C, D)))
+    size = _frobenius(A, B, C, D)
     return float((n + p) * (n + m) * np.finfo(float).eps * max(size, np.finfo(float).tiny))
 
 
+def _exponents(norms: FloatArray) -> NDArray[np.int64]:
+    """The exponents e of 2^e of positive norms (frexp's: norm = f 2^e, 1/2 <= f < 1); 0 for a
+    zero norm."""
+    _, e = np.frexp(norms)
+    return np.where(norms > 0.0, e, 0).astype(np.int64)
+
+
+def _log2_norm(*vectors: FloatArray) -> float:
+    """log2 of the 2-norm of the vectors joined, without overflow or underflow; -inf for zero."""
+    largest = max((float(np.max(np.abs(v), initial=0.0)) for v in vectors), default=0.0)
+    if largest == 0.0:
+        return -math.inf
+    total = sum(float(np.sum(np.square(v / largest))) for v in vectors)
+    return math.log2(largest) + 0.5 * math.log2(total)
+
+
+def _half_exponent(log2_size: float) -> int:
+    """The integer nearest -log2(size) / 2: 2^k of it brings size halfway to 1 (0 for -inf)."""
+    return -round(log2_size / 2) if math.isfinite(log2_size) else 0
+
+
+def _balance(
+    A: FloatArray, B: FloatArray, C: FloatArray, D: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, int]:
+    """The system matrix [[A, B], [C, D]] equilibrated by exact powers of two, and the exponent
+    f such that the zeros of the model are 2^f times those of the equilibrated one.
+
+    The zeros of (1) are those of (T A T⁻¹, T B Q, P C T⁻¹, P D Q) for any nonsingular
+    diagonal T (a change of state coordinates), P (of output units) and Q (of input units),
+    and 2^-s times those of (2^s A, 2^s B, C, D) (a change of the unit of frequency). The rank
+    decisions of the reduction compare singular values with ε ||S||, so a block much smaller
+    than the largest (D of 1 beside a C of 1e9) would be judged at the scale of the largest:
+    equilibrated, every row and column of S has about unit norm where the scalings allow.
+    Sweeps as Ruiz's equilibration (each output row of [C D] and input column of [B; D]
+    divided by the square root of its norm; A, with B, by the square root of ||A||, the unit
+    of frequency, so that the poles are near 1 and zeros of their size resolved) and, for
+    each state, Osborne's balancing of its row and column (the power of two nearest
+    sqrt(c / r), r and c the norms of the row of [A B] and the column of [A; C] without the
+    diagonal, which the similarity leaves unchanged), as LAPACK's xGEBAL does for a matrix.
+    Norms are formed as logarithms of scaled sums (no overflow, no underflow), and every
+    factor is applied with ``np.ldexp``, exactly.
+
+    References: D. Ruiz, "A scaling algorithm to equilibrate both rows and columns norms in
+    matrices", RAL-TR-2001-034, 2001; E. E. Osborne, J. ACM 7, 338-345, 1960."""
+    n, p, m = A.shape[0], C.shape[0], B.shape[1]
+    A, B, C, D = (np.array(M, dtype=np.float64) for M in (A, B, C, D))
+    frequency = 0
+    for _ in range(40):
+        changed = False
+        for i in range(p):
+            k = _half_exponent(_log2_norm(C[i], D[i]))
+            if k:
+                C[i], D[i] = np.ldexp(C[i], k), np.ldexp(D[i], k)
+                changed = True
+        for j in range(m):
+            k = _half_exponent(_log2_norm(B[:, j], D[:, j]))
+            if k:
+                B[:, j], D[:, j] = np.ldexp(B[:, j], k), np.ldexp(D[:, j], k)
+                changed = True
+        # The unit of frequency: A of unit norm (the poles near 1), else the rows of B.
+        size = _log2_norm(A)
+        if not math.isfinite(size):
+            size = _log2_norm(B) if n else -math.inf
+        k = _half_exponent(size)
+        if k:
+            A, B = np.ldexp(A, k), np.ldexp(B, k)
+            frequency -= k
+            changed = True
+        for i in range(n):
+            r = _log2_norm(np.delete(A[i], i), B[i])
+            c = _log2_norm(np.delete(A[:, i], i), C[:, i])
+            if not (math.isfinite(r) and math.isfinite(c)):
+                continue
+            k = round((c - r) / 2)
+            if k:
+                diagonal = A[i, i]  # unchanged by the similarity (scaled twice, it underflows)
+                A[i], B[i] = np.ldexp(A[i], k), np.ldexp(B[i], k)
+                A[:, i], C[:, i] = np.ldexp(A[:, i], -k), np.ldexp(C[:, i], -k)
+                A[i, i] = diagonal
+                changed = True
+        if not changed:
+            break
+    return A, B, C, D, frequency
+
+
 def _svd(M: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    U, s, Vt = np.linalg.svd(M, full_matrices=True)
+    try:
+        U, s, Vt = np.linalg.svd(M, full_matrices=True)
+    except np.linalg.LinAlgError as failed:
+        raise ConvergenceError(
+            "transmission_zeros: the singular value decomposition of the system matrix's "
+            "blocks did not converge"
+        ) from failed
     return U, s, Vt
 
 
@@ -124,8 +228,45 @@ class _Reduced:
 
 
 def _pencil_zeros(model: StateSpace, tol: float | None) -> _Reduced:
-    A, B, C, D = (np.array(M, dtype=np.float64) for M in (model.A, model.B, model.C, model.D))
-    tolerance = _tolerance(A, B, C, D) if tol is None else tol
+    """The finite zeros of the model's pencil.
+
+    With a tolerance given, those of the pencil as given (:func:`_scaled_pencil_zeros`).
+    Otherwise those of the pencil equilibrated (:func:`_balance`), where blocks of very
+    different sizes are each judged at their own scale (C of 1e9 beside A, B and D of 1: the
+    zeros 1e9 and 2e-9), and, beyond the largest zero that the equilibrated pencil resolves
+    from infinity, those of the pencil as given (a D that is small only beside the
+    equilibrated blocks: A of 1e-8 beside B of 1, C of 1e8 and D of 1 has a zero near 1e8,
+    at 1e16 times its poles)."""
+    As, Bs, Cs, Ds = (np.array(M, dtype=np.float64) for M in (model.A, model.B, model.C, model.D))
+    if tol is not None:
+        zeros, rank, _ = _scaled_pencil_zeros(As, Bs, Cs, Ds, 0, tol)
+        return _Reduced(_conjugate_clean(zeros), rank)
+    A, B, C, D, frequency = _balance(model.A, model.B, model.C, model.D)
+    zeros, rank, limit = _scaled_pencil_zeros(A, B, C, D, frequency, None)
+    if zeros.size < A.shape[0]:
+        more, _, _ = _scaled_pencil_zeros(As, Bs, Cs, Ds, 0, None)
+        with np.errstate(over="ignore"):
+            beyond = more[np.abs(more) > limit]
+        zeros = np.concatenate([zeros, beyond[: A.shape[0] - zeros.size]])
+    return _Reduced(_conjugate_clean(zeros), rank)
+
+
+def _scaled_pencil_zeros(
+    A: FloatArray, B: FloatArray, C: FloatArray, D: FloatArray, frequency: int, tol: float | None
+) -> tuple[ComplexArray, int, float]:
+    """(the finite zeros times 2^frequency, the normal rank, the modulus beyond which a zero
+    is infinite to the tolerance) of the pencil, scaled to unit size by a power of two 2^e
+    (the zeros of (2^-e A, 2^-e B, 2^-e C, 2^-e D) are 2^-e times those of (A, B, C, D),
+    exactly), reduced, and its regular part's generalized eigenvalues scaled back."""
+    log_size = _log2_norm(A, B, C, D)  # ||S|| itself may overflow (entries near 1e308)
+    e = math.floor(log_size) + 1 if math.isfinite(log_size) else 0
+    A, B, C, D = (np.ldexp(M, -e) for M in (A, B, C, D))
+    size = _frobenius(A, B, C, D)
+    tolerance = _tolerance(A, B, C, D) if tol is None else math.ldexp(tol, -e)
+    ratio = tolerance / max(size, np.finfo(float).tiny)
+    e += frequency
+    with np.errstate(over="ignore"):
+        limit = float(np.ldexp(1.0 / ratio, e)) if ratio > 0 else math.inf
     A, B, C, D = _reduce(A, B, C, D, tolerance)
     At, Bt, Ct, Dt = _reduce(A.T, C.T, B.T, D.T, tolerance)
     A, B, C, D = At.T, Ct.T, Bt.T, Dt.T
@@ -139,19 +280,106 @@ def _pencil_zeros(model: StateSpace, tol: float | None) -> _Reduced:
             "the model is too close to a degenerate one at the rank tolerance (give tol)"
         )
     if n == 0:
-        return _Reduced(np.zeros(0, dtype=np.complex128), rank)
+        return np.zeros(0, dtype=np.complex128), rank, limit
     # [C D] W = [0, Df]: W from the QR factorisation of [C D]ᵀ, its null space first.
     Q, _ = np.linalg.qr(np.hstack([C, D]).T, mode="complete")
     W = np.hstack([Q[:, m:], Q[:, :m]])
     Af = np.hstack([A, B]) @ W[:, :n]
     Bf = W[:n, :n]
-    form = qz(Af, Bf)
-    alpha, beta = form.alpha, form.beta
-    scale = np.maximum(np.abs(np.diag(form.AA)), np.abs(np.diag(form.BB))).max(initial=0.0)
-    finite = beta > tolerance * max(scale, 1.0) * 1e-3
-    zeros = np.asarray(alpha[finite] / beta[finite], dtype=np.complex128)
+    zeros = _regular_pencil_zeros(Af, Bf, ratio)
     zeros[np.abs(zeros) <= tolerance] = 0.0  # a zero at the origin, to rounding (a washout)
-    return _Reduced(_conjugate_clean(zeros), rank)
+    with np.errstate(over="ignore"):  # a zero beyond the range of doubles is warned of
+        zeros = np.ldexp(zeros.real, e) + 1j * np.ldexp(zeros.imag, e)
+    with np.errstate(over="ignore"):
+        finite_or_warn(np.abs(zeros), "a transmission zero")
+    return zeros, rank, limit
+
+
+def _paired(values: ComplexArray, count: int) -> bool:
+    """Whether the first ``count`` of ``values`` leave no complex pair split between them and
+    the rest."""
+    if count <= 0 or count >= len(values):
+        return True
+    first, rest = values[:count], values[count:]
+    return all(np.any(first == np.conj(v)) for v in first if v.imag != 0.0) and all(
+        np.any(rest == np.conj(v)) for v in rest if v.imag != 0.0
+    )
+
+
+def _backward_error(Af: FloatArray, Bf: FloatArray, alpha: complex, beta: float) -> float:
+    """The relative backward error of the eigenvalue α/β of Af - λBf: σ_min(β Af - α Bf) /
+    (|β| ||Af|| + |α| ||Bf||) (Frobenius norms), formed as σ_min(b A' - a B') / (|a| + |b|)
+    with A' = Af / ||Af||, B' = Bf / ||Bf||, b = β ||Af||, a = α ||Bf|| scaled to
+    max(|a|, |b|) = 1, so that nothing overflows; inf where it cannot be formed."""
+    size_a, size_b = _frobenius(Af), _frobenius(Bf)
+    unit_a = Af / size_a if size_a > 0.0 else Af
+    unit_b = Bf / size_b if size_b > 0.0 else Bf
+    with np.errstate(over="ignore", under="ignore"):
+        a = alpha / max(abs(alpha), abs(beta), np.finfo(float).tiny)
+        b = beta / max(abs(alpha), abs(beta), np.finfo(float).tiny)
+        a, b = a * (size_b if size_b > 0.0 else 1.0), b * (size_a if size_a > 0.0 else 1.0)
+        largest = max(abs(a), abs(b))
+        if not (math.isfinite(largest) and largest > 0.0):
+            return math.inf
+        a, b = a / largest, b / largest
+    try:
+        smallest = float(np.linalg.svd(b * unit_a - a * unit_b, compute_uv=False)[-1])
+    except np.linalg.LinAlgError:  # LAPACK's SVD failed: no measure, so not chosen
+        return math.inf
+    return smallest / (abs(a) + abs(b))
+
+
+def _regular_pencil_zeros(Af: FloatArray, Bf: FloatArray, ratio: float) -> ComplexArray:
+    """The finite eigenvalues of the regular pencil Af - λBf (of unit size): the largest from
+    the QZ form of Af - λBf, the others from that of the reversed pencil Bf - μAf (λ = 1/μ),
+    split where the largest backward error of the chosen eigenvalues is least.
+
+    A zero far beyond the others (a D small beside C B) makes Bf nearly singular. In exact
+    arithmetic every eigenvalue is finite (the reduced D is invertible); one with |α| ratio >=
+    |β| (ratio = tolerance / ||S||) is infinite to the tolerance: a change of S of the
+    tolerance's size moves it to infinity. The core's QZ standardizes a 2 x 2 block through
+    H T⁻¹, which loses the small eigenvalue of a block whose T is nearly singular (an absolute
+    error of u times the large one), so each eigenvalue is taken from the form in which it is
+    among the large ones: of the n + 1 ways to take the k largest of Af - λBf and the n - k
+    smallest of the reversed pencil (a complex pair kept together), the one whose worst
+    backward error σ_min(β Af - α Bf) / (|β| ||Af|| + |α| ||Bf||) is least."""
+    n = Af.shape[0]
+    forward, backward = qz(Af, Bf), qz(Bf, Af)
+    # Forward: (α, β) of λ = α/β, largest |λ| first; reversed: (β', α') of λ = β'/α',
+    # smallest |λ| first (β' >= 0 real, α' complex: the homogeneous pair is (β', α')).
+    pairs_forward = sorted(
+        zip(forward.alpha, forward.beta, strict=True),
+        key=lambda ab: -abs(ab[0]) / max(ab[1], abs(ab[0]), np.finfo(float).tiny),
+    )
+    pairs_backward = sorted(
+        ((complex(b), complex(a)) for a, b in zip(backward.alpha, backward.beta, strict=True)),
+        key=lambda ab: abs(ab[0]) / max(abs(ab[1]), abs(ab[0]), np.finfo(float).tiny),
+    )
+
+    def value(alpha: complex, beta: complex) -> complex:
+        return complex(alpha / beta) if beta != 0 else complex(math.inf)
+
+    large = np.array([value(a, b) for a, b in pairs_forward], dtype=np.complex128)
+    small = np.array([value(a, b) for a, b in pairs_backward], dtype=np.complex128)
+    errors_large = [_backward_error(Af, Bf, complex(a), abs(b)) for a, b in pairs_forward]
+    # The reversed pencil's β' is real and >= 0, α' complex: λ = β'/α' has the homogeneous
+    # pair (β'·conj(α')/|α'|, |α'|), of real second entry.
+    errors_small = [
+        _backward_error(Af, Bf, b * a.conjugate() / abs(a), abs(a))
+        if a != 0
+        else _backward_error(Af, Bf, 1.0, 0.0)
+        for b, a in pairs_backward
+    ]
+    best, best_error = n, math.inf
+    for count in range(n, -1, -1):
+        if not (_paired(large, count) and _paired(small, n - count)):
+            continue
+        worst = max(errors_large[:count] + errors_small[: n - count], default=0.0)
+        if worst < best_error:
+            best, best_error = count, worst
+    infinite = np.array([abs(a) * ratio >= b for a, b in pairs_forward], dtype=bool)
+    chosen = np.concatenate([large[:best][~infinite[:best]], small[: n - best]])
+    return np.asarray(chosen[np.isfinite(chosen)], dtype=np.complex128)
 
 
 def _conjugate_clean(roots: ComplexArray) -> ComplexArray:
@@ -188,7 +416,10 @@ def transmission_zeros(sys: System, tol: float | None = None) -> ComplexArray:
     ----------
     sys : StateSpace or (A, B, C, D)
     tol : float, optional
-        The tolerance of the rank decisions; default (n + p)(n + m) ε ||S||_F.
+        The tolerance of the rank decisions on the system matrix S as given; by default
+        (n + p)(n + m) ε ||S||_F of S balanced (scaled by exact powers of two, per state,
+        input and output, which leaves the zeros unchanged) so that blocks of very different
+        sizes are each judged at their own scale.
 
     Returns
     -------
@@ -382,6 +613,47 @@ def _single(key: SignalSelection | None, names: tuple[str, ...], what: str) -> i
     return indices[0]
 
 
+def _scaled_response(channel: StateSpace, omega: float, dt: float) -> tuple[complex, int]:
+    """(g, k) with G(jω) = 2^k g (G(e^{jω dt}) for a discrete model): the response of the model
+    with C and D divided by the power of two of the largest of them, and B and D by that of
+    the largest of B and the scaled D, so that large B and C (1e149) at a point near tiny
+    poles (1e-300) do not overflow where G does not in scaled form."""
+    A, B, C, D = channel.A, channel.B, channel.C, channel.D
+    k_out = int(_exponents(np.array([max(float(np.abs(C).max(initial=0.0)), abs(D[0, 0]))]))[0])
+    C, D = np.ldexp(C, -k_out), np.ldexp(D, -k_out)
+    k_in = int(_exponents(np.array([max(float(np.abs(B).max(initial=0.0)), abs(D[0, 0]))]))[0])
+    B, D = np.ldexp(B, -k_in), np.ldexp(D, -k_in)
+    with warnings.catch_warnings():
+        # An overflow of the scaled response is warned of by _gain, as the gain's.
+        warnings.simplefilter("ignore", NumericalOverflowWarning)
+        response = _core.frequency_response(A, B, C, D, np.array([omega]), dt or None)
+    return complex(response[0, 0, 0]), k_out + k_in
+
+
+def _gain(
+    response: complex, exponent: int, point: complex, zeros: ComplexArray, poles: ComplexArray
+) -> float:
+    """K = G(point) Π(point - p_j) / Π(point - z_i), with G(point) = 2^exponent response, as
+    the exponential of a sum of logarithms:
+    the products of many large (or small) factors overflow (or underflow) where K does not
+    (1/(s + 1e-151) + 1/(s + 2e-151) + 1/(s + 3e-151) is 3/s: K = 3 from products of sizes
+    1e-302 and 1e-453). A K beyond the range of doubles is infinite, with a warning."""
+    if response == 0.0:
+        return 0.0
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        terms = np.concatenate([[np.log(response)], np.log(point - poles), -np.log(point - zeros)])
+    if not np.all(np.isfinite(terms)):  # G(point) overflowed even scaled
+        gain = math.inf
+        finite_or_warn(np.array([gain]), "the gain")
+        return gain
+    log_size = float(np.sum(terms.real)) + exponent * math.log(2.0)
+    phase = float(np.sum(terms.imag))
+    with np.errstate(over="ignore"):
+        gain = float(np.exp(log_size) * math.cos(phase))
+    finite_or_warn(np.array([gain]), "the gain")
+    return gain
+
+
 def transfer_function(
     sys: System,
     output: SignalSelection | None = None,
@@ -429,7 +701,9 @@ def transfer_function(
         else np.zeros(0, np.complex128)
     )
     reduced = _pencil_zeros(channel, None)
-    denominator = np.real(np.poly(poles)) if poles.size else np.ones(1)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is warned of below
+        denominator = np.real(np.poly(poles)) if poles.size else np.ones(1)
+    finite_or_warn(denominator, "the denominator det(sI - A)")
     if reduced.normal_rank == 0:
         zeros = np.zeros(0, np.complex128)
         gain = 0.0
@@ -437,12 +711,11 @@ def transfer_function(
     else:
         zeros = reduced.zeros
         omega, point = _evaluation_point(np.concatenate([zeros, poles]), dt)
-        response = _core.frequency_response(
-            channel.A, channel.B, channel.C, channel.D, np.array([omega]), dt or None
-        )[0, 0, 0]
-        value = response * np.prod(point - poles) / np.prod(point - zeros)
-        gain = float(value.real)
-        numerator = gain * np.real(np.poly(zeros)) if zeros.size else np.array([gain])
+        response, exponent = _scaled_response(channel, omega, dt)
+        gain = _gain(response, exponent, point, zeros, poles)
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is warned of below
+            numerator = gain * np.real(np.poly(zeros)) if zeros.size else np.array([gain])
+        finite_or_warn(numerator, "the numerator")
     return TransferFunction(
         numerator=np.asarray(numerator, dtype=np.float64),
         denominator=np.asarray(denominator, dtype=np.float64),

@@ -26,12 +26,7 @@ from hypothesis import strategies as st
 import aerocontrol
 
 from .harness import Warned, exercise, plain
-from .known_defects import (
-    PENCIL_TOLERANCE_OVERFLOW,
-    TRANSFER_GAIN_UNDERFLOW,
-    TRANSFER_SCALE_OVERFLOW,
-    ZEROS_DROPPED,
-)
+from .known_defects import ZEROS_DROPPED
 from .oracles import (
     SLACK,
     TINY,
@@ -279,48 +274,73 @@ def _diagonal_channel(scale: float) -> tuple[np.ndarray, ...]:
     return (np.diag([-1.0, -2.0, -3.0]) * scale, np.ones((3, 1)), np.ones((1, 3)), np.zeros((1, 1)))
 
 
-@pytest.mark.xfail(strict=True, reason="pencil-tolerance-overflow: M * M overflows")
-def test_known_defect_pencil_tolerance_overflow() -> None:
+def test_regression_pencil_tolerance_overflow() -> None:
+    """||S||_F of entries beyond 1e154 was formed from their squares, which overflowed."""
     model = (np.array([[-1e155]]), np.eye(1), np.eye(1), np.zeros((1, 1)))
-    with PENCIL_TOLERANCE_OVERFLOW.reproducing():
-        exercise(
+    outcome = exercise(
+        "transmission_zeros",
+        lambda sys: aerocontrol.transmission_zeros(sys),
+        {"sys": plain(model)},
+        _zeros_oracle(False),
+    )
+    assert outcome.result.shape == (0,)  # 1/(s + 1e155): no finite zero
+
+
+def test_regression_transfer_scale_overflow() -> None:
+    """Poles near 1e103 (n = 3): det(sI - A) has a coefficient of 6e309, infinite, which came
+    back without a warning; the gain was formed from products that overflowed."""
+    outcome = exercise(
+        "transfer_function",
+        lambda sys, output, input: aerocontrol.transfer_function(sys, output, input),
+        {"sys": plain(_diagonal_channel(1e103)), "output": plain(None), "input": plain(None)},
+        _transfer_oracle(False),
+    )
+    assert aerocontrol.NumericalOverflowWarning in outcome.warned
+    assert outcome.result.gain == pytest.approx(3.0, rel=1e-12)  # sum of 1/(s + k 1e103)
+
+
+def test_regression_transfer_gain_underflow() -> None:
+    """Poles near 1e-151 (n = 3): Π(point - p) underflowed, and the gain of 3/s came out
+    -0.0. The zeros are 1e-151 (-2 ± 1/√3) (3 s² + 12 a s + 11 a², a = 1e-151)."""
+    outcome = exercise(
+        "transfer_function",
+        lambda sys, output, input: aerocontrol.transfer_function(sys, output, input),
+        {"sys": plain(_diagonal_channel(1e-151)), "output": plain(None), "input": plain(None)},
+        _transfer_oracle(False),
+    )
+    assert outcome.result.gain == pytest.approx(3.0, rel=1e-12)
+    expected = 1e-151 * np.array([-2.0 - 1.0 / np.sqrt(3.0), -2.0 + 1.0 / np.sqrt(3.0)])
+    np.testing.assert_allclose(outcome.result.zeros.real, expected, rtol=1e-10)
+
+
+def test_regression_zeros_of_badly_scaled_blocks() -> None:
+    """C of 1e9 beside A, B and D of 1: the zeros 1e9 - 3 and 2e-9 (s^2 + (3 - 1e9) s + 2)
+    were returned as [0]."""
+    model = (np.diag([-1.0, -2.0]), np.ones((2, 1)), np.array([[1e9, -2e9]]), np.eye(1))
+    with ZEROS_DROPPED.reproducing():  # the oracle in full, though the class is registered
+        outcome = exercise(
             "transmission_zeros",
             lambda sys: aerocontrol.transmission_zeros(sys),
             {"sys": plain(model)},
-            _zeros_oracle(False),
+            _zeros_oracle(True),
         )
+    small = 2.0 / (1e9 - 3.0)  # the product of the roots is 2
+    np.testing.assert_allclose(outcome.result.real, [small, 2.0 / small], rtol=1e-6)
 
 
-@pytest.mark.xfail(strict=True, reason="transfer-scale-overflow: inf without a warning")
-def test_known_defect_transfer_scale_overflow() -> None:
-    with TRANSFER_SCALE_OVERFLOW.reproducing():
-        exercise(
-            "transfer_function",
-            lambda sys, output, input: aerocontrol.transfer_function(sys, output, input),
-            {"sys": plain(_diagonal_channel(1e103)), "output": plain(None), "input": plain(None)},
-            _transfer_oracle(False),
-        )
-
-
-@pytest.mark.xfail(strict=True, reason="transfer-gain-underflow: gain -0.0 for 3/s")
-def test_known_defect_transfer_gain_underflow() -> None:
-    with TRANSFER_GAIN_UNDERFLOW.reproducing():
-        outcome = exercise(
-            "transfer_function",
-            lambda sys, output, input: aerocontrol.transfer_function(sys, output, input),
-            {"sys": plain(_diagonal_channel(1e-151)), "output": plain(None), "input": plain(None)},
-            _transfer_oracle(False),
-        )
-    assert outcome.result.gain == pytest.approx(3.0), f"gain {outcome.result.gain}, not 3"
-
-
-@pytest.mark.xfail(strict=True, reason="zeros-dropped-badly-scaled: the zero at 1e9 is lost")
-def test_known_defect_zeros_dropped() -> None:
-    model = (np.diag([-1.0, -2.0]), np.ones((2, 1)), np.array([[1e9, -2e9]]), np.eye(1))
+@pytest.mark.xfail(strict=True, reason="zeros-dropped-badly-scaled: zeros at two scales")
+def test_known_defect_zeros_at_two_scales() -> None:
+    rng = np.random.default_rng(0)
+    A = rng.standard_normal((3, 3)) * 1e-8
+    B, C, D = (
+        np.array([[0.1257302210933933], [-0.1321048632913019], [0.6404226504432821]]),
+        (np.array([[125.7302210933933, -132.10486329130188, 640.422650443282]])),
+        np.array([[0.1257302210933933]]),
+    )
     with ZEROS_DROPPED.reproducing():
         exercise(
             "transmission_zeros",
             lambda sys: aerocontrol.transmission_zeros(sys),
-            {"sys": plain(model)},
+            {"sys": plain((A, B, C, D))},
             _zeros_oracle(True),
         )
