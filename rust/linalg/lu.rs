@@ -3,6 +3,7 @@
 //! A thin layer over faer's in-place factorisation. For small systems the pivot vectors and
 //! faer's scratch live on the stack, so a solve allocates nothing.
 
+use crate::linalg::matrix::with_order;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
 use faer::linalg::lu::partial_pivoting::{factor, solve};
@@ -96,22 +97,12 @@ pub fn solve_with_inverse(a: MatMut<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
 /// entries.
 fn eliminate_and_substitute(a: MatMut<'_, f64>, b: MatMut<'_, f64>) {
     // At its order as a constant: the loops over a column unroll.
-    match a.nrows() {
-        0 => {}
-        1 => eliminate_and_substitute_in::<1>(a, b),
-        2 => eliminate_and_substitute_in::<2>(a, b),
-        3 => eliminate_and_substitute_in::<3>(a, b),
-        4 => eliminate_and_substitute_in::<4>(a, b),
-        5 => eliminate_and_substitute_in::<5>(a, b),
-        6 => eliminate_and_substitute_in::<6>(a, b),
-        7 => eliminate_and_substitute_in::<7>(a, b),
-        8 => eliminate_and_substitute_in::<8>(a, b),
-        9 => eliminate_and_substitute_in::<9>(a, b),
-        10 => eliminate_and_substitute_in::<10>(a, b),
-        11 => eliminate_and_substitute_in::<11>(a, b),
-        12 => eliminate_and_substitute_in::<12>(a, b),
-        n => unreachable!("eliminate_and_substitute of order {n} > UNBLOCKED_MAX_ORDER"),
-    }
+    with_order!(
+        a.nrows(),
+        [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12],
+        N => eliminate_and_substitute_in::<N>(a, b),
+        n => assert_eq!(n, 0, "eliminate_and_substitute of order {n} > UNBLOCKED_MAX_ORDER")
+    )
 }
 
 /// [`eliminate_and_substitute`] at the order N.

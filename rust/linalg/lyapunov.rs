@@ -32,7 +32,7 @@
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::range_scale;
 use crate::linalg::dense::view_product;
-use crate::linalg::matrix::{FaerView, Symmetrize, from_faer};
+use crate::linalg::matrix::{FaerView, Symmetrize, from_faer, with_order};
 use crate::linalg::schur::real_schur;
 use crate::linalg::sylvester::solve_small_sylvester;
 use crate::platform::dispatch::clear_upper_avx_state;
@@ -130,15 +130,15 @@ pub(crate) fn solve_kronecker(
 ) -> Result<DMatrix<f64>, Error> {
     // The order N and the system's order S = N(N+1)/2 as constants: the loops over rows of S
     // entries unroll, and the system takes no more stack than it needs.
-    match a.nrows() {
-        0 => Ok(DMatrix::zeros(0, 0)),
-        1 => solve_kronecker_in::<1, 1>(a, q, singularity),
-        2 => solve_kronecker_in::<2, 3>(a, q, singularity),
-        3 => solve_kronecker_in::<3, 6>(a, q, singularity),
-        4 => solve_kronecker_in::<4, 10>(a, q, singularity),
-        5 => solve_kronecker_in::<5, 15>(a, q, singularity),
-        n => unreachable!("solve_kronecker of order {n} > KRONECKER_MAX_ORDER"),
-    }
+    with_order!(
+        a.nrows(),
+        [1, 2, 3, 4, 5],
+        N => solve_kronecker_in::<N, { N * (N + 1) / 2 }>(a, q, singularity),
+        n => {
+            assert_eq!(n, 0, "solve_kronecker of order {n} > KRONECKER_MAX_ORDER");
+            Ok(DMatrix::zeros(0, 0))
+        }
+    )
 }
 
 /// [`solve_kronecker`] at the order N, S = N(N+1)/2.
