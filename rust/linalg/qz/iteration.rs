@@ -297,7 +297,7 @@ pub(crate) fn standardize_pair(p: &mut Pencil<'_>, k: usize) -> Result<bool, Err
     }
     let block = standardize_block(m[0][0], m[0][1], m[1][0], m[1][1]);
     if block.c == 0.0 {
-        split_real_pair(p, k, block.a);
+        split_real_pair(p, k, real_pair_eigenvalue(p, k, block.a));
         return Ok(false);
     }
     // Complex: T's block diagonal and positive. Columns of T's block made orthogonal
@@ -341,22 +341,65 @@ pub(crate) fn standardize_pair(p: &mut Pencil<'_>, k: usize) -> Result<bool, Err
         p.h[(l, l)] / t22,
     );
     if block.c == 0.0 {
-        split_real_pair(p, k, block.a);
+        split_real_pair(p, k, real_pair_eigenvalue(p, k, block.a));
         return Ok(false);
     }
     Ok(true)
 }
 
-/// Splits the 2 x 2 block at (k, k+1) with the real eigenvalue λ (T's block upper
-/// triangular): a column rotation through the right eigenvector of λ and a row rotation
-/// that annihilates below, leaving h_{k+1,k} = t_{k+1,k} = 0.
-fn split_real_pair(p: &mut Pencil<'_>, k: usize, lambda: f64) {
+/// The real eigenvalue of the 2 x 2 block at (k, k+1) (T's block upper triangular) nearest
+/// `estimate`, as a homogeneous pair (α, β), λ = α / β, from the block's own entries.
+///
+/// `estimate` comes from M = H T^-1, whose entries grow like 1 / t22: where T's block is
+/// nearly singular, M's small eigenvalue carries an absolute error of about u ||M|| and so a
+/// large relative one. Here both roots of det(βH - αT) = 0, that is of
+/// t11 t22 λ^2 - (h11 t22 + h22 t11 - h21 t12) λ + (h11 h22 - h12 h21) = 0, are formed
+/// without cancellation (the larger as q / (2 t11 t22), the smaller as 2 det H / q, with
+/// q = b + sign(b) sqrt(b^2 - 4 det T det H)), each as a pair so that an infinite eigenvalue
+/// (t11 t22 = 0) is (q, 0); the one nearer the estimate is returned. (LAPACK's dlag2 likewise
+/// avoids forming H T^-1.)
+fn real_pair_eigenvalue(p: &Pencil<'_>, k: usize, estimate: f64) -> (f64, f64) {
     let l = k + 1;
     let (t11, t12, t22) = (p.t[(k, k)], p.t[(k, l)], p.t[(l, l)]);
     let (h11, h12, h21, h22) = (p.h[(k, k)], p.h[(k, l)], p.h[(l, k)], p.h[(l, l)]);
+    let a = t11 * t22;
+    let b = h11 * t22 + h22 * t11 - h21 * t12;
+    let c = h11 * h22 - h12 * h21;
+    let discriminant = (b * b - 4.0 * a * c).max(0.0);
+    let q = b + b.signum() * discriminant.sqrt();
+    let roots = [(q, 2.0 * a), (2.0 * c, q)];
+    if !roots.iter().all(|&(x, y)| x.is_finite() && y.is_finite()) || q == 0.0 {
+        return (estimate, 1.0);
+    }
+    // |α - estimate β| / (|α| + |estimate β|): the chordal distance up to a factor.
+    let distance = |&(alpha, beta): &(f64, f64)| {
+        let scale = alpha.abs() + (estimate * beta).abs();
+        if scale == 0.0 {
+            0.0
+        } else {
+            (alpha - estimate * beta).abs() / scale
+        }
+    };
+    if distance(&roots[0]) <= distance(&roots[1]) {
+        roots[0]
+    } else {
+        roots[1]
+    }
+}
+
+/// Splits the 2 x 2 block at (k, k+1) with the real eigenvalue λ = α / β (T's block upper
+/// triangular): a column rotation through the right eigenvector of λ (the null vector of
+/// β H - α T) and a row rotation that annihilates below, leaving h_{k+1,k} = t_{k+1,k} = 0.
+fn split_real_pair(p: &mut Pencil<'_>, k: usize, (alpha, beta): (f64, f64)) {
+    let l = k + 1;
+    let (t11, t12, t22) = (p.t[(k, k)], p.t[(k, l)], p.t[(l, l)]);
+    let (h11, h12, h21, h22) = (p.h[(k, k)], p.h[(k, l)], p.h[(l, k)], p.h[(l, l)]);
+    // (α, β) scaled to the larger of unit size: the rows keep the size of H and T.
+    let size = alpha.abs().max(beta.abs());
+    let (alpha, beta) = (alpha / size, beta / size);
     let rows = [
-        [h11 - lambda * t11, h12 - lambda * t12],
-        [h21, h22 - lambda * t22],
+        [beta * h11 - alpha * t11, beta * h12 - alpha * t12],
+        [beta * h21, beta * h22 - alpha * t22],
     ];
     let norm = |r: &[f64; 2]| r[0].hypot(r[1]);
     let row = if norm(&rows[0]) >= norm(&rows[1]) {
