@@ -5,6 +5,7 @@ use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
 use super::linalg::{expm_flops, schur_cost};
+use crate::control::riccati::AlgebraicSolution;
 use crate::control::riccati::care::{CareOptions, solve_care as solve_care_core};
 use crate::control::riccati::dare::{DareOptions, solve_dare as solve_dare_core};
 use crate::control::riccati::ode::riccati_ode as riccati_ode_core;
@@ -20,7 +21,9 @@ pub fn care_cost(n: usize) -> Cost {
     Cost::of(40.0 * (order as f64).powi(3), 16.0, order)
 }
 
-type CareOutput<'py> = (
+/// An algebraic Riccati solution as Python receives it: (X, K, closed-loop eigenvalues,
+/// relative residual, rcond, Newton steps).
+type AlgebraicOutput<'py> = (
     Bound<'py, PyArrayDyn<f64>>,
     Bound<'py, PyArrayDyn<f64>>,
     Bound<'py, PyArrayDyn<c64>>,
@@ -28,6 +31,29 @@ type CareOutput<'py> = (
     f64,
     usize,
 );
+
+/// The arrays and numbers of an [`AlgebraicOutput`].
+fn algebraic_output<'py>(
+    py: Python<'py>,
+    solution: &AlgebraicSolution,
+) -> PyResult<AlgebraicOutput<'py>> {
+    let mut outputs = Outputs::new(py);
+    let n = solution.closed_loop_eigenvalues.len();
+    let result = (
+        outputs.matrix("X", solution.x.as_ref())?,
+        outputs.matrix("K", solution.gain.as_ref())?,
+        outputs.complex(
+            "the closed-loop eigenvalues",
+            &[n],
+            &solution.closed_loop_eigenvalues,
+        )?,
+        solution.residual,
+        solution.rcond,
+        solution.refinement_steps,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
 
 /// The stabilising solution of the CARE (6.228): (X, K, closed-loop eigenvalues, relative
 /// residual, rcond(U11), Newton steps).
@@ -43,7 +69,7 @@ fn solve_care<'py>(
     s: Option<&Bound<'py, PyAny>>,
     e: Option<&Bound<'py, PyAny>>,
     refine: bool,
-) -> PyResult<CareOutput<'py>> {
+) -> PyResult<AlgebraicOutput<'py>> {
     let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
     let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
     let s = Real::convert_optional(py, s, "S")?;
@@ -60,22 +86,7 @@ fn solve_care<'py>(
     let solution = compute(py, care_cost(a.nrows()), || {
         solve_care_core(a, b, q, r, options)
     })?;
-    let mut outputs = Outputs::new(py);
-    let n = solution.closed_loop_eigenvalues.len();
-    let result = (
-        outputs.matrix("X", solution.x.as_ref())?,
-        outputs.matrix("K", solution.gain.as_ref())?,
-        outputs.complex(
-            "the closed-loop eigenvalues",
-            &[n],
-            &solution.closed_loop_eigenvalues,
-        )?,
-        solution.residual,
-        solution.rcond,
-        solution.refinement_steps,
-    );
-    outputs.finish()?;
-    Ok(result)
+    algebraic_output(py, &solution)
 }
 
 /// The cost of one DARE of n states and m inputs: the QZ form of the compressed pencil (order
@@ -89,15 +100,6 @@ pub fn dare_cost(n: usize, m: usize) -> Cost {
     )
 }
 
-type DareOutput<'py> = (
-    Bound<'py, PyArrayDyn<f64>>,
-    Bound<'py, PyArrayDyn<f64>>,
-    Bound<'py, PyArrayDyn<c64>>,
-    f64,
-    f64,
-    usize,
-);
-
 /// The stabilising solution of the DARE: (X, K, closed-loop eigenvalues, relative residual,
 /// rcond(E U11), Newton steps).
 #[pyfunction]
@@ -110,7 +112,7 @@ fn solve_dare<'py>(
     r: &Bound<'py, PyAny>,
     s: Option<&Bound<'py, PyAny>>,
     e: Option<&Bound<'py, PyAny>>,
-) -> PyResult<DareOutput<'py>> {
+) -> PyResult<AlgebraicOutput<'py>> {
     let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
     let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
     let s = Real::convert_optional(py, s, "S")?;
@@ -126,22 +128,7 @@ fn solve_dare<'py>(
     let solution = compute(py, dare_cost(a.nrows(), b.ncols()), || {
         solve_dare_core(a, b, q, r, options)
     })?;
-    let mut outputs = Outputs::new(py);
-    let n = solution.closed_loop_eigenvalues.len();
-    let result = (
-        outputs.matrix("X", solution.x.as_ref())?,
-        outputs.matrix("K", solution.gain.as_ref())?,
-        outputs.complex(
-            "the closed-loop eigenvalues",
-            &[n],
-            &solution.closed_loop_eigenvalues,
-        )?,
-        solution.residual,
-        solution.rcond,
-        solution.refinement_steps,
-    );
-    outputs.finish()?;
-    Ok(result)
+    algebraic_output(py, &solution)
 }
 
 type RiccatiOdeOutput<'py> = (

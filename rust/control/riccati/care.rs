@@ -79,6 +79,7 @@
 //! a computed solution whose closed loop A - B K has an eigenvalue with Re λ >= 0 (the stable
 //! and unstable eigenvalues of H too ill-conditioned to be told apart).
 
+use super::AlgebraicSolution;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::balance;
 use crate::linalg::dense::{
@@ -125,23 +126,6 @@ pub const REFINEMENT_FLOOR: f64 = 4.0 * f64::EPSILON;
 /// Asymmetry ||M - M^T||_max / ||M||_max that Q and R may carry (rounding in how the caller
 /// formed them); they are then symmetrised.
 pub const SYMMETRY_TOLERANCE: f64 = 1e-12;
-
-/// The solution of a CARE and its diagnostics.
-#[derive(Debug, Clone)]
-pub struct Care {
-    /// The stabilising solution X = X^T.
-    pub x: Mat<f64>,
-    /// K = R^-1 (B^T X E + S^T), m x n.
-    pub gain: Mat<f64>,
-    /// The eigenvalues of (A - B K, E), pairs adjacent with Im > 0 first.
-    pub closed_loop_eigenvalues: Vec<c64>,
-    /// The relative residual of the general equation (see the module documentation).
-    pub residual: f64,
-    /// The reciprocal 1-norm condition number of U11.
-    pub rcond: f64,
-    /// Newton steps taken.
-    pub refinement_steps: usize,
-}
 
 /// The optional arguments of [`solve_care`].
 #[derive(Debug, Clone, Copy, Default)]
@@ -246,7 +230,7 @@ pub fn solve_care(
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
-) -> Result<Care, Error> {
+) -> Result<AlgebraicSolution, Error> {
     // An R that is symmetric but not positive definite: the extended pencil, which needs no
     // Cholesky factor (an asymmetric R is refused by the same check in both paths).
     if r.nrows() == r.ncols()
@@ -258,7 +242,7 @@ pub fn solve_care(
     {
         return super::care_pencil::solve_care_indefinite(a, b, q, r, options);
     }
-    solve_care_dense(a, b, q, r, options).map(|care| Care {
+    solve_care_dense(a, b, q, r, options).map(|care| AlgebraicSolution {
         x: care.x.to_faer(),
         gain: care.gain.to_faer(),
         closed_loop_eigenvalues: care.closed_loop_eigenvalues,
@@ -268,7 +252,7 @@ pub fn solve_care(
     })
 }
 
-/// [`Care`] with X and K as the solver forms them, for callers that copy them on (the batch
+/// [`AlgebraicSolution`] with X and K as the solver forms them, for callers that copy them on (the batch
 /// kernels), sparing the conversion.
 pub(crate) struct CareDense {
     pub(crate) x: DMatrix<f64>,

@@ -19,7 +19,8 @@
 //! closed loop (A - B K, E) with K = R^-1 (B^T X E + S^T) stable to working precision; the
 //! relative residual and rcond(E U11) are reported.
 
-use super::care::{AXIS_TOLERANCE, Care, CareOptions};
+use super::AlgebraicSolution;
+use super::care::{AXIS_TOLERANCE, CareOptions};
 use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
 use crate::linalg::lu::solve_with_inverse;
@@ -34,7 +35,7 @@ pub(crate) fn solve_care_indefinite(
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
-) -> Result<Care, Error> {
+) -> Result<AlgebraicSolution, Error> {
     let (q, r) = checked_weights(a, b, q, r, options.s, options.e)?;
     let (n, m) = (a.nrows(), b.ncols());
     // R must be invertible (the gain is R^-1 (B^T X E + S^T)).
@@ -144,7 +145,7 @@ pub(crate) fn solve_care_indefinite(
         + 2.0 * frobenius_norm(axe.as_ref())
         + frobenius_norm(quadratic.as_ref());
     let size = frobenius_norm(residual.as_ref());
-    Ok(Care {
+    Ok(AlgebraicSolution {
         x,
         gain,
         closed_loop_eigenvalues,

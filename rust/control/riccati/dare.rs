@@ -49,6 +49,7 @@
 //! R need not be positive definite (only symmetric): indefinite weights, as the H-infinity
 //! equations have, are solved where a stabilising solution exists.
 
+use super::AlgebraicSolution;
 use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
 use crate::linalg::lu::solve_with_inverse;
@@ -73,23 +74,6 @@ pub const MAX_REFINEMENT_STEPS: usize = 3;
 /// the vectorised system's (n^2 / 2)^3 / 3 flops outgrow the doubling's few dozen products.
 const SMITH_MIN_ORDER: usize = 8;
 
-/// The solution of a DARE and its diagnostics.
-#[derive(Debug, Clone)]
-pub struct Dare {
-    /// The stabilising solution X = X^T.
-    pub x: Mat<f64>,
-    /// K = (R + B^T X B)^-1 (B^T X A + S^T), m x n.
-    pub gain: Mat<f64>,
-    /// The eigenvalues of (A - B K, E).
-    pub closed_loop_eigenvalues: Vec<c64>,
-    /// The relative residual (see the module documentation).
-    pub residual: f64,
-    /// The reciprocal 1-norm condition number of E U11.
-    pub rcond: f64,
-    /// Newton steps taken.
-    pub refinement_steps: usize,
-}
-
 /// The optional arguments of [`solve_dare`].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct DareOptions<'a> {
@@ -106,13 +90,13 @@ pub fn solve_dare(
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
     options: DareOptions<'_>,
-) -> Result<Dare, Error> {
+) -> Result<AlgebraicSolution, Error> {
     let (q, r) = checked_weights(a, b, q, r, options.s, options.e)?;
     let (n, m) = (a.nrows(), b.ncols());
     let identity = Mat::<f64>::identity(n, n);
     let e = options.e.unwrap_or(identity.as_ref());
     if n == 0 {
-        return Ok(Dare {
+        return Ok(AlgebraicSolution {
             x: Mat::zeros(0, 0),
             gain: Mat::zeros(m, 0),
             closed_loop_eigenvalues: vec![],
@@ -159,7 +143,7 @@ pub fn solve_dare(
         &closed_loop_eigenvalues,
         frobenius_norm(evaluation.closed_loop.as_ref()),
     )?;
-    Ok(Dare {
+    Ok(AlgebraicSolution {
         x,
         gain: evaluation.gain,
         closed_loop_eigenvalues,
