@@ -20,16 +20,7 @@ pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
     }
     let largest = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if !(RANGE_LOW..=RANGE_HIGH).contains(&largest) {
-        // The reflector depends only on the direction of x: compute it for x times a power of
-        // two (exact; 2^±1000 at most, so that one step brings any finite x into range) and
-        // scale β back.
-        let exponent = (-largest.log2().round()).clamp(-1000.0, 1000.0) as i32;
-        let (up, down) = (2f64.powi(exponent), 2f64.powi(-exponent));
-        for v in x.iter_mut() {
-            *v *= up;
-        }
-        let (beta, tau) = reflector(x);
-        return (beta * down, tau);
+        return scaled_reflector(x, largest);
     }
     // Entries within 2^±500: the sum of squares neither overflows nor loses more than rounding
     // to underflow.
@@ -42,6 +33,22 @@ pub(crate) fn reflector(x: &mut [f64]) -> (f64, f64) {
         *v *= scale;
     }
     (beta, tau)
+}
+
+/// [`reflector`] for an x whose largest entry is outside 2^±500. The reflector depends only on
+/// the direction of x: it is computed for x times a power of two (exact; 2^±1000 at most, so
+/// that one step brings any finite x into range) and β scaled back. Kept out of line, so that
+/// [`reflector`] itself (not recursive) inlines into the sweeps.
+#[cold]
+#[inline(never)]
+fn scaled_reflector(x: &mut [f64], largest: f64) -> (f64, f64) {
+    let exponent = (-largest.log2().round()).clamp(-1000.0, 1000.0) as i32;
+    let (up, down) = (2f64.powi(exponent), 2f64.powi(-exponent));
+    for v in x.iter_mut() {
+        *v *= up;
+    }
+    let (beta, tau) = reflector(x);
+    (beta * down, tau)
 }
 
 /// The range of the largest entry in which [`reflector`] forms the norm without scaling.
