@@ -77,6 +77,9 @@ __all__ = [
 Names = str | Sequence[str] | None
 """Signal names of a constructor: one name as a string, or a sequence of names."""
 
+Matrices = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
+"""A, B, C and D of a model."""
+
 Source = str | tuple[str, float]
 """A signal feeding an input in :func:`connect`: ``"name"``, ``"-name"`` or ``("name", gain)``."""
 
@@ -394,7 +397,6 @@ def series(sys1: System, sys2: System, *systems: System) -> StateSpace:
                 f"series: {labels[k]} has {second.n_inputs} inputs but the model before it has "
                 f"{result.n_outputs} outputs"
             )
-        n1, n2 = result.n_states, second.n_states
         m1, p1, p2 = result.n_inputs, result.n_outputs, second.n_outputs
         # u2 = y1, z = y2: the connection matrices of _state_exponents.
         K = np.zeros((m1 + p1, p1 + p2))
@@ -402,18 +404,12 @@ def series(sys1: System, sys2: System, *systems: System) -> StateSpace:
         E = np.vstack([np.eye(m1), np.zeros((p1, m1))])
         F = np.hstack([np.zeros((p2, p1)), np.eye(p2)])
         G = np.zeros((p2, m1 + p1))
-        exponents = _state_exponents([result, second], K, E, F, G)
-        first, second = _rescaled(result, exponents[0]), _rescaled(second, exponents[1])
-        with np.errstate(over="ignore", invalid="ignore"):
-            A = np.block(
-                [[first.A, np.zeros((n1, n2))], [second.B @ first.C, second.A]],
-            )
-            matrices = (
-                A,
-                np.vstack([first.B, second.B @ first.D]),
-                np.hstack([second.D @ first.C, second.C]),
-                second.D @ first.D,
-            )
+        first = result
+        matrices = _series_matrices(first, second)
+        if not all(np.all(np.isfinite(M)) for M in matrices):
+            exponents = _state_exponents([result, second], K, E, F, G)
+            first, second = _rescaled(result, exponents[0]), _rescaled(second, exponents[1])
+            matrices = _series_matrices(first, second)
         _representable(matrices, "series", ", ".join(labels[: k + 1]))
         result = StateSpace(
             *matrices,
@@ -423,6 +419,18 @@ def series(sys1: System, sys2: System, *systems: System) -> StateSpace:
             dt=dt,
         )
     return result
+
+
+def _series_matrices(first: StateSpace, second: StateSpace) -> Matrices:
+    """A, B, C, D of ``second`` after ``first`` (non-finite where a product overflows)."""
+    n1, n2 = first.n_states, second.n_states
+    with np.errstate(over="ignore", invalid="ignore"):
+        return (
+            np.block([[first.A, np.zeros((n1, n2))], [second.B @ first.C, second.A]]),
+            np.vstack([first.B, second.B @ first.D]),
+            np.hstack([second.D @ first.C, second.C]),
+            second.D @ first.D,
+        )
 
 
 def parallel(sys1: System, sys2: System, *systems: System) -> StateSpace:
@@ -570,11 +578,27 @@ def _closed(
     K[m1:, :p1] = np.eye(p1)
     E = np.vstack([np.eye(m1), np.zeros((p1, m1))])
     F = np.hstack([np.eye(p1), np.zeros((p1, m1))])
-    exponents = _state_exponents([forward, back], K, E, F, np.zeros((p1, m1 + p1)))
-    first, second = _rescaled(forward, exponents[0]), _rescaled(back, exponents[1])
+    matrices = _loop_matrices(forward, back, s, function)
+    if not all(np.all(np.isfinite(M)) for M in matrices):
+        exponents = _state_exponents([forward, back], K, E, F, np.zeros((p1, m1 + p1)))
+        first, second = _rescaled(forward, exponents[0]), _rescaled(back, exponents[1])
+        matrices = _loop_matrices(first, second, s, function)
+    _representable(matrices, function, arguments)
+    return StateSpace(
+        *matrices,
+        state_names=forward.state_names + back.state_names,
+        input_names=forward.input_names,
+        output_names=forward.output_names,
+        dt=dt,
+    )
+
+
+def _loop_matrices(first: StateSpace, second: StateSpace, s: float, function: str) -> Matrices:
+    """A, B, C, D of :func:`feedback` (non-finite where a product overflows)."""
+    m1 = first.n_inputs
     A1, B1, C1, D1 = first.A, first.B, first.C, first.D
     A2, B2, C2, D2 = second.A, second.B, second.C, second.D
-    n1, n2 = forward.n_states, back.n_states
+    n1, n2 = first.n_states, second.n_states
     with np.errstate(over="ignore", invalid="ignore"):
         # u1 = U_x x + U_r r, from one solve with F = I - sign·D2·D1.
         loop_state = s * np.hstack([D2 @ C1, C2])
@@ -585,16 +609,7 @@ def _closed(
         B_u = np.vstack([B1, B2 @ D1])
         A = np.block([[A1, np.zeros((n1, n2))], [B2 @ C1, A2]]) + B_u @ U_x
         C = np.hstack([C1, np.zeros((C1.shape[0], n2))]) + D1 @ U_x
-        matrices = (A, B_u @ U_r, C, D1 @ U_r)
-    _representable(matrices, function, arguments)
-    result = StateSpace(
-        *matrices,
-        state_names=forward.state_names + back.state_names,
-        input_names=forward.input_names,
-        output_names=forward.output_names,
-        dt=dt,
-    )
-    return result
+        return (A, B_u @ U_r, C, D1 @ U_r)
 
 
 # ----- interconnection by name ------------------------------------------------------------------
@@ -874,22 +889,25 @@ def connect(
                 f"connect: the output {spec!r} names no block output, block input or external input"
             )
 
-    exponents = _state_exponents(models, K, E, F, G)
-    if any(exponents):
-        stacked = append(*(_rescaled(m, e) for m, e in zip(models, exponents, strict=True)))
-        B, C = stacked.B, stacked.C
-    n = A.shape[0]
-    with np.errstate(over="ignore", invalid="ignore"):
-        loop, right = K @ D, np.hstack([K @ C, E])
-    solved = _solve_loop(loop, right, "I - K·D", "connect")
-    with np.errstate(over="ignore", invalid="ignore"):
-        U_x, U_w = solved[:, :n], solved[:, n:]
-        matrices = (
-            A + B @ U_x,
-            B @ U_w,
-            F @ (C + D @ U_x) + G @ U_x,
-            F @ D @ U_w + G @ U_w + H,
-        )
+    def formed(B: FloatArray, C: FloatArray) -> Matrices:
+        n = A.shape[0]
+        with np.errstate(over="ignore", invalid="ignore"):
+            loop, right = K @ D, np.hstack([K @ C, E])
+        solved = _solve_loop(loop, right, "I - K·D", "connect")
+        with np.errstate(over="ignore", invalid="ignore"):
+            U_x, U_w = solved[:, :n], solved[:, n:]
+            return (
+                A + B @ U_x,
+                B @ U_w,
+                F @ (C + D @ U_x) + G @ U_x,
+                F @ D @ U_w + G @ U_w + H,
+            )
+
+    matrices = formed(B, C)
+    if not all(np.all(np.isfinite(M)) for M in matrices):
+        exponents = _state_exponents(models, K, E, F, G)
+        rescaled = append(*(_rescaled(m, e) for m, e in zip(models, exponents, strict=True)))
+        matrices = formed(rescaled.B, rescaled.C)
     _representable(matrices, "connect", "systems")
     result = StateSpace(
         *matrices,

@@ -190,7 +190,7 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     with np.errstate(divide="ignore"):
         terms = np.maximum(size_A, np.log2(np.abs(g)) + size_B + size_C)
     plain = (terms <= RESCALE_EXPONENT) & (size_B + size_C <= RESCALE_EXPONENT)
-    exponents = np.where(plain, 0, np.round(terms)).astype(np.int64)
+    exponents = np.where(plain | ~np.isfinite(terms), 0, np.round(terms)).astype(np.int64)
     stack = np.empty((k.size, n, n))
     if np.any(plain):
         stack[plain] = A - g[plain, None, None] * (B @ C)
@@ -512,7 +512,8 @@ def stability_margins(loop: System) -> StabilityMargins:
     if abs(1.0 + d) <= 8 * _EPS * max(1.0, abs(d)):
         _refuse_algebraic(model)
     exponent = _frequency_exponent(model)
-    if exponent:
+    sizes = (_log2_size(model.B), _log2_size(model.C))
+    if exponent or max(sizes) > RESCALE_EXPONENT:
         return _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
     return _continuous_margins(model)
 
@@ -530,12 +531,16 @@ def _frequency_exponent(model: StateSpace) -> int:
 
 def _slowed(model: StateSpace, exponent: int) -> StateSpace:
     """The loop L(2^e s): (A 2^-e, B 2^-e, C, D), whose frequencies are those of L divided by
-    2^e (exact), with its state then scaled by a power of two so that B and C are of one size
-    (which changes no transfer function)."""
+    2^e (exact), with its state then scaled by a power of two so that B and C are of one size,
+    or the nonzero one of unit size (which changes no transfer function)."""
     B = np.ldexp(model.B, -exponent)
-    balance = 0
-    if np.any(B) and np.any(model.C):
-        balance = round((_log2_size(model.C) - _log2_size(B)) / 2.0)
+    size_B, size_C = _log2_size(B), _log2_size(model.C)
+    if math.isfinite(size_B) and math.isfinite(size_C):
+        balance = round((size_C - size_B) / 2.0)
+    elif math.isfinite(size_B) or math.isfinite(size_C):  # L = D: the other to unit size
+        balance = -round(size_B) if math.isfinite(size_B) else round(size_C)
+    else:
+        balance = 0
     return StateSpace(
         np.ldexp(model.A, -exponent),
         np.ldexp(B, balance),

@@ -733,3 +733,17 @@ def test_regression_names_not_iterable() -> None:
         lambda bandwidth, input_names: aerocontrol.actuator(bandwidth, input_names=input_names),
         {"bandwidth": plain(1.0), "input_names": plain(3)},
     )
+
+
+def test_regression_connect_loop_near_the_range() -> None:
+    """b c = 1.3e307 in series, then unity feedback: representable as given, so formed as
+    given (a rescaled series was left unbalanced for the feedback after it)."""
+    part = (np.array([[-1.875]]), np.array([[0.1257]]), np.array([[1e308]]), np.zeros((1, 1)))
+    plant = _named(plain(part), ["e"], ["v"])
+    other = _named(plain(part), ["v"], ["z"])
+
+    def call(plant: Any, other: Any) -> Any:
+        junction = aerocontrol.summing_junction(["r", "-z"], "e")
+        return aerocontrol.connect([junction, plant, other], inputs="r", outputs="z")
+
+    exercise("connect", call, {"plant": plant, "other": other}, _connect_oracle("loop"))

@@ -464,3 +464,32 @@ def test_regression_damping_mode_without_poles() -> None:
         lambda loop, mode: aerocontrol.best_damping_gain(loop, mode),
         {"loop": plain(static), "mode": plain(-0.1 + 1j)},
     )
+
+
+def test_regression_margins_of_a_zero_loop_with_a_huge_c() -> None:
+    """B = 0, C = 1.3e299: L is 0 (the core overflowed on C's square and blamed A); no
+    crossover, the closed-loop pole is A's."""
+    model = (np.array([[-1.875]]), np.zeros((1, 1)), np.array([[1.257e299]]), np.zeros((1, 1)))
+    outcome = exercise(
+        "stability_margins",
+        lambda loop: aerocontrol.stability_margins(loop),
+        {"loop": plain(model)},
+        _margins_oracle,
+        nonfinite_by_definition=UNBOUNDED,
+    )
+    margins = outcome.result
+    assert margins.gain_crossovers.size == 0 and margins.phase_crossovers.size == 0
+    assert np.array_equal(margins.closed_loop_poles, [-1.875 + 0j])
+
+
+def test_regression_damping_of_a_loop_with_a_huge_c() -> None:
+    """A = 0, C B = 1.6e148: the gain grid reaches k C B beyond 2^256 (an exponent of -inf
+    for the gain 0 overflowed the int conversion)."""
+    model = (np.zeros((1, 1)), np.array([[0.1257]]), np.array([[1.257e149]]), np.zeros((1, 1)))
+    exercise(
+        "best_damping_gain",
+        lambda loop, mode, gains: aerocontrol.best_damping_gain(loop, mode, gains),
+        {"loop": plain(model), "mode": plain(None), "gains": plain(None)},
+        _design_oracle("best_damping_gain"),
+        nonfinite_by_definition=("pole",),
+    )
