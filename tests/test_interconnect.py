@@ -782,3 +782,72 @@ def test_pade_delay_against_the_approximant_in_high_precision(order: int, bound:
     ours = aerocontrol.frequency_response(aerocontrol.pade_delay(T, order), FREQUENCIES).response
     error = np.abs(ours[:, 0, 0] - np.array(exact))  # |G| = 1
     assert np.max(error) <= bound, np.max(error)
+
+
+# ----- products beyond the range of doubles -----------------------------------------------------
+
+#: 1/(s + 1) and 1/(s + 2) realised with B and C of 1e±200: B2 C1 = 1e400 overflows.
+_LAG_1 = (np.array([[-1.0]]), np.array([[1e-200]]), np.array([[1e200]]), np.zeros((1, 1)))
+_LAG_2 = (np.array([[-2.0]]), np.array([[1e200]]), np.array([[1e-200]]), np.zeros((1, 1)))
+
+
+def _response(sys: aerocontrol.StateSpace, s: complex) -> complex:
+    """C (sI - A)^-1 B + D by numpy, independently of the core."""
+    n = sys.n_states
+    return complex((sys.C @ np.linalg.solve(s * np.eye(n) - sys.A, sys.B) + sys.D)[0, 0])
+
+
+_POINTS = (0.0, 0.3j, 1.0 + 2.0j, 40.0j)
+
+
+def test_interconnections_whose_products_overflow_are_formed_in_scaled_states() -> None:
+    """The states are rescaled by powers of two, so the models are those of the transfer
+    functions: G2 G1 = 1/((s + 1)(s + 2)), G1/(1 + G2 G1) = (s + 2)/(s^2 + 3 s + 3), the
+    same by name, and S of the series loop (s + 1)(s + 2)/(s^2 + 3 s + 3); to 1e-14."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        chain = aerocontrol.series(_LAG_1, _LAG_2)
+        loop = aerocontrol.feedback(_LAG_1, _LAG_2)
+        named = aerocontrol.connect(
+            [
+                aerocontrol.summing_junction(["r", "-z"], "e"),
+                aerocontrol.StateSpace(*_LAG_1, input_names="e", output_names="y"),
+                aerocontrol.StateSpace(*_LAG_2, input_names="y", output_names="z"),
+            ],
+            inputs="r",
+            outputs="y",
+        )
+        S = aerocontrol.sensitivity(chain)
+    for s in _POINTS:
+        expected = {
+            "series": 1 / ((s + 1) * (s + 2)),
+            "feedback": (s + 2) / (s * s + 3 * s + 3),
+            "connect": (s + 2) / (s * s + 3 * s + 3),
+            "sensitivity": (s + 1) * (s + 2) / (s * s + 3 * s + 3),
+        }
+        for name, model in (("series", chain), ("feedback", loop), ("connect", named)):
+            assert _response(model, s) == pytest.approx(expected[name], rel=1e-14), name
+        assert _response(S, s) == pytest.approx(expected["sensitivity"], rel=1e-14)
+    assert np.sort_complex(np.linalg.eigvals(loop.A)) == pytest.approx(
+        [(-3 - 3**0.5 * 1j) / 2, (-3 + 3**0.5 * 1j) / 2], rel=1e-14
+    )
+    assert np.all(np.abs(chain.A) < 1e200) and np.all(np.abs(loop.A) < 1e200)
+
+
+def test_interconnections_beyond_the_range_of_doubles_are_refused_by_name() -> None:
+    """D2 D1 = 1e400, and the pole -1 - 1e400 of a loop: no state scaling brings them into
+    range, so InvalidArgumentError names the arguments (not NonFiniteError on A)."""
+    big = (np.array([[-1.0]]), np.array([[1e200]]), np.array([[1e200]]), np.zeros((1, 1)))
+    static = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[1e200]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="D overflows") as error:
+            aerocontrol.series(static, static)
+        assert not isinstance(error.value, aerocontrol.NonFiniteError)
+        assert error.value.argument == "sys1"
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="sys1, sys2") as error:
+            aerocontrol.feedback(big)
+        assert not isinstance(error.value, aerocontrol.NonFiniteError)
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="loop") as error:
+            aerocontrol.complementary_sensitivity(big)
+        assert error.value.argument == "loop"

@@ -347,3 +347,43 @@ def _matched(a: np.ndarray, b: np.ndarray) -> float:
     distance = np.abs(a[:, None] - b[None, :])
     rows, columns = linear_sum_assignment(distance)
     return float(np.max(distance[rows, columns]))
+
+
+# ----- loops beyond the core's range ------------------------------------------------------------
+
+
+def test_margins_of_a_loop_at_a_huge_frequency_scale() -> None:
+    """L(s) = L0(s/σ) with L0 = 2/(s(s + 1)(s + 2)) and σ = 2^600 (A and B times σ): the same
+    gain and phase margins as L0 (python-control, to 1e-9), its frequencies times σ, its delay
+    margin divided by σ and its closed-loop poles times σ."""
+    sigma = 2.0**600
+    L0 = _third_order(2.0)
+    huge = (L0.A * sigma, L0.B * sigma, L0.C, L0.D)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        margins = stability_margins(huge)
+    gm, pm, _, wpc, wgc, _ = control.stability_margins(control.ss(L0.A, L0.B, L0.C, L0.D))
+    assert margins.gain_margin == pytest.approx(gm, rel=1e-9)
+    assert margins.gain_margin == pytest.approx(3.0, rel=1e-12)
+    assert margins.phase_crossover == pytest.approx(sigma * wpc, rel=1e-9)
+    assert margins.phase_margin == pytest.approx(pm, rel=1e-9)
+    assert margins.gain_crossover == pytest.approx(sigma * wgc, rel=1e-9)
+    reference = stability_margins(L0)
+    assert margins.delay_margin == pytest.approx(reference.delay_margin / sigma, rel=1e-12)
+    assert margins.closed_loop_poles == pytest.approx(
+        sigma * np.sort_complex(np.linalg.eigvals(L0.A - L0.B @ L0.C)), rel=1e-12
+    )
+
+
+def test_root_locus_where_k_b_c_overflows() -> None:
+    """A = -1, B = C = 1e200: B C = 1e400 overflows, but the poles -1 - k 1e400 are doubles
+    for k = 1e-100 and 1e-300 (closed form, to 1e-15); at k = 1 the pole is beyond doubles:
+    -inf with a NumericalOverflowWarning."""
+    loop = (np.array([[-1.0]]), np.array([[1e200]]), np.array([[1e200]]), np.zeros((1, 1)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        poles = root_locus(loop, [0.0, 1e-300, 1e-100]).poles[:, 0]
+    assert poles == pytest.approx([-1.0, -1.0 - 1e100, -1e300], rel=1e-15)
+    with pytest.warns(aerocontrol.NumericalOverflowWarning):
+        poles = root_locus(loop, [1.0, 1e-300]).poles[:, 0]
+    assert poles[0] == -math.inf and poles[1] == pytest.approx(-1e100, rel=1e-15)

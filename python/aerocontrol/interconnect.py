@@ -23,18 +23,25 @@ eliminating u gives u = M^-1 (K C x + E w) with M = I - K D. M singular is an al
 (a loop of feedthrough with no dynamics whose gain is one): it has no solution and is refused
 by name. Continuous and discrete models combine alike; the sampling periods must agree (a
 static model, with no states, goes with either).
+
+Where products of the parts (B2 C1, D2 C1, ...) would overflow double precision, the states of
+the parts are first rescaled by powers of two (exact, and no transfer function changes) so
+that the interconnection's entries stay within range; one that no such scaling brings within
+range (D2 D1 beyond the doubles, a pole beyond them) is refused with InvalidArgumentError naming
+the arguments.
 """
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Sequence
 from fractions import Fraction
 from math import comb
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
@@ -69,6 +76,9 @@ __all__ = [
 
 Names = str | Sequence[str] | None
 """Signal names of a constructor: one name as a string, or a sequence of names."""
+
+Matrices = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
+"""A, B, C and D of a model."""
 
 Source = str | tuple[str, float]
 """A signal feeding an input in :func:`connect`: ``"name"``, ``"-name"`` or ``("name", gain)``."""
@@ -196,6 +206,13 @@ def _solve_loop(loop: FloatArray, right: FloatArray, what: str, function: str) -
     size = loop.shape[0]
     if size == 0:
         return right
+    if not np.all(np.isfinite(loop)):
+        error = InvalidArgumentError(
+            f"{function}: {what} overflows double precision: the feedthroughs (D) in the loop "
+            "are too large together"
+        )
+        error.argument = "D"
+        raise error
     M = np.eye(size) - loop
     smallest = float(np.linalg.svd(M, compute_uv=False)[-1])
     size_of_terms = 1.0 + float(np.linalg.norm(loop, 2))
@@ -213,8 +230,137 @@ def _solve_loop(loop: FloatArray, right: FloatArray, what: str, function: str) -
             IllConditionedWarning,
             stacklevel=3,
         )
-    solution = np.asarray(np.linalg.solve(M, right), dtype=np.float64)
+    with np.errstate(over="ignore", invalid="ignore"):
+        solution = np.asarray(np.linalg.solve(M, right), dtype=np.float64)
     return solution
+
+
+# ----- overflow: power-of-two state scalings -------------------------------------------------
+
+#: An interconnection whose entries could exceed 2^RESCALE_EXPONENT (a bound from the sizes of
+#: its parts) is formed from parts whose states are rescaled by powers of two.
+RESCALE_EXPONENT = 1000.0
+
+
+def _log2_size(M: NDArray[np.floating[Any]]) -> float:
+    """log2 of the largest |entry| of M: -inf for a zero or empty matrix, inf if it holds an
+    infinity."""
+    if M.size == 0:
+        return -math.inf
+    largest = float(np.max(np.abs(M)))
+    return math.log2(largest) if largest > 0.0 else -math.inf
+
+
+def _state_exponents(
+    models: Sequence[StateSpace],
+    K: FloatArray,
+    E: FloatArray,
+    F: FloatArray,
+    G: FloatArray,
+) -> list[int]:
+    """Exponents e_k of state scalings x_k -> 2^e_k x_k of the parts (B_k 2^e_k, C_k 2^-e_k:
+    exact in floating point, and no transfer function changes) under which the
+    interconnection u = K y + E w, z = F y + G u of the parts stays within the range of
+    doubles; all 0 when it does unscaled.
+
+    With W = M^-1 K, V = M^-1 E and Z = F + (F D + G) W (M = I - K D, D = diag(D_k)), the
+    interconnection is A = diag(A_k) + B W C, B V, Z C and a D that no state scaling changes.
+    Its block (i, j) of A is bounded by |B_i| |W_ij| |C_j| and scales by 2^(e_i - e_j), block
+    i of B by 2^e_i and block j of C by 2^-e_j (|.| the largest entry, in log2, times the
+    inner dimension). The largest of these bounds is reduced by sweeps in the manner of
+    Osborne's balancing: each e_i in turn equalises the largest bound that grows with it and
+    the largest that shrinks with it (the minimum over e_i of their maximum)."""
+    count = len(models)
+    exponents = [0] * count
+    if count == 0:
+        return exponents
+    D = _block_diagonal([m.D for m in models])
+    with np.errstate(all="ignore"):
+        M = np.eye(K.shape[0]) - K @ D
+        if not np.all(np.isfinite(M)):
+            return exponents
+        try:
+            solved = np.linalg.solve(M, np.hstack([K, E]))
+        except np.linalg.LinAlgError:
+            return exponents
+        W, V = solved[:, : K.shape[1]], solved[:, K.shape[1] :]
+        Z = F + (F @ D + G) @ W
+    if not (np.all(np.isfinite(W)) and np.all(np.isfinite(V)) and np.all(np.isfinite(Z))):
+        return exponents
+    rows = np.cumsum([0] + [m.n_inputs for m in models])
+    columns = np.cumsum([0] + [m.n_outputs for m in models])
+    size_B = [_log2_size(m.B) + math.log2(max(m.n_inputs, 1)) for m in models]
+    size_C = [_log2_size(m.C) + math.log2(max(m.n_outputs, 1)) for m in models]
+    coupling = np.full((count, count), -math.inf)
+    into = np.full(count, -math.inf)
+    out = np.full(count, -math.inf)
+    for i in range(count):
+        inputs = slice(rows[i], rows[i + 1])
+        outputs = slice(columns[i], columns[i + 1])
+        into[i] = size_B[i] + _log2_size(V[inputs, :])
+        out[i] = _log2_size(Z[:, outputs]) + size_C[i]
+        for j in range(count):
+            if j != i:
+                block = W[inputs, slice(columns[j], columns[j + 1])]
+                coupling[i, j] = size_B[i] + _log2_size(block) + size_C[j]
+    if not (np.all(coupling < math.inf) and np.all(into < math.inf) and np.all(out < math.inf)):
+        return exponents
+    largest = max(float(np.max(coupling)), float(np.max(into)), float(np.max(out)))
+    if largest <= RESCALE_EXPONENT:
+        return exponents
+    for _ in range(100):
+        changed = False
+        for i in range(count):
+            others = [j for j in range(count) if j != i]
+            growing = max([coupling[i, j] - exponents[j] for j in others] + [into[i], size_B[i]])
+            shrinking = max([coupling[j, i] + exponents[j] for j in others] + [out[i], size_C[i]])
+            if math.isfinite(growing) and math.isfinite(shrinking):
+                best = round((shrinking - growing) / 2.0)
+            elif math.isfinite(growing) or math.isfinite(shrinking):
+                # Only one side depends on this state: bring it to unit size.
+                best = -round(growing) if math.isfinite(growing) else round(shrinking)
+            else:
+                continue
+            if best != exponents[i]:
+                exponents[i], changed = best, True
+        if not changed:
+            break
+    if any(
+        max(size_B[i] + e, size_C[i] - e) >= 1023.0 for i, e in enumerate(exponents)
+    ):  # the parts themselves leave the range: left to _representable to refuse
+        return [0] * count
+    return exponents
+
+
+def _rescaled(model: StateSpace, exponent: int) -> StateSpace:
+    """``model`` with its state x -> 2^exponent x: B 2^exponent, C 2^-exponent (exact)."""
+    if exponent == 0 or model.n_states == 0:
+        return model
+    return StateSpace(
+        model.A,
+        np.ldexp(model.B, exponent),
+        np.ldexp(model.C, -exponent),
+        model.D,
+        state_names=model.state_names,
+        input_names=model.input_names,
+        output_names=model.output_names,
+        dt=model.dt,
+    )
+
+
+def _representable(matrices: Sequence[FloatArray], function: str, arguments: str) -> None:
+    """Refuses an interconnection whose matrices overflowed double precision although every
+    part is finite, naming the arguments whose products overflow (a NonFiniteError would
+    blame a matrix the caller gave finite)."""
+    for name, matrix in zip("ABCD", matrices, strict=True):
+        if not np.all(np.isfinite(matrix)):
+            error = InvalidArgumentError(
+                f"{function}: the interconnection's {name} overflows double precision: the "
+                f"entries of {arguments} are too large together, and no scaling of the states "
+                "brings it within range (scale the models' units)"
+            )
+            error.argument = arguments.split(",")[0]
+            raise error
 
 
 # ----- interconnections by position -------------------------------------------------------------
@@ -251,21 +397,40 @@ def series(sys1: System, sys2: System, *systems: System) -> StateSpace:
                 f"series: {labels[k]} has {second.n_inputs} inputs but the model before it has "
                 f"{result.n_outputs} outputs"
             )
-        n1, n2 = result.n_states, second.n_states
-        A = np.block(
-            [[result.A, np.zeros((n1, n2))], [second.B @ result.C, second.A]],
-        )
+        m1, p1, p2 = result.n_inputs, result.n_outputs, second.n_outputs
+        # u2 = y1, z = y2: the connection matrices of _state_exponents.
+        K = np.zeros((m1 + p1, p1 + p2))
+        K[m1:, :p1] = np.eye(p1)
+        E = np.vstack([np.eye(m1), np.zeros((p1, m1))])
+        F = np.hstack([np.zeros((p2, p1)), np.eye(p2)])
+        G = np.zeros((p2, m1 + p1))
+        first = result
+        matrices = _series_matrices(first, second)
+        if not all(np.all(np.isfinite(M)) for M in matrices):
+            exponents = _state_exponents([result, second], K, E, F, G)
+            first, second = _rescaled(result, exponents[0]), _rescaled(second, exponents[1])
+            matrices = _series_matrices(first, second)
+        _representable(matrices, "series", ", ".join(labels[: k + 1]))
         result = StateSpace(
-            A,
-            np.vstack([result.B, second.B @ result.D]),
-            np.hstack([second.D @ result.C, second.C]),
-            second.D @ result.D,
-            state_names=result.state_names + second.state_names,
-            input_names=result.input_names,
+            *matrices,
+            state_names=first.state_names + second.state_names,
+            input_names=first.input_names,
             output_names=second.output_names,
             dt=dt,
         )
     return result
+
+
+def _series_matrices(first: StateSpace, second: StateSpace) -> Matrices:
+    """A, B, C, D of ``second`` after ``first`` (non-finite where a product overflows)."""
+    n1, n2 = first.n_states, second.n_states
+    with np.errstate(over="ignore", invalid="ignore"):
+        return (
+            np.block([[first.A, np.zeros((n1, n2))], [second.B @ first.C, second.A]]),
+            np.vstack([first.B, second.B @ first.D]),
+            np.hstack([second.D @ first.C, second.C]),
+            second.D @ first.D,
+        )
 
 
 def parallel(sys1: System, sys2: System, *systems: System) -> StateSpace:
@@ -392,29 +557,59 @@ def feedback(sys1: System, sys2: System | None = None, sign: float = -1) -> Stat
             f"and as many outputs as sys1 has inputs ({forward.n_inputs}), got "
             f"{back.n_inputs} inputs and {back.n_outputs} outputs"
         )
-    A1, B1, C1, D1 = forward.A, forward.B, forward.C, forward.D
-    A2, B2, C2, D2 = back.A, back.B, back.C, back.D
-    n1, n2, m1 = forward.n_states, back.n_states, forward.n_inputs
-    # u1 = U_x x + U_r r, from one solve with F = I - sign·D2·D1.
-    loop_state = s * np.hstack([D2 @ C1, C2])
-    solved = _solve_loop(
-        s * D2 @ D1, np.hstack([loop_state, np.eye(m1)]), "I - sign·D2·D1", "feedback"
-    )
-    U_x, U_r = solved[:, : n1 + n2], solved[:, n1 + n2 :]
-    B_u = np.vstack([B1, B2 @ D1])
-    A = np.block([[A1, np.zeros((n1, n2))], [B2 @ C1, A2]]) + B_u @ U_x
-    C = np.hstack([C1, np.zeros((C1.shape[0], n2))]) + D1 @ U_x
-    result = StateSpace(
-        finite_or_warn(A, "the closed loop's A"),
-        B_u @ U_r,
-        C,
-        D1 @ U_r,
+    return _closed(forward, back, s, dt, "feedback", "sys1, sys2")
+
+
+def _closed(
+    forward: StateSpace,
+    back: StateSpace,
+    s: float,
+    dt: float | None,
+    function: str,
+    arguments: str,
+) -> StateSpace:
+    """The loop of :func:`feedback`, formed from the parts with their states rescaled by
+    powers of two where its products would overflow (:func:`_state_exponents`); an
+    interconnection beyond the range of doubles is refused naming ``arguments``."""
+    m1, p1 = forward.n_inputs, forward.n_outputs
+    # u1 = w + sign·y2, u2 = y1, z = y1: the connection matrices of _state_exponents.
+    K = np.zeros((m1 + p1, p1 + m1))
+    K[:m1, p1:] = s * np.eye(m1)
+    K[m1:, :p1] = np.eye(p1)
+    E = np.vstack([np.eye(m1), np.zeros((p1, m1))])
+    F = np.hstack([np.eye(p1), np.zeros((p1, m1))])
+    matrices = _loop_matrices(forward, back, s, function)
+    if not all(np.all(np.isfinite(M)) for M in matrices):
+        exponents = _state_exponents([forward, back], K, E, F, np.zeros((p1, m1 + p1)))
+        first, second = _rescaled(forward, exponents[0]), _rescaled(back, exponents[1])
+        matrices = _loop_matrices(first, second, s, function)
+    _representable(matrices, function, arguments)
+    return StateSpace(
+        *matrices,
         state_names=forward.state_names + back.state_names,
         input_names=forward.input_names,
         output_names=forward.output_names,
         dt=dt,
     )
-    return result
+
+
+def _loop_matrices(first: StateSpace, second: StateSpace, s: float, function: str) -> Matrices:
+    """A, B, C, D of :func:`feedback` (non-finite where a product overflows)."""
+    m1 = first.n_inputs
+    A1, B1, C1, D1 = first.A, first.B, first.C, first.D
+    A2, B2, C2, D2 = second.A, second.B, second.C, second.D
+    n1, n2 = first.n_states, second.n_states
+    with np.errstate(over="ignore", invalid="ignore"):
+        # u1 = U_x x + U_r r, from one solve with F = I - sign·D2·D1.
+        loop_state = s * np.hstack([D2 @ C1, C2])
+        loop = s * D2 @ D1
+    solved = _solve_loop(loop, np.hstack([loop_state, np.eye(m1)]), "I - sign·D2·D1", function)
+    with np.errstate(over="ignore", invalid="ignore"):
+        U_x, U_r = solved[:, : n1 + n2], solved[:, n1 + n2 :]
+        B_u = np.vstack([B1, B2 @ D1])
+        A = np.block([[A1, np.zeros((n1, n2))], [B2 @ C1, A2]]) + B_u @ U_x
+        C = np.hstack([C1, np.zeros((C1.shape[0], n2))]) + D1 @ U_x
+        return (A, B_u @ U_r, C, D1 @ U_r)
 
 
 # ----- interconnection by name ------------------------------------------------------------------
@@ -694,14 +889,28 @@ def connect(
                 f"connect: the output {spec!r} names no block output, block input or external input"
             )
 
-    n = A.shape[0]
-    solved = _solve_loop(K @ D, np.hstack([K @ C, E]), "I - K·D", "connect")
-    U_x, U_w = solved[:, :n], solved[:, n:]
+    def formed(B: FloatArray, C: FloatArray) -> Matrices:
+        n = A.shape[0]
+        with np.errstate(over="ignore", invalid="ignore"):
+            loop, right = K @ D, np.hstack([K @ C, E])
+        solved = _solve_loop(loop, right, "I - K·D", "connect")
+        with np.errstate(over="ignore", invalid="ignore"):
+            U_x, U_w = solved[:, :n], solved[:, n:]
+            return (
+                A + B @ U_x,
+                B @ U_w,
+                F @ (C + D @ U_x) + G @ U_x,
+                F @ D @ U_w + G @ U_w + H,
+            )
+
+    matrices = formed(B, C)
+    if not all(np.all(np.isfinite(M)) for M in matrices):
+        exponents = _state_exponents(models, K, E, F, G)
+        rescaled = append(*(_rescaled(m, e) for m, e in zip(models, exponents, strict=True)))
+        matrices = formed(rescaled.B, rescaled.C)
+    _representable(matrices, "connect", "systems")
     result = StateSpace(
-        finite_or_warn(A + B @ U_x, "the interconnection's A"),
-        B @ U_w,
-        F @ (C + D @ U_x) + G @ U_x,
-        F @ D @ U_w + G @ U_w + H,
+        *matrices,
         state_names=stacked.state_names,
         input_names=external,
         output_names=wanted,

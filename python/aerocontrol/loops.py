@@ -51,6 +51,14 @@ Root locus (:func:`root_locus`, :func:`best_damping_gain`, :func:`gain_for_dampi
     matrices of every gain are formed as one (k, n, n) stack and their eigenvalues computed in
     one parallel call of the core.
 
+Loops of huge size
+    A closed-loop matrix whose terms exceed 2^256 is formed divided by a power of two and its
+    eigenvalues multiplied back; the margins of a continuous loop of that size are those of
+    L(2^e s) (A and B divided by 2^e, B and C then balanced by a state scaling), with the
+    frequencies and poles multiplied by 2^e and the delays divided by it. Both are exact but
+    for the underflow of terms far below the largest; a pole or frequency beyond the doubles is
+    infinite, with a NumericalOverflowWarning.
+
 References
 ----------
 P. Seiler, A. Packard and P. Gahinet, "An introduction to disk margins", IEEE Control Systems
@@ -62,6 +70,7 @@ Letters 14, 1990 (the L∞ iteration).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from collections.abc import Callable
@@ -82,7 +91,7 @@ from .exceptions import (
     ShapeError,
     SingularMatrixError,
 )
-from .interconnect import feedback, gain
+from .interconnect import _closed, _time_base, gain
 from .statespace import StateSpace, as_state_space, period
 from .transfer import TransferFunction, transfer_function
 
@@ -124,16 +133,86 @@ def _siso(loop: System, name: str = "loop") -> StateSpace:
     return model
 
 
-def _closed_loop_matrix(model: StateSpace, k: float = 1.0) -> FloatArray:
-    """A - k B (1 + k D)⁻¹ C, or SingularMatrixError for 1 + k D = 0 (an algebraic loop)."""
+#: Closed-loop matrices (and loops, for the margins) with terms beyond 2^RESCALE_EXPONENT are
+#: formed divided by a power of two and their eigenvalues (frequencies) multiplied back: the
+#: core squares entries (Hamiltonians, norms), so it works within the square root of the range
+#: of doubles.
+RESCALE_EXPONENT = 256.0
+
+
+def _log2_size(M: FloatArray) -> float:
+    """log2 of the largest |entry| of M; -inf for a zero or empty matrix."""
+    largest = float(np.max(np.abs(M), initial=0.0))
+    return math.log2(largest) if largest > 0.0 else -math.inf
+
+
+def _refuse_algebraic(model: StateSpace, k: float = 1.0) -> None:
+    """SingularMatrixError for 1 + k D = 0: the loop closed with gain k is an algebraic loop."""
     d = float(model.D[0, 0])
-    denominator = 1.0 + k * d
-    if abs(denominator) <= 8 * _EPS * max(1.0, abs(k * d)):
+    with np.errstate(over="ignore"):
+        product = np.float64(k) * d
+    denominator = 1.0 + float(product)
+    if math.isfinite(product) and abs(denominator) <= 8 * _EPS * max(1.0, abs(product)):
         raise SingularMatrixError(
             f"the loop closed with gain {k:g} is an algebraic loop: 1 + k D = 0 (D = {d:g}), "
             "so it has no solution"
         )
-    return np.asarray(model.A - (k / denominator) * (model.B @ model.C), dtype=np.float64)
+
+
+def _closed_loop_gains(model: StateSpace, k: FloatArray) -> FloatArray:
+    """k (1 + k D)^-1 for each gain, as 1/(1/k + D) where k D overflows."""
+    d = float(model.D[0, 0])
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        denominators = 1.0 + k * d
+        g = k / denominators
+        far = ~np.isfinite(denominators)
+        g[far] = 1.0 / (1.0 / k[far] + d)
+    return np.asarray(g, dtype=np.float64)
+
+
+def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
+    """The eigenvalues of A - k B (1 + k D)^-1 C for each gain, each row sorted; the gains are
+    free of algebraic loops (:func:`_refuse_algebraic`).
+
+    The matrices of every gain are formed as one (k, n, n) stack and their eigenvalues taken
+    in one parallel call of the core. Where a term of a matrix (A, or g B C with
+    g = k/(1 + k D), bounded by |g| max|B| max|C|) exceeds 2^RESCALE_EXPONENT, the matrix is
+    formed divided by the power of two 2^e nearest its size, from B and C normalised by
+    powers of two (so that neither B C nor g B C overflows), and its eigenvalues multiplied by
+    2^e: exact but for the underflow of terms far below the largest. Poles beyond the range
+    of doubles are infinite, with a NumericalOverflowWarning."""
+    n = model.n_states
+    if n == 0:
+        return np.zeros((k.size, 0), np.complex128)
+    A, B, C = model.A, model.B, model.C
+    g = _closed_loop_gains(model, k)
+    size_A, size_B, size_C = _log2_size(A), _log2_size(B), _log2_size(C)
+    with np.errstate(divide="ignore"):
+        terms = np.maximum(size_A, np.log2(np.abs(g)) + size_B + size_C)
+    plain = (terms <= RESCALE_EXPONENT) & (size_B + size_C <= RESCALE_EXPONENT)
+    exponents = np.where(plain | ~np.isfinite(terms), 0, np.round(terms)).astype(np.int64)
+    stack = np.empty((k.size, n, n))
+    if np.any(plain):
+        stack[plain] = A - g[plain, None, None] * (B @ C)
+    if not np.all(plain):
+        eb, ec = int(np.frexp(np.max(np.abs(B)))[1]), int(np.frexp(np.max(np.abs(C)))[1])
+        normalised = np.ldexp(B, -eb) @ np.ldexp(C, -ec)
+        for i in np.flatnonzero(~plain):
+            e = int(exponents[i])
+            stack[i] = np.ldexp(A, -e) - np.ldexp(g[i], eb + ec - e) * normalised
+    poles = _core.eigenvalues(stack)
+    if np.any(exponents):
+        with np.errstate(over="ignore", invalid="ignore"):
+            scale = exponents[:, None]
+            poles = np.ldexp(poles.real, scale) + 1j * np.ldexp(poles.imag, scale)
+        if not np.all(np.isfinite(poles)):
+            warnings.warn(
+                "the closed-loop poles overflow double precision at the gains "
+                f"{k[~np.all(np.isfinite(poles), axis=1)]}: they are infinite",
+                NumericalOverflowWarning,
+                stacklevel=3,
+            )
+    return np.sort_complex(poles).astype(np.complex128)
 
 
 def _unstable(roots: ComplexArray, discrete: bool) -> NDArray[np.bool_]:
@@ -431,7 +510,83 @@ def stability_margins(loop: System) -> StabilityMargins:
         return _grid_margins(model)
     d = float(model.D[0, 0])
     if abs(1.0 + d) <= 8 * _EPS * max(1.0, abs(d)):
-        _closed_loop_matrix(model)  # raises the algebraic loop's SingularMatrixError
+        _refuse_algebraic(model)
+    exponent = _frequency_exponent(model)
+    sizes = (_log2_size(model.B), _log2_size(model.C))
+    if exponent or max(sizes) > RESCALE_EXPONENT:
+        return _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
+    return _continuous_margins(model)
+
+
+def _frequency_exponent(model: StateSpace) -> int:
+    """e such that the loop's matrices (A, and B C/(1 + D) of the closed loop) are of size
+    about 2^e, where that is beyond 2^RESCALE_EXPONENT; else 0."""
+    d = float(model.D[0, 0])
+    size = max(
+        _log2_size(model.A),
+        _log2_size(model.B) + _log2_size(model.C) - math.log2(abs(1.0 + d)),
+    )
+    return round(size) if size > RESCALE_EXPONENT else 0
+
+
+def _slowed(model: StateSpace, exponent: int) -> StateSpace:
+    """The loop L(2^e s): (A 2^-e, B 2^-e, C, D), whose frequencies are those of L divided by
+    2^e (exact), with its state then scaled by a power of two so that B and C are of one size,
+    or the nonzero one of unit size (which changes no transfer function)."""
+    B = np.ldexp(model.B, -exponent)
+    size_B, size_C = _log2_size(B), _log2_size(model.C)
+    if math.isfinite(size_B) and math.isfinite(size_C):
+        balance = round((size_C - size_B) / 2.0)
+    elif math.isfinite(size_B) or math.isfinite(size_C):  # L = D: the other to unit size
+        balance = -round(size_B) if math.isfinite(size_B) else round(size_C)
+    else:
+        balance = 0
+    return StateSpace(
+        np.ldexp(model.A, -exponent),
+        np.ldexp(B, balance),
+        np.ldexp(model.C, -balance),
+        model.D,
+        dt=model.dt,
+    )
+
+
+def _in_frequency_units(margins: StabilityMargins, exponent: int) -> StabilityMargins:
+    """The margins of L from those of L(2^e s) (:func:`_slowed`): frequencies and poles times
+    2^e, delays divided by it, gains and phases unchanged; values beyond the range of doubles
+    are infinite, with a NumericalOverflowWarning."""
+
+    def faster(x: FloatArray) -> FloatArray:
+        return np.asarray(np.ldexp(x, exponent), dtype=np.float64)
+
+    with np.errstate(over="ignore", invalid="ignore"):
+        poles = margins.closed_loop_poles
+        result = dataclasses.replace(
+            margins,
+            phase_crossover=float(faster(np.float64(margins.phase_crossover))),
+            gain_crossover=float(faster(np.float64(margins.gain_crossover))),
+            delay_margin=float(np.ldexp(margins.delay_margin, -exponent)),
+            disk_frequency=float(faster(np.float64(margins.disk_frequency))),
+            stability_frequency=float(faster(np.float64(margins.stability_frequency))),
+            phase_crossovers=faster(margins.phase_crossovers),
+            gain_crossovers=faster(margins.gain_crossovers),
+            delay_margins=np.ldexp(margins.delay_margins, -exponent),
+            closed_loop_poles=(faster(poles.real) + 1j * faster(poles.imag)).astype(np.complex128),
+        )
+    moved = np.concatenate(
+        [result.phase_crossovers, result.gain_crossovers, result.closed_loop_poles.view(float)]
+    )
+    if not np.all(np.isfinite(moved)):
+        warnings.warn(
+            "stability_margins: a crossover frequency or a closed-loop pole of the loop "
+            "overflows double precision: it is infinite",
+            NumericalOverflowWarning,
+            stacklevel=3,
+        )
+    return result
+
+
+def _continuous_margins(model: StateSpace) -> StabilityMargins:
+    """:func:`stability_margins` of a continuous loop by the core's eigenvalue methods."""
     (
         gain_w,
         gain_values,
@@ -478,7 +633,7 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
     method for discrete loops (the eigenvalue method of the core is continuous only) and for
     a loop real on the whole imaginary axis (its phase-crossover pencil is singular)."""
     discrete = model.is_discrete
-    closed = _eigenvalues(_closed_loop_matrix(model))
+    closed = _closed_loop_poles(model, np.ones(1))[0]
     open_poles = _eigenvalues(model.A)
     stable = _stable(closed, discrete)
     unstable_open = int(np.sum(_unstable(open_poles, discrete)))
@@ -658,7 +813,7 @@ def _verify_gain_margins(model: StateSpace, margins: StabilityMargins) -> None:
         if not math.isfinite(k):
             continue
         point = np.exp(1j * w * dt) if dt else 1j * w
-        poles = _eigenvalues(_closed_loop_matrix(model, float(k)))
+        poles = _closed_loop_poles(model, np.array([k]))[0]
         miss = float(np.min(np.abs(poles - point))) if poles.size else 0.0
         if poles.size and miss > 1e-6 * max(scale, abs(point)):
             raise AerocontrolLinAlgError(
@@ -680,8 +835,9 @@ def sensitivity(loop: System) -> StateSpace:
     0.333333333333
     """
     model = _siso(loop)
-    dt = model.dt
-    return feedback(gain(1.0, dt=dt), model)
+    unity = gain(1.0, dt=model.dt)
+    dt = _time_base([unity, model], ["1", "loop"], "sensitivity")
+    return _closed(unity, model, -1.0, dt, "sensitivity", "loop")
 
 
 def complementary_sensitivity(loop: System) -> StateSpace:
@@ -696,7 +852,9 @@ def complementary_sensitivity(loop: System) -> StateSpace:
     0.666666666667
     """
     model = _siso(loop)
-    return feedback(model, gain(1.0, dt=model.dt))
+    unity = gain(1.0, dt=model.dt)
+    dt = _time_base([model, unity], ["loop", "1"], "complementary_sensitivity")
+    return _closed(model, unity, -1.0, dt, "complementary_sensitivity", "loop")
 
 
 # ----- root locus ---------------------------------------------------------------------------
@@ -747,7 +905,8 @@ def _gains(gains: ArrayLike, name: str = "gains") -> FloatArray:
 
 
 def _closed_poles(model: StateSpace, k: float) -> ComplexArray:
-    return np.sort_complex(_eigenvalues(_closed_loop_matrix(model, k)))
+    poles: ComplexArray = _closed_loop_poles(model, np.array([k]))[0]
+    return poles
 
 
 def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
@@ -765,20 +924,16 @@ def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
     model = _siso(loop)
     k = _gains(gains)
     d = float(model.D[0, 0])
-    denominators = 1.0 + k * d
-    algebraic = np.abs(denominators) <= 8 * _EPS * np.maximum(1.0, np.abs(k * d))
+    with np.errstate(over="ignore", invalid="ignore"):
+        products = k * d
+        algebraic = np.isfinite(products) & (
+            np.abs(1.0 + products) <= 8 * _EPS * np.maximum(1.0, np.abs(products))
+        )
     if np.any(algebraic):
-        _closed_loop_matrix(model, float(k[np.argmax(algebraic)]))  # raises, naming the gain
-    n = model.n_states
-    if n:
-        # Every closed-loop matrix A - k B (1 + k D)⁻¹ C as one stack, one parallel call.
-        stack = model.A - (k / denominators)[:, None, None] * (model.B @ model.C)
-        poles = np.sort_complex(_core.eigenvalues(stack))
-    else:
-        poles = np.zeros((k.size, 0), np.complex128)
+        _refuse_algebraic(model, float(k[np.argmax(algebraic)]))  # raises, naming the gain
     return RootLocus(
         gains=k,
-        poles=poles.astype(np.complex128),
+        poles=_closed_loop_poles(model, k),
         dt=period(model) if model.is_discrete else 0.0,
         loop=model,
     )

@@ -22,38 +22,6 @@ import numpy as np
 from .harness import known_defect
 
 
-def _largest_entries(args: dict[str, Any]) -> list[float]:
-    """The largest |entry| of each model (tuple or attributes) among the arguments."""
-    found = []
-    for value in args.values():
-        if value is None or isinstance(value, (str, int, float)):
-            continue
-        matrices = value if isinstance(value, tuple) else (value.A, value.B, value.C, value.D)
-        found.append(max(float(np.max(np.abs(M), initial=0.0)) for M in matrices))
-    return sorted(found)
-
-
-def _products_overflow(args: dict[str, Any]) -> bool:
-    """Two entries of the models (of one model with unity feedback) whose product is beyond
-    the range of doubles."""
-    largest = _largest_entries(args)
-    if not largest:
-        return False
-    return largest[-1] * (largest[-2] if len(largest) > 1 else largest[-1]) > 1e300
-
-
-INTERCONNECT_OVERFLOW = known_defect(
-    "interconnect-overflow",
-    {"series", "feedback", "connect", "sensitivity", "complementary_sensitivity"},
-    "series/feedback/connect (and sensitivity, complementary_sensitivity, which close the "
-    "loop with feedback) of finite models whose products B2 C1 (D2 C1, ...) overflow: "
-    "numpy's 'overflow encountered in matmul' RuntimeWarning reaches the caller, then "
-    "NonFiniteError blames A (which the caller gave finite) instead of a NumericalOverflowWarning "
-    "or an error naming the overflow",
-    _products_overflow,
-)
-
-
 def _models_of(args: dict[str, Any]) -> list[tuple[np.ndarray, ...]]:
     found = []
     for value in args.values():
@@ -100,24 +68,6 @@ ZEROS_DROPPED = known_defect(
     "singular (it forms H T^-1), so Python takes each eigenvalue from the pencil or its "
     "reversal; a zero between the two scales is still computed in only one of them",
     lambda args: _block_spread(args) > 1e6 and _largest_entry(args) < 1e100,
-)
-
-
-def _closed_loop_overflow(args: dict[str, Any]) -> bool:
-    gains = args.get("gains")
-    k = float(np.max(np.abs(gains), initial=1.0)) if isinstance(gains, np.ndarray) else 1.0
-    largest = _largest_entry(args)
-    with np.errstate(all="ignore"):
-        return bool(np.float64(largest) * largest * max(k, 1.0) > 1e300)
-
-
-CLOSED_LOOP_OVERFLOW = known_defect(
-    "closed-loop-overflow",
-    {"root_locus", "stability_margins", "best_damping_gain", "gain_for_damping"},
-    "loops._closed_loop_matrix forms A - k B (1 + k D)^-1 C with numpy: where B C overflows "
-    "(B = 1e308) numpy's 'overflow encountered in matmul' RuntimeWarning reaches the caller",
-    _closed_loop_overflow,
-    symptom="overflow encountered in matmul",
 )
 
 

@@ -15,6 +15,7 @@ python-control's ``tf`` and ``zpk`` evaluated at s, with the conditioning of the
 
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
 from typing import Any
 
@@ -27,7 +28,6 @@ from hypothesis import strategies as st
 import aerocontrol
 
 from .harness import SAME, Arg, Warned, exercise, plain
-from .known_defects import INTERCONNECT_OVERFLOW
 from .oracles import (
     SLACK,
     TINY,
@@ -704,17 +704,27 @@ def test_feedback_of_a_unit_gain_is_an_algebraic_loop() -> None:
 # ----- known defects of the core (see known_defects.py) ------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason="interconnect-overflow: numpy's overflow warning, A blamed")
 @pytest.mark.parametrize("function", ["series", "feedback"])
-def test_known_defect_interconnect_overflow(function: str) -> None:
+def test_regression_interconnect_overflow(function: str) -> None:
+    """B2 C1 = 1e400 overflows, but the interconnection exists in doubles once the states are
+    scaled: series 1e400/(s + 1)^2, feedback poles -1 ± 1e200 j."""
     first = (np.array([[-1.0]]), np.array([[1.0]]), np.array([[1e200]]), np.zeros((1, 1)))
     second = (np.array([[-1.0]]), np.array([[1e200]]), np.array([[1.0]]), np.zeros((1, 1)))
-    with INTERCONNECT_OVERFLOW.reproducing():
-        exercise(
-            function,
-            lambda sys1, sys2: getattr(aerocontrol, function)(sys1, sys2),
-            {"sys1": plain(first), "sys2": plain(second)},
-        )
+    outcome = exercise(
+        function,
+        lambda sys1, sys2: getattr(aerocontrol, function)(sys1, sys2),
+        {"sys1": plain(first), "sys2": plain(second)},
+    )
+    result = outcome.result
+    assert outcome.error is None and outcome.warned == ()
+    poles = np.sort_complex(np.linalg.eigvals(result.A))
+    if function == "series":
+        assert np.array_equal(poles, [-1.0, -1.0])
+        # the second Markov parameter C A B = 1e400 as a product of doubles of 1e133
+        markov = [result.C[0, 1], (result.A[1, 0]), result.B[0, 0]]
+        assert math.fsum(math.log10(abs(x)) for x in markov) == pytest.approx(400.0, abs=1e-12)
+    else:
+        assert np.allclose(poles, [-1.0 - 1e200j, -1.0 + 1e200j], rtol=1e-15)
 
 
 def test_regression_names_not_iterable() -> None:
@@ -723,3 +733,17 @@ def test_regression_names_not_iterable() -> None:
         lambda bandwidth, input_names: aerocontrol.actuator(bandwidth, input_names=input_names),
         {"bandwidth": plain(1.0), "input_names": plain(3)},
     )
+
+
+def test_regression_connect_loop_near_the_range() -> None:
+    """b c = 1.3e307 in series, then unity feedback: representable as given, so formed as
+    given (a rescaled series was left unbalanced for the feedback after it)."""
+    part = (np.array([[-1.875]]), np.array([[0.1257]]), np.array([[1e308]]), np.zeros((1, 1)))
+    plant = _named(plain(part), ["e"], ["v"])
+    other = _named(plain(part), ["v"], ["z"])
+
+    def call(plant: Any, other: Any) -> Any:
+        junction = aerocontrol.summing_junction(["r", "-z"], "e")
+        return aerocontrol.connect([junction, plant, other], inputs="r", outputs="z")
+
+    exercise("connect", call, {"plant": plant, "other": other}, _connect_oracle("loop"))

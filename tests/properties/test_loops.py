@@ -24,12 +24,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import aerocontrol
-from aerocontrol.exceptions import IllConditionedWarning
+from aerocontrol.exceptions import IllConditionedWarning, NumericalOverflowWarning
 
 from .harness import Arg, Warned, exercise, plain
-from .known_defects import (
-    CLOSED_LOOP_OVERFLOW,
-)
 from .oracles import (
     SLACK,
     TINY,
@@ -423,15 +420,41 @@ def test_regression_margins_of_a_tiny_loop() -> None:
     assert aerocontrol.transfer_function(model).gain == pytest.approx(0.13, rel=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason="closed-loop-overflow: numpy's overflow in B C")
-def test_known_defect_closed_loop_overflow() -> None:
+def test_regression_closed_loop_overflow() -> None:
+    """k B C of 2e308: the pole -1 - 2e308 is beyond doubles, so it is -inf with a
+    NumericalOverflowWarning (no numpy warning); at k = 1e-10 it is -2e298."""
     model = (-np.eye(1), np.array([[1e308]]), np.array([[2.0]]), np.zeros((1, 1)))
-    with CLOSED_LOOP_OVERFLOW.reproducing():
-        exercise(
-            "root_locus",
-            lambda loop, gains: aerocontrol.root_locus(loop, gains),
-            {"loop": plain(model), "gains": plain([1.0])},
-        )
+    outcome = exercise(
+        "root_locus",
+        lambda loop, gains: aerocontrol.root_locus(loop, gains),
+        {"loop": plain(model), "gains": plain([1.0, 1e-10])},
+    )
+    assert outcome.warned == (NumericalOverflowWarning,)
+    assert outcome.result.poles[0, 0] == -np.inf
+    assert outcome.result.poles[1, 0] == pytest.approx(-2e298, rel=1e-15)
+
+
+def test_regression_margins_of_a_loop_of_huge_gain() -> None:
+    """L = C B/(s - a) with C B = 1.58e301: the core's squares of B and C overflowed (A was
+    blamed). Closed form: no phase crossover, the gain crossover at sqrt((C B)^2 - a^2), phase
+    margin 90° + atan(|a|/ω), the closed-loop pole a - C B."""
+    a, b, c = -1.8742697789066067, 125.7302210933933, 1.257302210933933e299
+    model = (np.array([[a]]), np.array([[b]]), np.array([[c]]), np.zeros((1, 1)))
+    outcome = exercise(
+        "stability_margins",
+        lambda loop: aerocontrol.stability_margins(loop),
+        {"loop": plain(model)},
+        _margins_oracle,
+        nonfinite_by_definition=UNBOUNDED,
+    )
+    margins = outcome.result
+    assert outcome.warned == ()
+    assert margins.gain_margin == math.inf and margins.phase_crossovers.size == 0
+    assert margins.gain_crossover == pytest.approx(b * c, rel=1e-14)
+    assert margins.phase_margin == pytest.approx(90.0, rel=1e-14)
+    assert margins.delay_margin == pytest.approx(math.pi / 2 / (b * c), rel=1e-14)
+    assert margins.closed_loop_poles == pytest.approx([a - b * c], rel=1e-15)
+    assert margins.closed_loop_stable and margins.stability_margin == pytest.approx(1.0)
 
 
 def test_regression_damping_mode_without_poles() -> None:
@@ -440,4 +463,33 @@ def test_regression_damping_mode_without_poles() -> None:
         "best_damping_gain",
         lambda loop, mode: aerocontrol.best_damping_gain(loop, mode),
         {"loop": plain(static), "mode": plain(-0.1 + 1j)},
+    )
+
+
+def test_regression_margins_of_a_zero_loop_with_a_huge_c() -> None:
+    """B = 0, C = 1.3e299: L is 0 (the core overflowed on C's square and blamed A); no
+    crossover, the closed-loop pole is A's."""
+    model = (np.array([[-1.875]]), np.zeros((1, 1)), np.array([[1.257e299]]), np.zeros((1, 1)))
+    outcome = exercise(
+        "stability_margins",
+        lambda loop: aerocontrol.stability_margins(loop),
+        {"loop": plain(model)},
+        _margins_oracle,
+        nonfinite_by_definition=UNBOUNDED,
+    )
+    margins = outcome.result
+    assert margins.gain_crossovers.size == 0 and margins.phase_crossovers.size == 0
+    assert np.array_equal(margins.closed_loop_poles, [-1.875 + 0j])
+
+
+def test_regression_damping_of_a_loop_with_a_huge_c() -> None:
+    """A = 0, C B = 1.6e148: the gain grid reaches k C B beyond 2^256 (an exponent of -inf
+    for the gain 0 overflowed the int conversion)."""
+    model = (np.zeros((1, 1)), np.array([[0.1257]]), np.array([[1.257e149]]), np.zeros((1, 1)))
+    exercise(
+        "best_damping_gain",
+        lambda loop, mode, gains: aerocontrol.best_damping_gain(loop, mode, gains),
+        {"loop": plain(model), "mode": plain(None), "gains": plain(None)},
+        _design_oracle("best_damping_gain"),
+        nonfinite_by_definition=("pole",),
     )
