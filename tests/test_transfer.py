@@ -3,6 +3,8 @@ generalized eigenvalues of the Rosenbrock pencil, and hand-derived examples."""
 
 from __future__ import annotations
 
+import warnings
+
 import control
 import numpy as np
 import pytest
@@ -234,3 +236,17 @@ def test_transmission_zeros_of_entries_beyond_1e154() -> None:
     # ||S||_F is formed scaled: 1/(s + 1e155) + 1 has its zero at -(1e155 + 1).
     zeros = transmission_zeros(([[-1e155]], [[1.0]], [[1.0]], [[1.0]]))
     np.testing.assert_allclose(zeros, [-1e155], rtol=1e-14)
+
+
+def test_transfer_function_of_poles_near_the_overflow_threshold() -> None:
+    """A of 1e308 and 1.7e308: the evaluation grid about the roots was centre · 10^1.5 (inf,
+    numpy's overflow warning); it is now kept inside the doubles, and the gain is exact."""
+    for a in (1e308, 1.7e308, -1.7e308):
+        model = aerocontrol.StateSpace(np.array([[a]]), np.eye(1), np.eye(1), np.zeros((1, 1)))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            g = transfer_function(model)
+        assert g.poles.tolist() == [complex(a)]
+        assert g.zeros.size == 0
+        assert g.gain == pytest.approx(1.0, rel=1e-12)
+        assert g.denominator.tolist() == [1.0, -a]

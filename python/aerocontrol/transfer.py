@@ -585,17 +585,29 @@ def _evaluation_point(roots: ComplexArray, dt: float) -> tuple[float, complex]:
         candidates = np.linspace(0.05, 0.95, 19) * math.pi / dt
         points = np.exp(1j * candidates * dt)
     else:
-        sizes = np.abs(roots[np.abs(roots) > 0])
-        centre = float(np.exp(np.mean(np.log(sizes)))) if sizes.size else 1.0
-        candidates = centre * np.logspace(-1.5, 1.5, 31)
+        with np.errstate(over="ignore"):  # |root| of a root near the overflow threshold
+            sizes = np.abs(roots[np.isfinite(roots) & (roots != 0)])
+            sizes = sizes[np.isfinite(sizes)]
+        # The grid is taken in log10 and kept inside the doubles (a root near 1e308 would
+        # otherwise put a candidate at infinity).
+        log_centre = float(np.mean(np.log10(sizes))) if sizes.size else 0.0
+        exponents = np.clip(log_centre + np.linspace(-1.5, 1.5, 31), -300.0, 307.0)
+        candidates = 10.0**exponents
         points = 1j * candidates
     if roots.size == 0:
         best = len(candidates) // 2
     else:
-        distance = np.min(
-            np.abs(points[:, None] - roots[None, :]) / np.maximum(np.abs(points[:, None]), 1e-300),
-            axis=1,
-        )
+        # Relative distances, computed after a power-of-two scaling by the largest candidate so
+        # that a difference of two numbers near 1e308 stays finite; a root so far away that its
+        # scaled difference still overflows is infinitely far (inf, never nan, for ranking).
+        scale = 2.0 ** -math.frexp(float(np.max(np.abs(points))))[1]
+        with np.errstate(over="ignore", invalid="ignore"):
+            distance = np.min(
+                np.abs(points[:, None] * scale - roots[None, :] * scale)
+                / np.maximum(np.abs(points[:, None]) * scale, 1e-300),
+                axis=1,
+            )
+        distance = np.nan_to_num(distance, nan=np.inf)
         best = int(np.argmax(distance))
     return float(candidates[best]), complex(points[best])
 
