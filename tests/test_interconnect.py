@@ -851,3 +851,15 @@ def test_interconnections_beyond_the_range_of_doubles_are_refused_by_name() -> N
         with pytest.raises(aerocontrol.InvalidArgumentError, match="loop") as error:
             aerocontrol.complementary_sensitivity(big)
         assert error.value.argument == "loop"
+
+
+def test_parallel_of_feedthroughs_whose_sum_overflows() -> None:
+    """D1 + D2 = 2e308: numpy's overflow warning in the sum, then a NonFiniteError blaming a D
+    the caller gave finite; now an InvalidArgumentError naming the models. A sum that cancels
+    is exact."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(aerocontrol.InvalidArgumentError, match=r"parallel: .*D overflows") as e:
+            aerocontrol.parallel(aerocontrol.gain(1e308), aerocontrol.gain(1e308))
+        assert getattr(e.value, "argument", None) == "sys1"
+        assert aerocontrol.parallel(aerocontrol.gain(1e308), aerocontrol.gain(-1e308)).D == 0.0

@@ -462,11 +462,19 @@ def parallel(sys1: System, sys2: System, *systems: System) -> StateSpace:
                 f"parallel: {label} has {model.n_outputs} outputs and {model.n_inputs} inputs "
                 f"but sys1 has {first.n_outputs} and {first.n_inputs}"
             )
-    return StateSpace(
+    with np.errstate(over="ignore", invalid="ignore"):  # refused by name below
+        D = np.sum([m.D for m in models], axis=0)
+    matrices = (
         _block_diagonal([m.A for m in models]),
         np.vstack([m.B for m in models]),
         np.hstack([m.C for m in models]),
-        np.sum([m.D for m in models], axis=0),
+        D,
+    )
+    # y = D1 u + D2 u + ...: a sum of feedthroughs beyond the doubles is beyond every state
+    # scaling too.
+    _representable(matrices, "parallel", ", ".join(labels))
+    return StateSpace(
+        *matrices,
         state_names=sum((m.state_names for m in models), ()),
         input_names=first.input_names,
         output_names=first.output_names,
