@@ -387,3 +387,53 @@ def test_root_locus_where_k_b_c_overflows() -> None:
     with pytest.warns(aerocontrol.NumericalOverflowWarning):
         poles = root_locus(loop, [1.0, 1e-300]).poles[:, 0]
     assert poles[0] == -math.inf and poles[1] == pytest.approx(-1e100, rel=1e-15)
+
+
+def test_half_difference_and_nearest_of_huge_values() -> None:
+    """|1 - L|/(2|1 + L|) of an L near 1e308 is 1/2 (it was inf/inf: numpy's warnings), and
+    the tracking of a mode among infinite poles picks a finite nearest one."""
+    from aerocontrol.loops import _damping, _half_difference, _nearest
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ratio = _half_difference(np.array([1.5e308 - 1.5e308j, 1e308 + 0j, -1.0 + 0j, 0.5 + 0j]))
+        assert ratio[:2] == pytest.approx([0.5, 0.5], rel=1e-15)
+        assert ratio[2] == math.inf
+        assert ratio[3] == pytest.approx(1.0 / 6.0, rel=1e-15)
+        poles = np.array([complex(math.inf, 0.0), 1e308 + 0j, -1e308 + 0j])
+        assert _nearest(poles, -1.7e308 + 0j) == 2
+        assert _nearest(poles, complex(math.inf, 0.0)) == 0
+        assert _damping(complex(-1.5e308, 1.5e308), 0.0) == pytest.approx(math.sqrt(0.5))
+
+
+def test_stability_margins_of_a_loop_with_a_feedthrough_near_the_overflow() -> None:
+    """L = 1e308 (C = 0, the grid path): |1 - L|/(2|1 + L|) was 1e308/inf = 0 (numpy's
+    overflow warning) and the disk margin 1/0 = inf; it is 1/(1/2) = 2. The root locus of
+    L = 1e308 + 0.0156/(s + 1.87) warned that its numerator overflows, for its poles."""
+    static = (np.array([[-1.87]]), np.array([[0.125]]), np.array([[0.0]]), np.array([[1e308]]))
+    model = (np.array([[-1.87]]), np.array([[0.125]]), np.array([[0.125]]), np.array([[1e308]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        margins = aerocontrol.stability_margins(static)
+        assert margins.disk_margin == pytest.approx(2.0, rel=1e-12)
+        assert margins.disk_phase_margin == pytest.approx(90.0, rel=1e-12)
+        locus = aerocontrol.root_locus(model, [0.0, 1.0, 5.0])
+        assert locus.open_loop_poles.tolist() == [-1.87 + 0j]
+        assert locus.open_loop_zeros.size == 1
+
+
+def test_damping_search_refuses_an_algebraic_gain_of_the_grid() -> None:
+    """D = -2 and the grid 0, 0.5, ...: 1 + 0.5 D = 0 made an infinite closed-loop matrix
+    (NonFiniteError blaming A, with C = 0 numpy's inf·0 warning); the gain is refused by name."""
+    for c in (0.0, 0.1257):
+        model = (np.array([[-1.87]]), np.array([[0.1257]]), np.array([[c]]), np.array([[-2.0]]))
+        with pytest.raises(aerocontrol.SingularMatrixError, match=r"gain 0\.5 is an algebraic"):
+            aerocontrol.best_damping_gain(model, gains=np.linspace(0.0, 10.0, 21))
+        with pytest.raises(aerocontrol.SingularMatrixError, match=r"gain 0\.5 is an algebraic"):
+            aerocontrol.gain_for_damping(model, 0.5, gains=np.linspace(0.0, 10.0, 21))
+    # C = 0 and no algebraic gain: the poles stay at A's, without warnings.
+    model = (np.array([[-1.87]]), np.array([[0.1257]]), np.array([[0.0]]), np.array([[-1.43]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        locus = aerocontrol.root_locus(model, [0.0, 2.0])
+    assert locus.poles.tolist() == [[-1.87 + 0j], [-1.87 + 0j]]

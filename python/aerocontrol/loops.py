@@ -187,6 +187,9 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     A, B, C = model.A, model.B, model.C
     g = _closed_loop_gains(model, k)
     size_A, size_B, size_C = _log2_size(A), _log2_size(B), _log2_size(C)
+    if not math.isfinite(size_B + size_C):  # B C = 0: the loop does not move the poles
+        g = np.zeros_like(g)
+        size_B = size_C = 0.0
     with np.errstate(divide="ignore"):
         terms = np.maximum(size_A, np.log2(np.abs(g)) + size_B + size_C)
     plain = (terms <= RESCALE_EXPONENT) & (size_B + size_C <= RESCALE_EXPONENT)
@@ -296,6 +299,32 @@ def _golden_max(f: Callable[[float], float], a: float, b: float) -> tuple[float,
 # ----- the frequency grid -------------------------------------------------------------------
 
 
+def _magnitude(values: ComplexArray) -> FloatArray:
+    """|values|, infinite only where the true modulus exceeds the doubles (numpy's hypot
+    overflows only then; its warning is the honest inf, not a defect)."""
+    with np.errstate(over="ignore"):
+        return np.asarray(np.abs(values), dtype=np.float64)
+
+
+def _half_difference(values: ComplexArray) -> FloatArray:
+    """|1 - L|/(2|1 + L|) without overflow: for |L| > 1 the same ratio of 1/L (both moduli
+    divided by |L|), so an L near 1e308 gives about 1/2, not inf/inf; inf where L = -1."""
+    L = np.asarray(values, dtype=np.complex128)
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore", under="ignore"):
+        big = _magnitude(L) > 1.0
+        w = np.where(big, 1.0 / np.where(big, L, 1.0), L)
+        return np.asarray(np.abs(1.0 - w) / (2.0 * np.abs(1.0 + w)), dtype=np.float64)
+
+
+def _nearest(points: ComplexArray, target: complex) -> int:
+    """The index of the point nearest ``target``; a difference beyond the doubles (an
+    infinite pole) is infinitely far, and an infinite target matches an equal point."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        distance = np.abs(points - target)
+    distance = np.where(points == target, 0.0, np.nan_to_num(distance, nan=np.inf))
+    return int(np.argmin(distance))
+
+
 class _Response:
     """L(jω) of a SISO model through the core, one frequency or many."""
 
@@ -315,10 +344,27 @@ class _Response:
         return complex(self.many(np.array([omega]))[0])
 
 
+def _roots_of(model: StateSpace) -> TransferFunction:
+    """L's transfer function for its poles, zeros and gain only: its polynomial coefficients
+    may overflow (a gain near 1e308 times a zero) with a NumericalOverflowWarning that is no
+    concern of a caller who asked for roots or margins, so that warning is not passed on."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NumericalOverflowWarning)
+        g = transfer_function(model)
+    for roots, what in ((g.poles, "poles"), (g.zeros, "zeros")):
+        if not np.all(np.isfinite(roots)):
+            warnings.warn(
+                f"the open loop's {what} overflow double precision: they are infinite",
+                NumericalOverflowWarning,
+                stacklevel=3,
+            )
+    return g
+
+
 def _grid(model: StateSpace) -> FloatArray:
     """Frequencies from below the slowest to beyond the fastest pole or zero of the loop and
     beyond its asymptotic crossovers, with points clustered at lightly damped roots."""
-    g = transfer_function(model)
+    g = _roots_of(model)
     dt = period(model) if model.is_discrete else 0.0
     roots = np.concatenate([g.poles, g.zeros])
     if dt:
@@ -606,7 +652,8 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
     unstable_open = int(np.sum(open_poles.real > 0.0))
     unstable_closed = int(np.sum(closed.real > 0.0))
     negative = phase_values.real < 0.0
-    gains = 1.0 / np.abs(phase_values[negative])
+    with np.errstate(divide="ignore"):
+        gains = 1.0 / _magnitude(phase_values[negative])
     phase_w = phase_w[negative]
     shifted = 180.0 + np.degrees(np.angle(gain_values))
     phases = shifted - 360.0 * np.round(shifted / 360.0)
@@ -658,24 +705,25 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
         if response.one(w).real < 0:
             phase_w.append(float(w))
     ends = [0.0] + ([math.pi / period(model)] if discrete else [])
-    largest = float(np.abs(values).max(initial=0.0))
+    largest = float(_magnitude(values).max(initial=0.0))
     for w in ends:
         value = response.one(w)
         # Not where L vanishes (a zero at the origin, a washout): no crossing there.
         if (
             np.isfinite(value)
             and value.real < -1e-10 * largest
-            and abs(value.imag) <= 1e-12 * abs(value)
+            and abs(value.imag) <= 1e-12 * math.hypot(value.real, value.imag)
         ):
             phase_w.append(float(w))
     phase_w = sorted(set(phase_w))
-    gains = np.array([1.0 / abs(response.one(w)) for w in phase_w])
+    with np.errstate(divide="ignore"):
+        gains = 1.0 / _magnitude(np.array([response.one(w) for w in phase_w], np.complex128))
 
     # Gain crossovers: log|L| changes sign.
     def log_magnitude(w: float) -> float:
-        return math.log(abs(response.one(w)))
+        return math.log(float(_magnitude(np.array([response.one(w)]))[0]))
 
-    logs = np.log(np.abs(values))
+    logs = np.log(_magnitude(values))
     gain_w: list[float] = []
     for i in np.nonzero(np.sign(logs[:-1]) != np.sign(logs[1:]))[0]:
         gain_w.append(
@@ -691,25 +739,22 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
 
     # |S - T|/2 = |1 - L|/(2|1 + L|) and |1 + L|, peak and minimum refined.
     def half_difference(w: FloatArray) -> FloatArray:
-        value = response.many(w)
-        return np.asarray(np.abs(1 - value) / (2 * np.abs(1 + value)), dtype=np.float64)
+        return _half_difference(response.many(w))
 
     def distance(w: FloatArray) -> FloatArray:
-        return np.asarray(-np.abs(1 + response.many(w)), dtype=np.float64)
+        return -_magnitude(1 + response.many(w))
 
     # ω = 0 too, where L is finite (the grid starts above it).
     at_zero = response.one(0.0)
     if np.isfinite(at_zero) and omega.size:
         omega, values = np.concatenate([[0.0], omega]), np.concatenate([[at_zero], values])
-    disk_w, disk_peak = _extremum(
-        omega, np.abs(1 - values) / (2 * np.abs(1 + values)), half_difference
-    )
+    disk_w, disk_peak = _extremum(omega, _half_difference(values), half_difference)
     if not discrete:  # the supremum may be approached as ω → ∞, where L = D
         d = float(model.D[0, 0])
-        at_infinity = abs(1 - d) / (2 * abs(1 + d))
+        at_infinity = float(_half_difference(np.array([d]))[0])
         if at_infinity > disk_peak:
             disk_w, disk_peak = math.inf, at_infinity
-    stab_w, stab_peak = _extremum(omega, -np.abs(1 + values), distance)
+    stab_w, stab_peak = _extremum(omega, -_magnitude(1 + values), distance)
 
     result = _assemble(
         gains,
@@ -814,8 +859,10 @@ def _verify_gain_margins(model: StateSpace, margins: StabilityMargins) -> None:
             continue
         point = np.exp(1j * w * dt) if dt else 1j * w
         poles = _closed_loop_poles(model, np.array([k]))[0]
-        miss = float(np.min(np.abs(poles - point))) if poles.size else 0.0
-        if poles.size and miss > 1e-6 * max(scale, abs(point)):
+        with np.errstate(over="ignore", invalid="ignore"):
+            gaps = np.nan_to_num(_magnitude(poles - point), nan=np.inf)
+        miss = float(gaps.min(initial=0.0)) if poles.size else 0.0
+        if poles.size and miss > 1e-6 * max(scale, math.hypot(point.real, point.imag)):
             raise AerocontrolLinAlgError(
                 f"stability_margins: the loop closed with its gain margin {k:.6g} has no pole "
                 f"at the phase crossover {w:.6g} rad/s (nearest at distance {miss:.3g})"
@@ -873,7 +920,7 @@ class RootLocus:
 
     @cached_property
     def _transfer(self) -> TransferFunction:
-        return transfer_function(self.loop)
+        return _roots_of(self.loop)
 
     @property
     def open_loop_poles(self) -> ComplexArray:
@@ -905,6 +952,10 @@ def _gains(gains: ArrayLike, name: str = "gains") -> FloatArray:
 
 
 def _closed_poles(model: StateSpace, k: float) -> ComplexArray:
+    """The closed-loop poles at one gain of a damping search; a gain of the search (one the
+    caller listed in ``gains``) that closes an algebraic loop, 1 + k D = 0, is refused by
+    name (the loop has no solution there, so no poles)."""
+    _refuse_algebraic(model, k)
     poles: ComplexArray = _closed_loop_poles(model, np.array([k]))[0]
     return poles
 
@@ -962,18 +1013,27 @@ def _continuous(poles: ComplexArray, dt: float) -> ComplexArray:
 
 def _least_damped(poles: ComplexArray, dt: float) -> tuple[float, complex]:
     s = _continuous(poles, dt)
-    oscillatory = np.isfinite(s) & (s.imag > 1e-9 * np.abs(s))
+    oscillatory = np.isfinite(s) & (s.imag > 1e-9 * _magnitude(s))
     if not np.any(oscillatory):
         return 1.0, complex(math.nan, math.nan)
     candidates = s[oscillatory]
-    zetas = -candidates.real / np.abs(candidates)
+    # ζ = -Re/|s| of the candidates scaled to parts at most 1 (|s| may exceed the doubles).
+    size = np.maximum(np.abs(candidates.real), np.abs(candidates.imag))
+    zetas = -(candidates.real / size) / np.abs(candidates / size)
     i = int(np.argmin(zetas))
     return float(zetas[i]), complex(poles[oscillatory][i])
 
 
 def _damping(pole: complex, dt: float) -> float:
     s = complex(np.log(pole)) / dt if dt else pole
-    return -s.real / abs(s) if abs(s.imag) > 1e-9 * abs(s) else 1.0
+    # |s| by a hypot of the parts scaled to at most 1 (Python's abs of a complex beyond the
+    # doubles raises OverflowError): ζ is a ratio, so the scale cancels.
+    size = max(abs(s.real), abs(s.imag))
+    if not (math.isfinite(size) and size > 0.0):
+        return 1.0
+    re, im = s.real / size, s.imag / size
+    modulus = math.hypot(re, im)
+    return -re / modulus if abs(im) > 1e-9 * modulus else 1.0
 
 
 class _Objective:
@@ -992,7 +1052,7 @@ class _Objective:
             current = complex(mode)
             for k in gains:
                 poles = _closed_poles(model, float(k))
-                current = complex(poles[int(np.argmin(np.abs(poles - current)))])
+                current = complex(poles[_nearest(poles, current)])
                 current = complex(current.real, abs(current.imag))
                 self.track.append(current)
 
@@ -1002,7 +1062,7 @@ class _Objective:
             zeta, pole = _least_damped(poles, self.dt)
             return zeta, pole, poles
         nearest = self.track[int(np.argmin(np.abs(self.gains - k)))]
-        pole = complex(poles[int(np.argmin(np.abs(poles - nearest)))])
+        pole = complex(poles[_nearest(poles, nearest)])
         pole = complex(pole.real, abs(pole.imag))
         return _damping(pole, self.dt), pole, poles
 
@@ -1018,7 +1078,7 @@ def _default_gains(model: StateSpace) -> FloatArray:
     poles = _continuous(_eigenvalues(model.A), period(model) if model.is_discrete else 0.0)
     sizes = np.abs(poles[np.isfinite(poles) & (np.abs(poles) > 0)])
     omega = sizes if sizes.size else np.array([1.0])
-    magnitude = np.abs(_Response(model).many(omega))
+    magnitude = _magnitude(_Response(model).many(omega))
     magnitude = magnitude[np.isfinite(magnitude) & (magnitude > 0)]
     reference = 1.0 / float(np.median(magnitude)) if magnitude.size else 1.0
     return np.concatenate([[0.0], reference * np.logspace(-3.0, 3.0, 400)])
