@@ -91,7 +91,8 @@ def closed_matrix(A: np.ndarray, B: np.ndarray, C: np.ndarray, d: float, k: floa
         denominator = 1.0 + k * d
         if denominator == 0:
             return None
-        c = k / denominator
+        # k/(1 + k d) as 1/(1/k + d) where k d overflows (k = 5, d = 1e308: not 5/inf = 0).
+        c = k / denominator if np.isfinite(denominator) else 1.0 / (1.0 / k + d)
         return A - c * (B @ C), norm(A) + abs(c) * norm(B) * norm(C)
 
 
@@ -493,3 +494,18 @@ def test_regression_damping_of_a_loop_with_a_huge_c() -> None:
         _design_oracle("best_damping_gain"),
         nonfinite_by_definition=("pole",),
     )
+
+
+def test_regression_locus_oracle_gain_times_huge_feedthrough() -> None:
+    """k = 5 and D = 1e308: the oracle's k/(1 + k D) was 5/inf = 0, the open-loop pole -1.874
+    for the true closed-loop pole -1.874 - 0.1257 · 1e308/(5e308) · 5 = -2; it now forms
+    1/(1/k + D), as aerocontrol does."""
+    a, b = -1.8742697789066067, 0.1257302210933933
+    model = (np.array([[a]]), np.array([[b]]), np.array([[1e308]]), np.array([[1e308]]))
+    outcome = exercise(
+        "root_locus",
+        lambda loop, gains: aerocontrol.root_locus(loop, gains),
+        {"loop": plain(model), "gains": plain(np.array([0.0, 1.0, 5.0]))},
+        _locus_oracle,
+    )
+    assert outcome.result.poles[:, 0].real == pytest.approx([-1.8742697789066067, -2.0, -2.0])
