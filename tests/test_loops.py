@@ -437,3 +437,20 @@ def test_damping_search_refuses_an_algebraic_gain_of_the_grid() -> None:
         warnings.simplefilter("error")
         locus = aerocontrol.root_locus(model, [0.0, 2.0])
     assert locus.poles.tolist() == [[-1.87 + 0j], [-1.87 + 0j]]
+
+
+def test_stability_margins_when_the_core_overflows_beside_a_huge_feedthrough() -> None:
+    """C and D of 1e308 (or C 1e308, D 1e300): the core's margin pencils overflowed (a
+    NonFiniteError 'A is NaN' for a finite loop); the grid search gives the margins: L is
+    about D everywhere, so no crossovers and |S - T|/2 = 1/2 (disk margin 2), and the closed
+    loop is A - B C/(1 + D)."""
+    a, b = -1.8742697789066067, 0.345584192064786
+    for c, d, pole in ((1e308, 1e308, a - b), (1e308, 1e300, a - b * 1e8)):
+        model = (np.array([[a]]), np.array([[b]]), np.array([[c]]), np.array([[d]]))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            margins = aerocontrol.stability_margins(model)
+        assert margins.disk_margin == pytest.approx(2.0, rel=1e-9)
+        assert margins.gain_margins.size == 0 and margins.phase_margins.size == 0
+        assert margins.closed_loop_poles.real == pytest.approx([pole], rel=1e-12)
+        assert margins.closed_loop_stable

@@ -87,6 +87,7 @@ from .exceptions import (
     AerocontrolLinAlgError,
     IllConditionedWarning,
     InvalidArgumentError,
+    NonFiniteError,
     NumericalOverflowWarning,
     ShapeError,
     SingularMatrixError,
@@ -559,9 +560,16 @@ def stability_margins(loop: System) -> StabilityMargins:
         _refuse_algebraic(model)
     exponent = _frequency_exponent(model)
     sizes = (_log2_size(model.B), _log2_size(model.C))
-    if exponent or max(sizes) > RESCALE_EXPONENT:
-        return _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
-    return _continuous_margins(model)
+    try:
+        if exponent or max(sizes) > RESCALE_EXPONENT:
+            return _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
+        return _continuous_margins(model)
+    except NonFiniteError:
+        # The loop is finite (checked above), so this is an overflow inside the core's
+        # pencils: B and C near 1e154 beside D near 1e308 (after the balancing of _slowed)
+        # overflow in its products with D. The grid search needs only L(jω) and the
+        # closed-loop eigenvalues, formed with the scalings that keep them finite.
+        return _grid_margins(model)
 
 
 def _frequency_exponent(model: StateSpace) -> int:
