@@ -863,3 +863,42 @@ def test_parallel_of_feedthroughs_whose_sum_overflows() -> None:
             aerocontrol.parallel(aerocontrol.gain(1e308), aerocontrol.gain(1e308))
         assert getattr(e.value, "argument", None) == "sys1"
         assert aerocontrol.parallel(aerocontrol.gain(1e308), aerocontrol.gain(-1e308)).D == 0.0
+
+
+@pytest.mark.parametrize(
+    ("make", "argument", "message"),
+    [
+        (lambda: aerocontrol.zpk([], [1e200 + 1e200j, 1e200 - 1e200j], 1.0), "p", "p has roots"),
+        (lambda: aerocontrol.zpk([], [1e200, 1e200], 1.0), "p", "second-order section"),
+        (lambda: aerocontrol.zpk([1e200, 1e200], [-1.0, -2.0], 1.0), "z", "z has roots"),
+        (lambda: aerocontrol.first_order_lag(1e-310), "tau", r"tau = 1e-310 is too small"),
+        (lambda: aerocontrol.washout(1e-310), "tau", "1/tau overflows"),
+        (lambda: aerocontrol.tf([1e300, 1.0], [1e-300, 1.0]), "num", "leading coefficient 1e-300"),
+        (lambda: aerocontrol.tf([1.0], [1e-300, 1.0, 1e300]), "den", "realisation's A overflows"),
+        (lambda: aerocontrol.second_order(1e308, 10.0), "zeta", "2 zeta omega_n"),
+        (lambda: aerocontrol.pade_delay(1e-310, 3), "T", "T = 1e-310 is too small"),
+    ],
+)
+def test_realisations_beyond_the_doubles_are_refused_by_name(
+    make: object, argument: str, message: str
+) -> None:
+    """Finite arguments whose realisation overflows: numpy's overflow warnings, an
+    OverflowError from the balancing (int(inf)) or a NonFiniteError blaming an A the caller
+    never gave; now an InvalidArgumentError naming the argument, and no warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(aerocontrol.InvalidArgumentError, match=message) as raised:
+            make()  # type: ignore[operator]
+    assert getattr(raised.value, "argument", None) == argument
+
+
+def test_realisations_near_the_limits_that_fit() -> None:
+    """Just inside the doubles the realisations are exact."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lag = aerocontrol.first_order_lag(2.0**-1000)
+        assert lag.A[0, 0] == -(2.0**1000) and lag.B[0, 0] == 2.0**1000
+        g = aerocontrol.zpk([], [1e150 + 1e150j, 1e150 - 1e150j], 1.0)
+        poles = np.sort_complex(np.linalg.eigvals(g.A))
+        np.testing.assert_allclose(poles, [1e150 - 1e150j, 1e150 + 1e150j], rtol=1e-12)
+        assert aerocontrol.second_order(5e306, 10.0).A[1, 1] == -1e308

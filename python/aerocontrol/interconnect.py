@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
+from ._validation import FloatArray, check_finite, real_array, real_scalar
 from .exceptions import (
     IllConditionedWarning,
     InvalidArgumentError,
@@ -110,6 +110,31 @@ def _positive(value: object, name: str) -> float:
     if number <= 0.0:
         raise InvalidArgumentError(f"{name} must be positive, got {number}")
     return number
+
+
+def _realisable(matrices: Sequence[FloatArray], function: str, argument: str, why: str) -> None:
+    """Refuses a realisation whose matrices overflowed double precision although every
+    argument is finite, by an InvalidArgumentError naming ``argument`` (numpy's overflow
+    warning, or a NonFiniteError blaming an A the caller never gave, otherwise)."""
+    for name, matrix in zip("ABCD", matrices, strict=True):
+        if not np.all(np.isfinite(matrix)):
+            error = InvalidArgumentError(
+                f"{function}: the realisation's {name} overflows double precision: {why}"
+            )
+            error.argument = argument
+            raise error
+
+
+def _reciprocal(value: float, name: str, function: str) -> float:
+    """1/value of a positive time, refused by name where it overflows (tau of 1e-310)."""
+    inverse = 1.0 / value
+    if not math.isfinite(inverse):
+        error = InvalidArgumentError(
+            f"{function}: {name} = {value:g} is too small: 1/{name} overflows double precision"
+        )
+        error.argument = name
+        raise error
+    return inverse
 
 
 def _signal_names(given: Names, count: int, default: str, argument: str) -> tuple[str, ...]:
@@ -935,6 +960,8 @@ def _balance(A: FloatArray, B: FloatArray, C: FloatArray) -> tuple[FloatArray, .
     row of [A B] and column of [A; C] of similar size, as SLICOT's TB01ID does: the
     companion forms of polynomial coefficients spread over many orders of magnitude."""
     A, B, C = A.copy(), B.copy(), C.copy()
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(B)) and np.all(np.isfinite(C))):
+        return A, B, C  # refused by the caller (_realisable)
     n = A.shape[0]
     for _ in range(100):
         changed = False
@@ -976,7 +1003,8 @@ def _observable_form(
     D = np.array([[numerator[0]]])
     A = np.zeros((n, n))
     A[np.arange(1, n), np.arange(n - 1)] = 1.0
-    B = (numerator[1:] - numerator[0] * a)[::-1].reshape(n, 1)
+    with np.errstate(over="ignore", invalid="ignore"):  # refused by the callers
+        B = (numerator[1:] - numerator[0] * a)[::-1].reshape(n, 1)
     C = np.zeros((1, n))
     if n:
         A[:, -1] = -a[::-1]
@@ -1043,12 +1071,20 @@ def tf(
             f"{denominator.size - 1}): it has no state-space model; add poles (a first-order "
             "lag) to make it proper"
         )
-    with np.errstate(over="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"):
         numerator = np.concatenate([np.zeros(denominator.size - numerator.size), numerator])
         leading = denominator[0]
-        A, B, C, D = _observable_form(numerator / leading, denominator / leading)
-    for matrix, what in ((A, "A"), (B, "B"), (D, "D")):
-        finite_or_warn(matrix, f"the realisation's {what}")
+        monic_den, monic_num = denominator / leading, numerator / leading
+        A, B, C, D = _observable_form(monic_num, monic_den)
+    # The coefficients divided by den's leading one are those of the realisation: beyond the
+    # doubles (den of 1e-300 s + 1e200), no state scaling of the companion form helps.
+    _realisable(
+        (A, B, C, D),
+        "tf",
+        "den" if not np.all(np.isfinite(monic_den)) else "num",
+        f"num and den divided by den's leading coefficient {leading:g} exceed the doubles "
+        "(scale the units of time or of the signals)",
+    )
     return _model(
         A,
         B,
@@ -1085,25 +1121,40 @@ def _real_factors(roots: np.ndarray, name: str) -> list[FloatArray]:
     upper = sorted((r for r in roots if r.imag > 0.0), key=lambda r: (r.real, r.imag))
     lower = [r for r in roots if r.imag < 0.0]
     factors: list[FloatArray] = []
-    for r in upper:
-        match = [k for k, q in enumerate(lower) if abs(q - r.conjugate()) <= 1e-10 * abs(r)]
-        if not match:
-            raise InvalidArgumentError(
-                f"{name} has the complex root {complex(r)} without its conjugate: a real model "
-                "has complex roots in conjugate pairs"
-            )
-        lower.pop(match[0])
-        factors.append(np.array([1.0, -2.0 * r.real, abs(r) ** 2]))
+    with np.errstate(over="ignore", invalid="ignore"):  # beyond the doubles: refused below
+        for r in upper:
+            _pair(r, lower, name, factors)
+        for k in range(0, len(real) - 1, 2):
+            factors.append(np.array([1.0, -(real[k] + real[k + 1]), real[k] * real[k + 1]]))
     if lower:
         raise InvalidArgumentError(
             f"{name} has the complex root {complex(lower[0])} without its conjugate: a real "
             "model has complex roots in conjugate pairs"
         )
-    for k in range(0, len(real) - 1, 2):
-        factors.append(np.array([1.0, -(real[k] + real[k + 1]), real[k] * real[k + 1]]))
     if len(real) % 2:
         factors.append(np.array([1.0, -real[-1]]))
+    for factor in factors:
+        if not np.all(np.isfinite(factor)):
+            error = InvalidArgumentError(
+                f"zpk: {name} has roots whose second-order section s² - (r1 + r2) s + r1 r2 "
+                "overflows double precision (roots beyond about 1e154 in modulus: scale the "
+                "units of time)"
+            )
+            error.argument = name
+            raise error
     return factors
+
+
+def _pair(r: complex, lower: list[complex], name: str, factors: list[FloatArray]) -> None:
+    """The quadratic factor of r and its conjugate (taken from ``lower``)."""
+    match = [k for k, q in enumerate(lower) if abs(q - r.conjugate()) <= 1e-10 * abs(r)]
+    if not match:
+        raise InvalidArgumentError(
+            f"{name} has the complex root {complex(r)} without its conjugate: a real model "
+            "has complex roots in conjugate pairs"
+        )
+    lower.pop(match[0])
+    factors.append(np.array([1.0, -2.0 * r.real, abs(r) ** 2]))
 
 
 def zpk(
@@ -1163,15 +1214,22 @@ def zpk(
     B = np.zeros((0, 1))
     C = np.zeros((1, 0))
     D = np.array([[1.0]])
-    for numerator, denominator in zip(numerators, pole_factors, strict=True):
-        padded = np.concatenate([np.zeros(denominator.size - numerator.size), numerator])
-        A2, B2, C2, D2 = _observable_form(padded, denominator)
-        # The new section's states first: A stays upper Hessenberg (see _observable_form).
-        A = np.block([[A2, B2 @ C], [np.zeros((A.shape[0], A2.shape[0])), A]])
-        B = np.vstack([B2 @ D, B])
-        C = np.hstack([C2, D2 @ C])
-        D = D2 @ D
-    C, D = factor * C, factor * D
+    with np.errstate(over="ignore", invalid="ignore"):  # refused by name below
+        for numerator, denominator in zip(numerators, pole_factors, strict=True):
+            padded = np.concatenate([np.zeros(denominator.size - numerator.size), numerator])
+            A2, B2, C2, D2 = _observable_form(padded, denominator)
+            # The new section's states first: A stays upper Hessenberg (see _observable_form).
+            A = np.block([[A2, B2 @ C], [np.zeros((A.shape[0], A2.shape[0])), A]])
+            B = np.vstack([B2 @ D, B])
+            C = np.hstack([C2, D2 @ C])
+            D = D2 @ D
+        C, D = factor * C, factor * D
+    _realisable(
+        (A, B, C, D),
+        "zpk",
+        "k",
+        "the gain k and the sections' coefficients are too large together (scale the units)",
+    )
     A, B, C = _balance(A, B, C)
     assert A.shape == (n, n)
     return _model(
@@ -1245,9 +1303,10 @@ def first_order_lag(
     """
     time_constant = _positive(tau, "tau")
     k = _finite(gain, "gain")
+    rate = _reciprocal(time_constant, "tau", "first_order_lag")
     return _model(
-        np.array([[-1.0 / time_constant]]),
-        np.array([[1.0 / time_constant]]),
+        np.array([[-rate]]),
+        np.array([[rate]]),
         np.array([[k]]),
         np.zeros((1, 1)),
         input_names=input_names,
@@ -1310,9 +1369,10 @@ def washout(
     array([0.      , 0.707107, 1.      ])
     """
     time_constant = _positive(tau, "tau")
+    rate = _reciprocal(time_constant, "tau", "washout")
     return _model(
-        np.array([[-1.0 / time_constant]]),
-        np.array([[1.0 / time_constant]]),
+        np.array([[-rate]]),
+        np.array([[rate]]),
         -np.ones((1, 1)),
         np.ones((1, 1)),
         input_names=input_names,
@@ -1349,6 +1409,12 @@ def second_order(
     damping = _finite(zeta, "zeta")
     if damping < 0.0:
         raise InvalidArgumentError(f"zeta must be non-negative, got {damping}")
+    if not math.isfinite(2.0 * damping * omega):
+        error = InvalidArgumentError(
+            f"second_order: 2 zeta omega_n = 2·{damping:g}·{omega:g} overflows double precision"
+        )
+        error.argument = "zeta"
+        raise error
     return _model(
         np.array([[0.0, omega], [-omega, -2.0 * damping * omega]]),
         np.array([[0.0], [omega]]),
@@ -1405,7 +1471,16 @@ def pade_delay(
         [float((-1) ** k * c / exact[n]) for k, c in reversed(list(enumerate(exact)))]
     )
     A, B, C, D = _observable_form(numerator, denominator)
-    A, B, C = _balance(A / delay, B / delay, C)
+    with np.errstate(over="ignore"):  # refused by name below
+        A, B = A / delay, B / delay
+    _realisable(
+        (A, B, C, D),
+        "pade_delay",
+        "T",
+        f"T = {delay:g} is too small: the approximant's poles, of size {order}/T, are beyond "
+        "the doubles",
+    )
+    A, B, C = _balance(A, B, C)
     return _model(
         A,
         B,
