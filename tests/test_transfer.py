@@ -3,6 +3,7 @@ generalized eigenvalues of the Rosenbrock pencil, and hand-derived examples."""
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import control
@@ -250,3 +251,29 @@ def test_transfer_function_of_poles_near_the_overflow_threshold() -> None:
         assert g.zeros.size == 0
         assert g.gain == pytest.approx(1.0, rel=1e-12)
         assert g.denominator.tolist() == [1.0, -a]
+
+
+def test_factored_form_of_roots_near_1e200() -> None:
+    """Poles and zeros near 1e200: G(s) was the product of the numerator's factors (1e400:
+    inf) over the denominator's (inf), nan with numpy's warnings; it is now formed zero by
+    pole. ζ and ω of a pair beyond 1e154 were Python's abs (OverflowError beyond the doubles);
+    a factor's coefficient ω² beyond the doubles is warned of by aerocontrol."""
+    A = np.array([[1e200, 1e200], [-1e200, 1e200]])
+    B = np.array([[1.0], [1.0]])
+    C = np.array([[1.0, 0.0]])
+    model = aerocontrol.StateSpace(A, B, C, np.array([[1.0]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", aerocontrol.NumericalOverflowWarning)  # coefficients
+        g = transfer_function(model)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_allclose(g.poles, [1e200 - 1e200j, 1e200 + 1e200j], rtol=1e-14)
+        # G(0) = D + C (-A)^-1 B = 1 - 2e200/(2e400) = 1 - 1e-200: the ratio, not nan.
+        assert g(0.0) == pytest.approx(1.0, rel=1e-14)
+        assert g(1e200 + 0j) == pytest.approx(complex(1.0, 0.0), abs=1e-14)
+        (pair,) = g.pole_factors
+        assert pair.omega == pytest.approx(math.sqrt(2.0) * 1e200, rel=1e-14)
+        assert pair.zeta == pytest.approx(-math.sqrt(0.5), rel=1e-14)
+    with pytest.warns(aerocontrol.NumericalOverflowWarning, match="factor's coefficients"):
+        coefficients = pair.coefficients
+    assert coefficients[1] == -2e200 and coefficients[2] == math.inf

@@ -386,7 +386,8 @@ def _conjugate_clean(roots: ComplexArray) -> ComplexArray:
     """Roots with a negligible imaginary part made real, and sorted (by real part, then
     imaginary part)."""
     cleaned = roots.copy()
-    tiny = np.abs(cleaned.imag) <= 8 * np.finfo(float).eps * np.abs(cleaned)
+    with np.errstate(over="ignore"):  # |root| beyond the doubles is inf: not tiny
+        tiny = np.abs(cleaned.imag) <= 8 * np.finfo(float).eps * np.abs(cleaned)
     cleaned[tiny] = cleaned[tiny].real
     return np.sort_complex(cleaned)
 
@@ -465,7 +466,10 @@ class Factor:
         if len(self.roots) == 1:
             return np.array([1.0, -self.roots[0].real])
         r = self.roots[0]
-        return np.array([1.0, -2.0 * r.real, abs(r) ** 2])
+        with np.errstate(over="ignore"):  # an overflow is warned of below
+            parts = np.array([r.real, r.imag])
+            coefficients = np.array([1.0, -2.0 * parts[0], float(np.sum(parts * parts))])
+        return finite_or_warn(coefficients, "the factor's coefficients")
 
 
 def _factors(roots: ComplexArray, dt: float) -> list[Factor]:
@@ -475,10 +479,11 @@ def _factors(roots: ComplexArray, dt: float) -> list[Factor]:
         value = float(r.real)
         tau = math.inf if value == 0.0 or dt else 1.0 / abs(value)
         factors.append(Factor((complex(value),), math.nan, abs(value), tau))
-    for r in sorted((r for r in roots if r.imag > 0.0), key=abs):
+    for r in sorted((r for r in roots if r.imag > 0.0), key=lambda r: math.hypot(r.real, r.imag)):
         s = complex(np.log(r)) / dt if dt else complex(r)
-        omega = abs(s)
-        zeta = -s.real / omega if omega > 0 else math.nan
+        omega = math.hypot(s.real, s.imag)  # inf beyond the doubles (abs raises OverflowError)
+        size = max(abs(s.real), abs(s.imag))
+        zeta = -(s.real / size) / math.hypot(s.real / size, s.imag / size) if size > 0 else math.nan
         factors.append(Factor((complex(r), complex(r).conjugate()), zeta, omega, math.nan))
     return factors
 
@@ -547,11 +552,25 @@ class TransferFunction:
     def __call__(self, s: complex | ComplexArray) -> complex | ComplexArray:
         """G at ``s`` (or at z for a discrete model), from the factored form."""
         value = np.asarray(s, dtype=np.complex128)
-        result = (
-            self.gain
-            * np.prod(value[..., None] - self.zeros, axis=-1)
-            / np.prod(value[..., None] - self.poles, axis=-1)
-        )
+        # Each zero's factor divided by a pole's, the roots paired by size, so that the
+        # partial products stay near the result's size (roots of 1e200: the products of the
+        # numerator and of the denominator each overflow, their ratio does not).
+        result = np.full(value.shape, complex(self.gain), dtype=np.complex128)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+            zeros = self.zeros[np.argsort(np.abs(self.zeros))]
+            poles = self.poles[np.argsort(np.abs(self.poles))]
+            for k in range(max(zeros.size, poles.size)):
+                if k < zeros.size:
+                    result = result * (value - zeros[k])
+                if k < poles.size:
+                    result = result / (value - poles[k])
+        if not np.all(np.isfinite(result)) and np.all(np.isfinite(value)):
+            warnings.warn(
+                "the result overflowed double precision: G is infinite or NaN (at a pole, or "
+                "beyond the doubles)",
+                NumericalOverflowWarning,
+                stacklevel=2,
+            )
         return complex(result) if result.ndim == 0 else result
 
     def aircraft_form(self, digits: int = 4) -> str:
