@@ -454,3 +454,22 @@ def test_stability_margins_when_the_core_overflows_beside_a_huge_feedthrough() -
         assert margins.gain_margins.size == 0 and margins.phase_margins.size == 0
         assert margins.closed_loop_poles.real == pytest.approx([pole], rel=1e-12)
         assert margins.closed_loop_stable
+
+
+def test_stability_margins_of_loops_that_are_their_feedthrough_to_rounding() -> None:
+    """Two fuzz loops of the grid path. L = 1.26e-309/(s + 1.87e-150): the grid's lowest
+    frequency underflowed and high/low overflowed (numpy's warning, then int(inf)). L =
+    -0.0399 + 1.6e-302/(s + 1.87): its gain margin 1/0.0399 makes 1 + k D = 0 in doubles, and
+    the check of the margin formed an infinite closed-loop matrix (NonFiniteError on A)."""
+    a, b, d = -1.8742697789066067, 0.1257302210933933, -0.03992465894713502
+    tiny = (np.array([[a * 1e-150]]), np.array([[b]]), np.array([[1e-308]]), np.zeros((1, 1)))
+    flat = (np.array([[a]]), np.array([[b]]), np.array([[b * 1e-300]]), np.array([[d]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        first = aerocontrol.stability_margins(tiny)
+        second = aerocontrol.stability_margins(flat)
+    assert first.disk_margin == pytest.approx(2.0, rel=1e-12)
+    assert first.closed_loop_stable
+    assert second.disk_margin == pytest.approx(2.0 * (1.0 + d) / (1.0 - d), rel=1e-12)
+    assert second.gain_margins.tolist() == pytest.approx([-1.0 / d], rel=1e-12)
+    assert second.phase_crossovers.tolist() == [0.0]

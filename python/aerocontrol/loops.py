@@ -397,8 +397,10 @@ def _grid(model: StateSpace) -> FloatArray:
                 low = min(low, k0 ** (1.0 / q) / 100.0)
     nyquist = math.pi / dt if dt else math.inf
     high = min(high, nyquist, 1e300)
-    low = min(low, high / 10.0)
-    decades = math.log10(high / low)
+    # Not below 1e-300 (roots and gains near 1e-300 put low at a subnormal or 0, and high/low
+    # overflowed: numpy's warning, then int(inf)).
+    low = max(min(low, high / 10.0), 1e-300)
+    decades = math.log10(high) - math.log10(low)
     grid = [np.logspace(math.log10(low), math.log10(high), int(decades * POINTS_PER_DECADE) + 2)]
     for root in s[np.isfinite(s)]:
         omega_n = abs(root)
@@ -862,8 +864,13 @@ def _verify_gain_margins(model: StateSpace, margins: StabilityMargins) -> None:
     (jω, or e^{jω dt}); a miss beyond 1e-6 of the pole's size is an error."""
     dt = period(model) if model.is_discrete else 0.0
     scale = 1.0 + float(np.abs(model.A).max(initial=0.0))
+    d = float(model.D[0, 0])
     for k, w in zip(margins.gain_margins, margins.phase_crossovers, strict=True):
         if not math.isfinite(k):
+            continue
+        if abs(1.0 + k * d) <= 8 * _EPS * max(1.0, abs(k * d)):
+            # L is D to rounding (a dynamic part of 1e-302 beside D of -0.04): 1 + k D = 0 in
+            # doubles, an algebraic loop whose poles cannot be formed, so nothing to check.
             continue
         point = np.exp(1j * w * dt) if dt else 1j * w
         poles = _closed_loop_poles(model, np.array([k]))[0]
