@@ -11,6 +11,7 @@ magnitude).
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import control
@@ -902,3 +903,20 @@ def test_realisations_near_the_limits_that_fit() -> None:
         poles = np.sort_complex(np.linalg.eigvals(g.A))
         np.testing.assert_allclose(poles, [1e150 - 1e150j, 1e150 + 1e150j], rtol=1e-12)
         assert aerocontrol.second_order(5e306, 10.0).A[1, 1] == -1e308
+
+
+def test_feedback_of_a_series_whose_states_differ_in_size() -> None:
+    """feedback(series(plant with B of 1e308, lag with C of 2.04)): B C of 2e308 under every
+    scaling of the series as one part ('no scaling of the states brings it within range', which
+    was false); each part is now balanced state by state first. The closed loop's poles are
+    a ± j √(b1 c1 b2 c2), exactly as the characteristic polynomial (s - a)² + b1 c1 b2 c2."""
+    a, b, c = -1.8742697789066067, 0.1257302210933933, 2.0409191213851825
+    plant = aerocontrol.StateSpace([[a]], [[1e308]], [[b]], [[0.0]])
+    lag = aerocontrol.StateSpace([[a]], [[b]], [[c]], [[0.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        closed = aerocontrol.feedback(aerocontrol.series(plant, lag))
+    poles = np.sort_complex(np.linalg.eigvals(closed.A))
+    omega = math.sqrt(1e308 * b * b * c)
+    np.testing.assert_allclose(poles.imag, [-omega, omega], rtol=1e-14)
+    np.testing.assert_allclose(poles.real, [a, a], rtol=1e-6)

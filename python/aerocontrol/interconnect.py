@@ -616,6 +616,14 @@ def _closed(
         exponents = _state_exponents([forward, back], K, E, F, np.zeros((p1, m1 + p1)))
         first, second = _rescaled(forward, exponents[0]), _rescaled(back, exponents[1])
         matrices = _loop_matrices(first, second, s, function)
+    if not all(np.all(np.isfinite(M)) for M in matrices):
+        # A part's states scaled as one are not enough where its own states differ in size
+        # (a series of B of 1e308 into C of 2: B C of 2e308 under every scaling of the
+        # part): balance each part state by state (exact powers of two), then rescale.
+        forward_b, back_b = _state_balanced(forward), _state_balanced(back)
+        exponents = _state_exponents([forward_b, back_b], K, E, F, np.zeros((p1, m1 + p1)))
+        first, second = _rescaled(forward_b, exponents[0]), _rescaled(back_b, exponents[1])
+        matrices = _loop_matrices(first, second, s, function)
     _representable(matrices, function, arguments)
     return StateSpace(
         *matrices,
@@ -623,6 +631,24 @@ def _closed(
         input_names=forward.input_names,
         output_names=forward.output_names,
         dt=dt,
+    )
+
+
+def _state_balanced(model: StateSpace) -> StateSpace:
+    """``model`` after the diagonal power-of-two similarity of :func:`_balance` (each state's
+    row of [A B] and column of [A; C] of similar size): the same transfer function, exactly."""
+    if model.n_states == 0:
+        return model
+    A, B, C = _balance(model.A, model.B, model.C)
+    return StateSpace(
+        A,
+        B,
+        C,
+        model.D,
+        state_names=model.state_names,
+        input_names=model.input_names,
+        output_names=model.output_names,
+        dt=model.dt,
     )
 
 
@@ -966,11 +992,16 @@ def _balance(A: FloatArray, B: FloatArray, C: FloatArray) -> tuple[FloatArray, .
     for _ in range(100):
         changed = False
         for i in range(n):
-            column = np.abs(A[:, i]).sum() - abs(A[i, i]) + np.abs(C[:, i]).sum()
-            row = np.abs(A[i, :]).sum() - abs(A[i, i]) + np.abs(B[i, :]).sum()
+            off_column = np.concatenate([np.delete(A[:, i], i), C[:, i]])
+            off_row = np.concatenate([np.delete(A[i, :], i), B[i, :]])
+            with np.errstate(over="ignore"):  # sums near 1e308: their largest terms instead
+                column, row = float(np.abs(off_column).sum()), float(np.abs(off_row).sum())
+            if not (math.isfinite(column) and math.isfinite(row)):
+                column, row = float(np.abs(off_column).max()), float(np.abs(off_row).max())
             if column == 0.0 or row == 0.0:
                 continue
-            exponent = int(np.round(0.5 * np.log2(row / column)))
+            # A difference of logarithms: row/column itself overflows (1e308/0.0158).
+            exponent = int(np.round(0.5 * (math.log2(row) - math.log2(column))))
             if exponent == 0:
                 continue
             factor = 2.0**exponent
