@@ -292,3 +292,22 @@ def test_gain_of_a_tiny_feedthrough_beside_a_huge_c() -> None:
     assert g.gain == pytest.approx(d, rel=1e-12)
     np.testing.assert_allclose(g.numerator, [d, -d * a], rtol=1e-12)
     assert g(1j) == pytest.approx(complex(d, 0.0), rel=1e-12)
+
+
+def test_balancing_beside_a_pole_near_1e308() -> None:
+    """A of 1e308, B of 1.26e-151, C of 1.26e149: the state balancing scaled A's row by 2^500
+    before restoring its diagonal, with numpy's overflow warning; G = D + B C/(s - A) has its
+    zero at A - B C/D (1e308 to rounding) and gain D."""
+    d = 0.1257302210933933
+    model = (
+        np.array([[1e308]]),
+        np.array([[d * 1e-150]]),
+        np.array([[d * 1e150]]),
+        np.array([[d]]),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        g = transfer_function(model)
+    assert g.poles.tolist() == [1e308 + 0j]
+    np.testing.assert_allclose(g.zeros.real, [1e308], rtol=1e-14)
+    assert g.gain == pytest.approx(d, rel=1e-12)

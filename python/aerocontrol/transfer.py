@@ -154,8 +154,11 @@ def _balance(
             k = round((c - r) / 2)
             if k:
                 diagonal = A[i, i]  # unchanged by the similarity (scaled twice, it underflows)
-                A[i], B[i] = np.ldexp(A[i], k), np.ldexp(B[i], k)
-                A[:, i], C[:, i] = np.ldexp(A[:, i], -k), np.ldexp(C[:, i], -k)
+                # Only the diagonal, restored below, may overflow here (A of 1e308 beside B of
+                # 1e-151 and C of 1e149): the off-diagonal entries move toward their mean size.
+                with np.errstate(over="ignore"):
+                    A[i], B[i] = np.ldexp(A[i], k), np.ldexp(B[i], k)
+                    A[:, i], C[:, i] = np.ldexp(A[:, i], -k), np.ldexp(C[:, i], -k)
                 A[i, i] = diagonal
                 changed = True
         if not changed:
