@@ -473,3 +473,17 @@ def test_stability_margins_of_loops_that_are_their_feedthrough_to_rounding() -> 
     assert second.disk_margin == pytest.approx(2.0 * (1.0 + d) / (1.0 - d), rel=1e-12)
     assert second.gain_margins.tolist() == pytest.approx([-1.0 / d], rel=1e-12)
     assert second.phase_crossovers.tolist() == [0.0]
+
+
+def test_open_loop_unstable_pole_that_the_frequency_scaling_underflows() -> None:
+    """A = 1.26e-301 > 0 beside B C of 1.6e148: the loop slowed by 2^-492 had A = 0, so the
+    unstable open-loop pole was not counted (a silent wrong answer); it is counted from A."""
+    b = 0.1257302210933933
+    model = (np.array([[b * 1e-300]]), np.array([[b]]), np.array([[b * 1e150]]), np.zeros((1, 1)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        margins = aerocontrol.stability_margins(model)
+    assert margins.open_loop_unstable_poles == 1
+    assert margins.closed_loop_stable
+    assert margins.encirclements == 1
+    assert margins.closed_loop_poles.real == pytest.approx([-b * b * 1e150], rel=1e-12)

@@ -564,7 +564,16 @@ def stability_margins(loop: System) -> StabilityMargins:
     sizes = (_log2_size(model.B), _log2_size(model.C))
     try:
         if exponent or max(sizes) > RESCALE_EXPONENT:
-            return _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
+            margins = _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
+            # The open-loop poles of the slowed loop, A 2^-e, may underflow (a pole 1.3e-301
+            # beside B C of 1.6e148 became 0, not unstable): counted from A itself.
+            unstable_open = int(np.sum(_eigenvalues(model.A).real > 0.0))
+            unstable_closed = int(np.sum(margins.closed_loop_poles.real > 0.0))
+            return dataclasses.replace(
+                margins,
+                open_loop_unstable_poles=unstable_open,
+                encirclements=unstable_open - unstable_closed,
+            )
         return _continuous_margins(model)
     except NonFiniteError:
         # The loop is finite (checked above), so this is an overflow inside the core's
