@@ -73,3 +73,16 @@ ZEROS_DROPPED = known_defect(
 
 def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
+
+
+EIGENVALUES_OF_A_DOMINANT_RANK_ONE = known_defect(
+    "eigenvalues-dominant-rank-one",
+    {"root_locus"},
+    "the core's eigenvalues of a closed-loop matrix A - k B C dominated by its rank-one term "
+    "(A of 4, B of 1e8, C of 2: norm 2.3e8, one eigenvalue 2.3e8 and three near -4) have a "
+    "backward error sigma_min(M - lambda I) of 1e-4 for the small ones, 6 times SLACK n u "
+    "||M||, where LAPACK's (numpy) reaches 1e-8: the core's Hessenberg QR loses the small "
+    "eigenvalues (-4.31329 ± 0.71612j for -4.31323 ± 0.71645j). The same matrix through "
+    "_core.eigenvalues directly shows it: a defect of the Rust eigenvalue solver",
+    lambda args: _block_spread(args) > 1e6 and _largest_entry(args) < 1e100,
+)

@@ -27,6 +27,7 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning, NumericalOverflowWarning
 
 from .harness import Arg, Warned, exercise, plain
+from .known_defects import EIGENVALUES_OF_A_DOMINANT_RANK_ONE
 from .oracles import (
     SLACK,
     TINY,
@@ -509,3 +510,25 @@ def test_regression_locus_oracle_gain_times_huge_feedthrough() -> None:
         _locus_oracle,
     )
     assert outcome.result.poles[:, 0].real == pytest.approx([-1.8742697789066067, -2.0, -2.0])
+
+
+@pytest.mark.xfail(strict=True, reason="eigenvalues-dominant-rank-one: the core's eigensolver")
+def test_known_defect_root_locus_dominant_rank_one() -> None:
+    A = np.array(
+        [
+            [-2.8742697789066067, -0.1321048632913019, 0.6404226504432821, 0.10490011715303971],
+            [-0.535669373161111, -2.638404945090515, 1.3040000451301372, 0.9470809631292422],
+            [-0.7037352358069926, -1.2654214710460525, -3.6232744625373523, 0.0413259793472436],
+            [-2.3250307746388343, -0.21879166393254573, -1.2459109472530652, -3.7322673547034517],
+        ]
+    )
+    B = np.array([[3.4558419206478603e07], [8.2161814350115836e07], [3.3043707618338715e07]])
+    B = np.vstack([B, [[-1.3031572316043609e08]]])
+    model = (A, B, np.array([[0.0, 0.0, 1.0, 2.0]]), np.zeros((1, 1)))
+    with EIGENVALUES_OF_A_DOMINANT_RANK_ONE.reproducing():
+        exercise(
+            "root_locus",
+            lambda loop, gains: aerocontrol.root_locus(loop, gains),
+            {"loop": plain(model), "gains": plain(np.array([0.0, 1.0, 5.0]))},
+            _locus_oracle,
+        )
