@@ -64,9 +64,8 @@ ZEROS_DROPPED = known_defect(
     "that of C B / D (A of 1e-8, B and D of 1, C of 1e3: zeros near 3e-9 and at -3526.6): "
     "the pencil equilibrated to the poles resolves the small zeros and gives the large one "
     "to a relative 3e-9, 1.2 times the backward error scipy's QZ of the pencil as given "
-    "reaches. The core's QZ loses the small eigenvalue of a 2 x 2 block whose T is nearly "
-    "singular (it forms H T^-1), so Python takes each eigenvalue from the pencil or its "
-    "reversal; a zero between the two scales is still computed in only one of them",
+    "reaches: each eigenvalue is taken from the pencil or its reversal, and a zero between "
+    "the two scales is computed in only one of them",
     lambda args: _block_spread(args) > 1e6 and _largest_entry(args) < 1e100,
 )
 
