@@ -77,9 +77,10 @@ def test_darex_residual_at_or_below_scipy(index: int) -> None:
     assert bool(caught) == (solution.rcond < 1e-8), [str(w.message) for w in caught]
     ours = relative_residual(A, B, Q, R, solution.X)
     theirs = relative_residual(A, B, Q, R, sl.solve_discrete_are(A, B, Q, R))
-    # At or below scipy's, or below one unit of rounding (where both are exact to rounding and
-    # the comparison is noise).
-    assert ours <= max(theirs, EPS), (ours, theirs)
+    # At or below scipy's, or below four units of rounding, where both are exact to rounding and
+    # the comparison is noise: in case 7 the exact solution is X = Q, and Q itself measures
+    # 5.9e-16 (ours differs from it by 1.5 u, scipy's by 3.5 u).
+    assert ours <= max(theirs, 4 * EPS), (ours, theirs)
     assert ours < 1e-15
     assert np.all(np.abs(solution.closed_loop_poles) < 1)
     np.testing.assert_allclose(solution.X, solution.X.T, rtol=0, atol=0)

@@ -35,7 +35,9 @@ def _sorted(values: np.ndarray) -> np.ndarray:
     return np.sort_complex(np.round(values, 8))
 
 
-@pytest.mark.parametrize("n", [1, 2, 3, 5, 8, 20, 50])
+# 33 and 130: above the order where B = Q R is blocked, and column groups of the reduction's
+# row rotations that do not fill four columns.
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 8, 20, 33, 50, 130])
 def test_random_pencils(n: int) -> None:
     rng = np.random.default_rng(n)
     A, B = rng.standard_normal((n, n)), rng.standard_normal((n, n))
@@ -56,14 +58,15 @@ def test_graded_pencil() -> None:
     _check(A, B, aerocontrol.qz(A, B))
 
 
-def test_singular_b_has_infinite_eigenvalues() -> None:
+@pytest.mark.parametrize("n", [6, 70])
+def test_singular_b_has_infinite_eigenvalues(n: int) -> None:
     rng = np.random.default_rng(2)
     U, V = (
-        np.linalg.qr(rng.standard_normal((6, 6)))[0],
-        np.linalg.qr(rng.standard_normal((6, 6)))[0],
+        np.linalg.qr(rng.standard_normal((n, n)))[0],
+        np.linalg.qr(rng.standard_normal((n, n)))[0],
     )
-    A = U @ np.triu(rng.standard_normal((6, 6)) + 3 * np.eye(6)) @ V.T
-    B = U @ np.diag([1.0, 2.0, 3.0, 4.0, 0.0, 0.0]) @ V.T
+    A = U @ np.triu(rng.standard_normal((n, n)) + 3 * np.eye(n)) @ V.T
+    B = U @ np.diag(np.r_[np.arange(1.0, n - 1), 0.0, 0.0]) @ V.T
     form = aerocontrol.qz(A, B)
     _check(A, B, form)
     assert np.sum(form.beta <= 1e-12 * np.linalg.norm(B)) == 2

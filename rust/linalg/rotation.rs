@@ -7,6 +7,7 @@
 //! transformation Q^T M recorded as rows is accumulated into Q as the same rotation on its
 //! columns.
 
+use crate::platform::dispatch::{fma_dispatch, multiply_add};
 use faer::Mat;
 use std::ops::Range;
 
@@ -82,13 +83,21 @@ impl Rotation {
             ck.expect("contiguous"),
         );
         let (ci, ck) = (ci.as_slice_mut(), ck.as_slice_mut());
-        for (x, y) in ci[rows.clone()].iter_mut().zip(&mut ck[rows]) {
-            let (a, b) = (*x, *y);
-            *x = self.c * a + self.s * b;
-            *y = -self.s * a + self.c * b;
-        }
+        rotate_pair(self.c, self.s, &mut ci[rows.clone()], &mut ck[rows]);
     }
 }
+
+/// (x, y) <- (c x + s y, -s x + c y) entrywise, for slices of one length.
+#[inline(always)]
+fn rotate_pair_kernel<const FMA: bool>(c: f64, s: f64, x: &mut [f64], y: &mut [f64]) {
+    for (x, y) in x.iter_mut().zip(y) {
+        let (a, b) = (*x, *y);
+        *x = multiply_add::<FMA>(c, a, s * b);
+        *y = multiply_add::<FMA>(c, b, -(s * a));
+    }
+}
+
+fma_dispatch!(fn rotate_pair(c: f64, s: f64, x: &mut [f64], y: &mut [f64]) => rotate_pair_kernel);
 
 /// A reflector I - τ u u^T of length 2 or 3 acting on consecutive rows or columns from
 /// `first`.
@@ -169,29 +178,59 @@ impl SmallReflector {
         if self.tau == 0.0 {
             return;
         }
-        assert!(first + self.len <= m.ncols() && rows.end <= m.nrows());
-        let stride = m.col_stride() as usize;
+        assert!(first + self.len <= m.ncols() && rows.end <= m.nrows() && rows.start <= rows.end);
+        let stride = m.col_stride();
         let base = m.as_ptr_mut();
-        let u = self.u;
-        for r in rows {
-            // SAFETY: row r and columns first..first + len are inside the matrix (asserted).
-            unsafe {
-                let p = base.add(r + first * stride);
-                if self.len == 3 {
-                    let w =
-                        self.tau * (u[0] * *p + u[1] * *p.add(stride) + u[2] * *p.add(2 * stride));
-                    *p -= w * u[0];
-                    *p.add(stride) -= w * u[1];
-                    *p.add(2 * stride) -= w * u[2];
-                } else {
-                    let w = self.tau * (u[0] * *p + u[1] * *p.add(stride));
-                    *p -= w * u[0];
-                    *p.add(stride) -= w * u[1];
-                }
-            }
+        let length = rows.end - rows.start;
+        // SAFETY: columns first..first + len of m are distinct (asserted in range), so the
+        // slices over their rows `rows` are disjoint and inside the matrix.
+        let column = |c: usize| unsafe {
+            std::slice::from_raw_parts_mut(
+                base.offset((first + c) as isize * stride + rows.start as isize),
+                length,
+            )
+        };
+        if self.len == 3 {
+            reflect_three(self.u, self.tau, column(0), column(1), column(2));
+        } else {
+            reflect_two(self.u, self.tau, column(0), column(1));
         }
     }
 }
+
+/// (x, y, z) <- (x, y, z) - τ (u · (x, y, z)) u row by row: a reflector of length 3 applied to
+/// three columns.
+#[inline(always)]
+fn reflect_three_kernel<const FMA: bool>(
+    u: [f64; 3],
+    tau: f64,
+    x: &mut [f64],
+    y: &mut [f64],
+    z: &mut [f64],
+) {
+    let [v0, v1, v2] = u;
+    for ((x, y), z) in x.iter_mut().zip(y.iter_mut()).zip(z.iter_mut()) {
+        let w = tau * multiply_add::<FMA>(v2, *z, multiply_add::<FMA>(v1, *y, v0 * *x));
+        *x = multiply_add::<FMA>(-w, v0, *x);
+        *y = multiply_add::<FMA>(-w, v1, *y);
+        *z = multiply_add::<FMA>(-w, v2, *z);
+    }
+}
+
+fma_dispatch!(fn reflect_three(u: [f64; 3], tau: f64, x: &mut [f64], y: &mut [f64], z: &mut [f64]) => reflect_three_kernel);
+
+/// [`reflect_three_kernel`] for a reflector of length 2.
+#[inline(always)]
+fn reflect_two_kernel<const FMA: bool>(u: [f64; 3], tau: f64, x: &mut [f64], y: &mut [f64]) {
+    let [v0, v1, _] = u;
+    for (x, y) in x.iter_mut().zip(y.iter_mut()) {
+        let w = tau * multiply_add::<FMA>(v1, *y, v0 * *x);
+        *x = multiply_add::<FMA>(-w, v0, *x);
+        *y = multiply_add::<FMA>(-w, v1, *y);
+    }
+}
+
+fma_dispatch!(fn reflect_two(u: [f64; 3], tau: f64, x: &mut [f64], y: &mut [f64]) => reflect_two_kernel);
 
 #[cfg(test)]
 mod tests {

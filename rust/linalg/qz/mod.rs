@@ -74,10 +74,12 @@ pub fn qz(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<GeneralizedSchur, Er
     // iteration's decisions compare entries of the two matrices and their tests are
     // relative to each, so a B of 1e-11 beside an A of 1 lost B's backward error (1e14 u).
     let (alpha, beta) = (unit_scale(a), unit_scale(b));
-    let mut s = Mat::from_fn(n, n, |i, j| a[(i, j)] / alpha);
-    let mut t = Mat::from_fn(n, n, |i, j| b[(i, j)] / beta);
-    let mut q = Mat::<f64>::identity(n, n);
-    let mut z = Mat::<f64>::identity(n, n);
+    // The callers form the pencil with faer's AVX products; the kernels here are SSE.
+    crate::platform::dispatch::clear_upper_avx_state();
+    let mut s = padded(n, |i, j| a[(i, j)] / alpha);
+    let mut t = padded(n, |i, j| b[(i, j)] / beta);
+    let mut q = padded(n, |i, j| if i == j { 1.0 } else { 0.0 });
+    let mut z = padded(n, |i, j| if i == j { 1.0 } else { 0.0 });
     reduction::hessenberg_triangular(&mut s, &mut t, &mut q, &mut z)?;
     iteration::qz_iteration(&mut Pencil {
         h: &mut s,
@@ -88,6 +90,22 @@ pub fn qz(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<GeneralizedSchur, Er
     s *= faer::Scale(alpha);
     t *= faer::Scale(beta);
     Ok(GeneralizedSchur { s, t, q, z })
+}
+
+/// An n x n matrix whose column stride is an odd number of 64-byte cache lines.
+///
+/// The iteration rotates rows of column-major matrices: with a stride of a power of two
+/// (n = 512: 4 KiB) every entry of a row falls in the same cache set and a row pair is
+/// fetched from memory again by each rotation; an odd stride spreads a row over all sets.
+fn padded(n: usize, f: impl FnMut(usize, usize) -> f64) -> Mat<f64> {
+    const LINE: usize = 8;
+    let mut stride = n.next_multiple_of(LINE);
+    if (stride / LINE).is_multiple_of(2) {
+        stride += LINE;
+    }
+    let mut m = Mat::with_capacity(stride, n);
+    m.resize_with(n, n, f);
+    m
 }
 
 /// The power of two nearest the largest magnitude of `m` (1 for a zero matrix), at most

@@ -11,11 +11,34 @@
 use crate::error::Error;
 use crate::linalg::householder::reflector;
 use crate::linalg::rotation::Rotation;
+use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
-use faer::Mat;
+use crate::platform::pool::scratch;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::householder::{
+    apply_block_householder_sequence_on_the_right_in_place_scratch,
+    apply_block_householder_sequence_on_the_right_in_place_with_conj,
+    apply_block_householder_sequence_transpose_on_the_left_in_place_scratch,
+    apply_block_householder_sequence_transpose_on_the_left_in_place_with_conj,
+};
+use faer::linalg::qr::no_pivoting::factor::{
+    qr_in_place, qr_in_place_scratch, recommended_block_size,
+};
+use faer::{Conj, Mat, Par};
+use std::ops::Range;
 
 /// Reduces (a, b) in place and accumulates the transformations into q and z (from the left
 /// and right: on return the original A is Q a Z^T when q and z entered as identities).
+///
+/// The rotations of one column j are applied in the order that keeps memory access down
+/// columns (the matrices are column-major, and a rotation of rows walks across them):
+/// - the row rotations G_i (rows i - 1, i; i = n - 1 down to j + 2) depend on column j of A
+///   alone, so they are formed first, and applied to A's other columns one column at a time;
+/// - the column rotation Z_i depends on B's entries (i - 1..=i, i - 1..=i) after G_i and
+///   Z_(i+1), and only columns i - 1 and i of B need G_i before it (a column c > i takes no
+///   further column rotation in this sweep), so B's columns beyond take G_i afterwards, again
+///   one column at a time;
+/// - left and right transformations commute, so A takes the Z_i after all of the G_i.
 pub(crate) fn hessenberg_triangular(
     a: &mut Mat<f64>,
     b: &mut Mat<f64>,
@@ -24,28 +47,160 @@ pub(crate) fn hessenberg_triangular(
 ) -> Result<(), Error> {
     let n = a.nrows();
     triangularize(b, a, q)?;
+    // gs[k] and zs[k] act on rows / columns (i - 1, i) with i = n - 1 - k.
+    let mut gs = Vec::with_capacity(n);
+    let mut zs = Vec::with_capacity(n);
     for j in 0..n.saturating_sub(2) {
         interrupt::check()?;
+        gs.clear();
+        zs.clear();
         for i in (j + 2..n).rev() {
             let (g, r) = Rotation::zeroing(a[(i - 1, j)], a[(i, j)]);
             a[(i - 1, j)] = r;
             a[(i, j)] = 0.0;
-            g.rows(a, i - 1, i, j + 1..n);
-            g.rows(b, i - 1, i, i - 1..n);
-            g.columns(q, i - 1, i, 0..n);
+            gs.push(g);
+        }
+        rotate_columns_down(a, j + 1..n, &gs, |_| 0);
+        for (k, g) in gs.iter().enumerate() {
+            let i = n - 1 - k;
+            g.rows(b, i - 1, i, i - 1..i + 1);
             let (g, r) = Rotation::zeroing_first(b[(i, i - 1)], b[(i, i)]);
             b[(i, i)] = r;
             b[(i, i - 1)] = 0.0;
             g.columns(b, i - 1, i, 0..i);
-            g.columns(a, i - 1, i, 0..n);
-            g.columns(z, i - 1, i, 0..n);
+            zs.push(g);
+        }
+        rotate_columns_down(b, j + 3..n, &gs, |c| n - c);
+        for (k, (g, zk)) in gs.iter().zip(&zs).enumerate() {
+            let i = n - 1 - k;
+            g.columns(q, i - 1, i, 0..n);
+            zk.columns(a, i - 1, i, 0..n);
+            zk.columns(z, i - 1, i, 0..n);
         }
     }
     Ok(())
 }
 
+/// Applies the row rotations gs[first(c)..] in order to each column c in `columns`, gs[k]
+/// acting on rows (i - 1, i) with i = n - 1 - k. Four columns at a time, so that their
+/// independent chains of rotations overlap (one column's chain is bound by the latency of its
+/// multiply-adds): each column first takes the rotations that the others of its group skip.
+fn rotate_columns_down(
+    m: &mut Mat<f64>,
+    columns: Range<usize>,
+    gs: &[Rotation],
+    first: impl Fn(usize) -> usize,
+) {
+    const WIDTH: usize = 4;
+    let n = m.nrows();
+    assert!(columns.end <= m.ncols() && gs.len() < n.max(1));
+    let stride = m.col_stride();
+    let base = m.as_ptr_mut();
+    let rotate = |p: *mut f64, k: usize, g: &Rotation| {
+        let i = n - 1 - k;
+        // SAFETY: p addresses a column of m, and k < gs.len() < n gives rows i - 1 and i
+        // inside it.
+        unsafe {
+            let (u, v) = (*p.add(i - 1), *p.add(i));
+            *p.add(i - 1) = g.c * u + g.s * v;
+            *p.add(i) = -g.s * u + g.c * v;
+        }
+    };
+    let mut c = columns.start;
+    while c < columns.end {
+        let width = WIDTH.min(columns.end - c);
+        // SAFETY: c + l < ncols: distinct columns of m.
+        let x: [*mut f64; WIDTH] = std::array::from_fn(|l| unsafe {
+            base.offset((c + l.min(width - 1)) as isize * stride)
+        });
+        let starts: [usize; WIDTH] = std::array::from_fn(|l| first(c + l.min(width - 1)));
+        let common = starts.iter().copied().max().unwrap_or(0).min(gs.len());
+        for (p, &start) in x.iter().zip(&starts).take(width) {
+            for (k, g) in gs.iter().enumerate().take(common).skip(start) {
+                rotate(*p, k, g);
+            }
+        }
+        if width == WIDTH {
+            for (k, g) in gs.iter().enumerate().skip(common) {
+                for p in x {
+                    rotate(p, k, g);
+                }
+            }
+        } else {
+            for p in &x[..width] {
+                for (k, g) in gs.iter().enumerate().skip(common) {
+                    rotate(*p, k, g);
+                }
+            }
+        }
+        c += width;
+    }
+}
+
+/// Up to this order B = Q R is the plain Householder loop of [`triangularize_unblocked`];
+/// above it, faer's blocked QR (whose set-up costs more than the whole loop at small orders).
+const UNBLOCKED_QR_MAX_ORDER: usize = 32;
+
 /// B = Q R by Householder reflectors; `other` (A) is multiplied by Q^T and Q accumulated.
 fn triangularize(b: &mut Mat<f64>, other: &mut Mat<f64>, q: &mut Mat<f64>) -> Result<(), Error> {
+    let n = b.nrows();
+    if n <= UNBLOCKED_QR_MAX_ORDER {
+        return triangularize_unblocked(b, other, q);
+    }
+    // Sequential, as the Hessenberg reduction: the result must not depend on the machine.
+    let par = Par::Seq;
+    let block_size = recommended_block_size::<f64>(n, n);
+    let mut householder = scratch(block_size, n);
+    let requirement = StackReq::any_of(&[
+        qr_in_place_scratch::<f64>(n, n, block_size, par, Default::default()),
+        apply_block_householder_sequence_transpose_on_the_left_in_place_scratch::<f64>(
+            n, block_size, n,
+        ),
+        apply_block_householder_sequence_on_the_right_in_place_scratch::<f64>(n, block_size, n),
+    ]);
+    let mut buffer = MemBuffer::new(requirement);
+    let stack = MemStack::new(&mut buffer);
+    qr_in_place(
+        b.as_mut(),
+        householder.as_mut(),
+        par,
+        stack,
+        Default::default(),
+    );
+    interrupt::check()?;
+    apply_block_householder_sequence_transpose_on_the_left_in_place_with_conj(
+        b.as_ref(),
+        householder.as_ref(),
+        Conj::No,
+        other.as_mut(),
+        par,
+        stack,
+    );
+    apply_block_householder_sequence_on_the_right_in_place_with_conj(
+        b.as_ref(),
+        householder.as_ref(),
+        Conj::No,
+        q.as_mut(),
+        par,
+        stack,
+    );
+    for j in 0..n {
+        for i in j + 1..n {
+            b[(i, j)] = 0.0;
+        }
+    }
+    // The rotations that follow are SSE code: without this, after faer's AVX kernels, each of
+    // their instructions pays the AVX-SSE transition.
+    clear_upper_avx_state();
+    Ok(())
+}
+
+/// [`triangularize`] by one reflector at a time.
+fn triangularize_unblocked(
+    b: &mut Mat<f64>,
+    other: &mut Mat<f64>,
+    q: &mut Mat<f64>,
+) -> Result<(), Error> {
     let n = b.nrows();
     let mut v = Vec::new();
     let mut w = vec![0.0; n];

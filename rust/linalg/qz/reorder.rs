@@ -150,10 +150,37 @@ fn columns_times(
     first: usize,
     rows: std::ops::Range<usize>,
 ) {
+    match m {
+        2 => columns_times_order::<2>(x, f, first, rows),
+        3 => columns_times_order::<3>(x, f, first, rows),
+        _ => columns_times_order::<4>(x, f, first, rows),
+    }
+}
+
+/// [`columns_times`] for m = M, down the M contiguous columns.
+fn columns_times_order<const M: usize>(
+    x: &mut Mat<f64>,
+    f: &Small,
+    first: usize,
+    rows: std::ops::Range<usize>,
+) {
+    assert!(first + M <= x.ncols() && rows.end <= x.nrows());
+    let stride = x.col_stride();
+    let base = x.as_ptr_mut();
+    // SAFETY: columns first..first + M of x (asserted in range) are distinct columns; each
+    // pointer addresses one of them, and r < nrows.
+    let columns: [*mut f64; M] =
+        std::array::from_fn(|c| unsafe { base.offset((first + c) as isize * stride) });
     for r in rows {
-        let old: [f64; 4] = std::array::from_fn(|c| if c < m { x[(r, first + c)] } else { 0.0 });
-        for c in 0..m {
-            x[(r, first + c)] = (0..m).map(|k| old[k] * f[k][c]).sum();
+        // SAFETY: r < nrows (asserted), inside each column.
+        let old: [f64; M] = std::array::from_fn(|c| unsafe { *columns[c].add(r) });
+        for (c, column) in columns.iter().enumerate() {
+            let mut sum = 0.0;
+            for k in 0..M {
+                sum += old[k] * f[k][c];
+            }
+            // SAFETY: as above.
+            unsafe { *column.add(r) = sum };
         }
     }
 }
