@@ -158,6 +158,26 @@ def test_cross_weight_and_descriptor_match_scipy() -> None:
     np.testing.assert_allclose(with_s, sl.solve_discrete_are(A, B, Q, R, s=S), rtol=1e-11)
 
 
+@pytest.mark.parametrize("n", [17, 24, 40])
+def test_descriptor_above_the_vectorised_order_is_refined(n: int) -> None:
+    # Above order 16 the Newton step's Stein equation with E is solved by doubling on the
+    # equation with E removed: each solve here takes at least one step and ends within a few
+    # units of rounding (the pencil alone left 1e-15 to 1e-14 on these).
+    rng = np.random.default_rng(n)
+    A = 1.2 * rng.standard_normal((n, n)) / np.sqrt(n)
+    B, Q, R = rng.standard_normal((n, 2)), np.eye(n), np.eye(2)
+    E = np.eye(n) + 0.3 * rng.standard_normal((n, n)) / np.sqrt(n)
+    solution = aerocontrol.solve_dare(A, B, Q, R, E=E)
+    assert solution.refinement_steps >= 1
+    assert solution.residual < 4 * EPS
+    Ei = np.linalg.inv(E)
+    reference = sl.solve_discrete_are(A @ Ei, B, Ei.T @ Q @ Ei, R)
+    np.testing.assert_allclose(
+        solution.X, reference, rtol=0, atol=1e-10 * np.linalg.norm(reference)
+    )
+    assert np.all(np.abs(sl.eigvals(A - B @ solution.K, E)) < 1)
+
+
 def test_singular_a_is_solved() -> None:
     # A deadbeat-like plant: A nilpotent, so the symplectic pencil has infinite eigenvalues.
     A = np.diag([1.0, 1.0], 1)
@@ -267,3 +287,117 @@ def test_dlqr_sweep_matches_dlqr_per_weight() -> None:
         aerocontrol.batch.dlqr_sweep(aerocontrol.StateSpace(A, B, dt=0), weights=weights)
     with pytest.raises(InvalidArgumentError, match="discrete"):
         aerocontrol.batch.lqr_sweep(sampled, weights=weights)
+
+
+# ----- the discrete finite horizon: riccati_difference and dlqr_finite -------------------------
+
+
+def _difference_oracle(
+    A: np.ndarray,
+    B: np.ndarray,
+    Q: np.ndarray,
+    R: np.ndarray,
+    N: np.ndarray,
+    Sf: np.ndarray,
+    steps: int,
+) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """S_k and K_k by the textbook recursion S = A^T S A - (A^T S B + N) K + Q in 40-digit
+    arithmetic (mpmath): an independent form and precision."""
+    mpmath = pytest.importorskip("mpmath")
+    mpmath.mp.dps = 40
+    a, b, q, r, cross = (mpmath.matrix(M.tolist()) for M in (A, B, Q, R, N))
+    s = mpmath.matrix(Sf.tolist())
+    S, K = [s], []
+    for _ in range(steps):
+        gain = (r + b.T * s * b) ** -1 * (b.T * s * a + cross.T)
+        s = a.T * s * a - (a.T * s * b + cross) * gain + q
+        S.append(s)
+        K.append(gain)
+    as_array = lambda M: np.array(M.tolist(), dtype=float)  # noqa: E731
+    return [as_array(M) for M in reversed(S)], [as_array(M) for M in reversed(K)]
+
+
+def test_riccati_difference_against_40_digits() -> None:
+    rng = np.random.default_rng(11)
+    n, m, steps = 4, 2, 30
+    A, B, Q, R = _random_stabilisable(rng, n, m)
+    A = 1.3 * A  # a plant that grows: the early S_k are large
+    N = 0.1 * rng.standard_normal((n, m))
+    G = rng.standard_normal((n, n))
+    Sf = G @ G.T
+    solution = aerocontrol.riccati_difference(A, B, Q, R, steps, Sf=Sf, N=N)
+    S, K = _difference_oracle(A, B, Q, R, N, Sf, steps)
+    assert solution.S.shape == (steps + 1, n, n) and solution.K.shape == (steps, m, n)
+    np.testing.assert_array_equal(solution.S[-1], Sf)
+    for k in range(steps):
+        np.testing.assert_allclose(solution.S[k], S[k], rtol=0, atol=1e-12 * np.linalg.norm(S[k]))
+        np.testing.assert_allclose(solution.K[k], K[k], rtol=0, atol=1e-12 * np.linalg.norm(K[k]))
+        np.testing.assert_array_equal(solution.S[k], solution.S[k].T)
+    np.testing.assert_array_equal(
+        aerocontrol.dlqr_finite(A, B, Q, R, steps, Sf=Sf, N=N), solution.K
+    )
+
+
+def test_riccati_difference_converges_to_the_dare() -> None:
+    # The chapter's lateral regulator sampled at 50 Hz: 3000 steps (60 s) reach the DARE.
+    A, B = aerocontrol.chapter.boeing747_lateral()
+    sampled = aerocontrol.discretize(A, B, 0.02)
+    Q, R = np.eye(4), np.eye(2)
+    solution = aerocontrol.riccati_difference(sampled.Phi, sampled.Gamma0, Q, R, 3000)
+    K, X, _ = aerocontrol.dlqr(sampled.Phi, sampled.Gamma0, Q, R)
+    np.testing.assert_allclose(solution.S[0], X, rtol=0, atol=1e-12 * np.linalg.norm(X))
+    np.testing.assert_allclose(solution.K[0], K, rtol=0, atol=1e-12 * np.linalg.norm(K))
+    # A discrete system gives the same; a continuous one is refused.
+    system = aerocontrol.StateSpace(
+        sampled.Phi, sampled.Gamma0, np.eye(4), np.zeros((4, 2)), dt=0.02
+    )
+    by_system = aerocontrol.riccati_difference(system, Q, R, 50)
+    np.testing.assert_array_equal(
+        by_system.K, aerocontrol.riccati_difference(sampled.Phi, sampled.Gamma0, Q, R, 50).K
+    )
+    continuous = control.ss(A, B, np.eye(4), np.zeros((4, 2)))  # dt = 0
+    with pytest.raises(InvalidArgumentError, match="discrete-time system"):
+        aerocontrol.riccati_difference(continuous, Q, R, 50)
+
+
+@pytest.mark.parametrize("steps", [-1, 2.5, True, "3", None])
+def test_riccati_difference_refuses_a_bad_step_count(steps: Any) -> None:
+    with pytest.raises(InvalidArgumentError, match=r"steps|number of steps"):
+        aerocontrol.riccati_difference([[1.0]], [[1.0]], [[1.0]], [[1.0]], steps)
+
+
+def test_riccati_difference_edges_and_errors() -> None:
+    # No step: S = [Sf], no gain.
+    solution = aerocontrol.riccati_difference(
+        np.eye(2), np.ones((2, 1)), np.eye(2), [[1.0]], np.int64(0), Sf=2 * np.eye(2)
+    )
+    assert solution.S.shape == (1, 2, 2) and solution.K.shape == (0, 1, 2)
+    np.testing.assert_array_equal(solution.S[0], 2 * np.eye(2))
+    # R = 0 with Sf = 0: the last step's R + B^T S B is zero, named with its step.
+    with pytest.raises(aerocontrol.exceptions.IllConditionedError, match="step 2"):
+        aerocontrol.riccati_difference([[1.0]], [[1.0]], [[1.0]], [[0.0]], 3)
+    # Nearly singular: warned.
+    with pytest.warns(aerocontrol.exceptions.IllConditionedWarning, match="rcond"):
+        aerocontrol.riccati_difference(np.eye(2), np.eye(2), np.eye(2), np.diag([1.0, 1e-12]), 1)
+    with pytest.raises(InvalidArgumentError, match="Sf must be symmetric"):
+        aerocontrol.riccati_difference(
+            np.eye(2), np.eye(2), np.eye(2), np.eye(2), 2, Sf=[[1.0, 1.0], [0.0, 1.0]]
+        )
+    with pytest.raises(ShapeError, match="N"):
+        aerocontrol.riccati_difference(np.eye(2), np.eye(2), np.eye(2), np.eye(2), 2, N=np.eye(3))
+    # A plant that outgrows the doubles over the horizon.
+    with pytest.raises(aerocontrol.exceptions.IllConditionedError, match="range of doubles"):
+        aerocontrol.riccati_difference([[1e10]], [[0.0]], [[1.0]], [[1.0]], 40)
+
+
+def test_riccati_difference_layouts_and_inputs_left_alone() -> None:
+    rng = np.random.default_rng(3)
+    A, B, Q, R = _random_stabilisable(rng, 3, 2)
+    reference = aerocontrol.riccati_difference(A, B, Q, R, 7)
+    arguments = [np.asfortranarray(A), B[:, ::-1][:, ::-1], Q.copy(), np.asfortranarray(R)]
+    copies = [M.copy() for M in arguments]
+    again = aerocontrol.riccati_difference(*arguments, 7)
+    np.testing.assert_array_equal(again.S, reference.S)
+    np.testing.assert_array_equal(again.K, reference.K)
+    for M, copy in zip(arguments, copies, strict=True):
+        np.testing.assert_array_equal(M, copy)

@@ -38,6 +38,7 @@ __all__ = [
     "place",
     "place_batch",
     "qz",
+    "riccati_difference",
     "riccati_ode",
     "schur",
     "simulate",
@@ -253,6 +254,16 @@ def place_batch(
     NDArray[np.float64],
     NDArray[np.float64],
 ]: ...
+def riccati_difference(
+    a: ArrayLike,
+    b: ArrayLike,
+    q: ArrayLike,
+    r: ArrayLike,
+    steps: int,
+    sf: ArrayLike | None,
+    s: ArrayLike | None,
+    /,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], float, float]: ...
 def riccati_ode(
     a: ArrayLike,
     b: ArrayLike,

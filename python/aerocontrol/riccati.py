@@ -14,11 +14,14 @@ S(t_f) = S_f, or, for an infinite horizon, the algebraic equation (6.199).
 * :func:`solve_lyapunov`: A X + X A^T + Q = 0 by Bartels-Stewart;
 * :func:`riccati_ode` and :func:`lqr_finite`: the finite-horizon solution S(t) and gain K(t)
   on a time grid, exact up to rounding at any step (the Hamiltonian transition matrix,
-  re-normalised every step).
+  re-normalised every step);
+* :func:`riccati_difference` and :func:`dlqr_finite`: the discrete finite-horizon solution S_k
+  and gain K_k over a number of steps (the Riccati difference equation in Joseph form).
 """
 
 from __future__ import annotations
 
+import operator
 import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -37,10 +40,13 @@ if TYPE_CHECKING:
 __all__ = [
     "CareSolution",
     "DareSolution",
+    "RiccatiDifferenceSolution",
     "RiccatiSolution",
     "dlqr",
+    "dlqr_finite",
     "lqr",
     "lqr_finite",
+    "riccati_difference",
     "riccati_ode",
     "solve_care",
     "solve_dare",
@@ -455,7 +461,9 @@ def riccati_ode(
     A: ArrayLike  # the system's plant matrix or the caller's
     if is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
-        require_continuous(sys, "riccati_ode", "the discrete finite horizon is not available yet")
+        require_continuous(
+            sys, "riccati_ode", "use riccati_difference for the discrete finite horizon"
+        )
         # riccati_ode(sys, Q, R, t, Sf): every argument shifts one place to the left.
         A, B, Q, R, t, Sf = sys.A, sys.B, B, Q, R, (t if t is not None else Sf)
     else:
@@ -487,6 +495,141 @@ def lqr_finite(
     """The time-varying gain K(t) = R^-1 B^T S(t) of the finite-horizon regulator (6.200), shape
     (len(t), m, n); arguments as :func:`riccati_ode`."""
     gains: FloatArray = riccati_ode(A_or_sys, B, Q, R, t, Sf).K
+    return gains
+
+
+@dataclass(frozen=True, eq=False)
+class RiccatiDifferenceSolution:
+    """S_k and K_k of the discrete finite-horizon regulator over N steps."""
+
+    S: FloatArray
+    """S_0 .. S_N, shape (N + 1, n, n), symmetric; S_N = Sf. x_k^T S_k x_k is the optimal cost
+    from step k to the end."""
+    K: FloatArray
+    """K_0 .. K_{N-1}, shape (N, m, n): u_k = -K_k x_k."""
+    rcond: float
+    """The smallest reciprocal condition number of R + B^T S_{k+1} B over the horizon (the
+    matrix each gain solves with); 1 when N = 0."""
+    error_estimate: float
+    """The largest estimated relative error of a step S_k from the rounding of A - B K_k:
+    (n + m) δ (2 ||A - B K_k|| + δ) ||S_{k+1}|| / ||S_k||, δ = u (||A|| + ||B|| ||K_k||)."""
+
+
+def riccati_difference(
+    A_or_sys: ArrayLike | SystemObject,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike | int | None = None,
+    steps: int | None = None,
+    Sf: ArrayLike | None = None,
+    N: ArrayLike | None = None,
+) -> RiccatiDifferenceSolution:
+    """The Riccati difference equation of the discrete finite-horizon regulator, backward from
+    S_N = Sf (default 0) over ``steps`` = N steps.
+
+    Called as ``riccati_difference(A, B, Q, R, steps, Sf=None, N=None)`` or
+    ``riccati_difference(sys, Q, R, steps, Sf=None, N=None)`` (a discrete system). For
+    x_{k+1} = A x_k + B u_k and J = x_N^T Sf x_N + Σ_{k<N} (x_k^T Q x_k + 2 x_k^T N u_k +
+    u_k^T R u_k), the optimal control is u_k = -K_k x_k with
+
+        K_k = (R + B^T S_{k+1} B)^-1 (B^T S_{k+1} A + N^T),
+        S_k = (A - B K_k)^T S_{k+1} (A - B K_k) + K_k^T R K_k - N K_k - K_k^T N^T + Q,
+
+    the discrete counterpart of the chapter's (6.196)-(6.200). The second line (the Joseph
+    form of S_k = A^T S A - (A^T S B + N) K_k + Q) keeps S_k symmetric positive semidefinite
+    under rounding where the weights are. Where A and B K are far larger than A - B K the
+    rounding of that difference can swamp S_k in any double-precision form; the estimate of
+    that error is returned (``error_estimate``) and warned about. A long horizon converges to
+    :func:`solve_dare`'s X.
+
+    Raises
+    ------
+    IllConditionedError
+        R + B^T S_{k+1} B is singular to working precision at some step (named), or S_k
+        leaves the range of doubles.
+
+    Warns
+    -----
+    IllConditionedWarning
+        rcond(R + B^T S_{k+1} B) < 1e-8 at some step (the gains may have lost digits), or the
+        error estimate is above 1e-8 (S_k may have).
+
+    >>> import aerocontrol
+    >>> sol = aerocontrol.riccati_difference([[2.0]], [[1.0]], [[1.0]], [[1.0]], 4)
+    >>> [round(float(s), 12) for s in sol.S[:, 0, 0]]     # (5 s + 1) / (1 + s) backward from 0
+    [4.2, 4.0, 3.0, 1.0, 0.0]
+    >>> float(sol.K[0, 0, 0])                                # 2 S_1 / (1 + S_1)
+    1.6
+    """
+    A: ArrayLike  # the system's plant matrix or the caller's
+    if is_system(A_or_sys):
+        if getattr(A_or_sys, "dt", None) == 0:
+            raise InvalidArgumentError(
+                "riccati_difference needs a discrete-time system, got a continuous one "
+                "(dt = 0); use riccati_ode"
+            )
+        sys = as_state_space(A_or_sys)
+        # riccati_difference(sys, Q, R, steps, Sf, N): every argument shifts one place left.
+        horizon: object = R
+        A, B, Q, R, Sf = sys.A, sys.B, B, Q, (steps if steps is not None else Sf)
+    else:
+        A, horizon = A_or_sys, steps
+    if horizon is None or R is None:
+        raise InvalidArgumentError(
+            "riccati_difference needs the weights Q, R and the number of steps"
+        )
+    count = _steps(horizon)
+    S, K, rcond, error_estimate = _core.riccati_difference(
+        A,
+        B,
+        _matrix(Q, "Q"),
+        _matrix(R, "R"),
+        count,
+        None if Sf is None else _matrix(Sf, "Sf"),
+        None if N is None else _matrix(N, "N"),
+    )
+    if rcond < RCOND_WARNING or error_estimate > RESIDUAL_WARNING:
+        warnings.warn(
+            "the finite-horizon solution may be inaccurate: rcond(R + B^T S B) = "
+            f"{rcond:.2e} and estimated relative error {error_estimate:.2e} at the worst step "
+            "(A and B K far larger than A - B K: scale the model)",
+            IllConditionedWarning,
+            stacklevel=2,
+        )
+    return RiccatiDifferenceSolution(S, K, rcond, error_estimate)
+
+
+def _steps(steps: object) -> int:
+    """The number of steps as a non-negative int (a bool, a float or a negative count is
+    refused, naming ``steps``)."""
+    if isinstance(steps, (bool, np.bool_)):
+        raise InvalidArgumentError(f"steps must be a non-negative integer, got {steps!r}")
+    try:
+        count = operator.index(steps)  # type: ignore[arg-type]
+    except TypeError:
+        raise InvalidArgumentError(f"steps must be a non-negative integer, got {steps!r}") from None
+    if count < 0:
+        raise InvalidArgumentError(f"steps must be a non-negative integer, got {count}")
+    return count
+
+
+def dlqr_finite(
+    A_or_sys: ArrayLike | SystemObject,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike | int | None = None,
+    steps: int | None = None,
+    Sf: ArrayLike | None = None,
+    N: ArrayLike | None = None,
+) -> FloatArray:
+    """The time-varying gains K_0 .. K_{N-1} of the discrete finite-horizon regulator, shape
+    (steps, m, n); arguments as :func:`riccati_difference`.
+
+    >>> import aerocontrol
+    >>> aerocontrol.dlqr_finite([[2.0]], [[1.0]], [[1.0]], [[1.0]], 3)[:, 0, 0].tolist()
+    [1.5, 1.0, 0.0]
+    """
+    gains: FloatArray = riccati_difference(A_or_sys, B, Q, R, steps, Sf, N).K
     return gains
 
 

@@ -1,5 +1,5 @@
-//! Bindings of `aerocontrol.riccati`: the algebraic Riccati equation, the Riccati
-//! differential equation, and the Lyapunov equation.
+//! Bindings of `aerocontrol.riccati`: the algebraic Riccati equations, the Riccati
+//! differential and difference equations, and the Lyapunov equation.
 
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
@@ -8,6 +8,9 @@ use super::linalg::{expm_flops, schur_cost};
 use crate::control::riccati::AlgebraicSolution;
 use crate::control::riccati::care::{CareOptions, solve_care as solve_care_core};
 use crate::control::riccati::dare::{DareOptions, solve_dare as solve_dare_core};
+use crate::control::riccati::difference::{
+    DifferenceOptions, riccati_difference as riccati_difference_core,
+};
 use crate::control::riccati::ode::riccati_ode as riccati_ode_core;
 use crate::linalg::lyapunov::solve_lyapunov as solve_lyapunov_core;
 use faer::c64;
@@ -182,6 +185,61 @@ fn riccati_ode<'py>(
     Ok(result)
 }
 
+/// S_0..S_N and K_0..K_{N-1} of the Riccati difference equation, the worst rcond of
+/// R + B^T S B and the error estimate.
+type RiccatiDifferenceOutput<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    f64,
+    f64,
+);
+
+/// The Riccati difference equation of the discrete finite-horizon regulator over `steps`
+/// steps backward from Sf: (S (steps + 1, n, n), K (steps, m, n), worst rcond).
+#[pyfunction]
+#[pyo3(signature = (a, b, q, r, steps, sf, s, /))]
+#[allow(clippy::too_many_arguments)]
+fn riccati_difference<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    r: &Bound<'py, PyAny>,
+    steps: usize,
+    sf: Option<&Bound<'py, PyAny>>,
+    s: Option<&Bound<'py, PyAny>>,
+) -> PyResult<RiccatiDifferenceOutput<'py>> {
+    let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
+    let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
+    let sf = Real::convert_optional(py, sf, "Sf")?;
+    let s = Real::convert_optional(py, s, "N")?;
+    let (a, b, q, r, sf, s) = (|| {
+        let sf = sf.as_ref().map(|m| m.matrix()).transpose()?;
+        let s = s.as_ref().map(|m| m.matrix()).transpose()?;
+        Ok((a.matrix()?, b.matrix()?, q.matrix()?, r.matrix()?, sf, s))
+    })()
+    .map_err(|e| to_py_err(py, e))?;
+    let (n, m) = (a.nrows(), b.ncols());
+    // Per step about six products of order n and a solve of order m.
+    let cost = Cost::of(12.0 * (n.max(m) as f64).powi(3), 8.0, n).times(steps.max(1));
+    let options = DifferenceOptions {
+        cross: s,
+        terminal: sf,
+    };
+    let solution = compute(py, cost, || {
+        riccati_difference_core(a, b, q, r, steps, options)
+    })?;
+    let mut outputs = Outputs::new(py);
+    let result = (
+        outputs.matrices("S", &solution.s, n, n)?,
+        outputs.matrices("K", &solution.gains, m, n)?,
+        solution.rcond,
+        solution.error_estimate,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
+
 /// The solution X of A X + X A^T + Q = 0.
 #[pyfunction]
 #[pyo3(signature = (a, q, /))]
@@ -206,5 +264,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve_care, m)?)?;
     m.add_function(wrap_pyfunction!(solve_dare, m)?)?;
     m.add_function(wrap_pyfunction!(riccati_ode, m)?)?;
+    m.add_function(wrap_pyfunction!(riccati_difference, m)?)?;
     Ok(())
 }

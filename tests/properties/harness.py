@@ -485,6 +485,7 @@ RESULT_TYPES = frozenset(
         "LqgDesign",
         "Modes",
         "Placement",
+        "RiccatiDifferenceSolution",
         "RiccatiSolution",
         "RootLocus",
         "StabilityMargins",

@@ -24,6 +24,12 @@ Oracles (oracles.py, "Riccati and Lyapunov equations"):
   is stabilisable by a margin of 1e-5, yet X is near 1e20: no solver should be asked for it.)
 * lqr and dlqr equal solve_care and solve_dare bitwise; lqr_finite equals riccati_ode's K;
   riccati_ode against the Hamiltonian transition matrix e^{-H (t_f - t)} in long double;
+* riccati_difference step by step in long double: each K_k solves its system
+  (R + B^T S_{k+1} B) K_k = B^T S_{k+1} A + N^T, and each S_k is the step
+  A^T S A - M^T W^-1 M + Q from S_{k+1} within SLACK (n + m)^2 u of the size of its terms over
+  rcond(W) (unless warned); S_N = Sf; the reported rcond, error estimate and the warning
+  agree; a short horizon with R definite and [[Q, N], [N^T, R]], Sf semidefinite is never
+  refused (R + B^T S B is then definite); dlqr_finite equals its K;
   solve_lyapunov by its residual and against scipy within the bound of its separation.
 """
 
@@ -84,6 +90,8 @@ COVERED = {
     "lqr_finite",
     "solve_dare",
     "dlqr",
+    "riccati_difference",
+    "dlqr_finite",
 }
 
 #: The errors by which a solver refuses a problem (besides refusing an argument).
@@ -728,6 +736,171 @@ def test_riccati_ode(data: st.DataObject) -> None:
         arguments["t"] = data.draw(presented(t * (MAX_WORK / span), LAYOUTS))
     oracle = _ode_oracle if name == "riccati_ode" else _lqr_finite_oracle
     exercise(name, _ode_call(name, form), arguments, oracle)
+
+
+# ----- riccati_difference and dlqr_finite -------------------------------------------------------
+
+
+def _difference_problem(args: dict[str, Any]) -> tuple[Problem, np.ndarray, np.ndarray, int]:
+    if "sys" in args:
+        A, B, _, _ = model_matrices(args["sys"])
+    else:
+        A, B = args["A_or_sys"], args["B"]
+    problem = _matrices({"A": A, "B": B, "Q": args["Q"], "R": args["R"]})
+    n, m = problem["B"].shape
+    Sf = np.zeros((n, n)) if args["Sf"] is None else np.asarray(args["Sf"], np.float64)
+    N = np.zeros((n, m)) if args["N"] is None else np.asarray(args["N"], np.float64)
+    return problem, Sf, N, int(args["steps"])
+
+
+#: The smallest normal double.
+TINY_NORMAL = float(np.finfo(np.float64).tiny)
+
+
+def _difference_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    problem, Sf, N, steps = _difference_problem(args)
+    A, B, Q, R = (problem[k] for k in "ABQR")
+    with silenced():
+        Sf, Q, R = symmetric_part(Sf), symmetric_part(Q), symmetric_part(R)
+    n, m = B.shape
+    assert result.S.shape == (steps + 1, n, n) and result.K.shape == (steps, m, n)
+    assert 0.0 <= result.rcond <= 1.0
+    assert result.error_estimate >= 0.0
+    assert (IllConditionedWarning in warned) == (
+        result.rcond < RCOND_WARNING or result.error_estimate > RESIDUAL_WARNING
+    )
+    assert_within_(norm(result.S[-1] - Sf), 4 * U * norm(Sf), "S_N = Sf")
+    for k in range(steps):
+        S_next, S, K = result.S[k + 1], result.S[k], result.K[k]
+        assert np.array_equal(S, S.T), f"S_{k} is not symmetric"
+        with silenced():
+            s, g = longdouble(S_next), longdouble(K)
+            weight = longdouble(R) + longdouble(B).T @ s @ longdouble(B)
+            mixed = longdouble(B).T @ s @ longdouble(A) + longdouble(N).T
+            error = norm(np.asarray(weight @ g - mixed, np.float64))
+            # The terms of forming W and M in double, and of the solve.
+            size = (
+                norm(np.asarray(weight, np.float64)) * norm(K)
+                + norm(B) * norm(S_next) * (norm(A) + norm(B) * norm(K))
+                + norm(R) * norm(K)
+                + norm(N)
+            )
+            # The step (1) from the returned S_{k+1}, with the gain solved again in double and
+            # refined once in long double: S = A^T S A - M^T W^-1 M + Q. Its terms bound the
+            # error of any evaluation in double (the solver's subtraction-free form is more
+            # accurate where they cancel).
+            exact = np.linalg.solve(np.asarray(weight, np.float64), np.asarray(mixed, np.float64))
+            exact = longdouble(exact) + longdouble(
+                np.linalg.solve(
+                    np.asarray(weight, np.float64),
+                    np.asarray(mixed - weight @ longdouble(exact), np.float64),
+                )
+            )
+            axa = longdouble(A).T @ s @ longdouble(A)
+            quadratic = mixed.T @ exact
+            step = axa - quadratic + longdouble(Q)
+            step_error = norm(S - np.asarray(step, np.float64))
+            step_size = (
+                norm(np.asarray(axa, np.float64))
+                + norm(np.asarray(quadratic, np.float64))
+                + norm(Q)
+            )
+        # A gain below the normal range (M tiny beside W) rounds to subnormals or zero.
+        weight_norm, mixed_norm = (
+            norm(np.asarray(weight, np.float64)),
+            norm(np.asarray(mixed, np.float64)),
+        )
+        underflow = mixed_norm if mixed_norm <= TINY_NORMAL * weight_norm / U else 0.0
+        if np.isfinite(size):
+            assert_within_(
+                error,
+                SLACK * (n + m) * U * size / max(result.rcond, U) + TINY + underflow,
+                f"K_{k} solves",
+            )
+        if np.isfinite(step_size) and IllConditionedWarning not in warned:
+            assert_within_(
+                step_error,
+                SLACK * (n + m) ** 2 * U * step_size / result.rcond + TINY,
+                f"S_{k} is the step",
+            )
+
+
+def _dlqr_finite_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    call = _difference_call("riccati_difference", "sys" if "sys" in args else "matrices")
+    alone = quietly(call, **args)
+    assert np.array_equal(result, alone.K), "dlqr_finite is not riccati_difference's K"
+
+
+def _difference_call(name: str, form: str) -> Any:
+    function = getattr(aerocontrol, name)
+    if form == "sys":
+        return lambda sys, Q, R, steps, Sf, N: function(sys, Q, R, steps, Sf=Sf, N=N)
+    return lambda A_or_sys, B, Q, R, steps, Sf, N: function(A_or_sys, B, Q, R, steps, Sf, N)
+
+
+def _never_refused(problem: Problem, Sf: np.ndarray, N: np.ndarray, steps: int) -> bool:
+    """R definite (κ <= 1e6), the joint weight [[Q, N], [N^T, R]] and Sf semidefinite, moderate
+    finite data and a short horizon: every S_k is then semidefinite, every R + B^T S B definite
+    and S stays in range, so a refusal is a defect."""
+    A, B, Q, R = (problem[k] for k in "ABQR")
+    if not finite(A, B, Q, R, Sf, N) or steps > 8:
+        return False
+    if any(norm(M) > 1e3 for M in (A, B, Q, R, Sf, N)) or norm(R) < 1e-3:
+        return False
+    if any(np.abs(M - M.T).max(initial=0.0) > 0.0 for M in (Q, R, Sf)):
+        return False  # asymmetric weights are refused beyond 1e-12 of their size
+    with silenced():
+        joint = symmetric_part(np.block([[Q, N], [N.T, R]]))
+        w = np.linalg.eigvalsh(joint)
+        r = np.linalg.eigvalsh(symmetric_part(R))
+        f = np.linalg.eigvalsh(Sf) if Sf.size else np.zeros(1)
+    return bool(
+        r.min() > 1e-6 * r.max()
+        and w.min() >= -1e-12 * max(1.0, abs(w).max())
+        and f.min() >= -1e-12 * max(1.0, abs(f).max())
+    )
+
+
+@given(st.data())
+def test_riccati_difference(data: st.DataObject) -> None:
+    name = data.draw(st.sampled_from(("riccati_difference", "riccati_difference", "dlqr_finite")))
+    n = data.draw(st.sampled_from((0, 1, 2, 3, 4, 6)))
+    problem = data.draw(riccati_problem(cross=True, descriptor_matrix=False, n=n))
+    A, B, Q, R, N = (problem[k] for k in "ABQRS")
+    n = A.shape[0]  # a planted problem may change the order
+    steps = data.draw(st.sampled_from((0, 1, 2, 5, 8, 40)))
+    kind = data.draw(st.sampled_from(("none", "none", "zero", "weight", "wrong shape")))
+    Sf: Arg = plain(None)
+    if kind == "zero":
+        Sf = data.draw(presented(np.zeros((n, n))))
+    elif kind == "weight":
+        Sf = data.draw(presented(data.draw(symmetric_weight(n))))
+    elif kind == "wrong shape":
+        Sf = data.draw(presented(np.eye(n + 1)))
+    form = data.draw(st.sampled_from(("matrices", "matrices", "sys")))
+    arguments: dict[str, Arg] = {}
+    if form == "sys":
+        m = B.shape[1]
+        arguments["sys"] = data.draw(
+            presented_system((A, B, np.eye(n), np.zeros((n, m))), container="attributes")
+        )
+    else:
+        arguments["A_or_sys"], arguments["B"] = data.draw(presented(A)), data.draw(presented(B))
+    arguments["Q"], arguments["R"] = data.draw(presented(Q)), data.draw(presented(R))
+    arguments["steps"] = plain(data.draw(st.sampled_from((steps, np.int64(steps)))))
+    arguments["Sf"], arguments["N"] = Sf, optional(data.draw, N)
+    oracle = _difference_oracle if name == "riccati_difference" else _dlqr_finite_oracle
+    outcome = exercise(name, _difference_call(name, form), arguments, oracle)
+    if outcome.error is None or kind == "wrong shape":
+        return
+    canonical = {key: arg.canonical for key, arg in arguments.items()}
+    if any(arg.expect != SAME for arg in arguments.values()):
+        return
+    problem_canonical, Sf_canonical, N_canonical, _ = _difference_problem(canonical)
+    assert not _never_refused(problem_canonical, Sf_canonical, N_canonical, steps), (
+        f"{name} refused a problem with R definite and Q, Sf semidefinite: "
+        f"{type(outcome.error).__name__}: {outcome.error}"
+    )
 
 
 # ----- known defects of the core (see known_defects.py) ------------------------------------------

@@ -44,7 +44,8 @@
 //! The pencil method is backward stable for the pencil, not for the equation; Newton steps
 //! (Hewer 1971; each a Stein equation, [`crate::linalg::stein`]) restore a residual of a few
 //! units of rounding where the pencil's solution lost digits to a badly conditioned subspace
-//! basis (with a descriptor E, only up to order [`crate::linalg::stein::KRONECKER_MAX_ORDER`]).
+//! basis (with a descriptor E above order [`crate::linalg::stein::KRONECKER_MAX_ORDER`], on
+//! the equation with E removed, E^-T (·) E^-1).
 //!
 //! R need not be positive definite (only symmetric): indefinite weights, as the H-infinity
 //! equations have, are solved where a stabilising solution exists.
@@ -52,13 +53,13 @@
 use super::AlgebraicSolution;
 use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
-use crate::linalg::lu::solve_with_inverse;
+use crate::linalg::lu::{solve_in_place, solve_with_inverse};
 use crate::linalg::matrix::Symmetrize;
 use crate::linalg::norm::{frobenius_norm, one_norm};
 use crate::linalg::qz::{generalized_eigenvalues, qz, reorder_qz};
 use crate::linalg::stein::{KRONECKER_MAX_ORDER, solve_stein_kronecker, solve_stein_smith};
 use crate::platform::interrupt;
-use faer::{Mat, MatRef, c64};
+use faer::{Mat, MatRef, Par, c64};
 
 /// Distance from the unit circle, relative, within which an eigenvalue counts as on it.
 pub const CIRCLE_TOLERANCE: f64 = 100.0 * f64::EPSILON;
@@ -91,7 +92,7 @@ pub fn solve_dare(
     r: MatRef<'_, f64>,
     options: DareOptions<'_>,
 ) -> Result<AlgebraicSolution, Error> {
-    let (q, r) = checked_weights(a, b, q, r, options.s, options.e)?;
+    let (q, r) = checked_weights(a, b, q, r, options.s.map(|s| (s, "S")), options.e)?;
     let (n, m) = (a.nrows(), b.ncols());
     let identity = Mat::<f64>::identity(n, n);
     let e = options.e.unwrap_or(identity.as_ref());
@@ -222,8 +223,9 @@ impl Problem<'_> {
 /// Newton steps (Hewer 1971) after the pencil's solution: with A_c = A - B K the closed loop of
 /// X, the correction solves A_c^T Δ A_c - E^T Δ E = -Res(X) (the derivative of the Riccati
 /// operator at X applied to Δ), in vectorised form up to order [`SMITH_MIN_ORDER`] (with a
-/// descriptor E up to [`crate::linalg::stein::KRONECKER_MAX_ORDER`]) and above it (E = I) by
-/// Smith's doubling; taken while the residual decreases and is
+/// descriptor E up to [`crate::linalg::stein::KRONECKER_MAX_ORDER`]) and above it by Smith's
+/// doubling (with E: on the equation [`without_descriptor`] forms); taken while the residual
+/// decreases and is
 /// above [`REFINEMENT_FLOOR`], at most [`MAX_REFINEMENT_STEPS`] times. Returns the steps taken.
 fn refine(
     problem: &Problem<'_>,
@@ -244,7 +246,12 @@ fn refine(
                 evaluation.residual.as_ref(),
             )?
         } else {
-            None
+            let (a, c) = without_descriptor(
+                evaluation.closed_loop.as_ref(),
+                problem.e,
+                evaluation.residual.as_ref(),
+            );
+            solve_stein_smith(a.as_ref(), c.as_ref())?
         };
         let Some(delta) = delta else {
             break;
@@ -264,6 +271,37 @@ fn refine(
         steps += 1;
     }
     Ok(steps)
+}
+
+/// The Stein equation of a Newton step with E removed: A_c^T Δ A_c - E^T Δ E = -Res is, with
+/// Ã = A_c E^-1 and C̃ = E^-T Res E^-1 (E is nonsingular: its pencil with A_c has the
+/// closed-loop eigenvalues, all finite), Δ - Ã^T Δ Ã = C̃. Returns (Ã, C̃), C̃ symmetrised; both
+/// by LU solves with E^T. An inaccurate Δ from a badly conditioned E is harmless: the step is
+/// taken only if it lowers the residual.
+fn without_descriptor(
+    closed_loop: MatRef<'_, f64>,
+    e: MatRef<'_, f64>,
+    residual: MatRef<'_, f64>,
+) -> (Mat<f64>, Mat<f64>) {
+    let n = e.nrows();
+    // E^T [Y | W] = [A_c^T | Res]: Ã = Y^T, W = E^-T Res.
+    let mut rhs = Mat::<f64>::zeros(n, 2 * n);
+    rhs.as_mut()
+        .subcols_mut(0, n)
+        .copy_from(closed_loop.transpose());
+    rhs.as_mut().subcols_mut(n, n).copy_from(residual);
+    solve_in_place(e.transpose().to_owned().as_mut(), rhs.as_mut(), Par::Seq);
+    let a_tilde = rhs.as_ref().subcols(0, n).transpose().to_owned();
+    // E^T V = W^T: C̃ = W E^-1 = V^T.
+    let mut c_tilde = rhs.as_ref().subcols(n, n).transpose().to_owned();
+    solve_in_place(
+        e.transpose().to_owned().as_mut(),
+        c_tilde.as_mut(),
+        Par::Seq,
+    );
+    let mut c_tilde = c_tilde.transpose().to_owned();
+    c_tilde.symmetrize();
+    (a_tilde, c_tilde)
 }
 
 /// The pencil of order 2n + m (module documentation) with its last m columns compressed away:

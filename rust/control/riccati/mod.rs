@@ -1,10 +1,12 @@
 //! Riccati equations: the algebraic equations of the infinite-horizon regulators, continuous
-//! ([`care`]) and discrete ([`dare`]), and the differential equation of the finite-horizon one
-//! ([`ode`]).
+//! ([`care`]) and discrete ([`dare`]), the differential equation of the continuous
+//! finite-horizon one ([`ode`]) and the difference equation of the discrete one
+//! ([`difference`]).
 
 pub mod care;
 pub(crate) mod care_pencil;
 pub mod dare;
+pub mod difference;
 pub mod ode;
 pub(crate) mod pencil;
 

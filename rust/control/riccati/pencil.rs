@@ -83,15 +83,16 @@ pub(crate) fn graph_solution(
     Some((x, rcond))
 }
 
-/// The checks shared by the pencil solvers: A square and finite, B finite with n rows, Q and R
-/// finite and symmetric (to [`super::care::SYMMETRY_TOLERANCE`]), S finite n x m and E finite
-/// n x n when given. Returns Q and R symmetrised.
+/// The checks shared by the pencil solvers and the difference equation: A square and finite,
+/// B finite with n rows, Q and R finite and symmetric (to [`super::care::SYMMETRY_TOLERANCE`]),
+/// the cross weight finite n x m (named by the caller: S or N) and E finite n x n when given.
+/// Returns Q and R symmetrised.
 pub(crate) fn checked_weights(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
-    s: Option<MatRef<'_, f64>>,
+    cross: Option<(MatRef<'_, f64>, &'static str)>,
     e: Option<MatRef<'_, f64>>,
 ) -> Result<(Mat<f64>, Mat<f64>), Error> {
     check_square(a, "A")?;
@@ -102,12 +103,12 @@ pub(crate) fn checked_weights(
     let m = b.ncols();
     let q = symmetric(q, "Q", n, "A")?.to_faer();
     let r = symmetric(r, "R", m, "the columns of B")?.to_faer();
-    if let Some(s) = s {
-        check_rows(s, "S", n, "A")?;
-        check_finite(s, "S")?;
+    if let Some((s, name)) = cross {
+        check_rows(s, name, n, "A")?;
+        check_finite(s, name)?;
         if s.ncols() != m {
             return Err(Error::Mismatch {
-                arg: "S",
+                arg: name,
                 what: "columns",
                 expected: m,
                 other: "B",
