@@ -401,3 +401,18 @@ def test_riccati_difference_layouts_and_inputs_left_alone() -> None:
     np.testing.assert_array_equal(again.K, reference.K)
     for M, copy in zip(arguments, copies, strict=True):
         np.testing.assert_array_equal(M, copy)
+
+
+def test_cross_weight_errors_name_the_callers_argument() -> None:
+    # python-control's lqr and dlqr call the cross weight N, MATLAB's care and dare S: each
+    # error names the argument as the caller wrote it.
+    A, B = np.array([[0.9, 0.1], [0.0, 0.8]]), np.array([[0.0], [1.0]])
+    Q, R = np.eye(2), np.eye(1)
+    for regulator in (aerocontrol.lqr, aerocontrol.dlqr):
+        with pytest.raises(ShapeError, match=r"^N must have as many rows as A"):
+            regulator(A, B, Q, R, np.ones((3, 1)))
+        with pytest.raises(aerocontrol.exceptions.NonFiniteError, match=r"^N\b"):
+            regulator(A, B, Q, R, N=np.array([[np.nan], [0.0]]))
+    for solver in (aerocontrol.solve_care, aerocontrol.solve_dare):
+        with pytest.raises(ShapeError, match=r"^S must have as many rows as A"):
+            solver(A, B, Q, R, S=np.ones((3, 1)))

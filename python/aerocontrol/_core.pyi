@@ -203,6 +203,7 @@ def solve_dare(
     r: ArrayLike,
     s: ArrayLike | None,
     e: ArrayLike | None,
+    cross_named_n: bool,
     /,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], float, float, int]: ...
 def solve_care(
@@ -213,6 +214,7 @@ def solve_care(
     s: ArrayLike | None,
     e: ArrayLike | None,
     refine: bool,
+    cross_named_n: bool,
     /,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], float, float, int]: ...
 def care_batch(

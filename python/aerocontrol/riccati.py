@@ -172,9 +172,11 @@ def _solve_care(
     S: ArrayLike | None,
     E: ArrayLike | None,
     refine: bool,
+    cross: str = "S",
 ) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
     """The native solve, as (X, K, poles, residual, rcond, steps), warning (at the caller of
-    :func:`solve_care` or :func:`lqr`) when the solution may be inaccurate."""
+    :func:`solve_care` or :func:`lqr`) when the solution may be inaccurate. ``cross`` is the
+    caller's name of the cross weight (N for lqr), used in errors."""
     # Two-dimensional float64 arrays go straight to the core (the common case, whose
     # conversion calls would cost a twentieth of a 4-state solve).
     if type(Q) is not np.ndarray or Q.ndim != 2 or Q.dtype != np.float64:
@@ -186,9 +188,10 @@ def _solve_care(
         B,
         Q,
         R,
-        None if S is None else _matrix(S, "S"),
+        None if S is None else _matrix(S, cross),
         None if E is None else _matrix(E, "E"),
         bool(refine),
+        cross == "N",
     )
     rcond, residual = result[4], result[3]
     if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
@@ -235,7 +238,7 @@ def lqr(
     True
     """
     A, B, Q, R, N = _regulator_arguments("lqr", sys_or_A, args, N)
-    result = _solve_care(A, B, Q, R, N, None, True)
+    result = _solve_care(A, B, Q, R, N, None, True, "N")
     return result[1], result[0], result[2]
 
 
@@ -327,16 +330,18 @@ def _solve_dare(
     R: ArrayLike,
     S: ArrayLike | None,
     E: ArrayLike | None,
+    cross: str = "S",
 ) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
     """The native solve, warning (at the caller of :func:`solve_dare` or :func:`dlqr`) when
-    the solution may be inaccurate."""
+    the solution may be inaccurate; ``cross`` names the cross weight in errors (N for dlqr)."""
     result = _core.solve_dare(
         A,
         B,
         _matrix(Q, "Q"),
         _matrix(R, "R"),
-        None if S is None else _matrix(S, "S"),
+        None if S is None else _matrix(S, cross),
         None if E is None else _matrix(E, "E"),
+        cross == "N",
     )
     residual, rcond = result[3], result[4]
     if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
@@ -380,7 +385,7 @@ def dlqr(
             "dlqr needs a discrete-time system, got a continuous one (dt = 0); use lqr"
         )
     A, B, Q, R, N = _regulator_arguments("dlqr", sys_or_A, args, N)
-    X, K, poles, *_ = _solve_dare(A, B, Q, R, N, None)
+    X, K, poles, *_ = _solve_dare(A, B, Q, R, N, None, "N")
     return K, X, poles
 
 

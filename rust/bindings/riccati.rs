@@ -17,6 +17,12 @@ use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 
+/// The cross weight's name in errors: N as python-control's lqr and dlqr call it, else S as
+/// MATLAB's care and dare do.
+fn cross_name(named_n: bool) -> &'static str {
+    if named_n { "N" } else { "S" }
+}
+
 /// The cost of one CARE of n states: the real Schur form of the Hamiltonian (order 2n), its
 /// reordering, and a few Newton steps.
 pub fn care_cost(n: usize) -> Cost {
@@ -61,7 +67,7 @@ fn algebraic_output<'py>(
 /// The stabilising solution of the CARE (6.228): (X, K, closed-loop eigenvalues, relative
 /// residual, rcond(U11), Newton steps).
 #[pyfunction]
-#[pyo3(signature = (a, b, q, r, s, e, refine, /))]
+#[pyo3(signature = (a, b, q, r, s, e, refine, cross_named_n, /))]
 #[allow(clippy::too_many_arguments)]
 fn solve_care<'py>(
     py: Python<'py>,
@@ -72,16 +78,19 @@ fn solve_care<'py>(
     s: Option<&Bound<'py, PyAny>>,
     e: Option<&Bound<'py, PyAny>>,
     refine: bool,
+    cross_named_n: bool,
 ) -> PyResult<AlgebraicOutput<'py>> {
+    let s_name = cross_name(cross_named_n);
     let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
     let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
-    let s = Real::convert_optional(py, s, "S")?;
+    let s = Real::convert_optional(py, s, s_name)?;
     let e = Real::convert_optional(py, e, "E")?;
     let (a, b, q, r, options) = (|| {
         let options = CareOptions {
             s: s.as_ref().map(|s| s.matrix()).transpose()?,
             e: e.as_ref().map(|e| e.matrix()).transpose()?,
             refine,
+            s_name: Some(s_name),
         };
         Ok((a.matrix()?, b.matrix()?, q.matrix()?, r.matrix()?, options))
     })()
@@ -106,7 +115,8 @@ pub fn dare_cost(n: usize, m: usize) -> Cost {
 /// The stabilising solution of the DARE: (X, K, closed-loop eigenvalues, relative residual,
 /// rcond(E U11), Newton steps).
 #[pyfunction]
-#[pyo3(signature = (a, b, q, r, s, e, /))]
+#[pyo3(signature = (a, b, q, r, s, e, cross_named_n, /))]
+#[allow(clippy::too_many_arguments)]
 fn solve_dare<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
@@ -115,15 +125,18 @@ fn solve_dare<'py>(
     r: &Bound<'py, PyAny>,
     s: Option<&Bound<'py, PyAny>>,
     e: Option<&Bound<'py, PyAny>>,
+    cross_named_n: bool,
 ) -> PyResult<AlgebraicOutput<'py>> {
+    let s_name = cross_name(cross_named_n);
     let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
     let (q, r) = (Real::convert(py, q, "Q")?, Real::convert(py, r, "R")?);
-    let s = Real::convert_optional(py, s, "S")?;
+    let s = Real::convert_optional(py, s, s_name)?;
     let e = Real::convert_optional(py, e, "E")?;
     let (a, b, q, r, options) = (|| {
         let options = DareOptions {
             s: s.as_ref().map(|s| s.matrix()).transpose()?,
             e: e.as_ref().map(|e| e.matrix()).transpose()?,
+            s_name: Some(s_name),
         };
         Ok((a.matrix()?, b.matrix()?, q.matrix()?, r.matrix()?, options))
     })()

@@ -136,6 +136,8 @@ pub struct CareOptions<'a> {
     pub e: Option<MatRef<'a, f64>>,
     /// Newton refinement after the Schur solution.
     pub refine: bool,
+    /// The caller's name of the cross weight in errors (default "S").
+    pub s_name: Option<&'static str>,
 }
 
 /// The data of the Hamiltonian: Ā, G and Q̄.
@@ -356,17 +358,18 @@ fn solve_care_balanced(
     let (q, l) = check_problem(a, b, q, r)?;
     let (n, m) = (a.nrows(), b.ncols());
     if let Some(s) = options.s {
-        check_rows(s, "S", n, "A")?;
+        let name = options.s_name.unwrap_or("S");
+        check_rows(s, name, n, "A")?;
         if s.ncols() != m {
             return Err(Error::Mismatch {
-                arg: "S",
+                arg: name,
                 what: "as many columns as",
                 expected: m,
                 other: "B",
                 got: s.ncols(),
             });
         }
-        check_finite(s, "S")?;
+        check_finite(s, name)?;
     }
     let (a_tilde, b_tilde) = match options.e {
         Some(e) => remove_descriptor(a, b, e)?,
@@ -1043,6 +1046,7 @@ mod tests {
                 s: s.as_ref().map(|s| s.as_ref()),
                 e: None,
                 refine: true,
+                s_name: None,
             };
             let solved = solve_care(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref(), options);
             assert!(

@@ -36,7 +36,14 @@ pub(crate) fn solve_care_indefinite(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<AlgebraicSolution, Error> {
-    let (q, r) = checked_weights(a, b, q, r, options.s.map(|s| (s, "S")), options.e)?;
+    let (q, r) = checked_weights(
+        a,
+        b,
+        q,
+        r,
+        options.s.map(|s| (s, options.s_name.unwrap_or("S"))),
+        options.e,
+    )?;
     let (n, m) = (a.nrows(), b.ncols());
     // R must be invertible (the gain is R^-1 (B^T X E + S^T)).
     let r_norm = one_norm(r.as_ref());

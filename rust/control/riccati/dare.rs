@@ -82,6 +82,8 @@ pub struct DareOptions<'a> {
     pub s: Option<MatRef<'a, f64>>,
     /// The descriptor matrix E (n x n).
     pub e: Option<MatRef<'a, f64>>,
+    /// The caller's name of the cross weight in errors (default "S").
+    pub s_name: Option<&'static str>,
 }
 
 /// Solves the DARE for its stabilising solution, verified (see the module documentation).
@@ -92,7 +94,14 @@ pub fn solve_dare(
     r: MatRef<'_, f64>,
     options: DareOptions<'_>,
 ) -> Result<AlgebraicSolution, Error> {
-    let (q, r) = checked_weights(a, b, q, r, options.s.map(|s| (s, "S")), options.e)?;
+    let (q, r) = checked_weights(
+        a,
+        b,
+        q,
+        r,
+        options.s.map(|s| (s, options.s_name.unwrap_or("S"))),
+        options.e,
+    )?;
     let (n, m) = (a.nrows(), b.ncols());
     let identity = Mat::<f64>::identity(n, n);
     let e = options.e.unwrap_or(identity.as_ref());
