@@ -124,6 +124,40 @@ fma_dispatch!(
 mod tests {
     use super::*;
 
+    /// Every kernel generic over `FMA` is `#[inline(always)]`: one compiled on its own (LLVM
+    /// may stop inlining a kernel as it grows) lacks the wrapper's target features, and each
+    /// of its fused multiply-adds becomes a call of the software fma (the multishift QR once
+    /// ran 3x slower so, with identical results).
+    #[test]
+    fn fma_kernels_are_always_inlined() {
+        fn visit(dir: &std::path::Path, offenders: &mut Vec<String>) {
+            for entry in std::fs::read_dir(dir).expect("the source tree is readable") {
+                let path = entry.expect("a directory entry").path();
+                if path.is_dir() {
+                    visit(&path, offenders);
+                } else if path.extension().is_some_and(|e| e == "rs") {
+                    let text = std::fs::read_to_string(&path).expect("a source file");
+                    let lines: Vec<&str> = text.lines().collect();
+                    for (i, line) in lines.iter().enumerate() {
+                        let trimmed = line.trim_start();
+                        let signature = trimmed.starts_with("fn ") || trimmed.starts_with("pub");
+                        let generic = signature && line.contains("const FMA: bool>(");
+                        let inlined = lines[i.saturating_sub(3)..i]
+                            .iter()
+                            .any(|l| l.trim() == "#[inline(always)]");
+                        if generic && !inlined {
+                            offenders.push(format!("{}:{}", path.display(), i + 1));
+                        }
+                    }
+                }
+            }
+        }
+        let mut offenders = Vec::new();
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("rust");
+        visit(&root, &mut offenders);
+        assert!(offenders.is_empty(), "not #[inline(always)]: {offenders:?}");
+    }
+
     #[test]
     fn slice_kernels() {
         let x: Vec<f64> = (0..37).map(|i| i as f64 * 0.25).collect();

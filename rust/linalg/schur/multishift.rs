@@ -601,6 +601,11 @@ struct StepReflector {
 /// the row where that bulge entered the slab down to the lowest row any reflector of the slab
 /// has reached so far (by induction: a reflector only mixes columns within its own reach), and
 /// only those rows are updated.
+///
+/// Always inlined into the dispatch's wrappers: compiled on its own, without the wrapper's
+/// target features, each fused multiply-add of the FMA variant would be a call of the
+/// software fma.
+#[inline(always)]
 fn chase_slab_kernel<const FMA: bool>(
     h: &mut Square,
     u: &mut Square,
