@@ -616,9 +616,18 @@ def test_nearly_undetectable_pairs_warn_at_the_callers_line() -> None:
             (A, [[1e-6], [1.0]], np.eye(2), np.zeros((2, 1))), np.eye(2), 1, 1, np.eye(2)
         )
     assert [w.filename for w in [*record, *more]] == [__file__] * (len(record) + len(more))
-    # Weighted 1e-8, the discrete filter cannot tell it from an undetectable one.
+    # Weighted 1e-8, the discrete filter is solved with a warning (P near 1e17, as scipy's);
+    # weighted 1e-12 it cannot be told from an undetectable one.
+    with pytest.warns(IllConditionedWarning, match="rcond"):
+        _, P, _ = aerocontrol.dlqe(
+            np.diag([2.0, 0.5]), np.eye(2), [[1e-8, 1.0]], np.eye(2), [[1.0]]
+        )
+    reference = sl.solve_discrete_are(
+        np.diag([2.0, 0.5]), np.array([[1e-8], [1.0]]), np.eye(2), np.eye(1)
+    )
+    np.testing.assert_allclose(P, reference, rtol=0, atol=1e-8 * np.linalg.norm(reference))
     with pytest.raises(NoStabilizingSolutionError, match="too weakly"):
-        aerocontrol.dlqe(np.diag([2.0, 0.5]), np.eye(2), [[1e-8, 1.0]], np.eye(2), [[1.0]])
+        aerocontrol.dlqe(np.diag([2.0, 0.5]), np.eye(2), [[1e-12, 1.0]], np.eye(2), [[1.0]])
 
 
 def test_bad_arguments_are_named() -> None:

@@ -141,10 +141,10 @@ pub struct CareOptions<'a> {
 }
 
 /// The data of the Hamiltonian: Ā, G and Q̄.
-struct Standard {
-    a: DMatrix<f64>,
-    g: DMatrix<f64>,
-    q: DMatrix<f64>,
+pub(crate) struct Standard {
+    pub(crate) a: DMatrix<f64>,
+    pub(crate) g: DMatrix<f64>,
+    pub(crate) q: DMatrix<f64>,
 }
 
 /// The equation with E removed, Ã^T Y + Y Ã - (Y B̃ + S) R^-1 (B̃^T Y + S^T) + Q = 0, in which
@@ -579,9 +579,9 @@ fn standardize(
 /// eigenvalues of H (the scalings are similarities, so they are the Hamiltonian's own), and
 /// above [`KRONECKER_MAX_ORDER`] the closed loop's Schur-like factorisation for the first
 /// Newton step (up to that order an exact step, solved directly, costs less).
-struct HamiltonianSolution {
-    y: DMatrix<f64>,
-    rcond: f64,
+pub(crate) struct HamiltonianSolution {
+    pub(crate) y: DMatrix<f64>,
+    pub(crate) rcond: f64,
     stable_eigenvalues: Vec<c64>,
     closed_loop: Option<ClosedLoopFactors>,
 }
@@ -656,7 +656,7 @@ impl ClosedLoopFactors {
     }
 }
 
-fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Error> {
+pub(crate) fn hamiltonian_solution(standard: &Standard) -> Result<HamiltonianSolution, Error> {
     with_order!(2 * standard.a.nrows(), order => hamiltonian_solution_in(order, standard))
 }
 

@@ -29,6 +29,15 @@
 //! subspace [U11; U21]: X = U21 (E U11)^-1, symmetrised. Exactly n eigenvalues must lie inside
 //! the unit circle and none within 100 u of it; else the equation has no stabilising solution.
 //!
+//! # The fast path
+//!
+//! For E = I and R positive definite the equation is first solved through the Cayley
+//! transform of the pencil (without its input block) to a Hamiltonian matrix and the
+//! continuous solver's Hamiltonian Schur method ([`super::cayley`]); its solution is kept when,
+//! after the refinement below, it passes every check of this module with a relative residual
+//! of at most [`CAYLEY_MAX_RESIDUAL`]. Otherwise (M + N ill-conditioned, an eigenvalue near
+//! z = -1, R indefinite or singular, a descriptor E) the pencil and QZ decide.
+//!
 //! # Checks and the reported numbers
 //!
 //! The gain's matrix R + B^T X B must be nonsingular; the closed loop A - B K (with E: the
@@ -51,6 +60,7 @@
 //! equations have, are solved where a stabilising solution exists.
 
 use super::AlgebraicSolution;
+use super::cayley::cayley_solution;
 use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
 use crate::linalg::lu::{solve_in_place, solve_with_inverse};
@@ -67,6 +77,10 @@ pub const CIRCLE_TOLERANCE: f64 = 100.0 * f64::EPSILON;
 /// Relative residual at which refinement stops: one unit of rounding (a step costs a tenth of
 /// a 4-state solve).
 pub const REFINEMENT_FLOOR: f64 = f64::EPSILON;
+
+/// The largest relative residual, after refinement, at which the Cayley transform's solution
+/// ([`super::cayley`]) is kept; above it the pencil decides.
+pub const CAYLEY_MAX_RESIDUAL: f64 = 4.0 * f64::EPSILON;
 
 /// Newton steps at most.
 pub const MAX_REFINEMENT_STEPS: usize = 3;
@@ -116,7 +130,27 @@ pub fn solve_dare(
         });
     }
     crate::platform::memory::reserve((2 * n + m).pow(2).saturating_mul(8 * 8))?;
+    let problem = Problem {
+        a,
+        b,
+        q: q.as_ref(),
+        r: r.as_ref(),
+        s: options.s,
+        e,
+        identity_e: options.e.is_none(),
+    };
+    if options.e.is_none()
+        && let Some((x, rcond)) = cayley_solution(a, b, q.as_ref(), r.as_ref(), options.s)
+        && let Ok(solution) = finish(&problem, x, rcond)
+        && solution.residual <= CAYLEY_MAX_RESIDUAL
+    {
+        return Ok(solution);
+    }
+    interrupt::check()?;
     let (pencil_m, pencil_n) = compressed_pencil(a, b, q.as_ref(), r.as_ref(), options.s, e);
+    if !pencil_m.is_all_finite() || !pencil_n.is_all_finite() {
+        return Err(out_of_range("its symplectic pencil"));
+    }
     interrupt::check()?;
     let form = qz(pencil_m.as_ref(), pencil_n.as_ref())?;
     let values = generalized_eigenvalues(form.s.as_ref(), form.t.as_ref());
@@ -129,26 +163,26 @@ pub fn solve_dare(
             2 * n
         )));
     }
-    let (mut x, rcond) = graph_solution(&form, e, n).ok_or_else(|| {
+    let (x, rcond) = graph_solution(&form, e, n).ok_or_else(|| {
         no_solution(
             "the stable deflating subspace is not a graph: E U11 is singular to working \
              precision"
                 .into(),
         )
     })?;
-    let problem = Problem {
-        a,
-        b,
-        q: q.as_ref(),
-        r: r.as_ref(),
-        s: options.s,
-        e,
-        identity_e: options.e.is_none(),
-    };
+    finish(&problem, x, rcond)
+}
+
+/// The refinement and the checks of a candidate solution X with its rcond.
+fn finish(problem: &Problem<'_>, mut x: Mat<f64>, rcond: f64) -> Result<AlgebraicSolution, Error> {
     let mut evaluation = problem.evaluate(&x)?;
-    let refinement_steps = refine(&problem, &mut x, &mut evaluation)?;
+    let refinement_steps = refine(problem, &mut x, &mut evaluation)?;
+    if !x.is_all_finite() || !evaluation.closed_loop.is_all_finite() {
+        return Err(out_of_range("the solution X or its closed loop A - B K"));
+    }
+    let descriptor = (!problem.identity_e).then_some(problem.e);
     let closed_loop_eigenvalues =
-        closed_loop_eigenvalues(evaluation.closed_loop.as_ref(), options.e)?;
+        closed_loop_eigenvalues(evaluation.closed_loop.as_ref(), descriptor)?;
     check_stabilising(
         &closed_loop_eigenvalues,
         frobenius_norm(evaluation.closed_loop.as_ref()),
@@ -373,6 +407,17 @@ fn check_separated(
         on_circle.len(),
         on_circle.join(", ")
     )))
+}
+
+/// The refusal of an equation whose `what` leaves the range of doubles.
+fn out_of_range(what: &str) -> Error {
+    Error::IllConditioned {
+        message: format!(
+            "the discrete Riccati equation cannot be solved in double precision: {what} \
+             exceeds the range of doubles (the model's entries and weights are too far apart \
+             in size); scale the model's units"
+        ),
+    }
 }
 
 fn no_solution(evidence: String) -> Error {

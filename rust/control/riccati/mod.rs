@@ -4,6 +4,7 @@
 //! ([`difference`]).
 
 pub mod care;
+pub(crate) mod cayley;
 pub(crate) mod care_pencil;
 pub mod dare;
 pub mod difference;
