@@ -168,3 +168,65 @@ def similarity(
             np.ldexp(B, -e[:, None]),
             np.ldexp(C, e[None, :]),
         )
+
+
+def matching_equilibration(M: FloatArray) -> tuple[IntArray, IntArray] | None:
+    """Row and column exponents r, s with every |M_ij| 2^(r_i + s_j) at most about 1 and those
+    of a transversal (one entry in each row and column) about 1; None if M has no transversal
+    of nonzero entries (M is then singular whatever its values: structurally singular).
+
+    The transversal is the one of largest product of |M_ij|, and r, s are the dual variables
+    of that assignment problem (solved by the Hungarian method with potentials on the costs
+    -log2 |M_ij|), as in MC64's scaling (I. S. Duff and J. Koster, "On algorithms for
+    permuting large entries to the diagonal of a sparse matrix", SIAM J. Matrix Anal. Appl.
+    22, 2001). A matrix that is merely badly scaled becomes one whose size is 1 and whose
+    large entries stand on a transversal, where a singular one stays singular: a test of
+    singularity relative to the norm is then a test of the matrix, not of its scaling.
+    Row and column scalings by powers of two are exact."""
+    n = M.shape[0]
+    if n == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    # A cost far above every -log2 |M_ij| (at most 1075) marks a zero entry.
+    absent = 1e7
+    cost = -log2_sizes(M)
+    cost[~np.isfinite(cost)] = absent
+    # The Hungarian method in its shortest augmenting path form, with row potentials u and
+    # column potentials v (cost_ij - u_i - v_j >= 0, equal on the assignment); index 0 is a
+    # sentinel column and row (1-based nodes, as in the usual formulation).
+    u = np.zeros(n + 1)
+    v = np.zeros(n + 1)
+    row_of = np.zeros(n + 1, dtype=np.int64)  # the row assigned to each column (0: none)
+    for i in range(1, n + 1):
+        row_of[0] = i
+        column = 0
+        shortest = np.full(n + 1, math.inf)
+        previous = np.zeros(n + 1, dtype=np.int64)
+        used = np.zeros(n + 1, dtype=bool)
+        while True:
+            used[column] = True
+            row = row_of[column]
+            free = ~used
+            free[0] = False
+            reduced = cost[row - 1, :] - u[row] - v[1:]
+            candidates = np.flatnonzero(free[1:]) + 1
+            better = candidates[reduced[candidates - 1] < shortest[candidates]]
+            shortest[better] = reduced[better - 1]
+            previous[better] = column
+            nearest = int(candidates[np.argmin(shortest[candidates])])
+            delta = float(shortest[nearest])
+            assigned = np.flatnonzero(used)
+            u[row_of[assigned]] += delta
+            v[assigned] -= delta
+            shortest[candidates] -= delta
+            column = nearest
+            if row_of[column] == 0:
+                break
+        while column:
+            before = int(previous[column])
+            row_of[column] = row_of[before]
+            column = before
+    rows = row_of[1:] - 1
+    if np.any(cost[rows, np.arange(n)] >= absent):
+        return None
+    # |M_ij| 2^(u_i + v_j) = 2^-(cost_ij - u_i - v_j) <= 1, with equality on the assignment.
+    return np.round(u[1:]).astype(np.int64), np.round(v[1:]).astype(np.int64)
