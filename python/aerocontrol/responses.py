@@ -671,7 +671,11 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     and columns scaled by powers of two, exactly, to put its largest entries on a transversal
     at size 1, as MC64 does) and solved again, so that an A merely badly scaled (a closed
     loop with couplings of 1e231 beside eigenvalues of 1.5) is solved, and only one whose
-    equilibrated matrix is singular too is refused, with the core's error for A.
+    equilibrated matrix is singular too is refused, with the core's error for A. The entries
+    of A are taken as exact: a row or column of tiny entries is a slow mode, solved, even
+    where they are the rounding errors of an integrator's zeros (A = [[1e-17, 0.1],
+    [2e-17, -0.5]] has the eigenvalue 1.4e-17, and -A^-1 B of 9e16 for B = (1, 1)); an
+    integrator whose zeros are zeros is refused.
 
     Examples
     --------
