@@ -487,3 +487,22 @@ def test_open_loop_unstable_pole_that_the_frequency_scaling_underflows() -> None
     assert margins.closed_loop_stable
     assert margins.encirclements == 1
     assert margins.closed_loop_poles.real == pytest.approx([-b * b * 1e150], rel=1e-12)
+
+
+def test_open_loop_poles_beyond_the_doubles_warn_as_other_results_do() -> None:
+    """The open loop's poles and zeros are checked by the one check of results formed in
+    Python (_validation.finite_or_warn, formerly a copy of it in loops): A = x [[1, 1], [1, 1]]
+    has the poles 0 and 2x (closed form), 2e308 beyond the doubles, so inf with a
+    NumericalOverflowWarning naming the poles; the zero 1e308 of C adj(sI - A) B = s - x is
+    finite, and its check is silent."""
+    x = 1e308
+    loop = (np.array([[x, x], [x, x]]), np.array([[1.0], [0.0]]), np.array([[1.0, 0.0]]), [[0.0]])
+    with pytest.warns(aerocontrol.NumericalOverflowWarning, match="closed-loop poles"):
+        locus = root_locus(loop, [0.0])
+    message = "infinite or NaN entries in the open loop's poles"
+    with pytest.warns(aerocontrol.NumericalOverflowWarning, match=message):
+        poles = locus.open_loop_poles
+    assert np.array_equal(np.sort_complex(poles), [0.0, np.inf])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.array_equal(locus.open_loop_zeros, [x])

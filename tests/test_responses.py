@@ -4,6 +4,9 @@ agreement with scipy.signal.lsim and python-control's forced_response.
 
 from __future__ import annotations
 
+import warnings
+from fractions import Fraction
+
 import control
 import numpy as np
 import pytest
@@ -141,6 +144,100 @@ def test_step_of_the_singular_example_against_quadrature() -> None:
         aerocontrol.steady_state((A, B), [1.0])
     with pytest.raises(SingularMatrixError):
         aerocontrol.dc_gain((A, B))
+
+
+def _exact_solve(A: np.ndarray, b: np.ndarray) -> list[Fraction]:
+    """A^-1 b of a 3 x 3 matrix in exact rational arithmetic (Cramer's rule; every double is a
+    rational)."""
+    M = [[Fraction(float(v)) for v in row] for row in A]
+    rhs = [Fraction(float(v)) for v in b]
+
+    def det(X: list[list[Fraction]]) -> Fraction:
+        return (
+            X[0][0] * (X[1][1] * X[2][2] - X[1][2] * X[2][1])
+            - X[0][1] * (X[1][0] * X[2][2] - X[1][2] * X[2][0])
+            + X[0][2] * (X[1][0] * X[2][1] - X[1][1] * X[2][0])
+        )
+
+    whole = det(M)
+    columns = []
+    for j in range(3):
+        replaced = [[rhs[i] if k == j else M[i][k] for k in range(3)] for i in range(3)]
+        columns.append(det(replaced) / whole)
+    return columns
+
+
+#: A closed loop of loop gain 2^1536 (the shape of feedback's balanced realisation of
+#: 2e154/(s + 1) into 1e308 (1/(s + 1) + 1/(s + 2)), closed): couplings of 2^767 and 2^769
+#: beside eigenvalues of 1.5 (and ±2^768·√3 j).
+_A_BADLY_SCALED = np.array(
+    [[-1.0, -(2.0**767), -(2.0**767)], [2.0**769, -1.0, 0.0], [2.0**769, 0.0, -2.0]]
+)
+
+
+@pytest.mark.parametrize("discrete", [False, True])
+def test_dc_gain_and_steady_state_of_a_badly_scaled_closed_loop(discrete: bool) -> None:
+    """The defect: the core refuses an A with an eigenvalue within 100 n u ||A|| of zero, and
+    the eigenvalue -1.5 is within 100·3·u·2^769 = 2e218 of it, so dc_gain reported 'A is
+    singular ... (computed as -1.5)' for a closed loop merely badly scaled: its equilibrated
+    matrix (rows and columns scaled by powers of two) has condition number 2.6. Oracle: -A^-1 B
+    and D - C A^-1 B in exact rational arithmetic, to 2 u (for the discrete model,
+    x = (I - A)^-1 B with A - I the same matrix). x0 = -2/(3·2^769)(1 + O(2^-767)), x1 and
+    x2 near ±1/3; the gain -1/3 + O(2^-767)."""
+    B = np.array([[1.0], [1.0], [0.0]])
+    C = np.array([[0.0, 1.0, 2.0]])
+    A = _A_BADLY_SCALED + np.eye(3) if discrete else _A_BADLY_SCALED
+    model = aerocontrol.StateSpace(A, B, C, [[0.0]], dt=0.1 if discrete else None)
+    if discrete:  # the matrix solved is A - I, formed exactly
+        assert np.array_equal(model.A - np.eye(3), _A_BADLY_SCALED)
+    exact = [-v for v in _exact_solve(_A_BADLY_SCALED, B[:, 0])]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        x = aerocontrol.steady_state(model, [1.0])
+        gain = aerocontrol.dc_gain(model)
+    np.testing.assert_allclose(x, [float(v) for v in exact], rtol=2 * np.finfo(float).eps)
+    expected = float(exact[1] + 2 * exact[2])
+    assert expected == pytest.approx(-1.0 / 3.0, rel=1e-15)
+    assert abs(gain[0, 0] - expected) <= 2 * np.finfo(float).eps * abs(expected)
+
+
+def test_dc_gain_of_feedback_of_a_huge_loop_gain() -> None:
+    """The closed loop that feedback forms of that loop (L(0) = 3e462): T(0) = 1 to the
+    doubles, and the steady state against exact rational arithmetic (its first entry,
+    3.3e-463, below the doubles: 0)."""
+    first = aerocontrol.StateSpace([[-1.0]], [[2.0]], [[1e154]], [[0.0]])
+    second = aerocontrol.StateSpace(
+        [[-1.0, 0.0], [0.0, -2.0]], [[1.0], [1.0]], [[1e308, 1e308]], [[0.0]]
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        closed = aerocontrol.feedback(aerocontrol.series(first, second))
+        gain = aerocontrol.dc_gain(closed)
+        x = aerocontrol.steady_state(closed, [1.0])
+    assert gain[0, 0] == 1.0
+    exact = [-v for v in _exact_solve(closed.A, closed.B[:, 0])]
+    np.testing.assert_allclose(x, [float(v) for v in exact], rtol=2 * np.finfo(float).eps)
+    assert x[0] == 0.0 and abs(exact[0]) < Fraction(1, 10**462)
+
+
+@pytest.mark.parametrize(
+    "A",
+    [
+        np.array([[0.0, 2.0**900], [0.0, -1.0]]),  # an integrator beside a huge coupling
+        np.diag([2.0**600, 2.0**-600])
+        @ np.array([[1.0, 2.0], [2.0, 4.0]])
+        @ np.diag([2.0**-300, 2.0**300]),  # rank one, badly scaled (exactly: powers of two)
+    ],
+)
+def test_singular_a_is_still_refused_after_equilibration(A: np.ndarray) -> None:
+    """Equilibration scales rows and columns by powers of two, exactly: a singular A stays
+    singular, and the core's error naming the zero eigenvalue stands."""
+    assert np.linalg.matrix_rank(np.diag([1.0, 2.0**-600]) @ A @ np.diag([1.0, 2.0**-300])) < 2
+    sys_ = (A, np.ones((2, 1)), np.ones((1, 2)), np.zeros((1, 1)))
+    with pytest.raises(SingularMatrixError, match="eigenvalue 0"):
+        aerocontrol.dc_gain(sys_)
+    with pytest.raises(SingularMatrixError, match="eigenvalue 0"):
+        aerocontrol.steady_state(sys_, [1.0])
 
 
 def test_multi_input_gives_one_response_per_input() -> None:

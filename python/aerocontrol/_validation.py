@@ -9,6 +9,7 @@ reads its inputs (copying them before it releases the GIL).
 from __future__ import annotations
 
 import warnings
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,6 +23,7 @@ from .exceptions import (
 )
 
 FloatArray = NDArray[np.float64]
+ArrayT = TypeVar("ArrayT", bound=NDArray[Any])
 
 
 def real_array(value: object, name: str) -> FloatArray:
@@ -73,14 +75,18 @@ def check_finite(values: FloatArray, name: str) -> FloatArray:
     return values
 
 
-def finite_or_warn(values: FloatArray, what: str) -> FloatArray:
+def finite_or_warn(values: ArrayT, what: str, *, stacklevel: int = 3) -> ArrayT:
     """``values``, with a NumericalOverflowWarning naming ``what`` if any entry is not finite
-    (the warning the core issues for its own results, for results formed in Python)."""
+    (the warning the core issues for its own results, for results formed in Python).
+
+    ``stacklevel`` is that of ``warnings.warn`` seen from here: 3, the default, names the
+    caller of the function that calls this one; a private helper one call deeper passes 4.
+    """
     if not np.all(np.isfinite(values)):
         warnings.warn(
-            f"the result overflowed double precision: {what} has infinite or NaN entries",
+            f"the result overflowed double precision: infinite or NaN entries in {what}",
             NumericalOverflowWarning,
-            stacklevel=3,
+            stacklevel=stacklevel,
         )
     return values
 

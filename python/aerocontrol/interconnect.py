@@ -24,11 +24,20 @@ eliminating u gives u = M^-1 (K C x + E w) with M = I - K D. M singular is an al
 by name. Continuous and discrete models combine alike; the sampling periods must agree (a
 static model, with no states, goes with either).
 
-Where products of the parts (B2 C1, D2 C1, ...) would overflow double precision, the states of
-the parts are first rescaled by powers of two (exact, and no transfer function changes) so
-that the interconnection's entries stay within range; one that no such scaling brings within
-range (D2 D1 beyond the doubles, a pole beyond them) is refused with InvalidArgumentError naming
-the arguments.
+Where products of the parts (B2 C1, D2 C1, the closed loop's B W C, ...) would overflow double
+precision, or underflow to nothing (5e-324 times 0.1), the interconnection is formed again from
+parts whose states are scaled by powers of two, state by state (exact, and no transfer function
+changes). The scaling is chosen on the entries of the interconnection actually formed, the
+closed loop's A + B W C among them, not on the parts one by one: it brings the largest to the
+least that any such scaling reaches (the maximum cycle mean of their sizes, ``_scaling``) and
+evens out the others. An interconnection that no such scaling brings within range (D2 D1
+beyond the doubles, a closed-loop A_ii beyond them, which no scaling changes) is refused with
+InvalidArgumentError naming the arguments.
+
+:func:`zpk` forms no product of two roots as a double: a second-order section holds the
+constant r1 r2 (or |r|²) as a mantissa and a power of two, and its realisation the scaled
+entries a0/t and t, so that roots of 1e200 give entries of 1e200, and roots of 1e-200 entries
+of 1e-200 where their product, 1e-400, is below the doubles.
 """
 
 from __future__ import annotations
@@ -36,13 +45,15 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from fractions import Fraction
 from math import comb
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _scaling
 from ._validation import FloatArray, check_finite, real_array, real_scalar
 from .exceptions import (
     IllConditionedWarning,
@@ -262,18 +273,137 @@ def _solve_loop(loop: FloatArray, right: FloatArray, what: str, function: str) -
 
 # ----- overflow: power-of-two state scalings -------------------------------------------------
 
-#: An interconnection whose entries could exceed 2^RESCALE_EXPONENT (a bound from the sizes of
-#: its parts) is formed from parts whose states are rescaled by powers of two.
-RESCALE_EXPONENT = 1000.0
+
+@dataclass(frozen=True)
+class _TermSizes:
+    """log2 of the largest term of each entry of an interconnection (``_term_sizes``)."""
+
+    graph: FloatArray
+    """The graph of ``_scaling``: the states, then the outside."""
+    A: FloatArray
+    B: FloatArray
+    C: FloatArray
+    terms: float
+    """log2 of a bound of the number of terms in a sum."""
 
 
-def _log2_size(M: NDArray[np.floating[Any]]) -> float:
-    """log2 of the largest |entry| of M: -inf for a zero or empty matrix, inf if it holds an
-    infinity."""
-    if M.size == 0:
-        return -math.inf
-    largest = float(np.max(np.abs(M)))
-    return math.log2(largest) if largest > 0.0 else -math.inf
+def _term_sizes(
+    A: FloatArray,
+    B: FloatArray,
+    C: FloatArray,
+    D: FloatArray,
+    K: FloatArray,
+    E: FloatArray,
+    F: FloatArray,
+    G: FloatArray,
+) -> _TermSizes | None:
+    """The log2 sizes of the terms of the interconnection u = K y + E w, z = F y + G u of
+    parts stacked as A, B, C, D (block diagonal); None where the loop's own matrices W, V, Z
+    overflow, which no state scaling changes.
+
+    With M = I - K D, W = M^-1 K, V = M^-1 E and Z = F + (F D + G) W, the interconnection is
+    A + B W C, B V, Z C (and a D that has no states). Entry (i, j) of its A has the terms of
+    A_ij and of B_ik W_kl C_lj; row i of its B those of B_ik V_kl; column j of its C those of
+    Z_rl C_lj. In the graph (see ``_scaling``), the intermediate products formed on the way
+    (K C, W C, D W C, B W D) and the parts' own B and C, which are scaled as well, are bounded
+    too, and the terms' sizes are multiplied by the number of terms summed (a bound of the
+    sums)."""
+    with np.errstate(all="ignore"):
+        M = np.eye(K.shape[0]) - K @ D
+        if not np.all(np.isfinite(M)):
+            return None
+        try:
+            solved = np.linalg.solve(M, np.hstack([K, E]))
+        except np.linalg.LinAlgError:
+            return None
+        W, V = solved[:, : K.shape[1]], solved[:, K.shape[1] :]
+        Z = F + (F @ D + G) @ W
+    if not (np.all(np.isfinite(W)) and np.all(np.isfinite(V)) and np.all(np.isfinite(Z))):
+        return None
+    n = A.shape[0]
+    a, b, c, d = (_scaling.log2_sizes(X) for X in (A, B, C, D))
+    w, v, z, k = (_scaling.log2_sizes(X) for X in (W, V, Z, K))
+    terms = math.log2(n + K.shape[0] + K.shape[1] + 2) + 1.0
+    wc = _scaling.max_plus(w, c)  # W C: (inputs, states), columns scaled by 2^e_j
+    wd = _scaling.max_plus(w, d)  # W D: (inputs, inputs), not scaled
+    closed_A = np.maximum(a, _scaling.max_plus(b, wc))
+    closed_B = _scaling.max_plus(b, v)
+    closed_C = _scaling.max_plus(z, c)
+    column_terms = [
+        np.max(c, axis=0, initial=-math.inf),
+        np.max(wc, axis=0, initial=-math.inf) + terms,
+        np.max(_scaling.max_plus(k, c), axis=0, initial=-math.inf) + terms,
+        np.max(_scaling.max_plus(d, wc), axis=0, initial=-math.inf) + terms,
+        np.max(closed_C, axis=0, initial=-math.inf) + terms,
+    ]
+    row_terms = [
+        np.max(b, axis=1, initial=-math.inf),
+        np.max(closed_B, axis=1, initial=-math.inf) + terms,
+        np.max(_scaling.max_plus(b, wd), axis=1, initial=-math.inf) + terms,
+    ]
+    graph = np.full((n + 1, n + 1), -math.inf)
+    graph[:n, :n] = closed_A + terms
+    graph[:n, n] = np.max(row_terms, axis=0)
+    graph[n, :n] = np.max(column_terms, axis=0)
+    return _TermSizes(graph, closed_A, closed_B, closed_C, terms)
+
+
+def _stacked(models: Sequence[StateSpace]) -> Matrices:
+    A, B, C, D = (_block_diagonal([getattr(m, name) for m in models]) for name in "ABCD")
+    return A, B, C, D
+
+
+#: log2 of the smallest normal double: an entry whose terms are all below it has lost digits
+#: to underflow, or all of them (5e-324 times 0.13 is 0).
+SMALLEST_EXPONENT = math.log2(np.finfo(np.float64).tiny)
+
+
+def _needs_scaling(
+    models: Sequence[StateSpace],
+    matrices: Matrices,
+    K: FloatArray,
+    E: FloatArray,
+    F: FloatArray,
+    G: FloatArray,
+) -> bool:
+    """Whether the interconnection formed in the parts' own states lost entries that a
+    scaling of the states would keep: an overflow (an infinite or NaN entry), or an entry of
+    its A, B or C that is zero or subnormal although its terms are not zero, because every
+    one of them is below the normal range (underflow, not cancellation)."""
+    if not all(np.all(np.isfinite(M)) for M in matrices):
+        return True
+    tiny = np.finfo(np.float64).tiny
+    if not any(np.any(np.abs(M) < tiny) for M in matrices[:3]):
+        return False
+    # Only a product of tiny factors underflows: skip the sizes when none is small enough.
+    A, B, C, D = _stacked(models)
+
+    def smallest(M: FloatArray) -> float:
+        nonzero = np.abs(M[M != 0.0])
+        return math.log2(float(nonzero.min())) if nonzero.size else 0.0
+
+    gains = min(0.0, *(smallest(M) for M in (D, K, E, F, G)))
+    if smallest(B) + smallest(C) + 2.0 * gains > SMALLEST_EXPONENT / 2.0:
+        return False
+    sizes = _term_sizes(A, B, C, D, K, E, F, G)
+    if sizes is None:
+        return False
+    for formed, largest in zip(matrices[:3], (sizes.A, sizes.B, sizes.C), strict=True):
+        lost = (
+            (np.abs(formed) < tiny)
+            & np.isfinite(largest)
+            & (largest < SMALLEST_EXPONENT + sizes.terms)
+        )
+        if np.any(lost):
+            return True
+    return False
+
+
+def _kept(unscaled: Matrices, scaled: Matrices) -> Matrices:
+    """The interconnection formed in scaled states, unless it overflows where the one formed
+    unscaled did not (which lost only digits to underflow)."""
+    finite = all(np.all(np.isfinite(M)) for M in scaled)
+    return scaled if finite or not all(np.all(np.isfinite(M)) for M in unscaled) else unscaled
 
 
 def _state_exponents(
@@ -282,89 +412,39 @@ def _state_exponents(
     E: FloatArray,
     F: FloatArray,
     G: FloatArray,
-) -> list[int]:
-    """Exponents e_k of state scalings x_k -> 2^e_k x_k of the parts (B_k 2^e_k, C_k 2^-e_k:
-    exact in floating point, and no transfer function changes) under which the
-    interconnection u = K y + E w, z = F y + G u of the parts stays within the range of
-    doubles; all 0 when it does unscaled.
+) -> list[NDArray[np.int64]]:
+    """Exponents of state scalings x = 2^e x̃ of the parts, state by state (exact in floating
+    point, and no transfer function changes: ``_scaling``), under which the largest term of
+    the interconnection u = K y + E w, z = F y + G u is the least that any such scaling
+    reaches, the others evened out below it; all 0 where the loop's own matrices overflow
+    (no state scaling helps).
 
-    With W = M^-1 K, V = M^-1 E and Z = F + (F D + G) W (M = I - K D, D = diag(D_k)), the
-    interconnection is A = diag(A_k) + B W C, B V, Z C and a D that no state scaling changes.
-    Its block (i, j) of A is bounded by |B_i| |W_ij| |C_j| and scales by 2^(e_i - e_j), block
-    i of B by 2^e_i and block j of C by 2^-e_j (|.| the largest entry, in log2, times the
-    inner dimension). The largest of these bounds is reduced by sweeps in the manner of
-    Osborne's balancing: each e_i in turn equalises the largest bound that grows with it and
-    the largest that shrinks with it (the minimum over e_i of their maximum)."""
-    count = len(models)
-    exponents = [0] * count
-    if count == 0:
-        return exponents
-    D = _block_diagonal([m.D for m in models])
-    with np.errstate(all="ignore"):
-        M = np.eye(K.shape[0]) - K @ D
-        if not np.all(np.isfinite(M)):
-            return exponents
-        try:
-            solved = np.linalg.solve(M, np.hstack([K, E]))
-        except np.linalg.LinAlgError:
-            return exponents
-        W, V = solved[:, : K.shape[1]], solved[:, K.shape[1] :]
-        Z = F + (F @ D + G) @ W
-    if not (np.all(np.isfinite(W)) and np.all(np.isfinite(V)) and np.all(np.isfinite(Z))):
-        return exponents
-    rows = np.cumsum([0] + [m.n_inputs for m in models])
-    columns = np.cumsum([0] + [m.n_outputs for m in models])
-    size_B = [_log2_size(m.B) + math.log2(max(m.n_inputs, 1)) for m in models]
-    size_C = [_log2_size(m.C) + math.log2(max(m.n_outputs, 1)) for m in models]
-    coupling = np.full((count, count), -math.inf)
-    into = np.full(count, -math.inf)
-    out = np.full(count, -math.inf)
-    for i in range(count):
-        inputs = slice(rows[i], rows[i + 1])
-        outputs = slice(columns[i], columns[i + 1])
-        into[i] = size_B[i] + _log2_size(V[inputs, :])
-        out[i] = _log2_size(Z[:, outputs]) + size_C[i]
-        for j in range(count):
-            if j != i:
-                block = W[inputs, slice(columns[j], columns[j + 1])]
-                coupling[i, j] = size_B[i] + _log2_size(block) + size_C[j]
-    if not (np.all(coupling < math.inf) and np.all(into < math.inf) and np.all(out < math.inf)):
-        return exponents
-    largest = max(float(np.max(coupling)), float(np.max(into)), float(np.max(out)))
-    if largest <= RESCALE_EXPONENT:
-        return exponents
-    for _ in range(100):
-        changed = False
-        for i in range(count):
-            others = [j for j in range(count) if j != i]
-            growing = max([coupling[i, j] - exponents[j] for j in others] + [into[i], size_B[i]])
-            shrinking = max([coupling[j, i] + exponents[j] for j in others] + [out[i], size_C[i]])
-            if math.isfinite(growing) and math.isfinite(shrinking):
-                best = round((shrinking - growing) / 2.0)
-            elif math.isfinite(growing) or math.isfinite(shrinking):
-                # Only one side depends on this state: bring it to unit size.
-                best = -round(growing) if math.isfinite(growing) else round(shrinking)
-            else:
-                continue
-            if best != exponents[i]:
-                exponents[i], changed = best, True
-        if not changed:
-            break
-    if any(
-        max(size_B[i] + e, size_C[i] - e) >= 1023.0 for i, e in enumerate(exponents)
-    ):  # the parts themselves leave the range: left to _representable to refuse
-        return [0] * count
-    return exponents
+    The terms are those of the matrices actually formed, the closed loop's A + B W C among
+    them (``_term_sizes``): a balancing of each part on its own would even out the parts'
+    entries and leave the couplings B_i W_ij C_j of the loop as large as before."""
+    sizes = [m.n_states for m in models]
+    unscaled = [np.zeros(size, dtype=np.int64) for size in sizes]
+    terms = _term_sizes(*_stacked(models), K, E, F, G)
+    if terms is None:
+        return unscaled
+    exponents, _ = _scaling.balancing_exponents(terms.graph, outside=True)
+    bounds = np.cumsum([0, *sizes])
+    return [exponents[bounds[k] : bounds[k + 1]] for k in range(len(models))]
 
 
-def _rescaled(model: StateSpace, exponent: int) -> StateSpace:
-    """``model`` with its state x -> 2^exponent x: B 2^exponent, C 2^-exponent (exact)."""
-    if exponent == 0 or model.n_states == 0:
+def _rescaled(model: StateSpace, exponents: NDArray[np.int64]) -> StateSpace:
+    """``model`` in the states x = 2^e x̃: T^-1 A T, T^-1 B, C T (exact); ``model`` itself
+    where that leaves the doubles (an interconnection no scaling brings within range, which
+    is then refused by name)."""
+    if model.n_states == 0 or not np.any(exponents):
+        return model
+    A, B, C = _scaling.similarity(model.A, model.B, model.C, exponents)
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(B)) and np.all(np.isfinite(C))):
         return model
     return StateSpace(
-        model.A,
-        np.ldexp(model.B, exponent),
-        np.ldexp(model.C, -exponent),
+        A,
+        B,
+        C,
         model.D,
         state_names=model.state_names,
         input_names=model.input_names,
@@ -422,28 +502,37 @@ def series(sys1: System, sys2: System, *systems: System) -> StateSpace:
                 f"series: {labels[k]} has {second.n_inputs} inputs but the model before it has "
                 f"{result.n_outputs} outputs"
             )
-        m1, p1, p2 = result.n_inputs, result.n_outputs, second.n_outputs
-        # u2 = y1, z = y2: the connection matrices of _state_exponents.
-        K = np.zeros((m1 + p1, p1 + p2))
-        K[m1:, :p1] = np.eye(p1)
-        E = np.vstack([np.eye(m1), np.zeros((p1, m1))])
-        F = np.hstack([np.zeros((p2, p1)), np.eye(p2)])
-        G = np.zeros((p2, m1 + p1))
-        first = result
-        matrices = _series_matrices(first, second)
-        if not all(np.all(np.isfinite(M)) for M in matrices):
-            exponents = _state_exponents([result, second], K, E, F, G)
-            first, second = _rescaled(result, exponents[0]), _rescaled(second, exponents[1])
-            matrices = _series_matrices(first, second)
-        _representable(matrices, "series", ", ".join(labels[: k + 1]))
-        result = StateSpace(
-            *matrices,
-            state_names=first.state_names + second.state_names,
-            input_names=first.input_names,
-            output_names=second.output_names,
-            dt=dt,
-        )
+        result = _series_step(result, second, dt, "series", ", ".join(labels[: k + 1]))
     return result
+
+
+def _series_step(
+    first: StateSpace, second: StateSpace, dt: float | None, function: str, arguments: str
+) -> StateSpace:
+    """``second`` after ``first``, formed from the parts with their states rescaled by powers
+    of two where its products overflow or underflow (:func:`_needs_scaling`,
+    :func:`_state_exponents`); beyond the range of doubles under every such scaling, refused
+    naming ``arguments``."""
+    m1, p1, p2 = first.n_inputs, first.n_outputs, second.n_outputs
+    # u2 = y1, z = y2: the connection matrices of _state_exponents.
+    K = np.zeros((m1 + p1, p1 + p2))
+    K[m1:, :p1] = np.eye(p1)
+    E = np.vstack([np.eye(m1), np.zeros((p1, m1))])
+    F = np.hstack([np.zeros((p2, p1)), np.eye(p2)])
+    G = np.zeros((p2, m1 + p1))
+    matrices = _series_matrices(first, second)
+    if _needs_scaling([first, second], matrices, K, E, F, G):
+        exponents = _state_exponents([first, second], K, E, F, G)
+        scaled = _series_matrices(_rescaled(first, exponents[0]), _rescaled(second, exponents[1]))
+        matrices = _kept(matrices, scaled)
+    _representable(matrices, function, arguments)
+    return StateSpace(
+        *matrices,
+        state_names=first.state_names + second.state_names,
+        input_names=first.input_names,
+        output_names=second.output_names,
+        dt=dt,
+    )
 
 
 def _series_matrices(first: StateSpace, second: StateSpace) -> Matrices:
@@ -549,8 +638,9 @@ def feedback(sys1: System, sys2: System | None = None, sign: float = -1) -> Stat
     and the closed loop has the states (x1, x2), the inputs and outputs of ``sys1`` and their
     names. A singular F (an algebraic loop, such as unity positive feedback around a unit
     gain) is refused with SingularMatrixError naming it; a nearly singular one warns
-    IllConditionedWarning with its condition number. The same as python-control's
-    ``feedback``.
+    IllConditionedWarning with its condition number. A loop whose products leave the range
+    of doubles is formed in states scaled by powers of two chosen on the closed loop's own
+    entries (see the module's documentation). The same as python-control's ``feedback``.
 
     Examples
     --------
@@ -602,8 +692,9 @@ def _closed(
     arguments: str,
 ) -> StateSpace:
     """The loop of :func:`feedback`, formed from the parts with their states rescaled by
-    powers of two where its products would overflow (:func:`_state_exponents`); an
-    interconnection beyond the range of doubles is refused naming ``arguments``."""
+    powers of two where its products overflow or underflow (:func:`_needs_scaling`,
+    :func:`_state_exponents`); an interconnection beyond the range of doubles is refused
+    naming ``arguments``."""
     m1, p1 = forward.n_inputs, forward.n_outputs
     # u1 = w + sign·y2, u2 = y1, z = y1: the connection matrices of _state_exponents.
     K = np.zeros((m1 + p1, p1 + m1))
@@ -611,19 +702,12 @@ def _closed(
     K[m1:, :p1] = np.eye(p1)
     E = np.vstack([np.eye(m1), np.zeros((p1, m1))])
     F = np.hstack([np.eye(p1), np.zeros((p1, m1))])
+    G = np.zeros((p1, m1 + p1))
     matrices = _loop_matrices(forward, back, s, function)
-    if not all(np.all(np.isfinite(M)) for M in matrices):
-        exponents = _state_exponents([forward, back], K, E, F, np.zeros((p1, m1 + p1)))
+    if _needs_scaling([forward, back], matrices, K, E, F, G):
+        exponents = _state_exponents([forward, back], K, E, F, G)
         first, second = _rescaled(forward, exponents[0]), _rescaled(back, exponents[1])
-        matrices = _loop_matrices(first, second, s, function)
-    if not all(np.all(np.isfinite(M)) for M in matrices):
-        # A part's states scaled as one are not enough where its own states differ in size
-        # (a series of B of 1e308 into C of 2: B C of 2e308 under every scaling of the
-        # part): balance each part state by state (exact powers of two), then rescale.
-        forward_b, back_b = _state_balanced(forward), _state_balanced(back)
-        exponents = _state_exponents([forward_b, back_b], K, E, F, np.zeros((p1, m1 + p1)))
-        first, second = _rescaled(forward_b, exponents[0]), _rescaled(back_b, exponents[1])
-        matrices = _loop_matrices(first, second, s, function)
+        matrices = _kept(matrices, _loop_matrices(first, second, s, function))
     _representable(matrices, function, arguments)
     return StateSpace(
         *matrices,
@@ -631,24 +715,6 @@ def _closed(
         input_names=forward.input_names,
         output_names=forward.output_names,
         dt=dt,
-    )
-
-
-def _state_balanced(model: StateSpace) -> StateSpace:
-    """``model`` after the diagonal power-of-two similarity of :func:`_balance` (each state's
-    row of [A B] and column of [A; C] of similar size): the same transfer function, exactly."""
-    if model.n_states == 0:
-        return model
-    A, B, C = _balance(model.A, model.B, model.C)
-    return StateSpace(
-        A,
-        B,
-        C,
-        model.D,
-        state_names=model.state_names,
-        input_names=model.input_names,
-        output_names=model.output_names,
-        dt=model.dt,
     )
 
 
@@ -948,7 +1014,7 @@ def connect(
                 f"connect: the output {spec!r} names no block output, block input or external input"
             )
 
-    def formed(B: FloatArray, C: FloatArray) -> Matrices:
+    def formed(A: FloatArray, B: FloatArray, C: FloatArray) -> Matrices:
         n = A.shape[0]
         with np.errstate(over="ignore", invalid="ignore"):
             loop, right = K @ D, np.hstack([K @ C, E])
@@ -962,11 +1028,11 @@ def connect(
                 F @ D @ U_w + G @ U_w + H,
             )
 
-    matrices = formed(B, C)
-    if not all(np.all(np.isfinite(M)) for M in matrices):
+    matrices = formed(A, B, C)
+    if _needs_scaling(models, matrices, K, E, F, G):
         exponents = _state_exponents(models, K, E, F, G)
         rescaled = append(*(_rescaled(m, e) for m, e in zip(models, exponents, strict=True)))
-        matrices = formed(rescaled.B, rescaled.C)
+        matrices = _kept(matrices, formed(rescaled.A, rescaled.B, rescaled.C))
     _representable(matrices, "connect", "systems")
     result = StateSpace(
         *matrices,
@@ -1002,13 +1068,29 @@ def _balance(A: FloatArray, B: FloatArray, C: FloatArray) -> tuple[FloatArray, .
                 continue
             # A difference of logarithms: row/column itself overflows (1e308/0.0158).
             exponent = int(np.round(0.5 * (math.log2(row) - math.log2(column))))
+            # Never so far that an entry of the column (times 2^exponent) or of the row
+            # (divided by it) leaves the normal range: a tiny a0 beside a large b0 in a row
+            # was divided into 0, which moves a pole.
+            column_sizes = _scaling.log2_sizes(off_column[off_column != 0.0])
+            row_sizes = _scaling.log2_sizes(off_row[off_row != 0.0])
+            lowest = math.ceil(
+                max(SMALLEST_EXPONENT - column_sizes.min(), row_sizes.max() - 1023.0)
+            )
+            highest = math.floor(
+                min(1023.0 - column_sizes.max(), row_sizes.min() - SMALLEST_EXPONENT)
+            )
+            exponent = min(max(exponent, min(lowest, 0)), max(highest, 0))
             if exponent == 0:
                 continue
-            factor = 2.0**exponent
-            A[:, i] *= factor
-            C[:, i] *= factor
-            A[i, :] /= factor
-            B[i, :] /= factor
+            # ldexp, not 2.0**exponent (an OverflowError beyond 2^1023), and the diagonal
+            # kept: A_ii times then divided by 2^exponent overflowed for A_ii of 1e308.
+            diagonal = A[i, i]
+            with np.errstate(over="ignore", under="ignore"):
+                A[:, i] = np.ldexp(A[:, i], exponent)
+                C[:, i] = np.ldexp(C[:, i], exponent)
+                A[i, :] = np.ldexp(A[i, :], -exponent)
+                B[i, :] = np.ldexp(B[i, :], -exponent)
+            A[i, i] = diagonal
             changed = True
         if not changed:
             break
@@ -1144,48 +1226,153 @@ def _roots(value: object, name: str) -> np.ndarray:
     return array
 
 
-def _real_factors(roots: np.ndarray, name: str) -> list[FloatArray]:
-    """The roots as real monic factors, highest power first: one quadratic per complex pair
-    (each complex root must come with its conjugate, to 1e-10 relative), then quadratics of
-    two real roots, then at most one linear factor."""
+@dataclass(frozen=True)
+class _Factor:
+    """A real monic factor s - root, or s² + linear·s + constant of a pair of roots, the
+    constant held as mantissa·2^exponent: the product of two roots of 1e200 (1e400) is kept
+    to the rounding the doubles would give it, were their range wide enough."""
+
+    degree: int
+    linear: float
+    """The coefficient of s^(degree - 1): -root, -(r1 + r2) or -2 Re r."""
+    mantissa: float = 0.0
+    exponent: int = 0
+
+    def log2_constant(self) -> float:
+        """log2 of the constant's modulus (-inf for 0)."""
+        return math.log2(abs(self.mantissa)) + self.exponent if self.mantissa else -math.inf
+
+    def constant_over(self, power: int) -> float:
+        """constant / 2^power (inf where that overflows)."""
+        with np.errstate(over="ignore", under="ignore"):
+            return float(np.ldexp(self.mantissa, self.exponent - power))
+
+
+def _product(r1: float, r2: float) -> _Factor:
+    """(s - r1)(s - r2) of two real roots: r1 r2 from the roots' mantissas."""
+    (m1, e1), (m2, e2) = np.frexp(r1), np.frexp(r2)
+    with np.errstate(over="ignore"):  # r1 + r2 beyond the doubles: refused by the caller
+        linear = -(r1 + r2)
+    return _Factor(2, float(linear), float(m1 * m2), int(e1) + int(e2))
+
+
+def _conjugate_pair(r: complex) -> _Factor:
+    """(s - r)(s - conj r) = s² - 2 Re r s + |r|²: |r|² = hypot(Re r, Im r)² from the
+    hypotenuse of the parts divided by a power of two, so that it is never squared beyond the
+    doubles (roots beyond 1e154 in modulus)."""
+    _, scale = np.frexp(max(abs(r.real), abs(r.imag)))
+    modulus = math.hypot(math.ldexp(r.real, -int(scale)), math.ldexp(r.imag, -int(scale)))
+    with np.errstate(over="ignore"):  # 2 Re r beyond the doubles: refused by the caller
+        linear = -2.0 * np.float64(r.real)
+    return _Factor(2, float(linear), modulus * modulus, 2 * int(scale))
+
+
+def _real_factors(roots: np.ndarray, name: str) -> list[_Factor]:
+    """The roots as real monic factors: one quadratic per complex pair (each complex root
+    must come with its conjugate, to 1e-10 relative), then quadratics of two real roots, then
+    at most one linear factor."""
     real = sorted(float(r.real) for r in roots if r.imag == 0.0)
     upper = sorted((r for r in roots if r.imag > 0.0), key=lambda r: (r.real, r.imag))
     lower = [r for r in roots if r.imag < 0.0]
-    factors: list[FloatArray] = []
-    with np.errstate(over="ignore", invalid="ignore"):  # beyond the doubles: refused below
-        for r in upper:
-            _pair(r, lower, name, factors)
-        for k in range(0, len(real) - 1, 2):
-            factors.append(np.array([1.0, -(real[k] + real[k + 1]), real[k] * real[k + 1]]))
+    factors: list[_Factor] = []
+    for r in upper:
+        _pair(r, lower, name)
+        factors.append(_conjugate_pair(complex(r)))
+    for k in range(0, len(real) - 1, 2):
+        factors.append(_product(real[k], real[k + 1]))
     if lower:
         raise InvalidArgumentError(
             f"{name} has the complex root {complex(lower[0])} without its conjugate: a real "
             "model has complex roots in conjugate pairs"
         )
     if len(real) % 2:
-        factors.append(np.array([1.0, -real[-1]]))
-    for factor in factors:
-        if not np.all(np.isfinite(factor)):
-            error = InvalidArgumentError(
-                f"zpk: {name} has roots whose second-order section s² - (r1 + r2) s + r1 r2 "
-                "overflows double precision (roots beyond about 1e154 in modulus: scale the "
-                "units of time)"
-            )
-            error.argument = name
-            raise error
+        factors.append(_Factor(1, -real[-1]))
     return factors
 
 
-def _pair(r: complex, lower: list[complex], name: str, factors: list[FloatArray]) -> None:
-    """The quadratic factor of r and its conjugate (taken from ``lower``)."""
-    match = [k for k, q in enumerate(lower) if abs(q - r.conjugate()) <= 1e-10 * abs(r)]
+def _pair(r: complex, lower: list[complex], name: str) -> None:
+    """Takes the conjugate of r from ``lower``, or refuses r as unpaired."""
+    # Compared divided by a power of two of r's size, so that |r| does not overflow.
+    _, power = np.frexp(max(abs(r.real), abs(r.imag)))
+    with np.errstate(over="ignore", invalid="ignore"):  # beyond the doubles: not a match
+        given = np.ldexp([r.real, -r.imag], -int(power))
+        others = [np.ldexp([q.real, q.imag], -int(power)) for q in lower]
+        limit = 1e-10 * math.hypot(*given)
+        match = [k for k, q in enumerate(others) if math.hypot(*(q - given)) <= limit]
     if not match:
         raise InvalidArgumentError(
             f"{name} has the complex root {complex(r)} without its conjugate: a real model "
             "has complex roots in conjugate pairs"
         )
     lower.pop(match[0])
-    factors.append(np.array([1.0, -2.0 * r.real, abs(r) ** 2]))
+
+
+def _section(numerator: _Factor | None, denominator: _Factor, argument: str) -> Matrices:
+    """numerator/denominator (numerator 1 for None) in the observable form of
+    :func:`_observable_form`, with its first state scaled by a power of two t chosen so that
+    no coefficient is formed beyond the doubles; balanced.
+
+    Of den = s² + a1 s + a0 and num = n2 s² + n1 s + n0 the observable form is
+    A = [[0, -a0], [1, -a1]], B = (n0 - n2 a0, n1 - n2 a1), C = (0, 1), D = n2; the scaling
+    makes it A = [[0, -a0/t], [t, -a1]], B = ((n0 - n2 a0)/t, n1 - n2 a1), with a0/t and n0/t
+    formed from the constants' mantissas, t about the square root of the larger of |a0|,
+    |n0|: roots of 1e200 give entries of 1e200, never their product 1e400. A first-order
+    section (s - z)/(s - p) is A = p, B = p - z, C = 1, D = 1 (B = C = 1, D = 0 without a
+    zero). Where no t keeps t, a0/t and (n0 - n2 a0)/t within the doubles, InvalidArgumentError
+    names ``argument``."""
+    if denominator.degree == 1:
+        A = np.array([[-denominator.linear]])
+        if numerator is None:
+            B, D = np.array([[1.0]]), np.array([[0.0]])
+        else:
+            with np.errstate(over="ignore"):  # refused by the caller
+                B = np.array([[numerator.linear - denominator.linear]])
+            D = np.array([[1.0]])
+        A, B, C = _balance(A, B, np.array([[1.0]]))
+        return A, B, C, D
+    n2 = 1.0 if numerator is not None and numerator.degree == 2 else 0.0
+    n1 = 0.0 if numerator is None else (1.0 if numerator.degree == 1 else numerator.linear)
+    size_a0 = denominator.log2_constant()
+    if numerator is None:
+        size_n0 = 0.0
+    elif numerator.degree == 1:
+        size_n0 = math.log2(abs(numerator.linear)) if numerator.linear else -math.inf
+    else:
+        size_n0 = numerator.log2_constant()
+    largest = max(size_a0, size_n0)
+    power = 0
+    if math.isfinite(largest):
+        # t = 2^power, within what keeps t and (n0 - n2 a0)/t below the overflow threshold
+        # and t and a0/t above the underflow threshold.
+        lowest = max(math.ceil(largest + 1.0 - 1023.0), -1022)
+        highest = 1023 if math.isinf(size_a0) else min(1023, math.floor(size_a0 + 1022.0))
+        if lowest > highest:
+            why = (
+                "its roots are beyond about 6e307 in modulus (2^1022.5), the largest that its "
+                "scaled coefficients hold (scale the units of time)"
+                if largest > 2045.0
+                else "its zeros and poles are too far apart in size (the products of its "
+                "zeros and of its poles more than 2^2045 apart)"
+            )
+            error = InvalidArgumentError(
+                f"zpk: a second-order section has no realisation in doubles: {why}"
+            )
+            error.argument = argument
+            raise error
+        power = min(max(round(largest / 2), lowest), highest)
+    with np.errstate(over="ignore", under="ignore"):  # overflow refused by the caller
+        t, n0 = float(np.ldexp(1.0, power)), float(np.ldexp(1.0, -power))
+        if numerator is not None and numerator.degree == 1:
+            n0 = float(np.ldexp(numerator.linear, -power))
+        elif numerator is not None:
+            n0 = numerator.constant_over(power)
+        a0 = denominator.constant_over(power)
+    with np.errstate(over="ignore", invalid="ignore"):  # refused by the caller
+        A = np.array([[0.0, -a0], [t, -denominator.linear]])
+        B = np.array([[n0 - n2 * a0], [n1 - n2 * denominator.linear]])
+    C = np.array([[0.0, 1.0]])
+    A, B, C = _balance(A, B, C)
+    return A, B, C, np.array([[n2]])
 
 
 def zpk(
@@ -1206,6 +1393,14 @@ def zpk(
     in balanced observable form, so that no polynomial of high degree is ever formed. More
     zeros than poles (an improper model) is refused.
 
+    No coefficient of a section is formed as the product of two roots: the constant r1 r2 (or
+    |r|²) is kept as a mantissa and a power of two and enters the realisation divided by a
+    power of two t near its square root (``_section``), so that roots anywhere up to about
+    6e307 in modulus, and down to the smallest doubles, are realised, and sections of very
+    different sizes are chained in states scaled by powers of two (as :func:`series`). A
+    section beyond that (roots of 1e308, or zeros and poles whose products are more than
+    2^2045 apart) is refused with InvalidArgumentError naming ``z`` or ``p``.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -1213,6 +1408,11 @@ def zpk(
     >>> g = aerocontrol.zpk([0.0], [-0.5, -10.0], 10.0)
     >>> np.sort(np.linalg.eigvals(g.A).real)
     array([-10. ,  -0.5])
+    >>> # A lightly damped pair of 1e200 rad/s: |p|^2 = 2e400 is beyond the doubles, the poles
+    >>> # are not.
+    >>> fast = aerocontrol.zpk([], [-1e198 + 1e200j, -1e198 - 1e200j], 1e300)
+    >>> np.sort_complex(np.linalg.eigvals(fast.A))
+    array([-1.e+198-1.e+200j, -1.e+198+1.e+200j])
     >>> aerocontrol.zpk([1 + 2j], [-1.0, -2.0], 1.0)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
@@ -1231,29 +1431,41 @@ def zpk(
     # Quadratic zero factors go with quadratic pole factors; a linear zero factor with a
     # quadratic one left over, else with the linear pole factor (there is one when the
     # quadratics are used up, since there are no more zeros than poles).
-    numerators: list[FloatArray] = [np.array([1.0]) for _ in pole_factors]
-    quadratic = [i for i, f in enumerate(pole_factors) if f.size == 3]
-    linear = [i for i, f in enumerate(pole_factors) if f.size == 2]
-    zero_quadratics = [f for f in zero_factors if f.size == 3]
-    zero_linear = [f for f in zero_factors if f.size == 2]
-    for f in zero_quadratics:
+    numerators: list[_Factor | None] = [None for _ in pole_factors]
+    quadratic = [i for i, f in enumerate(pole_factors) if f.degree == 2]
+    linear = [i for i, f in enumerate(pole_factors) if f.degree == 1]
+    for f in (f for f in zero_factors if f.degree == 2):
         numerators[quadratic.pop(0)] = f
-    for f in zero_linear:
+    for f in (f for f in zero_factors if f.degree == 1):
         numerators[(quadratic or linear).pop(0)] = f
     n = poles.size
-    A = np.zeros((0, 0))
-    B = np.zeros((0, 1))
-    C = np.zeros((1, 0))
-    D = np.array([[1.0]])
+    # The argument to blame for a section beyond the doubles: the larger roots.
+    with np.errstate(over="ignore"):
+        largest_zero = np.max(np.abs(zeros), initial=0.0)
+        larger = "z" if largest_zero > np.max(np.abs(poles), initial=0.0) else "p"
+    chain: StateSpace | None = None
+    for numerator, denominator in zip(numerators, pole_factors, strict=True):
+        section = _section(numerator, denominator, larger)
+        _realisable(
+            section,
+            "zpk",
+            larger,
+            f"{larger} has roots too large for a second-order section of them (beyond about "
+            "1e307: scale the units of time)",
+        )
+        model = StateSpace(*section)
+        # Sections beyond one another's range are formed in states scaled by powers of two.
+        chain = model if chain is None else _series_step(chain, model, None, "zpk", "p, z")
+    if chain is None:
+        A, B, C, D = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[1.0]])
+    else:
+        # The last section's states first: A is then upper Hessenberg (see _observable_form).
+        blocks = np.cumsum([0] + [f.degree for f in pole_factors])
+        order = np.concatenate(
+            [np.arange(blocks[i], blocks[i + 1]) for i in reversed(range(len(pole_factors)))]
+        )
+        A, B, C, D = chain.A[np.ix_(order, order)], chain.B[order], chain.C[:, order], chain.D
     with np.errstate(over="ignore", invalid="ignore"):  # refused by name below
-        for numerator, denominator in zip(numerators, pole_factors, strict=True):
-            padded = np.concatenate([np.zeros(denominator.size - numerator.size), numerator])
-            A2, B2, C2, D2 = _observable_form(padded, denominator)
-            # The new section's states first: A stays upper Hessenberg (see _observable_form).
-            A = np.block([[A2, B2 @ C], [np.zeros((A.shape[0], A2.shape[0])), A]])
-            B = np.vstack([B2 @ D, B])
-            C = np.hstack([C2, D2 @ C])
-            D = D2 @ D
         C, D = factor * C, factor * D
     _realisable(
         (A, B, C, D),

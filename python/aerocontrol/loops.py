@@ -82,7 +82,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._validation import FloatArray, check_finite, real_array, real_scalar
+from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
     IllConditionedWarning,
@@ -353,12 +353,7 @@ def _roots_of(model: StateSpace) -> TransferFunction:
         warnings.simplefilter("ignore", NumericalOverflowWarning)
         g = transfer_function(model)
     for roots, what in ((g.poles, "poles"), (g.zeros, "zeros")):
-        if not np.all(np.isfinite(roots)):
-            warnings.warn(
-                f"the open loop's {what} overflow double precision: they are infinite",
-                NumericalOverflowWarning,
-                stacklevel=3,
-            )
+        finite_or_warn(roots, f"the open loop's {what}", stacklevel=4)
     return g
 
 

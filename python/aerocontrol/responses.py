@@ -44,7 +44,7 @@ from typing import TYPE_CHECKING, Literal, cast
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import _core
+from . import _core, _scaling
 from ._validation import FloatArray, check_choice, check_finite, finite_or_warn, real_array
 from .exceptions import (
     InvalidArgumentError,
@@ -666,7 +666,16 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     discrete model, x∞ = (I - A)^-1 B η0.
 
     Raises SingularMatrixError naming the zero eigenvalue when A is singular (an integrator
-    has no steady state); for a discrete model, the eigenvalue 1 of A.
+    has no steady state); for a discrete model, the eigenvalue 1 of A. The core refuses an A
+    with an eigenvalue within 100 n u ||A|| of zero; where it does, A is equilibrated (rows
+    and columns scaled by powers of two, exactly, to put its largest entries on a transversal
+    at size 1, as MC64 does) and solved again, so that an A merely badly scaled (a closed
+    loop with couplings of 1e231 beside eigenvalues of 1.5) is solved, and only one whose
+    equilibrated matrix is singular too is refused, with the core's error for A. The entries
+    of A are taken as exact: a row or column of tiny entries is a slow mode, solved, even
+    where they are the rounding errors of an integrator's zeros (A = [[1e-17, 0.1],
+    [2e-17, -0.5]] has the eigenvalue 1.4e-17, and -A^-1 B of 9e16 for B = (1, 1)); an
+    integrator whose zeros are zeros is refused.
 
     Examples
     --------
@@ -687,9 +696,9 @@ def _steady_state(model: StateSpace, weights: ArrayLike) -> FloatArray:
     """-A^-1 B η0 for a continuous model; for a discrete one, -(A - I)^-1 B η0, with the
     error of a singular A - I naming the eigenvalue 1 of A."""
     if not model.is_discrete:
-        return _core.steady_state(model.A, model.B, weights)
+        return _equilibrated_solve(model.A, model.B, weights)
     try:
-        return _core.steady_state(model.A - np.eye(model.n_states), model.B, weights)
+        return _equilibrated_solve(model.A - np.eye(model.n_states), model.B, weights)
     except SingularMatrixError as error:
         raise SingularMatrixError(
             "A - I is singular: A has the eigenvalue 1 (a discrete integrator or neutral "
@@ -697,12 +706,71 @@ def _steady_state(model: StateSpace, weights: ArrayLike) -> FloatArray:
         ) from error
 
 
+def _equilibrated_solve(M: FloatArray, B: FloatArray, weights: ArrayLike) -> FloatArray:
+    """-M^-1 B η0 by the core, which refuses an M with an eigenvalue within 100 n u ||M|| of
+    zero; where it does, the same solve of R M S y = -R B η0, x = S y, with M equilibrated by
+    powers of two (R, S diagonal: ``_scaling.matching_equilibration``), and the core's error
+    only if that matrix is singular too (or M has no transversal of nonzero entries, such as
+    the zero column of an integrator).
+
+    A matrix merely badly scaled, such as the closed loop of a loop gain of 1e462 (entries of
+    4e231 beside eigenvalues of 1.5), is then solved; the scalings are exact, so x is the
+    solution of the same equations, to the conditioning of the equilibrated matrix."""
+    try:
+        result: FloatArray = _core.steady_state(M, B, weights)
+        return result
+    except SingularMatrixError:
+        scalings = _scaling.matching_equilibration(M)
+        if scalings is None or not (np.any(scalings[0]) or np.any(scalings[1])):
+            raise
+        rows, columns = scalings
+        forcing = _scaling.log2_sizes(B) + rows[:, None]
+        largest = float(np.max(forcing, initial=-np.inf))
+        # R B divided by a power of two to size 1 (so that it neither over- nor underflows),
+        # and x multiplied by it again.
+        shift = round(largest) if np.isfinite(largest) else 0
+        with np.errstate(over="ignore", under="ignore"):
+            scaled = np.ldexp(M, rows[:, None] + columns[None, :])
+            scaled_B = np.ldexp(B, rows[:, None] - shift)
+        try:
+            y = _core.steady_state(scaled, scaled_B, weights)
+        except SingularMatrixError:
+            pass
+        else:
+            with np.errstate(over="ignore", under="ignore"):
+                x = np.ldexp(y, columns + shift)
+            return finite_or_warn(x, "the steady state")
+        raise
+
+
 def dc_gain(sys: System) -> FloatArray:
     """The zero-frequency gain D - C A^-1 B (p, m): the steady output per unit step input;
     for a discrete model, G(z = 1) = D + C (I - A)^-1 B.
 
     Raises SingularMatrixError naming the zero eigenvalue when A is singular (the eigenvalue
-    1 for a discrete model).
+    1 for a discrete model). An A merely badly scaled is not singular: where the core finds
+    an eigenvalue within 100 n u ||A|| of zero, the solve is made again with the rows and
+    columns of A scaled by powers of two (exact) to entries of size 1, and only an A whose
+    equilibrated matrix is singular too is refused (see :func:`steady_state`).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> A, B = aerocontrol.chapter.boeing747_longitudinal()
+    >>> C = np.array([[0.0, 0.0, 0.0, 1.0]])                       # theta per unit elevator
+    >>> np.round(aerocontrol.dc_gain((A, B, C, [[0.0]])), 6)
+    array([[-0.914106]])
+    >>> # A closed loop of loop gain 2^1536: eigenvalues of 1.5 beside entries of 2^769.
+    >>> a, b = 2.0**767, 2.0**769
+    >>> loop = aerocontrol.StateSpace([[-1, -a, -a], [b, -1, 0], [b, 0, -2]], [[1], [1], [0]],
+    ...                               [[0, 1, 2]], [[0]])
+    >>> aerocontrol.dc_gain(loop)                                    # -1/3, exactly
+    array([[-0.33333333]])
+    >>> integrator = ([[0.0, 1.0], [0.0, -1.0]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]])
+    >>> aerocontrol.dc_gain(integrator)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    aerocontrol.exceptions.SingularMatrixError: A is singular: it has the eigenvalue 0 ...
     """
     model = as_state_space(sys)
     # One warning for the gain, not one per column's steady state.

@@ -747,3 +747,93 @@ def test_regression_connect_loop_near_the_range() -> None:
         return aerocontrol.connect([junction, plant, other], inputs="r", outputs="z")
 
     exercise("connect", call, {"plant": plant, "other": other}, _connect_oracle("loop"))
+
+
+#: The sixth-order blocks of two campaign inputs (Gaussian draws of the strategies).
+_BLOCK_A = np.array(
+    [
+        [-3.3237595216897846, -0.1321048632913019, 0.6404226504432821, 0.10490011715303971,
+         -0.535669373161111, 0.36159505490948474],
+        [1.3040000451301372, -2.5024087796539356, -0.7037352358069926, -1.2654214710460525,
+         -0.6232744625373522, 0.0413259793472436],
+        [-2.3250307746388343, -0.21879166393254573, -4.695400690036243, -0.7322673547034516,
+         -0.5442589828573099, -0.31630015636915454],
+        [0.4116305363741328, 1.0425133694426776, -0.12853466294403426, -2.083026272233492,
+         -0.6651946734866135, 0.3515100700930197],
+        [0.9034701816518086, 0.09401229776087457, -0.7434992493538084, -0.9217253762584194,
+         -3.907215568450517, 0.2201951234700494],
+        [-1.009618183538736, -0.20917557487171307, -0.15922500991447772, 0.5408455846858077,
+         0.2146591225063409, -3.0941170337432564],
+    ]
+)  # fmt: skip
+_BLOCK_B = np.array(
+    [[0.1257302210933933], [-0.1321048632913019], [0.6404226504432821], [0.10490011715303971],
+     [-0.535669373161111], [0.36159505490948474]]
+)  # fmt: skip
+_BLOCK_C = np.array(
+    [[3.4558419206478603e07, 8.2161814350115836e07, 3.3043707618338715e07,
+      -1.3031572316043609e08, 9.0535586667311773e07, 4.4637457236401126e07]]
+)  # fmt: skip
+_BIG_BLOCK_A = np.array(
+    [
+        [-3.3237595216897845e08, -1.3210486329130189e07, 6.4042265044328205e07,
+         1.0490011715303971e07, -5.3566937316111095e07, 3.6159505490948476e07],
+        [1.3040000451301372e08, -2.5024087796539357e08, -7.0373523580699265e07,
+         -1.2654214710460526e08, -6.2327446253735222e07, 4.1325979347243602e06],
+        [-2.3250307746388343e08, -2.1879166393254574e07, -4.6954006900362426e08,
+         -7.3226735470345154e07, -5.4425898285730988e07, -3.1630015636915453e07],
+        [4.1163053637413286e07, 1.0425133694426776e08, -1.2853466294403426e07,
+         -2.0830262722334921e08, -6.6519467348661356e07, 3.5151007009301968e07],
+        [9.0347018165180862e07, 9.4012297760874573e06, -7.4349924935380846e07,
+         -9.2172537625841945e07, -3.9072155684505171e08, 2.2019512347004943e07],
+        [-1.0096181835387360e08, -2.0917557487171307e07, -1.5922500991447771e07,
+         5.4084558468580768e07, 2.1465912250634089e07, -3.0941170337432563e08],
+    ]
+)  # fmt: skip
+_BIG_BLOCK_C = np.array(
+    [[3.9836996726397239e07, -5.6282333741752498e07, 5.8883494374844514e07,
+      4.2118102942453157e06, -1.5709005193070567e08, 1.0016547499330197e08]]
+)  # fmt: skip
+
+
+@pytest.mark.parametrize("case", ["pole of 1e308", "block without input"])
+def test_regression_connect_loop_balanced_state_by_state(case: str) -> None:
+    """Two campaign inputs of the loop by name, whose oracle (feedback of the series) failed:
+    a plant with A of 1e308 and B of 1.7e300 (the balancing of the series, each part on its
+    own, overflowed its A_ii: a NonFiniteError), and one with B of -1.2e300 into a block
+    with B = 0 and A, C of 1e8 (the closed loop's B C of 1.9e308, refused, though the block's
+    states, which the plant does not reach, scale freely)."""
+    c = np.array([[0.1257302210933933]])
+    if case == "pole of 1e308":
+        plant = (np.array([[1e308]]), np.array([[1.728162865989976e300]]), c)
+        block = (_BLOCK_A, _BLOCK_B, _BLOCK_C)
+    else:
+        plant = (np.array([[-1.8742697789066067]]), np.array([[-1.2316649689147774e300]]), c)
+        block = (_BIG_BLOCK_A, np.zeros((6, 1)), _BIG_BLOCK_C)
+    zero = np.zeros((1, 1))
+    arguments = {
+        "plant": _named(plain((*plant, zero)), ["e"], ["v"]),
+        "other": _named(plain((*block, zero)), ["v"], ["z"]),
+    }
+
+    def call(plant: Any, other: Any) -> Any:
+        junction = aerocontrol.summing_junction(["r", "-z"], "e")
+        return aerocontrol.connect([junction, plant, other], inputs="r", outputs="z")
+
+    outcome = exercise("connect", call, arguments, _connect_oracle("loop"))
+    assert outcome.error is None and outcome.warned == ()
+
+
+def test_regression_series_product_that_underflows() -> None:
+    """A campaign input: D2 C1 = 5e-324 x 0.126 underflowed to 0, and the series was the zero
+    model where G2 G1 is 4e-176."""
+    lag = (np.array([[-1.8742697789066067]]), np.array([[1.257302210933933e149]]))
+    lag += (np.array([[0.1257302210933933]]), np.zeros((1, 1)))
+    tiny = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[5e-324]]))
+    outcome = exercise(
+        "series",
+        lambda sys1, sys2: aerocontrol.series(sys1, sys2),
+        {"sys1": plain(lag), "sys2": plain(tiny)},
+        _series_oracle,
+    )
+    assert outcome.error is None and outcome.warned == ()

@@ -532,3 +532,20 @@ def test_known_defect_root_locus_dominant_rank_one() -> None:
             {"loop": plain(model), "gains": plain(np.array([0.0, 1.0, 5.0]))},
             _locus_oracle,
         )
+
+
+def test_regression_sensitivity_beyond_every_scaling() -> None:
+    """A campaign input: A of 2.3e300 and B C of 2.5e449 in the closed loop's A - B C, whose
+    diagonal no state scaling changes: refused by name. (A scaling that minimises the closed
+    loop's largest entry, applied although that least entry is beyond the doubles, overflowed
+    the loop's own A: a NonFiniteError naming an A the caller gave finite.)"""
+    A = np.array([[-2.2884833412797016e300, -1.321048632913019e299]])
+    A = np.vstack([A, [[6.4042265044328213e299, -2.3093134452200553e300]]])
+    model = (A, np.array([[1.257302210933933e299], [-1.321048632913019e299]]))
+    model += (np.array([[-2e150, 0.0]]), np.zeros((1, 1)))
+    outcome = exercise(
+        "sensitivity", aerocontrol.sensitivity, {"loop": plain(model)}, _sensitivity_oracle(False)
+    )
+    assert isinstance(outcome.error, aerocontrol.InvalidArgumentError)
+    assert not isinstance(outcome.error, aerocontrol.NonFiniteError)
+    assert getattr(outcome.error, "argument", None) == "loop"

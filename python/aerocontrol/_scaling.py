@@ -1,0 +1,232 @@
+"""Diagonal scalings of the states by powers of two, chosen on the sizes of the entries they
+change.
+
+A state scaling x = T x̃, T = diag(2^e), changes a model into T^-1 A T, T^-1 B, C T: entry
+(i, j) of A is multiplied by 2^(e_j - e_i), row i of B by 2^-e_i and column j of C by 2^e_j.
+Powers of two make it exact in floating point (no rounding, only over- or underflow), and no
+transfer function, eigenvalue or steady output changes.
+
+The sizes are held as a *graph*: a square matrix G of log2 sizes (-inf where an entry is
+zero), G[i, j] the log2 of the largest term of entry (i, j). With an *outside* node (the last
+one, whose exponent is fixed at 0) the rows of B are the entries (i, outside) and the columns
+of C the entries (outside, j). The largest scaled entry is then max_ij G[i, j] + e_j - e_i.
+
+Its least value over all exponents is the graph's maximum cycle mean (the largest mean of G
+over a cycle: every entry of a cycle is scaled by exponents that cancel around it, so its mean
+is invariant), computed by Karp's algorithm (R. M. Karp, "A characterization of the minimum
+cycle mean in a digraph", Discrete Mathematics 23, 1978). Exponents that reach it are the
+longest-path potentials of G minus that mean (Bellman-Ford in the (max, +) algebra); sweeps in
+the manner of Osborne's balancing, each exponent in turn lowering the largest entry of its
+row and column, then even out the entries below the largest (the max-balancing of Schneider
+and Schneider, "Max-balancing weighted directed graphs", Mathematics of Operations Research
+16, 1991) without raising it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: Sweeps of the max-balancing at most (each one pass over the states).
+SWEEPS = 100
+
+
+def log2_sizes(M: NDArray[np.floating[Any]]) -> FloatArray:
+    """log2 |M| entry by entry: -inf for a zero entry, inf for an infinite one."""
+    with np.errstate(divide="ignore"):
+        return np.asarray(np.log2(np.abs(M)), dtype=np.float64)
+
+
+def max_plus(P: FloatArray, Q: FloatArray) -> FloatArray:
+    """The (max, +) product of two matrices of log2 sizes: entry (i, j) is max_k P[i, k] +
+    Q[k, j], the log2 of the largest term of the product of the matrices they measure
+    (-inf where every term is zero, also for an inner dimension of 0)."""
+    if P.shape[1] == 0 or P.shape[0] == 0 or Q.shape[1] == 0:
+        return np.full((P.shape[0], Q.shape[1]), -math.inf)
+    with np.errstate(invalid="ignore"):  # -inf + inf cannot occur: the sizes are finite or -inf
+        return np.asarray(np.max(P[:, :, None] + Q[None, :, :], axis=1), dtype=np.float64)
+
+
+def largest_scaled(G: FloatArray, exponents: FloatArray) -> float:
+    """max_ij G[i, j] + e_j - e_i: the log2 of the largest entry under the scaling."""
+    if G.size == 0:
+        return -math.inf
+    return float(np.max(G + exponents[None, :] - exponents[:, None]))
+
+
+def max_cycle_mean(G: FloatArray) -> float:
+    """The largest mean of G over a cycle of the graph (-inf for a graph without cycles), by
+    Karp's algorithm: with D_k(v) the largest weight of a walk of k edges ending at v,
+    max_v min_k (D_N(v) - D_k(v)) / (N - k)."""
+    N = G.shape[0]
+    if N == 0:
+        return -math.inf
+    walks = np.empty((N + 1, N))
+    walks[0] = 0.0
+    for k in range(1, N + 1):
+        walks[k] = np.max(walks[k - 1][:, None] + G, axis=0)
+    last = walks[N]
+    best = -math.inf
+    for v in np.flatnonzero(np.isfinite(last)):
+        earlier = walks[:N, v]
+        finite = np.isfinite(earlier)
+        lengths = N - np.arange(N)
+        best = max(best, float(np.min((last[v] - earlier[finite]) / lengths[finite])))
+    return best
+
+
+def _potentials(G: FloatArray, bound: float) -> FloatArray:
+    """Exponents with G[i, j] + e_j - e_i <= bound wherever the graph has no cycle of mean
+    above ``bound``: e_i the longest walk from i in G - bound (at least 0)."""
+    N = G.shape[0]
+    weights = G - bound
+    exponents = np.zeros(N)
+    for _ in range(N + 1):
+        longer = np.maximum(0.0, np.max(weights + exponents[None, :], axis=1))
+        if np.array_equal(longer, exponents):
+            break
+        exponents = longer
+    return exponents
+
+
+def _sweep(G: FloatArray, exponents: FloatArray, movable: int) -> bool:
+    """One pass of max-balancing over the nodes 0 .. movable - 1; True if an exponent moved.
+
+    Node i's row entries are G[i, j] + e_j - e_i and its column entries G[j, i] + e_i - e_j
+    (j != i); the best e_i makes the largest of each equal, and is taken (as an integer) only
+    where it lowers the largest entry of the node's row and column. A node with entries on one
+    side only brings their largest to the size of 1 (or to the largest entry of the graph, if
+    that is smaller), so that nothing is left far above or below the rest."""
+    changed = False
+    N = G.shape[0]
+    ceiling = min(0.0, largest_scaled(G, exponents))
+    for i in range(movable):
+        others = np.arange(N) != i
+        row = float(np.max(G[i, others] + exponents[others], initial=-math.inf))
+        column = float(np.max(G[others, i] - exponents[others], initial=-math.inf))
+        current = exponents[i]
+        if math.isfinite(row) and math.isfinite(column):
+            middle = (row - column) / 2.0
+            best, best_size = current, max(row - current, column + current)
+            for candidate in (math.floor(middle), math.ceil(middle)):
+                size = max(row - candidate, column + candidate)
+                if size < best_size:
+                    best, best_size = float(candidate), size
+        elif math.isfinite(row):
+            best = float(math.ceil(row - ceiling))
+        elif math.isfinite(column):
+            best = float(math.floor(ceiling - column))
+        else:
+            continue
+        if best != current:
+            exponents[i], changed = best, True
+    return changed
+
+
+def balancing_exponents(G: FloatArray, *, outside: bool) -> tuple[IntArray, float]:
+    """Integer exponents e of the nodes of G that bring its largest scaled entry
+    max_ij G[i, j] + e_j - e_i to the least value any scaling reaches (to within one, for the
+    rounding to integers), the others evened out below it; and that largest entry.
+
+    With ``outside`` the last node is the outside of the model (its exponent 0, left out of
+    the answer); otherwise the exponents are centred on 0 (the scaling of a square matrix
+    alone is unchanged by adding a constant to all of them)."""
+    N = G.shape[0]
+    if N == 0 or not np.any(np.isfinite(G)):
+        return np.zeros(N - 1 if outside else N, dtype=np.int64), -math.inf
+    movable = N - 1 if outside else N
+    least = max_cycle_mean(G)
+    if math.isfinite(least):
+        exponents = np.round(_potentials(G, least + 1e-9 * (1.0 + abs(least))))
+    else:  # no cycle: every entry can be made as small as wished; start unscaled
+        exponents = np.zeros(N)
+    if outside:
+        exponents -= exponents[-1]
+    for _ in range(SWEEPS):
+        if not _sweep(G, exponents, movable):
+            break
+    if not outside and movable:
+        exponents -= np.round((np.max(exponents) + np.min(exponents)) / 2.0)
+    return exponents[:movable].astype(np.int64), largest_scaled(G, exponents)
+
+
+def similarity(
+    A: FloatArray, B: FloatArray, C: FloatArray, exponents: IntArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """T^-1 A T, T^-1 B, C T for T = diag(2^exponents): exact but for over- and underflow (the
+    diagonal of A is unchanged)."""
+    e = exponents.astype(np.int64)
+    with np.errstate(over="ignore", under="ignore"):
+        return (
+            np.ldexp(A, e[None, :] - e[:, None]),
+            np.ldexp(B, -e[:, None]),
+            np.ldexp(C, e[None, :]),
+        )
+
+
+def matching_equilibration(M: FloatArray) -> tuple[IntArray, IntArray] | None:
+    """Row and column exponents r, s with every |M_ij| 2^(r_i + s_j) at most about 1 and those
+    of a transversal (one entry in each row and column) about 1; None if M has no transversal
+    of nonzero entries (M is then singular whatever its values: structurally singular).
+
+    The transversal is the one of largest product of |M_ij|, and r, s are the dual variables
+    of that assignment problem (solved by the Hungarian method with potentials on the costs
+    -log2 |M_ij|), as in MC64's scaling (I. S. Duff and J. Koster, "On algorithms for
+    permuting large entries to the diagonal of a sparse matrix", SIAM J. Matrix Anal. Appl.
+    22, 2001). A matrix that is merely badly scaled becomes one whose size is 1 and whose
+    large entries stand on a transversal, where a singular one stays singular: a test of
+    singularity relative to the norm is then a test of the matrix, not of its scaling.
+    Row and column scalings by powers of two are exact."""
+    n = M.shape[0]
+    if n == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    # A cost far above every -log2 |M_ij| (at most 1075) marks a zero entry.
+    absent = 1e7
+    cost = -log2_sizes(M)
+    cost[~np.isfinite(cost)] = absent
+    # The Hungarian method in its shortest augmenting path form, with row potentials u and
+    # column potentials v (cost_ij - u_i - v_j >= 0, equal on the assignment); index 0 is a
+    # sentinel column and row (1-based nodes, as in the usual formulation).
+    u = np.zeros(n + 1)
+    v = np.zeros(n + 1)
+    row_of = np.zeros(n + 1, dtype=np.int64)  # the row assigned to each column (0: none)
+    for i in range(1, n + 1):
+        row_of[0] = i
+        column = 0
+        shortest = np.full(n + 1, math.inf)
+        previous = np.zeros(n + 1, dtype=np.int64)
+        used = np.zeros(n + 1, dtype=bool)
+        while True:
+            used[column] = True
+            row = row_of[column]
+            free = ~used
+            free[0] = False
+            reduced = cost[row - 1, :] - u[row] - v[1:]
+            candidates = np.flatnonzero(free[1:]) + 1
+            better = candidates[reduced[candidates - 1] < shortest[candidates]]
+            shortest[better] = reduced[better - 1]
+            previous[better] = column
+            nearest = int(candidates[np.argmin(shortest[candidates])])
+            delta = float(shortest[nearest])
+            assigned = np.flatnonzero(used)
+            u[row_of[assigned]] += delta
+            v[assigned] -= delta
+            shortest[candidates] -= delta
+            column = nearest
+            if row_of[column] == 0:
+                break
+        while column:
+            before = int(previous[column])
+            row_of[column] = row_of[before]
+            column = before
+    rows = row_of[1:] - 1
+    if np.any(cost[rows, np.arange(n)] >= absent):
+        return None
+    # |M_ij| 2^(u_i + v_j) = 2^-(cost_ij - u_i - v_j) <= 1, with equality on the assignment.
+    return np.round(u[1:]).astype(np.int64), np.round(v[1:]).astype(np.int64)
