@@ -80,7 +80,7 @@ pub(crate) fn cayley_solution(
     let combined = solve_with_inverse(sum.as_mut(), difference.as_ref());
     let (h, inverse) = combined.as_ref().split_at_col(2 * n);
     let rcond = 1.0 / (norm * one_norm(inverse));
-    if !(rcond >= MIN_RCOND) || !h.is_all_finite() {
+    if rcond.is_nan() || rcond < MIN_RCOND || !h.is_all_finite() {
         return None;
     }
     // H = [[H11, H12], [H21, -H11^T]] (to rounding): the CARE's Ā = H11, G = -H12, Q̄ = -H21.

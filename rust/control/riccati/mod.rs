@@ -4,8 +4,8 @@
 //! ([`difference`]).
 
 pub mod care;
-pub(crate) mod cayley;
 pub(crate) mod care_pencil;
+pub(crate) mod cayley;
 pub mod dare;
 pub mod difference;
 pub mod ode;
