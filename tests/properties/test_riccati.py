@@ -708,20 +708,26 @@ def _lqr_finite_oracle(result: Any, args: dict[str, Any], warned: Warned) -> Non
     assert np.array_equal(result, alone.K), "lqr_finite is not riccati_ode's K"
 
 
+def terminal_weight(data: st.DataObject, n: int) -> tuple[str, Arg]:
+    """Sf of a finite-horizon problem and how it was drawn: none, zero, a symmetric weight, or
+    of the wrong shape (refused)."""
+    kind = data.draw(st.sampled_from(("none", "none", "zero", "weight", "wrong shape")))
+    if kind == "zero":
+        return kind, data.draw(presented(np.zeros((n, n))))
+    if kind == "weight":
+        return kind, data.draw(presented(data.draw(symmetric_weight(n))))
+    if kind == "wrong shape":
+        return kind, data.draw(presented(np.eye(n + 1)))
+    return kind, plain(None)
+
+
 @given(st.data())
 def test_riccati_ode(data: st.DataObject) -> None:
     name = data.draw(st.sampled_from(("riccati_ode", "riccati_ode", "lqr_finite")))
     n = data.draw(st.sampled_from((0, 1, 2, 3, 4, 6)))
     problem = data.draw(riccati_problem(cross=False, descriptor_matrix=False, n=n))
     A, B, Q, R = (problem[k] for k in "ABQR")
-    kind = data.draw(st.sampled_from(("none", "none", "zero", "weight", "wrong shape")))
-    Sf: Arg = plain(None)
-    if kind == "zero":
-        Sf = data.draw(presented(np.zeros((n, n))))
-    elif kind == "weight":
-        Sf = data.draw(presented(data.draw(symmetric_weight(n))))
-    elif kind == "wrong shape":
-        Sf = data.draw(presented(np.eye(n + 1)))
+    _, Sf = terminal_weight(data, n)
     form = data.draw(st.sampled_from(("matrices", "matrices", "sys")))
     arguments: dict[str, Arg] = {}
     if form == "sys":
@@ -874,14 +880,7 @@ def test_riccati_difference(data: st.DataObject) -> None:
     A, B, Q, R, N = (problem[k] for k in "ABQRS")
     n = A.shape[0]  # a planted problem may change the order
     steps = data.draw(st.sampled_from((0, 1, 2, 5, 8, 40)))
-    kind = data.draw(st.sampled_from(("none", "none", "zero", "weight", "wrong shape")))
-    Sf: Arg = plain(None)
-    if kind == "zero":
-        Sf = data.draw(presented(np.zeros((n, n))))
-    elif kind == "weight":
-        Sf = data.draw(presented(data.draw(symmetric_weight(n))))
-    elif kind == "wrong shape":
-        Sf = data.draw(presented(np.eye(n + 1)))
+    kind, Sf = terminal_weight(data, n)
     form = data.draw(st.sampled_from(("matrices", "matrices", "sys")))
     arguments: dict[str, Arg] = {}
     if form == "sys":

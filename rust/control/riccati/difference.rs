@@ -179,29 +179,24 @@ fn joseph_step(
 mod tests {
     use super::*;
 
-    fn mat(rows: &[&[f64]]) -> Mat<f64> {
-        Mat::from_fn(rows.len(), rows[0].len(), |i, j| rows[i][j])
+    /// The scalar equation (a, b, q, r) over `steps` steps from S_f = 0.
+    fn scalar([a, b, q, r]: [f64; 4], steps: usize) -> Result<RiccatiDifferenceSolution, Error> {
+        let [a, b, q, r] = [a, b, q, r].map(|x| Mat::from_fn(1, 1, |_, _| x));
+        riccati_difference(
+            a.as_ref(),
+            b.as_ref(),
+            q.as_ref(),
+            r.as_ref(),
+            steps,
+            DifferenceOptions::default(),
+        )
     }
 
     #[test]
     fn scalar_recursion_has_its_closed_form() {
         // a = 2, b = 1, q = 1, r = 1, s_f = 0: s_k = (5 s + 1) / (1 + s) and k_k = 2 s / (1 + s)
         // with s = s_{k+1}; backward from s_4 = 0: 1, 3, 4, 21/5.
-        let (a, b, q, r) = (
-            mat(&[&[2.0]]),
-            mat(&[&[1.0]]),
-            mat(&[&[1.0]]),
-            mat(&[&[1.0]]),
-        );
-        let solution = riccati_difference(
-            a.as_ref(),
-            b.as_ref(),
-            q.as_ref(),
-            r.as_ref(),
-            4,
-            DifferenceOptions::default(),
-        )
-        .unwrap();
+        let solution = scalar([2.0, 1.0, 1.0, 1.0], 4).unwrap();
         let s: Vec<f64> = solution.s.iter().map(|s| s[(0, 0)]).collect();
         let expected = [21.0 / 5.0, 4.0, 3.0, 1.0, 0.0];
         for (got, want) in s.iter().zip(expected) {
@@ -219,33 +214,10 @@ mod tests {
         // a = 1.26e149, b = 3.46e149, q = r = 1: S_1 = 1, S_0 = a^2 / (1 + b^2) + 1 = 1.13,
         // but A - B K is 1e-150 beside terms of 1e149: no evaluation in double keeps a digit
         // of S_0, and the estimate says so.
-        let (a, b, q, r) = (
-            mat(&[&[1.257302210933933e149]]),
-            mat(&[&[3.45584192064786e149]]),
-            mat(&[&[1.0]]),
-            mat(&[&[1.0]]),
-        );
-        let solution = riccati_difference(
-            a.as_ref(),
-            b.as_ref(),
-            q.as_ref(),
-            r.as_ref(),
-            2,
-            DifferenceOptions::default(),
-        )
-        .unwrap();
+        let solution = scalar([1.257302210933933e149, 3.45584192064786e149, 1.0, 1.0], 2).unwrap();
         assert!(solution.error_estimate > 1.0, "{}", solution.error_estimate);
         // The scaled problem (a, b of order 1, the same ratio) is exact and unflagged.
-        let (a, b) = (mat(&[&[1.257302210933933]]), mat(&[&[3.45584192064786]]));
-        let solution = riccati_difference(
-            a.as_ref(),
-            b.as_ref(),
-            q.as_ref(),
-            r.as_ref(),
-            2,
-            DifferenceOptions::default(),
-        )
-        .unwrap();
+        let solution = scalar([1.257302210933933, 3.45584192064786, 1.0, 1.0], 2).unwrap();
         assert!(
             solution.error_estimate < 1e-14,
             "{}",
@@ -256,21 +228,7 @@ mod tests {
     #[test]
     fn singular_weight_is_refused_with_its_step() {
         // R = 0 and S_f = 0: W_{N-1} = 0.
-        let (a, b, q, r) = (
-            mat(&[&[1.0]]),
-            mat(&[&[1.0]]),
-            mat(&[&[1.0]]),
-            mat(&[&[0.0]]),
-        );
-        let error = riccati_difference(
-            a.as_ref(),
-            b.as_ref(),
-            q.as_ref(),
-            r.as_ref(),
-            3,
-            DifferenceOptions::default(),
-        )
-        .unwrap_err();
+        let error = scalar([1.0, 1.0, 1.0, 0.0], 3).unwrap_err();
         assert!(error.to_string().contains("step 2"), "{error}");
     }
 }
