@@ -708,6 +708,24 @@ def _lqr_finite_oracle(result: Any, args: dict[str, Any], warned: Warned) -> Non
     assert np.array_equal(result, alone.K), "lqr_finite is not riccati_ode's K"
 
 
+def plant_and_weights(
+    data: st.DataObject, A: np.ndarray, B: np.ndarray, Q: np.ndarray, R: np.ndarray
+) -> tuple[str, dict[str, Arg]]:
+    """The form of a finite-horizon call ("matrices": A_or_sys and B; "sys": a system) and
+    its plant and weight arguments, presented."""
+    form = data.draw(st.sampled_from(("matrices", "matrices", "sys")))
+    arguments: dict[str, Arg] = {}
+    if form == "sys":
+        n, m = B.shape
+        arguments["sys"] = data.draw(
+            presented_system((A, B, np.eye(n), np.zeros((n, m))), container="attributes")
+        )
+    else:
+        arguments["A_or_sys"], arguments["B"] = data.draw(presented(A)), data.draw(presented(B))
+    arguments["Q"], arguments["R"] = data.draw(presented(Q)), data.draw(presented(R))
+    return form, arguments
+
+
 def terminal_weight(data: st.DataObject, n: int) -> tuple[str, Arg]:
     """Sf of a finite-horizon problem and how it was drawn: none, zero, a symmetric weight, or
     of the wrong shape (refused)."""
@@ -728,16 +746,7 @@ def test_riccati_ode(data: st.DataObject) -> None:
     problem = data.draw(riccati_problem(cross=False, descriptor_matrix=False, n=n))
     A, B, Q, R = (problem[k] for k in "ABQR")
     _, Sf = terminal_weight(data, n)
-    form = data.draw(st.sampled_from(("matrices", "matrices", "sys")))
-    arguments: dict[str, Arg] = {}
-    if form == "sys":
-        m = B.shape[1]
-        arguments["sys"] = data.draw(
-            presented_system((A, B, np.eye(n), np.zeros((n, m))), container="attributes")
-        )
-    else:
-        arguments["A_or_sys"], arguments["B"] = data.draw(presented(A)), data.draw(presented(B))
-    arguments["Q"], arguments["R"] = data.draw(presented(Q)), data.draw(presented(R))
+    form, arguments = plant_and_weights(data, A, B, Q, R)
     arguments["t"], arguments["Sf"] = data.draw(time_grid()), Sf
     if hamiltonian_work(A, B, Q, R, arguments["t"].canonical) > MAX_WORK:
         # The call would run for hours (known defect riccati-ode-unbounded-substeps): the
@@ -881,16 +890,7 @@ def test_riccati_difference(data: st.DataObject) -> None:
     n = A.shape[0]  # a planted problem may change the order
     steps = data.draw(st.sampled_from((0, 1, 2, 5, 8, 40)))
     kind, Sf = terminal_weight(data, n)
-    form = data.draw(st.sampled_from(("matrices", "matrices", "sys")))
-    arguments: dict[str, Arg] = {}
-    if form == "sys":
-        m = B.shape[1]
-        arguments["sys"] = data.draw(
-            presented_system((A, B, np.eye(n), np.zeros((n, m))), container="attributes")
-        )
-    else:
-        arguments["A_or_sys"], arguments["B"] = data.draw(presented(A)), data.draw(presented(B))
-    arguments["Q"], arguments["R"] = data.draw(presented(Q)), data.draw(presented(R))
+    form, arguments = plant_and_weights(data, A, B, Q, R)
     arguments["steps"] = plain(data.draw(st.sampled_from((steps, np.int64(steps)))))
     arguments["Sf"], arguments["N"] = Sf, optional(data.draw, N)
     oracle = _difference_oracle if name == "riccati_difference" else _dlqr_finite_oracle
