@@ -234,6 +234,29 @@ def test_bad_arguments_are_named() -> None:
         aerocontrol.solve_dare([[np.nan]], [[1.0]], [[1.0]], [[1.0]])
 
 
+def test_weights_are_shaped_as_atleast_2d_by_every_riccati_solver() -> None:
+    """A scalar or 1-D weight means what numpy.atleast_2d makes of it (python-control's
+    R = 1), identically in the continuous, discrete and finite-horizon solvers; an array of
+    more than two dimensions is refused by name."""
+    A = np.array([[1.0, 0.1], [0.0, 1.0]])
+    B = np.array([[0.005], [0.1]])
+    for name, solve in (
+        ("dlqr", lambda R, S: aerocontrol.dlqr(A, B, np.eye(2), R, S)[0]),
+        ("lqr", lambda R, S: aerocontrol.lqr(A - np.eye(2), B, np.eye(2), R, S)[0]),
+        ("riccati_ode", lambda R, S: aerocontrol.riccati_ode(A, B, np.eye(2), R, [0, 1], S).S),
+        (
+            "riccati_difference",
+            lambda R, S: aerocontrol.riccati_difference(A, B, np.eye(2), R, 5, N=S).S,
+        ),
+    ):
+        N = None if name == "riccati_ode" else np.array([[0.1], [0.0]])
+        reference = solve(np.array([[2.0]]), N)
+        for weight in (2.0, 2, np.float32(2.0), [2.0], np.array(2.0)):
+            np.testing.assert_array_equal(solve(weight, N), reference, err_msg=name)
+        with pytest.raises(ShapeError, match="R must be a 2-D matrix or a scalar"):
+            solve(np.full((1, 1, 1), 2.0), N)
+
+
 def test_layouts_and_inputs_left_alone() -> None:
     rng = np.random.default_rng(3)
     A, B, Q, R = _random_stabilisable(rng, 4, 2)

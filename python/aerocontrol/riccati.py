@@ -177,19 +177,14 @@ def _solve_care(
     """The native solve, as (X, K, poles, residual, rcond, steps), warning (at the caller of
     :func:`solve_care` or :func:`lqr`) when the solution may be inaccurate. ``cross`` is the
     caller's name of the cross weight (N for lqr), used in errors."""
-    # Two-dimensional float64 arrays go straight to the core (the common case, whose
-    # conversion calls would cost a twentieth of a 4-state solve).
-    if type(Q) is not np.ndarray or Q.ndim != 2 or Q.dtype != np.float64:
-        Q = _matrix(Q, "Q")
-    if type(R) is not np.ndarray or R.ndim != 2 or R.dtype != np.float64:
-        R = _matrix(R, "R")
+    # The core shapes the weights (a scalar R as 1 x 1, as numpy.atleast_2d).
     result: tuple[FloatArray, FloatArray, ComplexArray, float, float, int] = _core.solve_care(
         A,
         B,
         Q,
         R,
-        None if S is None else _matrix(S, cross),
-        None if E is None else _matrix(E, "E"),
+        S,
+        E,
         bool(refine),
         cross == "N",
     )
@@ -203,12 +198,6 @@ def _solve_care(
             stacklevel=3,
         )
     return result
-
-
-def _matrix(value: object, name: str) -> FloatArray:
-    """A weight as a 2-D array: a scalar becomes 1 x 1 (python-control accepts R = 1)."""
-    array = real_array(value, name)
-    return np.atleast_2d(array) if array.ndim < 2 else array
 
 
 def lqr(
@@ -334,15 +323,7 @@ def _solve_dare(
 ) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
     """The native solve, warning (at the caller of :func:`solve_dare` or :func:`dlqr`) when
     the solution may be inaccurate; ``cross`` names the cross weight in errors (N for dlqr)."""
-    result = _core.solve_dare(
-        A,
-        B,
-        _matrix(Q, "Q"),
-        _matrix(R, "R"),
-        None if S is None else _matrix(S, cross),
-        None if E is None else _matrix(E, "E"),
-        cross == "N",
-    )
+    result = _core.solve_dare(A, B, Q, R, S, E, cross == "N")
     residual, rcond = result[3], result[4]
     if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
         warnings.warn(
@@ -380,13 +361,9 @@ def dlqr(
     >>> bool(np.all(abs(E) < 1)), K.shape
     (True, (1, 2))
     """
-    if is_system(sys_or_A) and getattr(sys_or_A, "dt", None) == 0:
-        raise InvalidArgumentError(
-            "dlqr needs a discrete-time system, got a continuous one (dt = 0); use lqr"
-        )
     A, B, Q, R, N = _regulator_arguments("dlqr", sys_or_A, args, N)
-    X, K, poles, *_ = _solve_dare(A, B, Q, R, N, None, "N")
-    return K, X, poles
+    solution = _solve_dare(A, B, Q, R, N, None, "N")
+    return solution[1], solution[0], solution[2]
 
 
 def _regulator_arguments(
@@ -404,6 +381,10 @@ def _regulator_arguments(
         sys = as_state_space(sys_or_A)
         if name == "lqr":
             require_continuous(sys, "lqr", "use dlqr for the discrete regulator")
+        elif getattr(sys_or_A, "dt", None) == 0:
+            raise InvalidArgumentError(
+                "dlqr needs a discrete-time system, got a continuous one (dt = 0); use lqr"
+            )
         A, B, Q, R = sys.A, sys.B, args[0], args[1]
         weights_given = 2
     else:
@@ -481,10 +462,10 @@ def riccati_ode(
     S, K, substeps = _core.riccati_ode(
         A,
         B,
-        _matrix(Q, "Q"),
-        _matrix(R, "R"),
+        Q,
+        R,
         times,
-        None if Sf is None else _matrix(Sf, "Sf"),
+        Sf,
     )
     return RiccatiSolution(np.array(times, dtype=np.float64), S, K, substeps)
 
@@ -587,11 +568,11 @@ def riccati_difference(
     S, K, rcond, error_estimate = _core.riccati_difference(
         A,
         B,
-        _matrix(Q, "Q"),
-        _matrix(R, "R"),
+        Q,
+        R,
         count,
-        None if Sf is None else _matrix(Sf, "Sf"),
-        None if N is None else _matrix(N, "N"),
+        Sf,
+        N,
     )
     if rcond < RCOND_WARNING or error_estimate > RESIDUAL_WARNING:
         warnings.warn(

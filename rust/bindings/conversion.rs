@@ -190,6 +190,17 @@ impl Real {
         }
     }
 
+    /// A weight of a Riccati equation as a matrix, shaped as `numpy.atleast_2d` shapes it
+    /// (python-control accepts R = 1): a scalar as 1 x 1, a 1-D array of length k as 1 x k.
+    pub fn weight(&self) -> Result<MatRef<'_, f64>, Error> {
+        match self.shape[..] {
+            [] => Ok(MatRef::from_row_major_slice(&self.values, 1, 1)),
+            [cols] => Ok(MatRef::from_row_major_slice(&self.values, 1, cols)),
+            [rows, cols] => Ok(MatRef::from_row_major_slice(&self.values, rows, cols)),
+            _ => Err(self.wrong_dimensions("a 2-D matrix or a scalar")),
+        }
+    }
+
     /// The argument as the input matrix of a single-input function: a 1-D b as the n x 1
     /// column, a 2-D one as it is.
     pub fn input_column(&self) -> Result<MatRef<'_, f64>, Error> {

@@ -87,12 +87,12 @@ fn solve_care<'py>(
     let e = Real::convert_optional(py, e, "E")?;
     let (a, b, q, r, options) = (|| {
         let options = CareOptions {
-            s: s.as_ref().map(|s| s.matrix()).transpose()?,
-            e: e.as_ref().map(|e| e.matrix()).transpose()?,
+            s: s.as_ref().map(|s| s.weight()).transpose()?,
+            e: e.as_ref().map(|e| e.weight()).transpose()?,
             refine,
             s_name: Some(s_name),
         };
-        Ok((a.matrix()?, b.matrix()?, q.matrix()?, r.matrix()?, options))
+        Ok((a.matrix()?, b.matrix()?, q.weight()?, r.weight()?, options))
     })()
     .map_err(|e| to_py_err(py, e))?;
     let solution = compute(py, care_cost(a.nrows()), || {
@@ -134,11 +134,11 @@ fn solve_dare<'py>(
     let e = Real::convert_optional(py, e, "E")?;
     let (a, b, q, r, options) = (|| {
         let options = DareOptions {
-            s: s.as_ref().map(|s| s.matrix()).transpose()?,
-            e: e.as_ref().map(|e| e.matrix()).transpose()?,
+            s: s.as_ref().map(|s| s.weight()).transpose()?,
+            e: e.as_ref().map(|e| e.weight()).transpose()?,
             s_name: Some(s_name),
         };
-        Ok((a.matrix()?, b.matrix()?, q.matrix()?, r.matrix()?, options))
+        Ok((a.matrix()?, b.matrix()?, q.weight()?, r.weight()?, options))
     })()
     .map_err(|e| to_py_err(py, e))?;
     let solution = compute(py, dare_cost(a.nrows(), b.ncols()), || {
@@ -172,13 +172,13 @@ fn riccati_ode<'py>(
     let t = Real::convert(py, t, "t")?;
     let sf = Real::convert_optional(py, sf, "Sf")?;
     let (a, b, q, r, sf, times) = (|| {
-        let sf = sf.as_ref().map(|s| s.matrix()).transpose()?;
+        let sf = sf.as_ref().map(|s| s.weight()).transpose()?;
         let times = t.vector("a 1-D array of times")?;
         Ok((
             a.matrix()?,
             b.matrix()?,
-            q.matrix()?,
-            r.matrix()?,
+            q.weight()?,
+            r.weight()?,
             sf,
             times,
         ))
@@ -227,9 +227,9 @@ fn riccati_difference<'py>(
     let sf = Real::convert_optional(py, sf, "Sf")?;
     let s = Real::convert_optional(py, s, "N")?;
     let (a, b, q, r, sf, s) = (|| {
-        let sf = sf.as_ref().map(|m| m.matrix()).transpose()?;
-        let s = s.as_ref().map(|m| m.matrix()).transpose()?;
-        Ok((a.matrix()?, b.matrix()?, q.matrix()?, r.matrix()?, sf, s))
+        let sf = sf.as_ref().map(|m| m.weight()).transpose()?;
+        let s = s.as_ref().map(|m| m.weight()).transpose()?;
+        Ok((a.matrix()?, b.matrix()?, q.weight()?, r.weight()?, sf, s))
     })()
     .map_err(|e| to_py_err(py, e))?;
     let (n, m) = (a.nrows(), b.ncols());

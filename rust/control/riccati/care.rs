@@ -539,7 +539,7 @@ fn remove_descriptor(
 }
 
 /// Ā = Ã - B̂ Ŝ^T, G = B̂ B̂^T, Q̄ = Q - Ŝ Ŝ^T with B̂ = B̃ L^-T, Ŝ = S L^-T.
-fn standardize(
+pub(crate) fn standardize(
     a_tilde: &DMatrix<f64>,
     b_tilde: &DMatrix<f64>,
     q: &DMatrix<f64>,
@@ -582,7 +582,7 @@ fn standardize(
 pub(crate) struct HamiltonianSolution {
     pub(crate) y: DMatrix<f64>,
     pub(crate) rcond: f64,
-    stable_eigenvalues: Vec<c64>,
+    pub(crate) stable_eigenvalues: Vec<c64>,
     closed_loop: Option<ClosedLoopFactors>,
 }
 

@@ -23,42 +23,72 @@
 //! only when, after its Newton refinement, the residual is within a few units of rounding
 //! and the closed loop passes its checks; otherwise it solves by the pencil and QZ.
 
-use super::care::{Standard, hamiltonian_solution};
+use super::care::{Standard, hamiltonian_solution, standardize};
+use crate::linalg::dense::cholesky;
 use crate::linalg::lu::solve_with_inverse;
-use crate::linalg::matrix::{FaerView, Symmetrize};
+use crate::linalg::matrix::{FaerView, Symmetrize, from_faer};
 use crate::linalg::norm::one_norm;
-use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
-use faer::{Mat, MatRef, Par};
+use faer::{Mat, MatRef, c64};
 use nalgebra::DMatrix;
 
 /// The smallest reciprocal 1-norm condition number of M + N for which the transform is used.
 pub const MIN_RCOND: f64 = 1e-6;
 
-/// X (symmetric) and rcond(U11) by the transform, or `None` where it does not apply (R not
-/// positive definite, M + N ill-conditioned) or the Hamiltonian method refuses.
+/// The transform's candidate solution of the DARE.
+pub(crate) struct CayleySolution {
+    /// X, symmetric.
+    pub(crate) x: Mat<f64>,
+    /// The reciprocal condition number of U11.
+    pub(crate) rcond: f64,
+    /// The closed-loop eigenvalues as the Hamiltonian's stable ones map back,
+    /// z = (1 + s) / (1 - s): estimates (the shifts of the closed loop's own eigenvalue
+    /// computation), not results.
+    pub(crate) closed_loop_estimates: Vec<c64>,
+}
+
+/// The solution by the transform, or `None` where it does not apply (R not positive
+/// definite, M + N ill-conditioned) or the Hamiltonian method refuses.
 pub(crate) fn cayley_solution(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
     s: Option<MatRef<'_, f64>>,
-) -> Option<(Mat<f64>, f64)> {
+) -> Option<CayleySolution> {
+    let standard = cayley_transform(a, b, q, r, s)?;
+    let solution = hamiltonian_solution(&standard).ok()?;
+    let closed_loop_estimates = solution
+        .stable_eigenvalues
+        .iter()
+        .map(|&s| (1.0 + s) / (1.0 - s))
+        .collect();
+    Some(CayleySolution {
+        x: solution.y.as_faer().to_owned(),
+        rcond: solution.rcond,
+        closed_loop_estimates,
+    })
+}
+
+/// The Hamiltonian H = (M + N)^-1 (M - N) as the blocks of a continuous equation, or `None`
+/// where the transform does not apply.
+fn cayley_transform(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    s: Option<MatRef<'_, f64>>,
+) -> Option<Standard> {
     let n = a.nrows();
-    let factor = r.llt(faer::Side::Lower).ok()?;
-    let l = factor.L();
-    // B̂^T = L^-1 B^T, Ŝ^T = L^-1 S^T.
-    let mut b_hat_t = b.transpose().to_owned();
-    solve_lower_triangular_in_place(l, b_hat_t.as_mut(), Par::Seq);
-    let mut g = b_hat_t.transpose() * &b_hat_t;
-    g.symmetrize();
-    let (mut a_tilde, mut q_tilde) = (a.to_owned(), q.to_owned());
-    if let Some(s) = s {
-        let mut s_hat_t = s.transpose().to_owned();
-        solve_lower_triangular_in_place(l, s_hat_t.as_mut(), Par::Seq);
-        a_tilde -= b_hat_t.transpose() * &s_hat_t;
-        q_tilde -= s_hat_t.transpose() * &s_hat_t;
-        q_tilde.symmetrize();
-    }
+    let l = cholesky(&from_faer(r))?;
+    // Ã = A - B̂ Ŝ^T, G = B̂ B̂^T, Q̃ = Q - Ŝ Ŝ^T: the continuous equation's standard form.
+    let plant = standardize(
+        &from_faer(a),
+        &from_faer(b),
+        &from_faer(q),
+        &l,
+        s.map(from_faer).as_ref(),
+    );
+    let (a_tilde, g, q_tilde) = (&plant.a, &plant.g, &plant.q);
     // M + N and M - N.
     let mut sum = Mat::<f64>::zeros(2 * n, 2 * n);
     let mut difference = Mat::<f64>::zeros(2 * n, 2 * n);
@@ -89,11 +119,9 @@ pub(crate) fn cayley_solution(
         m.symmetrize();
         m
     };
-    let standard = Standard {
+    Some(Standard {
         a: DMatrix::from_fn(n, n, |i, j| h[(i, j)]),
         g: block(0, n, -1.0),
         q: block(n, 0, -1.0),
-    };
-    let solution = hamiltonian_solution(&standard).ok()?;
-    Some((solution.y.as_faer().to_owned(), solution.rcond))
+    })
 }

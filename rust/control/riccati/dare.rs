@@ -63,6 +63,7 @@ use super::AlgebraicSolution;
 use super::cayley::cayley_solution;
 use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
+use crate::linalg::dense::view_product;
 use crate::linalg::lu::{solve_in_place, solve_with_inverse};
 use crate::linalg::matrix::Symmetrize;
 use crate::linalg::norm::{frobenius_norm, one_norm};
@@ -140,8 +141,13 @@ pub fn solve_dare(
         identity_e: options.e.is_none(),
     };
     if options.e.is_none()
-        && let Some((x, rcond)) = cayley_solution(a, b, q.as_ref(), r.as_ref(), options.s)
-        && let Ok(solution) = finish(&problem, x, rcond)
+        && let Some(candidate) = cayley_solution(a, b, q.as_ref(), r.as_ref(), options.s)
+        && let Ok(solution) = finish(
+            &problem,
+            candidate.x,
+            candidate.rcond,
+            &candidate.closed_loop_estimates,
+        )
         && solution.residual <= CAYLEY_MAX_RESIDUAL
     {
         return Ok(solution);
@@ -170,11 +176,17 @@ pub fn solve_dare(
                 .into(),
         )
     })?;
-    finish(&problem, x, rcond)
+    finish(&problem, x, rcond, &[])
 }
 
-/// The refinement and the checks of a candidate solution X with its rcond.
-fn finish(problem: &Problem<'_>, mut x: Mat<f64>, rcond: f64) -> Result<AlgebraicSolution, Error> {
+/// The refinement and the checks of a candidate solution X with its rcond; `estimates` of
+/// the closed-loop eigenvalues, if known, are the shifts of their computation.
+fn finish(
+    problem: &Problem<'_>,
+    mut x: Mat<f64>,
+    rcond: f64,
+    estimates: &[c64],
+) -> Result<AlgebraicSolution, Error> {
     let mut evaluation = problem.evaluate(&x)?;
     let refinement_steps = refine(problem, &mut x, &mut evaluation)?;
     if !x.is_all_finite() || !evaluation.closed_loop.is_all_finite() {
@@ -182,7 +194,7 @@ fn finish(problem: &Problem<'_>, mut x: Mat<f64>, rcond: f64) -> Result<Algebrai
     }
     let descriptor = (!problem.identity_e).then_some(problem.e);
     let closed_loop_eigenvalues =
-        closed_loop_eigenvalues(evaluation.closed_loop.as_ref(), descriptor)?;
+        closed_loop_eigenvalues(evaluation.closed_loop.as_ref(), descriptor, estimates)?;
     check_stabilising(
         &closed_loop_eigenvalues,
         frobenius_norm(evaluation.closed_loop.as_ref()),
@@ -224,15 +236,15 @@ impl Problem<'_> {
     fn evaluate(&self, x: &Mat<f64>) -> Result<Evaluation, Error> {
         let (a, b) = (self.a, self.b);
         let m = b.ncols();
-        let xb = x * b;
-        let weight = self.r + b.transpose() * &xb;
-        let mut mixed = xb.transpose() * a;
+        let xb = view_product(x.as_ref(), b);
+        let mut weight = view_product(b.transpose(), xb.as_ref());
+        weight += self.r;
+        let mut mixed = view_product(xb.transpose(), a);
         if let Some(s) = self.s {
             mixed += s.transpose();
         }
         let norm = one_norm(weight.as_ref());
-        let mut factor = weight.clone();
-        let combined = solve_with_inverse(factor.as_mut(), mixed.as_ref());
+        let combined = solve_with_inverse(weight.as_mut(), mixed.as_ref());
         let (gain, inverse) = combined.as_ref().split_at_col(a.nrows());
         let rcond = 1.0 / (norm * one_norm(inverse));
         if m > 0 && (!gain.is_all_finite() || rcond.is_nan() || rcond <= f64::EPSILON) {
@@ -243,15 +255,31 @@ impl Problem<'_> {
             });
         }
         let gain = gain.to_owned();
-        let closed_loop = a - b * &gain;
-        let axa = a.transpose() * x * a;
-        let exe = self.e.transpose() * x * self.e;
-        let quadratic = mixed.transpose() * &gain;
-        let residual = &axa - &exe - &quadratic + self.q;
-        let scale = frobenius_norm(self.q)
-            + frobenius_norm(axa.as_ref())
-            + frobenius_norm(exe.as_ref())
-            + frobenius_norm(quadratic.as_ref());
+        // A - B K, in the product's storage.
+        let mut closed_loop = view_product(b, gain.as_ref());
+        for j in 0..a.ncols() {
+            for (i, entry) in closed_loop.col_as_slice_mut(j).iter_mut().enumerate() {
+                *entry = a[(i, j)] - *entry;
+            }
+        }
+        let mut residual = view_product(view_product(a.transpose(), x.as_ref()).as_ref(), a);
+        let axa_norm = frobenius_norm(residual.as_ref());
+        let quadratic = view_product(mixed.transpose(), gain.as_ref());
+        let exe_norm = if self.identity_e {
+            residual -= x;
+            frobenius_norm(x.as_ref())
+        } else {
+            let exe = view_product(
+                view_product(self.e.transpose(), x.as_ref()).as_ref(),
+                self.e,
+            );
+            residual -= &exe;
+            frobenius_norm(exe.as_ref())
+        };
+        residual -= &quadratic;
+        residual += self.q;
+        let scale =
+            frobenius_norm(self.q) + axa_norm + exe_norm + frobenius_norm(quadratic.as_ref());
         let size = frobenius_norm(residual.as_ref());
         let relative = if scale > 0.0 { size / scale } else { size };
         Ok(Evaluation {
@@ -430,8 +458,12 @@ fn no_solution(evidence: String) -> Error {
 fn closed_loop_eigenvalues(
     closed_loop: MatRef<'_, f64>,
     e: Option<MatRef<'_, f64>>,
+    estimates: &[c64],
 ) -> Result<Vec<c64>, Error> {
     match e {
+        None if estimates.len() == closed_loop.nrows() => {
+            crate::linalg::schur::eigenvalues_near(closed_loop, estimates)
+        }
         None => crate::linalg::schur::eigenvalues(closed_loop),
         Some(e) => {
             let form = qz(closed_loop, e)?;
