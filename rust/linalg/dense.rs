@@ -8,7 +8,8 @@
 //! column lengths known at compile time where [`with_order!`] finds one; large ones lend the
 //! matrices to faer as views (no copy) for its blocked kernels.
 
-use faer::{Mat, MatRef};
+use faer::prelude::ReborrowMut;
+use faer::{Mat, MatMut, MatRef};
 use nalgebra::DMatrix;
 
 use crate::linalg::matrix::{FaerView, from_faer, with_order};
@@ -21,32 +22,53 @@ const LOOP_PRODUCT_MAX_WORK: usize = 16 * 16 * 16;
 /// loop when the product is small (the Riccati and Lyapunov solvers form a dozen products of
 /// order n and m at n = 4), faer's blocked kernel otherwise.
 pub fn view_product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
+    let mut out = Mat::<f64>::zeros(lhs.nrows(), rhs.ncols());
+    view_product_into(out.as_mut(), lhs, rhs, faer::Par::Seq);
+    out
+}
+
+/// out = lhs * rhs, as [`view_product`] forms it, with faer's kernel on `par` for large
+/// products.
+pub fn view_product_into(
+    mut out: MatMut<'_, f64>,
+    lhs: MatRef<'_, f64>,
+    rhs: MatRef<'_, f64>,
+    par: faer::Par,
+) {
     let (rows, inner, cols) = (lhs.nrows(), lhs.ncols(), rhs.ncols());
     debug_assert_eq!(inner, rhs.nrows());
+    debug_assert_eq!((rows, cols), (out.nrows(), out.ncols()));
     if rows * inner * cols > LOOP_PRODUCT_MAX_WORK {
-        return lhs * rhs;
+        faer::linalg::matmul::matmul(out, faer::Accum::Replace, lhs, rhs, 1.0, par);
+        return;
     }
-    let mut out = Mat::<f64>::zeros(rows, cols);
+    out.fill(0.0);
     for j in 0..cols {
-        let column = out.col_as_slice_mut(j);
+        let mut column = out.rb_mut().col_mut(j);
         for k in 0..inner {
             let coefficient = rhs[(k, j)];
             // Contiguous columns (faer's own matrices) as slices: no per-entry index checks.
-            match lhs.col(k).try_as_col_major() {
-                Some(lhs_column) => {
-                    for (entry, x) in column.iter_mut().zip(lhs_column.as_slice()) {
+            match (
+                lhs.col(k).try_as_col_major(),
+                column.rb_mut().try_as_col_major_mut(),
+            ) {
+                (Some(lhs_column), Some(out_column)) => {
+                    for (entry, x) in out_column
+                        .as_slice_mut()
+                        .iter_mut()
+                        .zip(lhs_column.as_slice())
+                    {
                         *entry += x * coefficient;
                     }
                 }
-                None => {
-                    for (i, entry) in column.iter_mut().enumerate() {
-                        *entry += lhs[(i, k)] * coefficient;
+                _ => {
+                    for i in 0..rows {
+                        column[i] += lhs[(i, k)] * coefficient;
                     }
                 }
             }
         }
     }
-    out
 }
 
 /// lhs * rhs. Each entry of a small product is the sum over k, in order, of
