@@ -49,8 +49,9 @@ fn spectra(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("staircase verdict", n), &a, |bench, a| {
             bench.iter(|| controllability_staircase(black_box(a.as_ref()), b.as_ref(), None, false))
         });
+        let eta0 = faer::mat![[1.0], [0.5]];
         group.bench_with_input(BenchmarkId::new("steady_state", n), &a, |bench, a| {
-            bench.iter(|| steady_state(black_box(a.as_ref()), b.as_ref(), &[1.0, 0.5]))
+            bench.iter(|| steady_state(black_box(a.as_ref()), b.as_ref(), eta0.as_ref()))
         });
         if n <= 16 {
             let b1 = seeded_matrix(n, 1, 5);

@@ -201,6 +201,45 @@ def test_dc_gain_and_steady_state_of_a_badly_scaled_closed_loop(discrete: bool) 
     assert abs(gain[0, 0] - expected) <= 2 * np.finfo(float).eps * abs(expected)
 
 
+@pytest.mark.parametrize("discrete", [False, True])
+def test_dc_gain_of_several_inputs_is_each_inputs_steady_state(discrete: bool) -> None:
+    """dc_gain solves for every input at once (one factorisation): each column is C x_j + D_j
+    with x_j the steady state of input j alone, and D - C A^-1 B (for a discrete model
+    D + C (I - A)^-1 B) from numpy; also through the equilibrated retry of a badly scaled A
+    (the closed loop above, with a second input)."""
+    rng = np.random.default_rng(7)
+    n, m, p = 16, 3, 2
+    A = rng.standard_normal((n, n)) / np.sqrt(n) - 2.0 * np.eye(n)
+    if discrete:
+        A = 0.3 * A / np.abs(np.linalg.eigvals(A)).max()
+    B, C, D = rng.standard_normal((n, m)), rng.standard_normal((p, n)), rng.standard_normal((p, m))
+    model = aerocontrol.StateSpace(A, B, C, D, dt=0.1 if discrete else None)
+    gain = aerocontrol.dc_gain(model)
+    M = A - np.eye(n) if discrete else A
+    expected = D - C @ np.linalg.solve(M, B)
+    np.testing.assert_allclose(gain, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+    for j in range(m):
+        state = aerocontrol.steady_state(model, np.eye(m)[j])
+        # The same x_j; C x_j + D_j summed in another order: within n u (|C| |x_j| + |D_j|).
+        bound = n * np.finfo(float).eps * (np.abs(C) @ np.abs(state) + np.abs(D[:, j]))
+        assert np.all(np.abs(gain[:, j] - (C @ state + D[:, j])) <= bound)
+    badly = aerocontrol.StateSpace(
+        _A_BADLY_SCALED,
+        np.array([[1.0, 2.0], [1.0, 0.0], [0.0, 1.0]]),
+        [[0.0, 1.0, 2.0]],
+        [[0.0, 0.0]],
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        gains = aerocontrol.dc_gain(badly)
+        for j in range(2):
+            state = aerocontrol.steady_state(badly, np.eye(2)[j])
+            assert abs(gains[0, j] - (state[1] + 2 * state[2])) <= 4 * np.finfo(float).eps * abs(
+                gains[0, j]
+            )
+    assert gains[0, 0] == pytest.approx(-1.0 / 3.0, rel=1e-15)
+
+
 def test_dc_gain_of_feedback_of_a_huge_loop_gain() -> None:
     """The closed loop that feedback forms of that loop (L(0) = 3e462): T(0) = 1 to the
     doubles, and the steady state against exact rational arithmetic (its first entry,

@@ -114,7 +114,9 @@ def simulate_models(
     method: str,
     /,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
-def steady_state(a: ArrayLike, b: ArrayLike, eta0: ArrayLike, /) -> NDArray[np.float64]: ...
+def steady_state(
+    a: ArrayLike, b: ArrayLike, eta0: ArrayLike, warn: bool, /
+) -> NDArray[np.float64]: ...
 def loop_margins(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /
 ) -> tuple[

@@ -36,7 +36,6 @@ share their sampling period.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal, cast
@@ -48,7 +47,6 @@ from . import _core, _scaling
 from ._validation import FloatArray, check_choice, check_finite, finite_or_warn, real_array
 from .exceptions import (
     InvalidArgumentError,
-    NumericalOverflowWarning,
     ShapeError,
     SingularMatrixError,
 )
@@ -688,17 +686,21 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     weights = real_array(eta0, "eta0")
     if weights.ndim == 0 and model.n_inputs == 1:  # a number for the one input
         weights = weights.reshape(1)
-    result: FloatArray = _steady_state(model, weights)
-    return result
+    if weights.ndim != 1:
+        raise ShapeError(
+            f"eta0 must be a 1-D array of one value per input, got an array of shape "
+            f"{weights.shape}"
+        )
+    return _steady_state(model, weights)
 
 
-def _steady_state(model: StateSpace, weights: ArrayLike) -> FloatArray:
+def _steady_state(model: StateSpace, weights: ArrayLike, warn: bool = True) -> FloatArray:
     """-A^-1 B η0 for a continuous model; for a discrete one, -(A - I)^-1 B η0, with the
     error of a singular A - I naming the eigenvalue 1 of A."""
     if not model.is_discrete:
-        return _equilibrated_solve(model.A, model.B, weights)
+        return _equilibrated_solve(model.A, model.B, weights, warn)
     try:
-        return _equilibrated_solve(model.A - np.eye(model.n_states), model.B, weights)
+        return _equilibrated_solve(model.A - np.eye(model.n_states), model.B, weights, warn)
     except SingularMatrixError as error:
         raise SingularMatrixError(
             "A - I is singular: A has the eigenvalue 1 (a discrete integrator or neutral "
@@ -706,7 +708,7 @@ def _steady_state(model: StateSpace, weights: ArrayLike) -> FloatArray:
         ) from error
 
 
-def _equilibrated_solve(M: FloatArray, B: FloatArray, weights: ArrayLike) -> FloatArray:
+def _equilibrated_solve(M: FloatArray, B: FloatArray, weights: ArrayLike, warn: bool) -> FloatArray:
     """-M^-1 B η0 by the core, which refuses an M with an eigenvalue within 100 n u ||M|| of
     zero; where it does, the same solve of R M S y = -R B η0, x = S y, with M equilibrated by
     powers of two (R, S diagonal: ``_scaling.matching_equilibration``), and the core's error
@@ -715,9 +717,11 @@ def _equilibrated_solve(M: FloatArray, B: FloatArray, weights: ArrayLike) -> Flo
 
     A matrix merely badly scaled, such as the closed loop of a loop gain of 1e462 (entries of
     4e231 beside eigenvalues of 1.5), is then solved; the scalings are exact, so x is the
-    solution of the same equations, to the conditioning of the equilibrated matrix."""
+    solution of the same equations, to the conditioning of the equilibrated matrix. ``weights``
+    is one input vector (1-D; x is 1-D) or one per column (2-D; x is n x k, one factorisation).
+    An x that overflows comes with a NumericalOverflowWarning if ``warn``."""
     try:
-        result: FloatArray = _core.steady_state(M, B, weights)
+        result: FloatArray = _core.steady_state(M, B, weights, warn)
         return result
     except SingularMatrixError:
         scalings = _scaling.matching_equilibration(M)
@@ -733,13 +737,14 @@ def _equilibrated_solve(M: FloatArray, B: FloatArray, weights: ArrayLike) -> Flo
             scaled = np.ldexp(M, rows[:, None] + columns[None, :])
             scaled_B = np.ldexp(B, rows[:, None] - shift)
         try:
-            y = _core.steady_state(scaled, scaled_B, weights)
+            y = _core.steady_state(scaled, scaled_B, weights, False)
         except SingularMatrixError:
             pass
         else:
+            exponents = columns + shift
             with np.errstate(over="ignore", under="ignore"):
-                x = np.ldexp(y, columns + shift)
-            return finite_or_warn(x, "the steady state")
+                x = np.ldexp(y, exponents if y.ndim == 1 else exponents[:, None])
+            return finite_or_warn(x, "the steady state") if warn else x
         raise
 
 
@@ -773,12 +778,8 @@ def dc_gain(sys: System) -> FloatArray:
     aerocontrol.exceptions.SingularMatrixError: A is singular: it has the eigenvalue 0 ...
     """
     model = as_state_space(sys)
-    # One warning for the gain, not one per column's steady state.
-    with np.errstate(over="ignore", invalid="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", NumericalOverflowWarning)
-        columns = [
-            model.C @ _steady_state(model, np.eye(model.n_inputs)[j]) + model.D[:, j]
-            for j in range(model.n_inputs)
-        ]
-    gain: FloatArray = np.stack(columns, axis=1) if columns else np.zeros((model.n_outputs, 0))
+    # Every input's steady state from one factorisation; one warning, for the gain.
+    states = _steady_state(model, np.eye(model.n_inputs), warn=False)
+    with np.errstate(over="ignore", invalid="ignore"):
+        gain: FloatArray = model.C @ states + model.D
     return finite_or_warn(gain, "the DC gain")

@@ -11,6 +11,7 @@ use crate::control::responses::{
     simulate_sampled_into, steady_state as steady_state_core, uniform_grid_step,
 };
 use crate::error::Error;
+use faer::MatRef;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 
@@ -247,28 +248,44 @@ fn simulate_models<'py>(
     Ok((x, y))
 }
 
-/// -A^-1 B eta0, the steady state of a step (6.45).
+/// -A^-1 B eta0, the steady state of a step (6.45): 1-D for one input vector eta0, n x k for
+/// the k columns of a 2-D eta0. With `warn` false a result that overflows comes without the
+/// NumericalOverflowWarning (for a caller that warns about what it makes of it).
 #[pyfunction]
-#[pyo3(signature = (a, b, eta0, /))]
+#[pyo3(signature = (a, b, eta0, warn, /))]
 fn steady_state<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     b: &Bound<'py, PyAny>,
     eta0: &Bound<'py, PyAny>,
+    warn: bool,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let a = Real::convert(py, a, "A")?;
     let b = Real::convert(py, b, "B")?;
     let eta0 = Real::convert(py, eta0, "eta0")?;
     let (a, b) = (|| Ok((a.matrix()?, b.matrix()?)))().map_err(|e| to_py_err(py, e))?;
-    let eta = eta0
-        .vector("a 1-D array of one value per input")
-        .map_err(|e| to_py_err(py, e))?;
+    // One input vector (1-D, one steady state), or one per column (2-D).
+    let single = eta0.shape().len() == 1;
+    let weights = if single {
+        let values = eta0
+            .vector("a 1-D array of one value per input")
+            .map_err(|e| to_py_err(py, e))?;
+        MatRef::from_column_major_slice(values, values.len(), 1)
+    } else {
+        eta0.matrix().map_err(|e| to_py_err(py, e))?
+    };
     let n = a.nrows();
     let cost = Cost::of(2.0 * (n as f64).powi(3), 3.0, n);
-    let x = compute(py, cost, || steady_state_core(a, b, eta))?;
+    let x = compute(py, cost, || steady_state_core(a, b, weights))?;
     let mut outputs = Outputs::new(py);
-    let out = outputs.real("the steady state", &[x.len()], &x)?;
-    outputs.finish()?;
+    let out = if single {
+        outputs.real("the steady state", &[n], x.col_as_slice(0))?
+    } else {
+        outputs.matrix("the steady state", x.as_ref())?
+    };
+    if warn {
+        outputs.finish()?;
+    }
     Ok(out)
 }
 

@@ -470,30 +470,31 @@ pub fn simulate_models_sampled_into(
         })
 }
 
-/// The steady state -A^-1 B η0 of a step (6.45), or an error naming the eigenvalue of A that
-/// makes it singular (an integrator or neutral mode has no steady state).
+/// The steady states -A^-1 B η0 of steps (6.45), one for each column η0 of `eta0` (m x k; one
+/// LU factorisation for all), or an error naming the eigenvalue of A that makes it singular
+/// (an integrator or neutral mode has no steady state).
 pub fn steady_state(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    eta0: &[f64],
-) -> Result<Vec<f64>, Error> {
+    eta0: MatRef<'_, f64>,
+) -> Result<Mat<f64>, Error> {
     check_finite(a, "A")?;
     let empty = Mat::<f64>::zeros(0, a.nrows());
     let no_feedthrough = Mat::<f64>::zeros(0, b.ncols());
     check_state_space(a, b, empty.as_ref(), no_feedthrough.as_ref())?;
-    if eta0.len() != b.ncols() {
+    if eta0.nrows() != b.ncols() {
         return Err(Error::Mismatch {
             arg: "eta0",
             what: "one value per input, as many as the columns of",
             expected: b.ncols(),
             other: "B",
-            got: eta0.len(),
+            got: eta0.nrows(),
         });
     }
-    check_finite_values(eta0, "eta0")?;
+    check_finite(eta0, "eta0")?;
     let n = a.nrows();
     let lu = a.partial_piv_lu();
-    let mut x = -(b * Mat::from_fn(b.ncols(), 1, |i, _| eta0[i]));
+    let mut x = -(b * eta0);
     lu.solve_in_place(x.as_mut());
     // A has an eigenvalue within `tolerance` of zero only if σ_min(A) <= tolerance. The
     // 1-norm estimate of A^-1 (Higham & Tisseur 2000; O(n^2) per step with the LU factors)
@@ -513,7 +514,7 @@ pub fn steady_state(
             });
         }
     }
-    Ok((0..n).map(|i| x[(i, 0)]).collect())
+    Ok(x)
 }
 
 /// An eigenvalue of A within this many n u ||A||_max of zero makes A singular for
@@ -662,7 +663,8 @@ mod tests {
             &mut y,
         )
         .unwrap();
-        let steady = steady_state(a.as_ref(), b.as_ref(), &eta0).unwrap();
+        let steady = steady_state(a.as_ref(), b.as_ref(), mat![[eta0[0]]].as_ref()).unwrap();
+        let steady: Vec<f64> = steady.col_as_slice(0).to_vec();
         let last = &x[(steps - 1) * 4..];
         for (l, s) in last.iter().zip(&steady) {
             assert!((l - s).abs() < 1e-7, "{l} vs {s}");
@@ -805,7 +807,7 @@ mod tests {
         // (6.95): A has the eigenvalue 0.
         let a = mat![[-3.0, 8.0], [0.0, 0.0]];
         let b = mat![[0.0], [4.0]];
-        let err = steady_state(a.as_ref(), b.as_ref(), &[1.0]).unwrap_err();
+        let err = steady_state(a.as_ref(), b.as_ref(), mat![[1.0]].as_ref()).unwrap_err();
         assert!(
             matches!(err, Error::Singular { arg: "A", eigenvalue_re, .. } if eigenvalue_re == 0.0)
         );
@@ -813,7 +815,7 @@ mod tests {
         // An eigenvalue at 1e-17 of a matrix of size 1 is zero to working precision.
         let a = mat![[-1.0, 1.0, 0.0], [0.0, 1e-17, 0.0], [0.0, 0.0, -2.0]];
         let b = mat![[0.0], [1.0], [1.0]];
-        let err = steady_state(a.as_ref(), b.as_ref(), &[1.0]).unwrap_err();
+        let err = steady_state(a.as_ref(), b.as_ref(), mat![[1.0]].as_ref()).unwrap_err();
         assert!(matches!(err, Error::Singular { eigenvalue_re, .. } if eigenvalue_re == 1e-17));
     }
 
@@ -823,8 +825,8 @@ mod tests {
         // do, and x = -A^-1 b is returned.
         let a = mat![[-1.0, 1e8], [0.0, -1.0]];
         let b = mat![[0.0], [1.0]];
-        let x = steady_state(a.as_ref(), b.as_ref(), &[1.0]).unwrap();
-        assert_eq!(x, vec![1e8, 1.0]);
+        let x = steady_state(a.as_ref(), b.as_ref(), mat![[1.0]].as_ref()).unwrap();
+        assert_eq!(x.col_as_slice(0), [1e8, 1.0]);
     }
 
     #[test]
