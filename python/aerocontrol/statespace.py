@@ -45,6 +45,30 @@ def _matrix(value: object, name: str) -> FloatArray:
     return np.array(array, dtype=np.float64, order="C")
 
 
+#: Default C = I and D = 0 up to this many entries are made once and shared (read-only).
+_SHARED_CONSTANT_MAX_ENTRIES = 64 * 64
+
+
+def _constant(rows: int, columns: int, identity: bool) -> FloatArray:
+    """The default C (the identity) or D (zeros) of a model, read-only: shared between models
+    up to :data:`_SHARED_CONSTANT_MAX_ENTRIES` entries (``np.eye`` costs a fifth of a small
+    model's construction), made afresh above."""
+    if rows * columns <= _SHARED_CONSTANT_MAX_ENTRIES:
+        return _shared_constant(rows, columns, identity)
+    return _made_constant(rows, columns, identity)
+
+
+@functools.lru_cache(maxsize=256)
+def _shared_constant(rows: int, columns: int, identity: bool) -> FloatArray:
+    return _made_constant(rows, columns, identity)
+
+
+def _made_constant(rows: int, columns: int, identity: bool) -> FloatArray:
+    matrix = np.eye(rows, columns) if identity else np.zeros((rows, columns))
+    matrix.setflags(write=False)
+    return matrix
+
+
 @functools.lru_cache(maxsize=256)
 def _default_names(prefix: str, count: int) -> tuple[str, ...]:
     """x0, x1, ... (a tuple of strings, immutable: shared by the models that use it; made
@@ -158,8 +182,8 @@ class StateSpace:
         B = _matrix(B_array.reshape(-1, 1) if B_array.ndim == 1 else B_array, "B")
         n, m = A.shape[0], B.shape[1]
         identity_output = C is None
-        C = np.eye(n) if identity_output else _matrix(C, "C")
-        D = np.zeros((C.shape[0], m)) if D is None else _matrix(D, "D")
+        C = _constant(n, n, identity=True) if identity_output else _matrix(C, "C")
+        D = _constant(C.shape[0], m, identity=False) if D is None else _matrix(D, "D")
         _core.check_model(A, B, C, D)
         for matrix in (A, B, C, D):
             matrix.setflags(write=False)
