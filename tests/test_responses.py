@@ -566,3 +566,26 @@ def test_impulse_weights_in_every_layout_give_the_c_ordered_result(layout: str) 
         reference = function(sys, T=np.array([0.0, 0.1]), eta0=eta0.copy())
         assert ours.x.tobytes() == reference.x.tobytes()
         assert ours.y.tobytes() == reference.y.tobytes()
+
+
+def test_the_default_grid_refuses_an_a_whose_norm_is_far_beyond_its_modes() -> None:
+    """A campaign input: a list of a model with modes of size 1 and a nilpotent A of 1e149
+    (no mode). The default grid took a step of 0.05 s from the first, on which the core
+    refused e^{hA} of the second (h ||A||_1 = 5e148 > 2^53) with an IllConditionedError that
+    named neither the grid nor T. Now the step is at most 2^52 / ||A||_1, and where that needs
+    more than 100,001 samples the grid is refused by name."""
+    nilpotent = aerocontrol.StateSpace(1e149 * np.triu(np.ones((4, 4)), 1), np.zeros((4, 0)))
+    modes = aerocontrol.StateSpace(-np.eye(4), np.zeros((4, 0)))
+    for sys in ([modes, nilpotent], nilpotent):
+        with pytest.raises(InvalidArgumentError, match="default time grid: A has the norm"):
+            aerocontrol.default_time_grid(sys)
+        with pytest.raises(InvalidArgumentError, match="default time grid: A has the norm"):
+            aerocontrol.initial_response(sys, np.ones(4))
+    # Where the smaller step fits, it is taken: ||A||_1 = 2^52 / 1e-4 gives h = 1e-4 s
+    # instead of 0.01 s (no mode), 100,001 samples to 10 s, and an exact response.
+    norm = 2.0**52 / 1e-4
+    shear = aerocontrol.StateSpace([[0.0, norm], [0.0, 0.0]], [[0.0], [0.0]])
+    t = aerocontrol.default_time_grid(shear)
+    assert t[1] == pytest.approx(1e-4, rel=1e-12) and len(t) == 100_001
+    x = aerocontrol.initial_response(shear, [0.0, 1.0]).x
+    assert np.allclose(x[:, 0], norm * t, rtol=1e-12, atol=0.0) and np.all(x[:, 1] == 1.0)

@@ -19,7 +19,10 @@ for the default grid: a step of 1/(20 |λ|max), twenty samples per time constant
 mode, and a final time of 7 time constants 1/|σ| of the slowest decaying mode (to 0.1 % of its
 amplitude), or 10/|λ|min when no mode decays; at most 100,001 samples (the step grows to fit).
 The default grid is made for any |λ|max up to 2.2e306, where 1/(20 |λ|max) is still a normal
-double; beyond, it is refused by name (InvalidArgumentError: give the grid T). A final time T
+double; beyond, it is refused by name (InvalidArgumentError: give the grid T). The step is
+also at most 2^52 / ||A||_1 (for an A far from normal, whose norm exceeds its eigenvalues:
+e^{hA} is refused beyond h ||A||_1 = 2^53), and where that needs more than 100,001 samples
+the default grid is refused likewise. A final time T
 whose 100 steps would be below the normal doubles (2.2e-306 s) is refused likewise, as is a
 step of T too long for A (A times the step overflows).
 
@@ -157,14 +160,43 @@ def default_time_grid(sys: Systems) -> FloatArray:
     """The default grid of the responses (see the module documentation).
 
     Raises InvalidArgumentError when an eigenvalue is so large (|λ| > 2e306) that the step
-    1/(20 |λ|) would not be a normal double: give the grid T instead."""
+    1/(20 |λ|) would not be a normal double, or when ||A||_1 is so far beyond the modes (a
+    nilpotent A of 1e149) that a step with h ||A||_1 <= 2^52 needs more than 100,001 samples
+    to the final time: give the grid T instead."""
     models, _ = _systems(sys)
     dt = _sampling_period(models)
     if dt > 0.0:
         return _discrete_grid(None, models, dt)[0]
     step, final = _default_step_and_final(models)
+    step = _within_the_exponential(step, final, models)
     samples = _steps_within(final / step, MAX_DEFAULT_SAMPLES - 1) + 1
     return np.linspace(0.0, (samples - 1) * step, samples)
+
+
+#: The largest ||h A||_1 of a default step h: the core refuses e^{hA} beyond 2^53 = 1/u
+#: (IllConditionedError: the rounding of A alone changes every digit), and half of it keeps
+#: the grid clear of that limit.
+LARGEST_STEP_NORM = 2.0**52
+
+
+def _within_the_exponential(step: float, final: float, models: list[StateSpace]) -> float:
+    """The default step of continuous models, made smaller where h ||A||_1 exceeds
+    :data:`LARGEST_STEP_NORM` (an A far from normal: a nilpotent A of 1e149 has no mode to
+    set the step, yet e^{hA} is refused at h = 0.01), or refused by name where the final
+    time would then need more than the samples allowed."""
+    with np.errstate(over="ignore"):
+        norm = max(float(np.abs(m.A).sum(axis=0).max(initial=0.0)) for m in models)
+    if not step * norm > LARGEST_STEP_NORM:
+        return step
+    limit = LARGEST_STEP_NORM / norm
+    if limit >= np.finfo(np.float64).tiny and final / limit <= MAX_DEFAULT_SAMPLES - 1:
+        return limit
+    raise InvalidArgumentError(
+        f"the default time grid: A has the norm ||A||_1 = {norm:.3g}, far beyond its modes "
+        f"(a final time of {final:.3g} s), so a step short enough for e^(hA) (h ||A||_1 at "
+        f"most 2^52, h = {limit:.3g} s) needs more than {MAX_DEFAULT_SAMPLES} samples; give "
+        "the grid T"
+    )
 
 
 def _steps_within(ratio: float, cap: int) -> int:
