@@ -589,3 +589,14 @@ def test_the_default_grid_refuses_an_a_whose_norm_is_far_beyond_its_modes() -> N
     assert t[1] == pytest.approx(1e-4, rel=1e-12) and len(t) == 100_001
     x = aerocontrol.initial_response(shear, [0.0, 1.0]).x
     assert np.allclose(x[:, 0], norm * t, rtol=1e-12, atol=0.0) and np.all(x[:, 1] == 1.0)
+
+
+def test_doublet_initial_state_is_formed_as_a_times_b_eta0() -> None:
+    """A campaign input: A = 1.26e-151, B = 1.26e-301, eta0 = 1.26e149. (A B) eta0 underflowed
+    A B (1.6e-452) to 0; A (B eta0) = 1.99e-303, a normal double, is x(0) to the rounding."""
+    a, b, eta = 1.257302210933933e-151, 1.257302210933933e-301, 1.257302210933933e149
+    response = aerocontrol.doublet_response(
+        (np.array([[a]]), np.array([[b]])), T=np.array([0.0, 1.0]), eta0=[eta]
+    )
+    assert response.x[0, 0] == pytest.approx(a * (b * eta), rel=4e-16)
+    assert response.x[0, 0] == pytest.approx(1.9875544616903434e-303, rel=1e-15)

@@ -599,7 +599,9 @@ def doublet_response(
         "doublet",
         sys,
         T,
-        lambda m: _initial_state(lambda: weights @ (m.A @ m.B).T, "A B eta0"),
+        # A (B η0), the order of the definition: (A B) η0 underflowed A B of 1e-452 to
+        # zero where A (B η0) with an η0 of 1e149 is 2e-303.
+        lambda m: _initial_state(lambda: (weights @ m.B.T) @ m.A.T, "A B eta0"),
         labels,
     )
 
