@@ -13,6 +13,7 @@ otherwise.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -887,3 +888,67 @@ def test_sampled_weights_of_a_stiff_plant_do_not_overflow() -> None:
     assert w.Q[0, 0] == pytest.approx(1.0 / 2e4, rel=1e-12)
     with pytest.raises(InvalidArgumentError, match="sampled_weights designs in continuous time"):
         aerocontrol.design.sampled_weights(aerocontrol.c2d(sys, 0.1), 0.1)
+
+
+# ----- matched pole-zero beyond |z| = 1e154 (trust fixes) ------------------------------------
+
+
+def _sampled_gain_at_one(sys: StateSpace) -> float:
+    n = sys.A.shape[0]
+    return float((sys.C @ np.linalg.solve(np.eye(n) - sys.A, sys.B))[0, 0] + sys.D[0, 0])
+
+
+@pytest.mark.parametrize("sigma", [300.0, 400.0, 700.0, 709.0])
+@pytest.mark.parametrize(
+    "case", ["complex pair", "real pair", "real pair with feedthrough", "stable and unstable"]
+)
+def test_matched_poles_beyond_1e154(sigma: float, case: str) -> None:
+    """Poles e^{σ dt} of 1e130 to 1e308: |z|^2 and the products of the gain overflowed beyond
+    |z| = 1e154 (numpy's RuntimeWarnings, then a B of inf refused) although the model fits.
+    Closed form: the poles are e^{p dt} (to the rounding of the exponential) and the DC gains
+    agree, G_d(1) = G(0) (the matched method's gain), to 1e-13 relatively."""
+    A, B, C, D = {
+        "complex pair": ([[sigma, 1.0], [-1.0, sigma]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]]),
+        "real pair": ([[sigma, 0.0], [0.0, sigma - 1]], [[1.0], [1.0]], [[1.0, 0.0]], [[0.0]]),
+        "real pair with feedthrough": (
+            [[sigma, 0.0], [0.0, sigma - 1]],
+            [[1.0], [1.0]],
+            [[1.0, 0.0]],
+            [[1.0]],
+        ),
+        "stable and unstable": ([[sigma, 0.0], [0.0, -1.0]], [[1.0], [1.0]], [[1.0, 2.0]], [[0.0]]),
+    }[case]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sampled = aerocontrol.c2d(StateSpace(A, B, C, D), 1.0, "matched")
+    assert np.all(np.isfinite(sampled.B)) and np.all(np.isfinite(sampled.C))
+    poles = np.sort_complex(np.log(np.linalg.eigvals(sampled.A).astype(complex)))
+    expected = np.sort_complex(np.linalg.eigvals(np.asarray(A)).astype(complex))
+    assert np.allclose(poles, expected, rtol=1e-13, atol=0.0)
+    continuous = float(
+        (np.asarray(C) @ np.linalg.solve(-np.asarray(A), np.asarray(B)))[0, 0] + D[0][0]
+    )
+    assert _sampled_gain_at_one(sampled) == pytest.approx(continuous, rel=1e-13)
+
+
+def test_matched_refuses_poles_whose_exponential_overflows() -> None:
+    """e^{710} is beyond the doubles: refused naming dt, without numpy warnings."""
+    sys = StateSpace([[710.0, 1.0], [-1.0, 710.0]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InvalidArgumentError, match="e\\^\\(r dt\\) overflow") as caught:
+            aerocontrol.c2d(sys, 1.0, "matched")
+    assert caught.value.argument == "dt"
+
+
+def test_matched_is_unchanged_below_the_scaling_threshold() -> None:
+    """Poles below 2^256 keep the sections as before: a real pair's subdiagonal 1, poles
+    e^{-dt}, e^{-2 dt} exactly."""
+    sampled = aerocontrol.c2d(
+        StateSpace([[-1.0, 0.0], [0.0, -2.0]], [[1.0], [1.0]], [[1.0, -1.0]], [[0.0]]),
+        0.1,
+        "matched",
+    )
+    assert sampled.A[1, 0] == 1.0
+    assert sorted(np.diag(sampled.A)) == sorted([np.exp(-0.1), np.exp(-0.2)])
+    assert _sampled_gain_at_one(sampled) == pytest.approx(0.5, rel=1e-14)

@@ -462,3 +462,180 @@ def test_a_number_is_not_a_model() -> None:
         aerocontrol.as_state_space(3.0)
     with pytest.raises(aerocontrol.NotRealError, match="both A and B"):
         aerocontrol.controllability(np.eye(2))
+
+
+# ----- numerical edges of the time grids (trust fixes) ----------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("sys", "T"),
+    [
+        # A final time 1e301 over the default step of 5e-302: a ratio of infinity, which
+        # int() refused with a bare OverflowError ("cannot convert float infinity").
+        ((np.array([[-1e300]]), np.array([[1.0]])), 3e301),
+        ((np.array([[-1e300]]), np.array([[1.0]])), 1.7e308),
+    ],
+)
+def test_final_time_beyond_the_samples_is_capped_not_overflowed(sys: tuple, T: float) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", aerocontrol.AerocontrolWarning)
+        try:
+            response = aerocontrol.step_response(sys, T=T)
+        except InvalidArgumentError as error:  # A h overflows: refused, naming T
+            assert error.argument == "T" and "T steps by" in str(error)
+            return
+    assert len(response.t) == aerocontrol.responses.MAX_DEFAULT_SAMPLES
+    assert response.t[-1] == T
+
+
+def test_a_step_too_long_for_the_model_is_refused_naming_T() -> None:
+    # The core's refusal named its own argument "dt" and printed 300 digits.
+    # T = 3e299 as a final time: 100,000 steps of 3e294 s, A h = -3e594.
+    with pytest.raises(InvalidArgumentError, match="T steps by 3e\\+294 s") as caught:
+        aerocontrol.step_response((np.array([[-1e300]]), np.array([[1.0]])), T=3e299)
+    assert caught.value.argument == "T" and caught.value.value == pytest.approx(3e294)
+    with pytest.raises(InvalidArgumentError, match="T steps by") as caught:
+        aerocontrol.forced_response(
+            (np.array([[-1e300]]), np.array([[1.0]])), np.array([0.0, 1e300]), [1.0, 1.0]
+        )
+    assert caught.value.argument == "T"
+
+
+@pytest.mark.parametrize("final", [1e-320, 5e-324, 2e-306])
+def test_a_final_time_with_subnormal_steps_is_refused(final: float) -> None:
+    # 1e-320 gave a grid of subnormal steps (not uniform: 1e-322 is 20 units of the last
+    # place); 5e-324 was refused as "dt must be positive", a name the caller never gave.
+    with pytest.raises(InvalidArgumentError, match=r"T as a final time .* too short"):
+        aerocontrol.step_response((np.array([[-1.0]]), np.array([[1.0]])), T=final)
+    # From 100 tiny normal steps on, the grid is uniform: t = k T / 100 to 1e-9 relatively.
+    t = aerocontrol.step_response((np.array([[-1.0]]), np.array([[1.0]])), T=3e-306).t
+    assert len(t) == 101 and np.max(np.abs(t - np.arange(101) * 3e-308)) <= 1e-9 * 3e-308
+
+
+@pytest.mark.parametrize(
+    "T", [None, 1e10, np.arange(5) * 1e10], ids=["default grid", "final time", "grid"]
+)
+def test_discrete_grids_of_too_many_periods_are_refused(T: object) -> None:
+    # dt = 1e-300 against 1e10 s: 1e310 periods, an infinite ratio that int() and round()
+    # refused with bare OverflowErrors. The default grid (7 / 0.69 s for z = 0.5 would be
+    # 1e301 periods) is finite here and kept; a slower mode needs its T.
+    model = aerocontrol.StateSpace([[0.5]], [[1.0]], [[1.0]], [[0.0]], dt=1e-300)
+    if T is None:
+        slow = aerocontrol.StateSpace([[1.0 - 1e-300]], [[1.0]], [[1.0]], [[0.0]], dt=1e-300)
+        t = aerocontrol.default_time_grid(model)
+        assert len(t) == 101 and t[1] == 1e-300
+        # 1 - 1e-300 rounds to 1: no mode, the final time 10 s of 1e301 periods, every
+        # q-th of them (q = 1e296 periods), not an overflow.
+        t = aerocontrol.default_time_grid(slow)
+        assert len(t) <= aerocontrol.responses.MAX_DEFAULT_SAMPLES
+        assert t[-1] == pytest.approx(10.0, rel=1e-4)
+        return
+    for function in (aerocontrol.step_response, aerocontrol.impulse_response):
+        with pytest.raises(InvalidArgumentError, match="sampling periods of dt = 1e-300 s"):
+            function(model, T=T)
+
+
+def test_discrete_steps_whose_recurrence_overflows_are_refused_naming_T() -> None:
+    # A^q for q = 1e210 periods of an unstable A = 1.5: numpy's RuntimeWarnings, then the
+    # core's NonFiniteError blaming A, which is finite.
+    unstable = aerocontrol.StateSpace([[1.5]], [[1.0]], [[1.0]], [[0.0]], dt=1e-200)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for call in (
+            lambda: aerocontrol.step_response(unstable, T=np.arange(5) * 1e10),
+            lambda: aerocontrol.initial_response(unstable, [1.0], T=np.arange(5) * 1e10),
+            lambda: aerocontrol.impulse_response(unstable, T=np.arange(5) * 1e10),
+        ):
+            with pytest.raises(InvalidArgumentError, match="overflows double precision"):
+                call()
+    # A stable A over as many periods is at rest: A^q = 0, and the step is at its steady
+    # state B / (1 - A) = 2 exactly from the first sample of T on.
+    stable = aerocontrol.StateSpace([[0.5]], [[1.0]], [[1.0]], [[0.0]], dt=1e-200)
+    response = aerocontrol.step_response(stable, T=np.arange(5) * 1e10)
+    assert np.array_equal(response.x[:, 0], [0.0, 2.0, 2.0, 2.0, 2.0])
+
+
+def test_forced_response_on_a_grid_of_1e300_times_smaller_steps() -> None:
+    """x' = -x + u, x(0) = 0, u = 1 on t = k 1e-300: x(t) = 1 - e^-t = t (1 - t/2 + ...),
+    so x_k = k 1e-300 to the last bit (the correction t^2/2 is below the rounding)."""
+    t = 1e-300 * np.arange(6)
+    for method in ("zoh", "foh"):
+        response = aerocontrol.forced_response(
+            (np.array([[-1.0]]), np.array([[1.0]])), t, np.ones(6), method=method
+        )
+        assert np.allclose(response.x[:, 0], t, rtol=4e-16, atol=0.0)
+    # A fast mode, A h = -1: x_k = 1e-300 (1 - e^-k) exactly as the continuous solution.
+    response = aerocontrol.forced_response((np.array([[-1e300]]), np.array([[1.0]])), t, np.ones(6))
+    expected = 1e-300 * -np.expm1(-np.arange(6.0))
+    assert np.allclose(response.x[:, 0], expected, rtol=1e-14, atol=0.0)
+
+
+@pytest.mark.parametrize("eigenvalue", [1e148, 1e154, 1e200, 1e300, 2e306])
+def test_the_default_grid_resolves_modes_up_to_2e306(eigenvalue: float) -> None:
+    """The step 1/(20 |λ|) is a normal double up to |λ| = 2.2e306: the grid is made, with the
+    documented step, and the response on it is finite. Beyond, refused naming the grid."""
+    sys = (np.array([[-eigenvalue]]), np.array([[1.0]]))
+    t = aerocontrol.default_time_grid(sys)
+    assert t[1] == pytest.approx(1.0 / (20.0 * eigenvalue), rel=1e-15)
+    # Final time 7 time constants, at least 100 steps.
+    assert len(t) == 141 and t[-1] == pytest.approx(7.0 / eigenvalue, rel=1e-14)
+    x = aerocontrol.step_response(sys).x[:, 0]
+    assert np.allclose(x, -np.expm1(-eigenvalue * t) / eigenvalue, rtol=1e-13, atol=0.0)
+    with pytest.raises(InvalidArgumentError, match="below the normal doubles; give the grid T"):
+        aerocontrol.default_time_grid((np.array([[-3e306]]), np.array([[1.0]])))
+
+
+@pytest.mark.parametrize("layout", ["negative strides", "Fortran", "strided", "zero strides"])
+def test_impulse_weights_in_every_layout_give_the_c_ordered_result(layout: str) -> None:
+    """eta0 on negative strides gave B eta0 rounded differently from its C-ordered copy (a
+    campaign input: two models of one state and three inputs)."""
+    B = np.array([[0.1257302210933933, -0.1321048632913019, 0.6404226504432821]])
+    sys = [aerocontrol.StateSpace(np.array([[0.1257302210933933]]), B)] * 2
+    eta0 = np.array([1.2573022109339329e-09, -1.3210486329130189e-09, 6.4042265044328204e-09])
+    if layout == "zero strides":
+        eta0 = np.full(3, 1.2573022109339329e-09)
+    presented = {
+        "negative strides": np.ascontiguousarray(eta0[::-1])[::-1],
+        "Fortran": np.asfortranarray(eta0),
+        "strided": np.repeat(eta0, 2)[::2],
+        "zero strides": np.broadcast_to(eta0[:1], (3,)),
+    }[layout]
+    for function in (aerocontrol.impulse_response, aerocontrol.doublet_response):
+        ours = function(sys, T=np.array([0.0, 0.1]), eta0=presented)
+        reference = function(sys, T=np.array([0.0, 0.1]), eta0=eta0.copy())
+        assert ours.x.tobytes() == reference.x.tobytes()
+        assert ours.y.tobytes() == reference.y.tobytes()
+
+
+def test_the_default_grid_refuses_an_a_whose_norm_is_far_beyond_its_modes() -> None:
+    """A campaign input: a list of a model with modes of size 1 and a nilpotent A of 1e149
+    (no mode). The default grid took a step of 0.05 s from the first, on which the core
+    refused e^{hA} of the second (h ||A||_1 = 5e148 > 2^53) with an IllConditionedError that
+    named neither the grid nor T. Now the step is at most 2^52 / ||A||_1, and where that needs
+    more than 100,001 samples the grid is refused by name."""
+    nilpotent = aerocontrol.StateSpace(1e149 * np.triu(np.ones((4, 4)), 1), np.zeros((4, 0)))
+    modes = aerocontrol.StateSpace(-np.eye(4), np.zeros((4, 0)))
+    for sys in ([modes, nilpotent], nilpotent):
+        with pytest.raises(InvalidArgumentError, match="default time grid: A has the norm"):
+            aerocontrol.default_time_grid(sys)
+        with pytest.raises(InvalidArgumentError, match="default time grid: A has the norm"):
+            aerocontrol.initial_response(sys, np.ones(4))
+    # Where the smaller step fits, it is taken: ||A||_1 = 2^52 / 1e-4 gives h = 1e-4 s
+    # instead of 0.01 s (no mode), 100,001 samples to 10 s, and an exact response.
+    norm = 2.0**52 / 1e-4
+    shear = aerocontrol.StateSpace([[0.0, norm], [0.0, 0.0]], [[0.0], [0.0]])
+    t = aerocontrol.default_time_grid(shear)
+    assert t[1] == pytest.approx(1e-4, rel=1e-12) and len(t) == 100_001
+    x = aerocontrol.initial_response(shear, [0.0, 1.0]).x
+    assert np.allclose(x[:, 0], norm * t, rtol=1e-12, atol=0.0) and np.all(x[:, 1] == 1.0)
+
+
+def test_doublet_initial_state_is_formed_as_a_times_b_eta0() -> None:
+    """A campaign input: A = 1.26e-151, B = 1.26e-301, eta0 = 1.26e149. (A B) eta0 underflowed
+    A B (1.6e-452) to 0; A (B eta0) = 1.99e-303, a normal double, is x(0) to the rounding."""
+    a, b, eta = 1.257302210933933e-151, 1.257302210933933e-301, 1.257302210933933e149
+    response = aerocontrol.doublet_response(
+        (np.array([[a]]), np.array([[b]])), T=np.array([0.0, 1.0]), eta0=[eta]
+    )
+    assert response.x[0, 0] == pytest.approx(a * (b * eta), rel=4e-16)
+    assert response.x[0, 0] == pytest.approx(1.9875544616903434e-303, rel=1e-15)

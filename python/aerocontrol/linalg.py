@@ -649,41 +649,72 @@ def _matched(model: StateSpace, dt: float) -> StateSpace:
             return StateSpace(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[0.0]], dt=dt)
         numerator = numerator[relative_degree:]
     zeros = _roots(numerator)
+    _refuse_exponential_overflow(poles, zeros, dt)
     # Poles and zeros at s = 0 map to z = 1; the gain is matched on the rest (their low
     # frequency asymptotes agree, with z - 1 ≈ s dt).
     tiny = 1e-12 * max(1.0, float(np.abs(poles).max(initial=0.0)))
     nonzero_poles, nonzero_zeros = poles[np.abs(poles) > tiny], zeros[np.abs(zeros) > tiny]
     excess = (len(zeros) - len(nonzero_zeros)) - (len(poles) - len(nonzero_poles))
-    continuous_gain = numerator[0] * np.prod(-nonzero_zeros) / np.prod(-nonzero_poles)
-    discrete_gain = np.prod(_one_minus_exp(nonzero_zeros * dt)) / np.prod(
-        _one_minus_exp(nonzero_poles * dt)
-    )
-    with np.errstate(over="ignore"):  # an overflow is refused by name below
-        gain = float((continuous_gain / discrete_gain).real) / dt**excess * beta * gamma
+    # gain = K N0 prod(-z) / prod(-p) * prod(1 - e^{p dt}) / prod(1 - e^{z dt}) / dt^excess
+    # * beta gamma, as a mantissa times a power of two: each product may overflow (or
+    # underflow) where the gain, or the model it scales, does not (e^{p dt} of 1e200).
+    dt_mantissa, dt_exponent = np.frexp(dt)
+    gain_factors = [
+        _scaled(complex(numerator[0])),
+        *(_scaled(complex(-z)) for z in nonzero_zeros),
+        *(_reciprocal(_scaled(complex(-p))) for p in nonzero_poles),
+        *(_one_minus_exp_scaled(complex(p * dt)) for p in nonzero_poles),
+        *(_reciprocal(_one_minus_exp_scaled(complex(z * dt))) for z in nonzero_zeros),
+        (complex(dt_mantissa) ** -excess, -int(dt_exponent) * excess),
+        (1.0 + 0.0j, int(np.log2(beta)) + int(np.log2(gamma))),
+    ]
+    gain_mantissa, gain_exponent = _scaled_product(gain_factors)
+    gain = float(gain_mantissa.real)
     # A cascade of first- and second-order sections, each a factor (z - e^{z_i dt}) ... over
     # (z - e^{p_i dt}) ...: the poles sit exactly in the sections' matrices, where the
     # coefficients of one polynomial of degree n would lose digits as the poles crowd towards
     # z = 1 (small dt).
     numerators = _real_factors(zeros, dt)
-    quadratic = [f for f in numerators if len(f) == 3]
-    linear = [f for f in numerators if len(f) == 2]
+    # Each factor is given scaled to unit size, with the power of two it was divided by.
+    quadratic = [f for f in numerators if len(f[0]) == 3]
+    linear = [f for f in numerators if len(f[0]) == 2]
     Ad, Bd, Cd, Dd = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1))
-    for A_k, B_k, denominator in _pole_sections(poles, dt):
+    for A_k, B_k, denominator, scale in _pole_sections(poles, dt):
         order = len(denominator) - 1
-        factor = np.ones(1)
+        factor, exponent = np.ones(1), 0
         if order == 2 and quadratic:
-            factor = quadratic.pop()
+            factor, exponent = quadratic.pop()
         elif linear:
-            factor = linear.pop()
+            factor, exponent = linear.pop()
         if order == 2 and len(factor) == 2 and linear:
-            factor = np.convolve(factor, linear.pop())
+            other, other_exponent = linear.pop()
+            factor, exponent = np.convolve(factor, other), exponent + other_exponent
         # A zero far outside the unit circle (e^{z dt} of a right-half-plane zero) makes its
         # factor's coefficients huge: scaled to unit size, its size goes into the gain.
         size = float(np.abs(factor).max())
-        factor, gain = factor / size, gain * size
+        factor = factor / size
+        gain_mantissa, gain_exponent = _scaled_product(
+            [(gain_mantissa, gain_exponent), (complex(size), exponent)]
+        )
+        gain = float(gain_mantissa.real)
         num = np.concatenate([np.zeros(order + 1 - len(factor)), factor])
-        remainder = num[1:] - num[0] * denominator[1:]  # of the strictly proper part
-        C_k = _output_row(A_k, B_k, remainder)
+        # The section in w = z / R (R = 4^k, a power of two near its poles' magnitude, 1
+        # below 2^256): the numerator's and denominator's coefficients of w^(order - i)
+        # divided by R^i keep unit size where those of z overflow (|z|^2 beyond 1e154). The
+        # realisation (A_k, B_k, R C_w), C_w the output row of A_k / R, has the transfer
+        # function wanted: (zI - A_k)^-1 = (wI - A_k/R)^-1 / R. Its states are then scaled by
+        # a power of two that gives B_k and C_k the same size (R C_w alone may overflow).
+        # The numerator in w is scaled by 2^lift to unit size too (a constant numerator
+        # would underflow as R^-order), and C_w by 2^-lift after.
+        powers = -scale * np.arange(order + 1)
+        lift = _unit_lift(num, powers) if scale else 0
+        with np.errstate(under="ignore"):
+            num_w = np.ldexp(num, powers + lift)
+            remainder = num_w[1:] - num_w[0] * denominator[1:]  # of the strictly proper part
+            C_k = _output_row(np.ldexp(A_k, -scale), B_k, remainder)
+            if scale:
+                shift = _balancing_shift(B_k, C_k, scale - lift)
+                B_k, C_k = np.ldexp(B_k, shift), np.ldexp(C_k, scale - lift - shift)
         D_k = num[:1].reshape(1, 1)
         # The section after the cascade so far: its input is the cascade's output.
         size_so_far = Ad.shape[0]
@@ -694,7 +725,13 @@ def _matched(model: StateSpace, dt: float) -> StateSpace:
     if quadratic or linear:  # pragma: no cover - a proper G has no more zeros than poles
         raise AssertionError("matched: zeros left over after the sections")
     with np.errstate(all="ignore"):  # an overflow is refused by name below
-        matrices = (Ad, gain * Bd, Cd, gain * Dd)
+        Bd, Dd = gain * Bd, np.ldexp(gain * Dd, gain_exponent)
+        shift = 0
+        if not np.all(np.isfinite(np.ldexp(Bd, gain_exponent))):
+            # The gain 2^e overflows B alone: the states scaled by 2^-shift, B by 2^(e - shift)
+            # and C by 2^shift, each of the size of sqrt(|gain B| |C|).
+            shift = gain_exponent - _balancing_shift(Bd, Cd, gain_exponent)
+        matrices = (Ad, np.ldexp(Bd, gain_exponent - shift), np.ldexp(Cd, shift), Dd)
     _refuse_overflow(matrices, dt)
     return StateSpace(
         *matrices,
@@ -706,33 +743,91 @@ def _matched(model: StateSpace, dt: float) -> StateSpace:
 
 def _pole_sections(
     poles: ComplexArray, dt: float
-) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
-    """(A_k, B_k, denominator) of each section with poles e^{p dt}: [[α, -β], [β, α]] and
-    B = [0, 1] for a pair α ± jβ, [[p1, 0], [1, p2]] and B = [1, 0] for two real poles, [[p]]
-    and B = [1] for the last real one; second-order sections first."""
+) -> list[tuple[FloatArray, FloatArray, FloatArray, int]]:
+    """(A_k, B_k, denominator, scale) of each section with poles e^{p dt}: [[α, -β], [β, α]]
+    and B = [0, 1] for a pair α ± jβ, [[p1, 0], [R, p2]] and B = [1, 0] for two real poles,
+    [[p]] and B = [1] for the last real one; second-order sections first.
+
+    ``scale`` is log2 R, R = 4^k the power of four nearest the largest magnitude of the
+    section's poles where it exceeds 2^256 (else R = 1), and ``denominator`` the monic one
+    in w = z / R: [1, -2α/R, (α/R)² + (β/R)²] for a pair, [1, -(p1 + p2)/R, p1 p2 / R²] for
+    two real poles. Its coefficients then have the size of the poles over R, where those in
+    z, |e^{p dt}|², overflow beyond 1e154 (the section's matrices hold only e^{p dt} itself,
+    and the subdiagonal R keeps the output row of two real poles at their size)."""
     sections = []
-    for r in poles[poles.imag > 0]:
-        z = np.exp(r.real * dt) * np.array([np.cos(r.imag * dt), np.sin(r.imag * dt)])
-        alpha, beta = float(z[0]), float(z[1])
-        sections.append(
-            (
-                np.array([[alpha, -beta], [beta, alpha]]),
-                np.array([[0.0], [1.0]]),
-                np.array([1.0, -2.0 * alpha, alpha * alpha + beta * beta]),
+    with np.errstate(under="ignore"):
+        for r in poles[poles.imag > 0]:
+            z = np.exp(r.real * dt) * np.array([np.cos(r.imag * dt), np.sin(r.imag * dt)])
+            alpha, beta = float(z[0]), float(z[1])
+            scale = _section_scale(np.hypot(alpha, beta))
+            a, b = np.ldexp(alpha, -scale), np.ldexp(beta, -scale)
+            sections.append(
+                (
+                    np.array([[alpha, -beta], [beta, alpha]]),
+                    np.array([[0.0], [1.0]]),
+                    np.array([1.0, -2.0 * a, a * a + b * b]),
+                    scale,
+                )
             )
-        )
-    reals = [float(np.exp(r.real * dt)) for r in poles if r.imag == 0]
-    for first, second in zip(reals[0::2], reals[1::2], strict=False):
-        sections.append(
-            (
-                np.array([[first, 0.0], [1.0, second]]),
-                np.array([[1.0], [0.0]]),
-                np.array([1.0, -(first + second), first * second]),
+        reals = [float(np.exp(r.real * dt)) for r in poles if r.imag == 0]
+        for first, second in zip(reals[0::2], reals[1::2], strict=False):
+            scale = _section_scale(max(abs(first), abs(second)))
+            f, g = np.ldexp(first, -scale), np.ldexp(second, -scale)
+            sections.append(
+                (
+                    np.array([[first, 0.0], [np.ldexp(1.0, scale), second]]),
+                    np.array([[1.0], [0.0]]),
+                    np.array([1.0, -(f + g), f * g]),
+                    scale,
+                )
             )
-        )
-    if len(reals) % 2:
-        sections.append((np.array([[reals[-1]]]), np.ones((1, 1)), np.array([1.0, -reals[-1]])))
+        if len(reals) % 2:
+            scale = _section_scale(abs(reals[-1]))
+            sections.append(
+                (
+                    np.array([[reals[-1]]]),
+                    np.ones((1, 1)),
+                    np.array([1.0, -np.ldexp(reals[-1], -scale)]),
+                    scale,
+                )
+            )
     return sections
+
+
+def _unit_lift(coefficients: FloatArray, powers: NDArray[np.int_]) -> int:
+    """The power of two that gives the coefficients c_i 2^(powers_i) a largest entry of
+    size 1 (0 when they are all zero)."""
+    nonzero = coefficients != 0.0
+    if not np.any(nonzero):
+        return 0
+    exponents = np.frexp(np.abs(coefficients[nonzero]))[1] + powers[nonzero]
+    return -int(np.max(exponents))
+
+
+def _balancing_shift(B: FloatArray, C: FloatArray, exponent: int) -> int:
+    """The power of two s for which B 2^s and C 2^(exponent - s) have the same largest
+    entry, to the nearest power (0 where B or C is zero): the state scaling that splits a
+    factor 2^exponent of C (or of B C) evenly, computed without forming it."""
+    largest_B, largest_C = (
+        float(np.max(np.abs(B), initial=0.0)),
+        float(np.max(np.abs(C), initial=0.0)),
+    )
+    if not (largest_B > 0.0 and largest_C > 0.0) or not np.isfinite(largest_B + largest_C):
+        return 0
+    size_B, size_C = int(np.frexp(largest_B)[1]), int(np.frexp(largest_C)[1])
+    return (size_C + exponent - size_B) // 2
+
+
+#: Sections whose poles are larger than this are formed in w = z / R (see _pole_sections).
+_SECTION_SCALING_THRESHOLD = 2.0**256
+
+
+def _section_scale(magnitude: float) -> int:
+    """log2 R for a section whose largest pole has ``magnitude``: R = 4^k nearest it beyond
+    :data:`_SECTION_SCALING_THRESHOLD`, else 0 (R = 1: the section exactly as in z)."""
+    if not magnitude > _SECTION_SCALING_THRESHOLD:
+        return 0
+    return 2 * round(float(np.log2(magnitude)) / 2)
 
 
 def _output_row(A: FloatArray, B: FloatArray, remainder: FloatArray) -> FloatArray:
@@ -756,21 +851,95 @@ def _one_minus_exp(s: ComplexArray) -> ComplexArray:
     return np.asarray(-(real + 1j * np.exp(a) * np.sin(b)), dtype=np.complex128)
 
 
-def _real_factors(roots: ComplexArray, dt: float) -> list[FloatArray]:
+def _real_factors(roots: ComplexArray, dt: float) -> list[tuple[FloatArray, int]]:
     """The monic real factors of prod (z - e^{r dt}) over the roots r (conjugate pairs exact):
     z^2 - 2 e^{σ dt} cos(ω dt) z + e^{2σ dt} for each pair σ ± jω, real roots two to a
-    quadratic, and at most one linear factor z - e^{r dt} left."""
-    factors = [
-        np.array([1.0, -2.0 * np.exp(r.real * dt) * np.cos(r.imag * dt), np.exp(2 * r.real * dt)])
-        for r in roots
-        if r.imag > 0
-    ]
-    reals = [float(np.exp(r.real * dt)) for r in roots if r.imag == 0]
-    for first, second in zip(reals[0::2], reals[1::2], strict=False):
-        factors.append(np.array([1.0, -(first + second), first * second]))
-    if len(reals) % 2:
-        factors.append(np.array([1.0, -reals[-1]]))
+    quadratic, and at most one linear factor z - e^{r dt} left; each as (f, e), the factor
+    equal to 2^e f, e even and f of the size of 1 or less: where e^{r dt} exceeds 2^256, f
+    is the factor in w = z / S scaled by S^degree (S = 2^(e/degree)), whose coefficients do
+    not overflow where e^{2σ dt} does (beyond 1e154)."""
+
+    def factor(coefficients_in_w: list[float], scale: int) -> tuple[FloatArray, int]:
+        degree = len(coefficients_in_w) - 1
+        powers = scale * (degree - np.arange(degree + 1))  # S^(degree - i) z^i ... / S^degree
+        with np.errstate(under="ignore"):
+            return np.ldexp(np.array(coefficients_in_w), -powers), scale * degree
+
+    factors = []
+    with np.errstate(under="ignore"):
+        for r in roots[roots.imag > 0]:
+            magnitude = float(np.exp(r.real * dt))
+            scale = _section_scale(magnitude)
+            m = np.ldexp(magnitude, -scale)
+            square = np.exp(2 * r.real * dt) if scale == 0 else m * m
+            factors.append(factor([1.0, -2.0 * m * np.cos(r.imag * dt), square], scale))
+        reals = [float(np.exp(r.real * dt)) for r in roots if r.imag == 0]
+        for first, second in zip(reals[0::2], reals[1::2], strict=False):
+            scale = _section_scale(max(abs(first), abs(second)))
+            f, g = np.ldexp(first, -scale), np.ldexp(second, -scale)
+            factors.append(factor([1.0, -(f + g), f * g], scale))
+        if len(reals) % 2:
+            scale = _section_scale(abs(reals[-1]))
+            factors.append(factor([1.0, -np.ldexp(reals[-1], -scale)], scale))
     return factors
+
+
+def _refuse_exponential_overflow(poles: ComplexArray, zeros: ComplexArray, dt: float) -> None:
+    """Refuses, naming dt, a matched model whose pole or zero e^{r dt} overflows double
+    precision (Re r dt beyond ln(2^1024) = 709.78): no section can hold it; or whose angle
+    Im r dt does (a frequency of 1e300 over a step of 1e10)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        exponents = np.concatenate([poles.real, zeros.real, np.zeros(1)]) * dt
+        angles = np.concatenate([poles.imag, zeros.imag, np.zeros(1)]) * dt
+    largest = float(np.max(np.abs(exponents)))  # also Re r dt = +-inf or NaN
+    if not np.all(np.isfinite(angles)):
+        error = InvalidArgumentError(
+            f"the sampled model's poles or zeros e^(r dt) cannot be formed: dt = {dt:g} is "
+            "too long for this model (a frequency Im r times dt overflows double precision)"
+        )
+        error.argument = "dt"
+        raise error
+    if not np.all(exponents < np.log(np.finfo(np.float64).max)):
+        error = InvalidArgumentError(
+            f"the sampled model's poles or zeros e^(r dt) overflow double precision: "
+            f"dt = {dt:g} is too long for this model (Re r dt reaches {largest:.6g}, beyond "
+            f"{np.log(np.finfo(np.float64).max):.6g})"
+        )
+        error.argument = "dt"
+        raise error
+
+
+def _scaled(value: complex) -> tuple[complex, int]:
+    """(m, e) with value = m 2^e and |m| in [0.5, 1) (m = 0, e = 0 for zero)."""
+    size = abs(value)
+    if size == 0.0 or not np.isfinite(size):
+        return value, 0
+    _, exponent = np.frexp(size)
+    return complex(value.real * 2.0 ** -int(exponent), value.imag * 2.0 ** -int(exponent)), int(
+        exponent
+    )
+
+
+def _reciprocal(scaled: tuple[complex, int]) -> tuple[complex, int]:
+    mantissa, exponent = scaled
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 1.0 / mantissa if mantissa != 0 else complex(np.inf), -exponent
+
+
+def _scaled_product(factors: list[tuple[complex, int]]) -> tuple[complex, int]:
+    """The product of values m 2^e, as (m, e) with |m| in [0.5, 1): renormalised after each
+    factor, so that no intermediate product over- or underflows."""
+    mantissa, exponent = 1.0 + 0.0j, 0
+    for m, e in factors:
+        m_scaled, m_exponent = _scaled(complex(m))
+        mantissa, shift = _scaled(mantissa * m_scaled)
+        exponent += e + m_exponent + shift
+    return mantissa, exponent
+
+
+def _one_minus_exp_scaled(s: complex) -> tuple[complex, int]:
+    """1 - e^s as (m, e), m 2^e (e^s itself fits: Re s < 709.78 was checked)."""
+    return _scaled(complex(_one_minus_exp(np.array([s]))[0]))
 
 
 #: The named selections of :func:`schur` (scipy.linalg.schur's ``sort`` names).

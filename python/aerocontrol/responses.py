@@ -18,6 +18,13 @@ resample yourself with ``numpy.interp`` if needed). ``T`` may be a grid, a final
 for the default grid: a step of 1/(20 |λ|max), twenty samples per time constant of the fastest
 mode, and a final time of 7 time constants 1/|σ| of the slowest decaying mode (to 0.1 % of its
 amplitude), or 10/|λ|min when no mode decays; at most 100,001 samples (the step grows to fit).
+The default grid is made for any |λ|max up to 2.2e306, where 1/(20 |λ|max) is still a normal
+double; beyond, it is refused by name (InvalidArgumentError: give the grid T). The step is
+also at most 2^52 / ||A||_1 (for an A far from normal, whose norm exceeds its eigenvalues:
+e^{hA} is refused beyond h ||A||_1 = 2^53), and where that needs more than 100,001 samples
+the default grid is refused likewise. A final time T
+whose 100 steps would be below the normal doubles (2.2e-306 s) is refused likewise, as is a
+step of T too long for A (A times the step overflows).
 
 Several responses come in one call: several initial states x0 (r, n), several input histories
 u (r, k, m), or a list of models of one size (``[sys1, sys2, ...]``); the result then has a
@@ -36,7 +43,8 @@ share their sampling period.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal, cast
 
@@ -150,14 +158,53 @@ def default_time_grid(sys: Systems) -> FloatArray:
     """The default grid of the responses (see the module documentation).
 
     Raises InvalidArgumentError when an eigenvalue is so large (|λ| > 2e306) that the step
-    1/(20 |λ|) would not be a normal double: give the grid T instead."""
+    1/(20 |λ|) would not be a normal double, or when ||A||_1 is so far beyond the modes (a
+    nilpotent A of 1e149) that a step with h ||A||_1 <= 2^52 needs more than 100,001 samples
+    to the final time: give the grid T instead."""
     models, _ = _systems(sys)
     dt = _sampling_period(models)
     if dt > 0.0:
         return _discrete_grid(None, models, dt)[0]
     step, final = _default_step_and_final(models)
-    samples = min(int(np.ceil(final / step)) + 1, MAX_DEFAULT_SAMPLES)
+    step = _within_the_exponential(step, final, models)
+    samples = _steps_within(final / step, MAX_DEFAULT_SAMPLES - 1) + 1
     return np.linspace(0.0, (samples - 1) * step, samples)
+
+
+#: The largest ||h A||_1 of a default step h: the core refuses e^{hA} beyond 2^53 = 1/u
+#: (IllConditionedError: the rounding of A alone changes every digit), and half of it keeps
+#: the grid clear of that limit.
+LARGEST_STEP_NORM = 2.0**52
+
+
+def _within_the_exponential(step: float, final: float, models: list[StateSpace]) -> float:
+    """The default step of continuous models, made smaller where h ||A||_1 exceeds
+    :data:`LARGEST_STEP_NORM` (an A far from normal: a nilpotent A of 1e149 has no mode to
+    set the step, yet e^{hA} is refused at h = 0.01), or refused by name where the final
+    time would then need more than the samples allowed."""
+    with np.errstate(over="ignore"):
+        norm = max(float(np.abs(m.A).sum(axis=0).max(initial=0.0)) for m in models)
+    if not step * norm > LARGEST_STEP_NORM:
+        return step
+    limit = LARGEST_STEP_NORM / norm
+    if limit >= np.finfo(np.float64).tiny and final / limit <= MAX_DEFAULT_SAMPLES - 1:
+        return limit
+    raise InvalidArgumentError(
+        f"the default time grid: A has the norm ||A||_1 = {norm:.3g}, far beyond its modes "
+        f"(a final time of {final:.3g} s), so a step short enough for e^(hA) (h ||A||_1 at "
+        f"most 2^52, h = {limit:.3g} s) needs more than {MAX_DEFAULT_SAMPLES} samples; give "
+        "the grid T"
+    )
+
+
+def _steps_within(ratio: float, cap: int) -> int:
+    """ceil(ratio) steps, at most ``cap``: the number of steps of a grid, from a ratio of
+    times that may be huge or infinite (a final time of 1e300 over a step of 1e-300), which
+    ``int`` cannot take (an OverflowError for an infinity); a ratio beyond the cap (or NaN,
+    which the callers' finite positive times exclude) gives the cap."""
+    if not ratio < cap:
+        return cap
+    return max(int(np.ceil(ratio)), 0)
 
 
 def _sampling_period(models: list[StateSpace]) -> float:
@@ -208,7 +255,15 @@ def _grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, fl
                 f"T as a final time must be positive and finite, got {final}"
             )
         step, _ = _default_step_and_final(models)
-        samples = min(max(int(np.ceil(final / step)) + 1, 101), MAX_DEFAULT_SAMPLES)
+        samples = max(_steps_within(final / step, MAX_DEFAULT_SAMPLES - 1), 100) + 1
+        if final / (samples - 1) < np.finfo(np.float64).tiny:
+            raise InvalidArgumentError(
+                f"T as a final time ({final:g} s) is too short for a grid: its {samples - 1} "
+                f"steps of {final / (samples - 1):.3g} s would be below the normal doubles "
+                f"({np.finfo(np.float64).tiny:.3g}), where a uniform grid cannot be "
+                "represented; give a final time of at least "
+                f"{(samples - 1) * np.finfo(np.float64).tiny:.3g} s"
+            )
         t = np.linspace(0.0, final, samples)
         return t, float(t[1] - t[0])
     step = _core.grid_step(times)
@@ -222,10 +277,19 @@ GRID_MULTIPLE_TOLERANCE = 1e-9
 def _discrete_grid(
     T: ArrayLike | None, models: list[StateSpace], dt: float
 ) -> tuple[FloatArray, int]:
-    """(t, q) for discrete models sampled every dt: the times, q dt apart."""
+    """(t, q) for discrete models sampled every dt: the times, q dt apart.
+
+    A final time or a step more than 2^1023 sampling periods long (a dt of 1e-300 against a
+    final time of 1e10) has no count of periods in doubles: refused by name, T (or the
+    default grid, which is given the final time of the slowest mode), not an OverflowError."""
     if T is None:
         _, final = _default_step_and_final(models)
-        steps = max(int(np.ceil(final / dt - GRID_MULTIPLE_TOLERANCE)), 100)
+        periods = _periods(
+            final / dt - GRID_MULTIPLE_TOLERANCE,
+            dt,
+            f"the default time grid's final time of {final:g} s (7 time constants)",
+        )
+        steps = max(int(np.ceil(periods)), 100)
     else:
         times = real_array(T, "T")
         if times.ndim == 0:
@@ -235,10 +299,11 @@ def _discrete_grid(
                     f"T as a final time must be finite and at least the sampling period "
                     f"dt = {dt:g} s, got {final}"
                 )
-            steps = int(np.floor(final / dt + GRID_MULTIPLE_TOLERANCE))
+            periods = _periods(final / dt + GRID_MULTIPLE_TOLERANCE, dt, f"T = {final:g} s")
+            steps = int(np.floor(periods))
         else:
             step = _core.grid_step(times)
-            q = round(step / dt)
+            q = round(_periods(step / dt, dt, f"T's step of {step:g} s"))
             if q < 1 or abs(step - q * dt) > GRID_MULTIPLE_TOLERANCE * step:
                 raise InvalidArgumentError(
                     f"T must be a grid of multiples of the sampling period dt = {dt:g} s "
@@ -250,25 +315,52 @@ def _discrete_grid(
     return np.arange(samples, dtype=np.float64) * (q * dt), q
 
 
+def _periods(ratio: float, dt: float, what: str) -> float:
+    """A number of sampling periods, refused by name when it overflows (the ratio of a time
+    to a tiny dt): no count of periods then exists in doubles, and ``int`` would raise an
+    OverflowError."""
+    if not np.isfinite(ratio):
+        raise InvalidArgumentError(
+            f"{what} is more than {np.finfo(np.float64).max:.3g} sampling periods of "
+            f"dt = {dt:g} s: the number of steps overflows double precision; give a grid "
+            "T of fewer sampling periods"
+        )
+    return ratio
+
+
 def _every_qth(model: StateSpace, q: int) -> tuple[FloatArray, FloatArray]:
     """(A^q, Σ_{i<q} A^i B): the recurrence of a discrete model between every q-th sample, the
     blocks of M^q for M = [[A, B], [0, I]].
 
     Binary powering on E_k = M^k - I (E_{j+k} = E_j E_k + E_j + E_k), not on M^k: a slow mode
     has A^q close to I, and M^k itself would carry its difference from I, which sets the
-    steady state, with an absolute error of q u instead of u."""
+    steady state, with an absolute error of q u instead of u.
+
+    Where q is so large that A^q or the sum overflows (an unstable or marginal mode over
+    10^k sampling periods), the recurrence between the samples of T does not exist in
+    doubles: refused by name (T), where numpy would warn and the core refuse the infinite
+    matrices as if they were the caller's."""
     if q == 1:
         return model.A, model.B
     n, m = model.n_states, model.n_inputs
     base = np.zeros((n + m, n + m))
     base[:n, :n], base[:n, n:] = model.A - np.eye(n), model.B
     power = np.zeros_like(base)
-    while q:
-        if q & 1:
-            power = power @ base + power + base
-        q >>= 1
-        if q:
-            base = base @ base + 2.0 * base
+    steps = q
+    with np.errstate(all="ignore"):
+        while q:
+            if q & 1:
+                power = power @ base + power + base
+            q >>= 1
+            if q:
+                base = base @ base + 2.0 * base
+    if not np.all(np.isfinite(power)):
+        raise InvalidArgumentError(
+            f"T steps by q = {float(steps):.6g} sampling periods, and the recurrence over one "
+            "step "
+            "(A^q and the sum of A^i B for i < q) overflows double precision: give a grid "
+            "with a smaller step"
+        )
     return np.eye(n) + power[:n, :n], power[:n, n:]
 
 
@@ -291,20 +383,40 @@ def _simulate(
     else:
         pairs = [(model.A, model.B) for model in models]
     if several:
-        return _core.simulate_models(
-            np.stack([a for a, _ in pairs]),
-            np.stack([b for _, b in pairs]),
-            np.stack([m.C for m in models]),
-            np.stack([m.D for m in models]),
-            x0,
-            u,
-            eta0,
-            step,
-            samples,
-            method,
-        )
+        with _grid_step_named_T(step):
+            return _core.simulate_models(
+                np.stack([a for a, _ in pairs]),
+                np.stack([b for _, b in pairs]),
+                np.stack([m.C for m in models]),
+                np.stack([m.D for m in models]),
+                x0,
+                u,
+                eta0,
+                step,
+                samples,
+                method,
+            )
     (A, B), model = pairs[0], models[0]
-    return _core.simulate(A, B, model.C, model.D, x0, u, eta0, step, samples, method)
+    with _grid_step_named_T(step):
+        return _core.simulate(A, B, model.C, model.D, x0, u, eta0, step, samples, method)
+
+
+@contextmanager
+def _grid_step_named_T(step: float) -> Iterator[None]:
+    """The core's refusal of its step ``dt`` (A dt overflows: a step of 1e300 for an A of
+    1e10) as the refusal of the caller's argument, T, whose step it is."""
+    try:
+        yield
+    except InvalidArgumentError as error:
+        if error.argument != "dt":
+            raise
+        refusal = InvalidArgumentError(
+            f"T steps by {step:.6g} s, too long for the model: A times the step overflows "
+            "double precision (the exponential e^{A h} of one step cannot be formed); give a "
+            "grid with a smaller step"
+        )
+        refusal.argument, refusal.value = "T", step
+        raise refusal from error
 
 
 def _time_grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, float, int]:
@@ -327,7 +439,9 @@ def _input_weights(eta0: ArrayLike | None, m: int) -> tuple[FloatArray, tuple[st
         weights = weights.reshape(1)
     if weights.ndim != 1 or weights.shape[0] != m:
         raise ShapeError(f"eta0 must have one weight per input ({m}), got shape {weights.shape}")
-    return check_finite(weights, "eta0").reshape(1, m), ("eta0",)
+    # C-ordered: the products with B (an impulse's B η0) must not depend on the caller's
+    # layout (a matmul on negative strides rounds differently from one on a C array).
+    return np.ascontiguousarray(check_finite(weights, "eta0").reshape(1, m)), ("eta0",)
 
 
 def _assemble(
@@ -445,8 +559,11 @@ def _discrete_impulse(
     pulses = weights[:1] if several else weights
 
     def start(model: StateSpace) -> FloatArray:
-        reach = np.linalg.matrix_power(model.A, q - 1) @ model.B
-        return _initial_state(lambda: pulses @ reach.T / dt, "A^(q-1) B eta0 / dt")
+        # A^(q-1) may overflow for a step of many periods: refused by _initial_state.
+        return _initial_state(
+            lambda: pulses @ (np.linalg.matrix_power(model.A, q - 1) @ model.B).T / dt,
+            "A^(q-1) B eta0 / dt",
+        )
 
     x0 = np.stack([start(m)[0] for m in models]) if several else start(models[0])
     x, y = _simulate(models, several, x0, None, None, q * dt, len(t) - 1, q)
@@ -480,7 +597,9 @@ def doublet_response(
         "doublet",
         sys,
         T,
-        lambda m: _initial_state(lambda: weights @ (m.A @ m.B).T, "A B eta0"),
+        # A (B η0), the order of the definition: (A B) η0 underflowed A B of 1e-452 to
+        # zero where A (B η0) with an η0 of 1e149 is 2e-303.
+        lambda m: _initial_state(lambda: (weights @ m.B.T) @ m.A.T, "A B eta0"),
         labels,
     )
 
@@ -505,7 +624,7 @@ def initial_response(sys: Systems, x0: ArrayLike, T: ArrayLike | None = None) ->
     """
     models, _ = _systems(sys)
     n = models[0].n_states
-    states = real_array(x0, "x0")
+    states = np.ascontiguousarray(real_array(x0, "x0"))
     if states.ndim == 1:
         states = states.reshape(1, -1)
     if states.ndim != 2 or states.shape[1] != n:

@@ -104,8 +104,11 @@ def _layout(a: np.ndarray, how: str) -> Any:
         frozen.setflags(write=False)
         return frozen
     if how == "zero strides" and a.ndim >= 1 and a.shape[0] > 0:
-        row = a[:1]
-        if np.array_equal(a, np.broadcast_to(row, a.shape), equal_nan=True):
+        # Bitwise, not np.array_equal: that takes -0.0 for +0.0 (and any NaN for any other),
+        # and a view of the first row must hold the very bits of every row.
+        row = np.ascontiguousarray(a[:1], dtype=np.float64)
+        repeated = np.ascontiguousarray(np.broadcast_to(row, a.shape))
+        if np.ascontiguousarray(a, dtype=np.float64).tobytes() == repeated.tobytes():
             return np.broadcast_to(row.copy(), a.shape)
     if how == "list" and 0 not in a.shape[:-1]:  # nested lists cannot hold (0, k)
         return a.tolist()

@@ -43,6 +43,7 @@ from .strategies import (
     SQUARE_KINDS,
     model_matrices,
     orders,
+    present,
     presented,
     presented_system,
     scalar,
@@ -837,3 +838,27 @@ def test_regression_series_product_that_underflows() -> None:
         _series_oracle,
     )
     assert outcome.error is None and outcome.warned == ()
+
+
+def test_regression_zero_strides_keep_the_sign_of_zero() -> None:
+    """The "zero strides" presentation took a matrix whose rows differ only in the sign of a
+    zero (np.array_equal: -0.0 == 0.0) for a broadcast of its first row, so the presented
+    matrix held +0.0 where the canonical one held -0.0, and append and parallel, which keep
+    the entries bitwise, failed their comparison with the canonical call."""
+    signed = np.array([[0.0, 1.0], [-0.0, 1.0]])
+    arg = present(signed, "zero strides")
+    assert np.array(arg.value).tobytes() == arg.canonical.tobytes()
+    # Rows that are bitwise equal are still presented as a view with stride 0.
+    same = present(np.array([[-0.0, 1.0], [-0.0, 1.0]]), "zero strides")
+    assert same.value.strides[0] == 0
+    assert np.array(same.value).tobytes() == same.canonical.tobytes()
+    # The campaign's failure: B = [[0], [-0]] of a model appended and added in parallel.
+    A, C, D = np.diag([-1.0, -2.0]), np.array([[1.0, 1.0]]), np.zeros((1, 1))
+    B = present(np.array([[0.0], [-0.0]]), "zero strides")
+    model = Arg((A, B.value, C, D), (A, B.canonical, C, D), "tuple of (C, zero strides, C, C)")
+    exercise("append", lambda **systems: aerocontrol.append(*systems.values()), {"sys0": model})
+    exercise(
+        "parallel",
+        lambda sys1, sys2: aerocontrol.parallel(sys1, sys2),
+        {"sys1": model, "sys2": model},
+    )
