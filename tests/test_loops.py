@@ -604,3 +604,16 @@ def test_margins_closed_loop_poles_of_a_dominant_rank_one_loop() -> None:
         smallest = np.linalg.svd(M - pole * np.eye(5), compute_uv=False)[-1]
         assert smallest <= 5 * np.finfo(float).eps * np.linalg.norm(M)
     assert not margins.closed_loop_stable
+
+
+def test_margins_grid_of_a_loop_with_a_huge_feedthrough() -> None:
+    """A of -1.87e-3, B of 2e8, C of 2e300, D of 1.26e299 (a campaign input, seed 0): the grid
+    search's low-frequency gain K Π|z| / Π|p| overflowed (numpy's warnings, then inf/inf); it
+    is formed in log2. Closed form: the closed-loop pole a - b c/(1 + d) = -3.1814e9."""
+    a, b, c, d = -0.00187426977890661, 2e8, 2e300, 1.257302210933933e299
+    model = (np.array([[a]]), np.array([[b]]), np.array([[c]]), np.array([[d]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        margins = stability_margins(model)
+    assert margins.closed_loop_poles[0] == pytest.approx(a - (b / (1 + d)) * c, rel=1e-12)
+    assert margins.closed_loop_stable

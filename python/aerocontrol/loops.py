@@ -476,9 +476,16 @@ def _grid(model: StateSpace) -> FloatArray:
         if q > 0:
             far_poles = g.poles[np.abs(g.poles) > 1e-12 * max(scale, 1.0)]
             far_zeros = g.zeros[np.abs(g.zeros) > 1e-12 * max(scale, 1.0)]
-            k0 = abs(g.gain * np.prod(-far_zeros) / np.prod(-far_poles))
-            if k0 > 0:
-                low = min(low, k0 ** (1.0 / q) / 100.0)
+            # |K0| = |K| Π|z| / Π|p| in log2: the products overflow (a D of 1e299 beside a
+            # zero near 3e306: numpy's overflow, then inf/inf) where K0^(1/q) need not.
+            with np.errstate(divide="ignore", over="ignore"):
+                log_k0 = (
+                    math.log2(abs(g.gain))
+                    + float(np.sum(np.log2(_magnitude(far_zeros))))
+                    - float(np.sum(np.log2(_magnitude(far_poles))))
+                )
+            if math.isfinite(log_k0):
+                low = min(low, 2.0 ** min(log_k0 / q, 1023.0) / 100.0)
     nyquist = math.pi / dt if dt else math.inf
     high = min(high, nyquist, 1e300)
     # Not below 1e-300 (roots and gains near 1e-300 put low at a subnormal or 0, and high/low
