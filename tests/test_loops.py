@@ -506,3 +506,114 @@ def test_open_loop_poles_beyond_the_doubles_warn_as_other_results_do() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert np.array_equal(locus.open_loop_zeros, [x])
+
+
+# ----- extreme scales: no NaN, no escaped numpy warning ------------------------------------------
+
+
+@pytest.mark.parametrize("d", [5e-324, 1e-308, 1e308])
+def test_best_damping_gain_refuses_a_default_grid_beyond_the_doubles(d: float) -> None:
+    """A static loop L = D (no state: every gain gives the same, empty, closed loop): the
+    default gains about 1/|D| (1/5e-324 is inf; 1e-308 gives 1e305 to 1e311) or 1e-308 about
+    1/1e308 (below the normal doubles) are not representable. The subnormal D returned a NaN
+    gain with no warning, 1e-308 escaped numpy's overflow warning: now refused naming the
+    loop, and with the gains given the answer is the first gain (ζ = 1 for every gain)."""
+    static = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[d]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InvalidArgumentError, match=r"loop: .*give the gains"):
+            best_damping_gain(static)
+        design = best_damping_gain(static, gains=[0.0, 1.0, 1e300])
+    assert design.gain == 0.0 and design.damping_ratio == 1.0
+    assert design.closed_loop_poles.shape == (0,)
+
+
+def test_best_damping_gain_of_a_flat_objective_stays_on_the_grid() -> None:
+    """1/(s + 1) with a D of 1e-200: no gain makes a pole oscillate, so ζ = 1 everywhere; the
+    golden-section refinement drifted from the grid gain 0 towards 8.6e-46 (a gain no better
+    than 0): the grid gain is kept unless the refinement damps strictly better."""
+    model = (np.array([[-1.0]]), np.array([[1.0]]), np.array([[1.0]]), np.array([[1e-200]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        design = best_damping_gain(model)
+    assert design.gain == 0.0 and design.damping_ratio == 1.0
+    assert design.closed_loop_poles.tolist() == [-1.0 + 0j]
+
+
+def test_closed_loop_gain_beyond_the_doubles_near_the_algebraic_gain() -> None:
+    """D = -1e-300 and k = 1e300 (1 + 1e-14), within 1e-14 of the algebraic gain -1/D: the
+    closed-loop gain k/(1 + k D) = -1e314 overflowed, and the matrix A - g B C was formed of
+    inf (a NonFiniteError blaming A, which is finite). With B C = 1e-200 the pole
+    -1 - 1e-200 k/(1 + k D) = 1.0008e114 is representable (closed form, with 1 + k D
+    evaluated in double precision as aerocontrol does)."""
+    model = (np.array([[-1.0]]), np.array([[1.0]]), np.array([[1e-200]]), np.array([[-1e-300]]))
+    k = 1e300 * (1 + 1e-14)
+    expected = -1.0 - 1e-200 * k / (1.0 + k * -1e-300)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        locus = root_locus(model, [k, 1.0])
+        design = best_damping_gain(model, gains=[0.0, k])
+    assert locus.poles[0, 0].real == pytest.approx(expected, rel=1e-12)
+    assert locus.poles[1, 0] == pytest.approx(-1.0 - 1e-200, rel=1e-15)
+    assert design.gain == 0.0 and design.closed_loop_poles.tolist() == [-1.0 + 0j]
+
+
+def test_margins_closed_loop_poles_of_a_dominant_rank_one_loop() -> None:
+    """A of 1e-8 beside B C of 1e3, B without a fifth entry (a hypothesis campaign's input,
+    seed 1): the core's balanced eigenvalues of A - B C had backward errors up to 1.5e-9 for
+    the four small poles (1000 n u ||A - B C||) and relative errors of 3%, though the
+    eigenvector matrix has condition 11. The reference is mpmath's eigenvalues at 50 digits;
+    the poles now agree to 1e-5 relatively (the condition times n u ||A - B C|| / |pole|:
+    11 · 5 · 1.1e-16 · 2.7e3 / 8e-9 = 2e-5) and the large pole to 1e-13."""
+    A = np.array(
+        [
+            [-3.1103377564063964e-08, -1.3210486329130189e-09, 6.4042265044328204e-09,
+             1.0490011715303971e-09, -5.3566937316111095e-09],
+            [3.6159505490948476e-09, -1.9320679323696528e-08, 9.4708096312924227e-09,
+             -7.0373523580699263e-09, -1.2654214710460525e-08],
+            [-6.2327446253735220e-09, 4.1325979347243599e-10, -5.5610987521386247e-08,
+             -2.1879166393254573e-09, -1.2459109472530651e-08],
+            [-7.3226735470345159e-09, -5.4425898285730992e-09, -3.1630015636915456e-09,
+             -2.8244374411256570e-08, 1.0425133694426777e-08],
+            [-1.2853466294403426e-09, 1.3664634705496860e-08, -6.6519467348661353e-09,
+             3.5151007009301971e-09, -2.3325977958479811e-08],
+        ]
+    )  # fmt: skip
+    B = np.array([[2.0], [-1.0], [-2.0], [-1.0], [0.0]])
+    C = np.array(
+        [[125.7302210933933, -132.10486329130188, 640.422650443282, 104.9001171530397,
+          -535.6693731611109]]
+    )  # fmt: skip
+    mpmath_poles = np.array(
+        [
+            -4.225538978942033e-08,
+            -3.933164096927389e-08,
+            -8.491470931616548e-09 - 8.398194677560902e-09j,
+            -8.491470931616548e-09 + 8.398194677560902e-09j,
+            1002.1801125024798,
+        ]
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        margins = stability_margins((A, B, C, np.zeros((1, 1))))
+    poles = margins.closed_loop_poles
+    np.testing.assert_allclose(poles[:4], mpmath_poles[:4], rtol=1e-5)
+    assert poles[4] == pytest.approx(mpmath_poles[4], rel=1e-13)
+    M = A - B @ C
+    for pole in poles:  # backward errors within n u ||M||_F, as a backward stable QR's
+        smallest = np.linalg.svd(M - pole * np.eye(5), compute_uv=False)[-1]
+        assert smallest <= 5 * np.finfo(float).eps * np.linalg.norm(M)
+    assert not margins.closed_loop_stable
+
+
+def test_margins_grid_of_a_loop_with_a_huge_feedthrough() -> None:
+    """A of -1.87e-3, B of 2e8, C of 2e300, D of 1.26e299 (a campaign input, seed 0): the grid
+    search's low-frequency gain K Π|z| / Π|p| overflowed (numpy's warnings, then inf/inf); it
+    is formed in log2. Closed form: the closed-loop pole a - b c/(1 + d) = -3.1814e9."""
+    a, b, c, d = -0.00187426977890661, 2e8, 2e300, 1.257302210933933e299
+    model = (np.array([[a]]), np.array([[b]]), np.array([[c]]), np.array([[d]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        margins = stability_margins(model)
+    assert margins.closed_loop_poles[0] == pytest.approx(a - (b / (1 + d)) * c, rel=1e-12)
+    assert margins.closed_loop_stable

@@ -311,3 +311,60 @@ def test_balancing_beside_a_pole_near_1e308() -> None:
     assert g.poles.tolist() == [1e308 + 0j]
     np.testing.assert_allclose(g.zeros.real, [1e308], rtol=1e-14)
     assert g.gain == pytest.approx(d, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("A", "expected_real"),
+    [
+        # Zeros of A - B C/D: [[0, 2h], [-h, 0]], ±j √2 h beyond the doubles, real part 0 to
+        # rounding (the pencil's 4e292 is 2e-16 of the imaginary part).
+        (np.array([[0.0, 1.7e308], [-1.7e308, 0.0]]), None),
+        # [[-h, 2h], [-h, -h]]: -h ± j √2 h.
+        (np.array([[-1.7e308, 1.7e308], [-1.7e308, -1.7e308]]), -1.7e308),
+    ],
+)
+def test_zeros_with_an_imaginary_part_beyond_the_doubles(
+    A: np.ndarray, expected_real: float | None
+) -> None:
+    """B = e1, C = [0, -h], D = 1 with h = 1.7e308: the zeros, the eigenvalues of A - B C/D,
+    have imaginary parts ±√2 h beyond the doubles. Scaling them back as real + 1j * imag made
+    1j * inf = NaN + inf j (numpy's 'invalid value' warning) and NaN zeros; now the imaginary
+    parts are ±inf, the real parts kept, one NumericalOverflowWarning, no NaN, sorted."""
+    B, C, D = np.array([[1.0], [0.0]]), np.array([[0.0, -1.7e308]]), np.ones((1, 1))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        zeros = transmission_zeros((A, B, C, D))
+    assert [type(w.message) for w in caught] == [aerocontrol.NumericalOverflowWarning]
+    assert not np.any(np.isnan(zeros))
+    assert sorted(zeros.imag.tolist()) == [-math.inf, math.inf]
+    if expected_real is None:
+        assert np.all(np.abs(zeros.real) <= 1e-15 * 1.7e308 * math.sqrt(2))
+    else:
+        np.testing.assert_allclose(zeros.real, [expected_real] * 2, rtol=1e-14)
+    assert np.all(zeros.real[1:] >= zeros.real[:-1])
+
+
+def test_zeros_of_modulus_beyond_the_doubles_keep_their_imaginary_parts() -> None:
+    """A = [[h, h], [-h, h]] (h = 1.7e308), B = C = 0, D = 1: the zeros (decoupling zeros)
+    are h ± j h, whose parts are doubles but whose modulus is not. |z| = inf made every
+    imaginary part 'negligible' (|Im| <= 8 ε |z|): the pair came back as the real h twice.
+    The zeros are finite, so no warning."""
+    h = 1.7e308
+    model = (np.array([[h, h], [-h, h]]), np.zeros((2, 1)), np.zeros((1, 2)), np.ones((1, 1)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        zeros = transmission_zeros(model)
+    np.testing.assert_allclose(zeros.real, [h, h], rtol=1e-14)
+    np.testing.assert_allclose(zeros.imag, [-h, h], rtol=1e-14)
+
+
+def test_equal_infinite_zeros_are_in_order() -> None:
+    """Two blocks [[h, h], [h, -h]] (h = 1.7e308): zeros ±√2 h, each twice, beyond the doubles:
+    -inf, -inf, inf, inf, with a NumericalOverflowWarning (np.diff of them is NaN: the order
+    is pairwise)."""
+    h = 1.7e308
+    block = np.array([[h, h], [h, -h]])
+    A = np.block([[block, np.zeros((2, 2))], [np.zeros((2, 2)), block]])
+    with pytest.warns(aerocontrol.NumericalOverflowWarning):
+        zeros = transmission_zeros((A, np.zeros((4, 1)), np.zeros((1, 4)), np.ones((1, 1))))
+    assert zeros.tolist() == [-math.inf, -math.inf, math.inf, math.inf]

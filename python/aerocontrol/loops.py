@@ -171,6 +171,23 @@ def _closed_loop_gains(model: StateSpace, k: FloatArray) -> FloatArray:
     return np.asarray(g, dtype=np.float64)
 
 
+def _closed_loop_gain_parts(model: StateSpace, k: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """k (1 + k D)^-1 for each gain as a mantissa and a power of two (m 2^e), which do not
+    overflow where the gain does: a k within 1e-14 of the algebraic gain -1/D, with D of
+    1e-300, has a closed-loop gain of 1e314, times a B C that may be small."""
+    d = float(model.D[0, 0])
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        denominators = 1.0 + k * d
+        near = np.isfinite(denominators)
+        mk, ek = np.frexp(k)
+        md, ed = np.frexp(denominators)
+        far_m, far_e = np.frexp(1.0 / k + d)  # k/(1 + k D) = 1/(1/k + D) where k D overflows
+        mantissa = np.where(near, mk / md, 1.0 / far_m)
+        exponent = np.where(near, ek - ed, -far_e).astype(np.float64)
+    zero = k == 0.0
+    return np.where(zero, 0.0, mantissa), np.where(zero, 0.0, exponent)
+
+
 def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     """The eigenvalues of A - k B (1 + k D)^-1 C for each gain, each row sorted; the gains are
     free of algebraic loops (:func:`_refuse_algebraic`).
@@ -187,13 +204,15 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
         return np.zeros((k.size, 0), np.complex128)
     A, B, C = model.A, model.B, model.C
     g = _closed_loop_gains(model, k)
+    mantissa, power = _closed_loop_gain_parts(model, k)
     size_A, size_B, size_C = _log2_size(A), _log2_size(B), _log2_size(C)
     if not math.isfinite(size_B + size_C):  # B C = 0: the loop does not move the poles
         g = np.zeros_like(g)
+        mantissa = np.zeros_like(mantissa)
         size_B = size_C = 0.0
     with np.errstate(divide="ignore"):
-        terms = np.maximum(size_A, np.log2(np.abs(g)) + size_B + size_C)
-    plain = (terms <= RESCALE_EXPONENT) & (size_B + size_C <= RESCALE_EXPONENT)
+        terms = np.maximum(size_A, np.log2(np.abs(mantissa)) + power + size_B + size_C)
+    plain = (terms <= RESCALE_EXPONENT) & (size_B + size_C <= RESCALE_EXPONENT) & np.isfinite(g)
     exponents = np.where(plain | ~np.isfinite(terms), 0, np.round(terms)).astype(np.int64)
     stack = np.empty((k.size, n, n))
     if np.any(plain):
@@ -203,8 +222,11 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
         normalised = np.ldexp(B, -eb) @ np.ldexp(C, -ec)
         for i in np.flatnonzero(~plain):
             e = int(exponents[i])
-            stack[i] = np.ldexp(A, -e) - np.ldexp(g[i], eb + ec - e) * normalised
+            shift = int(power[i]) + eb + ec - e
+            stack[i] = np.ldexp(A, -e) - np.ldexp(mantissa[i], shift) * normalised
     poles = _core.eigenvalues(stack)
+    for row in range(k.size):
+        poles[row] = _backward_stable_eigenvalues(stack[row], poles[row])
     if np.any(exponents):
         with np.errstate(over="ignore", invalid="ignore"):
             scale = exponents[:, None]
@@ -229,6 +251,73 @@ def _stable(roots: ComplexArray, discrete: bool) -> bool:
 
 def _eigenvalues(A: FloatArray) -> ComplexArray:
     return _core.eigenvalues(A) if A.shape[0] else np.zeros(0, np.complex128)
+
+
+#: The normwise backward error, in units of n u ||M||_F, beyond which the balanced eigenvalues
+#: of a closed-loop matrix are checked against those of its unbalanced Schur form.
+BACKWARD_ERROR_UNITS = 10.0
+
+#: Closed-loop matrices of at most this order have their balanced eigenvalues checked (about
+#: 2 n^4 flops for the n residuals of a matrix: within the cost of the core's eigenvalues for
+#: the orders of flight models). Larger ones take the core's eigenvalues as they are.
+CHECKED_MAX_ORDER = 32
+
+
+def _residual_bounds(M: FloatArray, values: ComplexArray) -> FloatArray:
+    """For each eigenvalue λ, an upper bound on its backward error σ_min(M - λI) (the norm of
+    the least perturbation of M of which λ is an eigenvalue): ||(M - λI) x|| / ||x|| for x
+    from two steps of inverse iteration from a fixed start (deterministic). A shift that is
+    singular to working precision (its solution overflows) has bound 0."""
+    n = M.shape[0]
+    shifted = M.astype(np.complex128)[None, :, :] - values[:, None, None] * np.eye(n)
+    x = np.broadcast_to(np.random.default_rng(0).standard_normal(n), (values.size, n))
+    x = x.astype(np.complex128)
+    singular = np.zeros(values.size, dtype=bool)
+    with np.errstate(all="ignore"):
+        for _ in range(2):
+            try:
+                x = np.linalg.solve(shifted, x[:, :, None])[:, :, 0]
+            except np.linalg.LinAlgError:  # an exactly singular shift: λ is exact
+                return np.zeros(values.size)
+            largest = np.max(np.abs(x), axis=1)
+            singular |= ~(np.isfinite(largest) & (largest > 0.0))
+            x = np.where(singular[:, None], 1.0, x / np.where(singular, 1.0, largest)[:, None])
+        residual = np.linalg.norm(np.einsum("kij,kj->ki", shifted, x), axis=1)
+        bounds = residual / np.linalg.norm(x, axis=1)
+    return np.asarray(np.where(singular, 0.0, bounds), dtype=np.float64)
+
+
+def _backward_stable_eigenvalues(M: FloatArray, values: ComplexArray) -> ComplexArray:
+    """The core's (balanced) eigenvalues ``values`` of M, or those of M's unbalanced Schur
+    form where the balanced ones are not backward stable for M itself.
+
+    The core balances M (a diagonal similarity D^-1 M D) before its QR iteration; its
+    eigenvalues are then those of M + D E D^-1 with E of about u ||D^-1 M D||, which is
+    small next to ||M|| for most badly scaled matrices but not for all: a closed-loop matrix
+    A - B C dominated by its rank-one term, with a state that B does not reach (A of 1e-8, B C
+    of 1e3), is balanced by a D of wide range, and its small eigenvalues came out with
+    backward errors of 1e-9 (1.5e-9 / (n u ||M||) = 1000) and relative errors of 3%, where the
+    unbalanced Schur form's QR, backward stable for M, has backward errors of 1e-14 and agrees
+    with mpmath to 1e-7. So the balanced eigenvalues are kept where their backward errors
+    (bounded by :func:`_residual_bounds`) are within BACKWARD_ERROR_UNITS n u ||M||_F, and
+    otherwise the set (balanced or unbalanced) whose largest backward error is less."""
+    n = M.shape[0]
+    if n == 0 or n > CHECKED_MAX_ORDER or not np.all(np.isfinite(values)):
+        return values
+    size = float(np.linalg.norm(M))
+    if not math.isfinite(size):
+        return values
+    allowed = BACKWARD_ERROR_UNITS * n * (_EPS / 2.0) * size
+    upper = values.imag >= 0.0  # a conjugate has the same backward error (M is real)
+    balanced = float(np.max(_residual_bounds(M, values[upper]), initial=0.0))
+    if balanced <= allowed:
+        return values
+    unbalanced_values = _core.schur(M, None)[2]
+    if not np.all(np.isfinite(unbalanced_values)):
+        return values
+    upper = unbalanced_values.imag >= 0.0
+    unbalanced = float(np.max(_residual_bounds(M, unbalanced_values[upper]), initial=0.0))
+    return unbalanced_values if unbalanced < balanced else values
 
 
 # ----- one-dimensional searches -------------------------------------------------------------
@@ -387,9 +476,16 @@ def _grid(model: StateSpace) -> FloatArray:
         if q > 0:
             far_poles = g.poles[np.abs(g.poles) > 1e-12 * max(scale, 1.0)]
             far_zeros = g.zeros[np.abs(g.zeros) > 1e-12 * max(scale, 1.0)]
-            k0 = abs(g.gain * np.prod(-far_zeros) / np.prod(-far_poles))
-            if k0 > 0:
-                low = min(low, k0 ** (1.0 / q) / 100.0)
+            # |K0| = |K| Π|z| / Π|p| in log2: the products overflow (a D of 1e299 beside a
+            # zero near 3e306: numpy's overflow, then inf/inf) where K0^(1/q) need not.
+            with np.errstate(divide="ignore", over="ignore"):
+                log_k0 = (
+                    math.log2(abs(g.gain))
+                    + float(np.sum(np.log2(_magnitude(far_zeros))))
+                    - float(np.sum(np.log2(_magnitude(far_poles))))
+                )
+            if math.isfinite(log_k0):
+                low = min(low, 2.0 ** min(log_k0 / q, 1023.0) / 100.0)
     nyquist = math.pi / dt if dt else math.inf
     high = min(high, nyquist, 1e300)
     # Not below 1e-300 (roots and gains near 1e-300 put low at a subnormal or 0, and high/low
@@ -662,6 +758,10 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
         # the phase crossovers, so the grid search decides.
         return _grid_margins(model)
+    d = float(model.D[0, 0])
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow: the core's kept
+        closed_matrix = model.A - np.outer(model.B[:, 0], model.C[0]) / (1.0 + d)  # as its own
+    closed = _backward_stable_eigenvalues(closed_matrix, closed)
     stable = bool(np.all(closed.real < 0.0))
     unstable_open = int(np.sum(open_poles.real > 0.0))
     unstable_closed = int(np.sum(closed.real > 0.0))
@@ -1092,15 +1192,40 @@ class _Objective:
         return zeta
 
 
+#: Decades of the default gain grid on each side of 1/|L| at the loop's modes.
+GAIN_DECADES = 3.0
+
+
 def _default_gains(model: StateSpace) -> FloatArray:
-    """0, then 400 gains log-spaced over six decades about 1/|L| at the loop's modes."""
+    """0, then 400 gains log-spaced over six decades about 1/|L| at the loop's modes.
+
+    The grid is formed in log2: 1/|L| itself overflows for an |L| below 2^-1024 (a subnormal
+    D of 5e-324 gave an infinite grid and a NaN gain), and the grid's ends over- or underflow
+    within three decades of the range. A grid that is not within the normal doubles
+    [2^-1022, 2^1024) is refused naming the loop (its gains, and the gain sought, are not
+    representable, or only to a few digits), with the advice to give the gains."""
     poles = _continuous(_eigenvalues(model.A), period(model) if model.is_discrete else 0.0)
-    sizes = np.abs(poles[np.isfinite(poles) & (np.abs(poles) > 0)])
+    with np.errstate(over="ignore"):
+        sizes = _magnitude(poles[np.isfinite(poles)])
+    sizes = sizes[np.isfinite(sizes) & (sizes > 0)]
     omega = sizes if sizes.size else np.array([1.0])
     magnitude = _magnitude(_Response(model).many(omega))
     magnitude = magnitude[np.isfinite(magnitude) & (magnitude > 0)]
-    reference = 1.0 / float(np.median(magnitude)) if magnitude.size else 1.0
-    return np.concatenate([[0.0], reference * np.logspace(-3.0, 3.0, 400)])
+    if not magnitude.size:
+        return np.concatenate([[0.0], np.logspace(-GAIN_DECADES, GAIN_DECADES, 400)])
+    centre = -math.log2(float(np.median(magnitude)))  # log2 of 1/|L|, finite for |L| > 0
+    spread = GAIN_DECADES * math.log2(10.0)
+    low, high = centre - spread, centre + spread
+    tiny, largest = np.finfo(float).tiny, np.finfo(float).max
+    if not (math.log2(tiny) <= low and high < math.log2(largest)):
+        raise InvalidArgumentError(
+            f"loop: its gain |L| at its modes is about 2^{-centre:.0f} "
+            f"({float(np.median(magnitude)):.3g}), so the default gains about 1/|L| "
+            f"(2^{low:.0f} to 2^{high:.0f}) are not within the normal doubles "
+            f"({tiny:.3g} to {largest:.3g}); give the gains to search"
+        )
+    reference = 1.0 / float(np.median(magnitude))
+    return np.concatenate([[0.0], reference * np.logspace(-GAIN_DECADES, GAIN_DECADES, 400)])
 
 
 def _mode(mode: complex | None) -> complex | None:
@@ -1157,7 +1282,10 @@ def best_damping_gain(
     if k.size > 2:
         a, b = float(k[max(i - 1, 0)]), float(k[min(i + 1, k.size - 1)])
         refined_k, refined_zeta = _golden_max(objective, a, b)
-        if refined_zeta >= best_zeta:
+        # Only a better damping moves the gain off the grid: where ζ is flat (no pole
+        # oscillates, or a static loop) the search drifts towards a = 0, to gains of 1e-46
+        # or subnormal ones (3e-313 beside a D of 1e308).
+        if refined_zeta > best_zeta:
             best_k, best_zeta = refined_k, refined_zeta
     zeta, pole, poles = objective.pole(best_k)
     return DampingDesign(best_k, zeta, pole, poles)

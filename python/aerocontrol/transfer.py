@@ -291,11 +291,20 @@ def _scaled_pencil_zeros(
     Bf = W[:n, :n]
     zeros = _regular_pencil_zeros(Af, Bf, ratio)
     zeros[np.abs(zeros) <= tolerance] = 0.0  # a zero at the origin, to rounding (a washout)
-    with np.errstate(over="ignore"):  # a zero beyond the range of doubles is warned of
-        zeros = np.ldexp(zeros.real, e) + 1j * np.ldexp(zeros.imag, e)
-    with np.errstate(over="ignore"):
-        finite_or_warn(np.abs(zeros), "a transmission zero")
+    zeros = _scaled_by_power_of_two(zeros, e)
+    finite_or_warn(zeros, "a transmission zero")
     return zeros, rank, limit
+
+
+def _scaled_by_power_of_two(values: ComplexArray, exponent: int) -> ComplexArray:
+    """values 2^exponent, part by part: a part beyond the range of doubles is ±inf and the
+    other keeps its value (not ``real + 1j * imag``, where 1j times an infinite part is
+    NaN + inf j: numpy's 'invalid value' warning, and a NaN real part)."""
+    scaled = np.empty(values.shape, dtype=np.complex128)
+    with np.errstate(over="ignore"):  # a zero beyond the range of doubles is warned of
+        scaled.real = np.ldexp(values.real, exponent)
+        scaled.imag = np.ldexp(values.imag, exponent)
+    return scaled
 
 
 def _paired(values: ComplexArray, count: int) -> bool:
@@ -387,10 +396,16 @@ def _regular_pencil_zeros(Af: FloatArray, Bf: FloatArray, ratio: float) -> Compl
 
 def _conjugate_clean(roots: ComplexArray) -> ComplexArray:
     """Roots with a negligible imaginary part made real, and sorted (by real part, then
-    imaginary part)."""
+    imaginary part; -inf first and +inf last).
+
+    Negligible is |Im| <= 8 ε max(|Re|, |Im|) (8 ε |root| to rounding, with no modulus to
+    overflow), judged of finite roots only: a root with an infinite part (beyond the doubles)
+    is kept as computed, since its modulus, and so what is negligible beside it, is unknown.
+    (|root| <= inf held for every root with an infinite part, so h (1 + j) beyond the doubles
+    became the real h, and 1j * inf had made a NaN real part.)"""
     cleaned = roots.copy()
-    with np.errstate(over="ignore"):  # |root| beyond the doubles is inf: not tiny
-        tiny = np.abs(cleaned.imag) <= 8 * np.finfo(float).eps * np.abs(cleaned)
+    parts = np.maximum(np.abs(cleaned.real), np.abs(cleaned.imag))
+    tiny = np.isfinite(cleaned) & (np.abs(cleaned.imag) <= 8 * np.finfo(float).eps * parts)
     cleaned[tiny] = cleaned[tiny].real
     return np.sort_complex(cleaned)
 
@@ -428,7 +443,10 @@ def transmission_zeros(sys: System, tol: float | None = None) -> ComplexArray:
     Returns
     -------
     ndarray of complex128
-        The finite zeros, sorted by real part.
+        The finite zeros, sorted by real part, then imaginary part (``numpy.sort_complex``).
+        A zero with a part beyond the range of doubles has that part infinite (the other
+        part as computed, never NaN), with a NumericalOverflowWarning, and takes its place in
+        the same order: a real part of -inf first, +inf last.
 
     Examples
     --------

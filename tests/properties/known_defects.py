@@ -72,18 +72,3 @@ ZEROS_DROPPED = known_defect(
 
 def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
-
-
-EIGENVALUES_OF_A_DOMINANT_RANK_ONE = known_defect(
-    "eigenvalues-dominant-rank-one",
-    {"root_locus"},
-    "the core's eigenvalues of a closed-loop matrix A - k B C dominated by its rank-one term "
-    "(A of 4, B of 1e8, C of 2: norm 2.3e8, one eigenvalue 2.3e8 and three near -4) have a "
-    "backward error sigma_min(M - lambda I) of 1e-4 for the small ones (mpmath), 6 times "
-    "the oracle's SLACK n u ||M||; LAPACK's dgeev (numpy) reaches 2.7e-5 on the same matrix, "
-    "also beyond n u ||M|| = 3.2e-7: both balance M, and a backward error small for the "
-    "balanced matrix need not be small for M. The forward errors are 6e-5 (ours) and 1.6e-5 "
-    "(LAPACK) relative. Open: whether the core's QR loses a factor 4 against LAPACK here, "
-    "and an oracle bound that accounts for balancing",
-    lambda args: _block_spread(args) > 1e6 and _largest_entry(args) < 1e100,
-)
