@@ -616,8 +616,10 @@ def test_nearly_undetectable_pairs_warn_at_the_callers_line() -> None:
             (A, [[1e-6], [1.0]], np.eye(2), np.zeros((2, 1))), np.eye(2), 1, 1, np.eye(2)
         )
     assert [w.filename for w in [*record, *more]] == [__file__] * (len(record) + len(more))
-    # Weighted 1e-8, the discrete filter is solved with a warning (P near 1e17, as scipy's);
-    # weighted 1e-12 it cannot be told from an undetectable one.
+    # Weighted 1e-8, the discrete filter is solved with a warning (P near 1e17, as scipy's).
+    # Weighted 1e-12 too (P near 9e24), by the doubling path, where scipy fails to find a
+    # finite solution: a true solution, its residual in 50 digits within 4 u of its size, and
+    # the filter stable. Weighted 1e-20 it cannot be told from an undetectable one.
     with pytest.warns(IllConditionedWarning, match="rcond"):
         _, P, _ = aerocontrol.dlqe(
             np.diag([2.0, 0.5]), np.eye(2), [[1e-8, 1.0]], np.eye(2), [[1.0]]
@@ -626,8 +628,20 @@ def test_nearly_undetectable_pairs_warn_at_the_callers_line() -> None:
         np.diag([2.0, 0.5]), np.array([[1e-8], [1.0]]), np.eye(2), np.eye(1)
     )
     np.testing.assert_allclose(P, reference, rtol=0, atol=1e-8 * np.linalg.norm(reference))
-    with pytest.raises(NoStabilizingSolutionError, match="too weakly"):
-        aerocontrol.dlqe(np.diag([2.0, 0.5]), np.eye(2), [[1e-12, 1.0]], np.eye(2), [[1.0]])
+    with pytest.warns(IllConditionedWarning, match="rcond"):
+        _, P, E = aerocontrol.dlqe(
+            np.diag([2.0, 0.5]), np.eye(2), [[1e-12, 1.0]], np.eye(2), [[1.0]]
+        )
+    assert P[0, 0] == pytest.approx(8.864462207e24, rel=1e-9) and np.all(np.abs(E) < 1)
+    with mpmath.workdps(50):
+        A_mp = mpmath.diag([2, mpmath.mpf("0.5")])
+        C_mp = mpmath.matrix([[mpmath.mpf(1e-12), 1]])
+        P_mp = mpmath.matrix(P.tolist())
+        gain = A_mp * P_mp * C_mp.T * (C_mp * P_mp * C_mp.T + mpmath.eye(1)) ** -1
+        residual = A_mp * P_mp * A_mp.T - gain * C_mp * P_mp * A_mp.T + mpmath.eye(2) - P_mp
+        assert mpmath.mnorm(residual, "F") <= 4 * np.finfo(float).eps * mpmath.mnorm(P_mp, "F")
+    with pytest.raises(NoStabilizingSolutionError, match="not detectable"):
+        aerocontrol.dlqe(np.diag([2.0, 0.5]), np.eye(2), [[1e-20, 1.0]], np.eye(2), [[1.0]])
 
 
 def test_bad_arguments_are_named() -> None:

@@ -68,6 +68,7 @@
 
 use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::error::Error;
+use crate::linalg::balance::nearest_power_of_two;
 use crate::linalg::schur::eigenvalues;
 use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
@@ -124,15 +125,6 @@ fn max_abs(x: MatRef<'_, f64>) -> f64 {
     m
 }
 
-/// The power of two nearest to x > 0 (1 for 0 or non-finite x): an exact scale factor.
-fn power_of_two(x: f64) -> f64 {
-    if x > 0.0 && x.is_finite() {
-        2f64.powi(x.log2().round() as i32)
-    } else {
-        1.0
-    }
-}
-
 /// The eigenvalues of the Hamiltonian of 1 - G(-s) G(s) for G = (A, B, C, d), r = 1 - d^2 != 0.
 fn hamiltonian_eigenvalues(
     a: MatRef<'_, f64>,
@@ -148,7 +140,7 @@ fn hamiltonian_eigenvalues(
         c.iter().fold(0.0f64, |m, v| m.max(v.abs())),
     );
     let beta = if nb > 0.0 && nc > 0.0 {
-        power_of_two((nc / nb).sqrt())
+        nearest_power_of_two((nc / nb).sqrt())
     } else {
         1.0
     };

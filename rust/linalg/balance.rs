@@ -33,6 +33,15 @@ pub(crate) fn scale_for_largest(largest: f64) -> f64 {
     }
 }
 
+/// The power of two nearest to x > 0 (1 for 0 or a non-finite x): an exact scale factor.
+pub(crate) fn nearest_power_of_two(x: f64) -> f64 {
+    if x > 0.0 && x.is_finite() {
+        2f64.powi(x.log2().round() as i32)
+    } else {
+        1.0
+    }
+}
+
 /// x 2^e for an integer e of any size, in two exact steps where one power would leave the range
 /// of doubles.
 pub(crate) fn times_power_of_two(x: f64, exponent: f64) -> f64 {

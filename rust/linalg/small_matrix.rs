@@ -23,7 +23,7 @@ use nalgebra::SMatrix;
 use crate::platform::dispatch::{fma_dispatch, multiply_add};
 
 /// The storage of an N x N matrix: N columns of N entries.
-type Columns<const N: usize> = [[f64; N]; N];
+pub(crate) type Columns<const N: usize> = [[f64; N]; N];
 
 /// The columns of `m`.
 #[inline(always)]
@@ -46,7 +46,7 @@ pub(crate) fn from_columns<const N: usize>(columns: Columns<N>) -> SMatrix<f64, 
 /// out += lhs * rhs: column j of the result gains rhs_kj times column k of lhs, k in order
 /// (each entry the sum over k, in order, of lhs_ik rhs_kj).
 #[inline(always)]
-fn add_product_kernel<const N: usize, const FMA: bool>(
+pub(crate) fn add_product_kernel<const N: usize, const FMA: bool>(
     lhs: &Columns<N>,
     rhs: &Columns<N>,
     out: &mut Columns<N>,
@@ -123,7 +123,10 @@ fma_dispatch!(fn absolute_power_norm_columns<const N: usize>(a: &Columns<N>, sca
 /// Gaussian elimination with partial pivoting in place: the unit lower factor below the
 /// diagonal, the upper factor on and above it; row k was swapped with row `pivots[k]`.
 #[inline(always)]
-fn lu_kernel<const N: usize, const FMA: bool>(a: &mut Columns<N>, pivots: &mut [usize; N]) {
+pub(crate) fn lu_kernel<const N: usize, const FMA: bool>(
+    a: &mut Columns<N>,
+    pivots: &mut [usize; N],
+) {
     for k in 0..N {
         let mut pivot_row = k;
         for i in k + 1..N {
@@ -154,7 +157,7 @@ fma_dispatch!(fn lu_in_place<const N: usize>(a: &mut Columns<N>, pivots: &mut [u
 
 /// Solves with the factors of [`lu_kernel`] for N right-hand sides in place, column by column.
 #[inline(always)]
-fn lu_solve_kernel<const N: usize, const FMA: bool>(
+pub(crate) fn lu_solve_kernel<const N: usize, const FMA: bool>(
     lu: &Columns<N>,
     pivots: &[usize; N],
     rhs: &mut Columns<N>,

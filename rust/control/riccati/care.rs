@@ -81,7 +81,7 @@
 
 use super::AlgebraicSolution;
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::linalg::balance::balance;
+use crate::linalg::balance::{balance, nearest_power_of_two};
 use crate::linalg::dense::{
     cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place, transposed_product,
 };
@@ -845,14 +845,6 @@ fn check_stabilising(closed_loop_eigenvalues: &[c64], closed_loop_norm: f64) -> 
             unstable.join(", ")
         ),
     })
-}
-
-fn nearest_power_of_two(value: f64) -> f64 {
-    if value.is_finite() && value > 0.0 {
-        2f64.powi(value.log2().round() as i32)
-    } else {
-        1.0
-    }
 }
 
 /// Newton (Kleinman) steps while the residual decreases and is above [`REFINEMENT_FLOOR`] times

@@ -29,14 +29,16 @@
 //! subspace [U11; U21]: X = U21 (E U11)^-1, symmetrised. Exactly n eigenvalues must lie inside
 //! the unit circle and none within 100 u of it; else the equation has no stabilising solution.
 //!
-//! # The fast path
+//! # The fast paths
 //!
-//! For E = I and R positive definite the equation is first solved through the Cayley
-//! transform of the pencil (without its input block) to a Hamiltonian matrix and the
-//! continuous solver's Hamiltonian Schur method ([`super::cayley`]); its solution is kept when,
-//! after the refinement below, it passes every check of this module with a relative residual
-//! of at most [`CAYLEY_MAX_RESIDUAL`]. Otherwise (M + N ill-conditioned, an eigenvalue near
-//! z = -1, R indefinite or singular, a descriptor E) the pencil and QZ decide.
+//! For E = I and R positive definite the equation is first solved, up to order
+//! [`super::doubling::MAX_ORDER`], by the structure-preserving doubling algorithm
+//! ([`super::doubling`]), then through the Cayley transform of the pencil (without its input
+//! block) to a Hamiltonian matrix and the continuous solver's Hamiltonian Schur method
+//! ([`super::cayley`]). A fast path's solution is kept when, after the refinement below, it
+//! passes every check of this module with a relative residual of at most
+//! [`FAST_PATH_MAX_RESIDUAL`]. Otherwise (the doubling diverged, M + N ill-conditioned, an
+//! eigenvalue near z = -1, R indefinite or singular, a descriptor E) the pencil and QZ decide.
 //!
 //! # Checks and the reported numbers
 //!
@@ -61,6 +63,7 @@
 
 use super::AlgebraicSolution;
 use super::cayley::cayley_solution;
+use super::doubling::doubling_solution;
 use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
 use crate::linalg::dense::view_product;
@@ -79,9 +82,9 @@ pub const CIRCLE_TOLERANCE: f64 = 100.0 * f64::EPSILON;
 /// a 4-state solve).
 pub const REFINEMENT_FLOOR: f64 = f64::EPSILON;
 
-/// The largest relative residual, after refinement, at which the Cayley transform's solution
-/// ([`super::cayley`]) is kept; above it the pencil decides.
-pub const CAYLEY_MAX_RESIDUAL: f64 = 4.0 * f64::EPSILON;
+/// The largest relative residual, after refinement, at which a fast path's solution
+/// ([`super::doubling`], [`super::cayley`]) is kept; above it the pencil decides.
+pub const FAST_PATH_MAX_RESIDUAL: f64 = 4.0 * f64::EPSILON;
 
 /// Newton steps at most.
 pub const MAX_REFINEMENT_STEPS: usize = 3;
@@ -141,14 +144,7 @@ pub fn solve_dare(
         identity_e: options.e.is_none(),
     };
     if options.e.is_none()
-        && let Some(candidate) = cayley_solution(a, b, q.as_ref(), r.as_ref(), options.s)
-        && let Ok(solution) = finish(
-            &problem,
-            candidate.x,
-            candidate.rcond,
-            &candidate.closed_loop_estimates,
-        )
-        && solution.residual <= CAYLEY_MAX_RESIDUAL
+        && let Some(solution) = fast_solution(&problem)
     {
         return Ok(solution);
     }
@@ -177,6 +173,28 @@ pub fn solve_dare(
         )
     })?;
     finish(&problem, x, rcond, &[])
+}
+
+/// The solution by the fast paths (module documentation), or `None` where neither gives one
+/// that passes.
+fn fast_solution(problem: &Problem<'_>) -> Option<AlgebraicSolution> {
+    let (a, b, q, r, s) = (problem.a, problem.b, problem.q, problem.r, problem.s);
+    let kept = |x, rcond, estimates: &[c64]| {
+        finish(problem, x, rcond, estimates)
+            .ok()
+            .filter(|solution| solution.residual <= FAST_PATH_MAX_RESIDUAL)
+    };
+    if let Some(candidate) = doubling_solution(a, b, q, r, s)
+        && let Some(solution) = kept(candidate.x, candidate.rcond, &[])
+    {
+        return Some(solution);
+    }
+    let candidate = cayley_solution(a, b, q, r, s)?;
+    kept(
+        candidate.x,
+        candidate.rcond,
+        &candidate.closed_loop_estimates,
+    )
 }
 
 /// The refinement and the checks of a candidate solution X with its rcond; `estimates` of

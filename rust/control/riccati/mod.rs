@@ -1,13 +1,15 @@
 //! Riccati equations: the algebraic equations of the infinite-horizon regulators, continuous
 //! ([`care`]) and discrete ([`dare`]), the differential equation of the continuous
 //! finite-horizon one ([`ode`]) and the difference equation of the discrete one
-//! ([`difference`]).
+//! ([`difference`]); the discrete equation's fast paths, by doubling ([`doubling`]) and the
+//! Cayley transform ([`cayley`]).
 
 pub mod care;
 pub(crate) mod care_pencil;
 pub(crate) mod cayley;
 pub mod dare;
 pub mod difference;
+pub mod doubling;
 pub mod ode;
 pub(crate) mod pencil;
 
