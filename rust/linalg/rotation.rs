@@ -11,6 +11,22 @@ use crate::platform::dispatch::{fma_dispatch, multiply_add};
 use faer::Mat;
 use std::ops::Range;
 
+/// x and y times one power of two that brings the larger magnitude into [2^-500, 2^500]
+/// (exact; unchanged where it is there, or zero, or not finite). A rotation depends only on
+/// the ratio of the pair it is formed from, and formed from subnormal numbers it loses
+/// orthogonality (their quotients and halves round to a few digits).
+pub(crate) fn in_normal_range(x: f64, y: f64) -> (f64, f64) {
+    const LOW: f64 = 3.054936363499605e-151; // 2^-500
+    const HIGH: f64 = 3.273390607896142e150; // 2^500
+    let largest = x.abs().max(y.abs());
+    if largest == 0.0 || !largest.is_finite() || (LOW..=HIGH).contains(&largest) {
+        return (x, y);
+    }
+    // 2^±1000 at most (2^1074 overflows); that brings any finite number to a normal one.
+    let scale = 2f64.powi(-(largest.log2().round() as i32).clamp(-1000, 1000));
+    (x * scale, y * scale)
+}
+
 /// A plane rotation, c^2 + s^2 = 1.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Rotation {
@@ -24,15 +40,24 @@ impl Rotation {
     pub fn zeroing(f: f64, g: f64) -> (Rotation, f64) {
         // The plain square root unless the squares leave the normal range (hypot is slow).
         let squares = f * f + g * g;
-        let r = if (f64::MIN_POSITIVE..f64::MAX).contains(&squares) {
-            squares.sqrt()
-        } else {
-            f.hypot(g)
-        };
-        if r == 0.0 {
+        if (f64::MIN_POSITIVE..f64::MAX).contains(&squares) {
+            let r = squares.sqrt();
+            return (Rotation { c: f / r, s: g / r }, r);
+        }
+        // c and s from (f, g) scaled into range: divided by a subnormal r (f and g near
+        // 1e-318) they came out with a few digits, and the rotation off orthogonal.
+        let (f_r, g_r) = in_normal_range(f, g);
+        let r_r = f_r.hypot(g_r);
+        if r_r == 0.0 {
             (Rotation { c: 1.0, s: 0.0 }, 0.0)
         } else {
-            (Rotation { c: f / r, s: g / r }, r)
+            (
+                Rotation {
+                    c: f_r / r_r,
+                    s: g_r / r_r,
+                },
+                f.hypot(g),
+            )
         }
     }
 
@@ -235,6 +260,28 @@ fma_dispatch!(fn reflect_two(u: [f64; 3], tau: f64, x: &mut [f64], y: &mut [f64]
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rotations_from_subnormal_pairs_are_orthogonal() {
+        for (f, g) in [
+            (1e-318, 3e-319),
+            (5e-324, 1e-323),
+            (-2.7e-319, 5.5e-319),
+            (1e300, 1e300),
+        ] {
+            let (rotation, r) = Rotation::zeroing(f, g);
+            let deviation = (rotation.c * rotation.c + rotation.s * rotation.s - 1.0).abs();
+            assert!(
+                deviation <= 4.0 * f64::EPSILON,
+                "({f:e}, {g:e}): {deviation:e}"
+            );
+            assert_eq!(r, f.hypot(g));
+            assert!(
+                rotation.c * g - rotation.s * f == 0.0
+                    || (rotation.c * g - rotation.s * f).abs() <= 4.0 * f64::EPSILON * r
+            );
+        }
+    }
 
     #[test]
     fn rotations_zero_what_they_say() {

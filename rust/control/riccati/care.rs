@@ -347,6 +347,17 @@ fn weights_out_of_range() -> Error {
     }
 }
 
+/// The refusal of an equation whose scaled Hamiltonian, solution or closed loop leaves the
+/// range of doubles.
+fn hamiltonian_out_of_range() -> Error {
+    Error::IllConditioned {
+        message: "the Riccati equation cannot be solved in double precision: its balanced \
+                  Hamiltonian (A, B R^-1 B^T and Q), its solution or the closed loop overflows; \
+                  scale the model's units"
+            .into(),
+    }
+}
+
 /// [`solve_care_dense`] for weights that need no scaling.
 fn solve_care_balanced(
     a: MatRef<'_, f64>,
@@ -414,6 +425,12 @@ fn solve_care_balanced(
     let reduced_residual = evaluation.relative_residual();
     let gain = evaluation.gain;
     let closed_loop = reduced.closed_loop(&gain);
+    // Y, its gain or the closed loop beyond the doubles (A near 1e308): refused as such, not
+    // as a non-finite A (the eigenvalue solver's name for its argument).
+    let finite = |m: &DMatrix<f64>| m.as_slice().iter().all(|x| x.is_finite());
+    if !(finite(&y) && finite(&gain) && finite(&closed_loop)) {
+        return Err(hamiltonian_out_of_range());
+    }
     // The stable eigenvalues of H are those of the closed loop of the exact solution: as
     // shifts they make the QR iteration converge in fewer sweeps.
     let closed_loop_eigenvalues = eigenvalues_near(closed_loop.as_faer(), &stable_eigenvalues)?;
@@ -702,6 +719,12 @@ fn hamiltonian_solution_in<O: Order>(
             h[(n + i, j)] *= d[i] * d[j];
             h[(n + i, n + j)] *= d[i] * d_inverse[j];
         }
+    }
+    // Entries near the largest doubles (A of 1e308) can overflow in the scalings: the
+    // Hamiltonian itself then has no double-precision Schur form, and the equation is refused
+    // as such (not as a non-finite A, which the caller's A is not).
+    if !h.iter().all(|x| x.is_finite()) {
+        return Err(hamiltonian_out_of_range());
     }
     let h_norm = frobenius_norm(h.as_faer());
     let spectrum = if 2 * n <= HAMILTONIAN_SHIFT_MAX_ORDER {

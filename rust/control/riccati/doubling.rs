@@ -34,12 +34,10 @@
 //! Riccati-type matrix equations", SIAM J. Matrix Anal. Appl. 28 (2006) 26-39.
 
 use super::care::standardize;
-use crate::linalg::balance::nearest_power_of_two;
 use crate::linalg::dense::cholesky;
 use crate::linalg::matrix::{FaerView, with_order};
 use crate::linalg::small_matrix::{
-    self, Columns, SmallLu, add_product, add_product_kernel, columns_mut, lu_kernel,
-    lu_solve_kernel,
+    self, Columns, SmallLu, add_product_kernel, columns_mut, lu_kernel, lu_solve_kernel,
 };
 use crate::platform::dispatch::fma_dispatch;
 use faer::{Mat, MatRef};
@@ -57,8 +55,7 @@ pub(crate) struct DoublingSolution {
     /// X, symmetric.
     pub(crate) x: Mat<f64>,
     /// The reciprocal condition number of U11 in the orthonormal basis [U11; U21] of the
-    /// graph of X (the subspace the pencil's method finds), from U11^T U11 = (I + X^2)^-1:
-    /// sqrt of the reciprocal 1-norm condition number of I + X^2.
+    /// graph of X (the subspace the pencil's method finds), estimated from X ([`graph_rcond`]).
     pub(crate) rcond: f64,
 }
 
@@ -200,19 +197,20 @@ fn one_norm<const N: usize>(m: &Columns<N>) -> f64 {
     norm
 }
 
-/// sqrt(rcond_1(I + X^2)): the reciprocal condition number of U11 in the orthonormal basis of
-/// the graph of X (module documentation of [`DoublingSolution::rcond`]), to within the factor
-/// between the 1-norm and the 2-norm. Formed as s^2 (I / s^2 + Y^2) with Y = X / s and s the
-/// power of two nearest max(1, ||X||_1) (the condition number does not see s^2), so that X^2
-/// cannot overflow; 0 where the solve breaks down (I / s^2 lost beside a singular Y^2).
+/// The reciprocal condition number of U11 in the orthonormal basis [U11; U21] of the graph of
+/// X: U11^T U11 = (I + X^2)^-1, so that for symmetric X it is
+/// sqrt(1 + λ_min^2) / sqrt(1 + λ_max^2) (λ the eigenvalues of X by magnitude), here with
+/// ||X||_1 for |λ_max| and 1 / ||X^-1||_1 for |λ_min| (each within a factor n; 0 for a
+/// singular X). hypot keeps it in range for X near the largest doubles.
 fn graph_rcond<const N: usize>(x: &SMatrix<f64, N, N>) -> f64 {
-    let s = nearest_power_of_two(small_matrix::one_norm(x).max(1.0));
-    let y = x / s;
-    let mut gram = SMatrix::<f64, N, N>::identity() / (s * s);
-    add_product(&mut gram, &y, &y);
-    let inverse = SmallLu::new(gram).solve(SMatrix::identity());
-    let rcond = (1.0 / (small_matrix::one_norm(&gram) * small_matrix::one_norm(&inverse))).sqrt();
-    if rcond.is_nan() { 0.0 } else { rcond }
+    let inverse = SmallLu::new(*x).solve(SMatrix::identity());
+    let inverse_norm = small_matrix::one_norm(&inverse);
+    let smallest = if inverse.iter().all(|v| v.is_finite()) && inverse_norm > 0.0 {
+        1.0 / inverse_norm
+    } else {
+        0.0
+    };
+    (1.0f64.hypot(smallest) / 1.0f64.hypot(small_matrix::one_norm(x))).min(1.0)
 }
 
 #[cfg(test)]
@@ -249,6 +247,20 @@ mod tests {
         let exact = (1e-6 + (1e-12f64 + 4.0 * 1e-4 * 1e-2).sqrt()) / 2e-4;
         assert!((x - exact).abs() <= 1e-13 * exact);
         assert!((12..=20).contains(&doublings), "{doublings}");
+    }
+
+    #[test]
+    fn graph_rcond_is_finite_from_identity_to_the_largest_doubles() {
+        let diag = |a: f64, b: f64| SMatrix::<f64, 2, 2>::new(a, 0.0, 0.0, b);
+        assert_eq!(graph_rcond(&diag(1.0, 1.0)), 1.0);
+        // sqrt(1 + 0) / sqrt(1 + 25) for a singular X.
+        assert!((graph_rcond(&diag(0.0, 5.0)) - 1.0 / 26f64.sqrt()).abs() < 1e-15);
+        // X near 1e303 (X^2 would overflow): 1 / 1e303 to rounding.
+        let tiny = graph_rcond(&diag(1.8e303, 0.4));
+        assert!(
+            (tiny * 1.8e303 - 0.4f64.hypot(1.0)).abs() < 1e-12,
+            "{tiny:e}"
+        );
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The real Schur form: T quasi-upper-triangular with 2 x 2 blocks in standard form, Z
 //! orthogonal; the eigenvalues of its blocks; the rotation of a 2 x 2 block into standard form.
 
+use crate::linalg::rotation::in_normal_range;
 use faer::{Mat, MatRef, c64};
 
 /// The Schur form A = Z T Z^T.
@@ -97,21 +98,27 @@ pub fn standardize_block(a: f64, b: f64, c: f64, d: f64) -> StandardBlock {
         let z = p + p.signum() * scale.sqrt() * z.sqrt();
         let a_new = d + z;
         let d_new = d - bcmax / z * bcmis;
-        let tau = c.hypot(z);
+        // The rotation from (z, c) in the normal range (see in_normal_range).
+        let (z_r, c_r) = in_normal_range(z, c);
+        let tau = c_r.hypot(z_r);
         return StandardBlock {
             a: a_new,
             b: b - c,
             c: 0.0,
             d: d_new,
-            cs: z / tau,
-            sn: c / tau,
+            cs: z_r / tau,
+            sn: c_r / tau,
         };
     }
     // Complex or nearly equal real eigenvalues: equalise the diagonal.
     let sigma = b + c;
-    let tau = sigma.hypot(temp);
-    let mut cs = (0.5 * (1.0 + sigma.abs() / tau)).sqrt();
-    let mut sn = -(p / (tau * cs)) * sigma.signum();
+    // From (sigma, a - d) in the normal range: a block with a - d = -5.5e-319 beside
+    // b = -c = 3 gave a rotation 1.7e-6 off orthogonal (halving a subnormal rounds), and its
+    // eigenvalues ±3j came back as ±2.999995j.
+    let (sigma_r, temp_r) = in_normal_range(sigma, temp);
+    let tau = sigma_r.hypot(temp_r);
+    let mut cs = (0.5 * (1.0 + sigma_r.abs() / tau)).sqrt();
+    let mut sn = -(0.5 * temp_r / (tau * cs)) * sigma_r.signum();
     // [aa bb; cc dd] = [a b; c d] G, then G^T [aa bb; cc dd].
     let (aa, bb) = (a * cs + b * sn, -a * sn + b * cs);
     let (cc, dd) = (c * cs + d * sn, -c * sn + d * cs);

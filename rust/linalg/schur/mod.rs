@@ -351,6 +351,34 @@ mod tests {
     /// the form and the eigenvalues are those of the unscaled matrix times the scale (before,
     /// entries below about 1e-290 all counted as negligible and the residual was 0.7).
     #[test]
+    fn couplings_whose_squares_are_subnormal_keep_the_form_orthogonal() {
+        // Block lower triangular: eigenvalues ±3j and ±2j exactly. The Hessenberg form has
+        // h11 = 5.5e-319 beside h10 = -h01 = 3, and the 2 x 2 block's rotation, formed from
+        // a - d = -5.5e-319, was 1.7e-6 off orthogonal (±3j came back as ±2.999995j).
+        for coupling in [1.26e-159, 1e-160, 3e-162, 1e-200, 1e-300] {
+            let a = mat![
+                [0.0, 3.0, 0.0, 0.0],
+                [-3.0, 0.0, 0.0, 0.0],
+                [-coupling, 1.05 * coupling, 0.0, 2.0],
+                [0.0, 0.0, -2.0, 0.0],
+            ];
+            assert_schur_form(&a, &format!("coupling {coupling:e}"));
+            let expected = sorted(vec![
+                c64::new(0.0, 3.0),
+                c64::new(0.0, -3.0),
+                c64::new(0.0, 2.0),
+                c64::new(0.0, -2.0),
+            ]);
+            let found = sorted(eigenvalues(a.as_ref()).unwrap());
+            let distance = spectral_distance(&found, &expected);
+            assert!(
+                distance < 1e-14,
+                "coupling {coupling:e}: off by {distance:e}"
+            );
+        }
+    }
+
+    #[test]
     fn tiny_and_huge_matrices_keep_their_schur_form() {
         for n in [6usize, 100] {
             let base = seeded(n, 7 + n as u64);

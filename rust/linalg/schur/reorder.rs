@@ -47,6 +47,7 @@
 use crate::error::Error;
 use crate::linalg::balance::range_scale;
 use crate::linalg::householder::reflector;
+use crate::linalg::rotation::Rotation;
 use crate::linalg::schur::form::{RealSchur, quasi_triangular_eigenvalues, standardize_block};
 use crate::linalg::sylvester::solve_small_sylvester;
 use crate::platform::dispatch::clear_upper_avx_state;
@@ -370,8 +371,8 @@ fn swap_one_by_one(t: &mut Mat<f64>, z: &mut Mat<f64>, j: usize) {
         return;
     }
     // The first column of the rotation is the eigenvector [t12, t22 - t11] of t22.
-    let norm = t12.hypot(t22 - t11);
-    let (cs, sn) = (t12 / norm, (t22 - t11) / norm);
+    let (rotation, _) = Rotation::zeroing(t12, t22 - t11);
+    let (cs, sn) = (rotation.c, rotation.s);
     rotate(t, z, j, cs, sn);
     t[(j, j)] = t22;
     t[(j + 1, j + 1)] = t11;
