@@ -46,16 +46,11 @@ pub(crate) struct CayleySolution {
     pub(crate) closed_loop_estimates: Vec<c64>,
 }
 
-/// The solution by the transform, or `None` where it does not apply (R not positive
-/// definite, M + N ill-conditioned) or the Hamiltonian method refuses.
-pub(crate) fn cayley_solution(
-    a: MatRef<'_, f64>,
-    b: MatRef<'_, f64>,
-    q: MatRef<'_, f64>,
-    r: MatRef<'_, f64>,
-    s: Option<MatRef<'_, f64>>,
-) -> Option<CayleySolution> {
-    let standard = cayley_transform(a, b, q, r, s)?;
+/// The solution by the transform of the equation in standard form `plant` (E = I, R
+/// positive definite: [`standard_form`]), or `None` where M + N is ill-conditioned or the
+/// Hamiltonian method refuses.
+pub(crate) fn cayley_solution(plant: &Standard) -> Option<CayleySolution> {
+    let standard = cayley_transform(plant)?;
     let solution = hamiltonian_solution(&standard).ok()?;
     let closed_loop_estimates = solution
         .stable_eigenvalues
@@ -69,25 +64,30 @@ pub(crate) fn cayley_solution(
     })
 }
 
-/// The Hamiltonian H = (M + N)^-1 (M - N) as the blocks of a continuous equation, or `None`
-/// where the transform does not apply.
-fn cayley_transform(
+/// The standard form of the DARE with E = I (Ã = A - B̂ Ŝ^T, G = B̂ B̂^T, Q̃ = Q - Ŝ Ŝ^T with
+/// R = L L^T, B̂ = B L^-T, Ŝ = S L^-T: the continuous equation's), from which both fast paths
+/// start; `None` when R is not positive definite.
+pub(crate) fn standard_form(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
     s: Option<MatRef<'_, f64>>,
 ) -> Option<Standard> {
-    let n = a.nrows();
     let l = cholesky(&from_faer(r))?;
-    // Ã = A - B̂ Ŝ^T, G = B̂ B̂^T, Q̃ = Q - Ŝ Ŝ^T: the continuous equation's standard form.
-    let plant = standardize(
+    Some(standardize(
         &from_faer(a),
         &from_faer(b),
         &from_faer(q),
         &l,
         s.map(from_faer).as_ref(),
-    );
+    ))
+}
+
+/// The Hamiltonian H = (M + N)^-1 (M - N) as the blocks of a continuous equation, or `None`
+/// where the transform does not apply.
+fn cayley_transform(plant: &Standard) -> Option<Standard> {
+    let n = plant.a.nrows();
     let (a_tilde, g, q_tilde) = (&plant.a, &plant.g, &plant.q);
     // M + N and M - N.
     let mut sum = Mat::<f64>::zeros(2 * n, 2 * n);

@@ -62,7 +62,7 @@
 //! equations have, are solved where a stabilising solution exists.
 
 use super::AlgebraicSolution;
-use super::cayley::cayley_solution;
+use super::cayley::{cayley_solution, standard_form};
 use super::doubling::doubling_solution;
 use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
@@ -178,18 +178,18 @@ pub fn solve_dare(
 /// The solution by the fast paths (module documentation), or `None` where neither gives one
 /// that passes.
 fn fast_solution(problem: &Problem<'_>) -> Option<AlgebraicSolution> {
-    let (a, b, q, r, s) = (problem.a, problem.b, problem.q, problem.r, problem.s);
+    let plant = standard_form(problem.a, problem.b, problem.q, problem.r, problem.s)?;
     let kept = |x, rcond, estimates: &[c64]| {
         finish(problem, x, rcond, estimates)
             .ok()
             .filter(|solution| solution.residual <= FAST_PATH_MAX_RESIDUAL)
     };
-    if let Some(candidate) = doubling_solution(a, b, q, r, s)
+    if let Some(candidate) = doubling_solution(&plant)
         && let Some(solution) = kept(candidate.x, candidate.rcond, &[])
     {
         return Some(solution);
     }
-    let candidate = cayley_solution(a, b, q, r, s)?;
+    let candidate = cayley_solution(&plant)?;
     kept(
         candidate.x,
         candidate.rcond,

@@ -33,14 +33,13 @@
 //! W.-W. Lin, S.-F. Xu, "Convergence analysis of structure-preserving doubling algorithms for
 //! Riccati-type matrix equations", SIAM J. Matrix Anal. Appl. 28 (2006) 26-39.
 
-use super::care::standardize;
-use crate::linalg::dense::cholesky;
+use super::care::Standard;
 use crate::linalg::matrix::{FaerView, with_order};
 use crate::linalg::small_matrix::{
     self, Columns, SmallLu, add_product_kernel, columns_mut, lu_kernel, lu_solve_kernel,
 };
 use crate::platform::dispatch::fma_dispatch;
-use faer::{Mat, MatRef};
+use faer::Mat;
 use nalgebra::{DMatrix, SMatrix};
 
 /// The largest order solved by doubling (the fixed orders of the small-matrix kernels).
@@ -59,22 +58,14 @@ pub(crate) struct DoublingSolution {
     pub(crate) rcond: f64,
 }
 
-/// The solution by doubling, or `None` where it does not apply (order above [`MAX_ORDER`], R
-/// not positive definite) or the recursion does not converge within [`MAX_DOUBLINGS`].
-pub(crate) fn doubling_solution(
-    a: MatRef<'_, f64>,
-    b: MatRef<'_, f64>,
-    q: MatRef<'_, f64>,
-    r: MatRef<'_, f64>,
-    s: Option<MatRef<'_, f64>>,
-) -> Option<DoublingSolution> {
-    let n = a.nrows();
+/// The solution by doubling of the equation in standard form `plant`
+/// ([`super::cayley::standard_form`]), or `None` where it does not apply (order above
+/// [`MAX_ORDER`]) or the recursion does not converge within [`MAX_DOUBLINGS`].
+pub(crate) fn doubling_solution(plant: &Standard) -> Option<DoublingSolution> {
+    let n = plant.a.nrows();
     if n == 0 || n > MAX_ORDER {
         return None;
     }
-    let l = cholesky(&DMatrix::from_fn(r.nrows(), r.ncols(), |i, j| r[(i, j)]))?;
-    let dense = |m: MatRef<'_, f64>| DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
-    let plant = standardize(&dense(a), &dense(b), &dense(q), &l, s.map(dense).as_ref());
     with_order!(
         n,
         [1, 2, 3, 4, 5, 6, 7, 8],
@@ -218,6 +209,18 @@ mod tests {
     use super::*;
     use faer::mat;
 
+    /// The solution by doubling of the DARE (A, B, Q, R), through its standard form.
+    fn doubled(a: &Mat<f64>, b: &Mat<f64>, q: &Mat<f64>, r: &Mat<f64>) -> Option<DoublingSolution> {
+        let plant = super::super::cayley::standard_form(
+            a.as_ref(),
+            b.as_ref(),
+            q.as_ref(),
+            r.as_ref(),
+            None,
+        )?;
+        doubling_solution(&plant)
+    }
+
     /// The scalar recursion from (a, g, q): its limit and doublings.
     fn scalar(a: f64, g: f64, q: f64) -> Option<(f64, usize)> {
         let m = |v: f64| SMatrix::<f64, 1, 1>::new(v);
@@ -228,8 +231,7 @@ mod tests {
     fn scalar_equation_has_its_closed_form() {
         // x = a^2 x / (1 + g x) + q with a = 2, g = 1, q = 1: x^2 - 4 x - 1 = 0, x = 2 + sqrt 5.
         let (a, b, q, r) = (mat![[2.0]], mat![[1.0]], mat![[1.0]], mat![[1.0]]);
-        let solution =
-            doubling_solution(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref(), None).unwrap();
+        let solution = doubled(&a, &b, &q, &r).unwrap();
         let exact = 2.0 + 5.0f64.sqrt();
         assert!((solution.x[(0, 0)] - exact).abs() <= 4.0 * f64::EPSILON * exact);
         // The closed loop a / (1 + g x) = 0.236: a handful of doublings.
@@ -269,7 +271,7 @@ mod tests {
         let a = mat![[2.0, 0.0], [0.0, 0.5]];
         let b = mat![[0.0], [1.0]];
         let (q, r) = (Mat::<f64>::identity(2, 2), mat![[1.0]]);
-        assert!(doubling_solution(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref(), None).is_none());
+        assert!(doubled(&a, &b, &q, &r).is_none());
     }
 
     #[test]
@@ -277,7 +279,7 @@ mod tests {
         // Q = 0 and A unstable: H stays 0, but A_k does not decay, so the iteration does not
         // report the non-stabilising X = 0 as converged (it diverges instead).
         let (a, b, q, r) = (mat![[2.0]], mat![[1.0]], mat![[0.0]], mat![[1.0]]);
-        let outcome = doubling_solution(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref(), None);
+        let outcome = doubled(&a, &b, &q, &r);
         assert!(outcome.is_none_or(|s| s.x[(0, 0)] != 0.0));
     }
 
@@ -286,9 +288,9 @@ mod tests {
         let a = Mat::<f64>::identity(9, 9) * 0.5;
         let b = Mat::<f64>::identity(9, 1);
         let (q, r) = (Mat::<f64>::identity(9, 9), mat![[1.0]]);
-        assert!(doubling_solution(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref(), None).is_none());
+        assert!(doubled(&a, &b, &q, &r).is_none());
         let (a, b, q) = (mat![[0.5]], mat![[1.0]], mat![[1.0]]);
         let r = mat![[-1.0]];
-        assert!(doubling_solution(a.as_ref(), b.as_ref(), q.as_ref(), r.as_ref(), None).is_none());
+        assert!(doubled(&a, &b, &q, &r).is_none());
     }
 }
