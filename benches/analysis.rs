@@ -3,7 +3,8 @@
 //! controllability and observability matrices and the staircase verdict, the companion form,
 //! the steady state of a step, and the Riccati differential equation. Seeded random matrices
 //! at n = 4, 16, 64 and 256 (the companion form and the Riccati ODE stop where their peers do:
-//! 16 and 64), and the crossovers and peaks of a SISO loop (loop_margins) at n = 4, 8 and 16.
+//! 16 and 64), the crossovers and peaks of a SISO loop (loop_margins) at n = 4, 8 and 16, and
+//! its root locus over 1000 gains (root_locus) at n = 4, 8 and 16.
 
 use aerocontrol::control::controllability::{controllability_staircase, ctrb, obsv};
 use aerocontrol::control::margins::loop_margins;
@@ -11,6 +12,7 @@ use aerocontrol::control::modal::modal_analysis;
 use aerocontrol::control::placement::companion_form;
 use aerocontrol::control::responses::steady_state;
 use aerocontrol::control::riccati::ode::riccati_ode;
+use aerocontrol::control::root_locus::root_locus;
 use aerocontrol::linalg::charpoly::charpoly;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
@@ -109,5 +111,30 @@ fn margins(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, spectra, margins);
+/// The closed-loop poles of the same loops over 1000 gains in [0, 5] (control/root_locus.rs).
+fn locus(c: &mut Criterion) {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut group = c.benchmark_group("analysis");
+    group.sample_size(20);
+    let gains: Vec<f64> = (0..1000).map(|i| 5.0 * i as f64 / 999.0).collect();
+    for n in [4, 8, 16] {
+        let a = stable(n, 10 + n as u64);
+        let (b, c_out) = (seeded_matrix(n, 1, 11), seeded_matrix(1, n, 12));
+        let mut out = vec![faer::c64::new(0.0, 0.0); gains.len() * n];
+        group.bench_with_input(BenchmarkId::new("root_locus", n), &a, |bench, a| {
+            bench.iter(|| {
+                root_locus(
+                    black_box(a.as_ref()),
+                    b.as_ref(),
+                    c_out.as_ref(),
+                    &gains,
+                    &mut out,
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, spectra, margins, locus);
 criterion_main!(benches);

@@ -130,6 +130,9 @@ def loop_margins(
     NDArray[np.complex128],
     bool,
 ]: ...
+def root_locus(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, gains: ArrayLike, /
+) -> NDArray[np.complex128]: ...
 def frequency_response(
     a: ArrayLike,
     b: ArrayLike,

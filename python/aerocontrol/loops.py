@@ -192,8 +192,9 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     """The eigenvalues of A - k B (1 + k D)^-1 C for each gain, each row sorted; the gains are
     free of algebraic loops (:func:`_refuse_algebraic`).
 
-    The matrices of every gain are formed as one (k, n, n) stack and their eigenvalues taken
-    in one parallel call of the core. Where a term of a matrix (A, or g B C with
+    The poles of every gain come from one parallel call of the core (``_core.root_locus``:
+    one controller-Hessenberg form of (A, B, C), then the QR iteration of each gain's
+    Hessenberg matrix, normwise backward stable). Where a term of a matrix (A, or g B C with
     g = k/(1 + k D), bounded by |g| max|B| max|C|) exceeds 2^RESCALE_EXPONENT, the matrix is
     formed divided by the power of two 2^e nearest its size, from B and C normalised by
     powers of two (so that neither B C nor g B C overflows), and its eigenvalues multiplied by
@@ -214,28 +215,36 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
         terms = np.maximum(size_A, np.log2(np.abs(mantissa)) + power + size_B + size_C)
     plain = (terms <= RESCALE_EXPONENT) & (size_B + size_C <= RESCALE_EXPONENT) & np.isfinite(g)
     exponents = np.where(plain | ~np.isfinite(terms), 0, np.round(terms)).astype(np.int64)
-    stack = np.empty((k.size, n, n))
+    poles = np.empty((k.size, n), np.complex128)
     if np.any(plain):
-        stack[plain] = A - g[plain, None, None] * (B @ C)
-    if not np.all(plain):
+        # One controller-Hessenberg form, then the unbalanced QR iteration per gain in one
+        # parallel call: normwise backward stable for every gain by construction.
+        poles[plain] = _core.root_locus(A, B, C, g[plain])
+    rescaled = np.flatnonzero(~plain)
+    if rescaled.size:
         eb, ec = int(np.frexp(np.max(np.abs(B)))[1]), int(np.frexp(np.max(np.abs(C)))[1])
         normalised = np.ldexp(B, -eb) @ np.ldexp(C, -ec)
-        for i in np.flatnonzero(~plain):
+        stack = np.empty((rescaled.size, n, n))
+        for row, i in enumerate(rescaled):
             e = int(exponents[i])
             shift = int(power[i]) + eb + ec - e
-            stack[i] = np.ldexp(A, -e) - np.ldexp(mantissa[i], shift) * normalised
-    poles = _core.eigenvalues(stack)
-    # The backward errors of every gain's eigenvalues bounded in one batch; only the gains
-    # whose worst exceeds the allowance have their eigenvalues checked one by one.
-    if n <= CHECKED_MAX_ORDER:
-        rows, columns = np.nonzero(poles.imag >= 0.0)
-        with np.errstate(all="ignore"):
-            bounds = _residual_bounds(stack[rows], poles[rows, columns])
-            allowed = BACKWARD_ERROR_UNITS * n * (_EPS / 2.0) * np.linalg.norm(stack, axis=(1, 2))
-        worst = np.zeros(k.size)
-        np.maximum.at(worst, rows, bounds)
-        for row in np.flatnonzero(worst > allowed):
-            poles[row] = _backward_stable_eigenvalues(stack[row], poles[row])
+            stack[row] = np.ldexp(A, -e) - np.ldexp(mantissa[i], shift) * normalised
+        poles[rescaled] = _core.eigenvalues(stack)
+        # The balanced eigenvalues of a rescaled matrix are checked for backward stability
+        # (in one batch; only the matrices whose worst bound exceeds the allowance one by one).
+        if n <= CHECKED_MAX_ORDER:
+            rows, columns = np.nonzero(poles[rescaled].imag >= 0.0)
+            with np.errstate(all="ignore"):
+                bounds = _residual_bounds(stack[rows], poles[rescaled][rows, columns])
+                allowed = (
+                    BACKWARD_ERROR_UNITS * n * (_EPS / 2.0) * np.linalg.norm(stack, axis=(1, 2))
+                )
+            worst = np.zeros(rescaled.size)
+            np.maximum.at(worst, rows, bounds)
+            for row in np.flatnonzero(worst > allowed):
+                poles[rescaled[row]] = _backward_stable_eigenvalues(
+                    stack[row], poles[rescaled[row]]
+                )
     if np.any(exponents):
         with np.errstate(over="ignore", invalid="ignore"):
             scale = exponents[:, None]

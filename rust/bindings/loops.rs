@@ -1,10 +1,11 @@
 //! Bindings of `aerocontrol.loops`: the crossovers and peaks of a SISO loop.
 
 use super::compute::{Cost, compute};
-use super::conversion::Outputs;
+use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::statespace::ModelArgs;
 use crate::control::margins::{Crossover, loop_margins as loop_margins_core};
+use crate::control::root_locus::root_locus as root_locus_core;
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -76,7 +77,52 @@ fn loop_margins<'py>(
     Ok(result)
 }
 
+/// The closed-loop poles of the SISO loop (A, b, c) at each closed-loop gain g of `gains`: the
+/// eigenvalues of A - g b c, a (k, n) complex array, each row in the order of the Schur form's
+/// diagonal (`control/root_locus.rs`: one controller-Hessenberg form, then the QR iteration
+/// per gain, in parallel).
+#[pyfunction]
+#[pyo3(signature = (a, b, c, gains, /))]
+fn root_locus<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    gains: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<c64>>> {
+    let a = Real::convert(py, a, "A")?;
+    let b = Real::convert(py, b, "B")?;
+    let c = Real::convert(py, c, "C")?;
+    let gains = Real::convert(py, gains, "gains")?;
+    let (a, b, c) = (
+        a.matrix().map_err(|e| to_py_err(py, e))?,
+        b.matrix().map_err(|e| to_py_err(py, e))?,
+        c.matrix().map_err(|e| to_py_err(py, e))?,
+    );
+    let gains = gains
+        .vector("a 1-D array of gains")
+        .map_err(|e| to_py_err(py, e))?;
+    let n = a.nrows();
+    let out = new_array::<c64>(py, &[gains.len(), n])?;
+    // SAFETY: new and not visible to Python until returned.
+    let data = unsafe { new_array_data(&out) };
+    // Per gain the double-shift QR iteration of a Hessenberg matrix (about 10 n^3 flops).
+    let threads = rayon::current_num_threads() as f64;
+    let cost = Cost {
+        flops: 10.0 * (n as f64).powi(3) * (gains.len() as f64 + 2.0),
+        bytes: 3.0 * threads * (n * n) as f64 * 8.0,
+        order: n,
+    };
+    compute(py, cost, || root_locus_core(a, b, c, gains, data))?;
+    let mut outputs = Outputs::new(py);
+    // SAFETY: as above; the computation is over.
+    outputs.check_complex("the closed-loop poles", unsafe { new_array_data(&out) });
+    outputs.finish()?;
+    Ok(out)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(loop_margins, m)?)?;
+    m.add_function(wrap_pyfunction!(root_locus, m)?)?;
     Ok(())
 }

@@ -9,6 +9,8 @@
 //!   verdicts.
 //! * [`placement`]: pole placement: Bass–Gura, Ackermann and the robust multi-input method.
 //! * [`riccati`]: the algebraic Riccati equation and LQR, and the Riccati differential equation.
+//! * [`root_locus`]: the closed-loop poles of a SISO loop over many gains, from one
+//!   controller-Hessenberg form.
 //! * [`batch`]: the same operations over stacks of problems, in parallel.
 
 pub mod batch;
@@ -20,3 +22,4 @@ pub mod modal;
 pub mod placement;
 pub mod responses;
 pub mod riccati;
+pub mod root_locus;

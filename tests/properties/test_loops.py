@@ -514,8 +514,9 @@ def test_regression_locus_oracle_gain_times_huge_feedthrough() -> None:
 def test_regression_root_locus_dominant_rank_one() -> None:
     """Formerly the known defect "eigenvalues-dominant-rank-one": A of 4, B of 1e8, C of 2;
     the core's balanced eigenvalues of A - k B C had backward errors of 1e-4 for the small
-    ones (6 times the oracle's bound). loops._backward_stable_eigenvalues now takes those of
-    the unbalanced Schur form where the balanced ones are not backward stable."""
+    ones (6 times the oracle's bound). The root locus now takes the unbalanced QR iteration of
+    the loop's controller-Hessenberg form (``_core.root_locus``), backward stable for A - k B C
+    itself."""
     A = np.array(
         [
             [-2.8742697789066067, -0.1321048632913019, 0.6404226504432821, 0.10490011715303971],
