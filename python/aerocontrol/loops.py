@@ -241,9 +241,9 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
                 )
             worst = np.zeros(rescaled.size)
             np.maximum.at(worst, rows, bounds)
-            for row in np.flatnonzero(worst > allowed):
-                poles[rescaled[row]] = _backward_stable_eigenvalues(
-                    stack[row], poles[rescaled[row]]
+            for failed in np.flatnonzero(worst > allowed):
+                poles[rescaled[failed]] = _backward_stable_eigenvalues(
+                    stack[failed], poles[rescaled[failed]]
                 )
     if np.any(exponents):
         with np.errstate(over="ignore", invalid="ignore"):
