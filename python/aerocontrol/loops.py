@@ -777,10 +777,6 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
         # the phase crossovers, so the grid search decides.
         return _grid_margins(model)
-    d = float(model.D[0, 0])
-    with np.errstate(over="ignore", invalid="ignore"):  # an overflow: the core's kept
-        closed_matrix = model.A - np.outer(model.B[:, 0], model.C[0]) / (1.0 + d)  # as its own
-    closed = _backward_stable_eigenvalues(closed_matrix, closed)
     stable = bool(np.all(closed.real < 0.0))
     unstable_open = int(np.sum(open_poles.real > 0.0))
     unstable_closed = int(np.sum(closed.real > 0.0))

@@ -53,7 +53,8 @@
 //! 1/max |S|.
 //!
 //! **Verification.** Every phase crossover with L(jω) < 0 gives a gain margin k = 1/|L(jω)|;
-//! the loop closed with k must have a pole at jω (the eigenvalues of A - k B (1 + k d)^-1 C,
+//! the loop closed with k must have a pole at jω (the eigenvalues of A - k B (1 + k d)^-1 C
+//! by the root locus's controller-Hessenberg form, `control/root_locus.rs`,
 //! within 1e-6 of max(1 + max|A|, ω)), else [`Error::IllConditioned`].
 //!
 //! References: S. Boyd, V. Balakrishnan and P. Kabamba, "A bisection method for computing the
@@ -67,6 +68,7 @@
 //! P. Gahinet, "An introduction to disk margins", IEEE Control Systems 40(5), 2020.
 
 use crate::control::frequency::{FrequencyEvaluator, check_state_space};
+use crate::control::root_locus;
 use crate::error::Error;
 use crate::linalg::balance::nearest_power_of_two;
 use crate::linalg::schur::eigenvalues;
@@ -99,7 +101,7 @@ pub struct LoopMargins {
     pub disk: Peak,
     /// max |S| = 1/min |1 + L|.
     pub sensitivity: Peak,
-    /// Eigenvalues of A - B (1 + d)^-1 C.
+    /// Eigenvalues of A - B (1 + d)^-1 C, by [`root_locus::closed_loop_poles`] (normwise backward stable).
     pub closed_loop_poles: Vec<c64>,
     /// Eigenvalues of A.
     pub open_loop_poles: Vec<c64>,
@@ -490,6 +492,42 @@ pub fn peak_gain(
     d: f64,
     poles: &[c64],
 ) -> Result<Peak, Error> {
+    let mut strictly_proper = strictly_proper_evaluator(a, b, c)?;
+    peak(a, b, c, d, poles, &mut |w| strictly_proper.siso(w))
+}
+
+/// The evaluator of C (jωI - A)^-1 B (one Hessenberg reduction), shared by the peaks of
+/// several feedthroughs d.
+fn strictly_proper_evaluator(
+    a: MatRef<'_, f64>,
+    b: &[f64],
+    c: &[f64],
+) -> Result<FrequencyEvaluator, Error> {
+    let n = a.nrows();
+    let bm = Mat::from_fn(n, 1, |i, _| b[i]);
+    let cm = Mat::from_fn(1, n, |_, j| c[j]);
+    FrequencyEvaluator::new(
+        a,
+        bm.as_ref(),
+        cm.as_ref(),
+        Mat::<f64>::zeros(1, 1).as_ref(),
+    )
+}
+
+/// [`peak_gain`] with `strictly_proper(ω)` = C (jωI - A)^-1 B.
+///
+/// The lower bound before the first Hamiltonian is the best of ω = ∞, ω = 0 and the poles'
+/// frequencies (|p| and |Im p|), refined by Brent's method between that frequency's
+/// neighbours among them: where the peak is a resonance near a pole (the usual case), the
+/// first Hamiltonian then has no imaginary eigenvalue and confirms it.
+fn peak(
+    a: MatRef<'_, f64>,
+    b: &[f64],
+    c: &[f64],
+    d: f64,
+    poles: &[c64],
+    strictly_proper: &mut impl FnMut(f64) -> c64,
+) -> Result<Peak, Error> {
     let n = a.nrows();
     let scale = poles.iter().fold(max_abs(a), |m, p| m.max(p.norm()));
     if let Some(p) = poles
@@ -501,27 +539,37 @@ pub fn peak_gain(
             value: f64::INFINITY,
         });
     }
-    let bm = Mat::from_fn(n, 1, |i, _| b[i]);
-    let cm = Mat::from_fn(1, n, |_, j| c[j]);
-    let dm = Mat::from_fn(1, 1, |_, _| d);
-    let mut evaluator = FrequencyEvaluator::new(a, bm.as_ref(), cm.as_ref(), dm.as_ref())?;
-    let mut magnitude = |w: f64| evaluator.siso(w).norm();
+    let mut magnitude = |w: f64| (strictly_proper(w) + d).norm();
     // The lower bound: ∞ first (ties keep it), then 0, then the poles' frequencies.
     let mut best = Peak {
         omega: f64::INFINITY,
         value: d.abs(),
     };
-    let tests = std::iter::once(0.0)
+    let mut tests = std::iter::once(0.0)
         .chain(poles.iter().flat_map(|p| [p.im.abs(), p.norm()]))
         .collect::<Vec<_>>();
-    for w in tests {
+    tests.sort_by(f64::total_cmp);
+    tests.dedup();
+    let mut best_test = None;
+    for (index, &w) in tests.iter().enumerate() {
         let value = magnitude(w);
         if value > best.value * (1.0 + 1e-12) {
             best = Peak { omega: w, value };
+            best_test = Some(index);
         }
     }
     if best.value == 0.0 {
         return Ok(best);
+    }
+    if let Some(index) = best_test {
+        let lo = if index > 0 { tests[index - 1] } else { 0.0 };
+        let hi = tests.get(index + 1).copied().unwrap_or(2.0 * tests[index]);
+        if hi > lo {
+            let (w, value) = golden_maximum(&mut magnitude, lo, hi);
+            if value > best.value {
+                best = Peak { omega: w, value };
+            }
+        }
     }
     for _ in 0..60 {
         crate::platform::interrupt::check()?;
@@ -589,7 +637,7 @@ pub fn loop_margins(
     let cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
     let open_loop_poles = eigenvalues(a)?;
     let closed = Mat::from_fn(n, n, |i, j| a[(i, j)] - bv[i] * cv[j] / denominator);
-    let closed_loop_poles = eigenvalues(closed.as_ref())?;
+    let closed_loop_poles = root_locus::closed_loop_poles(a, &bv, &cv, 1.0 / denominator)?;
     let mut this = Loop {
         a,
         b: bv.clone(),
@@ -613,19 +661,24 @@ pub fn loop_margins(
         },
         || {
             context.run(|| {
-                let sensitivity = peak_gain(
+                let mut closed_response = strictly_proper_evaluator(closed.as_ref(), &bs, &cs)?;
+                let mut response = |w: f64| closed_response.siso(w);
+                let (s_d, disk_d) = (1.0 / denominator, 1.0 / denominator - 0.5);
+                let sensitivity = peak(
                     closed.as_ref(),
                     &bs,
                     &cs,
-                    1.0 / denominator,
+                    s_d,
                     &closed_loop_poles,
+                    &mut response,
                 )?;
-                let disk = peak_gain(
+                let disk = peak(
                     closed.as_ref(),
                     &bs,
                     &cs,
-                    1.0 / denominator - 0.5,
+                    disk_d,
                     &closed_loop_poles,
+                    &mut response,
                 )?;
                 Ok((sensitivity, disk))
             })
@@ -642,9 +695,8 @@ pub fn loop_margins(
         if shifted.abs() <= 8.0 * f64::EPSILON * (k * d0).abs().max(1.0) || n == 0 {
             continue;
         }
-        let closed_k = Mat::from_fn(n, n, |i, j| a[(i, j)] - k * bv[i] * cv[j] / shifted);
         let point = c64::new(0.0, crossover.omega);
-        let miss = eigenvalues(closed_k.as_ref())?
+        let miss = root_locus::closed_loop_poles(a, &bv, &cv, k / shifted)?
             .iter()
             .map(|p| (p - point).norm())
             .fold(f64::INFINITY, f64::min);

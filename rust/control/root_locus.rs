@@ -41,9 +41,10 @@ use crate::platform::parallel::{ParallelContext, par_chunks};
 use faer::{MatRef, c64};
 use rayon::prelude::*;
 
-/// H, and the row r = β c Q that the gain scales: the closed loop at gain g is H - g e_1 r.
+/// H, β and the row c Q: the closed loop at gain g is H - g β e_1 (c Q).
 struct ControllerHessenberg<O: Order> {
     h: Square<O>,
+    beta: f64,
     row: Vec<f64>,
 }
 
@@ -70,9 +71,9 @@ fn controller_hessenberg<O: Order>(
     let mut q = identity_in(order);
     reduce_to_hessenberg(&mut h, Some(&mut q));
     let row = (0..n)
-        .map(|j| beta * (0..n).map(|i| c_reflected[i] * q[(i, j)]).sum::<f64>())
+        .map(|j| (0..n).map(|i| c_reflected[i] * q[(i, j)]).sum::<f64>())
         .collect();
-    ControllerHessenberg { h, row }
+    ControllerHessenberg { h, beta, row }
 }
 
 /// The eigenvalues of H - g e_1 r (upper Hessenberg), scaled into range.
@@ -82,8 +83,15 @@ fn closed_loop_eigenvalues<O: Order>(
 ) -> Result<Vec<c64>, Error> {
     let n = form.row.len();
     let mut m = form.h.clone();
+    // g β c Q is in range (the caller's scaling) where g β or β c Q alone may not be: the
+    // product is formed in the order that does not overflow.
+    let g_beta = g * form.beta;
     for (j, r) in form.row.iter().enumerate() {
-        m[(0, j)] -= g * r;
+        m[(0, j)] -= if g_beta.is_finite() {
+            g_beta * r
+        } else {
+            g * (form.beta * r)
+        };
     }
     let scale = range_scale(m.as_faer());
     if scale != 1.0 {
@@ -103,6 +111,22 @@ fn closed_loop_eigenvalues<O: Order>(
         });
     }
     Ok(values.into_iter().map(|v| v * scale).collect())
+}
+
+/// The eigenvalues of A - g b c (A n x n, b and c of length n) by the controller-Hessenberg
+/// form (see the module's documentation): normwise backward stable, and the same as
+/// [`root_locus`] gives at that gain.
+pub fn closed_loop_poles(
+    a: MatRef<'_, f64>,
+    b: &[f64],
+    c: &[f64],
+    g: f64,
+) -> Result<Vec<c64>, Error> {
+    let n = a.nrows();
+    if g == 0.0 || n == 0 {
+        return eigenvalues(a);
+    }
+    with_order!(n, order => closed_loop_eigenvalues(&controller_hessenberg(order, a, b, c), g))
 }
 
 /// The closed-loop poles of the SISO loop (A n x n, b n x 1, c 1 x n) at each closed-loop gain
