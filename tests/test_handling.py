@@ -1,6 +1,8 @@
 """Handling qualities against MIL-F-8785C: every limit of Tables IV, VI, VII and VIII and of
 3.2.1.2 approached from both sides in each Category and Class column, the chapter's Boeing 747
 in powered approach before and after its yaw damper, the tables printed, and bad arguments.
+Then the MIL-F-9490D margin check (the table as widely quoted, every cell unverified): each
+cell, the row edges, and verdicts on loops whose margins are known in closed form.
 
 The limits below are typed in from the specification (5 November 1980: 3.2.1.2 on p. 12,
 Table IV p. 13, Table VI p. 22, Tables VII and VIII p. 23), independently of the module's
@@ -15,14 +17,18 @@ import numpy as np
 import pytest
 
 import aerocontrol
-from aerocontrol.exceptions import InvalidArgumentError, NonFiniteError, ShapeError
+from aerocontrol.exceptions import InvalidArgumentError, NonFiniteError, NotRealError, ShapeError
 from aerocontrol.handling import (
     AIRCRAFT_CLASSES,
+    AIRSPEEDS,
     CATEGORIES,
+    MARGIN_TABLE,
     HandlingQualities,
     Requirement,
     assess,
     compare,
+    margin_requirement,
+    margins_check,
 )
 
 EPS = 1e-6  # relative step either side of a limit
@@ -548,3 +554,231 @@ def test_errors_are_value_errors() -> None:
     assert issubclass(InvalidArgumentError, ValueError)
     assert issubclass(ShapeError, InvalidArgumentError)
     assert issubclass(NonFiniteError, InvalidArgumentError)
+
+
+# --- MIL-F-9490D stability margins -------------------------------------------------------------
+#
+# The margin table as widely quoted, typed in here independently of handling.MARGIN_TABLE. No
+# cell could be verified against the specification (MIL-F-9490D, 6 June 1975, 3.1.3.6: its text
+# and its user's guide AFFDL-TR-74-116 could not be read), so these tests check the transcription
+# of the quoted table and the logic around it, not the specification itself.
+# (gain margin dB, phase margin deg) for f < 0.06 Hz, 0.06 Hz <= f < first aeroelastic mode, and
+# f >= first aeroelastic mode.
+QUOTED_9490 = {
+    "below Vo_min": ((6.0, 0.0), (6.0, 0.0), (6.0, 0.0)),  # GM 6 dB, "no phase requirement"
+    "Vo_min to Vo_max": ((4.5, 30.0), (6.0, 45.0), (8.0, 60.0)),
+    "at V_L": ((3.0, 20.0), (4.5, 30.0), (6.0, 45.0)),
+    "at 1.15 V_L": ((0.0, 0.0), (0.0, 0.0), (0.0, 0.0)),  # stable at nominal gain and phase
+}
+ROW_NAMES = ("f < 0.06 Hz", "0.06 Hz <= f < first aeroelastic mode", "f >= first aeroelastic mode")
+AERO = 5.0  # a first aeroelastic mode (Hz) for the tests that need one
+
+
+@pytest.mark.parametrize("airspeed", list(QUOTED_9490))
+@pytest.mark.parametrize(("row", "frequency"), [(0, 0.03), (1, 1.0), (2, 9.0)])
+def test_margin_table_cells(airspeed: str, row: int, frequency: float) -> None:
+    gm, pm = QUOTED_9490[airspeed][row]
+    assert margin_requirement(frequency, airspeed, AERO) == (gm, pm, ROW_NAMES[row])
+    assert MARGIN_TABLE[airspeed][row] == (gm, pm)
+    assert AIRSPEEDS == tuple(QUOTED_9490)
+
+
+@pytest.mark.parametrize(
+    ("frequency", "aeroelastic", "row"),
+    [
+        (0.0, math.inf, 0),
+        (math.nextafter(0.06, 0.0), math.inf, 0),
+        (0.06, math.inf, 1),  # 0.06 Hz itself is in the second row (0.06 <= f)
+        (math.nextafter(0.06, 1.0), math.inf, 1),
+        (1e9, math.inf, 1),  # no aeroelastic mode: the third row never applies
+        (math.nextafter(AERO, 0.0), AERO, 1),
+        (AERO, AERO, 2),  # at the first aeroelastic mode: the stricter row
+        (0.06, math.nextafter(0.06, 1.0), 1),
+        (math.nextafter(0.06, 1.0), math.nextafter(0.06, 1.0), 2),
+    ],
+)
+def test_margin_rows_at_their_edges(frequency: float, aeroelastic: float, row: int) -> None:
+    expected = (*QUOTED_9490["Vo_min to Vo_max"][row], ROW_NAMES[row])
+    assert margin_requirement(frequency, aeroelastic_hz=aeroelastic) == expected
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "argument", "message"),
+    [
+        ({"frequency_hz": math.nan}, NonFiniteError, "frequency_hz", "must be finite"),
+        ({"frequency_hz": math.inf}, NonFiniteError, "frequency_hz", "must be finite"),
+        ({"frequency_hz": -0.01}, InvalidArgumentError, "frequency_hz", "at least 0 Hz"),
+        ({"aeroelastic_hz": math.nan}, NonFiniteError, "aeroelastic_hz", "got NaN"),
+        ({"aeroelastic_hz": 0.06}, InvalidArgumentError, "aeroelastic_hz", "must exceed 0.06"),
+        ({"aeroelastic_hz": -3.0}, InvalidArgumentError, "aeroelastic_hz", "must exceed 0.06"),
+        ({"airspeed": "cruise"}, InvalidArgumentError, None, "airspeed must be one of"),
+        ({"airspeed": ["at V_L"]}, InvalidArgumentError, None, "airspeed must be one of"),
+    ],
+)
+def test_margin_requirement_bad_arguments(
+    kwargs: dict[str, object], error: type[Exception], argument: str | None, message: str
+) -> None:
+    arguments: dict[str, object] = {"frequency_hz": 0.2, **kwargs}
+    with pytest.raises(error, match=message) as info:
+        margin_requirement(**arguments)  # type: ignore[arg-type]
+    if argument is not None:
+        assert getattr(info.value, "argument", None) == argument
+
+
+def test_margin_requirement_not_a_number() -> None:
+    with pytest.raises(NotRealError, match="frequency_hz"):
+        margin_requirement("fast")  # type: ignore[arg-type]
+    with pytest.raises(ShapeError, match="frequency_hz must be a scalar"):
+        margin_requirement([0.1, 0.2])  # type: ignore[arg-type]
+    with pytest.raises(NotRealError, match="aeroelastic_hz"):
+        margin_requirement(0.1, aeroelastic_hz=1j)  # type: ignore[arg-type]
+
+
+def cubic_loop(k: float, a: float = 1.0) -> object:
+    """k/(s(s+1)(s+2)) with its frequency axis scaled by a: k a³/(s(s+a)(s+2a))."""
+    return aerocontrol.zpk([], [0.0, -a, -2.0 * a], k * a**3)
+
+
+def cubic_margins(k: float, a: float = 1.0) -> tuple[float, float, float, float]:
+    """The closed-form margins of cubic_loop(k, a), 0 < k: the phase crossover is at a√2 rad/s,
+    where |L| = k/6 (GM = 6/k); the gain crossover is at a√x, x the positive root of
+    x³ + 5x² + 4x - k² = 0 (|L(jω)|² = 1 with x = (ω/a)²), where the phase is
+    -90° - atan(√x) - atan(√x/2). Returns (GM dB, its Hz, PM deg, its Hz)."""
+    roots = np.roots([1.0, 5.0, 4.0, -k * k])
+    (x,) = [r.real for r in roots if abs(r.imag) < 1e-12 and r.real > 0]
+    w = math.sqrt(x)
+    pm = 90.0 - math.degrees(math.atan(w) + math.atan(w / 2.0))
+    return 20 * math.log10(6.0 / k), a * math.sqrt(2.0) / (2 * math.pi), pm, a * w / (2 * math.pi)
+
+
+# Verdicts worked by hand from the closed form and the quoted table, per airspeed column, as
+# (closed loop, gain margin, phase margin). The margins (GM dB at its Hz; PM deg at its Hz):
+#   k=1:          15.56 dB at 0.2251; 53.41° at 0.07094 (both in the second row)
+#   k=2:           9.54 dB at 0.2251; 32.61° at 0.1193
+#   k=2, a=0.1:    the same margins at a tenth of the frequencies: both in the first row
+#   k=3:           6.02 dB at 0.2251; 20.04° at 0.1543
+#   k=4:           3.52 dB at 0.2251; 11.42° at 0.1819
+#   k=1, aero 0.1: the phase crossover (0.2251 Hz) in the third row, the gain crossover not
+#   k=1, aero 0.07: both in the third row (8 dB, 60°)
+CUBIC_CASES = [
+    (1.0, 1.0, math.inf, "Vo_min to Vo_max", (True, True, True)),
+    (2.0, 1.0, math.inf, "Vo_min to Vo_max", (True, True, False)),  # 32.61° < 45°
+    (2.0, 1.0, math.inf, "at V_L", (True, True, True)),  # 4.5 dB, 30°
+    (2.0, 1.0, math.inf, "below Vo_min", (True, True, True)),  # 6 dB, no phase requirement
+    (2.0, 0.1, math.inf, "Vo_min to Vo_max", (True, True, True)),  # first row: 4.5 dB, 30°
+    (2.0, 0.1, math.inf, "at V_L", (True, True, True)),
+    (3.0, 1.0, math.inf, "Vo_min to Vo_max", (True, True, False)),  # 6.02 dB >= 6, 20° < 45°
+    (3.0, 1.0, math.inf, "at V_L", (True, True, False)),  # 20° < 30°
+    (3.0, 1.0, math.inf, "below Vo_min", (True, True, True)),
+    (3.0, 1.0, math.inf, "at 1.15 V_L", (True, True, True)),
+    (4.0, 1.0, math.inf, "below Vo_min", (True, False, True)),  # 3.52 dB < 6 dB
+    (4.0, 1.0, math.inf, "at V_L", (True, False, False)),  # 3.52 < 4.5; 11.4° < 30°
+    (4.0, 1.0, math.inf, "at 1.15 V_L", (True, True, True)),
+    (1.0, 1.0, 0.1, "Vo_min to Vo_max", (True, True, True)),  # 15.56 >= 8; 53.4° >= 45°
+    (1.0, 1.0, 0.07, "Vo_min to Vo_max", (True, True, False)),  # 53.4° < 60°
+    (1.0, 1.0, 0.07, "at V_L", (True, True, True)),  # 6 dB, 45°
+]
+
+
+@pytest.mark.parametrize(("k", "a", "aeroelastic", "airspeed", "verdicts"), CUBIC_CASES)
+def test_margins_check_on_k_over_s_s1_s2(
+    k: float, a: float, aeroelastic: float, airspeed: str, verdicts: tuple[bool, ...]
+) -> None:
+    gm_db, gm_hz, pm, pm_hz = cubic_margins(k, a)
+    check = margins_check({"L": cubic_loop(k, a)}, airspeed, aeroelastic)
+    assert [row[1] for row in check.rows] == ["closed loop", "gain margin", "phase margin"]
+    _, gain, phase = check.rows
+    assert float(gain[2].split()[0]) == pytest.approx(gm_db, abs=0.006)  # printed to 0.01 dB
+    assert float(gain[3].split()[0]) == pytest.approx(gm_hz, rel=1e-3)  # 4 digits
+    assert float(phase[2].split()[0]) == pytest.approx(pm, abs=0.06)  # printed to 0.1°
+    assert float(phase[3].split()[0]) == pytest.approx(pm_hz, rel=1e-3)
+    assert tuple(row[5] for row in check.rows) == verdicts
+    assert check.passed == {"L": all(verdicts)}
+    assert check.airspeed == airspeed
+
+
+@pytest.mark.parametrize("k", [0.5, 1.0, 2.0, 3.0, 4.0, 5.5])
+def test_cubic_loop_margins_match_the_closed_form(k: float) -> None:
+    """The margins the check reads, to 1e-9, before they are rounded for the table."""
+    m = aerocontrol.stability_margins(cubic_loop(k))
+    gm_db, gm_hz, pm, pm_hz = cubic_margins(k)
+    assert 20 * math.log10(m.gain_margins[0]) == pytest.approx(gm_db, abs=1e-9)
+    assert m.phase_crossovers[0] / (2 * math.pi) == pytest.approx(gm_hz, rel=1e-9)
+    assert m.phase_margins[0] == pytest.approx(pm, abs=1e-9)
+    assert m.gain_crossovers[0] / (2 * math.pi) == pytest.approx(pm_hz, rel=1e-9)
+    assert m.closed_loop_stable  # s³ + 3s² + 2s + k: stable for 0 < k < 6 (Routh)
+
+
+@pytest.mark.parametrize("airspeed", AIRSPEEDS)
+def test_unstable_closed_loop_fails_at_every_airspeed(airspeed: str) -> None:
+    """k = 7 > 6: unstable, and the gain margin 6/7 (-1.34 dB) is a reduction to stability."""
+    check = margins_check({"k = 7": cubic_loop(7.0)}, airspeed)
+    assert check.rows[0][1:3] == ("closed loop", "unstable") and not check.rows[0][5]
+    assert check.passed == {"k = 7": False}
+
+
+@pytest.mark.parametrize(
+    ("k", "airspeed", "passed"),
+    [
+        (2.0, "Vo_min to Vo_max", True),  # -6.02 dB at 0 Hz, first row: 4.5 dB
+        (2.0, "below Vo_min", True),  # 6.02 >= 6
+        (1.8, "Vo_min to Vo_max", True),  # -5.11 dB
+        (1.8, "below Vo_min", False),  # 5.11 < 6
+        (1.5, "Vo_min to Vo_max", False),  # -3.52 dB < 4.5
+        (1.5, "at V_L", True),  # 3.52 >= 3
+    ],
+)
+def test_gain_reduction_margin(k: float, airspeed: str, passed: bool) -> None:
+    """k/(s - 1), unstable open loop, closed loop s - 1 + k stable for k > 1: at ω = 0 the
+    loop is -k, so the gain may fall by a factor k (20 log10 k dB) before instability, and no
+    gain increase destabilises. The ± of the table asks that reduction too."""
+    check = margins_check({"L": aerocontrol.zpk([], [1.0], k)}, airspeed)
+    _, gain, phase = check.rows
+    assert float(gain[2].split()[0]) == pytest.approx(-20 * math.log10(k), abs=0.006)
+    assert gain[3] == "0 Hz" and gain[4].startswith("-")
+    assert gain[5] is passed
+    # PM = atan(ω) at ω = sqrt(k² - 1): 48.19°, 56.25°, 60° (second row, 45°; at V_L 30°)
+    assert float(phase[2].split()[0]) == pytest.approx(
+        math.degrees(math.atan(math.sqrt(k * k - 1))), abs=0.06
+    )
+    assert phase[5]
+
+
+def test_phase_margin_is_judged_in_magnitude() -> None:
+    """A phase margin of -p (a lead of p that destabilises) meets a ±p requirement as +p does;
+    checked on the k = 2 loop's margins with the phase margin's sign flipped."""
+    margins = aerocontrol.stability_margins(cubic_loop(2.0))
+    lead = dataclasses.replace(margins, phase_margins=-margins.phase_margins)
+    for airspeed, ok in (("at V_L", True), ("Vo_min to Vo_max", False)):  # 32.6° vs 30°, 45°
+        for m in (margins, lead):
+            phase = margins_check({"L": m}, airspeed).rows[2]
+            assert phase[5] is ok and phase[4].startswith("±")
+
+
+def test_loop_without_crossovers_passes() -> None:
+    """0.5/(s + 1): |L| < 1 everywhere and the phase never reaches -180°: no margin to fail."""
+    check = margins_check({"L": aerocontrol.zpk([], [-1.0], 0.5)}, "Vo_min to Vo_max", 2.0)
+    assert [row[1] for row in check.rows] == ["closed loop"] and check.passed == {"L": True}
+
+
+def test_margins_check_table_says_unverified() -> None:
+    text = str(margins_check({"k = 1": cubic_loop(1.0)}, "at V_L"))
+    title = text.splitlines()[0]
+    assert title.startswith("MIL-F-9490D 3.1.3.6 margins, airspeed at V_L")
+    assert "no cell verified" in title and "UNVERIFIED" in title
+    assert "+15.56 dB" in text and "+53.4 deg" in text and "±30 deg" in text
+
+
+def test_margins_check_bad_arguments() -> None:
+    loop = cubic_loop(1.0)
+    with pytest.raises(InvalidArgumentError, match="airspeed must be one of"):
+        margins_check({"L": loop}, "cruise")
+    with pytest.raises(InvalidArgumentError, match="aeroelastic_hz must exceed") as info:
+        margins_check({"L": loop}, aeroelastic_hz=0.01)
+    assert info.value.argument == "aeroelastic_hz"
+    with pytest.raises(NonFiniteError, match="aeroelastic_hz"):  # even with no crossover
+        margins_check({"L": aerocontrol.zpk([], [-1.0], 0.5)}, aeroelastic_hz=math.nan)
+    with pytest.raises(InvalidArgumentError, match="non-empty mapping"):
+        margins_check({})
+    with pytest.raises(InvalidArgumentError, match="non-empty mapping"):
+        margins_check([("L", loop)])  # type: ignore[arg-type]

@@ -161,7 +161,7 @@ def _parser() -> argparse.ArgumentParser:
         help="a yaw or pitch damper designed on the root locus, and its margins",
         description="A rate damper through a first-order actuator (and, for yaw, a washout) "
         "at the gain of best damping; its loop's transfer function, margins against "
-        "MIL-F-9490D (Table I values as widely quoted, unverified) and closed-loop modes.",
+        "MIL-F-9490D (Table I as widely quoted, every cell unverified) and closed-loop modes.",
     )
     damper.add_argument("aircraft", nargs="?", default=DEFAULT_AIRCRAFT, help=aircraft_help)
     damper.add_argument(

@@ -83,6 +83,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ._validation import check_choice, real_scalar
 from .exceptions import InvalidArgumentError, NonFiniteError, ShapeError
 
 __all__ = [
@@ -741,28 +742,76 @@ MARGIN_SPECIFICATION = "MIL-F-9490D"
 #: operational envelope), at the limit airspeed V_L, and at 1.15 V_L.
 AIRSPEEDS: tuple[str, ...] = ("below Vo_min", "Vo_min to Vo_max", "at V_L", "at 1.15 V_L")
 
-#: (gain margin dB, phase margin degrees) by mode frequency band and airspeed: the bands are
-#: f_M < 0.06 Hz, 0.06 Hz <= f_M < the first aeroelastic mode, and f_M at or beyond it.
-#: UNVERIFIED: the text of MIL-F-9490D (6 June 1975) paragraph 3.1.3.6 and its Table I could
-#: not be read while this was written; these are the values widely quoted from it (flight
-#: control texts and course notes), not read from the specification. "Below Vo_min" asks a
-#: 6 dB gain margin and no phase margin in every band; "at 1.15 V_L" asks only that the loop
-#: be stable at its nominal gain and phase (0 dB, 0 degrees). Check them against the
-#: specification before relying on a verdict.
+#: (gain margin dB, phase margin degrees) by airspeed column and mode-frequency row.
+#:
+#: UNVERIFIED, every cell: neither MIL-F-9490D (6 June 1975) nor its Background Information
+#: and User's Guide (AFFDL-TR-74-116, Boeing, January 1975, said to reproduce the table) could
+#: be read for this module. The cells are the table as widely quoted, "Gain and phase margin
+#: requirements (dB and degrees)" under 3.1.3.6 (cited as Table I; its number is unverified
+#: too):
+#:
+#: ==============================  ============  =============  =============  ===========
+#: mode frequency f_M              below Vo_min  Vo_min-Vo_max  at V_L         at 1.15 V_L
+#: ==============================  ============  =============  =============  ===========
+#: f_M < 0.06 Hz                   GM 6 dB       ±4.5 dB, ±30°  ±3.0 dB, ±20°  stable
+#: 0.06 Hz <= f_M < 1st aeroelas.  GM 6 dB       ±6.0 dB, ±45°  ±4.5 dB, ±30°  stable
+#: f_M >= 1st aeroelastic mode     GM 6 dB       ±8.0 dB, ±60°  ±6.0 dB, ±45°  stable
+#: ==============================  ============  =============  =============  ===========
+#:
+#: Below Vo_min the quoted table asks a 6 dB gain margin and no phase margin ("no phase
+#: requirement", stored as 0 degrees); at 1.15 V_L, stability at the nominal gain and phase
+#: (stored as 0 dB, 0 degrees). The only cell that secondary sources state, in words and not
+#: as a table, is the 6 dB / 45 degree one (0.06 Hz to the first aeroelastic mode, Vo_min to
+#: Vo_max): it is unverified as well. Not verified either: the quoted row at exactly the
+#: first aeroelastic mode (the stricter row is taken), and the conditions in the
+#: specification's text around the table (which loops are broken, and where).
 MARGIN_TABLE: dict[str, tuple[tuple[float, float], tuple[float, float], tuple[float, float]]] = {
     "below Vo_min": ((6.0, 0.0), (6.0, 0.0), (6.0, 0.0)),
     "Vo_min to Vo_max": ((4.5, 30.0), (6.0, 45.0), (8.0, 60.0)),
     "at V_L": ((3.0, 20.0), (4.5, 30.0), (6.0, 45.0)),
     "at 1.15 V_L": ((0.0, 0.0), (0.0, 0.0), (0.0, 0.0)),
 }
+_LOW_BAND_HZ = 0.06  # the edge between the quoted table's first two rows
 _BANDS = ("f < 0.06 Hz", "0.06 Hz <= f < first aeroelastic mode", "f >= first aeroelastic mode")
+_MARGIN_STATUS = "Table I as widely quoted; no cell verified against the specification: UNVERIFIED"
+
+
+def _aeroelastic_hz(value: object) -> float:
+    """The first aeroelastic mode's frequency (Hz), above the 0.06 Hz row edge (inf: none)."""
+    f = real_scalar(value, "aeroelastic_hz")
+    if math.isnan(f):
+        error: InvalidArgumentError = NonFiniteError(
+            "aeroelastic_hz must be a frequency in Hz (inf for none), got NaN"
+        )
+    elif f <= _LOW_BAND_HZ:
+        error = InvalidArgumentError(
+            f"aeroelastic_hz must exceed {_LOW_BAND_HZ} Hz (the margin table's rows assume "
+            f"the first aeroelastic mode above the 0.06 Hz row edge), got {f}"
+        )
+    else:
+        return f
+    error.argument, error.value = "aeroelastic_hz", f
+    raise error
+
+
+def _band(frequency_hz: float, aeroelastic_hz: float) -> int:
+    """The row of :data:`MARGIN_TABLE` for a mode at ``frequency_hz``: 0 below 0.06 Hz, 1 from
+    0.06 Hz up to (not including) the first aeroelastic mode, 2 at or above it."""
+    if frequency_hz < _LOW_BAND_HZ:
+        return 0
+    return 1 if frequency_hz < aeroelastic_hz else 2
 
 
 def margin_requirement(
     frequency_hz: float, airspeed: str = "Vo_min to Vo_max", aeroelastic_hz: float = math.inf
 ) -> tuple[float, float, str]:
-    """(gain margin dB, phase margin degrees, band) required of a loop mode at
-    ``frequency_hz`` (MIL-F-9490D 3.1.3.6, Table I; see :data:`MARGIN_TABLE`, UNVERIFIED).
+    """(gain margin dB, phase margin degrees, row) required of a loop mode at
+    ``frequency_hz`` (MIL-F-9490D 3.1.3.6; see :data:`MARGIN_TABLE`, whose every cell is
+    UNVERIFIED).
+
+    The rows: f < 0.06 Hz; 0.06 Hz <= f < ``aeroelastic_hz`` (the first aeroelastic mode, Hz;
+    inf when the model has none); f >= ``aeroelastic_hz``. A frequency exactly on an edge
+    takes the higher row.
 
     Examples
     --------
@@ -771,13 +820,21 @@ def margin_requirement(
     (6.0, 45.0, '0.06 Hz <= f < first aeroelastic mode')
     >>> margin_requirement(0.02, "at V_L")
     (3.0, 20.0, 'f < 0.06 Hz')
+    >>> margin_requirement(12.0, aeroelastic_hz=12.0)
+    (8.0, 60.0, 'f >= first aeroelastic mode')
     """
-    if airspeed not in MARGIN_TABLE:
-        allowed = ", ".join(repr(a) for a in AIRSPEEDS)
-        raise InvalidArgumentError(f"airspeed must be one of {allowed}, got {airspeed!r}")
-    f = float(frequency_hz)
-    band = 0 if f < 0.06 else (1 if f < aeroelastic_hz else 2)
-    gm, pm = MARGIN_TABLE[airspeed][band]
+    column = MARGIN_TABLE[check_choice(airspeed, "airspeed", AIRSPEEDS)]
+    f = real_scalar(frequency_hz, "frequency_hz")
+    if not math.isfinite(f) or f < 0:
+        error: InvalidArgumentError = (
+            NonFiniteError(f"frequency_hz must be finite, got {f}")
+            if not math.isfinite(f)
+            else InvalidArgumentError(f"frequency_hz must be at least 0 Hz, got {f}")
+        )
+        error.argument, error.value = "frequency_hz", f
+        raise error
+    band = _band(f, _aeroelastic_hz(aeroelastic_hz))
+    gm, pm = column[band]
     return gm, pm, _BANDS[band]
 
 
@@ -801,8 +858,7 @@ class MarginsCheck:
         header = ("loop", "quantity", "value", "at", "required", "verdict")
         rows = [(*row[:5], "pass" if row[5] else "FAIL") for row in self.rows]
         title = (
-            f"{MARGIN_SPECIFICATION} 3.1.3.6 margins, airspeed {self.airspeed} "
-            "(Table I values as widely quoted: UNVERIFIED against the specification)"
+            f"{MARGIN_SPECIFICATION} 3.1.3.6 margins, airspeed {self.airspeed} ({_MARGIN_STATUS})"
         )
         return "\n".join([title, *_columns(header, rows)])
 
@@ -815,19 +871,21 @@ def margins_check(
     airspeed: str = "Vo_min to Vo_max",
     aeroelastic_hz: float = math.inf,
 ) -> MarginsCheck:
-    """Each loop's margins against MIL-F-9490D 3.1.3.6 (Table I, UNVERIFIED values: see
-    :data:`MARGIN_TABLE`).
+    """Each loop's margins against MIL-F-9490D 3.1.3.6 (the margin table as widely quoted,
+    every cell UNVERIFIED: see :data:`MARGIN_TABLE`).
 
     ``loops`` maps a name to the loop (its open-loop transfer at the break point, negative
     feedback, as for :func:`~aerocontrol.stability_margins`) or to its
-    :class:`~aerocontrol.StabilityMargins`. The mode frequency f_M of each requirement is
-    taken as the frequency of the crossover where the margin is measured (the phase
-    crossover of a gain margin, the gain crossover of a phase margin), and its band is
-    chosen by it. Every gain margin must be at least the requirement in its direction (a gain
-    margin below 1, a gain reduction margin, at least that many dB of reduction); every phase
-    margin at least the requirement in magnitude (Table I's ±: a phase margin of -58° is a
-    lead of 58° that destabilises); and the closed loop must be stable (from its poles). A
-    loop without crossovers has infinite margins and passes them.
+    :class:`~aerocontrol.StabilityMargins`; for a multiloop system, break one loop at a time
+    with the others closed. The mode frequency f_M of each requirement is taken as the
+    frequency of the crossover where the margin is measured (the phase crossover of a gain
+    margin, the gain crossover of a phase margin), and chooses the row
+    (:func:`margin_requirement`). The table's ± is read as both directions: every gain margin
+    must be at least the requirement in its own direction (a gain margin below 1, a gain
+    reduction margin, at least that many dB of reduction), and every phase margin at least
+    the requirement in magnitude (a phase margin of -58° is a lead of 58° that destabilises).
+    The closed loop must also be stable (from its poles); that is the whole requirement at
+    1.15 V_L. A loop without crossovers has infinite margins and passes them.
 
     Examples
     --------
@@ -840,9 +898,8 @@ def margins_check(
     """
     from .loops import StabilityMargins, stability_margins
 
-    if airspeed not in MARGIN_TABLE:
-        allowed = ", ".join(repr(a) for a in AIRSPEEDS)
-        raise InvalidArgumentError(f"airspeed must be one of {allowed}, got {airspeed!r}")
+    check_choice(airspeed, "airspeed", AIRSPEEDS)
+    aeroelastic = _aeroelastic_hz(aeroelastic_hz)
     if not isinstance(loops, Mapping) or not loops:
         raise InvalidArgumentError("loops must be a non-empty mapping of names to loops")
     rows: list[tuple[str, str, str, str, str, bool]] = []
@@ -859,7 +916,7 @@ def margins_check(
             )
         )
         for gm, w in zip(m.gain_margins, m.phase_crossovers, strict=True):
-            required, _, band = margin_requirement(w / (2 * math.pi), airspeed, aeroelastic_hz)
+            required, _, band = margin_requirement(w / (2 * math.pi), airspeed, aeroelastic)
             db = 20 * math.log10(gm) if gm > 0 else -math.inf
             ok = (db >= required) if gm >= 1 else (-db >= required)
             rows.append(
@@ -873,14 +930,14 @@ def margins_check(
                 )
             )
         for pm, w in zip(m.phase_margins, m.gain_crossovers, strict=True):
-            _, required_pm, band = margin_requirement(w / (2 * math.pi), airspeed, aeroelastic_hz)
+            _, required_pm, band = margin_requirement(w / (2 * math.pi), airspeed, aeroelastic)
             rows.append(
                 (
                     name,
                     "phase margin",
                     f"{pm:+.1f} deg",
                     f"{w / (2 * math.pi):.4g} Hz",
-                    f"{required_pm:g} deg ({band})",
+                    f"±{required_pm:g} deg ({band})",
                     bool(abs(pm) >= required_pm),
                 )
             )

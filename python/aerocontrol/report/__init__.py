@@ -22,8 +22,8 @@ contained: the figures are embedded) and ``report.md`` with ``figures/*.png``. T
    full-state feedback;
 6a. stability augmentation by output feedback: a yaw damper (yaw rate to rudder through an
    actuator, with and without a washout) and a pitch damper designed on the root locus, their
-   margins against MIL-F-9490D (Table I as widely quoted, unverified), the root locus and the
-   response to a rudder pulse beside the open loop's;
+   margins against MIL-F-9490D (Table I as widely quoted, every cell unverified), the root
+   locus and the response to a rudder pulse beside the open loop's;
 7. the Levels after augmentation, and the open-loop Levels over Mach and altitude around the
    file's condition;
 8. for the embedded 747, the chapter's small examples (controllability (6.75-6.88), Figures 6.4

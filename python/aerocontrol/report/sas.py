@@ -62,7 +62,7 @@ def section(ctx: Context) -> str:
         "The gain k is chosen on the root locus of 1 + kL(s) = 0 for the best damping of the "
         "least-damped oscillation (yaw) or of the short period (pitch). Margins are those of "
         "kL broken at the surface command; MIL-F-9490D's Table I values are the widely quoted "
-        "ones, not verified against the specification's text."
+        "ones: no cell could be verified against the specification's text."
     )
     rows, lines, designs = [], [], {}
     builds: list[tuple[str, Callable[[], Damper]]] = [
