@@ -399,6 +399,29 @@ def test_skewed_disk_margins_against_mathworks(skew: float, printed: tuple[float
     _check_certificate(loop, m)
 
 
+def test_skews_one_and_minus_one_are_the_sensitivity_peaks() -> None:
+    # σ = 1: D(α, 1) = {1/(1 - δ)} and α = 1/||S||∞, the stability margin min|1 + L| of
+    # stability_margins (the core's L∞ iteration); σ = -1: α = 1/||T||∞, against scipy's
+    # bounded search on a numpy evaluation of L/(1 + L). (The zoom once stopped a step short
+    # of the peak: 1/||S||∞ came out 1.8e-10 too large.)
+    loop = _third_order(2.0)
+    sensitive = aerocontrol.disk_margins(loop, skew=1.0)
+    assert sensitive.multiloop.alpha == pytest.approx(
+        stability_margins(loop).stability_margin, rel=1e-12
+    )
+    complementary = aerocontrol.disk_margins(loop, skew=-1.0)
+    w = complementary.multiloop.frequency
+
+    def minus_t(x: float) -> float:
+        value = _numpy_response(loop, np.array([x]))[0]
+        return -abs(value / (1 + value))
+
+    best = minimize_scalar(
+        minus_t, bounds=(0.9 * w, 1.1 * w), method="bounded", options={"xatol": 1e-12}
+    )
+    assert complementary.multiloop.alpha == pytest.approx(-1.0 / best.fun, rel=1e-12)
+
+
 @pytest.mark.parametrize("skew", [-3.0, -1.0, -0.5, 0.0, 0.7, 1.0, 2.5])
 @pytest.mark.parametrize("alpha", [1e-4, 0.3, 1.0, 1.9, 2.0, 3.0])
 def test_disk_gain_and_phase_margins_lie_on_the_disk(alpha: float, skew: float) -> None:

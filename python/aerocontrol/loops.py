@@ -998,21 +998,24 @@ def _extremum(
     intervals: int = 64,
 ) -> tuple[float, float]:
     """(ω, f(ω)) at the grid's maximum of ``values``, refined between its neighbours by
-    zooming: ``intervals`` + 1 points in one call of the core, then again about the best of
-    them, until the bracket is 1e-9 of ω wide (near a smooth maximum f is then within about
-    1e-16 of it)."""
+    zooming: ``intervals`` + 1 points in one call of the core, then again within a step of
+    the best point so far, until the bracket is 1e-9 of ω wide (of the first bracket, for a
+    maximum at ω = 0; near a smooth maximum f is then within about 1e-16 of it). A round that
+    finds nothing better still narrows the bracket about the best point: the maximum may lie
+    within a step of it (stopping there left 1/||S||∞ of k/(s(s + 1)(s + 2)) 1.8e-10 too
+    large, 5e-6 off in ω)."""
     if omega.size == 0:
         return math.nan, math.nan
     i = int(np.argmax(values))
     best_w, best_value = float(omega[i]), float(values[i])
     low, high = float(omega[max(i - 1, 0)]), float(omega[min(i + 1, omega.size - 1)])
-    while high - low > 1e-9 * max(best_w, 1e-300):
+    first = high - low
+    while high - low > 1e-9 * max(best_w, first, 1e-300):
         points = np.linspace(low, high, intervals + 1)
         found = f(points)
         j = int(np.nanargmax(found)) if np.any(np.isfinite(found)) else 0
-        if not found[j] > best_value:
-            break
-        best_w, best_value = float(points[j]), float(found[j])
+        if found[j] > best_value:
+            best_w, best_value = float(points[j]), float(found[j])
         step = (high - low) / intervals
         low, high = max(best_w - step, low), min(best_w + step, high)
     return best_w, best_value
@@ -1247,6 +1250,10 @@ _STALLED = 1e-10
 _POWER_STEPS = 60
 _POWER_RESTARTS = 3
 
+#: Frequencies optimised before the others are screened: those of largest Osborne bound,
+#: whose lower bounds then set the level below which a frequency cannot set the peak.
+_SCREEN_FIRST = 8
+
 
 @dataclass(frozen=True)
 class _MuBounds:
@@ -1256,6 +1263,8 @@ class _MuBounds:
     lower: FloatArray
     delta: ComplexArray
     """(k, p): the diagonal of a Δ with max|δ_i| = 1/lower and det(I - M Δ) = 0."""
+    scaling: FloatArray
+    """(k, p): log d of the D with σ̄(D M D^-1) = upper."""
 
 
 def _scaled(M: ComplexArray, x: FloatArray) -> ComplexArray:
@@ -1336,16 +1345,16 @@ def _newton_step(M: ComplexArray, x: FloatArray, t: float) -> tuple[FloatArray, 
     return phi, top, g, direction
 
 
-def _descend(M: ComplexArray, x: FloatArray, bounds: _MuBounds) -> _MuBounds:
+def _descend(M: ComplexArray, bounds: _MuBounds) -> _MuBounds:
     """Minimise σ̄(D M D^-1) over positive diagonal D = diag(e^x), a convex function of x
-    (Sezginer and Overton 1990), from ``x``: damped Newton steps (Armijo backtracking) on the
-    smoothed φ_t for each t of _SMOOTHING in turn. Returns the bounds with the least σ̄ met as
-    the upper bound; after each stage the lower bound is raised by the power
-    method from the best scaling, and a matrix stops once its bounds are within _TIGHT (then
-    both are μ)."""
-    best, best_x = bounds.upper.copy(), x.copy()
+    (Sezginer and Overton 1990), from the bounds' scaling: damped Newton steps (Armijo
+    backtracking) on the smoothed φ_t for each t of _SMOOTHING in turn. Returns the bounds
+    with the least σ̄ met as the upper bound, and its scaling; after each stage the lower
+    bound is raised by the power method from the best scaling, and a matrix stops once its
+    bounds are within _TIGHT (then both are μ)."""
+    best, best_x = bounds.upper.copy(), bounds.scaling.copy()
     lower, delta = bounds.lower.copy(), bounds.delta.copy()
-    x = x.copy()
+    x = bounds.scaling.copy()
     for t in _SMOOTHING:
         active = np.flatnonzero(best > lower * (1.0 + _TIGHT))
         for _ in range(_NEWTON_STEPS):
@@ -1393,7 +1402,7 @@ def _descend(M: ComplexArray, x: FloatArray, bounds: _MuBounds) -> _MuBounds:
             better = found > lower[still]
             lower[still[better]] = found[better]
             delta[still[better]] = perturbation[better]
-    return _MuBounds(best, lower, delta)
+    return _MuBounds(best, lower, delta, best_x)
 
 
 def _unit(v: ComplexArray) -> ComplexArray:
@@ -1443,43 +1452,68 @@ def _power_from_scaling(M: ComplexArray, x: FloatArray) -> tuple[FloatArray, Com
     return _power_bound(M, u / d, v / d, u * d, v * d)
 
 
-def _mu_bounds(M: ComplexArray, floor: float = 0.0) -> _MuBounds:
+def _mu_bounds(M: ComplexArray, floor: float = 0.0, start: FloatArray | None = None) -> _MuBounds:
     """Upper and lower bounds of μ_Δ(M) for Δ = diag(δ_1, ..., δ_p), δ_i complex, for each
     matrix of the stack M (k, p, p) (one per frequency), sharp where they may set the peak.
 
     Upper bound: min over positive diagonal D of σ̄(D M D^-1) (equal to μ for p <= 3: Packard
-    and Doyle 1993, 2S + F <= 3), from Osborne's balancing, then by :func:`_descend` where
-    that bound exceeds the lower bound. Lower bound: the power method (:func:`_power_bound`)
-    from the scaling's singular vectors, and from _POWER_RESTARTS seeded random starts where
-    a gap remains. The matrices whose Osborne bound is at most the largest lower bound of the
-    stack, or ``floor`` (an upper bound of the peak found already), keep it: they cannot set
-    the peak. Each matrix is scaled by its largest entry first (μ is homogeneous)."""
-    p = M.shape[1]
+    and Doyle 1993, 2S + F <= 3), from Osborne's balancing (or the scaling ``start``, log d,
+    where it does better: that of a nearby frequency), then by :func:`_descend` where that
+    bound exceeds the lower bound. Lower bound: the power method (:func:`_power_bound`) from
+    the scaling's singular vectors, and from _POWER_RESTARTS seeded random starts where a
+    gap remains. The _SCREEN_FIRST matrices of largest starting bound are optimised first;
+    then those whose starting bound is at most the largest lower bound, or ``floor`` (an
+    upper bound of the peak found already), keep it: they cannot set the peak. Each matrix
+    is scaled by its largest entry first (μ is homogeneous)."""
     size = np.max(np.abs(M), axis=(1, 2), initial=0.0)
     scale = np.where(size == 0.0, 1.0, size)
     N = M / scale[:, None, None]
     x = _osborne(N)
     upper = np.asarray(np.linalg.svd(_scaled(N, x), compute_uv=False)[:, 0], dtype=np.float64)
+    if start is not None:
+        given = np.broadcast_to(start, x.shape)
+        warm = np.linalg.svd(_scaled(N, given), compute_uv=False)[:, 0]
+        better = warm < upper
+        x[better], upper[better] = given[better], warm[better]
     lower, delta = _power_from_scaling(N, x)
-    ceiling = max(floor, float(np.max(lower * size, initial=0.0)))
-    gap = np.flatnonzero((upper > lower * (1.0 + _TIGHT)) & (upper * size > ceiling))
-    if gap.size:
-        found = _descend(N[gap], x[gap], _MuBounds(upper[gap], lower[gap], delta[gap]))
-        upper[gap], lower[gap], delta[gap] = found.upper, found.lower, found.delta
-        rng = np.random.default_rng(0)
-        for _ in range(_POWER_RESTARTS):
-            b, w = rng.standard_normal((2, gap.size, p)) + 1j * rng.standard_normal(
-                (2, gap.size, p)
-            )
-            value, perturbation = _power_bound(N[gap], b, b, w, w)
-            better = value > lower[gap]
-            lower[gap[better]] = value[better]
-            delta[gap[better]] = perturbation[better]
+    bounds = _MuBounds(upper, lower, delta, x)
+    candidates = np.flatnonzero(upper > lower * (1.0 + _TIGHT))
+    candidates = candidates[np.argsort(-(upper * size)[candidates], kind="stable")]
+    for chosen in (candidates[:_SCREEN_FIRST], candidates[_SCREEN_FIRST:]):
+        ceiling = max(floor, float(np.max(bounds.lower * size, initial=0.0)))
+        chosen = chosen[bounds.upper[chosen] * size[chosen] > ceiling]
+        if chosen.size:
+            found = _sharpened(N[chosen], _subset(bounds, chosen))
+            for name in ("upper", "lower", "delta", "scaling"):
+                getattr(bounds, name)[chosen] = getattr(found, name)
     return _MuBounds(
-        upper=upper * size,
-        lower=lower * size,
-        delta=np.asarray(delta / scale[:, None], dtype=np.complex128),
+        upper=bounds.upper * size,
+        lower=bounds.lower * size,
+        delta=np.asarray(bounds.delta / scale[:, None], dtype=np.complex128),
+        scaling=bounds.scaling,
     )
+
+
+def _subset(bounds: _MuBounds, chosen: NDArray[np.intp]) -> _MuBounds:
+    return _MuBounds(
+        bounds.upper[chosen], bounds.lower[chosen], bounds.delta[chosen], bounds.scaling[chosen]
+    )
+
+
+def _sharpened(M: ComplexArray, bounds: _MuBounds) -> _MuBounds:
+    """The bounds of :func:`_descend`, with the lower bound raised by the power method from
+    _POWER_RESTARTS seeded random starts."""
+    found = _descend(M, bounds)
+    lower, delta = found.lower.copy(), found.delta.copy()
+    rng = np.random.default_rng(0)
+    k, p, _ = M.shape
+    for _ in range(_POWER_RESTARTS):
+        b, w = rng.standard_normal((2, k, p)) + 1j * rng.standard_normal((2, k, p))
+        value, perturbation = _power_bound(M, b, b, w, w)
+        better = value > lower
+        lower[better] = value[better]
+        delta[better] = perturbation[better]
+    return _MuBounds(found.upper, lower, delta, found.scaling)
 
 
 def _square_loop(loop: System) -> StateSpace:
@@ -1550,12 +1584,17 @@ class _Evaluated:
     upper: list[FloatArray] = field(default_factory=list)
     lower: list[FloatArray] = field(default_factory=list)
     delta: list[ComplexArray] = field(default_factory=list)
+    best: tuple[float, FloatArray] = (-math.inf, np.zeros(0))
+    """The largest upper bound so far and the scaling (log d) at it."""
 
     def add(self, omega: FloatArray, bounds: _MuBounds) -> None:
         self.omega.append(omega)
         self.upper.append(bounds.upper)
         self.lower.append(bounds.lower)
         self.delta.append(bounds.delta)
+        i = int(np.argmax(bounds.upper))
+        if bounds.upper[i] > self.best[0]:
+            self.best = (float(bounds.upper[i]), bounds.scaling[i])
 
     def arrays(self) -> tuple[FloatArray, FloatArray, FloatArray, ComplexArray]:
         """The frequencies in increasing order; at one evaluated twice (a zoom's end is a
@@ -1830,7 +1869,8 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
     if refine:
 
         def refined_upper(w: FloatArray) -> FloatArray:
-            found = _mu_bounds(sensitivity.at(w), floor=max(map(np.max, evaluated.upper)))
+            peak, scaling = evaluated.best
+            found = _mu_bounds(sensitivity.at(w), floor=peak, start=scaling)
             evaluated.add(w, found)
             return found.upper
 
