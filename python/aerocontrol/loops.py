@@ -1484,8 +1484,8 @@ def _mu_bounds(M: ComplexArray, floor: float = 0.0, start: FloatArray | None = N
         chosen = chosen[bounds.upper[chosen] * size[chosen] > ceiling]
         if chosen.size:
             found = _sharpened(N[chosen], _subset(bounds, chosen))
-            for name in ("upper", "lower", "delta", "scaling"):
-                getattr(bounds, name)[chosen] = getattr(found, name)
+            bounds.upper[chosen], bounds.lower[chosen] = found.upper, found.lower
+            bounds.delta[chosen], bounds.scaling[chosen] = found.delta, found.scaling
     return _MuBounds(
         upper=bounds.upper * size,
         lower=bounds.lower * size,
