@@ -203,6 +203,452 @@ def test_disk_margin_against_python_control(loop: aerocontrol.StateSpace) -> Non
     assert m.disk_margin == pytest.approx(-1.0 / best.fun, rel=1e-9)
 
 
+# ----- MIMO disk margins --------------------------------------------------------------------
+
+
+def _matrix_response(sys: aerocontrol.StateSpace, w: float) -> np.ndarray:
+    """L(jω) (L(e^{jω dt}) for a discrete loop) by numpy.linalg.solve, independent of the core."""
+    point = np.exp(1j * w * sys.dt) if sys.dt else 1j * w
+    n = sys.n_states
+    return sys.C @ np.linalg.solve(point * np.eye(n) - sys.A, sys.B) + sys.D
+
+
+def _satellite(a: float = 10.0) -> aerocontrol.StateSpace:
+    """The spinning satellite (Doyle; Seiler, Packard and Gahinet 2020), K = I:
+    P = [[s - a², a(s + 1)], [-a(s + 1), s - a²]]/(s² + a²)."""
+    return aerocontrol.StateSpace([[0.0, a], [-a, 0.0]], np.eye(2), [[1.0, a], [-a, 1.0]])
+
+
+def _stable_random_loop(
+    n: int, p: int, seed: int, dt: float | None = None
+) -> aerocontrol.StateSpace:
+    """A seeded random loop (n states, p x p, D small) whose closed loop I + L is stable,
+    checked by numpy's eigenvalues of A - B (I + D)^-1 C."""
+    rng = np.random.default_rng(seed)
+    while True:
+        A = rng.standard_normal((n, n))
+        if dt:
+            A *= 0.9 / np.max(np.abs(np.linalg.eigvals(A)))
+        else:
+            A -= (np.max(np.linalg.eigvals(A).real) + 0.5) * np.eye(n)
+        B, C = rng.standard_normal((n, p)), rng.standard_normal((p, n))
+        D = 0.1 * rng.standard_normal((p, p))
+        poles = np.linalg.eigvals(A - B @ np.linalg.solve(np.eye(p) + D, C))
+        if (np.max(np.abs(poles)) < 1.0) if dt else (np.max(poles.real) < 0.0):
+            return aerocontrol.StateSpace(A, B, C, D, dt=dt)
+
+
+def _mu_by_slycot(M: np.ndarray) -> float:
+    """AB13MD's upper bound of μ for p complex scalar blocks (python-control's oracle)."""
+    from slycot import ab13md
+
+    p = M.shape[0]
+    return float(ab13md(M.astype(complex), np.ones(p, int), 2 * np.ones(p, int))[0])
+
+
+def _balanced_delta(f: np.ndarray, skew: float) -> np.ndarray:
+    """δ of f = (1 + (1 - σ)δ/2)/(1 - (1 + σ)δ/2), inverted:
+    δ = (f - 1)/((1 - σ)/2 + (1 + σ) f/2)."""
+    return (f - 1.0) / (0.5 * (1.0 - skew) + 0.5 * (1.0 + skew) * f)
+
+
+def _check_certificate(
+    loop: aerocontrol.StateSpace, m: aerocontrol.DiskMargins, tol: float = 1e-10
+) -> None:
+    """The worst perturbation makes I + L(jω) F singular (numpy's L) and lies on the
+    boundary of D(α_upper, σ)."""
+    L = _matrix_response(loop, m.worst_frequency)
+    F = np.diag(m.worst_perturbation)
+    smallest = np.linalg.svd(np.eye(L.shape[0]) + L @ F, compute_uv=False)[-1]
+    assert smallest <= tol * (1.0 + np.linalg.norm(L, 2) * np.linalg.norm(F, 2))
+    sizes = np.abs(_balanced_delta(m.worst_perturbation, m.skew))
+    np.testing.assert_allclose(sizes, m.multiloop_bounds[1], rtol=1e-9)
+
+
+def test_disk_margins_of_one_loop_are_its_stability_margins() -> None:
+    # p = 1: the multiloop margin is the loop's disk margin (the Hamiltonian L∞ norm of
+    # stability_margins), bit for bit, and python-control's on a dense grid within 1e-5.
+    for loop in [_third_order(2.0), aerocontrol.series(_yaw_loop(3.0), aerocontrol.gain(2.5))]:
+        m = aerocontrol.disk_margins(loop)
+        siso = stability_margins(loop)
+        assert m.multiloop.alpha == m.loop_at_a_time[0].alpha == siso.disk_margin
+        assert m.multiloop.frequency == siso.disk_frequency
+        assert m.multiloop_bounds == (siso.disk_margin, siso.disk_margin)
+        assert m.multiloop.gain_margin == siso.disk_gain_margin
+        assert m.multiloop.phase_margin == siso.disk_phase_margin
+        _check_certificate(loop, m)
+        w = np.logspace(-4, 3, 20001)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            alpha = control.disk_margins(control.ss(loop.A, loop.B, loop.C, loop.D), w)[0]
+        assert m.multiloop.alpha == pytest.approx(float(alpha), rel=1e-5)
+        # The arrays are |S - 1/2| on the grid: never above the refined peak.
+        assert np.max(m.mu_upper) <= (1 + 1e-12) / m.multiloop.alpha
+
+
+def test_discrete_disk_margin_is_refined_beside_conjugate_roots() -> None:
+    # Regression: the grid's clusters about a conjugate pair of roots held near twins (ln z̄
+    # is not exactly the conjugate of ln z), and a grid maximum beside its twin left a zoom
+    # bracket of zero width, so no refinement: this discrete loop's disk margin came out
+    # 1.3e-4 too large (0.219583 at the grid point 23.4601 rad/s, for 0.219555 at 23.479).
+    dt = 0.05
+    others = aerocontrol.gain(np.diag([0.0, 1.0, 1.0]), dt=dt)
+    loop = aerocontrol.feedback(_stable_random_loop(5, 3, 6, dt), others)[0, 0]
+    m = stability_margins(loop)
+
+    def peak(x: float) -> float:
+        value = _matrix_response(loop, x)[0, 0]
+        return -abs(1 - value) / (2 * abs(1 + value))
+
+    best = minimize_scalar(
+        peak,
+        bounds=(m.disk_frequency * 0.98, m.disk_frequency * 1.02),
+        method="bounded",
+        options={"xatol": 1e-12},
+    )
+    assert m.disk_margin == pytest.approx(-1.0 / best.fun, rel=1e-9)
+
+
+def test_spinning_satellite_closed_form() -> None:
+    # Loop at a time each broken loop is 1/s (α = 2, gain margin ∞, phase margin 90°), but
+    # S - I/2 = [[s - 1, -2a], [2a, s - 1]]/(2(s + 1)) is normal, so μ = σ̄ = ρ and the
+    # multiloop α = 2 √((1 + ω²)/(1 + (ω + 2a)²)), least at ω = √(a² + 1) - a.
+    a = 10.0
+    loop = _satellite(a)
+    m = aerocontrol.disk_margins(loop)
+    w = math.sqrt(a * a + 1.0) - a
+    alpha = 2.0 * math.sqrt((1.0 + w * w) / (1.0 + (w + 2.0 * a) ** 2))
+    assert m.closed_loop_stable
+    np.testing.assert_allclose(m.closed_loop_poles, [-1.0, -1.0], atol=1e-12)
+    for single, classical in zip(m.loop_at_a_time, m.loops, strict=True):
+        assert single.alpha == pytest.approx(2.0, rel=1e-12)
+        assert single.gain_margin == (0.0, math.inf)
+        assert classical.gain_margin == math.inf
+        assert classical.phase_margin == pytest.approx(90.0, abs=1e-9)
+    assert m.multiloop.alpha == pytest.approx(alpha, rel=1e-12)
+    assert m.multiloop_bounds[1] == pytest.approx(alpha, rel=1e-12)
+    # A flat maximum: its place is known to about the square root of its value's accuracy.
+    assert m.multiloop.frequency == pytest.approx(w, rel=1e-4)
+    low, high = m.multiloop.gain_margin
+    assert low == pytest.approx((2 - alpha) / (2 + alpha), rel=1e-12)
+    assert high == pytest.approx((2 + alpha) / (2 - alpha), rel=1e-12)
+    assert m.multiloop.phase_margin == pytest.approx(math.degrees(2 * math.atan(alpha / 2)))
+    assert m.multiloop.phase_margin == pytest.approx(5.711, abs=5e-4)
+    _check_certificate(loop, m)
+    # python-control (AB13MD's bound of μ) on a grid through the peak.
+    grid = np.unique(np.concatenate([np.logspace(-3, 3, 400), [w]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        theirs = control.disk_margins(control.ss(loop.A, loop.B, loop.C, loop.D), grid)[0]
+    assert m.multiloop.alpha == pytest.approx(float(theirs), rel=1e-9)
+
+
+def test_mathworks_output_loop_example() -> None:
+    # MathWorks' diskmargin page: Lo = P C with the satellite P and C = [[1, -2], [0, 1]]. Its
+    # loop-at-a-time margins are 2 (printed), and its multiloop margin is printed as 0.3754
+    # with bounds [0.3754, 0.3762] at ω = 0. For two loops μ equals its D-scaled bound, and
+    # both are 0.376152 here: the peak is at ω = 0, where M = S(0) - I/2 is real and μ the
+    # maximum over θ of ρ(M diag(1, e^{jθ})) (scipy's bounded search), and AB13MD agrees.
+    loop = aerocontrol.series(aerocontrol.gain([[1.0, -2.0], [0.0, 1.0]]), _satellite())
+    m = aerocontrol.disk_margins(loop)
+    assert [d.alpha for d in m.loop_at_a_time] == pytest.approx([2.0, 2.0], rel=1e-12)
+    M = np.linalg.inv(np.eye(2) + _matrix_response(loop, 0.0)) - 0.5 * np.eye(2)
+
+    def minus_rho(theta: float) -> float:
+        return -float(np.max(np.abs(np.linalg.eigvals(M @ np.diag([1.0, np.exp(1j * theta)])))))
+
+    best = min(
+        (
+            minimize_scalar(
+                minus_rho, bounds=(c - 0.5, c + 0.5), method="bounded", options={"xatol": 1e-12}
+            )
+            for c in np.linspace(0.0, 2.0 * math.pi, 13)
+        ),
+        key=lambda r: r.fun,
+    )
+    assert m.multiloop.frequency == 0.0
+    assert m.multiloop.alpha == pytest.approx(-1.0 / best.fun, rel=1e-10)
+    assert m.multiloop.alpha == pytest.approx(1.0 / _mu_by_slycot(M), rel=1e-10)
+    assert 0.3754 <= m.multiloop.alpha <= 0.3762
+    assert m.multiloop_bounds[1] == pytest.approx(m.multiloop.alpha, rel=1e-12)
+    _check_certificate(loop, m)
+
+
+@pytest.mark.parametrize(
+    ("skew", "printed"),
+    [(-2.0, (0.4013, 1.3745)), (0.0, (0.6273, 1.5942)), (2.0, (0.7717, 1.7247))],
+)
+def test_skewed_disk_margins_against_mathworks(skew: float, printed: tuple[float, float]) -> None:
+    # MathWorks' diskmargin page, L = 25/(s³ + 10s² + 10s + 10): the disk-based gain margins
+    # printed for σ = -2, 0, 2 (four digits).
+    loop = aerocontrol.tf([25.0], [1.0, 10.0, 10.0, 10.0])
+    m = aerocontrol.disk_margins(loop, skew=skew)
+    np.testing.assert_allclose(m.multiloop.gain_margin, printed, atol=6e-5)
+    # The phase margin against python-control's formula from the real intercepts:
+    # cos φ = (1 + γmin γmax)/(γmin + γmax).
+    low, high = m.multiloop.gain_margin
+    assert m.multiloop.phase_margin == pytest.approx(
+        math.degrees(math.acos((1 + low * high) / (low + high))), rel=1e-10
+    )
+    # α against python-control's grid; ours is the refined peak, never above it.
+    w = np.logspace(-2, 2, 20001)
+    theirs = control.ss(loop.A, loop.B, loop.C, loop.D)
+    alpha = float(control.disk_margins(theirs, w, skew=skew)[0])
+    assert m.multiloop.alpha == pytest.approx(alpha, rel=1e-6)
+    assert m.multiloop.alpha <= alpha * (1 + 1e-12)
+    _check_certificate(loop, m)
+
+
+def test_skews_one_and_minus_one_are_the_sensitivity_peaks() -> None:
+    # σ = 1: D(α, 1) = {1/(1 - δ)} and α = 1/||S||∞, the stability margin min|1 + L| of
+    # stability_margins (the core's L∞ iteration); σ = -1: α = 1/||T||∞, against scipy's
+    # bounded search on a numpy evaluation of L/(1 + L). (The zoom once stopped a step short
+    # of the peak: 1/||S||∞ came out 1.8e-10 too large.)
+    loop = _third_order(2.0)
+    sensitive = aerocontrol.disk_margins(loop, skew=1.0)
+    assert sensitive.multiloop.alpha == pytest.approx(
+        stability_margins(loop).stability_margin, rel=1e-12
+    )
+    complementary = aerocontrol.disk_margins(loop, skew=-1.0)
+    w = complementary.multiloop.frequency
+
+    def minus_t(x: float) -> float:
+        value = _numpy_response(loop, np.array([x]))[0]
+        return -abs(value / (1 + value))
+
+    best = minimize_scalar(
+        minus_t, bounds=(0.9 * w, 1.1 * w), method="bounded", options={"xatol": 1e-12}
+    )
+    assert complementary.multiloop.alpha == pytest.approx(-1.0 / best.fun, rel=1e-12)
+
+
+@pytest.mark.parametrize("skew", [-3.0, -1.0, -0.5, 0.0, 0.7, 1.0, 2.5])
+@pytest.mark.parametrize("alpha", [1e-4, 0.3, 1.0, 1.9, 2.0, 3.0])
+def test_disk_gain_and_phase_margins_lie_on_the_disk(alpha: float, skew: float) -> None:
+    # The disk D(α, σ) = {f : |δ(f)| < α}, δ(f) = (f - 1)/((1 - σ)/2 + (1 + σ) f/2): finite
+    # gain margins are on its boundary and the gains between them inside; the phase margin
+    # e^{jφ} is on the boundary unless the disk holds the whole unit circle (φ = 180°).
+    disk = aerocontrol.DiskMargin(alpha, skew, 1.0)
+    low, high = disk.gain_margin
+    assert 0.0 <= low <= 1.0 <= high
+    for end in (low, high):
+        if 0.0 < end < math.inf:
+            assert abs(_balanced_delta(np.array(end), skew)) == pytest.approx(alpha, rel=1e-9)
+    inside = np.linspace(low, min(high, 1e6), 1001)[1:-1]
+    assert np.all(np.abs(_balanced_delta(inside, skew)) < alpha * (1 + 1e-12))
+    if high == math.inf:  # every large gain is inside
+        assert abs(_balanced_delta(np.array(1e12), skew)) < alpha
+    phase = disk.phase_margin
+    arc = np.exp(1j * np.radians(np.linspace(0.0, phase, 1001)[:-1]))
+    assert np.all(np.abs(_balanced_delta(arc, skew)) < alpha * (1 + 1e-12))
+    if phase < 180.0:
+        edge = np.exp(1j * math.radians(phase))
+        assert abs(_balanced_delta(edge, skew)) == pytest.approx(alpha, rel=1e-9)
+    if skew == 0.0:
+        assert phase == pytest.approx(math.degrees(2 * math.atan(alpha / 2)), rel=1e-14)
+
+
+def test_diagonal_loop_multiloop_margin_is_the_least_loop_margin() -> None:
+    # Decoupled loops: S is diagonal, μ of a diagonal matrix is its largest entry, so the
+    # multiloop margin is the least loop-at-a-time margin, at that loop's frequency.
+    parts = [
+        _third_order(2.0),
+        aerocontrol.zpk([-2.0], [-0.1 + 1j, -0.1 - 1j, -20.0], 20.0),
+        aerocontrol.tf([4.0], [1.0, 3.0, 1.0]),
+    ]
+    m = aerocontrol.disk_margins(aerocontrol.append(*parts))
+    singles = [stability_margins(part) for part in parts]
+    # Each L_i is L_ii with the other loops' states (unobservable): its margin to rounding.
+    for single, siso in zip(m.loop_at_a_time, singles, strict=True):
+        assert single.alpha == pytest.approx(siso.disk_margin, rel=1e-12)
+        assert single.frequency == pytest.approx(siso.disk_frequency, rel=1e-6)  # flat peak
+    least = min(range(3), key=lambda i: singles[i].disk_margin)
+    assert m.multiloop.alpha == pytest.approx(singles[least].disk_margin, rel=1e-12)
+    assert m.multiloop_bounds[1] == pytest.approx(singles[least].disk_margin, rel=1e-12)
+    assert m.multiloop.frequency == pytest.approx(singles[least].disk_frequency, rel=1e-6)
+    _check_certificate(aerocontrol.append(*parts), m)
+
+
+@pytest.mark.parametrize(
+    ("n", "p", "seed", "dt"),
+    [(4, 2, 1, None), (5, 3, 2, None), (6, 3, 3, None), (4, 2, 5, 0.1), (5, 3, 6, 0.05)],
+)
+def test_random_loops_against_python_control(n: int, p: int, seed: int, dt: float | None) -> None:
+    loop = _stable_random_loop(n, p, seed, dt)
+    m = aerocontrol.disk_margins(loop)
+    assert m.closed_loop_stable
+    # p <= 3: μ is its D-scaled bound, so the bounds meet (the lower bound's power method
+    # reaches it) and no gap is reported.
+    assert m.multiloop_bounds[1] == pytest.approx(m.multiloop_bounds[0], rel=1e-10)
+    _check_certificate(loop, m, tol=1e-9)
+    # python-control (AB13MD at each frequency) on a grid through our peak: the same margin,
+    # and ours restricted to that grid agrees at every point.
+    nyquist = math.pi / dt if dt else 1e3
+    grid = np.unique(
+        np.concatenate([np.logspace(-3, math.log10(nyquist), 300), [m.multiloop.frequency]])
+    )
+    theirs = control.ss(loop.A, loop.B, loop.C, loop.D, dt if dt else 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        alphas = control.disk_margins(theirs, grid, returnall=True)[0]
+    assert m.multiloop.alpha == pytest.approx(float(alphas.min()), rel=1e-9)
+    # At every frequency our lower bound is at most AB13MD's upper bound, and our upper bound
+    # at least it (for p <= 3 both it and ours are μ where the scaling is optimised: off the
+    # peak only Osborne's scaling is, by design); where our bounds meet, they are AB13MD's.
+    on_grid = aerocontrol.disk_margins(loop, omega=grid)
+    theirs_mu = 1.0 / alphas
+    assert np.all(on_grid.mu_lower <= theirs_mu * (1 + 1e-9))
+    assert np.all(on_grid.mu_upper >= theirs_mu * (1 - 1e-9))
+    met = on_grid.mu_upper <= on_grid.mu_lower * (1 + 1e-10)
+    assert met[np.argmax(on_grid.mu_upper)]
+    np.testing.assert_allclose(on_grid.mu_upper[met], theirs_mu[met], rtol=1e-9)
+    assert on_grid.multiloop.alpha == pytest.approx(float(alphas.min()), rel=1e-9)
+    # Loop at a time against python-control's own interconnection: loop i broken with the
+    # others closed, then its disk margin on a dense grid through our peak; a peak as ω → ∞
+    # (beyond any grid) against |S_ii - 1/2| of S(∞) = (I + D)^-1.
+    for i, single in enumerate(m.loop_at_a_time):
+        others = np.eye(p)
+        others[i, i] = 0.0
+        broken = control.feedback(theirs, others)[i, i]
+        peak = [single.frequency] if math.isfinite(single.frequency) else []
+        dense = np.unique(np.concatenate([np.logspace(-3, math.log10(nyquist), 2000), peak]))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            alpha_i = float(control.disk_margins(broken, dense)[0])
+        if math.isfinite(single.frequency):
+            assert single.alpha == pytest.approx(alpha_i, rel=1e-9)
+        else:
+            at_infinity = abs(np.linalg.inv(np.eye(p) + loop.D)[i, i] - 0.5)
+            assert single.alpha == pytest.approx(1.0 / at_infinity, rel=1e-12)
+            assert single.alpha <= alpha_i * (1 + 1e-12)
+        assert m.multiloop.alpha <= single.alpha * (1 + 1e-12)
+
+
+def test_two_and_three_loops_upper_bound_is_the_optimal_scaling() -> None:
+    # At the peak, μ's upper bound against an independent minimisation of σ̄(D M D^-1) over
+    # D = diag(e^x, 1) (p = 2, scipy's bounded search) and AB13MD (p = 3).
+    for p, seed in [(2, 1), (3, 2)]:
+        loop = _stable_random_loop(4 + p, p, seed)
+        m = aerocontrol.disk_margins(loop)
+        L = _matrix_response(loop, m.multiloop.frequency)
+        M = np.linalg.inv(np.eye(p) + L) - 0.5 * np.eye(p)
+        peak = 1.0 / m.multiloop.alpha
+        if p == 2:
+
+            def scaled_norm(x: float, M: np.ndarray = M) -> float:
+                D = np.diag([math.exp(x), 1.0])
+                return float(np.linalg.norm(D @ M @ np.linalg.inv(D), 2))
+
+            best = minimize_scalar(
+                scaled_norm, bounds=(-20.0, 20.0), method="bounded", options={"xatol": 1e-12}
+            )
+            assert peak == pytest.approx(best.fun, rel=1e-9)
+        assert peak == pytest.approx(_mu_by_slycot(M), rel=1e-9)
+        # Two and three scalar blocks: the bounds meet at every frequency whose upper bound
+        # could set the peak (above the largest lower bound); elsewhere the scaling is
+        # Osborne's, which is still an upper bound, below that level.
+        settles = m.mu_upper > np.max(m.mu_lower) * (1 + 1e-10)
+        met = m.mu_upper <= m.mu_lower * (1 + 1e-9)
+        assert np.all(met | ~settles)
+
+
+def test_unstable_closed_loop_has_no_disk_margins() -> None:
+    # The satellite with K = 0.05 I: A - 0.05 C has eigenvalues -0.05 ± j√(100 - 0.25·...)...
+    # any K = k I with k < 0 destabilises; numpy's closed-loop eigenvalues are the oracle.
+    loop = aerocontrol.series(aerocontrol.gain(-0.5 * np.eye(2)), _satellite())
+    poles = np.linalg.eigvals(loop.A - loop.B @ np.linalg.solve(np.eye(2) + loop.D, loop.C))
+    assert np.max(poles.real) > 0
+    m = aerocontrol.disk_margins(loop)
+    assert not m.closed_loop_stable
+    np.testing.assert_allclose(np.sort_complex(m.closed_loop_poles), np.sort_complex(poles))
+    assert all(d.alpha == 0.0 and math.isnan(d.frequency) for d in m.loop_at_a_time)
+    assert m.multiloop.alpha == 0.0 and m.multiloop_bounds == (0.0, 0.0)
+    assert m.multiloop.gain_margin == (1.0, 1.0) and m.multiloop.phase_margin == 0.0
+    assert all(classical.disk_margin == 0.0 for classical in m.loops)
+    assert m.frequencies.size == 0 and np.all(m.worst_perturbation == 1.0)
+    assert "UNSTABLE" in str(m)
+
+
+def _gap_loop(M0: np.ndarray, w0: float = 2.0, zeta: float = 0.01) -> aerocontrol.StateSpace:
+    """A loop whose S - I/2 is N(s) = (X s + Y)/(s² + 2ζω0 s + ω0²) with N(jω0) = M0:
+    S = I/2 + N, L = S^-1 - I (state-space inverse), closed loop the stable N."""
+    p = M0.shape[0]
+    X, Y = 2 * zeta * w0 * M0.real, -2 * zeta * w0**2 * M0.imag
+    I, Z = np.eye(p), np.zeros((p, p))
+    A = np.block([[Z, I], [-(w0**2) * I, -2 * zeta * w0 * I]])
+    B, C = np.vstack([Z, I]), np.hstack([Y, X])
+    return aerocontrol.StateSpace(A - 2 * B @ C, 2 * B, -2 * C, I)
+
+
+def test_four_loops_with_a_gap_between_the_bounds_warn() -> None:
+    # A complex 4 x 4 matrix whose μ is strictly below its D-scaled bound (a search over
+    # integer matrices): AB13MD's bound 8.14329, and a dense search of ρ(M0 U) over diagonal
+    # unitary U (36³ grid, then Nelder-Mead) finds no more than 7.69528. Put at the peak of
+    # a lightly damped loop, the multiloop margin is known within that 5.5% gap: a warning,
+    # the lower end returned, and the certificate at the upper end.
+    M0 = np.array(
+        [
+            [-2 + 1j, 3 - 1j, 3 + 3j, -2 + 3j],
+            [-2 - 1j, 3 + 1j, -2 + 0j, 3 - 2j],
+            [3 + 0j, -1 + 1j, -2 + 1j, -3 - 2j],
+            [0 - 3j, -2 + 3j, 0 - 3j, 0 + 1j],
+        ]
+    )
+    loop = _gap_loop(M0)
+    with pytest.warns(aerocontrol.LooseBoundWarning, match="known only within"):
+        m = aerocontrol.disk_margins(loop)
+    low, high = m.multiloop_bounds
+    assert (high - low) / high > 0.05
+    L = _matrix_response(loop, m.multiloop.frequency)
+    M = np.linalg.inv(np.eye(4) + L) - 0.5 * np.eye(4)
+    assert 1.0 / low == pytest.approx(_mu_by_slycot(M), rel=1e-6)
+    assert 1.0 / low >= _mu_by_slycot(M) * (1 - 1e-6)
+    assert 1.0 / high == pytest.approx(7.69527538, rel=1e-3)
+    _check_certificate(loop, m, tol=1e-9)
+
+
+def test_disk_margins_refuse_bad_arguments_by_name() -> None:
+    satellite = _satellite()
+    with pytest.raises(ShapeError, match="loop must be square"):
+        aerocontrol.disk_margins(satellite[:, 0])
+    with pytest.raises(aerocontrol.NonFiniteError, match="skew"):
+        aerocontrol.disk_margins(satellite, skew=math.nan)
+    with pytest.raises(aerocontrol.NotRealError, match="skew"):
+        aerocontrol.disk_margins(satellite, skew=1j)  # type: ignore[arg-type]
+    with pytest.raises(aerocontrol.NonFiniteError, match="omega"):
+        aerocontrol.disk_margins(satellite, omega=[1.0, math.inf])
+    with pytest.raises(InvalidArgumentError, match="omega must be non-negative"):
+        aerocontrol.disk_margins(satellite, omega=[1.0, -2.0])
+    with pytest.raises(ShapeError, match="omega"):
+        aerocontrol.disk_margins(satellite, omega=np.ones((2, 2)))
+    with pytest.raises(ShapeError, match="omega"):
+        aerocontrol.disk_margins(satellite, omega=[])
+    discrete = _stable_random_loop(3, 2, 5, 0.1)
+    with pytest.raises(InvalidArgumentError, match="Nyquist"):
+        aerocontrol.disk_margins(discrete, omega=[1.0, 40.0])
+    # I + D singular: closing the loops is an algebraic loop.
+    algebraic = aerocontrol.StateSpace(-np.eye(2), np.eye(2), np.eye(2), [[-1.0, 0.0], [0.0, 0.5]])
+    with pytest.raises(SingularMatrixError):
+        aerocontrol.disk_margins(algebraic)
+
+
+def test_disk_margins_leave_inputs_alone_and_ignore_layout() -> None:
+    loop = _stable_random_loop(5, 3, 2)
+    matrices = [np.asfortranarray(m) for m in (loop.A, loop.B, loop.C, loop.D)]
+    copies = [m.copy() for m in matrices]
+    omega = np.logspace(-2, 2, 50)[::2]  # a strided view
+    omega_copy = omega.copy()
+    fortran = aerocontrol.disk_margins(tuple(matrices), omega=omega)
+    plain = aerocontrol.disk_margins(loop, omega=omega_copy)
+    for given, copy in zip(matrices, copies, strict=True):
+        np.testing.assert_array_equal(given, copy)
+    np.testing.assert_array_equal(omega, omega_copy)
+    assert fortran.multiloop_bounds == plain.multiloop_bounds
+    np.testing.assert_array_equal(fortran.mu_upper, plain.mu_upper)
+    fortran.frequencies[0] = -1.0  # the result's own arrays
+    np.testing.assert_array_equal(omega, omega_copy)
+
+
 def test_unit_feedthrough_and_even_loops() -> None:
     # d² = 1 (the Hamiltonian does not exist; the core takes the pencil of 1 - L(-s)L(s)):
     # L = (s² + 0.5 s + 2)/(s² + 1.5 s + 1), |num|² - |den|² = 3 - 4ω²: a crossover at √3/2.

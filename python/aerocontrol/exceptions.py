@@ -25,7 +25,7 @@ class                         raised when
 ============================  ===========================================================
 
 Warnings (``AerocontrolWarning`` and subclasses) report results that were computed but deserve
-care: overflow, ill-conditioning.
+care: overflow, ill-conditioning, bounds that leave a gap (``LooseBoundWarning``).
 """
 
 from __future__ import annotations
@@ -40,6 +40,7 @@ __all__ = [
     "IllConditionedError",
     "IllConditionedWarning",
     "InvalidArgumentError",
+    "LooseBoundWarning",
     "NoContinuousEquivalentError",
     "NoStabilizingSolutionError",
     "NonFiniteError",
@@ -148,6 +149,12 @@ class IllConditionedWarning(AerocontrolWarning, RuntimeWarning):
 
 class NumericalOverflowWarning(AerocontrolWarning, RuntimeWarning):
     """A result overflowed double precision and contains infinite (or NaN) entries."""
+
+
+class LooseBoundWarning(AerocontrolWarning, RuntimeWarning):
+    """A quantity computable only within bounds (the structured singular value of a
+    multiloop disk margin) has bounds further apart than the tolerance; the conservative
+    bound was returned and the message gives both."""
 
 
 class OutputFolderError(AerocontrolError, OSError):

@@ -336,6 +336,18 @@ margins = aerocontrol.stability_margins(yaw_loop)
 assert_type(margins, aerocontrol.StabilityMargins)
 assert_type(margins.gain_margins, Floats)
 assert_type(margins.disk_gain_margin, tuple[float, float])
+disks = aerocontrol.disk_margins(
+    aerocontrol.append(yaw_loop, yaw_loop), omega=np.logspace(-2, 1, 30), skew=0.5
+)
+assert_type(disks, aerocontrol.DiskMargins)
+assert_type(disks.multiloop, aerocontrol.DiskMargin)
+assert_type(disks.multiloop.gain_margin, tuple[float, float])
+assert_type(disks.multiloop_bounds, tuple[float, float])
+assert_type(disks.loop_at_a_time[0].phase_margin, float)
+assert_type(disks.mu_upper, Floats)
+assert_type(disks.worst_perturbation, Complexes)
+assert_type(disks.loops[1], aerocontrol.StabilityMargins)
+assert_type(disks.table(), str)
 assert_type(aerocontrol.sensitivity(yaw_loop), aerocontrol.StateSpace)
 assert_type(aerocontrol.complementary_sensitivity(yaw_loop), aerocontrol.StateSpace)
 locus = aerocontrol.root_locus(yaw_loop, [0.0, 1.0, 2.0])
@@ -369,4 +381,5 @@ def _misuse() -> None:
     sys["r"]  # type: ignore[index]  # outputs and inputs, both
     aerocontrol.connect(sys, inputs="r")  # type: ignore[arg-type]  # a list of models
     aerocontrol.stability_margins(yaw_loop, 1.0)  # type: ignore[call-arg]  # no frequencies
+    aerocontrol.disk_margins(yaw_loop, skew="0")  # type: ignore[arg-type]  # a number
     del exponential, gains, estimate
