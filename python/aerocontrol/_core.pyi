@@ -40,6 +40,7 @@ __all__ = [
     "qz",
     "riccati_difference",
     "riccati_ode",
+    "root_locus",
     "schur",
     "simulate",
     "simulate_models",
