@@ -165,7 +165,7 @@ RESCALE_EXPONENT = 256.0
 
 def _log2_size(M: FloatArray) -> float:
     """log2 of the largest |entry| of M; -inf for a zero or empty matrix."""
-    largest = float(np.max(np.abs(M), initial=0.0))
+    largest = float(abs(M).max()) if M.size else 0.0
     return math.log2(largest) if largest > 0.0 else -math.inf
 
 
