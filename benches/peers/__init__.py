@@ -12,8 +12,9 @@ Every public numerical operation that has a peer in scipy, python-control (with 
 n = 4 (the 747 where it is natural), 16, 64 and 256 (expm also 8 and 1024; the batch API on 1000
 problems): expm (one matrix and a stack), transition_matrix, discretize, schur (plain and reordered)
 [linalg]; the step, impulse, doublet, initial-condition and forced responses, steady_state, dc_gain
-[responses]; frequency_response [frequency]; stability_margins of the 747 dampers' loops and
-root_locus over 1000 gains [loops]; modes, charpoly [modal]; place_bass_gura, place_ackermann,
+[responses]; frequency_response [frequency]; stability_margins of the 747 dampers' loops,
+root_locus over 1000 gains, transfer_function of every channel [loops]; modes, charpoly
+[modal]; place_bass_gura, place_ackermann,
 place, companion_form [placement]; is_controllable, is_observable, controllability, ctrb, obsv
 [controllability]; lqr, solve_care (with S and E), riccati_ode, lqr_finite, solve_lyapunov
 [riccati]; batch.lqr_sweep, batch.solve_care_batch [batch]. Where a size is capped (single-input

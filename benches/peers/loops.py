@@ -1,5 +1,6 @@
 """Peer cases of aerocontrol.loops: stability margins of the 747 dampers' loops against
-python-control, and the root locus over 1000 gains against a Python loop over numpy."""
+python-control, the root locus over 1000 gains against a Python loop over numpy, and the
+transfer functions of every channel of the 747's lateral model against control.ss2tf."""
 
 from __future__ import annotations
 
@@ -101,7 +102,8 @@ def _locus_numpy(loop: Any, gains: np.ndarray) -> Any:
 
 
 def _compare_poles(ours: Any, peer: Any) -> Pairs:
-    """Real and imaginary parts of the sorted closed-loop poles, gain by gain."""
+    """Real and imaginary parts, entry by entry (the sorted closed-loop poles gain by gain; the
+    channels' values frequency by frequency)."""
     return [(ours.real, peer.real), (ours.imag, peer.imag)]
 
 
@@ -131,5 +133,62 @@ def root_locus_cases() -> list[Case]:
     ]
 
 
-GROUPS = (margins_cases, root_locus_cases)
+def _lateral_channels(rng: np.random.Generator) -> tuple[Any, ...]:
+    """The 747 cruise lateral model with the outputs p and r: 4 states, 2 inputs (rudder,
+    aileron), 2 outputs."""
+    model = aerocontrol.aircraft.load("b747-cruise").lateral()
+    return (model[["p", "r"], :],)
+
+
+#: The frequencies at which both sides' transfer functions are compared (rad/s).
+_TEST_FREQUENCIES = np.array([0.05, 0.3, 1.0, 4.0])
+
+
+def _channels_ours(model: Any) -> Any:
+    """Every channel's TransferFunction, evaluated at the test frequencies."""
+    functions = [
+        aerocontrol.transfer_function(model, i, j)
+        for i in range(model.n_outputs)
+        for j in range(model.n_inputs)
+    ]
+    return np.array([f(1j * _TEST_FREQUENCIES) for f in functions])
+
+
+def _channels_control(model: Any) -> Any:
+    """control.ss2tf of the MIMO model (slycot's TB04AD), evaluated like ours."""
+    g = control.ss2tf(control.ss(model.A, model.B, model.C, model.D))
+    values = g(1j * _TEST_FREQUENCIES)  # (outputs, inputs, frequencies)
+    return values.reshape(-1, _TEST_FREQUENCIES.size)
+
+
+def transfer_function_cases() -> list[Case]:
+    """transfer_function of each of the four channels of the 747 lateral model (4 states, 2
+    inputs, 2 outputs), against control.ss2tf of the whole model in one call (which returns
+    every channel). The issue's target: 20x. Compared by their values at four frequencies.
+
+    Peer: python-control's ss2tf (slycot TB04AD).
+    """
+    return [
+        Case(
+            op="transfer_function every channel",
+            size="n=4 m=2 p=2 747 lateral",
+            seed=0,
+            setup=_lateral_channels,
+            ours=_channels_ours,
+            peers=[
+                Peer(
+                    "control.ss2tf",
+                    _channels_control,
+                    compare=_compare_poles,
+                    target=Target(
+                        "transfer_function vs control.ss2tf: ratio >= 20", min_ratio=20.0
+                    ),
+                    rtol=1e-9,
+                )
+            ],
+        )
+    ]
+
+
+GROUPS = (margins_cases, root_locus_cases, transfer_function_cases)
 """The case builders of this file, in the order they run."""
