@@ -141,7 +141,7 @@ impl fmt::Display for Error {
                 arg,
                 value,
                 requirement,
-            } => write!(f, "{arg} must be {requirement}, got {value}"),
+            } => write!(f, "{arg} must be {requirement}, got {value:?}"),
             Error::Singular {
                 arg,
                 eigenvalue_re,
@@ -299,6 +299,12 @@ mod tests {
 
         let err = check_positive(-0.5, "dt").unwrap_err();
         assert_eq!(err.to_string(), "dt must be positive and finite, got -0.5");
+        // An extreme value in exponent form, not its 300-digit decimal expansion.
+        let err = check_positive(-1e-300, "dt").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "dt must be positive and finite, got -1e-300"
+        );
 
         let err = check_finite_values(&[0.0, 1.0, f64::INFINITY], "t").unwrap_err();
         assert_eq!(err.to_string(), "t must be finite, but t[2] is inf");

@@ -235,8 +235,8 @@ pub fn bilinear(
         return Err(Error::InvalidArgument {
             arg: "dt",
             message: format!(
-                "I - alpha dt A is singular to working precision for dt = {dt} and alpha = \
-                 {alpha}: A has an eigenvalue at or near 1 / (alpha dt) = {}, which the \
+                "I - alpha dt A is singular to working precision for dt = {dt:?} and alpha = \
+                 {alpha:?}: A has an eigenvalue at or near 1 / (alpha dt) = {:?}, which the \
                  bilinear transformation sends to infinity; choose another dt",
                 1.0 / (alpha * dt)
             ),
@@ -277,8 +277,8 @@ pub fn inverse_bilinear(
         return Err(Error::InvalidArgument {
             arg: "A",
             message: format!(
-                "alpha A + (1 - alpha) I is singular to working precision for alpha = {alpha}: \
-                 the discrete A has an eigenvalue at or near -(1 - alpha) / alpha = {}, the \
+                "alpha A + (1 - alpha) I is singular to working precision for alpha = {alpha:?}: \
+                 the discrete A has an eigenvalue at or near -(1 - alpha) / alpha = {:?}, the \
                  image of s = infinity, so no continuous model maps to it",
                 -(1.0 - alpha) / alpha
             ),

@@ -703,7 +703,7 @@ pub fn loop_margins(
         if miss.is_nan() || miss > 1e-6 * size.max(crossover.omega) {
             return Err(Error::IllConditioned {
                 message: format!(
-                    "stability_margins: the loop closed with its gain margin {k:.6} has no pole \
+                    "stability_margins: the loop closed with its gain margin {k:.6e} has no pole \
                      at the phase crossover {:.6} rad/s (nearest at distance {miss:.3e})",
                     crossover.omega
                 ),
