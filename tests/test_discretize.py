@@ -96,6 +96,14 @@ def test_bad_step(dt: float) -> None:
         aerocontrol.discretize(A747, B747, dt)
 
 
+def test_an_extreme_step_is_quoted_in_exponent_form() -> None:
+    """A dt of 1e300 that makes A dt overflow is refused with the value as 1e300, not as the
+    301-digit decimal expansion the core's messages used to print."""
+    with pytest.raises(InvalidArgumentError) as raised:
+        aerocontrol.c2d(([[1e10]], [[1.0]]), 1e300)
+    assert str(raised.value) == "dt must be small enough that A dt is finite, got 1e300"
+
+
 def test_bad_arguments_are_named() -> None:
     with pytest.raises(ShapeError, match=r"B must have as many rows as A \(4\), got 3"):
         aerocontrol.discretize(A747, np.ones((3, 1)), 0.1)
