@@ -8,7 +8,9 @@
 use crate::error::Error;
 use crate::linalg::balance::{balance, range_scale};
 use crate::linalg::householder::reflector;
-use crate::linalg::matrix::{FaerView, Order, Square, Transformations, from_faer_in};
+use crate::linalg::matrix::{
+    FaerView, Order, Square, Transformations, from_faer_in, identity_in, with_order,
+};
 use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
 use crate::platform::pool::scratch;
@@ -35,6 +37,19 @@ pub struct Hessenberg {
 /// computation was interrupted.
 pub fn hessenberg(a: MatRef<'_, f64>) -> Result<Hessenberg, Error> {
     let n = a.nrows();
+    if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+        // The plain Householder loop at a fixed order: faer's blocked reduction (its set-up
+        // and workspace) costs several times the arithmetic at these orders.
+        return Ok(with_order!(n, order => {
+            let mut h = from_faer_in(order, a);
+            let mut q = identity_in(order);
+            reduce_to_hessenberg(&mut h, Some(&mut q));
+            Hessenberg {
+                h: h.to_faer(),
+                q: q.to_faer(),
+            }
+        }));
+    }
     let mut h = a.to_owned();
     let mut q = Mat::<f64>::identity(n, n);
     reduce(h.as_mut(), Some(q.as_mut()))?;
