@@ -25,7 +25,7 @@ class                         raised when
 ============================  ===========================================================
 
 Warnings (``AerocontrolWarning`` and subclasses) report results that were computed but deserve
-care: overflow, ill-conditioning.
+care: overflow, underflow, ill-conditioning.
 """
 
 from __future__ import annotations
@@ -46,6 +46,7 @@ __all__ = [
     "NotPositiveDefiniteError",
     "NotRealError",
     "NumericalOverflowWarning",
+    "NumericalUnderflowWarning",
     "OutputFolderError",
     "ShapeError",
     "SingularMatrixError",
@@ -148,6 +149,12 @@ class IllConditionedWarning(AerocontrolWarning, RuntimeWarning):
 
 class NumericalOverflowWarning(AerocontrolWarning, RuntimeWarning):
     """A result overflowed double precision and contains infinite (or NaN) entries."""
+
+
+class NumericalUnderflowWarning(AerocontrolWarning, RuntimeWarning):
+    """A result is below the range of normal doubles: it was rounded to a subnormal number
+    (fewer significant digits) or to zero. The message names the result, its size (as a
+    power of ten) and what was returned in its place."""
 
 
 class OutputFolderError(AerocontrolError, OSError):
