@@ -812,9 +812,9 @@ def _scaled_poly(roots: ComplexArray, mantissa: float, exponent: int) -> FloatAr
             coefficients = np.real(np.poly(roots)) * mantissa
             return np.asarray(np.ldexp(coefficients, exponent), dtype=np.float64)
     q = math.frexp(largest)[1] if largest > 0.0 else 0
-    coefficients = np.real(np.poly(_scaled_by_power_of_two(roots, -q))) * mantissa
     powers = exponent + q * np.arange(roots.size + 1)
-    with np.errstate(over="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"):  # an infinite gain: warned of by callers
+        coefficients = np.real(np.poly(_scaled_by_power_of_two(roots, -q))) * mantissa
         return np.asarray(np.ldexp(coefficients, powers), dtype=np.float64)
 
 
