@@ -945,6 +945,34 @@ def _gain(
     return fraction, int(e[0]) + shift
 
 
+def _roots_and_gain(channel: StateSpace) -> tuple[ComplexArray, ComplexArray, float, int]:
+    """(poles, zeros, k, e) of a single-input, single-output channel G = K Π(s - z)/Π(s - p)
+    (in z for a discrete model) with K = k 2^e as a mantissa and a power of two, exact where
+    K itself is beyond the doubles; (poles, no zeros, 0, 0) for a zero channel.
+
+    The poles are the eigenvalues of A, the zeros those of the channel's pencil; K = D where
+    D is nonzero (G -> D as s -> inf: evaluated at a point, K carried the zeros' rounding,
+    1e-10 for zeros at 1 and 1e-149 beside poles at 1e-150), else G at a point away from every
+    root times Π(point - p)/Π(point - z), each factor renormalised (:func:`_gain`)."""
+    poles = (
+        _conjugate_clean(_core.eigenvalues(channel.A))
+        if channel.n_states
+        else np.zeros(0, np.complex128)
+    )
+    reduced = _pencil_zeros(channel, None)
+    d = float(channel.D[0, 0])
+    if d != 0.0 and reduced.zeros.size == channel.n_states:
+        mantissa, exponent = math.frexp(d)
+        return poles, reduced.zeros, mantissa, exponent
+    if reduced.normal_rank == 0:
+        return poles, np.zeros(0, np.complex128), 0.0, 0
+    point = _evaluation_point(np.concatenate([reduced.zeros, poles]), period(channel) or 0.0)
+    mantissa, exponent = _gain(*_scaled_response(channel, point), point, reduced.zeros, poles)
+    if mantissa == 0.0:
+        return poles, np.zeros(0, np.complex128), 0.0, 0
+    return poles, reduced.zeros, mantissa, exponent
+
+
 def transfer_function(
     sys: System,
     output: SignalSelection | None = None,
@@ -986,26 +1014,9 @@ def transfer_function(
     j = _single(input, model.input_names, "input")
     channel = model[[i], [j]]
     dt = period(model) if model.is_discrete else 0.0
-    poles = (
-        _conjugate_clean(_core.eigenvalues(channel.A))
-        if channel.n_states
-        else np.zeros(0, np.complex128)
-    )
-    reduced = _pencil_zeros(channel, None)
+    poles, zeros, mantissa, exponent = _roots_and_gain(channel)
     denominator = _scaled_poly(poles, 1.0, 0)
     finite_or_warn(denominator, "the denominator det(sI - A)")
-    zeros = np.zeros(0, np.complex128)
-    mantissa, exponent = 0.0, 0
-    d = float(channel.D[0, 0])
-    if d != 0.0 and reduced.zeros.size == channel.n_states:
-        # G(s) -> D as s -> inf: K = D exactly (the evaluation below carries the zeros'
-        # rounding, 1e-10 for zeros at 1 and 1e-149 beside poles at 1e-150).
-        mantissa, exponent = math.frexp(d)
-        zeros = reduced.zeros
-    elif reduced.normal_rank != 0:
-        point = _evaluation_point(np.concatenate([reduced.zeros, poles]), dt)
-        mantissa, exponent = _gain(*_scaled_response(channel, point), point, reduced.zeros, poles)
-        zeros = reduced.zeros
     with np.errstate(over="ignore"):
         gain = float(np.ldexp(mantissa, exponent))
     if mantissa != 0.0 and gain == 0.0:
