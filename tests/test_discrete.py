@@ -1014,3 +1014,31 @@ def test_matched_real_pair_is_realised_larger_pole_first() -> None:
         assert _sampled_gain_at_one(sampled) == pytest.approx(
             _continuous_dc_gain(A, [[1.0], [1.0]], C, [[0.0]]), rel=1e-13
         )
+
+
+def test_d2c_backward_difference_of_a_tiny_pole() -> None:
+    """Ad = 1.26e-151 (dt = 0.1, no inputs or outputs), backward difference: the condition
+    check formed (α ||A|| + 1) - α = (1.26e-151 + 1) - 1 = 0 and divided by it (a bare
+    ZeroDivisionError, found by the property suite). The continuous pole is
+    (z - 1)/(z dt) = -7.95e151 and samples back to Ad."""
+    a = 1.257302210933933e-151
+    sampled = StateSpace([[a]], np.zeros((1, 0)), np.zeros((0, 1)), np.zeros((0, 0)), dt=0.1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        continuous = aerocontrol.d2c(sampled, "backward_diff")
+    assert continuous.A[0, 0] == pytest.approx((a - 1.0) / (a * 0.1), rel=1e-14)
+    again = aerocontrol.c2d(continuous, 0.1, "backward_diff")
+    assert again.A[0, 0] == pytest.approx(a, rel=1e-14)
+
+
+def test_d2c_refuses_a_continuous_model_beyond_the_doubles_by_name() -> None:
+    """Tustin's inverse of Ad = 0 with C of 1e308: C (I + Ad)^-1 scaled by 2 is inf, and the
+    model was refused as 'C must be finite, but C[0, 0] is inf' (a NonFiniteError blaming a C
+    the caller never gave, found by the property suite). It is refused naming sys."""
+    sampled = StateSpace([[0.0]], np.zeros((1, 0)), [[1e308]], np.zeros((1, 0)), dt=0.1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InvalidArgumentError, match="continuous model's C overflows") as caught:
+            aerocontrol.d2c(sampled, "tustin")
+    assert caught.value.argument == "sys"
+    assert not isinstance(caught.value, aerocontrol.NonFiniteError)

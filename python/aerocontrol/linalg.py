@@ -21,6 +21,7 @@ from .exceptions import (
     IllConditionedWarning,
     InvalidArgumentError,
     NoContinuousEquivalentError,
+    NumericalOverflowWarning,
     ShapeError,
 )
 from .statespace import StateSpace, as_state_space, period, sampling_period
@@ -435,7 +436,8 @@ def d2c(
         ``"sys"`` and the eigenvalue in ``eigenvalues``; the message names both.
     InvalidArgumentError
         ``sys`` is continuous, an unknown method, or ``prewarp``/``alpha`` where they do not
-        apply.
+        apply; or the continuous model overflows double precision (``argument`` ``"sys"``:
+        a C of 1e308 under Tustin's inverse).
 
     Warns
     -----
@@ -484,18 +486,37 @@ def d2c(
             if error.argument != "A":
                 raise
             raise _no_equivalent(f"sys.A: {error}", None) from None
+        _refuse_continuous_overflow((A, B))
         return _named_like(model, A, B, model.C, model.D, 0.0)
     weight = _bilinear_weight(chosen, alpha)
     warped = _warped_step(chosen, weight, period(model), prewarp)
     try:
-        A, B, C, D = _core.inverse_bilinear(model.A, model.B, model.C, model.D, warped, weight)
+        with warnings.catch_warnings():  # a result beyond the doubles is refused below
+            warnings.simplefilter("ignore", NumericalOverflowWarning)
+            A, B, C, D = _core.inverse_bilinear(model.A, model.B, model.C, model.D, warped, weight)
     except InvalidArgumentError as error:
         if error.argument != "A":
             raise
         infinity = -(1.0 - weight) / weight if weight else None
         raise _no_equivalent(f"sys.A: {error}", infinity) from None
+    _refuse_continuous_overflow((A, B, C, D))
     _check_bilinear_condition(model.A, weight, chosen)
     return _named_like(model, A, B, C, D, 0.0)
+
+
+def _refuse_continuous_overflow(matrices: tuple[ArrayLike, ...]) -> None:
+    """Refuses, naming sys, a continuous model from d2c whose matrix overflowed double
+    precision (a C of 1e308 with Tustin's inverse, C (I + Ad)^-1 times 2: inf), instead of a
+    NonFiniteError from StateSpace blaming a C that the caller never gave."""
+    for name, matrix in zip("ABCD"[: len(matrices)], matrices, strict=True):
+        if not np.all(np.isfinite(np.asarray(matrix))):
+            error = InvalidArgumentError(
+                f"the continuous model's {name} overflows double precision: sys is beyond the "
+                "range of doubles under this inverse map (its entries, or those of "
+                "(I + (1 - alpha) Ad)^-1, are too large)"
+            )
+            error.argument = "sys"
+            raise error
 
 
 def _named_like(
@@ -577,7 +598,10 @@ def _check_bilinear_condition(A: FloatArray, weight: float, method: str) -> None
     denominator = weight * A + (1.0 - weight) * np.eye(A.shape[0])
     smallest = float(np.linalg.svd(denominator, compute_uv=False)[-1])
     largest = float(np.linalg.svd(A, compute_uv=False)[0])
-    rcond = smallest / (weight * largest + 1.0 - weight)
+    # The terms' size as α ||A|| + (1 - α): formed left to right, (α ||A|| + 1) - α lost a
+    # ||A|| of 1.3e-151 beside 1 (backward_diff, α = 1) and divided by zero.
+    terms = weight * largest + (1.0 - weight)
+    rcond = smallest / terms if terms > 0.0 else 0.0
     if rcond < BILINEAR_RCOND_WARNING:
         eigenvalues = _core.eigenvalues(A)
         infinity = -(1.0 - weight) / weight

@@ -124,3 +124,28 @@ QZ_ALL_INFINITE = known_defect(
     _all_infinite_pencil,
     "Z^T !=",
 )
+
+
+def _tiny_entry_beside_a_huge_frequency(args: dict[str, Any]) -> bool:
+    """A nonzero entry of A below 2^-1022 times the largest frequency (their ratio subnormal
+    or zero)."""
+    models = _models_of(args)
+    omega = args.get("omega")
+    if not models or omega is None:
+        return False
+    A = models[0][0]
+    entries = np.abs(A[A != 0])
+    largest = float(np.max(np.abs(np.asarray(omega, dtype=float)), initial=0.0))
+    return bool(entries.size) and float(np.min(entries)) < np.finfo(float).tiny * largest
+
+
+FREQUENCY_SUBNORMAL_RATIO = known_defect(
+    "frequency-response-subnormal-ratio",
+    {"frequency_response", "bode"},
+    "the core's frequency_response of A = [[a]] with a nonzero and |a| / ω below the normal "
+    "doubles returns 0 where G(jω) = b c / (jω - a) is a normal double: a = 1.26e-151, "
+    "B = 0.126, C = 1 at ω = 1e200 gives 0 for -1.26e-201j (a = 1e-200 at ω = 1e150: 0 for "
+    "-1e-150j); a = 0, or a ratio in the normal range, is right",
+    _tiny_entry_beside_a_huge_frequency,
+    "G(j",
+)
