@@ -83,13 +83,6 @@ def _tolerance(A: FloatArray, B: FloatArray, C: FloatArray, D: FloatArray) -> fl
     return float((n + p) * (n + m) * np.finfo(float).eps * max(size, np.finfo(float).tiny))
 
 
-def _exponents(norms: FloatArray) -> NDArray[np.int64]:
-    """The exponents e of 2^e of positive norms (frexp's: norm = f 2^e, 1/2 <= f < 1); 0 for a
-    zero norm."""
-    _, e = np.frexp(norms)
-    return np.where(norms > 0.0, e, 0).astype(np.int64)
-
-
 def _log2_norm(*vectors: FloatArray) -> float:
     """log2 of the 2-norm of the vectors joined, without overflow or underflow; -inf for zero."""
     largest = max((float(np.max(np.abs(v), initial=0.0)) for v in vectors), default=0.0)
@@ -139,8 +132,11 @@ def _balance(
     each state, Osborne's balancing of its row and column (the power of two nearest
     sqrt(c / r), r and c the norms of the row of [A B] and the column of [A; C] without the
     diagonal, which the similarity leaves unchanged), as LAPACK's xGEBAL does for a matrix.
-    Norms are formed as logarithms of scaled sums (no overflow, no underflow), and every
-    factor is applied with ``np.ldexp``, exactly.
+    The scalings are kept as exponents (of the outputs, the inputs, the states and the unit
+    of frequency), the norms formed from the logarithms of the entries plus those exponents
+    (no overflow, no underflow), and the scalings applied once at the end with ``np.ldexp``,
+    exactly: applied step by step, an entry that a later sweep brings back can underflow on
+    the way.
 
     References: D. Ruiz, "A scaling algorithm to equilibrate both rows and columns norms in
     matrices", RAL-TR-2001-034, 2001; E. E. Osborne, J. ACM 7, 338-345, 1960."""
