@@ -952,3 +952,93 @@ def test_matched_is_unchanged_below_the_scaling_threshold() -> None:
     assert sampled.A[1, 0] == 1.0
     assert sorted(np.diag(sampled.A)) == sorted([np.exp(-0.1), np.exp(-0.2)])
     assert _sampled_gain_at_one(sampled) == pytest.approx(0.5, rel=1e-14)
+
+
+# ----- matched pole-zero of huge or tiny dynamics (defects found by fuzzing) -------------------
+
+
+def _continuous_dc_gain(A: Any, B: Any, C: Any, D: Any) -> float:
+    """G(0) = D - C A^-1 B in 400-bit arithmetic (mpmath)."""
+    mpmath = pytest.importorskip("mpmath")
+    with mpmath.workprec(400):
+        x = mpmath.lu_solve(-mpmath.matrix(np.asarray(A).tolist()), mpmath.matrix(B))
+        return float((mpmath.matrix(C) * x)[0, 0] + D[0][0])
+
+
+@pytest.mark.parametrize("scale", [1e100, 1e200, 1e300])
+def test_matched_of_a_huge_a(scale: float) -> None:
+    """A of 1e100 to 1e300 sampled at dt = 0.2 / scale (Re p dt near -0.3): the numerator was
+    formed from characteristic polynomials, whose coefficients (of 1e400 and more) overflowed:
+    numpy's warnings, then a NaN companion matrix refused as 'A must be finite' (blaming the
+    caller's finite A). The zeros and the gain now come from the system pencil; the poles are
+    e^{p dt} and the DC gains agree with mpmath's G(0)."""
+    A = scale * np.array([[-1.0, 0.5, 0.0], [-0.3, -2.0, 0.4], [0.0, 0.2, -1.5]])
+    B, C, D = [[1.0], [0.0], [2.0]], [[1.0, -1.0, 0.5]], [[0.0]]
+    dt = 0.2 / scale
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sampled = aerocontrol.c2d(StateSpace(A, B, C, D), dt, "matched")
+    expected = np.sort_complex(np.exp(np.linalg.eigvals(A / scale) * 0.2))
+    np.testing.assert_allclose(np.sort_complex(np.linalg.eigvals(sampled.A)), expected, rtol=1e-13)
+    continuous = _continuous_dc_gain(A, B, C, D)
+    assert _sampled_gain_at_one(sampled) == pytest.approx(continuous, rel=1e-12)
+
+
+def test_matched_pair_whose_exponential_underflows() -> None:
+    """Poles -2e100 ± 1.4e100j and -2.8e100 sampled at 1000 s: every e^{p dt} underflows to 0
+    (to within the smallest double, as exactly as it can be), so the pair's section was
+    0 I with B = [0, 1], not controllable: its output row divided by zero (numpy's warning)
+    and the model was refused blaming dt. The pair now goes with the real poles, and the
+    sampled model z^3-poles at the origin has the continuous DC gain."""
+    A = 1e100 * np.array([[-2.0, 1.4, 0.0], [-1.4, -2.0, 0.0], [0.3, 0.0, -2.8]])
+    B, C, D = [[1.0], [0.5], [1.0]], [[0.2, -1.0, 1.0]], [[1.0]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sampled = aerocontrol.c2d(StateSpace(A, B, C, D), 1000.0, "matched")
+    assert np.all(np.linalg.eigvals(sampled.A) == 0.0)
+    assert _sampled_gain_at_one(sampled) == pytest.approx(
+        _continuous_dc_gain(A, B, C, D), rel=1e-12
+    )
+
+
+def test_matched_real_pair_is_realised_larger_pole_first() -> None:
+    """Poles -1 and 300 (in that order from the Schur form): the real pair's section fed the
+    state of e^{300} from that of e^{-1} through R = 1e130 with the smaller first, and the
+    output row's two terms of 7e43 cancelled to the DC gain: 2.2e27 for 1.9967 (a silent
+    wrong answer). The larger pole comes first now, whatever the order of the eigenvalues."""
+    for A, C in (
+        ([[-1.0, 0.0], [0.0, 300.0]], [[2.0, 1.0]]),
+        ([[300.0, 0.0], [0.0, -1.0]], [[1.0, 2.0]]),
+    ):
+        sampled = aerocontrol.c2d(StateSpace(A, [[1.0], [1.0]], C, [[0.0]]), 1.0, "matched")
+        assert _sampled_gain_at_one(sampled) == pytest.approx(
+            _continuous_dc_gain(A, [[1.0], [1.0]], C, [[0.0]]), rel=1e-13
+        )
+
+
+def test_d2c_backward_difference_of_a_tiny_pole() -> None:
+    """Ad = 1.26e-151 (dt = 0.1, no inputs or outputs), backward difference: the condition
+    check formed (α ||A|| + 1) - α = (1.26e-151 + 1) - 1 = 0 and divided by it (a bare
+    ZeroDivisionError, found by the property suite). The continuous pole is
+    (z - 1)/(z dt) = -7.95e151 and samples back to Ad."""
+    a = 1.257302210933933e-151
+    sampled = StateSpace([[a]], np.zeros((1, 0)), np.zeros((0, 1)), np.zeros((0, 0)), dt=0.1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        continuous = aerocontrol.d2c(sampled, "backward_diff")
+    assert continuous.A[0, 0] == pytest.approx((a - 1.0) / (a * 0.1), rel=1e-14)
+    again = aerocontrol.c2d(continuous, 0.1, "backward_diff")
+    assert again.A[0, 0] == pytest.approx(a, rel=1e-14)
+
+
+def test_d2c_refuses_a_continuous_model_beyond_the_doubles_by_name() -> None:
+    """Tustin's inverse of Ad = 0 with C of 1e308: C (I + Ad)^-1 scaled by 2 is inf, and the
+    model was refused as 'C must be finite, but C[0, 0] is inf' (a NonFiniteError blaming a C
+    the caller never gave, found by the property suite). It is refused naming sys."""
+    sampled = StateSpace([[0.0]], np.zeros((1, 0)), [[1e308]], np.zeros((1, 0)), dt=0.1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InvalidArgumentError, match="continuous model's C overflows") as caught:
+            aerocontrol.d2c(sampled, "tustin")
+    assert caught.value.argument == "sys"
+    assert not isinstance(caught.value, aerocontrol.NonFiniteError)

@@ -3,6 +3,8 @@ penalty terms integrate to the performance index."""
 
 from __future__ import annotations
 
+import warnings
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -211,3 +213,44 @@ def test_compared_draws_held_samples_as_steps() -> None:
     with pytest.raises(aerocontrol.InvalidArgumentError, match="neither a state nor an output"):
         plotting.plot_compared({"x": (continuous, "phi")})
     plt.close("all")
+
+
+def test_marked_weights_without_a_logarithm_are_marked_deliberately() -> None:
+    """A gain of 0 marked on a sweep from k = 0 compared log(0) - log(0) (NaN, numpy's
+    'invalid value' warning, seen in the report of an extreme aircraft). An equal weight is
+    marked as it is, an infinite value at the largest weight, a negative one at the nearest
+    by difference, and a NaN is not marked and says so in the legend."""
+    weights = np.array([0.0, 0.5, 1.0, 2.0])
+    poles = np.column_stack([-1.0 - weights, -2.0 + 1j * weights])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ax = plotting.plot_root_locus(weights, poles, marked=[0.0, np.inf, -1.0, np.nan, 0.9])
+        ax.figure.canvas.draw()
+    assert _labels(ax) == ["c = 0", "c = 2", "c = 0", "c = nan: not marked", "c = 1"]
+    marks = [line for line in ax.get_lines() if line.get_label() == "c = 2"]
+    np.testing.assert_array_equal(marks[0].get_xdata(), poles[-1].real)
+
+
+def test_values_that_cannot_be_drawn_are_masked_with_a_note() -> None:
+    """Roots and responses beyond ±1e300, infinite or NaN: matplotlib's autoscaling of data
+    spanning ±1e308 overflowed (numpy's warning from inside matplotlib). They are left out as
+    gaps, and a note on the axes counts them; finite values are drawn as they are."""
+    weights = np.array([0.0, 1.0, 2.0])
+    poles = np.array([[np.inf, -1.0], [np.nan, -2.0 + 1.0j], [1e308, -1e308]])
+    lag = aerocontrol.StateSpace(np.array([[-20.0, 0.0], [0.0, -2.0]]), np.ones((2, 1)))
+    # 1e301 e^(-20 t): beyond ±1e300 at t = 0 only (6.7e298 at t = 0.25).
+    response = aerocontrol.initial_response(lag, [1e301, -1.0], T=np.linspace(0.0, 1.0, 5))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ax = plotting.plot_root_locus(weights, poles, marked=[1.0])
+        ax.figure.canvas.draw()
+        drawn = response.plot()
+        drawn.figure.canvas.draw()
+    # inf, NaN, 1e308 and -1e308 on the paths, and the NaN of the marked row.
+    assert [text.get_text() for text in ax.texts] == [
+        "5 values not drawn (NaN, infinite or beyond ±1e300)"
+    ]
+    assert drawn.texts[0].get_text().startswith("1 value not drawn")
+    first = drawn.get_lines()[0].get_ydata()
+    assert np.isnan(first[0]) and np.array_equal(first[1:], response.states()[1:, 0])
+    assert response.states()[0, 0] == 1e301  # the result itself is not changed

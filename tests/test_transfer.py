@@ -368,3 +368,150 @@ def test_equal_infinite_zeros_are_in_order() -> None:
     with pytest.warns(aerocontrol.NumericalOverflowWarning):
         zeros = transmission_zeros((A, np.zeros((4, 1)), np.zeros((1, 4)), np.ones((1, 1))))
     assert zeros.tolist() == [-math.inf, -math.inf, math.inf, math.inf]
+
+
+# ----- gains, responses and zeros of extreme scalings (references: mpmath, closed forms) --------
+
+
+def _mp_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, s: complex) -> complex:
+    """C (sI - A)^-1 B in 400-bit arithmetic (mpmath), rounded to a complex double."""
+    mpmath = pytest.importorskip("mpmath")
+    with mpmath.workprec(400):
+        M = mpmath.mpc(s.real, s.imag) * mpmath.eye(A.shape[0]) - mpmath.matrix(A.tolist())
+        value = (mpmath.matrix(C.tolist()) * mpmath.lu_solve(M, mpmath.matrix(B.tolist())))[0]
+        return complex(value)
+
+
+@pytest.mark.parametrize(
+    ("A", "B", "C"),
+    [
+        # C B = 1.6e-452: the factors are doubles, their product is not.
+        (np.array([[-1.0]]), np.array([[1e-226]]), np.array([[1.6e-226]])),
+        # Relative degree 3 through couplings of 1e-200: C A² B = 1e-500 (B, C of 1).
+        (
+            np.diag([-1.0, -2.0, -3.0]) + np.diag([1e-200, 1e-200], 1),
+            np.array([[0.0], [0.0], [1e-100]]),
+            np.array([[1.0, 0.0, 0.0]]),
+        ),
+        # Relative degree 1 with a finite zero (-3.2): C B = 1.2e-450.
+        (
+            np.array([[-1.0, -0.5356693731611109], [0.0, -2.0]]),
+            np.array([[0.9470809631292422e-150], [-0.7037352358069926e-150]]),
+            np.array([[-1.265421470904605e-300, -0.6232744625373523e-300]]),
+        ),
+    ],
+)
+def test_gain_below_the_doubles_gives_a_zero_transfer_function_with_a_warning(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray
+) -> None:
+    """K below the smallest double: it underflowed to 0 beside the zeros of a nonzero
+    numerator (the last model came back with gain 0, numerator [-0, -0] and the zero -3.2).
+    The channel is now zero throughout, with a NumericalUnderflowWarning that gives K's size."""
+    with pytest.warns(aerocontrol.NumericalUnderflowWarning, match=r"10\^-4[5-9]\d|10\^-500"):
+        g = transfer_function((A, B, C, np.zeros((1, 1))))
+    assert g.gain == 0.0
+    assert g.numerator.tolist() == [0.0]
+    assert g.zeros.size == 0
+    np.testing.assert_allclose(g.poles.real, np.sort(np.diag(A)), rtol=1e-14)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert g(1j) == 0.0
+        assert g.aircraft_form().startswith("0 / ")
+
+
+def test_gain_of_a_chain_whose_solution_passes_below_and_above_the_doubles() -> None:
+    """Chains of integrators whose responses pass through 1e-400 and 1e+360 on the way from
+    B to C (the solve of (sI - A) x = B in doubles gave 0 and inf), while K does not:
+    K = C A^(n-1) B = 1e100 · 1e-400 · 1e200 = 1e-100, and 1e-100 · 1e360 · 1e-100 = 1e160.
+    G = K / Π(s - p), no zeros (closed form)."""
+    poles = np.array([-1.0, -2.0, -3.0, -4.0])
+    for coupling, b, c, gain in ((1e-200, 1e100, 1e200, 1e-100), (1e120, 1e-100, 1e-100, 1e160)):
+        n = 3 if coupling < 1 else 4
+        A = np.diag(poles[:n]) + np.diag(np.full(n - 1, coupling), 1)
+        B = np.zeros((n, 1))
+        B[-1] = b
+        C = np.zeros((1, n))
+        C[0, 0] = c
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            g = transfer_function((A, B, C, np.zeros((1, 1))))
+            assert g.zeros.size == 0
+            assert g.gain == pytest.approx(gain, rel=1e-14)
+            s = 0.5 + 1.5j
+            assert g(s) == pytest.approx(gain / np.prod(s - poles[:n]), rel=1e-14)
+
+
+def test_gain_beyond_the_doubles_keeps_the_response_exact() -> None:
+    """K = C B = 1e450 (B of 1e300, C of 1e150, a pole at -1e150): the gain is infinite with
+    a NumericalOverflowWarning, but G = K/(s + 1e150) is a double at s of the pole's size,
+    and is evaluated from K held as a mantissa and a power of two (it was -inf + inf j)."""
+    A, B, C = np.array([[-1e150]]), np.array([[1e300]]), np.array([[1e150]])
+    with pytest.warns(aerocontrol.NumericalOverflowWarning, match="numerator"):
+        g = transfer_function((A, B, C, np.zeros((1, 1))))
+    assert g.gain == math.inf and g.scaled_gain is not None
+    mantissa, exponent = g.scaled_gain
+    assert math.ldexp(mantissa, exponent - 1400) == pytest.approx(
+        1e300 * 2.0**-700 * (1e150 * 2.0**-700), rel=1e-15
+    )
+    for s in (1e150j, 3e149 + 1.1e150j):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            got = g(s)
+        assert got == pytest.approx(_mp_response(A, B, C, s), rel=1e-14)
+
+
+def test_zeros_of_an_equilibration_that_passed_below_the_doubles() -> None:
+    """A of 1e300, B of 1, C of 1e-300 (upper triangular A): the zero is
+    (c1 b1 a22 - c1 a12 b2 + c2 a11 b2) / (c1 b1 + c2 b2) = -3.2050559935e300. The pencil's
+    equilibration scaled B step by step and lost its first entry to 0 on the way (its
+    product with C's first entry, which no state scaling changes, fixes the zero), and the
+    zero came back as 8.8e298; the scalings are now kept as exponents and applied once."""
+    unit = np.array([[-1.0, -0.5356693731611109], [0.0, -2.0]])
+    B = np.array([[0.9470809631292422], [-0.7037352358069926]])
+    C = 1e-300 * np.array([[-1.265421470904605, -0.6232744625373523]])
+    (a11, a12), (_, a22) = unit
+    (b1,), (b2,) = B
+    c1, c2 = C[0] * 1e300
+    expected = (c1 * b1 * a22 - c1 * a12 * b2 + c2 * a11 * b2) / (c1 * b1 + c2 * b2)
+    # The zeros of (a A, b B, c C, 0) are a times those of (A, B, C, 0).
+    for a, b in ((1e300, 1.0), (1e-300, 1e300)):
+        zeros = transmission_zeros((a * unit, b * B, C, np.zeros((1, 1))))
+        np.testing.assert_allclose(zeros.real, [a * expected], rtol=1e-12)
+
+
+def test_zeros_are_each_taken_once_from_the_forward_and_reversed_pencils() -> None:
+    """A of 1e300, B of 1e300, C of 1e150 (a third-order channel with zeros 1e300 (-13.394...,
+    204.560...), from mpmath's roots of C adj(sI - A) B): the eigenvalues of the regular
+    pencil were sorted by |α| / max(β, |α|), which ties every |λ| >= 1, and the zero -13.39e300
+    was taken twice (from the pencil and its reversal) and 204.56e300 not at all."""
+    A = np.array(
+        [
+            [-1.0, -0.2812874181513504, -0.6680463461089501],
+            [0.0, -2.0, 0.48194538850678587],
+            [0.0, 0.0, -3.0],
+        ]
+    )
+    B = np.array([[0.02425956507666462], [1.545820851212812], [0.5451055226876446]])
+    C = np.array([[-0.505228735614018, -0.1828389745977349, 0.5405251317548021]])
+    expected = np.array([-13.394413590475666, 204.56027418012547]) * 1e300
+    for b, c in ((1e300, 1e150), (1.0, 1.0), (1e150, 1e150)):
+        zeros = transmission_zeros((A * 1e300, B * b, C * c, np.zeros((1, 1))))
+        np.testing.assert_allclose(zeros.real, expected, rtol=1e-12)
+
+
+def test_gain_with_a_feedthrough_is_the_feedthrough() -> None:
+    """G(s) -> D as s -> inf, so K = D exactly; evaluated at a point it carried the rounding of
+    the zeros (A of 1e-150 beside B, C, D of 1: K = 1 + 1.1e-10)."""
+    A = 1e-150 * np.array(
+        [
+            [-1.0, -0.2812874181513504, -0.6680463461089501],
+            [0.0, -2.0, 0.48194538850678587],
+            [0.0, 0.0, -3.0],
+        ]
+    )
+    B = np.array([[0.02425956507666462], [1.545820851212812], [0.5451055226876446]])
+    C = np.array([[-0.505228735614018, -0.1828389745977349, 0.5405251317548021]])
+    for d in (1.0, -0.3, 1e-8):
+        g = transfer_function((A, B, C, np.array([[d]])))
+        assert g.gain == d
+        assert g.numerator[0] == d

@@ -25,7 +25,7 @@ class                         raised when
 ============================  ===========================================================
 
 Warnings (``AerocontrolWarning`` and subclasses) report results that were computed but deserve
-care: overflow, ill-conditioning, bounds that leave a gap (``LooseBoundWarning``).
+care: overflow, underflow, ill-conditioning, bounds that leave a gap (``LooseBoundWarning``).
 """
 
 from __future__ import annotations
@@ -47,6 +47,7 @@ __all__ = [
     "NotPositiveDefiniteError",
     "NotRealError",
     "NumericalOverflowWarning",
+    "NumericalUnderflowWarning",
     "OutputFolderError",
     "ShapeError",
     "SingularMatrixError",
@@ -155,6 +156,12 @@ class LooseBoundWarning(AerocontrolWarning, RuntimeWarning):
     """A quantity computable only within bounds (the structured singular value of a
     multiloop disk margin) has bounds further apart than the tolerance; the conservative
     bound was returned and the message gives both."""
+
+
+class NumericalUnderflowWarning(AerocontrolWarning, RuntimeWarning):
+    """A result is below the range of normal doubles: it was rounded to a subnormal number
+    (fewer significant digits) or to zero. The message names the result, its size (as a
+    power of ten) and what was returned in its place."""
 
 
 class OutputFolderError(AerocontrolError, OSError):

@@ -21,6 +21,7 @@ from .exceptions import (
     IllConditionedWarning,
     InvalidArgumentError,
     NoContinuousEquivalentError,
+    NumericalOverflowWarning,
     ShapeError,
 )
 from .statespace import StateSpace, as_state_space, period, sampling_period
@@ -435,7 +436,8 @@ def d2c(
         ``"sys"`` and the eigenvalue in ``eigenvalues``; the message names both.
     InvalidArgumentError
         ``sys`` is continuous, an unknown method, or ``prewarp``/``alpha`` where they do not
-        apply.
+        apply; or the continuous model overflows double precision (``argument`` ``"sys"``:
+        a C of 1e308 under Tustin's inverse).
 
     Warns
     -----
@@ -484,18 +486,37 @@ def d2c(
             if error.argument != "A":
                 raise
             raise _no_equivalent(f"sys.A: {error}", None) from None
+        _refuse_continuous_overflow((A, B))
         return _named_like(model, A, B, model.C, model.D, 0.0)
     weight = _bilinear_weight(chosen, alpha)
     warped = _warped_step(chosen, weight, period(model), prewarp)
     try:
-        A, B, C, D = _core.inverse_bilinear(model.A, model.B, model.C, model.D, warped, weight)
+        with warnings.catch_warnings():  # a result beyond the doubles is refused below
+            warnings.simplefilter("ignore", NumericalOverflowWarning)
+            A, B, C, D = _core.inverse_bilinear(model.A, model.B, model.C, model.D, warped, weight)
     except InvalidArgumentError as error:
         if error.argument != "A":
             raise
         infinity = -(1.0 - weight) / weight if weight else None
         raise _no_equivalent(f"sys.A: {error}", infinity) from None
+    _refuse_continuous_overflow((A, B, C, D))
     _check_bilinear_condition(model.A, weight, chosen)
     return _named_like(model, A, B, C, D, 0.0)
+
+
+def _refuse_continuous_overflow(matrices: tuple[ArrayLike, ...]) -> None:
+    """Refuses, naming sys, a continuous model from d2c whose matrix overflowed double
+    precision (a C of 1e308 with Tustin's inverse, C (I + Ad)^-1 times 2: inf), instead of a
+    NonFiniteError from StateSpace blaming a C that the caller never gave."""
+    for name, matrix in zip("ABCD"[: len(matrices)], matrices, strict=True):
+        if not np.all(np.isfinite(np.asarray(matrix))):
+            error = InvalidArgumentError(
+                f"the continuous model's {name} overflows double precision: sys is beyond the "
+                "range of doubles under this inverse map (its entries, or those of "
+                "(I + (1 - alpha) Ad)^-1, are too large)"
+            )
+            error.argument = "sys"
+            raise error
 
 
 def _named_like(
@@ -577,7 +598,10 @@ def _check_bilinear_condition(A: FloatArray, weight: float, method: str) -> None
     denominator = weight * A + (1.0 - weight) * np.eye(A.shape[0])
     smallest = float(np.linalg.svd(denominator, compute_uv=False)[-1])
     largest = float(np.linalg.svd(A, compute_uv=False)[0])
-    rcond = smallest / (weight * largest + 1.0 - weight)
+    # The terms' size as α ||A|| + (1 - α): formed left to right, (α ||A|| + 1) - α lost a
+    # ||A|| of 1.3e-151 beside 1 (backward_diff, α = 1) and divided by zero.
+    terms = weight * largest + (1.0 - weight)
+    rcond = smallest / terms if terms > 0.0 else 0.0
     if rcond < BILINEAR_RCOND_WARNING:
         eigenvalues = _core.eigenvalues(A)
         infinity = -(1.0 - weight) / weight
@@ -592,25 +616,6 @@ def _check_bilinear_condition(A: FloatArray, weight: float, method: str) -> None
         )
 
 
-def _roots(coefficients: FloatArray) -> ComplexArray:
-    """The roots of a polynomial (highest power first, leading coefficient nonzero): the
-    eigenvalues of its companion matrix, by aerocontrol's own Schur form."""
-    degree = len(coefficients) - 1
-    if degree < 1:
-        return np.zeros(0, dtype=np.complex128)
-    companion = np.zeros((degree, degree))
-    companion[0, :] = -coefficients[1:] / coefficients[0]
-    companion[1:, :-1] = np.eye(degree - 1)
-    return _core.eigenvalues(companion)
-
-
-def _power_of_two(value: float) -> float:
-    """The power of two nearest ``value`` (1 for 0 or a non-finite value)."""
-    if value > 0.0 and np.isfinite(value):
-        return float(2.0 ** round(np.log2(value)))
-    return 1.0
-
-
 def _matched(model: StateSpace, dt: float) -> StateSpace:
     """Matched pole-zero discretisation of a single-input, single-output model."""
     if (model.n_inputs, model.n_outputs) != (1, 1):
@@ -619,54 +624,36 @@ def _matched(model: StateSpace, dt: float) -> StateSpace:
             f"{model.n_inputs} input(s) and {model.n_outputs} output(s); discretise each "
             "input-output pair, or use another method"
         )
-    A, b, c, d = model.A, model.B[:, 0], model.C[0], float(model.D[0, 0])
-    n = model.n_states
-    poles = _core.eigenvalues(A) if n else np.zeros(0, dtype=np.complex128)
-    # b / beta and c / gamma for the powers of two that give each the norm sqrt(||A||):
-    # det(sI - A + b c) - P cancels least when b c is as large as A, and the zeros do not
-    # depend on the scale of b or c (a C of 1e50 moved a zero). N = beta gamma N-hat.
-    size = float(np.sqrt(max(float(np.abs(A).max(initial=0.0)), np.finfo(float).tiny)))
-    beta, gamma = (_power_of_two(float(np.linalg.norm(v)) / size) for v in (b, c))
-    b, c = b / beta, c / gamma
-    # G(s) = N(s) / P(s) with P = det(sI - A) and, by the matrix determinant lemma,
-    # N = d P + det(sI - A + b c) - P. Without feedthrough the leading coefficients of N are
-    # the Markov parameters c A^(k-1) b, zero below the relative degree.
-    P = _core.charpoly(A) if n else np.ones(1)
-    with np.errstate(over="ignore", under="ignore"):
-        hat_d = d / beta / gamma
-    numerator = hat_d * P + ((_core.charpoly(A - np.outer(b, c)) - P) if n else np.zeros(1))
-    if d == 0.0:
-        eps = np.finfo(float).eps
-        scale = float(np.linalg.norm(c) * np.linalg.norm(b))
-        norm_A = max(float(np.abs(A).sum(axis=0).max()) if n else 0.0, 1.0)
-        relative_degree, power = None, b.copy()
-        for k in range(1, n + 1):
-            if abs(float(c @ power)) > 1e3 * n * eps * scale * norm_A ** (k - 1):
-                relative_degree = k
-                break
-            power = A @ power
-        if relative_degree is None:  # G = 0
-            return StateSpace(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[0.0]], dt=dt)
-        numerator = numerator[relative_degree:]
-    zeros = _roots(numerator)
+    # G = K Π(s - z)/Π(s - p): the poles are the eigenvalues of A, the zeros those of the
+    # system pencil and K as a mantissa and a power of two (the transfer function's own
+    # computation). Formed from characteristic polynomials (det(sI - A + b c) - det(sI - A)),
+    # they overflowed for A of 1e200 (coefficients of 1e400: a NaN companion matrix blamed
+    # on A, and numpy's warnings), and the relative degree from the powers A^k b.
+    from .transfer import _roots_and_gain
+
+    _, zeros, k, e = _roots_and_gain(model)
+    # The poles in the order of the core's Schur form (the sections pair them in it).
+    poles = _core.eigenvalues(model.A) if model.n_states else np.zeros(0, dtype=np.complex128)
+    if k == 0.0:  # G = 0
+        return StateSpace(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[0.0]], dt=dt)
     _refuse_exponential_overflow(poles, zeros, dt)
     # Poles and zeros at s = 0 map to z = 1; the gain is matched on the rest (their low
     # frequency asymptotes agree, with z - 1 ≈ s dt).
-    tiny = 1e-12 * max(1.0, float(np.abs(poles).max(initial=0.0)))
-    nonzero_poles, nonzero_zeros = poles[np.abs(poles) > tiny], zeros[np.abs(zeros) > tiny]
+    with np.errstate(over="ignore"):  # |root| beyond the doubles is inf, still "not zero"
+        tiny = 1e-12 * max(1.0, float(np.abs(poles).max(initial=0.0)))
+        nonzero_poles, nonzero_zeros = poles[np.abs(poles) > tiny], zeros[np.abs(zeros) > tiny]
     excess = (len(zeros) - len(nonzero_zeros)) - (len(poles) - len(nonzero_poles))
-    # gain = K N0 prod(-z) / prod(-p) * prod(1 - e^{p dt}) / prod(1 - e^{z dt}) / dt^excess
-    # * beta gamma, as a mantissa times a power of two: each product may overflow (or
-    # underflow) where the gain, or the model it scales, does not (e^{p dt} of 1e200).
+    # gain = K prod(-z) / prod(-p) * prod(1 - e^{p dt}) / prod(1 - e^{z dt}) / dt^excess, as
+    # a mantissa times a power of two: each product may overflow (or underflow) where the
+    # gain, or the model it scales, does not (e^{p dt} of 1e200, or K of 1e-400).
     dt_mantissa, dt_exponent = np.frexp(dt)
     gain_factors = [
-        _scaled(complex(numerator[0])),
+        (complex(k), e),
         *(_scaled(complex(-z)) for z in nonzero_zeros),
         *(_reciprocal(_scaled(complex(-p))) for p in nonzero_poles),
         *(_one_minus_exp_scaled(complex(p * dt)) for p in nonzero_poles),
         *(_reciprocal(_one_minus_exp_scaled(complex(z * dt))) for z in nonzero_zeros),
         (complex(dt_mantissa) ** -excess, -int(dt_exponent) * excess),
-        (1.0 + 0.0j, int(np.log2(beta)) + int(np.log2(gamma))),
     ]
     gain_mantissa, gain_exponent = _scaled_product(gain_factors)
     gain = float(gain_mantissa.real)
@@ -755,10 +742,18 @@ def _pole_sections(
     z, |e^{p dt}|², overflow beyond 1e154 (the section's matrices hold only e^{p dt} itself,
     and the subdiagonal R keeps the output row of two real poles at their size)."""
     sections = []
+    # A pair mapped to a real double pole (β = 0: e^{σ dt} below the doubles, or ω dt a
+    # multiple of π) goes with the real poles: the pair's section α I with B = [0, 1] is not
+    # controllable, and its output row divided by zero (NaN, numpy's warning, then a refusal
+    # that blamed dt for A of 1e100 sampled at 1000 s, whose poles all map to z = 0).
+    reals = [float(np.exp(r.real * dt)) for r in poles if r.imag == 0]
     with np.errstate(under="ignore"):
         for r in poles[poles.imag > 0]:
             z = np.exp(r.real * dt) * np.array([np.cos(r.imag * dt), np.sin(r.imag * dt)])
             alpha, beta = float(z[0]), float(z[1])
+            if beta == 0.0:
+                reals += [alpha, alpha]
+                continue
             scale = _section_scale(np.hypot(alpha, beta))
             a, b = np.ldexp(alpha, -scale), np.ldexp(beta, -scale)
             sections.append(
@@ -769,8 +764,13 @@ def _pole_sections(
                     scale,
                 )
             )
-        reals = [float(np.exp(r.real * dt)) for r in poles if r.imag == 0]
         for first, second in zip(reals[0::2], reals[1::2], strict=False):
+            # The larger pole first: the coupling R (of the larger's size) then feeds the
+            # state of the larger pole from that of the smaller, and no output row has to
+            # cancel terms of R's size (e^{-1} before e^{300} gave a DC gain of 2e27 for 2:
+            # the output row's two terms of 7e43 cancelled).
+            if abs(first) < abs(second):
+                first, second = second, first
             scale = _section_scale(max(abs(first), abs(second)))
             f, g = np.ldexp(first, -scale), np.ldexp(second, -scale)
             sections.append(
@@ -910,8 +910,10 @@ def _refuse_exponential_overflow(poles: ComplexArray, zeros: ComplexArray, dt: f
 
 
 def _scaled(value: complex) -> tuple[complex, int]:
-    """(m, e) with value = m 2^e and |m| in [0.5, 1) (m = 0, e = 0 for zero)."""
-    size = abs(value)
+    """(m, e) with value = m 2^e and the larger part of m in [0.5, 1) (m = 0, e = 0 for
+    zero). By the larger part, not |value|, which overflows (Python's abs raises
+    OverflowError) for parts near 1e308."""
+    size = max(abs(value.real), abs(value.imag))
     if size == 0.0 or not np.isfinite(size):
         return value, 0
     _, exponent = np.frexp(size)

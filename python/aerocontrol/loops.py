@@ -108,6 +108,7 @@ from .exceptions import (
     LooseBoundWarning,
     NonFiniteError,
     NumericalOverflowWarning,
+    NumericalUnderflowWarning,
     ShapeError,
     SingularMatrixError,
 )
@@ -477,10 +478,13 @@ class _Response:
 
 def _roots_of(model: StateSpace) -> TransferFunction:
     """L's transfer function for its poles, zeros and gain only: its polynomial coefficients
-    may overflow (a gain near 1e308 times a zero) with a NumericalOverflowWarning that is no
-    concern of a caller who asked for roots or margins, so that warning is not passed on."""
+    may overflow (a gain near 1e308 times a zero) with a NumericalOverflowWarning, and a gain
+    below the doubles makes it zero with a NumericalUnderflowWarning (L is then negligible
+    at every gain k of the doubles); neither is a concern of a caller who asked for roots or
+    margins, so neither is passed on."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", NumericalOverflowWarning)
+        warnings.simplefilter("ignore", NumericalUnderflowWarning)
         g = transfer_function(model)
     for roots, what in ((g.poles, "poles"), (g.zeros, "zeros")):
         finite_or_warn(roots, f"the open loop's {what}", stacklevel=4)

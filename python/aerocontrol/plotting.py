@@ -110,6 +110,50 @@ def _new_axes(rows: int = 1, columns: int = 1, **options: Any) -> Any:
     return axes
 
 
+#: The largest |value| drawn: matplotlib's autoscaling subtracts the limits and adds margins,
+#: which overflows (numpy's warning, from inside matplotlib) for data spanning ±1e308.
+PLOT_LIMIT = 1e300
+
+
+def _drawable(ax: Axes, values: ArrayLike) -> FloatArray:
+    """``values`` as floats with every entry that cannot be drawn (NaN, infinite, or beyond
+    ±PLOT_LIMIT) masked as NaN (a gap in a line), counted on ``ax`` for the note that
+    :func:`_note_hidden` writes; the caller's array is not modified."""
+    array = np.array(values, dtype=np.float64, copy=True)
+    with np.errstate(invalid="ignore"):
+        hidden = ~(np.abs(array) <= PLOT_LIMIT)
+    if np.any(hidden):
+        array[hidden] = np.nan
+        count = int(getattr(ax, "_aerocontrol_hidden", 0)) + int(np.count_nonzero(hidden))
+        ax._aerocontrol_hidden = count  # type: ignore[attr-defined]
+        _note_hidden(ax)
+    return array
+
+
+def _drawable_complex(ax: Axes, values: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Real and imaginary parts of complex ``values``, each :func:`_drawable`; a point with
+    either part hidden is hidden whole."""
+    points = np.asarray(values, dtype=np.complex128)
+    with np.errstate(invalid="ignore"):
+        hidden = ~((np.abs(points.real) <= PLOT_LIMIT) & (np.abs(points.imag) <= PLOT_LIMIT))
+    real = np.where(hidden, np.inf, points.real)
+    return _drawable(ax, real), _drawable(ax, np.where(hidden, 0.0, points.imag))
+
+
+def _note_hidden(ax: Axes) -> None:
+    """One note in the corner of ``ax``: how many values were not drawn, and why."""
+    count = int(getattr(ax, "_aerocontrol_hidden", 0))
+    text = f"{count} value{'s' if count > 1 else ''} not drawn (NaN, infinite or beyond ±1e300)"
+    note = getattr(ax, "_aerocontrol_note", None)
+    if note is None:
+        note = ax.text(
+            0.01, 0.01, text, transform=ax.transAxes, fontsize="x-small", color="0.35", va="bottom"
+        )
+        ax._aerocontrol_note = note  # type: ignore[attr-defined]
+    else:
+        note.set_text(text)
+
+
 def _finish(ax: Axes, xlabel: str, ylabel: str, title: str | None = None) -> None:
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
@@ -172,7 +216,9 @@ def plot_time_response(
     ax = _new_axes() if ax is None else ax
     shown = slice(None) if t_max is None else result.t <= t_max
     for column, name in zip(values.T, names, strict=True):
-        ax.plot(result.t[shown], column[shown], linestyle, label=label(name) + suffix)
+        ax.plot(
+            result.t[shown], _drawable(ax, column[shown]), linestyle, label=label(name) + suffix
+        )
     if title is None:
         title = f"{result.kind} response"
         if result.n_responses > 1:
@@ -256,11 +302,12 @@ def plot_with_controls(
     """
     gain = _gain(K, result)
     states = result.states(_response_index(result, response))
-    controls = -states @ gain.T
+    with np.errstate(over="ignore", invalid="ignore"):  # beyond the doubles: not drawn
+        controls = -states @ gain.T
     ax = plot_time_response(result, ax, "states", response, title=title)
     names = _control_names(result, gain.shape[0])
     for column, name in zip(controls.T, names, strict=True):
-        ax.plot(result.t, column, "--", label=label(name))
+        ax.plot(result.t, _drawable(ax, column), "--", label=label(name))
     _finish(ax, "time (s)", _axis_label((*result.state_names, *names), "states and controls"))
     return ax
 
@@ -306,7 +353,7 @@ def plot_compared(
                 f"of its response (states {result.state_names})"
             )
         style = "steps-post" if name in staircase else "default"
-        ax.plot(result.t, values, label=name, drawstyle=style)
+        ax.plot(result.t, _drawable(ax, values), label=name, drawstyle=style)
         first = variable if first is None else first
     _finish(ax, "time (s)", label(first) if first is not None else "", title)
     return ax
@@ -328,9 +375,11 @@ def penalty_terms(
         raise ShapeError(f"Q must be {n} x {n}, got shape {Q_matrix.shape}")
     if R_matrix.shape != (m, m):
         raise ShapeError(f"R must be {m} x {m}, got shape {R_matrix.shape}")
-    controls = -states @ gain.T
-    state_term = np.einsum("ti,ij,tj->t", states, Q_matrix, states)
-    control_term = np.einsum("ti,ij,tj->t", controls, R_matrix, controls)
+    # A term beyond the doubles is infinite (or NaN), as its sum is; the plot does not draw it.
+    with np.errstate(over="ignore", invalid="ignore"):
+        controls = -states @ gain.T
+        state_term = np.einsum("ti,ij,tj->t", states, Q_matrix, states)
+        control_term = np.einsum("ti,ij,tj->t", controls, R_matrix, controls)
     return state_term, control_term
 
 
@@ -348,13 +397,16 @@ def plot_penalty(
     the trapezoidal rule. Call once per design on the same axes to compare. Returns the axes.
     """
     state_term, control_term = penalty_terms(result, K, Q, R, response)
-    total = state_term + control_term
-    J = float(0.5 * np.sum((total[1:] + total[:-1]) * np.diff(result.t)))
+    with np.errstate(over="ignore", invalid="ignore"):  # J beyond the doubles: said so
+        total = state_term + control_term
+        J = float(0.5 * np.sum((total[1:] + total[:-1]) * np.diff(result.t)))
+    index = f"J = {J:.4g}" if np.isfinite(J) else "J beyond the doubles"
     ax = _new_axes() if ax is None else ax
     prefix = f"{name}: " if name else ""
-    (line,) = ax.plot(result.t, state_term, label=f"{prefix}x'Qx (J = {J:.4g})")
-    ax.plot(result.t, -control_term, "--", color=line.get_color(), label=f"{prefix}-η'Rη")
-    ax.fill_between(result.t, -control_term, state_term, color=line.get_color(), alpha=0.12)
+    upper, lower = _drawable(ax, state_term), _drawable(ax, -control_term)
+    (line,) = ax.plot(result.t, upper, label=f"{prefix}x'Qx ({index})")
+    ax.plot(result.t, lower, "--", color=line.get_color(), label=f"{prefix}-η'Rη")
+    ax.fill_between(result.t, lower, upper, color=line.get_color(), alpha=0.12)
     ax.axhline(0.0, color="black", linewidth=0.8)
     _finish(ax, "time (s)", "penalty terms (model units)", "penalty terms of J")
     return ax
@@ -362,11 +414,18 @@ def plot_penalty(
 
 def _tracks(poles: NDArray[np.generic]) -> NDArray[np.complex128]:
     """Reorder each row of ``poles`` so that column j follows one root from row to row:
-    greedy nearest matching to the previous row."""
+    greedy nearest matching to the previous row.
+
+    A root beyond the doubles (inf, NaN) is at an infinite distance from every other (inf -
+    inf is NaN, and numpy's 'invalid value' warning), so it is matched last, and a
+    difference of two huge roots that overflows is infinite, not a warning; matplotlib
+    leaves a gap at a non-finite point."""
     tracked = np.array(poles, dtype=np.complex128, copy=True)
     for k in range(1, len(tracked)):
-        previous, current = tracked[k - 1], poles[k]
-        distance = np.abs(previous[:, None] - current[None, :])
+        previous, current = tracked[k - 1], tracked[k].copy()
+        with np.errstate(over="ignore", invalid="ignore"):
+            distance = np.abs(previous[:, None] - current[None, :])
+        distance[~np.isfinite(distance)] = np.inf
         order = np.empty(len(current), dtype=int)
         for _ in range(len(current)):
             i, j = np.unravel_index(np.argmin(distance), distance.shape)
@@ -375,6 +434,32 @@ def _tracks(poles: NDArray[np.generic]) -> NDArray[np.complex128]:
             distance[:, j] = np.inf
         tracked[k] = current[order]
     return tracked
+
+
+def _nearest_weight(weights: FloatArray, value: float) -> int | None:
+    """The index of the weight nearest ``value``, or None where there is none to mark (NaN,
+    or no finite weight).
+
+    An equal weight first; else, for a positive value among positive weights, the nearest by
+    ratio (log |w / value|, the distance on a logarithmic sweep), and otherwise by difference.
+    Weights of 0 (k = 0 of a gain sweep) and infinite values (the largest weight is the
+    nearest) have no logarithm to compare: log(0) - log(0) was NaN with numpy's 'invalid
+    value' warning, leaked to the user by the report of an extreme aircraft."""
+    finite = np.flatnonzero(np.isfinite(weights))
+    if np.isnan(value) or finite.size == 0:
+        return None
+    equal = np.flatnonzero(weights == value)
+    if equal.size:
+        return int(equal[0])
+    candidates = weights[finite]
+    if np.isinf(value):
+        return int(finite[np.argmax(candidates) if value > 0 else np.argmin(candidates)])
+    positive = candidates > 0
+    if value > 0 and np.any(positive):
+        ratios = np.abs(np.log(candidates[positive]) - np.log(value))
+        return int(finite[np.flatnonzero(positive)[np.argmin(ratios)]])
+    with np.errstate(over="ignore"):  # a difference beyond the doubles is infinitely far
+        return int(finite[np.argmin(np.abs(candidates - value))])
 
 
 def plot_root_locus(
@@ -402,12 +487,10 @@ def plot_root_locus(
     ax = _new_axes() if ax is None else ax
     tracked = _tracks(roots)
     for j in range(tracked.shape[1]):
-        ax.plot(tracked[:, j].real, tracked[:, j].imag, color="0.55", linewidth=1.0)
+        ax.plot(*_drawable_complex(ax, tracked[:, j]), color="0.55", linewidth=1.0)
     if not marked:  # the start of each root's path
-        start = tracked[0]
         ax.plot(
-            start.real,
-            start.imag,
+            *_drawable_complex(ax, tracked[0]),
             "o",
             mfc="none",
             color="black",
@@ -418,11 +501,14 @@ def plot_root_locus(
     # viridis up to 0.85: its last yellows are too light on white.
     colours = colormaps["viridis"](np.linspace(0.0, 0.85, len(marked)))
     for index, value in enumerate(marked):
-        row = int(np.argmin(np.abs(np.log(c_values) - np.log(value))))
+        nearest = _nearest_weight(c_values, float(value))
+        if nearest is None:  # nothing to mark: said in the legend
+            ax.plot([], [], " ", label=f"{weight_name} = {value:g}: not marked")
+            continue
+        row = nearest
         symbol = markers[index % len(markers)]
         ax.plot(
-            tracked[row].real,
-            tracked[row].imag,
+            *_drawable_complex(ax, tracked[row]),
             symbol,
             mfc="none",
             color=colours[index],
@@ -448,26 +534,23 @@ def plot_gain_root_locus(
     (arcs, labelled ω_n). A discrete locus is drawn in the z-plane with the unit circle.
     Returns the axes.
     """
-    with np.errstate(divide="ignore"):  # k = 0 is marked by its nearest gain
-        ax = plot_root_locus(
-            locus.gains,
-            locus.poles,
-            ax=ax,
-            marked=marked,
-            weight_name="k",
-            title=title,
-        )
+    ax = plot_root_locus(
+        locus.gains,
+        locus.poles,
+        ax=ax,
+        marked=marked,
+        weight_name="k",
+        title=title,
+    )
     ax.plot(
-        locus.open_loop_poles.real,
-        locus.open_loop_poles.imag,
+        *_drawable_complex(ax, locus.open_loop_poles),
         "x",
         color="black",
         label="open-loop poles",
     )
     if locus.open_loop_zeros.size:
         ax.plot(
-            locus.open_loop_zeros.real,
-            locus.open_loop_zeros.imag,
+            *_drawable_complex(ax, locus.open_loop_zeros),
             "o",
             mfc="none",
             color="black",
@@ -512,8 +595,10 @@ def plot_bode(
             raise InvalidArgumentError(f"{argument} must be in 0 ... {len(names) - 1}, got {value}")
     magnitude_axis, phase_axis = _pair(_new_axes(2, 1, sharex=True) if ax is None else ax, "ax")
     text = f"{result.input_names[input]} -> {result.output_names[output]}"
-    magnitude_axis.semilogx(result.omega, result.magnitude_db[:, output, input], label=text)
-    phase_axis.semilogx(result.omega, result.phase_deg[:, output, input], label=text)
+    magnitude = _drawable(magnitude_axis, result.magnitude_db[:, output, input])
+    magnitude_axis.semilogx(result.omega, magnitude, label=text)
+    phase = _drawable(phase_axis, result.phase_deg[:, output, input])
+    phase_axis.semilogx(result.omega, phase, label=text)
     magnitude_axis.set_ylabel("magnitude (dB)")
     phase_axis.set_ylabel("phase (deg)")
     phase_axis.set_xlabel("frequency (rad/s)")
@@ -581,7 +666,9 @@ def plot_modes(modes: Modes, ax: Axes | None = None, marker: str = "x", suffix: 
     for k, name in enumerate(modes.mode_names):
         lam = modes.eigenvalue[k]
         points = np.array([lam, np.conj(lam)]) if modes.oscillatory[k] else np.array([lam])
-        ax.plot(points.real, points.imag, marker, markersize=9, mfc="none", label=name + suffix)
+        ax.plot(
+            *_drawable_complex(ax, points), marker, markersize=9, mfc="none", label=name + suffix
+        )
     ax.margins(0.12)  # the extreme markers whole, not cut by the frame
     ax.axvline(0.0, color="black", linewidth=0.8)
     ax.axhline(0.0, color="black", linewidth=0.8)

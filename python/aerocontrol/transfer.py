@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -44,7 +44,12 @@ from numpy.typing import NDArray
 
 from . import _core
 from ._validation import FloatArray, finite_or_warn, real_scalar
-from .exceptions import ConvergenceError, InvalidArgumentError, NumericalOverflowWarning
+from .exceptions import (
+    ConvergenceError,
+    InvalidArgumentError,
+    NumericalOverflowWarning,
+    NumericalUnderflowWarning,
+)
 from .linalg import qz
 from .statespace import StateSpace, as_state_space, period, signal_indices
 
@@ -78,13 +83,6 @@ def _tolerance(A: FloatArray, B: FloatArray, C: FloatArray, D: FloatArray) -> fl
     return float((n + p) * (n + m) * np.finfo(float).eps * max(size, np.finfo(float).tiny))
 
 
-def _exponents(norms: FloatArray) -> NDArray[np.int64]:
-    """The exponents e of 2^e of positive norms (frexp's: norm = f 2^e, 1/2 <= f < 1); 0 for a
-    zero norm."""
-    _, e = np.frexp(norms)
-    return np.where(norms > 0.0, e, 0).astype(np.int64)
-
-
 def _log2_norm(*vectors: FloatArray) -> float:
     """log2 of the 2-norm of the vectors joined, without overflow or underflow; -inf for zero."""
     largest = max((float(np.max(np.abs(v), initial=0.0)) for v in vectors), default=0.0)
@@ -92,6 +90,23 @@ def _log2_norm(*vectors: FloatArray) -> float:
         return -math.inf
     total = sum(float(np.sum(np.square(v / largest))) for v in vectors)
     return math.log2(largest) + 0.5 * math.log2(total)
+
+
+def _log2_sizes(M: FloatArray) -> FloatArray:
+    """log2 |M| entry by entry, -inf for a zero entry."""
+    with np.errstate(divide="ignore"):
+        return np.asarray(np.log2(np.abs(M)), dtype=np.float64)
+
+
+def _log2_norm_of_logs(*logs: FloatArray) -> float:
+    """log2 of the 2-norm of the entries whose log2 sizes are given (-inf for zero
+    entries), without forming the entries: log2 sqrt(sum 4^l)."""
+    values = np.concatenate([np.ravel(v) for v in logs]) if logs else np.zeros(0)
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return -math.inf
+    largest = float(np.max(values))
+    return largest + 0.5 * math.log2(float(np.sum(np.exp2(2.0 * (values - largest)))))
 
 
 def _half_exponent(log2_size: float) -> int:
@@ -117,53 +132,85 @@ def _balance(
     each state, Osborne's balancing of its row and column (the power of two nearest
     sqrt(c / r), r and c the norms of the row of [A B] and the column of [A; C] without the
     diagonal, which the similarity leaves unchanged), as LAPACK's xGEBAL does for a matrix.
-    Norms are formed as logarithms of scaled sums (no overflow, no underflow), and every
-    factor is applied with ``np.ldexp``, exactly.
+    The scalings are kept as exponents (of the outputs, the inputs, the states and the unit
+    of frequency), the norms formed from the logarithms of the entries plus those exponents
+    (no overflow, no underflow), and the scalings applied once at the end with ``np.ldexp``,
+    exactly: applied step by step, an entry that a later sweep brings back can underflow on
+    the way.
 
     References: D. Ruiz, "A scaling algorithm to equilibrate both rows and columns norms in
     matrices", RAL-TR-2001-034, 2001; E. E. Osborne, J. ACM 7, 338-345, 1960."""
     n, p, m = A.shape[0], C.shape[0], B.shape[1]
-    A, B, C, D = (np.array(M, dtype=np.float64) for M in (A, B, C, D))
-    frequency = 0
+    A, B, C, D = (np.asarray(M, dtype=np.float64) for M in (A, B, C, D))
+    # The scalings are kept as exponents and applied once at the end: applied step by step,
+    # an entry that a later sweep brings back could underflow on the way (B of 1 beside A of
+    # 1e300 and C of 1e-300 lost an entry of B to 0, though the product of B and C, which no
+    # state scaling changes, matters to the zero near 3e300, which moved to 9e298).
+    logs = [_log2_sizes(M) for M in (A, B, C, D)]
+    state = np.zeros(n, dtype=np.int64)  # row i of [A B] by 2^t_i, column i of [A; C] by 2^-t_i
+    outputs = np.zeros(p, dtype=np.int64)
+    inputs = np.zeros(m, dtype=np.int64)
+    frequency = 0  # A and B by 2^-frequency
+
+    def exponents() -> tuple[NDArray[np.int64], ...]:
+        return (
+            state[:, None] - state[None, :] - frequency,
+            state[:, None] + inputs[None, :] - frequency,
+            outputs[:, None] - state[None, :],
+            outputs[:, None] + inputs[None, :],
+        )
+
     for _ in range(40):
         changed = False
+        eA, eB, eC, eD = exponents()
         for i in range(p):
-            k = _half_exponent(_log2_norm(C[i], D[i]))
+            k = _half_exponent(_log2_norm_of_logs(logs[2][i] + eC[i], logs[3][i] + eD[i]))
             if k:
-                C[i], D[i] = np.ldexp(C[i], k), np.ldexp(D[i], k)
+                outputs[i] += k
+                eC[i] += k
+                eD[i] += k
                 changed = True
         for j in range(m):
-            k = _half_exponent(_log2_norm(B[:, j], D[:, j]))
+            k = _half_exponent(
+                _log2_norm_of_logs(logs[1][:, j] + eB[:, j], logs[3][:, j] + eD[:, j])
+            )
             if k:
-                B[:, j], D[:, j] = np.ldexp(B[:, j], k), np.ldexp(D[:, j], k)
+                inputs[j] += k
+                eB[:, j] += k
+                eD[:, j] += k
                 changed = True
         # The unit of frequency: A of unit norm (the poles near 1), else the rows of B.
-        size = _log2_norm(A)
+        size = _log2_norm_of_logs(logs[0] + eA)
         if not math.isfinite(size):
-            size = _log2_norm(B) if n else -math.inf
+            size = _log2_norm_of_logs(logs[1] + eB) if n else -math.inf
         k = _half_exponent(size)
         if k:
-            A, B = np.ldexp(A, k), np.ldexp(B, k)
             frequency -= k
             changed = True
+        eA, eB, eC, eD = exponents()
         for i in range(n):
-            r = _log2_norm(np.delete(A[i], i), B[i])
-            c = _log2_norm(np.delete(A[:, i], i), C[:, i])
+            others = np.arange(n) != i
+            r = _log2_norm_of_logs(logs[0][i, others] + eA[i, others], logs[1][i] + eB[i])
+            c = _log2_norm_of_logs(logs[0][others, i] + eA[others, i], logs[2][:, i] + eC[:, i])
             if not (math.isfinite(r) and math.isfinite(c)):
                 continue
             k = round((c - r) / 2)
             if k:
-                diagonal = A[i, i]  # unchanged by the similarity (scaled twice, it underflows)
-                # Only the diagonal, restored below, may overflow here (A of 1e308 beside B of
-                # 1e-151 and C of 1e149): the off-diagonal entries move toward their mean size.
-                with np.errstate(over="ignore"):
-                    A[i], B[i] = np.ldexp(A[i], k), np.ldexp(B[i], k)
-                    A[:, i], C[:, i] = np.ldexp(A[:, i], -k), np.ldexp(C[:, i], -k)
-                A[i, i] = diagonal
+                state[i] += k
+                eA[i, others] += k
+                eA[others, i] -= k
+                eB[i] += k
+                eC[:, i] -= k
                 changed = True
         if not changed:
             break
-    return A, B, C, D, frequency
+    eA, eB, eC, eD = exponents()
+    np.fill_diagonal(eA, -frequency)
+    # Entries far below the others (negligible beside the tolerance) may underflow here; only
+    # the diagonal of A can overflow (A of 1e308 beside B of 1e-151 and C of 1e149: the
+    # off-diagonal entries move toward their mean size), and is warned of by the zeros.
+    with np.errstate(over="ignore", under="ignore"):
+        return np.ldexp(A, eA), np.ldexp(B, eB), np.ldexp(C, eC), np.ldexp(D, eD), frequency
 
 
 def _svd(M: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -341,6 +388,16 @@ def _backward_error(Af: FloatArray, Bf: FloatArray, alpha: complex, beta: float)
     return smallest / (abs(a) + abs(b))
 
 
+def _modulus_ratio(numerator: complex, denominator: complex) -> float:
+    """|numerator / denominator| (inf beyond the doubles, and for a zero denominator; 0 for
+    0/0, a singular pair, which sorts among the smallest)."""
+    top, bottom = np.float64(abs(numerator)), np.float64(abs(denominator))
+    if bottom == 0.0:
+        return math.inf if top else 0.0
+    with np.errstate(over="ignore", under="ignore"):
+        return float(top / bottom)
+
+
 def _regular_pencil_zeros(Af: FloatArray, Bf: FloatArray, ratio: float) -> ComplexArray:
     """The finite eigenvalues of the regular pencil Af - λBf (of unit size): the largest from
     the QZ form of Af - λBf, the others from that of the reversed pencil Bf - μAf (λ = 1/μ),
@@ -359,13 +416,17 @@ def _regular_pencil_zeros(Af: FloatArray, Bf: FloatArray, ratio: float) -> Compl
     forward, backward = qz(Af, Bf), qz(Bf, Af)
     # Forward: (α, β) of λ = α/β, largest |λ| first; reversed: (β', α') of λ = β'/α',
     # smallest |λ| first (β' >= 0 real, α' complex: the homogeneous pair is (β', α')).
+    # By |λ| itself (inf for a zero denominator): a key bounded by 1 (|α| / max(β, |α|))
+    # tied every |λ| >= 1 of the forward form, which then kept the QZ's order, and the same
+    # eigenvalue could be taken from both forms (zeros -5 and 76 of a balanced pencil came
+    # back as -5 twice).
     pairs_forward = sorted(
         zip(forward.alpha, forward.beta, strict=True),
-        key=lambda ab: -abs(ab[0]) / max(ab[1], abs(ab[0]), np.finfo(float).tiny),
+        key=lambda ab: -_modulus_ratio(complex(ab[0]), complex(ab[1])),
     )
     pairs_backward = sorted(
         ((complex(b), complex(a)) for a, b in zip(backward.alpha, backward.beta, strict=True)),
-        key=lambda ab: abs(ab[0]) / max(abs(ab[1]), abs(ab[0]), np.finfo(float).tiny),
+        key=lambda ab: _modulus_ratio(ab[0], ab[1]),
     )
 
     def value(alpha: complex, beta: complex) -> complex:
@@ -554,6 +615,10 @@ class TransferFunction:
     """0.0 for a continuous model, else the sampling period in seconds."""
     output_name: str
     input_name: str
+    scaled_gain: tuple[float, int] | None = field(default=None, repr=False)
+    """K as (mantissa, exponent), K = mantissa 2^exponent, where K itself lies beyond the
+    doubles (``gain`` is then infinite): :meth:`__call__` evaluates G from it. None when
+    ``gain`` is K."""
 
     @property
     def variable(self) -> str:
@@ -571,20 +636,24 @@ class TransferFunction:
         return _factors(self.poles, self.dt)
 
     def __call__(self, s: complex | ComplexArray) -> complex | ComplexArray:
-        """G at ``s`` (or at z for a discrete model), from the factored form."""
+        """G at ``s`` (or at z for a discrete model), from the factored form.
+
+        K Π(s - z_i) / Π(s - p_j) is formed as a mantissa and a power of two, renormalised
+        after each factor (a zero's, then a pole's, by increasing modulus), and scaled once
+        at the end: roots of 1e200 make the products of the numerator and of the denominator
+        overflow where their ratio does not, and a K of 1e450 beside poles of 1e150 gives a
+        G of 1e300. A G beyond the doubles is infinite, with a NumericalOverflowWarning; one
+        below them rounds to 0 (or a subnormal), as a product of doubles does."""
         value = np.asarray(s, dtype=np.complex128)
-        # Each zero's factor divided by a pole's, the roots paired by size, so that the
-        # partial products stay near the result's size (roots of 1e200: the products of the
-        # numerator and of the denominator each overflow, their ratio does not).
-        result = np.full(value.shape, complex(self.gain), dtype=np.complex128)
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
-            zeros = self.zeros[np.argsort(np.abs(self.zeros))]
-            poles = self.poles[np.argsort(np.abs(self.poles))]
-            for k in range(max(zeros.size, poles.size)):
-                if k < zeros.size:
-                    result = result * (value - zeros[k])
-                if k < poles.size:
-                    result = result / (value - poles[k])
+        points = value.reshape(-1)
+        k, e = self.scaled_gain if self.scaled_gain is not None else math.frexp(self.gain)
+        mantissa = np.full(points.shape, complex(k), dtype=np.complex128)
+        exponent = np.full(points.shape, e, dtype=np.int64)
+        m, power = _scaled_factored(mantissa, exponent, points, self.zeros, self.poles)
+        flat = np.empty(points.shape, dtype=np.complex128)
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is warned of below
+            flat.real, flat.imag = np.ldexp(m.real, power), np.ldexp(m.imag, power)
+        result = flat.reshape(value.shape)
         if not np.all(np.isfinite(result)) and np.all(np.isfinite(value)):
             warnings.warn(
                 "the result overflowed double precision: G is infinite or NaN (at a pole, or "
@@ -619,8 +688,8 @@ class TransferFunction:
         return "\n".join(lines)
 
 
-def _evaluation_point(roots: ComplexArray, dt: float) -> tuple[float, complex]:
-    """A frequency ω whose point s = jω (z = e^{jω dt}) is far from every root."""
+def _evaluation_point(roots: ComplexArray, dt: float) -> complex:
+    """A point s = jω (z = e^{jω dt}) far from every root."""
     if dt:
         candidates = np.linspace(0.05, 0.95, 19) * math.pi / dt
         points = np.exp(1j * candidates * dt)
@@ -649,7 +718,7 @@ def _evaluation_point(roots: ComplexArray, dt: float) -> tuple[float, complex]:
             )
         distance = np.nan_to_num(distance, nan=np.inf)
         best = int(np.argmax(distance))
-    return float(candidates[best]), complex(points[best])
+    return complex(points[best])
 
 
 def _single(key: SignalSelection | None, names: tuple[str, ...], what: str) -> int:
@@ -665,62 +734,239 @@ def _single(key: SignalSelection | None, names: tuple[str, ...], what: str) -> i
     return indices[0]
 
 
-def _scaled_response(channel: StateSpace, omega: float, dt: float) -> tuple[complex, int]:
-    """(g, k) with G(jω) = 2^k g (G(e^{jω dt}) for a discrete model): the response of the model
-    with C and D divided by the power of two of the largest of them, and B and D by that of
-    the largest of B and the scaled D, so that large B and C (1e149) at a point near tiny
-    poles (1e-300) do not overflow where G does not in scaled form."""
-    A, B, C, D = channel.A, channel.B, channel.C, channel.D
-    # The dynamic part C (jωI - A)^-1 B with C and B each scaled to unit size, and D added
-    # afterwards at a common power of two: scaling D with C (C of 1e299 beside D of 1e-151)
-    # underflowed D to 0 and gave a zero gain for G = D.
-    k_out = int(_exponents(np.array([float(np.abs(C).max(initial=0.0))]))[0])
-    k_in = int(_exponents(np.array([float(np.abs(B).max(initial=0.0))]))[0])
-    with warnings.catch_warnings():
-        # An overflow of the scaled response is warned of by _gain, as the gain's.
-        warnings.simplefilter("ignore", NumericalOverflowWarning)
-        dynamic = _core.frequency_response(
-            A,
-            np.ldexp(B, -k_in),
-            np.ldexp(C, -k_out),
-            np.zeros((1, 1)),
-            np.array([omega]),
-            dt or None,
-        )
-    r, e = complex(dynamic[0, 0, 0]), k_out + k_in
-    d = float(D[0, 0])
-    if d == 0.0 or not (math.isfinite(r.real) and math.isfinite(r.imag)):
-        return r, e
-    size_r = math.frexp(max(abs(r.real), abs(r.imag)))[1] + e if r != 0 else -(10**9)
-    common = max(math.frexp(d)[1], size_r)
-    g = complex(
-        math.ldexp(d, -common) + math.ldexp(r.real, e - common), math.ldexp(r.imag, e - common)
+def _renormalized(values: ComplexArray, exponents: NDArray[np.int64]) -> None:
+    """Bring each complex value to a largest part in [1/2, 1) by a power of two, in place,
+    adding that power to its exponent (a zero or non-finite value is left as it is)."""
+    parts = np.maximum(np.abs(values.real), np.abs(values.imag))
+    _, e = np.frexp(parts)
+    e = np.where((parts > 0.0) & np.isfinite(parts), e, 0).astype(np.int64)
+    values.real, values.imag = np.ldexp(values.real, -e), np.ldexp(values.imag, -e)
+    exponents += e
+
+
+def _scaled_differences(points: ComplexArray, root: complex) -> tuple[ComplexArray, int]:
+    """(d, q) with points - root = 2^q d, formed after scaling both by 2^-q, q the exponent
+    of the largest part among them: the difference of two numbers near ±1e308 stays finite."""
+    largest = max(
+        float(np.max(np.abs(points.real), initial=0.0)),
+        float(np.max(np.abs(points.imag), initial=0.0)),
+        abs(root.real),
+        abs(root.imag),
     )
-    return g, common
+    q = math.frexp(largest)[1] if 0.0 < largest < math.inf else 0
+    scaled_points = _scaled_by_power_of_two(points, -q)
+    scaled_root = _scaled_by_power_of_two(np.array([root]), -q)[0]
+    with np.errstate(invalid="ignore", over="ignore"):  # an infinite root: warned of by callers
+        return scaled_points - scaled_root, q
+
+
+def _scaled_factored(
+    mantissa: ComplexArray,
+    exponent: NDArray[np.int64],
+    points: ComplexArray,
+    multiply: ComplexArray,
+    divide: ComplexArray,
+) -> tuple[ComplexArray, NDArray[np.int64]]:
+    """(m, e) with m 2^e = mantissa 2^exponent Π(points - multiply_i) / Π(points - divide_j)
+    at each point, the product renormalised after every factor (each factor's difference
+    itself formed scaled, :func:`_scaled_differences`), so that nothing overflows or
+    underflows where the result, as a mantissa and a power of two, is exact to (2 k + 1) u
+    for k factors. The roots are taken by increasing modulus, a zero's factor then a pole's."""
+    m = np.array(mantissa, dtype=np.complex128)
+    e = np.array(exponent, dtype=np.int64)
+    _renormalized(m, e)
+    with np.errstate(over="ignore"):
+        multiply = multiply[np.argsort(np.abs(multiply))]
+        divide = divide[np.argsort(np.abs(divide))]
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+        for k in range(max(multiply.size, divide.size)):
+            if k < multiply.size:
+                d, q = _scaled_differences(points, complex(multiply[k]))
+                m = m * d
+                e = e + q
+                _renormalized(m, e)
+            if k < divide.size:
+                d, q = _scaled_differences(points, complex(divide[k]))
+                m = m / d
+                e = e - q
+                _renormalized(m, e)
+    return m, e
+
+
+def _scaled_poly(roots: ComplexArray, mantissa: float, exponent: int) -> FloatArray:
+    """mantissa 2^exponent Π(s - root), coefficients highest power first, formed with the
+    roots scaled by 2^-q (q the exponent of the largest part of a root) and coefficient k
+    scaled back by 2^(q k) once: the polynomial of roots near 1e200 (or 1e-200) has
+    coefficients beyond (or below) the doubles only where the coefficient itself is, and a
+    gain of 1e-300 with zeros of 1e200 has a finite numerator."""
+    if roots.size == 0:
+        with np.errstate(over="ignore"):
+            return np.array([np.ldexp(mantissa, exponent)])
+    largest = max(float(np.max(np.abs(roots.real))), float(np.max(np.abs(roots.imag))))
+    if not math.isfinite(largest):
+        with np.errstate(over="ignore", invalid="ignore"):
+            coefficients = np.real(np.poly(roots)) * mantissa
+            return np.asarray(np.ldexp(coefficients, exponent), dtype=np.float64)
+    q = math.frexp(largest)[1] if largest > 0.0 else 0
+    powers = exponent + q * np.arange(roots.size + 1)
+    with np.errstate(over="ignore", invalid="ignore"):  # an infinite gain: warned of by callers
+        coefficients = np.real(np.poly(_scaled_by_power_of_two(roots, -q))) * mantissa
+        return np.asarray(np.ldexp(coefficients, powers), dtype=np.float64)
+
+
+def _scaled_sum(
+    mantissas: ComplexArray, exponents: NDArray[np.int64], axis: int
+) -> tuple[ComplexArray, NDArray[np.int64]]:
+    """The sums along ``axis`` of the values mantissa 2^exponent, each as a renormalised
+    mantissa and a power of two: the terms are brought to the exponent of the largest
+    (those far below it lose their low bits, as in floating-point addition) and added."""
+    nonzero = mantissas != 0
+    common = np.max(np.where(nonzero, exponents, np.iinfo(np.int64).min), axis=axis)
+    common = np.where(np.any(nonzero, axis=axis), common, 0)
+    shift = np.where(nonzero, exponents - np.expand_dims(common, axis), 0)
+    aligned = np.empty(mantissas.shape, dtype=np.complex128)
+    with np.errstate(under="ignore"):
+        aligned.real, aligned.imag = (
+            np.ldexp(mantissas.real, shift),
+            np.ldexp(mantissas.imag, shift),
+        )
+    total = np.asarray(np.sum(aligned, axis=axis), dtype=np.complex128)
+    power = np.asarray(common, dtype=np.int64)
+    _renormalized(total, power)
+    return total, power
+
+
+def _scaled_solve(
+    M: ComplexArray, b: ComplexArray
+) -> tuple[ComplexArray, NDArray[np.int64]] | None:
+    """The solution of M x = b by Gaussian elimination with partial pivoting, every value
+    held as a mantissa (largest part in [1/2, 1)) and a power of two of its own: the
+    rounding of each operation is that of double precision (backward stable as LAPACK's
+    LU), and nothing overflows or underflows, whatever the spread of the solution's entries
+    (a chain of couplings of 1e-200 makes them 1, 1e-200, 1e-400, ...). None if a pivot is
+    zero (M singular)."""
+    n = M.shape[0]
+    m = np.array(M, dtype=np.complex128)
+    e = np.zeros(m.shape, dtype=np.int64)
+    _renormalized(m, e)
+    bm = np.array(b, dtype=np.complex128)
+    be = np.zeros(bm.shape, dtype=np.int64)
+    _renormalized(bm, be)
+    for k in range(n):
+        parts = np.maximum(np.abs(m[k:, k].real), np.abs(m[k:, k].imag))
+        if not np.any(parts):
+            return None
+        with np.errstate(divide="ignore"):
+            size = np.where(parts > 0.0, e[k:, k] + np.log2(parts), -np.inf)
+        pivot = k + int(np.argmax(size))
+        for a in (m, e):
+            a[[k, pivot]] = a[[pivot, k]]
+        for a in (bm, be):
+            a[[k, pivot]] = a[[pivot, k]]
+        if k == n - 1:
+            break
+        lm = m[k + 1 :, k] / m[k, k]
+        le = e[k + 1 :, k] - e[k, k]
+        _renormalized(lm, le)
+        # Row i ← row i - l_i row k, on the columns after k and on b.
+        product_m = -lm[:, None] * m[k, k + 1 :][None, :]
+        product_e = le[:, None] + e[k, k + 1 :][None, :]
+        stacked_m = np.stack([m[k + 1 :, k + 1 :], product_m])
+        stacked_e = np.stack([e[k + 1 :, k + 1 :], product_e])
+        m[k + 1 :, k + 1 :], e[k + 1 :, k + 1 :] = _scaled_sum(stacked_m, stacked_e, 0)
+        m[k + 1 :, k], e[k + 1 :, k] = 0.0, 0
+        stacked_m = np.stack([bm[k + 1 :], -lm * bm[k]])
+        stacked_e = np.stack([be[k + 1 :], le + be[k]])
+        bm[k + 1 :], be[k + 1 :] = _scaled_sum(stacked_m, stacked_e, 0)
+    xm = np.zeros(n, dtype=np.complex128)
+    xe = np.zeros(n, dtype=np.int64)
+    for i in range(n - 1, -1, -1):
+        terms_m = np.concatenate([[bm[i]], -m[i, i + 1 :] * xm[i + 1 :]])
+        terms_e = np.concatenate([[be[i]], e[i, i + 1 :] + xe[i + 1 :]])
+        total_m, total_e = _scaled_sum(terms_m, terms_e, 0)
+        value = np.array([complex(total_m) / m[i, i]])
+        power = np.array([int(total_e) - int(e[i, i])], dtype=np.int64)
+        _renormalized(value, power)
+        xm[i], xe[i] = value[0], power[0]
+    return xm, xe
+
+
+def _scaled_response(channel: StateSpace, point: complex) -> tuple[complex, int]:
+    """(g, k) with G(point) = 2^k g, g of largest part in [1/2, 1) (or 0), for a channel
+    G(s) = C (sI - A)⁻¹ B + D (s = z for a discrete model): (point I - A) x = B solved with
+    every value as a mantissa and a power of two (:func:`_scaled_solve`), C x summed
+    likewise, and D added at the common power of two. G is then exact to the rounding of a
+    backward stable solve wherever it, as a mantissa and a power of two, is: the dynamic part
+    of a chain of integrators with couplings of 1e-200, and B and C of 1e100 and 1e200, is
+    1e-100 where its solution in doubles passes through 1e-400 (0); a D of 1e-151 beside a
+    C of 1e299 is not lost to the scaling of C."""
+    A, B, C, D = channel.A, channel.B, channel.C, channel.D
+    n = A.shape[0]
+    terms_m = np.array([complex(D[0, 0])])
+    terms_e = np.zeros(1, dtype=np.int64)
+    if n and np.any(B) and np.any(C):
+        M = np.asarray(point * np.eye(n) - A, dtype=np.complex128)
+        solution = _scaled_solve(M, B[:, 0].astype(np.complex128))
+        if solution is not None:
+            xm, xe = solution
+            cm = C[0].astype(np.complex128)
+            ce = np.zeros(n, dtype=np.int64)
+            _renormalized(cm, ce)
+            terms_m = np.concatenate([terms_m, cm * xm])
+            terms_e = np.concatenate([terms_e, ce + xe])
+    _renormalized(terms_m, terms_e)
+    total_m, total_e = _scaled_sum(terms_m, terms_e, 0)
+    return complex(total_m), int(total_e)
 
 
 def _gain(
     response: complex, exponent: int, point: complex, zeros: ComplexArray, poles: ComplexArray
-) -> float:
-    """K = G(point) Π(point - p_j) / Π(point - z_i), with G(point) = 2^exponent response, as
-    the exponential of a sum of logarithms:
-    the products of many large (or small) factors overflow (or underflow) where K does not
+) -> tuple[float, int]:
+    """(k, e) with the gain K = 2^e k = G(point) Π(point - p_j) / Π(point - z_i), G(point) =
+    2^exponent response, as a mantissa and a power of two (:func:`_scaled_factored`): the
+    products of many large (or small) factors overflow (or underflow) where K does not
     (1/(s + 1e-151) + 1/(s + 2e-151) + 1/(s + 3e-151) is 3/s: K = 3 from products of sizes
-    1e-302 and 1e-453). A K beyond the range of doubles is infinite, with a warning."""
+    1e-302 and 1e-453), and K itself may lie beyond the doubles where G does not. K is real:
+    the imaginary part of the product is rounding. (inf, 0) where a root is beyond the
+    doubles."""
     if response == 0.0:
-        return 0.0
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        terms = np.concatenate([[np.log(response)], np.log(point - poles), -np.log(point - zeros)])
-    if not np.all(np.isfinite(terms)):  # G(point) overflowed even scaled
-        gain = math.inf
-        finite_or_warn(np.array([gain]), "the gain")
-        return gain
-    log_size = float(np.sum(terms.real)) + exponent * math.log(2.0)
-    phase = float(np.sum(terms.imag))
-    with np.errstate(over="ignore"):
-        gain = float(np.exp(log_size) * math.cos(phase))
-    finite_or_warn(np.array([gain]), "the gain")
-    return gain
+        return 0.0, 0
+    m, e = _scaled_factored(
+        np.array([response]), np.array([exponent]), np.array([point]), poles, zeros
+    )
+    mantissa = float(m[0].real)
+    if not math.isfinite(mantissa):
+        return math.inf, 0
+    fraction, shift = math.frexp(mantissa)
+    return fraction, int(e[0]) + shift
+
+
+def _roots_and_gain(channel: StateSpace) -> tuple[ComplexArray, ComplexArray, float, int]:
+    """(poles, zeros, k, e) of a single-input, single-output channel G = K Π(s - z)/Π(s - p)
+    (in z for a discrete model) with K = k 2^e as a mantissa and a power of two, exact where
+    K itself is beyond the doubles; (poles, no zeros, 0, 0) for a zero channel.
+
+    The poles are the eigenvalues of A, the zeros those of the channel's pencil; K = D where
+    D is nonzero (G -> D as s -> inf: evaluated at a point, K carried the zeros' rounding,
+    1e-10 for zeros at 1 and 1e-149 beside poles at 1e-150), else G at a point away from every
+    root times Π(point - p)/Π(point - z), each factor renormalised (:func:`_gain`)."""
+    poles = (
+        _conjugate_clean(_core.eigenvalues(channel.A))
+        if channel.n_states
+        else np.zeros(0, np.complex128)
+    )
+    reduced = _pencil_zeros(channel, None)
+    d = float(channel.D[0, 0])
+    if d != 0.0 and reduced.zeros.size == channel.n_states:
+        mantissa, exponent = math.frexp(d)
+        return poles, reduced.zeros, mantissa, exponent
+    if reduced.normal_rank == 0:
+        return poles, np.zeros(0, np.complex128), 0.0, 0
+    point = _evaluation_point(np.concatenate([reduced.zeros, poles]), period(channel) or 0.0)
+    mantissa, exponent = _gain(*_scaled_response(channel, point), point, reduced.zeros, poles)
+    if mantissa == 0.0:
+        return poles, np.zeros(0, np.complex128), 0.0, 0
+    return poles, reduced.zeros, mantissa, exponent
 
 
 def transfer_function(
@@ -764,34 +1010,34 @@ def transfer_function(
     j = _single(input, model.input_names, "input")
     channel = model[[i], [j]]
     dt = period(model) if model.is_discrete else 0.0
-    poles = (
-        _conjugate_clean(_core.eigenvalues(channel.A))
-        if channel.n_states
-        else np.zeros(0, np.complex128)
-    )
-    reduced = _pencil_zeros(channel, None)
-    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is warned of below
-        denominator = np.real(np.poly(poles)) if poles.size else np.ones(1)
+    poles, zeros, mantissa, exponent = _roots_and_gain(channel)
+    denominator = _scaled_poly(poles, 1.0, 0)
     finite_or_warn(denominator, "the denominator det(sI - A)")
-    if reduced.normal_rank == 0:
+    with np.errstate(over="ignore"):
+        gain = float(np.ldexp(mantissa, exponent))
+    if mantissa != 0.0 and gain == 0.0:
+        # Below the doubles (subnormals included): the channel is returned as zero, numerator,
+        # gain and zeros alike, not as a gain of 0 beside the zeros of a nonzero numerator.
+        size = (math.log2(abs(mantissa)) + exponent) * math.log10(2.0)
+        warnings.warn(
+            f"the gain K of {model.output_names[i]}/{model.input_names[j]} is about "
+            f"10^{size:.1f}, below the range of doubles: the transfer function is returned "
+            "as zero (numerator [0.], no zeros)",
+            NumericalUnderflowWarning,
+            stacklevel=2,
+        )
         zeros = np.zeros(0, np.complex128)
-        gain = 0.0
-        numerator = np.zeros(1)
-    else:
-        zeros = reduced.zeros
-        omega, point = _evaluation_point(np.concatenate([zeros, poles]), dt)
-        response, exponent = _scaled_response(channel, omega, dt)
-        gain = _gain(response, exponent, point, zeros, poles)
-        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is warned of below
-            numerator = gain * np.real(np.poly(zeros)) if zeros.size else np.array([gain])
-        finite_or_warn(numerator, "the numerator")
+        gain = 0.0  # not -0.0
+    numerator = _scaled_poly(zeros, mantissa, exponent) if gain != 0.0 else np.zeros(1)
+    finite_or_warn(numerator, "the numerator")
     return TransferFunction(
-        numerator=np.asarray(numerator, dtype=np.float64),
-        denominator=np.asarray(denominator, dtype=np.float64),
+        numerator=numerator,
+        denominator=denominator,
         zeros=zeros,
         poles=poles,
         gain=gain,
         dt=dt,
         output_name=model.output_names[i],
         input_name=model.input_names[j],
+        scaled_gain=(mantissa, exponent) if math.isinf(gain) else None,
     )

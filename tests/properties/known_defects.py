@@ -72,3 +72,80 @@ ZEROS_DROPPED = known_defect(
 
 def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
+
+
+def _near_proportional_pencil(args: dict[str, Any]) -> bool:
+    """A within a relative 1e-3 of c B for the c of least squares (B nonzero, same shape)."""
+    A, B = (np.asarray(args[key], dtype=float) for key in ("A", "B"))
+    if A.shape != B.shape or A.ndim != 2 or not np.any(B) or not np.any(A):
+        return False
+    scale = float(np.max(np.abs(B)))
+    a, b = A / float(np.max(np.abs(A))), B / scale
+    c = float(np.sum(a * b) / np.sum(b * b))
+    return float(np.linalg.norm(a - c * b)) <= 1e-3 * float(np.linalg.norm(a))
+
+
+QZ_NEAR_PROPORTIONAL = known_defect(
+    "qz-near-proportional-pencil",
+    {"qz"},
+    "qz of a pencil near a proportional one, A = c B + E with ||E|| small beside ||A|| (all "
+    "eigenvalues clustered about c): the core's QZ iteration loses backward stability, "
+    "||Q AA Z^T - A|| / ||A|| = 9.3e-10 for A the float32 rounding of a 2 x 2 B (scipy's "
+    "dgges: 5.8e-16), up to 1e-9 for E of 1e-6, and for E of 1e-12 it often fails to "
+    "converge (ConvergenceError in 23 of 40 random 3 x 3 pencils); found through the "
+    "big-endian float32 presentation of A = B",
+    _near_proportional_pencil,
+    "Z^T !=",
+)
+
+
+def _all_infinite_pencil(args: dict[str, Any]) -> bool:
+    """B nonzero and A well conditioned with A^-1 B nilpotent to rounding (every generalized
+    eigenvalue of A - λB infinite: det(A - λB) is constant)."""
+    A, B = (np.asarray(args[key], dtype=float) for key in ("A", "B"))
+    if A.shape != B.shape or A.ndim != 2 or A.shape[0] < 2 or not np.any(B):
+        return False
+    with np.errstate(all="ignore"):
+        if not np.isfinite(np.linalg.cond(A)) or np.linalg.cond(A) > 1e12:
+            return False
+        M = np.linalg.solve(A, B)
+        radius = float(np.max(np.abs(np.linalg.eigvals(M))))
+    return radius <= 1e-2 * float(np.linalg.norm(M))
+
+
+QZ_ALL_INFINITE = known_defect(
+    "qz-all-infinite-pencil",
+    {"qz"},
+    "qz of a pencil whose eigenvalues are all infinite, A nonsingular and B = H N H^T (N "
+    "strictly upper triangular, H orthogonal): the core's deflation of infinite eigenvalues "
+    "loses backward stability, ||Q BB Z^T - B|| / ||B|| = 3e-12 on a 3 x 3 example and up to "
+    "2.7e-10 in 40 of 150 random ones of orders 3 to 5 (scipy's dgges: at most 3.1e-15); B "
+    "already triangular, or B nilpotent beside a random A, is exact",
+    _all_infinite_pencil,
+    "Z^T !=",
+)
+
+
+def _tiny_entry_beside_a_huge_frequency(args: dict[str, Any]) -> bool:
+    """A nonzero entry of A below 2^-1022 times the largest frequency (their ratio subnormal
+    or zero)."""
+    models = _models_of(args)
+    omega = args.get("omega")
+    if not models or omega is None:
+        return False
+    A = models[0][0]
+    entries = np.abs(A[A != 0])
+    largest = float(np.max(np.abs(np.asarray(omega, dtype=float)), initial=0.0))
+    return bool(entries.size) and float(np.min(entries)) < np.finfo(float).tiny * largest
+
+
+FREQUENCY_SUBNORMAL_RATIO = known_defect(
+    "frequency-response-subnormal-ratio",
+    {"frequency_response", "bode"},
+    "the core's frequency_response of A = [[a]] with a nonzero and |a| / ω below the normal "
+    "doubles returns 0 where G(jω) = b c / (jω - a) is a normal double: a = 1.26e-151, "
+    "B = 0.126, C = 1 at ω = 1e200 gives 0 for -1.26e-201j (a = 1e-200 at ω = 1e150: 0 for "
+    "-1e-150j); a = 0, or a ratio in the normal range, is right",
+    _tiny_entry_beside_a_huge_frequency,
+    "G(j",
+)

@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 import aerocontrol
 
 from .harness import Arg, Warned, exercise, plain
-from .oracles import SLACK, TINY, U, finite, norm, quietly, silenced
+from .known_defects import FREQUENCY_SUBNORMAL_RATIO
+from .oracles import SLACK, TINY, U, eigenvalue_conditions, finite, norm, quietly, silenced
 from .oracles import condition as condition_number
 from .strategies import (
     ALL_PRESENTATIONS,
@@ -137,9 +138,31 @@ def _grid_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
     # well-conditioned slowest mode, and within sqrt(u) ||A||_F for a near-defective one close
     # to zero (whose magnitude neither solver determines better).
     allowed = 1e-6 * low + 0.1 * np.sqrt(np.finfo(float).eps) * float(np.linalg.norm(A))
-    assert abs(result[0] - low) <= allowed, f"starts at {result[0]}, not {low}"
+    # A defective eigenvalue at 0 (a Jordan block of order k) is determined only to
+    # u^(1/k) ||A||: one solver may return it as 0 (left out of the grid's range) and the
+    # other as 1.4e-8 (the grid then starts at 1.4e-9: a companion matrix of s^2 (s + 1)(s + 2),
+    # where numpy's eigenvalues are exactly 0). Such a start is allowed where numpy also has
+    # an eigenvalue within that uncertainty of 0.
+    with silenced():
+        uncertainty = np.finfo(float).eps ** (1.0 / max(len(A), 1)) * float(np.linalg.norm(A))
+    near_zero = bool(np.any(magnitudes <= uncertainty)) and 10 * result[0] <= uncertainty
+    # And each mode is known to its condition number times its backward error (a 9 x 9 A
+    # whose slowest |λ| the core and numpy give 5.6e-6 apart relatively); a near-defective
+    # one (κ u above 1e-8: the companion matrix of a root of multiplicity 4) only to the
+    # Hölder bound u^(1/n) ||A|| (30.0138 for 30, ten times its largest root).
+    spread = 0.0
+    if len(A):
+        with silenced():
+            _, conditions = eigenvalue_conditions(A)
+            worst = float(np.max(conditions[np.isfinite(conditions)], initial=np.inf))
+            spread = SLACK * len(A) * U * float(np.linalg.norm(A)) * min(worst, 1e300)
+            if not worst * U <= 1e-8:
+                spread += uncertainty
+            allowed += spread / 10
+    assert abs(result[0] - low) <= allowed or near_zero, f"starts at {result[0]}, not {low}"
     if count > 1:
-        assert abs(result[-1] / min(high, 1e308) - 1) < 1e-6, f"ends at {result[-1]}"
+        end = min(high, 1e308)
+        assert abs(result[-1] - end) <= 1e-6 * end + 10 * spread, f"ends at {result[-1]}"
 
 
 @given(st.data())
@@ -180,3 +203,33 @@ def test_frequency_extreme_scale(example: str) -> None:
         {"sys": plain(sys), "omega": plain(omega)},
         _frequency_oracle,
     )
+
+
+def test_regression_grid_oracle_of_a_defective_zero_eigenvalue() -> None:
+    """The companion matrix of s^2 (s + 1)(s + 2): numpy's eigenvalues include 0 twice
+    exactly, the core's ±1.4e-8 (within sqrt(u) ||A|| of the defective eigenvalue): the grid
+    began at 1.4e-9 and the oracle, which left out numpy's zeros, wanted 0.1."""
+    A = np.array(
+        [[-3.0, -2.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]]
+    )
+    B = np.array([[0.1257302210933933], [-0.1321048632913019], [0.6404226504432821], [0.1049]])
+    model = (A, B, B.T.copy(), np.zeros((1, 1)))
+    outcome = exercise(
+        "default_frequency_grid",
+        aerocontrol.default_frequency_grid,
+        {"sys": plain(model), "count": plain(1000)},
+        _grid_oracle,
+    )
+    assert outcome.result[0] < 1e-6 and outcome.result[-1] == pytest.approx(20.0, rel=1e-6)
+
+
+@pytest.mark.xfail(strict=True, reason="frequency-response-subnormal-ratio: core")
+def test_known_defect_frequency_response_of_a_tiny_pole_at_a_huge_frequency() -> None:
+    model = (np.array([[1.257302210933933e-151]]), np.array([[0.1257302210933933]]))
+    with FREQUENCY_SUBNORMAL_RATIO.reproducing():
+        exercise(
+            "frequency_response",
+            aerocontrol.frequency_response,
+            {"sys": plain(model), "omega": plain(np.array([0.0, 1e200, 1e300]))},
+            _frequency_oracle,
+        )

@@ -13,6 +13,7 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -20,7 +21,18 @@ import aerocontrol
 from aerocontrol.responses import MAX_DEFAULT_SAMPLES
 
 from .harness import Arg, Warned, exercise, plain
-from .oracles import SLACK, TINY, U, exact_response, finite, norm, quietly, row_norms, silenced
+from .oracles import (
+    SLACK,
+    TINY,
+    U,
+    exact_response,
+    expm_long,
+    finite,
+    norm,
+    quietly,
+    row_norms,
+    silenced,
+)
 from .oracles import condition as condition_number
 from .strategies import (
     ALL_PRESENTATIONS,
@@ -488,3 +500,33 @@ def test_as_state_space(data: st.DataObject) -> None:
     )
     if kind in ("three matrices", "number", "matrix"):
         assert outcome.error is not None, f"{kind} was taken for a model"
+
+
+# ----- inputs a campaign found ------------------------------------------------------------------
+
+
+def test_regression_initial_response_oracle_of_a_huge_off_diagonal() -> None:
+    """A = [[0, 0], [9e15, 2]] from x0 = (0.126, -0.132) over one second: the long double
+    reference squared I + F 55 times and rounded the diagonal 1 + 2^-54 of e^(A / 2^55) to a
+    relative 1e-3, so the reference was 1.1e6 off in 3.6e15 and blamed aerocontrol's answer
+    (0.006 ulp from mpmath's). The reference now squares F = e^Y - I, and both it and the
+    response are checked against the closed form e^(At) = [[1, 0], [c (e^(2t) - 1)/2,
+    e^(2t)]], evaluated in 50 digits (mpmath)."""
+    mpmath = pytest.importorskip("mpmath")
+    c = 9.007199254740994e15
+    A = np.array([[0.0, 0.0], [c, 2.0]])
+    B = np.array([[0.1257302210933933], [-0.1321048632913019]])
+    x0 = np.array([0.1257302210933933, -0.1321048632913019])
+    with mpmath.workdps(50):
+        e2 = mpmath.exp(2)
+        exact = [x0[0], mpmath.mpf(c) * (e2 - 1) / 2 * x0[0] + e2 * mpmath.mpf(x0[1])]
+        exact = np.array([float(v) for v in exact])
+    reference = (expm_long(A) @ x0.astype(np.longdouble)).astype(np.float64)
+    assert np.max(np.abs(reference - exact)) <= 4 * U * np.max(np.abs(exact))
+    outcome = exercise(
+        "initial_response",
+        aerocontrol.initial_response,
+        {"sys": plain((A, B)), "x0": plain(x0), "T": plain(np.array([0.0, 1.0]))},
+        _free_oracle("initial"),
+    )
+    assert np.max(np.abs(outcome.result.x[-1] - exact)) <= 4 * U * np.max(np.abs(exact))

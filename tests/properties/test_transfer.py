@@ -25,6 +25,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import aerocontrol
+from aerocontrol.exceptions import NumericalUnderflowWarning
 
 from .harness import Warned, exercise, plain
 from .known_defects import ZEROS_DROPPED
@@ -259,7 +260,20 @@ def _transfer_oracle(general: bool) -> Any:
             assert np.array_equal(result.zeros, zeros), "the zeros are not the channel's"
             assert result.numerator[0] == result.gain
         else:
-            assert np.array_equal(result.numerator, [0.0])
+            # A zero channel, or one whose gain is below the doubles (warned of): zero
+            # throughout, never a gain of 0 beside the zeros of a nonzero numerator.
+            assert np.array_equal(result.numerator, [0.0]), f"gain 0, numerator {result.numerator}"
+            assert result.zeros.size == 0, f"gain 0 beside the zeros {result.zeros}"
+            assert math.copysign(1.0, result.gain) == 1.0, "gain -0.0"
+            if NumericalUnderflowWarning not in warned:
+                value = response_at(A, b, c, d, POINTS[1])
+                if value is not None:
+                    G, size = value
+                    assert_within(
+                        abs(G[0, 0]), SLACK * max(n, 1) * (U * size + TINY), "a gain of 0"
+                    )
+        if NumericalUnderflowWarning in warned:
+            assert result.gain == 0.0, "an underflow warning beside a nonzero gain"
         if not finite(A, b, c, d, result.poles, result.numerator, result.denominator):
             return
         assert_spectrum(A, result.poles, "the poles")
@@ -518,3 +532,29 @@ def test_regression_zeros_backward_error_with_a_given_tol() -> None:
     # Without tol the zero is resolved at the model's own scale.
     zeros = aerocontrol.transmission_zeros(model)
     np.testing.assert_allclose(zeros.real, [1.3727543e-151], rtol=1e-7)
+
+
+def test_regression_transfer_gain_below_the_doubles() -> None:
+    """The fuzz input: A of 1e149, B of 1e-151, C of 1e-301, D = 0: K = C B = 1.5e-452, which
+    came back as gain 0 beside the numerator [0, -0] (and, where the channel has a finite
+    zero, beside that zero), with no warning. The channel is now zero throughout, with a
+    NumericalUnderflowWarning."""
+    model = (
+        np.array(
+            [
+                [1.2573022109339329e149, -1.3210486329130188e149],
+                [6.4042265044328201e149, 1.0490011715303971e149],
+            ]
+        ),
+        np.array([[1.2573022109339330e-151], [-1.3210486329130188e-151]]),
+        np.array([[1.257302210933933e-301, -1.321048632913019e-301]]),
+        np.zeros((1, 1)),
+    )
+    outcome = exercise(
+        "transfer_function",
+        lambda sys, output, input: aerocontrol.transfer_function(sys, output, input),
+        {"sys": plain(model), "output": plain(None), "input": plain(None)},
+        _transfer_oracle(False),
+    )
+    assert outcome.warned == (NumericalUnderflowWarning,)
+    assert outcome.result.numerator.tolist() == [0.0] and outcome.result.zeros.size == 0
