@@ -227,6 +227,30 @@ def test_an_inconsistent_count_is_refused(monkeypatch: pytest.MonkeyPatch) -> No
         nyquist(aerocontrol.zpk([], [-1.0, -1.0, -1.0], 4.0))
 
 
+def test_a_count_that_disagrees_once_is_retried_on_a_finer_contour(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    calls: list[int] = []
+    winding = loops._Contour.winding
+
+    def wrong_once(self: loops._Contour, centre: complex) -> float:
+        calls.append(self.values.size)
+        return 3.0 if len(calls) == 1 else winding(self, centre)
+
+    monkeypatch.setattr(loops._Contour, "winding", wrong_once)
+    r = nyquist(aerocontrol.zpk([], [0.0, -1.0, -2.0], 10.0))
+    assert r.encirclements == -2 and len(calls) == 2
+    assert calls[1] > calls[0]  # twice the points (and indentations 100 times smaller)
+    # The nearest other root of the origin is the open-loop pole -1: radius 1e-2, then 1e-4.
+    assert r.indentations[0][1] == pytest.approx(1e-4, rel=1e-12)
+
+
+def test_python_control_state_space_is_accepted() -> None:
+    loop = control.ss(control.tf([10.0], [1.0, 3.0, 3.0, 1.0]))
+    assert nyquist(loop).encirclements == -2
+    assert nichols(loop, [math.sqrt(3.0)]).phase_deg[0] == pytest.approx(-180.0, abs=1e-11)
+
+
 def _random_loop(rng: np.random.Generator, discrete: bool) -> aerocontrol.StateSpace:
     """A loop of order 1 to 6 with random real and complex poles (some unstable), in a random
     basis, random B, C and D, and a gain over three decades."""
