@@ -125,12 +125,16 @@ __all__ = [
     "DampingDesign",
     "DiskMargin",
     "DiskMargins",
+    "NicholsResponse",
+    "NyquistResponse",
     "RootLocus",
     "StabilityMargins",
     "best_damping_gain",
     "complementary_sensitivity",
     "disk_margins",
     "gain_for_damping",
+    "nichols",
+    "nyquist",
     "root_locus",
     "sensitivity",
     "stability_margins",
@@ -2262,3 +2266,806 @@ def gain_for_damping(
             stacklevel=2,
         )
     return DampingDesign(found, z, pole, poles)
+
+
+# ----- Nyquist and Nichols ------------------------------------------------------------------
+
+BoolArray = NDArray[np.bool_]
+IntArray = NDArray[np.int64]
+
+#: The widest turn (radians) of the curve about its centre (-1 for the Nyquist count, 0 for the
+#: Nichols phase) between neighbouring points of the contour; a wider step is bisected.
+MAX_TURN = math.pi / 8
+
+#: Rounds of bisection of the contour, and the most points it may reach.
+REFINE_ROUNDS = 40
+MAX_CONTOUR_POINTS = 100_000
+
+#: An indentation's radius as a fraction of the distance from the pole it avoids to the
+#: nearest other open- or closed-loop pole (or asked frequency).
+INDENT_FRACTION = 1e-2
+
+#: Points on each quarter turn of an indentation, per unit of the pole's multiplicity, before
+#: bisection.
+ARC_POINTS = 16
+
+#: Retries of a winding number that disagrees with P - Z, each with indentations a hundred
+#: times smaller and twice the points, before the count is refused.
+COUNT_RETRIES = 2
+
+
+def _asked_frequencies(omega: ArrayLike | None, dt: float) -> FloatArray | None:
+    """The caller's frequencies, checked by name and returned sorted without repeats."""
+    if omega is None:
+        return None
+    values = real_array(omega, "omega")
+    if values.ndim == 0:
+        values = values.reshape(1)
+    if values.ndim != 1 or values.size == 0:
+        raise ShapeError(
+            f"omega must be a non-empty 1-D array of frequencies (rad/s), got shape {values.shape}"
+        )
+    check_finite(values, "omega")
+    negative = np.flatnonzero(values < 0.0)
+    if negative.size:
+        i = int(negative[0])
+        raise InvalidArgumentError(
+            f"omega must be non-negative (the curve for ω < 0 is the mirror image of the curve "
+            f"for ω > 0), but omega[{i}] is {values[i]:g}"
+        )
+    if dt:
+        beyond = np.flatnonzero(values > math.pi / dt)
+        if beyond.size:
+            i = int(beyond[0])
+            raise InvalidArgumentError(
+                f"omega must not exceed the Nyquist frequency π/dt = {math.pi / dt:.6g} rad/s "
+                f"of the discrete loop, but omega[{i}] is {values[i]:.6g}"
+            )
+    return np.unique(values)
+
+
+def _boundary_tolerance(size: float, discrete: bool) -> float:
+    """How near the stability boundary a computed root may be and still be taken to lie on
+    it: √u times the size of its matrix (the error of an eigenvalue of a 2 x 2 Jordan block,
+    a double integrator, computed backward stably); at least √u for the unit circle."""
+    return math.sqrt(_EPS) * (max(size, 1.0) if discrete else size)
+
+
+def _on_boundary(roots: ComplexArray, discrete: bool, tolerance: float) -> BoolArray:
+    """Which roots lie on the imaginary axis (on the unit circle) to ``tolerance``."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        distance = np.abs(np.abs(roots) - 1.0) if discrete else np.abs(roots.real)
+    return np.asarray(distance <= tolerance, dtype=np.bool_)
+
+
+def _matrix_size(M: FloatArray) -> float:
+    """||M||_F, formed from M divided by its largest |entry| (the squares of entries below
+    1e-154 underflow: numpy's norm of a matrix of 1e-300 is 0), or that entry where the norm
+    overflows."""
+    largest = float(np.max(np.abs(M), initial=0.0))
+    if not (0.0 < largest < math.inf):
+        return largest
+    with np.errstate(over="ignore"):
+        size = largest * float(np.linalg.norm(M / largest))
+    return size if math.isfinite(size) else largest
+
+
+@dataclass(frozen=True)
+class _Indentation:
+    """A small half circle s = jω0 + ε e^{jφ} (z = e^{s dt}) to the right of open-loop poles
+    (for the Nichols phase, also zeros) on the imaginary axis (outside the unit circle)."""
+
+    frequency: float
+    """ω0 (rad/s), at least 0."""
+    radius: float
+    """ε (rad/s)."""
+    multiplicity: int
+    """The number of roots at jω0."""
+    low: float
+    """The first angle φ of the ω ≥ 0 half (0 for ω0 = 0, else -π/2)."""
+    high: float
+    """The last angle φ (0 for ω0 = π/dt, else π/2)."""
+
+
+def _indentations(
+    poles: ComplexArray,
+    clear_of: ComplexArray,
+    asked: FloatArray | None,
+    dt: float,
+    tolerance: float,
+    fraction: float,
+) -> list[_Indentation]:
+    """One indentation per distinct frequency of the roots ``poles`` on the boundary, of
+    radius ``fraction`` times the distance from its centre to the nearest other root of
+    ``clear_of`` (the open- and closed-loop poles, or the open loop's poles and zeros) or
+    asked frequency."""
+    if poles.size == 0:
+        return []
+    nyquist = math.pi / dt if dt else math.inf
+    w_tolerance = tolerance / dt if dt else tolerance
+    w = np.abs(np.angle(poles) / dt if dt else poles.imag)
+    w = np.sort(w)
+    groups = np.split(w, np.flatnonzero(np.diff(w) > 2.0 * w_tolerance) + 1)
+    result = []
+    for group in groups:
+        centre = float(np.mean(group))
+        spread = float(group[-1] - group[0])
+        if centre <= w_tolerance + spread:
+            centre = 0.0
+        elif dt and abs(centre - nyquist) <= w_tolerance + spread:
+            centre = nyquist
+        on_real_axis = centre == 0.0 or centre == nyquist
+        multiplicity = group.size if on_real_axis else max(group.size // 2, 1)
+        if dt:
+            point = complex(np.exp(1j * centre * dt))
+            with np.errstate(over="ignore", invalid="ignore"):
+                distances = _magnitude(clear_of - point) / dt
+        else:
+            with np.errstate(over="ignore", invalid="ignore"):
+                distances = _magnitude(clear_of - 1j * centre)
+        if asked is not None:
+            distances = np.concatenate([distances, np.abs(asked - centre)])
+        distances = distances[distances > 4.0 * w_tolerance + spread]
+        nearest = float(np.min(distances, initial=math.inf))
+        if not math.isfinite(nearest):
+            nearest = nyquist if dt else max(centre, 1.0)
+        radius = fraction * nearest
+        if dt:
+            radius = min(radius, fraction * nyquist)
+        low = 0.0 if centre == 0.0 else -math.pi / 2
+        high = 0.0 if centre == nyquist else math.pi / 2
+        result.append(_Indentation(centre, radius, multiplicity, low, high))
+    return result
+
+
+def _contour_frequencies(
+    model: StateSpace,
+    indentations: list[_Indentation],
+    closed: ComplexArray,
+    asked: FloatArray | None,
+) -> FloatArray:
+    """The frequencies of the contour's points on the axis: the loop's grid (:func:`_grid`),
+    0 (and π/dt), points clustered at the closed-loop poles (spaced |Re s|/4 about Im s, where
+    the curve passes -1 nearest), points from each indentation's radius out to the pole's
+    neighbours, and the asked frequencies."""
+    dt = period(model) if model.is_discrete else 0.0
+    with warnings.catch_warnings():  # roots beyond the doubles only leave the grid shorter
+        warnings.simplefilter("ignore", NumericalOverflowWarning)
+        parts = [_grid(model), np.zeros(1)]
+    if dt:
+        parts.append(np.array([math.pi / dt]))
+    s = _continuous(closed, dt)
+    s = s[np.isfinite(s)]
+    spread = np.linspace(-10.0, 10.0, 81)
+    with np.errstate(over="ignore", invalid="ignore"):  # beyond the doubles: dropped below
+        for root in s:
+            parts.append(abs(root.imag) + abs(root.real) * spread)
+        for indentation in indentations:
+            reach = indentation.radius * np.logspace(0.05, math.log10(1.0 / INDENT_FRACTION), 25)
+            parts.append(indentation.frequency + reach)
+            parts.append(indentation.frequency - reach)
+    if asked is not None:
+        parts.append(asked)
+    omega = np.unique(np.concatenate(parts))
+    omega = omega[np.isfinite(omega) & (omega >= 0.0)]
+    if dt:
+        omega = omega[omega <= math.pi / dt]
+    return np.asarray(omega, dtype=np.float64)
+
+
+class _Contour:
+    """The ω ≥ 0 half of the Nyquist contour of a SISO loop and L at its points.
+
+    Its pieces alternate: piece 2k lies on the imaginary axis (for a discrete loop, the unit
+    circle z = e^{jω dt}), with the frequency ω as parameter (ω = ∞ is the point at infinity of
+    a continuous loop, where L = D); piece 2k + 1 is indentation k, s = jω0 + ε e^{jφ} with the
+    angle φ as parameter (z = e^{s dt}). The mirror half, ω ≤ 0, is the complex conjugate."""
+
+    def __init__(
+        self, model: StateSpace, indentations: list[_Indentation], omega: FloatArray
+    ) -> None:
+        self.model = model
+        self.dt = period(model) if model.is_discrete else 0.0
+        self.indentations = indentations
+        self.response = _Response(model)
+        self.piece = np.zeros(0, np.int64)
+        self.parameter = np.zeros(0)
+        self.s = np.zeros(0, np.complex128)
+        self.values = np.zeros(0, np.complex128)
+        outside = np.ones(omega.size, dtype=bool)
+        for indentation in indentations:
+            outside &= np.abs(omega - indentation.frequency) > indentation.radius
+        axis = omega[outside]
+        if not self.dt:
+            axis = np.concatenate([axis, [math.inf]])
+        centres = np.array([indentation.frequency for indentation in indentations])
+        pieces = [2 * np.searchsorted(centres, axis).astype(np.int64)]
+        parameters = [axis]
+        for k, indentation in enumerate(indentations):
+            quarters = round((indentation.high - indentation.low) / (math.pi / 2))
+            count = quarters * ARC_POINTS * indentation.multiplicity + 1
+            pieces.append(np.full(count, 2 * k + 1, dtype=np.int64))
+            parameters.append(np.linspace(indentation.low, indentation.high, count))
+        self.add(np.concatenate(pieces), np.concatenate(parameters))
+
+    def _points(self, piece: IntArray, parameter: FloatArray) -> ComplexArray:
+        """s at each (piece, parameter)."""
+        s = np.zeros(piece.size, np.complex128)
+        axis = piece % 2 == 0
+        s.imag[axis] = parameter[axis]
+        for k, indentation in enumerate(self.indentations):
+            on = piece == 2 * k + 1
+            phi = parameter[on]
+            # φ = ±π/2 is on the axis: cos(π/2) = 6e-17 is not 0.
+            s.real[on] = np.where(np.abs(phi) == math.pi / 2, 0.0, indentation.radius * np.cos(phi))
+            s.imag[on] = indentation.frequency + indentation.radius * np.sin(phi)
+        return s
+
+    def _evaluate(self, s: ComplexArray) -> ComplexArray:
+        """L(s) (L(e^{s dt})): on the axis by one call of the core; off it (on an indentation,
+        s = σ + jω) from the shifted loop, L(σ + jω) = C (jωI - (A - σI))⁻¹ B + D, or for a
+        discrete loop with r = e^{σ dt}, L(r e^{jω dt}) = C (e^{jω dt} I - A/r)⁻¹ (B/r) + D."""
+        m = self.model
+        values = np.empty(s.size, np.complex128)
+        infinite = np.isinf(s.imag)
+        values[infinite] = m.D[0, 0]
+        axis = (s.real == 0.0) & ~infinite
+        values[axis] = self.response.many(np.array(s.imag[axis]))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", NumericalOverflowWarning)
+            for i in np.flatnonzero(~axis & ~infinite):
+                sigma, w = float(s.real[i]), np.array([s.imag[i]])
+                if self.dt:
+                    shrink = math.exp(-sigma * self.dt)
+                    response = _core.frequency_response(
+                        m.A * shrink, m.B * shrink, m.C, m.D, w, self.dt
+                    )
+                else:
+                    shifted = m.A - sigma * np.eye(m.n_states)
+                    response = _core.frequency_response(shifted, m.B, m.C, m.D, w, None)
+                values[i] = response[0, 0, 0]
+        return values
+
+    def add(self, piece: IntArray, parameter: FloatArray) -> None:
+        """Adds points, evaluating L at them, and keeps the points in contour order."""
+        s = self._points(piece, parameter)
+        values = self._evaluate(s)
+        self.piece = np.concatenate([self.piece, piece])
+        self.parameter = np.concatenate([self.parameter, parameter])
+        self.s = np.concatenate([self.s, s])
+        self.values = np.concatenate([self.values, values])
+        order = np.lexsort((self.parameter, self.piece))
+        self.piece, self.parameter = self.piece[order], self.parameter[order]
+        self.s, self.values = self.s[order], self.values[order]
+
+    def bisect(self, steps: BoolArray) -> None:
+        """Adds the midpoint of each step (between points i and i + 1) marked in ``steps``:
+        the mean angle on an indentation; on the axis the mean frequency (geometric for a step
+        over more than a factor of 4; ten times the last frequency towards ω = ∞)."""
+        i = np.flatnonzero(steps)
+        piece_a, piece_b = self.piece[i], self.piece[i + 1]
+        a, b = self.parameter[i], self.parameter[i + 1]
+        piece = np.where(
+            piece_a == piece_b, piece_a, np.where(piece_a % 2 == 0, piece_a, piece_a + 1)
+        )
+        axis = piece % 2 == 0
+        w_a = np.where(piece_a % 2 == 0, a, self.s.imag[i])
+        w_b = np.where(piece_b % 2 == 0, b, self.s.imag[i + 1])
+        with np.errstate(over="ignore", invalid="ignore"):
+            geometric = np.sqrt(w_a * w_b)
+            middle = np.where(
+                np.isinf(w_b),
+                np.where(w_a > 0.0, 10.0 * w_a, 1.0),
+                np.where((w_a > 0.0) & (w_b > 4.0 * w_a), geometric, 0.5 * (w_a + w_b)),
+            )
+        parameter = np.where(axis, middle, 0.5 * (a + b))
+        self.add(piece.astype(np.int64), parameter.astype(np.float64))
+
+    def turns(self, centre: complex) -> FloatArray:
+        """The angle (radians, in [-π, π)) that the curve turns about ``centre`` over each
+        step of the half contour."""
+        with np.errstate(invalid="ignore"):
+            angles = np.angle(self.values - centre)
+        steps = np.diff(angles)
+        return np.asarray((steps + math.pi) % (2.0 * math.pi) - math.pi, dtype=np.float64)
+
+    def refine(self, centres: list[complex]) -> None:
+        """Bisects every step over which the curve turns by more than MAX_TURN about one of
+        ``centres``, for REFINE_ROUNDS rounds or up to MAX_CONTOUR_POINTS points. Steps from
+        a point at a centre (L = 0 at a zero on the axis, for the phase) are left alone."""
+        for _ in range(REFINE_ROUNDS):
+            wide = np.zeros(max(self.values.size - 1, 0), dtype=bool)
+            for centre in centres:
+                at = self.values == centre
+                wide |= (np.abs(self.turns(centre)) > MAX_TURN) & ~at[:-1] & ~at[1:]
+            count = int(np.sum(wide))
+            if count == 0 or self.values.size + count > MAX_CONTOUR_POINTS:
+                return
+            self.bisect(wide)
+
+    def winding(self, centre: complex) -> float:
+        """The number of counterclockwise turns about ``centre`` of the closed curve: the
+        mirror half (ω from -∞ to 0, the conjugates in reverse) then the half ω ≥ 0."""
+        closed = np.concatenate([np.conj(self.values[::-1]), self.values])
+        angles = np.angle(closed - centre)
+        steps = np.diff(np.concatenate([angles, angles[:1]]))
+        wrapped = (steps + math.pi) % (2.0 * math.pi) - math.pi
+        return float(np.sum(wrapped) / (2.0 * math.pi))
+
+    @property
+    def axis(self) -> BoolArray:
+        """The points on the axis at finite frequencies."""
+        return np.asarray((self.piece % 2 == 0) & np.isfinite(self.parameter), dtype=np.bool_)
+
+    @property
+    def points(self) -> ComplexArray:
+        """The contour in the loop's variable: s, or z = e^{s dt} (exactly ±1 at the ends)."""
+        if not self.dt:
+            return self.s
+        z = np.exp(self.s * self.dt)
+        real = self.s.imag == 0.0
+        z.imag[real] = 0.0
+        nyquist = self.s.imag == math.pi / self.dt
+        z.imag[nyquist] = 0.0
+        return np.asarray(z, dtype=np.complex128)
+
+
+def _check_finite_curve(contour: _Contour, function: str) -> None:
+    bad = ~np.isfinite(contour.values)
+    if np.any(bad):
+        where = contour.points[np.argmax(bad)]
+        raise AerocontrolLinAlgError(
+            f"{function}: the loop's response overflows double precision on its Nyquist "
+            f"contour (at {where:.6g}), so the curve cannot be followed"
+        )
+
+
+@dataclass(frozen=True)
+class _Poles:
+    """The open- and closed-loop poles of a loop and which lie on the stability boundary."""
+
+    open: ComplexArray
+    open_boundary: BoolArray
+    closed: ComplexArray
+    closed_boundary: BoolArray
+    tolerance: float
+    """The open loop's boundary tolerance (:func:`_boundary_tolerance`)."""
+
+
+def _poles(model: StateSpace, closed_loop: bool) -> _Poles:
+    discrete = model.is_discrete
+    open_poles = _eigenvalues(model.A)
+    tolerance = _boundary_tolerance(_matrix_size(model.A), discrete)
+    if closed_loop:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", NumericalOverflowWarning)
+            closed = _closed_loop_poles(model, np.ones(1))[0]
+        if not np.all(np.isfinite(closed)):
+            raise AerocontrolLinAlgError(
+                "nyquist: the closed-loop poles overflow double precision, so the unstable "
+                "ones (Z) cannot be counted"
+            )
+        with np.errstate(over="ignore", invalid="ignore"):
+            matrix = model.A - np.outer(model.B[:, 0], model.C[0]) / (1.0 + float(model.D[0, 0]))
+        size = _matrix_size(matrix)
+        if not math.isfinite(size):
+            size = float(np.max(_magnitude(closed), initial=0.0))
+        closed_tolerance = _boundary_tolerance(size, discrete)
+    else:
+        closed, closed_tolerance = np.zeros(0, np.complex128), 0.0
+    return _Poles(
+        open=open_poles,
+        open_boundary=_on_boundary(open_poles, discrete, tolerance),
+        closed=closed,
+        closed_boundary=_on_boundary(closed, discrete, closed_tolerance),
+        tolerance=tolerance,
+    )
+
+
+def _half_contour(
+    model: StateSpace,
+    indented: ComplexArray,
+    clear_of: ComplexArray,
+    closed: ComplexArray,
+    asked: FloatArray | None,
+    tolerance: float,
+    fraction: float,
+) -> _Contour:
+    """The half contour with indentations around the roots ``indented`` (on the boundary),
+    clear of the roots ``clear_of``, through the asked frequencies (but those at an indented
+    root), with points clustered at the closed-loop poles ``closed``."""
+    dt = period(model) if model.is_discrete else 0.0
+    indentations = _indentations(indented, clear_of, asked, dt, tolerance, fraction)
+    if asked is not None:  # an asked frequency at an indented root is not on the contour
+        at_root = np.zeros(asked.size, dtype=bool)
+        for indentation in indentations:
+            at_root |= np.abs(asked - indentation.frequency) <= indentation.radius
+        asked = asked[~at_root]
+    omega = _contour_frequencies(model, indentations, closed, asked)
+    return _Contour(model, indentations, omega)
+
+
+@dataclass(frozen=True, eq=False)
+class NyquistResponse:
+    """The Nyquist curve of a SISO loop, negative feedback (1 + L = 0), and its count of
+    encirclements of -1 checked against the open- and closed-loop poles; ``print`` shows P, N,
+    Z and the verdict.
+
+    The Nyquist contour runs up the imaginary axis, ω from -∞ to ∞, and is closed by the half
+    circle at infinity, where L = D (L is proper); a discrete loop's contour is the unit
+    circle z = e^{jω dt}, ω from -π/dt to π/dt. Open-loop poles on the axis (the circle) are
+    passed by small half circles to their right (outside the circle), so they count as stable
+    in P; the image of such an indentation is a large arc, turning clockwise by 180° times the
+    poles' multiplicity. The arrays hold the half ω ≥ 0: the half ω ≤ 0 is its mirror image,
+    the complex conjugate (:attr:`closed_curve` joins them).
+    """
+
+    omega: FloatArray
+    """The frequencies asked for (rad/s, increasing), or by default every frequency of the
+    contour's points on the axis."""
+    response: ComplexArray
+    """L(jω) (L(e^{jω dt})) at ``omega``; infinite (or huge) at a pole on the axis."""
+    contour: ComplexArray
+    """The half ω ≥ 0 of the Nyquist contour in order, in the loop's variable: s from 0 (or
+    from the indentation about a pole at 0) to j∞ (``complex(0, inf)``, the last point), or
+    z from 1 to -1; indentations included."""
+    curve: ComplexArray
+    """L on ``contour``: the half ω ≥ 0 of the Nyquist curve (ending at L(j∞) = D)."""
+    indented: BoolArray
+    """Which points of ``contour`` lie on an indentation."""
+    indentations: tuple[tuple[float, float, int], ...]
+    """(ω0 in rad/s, radius ε in rad/s, number of poles) of each indentation, s = jω0 + ε e^{jφ}
+    (z = e^{s dt})."""
+    open_loop_unstable_poles: int
+    """P: open-loop poles in the open right half plane (outside the unit circle)."""
+    encirclements: int | None
+    """N: counterclockwise encirclements of -1 by the closed curve, P - Z (the convention of
+    :attr:`StabilityMargins.encirclements`; python-control counts clockwise ones, Z - P). None
+    when the curve passes through -1 (:attr:`marginal`)."""
+    closed_loop_unstable_poles: int
+    """Z: closed-loop poles (eigenvalues of A - B (1 + D)⁻¹ C) in the open right half plane
+    (outside the unit circle)."""
+    closed_loop_poles: ComplexArray
+    boundary_poles: ComplexArray
+    """The closed-loop poles on the imaginary axis (the unit circle), to √u times the size of
+    the closed-loop matrix; empty unless :attr:`marginal`."""
+    dt: float
+    """The sampling period (s), 0 for a continuous loop."""
+    loop: StateSpace = field(repr=False)
+
+    @property
+    def marginal(self) -> bool:
+        """True when closed-loop poles lie on the imaginary axis (the unit circle): the curve
+        passes through -1 (unless they are hidden modes), N is not defined, and the closed
+        loop is not asymptotically stable."""
+        return bool(self.boundary_poles.size)
+
+    @property
+    def closed_loop_stable(self) -> bool:
+        """Every closed-loop pole in the open left half plane (inside the unit circle)."""
+        return not self.marginal and self.closed_loop_unstable_poles == 0
+
+    @property
+    def closed_curve(self) -> ComplexArray:
+        """The whole closed Nyquist curve in the order of the contour: the mirror half (ω from
+        -∞ to 0) then the half ω ≥ 0."""
+        return np.concatenate([np.conj(self.curve[::-1]), self.curve])
+
+    def table(self) -> str:
+        """P, N and Z, the verdict and the indentations, one line each."""
+        region = "outside the unit circle" if self.dt else "in the open right half plane"
+        boundary = "unit circle" if self.dt else "imaginary axis"
+        lines = [
+            "Nyquist criterion, negative feedback (1 + L = 0): Z = P - N",
+            f"  P = {self.open_loop_unstable_poles:<4d} open-loop poles {region}",
+        ]
+        if self.encirclements is None:
+            shown = ", ".join(f"{p:.6g}" for p in self.boundary_poles)
+            lines.append(
+                f"  N undefined: the curve passes through -1 (closed-loop poles on the "
+                f"{boundary}: {shown})"
+            )
+        else:
+            lines.append(f"  N = {self.encirclements:<4d} counterclockwise encirclements of -1")
+        lines.append(
+            f"  Z = {self.closed_loop_unstable_poles:<4d} closed-loop poles {region} "
+            "(from the closed-loop eigenvalues)"
+        )
+        if self.closed_loop_stable:
+            verdict = "closed loop stable"
+        elif self.closed_loop_unstable_poles:
+            verdict = "closed loop UNSTABLE"
+        else:
+            verdict = f"closed loop MARGINAL: poles on the {boundary}, not asymptotically stable"
+        lines.append(verdict)
+        for w0, radius, count in self.indentations:
+            lines.append(
+                f"indented around {count} open-loop pole{'s' if count > 1 else ''} at "
+                f"ω = {w0:.6g} rad/s, radius {radius:.3g} rad/s"
+            )
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.table()
+
+    def plot(
+        self, ax: Axes | None = None, unit_circle: bool = False, max_magnitude: float = 20.0
+    ) -> Axes:
+        """The curve, solid for ω ≥ 0 and dashed for its mirror, with arrows, -1 and (with
+        ``unit_circle``) the unit circle; radii beyond ``max_magnitude`` are compressed (see
+        :func:`~aerocontrol.plotting.plot_nyquist`)."""
+        from .plotting import plot_nyquist
+
+        return plot_nyquist(self, ax=ax, unit_circle=unit_circle, max_magnitude=max_magnitude)
+
+
+def nyquist(loop: System, omega: ArrayLike | None = None) -> NyquistResponse:
+    """The Nyquist curve of a SISO loop and the encirclements of -1 (negative feedback,
+    1 + L(s) = 0), checked against the open- and closed-loop poles.
+
+    The principle of the argument applied to 1 + L(s) = (1 + D) det(sI - A_cl)/det(sI - A),
+    with A_cl = A - B (1 + D)⁻¹ C, gives N = P - Z: the counterclockwise encirclements of -1
+    by L along the Nyquist contour (up the imaginary axis and round the right half plane, or
+    counterclockwise round the unit circle) are the open-loop poles P less the closed-loop
+    poles Z in the open right half plane (outside the unit circle). Uncontrollable or
+    unobservable modes are poles of both and cancel.
+
+    The curve is L on the contour (the core's frequency response on the axis, and the shifted
+    loop's on the indentations): on the loop's grid of frequencies (clustered at lightly
+    damped open-loop roots and at the closed-loop poles, where the curve passes -1 nearest),
+    every step over which the curve turns more than 22.5° about -1 bisected. N is its winding
+    number about -1. It is returned only if it equals P - Z with Z counted from the closed-loop
+    eigenvalues; otherwise the contour is tried again with indentations a hundred times
+    smaller and twice the points, and a count that still disagrees is refused.
+
+    Roots within √u ||A||_F of the boundary (the error of a double integrator's computed
+    eigenvalues) are taken to lie on it: open-loop ones are indented and do not count in P;
+    closed-loop ones make the loop :attr:`~NyquistResponse.marginal`, its curve passes
+    through -1 and N is None (the result is still returned, for the plot).
+
+    Parameters
+    ----------
+    loop : StateSpace or (A, B, C, D)
+        The open-loop transfer L, one input and one output; continuous or discrete.
+    omega : array_like, optional
+        Frequencies (rad/s, non-negative, at most π/dt for a discrete loop) at which to
+        report L; the contour passes through them. By default every frequency of the contour
+        on the axis is reported.
+
+    Returns
+    -------
+    NyquistResponse
+
+    Raises
+    ------
+    ShapeError
+        The loop is not single-input, single-output, or ``omega`` is not a 1-D array.
+    NonFiniteError, InvalidArgumentError
+        ``omega`` has a NaN or infinite, negative, or (discrete loop) beyond π/dt entry.
+    SingularMatrixError
+        1 + D = 0: closing the loop is an algebraic loop.
+    AerocontrolLinAlgError
+        The winding number disagrees with P - Z after the retries (the curve passes too near
+        -1 to count), or L overflows on the contour.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> # k/(s + 1)³ is stable for k < 8; at k = 10 the curve circles -1 twice clockwise.
+    >>> r = aerocontrol.nyquist(aerocontrol.zpk([], [-1.0, -1.0, -1.0], 10.0))
+    >>> r.open_loop_unstable_poles, r.encirclements, r.closed_loop_unstable_poles
+    (0, -2, 2)
+    >>> # 10 (s + 2)/((s - 1)(s + 5)): one open-loop pole in the right half plane, one
+    >>> # counterclockwise encirclement, so the closed loop s² + 14 s + 15 is stable.
+    >>> r = aerocontrol.nyquist(aerocontrol.zpk([-2.0], [1.0, -5.0], 10.0))
+    >>> r.encirclements, r.closed_loop_stable
+    (1, True)
+    >>> # 6/(s (s + 1)(s + 2)) is at its gain margin: closed-loop poles ±j√2.
+    >>> r = aerocontrol.nyquist(aerocontrol.zpk([], [0.0, -1.0, -2.0], 6.0))
+    >>> r.marginal, r.encirclements
+    (True, None)
+    """
+    model = _siso(loop)
+    _refuse_algebraic(model)
+    discrete = model.is_discrete
+    dt = period(model) if discrete else 0.0
+    asked = _asked_frequencies(omega, dt)
+    poles = _poles(model, closed_loop=True)
+    unstable_open = int(np.sum(_unstable(poles.open, discrete) & ~poles.open_boundary))
+    unstable_closed = int(np.sum(_unstable(poles.closed, discrete) & ~poles.closed_boundary))
+    marginal = bool(np.any(poles.closed_boundary))
+    expected = unstable_open - unstable_closed
+    encirclements: int | None = None
+    indented = poles.open[poles.open_boundary]
+    clear_of = np.concatenate([poles.open, poles.closed])
+    for attempt in range(COUNT_RETRIES + 1):
+        fraction = INDENT_FRACTION * 0.01**attempt
+        contour = _half_contour(
+            model, indented, clear_of, poles.closed, asked, poles.tolerance, fraction
+        )
+        if attempt:
+            contour.bisect(np.ones(contour.values.size - 1, dtype=bool))
+        contour.refine([] if marginal else [-1.0])
+        _check_finite_curve(contour, "nyquist")
+        if marginal:
+            break
+        winding = contour.winding(-1.0)
+        count = round(winding)
+        if abs(winding - count) <= 1e-3 and count == expected:
+            encirclements = count
+            break
+    else:
+        distance = float(np.min(_magnitude(1.0 + contour.values)))
+        raise AerocontrolLinAlgError(
+            f"nyquist: the curve's winding number about -1 is {winding:.4g}, not P - Z = "
+            f"{unstable_open} - {unstable_closed} = {expected} from the open- and closed-loop "
+            f"poles, with {contour.values.size} points and indentations of radius down to "
+            f"{INDENT_FRACTION * 0.01**COUNT_RETRIES:g} of the poles' distances: the curve "
+            f"passes within {distance:.3g} of -1, too near to count"
+        )
+    if asked is None:
+        axis = contour.axis
+        frequencies, response = contour.parameter[axis], contour.values[axis]
+    else:
+        frequencies, response = asked, _Response(model).many(asked)
+    return NyquistResponse(
+        omega=np.array(frequencies, dtype=np.float64),
+        response=np.array(response, dtype=np.complex128),
+        contour=contour.points,
+        curve=contour.values,
+        indented=np.asarray(contour.piece % 2 == 1, dtype=np.bool_),
+        indentations=tuple((i.frequency, i.radius, i.multiplicity) for i in contour.indentations),
+        open_loop_unstable_poles=unstable_open,
+        encirclements=encirclements,
+        closed_loop_unstable_poles=unstable_closed,
+        closed_loop_poles=np.sort_complex(poles.closed).astype(np.complex128),
+        boundary_poles=np.sort_complex(poles.closed[poles.closed_boundary]).astype(np.complex128),
+        dt=dt,
+        loop=model,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class NicholsResponse:
+    """The open-loop gain (dB) against the phase (degrees) of a SISO loop over frequency, for
+    the Nichols chart; ``print`` shows the ranges."""
+
+    omega: FloatArray
+    """Frequencies (rad/s, increasing)."""
+    response: ComplexArray
+    """L(jω) (L(e^{jω dt}))."""
+    gain_db: FloatArray
+    """20 log10 |L| (∞ at a pole on the axis, -∞ at a zero)."""
+    phase_deg: FloatArray
+    """∠L in degrees, continuous along the Nyquist contour with indentations to the right of
+    the poles and zeros on the axis (so the phase steps by -180° per pole and +180° per zero
+    there, the indentations' turns), starting in [-180°, 180°) at the contour's first point
+    (ω = 0, or the start of the indentation at s = 0); NaN at a frequency asked at such a
+    pole or zero."""
+    dt: float
+    """The sampling period (s), 0 for a continuous loop."""
+    loop: StateSpace = field(repr=False)
+
+    def table(self) -> str:
+        """The frequency, gain and phase ranges."""
+        finite = np.isfinite(self.gain_db) & np.isfinite(self.phase_deg)
+        if not np.any(finite):
+            return f"Nichols: {self.omega.size} frequencies, no finite gain and phase"
+        gain, phase = self.gain_db[finite], self.phase_deg[finite]
+        return "\n".join(
+            [
+                f"Nichols: {self.omega.size} frequencies, {self.omega.min():.4g} ... "
+                f"{self.omega.max():.4g} rad/s",
+                f"  gain  {gain.min():+.2f} ... {gain.max():+.2f} dB",
+                f"  phase {phase.min():+.2f} ... {phase.max():+.2f} deg",
+            ]
+        )
+
+    def __str__(self) -> str:
+        return self.table()
+
+    def plot(self, ax: Axes | None = None, grid: bool = True) -> Axes:
+        """The Nichols chart: the curve, the critical points (-180° + k 360°, 0 dB) and, with
+        ``grid``, contours of constant closed-loop gain and phase (see
+        :func:`~aerocontrol.plotting.plot_nichols`)."""
+        from .plotting import plot_nichols
+
+        return plot_nichols(self, ax=ax, grid=grid)
+
+
+def _contour_phase(values: ComplexArray) -> FloatArray:
+    """∠L in radians along the contour, unwrapped, the first in [-π, π); NaN where L is 0 or
+    not finite."""
+    usable = np.isfinite(values) & (values != 0)
+    phase = np.full(values.size, math.nan)
+    if np.any(usable):
+        unwrapped = np.unwrap(np.angle(values[usable]))
+        if unwrapped[0] >= math.pi - 1e-12:
+            unwrapped -= 2.0 * math.pi
+        phase[usable] = unwrapped
+    return phase
+
+
+def nichols(loop: System, omega: ArrayLike | None = None) -> NicholsResponse:
+    """The open-loop gain (dB) and phase (degrees) of a SISO loop over frequency, for the
+    Nichols chart (negative feedback, 1 + L = 0: the critical points are 0 dB at
+    -180° + k 360°).
+
+    L is evaluated along the ω ≥ 0 half of the Nyquist contour of :func:`nyquist`, indented
+    to the right of the open loop's poles and zeros on the imaginary axis (the unit circle),
+    every step over which its phase turns more than 22.5° bisected, and the phase is
+    unwrapped along it: across such a pole it falls by 180° per pole and across such a zero
+    it rises by 180° per zero, as along the indentations. It starts in [-180°, 180°) at the
+    contour's first point, so a loop with q integrators starts at -90° q, a washout (a zero
+    at s = 0) at +90°, and an open loop with L(0) < 0 at -180°. (The indentation keeps the
+    phase off L(0) = 0, which the core computes as rounding noise of random sign.)
+
+    Parameters
+    ----------
+    loop : StateSpace or (A, B, C, D)
+        The open-loop transfer L, one input and one output; continuous or discrete.
+    omega : array_like, optional
+        Frequencies (rad/s, non-negative, at most π/dt for a discrete loop), reported sorted;
+        the contour passes through them. A frequency at a pole or zero on the axis has the
+        core's L there (not finite at a pole) and phase NaN. By default the contour's
+        frequencies on the axis.
+
+    Returns
+    -------
+    NicholsResponse
+
+    Raises
+    ------
+    ShapeError, NonFiniteError, InvalidArgumentError
+        As :func:`nyquist`, for the loop and ``omega``.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> # 2/(s (s + 1)(s + 2)): -90° - atan ω - atan(ω/2), so -180° at ω = √2, at 20 log10(1/3) dB.
+    >>> n = aerocontrol.nichols(aerocontrol.zpk([], [0.0, -1.0, -2.0], 2.0), [np.sqrt(2.0)])
+    >>> round(float(n.phase_deg[0]), 10), round(float(n.gain_db[0]), 10)
+    (-180.0, -9.5424250944)
+    """
+    model = _siso(loop)
+    dt = period(model) if model.is_discrete else 0.0
+    asked = _asked_frequencies(omega, dt)
+    poles = _poles(model, closed_loop=False)
+    # The zeros on the axis by the poles' band: a band from the size of the system pencil
+    # would grow with B and C, which do not move the zeros.
+    with warnings.catch_warnings():  # a zero beyond the doubles is not on the axis
+        warnings.simplefilter("ignore", NumericalOverflowWarning)
+        zeros = _roots_of(model).zeros
+    boundary_zeros = zeros[_on_boundary(zeros, model.is_discrete, poles.tolerance)]
+    contour = _half_contour(
+        model,
+        np.concatenate([poles.open[poles.open_boundary], boundary_zeros]),
+        np.concatenate([poles.open, zeros]),
+        np.zeros(0, np.complex128),
+        asked,
+        poles.tolerance,
+        INDENT_FRACTION,
+    )
+    contour.refine([0.0])
+    _check_finite_curve(contour, "nichols")
+    phase = _contour_phase(contour.values)
+    axis = contour.axis
+    if asked is None:
+        keep = axis & ~np.isnan(phase)
+        frequencies, response, phases = contour.parameter[keep], contour.values[keep], phase[keep]
+    else:
+        frequencies, response = asked, _Response(model).many(asked)
+        on_axis = contour.parameter[axis]
+        index = np.minimum(np.searchsorted(on_axis, asked), on_axis.size - 1)
+        found = on_axis[index] == asked
+        phases = np.where(found, phase[axis][index], math.nan)
+    with np.errstate(divide="ignore", over="ignore"):
+        gain_db = 20.0 * np.log10(_magnitude(response))
+    return NicholsResponse(
+        omega=np.array(frequencies, dtype=np.float64),
+        response=np.array(response, dtype=np.complex128),
+        gain_db=np.asarray(gain_db, dtype=np.float64),
+        phase_deg=np.degrees(phases).astype(np.float64),
+        dt=dt,
+        loop=model,
+    )

@@ -20,6 +20,9 @@ function                       the chapter's figure
                                as held samples (the report's digital designs)
 :func:`plot_root_locus`        closed-loop roots over a weight c (Figures 6.8, 6.12)
 :func:`plot_bode`              magnitude and phase of one input-output pair
+:func:`plot_nyquist`           the Nyquist curve of a loop, with -1 and the direction of ω
+:func:`plot_nichols`           the Nichols chart of a loop, with closed-loop gain and phase
+                               contours
 :func:`plot_modes`             the eigenvalues in the complex plane, by mode
 =============================  ===============================================================
 
@@ -29,6 +32,7 @@ States, inputs and outputs with the names of the aircraft models (``u/u0``, ``al
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, cast
 
@@ -43,11 +47,13 @@ if TYPE_CHECKING:
     from matplotlib.legend import Legend
 
     from .frequency import FrequencyResponse
-    from .loops import RootLocus
+    from .loops import NicholsResponse, NyquistResponse, RootLocus
     from .modal import Modes
     from .responses import TimeResponse
 
 __all__ = [
+    "closed_loop_gain_contour",
+    "closed_loop_phase_contour",
     "label",
     "penalty_terms",
     "plot_bode",
@@ -55,6 +61,8 @@ __all__ = [
     "plot_gain_root_locus",
     "plot_levels",
     "plot_modes",
+    "plot_nichols",
+    "plot_nyquist",
     "plot_open_closed",
     "plot_penalty",
     "plot_root_locus",
@@ -606,6 +614,293 @@ def plot_bode(
         axis.grid(True, which="both", alpha=0.3)
     magnitude_axis.legend(loc="best", fontsize="small")
     return magnitude_axis, phase_axis
+
+
+def _compressed(values: NDArray[np.complex128], limit: float) -> NDArray[np.complex128]:
+    """``values`` with each radius r beyond ``limit`` (R) drawn at R (1 + x/(1 + x)),
+    x = ln(r/R): continuous with slope 1 at R, logarithmic in r, below 2R."""
+    radius = np.abs(values)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        x = np.log(radius / limit)
+        drawn = np.where(radius > limit, limit * (1.0 + x / (1.0 + x)), radius)
+        scale = np.where(radius > 0.0, drawn / radius, 0.0)
+    return np.asarray(values * scale, dtype=np.complex128)
+
+
+def _arrow(ax: Axes, points: NDArray[np.complex128], fraction: float, colour: str) -> None:
+    """An arrowhead on the polyline ``points`` at ``fraction`` of its length, pointing along
+    it."""
+    lengths = np.abs(np.diff(points))
+    if not np.any(lengths > 0.0):
+        return
+    cumulative = np.cumsum(lengths)
+    i = int(np.searchsorted(cumulative, fraction * cumulative[-1]))
+    i = min(i, lengths.size - 1)
+    while lengths[i] == 0.0 and i > 0:
+        i -= 1
+    if lengths[i] == 0.0:
+        return
+    start, end = points[i], points[i + 1]
+    ax.annotate(
+        "",
+        xy=(end.real, end.imag),
+        xytext=(start.real, start.imag),
+        arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 1.0, "mutation_scale": 14},
+    )
+
+
+def plot_nyquist(
+    result: NyquistResponse,
+    ax: Axes | None = None,
+    unit_circle: bool = False,
+    max_magnitude: float = 20.0,
+) -> Axes:
+    """The Nyquist curve of a :class:`~aerocontrol.loops.NyquistResponse`: the half ω ≥ 0
+    solid, its mirror image (ω ≤ 0) dashed, arrows in the direction of increasing ω, the
+    critical point -1 (a red +) and, with ``unit_circle``, the unit circle (dotted: its
+    crossings are the gain crossovers). The title gives P, N and Z. Returns the axes.
+
+    Radii beyond ``max_magnitude`` (R) are compressed: a point with |L| = r > R is drawn at
+    radius R (1 + x/(1 + x)), x = ln(r/R), at its true angle. The map is continuous with
+    slope 1 at R, logarithmic in r and bounded by 2R, so the large arcs that are the images of
+    the indentations around poles on the imaginary axis (|L| of 1e4 to 1e12 and more) are
+    drawn between R and 2R and the curve closes as it does in the plane: its encirclements of
+    -1 can be counted on the plot. (python-control and MATLAB clip such arcs at a
+    ``max_curve_magnitude`` instead.) The circle |L| = R is drawn, dotted, when a point is
+    compressed.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import aerocontrol
+    >>> ax = aerocontrol.nyquist(aerocontrol.zpk([], [0.0, -1.0, -2.0], 2.0)).plot()
+    >>> ax.get_xlabel(), ax.get_title()
+    ('Re L', 'Nyquist: P = 0, N = 0, Z = 0, closed loop stable')
+    """
+    from matplotlib.colors import to_hex
+
+    limit = float(max_magnitude)
+    if not (math.isfinite(limit) and limit > 0.0):
+        raise InvalidArgumentError(f"max_magnitude must be positive and finite, got {limit}")
+    ax = _new_axes() if ax is None else ax
+    half = _compressed(result.curve, limit)
+    mirror = np.conj(half[::-1])
+    (line,) = ax.plot(half.real, half.imag, "-", label="ω ≥ 0")
+    colour = to_hex(line.get_color())
+    ax.plot(mirror.real, mirror.imag, "--", color=colour, label="ω ≤ 0 (mirror image)")
+    for fraction in (0.3, 0.7):
+        _arrow(ax, half, fraction, colour)
+        _arrow(ax, mirror, fraction, colour)
+    ax.plot([-1.0], [0.0], "+", color="red", markersize=12, markeredgewidth=2, label="-1")
+    turn = np.linspace(0.0, 2.0 * math.pi, 361)
+    if unit_circle:
+        ax.plot(np.cos(turn), np.sin(turn), ":", color="0.5", linewidth=0.8, label="|L| = 1")
+    if np.any(np.abs(result.curve) > limit):
+        ax.plot(
+            limit * np.cos(turn),
+            limit * np.sin(turn),
+            ":",
+            color="0.75",
+            linewidth=0.8,
+            label=f"|L| = {limit:g}, compressed beyond",
+        )
+    ax.axhline(0.0, color="black", linewidth=0.6)
+    ax.axvline(0.0, color="black", linewidth=0.6)
+    ax.set_aspect("equal", adjustable="datalim")
+    if result.encirclements is None:
+        counts = f"P = {result.open_loop_unstable_poles}, N undefined (curve through -1)"
+    else:
+        counts = (
+            f"P = {result.open_loop_unstable_poles}, N = {result.encirclements}, "
+            f"Z = {result.closed_loop_unstable_poles}"
+        )
+    verdict = (
+        "closed loop stable"
+        if result.closed_loop_stable
+        else ("closed loop unstable" if result.closed_loop_unstable_poles else "marginal")
+    )
+    _finish(ax, "Re L", "Im L", f"Nyquist: {counts}, {verdict}")
+    return ax
+
+
+#: Closed-loop gains (dB) and phases (degrees) of the Nichols chart's grid.
+NICHOLS_GAINS_DB = (-20.0, -12.0, -6.0, -3.0, -1.0, 0.0, 1.0, 3.0, 6.0, 12.0)
+NICHOLS_PHASES_DEG = (
+    -5.0,
+    -15.0,
+    -30.0,
+    -60.0,
+    -90.0,
+    -120.0,
+    -150.0,
+    -180.0,
+    -210.0,
+    -240.0,
+    -270.0,
+    -300.0,
+    -330.0,
+    -345.0,
+    -355.0,
+)
+
+
+def _open_loop_points(T: NDArray[np.complex128]) -> tuple[FloatArray, FloatArray]:
+    """(phase in (-360°, 0°], gain in dB) of L = T/(1 - T), the open loop whose closed loop
+    L/(1 + L) is T, with NaN between neighbours whose phases differ by more than 180° (where
+    the phase wraps), so that a line drawn through them breaks there."""
+    L = T / (1.0 - T)
+    phase = np.degrees(np.angle(L))
+    phase = np.where(phase > 0.0, phase - 360.0, phase)
+    gain = 20.0 * np.log10(np.abs(L))
+    jumps = np.flatnonzero(np.abs(np.diff(phase)) > 180.0) + 1
+    return (
+        np.asarray(np.insert(phase, jumps, np.nan), dtype=np.float64),
+        np.asarray(np.insert(gain, jumps, np.nan), dtype=np.float64),
+    )
+
+
+def closed_loop_gain_contour(gain_db: float, count: int = 721) -> tuple[FloatArray, FloatArray]:
+    """The open-loop (phase in (-360°, 0°], gain in dB) at which the closed loop
+    T = L/(1 + L) has the gain ``gain_db``: L = T/(1 - T) for T = M e^{jθ},
+    M = 10^(gain_db/20), θ over the circle (θ = 0 left out for M = 1, where L = ∞). NaN
+    separates the pieces where the phase wraps.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> phase, gain = closed_loop_gain_contour(0.0)   # |T| = 1: Re L = -1/2
+    >>> L = 10 ** (gain / 20) * np.exp(1j * np.radians(phase))
+    >>> bool(np.allclose(L[np.isfinite(L)].real, -0.5))
+    True
+    """
+    magnitude = 10.0 ** (float(gain_db) / 20.0)
+    theta = np.linspace(0.0, 2.0 * math.pi, count)
+    if magnitude == 1.0:
+        theta = theta[1:-1]
+    return _open_loop_points(magnitude * np.exp(1j * theta))
+
+
+def closed_loop_phase_contour(
+    phase_deg: float, low_db: float = -20.0, high_db: float = 32.0, count: int = 721
+) -> tuple[FloatArray, FloatArray]:
+    """The open-loop (phase in (-360°, 0°], gain in dB) at which the closed loop
+    T = L/(1 + L) has the phase ``phase_deg`` (in (-360°, 0°)): L = T/(1 - T) for
+    T = m e^{j phase}, the closed-loop gain 20 log10 m from ``low_db`` to ``high_db`` (L then
+    runs from about ``low_db`` at that phase towards the critical point -1)."""
+    magnitudes = np.logspace(float(low_db) / 20.0, float(high_db) / 20.0, count)
+    return _open_loop_points(magnitudes * np.exp(1j * math.radians(float(phase_deg))))
+
+
+def plot_nichols(
+    result: NicholsResponse,
+    ax: Axes | None = None,
+    grid: bool = True,
+    gains_db: Sequence[float] = NICHOLS_GAINS_DB,
+    phases_deg: Sequence[float] = NICHOLS_PHASES_DEG,
+) -> Axes:
+    """The Nichols chart of a :class:`~aerocontrol.loops.NicholsResponse`: open-loop gain (dB)
+    against phase (degrees), the critical points (-180° + k 360°, 0 dB) as red +, and with
+    ``grid`` the contours of constant closed-loop gain |T| (``gains_db``) and phase ∠T
+    (``phases_deg``, in (-360°, 0°)) of T = L/(1 + L), dotted (from
+    :func:`closed_loop_gain_contour` and :func:`closed_loop_phase_contour`, the phase
+    contours over the closed-loop gains from the least of ``gains_db`` to 20 dB beyond the
+    largest), repeated every 360° over the phases shown and labelled about the critical point
+    nearest the curve's gain crossover. The curve is broken where its phase steps by more
+    than 90° between neighbouring frequencies: across a pole on the imaginary axis, where the
+    gain passes through infinity. Returns the axes.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import aerocontrol
+    >>> ax = aerocontrol.nichols(aerocontrol.zpk([], [0.0, -1.0, -2.0], 2.0)).plot()
+    >>> ax.get_xlabel(), ax.get_ylabel()
+    ('open-loop phase (deg)', 'open-loop gain (dB)')
+    """
+    from matplotlib.ticker import MultipleLocator
+
+    for value in phases_deg:
+        if not -360.0 < float(value) < 0.0:
+            raise InvalidArgumentError(f"phases_deg must lie in (-360, 0), got {value}")
+    ax = _new_axes() if ax is None else ax
+    finite = np.isfinite(result.gain_db) & np.isfinite(result.phase_deg)
+    phase = np.where(finite, result.phase_deg, np.nan)
+    gain = np.where(finite, result.gain_db, np.nan)
+    breaks = np.flatnonzero(np.abs(np.diff(phase)) > 90.0) + 1
+    ax.plot(np.insert(phase, breaks, np.nan), np.insert(gain, breaks, np.nan), "-", label="L(jω)")
+    shown_phase = phase[finite] if np.any(finite) else np.array([-180.0])
+    shown_gain = gain[finite] if np.any(finite) else np.array([0.0])
+    low = 360.0 * math.floor(float(shown_phase.min()) / 360.0)
+    high = 360.0 * math.ceil(float(shown_phase.max()) / 360.0)
+    if high <= low:  # every phase a multiple of 360°: the period below it
+        low = high - 360.0
+    lowest, highest = min(gains_db, default=-20.0), max(gains_db, default=12.0)
+    bottom = min(float(shown_gain.min()), lowest - 6.0) - 3.0
+    top = max(float(shown_gain.max()), highest + 6.0) + 3.0
+    periods = list(range(round(low / 360.0) + 1, round(high / 360.0) + 1))
+    # Labels about the critical point nearest the phase where the gain is nearest 0 dB.
+    crossover = float(shown_phase[np.argmin(np.abs(shown_gain))])
+    labelled = min(periods, key=lambda k: abs(crossover - (360.0 * k - 180.0)))
+    if grid:
+        for k in periods:
+            offset = 360.0 * k
+            for m_db in gains_db:
+                x, y = closed_loop_gain_contour(m_db)
+                (line,) = ax.plot(x + offset, y, ":", color="0.6", linewidth=0.7)
+                line.set_gid(f"closed-loop gain {m_db:g} dB")
+                if k == labelled:
+                    _label_gain_contour(ax, m_db, offset)
+            for n_deg in phases_deg:
+                x, y = closed_loop_phase_contour(n_deg, lowest, highest + 20.0)
+                (line,) = ax.plot(x + offset, y, ":", color="0.75", linewidth=0.7)
+                line.set_gid(f"closed-loop phase {n_deg:g} deg")
+                if k == labelled and n_deg % 60.0 == 0.0:
+                    ax.annotate(
+                        f"{n_deg:g}°",
+                        (x[0] + offset, y[0]),
+                        fontsize=6,
+                        color="0.5",
+                        ha="center",
+                        va="top",
+                    )
+    critical = [360.0 * k - 180.0 for k in periods]
+    ax.plot(
+        critical,
+        np.zeros(len(critical)),
+        "+",
+        color="red",
+        markersize=12,
+        markeredgewidth=2,
+        label="critical points",
+    )
+    ax.set_xlim(low, high)
+    ax.set_ylim(bottom, top)
+    ax.xaxis.set_major_locator(MultipleLocator(45.0 if high - low <= 720.0 else 90.0))
+    _finish(ax, "open-loop phase (deg)", "open-loop gain (dB)", "Nichols chart")
+    return ax
+
+
+def _label_gain_contour(ax: Axes, gain_db: float, offset: float) -> None:
+    """The label of the closed-loop gain contour ``gain_db``: for |T| = M > 1 at the top of
+    its oval about the critical point (phase -180°, L = -M/(M - 1)); for M ≤ 1 at phase 0°
+    (the period's right edge), where L = M/(1 - M) (M = 1 at -180°, where L = -1/2)."""
+    magnitude = 10.0 ** (gain_db / 20.0)
+    if magnitude > 1.0:
+        x, g = offset - 180.0, magnitude / (magnitude - 1.0)
+    elif magnitude < 1.0:
+        x, g = offset - 2.0, magnitude / (1.0 - magnitude)
+    else:
+        x, g = offset - 180.0, 0.5
+    ax.annotate(
+        f"{gain_db:g} dB",
+        (x, 20.0 * math.log10(g)),
+        fontsize=6,
+        color="0.4",
+        ha="right" if magnitude < 1.0 else "center",
+        va="bottom",
+    )
 
 
 _LEVEL_COLOURS = ("0.8", "#4daf4a", "#ffd92f", "#ff7f00", "#e41a1c")

@@ -484,6 +484,8 @@ RESULT_TYPES = frozenset(
         "KalmanFilter",
         "LqgDesign",
         "Modes",
+        "NicholsResponse",
+        "NyquistResponse",
         "Placement",
         "RiccatiDifferenceSolution",
         "RiccatiSolution",

@@ -149,3 +149,27 @@ FREQUENCY_SUBNORMAL_RATIO = known_defect(
     _tiny_entry_beside_a_huge_frequency,
     "G(j",
 )
+
+
+def _tiny_state_matrix(args: dict[str, Any]) -> bool:
+    """A nonzero A whose largest entry is below 1e-250, so that σ 2^1024 (σ the power of two
+    the core scales A by) is below about 1e58 rad/s, within the frequencies a loop of the
+    suite's B and C reaches."""
+    models = _models_of(args)
+    if not models:
+        return False
+    largest = float(np.max(np.abs(models[0][0]), initial=0.0))
+    return 0.0 < largest < 1e-250
+
+
+FREQUENCY_POINT_OVERFLOW = known_defect(
+    "frequency-point-overflow",
+    {"nyquist", "nichols", "frequency_response", "bode"},
+    "the frequency response of a model whose A is tiny but not zero: the core holds A / σ, "
+    "σ the power of two of A's largest entry, and divides the point s by σ too, which "
+    "overflows to infinity for |s| beyond σ 2^1024, and G is then D: A with one entry 1e-300 "
+    "and B, C of ones gives G(j1e10) = 0, not -3e-10j (rust/control/frequency.rs, "
+    "FrequencyEvaluator::at and frequency_response_into); the Nyquist curve of such a loop "
+    "(a triple integrator perturbed by 1e-308, C of 1e149) is 0 beyond 1e131 rad/s",
+    _tiny_state_matrix,
+)

@@ -28,6 +28,7 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning, NumericalOverflowWarning
 
 from .harness import Arg, Warned, exercise, plain
+from .known_defects import FREQUENCY_POINT_OVERFLOW
 from .oracles import (
     SLACK,
     TINY,
@@ -57,6 +58,8 @@ COVERED = {
     "root_locus",
     "best_damping_gain",
     "gain_for_damping",
+    "nyquist",
+    "nichols",
 }
 
 TAME = ("stable", "gaussian", "companion", "integers", "imaginary axis", "diagonal")
@@ -606,3 +609,128 @@ def test_regression_locus_oracle_of_open_loop_poles_beyond_the_doubles() -> None
         # The others are 0 to within the backward error n u ||A|| (-4e292 for n = 3).
         others = poles[np.isfinite(poles)]
         assert others.size == n - 1 and np.all(np.abs(others) <= SLACK * n * U * n * 1e308)
+
+
+# ----- Nyquist and Nichols ----------------------------------------------------------------------
+
+#: Frequencies asked of nyquist and nichols (and some that must be refused).
+FREQUENCIES = (
+    None,
+    np.array([0.0, 0.5, 2.0]),
+    np.array([3.0, 0.1]),
+    np.array([1.0]),
+    np.array([-1.0, 1.0]),
+    np.array([1.0, np.nan]),
+    np.zeros(0),
+    np.ones((2, 2)),
+)
+
+
+def _unstable_count(A: np.ndarray, size: float) -> int | None:
+    """The eigenvalues of A right of the band |Re| <= √u ||A||_F that the Nyquist analysis
+    takes to be the imaginary axis; None where one is within its sensitivity of the band's
+    edge (or of the axis, for a matrix of size 0)."""
+    if A.shape[0] == 0:
+        return 0
+    if not finite(A) or not np.isfinite(size):
+        return None
+    values, conditions = eigenvalue_conditions(A)
+    with silenced():
+        margin = SLACK * A.shape[0] * U * size * conditions + TINY
+    band = math.sqrt(2 * U) * size
+    if np.any(np.abs(np.abs(values.real) - band) <= margin) or not np.all(np.isfinite(margin)):
+        return None
+    return int(np.sum(values.real > band))
+
+
+def _check_response(A: Any, B: Any, C: Any, D: Any, s: complex, value: complex, what: str) -> None:
+    got = response_at(A, B, C, D, s)
+    if got is None or not np.isfinite(value):
+        return
+    G, size = got
+    bound = SLACK * max(A.shape[0], 1) * (U * size + TINY)
+    assert_within(abs(complex(G[0, 0]) - value), bound, f"{what} at s = {s}")
+
+
+def _nyquist_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    A, B, C, D = model_matrices(args["loop"])
+    d = float(D[0, 0])
+    formed = closed_matrix(A, B, C, d, 1.0)
+    assert formed is not None
+    closed, size = formed
+    assert_poles(closed, size, result.closed_loop_poles, "the closed-loop poles")
+    P = _unstable_count(A, norm(A))
+    if P is not None:
+        assert result.open_loop_unstable_poles == P, f"P = {result.open_loop_unstable_poles}"
+    with silenced():
+        closed_size = norm(closed)
+    Z = _unstable_count(closed, closed_size)
+    if Z is not None:
+        assert result.closed_loop_unstable_poles == Z, f"Z = {result.closed_loop_unstable_poles}"
+    if result.marginal:
+        assert result.encirclements is None and not result.closed_loop_stable
+    else:
+        expected = result.open_loop_unstable_poles - result.closed_loop_unstable_poles
+        assert result.encirclements == expected
+        turns = np.diff(np.unwrap(np.angle(result.closed_curve + 1.0)))
+        assert round(float(np.sum(turns)) / (2 * math.pi)) == expected
+    assert result.curve.shape == result.contour.shape == result.indented.shape
+    assert np.all(np.diff(result.omega) > 0), "the frequencies are not increasing"
+    for w, value in zip(result.omega, result.response, strict=True):
+        _check_response(A, B, C, D, 1j * w, complex(value), "L(jω)")
+    for i in np.linspace(0, result.contour.size - 2, 12).astype(int):
+        _check_response(A, B, C, D, complex(result.contour[i]), complex(result.curve[i]), "L")
+    assert "P = " in str(result)
+
+
+def _nichols_oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
+    A, B, C, D = model_matrices(args["loop"])
+    assert np.all(np.diff(result.omega) > 0), "the frequencies are not increasing"
+    for w, value, gain, phase in zip(
+        result.omega, result.response, result.gain_db, result.phase_deg, strict=True
+    ):
+        _check_response(A, B, C, D, 1j * w, complex(value), "L(jω)")
+        if np.isfinite(value) and value != 0:
+            expected = 20 * math.log10(abs(value))
+            assert_within(abs(gain - expected), 1e-13 * max(1.0, abs(expected)), f"gain of {value}")
+            if np.isfinite(phase):
+                gap = (float(phase) - math.degrees(np.angle(value)) + 180.0) % 360.0 - 180.0
+                assert_within(abs(gap), 1e-9, f"the phase {phase} of L(j{w}) = {value}")
+    assert isinstance(str(result), str)
+
+
+@given(st.data())
+def test_nyquist_and_nichols(data: st.DataObject) -> None:
+    name = data.draw(st.sampled_from(("nyquist", "nichols")))
+    omega = FREQUENCIES[data.draw(st.integers(0, len(FREQUENCIES) - 1))]
+    arguments = {"loop": data.draw(loop())}
+    if omega is not None:
+        arguments["omega"] = data.draw(presented(omega))
+    outcome = exercise(
+        name,
+        getattr(aerocontrol, name),
+        arguments,
+        _nyquist_oracle if name == "nyquist" else _nichols_oracle,
+        nonfinite_by_definition=("contour", "response", "gain_db", "phase_deg"),
+    )
+    given_omega = arguments["omega"].canonical if "omega" in arguments else None
+    if isinstance(given_omega, np.ndarray) and given_omega.dtype.kind in "biuf":
+        if given_omega.ndim != 1 or given_omega.size == 0 or np.any(given_omega < 0):
+            assert outcome.error is not None, f"{name} accepted omega {given_omega}"
+
+
+@pytest.mark.xfail(strict=True, reason="frequency-point-overflow: ω / max|A| beyond 2^1024")
+def test_known_defect_frequency_point_overflow() -> None:
+    """A defect of the native core found by the suite (see ``known_defects.py``)."""
+    A = np.zeros((3, 3))
+    A[2, 0] = 1e-308
+    B = np.array([[0.1257302210933933], [-0.1321048632913019], [0.6404226504432821]])
+    C = np.array([[1.2573022109339329e149, -1.3210486329130188e149, 6.4042265044328201e149]])
+    with FREQUENCY_POINT_OVERFLOW.reproducing():
+        exercise(
+            "nyquist",
+            aerocontrol.nyquist,
+            {"loop": plain((A, B, C, np.zeros((1, 1))))},
+            _nyquist_oracle,
+            nonfinite_by_definition=("contour", "response"),
+        )

@@ -350,6 +350,18 @@ assert_type(disks.loops[1], aerocontrol.StabilityMargins)
 assert_type(disks.table(), str)
 assert_type(aerocontrol.sensitivity(yaw_loop), aerocontrol.StateSpace)
 assert_type(aerocontrol.complementary_sensitivity(yaw_loop), aerocontrol.StateSpace)
+nyquist_curve = aerocontrol.nyquist(yaw_loop, omega=np.logspace(-2.0, 1.0, 50))
+assert_type(nyquist_curve, aerocontrol.NyquistResponse)
+assert_type(nyquist_curve.encirclements, int | None)
+assert_type(nyquist_curve.closed_curve, Complexes)
+assert_type(nyquist_curve.indentations, tuple[tuple[float, float, int], ...])
+assert_type(nyquist_curve.plot(ax=Figure().subplots(), unit_circle=True), Axes)
+assert_type(aerocontrol.nyquist(yaw_loop).table(), str)
+nichols_chart = aerocontrol.nichols(yaw_loop, [0.1, 1.0])
+assert_type(nichols_chart, aerocontrol.NicholsResponse)
+assert_type(nichols_chart.phase_deg, Floats)
+assert_type(plotting.plot_nichols(nichols_chart, ax=Figure().subplots(), grid=False), Axes)
+assert_type(plotting.closed_loop_gain_contour(3.0), tuple[Floats, Floats])
 locus = aerocontrol.root_locus(yaw_loop, [0.0, 1.0, 2.0])
 assert_type(locus, aerocontrol.RootLocus)
 assert_type(aerocontrol.best_damping_gain(yaw_loop), aerocontrol.DampingDesign)
@@ -382,4 +394,6 @@ def _misuse() -> None:
     aerocontrol.connect(sys, inputs="r")  # type: ignore[arg-type]  # a list of models
     aerocontrol.stability_margins(yaw_loop, 1.0)  # type: ignore[call-arg]  # no frequencies
     aerocontrol.disk_margins(yaw_loop, skew="0")  # type: ignore[arg-type]  # a number
+    aerocontrol.nichols(yaw_loop, grid=True)  # type: ignore[call-arg]  # a plot argument
+    aerocontrol.nyquist(yaw_loop).plot(max_magnitude="20")  # type: ignore[arg-type]
     del exponential, gains, estimate
