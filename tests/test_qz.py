@@ -159,3 +159,16 @@ def test_small_eigenvalue_beside_a_nearly_singular_b_is_accurate(seed: int) -> N
         if abs(value) < 1e3:
             error = np.min(np.abs(found - value)) / abs(value)
             assert error < 1e-9, (value, found)
+
+
+@pytest.mark.xfail(strict=True, reason="core QZ: exact zero structure (reported, not yet fixed)")
+def test_known_defect_pencil_with_exact_zeros_and_a_double_zero_eigenvalue() -> None:
+    """A = [[-1, 0, 0], [1, 0, 0], [0, 1, 0]] (eigenvalues -1 and a defective double 0 of
+    B^-1 A), B = [[1, 0, 0], [0, 2, 0], [0, 1, 2]]: the core returns the eigenvalues -1, 0.217
+    and -0.235 with ||Q^T A Z - AA|| / ||A|| = 0.117 (scipy: 0, 0, -1 to 1e-16). A
+    perturbation of 1e-14 in A gives a backward error of 4e-16: the defect is on a path that
+    only exact zeros take. Found by the qz property suite (a companion A beside an integer B
+    of rank 7 gave 1.1e-7 in B)."""
+    A = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    B = np.array([[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 1.0, 2.0]])
+    _check(A, B, aerocontrol.qz(A, B))

@@ -173,3 +173,32 @@ FREQUENCY_POINT_OVERFLOW = known_defect(
     "(a triple integrator perturbed by 1e-308, C of 1e149) is 0 beyond 1e131 rad/s",
     _tiny_state_matrix,
 )
+
+
+def _tolerance_beyond_the_scaled_doubles(args: dict[str, Any]) -> bool:
+    """A tolerance given whose ratio to the largest entry of A and B (or C) is beyond the
+    doubles."""
+    tol = args.get("tol")
+    if tol is None or not np.isfinite(float(tol)) or float(tol) <= 0:
+        return False
+    sizes = [
+        float(np.max(np.abs(np.asarray(value, dtype=float)), initial=0.0))
+        for key, value in args.items()
+        if key in ("A_or_sys", "B", "C") and value is not None and np.ndim(value) == 2
+    ]
+    sizes += [float(np.max(np.abs(M), initial=0.0)) for model in _models_of(args) for M in model]
+    largest = max(sizes, default=0.0)
+    with np.errstate(over="ignore", divide="ignore"):
+        return bool(float(tol) / max(largest, np.finfo(float).tiny) > np.finfo(float).max)
+
+
+CONTROLLABILITY_TOLERANCE_OVERFLOW = known_defect(
+    "controllability-tolerance-overflow",
+    {"controllability", "observability", "is_controllable", "is_observable"},
+    "the core's controllability reports the tolerance it was given as inf, without a "
+    "warning, when the tolerance over the size of A and B is beyond the doubles: A = "
+    "[[1.26e-151]], B with no columns, tol = 1e300 gives tolerance inf (A = [[1]] gives "
+    "1e300): the tolerance is scaled with the problem and overflows",
+    _tolerance_beyond_the_scaled_doubles,
+    "'.tolerance'",
+)

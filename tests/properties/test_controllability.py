@@ -22,6 +22,7 @@ from hypothesis import strategies as st
 import aerocontrol
 
 from .harness import Warned, exercise, plain
+from .known_defects import CONTROLLABILITY_TOLERANCE_OVERFLOW
 from .oracles import SLACK, TINY, U, assert_spectrum, finite, norm, quietly, silenced
 from .strategies import (
     canonical,
@@ -271,3 +272,21 @@ def test_controllability_extreme_entries(example: str) -> None:
     # Both pairs are controllable in exact arithmetic and far from any uncontrollable one
     # relative to their tolerance.
     assert outcome.result.controllable, "a controllable pair was declared uncontrollable"
+
+
+@pytest.mark.xfail(strict=True, reason="controllability-tolerance-overflow: core")
+def test_known_defect_controllability_tolerance_beyond_the_scaled_doubles() -> None:
+    arguments = {
+        "A_or_sys": plain(np.array([[1.257302210933933e-151]])),
+        "B": plain(np.zeros((1, 0))),
+        "tol": plain(1e300),
+        "method": plain("full"),
+    }
+    with CONTROLLABILITY_TOLERANCE_OVERFLOW.reproducing():
+        exercise(
+            "controllability",
+            aerocontrol.controllability,
+            arguments,
+            _through_models(_analysis_oracle(False, False), "B"),
+            nonfinite_by_definition=("smallest_pivot",),
+        )

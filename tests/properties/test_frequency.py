@@ -45,6 +45,9 @@ def _check_response(
     n = A.shape[0]
     omega = result.omega
     assert result.response.shape == (len(omega), C.shape[0], B.shape[1])
+    kb, kc = (
+        int(np.frexp(float(np.max(np.abs(M), initial=0.0)))[1]) if finite(M) else 0 for M in (B, C)
+    )
     assert result.response.dtype == np.complex128
     for k, w in enumerate(omega):
         M = 1j * w * np.eye(n) - A
@@ -52,14 +55,19 @@ def _check_response(
         if not np.isfinite(condition) or condition * U > 1e-3:
             continue
         with silenced():
-            X = np.linalg.solve(M, B.astype(complex)) if n else np.zeros((0, B.shape[1]))
-            expected = C @ X + D
+            # B and C scaled to unit size by powers of two, and C X scaled back once: the solve
+            # with B of 1.3e-301 beside jω - A of 1e149 underflowed X to 0, and the reference
+            # G = 0 blamed aerocontrol's correct -1.24e-301.
+            X = np.linalg.solve(M, np.ldexp(B, -kb).astype(complex)) if n else B[:0] * 0j
+            product = np.ldexp(C, -kc) @ X
+            expected = np.ldexp(product.real, kb + kc) + 1j * np.ldexp(product.imag, kb + kc) + D
         if not finite(expected) or np.max(np.abs(expected), initial=0.0) > 1e300:
             continue  # near or beyond overflow: the harness checks the warning
         got = result.response[k]
         assert finite(got), f"NaN or Inf at ω = {w}, where G is finite (cond {condition:.2e})"
         with silenced():
-            bound = SLACK * max(n, 1) * (U * (condition * norm(C) * norm(X) + norm(D)) + TINY)
+            terms = np.ldexp(condition * norm(np.ldexp(C, -kc)) * norm(X), kb + kc)
+            bound = SLACK * max(n, 1) * (U * (terms + norm(D)) + TINY)
         if not np.isfinite(bound):
             continue  # C X overflows in the reference: no measure of the error
         error = norm(got - expected)
@@ -233,3 +241,19 @@ def test_known_defect_frequency_response_of_a_tiny_pole_at_a_huge_frequency() ->
             {"sys": plain(model), "omega": plain(np.array([0.0, 1e200, 1e300]))},
             _frequency_oracle,
         )
+
+
+def test_regression_frequency_oracle_of_a_response_below_its_factors() -> None:
+    """A of 1.26e149, B of 1.26e-301, C of 1.26e149 at ω = 1.26e148: the reference solve
+    (jωI - A) X = B underflowed X (1e-450) to 0, and its G = 0 blamed aerocontrol's correct
+    G = B C / (jω - A) = -1.245e-301 - 1.245e-302j (closed form)."""
+    a, b, c = 1.257302210933933e149, 1.257302210933933e-301, 1.257302210933933e149
+    w = 1.2573022109339299e148
+    outcome = exercise(
+        "frequency_response",
+        aerocontrol.frequency_response,
+        {"sys": plain(([[a]], [[b]], [[c]], [[0.0]])), "omega": plain(np.array([w]))},
+        _frequency_oracle,
+    )
+    expected = (b * c) / complex(-a, w)
+    assert outcome.result.response[0, 0, 0] == pytest.approx(expected, rel=1e-14)
