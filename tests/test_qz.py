@@ -161,14 +161,16 @@ def test_small_eigenvalue_beside_a_nearly_singular_b_is_accurate(seed: int) -> N
             assert error < 1e-9, (value, found)
 
 
-@pytest.mark.xfail(strict=True, reason="core QZ: exact zero structure (reported, not yet fixed)")
-def test_known_defect_pencil_with_exact_zeros_and_a_double_zero_eigenvalue() -> None:
-    """A = [[-1, 0, 0], [1, 0, 0], [0, 1, 0]] (eigenvalues -1 and a defective double 0 of
-    B^-1 A), B = [[1, 0, 0], [0, 2, 0], [0, 1, 2]]: the core returns the eigenvalues -1, 0.217
-    and -0.235 with ||Q^T A Z - AA|| / ||A|| = 0.117 (scipy: 0, 0, -1 to 1e-16). A
-    perturbation of 1e-14 in A gives a backward error of 4e-16: the defect is on a path that
-    only exact zeros take. Found by the qz property suite (a companion A beside an integer B
-    of rank 7 gave 1.1e-7 in B)."""
+def test_regression_pencil_with_exact_zeros_and_a_double_zero_eigenvalue() -> None:
+    """Formerly a known defect: A = [[-1, 0, 0], [1, 0, 0], [0, 1, 0]] (eigenvalues -1 and a
+    defective double 0 of B^-1 A), B = [[1, 0, 0], [0, 2, 0], [0, 1, 2]]: the core returned
+    the eigenvalues -1, 0.217 and -0.235 with ||Q^T A Z - AA|| / ||A|| = 0.117 (scipy: 0, 0,
+    -1 to 1e-16). The split of the real 2 x 2 block chose its eigenvalue by a distance that
+    put every root at 1 from the estimate 0, and took the 0/0 root; it is now the chordal
+    distance. Found by the qz property suite."""
     A = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
     B = np.array([[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 1.0, 2.0]])
+    result = aerocontrol.qz(A, B)
+    values = np.sort((result.alpha / result.beta).real)
+    np.testing.assert_allclose(values, [-1.0, 0.0, 0.0], atol=1e-7)
     _check(A, B, aerocontrol.qz(A, B))

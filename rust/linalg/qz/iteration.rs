@@ -371,11 +371,15 @@ fn real_pair_eigenvalue(p: &Pencil<'_>, k: usize, estimate: f64) -> (f64, f64) {
     if !roots.iter().all(|&(x, y)| x.is_finite() && y.is_finite()) || q == 0.0 {
         return (estimate, 1.0);
     }
-    // |α - estimate β| / (|α| + |estimate β|): the chordal distance up to a factor.
+    // The chordal distance |α - estimate β| / (||(α, β)|| ||(estimate, 1)||) (the common
+    // factor dropped). Normalised by |α| + |estimate β| instead, an estimate of 0 put every
+    // root at distance 1: a defective double zero (H and T's blocks nilpotent to rounding,
+    // b and det H of 1e-17) took the 0/0 root 2 det H / q = 0.67, and the split that forced
+    // its h_{k+1,k} to zero had a backward error of 0.2.
     let distance = |&(alpha, beta): &(f64, f64)| {
-        let scale = alpha.abs() + (estimate * beta).abs();
+        let scale = alpha.hypot(beta);
         if scale == 0.0 {
-            0.0
+            f64::INFINITY
         } else {
             (alpha - estimate * beta).abs() / scale
         }

@@ -198,3 +198,23 @@ fn bad_arguments_are_named() {
         Err(Error::NonFinite { arg: "A", .. })
     ));
 }
+
+/// A defective double zero with exact zeros in A (A = [[-1, 0, 0], [1, 0, 0], [0, 1, 0]]): the
+/// 2 x 2 block's real eigenvalue was chosen by a distance that put every root at 1 from the
+/// estimate 0, and the 0/0 root 0.67 was split off with a backward error of 0.2.
+#[test]
+fn a_defective_double_zero_is_split_backward_stably() {
+    let a = faer::mat![[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let b = faer::mat![[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 1.0, 2.0]];
+    let form = qz(a.as_ref(), b.as_ref()).unwrap();
+    let backward = check_form(&a, &b, &form);
+    assert!(backward < 10.0, "backward error {backward} u");
+    let mut values: Vec<f64> = (0..3).map(|k| form.s[(k, k)] / form.t[(k, k)]).collect();
+    values.sort_by(f64::total_cmp);
+    // -1 exactly conditioned; the defective double 0 to about sqrt(u).
+    assert!((values[0] + 1.0).abs() < 1e-14, "{values:?}");
+    assert!(
+        values[1].abs() < 1e-7 && values[2].abs() < 1e-7,
+        "{values:?}"
+    );
+}
