@@ -608,3 +608,19 @@ def test_regression_closed_loop_pole_near_the_largest_double() -> None:
         warnings.simplefilter("error")
         r = nyquist(([[-1.5636496689062018]], [[-1e308]], [[1.0]], [[0.0]]))
     assert (r.open_loop_unstable_poles, r.encirclements, r.closed_loop_unstable_poles) == (0, -1, 1)
+
+
+def test_regression_poles_near_the_largest_double() -> None:
+    """A pole at -1e308 (B of 1e308): the grid reaches the largest doubles, where the
+    midpoint (a + b)/2 and the step 10 ω towards ∞ overflowed with numpy's RuntimeWarning.
+    Midpoints are now a/2 + b/2, the step towards ∞ stops at the largest double, and L there
+    is checked against L = C/(s/1e308 + 1) + D, formed scaled."""
+    C, D = 12573022.10933933, -65179115.261168964
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = nyquist(([[-1e308]], [[1e308]], [[C]], [[D]]))
+    assert (r.open_loop_unstable_poles, r.encirclements, r.closed_loop_unstable_poles) == (0, 0, 0)
+    assert 1e308 < r.omega.max() <= np.finfo(float).max
+    exact = C / (1j * (r.omega / 1e308) + 1.0) + D
+    np.testing.assert_allclose(r.response, exact, rtol=1e-14)
+    assert r.curve[-1] == D

@@ -2552,14 +2552,18 @@ class _Contour:
         w_a = np.where(piece_a % 2 == 0, a, self.s.imag[i])
         w_b = np.where(piece_b % 2 == 0, b, self.s.imag[i + 1])
         with np.errstate(over="ignore", invalid="ignore"):
-            geometric = np.sqrt(w_a * w_b)
+            geometric = np.sqrt(w_a) * np.sqrt(w_b)
+            towards_infinity = np.minimum(10.0 * w_a, np.finfo(float).max)
             middle = np.where(
                 np.isinf(w_b),
-                np.where(w_a > 0.0, 10.0 * w_a, 1.0),
-                np.where((w_a > 0.0) & (w_b > 4.0 * w_a), geometric, 0.5 * (w_a + w_b)),
+                np.where(w_a > 0.0, towards_infinity, 1.0),
+                np.where((w_a > 0.0) & (w_b > 4.0 * w_a), geometric, 0.5 * w_a + 0.5 * w_b),
             )
-        parameter = np.where(axis, middle, 0.5 * (a + b))
-        self.add(piece.astype(np.int64), parameter.astype(np.float64))
+        parameter = np.where(axis, middle, 0.5 * a + 0.5 * b)
+        # A step that cannot be split (between neighbouring doubles, or from the largest
+        # double to ∞) is left as it is.
+        new = (parameter != a) & (parameter != b)
+        self.add(piece[new].astype(np.int64), parameter[new].astype(np.float64))
 
     def turns(self, centre: complex) -> FloatArray:
         """The angle (radians, in [-π, π)) that the curve turns about ``centre`` over each
@@ -2581,7 +2585,10 @@ class _Contour:
             count = int(np.sum(wide))
             if count == 0 or self.values.size + count > MAX_CONTOUR_POINTS:
                 return
+            size = self.values.size
             self.bisect(wide)
+            if self.values.size == size:  # no step could be split
+                return
 
     def winding(self, centre: complex) -> float:
         """The number of counterclockwise turns about ``centre`` of the closed curve: the
@@ -2829,8 +2836,9 @@ def nyquist(loop: System, omega: ArrayLike | None = None) -> NyquistResponse:
         The open-loop transfer L, one input and one output; continuous or discrete.
     omega : array_like, optional
         Frequencies (rad/s, non-negative, at most π/dt for a discrete loop) at which to
-        report L; the contour passes through them. By default every frequency of the contour
-        on the axis is reported.
+        report L, sorted and without repeats; the contour passes through them (but through
+        none at a pole on the axis, where L is the core's, not finite). By default every
+        frequency of the contour on the axis is reported.
 
     Returns
     -------
