@@ -617,7 +617,7 @@ pub fn loop_margins(
         return Err(Error::InvalidArgument {
             arg: "loop",
             message: format!(
-                "must have one input and one output, got {} outputs and {} inputs",
+                "loop must have one input and one output, got {} outputs and {} inputs",
                 c.nrows(),
                 b.ncols()
             ),

@@ -147,7 +147,7 @@ pub fn root_locus(
         return Err(Error::InvalidArgument {
             arg: "loop",
             message: format!(
-                "must have one input and one output with B {n} x 1 and C 1 x {n}, got B {} x {} \
+                "loop must have one input and one output, B {n} x 1 and C 1 x {n}, got B {} x {} \
                  and C {} x {}",
                 b.nrows(),
                 b.ncols(),
@@ -256,5 +256,10 @@ mod tests {
             &mut out,
         );
         assert!(matches!(error, Err(Error::NonFinite { arg: "gains", .. })));
+        let wide = Mat::from_fn(1, 2, |_, _| 1.0);
+        let error = root_locus(a.as_ref(), wide.as_ref(), b.as_ref(), &[1.0], &mut out)
+            .unwrap_err()
+            .to_string();
+        assert!(error.starts_with("loop must have one input"), "{error}");
     }
 }
