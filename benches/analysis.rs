@@ -4,7 +4,8 @@
 //! the steady state of a step, and the Riccati differential equation. Seeded random matrices
 //! at n = 4, 16, 64 and 256 (the companion form and the Riccati ODE stop where their peers do:
 //! 16 and 64), the crossovers and peaks of a SISO loop (loop_margins) at n = 4, 8 and 16, and
-//! its root locus over 1000 gains (root_locus) at n = 4, 8 and 16.
+//! its root locus over 1000 gains (root_locus) at n = 4, 8 and 16, and the transfer functions
+//! of every channel of two-input, two-output models (transfer_channels) at n = 4, 8 and 16.
 
 use aerocontrol::control::controllability::{controllability_staircase, ctrb, obsv};
 use aerocontrol::control::margins::loop_margins;
@@ -13,6 +14,7 @@ use aerocontrol::control::placement::companion_form;
 use aerocontrol::control::responses::steady_state;
 use aerocontrol::control::riccati::ode::riccati_ode;
 use aerocontrol::control::root_locus::root_locus;
+use aerocontrol::control::transfer::transfer_channels;
 use aerocontrol::linalg::charpoly::charpoly;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use faer::Mat;
@@ -136,5 +138,32 @@ fn locus(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, spectra, margins, locus);
+/// Every channel's transfer function of the same models with two inputs and two outputs
+/// (control/transfer.rs), D = 0.
+fn transfer(c: &mut Criterion) {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let mut group = c.benchmark_group("analysis");
+    group.sample_size(20);
+    let channels = [(0, 0), (0, 1), (1, 0), (1, 1)];
+    for n in [4, 8, 16] {
+        let a = stable(n, 10 + n as u64);
+        let (b, c_out) = (seeded_matrix(n, 2, 11), seeded_matrix(2, n, 12));
+        let d = Mat::<f64>::zeros(2, 2);
+        group.bench_with_input(BenchmarkId::new("transfer_channels", n), &a, |bench, a| {
+            bench.iter(|| {
+                transfer_channels(
+                    black_box(a.as_ref()),
+                    b.as_ref(),
+                    c_out.as_ref(),
+                    d.as_ref(),
+                    0.0,
+                    &channels,
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, spectra, margins, locus, transfer);
 criterion_main!(benches);

@@ -515,3 +515,184 @@ def test_gain_with_a_feedthrough_is_the_feedthrough() -> None:
         g = transfer_function((A, B, C, np.array([[d]])))
         assert g.gain == d
         assert g.numerator[0] == d
+
+
+# ----- the core's fast path and the transfer matrix ---------------------------------------------
+
+
+def _random_channels(seed: int) -> list[tuple[aerocontrol.StateSpace, int, int]]:
+    """Random models of 1 to 8 states, 1 or 2 inputs and outputs: dense, sparse (structural
+    zeros, double zeros at the origin, zero channels), states scaled over 1e±4, discrete."""
+    rng = np.random.default_rng(seed)
+    channels = []
+    for trial in range(120):
+        n, p, m = (int(x) for x in (rng.integers(1, 9), rng.integers(1, 3), rng.integers(1, 3)))
+        A, B = rng.standard_normal((n, n)), rng.standard_normal((n, m))
+        C = rng.standard_normal((p, n))
+        D = rng.standard_normal((p, m)) * (rng.random() < 0.3)
+        kind = trial % 4
+        if kind == 1:
+            A *= rng.random((n, n)) < 0.4
+            B *= rng.random((n, m)) < 0.5
+            C *= rng.random((p, n)) < 0.5
+        if kind == 2:
+            s = 10.0 ** rng.uniform(-4, 4, n)
+            A, B, C = A * s[:, None] / s[None, :], B * s[:, None], C / s[None, :]
+        model = aerocontrol.StateSpace(A, B, C, D, dt=0.1 if kind == 3 else None)
+        channels += [(model, i, j) for i in range(p) for j in range(m)]
+    return channels
+
+
+def _state_space_value(model: aerocontrol.StateSpace, i: int, j: int, s: complex) -> complex:
+    n = model.n_states
+    x = np.linalg.solve(s * np.eye(n) - model.A, model.B[:, j]) if n else np.zeros(0)
+    return complex(model.C[i] @ x + model.D[i, j])
+
+
+@pytest.mark.parametrize("seed", [11, 12])
+def test_fast_path_agrees_with_the_reference_path(seed: int) -> None:
+    # The core's fast path (rust/control/transfer.rs) and the reference path (transfer.py)
+    # on the same channels: the same number of zeros, the zeros within 1e-7 (relative; a
+    # double zero at the origin that the reference's QZ splits to ±1e-8 is 0 in the fast
+    # path), the gains within 1e-7, and both reproduce C (sI - A)⁻¹ B + D to 1e-9 at points
+    # away from the roots. The fast path takes at least 95% of the channels.
+    from aerocontrol import _core
+    from aerocontrol.transfer import _fast_channel, _reference_channel
+
+    taken = 0
+    channels = _random_channels(seed)
+    for model, i, j in channels:
+        dt = model.dt or 0.0
+        poles, denominator, (fast,) = _core.transfer_channels(
+            model.A, model.B, model.C, model.D, dt, [(i, j)]
+        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            reference = _reference_channel(model, i, j, dt, stacklevel=2)
+        if fast is None:
+            continue
+        taken += 1
+        ours = _fast_channel(model, i, j, dt, poles, denominator, fast)
+        assert ours.zeros.size == reference.zeros.size
+        assert _matched_error(ours.zeros, reference.zeros) <= 1e-7
+        assert ours.gain == pytest.approx(reference.gain, rel=1e-7, abs=0.0)
+        np.testing.assert_allclose(ours.denominator, reference.denominator, rtol=1e-12, atol=1e-12)
+        points = np.exp(1j * np.array([0.3, 1.1, 2.3])) if dt else 1j * np.array([0.13, 1.1, 7.7])
+        expected = np.array([_state_space_value(model, i, j, s) for s in points])
+        scale = np.abs(expected) + 1e-300
+        if (
+            np.all(np.isfinite(ours(points)))
+            and np.min(np.abs(points[:, None] - np.concatenate([ours.zeros, ours.poles])[None, :]))
+            > 1e-3
+        ):
+            assert np.max(np.abs(ours(points) - expected) / scale) <= 1e-9
+    assert taken >= 0.95 * len(channels)
+
+
+def test_reference_gain_is_confirmed_at_a_second_point() -> None:
+    # Four poles at the origin and a double zero there: G = K/s² with K = -1.3122 (from the
+    # state space, c A b = 0 and c A² b... by hand: G(s) = c (sI - A)⁻¹ b, A nilpotent). The
+    # reference path's QZ split the double zero to ±1.6e-9, the grid of evaluation points
+    # went to 1e-9, where C (sI - A)⁻¹ B cancels to the size of G, and K came back 1000
+    # times too small, silently. The gain is now confirmed at a second point, and the grid
+    # around ||A|| is tried when it is not.
+    from aerocontrol.transfer import _reference_channel
+
+    A = np.array(
+        [
+            [0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0],
+            [0.90735503, 0.0, 0.0, 0.28741138],
+            [0.0, 0.41920303, 0.0, 0.0],
+        ]
+    )
+    b = np.array([[1.6018475], [0.0], [0.0], [1.63150833]])
+    c = np.array([[0.0, 0.0, -0.6825994, 0.0]])
+    model = aerocontrol.StateSpace(A, b, c, np.zeros((1, 1)))
+    # c (sI - A)^-1 b = -0.6825994 (0.90735503 1.6018475 + 0.28741138 1.63150833) / s^2.
+    k = -0.6825994 * (0.90735503 * 1.6018475 + 0.28741138 * 1.63150833)
+    for g in (_reference_channel(model, 0, 0, 0.0, stacklevel=2), transfer_function(model)):
+        assert g.gain == pytest.approx(k, rel=1e-7)
+        assert g(2.0j) == pytest.approx(k / (2.0j) ** 2, rel=1e-7)
+
+
+def test_transfer_matrix_is_every_transfer_function() -> None:
+    lateral = aerocontrol.aircraft.load("b747-cruise").lateral()
+    model = lateral[["p", "r", "beta"], :]
+    g = aerocontrol.transfer_matrix(model)
+    assert g.shape == (3, 2)
+    points = 1j * np.array([0.05, 0.3, 1.0, 4.0])
+    values = g(points)
+    assert values.shape == (3, 2, 4)
+    for i, output in enumerate(model.output_names):
+        for j, input_name in enumerate(model.input_names):
+            single = transfer_function(model, output, input_name)
+            channel = g[output, input_name]
+            assert channel is g[i, j]  # made once
+            np.testing.assert_array_equal(channel.zeros, single.zeros)
+            assert channel.gain == single.gain
+            np.testing.assert_array_equal(channel.numerator, single.numerator)
+            np.testing.assert_array_equal(channel.poles, single.poles)
+            np.testing.assert_allclose(values[i, j], single(points), rtol=1e-14)
+            expected = [_state_space_value(model, i, j, s) for s in points]
+            np.testing.assert_allclose(values[i, j], expected, rtol=1e-11)
+    # Against python-control's ss2tf (slycot TB04AD), channel by channel.
+    peer = control.ss2tf(control.ss(model.A, model.B, model.C, model.D))
+    np.testing.assert_allclose(values, peer(points), rtol=1e-10)
+    # A scalar point gives (outputs, inputs).
+    assert g(1.0j).shape == (3, 2)
+    assert "TransferMatrix" in repr(g) and "r/rudder" in str(g)
+
+
+def test_transfer_matrix_defers_a_channel_beyond_the_fast_path() -> None:
+    # Entries beyond 2^250 leave a channel to the reference path (scaled products); the other
+    # channel is the fast path's. Both are right: G = 1e300/(s + 1) and 2/(s + 1).
+    model = aerocontrol.StateSpace([[-1.0]], [[1e300, 2.0]], [[1.0]], [[0.0, 0.0]])
+    g = aerocontrol.transfer_matrix(model)
+    assert g[0, 0].gain == pytest.approx(1e300, rel=1e-14)
+    assert g[0, 1].gain == pytest.approx(2.0, rel=1e-14)
+    np.testing.assert_allclose(g(0.0), [[1e300, 2.0]], rtol=1e-14)
+
+
+def test_transfer_matrix_of_a_discrete_model_and_bad_keys() -> None:
+    sys = control.ss(
+        [[0.9, 0.1], [0.0, 0.8]], [[1.0, 0.0], [0.5, 1.0]], [[1.0, 0.0], [0.0, 1.0]], 0, 0.05
+    )
+    model = aerocontrol.StateSpace(sys.A, sys.B, sys.C, sys.D, dt=0.05)
+    g = aerocontrol.transfer_matrix(model)
+    assert g.dt == 0.05 and g["y0", "u1"].variable == "z"
+    z = np.exp(1j * np.array([0.2, 1.0]))
+    np.testing.assert_allclose(g(z), control.ss2tf(sys)(z), rtol=1e-12)
+    with pytest.raises(InvalidArgumentError, match="output"):
+        g["nope", 0]
+    with pytest.raises(InvalidArgumentError, match=r"\[output, input\]"):
+        g[0]  # type: ignore[index]
+
+
+def test_zeros_of_equal_modulus_are_each_taken_once() -> None:
+    # Zeros ±1.0246 (and -0.3237, -0.0293 ± 0.8647j; scipy's generalized eigenvalues of the
+    # pencil): their moduli tie, the forward and the reversed QZ forms ordered the tie
+    # differently, and the split by count took 1.0246 from both forms: 1.0246 twice and no
+    # -1.0246, silently. The reversed form's share is now what is left when each of the
+    # forward form's largest has taken its nearest.
+    A = np.array(
+        [
+            [-0.5224016193394476, -0.0, -0.0, -0.0, 0.25018491477761295],
+            [-0.0, -0.0, 0.0, -2.2854597440689717, -0.33248557299438186],
+            [0.0, 0.0, 0.0, 0.0, 0.5791181163366733],
+            [0.027460802271533708, -0.45938269207844, 0.0, 0.0, -2.045483729295253],
+            [-0.8635969058500171, -0.0, -0.9964405130152794, -0.0, -0.0],
+        ]
+    )
+    b = np.array([0.9259719948820543, -0.0, 0.5750596771201096, -0.0, 0.678266188103397])[:, None]
+    c = np.array([0.19944556062296265, -0.0, -0.0, -0.0, 0.0])[None, :]
+    d = np.array([[-1.3185813215677191]])
+    ours = transmission_zeros((A, b, c, d))
+    n = A.shape[0]
+    S = np.block([[A, b], [c, d]])
+    E = np.zeros_like(S)
+    E[:n, :n] = np.eye(n)
+    expected = scipy.linalg.eigvals(S, E)
+    expected = expected[np.isfinite(expected)]
+    assert ours.size == expected.size == 5
+    assert _matched_error(ours, expected) <= 1e-12

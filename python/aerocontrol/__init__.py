@@ -130,7 +130,14 @@ from .riccati import (
     solve_lyapunov,
 )
 from .statespace import StateSpace, as_state_space
-from .transfer import Factor, TransferFunction, transfer_function, transmission_zeros
+from .transfer import (
+    Factor,
+    TransferFunction,
+    TransferMatrix,
+    transfer_function,
+    transfer_matrix,
+    transmission_zeros,
+)
 
 try:
     __version__ = version("aerocontrol")
@@ -180,6 +187,7 @@ __all__ = [
     "StateSpace",
     "TimeResponse",
     "TransferFunction",
+    "TransferMatrix",
     "UncontrollableError",
     "__version__",
     "actuator",
@@ -257,6 +265,7 @@ __all__ = [
     "summing_junction",
     "tf",
     "transfer_function",
+    "transfer_matrix",
     "transition_matrix",
     "transmission_zeros",
     "washout",

@@ -29,6 +29,7 @@ __all__ = [
     "exception_classes",
     "expm",
     "expm_pade_choice",
+    "factored_response",
     "frequency_response",
     "grid_step",
     "inverse_bilinear",
@@ -48,6 +49,7 @@ __all__ = [
     "solve_dare",
     "solve_lyapunov",
     "steady_state",
+    "transfer_channels",
     "transition_matrices",
     "undiscretize_zoh",
 ]
@@ -133,6 +135,27 @@ def loop_margins(
 ]: ...
 def root_locus(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, gains: ArrayLike, /
+) -> NDArray[np.complex128]: ...
+def transfer_channels(
+    a: ArrayLike,
+    b: ArrayLike,
+    c: ArrayLike,
+    d: ArrayLike,
+    dt: float,
+    channels: list[tuple[int, int]],
+    /,
+) -> tuple[
+    NDArray[np.complex128],
+    NDArray[np.float64],
+    list[tuple[NDArray[np.complex128], float, NDArray[np.float64]] | None],
+]: ...
+def factored_response(
+    mantissas: list[float],
+    exponents: list[int],
+    zeros: list[NDArray[np.complex128]],
+    poles: NDArray[np.complex128],
+    points: NDArray[np.complex128],
+    /,
 ) -> NDArray[np.complex128]: ...
 def frequency_response(
     a: ArrayLike,

@@ -34,6 +34,7 @@ structural invariants of generalized state-space systems", Automatica 30(12), 19
 
 from __future__ import annotations
 
+import cmath
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -46,6 +47,7 @@ from . import _core
 from ._validation import FloatArray, finite_or_warn, real_scalar
 from .exceptions import (
     ConvergenceError,
+    IllConditionedWarning,
     InvalidArgumentError,
     NumericalOverflowWarning,
     NumericalUnderflowWarning,
@@ -56,7 +58,14 @@ from .statespace import StateSpace, as_state_space, period, signal_indices
 if TYPE_CHECKING:
     from ._typing import SignalSelection, System
 
-__all__ = ["Factor", "TransferFunction", "transfer_function", "transmission_zeros"]
+__all__ = [
+    "Factor",
+    "TransferFunction",
+    "TransferMatrix",
+    "transfer_function",
+    "transfer_matrix",
+    "transmission_zeros",
+]
 
 ComplexArray = NDArray[np.complex128]
 
@@ -365,6 +374,25 @@ def _paired(values: ComplexArray, count: int) -> bool:
     )
 
 
+def _unmatched(taken: ComplexArray, pool: ComplexArray) -> NDArray[np.int64]:
+    """The indices (in order) of the values of ``pool`` left when each value of ``taken``, in
+    turn, removes the nearest one left (by relative distance; an infinite value is nearest
+    an infinite one)."""
+    left = list(range(pool.size))
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        for value in taken:
+            if not left:
+                break
+            candidates = pool[left]
+            if not cmath.isfinite(value):
+                distance = np.where(np.isfinite(candidates), np.inf, 0.0)
+            else:
+                size = np.maximum(np.maximum(np.abs(candidates), abs(value)), 1e-300)
+                distance = np.nan_to_num(np.abs(candidates - value) / size, nan=np.inf)
+            left.pop(int(np.argmin(distance)))
+    return np.array(left, dtype=np.int64)
+
+
 def _backward_error(Af: FloatArray, Bf: FloatArray, alpha: complex, beta: float) -> float:
     """The relative backward error of the eigenvalue α/β of Af - λBf: σ_min(β Af - α Bf) /
     (|β| ||Af|| + |α| ||Bf||) (Frobenius norms), formed as σ_min(b A' - a B') / (|a| + |b|)
@@ -443,15 +471,19 @@ def _regular_pencil_zeros(Af: FloatArray, Bf: FloatArray, ratio: float) -> Compl
         else _backward_error(Af, Bf, 1.0, 0.0)
         for b, a in pairs_backward
     ]
-    best, best_error = n, math.inf
+    best, best_error, best_rest = n, math.inf, np.zeros(0, dtype=np.int64)
     for count in range(n, -1, -1):
-        if not (_paired(large, count) and _paired(small, n - count)):
+        # The reversed form's eigenvalues other than the count largest: those left when each
+        # of the forward form's count largest has taken its nearest (by moduli alone, ties
+        # such as ±1.02 were split differently in the two forms, and 1.02 came back twice).
+        rest = _unmatched(large[:count], small)
+        if not (_paired(large, count) and _paired(small[rest], rest.size)):
             continue
-        worst = max(errors_large[:count] + errors_small[: n - count], default=0.0)
+        worst = max(errors_large[:count] + [errors_small[k] for k in rest], default=0.0)
         if worst < best_error:
-            best, best_error = count, worst
+            best, best_error, best_rest = count, worst, rest
     infinite = np.array([abs(a) * ratio >= b for a, b in pairs_forward], dtype=bool)
-    chosen = np.concatenate([large[:best][~infinite[:best]], small[: n - best]])
+    chosen = np.concatenate([large[:best][~infinite[:best]], small[best_rest]])
     return np.asarray(chosen[np.isfinite(chosen)], dtype=np.complex128)
 
 
@@ -645,14 +677,14 @@ class TransferFunction:
         G of 1e300. A G beyond the doubles is infinite, with a NumericalOverflowWarning; one
         below them rounds to 0 (or a subnormal), as a product of doubles does."""
         value = np.asarray(s, dtype=np.complex128)
-        points = value.reshape(-1)
         k, e = self.scaled_gain if self.scaled_gain is not None else math.frexp(self.gain)
-        mantissa = np.full(points.shape, complex(k), dtype=np.complex128)
-        exponent = np.full(points.shape, e, dtype=np.int64)
-        m, power = _scaled_factored(mantissa, exponent, points, self.zeros, self.poles)
-        flat = np.empty(points.shape, dtype=np.complex128)
-        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is warned of below
-            flat.real, flat.imag = np.ldexp(m.real, power), np.ldexp(m.imag, power)
+        flat = _core.factored_response(
+            [float(k)],
+            [int(e)],
+            [np.asarray(self.zeros, dtype=np.complex128).reshape(-1)],
+            np.asarray(self.poles, dtype=np.complex128).reshape(-1),
+            value.reshape(-1),
+        )[0]
         result = flat.reshape(value.shape)
         if not np.all(np.isfinite(result)) and np.all(np.isfinite(value)):
             warnings.warn(
@@ -688,37 +720,41 @@ class TransferFunction:
         return "\n".join(lines)
 
 
-def _evaluation_point(roots: ComplexArray, dt: float) -> complex:
-    """A point s = jω (z = e^{jω dt}) far from every root."""
+def _evaluation_points(
+    roots: ComplexArray, dt: float, centre: float | None = None
+) -> list[complex]:
+    """Points s = jω (z = e^{jω dt}) ranked by their relative distance to the nearest root,
+    farthest first: 31 frequencies over three decades around the roots' sizes (around
+    10^centre when given), or 19 angles of the unit circle for a discrete model."""
     if dt:
         candidates = np.linspace(0.05, 0.95, 19) * math.pi / dt
         points = np.exp(1j * candidates * dt)
     else:
-        with np.errstate(over="ignore"):  # |root| of a root near the overflow threshold
-            sizes = np.abs(roots[np.isfinite(roots) & (roots != 0)])
-            sizes = sizes[np.isfinite(sizes)]
+        if centre is None:
+            with np.errstate(over="ignore"):  # |root| of a root near the overflow threshold
+                sizes = np.abs(roots[np.isfinite(roots) & (roots != 0)])
+                sizes = sizes[np.isfinite(sizes)]
+            centre = float(np.mean(np.log10(sizes))) if sizes.size else 0.0
         # The grid is taken in log10 and kept inside the doubles (a root near 1e308 would
         # otherwise put a candidate at infinity).
-        log_centre = float(np.mean(np.log10(sizes))) if sizes.size else 0.0
-        exponents = np.clip(log_centre + np.linspace(-1.5, 1.5, 31), -300.0, 307.0)
+        exponents = np.clip(centre + np.linspace(-1.5, 1.5, 31), -300.0, 307.0)
         candidates = 10.0**exponents
         points = 1j * candidates
     if roots.size == 0:
-        best = len(candidates) // 2
-    else:
-        # Relative distances, computed after a power-of-two scaling by the largest candidate so
-        # that a difference of two numbers near 1e308 stays finite; a root so far away that its
-        # scaled difference still overflows is infinitely far (inf, never nan, for ranking).
-        scale = 2.0 ** -math.frexp(float(np.max(np.abs(points))))[1]
-        with np.errstate(over="ignore", invalid="ignore"):
-            distance = np.min(
-                np.abs(points[:, None] * scale - roots[None, :] * scale)
-                / np.maximum(np.abs(points[:, None]) * scale, 1e-300),
-                axis=1,
-            )
-        distance = np.nan_to_num(distance, nan=np.inf)
-        best = int(np.argmax(distance))
-    return complex(points[best])
+        middle = len(candidates) // 2
+        return [complex(p) for p in np.roll(points, -middle)]
+    # Relative distances, computed after a power-of-two scaling by the largest candidate so
+    # that a difference of two numbers near 1e308 stays finite; a root so far away that its
+    # scaled difference still overflows is infinitely far (inf, never nan, for ranking).
+    scale = 2.0 ** -math.frexp(float(np.max(np.abs(points))))[1]
+    with np.errstate(over="ignore", invalid="ignore"):
+        distance = np.min(
+            np.abs(points[:, None] * scale - roots[None, :] * scale)
+            / np.maximum(np.abs(points[:, None]) * scale, 1e-300),
+            axis=1,
+        )
+    distance = np.nan_to_num(distance, nan=np.inf)
+    return [complex(points[k]) for k in np.argsort(-distance, kind="stable")]
 
 
 def _single(key: SignalSelection | None, names: tuple[str, ...], what: str) -> int:
@@ -962,11 +998,65 @@ def _roots_and_gain(channel: StateSpace) -> tuple[ComplexArray, ComplexArray, fl
         return poles, reduced.zeros, mantissa, exponent
     if reduced.normal_rank == 0:
         return poles, np.zeros(0, np.complex128), 0.0, 0
-    point = _evaluation_point(np.concatenate([reduced.zeros, poles]), period(channel) or 0.0)
-    mantissa, exponent = _gain(*_scaled_response(channel, point), point, reduced.zeros, poles)
+    mantissa, exponent = _verified_gain(channel, reduced.zeros, poles)
     if mantissa == 0.0:
         return poles, np.zeros(0, np.complex128), 0.0, 0
     return poles, reduced.zeros, mantissa, exponent
+
+
+def _verified_gain(
+    channel: StateSpace, zeros: ComplexArray, poles: ComplexArray
+) -> tuple[float, int]:
+    """K (as a mantissa and a power of two) from G at the point of the grid around the roots
+    farthest from them, confirmed by G at the next point (to 1e-6, relative): where G at the
+    first point cannot be computed accurately (poles at the origin beside a double zero that
+    rounding split to ±1e-9 put every point of the grid near 1e-9, where the terms of
+    C (sI - A)⁻¹ B cancel to the size of G: K came back 1000 times too small), the points of
+    the grid around ||A|| (and 1) are tried. If no point is confirmed, the best is returned
+    with an IllConditionedWarning."""
+    dt = period(channel) or 0.0
+    roots = np.concatenate([zeros, poles])
+    size = float(np.max(np.abs(channel.A), initial=0.0))
+    grids = [_evaluation_points(roots, dt)]
+    if not dt:
+        grids += [
+            _evaluation_points(roots, dt, math.log10(size) if size > 0.0 else 0.0),
+            _evaluation_points(roots, dt, 0.0),
+        ]
+    best: tuple[float, tuple[float, int]] | None = None
+    for grid in grids:
+        point, check = grid[0], grid[1]
+        mantissa, exponent = _gain(*_scaled_response(channel, point), point, zeros, poles)
+        if mantissa == 0.0 or not math.isfinite(mantissa):
+            return mantissa, exponent
+        g_m, g_e = _scaled_response(channel, check)
+        f_m, f_e = _scaled_factored(
+            np.array([complex(mantissa)]),
+            np.array([exponent]),
+            np.array([check]),
+            zeros,
+            poles,
+        )
+        # Both renormalised (largest part in [1/2, 1)): near 1 only for exponents within 2.
+        shift = int(f_e[0]) - g_e
+        if g_m == 0.0 or abs(shift) > 2:
+            error = math.inf
+        else:
+            ratio = complex(f_m[0]) / g_m * 2.0**shift
+            error = abs(ratio - 1.0) if cmath.isfinite(ratio) else math.inf
+        if error <= 1e-6:
+            return mantissa, exponent
+        if best is None or error < best[0]:
+            best = (error, (mantissa, exponent))
+    assert best is not None
+    warnings.warn(
+        f"transfer_function: the gain of {channel.output_names[0]}/{channel.input_names[0]} "
+        f"could not be confirmed: the factored form differs from C (sI - A)⁻¹ B + D by "
+        f"{best[0]:.1e} (relative) at a second point (ill-conditioned zeros or poles)",
+        IllConditionedWarning,
+        stacklevel=5,
+    )
+    return best[1]
 
 
 def transfer_function(
@@ -1008,11 +1098,62 @@ def transfer_function(
     model = as_state_space(sys)
     i = _single(output, model.output_names, "output")
     j = _single(input, model.input_names, "input")
-    channel = model[[i], [j]]
     dt = period(model) if model.is_discrete else 0.0
+    poles, denominator, (fast,) = _core.transfer_channels(
+        model.A, model.B, model.C, model.D, dt, [(i, j)]
+    )
+    if fast is not None:
+        denominator = _checked_denominator(poles, denominator, 3)
+        return _fast_channel(model, i, j, dt, poles, denominator, fast)
+    return _reference_channel(model, i, j, dt, stacklevel=3)
+
+
+def _checked_denominator(
+    poles: ComplexArray, denominator: FloatArray, stacklevel: int
+) -> FloatArray:
+    """The core's Π(s - p_j), or (when it overflowed: empty) the same scaled by powers of two
+    (:func:`_scaled_poly`), warned of when a coefficient lies beyond the doubles."""
+    if denominator.size != poles.size + 1:  # the core's overflowed
+        denominator = _scaled_poly(poles, 1.0, 0)
+        finite_or_warn(denominator, "the denominator det(sI - A)", stacklevel=stacklevel + 1)
+    return denominator
+
+
+def _fast_channel(
+    model: StateSpace,
+    i: int,
+    j: int,
+    dt: float,
+    poles: ComplexArray,
+    denominator: FloatArray,
+    fast: tuple[ComplexArray, float, FloatArray],
+) -> TransferFunction:
+    """The TransferFunction of the core's fast path (``rust/control/transfer.rs``), which
+    computes what :func:`_reference_channel` computes and leaves it every channel where the
+    two could differ."""
+    zeros, gain, numerator = fast
+    return TransferFunction(
+        numerator=numerator,
+        denominator=denominator,
+        zeros=zeros,
+        poles=poles,
+        gain=gain,
+        dt=dt,
+        output_name=model.output_names[i],
+        input_name=model.input_names[j],
+    )
+
+
+def _reference_channel(
+    model: StateSpace, i: int, j: int, dt: float, stacklevel: int
+) -> TransferFunction:
+    """Channel (i, j) by the reference path: the zeros of the equilibrated pencil
+    (:func:`_pencil_zeros`), the gain from G at a point, every product held as a mantissa and
+    a power of two (any scaling the doubles can hold)."""
+    channel = model[[i], [j]]
     poles, zeros, mantissa, exponent = _roots_and_gain(channel)
     denominator = _scaled_poly(poles, 1.0, 0)
-    finite_or_warn(denominator, "the denominator det(sI - A)")
+    finite_or_warn(denominator, "the denominator det(sI - A)", stacklevel=stacklevel + 1)
     with np.errstate(over="ignore"):
         gain = float(np.ldexp(mantissa, exponent))
     if mantissa != 0.0 and gain == 0.0:
@@ -1024,12 +1165,12 @@ def transfer_function(
             f"10^{size:.1f}, below the range of doubles: the transfer function is returned "
             "as zero (numerator [0.], no zeros)",
             NumericalUnderflowWarning,
-            stacklevel=2,
+            stacklevel=stacklevel,
         )
         zeros = np.zeros(0, np.complex128)
         gain = 0.0  # not -0.0
     numerator = _scaled_poly(zeros, mantissa, exponent) if gain != 0.0 else np.zeros(1)
-    finite_or_warn(numerator, "the numerator")
+    finite_or_warn(numerator, "the numerator", stacklevel=stacklevel + 1)
     return TransferFunction(
         numerator=numerator,
         denominator=denominator,
@@ -1041,3 +1182,171 @@ def transfer_function(
         input_name=model.input_names[j],
         scaled_gain=(mantissa, exponent) if math.isinf(gain) else None,
     )
+
+
+class TransferMatrix:
+    """Every channel of a model, computed in one call: ``g[output, input]`` is a channel's
+    :class:`TransferFunction` (by name or index), ``g(s)`` the values of all channels.
+
+    The channels share the poles and the denominator det(sI - A); each has its own zeros and
+    gain, computed as :func:`transfer_function` computes them.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> lateral = aerocontrol.aircraft.load("b747-cruise").lateral()
+    >>> g = aerocontrol.transfer_matrix(lateral[["p", "r"], :])
+    >>> g.shape
+    (2, 2)
+    >>> g["r", "rudder"].zeros.size
+    3
+    >>> g(1j * np.array([0.1, 1.0])).shape      # (outputs, inputs, points)
+    (2, 2, 2)
+    """
+
+    __slots__ = (
+        "_channels",
+        "_exponents",
+        "_mantissas",
+        "_zeros",
+        "denominator",
+        "dt",
+        "input_names",
+        "output_names",
+        "poles",
+    )
+
+    def __init__(
+        self,
+        poles: ComplexArray,
+        denominator: FloatArray,
+        dt: float,
+        output_names: tuple[str, ...],
+        input_names: tuple[str, ...],
+        channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray]],
+    ) -> None:
+        self.poles = poles
+        """The eigenvalues of A, sorted."""
+        self.denominator = denominator
+        """det(sI - A), monic, highest power first."""
+        self.dt = dt
+        """0.0 for a continuous model, else the sampling period in seconds."""
+        self.output_names = output_names
+        self.input_names = input_names
+        self._channels = channels
+        # Each channel's gain as a mantissa and a power of two, and its zeros, for __call__.
+        self._mantissas: list[float] = []
+        self._exponents: list[int] = []
+        self._zeros: list[ComplexArray] = []
+        for channel in channels:
+            if isinstance(channel, TransferFunction):
+                k, e = channel.scaled_gain or math.frexp(channel.gain)
+                self._zeros.append(channel.zeros)
+            else:
+                k, e = math.frexp(channel[1])
+                self._zeros.append(channel[0])
+            self._mantissas.append(k)
+            self._exponents.append(e)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(outputs, inputs)."""
+        return len(self.output_names), len(self.input_names)
+
+    def _channel(self, i: int, j: int) -> TransferFunction:
+        index = i * len(self.input_names) + j
+        channel = self._channels[index]
+        if isinstance(channel, TransferFunction):
+            return channel
+        made = TransferFunction(
+            numerator=channel[2],
+            denominator=self.denominator,
+            zeros=channel[0],
+            poles=self.poles,
+            gain=channel[1],
+            dt=self.dt,
+            output_name=self.output_names[i],
+            input_name=self.input_names[j],
+        )
+        self._channels[index] = made
+        return made
+
+    def __getitem__(self, key: tuple[SignalSelection, SignalSelection]) -> TransferFunction:
+        if not (isinstance(key, tuple) and len(key) == 2):
+            raise InvalidArgumentError(
+                "a TransferMatrix is indexed by [output, input] (a name or an index each)"
+            )
+        i = _single(key[0], self.output_names, "output")
+        j = _single(key[1], self.input_names, "input")
+        return self._channel(i, j)
+
+    def __call__(self, s: complex | ComplexArray) -> ComplexArray:
+        """G(s) of every channel from its factored form (as :meth:`TransferFunction.__call__`):
+        shape (outputs, inputs) + the shape of ``s``."""
+        value = np.asarray(s, dtype=np.complex128)
+        points = value.reshape(-1)
+        p, m = self.shape
+        result = _core.factored_response(
+            self._mantissas, self._exponents, self._zeros, self.poles, points
+        )
+        if not np.isfinite(result).all() and np.isfinite(points).all():
+            warnings.warn(
+                "the result overflowed double precision: G is infinite or NaN (at a pole, or "
+                "beyond the doubles)",
+                NumericalOverflowWarning,
+                stacklevel=2,
+            )
+        return np.asarray(result.reshape((p, m, *value.shape)))
+
+    def __str__(self) -> str:
+        return "\n".join(
+            str(self._channel(i, j)) for i in range(self.shape[0]) for j in range(self.shape[1])
+        )
+
+    def __repr__(self) -> str:
+        return (
+            f"TransferMatrix(outputs={list(self.output_names)}, inputs={list(self.input_names)}, "
+            f"poles={self.poles!r})"
+        )
+
+
+def transfer_matrix(sys: System) -> TransferMatrix:
+    """The transfer functions of every channel of a model, in one call.
+
+    Each channel is what :func:`transfer_function` gives for it (the poles, the eigenvalues
+    of A, shared; the zeros of the channel's pencil; the gain from G at a point); the core
+    computes all of them at once, and a channel it cannot confirm is computed by the
+    reference path, as :func:`transfer_function` does.
+
+    Parameters
+    ----------
+    sys : StateSpace or (A, B, C, D)
+
+    Returns
+    -------
+    TransferMatrix
+        ``g[output, input]`` a :class:`TransferFunction`, ``g(s)`` the values, of shape
+        (outputs, inputs) + the shape of ``s``.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> lateral = aerocontrol.aircraft.load("b747-approach").lateral()
+    >>> g = aerocontrol.transfer_matrix(lateral[["r"], ["rudder", "aileron"]])
+    >>> print(g["r", "rudder"].aircraft_form(3))   # doctest: +NORMALIZE_WHITESPACE
+    -0.244 (s + 1.23)(s² + 2(-0.0707)(0.37)s + (0.37)²) /
+        (s + 0.0464)(s + 1.23)(s² + 2(0.108)(0.748)s + (0.748)²)
+    """
+    model = as_state_space(sys)
+    dt = period(model) if model.is_discrete else 0.0
+    p, m = model.n_outputs, model.n_inputs
+    wanted = [(i, j) for i in range(p) for j in range(m)]
+    poles, denominator, fast = _core.transfer_channels(
+        model.A, model.B, model.C, model.D, dt, wanted
+    )
+    denominator = _checked_denominator(poles, denominator, 2)
+    channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray]] = [
+        result if result is not None else _reference_channel(model, i, j, dt, stacklevel=2)
+        for (i, j), result in zip(wanted, fast, strict=True)
+    ]
+    return TransferMatrix(poles, denominator, dt, model.output_names, model.input_names, channels)

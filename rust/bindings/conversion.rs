@@ -65,7 +65,7 @@ pub fn entries(shape: &[usize]) -> PyResult<usize> {
 
 /// The values of an ndarray of element type `T`, copied in C order, whatever its strides and
 /// alignment.
-fn copy_values<T: Element + Copy>(
+pub fn copy_values<T: Element + Copy>(
     py: Python<'_>,
     array: &Bound<'_, PyArrayDyn<T>>,
 ) -> PyResult<Vec<T>> {

@@ -23,6 +23,7 @@ mod placement;
 mod responses;
 mod riccati;
 mod statespace;
+mod transfer;
 
 use pyo3::prelude::*;
 
@@ -40,6 +41,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     responses::register(m)?;
     frequency::register(m)?;
     loops::register(m)?;
+    transfer::register(m)?;
     modal::register(m)?;
     controllability::register(m)?;
     placement::register(m)?;

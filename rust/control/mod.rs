@@ -11,6 +11,8 @@
 //! * [`riccati`]: the algebraic Riccati equation and LQR, and the Riccati differential equation.
 //! * [`root_locus`]: the closed-loop poles of a SISO loop over many gains, from one
 //!   controller-Hessenberg form.
+//! * [`transfer`]: transfer functions of SISO channels from the state space, and their
+//!   factored evaluation.
 //! * [`batch`]: the same operations over stacks of problems, in parallel.
 
 pub mod batch;
@@ -23,3 +25,4 @@ pub mod placement;
 pub mod responses;
 pub mod riccati;
 pub mod root_locus;
+pub mod transfer;

@@ -1,0 +1,897 @@
+//! Transfer functions of single-input, single-output channels from the state space, and the
+//! evaluation of a factored transfer function G(s) = K Π(s - z_i) / Π(s - p_j).
+//!
+//! [`transfer_channels`] is the fast path of `aerocontrol.transfer_function` and
+//! `aerocontrol.transfer_matrix`: for each channel G = c (sI - A)^-1 b + d it computes the same
+//! zeros, gain and numerator as the package's reference path (`transfer.py`: the system matrix
+//! S = [[A, b], [c, d]] equilibrated by powers of two, Emami-Naeini and Van Dooren's reduction,
+//! the gain from G at a point away from every root), and defers a channel to that path
+//! (returns None for it) wherever the two could differ or the result could not be confirmed:
+//!
+//! 1. **Equilibration** as `transfer._balance` (Ruiz's sweeps on the output row and the input
+//!    column, the unit of frequency from ||A||, Osborne's balancing per state; exponents only,
+//!    applied once), then S divided by the power of two above ||S||_F.
+//! 2. **Reduction** (Emami-Naeini and Van Dooren 1982, procedure "reduce", for one output):
+//!    while |d| <= tol = (n + 1)^2 ε ||S||_F, a Householder reflection H with c H = ±||c|| e_N
+//!    moves the output onto the last state, and the system becomes
+//!    (A11, b1, [H A H]_{N,1:N-1}, (H b)_N) of order N - 1, with the same finite zeros. A norm
+//!    ||c|| <= tol (or no state left) is a channel of normal rank 0: G = 0. A decision value
+//!    within a factor of 2 of tol is deferred (the reference's rotations round differently).
+//! 3. **Zeros.** With d̂ = |d| > tol, the zeros are the eigenvalues of A - b c / d: backward
+//!    stable for the pencil when ||[c, d]|| <= 16 |d|; up to 2^10 |d| the generalized
+//!    eigenvalues of the compressed pencil (Af, Bf) = ([A b] W, W_11) by QZ (W a reflection with
+//!    [c d] W = ±||[c d]|| e_N); beyond, deferred (a zero far beyond the system's scale, which
+//!    the reference takes from the better of two QZ forms). Zeros within tol of the origin are
+//!    0 (a washout's). The same reduction on the unequilibrated S must find no more zeros
+//!    (the reference then adds those beyond the equilibrated pencil's reach), else deferred.
+//! 4. **Gain** K = d where d != 0 and there are n zeros; otherwise K = G(s0) Π(s0 - p)/Π(s0 - z)
+//!    at the point s0 = jω (z = e^{jωh}) of a grid farthest from every root (as
+//!    `transfer._evaluation_point`), G(s0) solved on the equilibrated system and every product
+//!    renormalised by powers of two.
+//! 5. **Verification.** G at a second grid point, from the state space, must agree with the
+//!    factored form to 1e-8 (relative); a G(s0) of 0 or below the normal range, a gain or a
+//!    numerator beyond the doubles, and a channel whose entries make products leave the range
+//!    of doubles are deferred.
+//!
+//! [`factored_response`] evaluates K Π(s - z_i) / Π(s - p_j) with the product held as a mantissa
+//! and a power of two, renormalised after each factor (a zero's, then a pole's, by increasing
+//! modulus), and scaled once at the end: nothing overflows or underflows where the result does
+//! not.
+//!
+//! Reference: A. Emami-Naeini and P. Van Dooren, "Computation of zeros of linear multivariable
+//! systems", Automatica 18(4), 415-430, 1982.
+
+use crate::error::Error;
+use crate::linalg::householder::reflector;
+use crate::linalg::qz::{generalized_eigenvalues, qz};
+use crate::linalg::schur::eigenvalues;
+use faer::{Mat, MatRef, c64};
+
+/// One channel's zeros (sorted, as `numpy.sort_complex`), gain K and numerator K Π(s - z_i)
+/// (highest power first).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Channel {
+    pub zeros: Vec<c64>,
+    pub gain: f64,
+    pub numerator: Vec<f64>,
+}
+
+/// The poles (the eigenvalues of A, sorted), the denominator Π(s - p_j) and each requested
+/// channel (None: deferred to the reference path).
+#[derive(Debug, Clone)]
+pub struct Transfer {
+    pub poles: Vec<c64>,
+    pub denominator: Vec<f64>,
+    pub channels: Vec<Option<Channel>>,
+}
+
+/// The channels (output i, input j) of the model (A, B, C, D) (see the module's
+/// documentation); `dt` is 0 for a continuous model, else the sampling period.
+pub fn transfer_channels(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    d: MatRef<'_, f64>,
+    dt: f64,
+    channels: &[(usize, usize)],
+) -> Result<Transfer, Error> {
+    crate::control::frequency::check_state_space(a, b, c, d)?;
+    for &(i, j) in channels {
+        if i >= c.nrows() || j >= b.ncols() {
+            return Err(Error::InvalidArgument {
+                arg: "channels",
+                message: format!(
+                    "channel ({i}, {j}) is not one of the model's {} x {} channels",
+                    c.nrows(),
+                    b.ncols()
+                ),
+            });
+        }
+    }
+    let n = a.nrows();
+    let poles = if n > 0 {
+        cleaned(eigenvalues(a)?)
+    } else {
+        Vec::new()
+    };
+    let denominator = polynomial(&poles, 1.0).unwrap_or_default();
+    let mut out = Vec::with_capacity(channels.len());
+    for &(i, j) in channels {
+        crate::platform::interrupt::check()?;
+        let bv: Vec<f64> = (0..n).map(|k| b[(k, j)]).collect();
+        let cv: Vec<f64> = (0..n).map(|k| c[(i, k)]).collect();
+        out.push(channel(a, &bv, &cv, d[(i, j)], dt, &poles)?);
+    }
+    Ok(Transfer {
+        poles,
+        denominator,
+        channels: out,
+    })
+}
+
+/// Roots with an imaginary part below 8 ε max(|Re|, |Im|) made real, sorted by real part,
+/// then imaginary part (as `transfer._conjugate_clean`).
+fn cleaned(mut roots: Vec<c64>) -> Vec<c64> {
+    for r in &mut roots {
+        let part = r.re.abs().max(r.im.abs());
+        if r.re.is_finite() && r.im.is_finite() && r.im.abs() <= 8.0 * f64::EPSILON * part {
+            r.im = 0.0;
+        }
+    }
+    roots.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+    roots
+}
+
+/// k Π(s - r) for roots in conjugate pairs (a real factor per real root, a quadratic per pair),
+/// highest power first; None when a root has no conjugate partner or a coefficient is not
+/// finite.
+fn polynomial(roots: &[c64], k: f64) -> Option<Vec<f64>> {
+    let upper = roots.iter().filter(|r| r.im > 0.0).count();
+    let lower = roots.iter().filter(|r| r.im < 0.0).count();
+    if upper != lower {
+        return None;
+    }
+    let mut p = vec![k];
+    for r in roots {
+        if r.im < 0.0 {
+            continue;
+        }
+        let factor: &[f64] = if r.im == 0.0 {
+            &[1.0, -r.re]
+        } else {
+            &[1.0, -2.0 * r.re, r.re * r.re + r.im * r.im]
+        };
+        let mut next = vec![0.0; p.len() + factor.len() - 1];
+        for (x, &pi) in p.iter().enumerate() {
+            for (y, &fi) in factor.iter().enumerate() {
+                next[x + y] += pi * fi;
+            }
+        }
+        p = next;
+    }
+    p.iter().all(|v| v.is_finite()).then_some(p)
+}
+
+// ----- powers of two ---------------------------------------------------------------------------
+
+/// 2^k for k in the normal range [-1022, 1023], exactly.
+fn two_to(k: i64) -> f64 {
+    debug_assert!((-1022..=1023).contains(&k));
+    f64::from_bits(((k + 1023) as u64) << 52)
+}
+
+/// x 2^e, rounded once (x of magnitude in [1/2, 1), as a renormalised mantissa is).
+fn ldexp(x: f64, e: i64) -> f64 {
+    let e = e.clamp(-2200, 2200);
+    if e > 1023 {
+        x * two_to(1023) * two_to((e - 1023).min(1023))
+    } else if e < -1021 {
+        // x 2^(e + 1000) is normal (exact), then one rounding into the subnormals.
+        x * two_to((e + 1000).max(-1022)) * two_to(-1000)
+    } else {
+        x * two_to(e)
+    }
+}
+
+/// The exponent e with |x| = f 2^e, f in [1/2, 1) (0 for 0 and non-finite x).
+fn exponent_of(x: f64) -> i64 {
+    if x == 0.0 || !x.is_finite() {
+        return 0;
+    }
+    let bits = x.abs().to_bits();
+    let biased = (bits >> 52) as i64;
+    if biased == 0 {
+        exponent_of(x * two_to(64)) - 64
+    } else {
+        biased - 1022
+    }
+}
+
+/// A complex value m 2^e, m of largest part in [1/2, 1) (or 0, or not finite).
+#[derive(Debug, Clone, Copy)]
+struct Scaled {
+    m: c64,
+    e: i64,
+}
+
+/// The range of the largest part within which a [`Scaled`] mantissa is left as it is: a product
+/// or quotient of two such values stays normal (2^±400), and a part 2^-600 below the other,
+/// which could fall into the subnormals there, is negligible beside it.
+const MANTISSA_RANGE: (f64, f64) = (6.223015277861142e-61, 1.6069380442589903e60);
+
+impl Scaled {
+    fn new(m: c64, e: i64) -> Self {
+        let mut s = Scaled { m, e };
+        s.renormalize();
+        s
+    }
+
+    /// Brings the largest part to [1/2, 1) by a power of two (exact) when it has left
+    /// [`MANTISSA_RANGE`]: multiplications by powers of two commute with the rounding of
+    /// the products in between, so renormalising less often changes nothing else.
+    fn renormalize(&mut self) {
+        let part = self.m.re.abs().max(self.m.im.abs());
+        if part > 0.0 && part.is_finite() && !(MANTISSA_RANGE.0..=MANTISSA_RANGE.1).contains(&part)
+        {
+            let k = exponent_of(part);
+            self.m = c64::new(ldexp(self.m.re, -k), ldexp(self.m.im, -k));
+            self.e += k;
+        }
+    }
+
+    /// (point - root) as a scaled value: both divided by the power of two of their largest
+    /// part first when that is near the overflow threshold, so that the difference of two
+    /// numbers near ±1e308 stays finite.
+    fn difference(point: c64, root: c64) -> Self {
+        let largest = [point.re, point.im, root.re, root.im]
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        if largest < 1e300 {
+            return Scaled::new(point - root, 0);
+        }
+        let q = if largest.is_finite() {
+            exponent_of(largest)
+        } else {
+            0
+        };
+        let scale = |z: c64| c64::new(ldexp(z.re, -q), ldexp(z.im, -q));
+        Scaled::new(scale(point) - scale(root), q)
+    }
+
+    fn times(&mut self, other: Scaled) {
+        self.m *= other.m;
+        self.e += other.e;
+        self.renormalize();
+    }
+
+    fn divided_by(&mut self, other: Scaled) {
+        self.m = quotient(self.m, other.m);
+        self.e -= other.e;
+        self.renormalize();
+    }
+
+    fn value(self) -> c64 {
+        if self.e == 0 {
+            return self.m;
+        }
+        // Renormalised first, so that the one scaling rounds once (into the subnormals).
+        let mut s = self;
+        let part = s.m.re.abs().max(s.m.im.abs());
+        if part > 0.0 && part.is_finite() {
+            let k = exponent_of(part);
+            s.m = c64::new(ldexp(s.m.re, -k), ldexp(s.m.im, -k));
+            s.e += k;
+        }
+        c64::new(ldexp(s.m.re, s.e), ldexp(s.m.im, s.e))
+    }
+}
+
+/// x / y as numpy divides complex numbers (Smith's method; x / 0 is inf or NaN, never an
+/// error).
+fn quotient(x: c64, y: c64) -> c64 {
+    if y.re == 0.0 && y.im == 0.0 {
+        return c64::new(x.re / 0.0, x.im / 0.0);
+    }
+    if y.re.abs() >= y.im.abs() {
+        let ratio = y.im / y.re;
+        let denominator = y.re + y.im * ratio;
+        c64::new(
+            (x.re + x.im * ratio) / denominator,
+            (x.im - x.re * ratio) / denominator,
+        )
+    } else {
+        let ratio = y.re / y.im;
+        let denominator = y.re * ratio + y.im;
+        c64::new(
+            (x.re * ratio + x.im) / denominator,
+            (x.im * ratio - x.re) / denominator,
+        )
+    }
+}
+
+/// The roots by increasing modulus (an overflowing modulus is infinite).
+fn by_modulus(roots: &[c64]) -> Vec<c64> {
+    let mut sorted = roots.to_vec();
+    sorted.sort_by(|x, y| x.norm().total_cmp(&y.norm()));
+    sorted
+}
+
+/// `start` Π(point - multiply_i) / Π(point - divide_j), renormalised after each factor (the
+/// roots already sorted by modulus; a zero's factor, then a pole's).
+fn factored(start: Scaled, point: c64, multiply: &[c64], divide: &[c64]) -> Scaled {
+    let mut value = start;
+    for k in 0..multiply.len().max(divide.len()) {
+        if let Some(&r) = multiply.get(k) {
+            value.times(Scaled::difference(point, r));
+        }
+        if let Some(&r) = divide.get(k) {
+            value.divided_by(Scaled::difference(point, r));
+        }
+    }
+    value
+}
+
+/// K Π(s - z_i) / Π(s - p_j) at each point into `out`, K = mantissa 2^exponent (see the
+/// module's documentation). A point at a pole gives an infinite or NaN value.
+pub fn factored_response(
+    mantissa: f64,
+    exponent: i64,
+    zeros: &[c64],
+    poles: &[c64],
+    points: &[c64],
+    out: &mut [c64],
+) {
+    let (zeros, poles) = (by_modulus(zeros), by_modulus(poles));
+    let start = Scaled::new(c64::new(mantissa, 0.0), exponent);
+    for (point, value) in points.iter().zip(out.iter_mut()) {
+        *value = factored(start, *point, &zeros, &poles).value();
+    }
+}
+
+// ----- equilibration ---------------------------------------------------------------------------
+
+/// The range of the magnitudes of a channel's nonzero entries in which the fast path forms sums
+/// of squares and products of entries directly: 2^±250.
+const ENTRY_RANGE: (f64, f64) = (5.527147875260445e-76, 1.8092513943330656e75);
+
+/// The integer nearest -log2(norm) / 2, ties to even (Python's round); 0 for a zero norm.
+fn half_exponent(norm: f64) -> i64 {
+    if norm > 0.0 {
+        -((norm.log2() / 2.0).round_ties_even() as i64)
+    } else {
+        0
+    }
+}
+
+/// A SISO system (A, b, c, d).
+#[derive(Debug, Clone)]
+struct Siso {
+    a: Mat<f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+    d: f64,
+}
+
+fn squares(values: impl Iterator<Item = f64>) -> f64 {
+    values.map(|v| v * v).sum()
+}
+
+/// The system equilibrated as `transfer._balance` does for one input and one output (Ruiz's
+/// sweeps on the output row [c d] and the input column [b; d], the unit of frequency from
+/// ||A||, then Osborne's balancing of each state's row of [A b] against its column of [A; c],
+/// without the diagonal; every scaling the power of two nearest the square root of the norms'
+/// ratio), here applied to the entries as it goes (exact: the entries lie in [`ENTRY_RANGE`]);
+/// returns it with f, A and b having been multiplied by 2^-f (its zeros times 2^f are the
+/// model's), and o + i, the output's and input's exponents (G(s) = 2^-(o + i) G_e(s 2^-f)).
+fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
+    let n = s.a.nrows();
+    let (mut frequency, mut units) = (0i64, 0i64);
+    let scale = |x: &mut f64, k: i64| *x *= two_to(k);
+    for _ in 0..40 {
+        let mut changed = false;
+        let k = half_exponent(squares(s.c.iter().copied().chain([s.d])).sqrt());
+        if k != 0 {
+            s.c.iter_mut().for_each(|x| scale(x, k));
+            scale(&mut s.d, k);
+            units += k;
+            changed = true;
+        }
+        let k = half_exponent(squares(s.b.iter().copied().chain([s.d])).sqrt());
+        if k != 0 {
+            s.b.iter_mut().for_each(|x| scale(x, k));
+            scale(&mut s.d, k);
+            units += k;
+            changed = true;
+        }
+        let mut size = squares((0..n * n).map(|x| s.a[(x % n, x / n)])).sqrt();
+        if size == 0.0 {
+            size = squares(s.b.iter().copied()).sqrt();
+        }
+        let k = half_exponent(size);
+        if k != 0 {
+            for j in 0..n {
+                for i in 0..n {
+                    scale(&mut s.a[(i, j)], k);
+                }
+            }
+            s.b.iter_mut().for_each(|x| scale(x, k));
+            frequency -= k;
+            changed = true;
+        }
+        for i in 0..n {
+            let row = squares(
+                (0..n)
+                    .filter(|&j| j != i)
+                    .map(|j| s.a[(i, j)])
+                    .chain([s.b[i]]),
+            );
+            let col = squares(
+                (0..n)
+                    .filter(|&j| j != i)
+                    .map(|j| s.a[(j, i)])
+                    .chain([s.c[i]]),
+            );
+            if row == 0.0 || col == 0.0 {
+                continue;
+            }
+            let k = ((col.log2() - row.log2()) / 4.0).round_ties_even() as i64;
+            if k != 0 {
+                for j in (0..n).filter(|&j| j != i) {
+                    scale(&mut s.a[(i, j)], k);
+                    scale(&mut s.a[(j, i)], -k);
+                }
+                scale(&mut s.b[i], k);
+                scale(&mut s.c[i], -k);
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    (s, frequency, units)
+}
+
+/// The entries of the system matrix [[A, b], [c, d]].
+fn entries(s: &Siso) -> impl Iterator<Item = f64> + Clone + '_ {
+    let n = s.a.nrows();
+    (0..n * n)
+        .map(move |x| s.a[(x % n, x / n)])
+        .chain(s.b.iter().copied())
+        .chain(s.c.iter().copied())
+        .chain(std::iter::once(s.d))
+}
+
+fn frobenius(s: &Siso) -> f64 {
+    squares(entries(s)).sqrt()
+}
+
+/// The system divided by the power of two 2^e above ||S||_F (exactly), and e.
+fn unit_scaled(mut s: Siso) -> (Siso, i64) {
+    let e = exponent_of(frobenius(&s));
+    let factor = two_to(-e);
+    let n = s.a.nrows();
+    for j in 0..n {
+        for i in 0..n {
+            s.a[(i, j)] *= factor;
+        }
+    }
+    for x in s.b.iter_mut().chain(s.c.iter_mut()) {
+        *x *= factor;
+    }
+    s.d *= factor;
+    (s, e)
+}
+
+/// x 2^e for any finite x (renormalised first, then [`ldexp`]).
+fn ldexp_any(x: f64, e: i64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let k = exponent_of(x);
+    ldexp(ldexp(x, -k), e + k)
+}
+
+// ----- the reduction ---------------------------------------------------------------------------
+
+/// The outcome of the reduction.
+enum Reduced {
+    /// A system with the same finite zeros and |d| > tol.
+    Regular(Siso),
+    /// Normal rank 0: the channel is zero.
+    Zero,
+    /// A decision value within a factor of 2 of the tolerance.
+    Ambiguous,
+}
+
+/// Whether `value` is above `tol`, or None within a factor of 8 of it (the reference's
+/// equilibration, in logarithms, and its rotations round differently).
+fn above(value: f64, tol: f64) -> Option<bool> {
+    if value > 8.0 * tol {
+        Some(true)
+    } else if value <= 0.125 * tol {
+        Some(false)
+    } else {
+        None
+    }
+}
+
+/// H = I - τ u u^T with c H = β e_N (u_N = 1): the reflector of `transfer._reduce`'s V.
+fn output_reflector(c: &[f64]) -> (Vec<f64>, f64) {
+    let mut x: Vec<f64> = c.iter().rev().copied().collect();
+    let (_, tau) = reflector(&mut x);
+    x[0] = 1.0;
+    x.reverse();
+    (x, tau)
+}
+
+/// A <- H A H, b <- H b for H = I - τ u u^T.
+fn reflect(s: &mut Siso, u: &[f64], tau: f64) {
+    let n = u.len();
+    for j in 0..n {
+        let dot: f64 = (0..n).map(|i| u[i] * s.a[(i, j)]).sum();
+        for (i, ui) in u.iter().enumerate() {
+            s.a[(i, j)] -= tau * dot * ui;
+        }
+    }
+    for i in 0..n {
+        let dot: f64 = (0..n).map(|j| s.a[(i, j)] * u[j]).sum();
+        for (j, uj) in u.iter().enumerate() {
+            s.a[(i, j)] -= tau * dot * uj;
+        }
+    }
+    let dot: f64 = u.iter().zip(&s.b).map(|(x, y)| x * y).sum();
+    for (bi, ui) in s.b.iter_mut().zip(u) {
+        *bi -= tau * dot * ui;
+    }
+}
+
+/// Emami-Naeini and Van Dooren's reduction for one output (see the module's documentation).
+fn reduce(mut s: Siso, tol: f64) -> Reduced {
+    loop {
+        match above(s.d.abs(), tol) {
+            None => return Reduced::Ambiguous,
+            Some(true) => return Reduced::Regular(s),
+            Some(false) => {}
+        }
+        let n = s.a.nrows();
+        if n == 0 {
+            return Reduced::Zero;
+        }
+        let norm = s.c.iter().map(|v| v * v).sum::<f64>().sqrt();
+        match above(norm, tol) {
+            None => return Reduced::Ambiguous,
+            Some(false) => return Reduced::Zero,
+            Some(true) => {}
+        }
+        let (u, tau) = output_reflector(&s.c);
+        reflect(&mut s, &u, tau);
+        let m = n - 1;
+        s = Siso {
+            a: Mat::from_fn(m, m, |i, j| s.a[(i, j)]),
+            b: s.b[..m].to_vec(),
+            c: (0..m).map(|j| s.a[(m, j)]).collect(),
+            d: s.b[m],
+        };
+    }
+}
+
+/// The finite zeros of a reduced system (|d| > tol), or None when ||[c d]|| > 2^10 |d|.
+fn regular_zeros(s: &Siso) -> Result<Option<Vec<c64>>, Error> {
+    let n = s.a.nrows();
+    if n == 0 {
+        return Ok(Some(Vec::new()));
+    }
+    let norm = (s.c.iter().map(|v| v * v).sum::<f64>() + s.d * s.d).sqrt();
+    if norm <= 16.0 * s.d.abs() {
+        let m = Mat::from_fn(n, n, |i, j| s.a[(i, j)] - s.b[i] * (s.c[j] / s.d));
+        return Ok(Some(eigenvalues(m.as_ref())?));
+    }
+    if norm > 1024.0 * s.d.abs() {
+        return Ok(None);
+    }
+    // [c d] W = [0, β]: W = I - τ u u^T with u_{N+1} = 1.
+    let row: Vec<f64> = s.c.iter().copied().chain(std::iter::once(s.d)).collect();
+    let (u, tau) = output_reflector(&row);
+    let w = |i: usize, j: usize| if i == j { 1.0 } else { 0.0 } - tau * u[i] * u[j];
+    let af = Mat::from_fn(n, n, |i, j| {
+        (0..n).map(|k| s.a[(i, k)] * w(k, j)).sum::<f64>() + s.b[i] * w(n, j)
+    });
+    let bf = Mat::from_fn(n, n, w);
+    let schur = qz(af.as_ref(), bf.as_ref())?;
+    let values = generalized_eigenvalues(schur.s.as_ref(), schur.t.as_ref());
+    if values.iter().any(|v| v.beta == 0.0) {
+        return Ok(None);
+    }
+    Ok(Some(values.into_iter().map(|v| v.value()).collect()))
+}
+
+/// The number of finite zeros the reduction of `s` as given leaves, None if ambiguous.
+fn zero_count(s: &Siso) -> Option<usize> {
+    let n = s.a.nrows();
+    let tol = ((n + 1) * (n + 1)) as f64 * f64::EPSILON * frobenius(s).max(f64::MIN_POSITIVE);
+    match reduce(s.clone(), tol) {
+        Reduced::Regular(r) => Some(r.a.nrows()),
+        Reduced::Zero => Some(0),
+        Reduced::Ambiguous => None,
+    }
+}
+
+// ----- one channel -----------------------------------------------------------------------------
+
+/// G(point) = c (point I - A)^-1 b + d by Gaussian elimination with partial pivoting, or None
+/// when a pivot vanishes.
+fn response(s: &Siso, point: c64) -> Option<c64> {
+    let n = s.a.nrows();
+    let mut m: Vec<c64> = (0..n * n)
+        .map(|x| {
+            let (i, j) = (x / n, x % n);
+            let diagonal = if i == j { point } else { c64::new(0.0, 0.0) };
+            diagonal - s.a[(i, j)]
+        })
+        .collect();
+    let mut x: Vec<c64> = s.b.iter().map(|&v| c64::new(v, 0.0)).collect();
+    let size = |z: c64| z.re.abs() + z.im.abs();
+    for k in 0..n {
+        let pivot = (k..n).max_by(|&p, &q| size(m[p * n + k]).total_cmp(&size(m[q * n + k])))?;
+        if size(m[pivot * n + k]) == 0.0 {
+            return None;
+        }
+        if pivot != k {
+            for j in 0..n {
+                m.swap(k * n + j, pivot * n + j);
+            }
+            x.swap(k, pivot);
+        }
+        for i in k + 1..n {
+            let l = quotient(m[i * n + k], m[k * n + k]);
+            for j in k + 1..n {
+                let t = m[k * n + j];
+                m[i * n + j] -= l * t;
+            }
+            let t = x[k];
+            x[i] -= l * t;
+        }
+    }
+    for i in (0..n).rev() {
+        let mut total = x[i];
+        for j in i + 1..n {
+            total -= m[i * n + j] * x[j];
+        }
+        x[i] = quotient(total, m[i * n + i]);
+    }
+    let dynamic: c64 = (0..n).map(|j| x[j] * s.c[j]).sum();
+    Some(dynamic + s.d)
+}
+
+/// The grid of evaluation points of `transfer._evaluation_point`, best first: s = jω on 31
+/// frequencies around the roots' sizes (z = e^{jθ} at 19 angles for a discrete model), by
+/// decreasing relative distance to the nearest root (ties in grid order).
+fn evaluation_points(roots: &[c64], dt: f64) -> Vec<c64> {
+    let points: Vec<c64> = if dt > 0.0 {
+        (0..19)
+            .map(|k| {
+                let theta = (0.05 + 0.05 * k as f64) * std::f64::consts::PI / dt * dt;
+                c64::new(theta.cos(), theta.sin())
+            })
+            .collect()
+    } else {
+        let logs: Vec<f64> = roots
+            .iter()
+            .filter(|r| r.re.is_finite() && r.im.is_finite() && r.norm() != 0.0)
+            .map(|r| r.norm())
+            .filter(|m| m.is_finite())
+            .map(f64::log10)
+            .collect();
+        let centre = if logs.is_empty() {
+            0.0
+        } else {
+            logs.iter().sum::<f64>() / logs.len() as f64
+        };
+        // 10^(centre - 1.5 + k/10), k = 0..30 (one power, then exact-enough steps: any point
+        // of the grid serves, the gain does not depend on it).
+        let step = 10f64.powf(0.1);
+        let mut omega = 10f64.powf(centre - 1.5);
+        (0..31)
+            .map(|_| {
+                let point = c64::new(0.0, omega.clamp(1e-300, 1e307));
+                omega *= step;
+                point
+            })
+            .collect()
+    };
+    // min |p - r|^2 / |p|^2 over the roots: the relative distance, squared (no hypot).
+    let distance = |p: c64| {
+        let size = p.norm_sqr();
+        roots
+            .iter()
+            .map(|r| (p - r).norm_sqr() / size)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut ranked: Vec<(f64, c64)> = points.into_iter().map(|p| (distance(p), p)).collect();
+    if roots.is_empty() {
+        // No root: the middle of the grid first, as the reference.
+        let middle = ranked.len() / 2;
+        ranked.rotate_left(middle);
+        return ranked.into_iter().map(|(_, p)| p).collect();
+    }
+    // Stable: equal distances keep the grid's order (numpy.argmax takes the first).
+    ranked.sort_by(|x, y| y.0.total_cmp(&x.0));
+    ranked.into_iter().map(|(_, p)| p).collect()
+}
+
+/// One channel (see the module's documentation), None when deferred.
+fn channel(
+    a: MatRef<'_, f64>,
+    b: &[f64],
+    c: &[f64],
+    d: f64,
+    dt: f64,
+    poles: &[c64],
+) -> Result<Option<Channel>, Error> {
+    let n = a.nrows();
+    let given = Siso {
+        a: a.to_owned(),
+        b: b.to_vec(),
+        c: c.to_vec(),
+        d,
+    };
+    if !entries(&given).all(|v| v == 0.0 || (ENTRY_RANGE.0..=ENTRY_RANGE.1).contains(&v.abs())) {
+        return Ok(None);
+    }
+    let (s, frequency, units) = equilibrated(given.clone());
+    let (s, e) = unit_scaled(s);
+    // Products of up to n + 1 entries must stay normal: no entry below 2^(-1000 / (n + 1)).
+    let smallest = entries(&s)
+        .filter(|v| *v != 0.0)
+        .fold(f64::INFINITY, |m, v| m.min(v.abs()));
+    if smallest < (-1000.0 / (n as f64 + 1.0)).exp2() {
+        return Ok(None);
+    }
+    let tol = ((n + 1) * (n + 1)) as f64 * f64::EPSILON * frobenius(&s).max(f64::MIN_POSITIVE);
+    let reduced = match reduce(s.clone(), tol) {
+        Reduced::Ambiguous => return Ok(None),
+        Reduced::Zero => {
+            return Ok(Some(Channel {
+                zeros: Vec::new(),
+                gain: 0.0,
+                numerator: vec![0.0],
+            }));
+        }
+        Reduced::Regular(r) => r,
+    };
+    let Some(mut zeros) = regular_zeros(&reduced)? else {
+        return Ok(None);
+    };
+    // The reference adds the zeros of the unequilibrated pencil beyond the equilibrated one's
+    // reach: there must be none.
+    if zeros.len() < n && zero_count(&given).is_none_or(|k| k > zeros.len()) {
+        return Ok(None);
+    }
+    let scale = frequency + e;
+    for z in &mut zeros {
+        if z.norm() <= tol {
+            *z = c64::new(0.0, 0.0);
+        }
+        *z = c64::new(ldexp_any(z.re, scale), ldexp_any(z.im, scale));
+    }
+    if zeros
+        .iter()
+        .any(|z| !(z.re.is_finite() && z.im.is_finite()))
+    {
+        return Ok(None);
+    }
+    let zeros = cleaned(zeros);
+    let gain = if d != 0.0 && zeros.len() == n {
+        d
+    } else {
+        // G(point) = 2^-(o + i) 2^e G_s(point 2^-(f + e)) on the equilibrated system.
+        let roots: Vec<c64> = zeros.iter().chain(poles).copied().collect();
+        let points = evaluation_points(&roots, dt);
+        let at = |point: c64| -> Option<Scaled> {
+            let value = response(
+                &s,
+                c64::new(ldexp_any(point.re, -scale), ldexp_any(point.im, -scale)),
+            )?;
+            let part = value.re.abs().max(value.im.abs());
+            (part.is_finite() && part >= f64::MIN_POSITIVE).then(|| Scaled::new(value, e - units))
+        };
+        let (sorted_zeros, sorted_poles) = (by_modulus(&zeros), by_modulus(poles));
+        let Some(g0) = at(points[0]) else {
+            return Ok(None);
+        };
+        let k = factored(g0, points[0], &sorted_poles, &sorted_zeros)
+            .value()
+            .re;
+        if !(k.is_finite() && k.abs() >= f64::MIN_POSITIVE) {
+            return Ok(None);
+        }
+        // The check: G at the second point from the state space and from the factored form.
+        if let Some(&check) = points.get(1) {
+            let Some(g1) = at(check) else {
+                return Ok(None);
+            };
+            let start = Scaled::new(c64::new(k, 0.0), 0);
+            let mut factored_value = factored(start, check, &sorted_zeros, &sorted_poles);
+            factored_value.divided_by(g1);
+            let ratio = factored_value.value();
+            let agrees = (ratio - 1.0).norm() <= 1e-8; // false for NaN
+            if !agrees {
+                return Ok(None);
+            }
+        }
+        k
+    };
+    let Some(numerator) = polynomial(&zeros, gain) else {
+        return Ok(None);
+    };
+    Ok(Some(Channel {
+        zeros,
+        gain,
+        numerator,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one_channel(a: &[&[f64]], b: &[f64], c: &[f64], d: f64) -> Option<Channel> {
+        let n = b.len();
+        let am = Mat::from_fn(n, n, |i, j| a[i][j]);
+        let bm = Mat::from_fn(n, 1, |i, _| b[i]);
+        let cm = Mat::from_fn(1, n, |_, j| c[j]);
+        let dm = Mat::from_fn(1, 1, |_, _| d);
+        let t = transfer_channels(
+            am.as_ref(),
+            bm.as_ref(),
+            cm.as_ref(),
+            dm.as_ref(),
+            0.0,
+            &[(0, 0)],
+        )
+        .unwrap();
+        t.channels.into_iter().next().unwrap()
+    }
+
+    #[test]
+    fn canonical_form_of_a_known_transfer_function() {
+        // (s + 3)/((s + 1)(s + 2)) = (s + 3)/(s^2 + 3 s + 2): zero -3, gain 1.
+        let g = one_channel(&[&[-3.0, -2.0], &[1.0, 0.0]], &[1.0, 0.0], &[1.0, 3.0], 0.0).unwrap();
+        assert_eq!(g.zeros.len(), 1);
+        assert!((g.zeros[0] - c64::new(-3.0, 0.0)).norm() <= 4.0 * f64::EPSILON * 3.0);
+        assert!((g.gain - 1.0).abs() <= 4.0 * f64::EPSILON);
+        assert!((g.numerator[1] - 3.0).abs() <= 16.0 * f64::EPSILON);
+        // With a feedthrough 2: 2 + (s + 3)/(s^2 + 3 s + 2) = (2 s^2 + 7 s + 7)/(...), K = D.
+        let g = one_channel(&[&[-3.0, -2.0], &[1.0, 0.0]], &[1.0, 0.0], &[1.0, 3.0], 2.0).unwrap();
+        assert_eq!(g.gain, 2.0);
+        let expected = [2.0, 7.0, 7.0];
+        for (x, y) in g.numerator.iter().zip(expected) {
+            assert!((x - y).abs() <= 32.0 * f64::EPSILON * y, "{x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn zero_channel_and_deferred_channel() {
+        // The output does not see the input: G = 0.
+        let g = one_channel(&[&[-1.0, 0.0], &[0.0, -2.0]], &[1.0, 0.0], &[0.0, 1.0], 0.0).unwrap();
+        assert_eq!(
+            (g.gain, g.zeros.len(), g.numerator.clone()),
+            (0.0, 0, vec![0.0])
+        );
+        // An entry beyond 2^250 is left to the reference path.
+        assert!(one_channel(&[&[-1.0]], &[1e300], &[1.0], 0.0).is_none());
+    }
+
+    #[test]
+    fn powers_of_two_are_exact() {
+        assert_eq!(exponent_of(1.0), 1);
+        assert_eq!(exponent_of(0.75), 0);
+        assert_eq!(exponent_of(f64::MIN_POSITIVE / 8.0), -1024);
+        // Rounded once, to nearest even: 2^-1075 is a tie (to 0), 1.5 2^-1074 one to 2^-1073
+        // (a double rounding through 2^-1022 would have given other values).
+        assert_eq!(ldexp(0.5, -1074), 0.0);
+        assert_eq!(ldexp(0.75, -1074), 5e-324);
+        assert_eq!(ldexp(0.75, -1073), 1e-323);
+        assert_eq!(ldexp(0.5, 1024), 8.98846567431158e307);
+        assert_eq!(ldexp(0.5, 1025), f64::INFINITY);
+    }
+
+    #[test]
+    fn factored_response_beyond_the_doubles() {
+        // (s - 1e200)/(s - 2e200) at 0 is 1/2, though both products overflow in doubles
+        // squared: K = 1e300 (as 2^997 m) times 1/2.
+        let (m, e) = (1e300 / 2f64.powi(997), 997);
+        let mut out = [c64::new(0.0, 0.0); 2];
+        factored_response(
+            m,
+            e,
+            &[c64::new(1e200, 0.0)],
+            &[c64::new(2e200, 0.0)],
+            &[c64::new(0.0, 0.0), c64::new(2e200, 0.0)],
+            &mut out,
+        );
+        assert!((out[0].re - 0.5e300).abs() <= 4.0 * f64::EPSILON * 0.5e300);
+        assert!(!out[1].re.is_finite()); // at the pole
+    }
+}
