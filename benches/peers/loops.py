@@ -39,6 +39,35 @@ def _margins_control(loop: Any) -> Any:
         return control.stability_margins(control.ss(loop.A, loop.B, loop.C, loop.D), returnall=True)
 
 
+#: The grid of control.disk_margins in the composite peer (rad/s): 1000 points over six decades.
+_DISK_GRID = np.logspace(-3.0, 3.0, 1000)
+
+
+def _margins_composite(loop: Any) -> Any:
+    """What stability_margins returns, from python-control: stability_margins(returnall=True)
+    for the crossovers, disk_margins on a 1000-point grid for the disk margin (python-control
+    has no grid-free one), and numpy.linalg.eigvals of A - B (1 + D)^-1 C for the closed
+    loop's stability."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        L = control.ss(loop.A, loop.B, loop.C, loop.D)
+        margins = control.stability_margins(L, returnall=True)
+        disk = control.disk_margins(L, _DISK_GRID)
+    closed = np.linalg.eigvals(loop.A - loop.B @ loop.C / (1.0 + loop.D[0, 0]))
+    return margins, disk, closed
+
+
+def _compare_composite(ours: Any, peer: Any) -> Pairs:
+    """The crossovers as :func:`_compare_margins`, the disk margin (the grid's, within its
+    spacing: 1.4% in ω, so about 1e-4 in α at a smooth peak) and the closed-loop poles."""
+    margins, disk, closed = peer
+    return [
+        *_compare_margins(ours, margins),
+        (np.array([ours.disk_margin]), np.array([float(disk[0])])),
+        (np.sort(ours.closed_loop_poles.real), np.sort(closed.real)),
+    ]
+
+
 def _compare_margins(ours: Any, peer: Any) -> Pairs:
     """Phase margins and their frequencies; gain margins at the phase crossovers with ω > 0
     (python-control also reports L(0) = 1e-13 of the washout's zero at the origin as a phase
@@ -59,7 +88,9 @@ def margins_cases() -> list[Case]:
     """stability_margins of the 747 cruise yaw damper's loop (n = 6) and pitch damper's loop
     (n = 5). The issue's target: 20x python-control.
 
-    Peer: python-control's stability_margins(returnall=True).
+    Peers: python-control's stability_margins(returnall=True), which gives the gain and phase
+    margins only; and the composite of python-control calls that gives what stability_margins
+    returns (with the disk margin on a grid and the closed-loop poles).
     """
     target = Target("stability_margins vs control: ratio >= 20", min_ratio=20.0)
     return [
@@ -76,7 +107,13 @@ def margins_cases() -> list[Case]:
                     compare=_compare_margins,
                     target=target,
                     rtol=1e-7,
-                )
+                ),
+                Peer(
+                    "control composite (margins, disk_margins grid, eigvals)",
+                    _margins_composite,
+                    compare=_compare_composite,
+                    rtol=1e-3,
+                ),
             ],
         )
         for size, setup in [("n=6 747 yaw", _yaw_loop), ("n=5 747 pitch", _pitch_loop)]
