@@ -272,6 +272,8 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
                 poles[rescaled[failed]] = _backward_stable_eigenvalues(
                     stack[failed], poles[rescaled[failed]]
                 )
+    if rescaled.size == 0:
+        return poles  # each row sorted by the core, as numpy.sort_complex sorts
     if np.any(exponents):
         with np.errstate(over="ignore", invalid="ignore"):
             scale = exponents[:, None]

@@ -78,9 +78,9 @@ fn loop_margins<'py>(
 }
 
 /// The closed-loop poles of the SISO loop (A, b, c) at each closed-loop gain g of `gains`: the
-/// eigenvalues of A - g b c, a (k, n) complex array, each row in the order of the Schur form's
-/// diagonal (`control/root_locus.rs`: one controller-Hessenberg form, then the QR iteration
-/// per gain, in parallel).
+/// eigenvalues of A - g b c, a (k, n) complex array, each row sorted as `numpy.sort_complex`
+/// sorts (`control/root_locus.rs`: one controller-Hessenberg form, then the QR iteration per
+/// gain, in parallel).
 #[pyfunction]
 #[pyo3(signature = (a, b, c, gains, /))]
 fn root_locus<'py>(

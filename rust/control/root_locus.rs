@@ -129,10 +129,16 @@ pub fn closed_loop_poles(
     with_order!(n, order => closed_loop_eigenvalues(&controller_hessenberg(order, a, b, c), g))
 }
 
+/// Sorted by real part, then imaginary part (as `numpy.sort_complex`).
+fn sorted(mut values: Vec<c64>) -> Vec<c64> {
+    values.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+    values
+}
+
 /// The closed-loop poles of the SISO loop (A n x n, b n x 1, c 1 x n) at each closed-loop gain
-/// g of `gains` (the eigenvalues of A - g b c), written into `out` (n per gain, in the order of
-/// the Schur form's diagonal, each conjugate pair adjacent with Im > 0 first), in parallel
-/// over chunks of gains. See the module's documentation.
+/// g of `gains` (the eigenvalues of A - g b c), written into `out` (n per gain, sorted by real
+/// part, then imaginary part, as `numpy.sort_complex`), in parallel over chunks of gains. See
+/// the module's documentation.
 pub fn root_locus(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -166,7 +172,7 @@ pub fn root_locus(
     let bv: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
     let cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
     let open_loop = if gains.contains(&0.0) {
-        eigenvalues(a)?
+        sorted(eigenvalues(a)?)
     } else {
         Vec::new()
     };
@@ -183,7 +189,7 @@ pub fn root_locus(
                     } else {
                         let values = closed_loop_eigenvalues(&form, g)
                             .map_err(|e| Error::in_batch(index, e))?;
-                        poles.copy_from_slice(&values);
+                        poles.copy_from_slice(&sorted(values));
                     }
                     Ok(())
                 })
@@ -195,11 +201,6 @@ pub fn root_locus(
 mod tests {
     use super::*;
     use faer::Mat;
-
-    fn sorted(mut v: Vec<c64>) -> Vec<c64> {
-        v.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
-        v
-    }
 
     /// Against the eigenvalues of each closed-loop matrix formed directly.
     #[test]
