@@ -696,3 +696,17 @@ def test_zeros_of_equal_modulus_are_each_taken_once() -> None:
     expected = expected[np.isfinite(expected)]
     assert ours.size == expected.size == 5
     assert _matched_error(ours, expected) <= 1e-12
+
+
+def test_transfer_matrix_of_any_memory_layout() -> None:
+    # Strided and transposed points, Fortran-ordered matrices: the values of C-ordered copies.
+    model = aerocontrol.aircraft.load("b747-cruise").lateral()[["p", "r"], :]
+    g = aerocontrol.transfer_matrix(model)
+    w = 1j * np.linspace(0.1, 3.0, 12)
+    for points in (w[::3], w.reshape(3, 4).T):
+        np.testing.assert_array_equal(g(points), g(np.ascontiguousarray(points)))
+        np.testing.assert_array_equal(g["p", 0](points), g["p", 0](points.copy()))
+    fortran = aerocontrol.StateSpace(
+        np.asfortranarray(model.A), np.asfortranarray(model.B), model.C[:, ::1], model.D
+    )
+    np.testing.assert_array_equal(aerocontrol.transfer_matrix(fortran)(w), g(w))
