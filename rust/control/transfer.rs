@@ -599,49 +599,74 @@ fn zero_count(s: &Siso) -> Option<usize> {
 
 // ----- one channel -----------------------------------------------------------------------------
 
-/// G(point) = c (point I - A)^-1 b + d by Gaussian elimination with partial pivoting, or None
-/// when a pivot vanishes.
+/// The LU factorisation with partial pivoting (by |re| + |im|) of point I - A, row-major.
+struct ShiftedLu {
+    n: usize,
+    m: Vec<c64>,
+    rows: Vec<usize>,
+}
+
+impl ShiftedLu {
+    /// None when a pivot vanishes (point is an eigenvalue of A to rounding).
+    fn new(a: MatRef<'_, f64>, point: c64) -> Option<Self> {
+        let n = a.nrows();
+        let mut m: Vec<c64> = (0..n * n)
+            .map(|x| {
+                let (i, j) = (x / n, x % n);
+                let diagonal = if i == j { point } else { c64::new(0.0, 0.0) };
+                diagonal - a[(i, j)]
+            })
+            .collect();
+        let mut rows: Vec<usize> = (0..n).collect();
+        let size = |z: c64| z.re.abs() + z.im.abs();
+        for k in 0..n {
+            let pivot =
+                (k..n).max_by(|&p, &q| size(m[p * n + k]).total_cmp(&size(m[q * n + k])))?;
+            if size(m[pivot * n + k]) == 0.0 {
+                return None;
+            }
+            if pivot != k {
+                for j in 0..n {
+                    m.swap(k * n + j, pivot * n + j);
+                }
+                rows.swap(k, pivot);
+            }
+            for i in k + 1..n {
+                let l = quotient(m[i * n + k], m[k * n + k]);
+                m[i * n + k] = l;
+                for j in k + 1..n {
+                    let t = m[k * n + j];
+                    m[i * n + j] -= l * t;
+                }
+            }
+        }
+        Some(ShiftedLu { n, m, rows })
+    }
+
+    /// c (point I - A)^-1 b + d.
+    fn response(&self, b: &[f64], c: &[f64], d: f64) -> c64 {
+        let (n, m) = (self.n, &self.m);
+        let mut x: Vec<c64> = self.rows.iter().map(|&r| c64::new(b[r], 0.0)).collect();
+        for i in 0..n {
+            for k in 0..i {
+                let t = x[k];
+                x[i] -= m[i * n + k] * t;
+            }
+        }
+        for i in (0..n).rev() {
+            let mut total = x[i];
+            for j in i + 1..n {
+                total -= m[i * n + j] * x[j];
+            }
+            x[i] = quotient(total, m[i * n + i]);
+        }
+        (0..n).map(|j| x[j] * c[j]).sum::<c64>() + d
+    }
+}
+
+/// G(point) = c (point I - A)^-1 b + d of a SISO system, or None when a pivot vanishes.
 fn response(s: &Siso, point: c64) -> Option<c64> {
-    let n = s.a.nrows();
-    let mut m: Vec<c64> = (0..n * n)
-        .map(|x| {
-            let (i, j) = (x / n, x % n);
-            let diagonal = if i == j { point } else { c64::new(0.0, 0.0) };
-            diagonal - s.a[(i, j)]
-        })
-        .collect();
-    let mut x: Vec<c64> = s.b.iter().map(|&v| c64::new(v, 0.0)).collect();
-    let size = |z: c64| z.re.abs() + z.im.abs();
-    for k in 0..n {
-        let pivot = (k..n).max_by(|&p, &q| size(m[p * n + k]).total_cmp(&size(m[q * n + k])))?;
-        if size(m[pivot * n + k]) == 0.0 {
-            return None;
-        }
-        if pivot != k {
-            for j in 0..n {
-                m.swap(k * n + j, pivot * n + j);
-            }
-            x.swap(k, pivot);
-        }
-        for i in k + 1..n {
-            let l = quotient(m[i * n + k], m[k * n + k]);
-            for j in k + 1..n {
-                let t = m[k * n + j];
-                m[i * n + j] -= l * t;
-            }
-            let t = x[k];
-            x[i] -= l * t;
-        }
-    }
-    for i in (0..n).rev() {
-        let mut total = x[i];
-        for j in i + 1..n {
-            total -= m[i * n + j] * x[j];
-        }
-        x[i] = quotient(total, m[i * n + i]);
-    }
-    let dynamic: c64 = (0..n).map(|j| x[j] * s.c[j]).sum();
-    Some(dynamic + s.d)
+    Some(ShiftedLu::new(s.a.as_ref(), point)?.response(&s.b, &s.c, s.d))
 }
 
 /// The grid of evaluation points of `transfer._evaluation_point`, best first: s = jω on 31
