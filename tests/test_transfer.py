@@ -616,6 +616,60 @@ def test_reference_gain_is_confirmed_at_a_second_point() -> None:
         assert g(2.0j) == pytest.approx(k / (2.0j) ** 2, rel=1e-7)
 
 
+def test_gain_of_a_channel_with_a_nilpotent_state_matrix() -> None:
+    # A nilpotent (a double pole at the origin, which rounding puts at ±3e-16j): by hand
+    # (sI - A)⁻¹ b = [s + 2, 1]ᵀ / s², so G = (s + 3)/s², K = 1. The grid of evaluation
+    # points went to 1e-9, where sI - A is singular to working precision: G was taken as D = 0
+    # there and the channel returned as zero (numerator [0.], no zeros), silently.
+    from aerocontrol.transfer import _reference_channel
+
+    A = np.array([[2.0, -4.0], [1.0, -2.0]])
+    model = aerocontrol.StateSpace(A, [[1.0], [0.0]], [[1.0, 1.0]], [[0.0]])
+    peer = control.ss2tf(control.ss(model.A, model.B, model.C, model.D))
+    for g in (
+        _reference_channel(model, 0, 0, 0.0, stacklevel=2),
+        transfer_function(model),
+        aerocontrol.transfer_matrix(model)[0, 0],
+    ):
+        assert g.gain == pytest.approx(1.0, rel=1e-12)
+        np.testing.assert_allclose(g.zeros, [-3.0], rtol=1e-12)
+        np.testing.assert_allclose(g.numerator, [1.0, 3.0], rtol=1e-12)
+        for s in (0.3j, 2.0j, 1.0 + 5.0j):
+            assert g(s) == pytest.approx((s + 3.0) / s**2, rel=1e-12)
+            assert g(s) == pytest.approx(complex(peer(s)), rel=1e-10)
+    # s²/(s (s + 1)(s + 2)) with every eigenvalue exact but the double zero at the origin
+    # split to ±2.2e-9: also returned as zero. G(j) = (3 + j)/10 by hand.
+    A = np.array([[-2.0, -1.0, -2.0], [1.0, -1.0, 1.0], [0.0, 1.0, 0.0]])
+    model = aerocontrol.StateSpace(A, [[1.0], [0.0], [0.0]], [[1.0, -1.0, 1.0]], [[0.0]])
+    for g in (transfer_function(model), aerocontrol.transfer_matrix(model)[0, 0]):
+        assert g.gain == pytest.approx(1.0, rel=1e-12)
+        assert g.zeros.size == 2 and np.max(np.abs(g.zeros)) <= 1e-7
+        assert g(1.0j) == pytest.approx(0.3 + 0.1j, rel=1e-12)
+
+
+def test_gain_is_confirmed_at_a_point_of_another_grid() -> None:
+    # s²/(s (s + 1)(s + 2)) in state coordinates scaled by 10^±2: rounding splits the double
+    # zero at the origin to ±2e-8j, the first grid of evaluation points centres near
+    # 1e-3, where the terms of C (sI - A)⁻¹ B cancel to the size of G, and K came back
+    # 1.0000034; the next point of the same grid shared that rounding and confirmed it. K is 1
+    # (the realisation's leading Markov parameter c b = 20 0.01 + 0.04 20 = 1, by hand).
+    A = np.array(
+        [
+            [0.6000000000000001, -0.0028000000000000004, 0.12],
+            [600.0, -2.8000000000000003, 120.0],
+            [-4.0, 0.002, -0.8],
+        ]
+    )
+    b = np.array([[0.01], [20.0], [0.0]])
+    c = np.array([[20.0, 0.04000000000000001, 4.0]])
+    model = aerocontrol.StateSpace(A, b, c, [[0.0]])
+    g = transfer_function(model)
+    assert g.gain == pytest.approx(1.0, rel=1e-12)
+    for s in (0.37j + 0.11, 1.7j - 0.3, 5.3j):
+        assert g(s) == pytest.approx(_state_space_value(model, 0, 0, s), rel=1e-10)
+        assert g(s) == pytest.approx(s / ((s + 1.0) * (s + 2.0)), rel=1e-10)
+
+
 def test_transfer_matrix_is_every_transfer_function() -> None:
     lateral = aerocontrol.aircraft.load("b747-cruise").lateral()
     model = lateral[["p", "r", "beta"], :]

@@ -927,7 +927,7 @@ def _scaled_solve(
     return xm, xe
 
 
-def _scaled_response(channel: StateSpace, point: complex) -> tuple[complex, int]:
+def _scaled_response(channel: StateSpace, point: complex) -> tuple[complex, int] | None:
     """(g, k) with G(point) = 2^k g, g of largest part in [1/2, 1) (or 0), for a channel
     G(s) = C (sI - A)⁻¹ B + D (s = z for a discrete model): (point I - A) x = B solved with
     every value as a mantissa and a power of two (:func:`_scaled_solve`), C x summed
@@ -935,7 +935,8 @@ def _scaled_response(channel: StateSpace, point: complex) -> tuple[complex, int]
     backward stable solve wherever it, as a mantissa and a power of two, is: the dynamic part
     of a chain of integrators with couplings of 1e-200, and B and C of 1e100 and 1e200, is
     1e-100 where its solution in doubles passes through 1e-400 (0); a D of 1e-151 beside a
-    C of 1e299 is not lost to the scaling of C."""
+    C of 1e299 is not lost to the scaling of C. None where point I - A is singular to
+    working precision (a zero pivot): G cannot be evaluated there (its value is not D)."""
     A, B, C, D = channel.A, channel.B, channel.C, channel.D
     n = A.shape[0]
     terms_m = np.array([complex(D[0, 0])])
@@ -943,13 +944,14 @@ def _scaled_response(channel: StateSpace, point: complex) -> tuple[complex, int]
     if n and np.any(B) and np.any(C):
         M = np.asarray(point * np.eye(n) - A, dtype=np.complex128)
         solution = _scaled_solve(M, B[:, 0].astype(np.complex128))
-        if solution is not None:
-            xm, xe = solution
-            cm = C[0].astype(np.complex128)
-            ce = np.zeros(n, dtype=np.int64)
-            _renormalized(cm, ce)
-            terms_m = np.concatenate([terms_m, cm * xm])
-            terms_e = np.concatenate([terms_e, ce + xe])
+        if solution is None:
+            return None
+        xm, xe = solution
+        cm = C[0].astype(np.complex128)
+        ce = np.zeros(n, dtype=np.int64)
+        _renormalized(cm, ce)
+        terms_m = np.concatenate([terms_m, cm * xm])
+        terms_e = np.concatenate([terms_e, ce + xe])
     _renormalized(terms_m, terms_e)
     total_m, total_e = _scaled_sum(terms_m, terms_e, 0)
     return complex(total_m), int(total_e)
@@ -1007,13 +1009,20 @@ def _roots_and_gain(channel: StateSpace) -> tuple[ComplexArray, ComplexArray, fl
 def _verified_gain(
     channel: StateSpace, zeros: ComplexArray, poles: ComplexArray
 ) -> tuple[float, int]:
-    """K (as a mantissa and a power of two) from G at the point of the grid around the roots
-    farthest from them, confirmed by G at the next point (to 1e-6, relative): where G at the
-    first point cannot be computed accurately (poles at the origin beside a double zero that
-    rounding split to ±1e-9 put every point of the grid near 1e-9, where the terms of
-    C (sI - A)⁻¹ B cancel to the size of G: K came back 1000 times too small), the points of
-    the grid around ||A|| (and 1) are tried. If no point is confirmed, the best is returned
-    with an IllConditionedWarning."""
+    """K (as a mantissa and a power of two) of a channel of normal rank 1 (G not identically
+    zero) from G at the point of the grid around the roots farthest from them, confirmed by G
+    at the first point of another grid (to 1e-6, relative; for a discrete model, whose one
+    grid is the unit circle, at its next point): where G at the first point cannot be computed
+    accurately, the points of the grids around ||A|| and around 1 are tried. Poles at the
+    origin beside a double zero that rounding split to ±1e-9 put every point of the first
+    grid near 1e-9, where the terms of C (sI - A)⁻¹ B cancel to the size of G (K came back
+    1000 times too small); a nilpotent A, whose eigenvalues rounding puts near 1e-16, puts
+    them where sI - A is singular to working precision, or G rounds to exactly 0 (K came back
+    0 and the channel as zero). So a point where G cannot be evaluated, or evaluates to 0
+    (not a zero of the channel, so a cancellation), gives no gain. If no point is confirmed,
+    the best is returned with an IllConditionedWarning; if no point gave a nonzero G, 0 is
+    returned, with that warning unless G was exactly 0 at every point tried (a channel that
+    is zero to working precision, which the rank decisions judged nonzero)."""
     dt = period(channel) or 0.0
     roots = np.concatenate([zeros, poles])
     size = float(np.max(np.abs(channel.A), initial=0.0))
@@ -1024,39 +1033,76 @@ def _verified_gain(
             _evaluation_points(roots, dt, 0.0),
         ]
     best: tuple[float, tuple[float, int]] | None = None
-    for grid in grids:
-        point, check = grid[0], grid[1]
-        mantissa, exponent = _gain(*_scaled_response(channel, point), point, zeros, poles)
-        if mantissa == 0.0 or not math.isfinite(mantissa):
+    singular = False
+    for index, grid in enumerate(grids):
+        point = grid[0]
+        response = _scaled_response(channel, point)
+        if response is None:
+            singular = True
+            continue
+        mantissa, exponent = _gain(*response, point, zeros, poles)
+        if not math.isfinite(mantissa):
             return mantissa, exponent
-        g_m, g_e = _scaled_response(channel, check)
-        f_m, f_e = _scaled_factored(
-            np.array([complex(mantissa)]),
-            np.array([exponent]),
-            np.array([check]),
-            zeros,
-            poles,
+        if mantissa == 0.0:
+            continue
+        # Confirmed at a point of another grid: G at the next point of the same grid shares
+        # the first's rounding where the terms of C (sI - A)⁻¹ B cancel (a double zero at the
+        # origin split to ±2e-8j by rounding, beside poles at 0, -1, -2, centred the grid near
+        # 1e-3, where K came back 3.4e-6 too large and the next point agreed with it).
+        checks = [g[0] if g[0] != point else g[1] for k, g in enumerate(grids) if k != index]
+        error = min(
+            _factored_error(channel, mantissa, exponent, c, zeros, poles)
+            for c in checks or [grid[1]]
         )
-        # Both renormalised (largest part in [1/2, 1)): near 1 only for exponents within 2.
-        shift = int(f_e[0]) - g_e
-        if g_m == 0.0 or abs(shift) > 2:
-            error = math.inf
-        else:
-            ratio = complex(f_m[0]) / g_m * 2.0**shift
-            error = abs(ratio - 1.0) if cmath.isfinite(ratio) else math.inf
         if error <= 1e-6:
             return mantissa, exponent
         if best is None or error < best[0]:
             best = (error, (mantissa, exponent))
-    assert best is not None
+    name = f"{channel.output_names[0]}/{channel.input_names[0]}"
+    if best is None:
+        if singular:
+            warnings.warn(
+                f"transfer_function: the gain of {name} could not be computed: G = C (sI - A)⁻¹ "
+                "B + D is 0, or sI - A singular, to working precision at every point tried; "
+                "the channel is returned as zero",
+                IllConditionedWarning,
+                stacklevel=5,
+            )
+        return 0.0, 0
     warnings.warn(
-        f"transfer_function: the gain of {channel.output_names[0]}/{channel.input_names[0]} "
-        f"could not be confirmed: the factored form differs from C (sI - A)⁻¹ B + D by "
-        f"{best[0]:.1e} (relative) at a second point (ill-conditioned zeros or poles)",
+        f"transfer_function: the gain of {name} could not be confirmed: the factored form "
+        f"differs from C (sI - A)⁻¹ B + D by {best[0]:.1e} (relative) at a second point "
+        "(ill-conditioned zeros or poles)",
         IllConditionedWarning,
         stacklevel=5,
     )
     return best[1]
+
+
+def _factored_error(
+    channel: StateSpace,
+    mantissa: float,
+    exponent: int,
+    point: complex,
+    zeros: ComplexArray,
+    poles: ComplexArray,
+) -> float:
+    """|F/G - 1| at ``point``, F = K Π(s - z)/Π(s - p) with K = mantissa 2^exponent and G =
+    C (sI - A)⁻¹ B + D from the state space (:func:`_scaled_response`); inf where G cannot be
+    evaluated, is 0, or the two differ by more than a factor of 4."""
+    checked = _scaled_response(channel, point)
+    if checked is None or checked[0] == 0.0:
+        return math.inf
+    g_m, g_e = checked
+    f_m, f_e = _scaled_factored(
+        np.array([complex(mantissa)]), np.array([exponent]), np.array([point]), zeros, poles
+    )
+    # Both renormalised (largest part in [1/2, 1)): near 1 only for exponents within 2.
+    shift = int(f_e[0]) - g_e
+    if abs(shift) > 2:
+        return math.inf
+    ratio = complex(f_m[0]) / g_m * 2.0**shift
+    return abs(ratio - 1.0) if cmath.isfinite(ratio) else math.inf
 
 
 def transfer_function(

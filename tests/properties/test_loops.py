@@ -28,7 +28,7 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning, NumericalOverflowWarning
 
 from .harness import Arg, Warned, exercise, plain
-from .known_defects import FREQUENCY_POINT_OVERFLOW
+from .known_defects import FREQUENCY_POINT_OVERFLOW, MARGINS_CROSSOVER_MISSED
 from .oracles import (
     SLACK,
     TINY,
@@ -745,4 +745,40 @@ def test_known_defect_frequency_point_overflow() -> None:
             {"loop": plain((A, B, C, np.zeros((1, 1))))},
             _nyquist_oracle,
             nonfinite_by_definition=("contour", "response"),
+        )
+
+
+@pytest.mark.xfail(strict=True, reason="margins-crossover-badly-scaled-states: crossover missed")
+def test_known_defect_phase_crossover_of_badly_scaled_states() -> None:
+    """A defect of the native core found by an oracle hunt (see ``known_defects.py``).
+
+    L = (s - 1)²/((s + 2)(s + 3)(s + 4)) with its states scaled by 10^±6: Im L(jω) = 0 where
+    ω⁴ - 45 ω² + 74 = 0 (by hand), L negative at ω² = (45 - √1729)/2 (ω = 1.3074, L =
+    -0.0823, a gain margin of 12.145, as python-control's stability_margins gives)."""
+    A = np.array(
+        [
+            [4.0, -270000.0, -200000000.0],
+            [-0.0003999999999999999, 26.000000000000004, 20000.0],
+            [9.000000000000001e-07, -0.051, -39.0],
+        ]
+    )
+    B = np.array([[10.0], [-0.001], [2e-06]])
+    C = np.array([[-0.09999999999999999, -2000.0, 0.0]])
+    w = math.sqrt((45.0 - math.sqrt(1729.0)) / 2.0)
+    s = 1j * w
+    L = (s - 1.0) ** 2 / ((s + 2.0) * (s + 3.0) * (s + 4.0))
+
+    def complete(result: Any, args: dict[str, Any], warned: Warned) -> None:
+        _margins_oracle(result, args, warned)
+        found = np.abs(result.phase_crossovers - w) <= 1e-9 * w
+        assert np.any(found), f"the phase crossover {w} is missing: {result.phase_crossovers}"
+        assert result.gain_margins[found][0] == pytest.approx(1.0 / abs(L), rel=1e-9)
+
+    with MARGINS_CROSSOVER_MISSED.reproducing():
+        exercise(
+            "stability_margins",
+            lambda loop: aerocontrol.stability_margins(loop),
+            {"loop": plain((A, B, C, np.zeros((1, 1))))},
+            complete,
+            nonfinite_by_definition=UNBOUNDED,
         )
