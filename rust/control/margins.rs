@@ -52,6 +52,11 @@
 //! (A - B C/(1 + d), B/(1 + d), -C/(1 + d), 1/(1 + d)); the stability margin min |1 + L| is
 //! 1/max |S|.
 //!
+//! **Scaling.** The loop's states are balanced first by a diagonal similarity of powers of two
+//! (Osborne's iteration on [[A, b], [c, 0]] over the states; the transfer function is
+//! unchanged), so that the eigenvalue problems below are solved to a backward error relative
+//! to a system whose rows and columns are of one size.
+//!
 //! **Verification.** Every phase crossover with L(jω) < 0 gives a gain margin k = 1/|L(jω)|;
 //! the loop closed with k must have a pole at jω (the eigenvalues of A - k B (1 + k d)^-1 C
 //! by the root locus's controller-Hessenberg form, `control/root_locus.rs`,
@@ -70,7 +75,7 @@
 use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::control::root_locus;
 use crate::error::Error;
-use crate::linalg::balance::nearest_power_of_two;
+use crate::linalg::balance::{balance_siso_states, nearest_power_of_two};
 use crate::linalg::schur::eigenvalues;
 use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
@@ -633,8 +638,17 @@ pub fn loop_margins(
             eigenvalue_im: 0.0,
         });
     }
-    let bv: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
-    let cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
+    // The states balanced first (T A T^-1, T b, c T^-1: the same loop): the pencils' zeros and
+    // the Hamiltonians' eigenvalues are computed to a backward error relative to the system's
+    // size, and states scaled by 10^±6 put the phase crossovers' zeros off the axis.
+    let mut a = a.to_owned();
+    let mut bv: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
+    let mut cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
+    balance_siso_states(&mut a, &mut bv, &mut cv);
+    let a = a.as_ref();
+    let bm = Mat::from_fn(n, 1, |i, _| bv[i]);
+    let cm = Mat::from_fn(1, n, |_, j| cv[j]);
+    let (b, c) = (bm.as_ref(), cm.as_ref());
     let open_loop_poles = eigenvalues(a)?;
     let closed = Mat::from_fn(n, n, |i, j| a[(i, j)] - bv[i] * cv[j] / denominator);
     let closed_loop_poles = root_locus::closed_loop_poles(a, &bv, &cv, 1.0 / denominator)?;
@@ -752,6 +766,32 @@ mod tests {
 
     fn close(x: f64, y: f64, tol: f64) {
         assert!((x - y).abs() <= tol * y.abs().max(1e-300), "{x} vs {y}");
+    }
+
+    #[test]
+    fn phase_crossover_of_badly_scaled_states() {
+        // (s - 1)^2/((s + 2)(s + 3)(s + 4)) in states scaled by 10^±6: Im L(jω) = 0 at
+        // ω^4 - 45 ω^2 + 74 = 0, L(j1.3074) = -0.0823 (by hand). Missed before the balancing.
+        let rows = [
+            [4.0, -270000.0, -200000000.0],
+            [-0.0003999999999999999, 26.000000000000004, 20000.0],
+            [9.000000000000001e-07, -0.051, -39.0],
+        ];
+        let a = Mat::from_fn(3, 3, |i, j| rows[i][j]);
+        let b = Mat::from_fn(3, 1, |i, _| [10.0, -0.001, 2e-06][i]);
+        let c = Mat::from_fn(1, 3, |_, j| [-0.09999999999999999, -2000.0, 0.0][j]);
+        let d = Mat::<f64>::zeros(1, 1);
+        let m = loop_margins(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()).unwrap();
+        let w = ((45.0 - 1729f64.sqrt()) / 2.0).sqrt();
+        let s = c64::new(0.0, w);
+        let one = c64::new(1.0, 0.0);
+        let l = (s - one) * (s - one) / ((s + 2.0 * one) * (s + 3.0 * one) * (s + 4.0 * one));
+        let found = m
+            .phase_crossovers
+            .iter()
+            .find(|x| (x.omega - w).abs() <= 1e-9 * w)
+            .expect("the phase crossover");
+        assert!((found.value - l).norm() <= 1e-9 * l.norm());
     }
 
     #[test]

@@ -28,7 +28,8 @@
 //!    at the point s0 = jω (z = e^{jωh}) of a grid farthest from every root (as
 //!    `transfer._evaluation_point`), G(s0) solved on the equilibrated system and every product
 //!    renormalised by powers of two.
-//! 5. **Verification.** G at a second grid point, from the state space, must agree with the
+//! 5. **Verification.** G at the best point of a second grid (around max|A|; the next point of
+//!    the unit circle for a discrete model), from the state space, must agree with the
 //!    factored form to 1e-8 (relative); a G(s0) of 0 or below the normal range, a gain or a
 //!    numerator beyond the doubles, and a channel whose entries make products leave the range
 //!    of doubles are deferred.
@@ -43,6 +44,7 @@
 
 use crate::error::Error;
 use crate::linalg::householder::reflector;
+use crate::linalg::norm::max_abs;
 use crate::linalg::qz::{generalized_eigenvalues, qz};
 use crate::linalg::schur::eigenvalues;
 use faer::{Mat, MatRef, c64};
@@ -672,7 +674,7 @@ fn response(s: &Siso, point: c64) -> Option<c64> {
 /// The grid of evaluation points of `transfer._evaluation_point`, best first: s = jω on 31
 /// frequencies around the roots' sizes (z = e^{jθ} at 19 angles for a discrete model), by
 /// decreasing relative distance to the nearest root (ties in grid order).
-fn evaluation_points(roots: &[c64], dt: f64) -> Vec<c64> {
+fn evaluation_points(roots: &[c64], dt: f64, centre: Option<f64>) -> Vec<c64> {
     let points: Vec<c64> = if dt > 0.0 {
         (0..19)
             .map(|k| {
@@ -688,11 +690,11 @@ fn evaluation_points(roots: &[c64], dt: f64) -> Vec<c64> {
             .filter(|m| m.is_finite())
             .map(f64::log10)
             .collect();
-        let centre = if logs.is_empty() {
+        let centre = centre.unwrap_or(if logs.is_empty() {
             0.0
         } else {
             logs.iter().sum::<f64>() / logs.len() as f64
-        };
+        });
         // 10^(centre - 1.5 + k/10), k = 0..30 (one power, then exact-enough steps: any point
         // of the grid serves, the gain does not depend on it).
         let step = 10f64.powf(0.1);
@@ -792,7 +794,21 @@ fn channel(
     } else {
         // G(point) = 2^-(o + i) 2^e G_s(point 2^-(f + e)) on the equilibrated system.
         let roots: Vec<c64> = zeros.iter().chain(poles).copied().collect();
-        let points = evaluation_points(&roots, dt);
+        let points = evaluation_points(&roots, dt, None);
+        // The check point is the best of another grid (around max|A|, else around 1): the
+        // next point of the same grid shares the first's rounding where the terms of
+        // c (sI - A)^-1 b cancel. A discrete model's one grid is the unit circle.
+        let check = if dt > 0.0 {
+            points.get(1).copied()
+        } else {
+            let size = max_abs(a);
+            let other = evaluation_points(
+                &roots,
+                dt,
+                Some(if size > 0.0 { size.log10() } else { 0.0 }),
+            );
+            other.into_iter().find(|p| *p != points[0])
+        };
         let at = |point: c64| -> Option<Scaled> {
             let value = response(
                 &s,
@@ -812,7 +828,7 @@ fn channel(
             return Ok(None);
         }
         // The check: G at the second point from the state space and from the factored form.
-        if let Some(&check) = points.get(1) {
+        if let Some(check) = check {
             let Some(g1) = at(check) else {
                 return Ok(None);
             };

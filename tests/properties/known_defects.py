@@ -202,31 +202,3 @@ CONTROLLABILITY_TOLERANCE_OVERFLOW = known_defect(
     _tolerance_beyond_the_scaled_doubles,
     "'.tolerance'",
 )
-
-
-def _badly_scaled_states(args: dict[str, Any]) -> bool:
-    """The nonzero entries of A spread over more than ten decades (state coordinates of very
-    different units), which a diagonal similarity would bring together."""
-    models = _models_of(args)
-    if not models:
-        return False
-    entries = np.abs(models[0][0][models[0][0] != 0])
-    return bool(entries.size) and float(np.max(entries) / np.min(entries)) > 1e10
-
-
-MARGINS_CROSSOVER_MISSED = known_defect(
-    "margins-crossover-badly-scaled-states",
-    {"stability_margins"},
-    "the core's loop_margins misses a phase crossover of a loop whose state coordinates are "
-    "badly scaled: (s - 1)²/((s + 2)(s + 3)(s + 4)) realised with states scaled by 10^±6 "
-    "(A from 9e-7 to 2e8) gives no phase crossover and a gain margin of inf, where L(j1.3074) "
-    "= -0.0823 (gain margin 12.145, python-control's too); the same loop with its states "
-    "balanced by powers of two (scipy's matrix_balance, which changes no transfer function) "
-    "gives the crossover. Suspected: the phase-crossover candidates are the axis zeros of "
-    "L(s) - L(-s), found by siso_zeros on the doubled system (A ⊕ -A, [b; b], [c, c]) as "
-    "given, without balancing (rust/control/margins.rs, Loop::phase_crossovers and "
-    "siso_zeros), so the zeros come back off the axis by more than AXIS_TOLERANCE and "
-    "axis_candidates drops them",
-    _badly_scaled_states,
-    "phase crossover",
-)

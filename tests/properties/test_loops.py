@@ -28,7 +28,7 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning, NumericalOverflowWarning
 
 from .harness import Arg, Warned, exercise, plain
-from .known_defects import FREQUENCY_POINT_OVERFLOW, MARGINS_CROSSOVER_MISSED
+from .known_defects import FREQUENCY_POINT_OVERFLOW
 from .oracles import (
     SLACK,
     TINY,
@@ -748,9 +748,10 @@ def test_known_defect_frequency_point_overflow() -> None:
         )
 
 
-@pytest.mark.xfail(strict=True, reason="margins-crossover-badly-scaled-states: crossover missed")
-def test_known_defect_phase_crossover_of_badly_scaled_states() -> None:
-    """A defect of the native core found by an oracle hunt (see ``known_defects.py``).
+def test_regression_phase_crossover_of_badly_scaled_states() -> None:
+    """Found by an oracle hunt: the core's loop_margins missed this phase crossover (gain
+    margin inf, silently), its doubled system's zeros off the axis by more than the axis
+    tolerance; the loop's states are now balanced first.
 
     L = (s - 1)²/((s + 2)(s + 3)(s + 4)) with its states scaled by 10^±6: Im L(jω) = 0 where
     ω⁴ - 45 ω² + 74 = 0 (by hand), L negative at ω² = (45 - √1729)/2 (ω = 1.3074, L =
@@ -774,11 +775,10 @@ def test_known_defect_phase_crossover_of_badly_scaled_states() -> None:
         assert np.any(found), f"the phase crossover {w} is missing: {result.phase_crossovers}"
         assert result.gain_margins[found][0] == pytest.approx(1.0 / abs(L), rel=1e-9)
 
-    with MARGINS_CROSSOVER_MISSED.reproducing():
-        exercise(
-            "stability_margins",
-            lambda loop: aerocontrol.stability_margins(loop),
-            {"loop": plain((A, B, C, np.zeros((1, 1))))},
-            complete,
-            nonfinite_by_definition=UNBOUNDED,
-        )
+    exercise(
+        "stability_margins",
+        lambda loop: aerocontrol.stability_margins(loop),
+        {"loop": plain((A, B, C, np.zeros((1, 1))))},
+        complete,
+        nonfinite_by_definition=UNBOUNDED,
+    )
