@@ -624,3 +624,31 @@ def test_regression_poles_near_the_largest_double() -> None:
     exact = C / (1j * (r.omega / 1e308) + 1.0) + D
     np.testing.assert_allclose(r.response, exact, rtol=1e-14)
     assert r.curve[-1] == D
+
+
+def test_unstable_closed_loop_of_badly_scaled_states_is_not_marginal() -> None:
+    # Found by an oracle hunt: zeros ±4, ±4j over poles -1 ... -5 in states scaled by 10^±6
+    # (A from 5e-22 to 2e11). The closed loop has a real pole at +0.3683 (numpy's eigvals of
+    # A - B C), so Z = 1 and N = P - Z = -1; the boundary tolerance was taken from the
+    # unbalanced size of A - B C (2e11), so every closed-loop pole counted as on the axis:
+    # marginal, Z = 0 and no encirclement count, silently.
+    A = np.array(
+        [
+            [-15.000000000000002, 13099999.999999998, -225000000000.0, 1079999.9999999998,
+             -1200000.0000000002],
+            [1e-05, 0.0, -20000.0, 0.0, 0.0],
+            [0.0, -3.333333333333333e-05, 0.0, -6.666666666666667e-06, 5.551115123125783e-22],
+            [-0.0002, 0.0, 100000.0, 0.0, 0.0],
+            [0.0, -6.666666666666665, 100000.0, -0.33333333333333326, 1.1102230246251565e-16],
+        ]
+    )  # fmt: skip
+    B = np.array([[100000.0], [0.0], [0.0], [0.0], [0.0]])
+    C = np.array([[1e-05, -170.66666666666663, 0.0, -8.533333333333331, -25.599999999999998]])
+    expected = np.linalg.eigvals(A - B @ C)
+    assert np.sum(expected.real > 0.0) == 1
+    result = aerocontrol.nyquist((A, B, C, np.zeros((1, 1))))
+    assert not result.marginal
+    assert result.closed_loop_unstable_poles == 1
+    assert result.open_loop_unstable_poles == 0
+    assert result.encirclements == -1
+    assert not result.closed_loop_stable

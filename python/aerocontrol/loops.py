@@ -2641,11 +2641,28 @@ class _Poles:
     """The open loop's boundary tolerance (:func:`_boundary_tolerance`)."""
 
 
+def _state_balanced(model: StateSpace) -> StateSpace:
+    """The SISO loop with its states balanced by a diagonal similarity of powers of two (the
+    core's ``balance_siso_states``: T A T⁻¹, T B, C T⁻¹, exact), the same transfer function."""
+    if model.n_states == 0:
+        return model
+    A, B, C = _core.balance_siso_states(model.A, model.B, model.C)
+    return StateSpace(A, B, C, model.D, dt=model.dt)
+
+
 def _poles(model: StateSpace, closed_loop: bool) -> _Poles:
+    """The open- and closed-loop poles and which lie on the stability boundary. The open-loop
+    poles and their tolerance come from A (whose eigenvalues the core balances itself); the
+    closed-loop ones from the loop with its states balanced (:func:`_state_balanced`), and
+    their tolerance from the size of that closed loop: the core's root-locus QR is unbalanced,
+    so its errors are relative to the matrix it is given, and a tolerance from the unbalanced
+    size (2e11 for states scaled by 10^±6) counted a closed-loop pole at +0.37 as on the
+    axis."""
     discrete = model.is_discrete
     open_poles = _eigenvalues(model.A)
     tolerance = _boundary_tolerance(_matrix_size(model.A), discrete)
     if closed_loop:
+        model = _state_balanced(model)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NumericalOverflowWarning)
             closed = _closed_loop_poles(model, np.ones(1))[0]

@@ -6,6 +6,8 @@ use super::errors::to_py_err;
 use super::statespace::ModelArgs;
 use crate::control::margins::{Crossover, loop_margins as loop_margins_core};
 use crate::control::root_locus::root_locus as root_locus_core;
+use crate::error::Error;
+use crate::linalg::balance::balance_siso_states as balance_siso_states_core;
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -121,7 +123,63 @@ fn root_locus<'py>(
     Ok(out)
 }
 
+/// The SISO loop (A, b, c) with its states balanced by a diagonal similarity of powers of two,
+/// (T A T^-1, T b, c T^-1) (`linalg/balance.rs`, balance_siso_states): the same transfer
+/// function, rows and columns of [[A, b], [c, 0]] of one size.
+#[pyfunction]
+#[pyo3(signature = (a, b, c, /))]
+#[allow(clippy::type_complexity)]
+fn balance_siso_states<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+)> {
+    let a = Real::convert(py, a, "A")?;
+    let b = Real::convert(py, b, "B")?;
+    let c = Real::convert(py, c, "C")?;
+    let (a, b, c) = (
+        a.matrix().map_err(|e| to_py_err(py, e))?,
+        b.matrix().map_err(|e| to_py_err(py, e))?,
+        c.matrix().map_err(|e| to_py_err(py, e))?,
+    );
+    let n = a.nrows();
+    if a.ncols() != n || b.nrows() != n || b.ncols() != 1 || c.nrows() != 1 || c.ncols() != n {
+        return Err(to_py_err(
+            py,
+            Error::InvalidArgument {
+                arg: "loop",
+                message: format!(
+                    "loop must have one input and one output, A {n} x {n}, B {n} x 1 and C 1 x \
+                     {n}, got A {} x {}, B {} x {} and C {} x {}",
+                    a.nrows(),
+                    a.ncols(),
+                    b.nrows(),
+                    b.ncols(),
+                    c.nrows(),
+                    c.ncols()
+                ),
+            },
+        ));
+    }
+    let mut am = a.to_owned();
+    let mut bv: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
+    let mut cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
+    balance_siso_states_core(&mut am, &mut bv, &mut cv);
+    let mut outputs = Outputs::new(py);
+    let a_out = outputs.matrix("A", am.as_ref())?;
+    let b_out = outputs.real("B", &[n, 1], &bv)?;
+    let c_out = outputs.real("C", &[1, n], &cv)?;
+    outputs.finish()?;
+    Ok((a_out, b_out, c_out))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(balance_siso_states, m)?)?;
     m.add_function(wrap_pyfunction!(loop_margins, m)?)?;
     m.add_function(wrap_pyfunction!(root_locus, m)?)?;
     Ok(())
