@@ -671,32 +671,37 @@ fn response(s: &Siso, point: c64) -> Option<c64> {
     Some(ShiftedLu::new(s.a.as_ref(), point)?.response(&s.b, &s.c, s.d))
 }
 
-/// The grid of evaluation points of `transfer._evaluation_point`, best first: s = jω on 31
-/// frequencies around the roots' sizes (z = e^{jθ} at 19 angles for a discrete model), by
-/// decreasing relative distance to the nearest root (ties in grid order).
-fn evaluation_points(roots: &[c64], dt: f64, centre: Option<f64>) -> Vec<c64> {
+/// The mean log10 of the roots' finite, nonzero moduli (0 without one): the centre of the grid
+/// of evaluation points, as `transfer._evaluation_points` takes it.
+fn log_centre(roots: &[c64]) -> f64 {
+    let logs: Vec<f64> = roots
+        .iter()
+        .map(|r| r.norm())
+        .filter(|m| m.is_finite() && *m != 0.0)
+        .map(f64::log10)
+        .collect();
+    if logs.is_empty() {
+        0.0
+    } else {
+        logs.iter().sum::<f64>() / logs.len() as f64
+    }
+}
+
+/// The two points of the grid of `transfer._evaluation_points` farthest from the roots (by
+/// relative distance to the nearest), best first, ties in grid order: s = jω at 31 frequencies
+/// 10^(centre - 1.5 + k/10), or z = e^{jθ} at 19 angles of the unit circle for a discrete
+/// model; without roots, the middle of the grid and the point after it.
+fn best_points(roots: &[c64], dt: f64, centre: f64) -> (c64, c64) {
     let points: Vec<c64> = if dt > 0.0 {
         (0..19)
             .map(|k| {
-                let theta = (0.05 + 0.05 * k as f64) * std::f64::consts::PI / dt * dt;
+                let theta = (0.05 + 0.05 * k as f64) * std::f64::consts::PI;
                 c64::new(theta.cos(), theta.sin())
             })
             .collect()
     } else {
-        let logs: Vec<f64> = roots
-            .iter()
-            .filter(|r| r.re.is_finite() && r.im.is_finite() && r.norm() != 0.0)
-            .map(|r| r.norm())
-            .filter(|m| m.is_finite())
-            .map(f64::log10)
-            .collect();
-        let centre = centre.unwrap_or(if logs.is_empty() {
-            0.0
-        } else {
-            logs.iter().sum::<f64>() / logs.len() as f64
-        });
-        // 10^(centre - 1.5 + k/10), k = 0..30 (one power, then exact-enough steps: any point
-        // of the grid serves, the gain does not depend on it).
+        // One power, then steps of 10^0.1: any point of the grid serves (the gain does not
+        // depend on it).
         let step = 10f64.powf(0.1);
         let mut omega = 10f64.powf(centre - 1.5);
         (0..31)
@@ -707,6 +712,10 @@ fn evaluation_points(roots: &[c64], dt: f64, centre: Option<f64>) -> Vec<c64> {
             })
             .collect()
     };
+    if roots.is_empty() {
+        let middle = points.len() / 2;
+        return (points[middle], points[middle + 1]);
+    }
     // min |p - r|^2 / |p|^2 over the roots: the relative distance, squared (no hypot).
     let distance = |p: c64| {
         let size = p.norm_sqr();
@@ -715,16 +724,20 @@ fn evaluation_points(roots: &[c64], dt: f64, centre: Option<f64>) -> Vec<c64> {
             .map(|r| (p - r).norm_sqr() / size)
             .fold(f64::INFINITY, f64::min)
     };
-    let mut ranked: Vec<(f64, c64)> = points.into_iter().map(|p| (distance(p), p)).collect();
-    if roots.is_empty() {
-        // No root: the middle of the grid first, as the reference.
-        let middle = ranked.len() / 2;
-        ranked.rotate_left(middle);
-        return ranked.into_iter().map(|(_, p)| p).collect();
+    let (mut first, mut second) = (
+        (f64::NEG_INFINITY, points[0]),
+        (f64::NEG_INFINITY, points[1]),
+    );
+    for p in points {
+        let value = distance(p);
+        if value > first.0 {
+            second = first;
+            first = (value, p);
+        } else if value > second.0 {
+            second = (value, p);
+        }
     }
-    // Stable: equal distances keep the grid's order (numpy.argmax takes the first).
-    ranked.sort_by(|x, y| y.0.total_cmp(&x.0));
-    ranked.into_iter().map(|(_, p)| p).collect()
+    (first.1, second.1)
 }
 
 /// One channel (see the module's documentation), None when deferred.
@@ -794,20 +807,17 @@ fn channel(
     } else {
         // G(point) = 2^-(o + i) 2^e G_s(point 2^-(f + e)) on the equilibrated system.
         let roots: Vec<c64> = zeros.iter().chain(poles).copied().collect();
-        let points = evaluation_points(&roots, dt, None);
+        let (first, next) = best_points(&roots, dt, log_centre(&roots));
         // The check point is the best of another grid (around max|A|, else around 1): the
         // next point of the same grid shares the first's rounding where the terms of
         // c (sI - A)^-1 b cancel. A discrete model's one grid is the unit circle.
         let check = if dt > 0.0 {
-            points.get(1).copied()
+            next
         } else {
             let size = max_abs(a);
-            let other = evaluation_points(
-                &roots,
-                dt,
-                Some(if size > 0.0 { size.log10() } else { 0.0 }),
-            );
-            other.into_iter().find(|p| *p != points[0])
+            let (best, after) =
+                best_points(&roots, dt, if size > 0.0 { size.log10() } else { 0.0 });
+            if best != first { best } else { after }
         };
         let at = |point: c64| -> Option<Scaled> {
             let value = response(
@@ -818,28 +828,24 @@ fn channel(
             (part.is_finite() && part >= f64::MIN_POSITIVE).then(|| Scaled::new(value, e - units))
         };
         let (sorted_zeros, sorted_poles) = (by_modulus(&zeros), by_modulus(poles));
-        let Some(g0) = at(points[0]) else {
+        let Some(g0) = at(first) else {
             return Ok(None);
         };
-        let k = factored(g0, points[0], &sorted_poles, &sorted_zeros)
-            .value()
-            .re;
+        let k = factored(g0, first, &sorted_poles, &sorted_zeros).value().re;
         if !(k.is_finite() && k.abs() >= f64::MIN_POSITIVE) {
             return Ok(None);
         }
         // The check: G at the second point from the state space and from the factored form.
-        if let Some(check) = check {
-            let Some(g1) = at(check) else {
-                return Ok(None);
-            };
-            let start = Scaled::new(c64::new(k, 0.0), 0);
-            let mut factored_value = factored(start, check, &sorted_zeros, &sorted_poles);
-            factored_value.divided_by(g1);
-            let ratio = factored_value.value();
-            let agrees = (ratio - 1.0).norm() <= 1e-8; // false for NaN
-            if !agrees {
-                return Ok(None);
-            }
+        let Some(g1) = at(check) else {
+            return Ok(None);
+        };
+        let start = Scaled::new(c64::new(k, 0.0), 0);
+        let mut factored_value = factored(start, check, &sorted_zeros, &sorted_poles);
+        factored_value.divided_by(g1);
+        let ratio = factored_value.value();
+        let agrees = (ratio - 1.0).norm() <= 1e-8; // false for NaN
+        if !agrees {
+            return Ok(None);
         }
         k
     };
