@@ -160,7 +160,7 @@ def factored_response(
     poles: NDArray[np.complex128],
     points: NDArray[np.complex128],
     /,
-) -> NDArray[np.complex128]: ...
+) -> tuple[NDArray[np.complex128], bool]: ...
 def frequency_response(
     a: ArrayLike,
     b: ArrayLike,

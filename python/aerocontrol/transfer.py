@@ -678,15 +678,15 @@ class TransferFunction:
         below them rounds to 0 (or a subnormal), as a product of doubles does."""
         value = np.asarray(s, dtype=np.complex128)
         k, e = self.scaled_gain if self.scaled_gain is not None else math.frexp(self.gain)
-        flat = _core.factored_response(
+        values, finite = _core.factored_response(
             [float(k)],
             [int(e)],
             [np.asarray(self.zeros, dtype=np.complex128).reshape(-1)],
             np.asarray(self.poles, dtype=np.complex128).reshape(-1),
             value.reshape(-1),
-        )[0]
-        result = flat.reshape(value.shape)
-        if not np.all(np.isfinite(result)) and np.all(np.isfinite(value)):
+        )
+        result = values[0].reshape(value.shape)
+        if not finite and np.isfinite(value).all():
             warnings.warn(
                 "the result overflowed double precision: G is infinite or NaN (at a pole, or "
                 "beyond the doubles)",
@@ -1332,10 +1332,10 @@ class TransferMatrix:
         value = np.asarray(s, dtype=np.complex128)
         points = value.reshape(-1)
         p, m = self.shape
-        result = _core.factored_response(
+        result, finite = _core.factored_response(
             self._mantissas, self._exponents, self._zeros, self.poles, points
         )
-        if not np.isfinite(result).all() and np.isfinite(points).all():
+        if not finite and np.isfinite(points).all():
             warnings.warn(
                 "the result overflowed double precision: G is infinite or NaN (at a pole, or "
                 "beyond the doubles)",

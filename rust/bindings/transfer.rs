@@ -66,7 +66,7 @@ fn transfer_channels<'py>(
 /// K_k Π(s - z_ki) / Π(s - p_j) for each channel k (K_k = mantissas[k] 2^exponents[k], its
 /// zeros zeros[k]) at each of `points` (1-D complex128): a (channels, points) complex array,
 /// the products renormalised by powers of two after each factor; infinite or NaN at a pole
-/// (not warned of: the caller does).
+/// (not warned of: the caller does), with whether every value is finite.
 #[pyfunction]
 #[pyo3(signature = (mantissas, exponents, zeros, poles, points, /))]
 fn factored_response<'py>(
@@ -76,7 +76,7 @@ fn factored_response<'py>(
     zeros: Vec<Bound<'py, PyArrayDyn<c64>>>,
     poles: &Bound<'py, PyArrayDyn<c64>>,
     points: &Bound<'py, PyArrayDyn<c64>>,
-) -> PyResult<Bound<'py, PyArrayDyn<c64>>> {
+) -> PyResult<(Bound<'py, PyArrayDyn<c64>>, bool)> {
     if exponents.len() != mantissas.len() || zeros.len() != mantissas.len() {
         return Err(to_py_err(
             py,
@@ -117,7 +117,11 @@ fn factored_response<'py>(
         }
         Ok(())
     })?;
-    Ok(out)
+    // SAFETY: as above; the computation is over.
+    let finite = unsafe { new_array_data(&out) }
+        .iter()
+        .all(|z| z.re.is_finite() && z.im.is_finite());
+    Ok((out, finite))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
