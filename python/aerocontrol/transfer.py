@@ -22,7 +22,14 @@ pencil (for one input and one output det S(s) = ±det(sI - A) G(s), so they are 
 roots of the numerator over that denominator), and the gain K evaluated from G at a point
 away from every pole and zero. Nothing is obtained by cancelling characteristic polynomials.
 The result prints in the factored "aircraft" form, with (s + 1/T) and
-(s² + 2ζωs + ω²) factors.
+(s² + 2ζωs + ω²) factors. :func:`transfer_matrix` gives every channel of a model in one call.
+
+Two paths compute a channel. The core's fast path (``rust/control/transfer.rs``) takes the
+same steps in doubles (the equilibration, the reduction by Householder reflections, the gain
+confirmed at a point of a second grid) and hands back every channel where its rank decisions
+lie near the tolerance, a zero lies far beyond the system's scale, an entry lies beyond
+2^±250 or its check fails; the reference path here then computes it, every product held as
+a mantissa and a power of two.
 
 References
 ----------
