@@ -784,8 +784,10 @@ fn channel(
         return Ok(None);
     };
     // The reference adds the zeros of the unequilibrated pencil beyond the equilibrated one's
-    // reach: there must be none.
-    if zeros.len() < n && zero_count(&given).is_none_or(|k| k > zeros.len()) {
+    // reach: there must be none. (With d = 0 exactly the unequilibrated pencil has at most
+    // n - 1 zeros, so n - 1 here needs no second reduction.)
+    let at_most = d == 0.0 && zeros.len() + 1 == n;
+    if zeros.len() < n && !at_most && zero_count(&given).is_none_or(|k| k > zeros.len()) {
         return Ok(None);
     }
     let scale = frequency + e;
