@@ -146,7 +146,7 @@ def transfer_channels(
     c: ArrayLike,
     d: ArrayLike,
     dt: float,
-    channels: list[tuple[int, int]],
+    channels: list[tuple[int, int]] | None,
     /,
 ) -> tuple[
     NDArray[np.complex128],

@@ -1392,14 +1392,11 @@ def transfer_matrix(sys: System) -> TransferMatrix:
     """
     model = as_state_space(sys)
     dt = period(model) if model.is_discrete else 0.0
-    p, m = model.n_outputs, model.n_inputs
-    wanted = [(i, j) for i in range(p) for j in range(m)]
-    poles, denominator, fast = _core.transfer_channels(
-        model.A, model.B, model.C, model.D, dt, wanted
-    )
+    m = model.n_inputs
+    poles, denominator, fast = _core.transfer_channels(model.A, model.B, model.C, model.D, dt, None)
     denominator = _checked_denominator(poles, denominator, 2)
     channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray]] = [
-        result if result is not None else _reference_channel(model, i, j, dt, stacklevel=2)
-        for (i, j), result in zip(wanted, fast, strict=True)
+        result if result is not None else _reference_channel(model, k // m, k % m, dt, stacklevel=2)
+        for k, result in enumerate(fast)
     ]
     return TransferMatrix(poles, denominator, dt, model.output_names, model.input_names, channels)

@@ -18,7 +18,8 @@ type ChannelOutput<'py> = Option<(
     Bound<'py, PyArrayDyn<f64>>,
 )>;
 
-/// The channels (output i, input j) of the model (`control/transfer.rs`): (poles, denominator,
+/// The channels (output i, input j) of the model (`control/transfer.rs`; None: every channel,
+/// output by output): (poles, denominator,
 /// [None or (zeros, gain, numerator) per channel]), None where the channel is left to the
 /// reference path of `aerocontrol.transfer`. The denominator is empty when it overflows.
 #[pyfunction]
@@ -31,7 +32,7 @@ fn transfer_channels<'py>(
     c: &Bound<'py, PyAny>,
     d: &Bound<'py, PyAny>,
     dt: f64,
-    channels: Vec<(usize, usize)>,
+    channels: Option<Vec<(usize, usize)>>,
 ) -> PyResult<(
     Bound<'py, PyArrayDyn<c64>>,
     Bound<'py, PyArrayDyn<f64>>,
@@ -40,6 +41,10 @@ fn transfer_channels<'py>(
     let args = ModelArgs::convert(py, a, b, c, d)?;
     let model = args.model().map_err(|e| to_py_err(py, e))?;
     let n = model.a.nrows();
+    let channels = channels.unwrap_or_else(|| {
+        let (p, m) = (model.c.nrows(), model.b.ncols());
+        (0..p * m).map(|k| (k / m, k % m)).collect()
+    });
     // An eigenvalue problem of order n, and per channel a reduction and one of order n.
     let cost = Cost::of(25.0 * (n as f64).powi(3), 4.0, n).times(channels.len() + 1);
     let transfer = compute(py, cost, || {
