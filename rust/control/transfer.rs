@@ -9,14 +9,17 @@
 //! (returns None for it) wherever the two could differ or the result could not be confirmed:
 //!
 //! 1. **Equilibration** as `transfer._balance` (Ruiz's sweeps on the output row and the input
-//!    column, the unit of frequency from ||A||, Osborne's balancing per state; exponents only,
-//!    applied once), then S divided by the power of two above ||S||_F.
+//!    column, the unit of frequency from ||A||, Osborne's balancing per state, by powers of
+//!    two), applied to the entries as it goes (the reference works on their logarithms: the
+//!    fast path takes only channels whose nonzero entries lie within 2^±250), then S divided
+//!    by the power of two above ||S||_F.
 //! 2. **Reduction** (Emami-Naeini and Van Dooren 1982, procedure "reduce", for one output):
 //!    while |d| <= tol = (n + 1)^2 ε ||S||_F, a Householder reflection H with c H = ±||c|| e_N
 //!    moves the output onto the last state, and the system becomes
 //!    (A11, b1, [H A H]_{N,1:N-1}, (H b)_N) of order N - 1, with the same finite zeros. A norm
 //!    ||c|| <= tol (or no state left) is a channel of normal rank 0: G = 0. A decision value
-//!    within a factor of 2 of tol is deferred (the reference's rotations round differently).
+//!    within a factor of 8 of tol is deferred (the reference's equilibration and rotations
+//!    round differently).
 //! 3. **Zeros.** With d̂ = |d| > tol, the zeros are the eigenvalues of A - b c / d: backward
 //!    stable for the pencil when ||[c, d]|| <= 16 |d|; up to 2^10 |d| the generalized
 //!    eigenvalues of the compressed pencil (Af, Bf) = ([A b] W, W_11) by QZ (W a reflection with
@@ -26,7 +29,7 @@
 //!    (the reference then adds those beyond the equilibrated pencil's reach), else deferred.
 //! 4. **Gain** K = d where d != 0 and there are n zeros; otherwise K = G(s0) Π(s0 - p)/Π(s0 - z)
 //!    at the point s0 = jω (z = e^{jωh}) of a grid farthest from every root (as
-//!    `transfer._evaluation_point`), G(s0) solved on the equilibrated system and every product
+//!    `transfer._evaluation_points`), G(s0) solved on the equilibrated system and the product
 //!    renormalised by powers of two.
 //! 5. **Verification.** G at the best point of a second grid (around max|A|; the next point of
 //!    the unit circle for a discrete model), from the state space, must agree with the
@@ -35,9 +38,9 @@
 //!    of doubles are deferred.
 //!
 //! [`factored_response`] evaluates K Π(s - z_i) / Π(s - p_j) with the product held as a mantissa
-//! and a power of two, renormalised after each factor (a zero's, then a pole's, by increasing
-//! modulus), and scaled once at the end: nothing overflows or underflows where the result does
-//! not.
+//! and a power of two, the factors taken a zero's, then a pole's, by increasing modulus, the
+//! mantissa renormalised whenever it leaves 2^±200, and scaled once at the end: nothing
+//! overflows or underflows where the result does not.
 //!
 //! Reference: A. Emami-Naeini and P. Van Dooren, "Computation of zeros of linear multivariable
 //! systems", Automatica 18(4), 415-430, 1982.
