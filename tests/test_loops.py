@@ -1155,3 +1155,48 @@ def test_pole_cancelled_at_the_origin_is_not_a_stable_closed_loop() -> None:
         margins = stability_margins(loop)
         assert not margins.closed_loop_stable and margins.disk_margin == 0.0
         assert aerocontrol.nyquist(loop).marginal
+
+
+def _numpy_damping(loop: aerocontrol.StateSpace, k: float) -> float:
+    """ζ of the least-damped oscillatory pole of A - k B C (D = 0) by numpy's eigvals, -1 if a
+    pole is unstable, 1 if none oscillates: the damping search's independent oracle."""
+    poles = np.linalg.eigvals(loop.A - k * loop.B @ loop.C)
+    if np.any(poles.real > 0):
+        return -1.0
+    oscillatory = poles[poles.imag > 1e-9 * np.abs(poles)]
+    return float(np.min(-oscillatory.real / np.abs(oscillatory))) if oscillatory.size else 1.0
+
+
+def test_root_locus_and_damping_of_the_747_yaw_loop_in_badly_scaled_states() -> None:
+    """The 747 yaw damper loop, its six states scaled by 10^(±6, ∓6, ...): the core's root-locus
+    QR is unbalanced, and the poles came out with errors 1800 times their size (silently);
+    best_damping_gain then chose k = 0 (ζ 0.035) or k = 1.80 with ζ 0.332, above the true
+    maximum. The loop's states are now balanced first. Oracle: numpy's eigvals of the
+    unscaled A - k B C, on 8001 gains over the default six decades, the best refined by
+    scipy's bounded minimize_scalar: k = 1.48732, ζ = 0.291199."""
+    loop = aerocontrol.design.yaw_damper(aerocontrol.aircraft.load("b747-cruise")).loop
+    assert not np.any(loop.D)
+    gains = np.logspace(np.log10(3.9136e-3), np.log10(3.9136e3), 8001)
+    grid = np.array([_numpy_damping(loop, k) for k in gains])
+    i = int(np.argmax(grid))
+    found = minimize_scalar(
+        lambda k: -_numpy_damping(loop, k),
+        bounds=(gains[i - 1], gains[i + 1]),
+        method="bounded",
+        options={"xatol": 1e-10},
+    )
+    best_k, best_zeta = float(found.x), -float(found.fun)
+    assert best_zeta >= grid[i]
+    for exponents in ([6, -6, 6, -6, 6, -6], [-6, 6, -6, 6, -6, 6], [-6, -6, -4, 4, 2, 5]):
+        A, B, C = _scaled_states(loop.A, loop.B, loop.C, exponents)
+        scaled = aerocontrol.StateSpace(A, B, C, loop.D)
+        ks = np.array([0.1, 1.0, best_k, 10.0])
+        locus = root_locus(scaled, ks)
+        for k, poles in zip(ks, locus.poles, strict=True):
+            theirs = np.sort_complex(np.linalg.eigvals(loop.A - k * loop.B @ loop.C))
+            error = np.max(np.abs(np.sort_complex(poles) - theirs))
+            assert error <= 1e-12 * np.max(np.abs(theirs))
+        design = best_damping_gain(scaled)
+        assert design.damping_ratio == pytest.approx(best_zeta, abs=1e-12)
+        assert design.gain == pytest.approx(best_k, rel=1e-6)
+        assert design.damping_ratio == pytest.approx(_numpy_damping(loop, design.gain), abs=1e-12)

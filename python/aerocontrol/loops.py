@@ -221,7 +221,10 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
 
     The poles of every gain come from one parallel call of the core (``_core.root_locus``:
     one controller-Hessenberg form of (A, B, C), then the QR iteration of each gain's
-    Hessenberg matrix, normwise backward stable). Where a term of a matrix (A, or g B C with
+    Hessenberg matrix, normwise backward stable) on the loop with its states balanced
+    (:func:`_state_balanced`): the QR is not balanced itself, so its errors are relative to
+    the matrix it is given, and states scaled by 10^±6 gave poles wrong by 1800 times their
+    size. Where a term of a matrix (A, or g B C with
     g = k/(1 + k D), bounded by |g| max|B| max|C|) exceeds 2^RESCALE_EXPONENT, the matrix is
     formed divided by the power of two 2^e nearest its size, from B and C normalised by
     powers of two (so that neither B C nor g B C overflows), and its eigenvalues multiplied by
@@ -230,6 +233,7 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     n = model.n_states
     if n == 0:
         return np.zeros((k.size, 0), np.complex128)
+    model = _state_balanced(model)
     A, B, C = model.A, model.B, model.C
     g = _closed_loop_gains(model, k)
     mantissa, power = _closed_loop_gain_parts(model, k)
@@ -2371,7 +2375,7 @@ def _balancing(M: FloatArray, count: int) -> FloatArray:
         changed = False
         for i in range(count):
             c, r = float(np.sum(off[:, i])), float(np.sum(off[i, :]))
-            if c == 0.0 or r == 0.0:
+            if not (0.0 < c < math.inf and 0.0 < r < math.inf):
                 continue
             f, scaled_c, scaled_r = 1.0, c, r
             while scaled_c < scaled_r / 2.0:
@@ -2406,10 +2410,15 @@ def _balanced_states(model: StateSpace) -> StateSpace:
     p = model.n_inputs
     pencil = np.block([[model.A, model.B], [model.C, np.zeros((p, p))]])
     d = _balancing(pencil, n)[:n]
+    with np.errstate(over="ignore", under="ignore"):
+        A = model.A * (d[None, :] / d[:, None])
+        B, C = model.B / d[:, None], model.C * d[None, :]
+    if not _exactly_scaled((model.A, A), (model.B, B), (model.C, C)):
+        return model
     return StateSpace(
-        model.A * d[None, :] / d[:, None],
-        model.B / d[:, None],
-        model.C * d[None, :],
+        A,
+        B,
+        C,
         model.D,
         dt=model.dt,
         state_names=model.state_names,
@@ -2745,11 +2754,25 @@ class _Poles:
 
 def _state_balanced(model: StateSpace) -> StateSpace:
     """The SISO loop with its states balanced by a diagonal similarity of powers of two (the
-    core's ``balance_siso_states``: T A T⁻¹, T B, C T⁻¹, exact), the same transfer function."""
+    core's ``balance_siso_states``: T A T⁻¹, T B, C T⁻¹, exact), the same transfer function;
+    the loop as given where the scaling would push an entry out of the normal doubles."""
     if model.n_states == 0:
         return model
     A, B, C = _core.balance_siso_states(model.A, model.B, model.C)
+    if not _exactly_scaled((model.A, A), (model.B, B), (model.C, C)):
+        return model
     return StateSpace(A, B, C, model.D, dt=model.dt)
+
+
+def _exactly_scaled(*pairs: tuple[FloatArray, FloatArray]) -> bool:
+    """Whether each matrix scaled by powers of two kept every entry a normal, finite double
+    (the scaling is then exact): an A of 1e-300 beside B of 0.1 and C of 1e-151 is balanced by
+    2^±250, and its off-diagonal 1.3e-301 underflowed to 0."""
+    tiny = np.finfo(float).tiny
+    return all(
+        np.all(np.isfinite(after)) and not np.any((np.abs(after) < tiny) & (before != 0.0))
+        for before, after in pairs
+    )
 
 
 def _poles(model: StateSpace, closed_loop: bool) -> _Poles:
