@@ -100,6 +100,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._balance import balanced_states, balancing, exactly_scaled
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
@@ -1780,7 +1781,7 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
       margin is the loop's disk margin.
 
     The loop's states are first balanced by a diagonal similarity of powers of two (exact,
-    the same L; :func:`_balanced_states`), so that states scaled by 10^±6 give the margins
+    the same L; :func:`balanced_states`), so that states scaled by 10^±6 give the margins
     of the well-scaled loop. The results are checked: the destabilising perturbation of the
     lower bound must make I + L(jω) F singular (I - M Δ where L has a pole at ω;
     AerocontrolLinAlgError otherwise), and the lower bound may not exceed the upper. A
@@ -1833,7 +1834,7 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
     >>> np.round(m.multiloop.gain_margin_db, 3), round(m.multiloop.phase_margin, 3)
     (array([-0.867,  0.867]), 5.711)
     """
-    model = _balanced_states(_square_loop(loop))
+    model = balanced_states(_square_loop(loop))
     sigma = real_scalar(skew, "skew")
     check_finite(np.array([sigma]), "skew")
     grid = None if omega is None else _frequencies(omega, model)
@@ -2362,69 +2363,14 @@ def _on_boundary(roots: ComplexArray, discrete: bool, tolerance: float) -> BoolA
     return np.asarray(distance <= tolerance, dtype=np.bool_)
 
 
-def _balancing(M: FloatArray, count: int) -> FloatArray:
-    """The diagonal D of powers of two (ones beyond the first ``count`` indices) that balances
-    M as D⁻¹ M D by Parlett and Reinsch's iteration (1969; LAPACK's xGEBAL without
-    permutations): each scaled index's off-diagonal row and column 1-norms brought within a
-    factor 2 of each other while that lowers their sum. Exact: only exponents change."""
-    off = np.abs(np.array(M, dtype=np.float64))
-    np.fill_diagonal(off, 0.0)
-    d = np.ones(off.shape[0])
-    changed = True
-    while changed:
-        changed = False
-        for i in range(count):
-            c, r = float(np.sum(off[:, i])), float(np.sum(off[i, :]))
-            if not (0.0 < c < math.inf and 0.0 < r < math.inf):
-                continue
-            f, scaled_c, scaled_r = 1.0, c, r
-            while scaled_c < scaled_r / 2.0:
-                scaled_c, scaled_r, f = scaled_c * 2.0, scaled_r / 2.0, f * 2.0
-            while scaled_c >= scaled_r * 2.0:
-                scaled_c, scaled_r, f = scaled_c / 2.0, scaled_r * 2.0, f / 2.0
-            if f != 1.0 and scaled_c + scaled_r < 0.95 * (c + r):
-                off[:, i] *= f
-                off[i, :] /= f
-                d[i] *= f
-                changed = True
-    return d
-
-
 def _balanced_size(M: FloatArray) -> float:
-    """:func:`_matrix_size` of M balanced (:func:`_balancing`): the size of the matrix whose
+    """:func:`_matrix_size` of M balanced (:func:`balancing`): the size of the matrix whose
     eigenvalues are computed, not of coordinates scaled by 10^±6 (whose size, 1e12 for a
     well-conditioned model, would put every root within √u size of the axis)."""
     if M.shape[0] == 0 or not np.all(np.isfinite(M)):
         return _matrix_size(M)
-    d = _balancing(M, M.shape[0])
+    d = balancing(M, M.shape[0])
     return _matrix_size(M * d[None, :] / d[:, None])
-
-
-def _balanced_states(model: StateSpace) -> StateSpace:
-    """The loop with its states balanced (D⁻¹ A D, D⁻¹ B, C D, D of powers of two from
-    :func:`_balancing` of [[A, B], [C, 0]] over the states; exact): the same transfer
-    matrix, its frequency response computed from a well-scaled A."""
-    n = model.n_states
-    if n == 0 or not (np.all(np.isfinite(model.B)) and np.all(np.isfinite(model.C))):
-        return model
-    p = model.n_inputs
-    pencil = np.block([[model.A, model.B], [model.C, np.zeros((p, p))]])
-    d = _balancing(pencil, n)[:n]
-    with np.errstate(over="ignore", under="ignore"):
-        A = model.A * (d[None, :] / d[:, None])
-        B, C = model.B / d[:, None], model.C * d[None, :]
-    if not _exactly_scaled((model.A, A), (model.B, B), (model.C, C)):
-        return model
-    return StateSpace(
-        A,
-        B,
-        C,
-        model.D,
-        dt=model.dt,
-        state_names=model.state_names,
-        input_names=model.input_names,
-        output_names=model.output_names,
-    )
 
 
 def _closed_matrix(model: StateSpace) -> FloatArray:
@@ -2759,20 +2705,9 @@ def _state_balanced(model: StateSpace) -> StateSpace:
     if model.n_states == 0:
         return model
     A, B, C = _core.balance_siso_states(model.A, model.B, model.C)
-    if not _exactly_scaled((model.A, A), (model.B, B), (model.C, C)):
+    if not exactly_scaled((model.A, A), (model.B, B), (model.C, C)):
         return model
     return StateSpace(A, B, C, model.D, dt=model.dt)
-
-
-def _exactly_scaled(*pairs: tuple[FloatArray, FloatArray]) -> bool:
-    """Whether each matrix scaled by powers of two kept every entry a normal, finite double
-    (the scaling is then exact): an A of 1e-300 beside B of 0.1 and C of 1e-151 is balanced by
-    2^±250, and its off-diagonal 1.3e-301 underflowed to 0."""
-    tiny = np.finfo(float).tiny
-    return all(
-        np.all(np.isfinite(after)) and not np.any((np.abs(after) < tiny) & (before != 0.0))
-        for before, after in pairs
-    )
 
 
 def _poles(model: StateSpace, closed_loop: bool) -> _Poles:
