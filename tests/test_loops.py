@@ -1200,3 +1200,20 @@ def test_root_locus_and_damping_of_the_747_yaw_loop_in_badly_scaled_states() -> 
         assert design.damping_ratio == pytest.approx(best_zeta, abs=1e-12)
         assert design.gain == pytest.approx(best_k, rel=1e-6)
         assert design.damping_ratio == pytest.approx(_numpy_damping(loop, design.gain), abs=1e-12)
+
+
+def test_discrete_margins_in_badly_scaled_states() -> None:
+    """0.5 (s + 3)/(s (s + 2)(s + 5)) held (ZOH, 0.1 s), its states scaled by 10^(6, -6, 6):
+    the grid search's L(e^jωT) came from the core's unbalanced solve, and the gain margin
+    came out 0.007 for 167.76 (phase margin 0.39° off), silently; the states are now balanced
+    first. Oracle: python-control's stability_margins of the unscaled loop."""
+    A0, B0, C0, D0, _ = cont2discrete(tf2ss([0.5, 1.5], np.poly([0.0, -2.0, -5.0])), 0.1)
+    with warnings.catch_warnings():  # python-control: falling back to its 'frd' method
+        warnings.simplefilter("ignore", UserWarning)
+        gm, pm, _, _, _, _ = control.stability_margins(control.ss(A0, B0, C0, D0, 0.1))
+    for exponents in ([6, -6, 6], [3, -6, 6], [-6, 0, 6]):
+        A, B, C = _scaled_states(A0, B0, C0, exponents)
+        m = stability_margins(aerocontrol.StateSpace(A, B, C, D0, dt=0.1))
+        assert m.gain_margin == pytest.approx(gm, rel=1e-8)
+        assert m.phase_margin == pytest.approx(pm, abs=1e-7)
+        assert m.closed_loop_stable

@@ -469,10 +469,13 @@ def _nearest(points: ComplexArray, target: complex) -> int:
 
 
 class _Response:
-    """L(jω) of a SISO model through the core, one frequency or many."""
+    """L(jω) of a SISO model through the core, one frequency or many, from the model with its
+    states balanced (:func:`_state_balanced`: the core's solve has errors relative to the
+    matrix it is given, and states scaled by 10^±6 moved a discrete loop's phase margin by
+    1.2e-3 degrees)."""
 
     def __init__(self, model: StateSpace) -> None:
-        self.model = model
+        self.model = _state_balanced(model)
         self.dt = period(model) if model.is_discrete else None
 
     def many(self, omega: FloatArray) -> ComplexArray:
