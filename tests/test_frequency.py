@@ -93,3 +93,71 @@ def test_the_count_of_the_default_grid_is_checked() -> None:
         with pytest.raises(aerocontrol.InvalidArgumentError, match="count must be a positive"):
             aerocontrol.default_frequency_grid((A_LON, B_LON), count)  # type: ignore[arg-type]
     assert len(aerocontrol.default_frequency_grid((A_LON, B_LON), np.int64(3))) == 3
+
+
+def test_frequency_response_of_badly_scaled_states_is_that_of_the_model() -> None:
+    """A well-conditioned 4-state 2 x 2 model (cond(A) = 8) in states scaled by
+    10^(-4, -3, 4, 6): the core's Hessenberg solve has errors relative to the size of the
+    matrix it is given, and the response was wrong by 1.6e-3 of its size; the states are now
+    balanced first (exact powers of two). Oracle: numpy's solve of the unscaled model, and
+    python-control's frequency_response of it; also 50 random scaled models (2 to 6 states)."""
+    A = np.array(
+        [
+            [-1.5578037015944788, -1.4641393051201623, 0.26913287834979754, 0.5642681004713006],
+            [1.467471704389781, -1.703154654560851, 0.24120445283023215, 0.08867354909967969],
+            [-0.05003194727880665, 1.1474753245159799, -3.2809249028907703, 0.5302385977171965],
+            [-0.08412698087139053, 0.2503985407752395, -0.25238638051859014, -0.48775170060637674],
+        ]
+    )
+    B = np.array(
+        [
+            [-0.6467331644864861, 0.26380847414351544],
+            [0.28688782084437325, 0.6192367647758478],
+            [0.4617531850459596, 0.4360343563754495],
+            [0.9934980811484962, -1.4932654754390196],
+        ]
+    )
+    C = np.array(
+        [
+            [0.021734239849973837, -1.221681561296693, 0.24459577811774602, -1.1706072134118364],
+            [-0.9478177259625263, -0.04824624693552761, 1.4088457450675202, 0.5899841756446085],
+        ]
+    )
+    D = np.array(
+        [[0.09279650732959999, 0.42484393366617484], [-0.27967821908561374, -0.6237068580187078]]
+    )
+    omega = np.array([1e-3, 0.1, 3.0, 40.0])
+    theirs = control.ss(A, B, C, D)(1j * omega)  # (outputs, inputs, frequencies)
+    cases = [(A, B, C, D, [-4, -3, 4, 6])]
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        n = int(rng.integers(2, 7))
+        M = rng.standard_normal((n, n))
+        M -= (np.max(np.linalg.eigvals(M).real) + 0.5) * np.eye(n)
+        cases.append(
+            (
+                M,
+                rng.standard_normal((n, 2)),
+                rng.standard_normal((1, n)),
+                np.zeros((1, 2)),
+                list(rng.integers(-6, 7, n)),
+            )
+        )
+    for M, b, c, d, exponents in cases:
+        scaled = aerocontrol.StateSpace(*_scaled(M, b, c, exponents), d)
+        ours = aerocontrol.frequency_response(scaled, omega).response
+        n = M.shape[0]
+        exact = np.array([c @ np.linalg.solve(1j * w * np.eye(n) - M, b) + d for w in omega])
+        assert np.max(np.abs(ours - exact)) <= 1e-12 * np.max(np.abs(exact))
+    ours = aerocontrol.frequency_response(
+        aerocontrol.StateSpace(*_scaled(A, B, C, [-4, -3, 4, 6]), D), omega
+    ).response
+    np.testing.assert_allclose(ours, np.moveaxis(theirs, -1, 0), rtol=1e-12, atol=0)
+
+
+def _scaled(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, exponents: list[int]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """T A T⁻¹, T B, C T⁻¹ with T = diag(10^e): the same model in badly scaled states."""
+    t = 10.0 ** np.array(exponents, dtype=float)
+    return A * (t[:, None] / t[None, :]), B * t[:, None], C / t[None, :]

@@ -10,6 +10,7 @@ import control
 import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
+from scipy.signal import cont2discrete, tf2ss
 
 import aerocontrol
 from aerocontrol import (
@@ -1063,3 +1064,156 @@ def test_margins_grid_of_a_loop_with_a_huge_feedthrough() -> None:
         margins = stability_margins(model)
     assert margins.closed_loop_poles[0] == pytest.approx(a - (b / (1 + d)) * c, rel=1e-12)
     assert margins.closed_loop_stable
+
+
+def _scaled_states(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, exponents: list[int]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """T A T⁻¹, T B, C T⁻¹ with T = diag(10^e): the same transfer matrix in badly scaled states."""
+    t = 10.0 ** np.array(exponents, dtype=float)
+    return A * t[:, None] / t[None, :], B * t[:, None], C / t[None, :]
+
+
+def test_disk_margins_of_a_multiloop_in_states_scaled_by_a_million() -> None:
+    """The satellite (K = I) behind actuators 5/(s + 5), its states scaled by 10^(6, -6, 6, -6):
+    the destabilising perturbation failed its check ('leaves I + L F nonsingular', smallest
+    singular value 0.1 of its terms): the loop's states are now balanced by powers of two
+    first. Oracle: python-control's disk_margins (slycot's AB13MD) on the unscaled loop, on
+    the same grid; the refined margin lies below the grid's, within 1e-6."""
+    a = 10.0
+    core = np.array([[0.0, a], [-a, 0.0]])
+    A1 = np.block([[core, 5.0 * np.eye(2)], [np.zeros((2, 2)), -5.0 * np.eye(2)]])
+    B1 = np.vstack([np.zeros((2, 2)), np.eye(2)])
+    C1 = np.hstack([np.array([[1.0, a], [-a, 1.0]]), np.zeros((2, 2))])
+    D = np.zeros((2, 2))
+    scaled = aerocontrol.StateSpace(*_scaled_states(A1, B1, C1, [6, -6, 6, -6]), D)
+    grid = np.linspace(0.3, 0.5, 2001)
+    for skew in (0.0, 0.5, -0.5):
+        theirs = float(control.disk_margins(control.ss(A1, B1, C1, D), grid, skew=skew)[0])
+        on_grid = aerocontrol.disk_margins(scaled, omega=grid, skew=skew)
+        assert on_grid.multiloop.alpha == pytest.approx(theirs, rel=1e-12)
+        refined = aerocontrol.disk_margins(scaled, skew=skew)
+        assert theirs * (1 - 1e-6) <= refined.multiloop.alpha <= theirs * (1 + 1e-12)
+        assert refined.closed_loop_stable
+
+
+def test_disk_margins_of_a_discrete_loop_in_badly_scaled_states() -> None:
+    """1.5 (s² - 2s + 2)(s² + 2s + 2)/((s + 1)(s² + 2s + 5)(s + 4)(s + 5)) (zeros ±1 ± j) held
+    (ZOH, 0.1 s), its states scaled by 10^(∓6): refused ('leaves I + L F nonsingular');
+    oracle python-control's disk_margins of the unscaled loop on 20001 points up to π/dt (the
+    refined margin below the grid's by 7e-8 at most)."""
+    num = [1.5, 0.0, 0.0, 0.0, 6.0]
+    den = np.poly([-1.0, -1.0 + 2j, -1.0 - 2j, -4.0, -5.0]).real
+    A0, B0, C0, D0, _ = cont2discrete(tf2ss(num, den), 0.1, method="zoh")
+    grid = np.linspace(0.0, math.pi / 0.1, 20001)
+    for exponents in ([-6, 6, -6, 6, -6], [6, -6, 6, -6, 6], [-6, -3, 0, 3, 6]):
+        A, B, C = _scaled_states(A0, B0, C0, exponents)
+        loop = aerocontrol.StateSpace(A, B, C, D0, dt=0.1)
+        for skew in (0.0, 0.5, -0.5):
+            theirs = float(
+                control.disk_margins(control.ss(A0, B0, C0, D0, 0.1), grid, skew=skew)[0]
+            )
+            ours = aerocontrol.disk_margins(loop, skew=skew).multiloop.alpha
+            assert theirs * (1 - 1e-6) <= ours <= theirs * (1 + 1e-12)
+
+
+def test_skewed_disk_margin_of_an_integrating_loop_peaks_at_zero() -> None:
+    """k (s + 3)/(s (s + 2)(s + 5)), skew -0.5: |S + (σ - 1)/2| peaks at ω = 0, where S = 0 and
+    L has its pole, so α = 1/0.75 (closed form; python-control from 1e-9 rad/s agrees). The
+    check of the destabilising gain (f = 0) formed I + L F with L infinite: numpy's 'SVD did
+    not converge'. It is checked as I - M Δ there."""
+    for k in (0.5, 2.0):
+        loop = aerocontrol.zpk([-3.0], [0.0, -2.0, -5.0], k)
+        grid = np.concatenate([[1e-9], np.logspace(-6, 4, 2001)])
+        theirs = float(
+            control.disk_margins(control.ss(loop.A, loop.B, loop.C, loop.D), grid, skew=-0.5)[0]
+        )
+        m = aerocontrol.disk_margins(loop, skew=-0.5)
+        assert m.multiloop.alpha == pytest.approx(4.0 / 3.0, rel=1e-14)
+        assert theirs == pytest.approx(4.0 / 3.0, rel=1e-8)
+        assert m.multiloop.frequency == 0.0
+        assert abs(m.worst_perturbation[0]) <= 1e-15  # gain 0: the open integrator
+
+
+def test_pole_cancelled_at_the_origin_is_not_a_stable_closed_loop() -> None:
+    """(s² + s)/(s (s + 2)(s + 3)) in controllable form: its mode at 0 is unobservable, so the
+    closed loop keeps it (s (s² + 6s + 7): eigenvalues 0 and -3 ± √2). Computed as -2.7e-18,
+    3.6e-16 or 1.8e-12 by the scaling of the states, its sign decided the answer:
+    stability_margins called the loop stable (disk margin 0), disk_margins refused it
+    ('sensitivity overflows at 0 rad/s') or called it unstable. A pole within the boundary
+    tolerance of the balanced closed loop now makes it not stable, as nyquist calls it
+    marginal, for every scaling."""
+    A = np.array([[-5.0, -6.0, -0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    B, C, D = np.array([[1.0], [0.0], [0.0]]), np.array([[1.0, 1.0, 0.0]]), np.zeros((1, 1))
+    for exponents in ([0, 0, 0], [-6, 0, 6], [6, 0, -6], [4, 0, -4]):
+        loop = aerocontrol.StateSpace(*_scaled_states(A, B, C, exponents), D)
+        m = aerocontrol.disk_margins(loop)
+        assert not m.closed_loop_stable and m.multiloop.alpha == 0.0
+        closed = np.sort(m.closed_loop_poles.real)
+        np.testing.assert_allclose(closed[:2], [-3 - math.sqrt(2), -3 + math.sqrt(2)], rtol=1e-12)
+        assert abs(closed[2]) <= 1e-6
+        margins = stability_margins(loop)
+        assert not margins.closed_loop_stable and margins.disk_margin == 0.0
+        assert aerocontrol.nyquist(loop).marginal
+
+
+def _numpy_damping(loop: aerocontrol.StateSpace, k: float) -> float:
+    """ζ of the least-damped oscillatory pole of A - k B C (D = 0) by numpy's eigvals, -1 if a
+    pole is unstable, 1 if none oscillates: the damping search's independent oracle."""
+    poles = np.linalg.eigvals(loop.A - k * loop.B @ loop.C)
+    if np.any(poles.real > 0):
+        return -1.0
+    oscillatory = poles[poles.imag > 1e-9 * np.abs(poles)]
+    return float(np.min(-oscillatory.real / np.abs(oscillatory))) if oscillatory.size else 1.0
+
+
+def test_root_locus_and_damping_of_the_747_yaw_loop_in_badly_scaled_states() -> None:
+    """The 747 yaw damper loop, its six states scaled by 10^(±6, ∓6, ...): the core's root-locus
+    QR is unbalanced, and the poles came out with errors 1800 times their size (silently);
+    best_damping_gain then chose k = 0 (ζ 0.035) or k = 1.80 with ζ 0.332, above the true
+    maximum. The loop's states are now balanced first. Oracle: numpy's eigvals of the
+    unscaled A - k B C, on 8001 gains over the default six decades, the best refined by
+    scipy's bounded minimize_scalar: k = 1.48732, ζ = 0.291199."""
+    loop = aerocontrol.design.yaw_damper(aerocontrol.aircraft.load("b747-cruise")).loop
+    assert not np.any(loop.D)
+    gains = np.logspace(np.log10(3.9136e-3), np.log10(3.9136e3), 8001)
+    grid = np.array([_numpy_damping(loop, k) for k in gains])
+    i = int(np.argmax(grid))
+    found = minimize_scalar(
+        lambda k: -_numpy_damping(loop, k),
+        bounds=(gains[i - 1], gains[i + 1]),
+        method="bounded",
+        options={"xatol": 1e-10},
+    )
+    best_k, best_zeta = float(found.x), -float(found.fun)
+    assert best_zeta >= grid[i]
+    for exponents in ([6, -6, 6, -6, 6, -6], [-6, 6, -6, 6, -6, 6], [-6, -6, -4, 4, 2, 5]):
+        A, B, C = _scaled_states(loop.A, loop.B, loop.C, exponents)
+        scaled = aerocontrol.StateSpace(A, B, C, loop.D)
+        ks = np.array([0.1, 1.0, best_k, 10.0])
+        locus = root_locus(scaled, ks)
+        for k, poles in zip(ks, locus.poles, strict=True):
+            theirs = np.sort_complex(np.linalg.eigvals(loop.A - k * loop.B @ loop.C))
+            error = np.max(np.abs(np.sort_complex(poles) - theirs))
+            assert error <= 1e-12 * np.max(np.abs(theirs))
+        design = best_damping_gain(scaled)
+        assert design.damping_ratio == pytest.approx(best_zeta, abs=1e-12)
+        assert design.gain == pytest.approx(best_k, rel=1e-6)
+        assert design.damping_ratio == pytest.approx(_numpy_damping(loop, design.gain), abs=1e-12)
+
+
+def test_discrete_margins_in_badly_scaled_states() -> None:
+    """0.5 (s + 3)/(s (s + 2)(s + 5)) held (ZOH, 0.1 s), its states scaled by 10^(6, -6, 6):
+    the grid search's L(e^jωT) came from the core's unbalanced solve, and the gain margin
+    came out 0.007 for 167.76 (phase margin 0.39° off), silently; the states are now balanced
+    first. Oracle: python-control's stability_margins of the unscaled loop."""
+    A0, B0, C0, D0, _ = cont2discrete(tf2ss([0.5, 1.5], np.poly([0.0, -2.0, -5.0])), 0.1)
+    with warnings.catch_warnings():  # python-control: falling back to its 'frd' method
+        warnings.simplefilter("ignore", UserWarning)
+        gm, pm, _, _, _, _ = control.stability_margins(control.ss(A0, B0, C0, D0, 0.1))
+    for exponents in ([6, -6, 6], [3, -6, 6], [-6, 0, 6]):
+        A, B, C = _scaled_states(A0, B0, C0, exponents)
+        m = stability_margins(aerocontrol.StateSpace(A, B, C, D0, dt=0.1))
+        assert m.gain_margin == pytest.approx(gm, rel=1e-8)
+        assert m.phase_margin == pytest.approx(pm, abs=1e-7)
+        assert m.closed_loop_stable

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._balance import balanced_matrices
 from ._validation import FloatArray, real_array
 from .exceptions import InvalidArgumentError, ShapeError
 from .statespace import as_state_space, continuous_eigenvalues, grid_frequencies, period
@@ -94,6 +95,12 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
     """G(jω) = C (jωI - A)^-1 B + D at each frequency of ``omega`` (rad/s); for a discrete
     model, G(e^{jω dt}) = C (e^{jω dt} I - A)^-1 B + D.
 
+    The states are first balanced by an exact diagonal similarity of powers of two
+    (Parlett and Reinsch's iteration on [[A, B], [C, 0]] over the states), so that a model in
+    badly scaled coordinates has the response of the well-scaled one: the core's Hessenberg
+    solve has errors relative to the size of the matrix it is given (relative errors of 1.6e-3
+    for a well-conditioned 4-state model in states scaled by 10^(-4, -3, 4, 6)).
+
     A frequency at an imaginary-axis pole (a pole on the unit circle, for a discrete model)
     gives infinite or NaN entries.
 
@@ -114,10 +121,11 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
         frequencies = frequencies.reshape(1)
     if frequencies.ndim != 1:
         raise ShapeError(f"omega must be a 1-D array of frequencies, got {frequencies.shape}")
+    A, B, C = balanced_matrices(model.A, model.B, model.C)
     response = _core.frequency_response(
-        model.A,
-        model.B,
-        model.C,
+        A,
+        B,
+        C,
         model.D,
         frequencies,
         period(model) if model.is_discrete else None,

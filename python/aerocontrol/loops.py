@@ -100,6 +100,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._balance import balanced_states, balancing, exactly_scaled
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
@@ -221,7 +222,10 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
 
     The poles of every gain come from one parallel call of the core (``_core.root_locus``:
     one controller-Hessenberg form of (A, B, C), then the QR iteration of each gain's
-    Hessenberg matrix, normwise backward stable). Where a term of a matrix (A, or g B C with
+    Hessenberg matrix, normwise backward stable) on the loop with its states balanced
+    (:func:`_state_balanced`): the QR is not balanced itself, so its errors are relative to
+    the matrix it is given, and states scaled by 10^±6 gave poles wrong by 1800 times their
+    size. Where a term of a matrix (A, or g B C with
     g = k/(1 + k D), bounded by |g| max|B| max|C|) exceeds 2^RESCALE_EXPONENT, the matrix is
     formed divided by the power of two 2^e nearest its size, from B and C normalised by
     powers of two (so that neither B C nor g B C overflows), and its eigenvalues multiplied by
@@ -230,6 +234,7 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     n = model.n_states
     if n == 0:
         return np.zeros((k.size, 0), np.complex128)
+    model = _state_balanced(model)
     A, B, C = model.A, model.B, model.C
     g = _closed_loop_gains(model, k)
     mantissa, power = _closed_loop_gain_parts(model, k)
@@ -464,10 +469,13 @@ def _nearest(points: ComplexArray, target: complex) -> int:
 
 
 class _Response:
-    """L(jω) of a SISO model through the core, one frequency or many."""
+    """L(jω) of a SISO model through the core, one frequency or many, from the model with its
+    states balanced (:func:`_state_balanced`: the core's solve has errors relative to the
+    matrix it is given, and states scaled by 10^±6 moved a discrete loop's phase margin by
+    1.2e-3 degrees)."""
 
     def __init__(self, model: StateSpace) -> None:
-        self.model = model
+        self.model = _state_balanced(model)
         self.dt = period(model) if model.is_discrete else None
 
     def many(self, omega: FloatArray) -> ComplexArray:
@@ -828,7 +836,7 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
         # the phase crossovers, so the grid search decides.
         return _grid_margins(model)
-    stable = bool(np.all(closed.real < 0.0))
+    stable = _closed_loop_stable(_closed_matrix(model), closed, False)
     unstable_open = int(np.sum(open_poles.real > 0.0))
     unstable_closed = int(np.sum(closed.real > 0.0))
     negative = phase_values.real < 0.0
@@ -862,7 +870,7 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
     discrete = model.is_discrete
     closed = _closed_loop_poles(model, np.ones(1))[0]
     open_poles = _eigenvalues(model.A)
-    stable = _stable(closed, discrete)
+    stable = _closed_loop_stable(_closed_matrix(model), closed, discrete)
     unstable_open = int(np.sum(_unstable(open_poles, discrete)))
     unstable_closed = int(np.sum(_unstable(closed, discrete)))
 
@@ -1691,11 +1699,18 @@ def _refined_peak(
     return w, value
 
 
-def _certify(model: StateSpace, frequency: float, delta: ComplexArray, skew: float) -> ComplexArray:
+def _certify(
+    model: StateSpace,
+    sensitivity: _Sensitivity,
+    frequency: float,
+    delta: ComplexArray,
+    skew: float,
+) -> ComplexArray:
     """The gains f_i = (1 + (1 - σ)δ_i/2)/(1 - (1 + σ)δ_i/2) of the destabilising Δ, checked:
     with L = L(jω) from the loop itself (not from the sensitivity the bound came from),
     (I + L + (aL - bI)Δ) = (I + L F)(I - bΔ), a = (1 - σ)/2, b = (1 + σ)/2, must be singular
-    to CERTIFICATE_TOLERANCE of the size of its terms, else AerocontrolLinAlgError."""
+    to CERTIFICATE_TOLERANCE of the size of its terms, else AerocontrolLinAlgError. Where L
+    has a pole at ω (not finite), the equivalent I - M Δ (M = S - aI, finite) is checked."""
     a, b = 0.5 * (1.0 - skew), 0.5 * (1.0 + skew)
     p = model.n_inputs
     if math.isfinite(frequency):
@@ -1713,11 +1728,18 @@ def _certify(model: StateSpace, frequency: float, delta: ComplexArray, skew: flo
         L = model.D.astype(np.complex128)
     identity = np.eye(p)
     Delta = np.diag(delta)
-    pencil = identity + L + (a * L - b * identity) @ Delta
+    largest = float(np.max(np.abs(delta), initial=0.0))
+    if np.all(np.isfinite(L)):
+        pencil = identity + L + (a * L - b * identity) @ Delta
+        size = (
+            float(np.linalg.norm(identity + L, 2))
+            + float(np.linalg.norm(a * L - b * identity, 2)) * largest
+        )
+    else:  # a pole of L at ω (an integrator at 0): I - M Δ, from the finite M = S - aI
+        M = sensitivity.at(np.array([frequency]))[0]
+        pencil = identity - M @ Delta
+        size = 1.0 + float(np.linalg.norm(M, 2)) * largest
     smallest = float(np.linalg.svd(pencil, compute_uv=False)[-1])
-    size = float(np.linalg.norm(identity + L, 2)) + float(
-        np.linalg.norm(a * L - b * identity, 2)
-    ) * float(np.max(np.abs(delta), initial=0.0))
     if not smallest <= CERTIFICATE_TOLERANCE * size:
         raise AerocontrolLinAlgError(
             f"disk_margins: the destabilising perturbation found at {frequency:.6g} rad/s "
@@ -1761,10 +1783,14 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
       gap beyond MU_GAP_TOLERANCE warns (LooseBoundWarning). For p = 1 the multiloop
       margin is the loop's disk margin.
 
-    The results are checked: the destabilising perturbation of the lower bound must make
-    I + L(jω) F singular (AerocontrolLinAlgError otherwise), and the lower bound may not
-    exceed the upper. A closed loop that is not stable (from the eigenvalues of
-    A - B (I + D)^-1 C) has every disk margin 0.
+    The loop's states are first balanced by a diagonal similarity of powers of two (exact,
+    the same L; :func:`balanced_states`), so that states scaled by 10^±6 give the margins
+    of the well-scaled loop. The results are checked: the destabilising perturbation of the
+    lower bound must make I + L(jω) F singular (I - M Δ where L has a pole at ω;
+    AerocontrolLinAlgError otherwise), and the lower bound may not exceed the upper. A
+    closed loop that is not stable (from the eigenvalues of A - B (I + D)^-1 C, one within
+    √u of the balanced matrix's size of the boundary, such as a mode at the origin that the
+    loop cancels, counting as not stable) has every disk margin 0.
 
     Parameters
     ----------
@@ -1811,7 +1837,7 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
     >>> np.round(m.multiloop.gain_margin_db, 3), round(m.multiloop.phase_margin, 3)
     (array([-0.867,  0.867]), 5.711)
     """
-    model = _square_loop(loop)
+    model = balanced_states(_square_loop(loop))
     sigma = real_scalar(skew, "skew")
     check_finite(np.array([sigma]), "skew")
     grid = None if omega is None else _frequencies(omega, model)
@@ -1819,7 +1845,7 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
     sensitivity = _Sensitivity(model, sigma)
     A_closed = sensitivity.model.A
     closed = _backward_stable_eigenvalues(A_closed, _eigenvalues(A_closed))
-    stable = _stable(closed, model.is_discrete)
+    stable = _closed_loop_stable(A_closed, closed, model.is_discrete)
     loops = tuple(stability_margins(_broken_loop(model, i)) for i in range(p))
     names = model.input_names
     if not stable:
@@ -1926,7 +1952,7 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
                 stacklevel=2,
             )
     if np.any(delta != 0.0):
-        perturbation = _certify(model, worst_frequency, delta, sigma)
+        perturbation = _certify(model, sensitivity, worst_frequency, delta, sigma)
     else:  # μ = 0: no perturbation of any size destabilises the loop
         perturbation, worst_frequency = np.full(p, complex(math.nan, math.nan)), math.nan
     return DiskMargins(
@@ -2340,6 +2366,40 @@ def _on_boundary(roots: ComplexArray, discrete: bool, tolerance: float) -> BoolA
     return np.asarray(distance <= tolerance, dtype=np.bool_)
 
 
+def _balanced_size(M: FloatArray) -> float:
+    """:func:`_matrix_size` of M balanced (:func:`balancing`): the size of the matrix whose
+    eigenvalues are computed, not of coordinates scaled by 10^±6 (whose size, 1e12 for a
+    well-conditioned model, would put every root within √u size of the axis)."""
+    if M.shape[0] == 0 or not np.all(np.isfinite(M)):
+        return _matrix_size(M)
+    d = balancing(M, M.shape[0])
+    return _matrix_size(M * d[None, :] / d[:, None])
+
+
+def _closed_matrix(model: StateSpace) -> FloatArray:
+    """A - B (1 + D)⁻¹ C of a SISO loop (entries beyond the range of doubles infinite)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.asarray(
+            model.A - np.outer(model.B[:, 0], model.C[0]) / (1.0 + float(model.D[0, 0])),
+            dtype=np.float64,
+        )
+
+
+def _closed_loop_stable(matrix: FloatArray, closed: ComplexArray, discrete: bool) -> bool:
+    """Whether every closed-loop pole lies strictly inside the stability region, none of them
+    on its boundary to :func:`_boundary_tolerance` of the balanced closed-loop ``matrix``
+    (:func:`_balanced_size`): a mode at the origin that the loop does not reach (a pole of L
+    cancelled by a zero there) stays at 0, computed as ±1e-16 or so, and its sign is
+    rounding, so such a loop is not stable rather than stable or unstable by chance."""
+    if not _stable(closed, discrete):
+        return False
+    size = _balanced_size(matrix)
+    if not math.isfinite(size):  # B C beyond the range of doubles: the poles' own size
+        size = float(np.max(_magnitude(closed), initial=0.0))
+    tolerance = _boundary_tolerance(size, discrete)
+    return not bool(np.any(_on_boundary(closed, discrete, tolerance)))
+
+
 def _matrix_size(M: FloatArray) -> float:
     """||M||_F, formed from M divided by its largest |entry| (the squares of entries below
     1e-154 underflow: numpy's norm of a matrix of 1e-300 is 0), or that entry where the norm
@@ -2643,10 +2703,13 @@ class _Poles:
 
 def _state_balanced(model: StateSpace) -> StateSpace:
     """The SISO loop with its states balanced by a diagonal similarity of powers of two (the
-    core's ``balance_siso_states``: T A T⁻¹, T B, C T⁻¹, exact), the same transfer function."""
+    core's ``balance_siso_states``: T A T⁻¹, T B, C T⁻¹, exact), the same transfer function;
+    the loop as given where the scaling would push an entry out of the normal doubles."""
     if model.n_states == 0:
         return model
     A, B, C = _core.balance_siso_states(model.A, model.B, model.C)
+    if not exactly_scaled((model.A, A), (model.B, B), (model.C, C)):
+        return model
     return StateSpace(A, B, C, model.D, dt=model.dt)
 
 

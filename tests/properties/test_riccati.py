@@ -48,6 +48,7 @@ from aerocontrol.exceptions import AerocontrolError, IllConditionedWarning
 from aerocontrol.riccati import RCOND_WARNING, RESIDUAL_WARNING
 
 from .harness import SAME, Arg, Outcome, Warned, _known_defect, exercise, plain
+from .known_defects import DARE_BADLY_SCALED_STATES
 from .oracles import (
     SLACK,
     TINY,
@@ -908,6 +909,31 @@ def test_riccati_difference(data: st.DataObject) -> None:
 
 
 # ----- known defects of the core (see known_defects.py) ------------------------------------------
+
+
+@pytest.mark.xfail(strict=True, reason="dare-badly-scaled-states: refused in states scaled by 1e6")
+def test_known_defect_dare_badly_scaled_states() -> None:
+    """A defect of the native core found by an oracle hunt (see ``known_defects.py``): the
+    regulator of a well-conditioned 3-state model in states T = diag(1e-5, 1e6, 1e-4), which
+    is that of the unscaled model (X = T^-T X0 T^-1, K = K0 T^-1, the same closed loop)."""
+    A = np.array(
+        [
+            [0.9153299667155719, -4.225366333414862e-12, 0.08260637158803313],
+            [110381521018.32742, 0.2226317431058629, -4042243188.6160803],
+            [9.829712051107036, 7.585139064630774e-11, 0.6870135440031627],
+        ]
+    )
+    B = np.array([[-1.68095734956127e-05], [437652.243575086], [0.00020643404268335362]])
+    Q, R = np.diag([1e10, 1e-12, 1e8]), np.eye(1)
+    t = np.array([1e-5, 1e6, 1e-4])
+    _, _, unscaled = aerocontrol.dlqr(A * (t[None, :] / t[:, None]), B / t[:, None], np.eye(3), R)
+    X = sl.solve_discrete_are(A, B, Q, R)
+    K = np.linalg.solve(B.T @ X @ B + R, B.T @ X @ A)
+    theirs = np.sort(np.abs(np.linalg.eigvals(A - B @ K)))
+    np.testing.assert_allclose(np.sort(np.abs(unscaled)), theirs, rtol=1e-8)
+    with DARE_BADLY_SCALED_STATES.reproducing():
+        _, _, poles = aerocontrol.dlqr(A, B, Q, R)
+    np.testing.assert_allclose(np.sort(np.abs(poles)), theirs, rtol=1e-6)
 
 
 def test_regression_care_empty_indefinite_rcond() -> None:
