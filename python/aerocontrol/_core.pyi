@@ -17,7 +17,7 @@ __all__ = [
     "PRODUCT_WORKSPACE_BYTES",
     "SMALL_MAX_ORDER",
     "Placement",
-    "balance_siso_states",
+    "balance_states",
     "bilinear",
     "care_batch",
     "charpoly",
@@ -121,7 +121,7 @@ def simulate_models(
 def steady_state(
     a: ArrayLike, b: ArrayLike, eta0: ArrayLike, warn: bool, /
 ) -> NDArray[np.float64]: ...
-def balance_siso_states(
+def balance_states(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
 def loop_margins(

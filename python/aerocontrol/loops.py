@@ -100,7 +100,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._balance import balanced_states, balancing, exactly_scaled
+from ._balance import balanced_matrices, balanced_matrix, balanced_states
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
@@ -223,7 +223,7 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     The poles of every gain come from one parallel call of the core (``_core.root_locus``:
     one controller-Hessenberg form of (A, B, C), then the QR iteration of each gain's
     Hessenberg matrix, normwise backward stable) on the loop with its states balanced
-    (:func:`_state_balanced`): the QR is not balanced itself, so its errors are relative to
+    (:func:`balanced_states`): the QR is not balanced itself, so its errors are relative to
     the matrix it is given, and states scaled by 10^±6 gave poles wrong by 1800 times their
     size. Where a term of a matrix (A, or g B C with
     g = k/(1 + k D), bounded by |g| max|B| max|C|) exceeds 2^RESCALE_EXPONENT, the matrix is
@@ -234,8 +234,7 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     n = model.n_states
     if n == 0:
         return np.zeros((k.size, 0), np.complex128)
-    model = _state_balanced(model)
-    A, B, C = model.A, model.B, model.C
+    A, B, C = balanced_matrices(model.A, model.B, model.C)
     g = _closed_loop_gains(model, k)
     mantissa, power = _closed_loop_gain_parts(model, k)
     size_A, size_B, size_C = _log2_size(A), _log2_size(B), _log2_size(C)
@@ -470,12 +469,12 @@ def _nearest(points: ComplexArray, target: complex) -> int:
 
 class _Response:
     """L(jω) of a SISO model through the core, one frequency or many, from the model with its
-    states balanced (:func:`_state_balanced`: the core's solve has errors relative to the
+    states balanced (:func:`balanced_states`: the core's solve has errors relative to the
     matrix it is given, and states scaled by 10^±6 moved a discrete loop's phase margin by
     1.2e-3 degrees)."""
 
     def __init__(self, model: StateSpace) -> None:
-        self.model = _state_balanced(model)
+        self.model = balanced_states(model)
         self.dt = period(model) if model.is_discrete else None
 
     def many(self, omega: FloatArray) -> ComplexArray:
@@ -2367,13 +2366,12 @@ def _on_boundary(roots: ComplexArray, discrete: bool, tolerance: float) -> BoolA
 
 
 def _balanced_size(M: FloatArray) -> float:
-    """:func:`_matrix_size` of M balanced (:func:`balancing`): the size of the matrix whose
-    eigenvalues are computed, not of coordinates scaled by 10^±6 (whose size, 1e12 for a
+    """:func:`_matrix_size` of M balanced (:func:`balanced_matrix`): the size of the matrix
+    whose eigenvalues are computed, not of coordinates scaled by 10^±6 (whose size, 1e12 for a
     well-conditioned model, would put every root within √u size of the axis)."""
     if M.shape[0] == 0 or not np.all(np.isfinite(M)):
         return _matrix_size(M)
-    d = balancing(M, M.shape[0])
-    return _matrix_size(M * d[None, :] / d[:, None])
+    return _matrix_size(balanced_matrix(M))
 
 
 def _closed_matrix(model: StateSpace) -> FloatArray:
@@ -2701,22 +2699,10 @@ class _Poles:
     """The open loop's boundary tolerance (:func:`_boundary_tolerance`)."""
 
 
-def _state_balanced(model: StateSpace) -> StateSpace:
-    """The SISO loop with its states balanced by a diagonal similarity of powers of two (the
-    core's ``balance_siso_states``: T A T⁻¹, T B, C T⁻¹, exact), the same transfer function;
-    the loop as given where the scaling would push an entry out of the normal doubles."""
-    if model.n_states == 0:
-        return model
-    A, B, C = _core.balance_siso_states(model.A, model.B, model.C)
-    if not exactly_scaled((model.A, A), (model.B, B), (model.C, C)):
-        return model
-    return StateSpace(A, B, C, model.D, dt=model.dt)
-
-
 def _poles(model: StateSpace, closed_loop: bool) -> _Poles:
     """The open- and closed-loop poles and which lie on the stability boundary. The open-loop
     poles and their tolerance come from A (whose eigenvalues the core balances itself); the
-    closed-loop ones from the loop with its states balanced (:func:`_state_balanced`), and
+    closed-loop ones from the loop with its states balanced (:func:`balanced_states`), and
     their tolerance from the size of that closed loop: the core's root-locus QR is unbalanced,
     so its errors are relative to the matrix it is given, and a tolerance from the unbalanced
     size (2e11 for states scaled by 10^±6) counted a closed-loop pole at +0.37 as on the
@@ -2725,7 +2711,7 @@ def _poles(model: StateSpace, closed_loop: bool) -> _Poles:
     open_poles = _eigenvalues(model.A)
     tolerance = _boundary_tolerance(_matrix_size(model.A), discrete)
     if closed_loop:
-        model = _state_balanced(model)
+        model = balanced_states(model)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NumericalOverflowWarning)
             closed = _closed_loop_poles(model, np.ones(1))[0]

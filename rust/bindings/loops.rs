@@ -7,7 +7,7 @@ use super::statespace::ModelArgs;
 use crate::control::margins::{Crossover, loop_margins as loop_margins_core};
 use crate::control::root_locus::root_locus as root_locus_core;
 use crate::error::Error;
-use crate::linalg::balance::balance_siso_states as balance_siso_states_core;
+use crate::linalg::balance::balanced_states;
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -123,13 +123,14 @@ fn root_locus<'py>(
     Ok(out)
 }
 
-/// The SISO loop (A, b, c) with its states balanced by a diagonal similarity of powers of two,
-/// (T A T^-1, T b, c T^-1) (`linalg/balance.rs`, balance_siso_states): the same transfer
-/// function, rows and columns of [[A, b], [c, 0]] of one size.
+/// The system (A, B, C) with its states balanced by a diagonal similarity of powers of two,
+/// (T A T^-1, T B, C T^-1) (`linalg/balance.rs`, balanced_states): the same transfer matrix,
+/// the rows and columns of [[A, B], [C, 0]] of one size; (A, B, C) as given where the scaling
+/// would not be exact.
 #[pyfunction]
 #[pyo3(signature = (a, b, c, /))]
 #[allow(clippy::type_complexity)]
-fn balance_siso_states<'py>(
+fn balance_states<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     b: &Bound<'py, PyAny>,
@@ -148,14 +149,13 @@ fn balance_siso_states<'py>(
         c.matrix().map_err(|e| to_py_err(py, e))?,
     );
     let n = a.nrows();
-    if a.ncols() != n || b.nrows() != n || b.ncols() != 1 || c.nrows() != 1 || c.ncols() != n {
+    if a.ncols() != n || b.nrows() != n || c.ncols() != n {
         return Err(to_py_err(
             py,
             Error::InvalidArgument {
-                arg: "loop",
+                arg: "A",
                 message: format!(
-                    "loop must have one input and one output, A {n} x {n}, B {n} x 1 and C 1 x \
-                     {n}, got A {} x {}, B {} x {} and C {} x {}",
+                    "A must be n x n, B n x m and C p x n, got A {} x {}, B {} x {} and C {} x {}",
                     a.nrows(),
                     a.ncols(),
                     b.nrows(),
@@ -166,20 +166,20 @@ fn balance_siso_states<'py>(
             },
         ));
     }
-    let mut am = a.to_owned();
-    let mut bv: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
-    let mut cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
-    balance_siso_states_core(&mut am, &mut bv, &mut cv);
+    let (am, bm, cm) =
+        balanced_states(a, b, c).unwrap_or_else(|| (a.to_owned(), b.to_owned(), c.to_owned()));
     let mut outputs = Outputs::new(py);
-    let a_out = outputs.matrix("A", am.as_ref())?;
-    let b_out = outputs.real("B", &[n, 1], &bv)?;
-    let c_out = outputs.real("C", &[1, n], &cv)?;
+    let result = (
+        outputs.matrix("A", am.as_ref())?,
+        outputs.matrix("B", bm.as_ref())?,
+        outputs.matrix("C", cm.as_ref())?,
+    );
     outputs.finish()?;
-    Ok((a_out, b_out, c_out))
+    Ok(result)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(balance_siso_states, m)?)?;
+    m.add_function(wrap_pyfunction!(balance_states, m)?)?;
     m.add_function(wrap_pyfunction!(loop_margins, m)?)?;
     m.add_function(wrap_pyfunction!(root_locus, m)?)?;
     Ok(())

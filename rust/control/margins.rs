@@ -53,8 +53,8 @@
 //! 1/max |S|.
 //!
 //! **Scaling.** The loop's states are balanced first by a diagonal similarity of powers of two
-//! (Osborne's iteration on [[A, b], [c, 0]] over the states; the transfer function is
-//! unchanged), so that the eigenvalue problems below are solved to a backward error relative
+//! (`linalg/balance.rs`'s balanced_states: Osborne's iteration on [[A, b], [c, 0]] over the
+//! states; the transfer function is unchanged), so that the eigenvalue problems below are solved to a backward error relative
 //! to a system whose rows and columns are of one size.
 //!
 //! **Verification.** Every phase crossover with L(jω) < 0 gives a gain margin k = 1/|L(jω)|;
@@ -75,7 +75,7 @@
 use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::control::root_locus;
 use crate::error::Error;
-use crate::linalg::balance::{balance_siso_states, nearest_power_of_two};
+use crate::linalg::balance::{balanced_states, nearest_power_of_two};
 use crate::linalg::schur::eigenvalues;
 use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
@@ -641,14 +641,11 @@ pub fn loop_margins(
     // The states balanced first (T A T^-1, T b, c T^-1: the same loop): the pencils' zeros and
     // the Hamiltonians' eigenvalues are computed to a backward error relative to the system's
     // size, and states scaled by 10^±6 put the phase crossovers' zeros off the axis.
-    let mut a = a.to_owned();
-    let mut bv: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
-    let mut cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
-    balance_siso_states(&mut a, &mut bv, &mut cv);
-    let a = a.as_ref();
-    let bm = Mat::from_fn(n, 1, |i, _| bv[i]);
-    let cm = Mat::from_fn(1, n, |_, j| cv[j]);
-    let (b, c) = (bm.as_ref(), cm.as_ref());
+    let (am, bm, cm) =
+        balanced_states(a, b, c).unwrap_or_else(|| (a.to_owned(), b.to_owned(), c.to_owned()));
+    let (a, b, c) = (am.as_ref(), bm.as_ref(), cm.as_ref());
+    let bv: Vec<f64> = (0..n).map(|i| b[(i, 0)]).collect();
+    let cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
     let open_loop_poles = eigenvalues(a)?;
     let closed = Mat::from_fn(n, n, |i, j| a[(i, j)] - bv[i] * cv[j] / denominator);
     let closed_loop_poles = root_locus::closed_loop_poles(a, &bv, &cv, 1.0 / denominator)?;

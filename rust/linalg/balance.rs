@@ -5,7 +5,7 @@
 use crate::linalg::matrix::{Order, Square};
 use crate::linalg::norm::{max_abs, vector_norm};
 use crate::platform::dispatch::clear_upper_avx_state;
-use faer::MatRef;
+use faer::{Mat, MatRef};
 
 /// Entries of the largest magnitude outside [`SMALL_ENTRY`], 1 / [`SMALL_ENTRY`] are brought
 /// to 1 first (as LAPACK's dgees scales): the deflation tests compare entries with the
@@ -49,19 +49,37 @@ pub(crate) fn times_power_of_two(x: f64, exponent: f64) -> f64 {
     x * half.exp2() * (exponent - half).exp2()
 }
 
-/// Balances the states of a single-input, single-output system (A, b, c) in place by a diagonal
-/// similarity of powers of two, (T A T^-1, T b, c T^-1), which changes no transfer function:
-/// Osborne's iteration on the system matrix [[A, b], [c, 0]] over the state indices (the row i
-/// of [A b] and the column i of [A; c], without the diagonal, brought within a factor of 2 of
+/// The states of the system (A, B, C) (A n x n, B n x m, C p x n) balanced by a diagonal
+/// similarity of powers of two, (T A T^-1, T B, C T^-1), which changes no transfer matrix:
+/// Osborne's iteration on the system matrix [[A, B], [C, 0]] over the state indices (the row i
+/// of [A B] and the column i of [A; C], without the diagonal, brought within a factor of 2 of
 /// each other), while a scaling reduces the sum of the two norms by 5 % or more. The norms are
-/// formed without overflow ([`vector_norm`]); a row or column that is zero is left alone.
-pub(crate) fn balance_siso_states(a: &mut faer::Mat<f64>, b: &mut [f64], c: &mut [f64]) {
+/// formed without overflow ([`vector_norm`]); a state whose row or column is zero is left
+/// alone. None when the scaling is not exact: a nonzero entry would leave the normal doubles
+/// (an A of 1e-300 beside B of 0.1 and C of 1e-151 is balanced by 2^±250, and an entry of
+/// 1.3e-301 would underflow).
+pub(crate) fn balanced_states(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+) -> Option<(Mat<f64>, Mat<f64>, Mat<f64>)> {
     let n = a.nrows();
+    let (mut a2, mut b2, mut c2) = (a.to_owned(), b.to_owned(), c.to_owned());
     for _ in 0..100 {
         let mut changed = false;
         for i in 0..n {
-            let row = vector_norm((0..n).filter(|&k| k != i).map(|k| a[(i, k)]).chain([b[i]]));
-            let col = vector_norm((0..n).filter(|&k| k != i).map(|k| a[(k, i)]).chain([c[i]]));
+            let row = vector_norm(
+                (0..n)
+                    .filter(|&k| k != i)
+                    .map(|k| a2[(i, k)])
+                    .chain((0..b2.ncols()).map(|k| b2[(i, k)])),
+            );
+            let col = vector_norm(
+                (0..n)
+                    .filter(|&k| k != i)
+                    .map(|k| a2[(k, i)])
+                    .chain((0..c2.nrows()).map(|k| c2[(k, i)])),
+            );
             if row == 0.0 || col == 0.0 || !(row + col).is_finite() {
                 continue;
             }
@@ -79,16 +97,29 @@ pub(crate) fn balance_siso_states(a: &mut faer::Mat<f64>, b: &mut [f64], c: &mut
             changed = true;
             let f_inverse = 1.0 / f;
             for j in (0..n).filter(|&j| j != i) {
-                a[(i, j)] *= f;
-                a[(j, i)] *= f_inverse;
+                a2[(i, j)] *= f;
+                a2[(j, i)] *= f_inverse;
             }
-            b[i] *= f;
-            c[i] *= f_inverse;
+            for j in 0..b2.ncols() {
+                b2[(i, j)] *= f;
+            }
+            for j in 0..c2.nrows() {
+                c2[(j, i)] *= f_inverse;
+            }
         }
         if !changed {
             break;
         }
     }
+    let exact = |before: MatRef<'_, f64>, after: &Mat<f64>| {
+        (0..before.ncols()).all(|j| {
+            (0..before.nrows()).all(|i| {
+                let (x, y) = (before[(i, j)], after[(i, j)]);
+                x == 0.0 || (y.is_finite() && y.abs() >= f64::MIN_POSITIVE) || !x.is_finite()
+            })
+        })
+    };
+    (exact(a, &a2) && exact(b, &b2) && exact(c, &c2)).then_some((a2, b2, c2))
 }
 
 /// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
@@ -140,4 +171,45 @@ pub(crate) fn balance<O: Order>(a: &mut Square<O>) -> Vec<f64> {
         }
     }
     scale
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn balanced_states_is_an_exact_similarity() {
+        // States scaled by 10^±6: the balanced system's rows and columns are of one size, and
+        // T is a power of two, so C (sI - A)^-1 B at s = 0 (C A^-1 B here) is unchanged.
+        let s = [1e6, 1e-6, 1.0];
+        let base = [[-1.0, 2.0, 0.5], [-3.0, -2.0, 1.0], [0.25, -1.0, -4.0]];
+        let a = Mat::from_fn(3, 3, |i, j| base[i][j] * s[i] / s[j]);
+        let b = Mat::from_fn(3, 1, |i, _| [1.0, 0.5, -1.0][i] * s[i]);
+        let c = Mat::from_fn(1, 3, |_, j| [1.0, -2.0, 0.5][j] / s[j]);
+        let (a2, b2, c2) = balanced_states(a.as_ref(), b.as_ref(), c.as_ref()).unwrap();
+        let largest = max_abs(a2.as_ref())
+            .max(max_abs(b2.as_ref()))
+            .max(max_abs(c2.as_ref()));
+        assert!(largest < 64.0, "{largest}");
+        for i in 0..3 {
+            // T_ii = b2_i / b_i, a power of two; T A T^-1 exactly.
+            let t = b2[(i, 0)] / b[(i, 0)];
+            assert_eq!(t, 2f64.powi(t.log2().round() as i32));
+            for j in 0..3 {
+                let tj = b2[(j, 0)] / b[(j, 0)];
+                assert_eq!(a2[(i, j)], a[(i, j)] * t / tj);
+            }
+            assert_eq!(c2[(0, i)], c[(0, i)] / t);
+        }
+    }
+
+    #[test]
+    fn balanced_states_refuses_an_inexact_scaling() {
+        // A of 1e-300 beside B of 0.1 and C of 1e-151: the balancing scales by 2^±250 and an
+        // entry of 1.3e-301 would leave the normal doubles.
+        let a = Mat::from_fn(2, 2, |i, j| if i == j { -1e-300 } else { 1.3e-301 });
+        let b = Mat::from_fn(2, 1, |_, _| 0.1);
+        let c = Mat::from_fn(1, 2, |_, _| 1e-151);
+        assert!(balanced_states(a.as_ref(), b.as_ref(), c.as_ref()).is_none());
+    }
 }
