@@ -136,6 +136,7 @@ def loop_margins(
     NDArray[np.complex128],
     NDArray[np.complex128],
     bool,
+    float,
 ]: ...
 def root_locus(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, gains: ArrayLike, /

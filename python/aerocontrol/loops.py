@@ -830,12 +830,13 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         closed,
         open_poles,
         degenerate,
+        closed_size,
     ) = _core.loop_margins(model.A, model.B, model.C, model.D)
     if degenerate:
         # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
         # the phase crossovers, so the grid search decides.
         return _grid_margins(model)
-    stable = _closed_loop_stable(_closed_matrix(model), closed, False)
+    stable = _closed_loop_stable(closed, False, closed_size)
     unstable_open = int(np.sum(open_poles.real > 0.0))
     unstable_closed = int(np.sum(closed.real > 0.0))
     negative = phase_values.real < 0.0
@@ -869,7 +870,7 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
     discrete = model.is_discrete
     closed = _closed_loop_poles(model, np.ones(1))[0]
     open_poles = _eigenvalues(model.A)
-    stable = _closed_loop_stable(_closed_matrix(model), closed, discrete)
+    stable = _closed_loop_stable(closed, discrete, _balanced_size(_closed_matrix(model)))
     unstable_open = int(np.sum(_unstable(open_poles, discrete)))
     unstable_closed = int(np.sum(_unstable(closed, discrete)))
 
@@ -1844,7 +1845,7 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
     sensitivity = _Sensitivity(model, sigma)
     A_closed = sensitivity.model.A
     closed = _backward_stable_eigenvalues(A_closed, _eigenvalues(A_closed))
-    stable = _closed_loop_stable(A_closed, closed, model.is_discrete)
+    stable = _closed_loop_stable(closed, model.is_discrete, _balanced_size(A_closed))
     loops = tuple(stability_margins(_broken_loop(model, i)) for i in range(p))
     names = model.input_names
     if not stable:
@@ -2383,15 +2384,15 @@ def _closed_matrix(model: StateSpace) -> FloatArray:
         )
 
 
-def _closed_loop_stable(matrix: FloatArray, closed: ComplexArray, discrete: bool) -> bool:
+def _closed_loop_stable(closed: ComplexArray, discrete: bool, size: float) -> bool:
     """Whether every closed-loop pole lies strictly inside the stability region, none of them
-    on its boundary to :func:`_boundary_tolerance` of the balanced closed-loop ``matrix``
-    (:func:`_balanced_size`): a mode at the origin that the loop does not reach (a pole of L
-    cancelled by a zero there) stays at 0, computed as ±1e-16 or so, and its sign is
-    rounding, so such a loop is not stable rather than stable or unstable by chance."""
+    on its boundary to :func:`_boundary_tolerance` of ``size``, the balanced closed-loop
+    matrix's (:func:`_balanced_size`, or the core's): a mode at the origin that the loop does
+    not reach (a pole of L cancelled by a zero there) stays at 0, computed as ±1e-16 or so,
+    and its sign is rounding, so such a loop is not stable rather than stable or unstable by
+    chance."""
     if not _stable(closed, discrete):
         return False
-    size = _balanced_size(matrix)
     if not math.isfinite(size):  # B C beyond the range of doubles: the poles' own size
         size = float(np.max(_magnitude(closed), initial=0.0))
     tolerance = _boundary_tolerance(size, discrete)

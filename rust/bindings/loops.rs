@@ -22,12 +22,14 @@ type MarginsOutput<'py> = (
     Bound<'py, PyArrayDyn<c64>>,
     Bound<'py, PyArrayDyn<c64>>,
     bool,
+    f64,
 );
 
 /// The crossovers of the continuous SISO loop L(s) = C (sI - A)^-1 B + D by eigenvalue
 /// methods (`control/margins.rs`): (gain-crossover ω, L there, phase-crossover ω, L there,
 /// (ω, max |1 - L|/(2|1 + L|)), (ω, max 1/|1 + L|), closed-loop poles, open-loop poles,
-/// degenerate), every gain margin verified by a closed-loop pole.
+/// degenerate, the balanced closed loop's Frobenius norm), every gain margin verified by a
+/// closed-loop pole.
 #[pyfunction]
 #[pyo3(signature = (a, b, c, d, /))]
 fn loop_margins<'py>(
@@ -74,6 +76,7 @@ fn loop_margins<'py>(
             &margins.open_loop_poles,
         )?,
         margins.degenerate,
+        margins.closed_loop_size,
     );
     outputs.finish()?;
     Ok(result)

@@ -76,6 +76,7 @@ use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::control::root_locus;
 use crate::error::Error;
 use crate::linalg::balance::{balanced_states, nearest_power_of_two};
+use crate::linalg::norm::frobenius_norm;
 use crate::linalg::schur::eigenvalues;
 use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
@@ -113,6 +114,9 @@ pub struct LoopMargins {
     /// L(s) - L(-s) vanishes identically (or its pencil is singular): the phase crossovers
     /// could not be located by the pencil.
     pub degenerate: bool,
+    /// ||A - B (1 + d)^-1 C||_F of the closed loop balanced alone ([`balanced_states`]): the
+    /// size the closed-loop poles' errors are relative to (the boundary tolerance).
+    pub closed_loop_size: f64,
 }
 
 /// Relative distance from the imaginary axis within which an eigenvalue is a candidate.
@@ -721,6 +725,9 @@ pub fn loop_margins(
             });
         }
     }
+    let empty = Mat::<f64>::zeros(n, 0);
+    let closed_balanced = balanced_states(closed.as_ref(), empty.as_ref(), empty.transpose())
+        .map_or(closed, |(m, _, _)| m);
     Ok(LoopMargins {
         gain_crossovers,
         phase_crossovers,
@@ -729,6 +736,7 @@ pub fn loop_margins(
         closed_loop_poles,
         open_loop_poles,
         degenerate,
+        closed_loop_size: frobenius_norm(closed_balanced.as_ref()),
     })
 }
 
