@@ -1157,7 +1157,8 @@ def transfer_function(
     )
     if fast is not None:
         denominator = _checked_denominator(poles, denominator, 3)
-        return _fast_channel(model, i, j, dt, poles, denominator, fast)
+        names = (model.output_names[i], model.input_names[j])
+        return _fast_channel(names, dt, poles, denominator, fast)
     return _reference_channel(model, i, j, dt, stacklevel=3)
 
 
@@ -1173,17 +1174,15 @@ def _checked_denominator(
 
 
 def _fast_channel(
-    model: StateSpace,
-    i: int,
-    j: int,
+    names: tuple[str, str],
     dt: float,
     poles: ComplexArray,
     denominator: FloatArray,
     fast: tuple[ComplexArray, float, FloatArray],
 ) -> TransferFunction:
-    """The TransferFunction of the core's fast path (``rust/control/transfer.rs``), which
-    computes what :func:`_reference_channel` computes and leaves it every channel where the
-    two could differ."""
+    """The TransferFunction (output and input ``names``) of the core's fast path
+    (``rust/control/transfer.rs``), which computes what :func:`_reference_channel` computes and
+    leaves it every channel where the two could differ."""
     zeros, gain, numerator = fast
     return TransferFunction(
         numerator=numerator,
@@ -1192,8 +1191,8 @@ def _fast_channel(
         poles=poles,
         gain=gain,
         dt=dt,
-        output_name=model.output_names[i],
-        input_name=model.input_names[j],
+        output_name=names[0],
+        input_name=names[1],
     )
 
 
@@ -1311,16 +1310,8 @@ class TransferMatrix:
         channel = self._channels[index]
         if isinstance(channel, TransferFunction):
             return channel
-        made = TransferFunction(
-            numerator=channel[2],
-            denominator=self.denominator,
-            zeros=channel[0],
-            poles=self.poles,
-            gain=channel[1],
-            dt=self.dt,
-            output_name=self.output_names[i],
-            input_name=self.input_names[j],
-        )
+        names = (self.output_names[i], self.input_names[j])
+        made = _fast_channel(names, self.dt, self.poles, self.denominator, channel)
         self._channels[index] = made
         return made
 
