@@ -716,6 +716,35 @@ def test_root_locus_closed_form_and_numpy() -> None:
         )
 
 
+def test_root_locus_dense_gains_against_numpy() -> None:
+    """1000 gains: most are taken by the core's continuation (Aberth's iteration from the
+    previous gain), the rest by the QR iteration; every gain's poles as numpy's eigenvalues of
+    the closed loop, through the breakaway points of the 747 yaw damper's locus and of
+    k (s + 1)/(s (s + 2)(s + 4)) with negative gains too."""
+    cases = [
+        (_yaw_loop(3.0), np.linspace(0.0, 5.0, 1000)),
+        (aerocontrol.zpk([-1.0], [0.0, -2.0, -4.0], 1.0), np.linspace(-10.0, 40.0, 1000)),
+        (
+            aerocontrol.zpk([-3.0, -0.5 + 2j, -0.5 - 2j], [-1.0, -1.0, -5.0, 1.0], 2.0),
+            np.logspace(-3.0, 3.0, 1000),
+        ),
+    ]
+    for loop, gains in cases:
+        locus = root_locus(loop, gains)
+        for value, poles in zip(gains, locus.poles, strict=True):
+            A = loop.A - value * loop.B @ loop.C / (1 + value * loop.D[0, 0])
+            expected = np.sort_complex(np.linalg.eigvals(A))
+            # Near a breakaway point (a double pole) either method is accurate to about
+            # sqrt(u) of the closed loop's size.
+            tolerance = 2e-7 * max(1.0, float(np.abs(expected).max()))
+            np.testing.assert_allclose(poles, expected, rtol=0, atol=tolerance)
+        # Real poles exactly real, complex ones in exact conjugate pairs.
+        for poles in locus.poles:
+            upper = np.sort_complex(poles[poles.imag > 0])
+            lower = np.sort_complex(np.conj(poles[poles.imag < 0]))
+            np.testing.assert_array_equal(upper, lower)
+
+
 def test_gain_for_damping_closed_forms() -> None:
     design = gain_for_damping(aerocontrol.zpk([], [0.0, -2.0], 1.0), 0.5)
     assert design.gain == pytest.approx(4.0, rel=1e-10)  # ζ = 1/√k

@@ -221,8 +221,12 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     free of algebraic loops (:func:`_refuse_algebraic`).
 
     The poles of every gain come from one parallel call of the core (``_core.root_locus``:
-    one controller-Hessenberg form of (A, B, C), then the QR iteration of each gain's
-    Hessenberg matrix, normwise backward stable) on the loop with its states balanced
+    one controller-Hessenberg form of (A, B, C) and the QR iteration of a gain's Hessenberg
+    matrix, normwise backward stable, at the first gain of each run of gains; from there
+    Aberth's iteration on the factored characteristic polynomial from gain to gain, each
+    gain's poles verified against the traces of the closed loop and its square, and the QR
+    iteration wherever that fails; see ``rust/control/root_locus.rs``) on the loop with its
+    states balanced
     (:func:`balanced_states`): the QR is not balanced itself, so its errors are relative to
     the matrix it is given, and states scaled by 10^±6 gave poles wrong by 1800 times their
     size. Where a term of a matrix (A, or g B C with
@@ -236,8 +240,14 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
         return np.zeros((k.size, 0), np.complex128)
     A, B, C = balanced_matrices(model.A, model.B, model.C)
     g = _closed_loop_gains(model, k)
-    mantissa, power = _closed_loop_gain_parts(model, k)
     size_A, size_B, size_C = _log2_size(A), _log2_size(B), _log2_size(C)
+    largest = float(np.max(np.abs(g)))
+    if math.isfinite(largest) and math.isfinite(size_B + size_C):
+        # Every term in range (the test below, for every gain at once): one call of the core.
+        size = math.log2(largest) if largest > 0.0 else -math.inf
+        if max(size_A, size + size_B + size_C, size_B + size_C) <= RESCALE_EXPONENT:
+            return _core.root_locus(A, B, C, g)  # each row sorted by the core
+    mantissa, power = _closed_loop_gain_parts(model, k)
     if not math.isfinite(size_B + size_C):  # B C = 0: the loop does not move the poles
         g = np.zeros_like(g)
         mantissa = np.zeros_like(mantissa)
@@ -246,10 +256,10 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
         terms = np.maximum(size_A, np.log2(np.abs(mantissa)) + power + size_B + size_C)
     plain = (terms <= RESCALE_EXPONENT) & (size_B + size_C <= RESCALE_EXPONENT) & np.isfinite(g)
     exponents = np.where(plain | ~np.isfinite(terms), 0, np.round(terms)).astype(np.int64)
+    if np.all(plain):
+        return _core.root_locus(A, B, C, g)  # each row sorted by the core
     poles = np.empty((k.size, n), np.complex128)
     if np.any(plain):
-        # One controller-Hessenberg form, then the unbalanced QR iteration per gain in one
-        # parallel call: normwise backward stable for every gain by construction.
         poles[plain] = _core.root_locus(A, B, C, g[plain])
     rescaled = np.flatnonzero(~plain)
     if rescaled.size:
@@ -276,8 +286,6 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
                 poles[rescaled[failed]] = _backward_stable_eigenvalues(
                     stack[failed], poles[rescaled[failed]]
                 )
-    if rescaled.size == 0:
-        return poles  # each row sorted by the core, as numpy.sort_complex sorts
     if np.any(exponents):
         with np.errstate(over="ignore", invalid="ignore"):
             scale = exponents[:, None]
@@ -2043,13 +2051,14 @@ def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
     model = _siso(loop)
     k = _gains(gains)
     d = float(model.D[0, 0])
-    with np.errstate(over="ignore", invalid="ignore"):
-        products = k * d
-        algebraic = np.isfinite(products) & (
-            np.abs(1.0 + products) <= 8 * _EPS * np.maximum(1.0, np.abs(products))
-        )
-    if np.any(algebraic):
-        _refuse_algebraic(model, float(k[np.argmax(algebraic)]))  # raises, naming the gain
+    if d != 0.0:
+        with np.errstate(over="ignore", invalid="ignore"):
+            products = k * d
+            algebraic = np.isfinite(products) & (
+                np.abs(1.0 + products) <= 8 * _EPS * np.maximum(1.0, np.abs(products))
+            )
+        if np.any(algebraic):
+            _refuse_algebraic(model, float(k[np.argmax(algebraic)]))  # raises, naming the gain
     return RootLocus(
         gains=k,
         poles=_closed_loop_poles(model, k),

@@ -12,8 +12,7 @@
 //!
 //! which differs from H in its first row only and is again upper Hessenberg: each gain costs
 //! the double-shift QR iteration alone, with no reduction (and no balancing), in parallel
-//! over the gains. (The previous gain's poles as shift estimates, [`Spectrum::Near`], did not
-//! reduce the number of sweeps: about 10 per gain at n = 6 either way.)
+//! over the gains.
 //!
 //! **Backward stability.** The reduction and the QR iteration are orthogonal and unbalanced:
 //! each gain's eigenvalues are those of A - g b c + E with ||E|| = O(n u (||A|| + |g| ||b|| ||c||)),
@@ -25,10 +24,41 @@
 //! The gain 0 (the open loop) is taken by [`eigenvalues`] itself, which returns the diagonal of
 //! a triangular A exactly (a repeated pole would otherwise split by sqrt(u) ||A||).
 //!
+//! **Continuation.** Along a run of gains, each gain's poles are found from the previous
+//! gain's (extrapolated through the two before) by Aberth's simultaneous iteration on the
+//! closed-loop characteristic polynomial in factored form,
+//!
+//! ```text
+//!     χ_g(s) = det(sI - A + g b c) = Π(s - p_i) + g K Π(s - z_j) = D(s) (1 + R(s)),
+//!     R(s) = g K Π(s - z_j) / Π(s - p_i),   χ'/χ = (S_p + R S_z) / (1 + R),
+//! ```
+//!
+//! with the open-loop poles p_i, the zeros z_j and the gain K of c (sI - A)^-1 b from
+//! [`transfer::transfer_channels`], and S_p = Σ 1/(s - p_i), S_z = Σ 1/(s - z_j). Each
+//! approximation x_i moves by 1 / (χ'/χ(x_i) - Σ_{j≠i} 1/(x_i - x_j)) (Aberth 1973, eq. 2),
+//! and stops once |1 + R(x_i)| <= η (1 + |R(x_i)|), η = 32 (n + m + 1) u: x_i is then a root of
+//! the factored χ_g with its factors perturbed by O(η). The iteration keeps the real
+//! structure: a real pole is iterated on the real axis, a complex pair as its upper member
+//! (its conjugate counted in the sums). Every run starts at a gain solved by the QR
+//! iteration, and a gain whose continuation does not converge in [`ABERTH_ITERATIONS`]
+//! sweeps (a breakaway point, where a real pair becomes complex, or a step too long) is solved
+//! by the QR iteration, which restarts the run. Each continued gain is verified against the
+//! state space: its poles must sum to tr(A - g b c) = tr A - g c b to within 8 n^2 u ||M||_F, and
+//! their squares to tr((A - g b c)^2) = tr A^2 - 2 g c A b + g^2 (c b)^2 to within
+//! 16 n^2 u ||M||_F^2 (M = A - g b c); a miss falls back to the QR iteration, as does a point
+//! where R is 0 or leaves the doubles. A zero within 8 n u ||A||_F of a pole (the accuracy of
+//! the poles themselves) cancels it: that pole is a closed-loop pole at every gain, taken out
+//! of both products. Loops whose transfer function the fast path defers, or whose poles or
+//! zeros are not exactly closed under conjugation, use the QR iteration at every gain.
+//!
 //! Reference: G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., 2013, §7.4-7.5
 //! (the Hessenberg reduction and the Francis double-shift iteration); the controller-Hessenberg
-//! form of a single-input system is that of §7.4.8's staircase with one input.
+//! form of a single-input system is that of §7.4.8's staircase with one input. O. Aberth,
+//! "Iteration methods for finding all zeros of a polynomial simultaneously", Mathematics of
+//! Computation 27(122), 339-344, 1973; D. A. Bini, "Numerical computation of polynomial zeros
+//! by means of Aberth's method", Numerical Algorithms 13, 179-200, 1996 (the stopping rule).
 
+use crate::control::transfer::transfer_channels;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
 use crate::linalg::balance::range_scale;
 use crate::linalg::hessenberg::reduce_to_hessenberg;
@@ -37,7 +67,7 @@ use crate::linalg::matrix::{
     FaerView, Order, Square, Transformations, from_faer_in, identity_in, with_order,
 };
 use crate::linalg::schur::{Spectrum, eigenvalues, francis_qr, quasi_triangular_eigenvalues};
-use crate::platform::parallel::{ParallelContext, par_chunks};
+use crate::platform::parallel::ParallelContext;
 use faer::{MatRef, c64};
 use rayon::prelude::*;
 
@@ -131,8 +161,13 @@ pub fn closed_loop_poles(
 
 /// Sorted by real part, then imaginary part (as `numpy.sort_complex`).
 fn sorted(mut values: Vec<c64>) -> Vec<c64> {
-    values.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+    sort(&mut values);
     values
+}
+
+/// Sorts by real part, then imaginary part (as `numpy.sort_complex`).
+fn sort(values: &mut [c64]) {
+    values.sort_unstable_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
 }
 
 /// The closed-loop poles of the SISO loop (A n x n, b n x 1, c 1 x n) at each closed-loop gain
@@ -176,25 +211,460 @@ pub fn root_locus(
     } else {
         Vec::new()
     };
+    // The factored form costs about as much as a few gains' QR iterations.
+    let factored = if gains.len() >= MIN_CONTINUED {
+        Factored::of(a, &bv, &cv)?
+    } else {
+        None
+    };
+    // Runs of consecutive gains, a few per thread: each starts with the QR iteration.
+    let runs = (rayon::current_num_threads() * 4).max(1);
+    let run_length = gains.len().div_ceil(runs).max(MIN_RUN);
     let context = ParallelContext::capture(0);
     with_order!(n, order => {
         let form = controller_hessenberg(order, a, &bv, &cv);
-        par_chunks(out, n, gains.len())
-            .zip(gains.par_iter())
+        out.par_chunks_mut(run_length * n)
+            .zip(gains.par_chunks(run_length))
             .enumerate()
-            .try_for_each(|(index, (poles, &g))| {
+            .try_for_each(|(run, (poles, run_gains))| {
                 context.run(|| {
-                    if g == 0.0 {
-                        poles.copy_from_slice(&open_loop);
-                    } else {
+                    let mut continuation = Continuation::default();
+                    for (k, (poles, &g)) in poles.chunks_mut(n).zip(run_gains).enumerate() {
+                        crate::platform::interrupt::check()?;
+                        if g == 0.0 {
+                            poles.copy_from_slice(&open_loop);
+                            continuation = Continuation::default();
+                            continue;
+                        }
+                        if factored.as_ref().is_some_and(|f| continuation.next(f, g, poles)) {
+                            sort(poles);
+                            continue;
+                        }
                         let values = closed_loop_eigenvalues(&form, g)
-                            .map_err(|e| Error::in_batch(index, e))?;
-                        poles.copy_from_slice(&sorted(values));
+                            .map_err(|e| Error::in_batch(run * run_length + k, e))?;
+                        continuation = match &factored {
+                            Some(f) => Continuation::restart(g, &values, &f.fixed),
+                            None => Continuation::default(),
+                        };
+                        poles.copy_from_slice(&values);
+                        sort(poles);
                     }
                     Ok(())
                 })
             })
     })
+}
+
+/// Gains per run of the continuation, at least (each run starts with a QR iteration).
+const MIN_RUN: usize = 16;
+
+/// Gains of a call, at least, for the continuation.
+const MIN_CONTINUED: usize = 4;
+
+/// Sweeps of Aberth's iteration before a gain falls back to the QR iteration.
+const ABERTH_ITERATIONS: usize = 12;
+
+/// A set of roots closed under conjugation: the real ones, and the upper member (Im > 0) of
+/// each complex pair.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct Conjugates {
+    real: Vec<f64>,
+    upper: Vec<c64>,
+}
+
+impl Conjugates {
+    /// None unless every complex value has its exact conjugate among `values`.
+    fn of(values: &[c64]) -> Option<Self> {
+        let real = values
+            .iter()
+            .filter(|x| x.im == 0.0)
+            .map(|x| x.re)
+            .collect();
+        let mut upper: Vec<c64> = values.iter().filter(|x| x.im > 0.0).copied().collect();
+        let mut lower: Vec<c64> = values
+            .iter()
+            .filter(|x| x.im < 0.0)
+            .map(|x| x.conj())
+            .collect();
+        let order = |x: &c64, y: &c64| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im));
+        upper.sort_by(order);
+        lower.sort_by(order);
+        (upper == lower).then_some(Self { real, upper })
+    }
+
+    /// Every root, conjugates included.
+    fn all(&self) -> impl Iterator<Item = c64> + '_ {
+        let real = self.real.iter().map(|&x| c64::new(x, 0.0));
+        real.chain(self.upper.iter().flat_map(|&y| [y, y.conj()]))
+    }
+
+    /// Σ 1/(x_i - v) over every root v but x_i itself (its conjugate included), x_i the i-th
+    /// real root or, from i = real.len(), the upper member of the (i - real.len())-th pair.
+    fn repulsion(&self, i: usize) -> c64 {
+        let reals = self.real.len();
+        if i < reals {
+            let x = self.real[i];
+            let mut sum = 0.0;
+            for (j, v) in self.real.iter().enumerate() {
+                if j != i {
+                    sum += 1.0 / (x - v);
+                }
+            }
+            for v in &self.upper {
+                let d = x - v.re;
+                sum += 2.0 * d / (d * d + v.im * v.im);
+            }
+            return c64::new(sum, 0.0);
+        }
+        let x = self.upper[i - reals];
+        let mut sum = c64::new(0.0, 1.0) * (-0.5 / x.im); // 1/(x - x̄) = 1/(2i Im x)
+        for v in &self.real {
+            sum += reciprocal(c64::new(x.re - v, x.im));
+        }
+        for (j, v) in self.upper.iter().enumerate() {
+            if j + reals != i {
+                sum += reciprocal(x - v) + reciprocal(x - v.conj());
+            }
+        }
+        sum
+    }
+
+    fn len(&self) -> usize {
+        self.real.len() + 2 * self.upper.len()
+    }
+
+    /// Π (x - v) over the roots v (for a real x, in real arithmetic).
+    #[inline]
+    fn product(&self, x: c64) -> c64 {
+        if x.im == 0.0 {
+            let x = x.re;
+            let mut product = 1.0;
+            for v in &self.real {
+                product *= x - v;
+            }
+            for v in &self.upper {
+                // (x - v)(x - v̄) = (x - Re v)^2 + (Im v)^2.
+                let d = x - v.re;
+                product *= d * d + v.im * v.im;
+            }
+            return c64::new(product, 0.0);
+        }
+        let mut product = c64::new(1.0, 0.0);
+        for v in &self.real {
+            product *= c64::new(x.re - v, x.im);
+        }
+        for v in &self.upper {
+            // Not (x - Re v)^2 + (Im v)^2: it cancels where x is near v.
+            product *= (x - v) * (x - v.conj());
+        }
+        product
+    }
+
+    /// Σ 1/(x - v) over the roots v (for a real x, in real arithmetic).
+    #[inline]
+    fn sum(&self, x: c64) -> c64 {
+        if x.im == 0.0 {
+            let x = x.re;
+            let mut sum = 0.0;
+            for v in &self.real {
+                sum += 1.0 / (x - v);
+            }
+            for v in &self.upper {
+                // The pair's reciprocals sum to 2 (x - Re v) / ((x - Re v)^2 + (Im v)^2).
+                let d = x - v.re;
+                sum += 2.0 * d / (d * d + v.im * v.im);
+            }
+            return c64::new(sum, 0.0);
+        }
+        let mut sum = c64::new(0.0, 0.0);
+        for v in &self.real {
+            sum += reciprocal(c64::new(x.re - v, x.im));
+        }
+        for v in &self.upper {
+            sum += reciprocal(x - v) + reciprocal(x - v.conj());
+        }
+        sum
+    }
+}
+
+/// The loop in the factored form of the continuation (see the module's documentation), and
+/// the state-space invariants that verify each gain's poles.
+struct Factored {
+    /// The open-loop poles and the zeros, common factors taken out.
+    poles: Conjugates,
+    zeros: Conjugates,
+    /// K of c (sI - A)^-1 b = K Π(s - z_j) / Π(s - p_i).
+    gain: f64,
+    /// The common factors: poles of the closed loop at every gain.
+    fixed: Vec<c64>,
+    /// tr A, tr A^2, c b, c A b, ||A||_F^2, b^T A c^T and ||b||^2 ||c||^2.
+    trace: f64,
+    trace_square: f64,
+    cb: f64,
+    cab: f64,
+    size_a: f64,
+    bac: f64,
+    size_bc: f64,
+}
+
+impl Factored {
+    /// None where the transfer function's fast path defers the loop, or where its poles or
+    /// zeros are not exactly closed under conjugation.
+    fn of(a: MatRef<'_, f64>, b: &[f64], c: &[f64]) -> Result<Option<Self>, Error> {
+        let n = b.len();
+        let d = [0.0];
+        let transfer = transfer_channels(
+            a,
+            MatRef::from_column_major_slice(b, n, 1),
+            MatRef::from_row_major_slice(c, 1, n),
+            MatRef::from_column_major_slice(&d, 1, 1),
+            0.0,
+            &[(0, 0)],
+        )?;
+        let Some(Some(channel)) = transfer.channels.into_iter().next() else {
+            return Ok(None);
+        };
+        // A zero within 8 n u ||A||_F of a pole (the accuracy of the poles themselves) cancels
+        // it: the closed loop keeps the pole at every gain.
+        let size = (0..n)
+            .flat_map(|j| (0..n).map(move |i| (i, j)))
+            .map(|(i, j)| a[(i, j)] * a[(i, j)])
+            .sum::<f64>()
+            .sqrt();
+        let tolerance = 8.0 * n as f64 * f64::EPSILON * size;
+        let mut poles = transfer.poles;
+        let mut zeros = Vec::with_capacity(channel.zeros.len());
+        let mut fixed = Vec::new();
+        for z in channel.zeros {
+            let nearest = (0..poles.len())
+                .min_by(|&i, &j| (poles[i] - z).norm().total_cmp(&(poles[j] - z).norm()));
+            match nearest.filter(|&i| {
+                (poles[i] - z).norm() <= tolerance && (poles[i].im == 0.0) == (z.im == 0.0)
+            }) {
+                Some(i) => fixed.push(poles.remove(i)),
+                None => zeros.push(z),
+            }
+        }
+        let (Some(poles), Some(zeros)) = (Conjugates::of(&poles), Conjugates::of(&zeros)) else {
+            return Ok(None);
+        };
+        let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(u, v)| u * v).sum::<f64>();
+        let times = |v: &[f64]| -> Vec<f64> {
+            (0..n)
+                .map(|i| (0..n).map(|j| a[(i, j)] * v[j]).sum())
+                .collect()
+        };
+        let entries = || (0..n).flat_map(|j| (0..n).map(move |i| (i, j)));
+        Ok(Some(Self {
+            poles,
+            zeros,
+            gain: channel.gain,
+            fixed,
+            trace: (0..n).map(|i| a[(i, i)]).sum(),
+            trace_square: entries().map(|(i, j)| a[(i, j)] * a[(j, i)]).sum(),
+            cb: dot(c, b),
+            cab: dot(c, &times(b)),
+            size_a: entries().map(|(i, j)| a[(i, j)] * a[(i, j)]).sum(),
+            bac: dot(b, &times(c)),
+            size_bc: dot(b, b) * dot(c, c),
+        }))
+    }
+
+    /// R(x) = g K Π(x - z_j) / Π(x - p_i); None where it is not finite or is 0 (x on a pole
+    /// or a zero, or a product beyond the doubles).
+    #[inline]
+    fn r(&self, x: c64, g: f64) -> Option<c64> {
+        let r = self.zeros.product(x) * reciprocal(self.poles.product(x)) * (g * self.gain);
+        (r.re.is_finite() && r.im.is_finite() && r != c64::new(0.0, 0.0)).then_some(r)
+    }
+
+    /// χ'/χ = (S_p + R S_z) / (1 + R) at x, formed as (S_p / R + S_z) / (1 / R + 1) where
+    /// |R| > 1; not finite where 1 + R = 0 exactly.
+    fn logarithmic_derivative(&self, x: c64, r: c64) -> c64 {
+        let (s_p, s_z) = (self.poles.sum(x), self.zeros.sum(x));
+        if modulus(r) <= 1.0 {
+            (s_p + r * s_z) * reciprocal(r + 1.0)
+        } else {
+            let inverse = reciprocal(r);
+            (s_p * inverse + s_z) * reciprocal(inverse + 1.0)
+        }
+    }
+
+    /// Whether `roots` (every closed-loop pole at g) pass the trace and trace-of-square checks
+    /// (see the module's documentation).
+    fn verified(&self, roots: &[c64], g: f64) -> bool {
+        let n = roots.len() as f64;
+        let size = (self.size_a - 2.0 * g * self.bac + g * g * self.size_bc).max(0.0);
+        let sum: f64 = roots.iter().map(|x| x.re).sum();
+        let square: f64 = roots.iter().map(|x| (x * x).re).sum();
+        let trace = self.trace - g * self.cb;
+        let trace_square = self.trace_square - 2.0 * g * self.cab + g * g * self.cb * self.cb;
+        let u = f64::EPSILON;
+        (sum - trace).abs() <= 8.0 * n * n * u * size.sqrt()
+            && (square - trace_square).abs() <= 16.0 * n * n * u * size
+    }
+}
+
+/// |1 + R| / (1 + |R|): a point where R(x) = r is a root of the factored χ_g with its factors
+/// perturbed by about this much (relative).
+fn residual(r: c64) -> f64 {
+    modulus(r + 1.0) / (1.0 + modulus(r))
+}
+
+/// |z|, by a square root where |z|^2 stays in the normal range.
+#[inline]
+fn modulus(z: c64) -> f64 {
+    let norm = z.re * z.re + z.im * z.im;
+    if (1e-290..=1e290).contains(&norm) {
+        norm.sqrt()
+    } else {
+        z.re.hypot(z.im)
+    }
+}
+
+/// 1/z by one real division, its parts scaled first only where |z|^2 would leave the normal
+/// range.
+#[inline]
+fn reciprocal(z: c64) -> c64 {
+    let norm = z.re * z.re + z.im * z.im;
+    if (1e-290..=1e290).contains(&norm) {
+        let inverse = 1.0 / norm;
+        return c64::new(z.re * inverse, -z.im * inverse);
+    }
+    let scale = z.re.abs().max(z.im.abs());
+    let (re, im) = (z.re / scale, z.im / scale);
+    let denominator = scale * (re * re + im * im);
+    c64::new(re / denominator, -im / denominator)
+}
+
+/// A run of the continuation: the approximations at its last gain and at the one before, and
+/// the buffers of the next gain's.
+#[derive(Default)]
+struct Continuation {
+    last: Option<(f64, Conjugates)>,
+    before: Option<(f64, Conjugates)>,
+    work: Conjugates,
+    converged: Vec<bool>,
+}
+
+impl Continuation {
+    /// A run starting from the poles `values` at the gain g (the QR iteration's: real poles
+    /// exactly real, complex pairs exactly conjugate), less those nearest the common factors
+    /// `fixed`.
+    fn restart(g: f64, values: &[c64], fixed: &[c64]) -> Self {
+        let Some(mut x) = Conjugates::of(values) else {
+            return Self::default();
+        };
+        for f in fixed.iter().filter(|f| f.im >= 0.0) {
+            let distance = |v: c64| (v - f).norm();
+            let removed = if f.im == 0.0 {
+                let far = |i: usize| distance(c64::new(x.real[i], 0.0));
+                let nearest = (0..x.real.len()).min_by(|&i, &j| far(i).total_cmp(&far(j)));
+                nearest.map(|i| x.real.swap_remove(i))
+            } else {
+                let far = |i: usize| distance(x.upper[i]);
+                let nearest = (0..x.upper.len()).min_by(|&i, &j| far(i).total_cmp(&far(j)));
+                nearest.map(|i| x.upper.swap_remove(i).re)
+            };
+            if removed.is_none() {
+                return Self::default();
+            }
+        }
+        Self {
+            last: Some((g, x)),
+            ..Self::default()
+        }
+    }
+
+    /// The closed-loop poles at g by Aberth's iteration from the run's last gain, written
+    /// into `out`; false where the caller must take the QR iteration.
+    fn next(&mut self, factored: &Factored, g: f64, out: &mut [c64]) -> bool {
+        let Some((g1, last)) = &self.last else {
+            return false;
+        };
+        let x = &mut self.work;
+        x.clone_from(last);
+        if let Some((g0, before)) = &self.before {
+            // The secant through the two previous gains' poles.
+            let t = (g - g1) / (g1 - g0);
+            if t.is_finite() && t.abs() <= 4.0 {
+                for (y, y0) in x.real.iter_mut().zip(&before.real) {
+                    *y += (*y - y0) * t;
+                }
+                for (y, y0) in x.upper.iter_mut().zip(&before.upper) {
+                    let predicted = *y + (*y - y0) * t;
+                    if predicted.im > 0.0 {
+                        *y = predicted;
+                    }
+                }
+            }
+        }
+        if !aberth(factored, g, x, &mut self.converged) {
+            return false;
+        }
+        for (slot, root) in out
+            .iter_mut()
+            .zip(factored.fixed.iter().copied().chain(x.all()))
+        {
+            *slot = root;
+        }
+        if !factored.verified(out, g) {
+            return false;
+        }
+        // The work buffer becomes the last gain's, the one before's is reused as the next work.
+        let previous = self.last.replace((g, std::mem::take(&mut self.work)));
+        if let Some((_, mut reused)) = std::mem::replace(&mut self.before, previous) {
+            std::mem::swap(&mut self.work, &mut reused);
+        }
+        true
+    }
+}
+
+/// Aberth's iteration on the approximations `x` of the roots of χ_g (a real one kept real, a
+/// pair iterated as its upper member), updated in place; false if they do not all converge
+/// within [`ABERTH_ITERATIONS`] sweeps.
+fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<bool>) -> bool {
+    let eta = 32.0 * (factored.poles.len() + factored.zeros.len() + 1) as f64 * f64::EPSILON;
+    let reals = x.real.len();
+    converged.clear();
+    converged.resize(reals + x.upper.len(), false);
+    for _ in 0..ABERTH_ITERATIONS {
+        let mut done = true;
+        for (i, converged) in converged.iter_mut().enumerate() {
+            if *converged {
+                continue;
+            }
+            let xi = if i < reals {
+                c64::new(x.real[i], 0.0)
+            } else {
+                x.upper[i - reals]
+            };
+            let Some(r) = factored.r(xi, g) else {
+                return false;
+            };
+            if residual(r) <= eta {
+                *converged = true;
+                continue;
+            }
+            done = false;
+            let step = reciprocal(factored.logarithmic_derivative(xi, r) - x.repulsion(i));
+            let next = xi - step;
+            if !(next.re.is_finite() && next.im.is_finite()) {
+                return false;
+            }
+            if i < reals {
+                x.real[i] = next.re;
+            } else if next.im > 0.0 {
+                x.upper[i - reals] = next;
+            } else {
+                return false; // the pair has met the real axis: a breakaway point
+            }
+        }
+        if done {
+            return true;
+        }
+    }
+    false
 }
 
 #[cfg(test)]
@@ -224,6 +694,94 @@ mod tests {
                         "n={n} g={g}: {x} vs {y}"
                     );
                 }
+            }
+        }
+    }
+
+    /// The continuation against the QR iteration at every gain: loops with real and complex
+    /// poles and zeros, relative degrees 1 to 3, gains of both signs through breakaway
+    /// points; most gains must be taken by the continuation.
+    #[test]
+    fn the_continuation_agrees_with_the_qr_iteration() {
+        for (n, seed) in [
+            (2usize, 1usize),
+            (3, 2),
+            (4, 3),
+            (6, 4),
+            (6, 5),
+            (8, 6),
+            (12, 7),
+        ] {
+            let a = Mat::from_fn(n, n, |i, j| {
+                let x = ((i * 7 + j * 13 + seed * 5) % 17) as f64 / 8.0 - 1.0;
+                if i == j { x - 1.5 } else { x }
+            });
+            let b = Mat::from_fn(n, 1, |i, _| ((i * 5 + seed) % 7) as f64 / 3.0 - 1.0);
+            let c = Mat::from_fn(1, n, |_, j| ((j * 3 + seed) % 5) as f64 / 2.0 - 1.0);
+            let (bv, cv): (Vec<f64>, Vec<f64>) = (
+                (0..n).map(|i| b[(i, 0)]).collect(),
+                c.row(0).iter().copied().collect(),
+            );
+            let factored = Factored::of(a.as_ref(), &bv, &cv)
+                .unwrap()
+                .expect("not deferred");
+            let gains: Vec<f64> = (0..400)
+                .map(|i| -2.0 + 0.0125 * i as f64)
+                .filter(|g| *g != 0.0)
+                .collect();
+            let mut continuation = Continuation::default();
+            let mut continued = 0;
+            let mut out = vec![c64::new(0.0, 0.0); n];
+            for &g in &gains {
+                let expected = sorted(closed_loop_poles(a.as_ref(), &bv, &cv, g).unwrap());
+                if continuation.next(&factored, g, &mut out) {
+                    continued += 1;
+                    sort(&mut out);
+                    let scale = expected.iter().fold(1.0f64, |m, x| m.max(x.norm()));
+                    for (x, y) in out.iter().zip(&expected) {
+                        // A pole near a breakaway point (a double root) is accurate to about
+                        // sqrt(u) by either method.
+                        assert!((x - y).norm() <= 1e-7 * scale, "n={n} g={g}: {x} vs {y}");
+                    }
+                } else {
+                    continuation = Continuation::restart(g, &expected, &factored.fixed);
+                }
+            }
+            assert!(
+                continued * 10 >= gains.len() * 9,
+                "n={n}: {continued} of {}",
+                gains.len()
+            );
+        }
+    }
+
+    /// A mode the loop does not see (a pole cancelled by an equal zero) stays at its place for
+    /// every gain (taken out of the continuation as a common factor).
+    #[test]
+    fn a_cancelled_mode_stays_put() {
+        // (s + 5) / ((s + 5)(s + 1)(s + 3)): the state at -5 is unobservable through c.
+        let a = faer::mat![[-5.0, 0.0, 0.0], [0.0, -1.0, 1.0], [0.0, 0.0, -3.0]];
+        let b = faer::mat![[1.0], [0.0], [1.0]];
+        let c = faer::mat![[0.0, 1.0, 0.0]];
+        let gains: Vec<f64> = (1..200).map(|i| 0.05 * i as f64).collect();
+        let n = 3;
+        let mut out = vec![c64::new(0.0, 0.0); gains.len() * n];
+        root_locus(a.as_ref(), b.as_ref(), c.as_ref(), &gains, &mut out).unwrap();
+        for (k, g) in gains.iter().enumerate() {
+            let poles = &out[k * n..(k + 1) * n];
+            assert!(
+                poles
+                    .iter()
+                    .any(|p| (p - c64::new(-5.0, 0.0)).norm() <= 1e-14),
+                "{g}: {poles:?}"
+            );
+            // (s + 1)(s + 3) + g = 0: s = -2 ± sqrt(1 - g).
+            let root = c64::new(1.0 - g, 0.0).sqrt();
+            for root in [c64::new(-2.0, 0.0) + root, c64::new(-2.0, 0.0) - root] {
+                assert!(
+                    poles.iter().any(|p| (p - root).norm() <= 1e-7),
+                    "{g}: {poles:?} {root}"
+                );
             }
         }
     }

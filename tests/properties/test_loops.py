@@ -326,6 +326,8 @@ GAINS = (
     np.logspace(-2, 2, 7),
     np.array([-1.0, 2.0]),
     np.array([1e300, 1.0]),
+    np.linspace(-3.0, 3.0, 241),  # runs of the core's continuation, through breakaway points
+    np.logspace(-4.0, 4.0, 161),
     np.zeros(0),
     np.array([1.0, np.nan]),
     np.ones((2, 2)),
