@@ -818,7 +818,7 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
             f"eta0 must be a 1-D array of one value per input, got an array of shape "
             f"{weights.shape}"
         )
-    return _steady_state(A, B, dt, weights)
+    return _steady_state(A, B, dt, weights) if dt else _equilibrated_solve(A, B, weights, True)
 
 
 def _steady_state(
@@ -910,7 +910,12 @@ def dc_gain(sys: System) -> FloatArray:
     """
     A, B, C, D, dt = plant_arrays(sys)
     # Every input's steady state from one factorisation; one warning, for the gain.
-    states = _steady_state(A, B, dt, identity(B.shape[1]), warn=False)
+    weights = identity(B.shape[1])
+    states = (
+        _steady_state(A, B, dt, weights, warn=False)
+        if dt
+        else _equilibrated_solve(A, B, weights, False)
+    )
     with np.errstate(over="ignore", invalid="ignore"):
         gain: FloatArray = C @ states + D
     return finite_or_warn(gain, "the DC gain")

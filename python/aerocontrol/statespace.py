@@ -37,9 +37,21 @@ def _matrix(value: object, name: str) -> FloatArray:
     return np.array(matrix_view(value, name), dtype=np.float64, order="C")
 
 
+def _is_matrix(value: object) -> TypeIs[FloatArray]:
+    """Whether ``value`` is already what :func:`matrix_view` makes of it."""
+    return (
+        type(value) is np.ndarray
+        and value.ndim == 2
+        and value.dtype == np.float64
+        and value.flags.aligned
+    )
+
+
 def matrix_view(value: object, name: str) -> FloatArray:
     """``value`` as a 2-D float64 array, or ShapeError naming ``name``: the array itself when
     it is one already (no copy; see :func:`~aerocontrol._validation.real_array`)."""
+    if _is_matrix(value):
+        return value
     array = real_array(value, name)
     if array.ndim == 1:
         raise ShapeError(
@@ -419,8 +431,10 @@ def plant_arrays(
         return model.A, model.B, model.C, model.D, period(model)
     if isinstance(model, (tuple, list)) and len(model) in (2, 4):
         A = matrix_view(model[0], "A")
-        B = real_array(model[1], "B")
-        B = matrix_view(B.reshape(-1, 1) if B.ndim == 1 else B, "B")
+        B = model[1]
+        if not _is_matrix(B):
+            B = real_array(B, "B")
+            B = matrix_view(B.reshape(-1, 1) if B.ndim == 1 else B, "B")
         given = len(model) == 4 and (model[2] is not None or model[3] is not None)
         C = _constant(A.shape[0], A.shape[0], True)
         if len(model) == 4 and model[2] is not None:
