@@ -94,3 +94,25 @@ def test_mode_names_of_the_wrong_count_are_a_shape_error() -> None:
     # Found by the property suite: a bare ValueError, not one of aerocontrol's.
     with pytest.raises(aerocontrol.ShapeError, match="mode_names must name 3 modes, got 1"):
         aerocontrol.modes(A_LAT, mode_names=["spiral"])
+
+
+def test_a_tuple_in_any_layout_gives_the_state_spaces_modes() -> None:
+    """modes reads a tuple's matrices without building a StateSpace: a Fortran-ordered A and
+    a strided B give the bits of the StateSpace's C-ordered copies, unmodified, and a bad B is
+    refused by name as StateSpace refuses it."""
+    wide = np.zeros((4, 4))
+    wide[:, ::2] = B_LAT
+    A, B = np.asfortranarray(A_LAT), wide[:, ::2]
+    ours = aerocontrol.modes((A, B))
+    reference = aerocontrol.modes(aerocontrol.StateSpace(A_LAT, B_LAT))
+    np.testing.assert_array_equal(ours.eigenvalues, reference.eigenvalues)
+    np.testing.assert_array_equal(ours.modal_input, reference.modal_input)
+    np.testing.assert_array_equal(ours.damping_ratio, reference.damping_ratio)
+    assert ours.mode_names == ("mode 1", "mode 2", "mode 3")
+    np.testing.assert_array_equal(A, A_LAT)
+    assert A.flags.writeable and B.flags.writeable
+    bad = np.full((4, 2), np.nan)
+    with pytest.raises(aerocontrol.NonFiniteError, match=r"^B must be finite, but B\[0, 0\]"):
+        aerocontrol.modes((A_LAT, bad))
+    with pytest.raises(aerocontrol.ShapeError, match="B must have as many rows as A"):
+        aerocontrol.modes((A_LAT, B_LAT[:3]))

@@ -279,6 +279,75 @@ def test_singular_a_is_still_refused_after_equilibration(A: np.ndarray) -> None:
         aerocontrol.steady_state(sys_, [1.0])
 
 
+_GOOD = (A_LON, B_LON, np.array([[0.0, 0.0, 0.0, 1.0]]), np.zeros((1, 1)))
+
+
+def _with(index: int, value: object) -> tuple[object, ...]:
+    return tuple(value if k == index else m for k, m in enumerate(_GOOD))
+
+
+_BAD_MATRICES = [
+    _with(0, A_LON[0]),  # A 1-D
+    _with(0, A_LON[:, :3]),  # A not square
+    _with(0, A_LON + 1j),  # A complex
+    _with(0, np.where(np.eye(4) > 0, np.nan, A_LON)),  # A NaN
+    _with(1, B_LON[:3]),  # B rows
+    _with(1, np.full((4, 1), np.inf)),  # B infinite
+    _with(1, [["a"], ["b"], ["c"], ["d"]]),  # B not numbers
+]
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        *_BAD_MATRICES,
+        *(bad[:2] for bad in _BAD_MATRICES),
+        _with(2, np.ones((1, 3))),  # C columns
+        _with(2, np.array([[0.0, np.nan, 0.0, 1.0]])),  # C NaN
+        _with(3, np.zeros((1, 2))),  # D columns
+        _with(3, np.array([[np.inf]])),  # D infinite
+        _GOOD[:3],  # (A, B, C) is no system
+    ],
+)
+def test_a_tuple_is_checked_as_a_state_space_is(bad: tuple[object, ...]) -> None:
+    """steady_state and dc_gain read a tuple's matrices without building a StateSpace: each
+    bad matrix is refused with the exception and the message StateSpace gives it (those of
+    (A, B) by the core's solve, C and D by the core's check_model)."""
+    with pytest.raises(Exception) as expected:
+        aerocontrol.statespace.as_state_space(bad)  # type: ignore[arg-type]
+    with pytest.raises(type(expected.value)) as gain:
+        aerocontrol.dc_gain(bad)  # type: ignore[arg-type]
+    with pytest.raises(type(expected.value)) as state:
+        aerocontrol.steady_state(bad, [1.0])  # type: ignore[arg-type]
+    assert str(gain.value) == str(state.value) == str(expected.value)
+
+
+def test_a_tuple_in_any_layout_gives_the_state_spaces_answer() -> None:
+    """Fortran-ordered and strided views give the bits of the StateSpace's C-ordered copies,
+    and the caller's arrays are neither modified nor made read-only."""
+    model = _random_stable(6, 2, 3, seed=11)
+    wide = np.zeros((12, 12))
+    wide[::2, ::2] = model.A
+    views = (
+        wide[::2, ::2],
+        np.asfortranarray(model.B),
+        np.asfortranarray(model.C),
+        np.array(model.D),
+    )
+    before = [v.copy() for v in views]
+    np.testing.assert_array_equal(aerocontrol.dc_gain(views), aerocontrol.dc_gain(model))
+    np.testing.assert_array_equal(
+        aerocontrol.steady_state(views[:2], [1.0, -0.5]),
+        aerocontrol.steady_state(model, [1.0, -0.5]),
+    )
+    np.testing.assert_array_equal(
+        aerocontrol.dc_gain(views[:2]), aerocontrol.dc_gain((model.A, model.B))
+    )
+    for view, copy in zip(views, before, strict=True):
+        np.testing.assert_array_equal(view, copy)
+        assert view.flags.writeable
+
+
 def test_multi_input_gives_one_response_per_input() -> None:
     t = np.linspace(0.0, 10.0, 101)
     lateral = aerocontrol.StateSpace(A_LAT, B_LAT, input_names=["rudder", "aileron"])

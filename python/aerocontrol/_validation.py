@@ -82,7 +82,7 @@ def finite_or_warn(values: ArrayT, what: str, *, stacklevel: int = 3) -> ArrayT:
     ``stacklevel`` is that of ``warnings.warn`` seen from here: 3, the default, names the
     caller of the function that calls this one; a private helper one call deeper passes 4.
     """
-    if not np.all(np.isfinite(values)):
+    if not np.isfinite(values).all():
         warnings.warn(
             f"the result overflowed double precision: infinite or NaN entries in {what}",
             NumericalOverflowWarning,

@@ -22,7 +22,7 @@ the dual: (A, C) is observable if and only if (A^T, C^T) is controllable.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -98,7 +98,7 @@ class Controllability:
     staircase_A: FloatArray
     staircase_B: FloatArray
     Z: FloatArray
-    """The orthogonal transformation (0 x 0 from is_controllable, which does not need it)."""
+    """The orthogonal transformation."""
     kind: str
     """"controllability" or "observability"."""
 
@@ -113,19 +113,31 @@ class Controllability:
         return f"not {word}: eigenvalues {listed} (tolerance {self.tolerance:.2e})"
 
 
-def _analyse(
+def _core_analysis(
     A: ArrayLike,
     second: ArrayLike,
     tol: float | None,
     method: str,
     dual: bool,
-    transformation: bool = True,
-) -> Controllability:
+    transformation: bool,
+) -> dict[str, Any]:
+    """The core's analysis of the pair (see ``rust/bindings/controllability.rs``), with
+    ``method`` and ``tol`` checked by name."""
     check_choice(method, "method", _METHODS)
     tolerance = None if tol is None else real_scalar(tol, "tol")
-    result = _core.controllability(A, second, tolerance, method == "full", transformation, dual)
+    return _core.controllability(A, second, tolerance, method == "full", transformation, dual)
+
+
+def _analyse(
+    A: ArrayLike, second: ArrayLike, tol: float | None, method: str, dual: bool
+) -> Controllability:
+    result = _core_analysis(A, second, tol, method, dual, True)
     unreachable = result["uncontrollable_eigenvalues"]
-    return Controllability(
+    # The frozen dataclass's __init__ sets each field through object.__setattr__, which costs
+    # half of the staircase of a 4-state pair; filling the instance dictionary directly is the
+    # same object.
+    analysis = object.__new__(Controllability)
+    vars(analysis).update(
         controllable=len(unreachable) == 0,
         uncontrollable_eigenvalues=unreachable,
         tolerance=float(result["tolerance"]),
@@ -139,6 +151,14 @@ def _analyse(
         Z=result["z"],
         kind="observability" if dual else "controllability",
     )
+    return analysis
+
+
+def _verdict(A: ArrayLike, second: ArrayLike, tol: float | None, method: str, dual: bool) -> bool:
+    """The verdict of :func:`_analyse` (no uncontrollable eigenvalue), without the staircase's
+    transformation Z and the result object."""
+    result = _core_analysis(A, second, tol, method, dual, False)
+    return len(result["uncontrollable_eigenvalues"]) == 0
 
 
 def controllability(
@@ -206,7 +226,7 @@ def is_controllable(
     False
     """
     A, B = plant_pair(A_or_sys, B, "B")
-    return _analyse(A, B, tol, method, dual=False, transformation=False).controllable
+    return _verdict(A, B, tol, method, dual=False)
 
 
 def is_observable(
@@ -223,4 +243,4 @@ def is_observable(
     False
     """
     A, C = plant_pair(A_or_sys, C, "C")
-    return _analyse(A, C, tol, method, dual=True, transformation=False).controllable
+    return _verdict(A, C, tol, method, dual=True)

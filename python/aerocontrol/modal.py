@@ -31,6 +31,7 @@ warning gives the condition number that showed it.
 
 from __future__ import annotations
 
+import functools
 import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -41,7 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, ShapeError
-from .statespace import as_state_space, is_system, period
+from .statespace import is_system, plant_arrays
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -129,22 +130,20 @@ class Modes:
         return plot_modes(self, ax=ax)
 
 
-def _plant(A_or_sys: ArrayLike | System) -> tuple[FloatArray, FloatArray | None]:
-    """(A, B or None) from a plant matrix or a system."""
-    if is_system(A_or_sys):
-        sys = as_state_space(A_or_sys)
-        return sys.A, sys.B
-    if isinstance(A_or_sys, tuple):
-        sys = as_state_space(A_or_sys)
-        return sys.A, sys.B
-    return real_array(A_or_sys, "A"), None
-
-
-def _plant_period(A_or_sys: ArrayLike | System) -> float:
-    """The sampling period of a discrete system; 0.0 for a continuous one or a matrix."""
+def _plant(A_or_sys: ArrayLike | System) -> tuple[FloatArray, FloatArray | None, float]:
+    """(A, B or None, the sampling period: 0.0 for a continuous system or a matrix) from a
+    plant matrix or a system."""
     if is_system(A_or_sys) or isinstance(A_or_sys, tuple):
-        return period(as_state_space(A_or_sys))
-    return 0.0
+        # The core checks A and B (see plant_arrays).
+        A, B, _, _, dt = plant_arrays(A_or_sys)
+        return A, B, dt
+    return real_array(A_or_sys, "A"), None, 0.0
+
+
+@functools.lru_cache(maxsize=64)
+def _default_names(count: int) -> tuple[str, ...]:
+    """'mode 1', 'mode 2', ... (an immutable tuple, shared by the results that use it)."""
+    return tuple(f"mode {k + 1}" for k in range(count))
 
 
 def _equivalent_continuous(result: dict[str, Any], dt: float) -> dict[str, Any]:
@@ -213,14 +212,13 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
     >>> [round(float(w), 4) for w in aerocontrol.modes(lateral).natural_frequency]
     [0.0464, 0.7477, 1.2308]
     """
-    A, B = _plant(A_or_sys)
+    A, B, dt = _plant(A_or_sys)
     result = _core.modal_analysis(A, B)
-    dt = _plant_period(A_or_sys)
     if dt > 0.0:
         result = _equivalent_continuous(result, dt)
     count = len(result["mode_eigenvalue"])
     if mode_names is None:
-        names = tuple(f"mode {k + 1}" for k in range(count))
+        names = _default_names(count)
     else:
         if len(mode_names) != count:
             raise ShapeError(f"mode_names must name {count} modes, got {len(mode_names)}")
@@ -235,7 +233,11 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
             IllConditionedWarning,
             stacklevel=2,
         )
-    return Modes(
+    # The frozen dataclass's __init__ sets each of the 16 fields through object.__setattr__,
+    # which costs half of the analysis of a 4-state A; filling the instance dictionary
+    # directly is the same object.
+    analysis = object.__new__(Modes)
+    vars(analysis).update(
         eigenvalues=result["eigenvalues"],
         eigenvalue=result["mode_eigenvalue"],
         oscillatory=np.asarray(result["oscillatory"], dtype=bool),
@@ -253,6 +255,7 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
         characteristic_polynomial=result["characteristic_polynomial"],
         mode_names=names,
     )
+    return analysis
 
 
 def charpoly(A: ArrayLike) -> FloatArray:

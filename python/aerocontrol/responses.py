@@ -58,7 +58,15 @@ from .exceptions import (
     ShapeError,
     SingularMatrixError,
 )
-from .statespace import StateSpace, as_state_space, grid_frequencies, is_system, period
+from .statespace import (
+    StateSpace,
+    as_state_space,
+    grid_frequencies,
+    identity,
+    is_system,
+    period,
+    plant_arrays,
+)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -801,25 +809,29 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     >>> np.round(aerocontrol.steady_state((A, B), [np.pi / 180]), 6)   # (6.51)
     array([ 0.045965, -0.018563,  0.      , -0.015954])
     """
-    model = as_state_space(sys)
+    A, B, _, _, dt = plant_arrays(sys)
     weights = real_array(eta0, "eta0")
-    if weights.ndim == 0 and model.n_inputs == 1:  # a number for the one input
+    if weights.ndim == 0 and B.shape[1] == 1:  # a number for the one input
         weights = weights.reshape(1)
     if weights.ndim != 1:
         raise ShapeError(
             f"eta0 must be a 1-D array of one value per input, got an array of shape "
             f"{weights.shape}"
         )
-    return _steady_state(model, weights)
+    return _steady_state(A, B, dt, weights) if dt else _equilibrated_solve(A, B, weights, True)
 
 
-def _steady_state(model: StateSpace, weights: ArrayLike, warn: bool = True) -> FloatArray:
-    """-A^-1 B η0 for a continuous model; for a discrete one, -(A - I)^-1 B η0, with the
-    error of a singular A - I naming the eigenvalue 1 of A."""
-    if not model.is_discrete:
-        return _equilibrated_solve(model.A, model.B, weights, warn)
+def _steady_state(
+    A: FloatArray, B: FloatArray, dt: float, weights: ArrayLike, warn: bool = True
+) -> FloatArray:
+    """-A^-1 B η0 for a continuous model (dt = 0); for a discrete one, -(A - I)^-1 B η0, with
+    the error of a singular A - I naming the eigenvalue 1 of A. The core checks A and B (the
+    matrices of :func:`~aerocontrol.statespace.plant_arrays`); a discrete model's are those of
+    a StateSpace, checked when it was made."""
+    if not dt:
+        return _equilibrated_solve(A, B, weights, warn)
     try:
-        return _equilibrated_solve(model.A - np.eye(model.n_states), model.B, weights, warn)
+        return _equilibrated_solve(A - np.eye(A.shape[0]), B, weights, warn)
     except SingularMatrixError as error:
         raise SingularMatrixError(
             "A - I is singular: A has the eigenvalue 1 (a discrete integrator or neutral "
@@ -896,9 +908,14 @@ def dc_gain(sys: System) -> FloatArray:
     ...
     aerocontrol.exceptions.SingularMatrixError: A is singular: it has the eigenvalue 0 ...
     """
-    model = as_state_space(sys)
+    A, B, C, D, dt = plant_arrays(sys)
     # Every input's steady state from one factorisation; one warning, for the gain.
-    states = _steady_state(model, np.eye(model.n_inputs), warn=False)
+    weights = identity(B.shape[1])
+    states = (
+        _steady_state(A, B, dt, weights, warn=False)
+        if dt
+        else _equilibrated_solve(A, B, weights, False)
+    )
     with np.errstate(over="ignore", invalid="ignore"):
-        gain: FloatArray = model.C @ states + model.D
+        gain: FloatArray = C @ states + D
     return finite_or_warn(gain, "the DC gain")

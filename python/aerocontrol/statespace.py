@@ -34,6 +34,24 @@ __all__ = ["StateSpace", "as_state_space"]
 
 
 def _matrix(value: object, name: str) -> FloatArray:
+    return np.array(matrix_view(value, name), dtype=np.float64, order="C")
+
+
+def _is_matrix(value: object) -> TypeIs[FloatArray]:
+    """Whether ``value`` is already what :func:`matrix_view` makes of it."""
+    return (
+        type(value) is np.ndarray
+        and value.ndim == 2
+        and value.dtype == np.float64
+        and value.flags.aligned
+    )
+
+
+def matrix_view(value: object, name: str) -> FloatArray:
+    """``value`` as a 2-D float64 array, or ShapeError naming ``name``: the array itself when
+    it is one already (no copy; see :func:`~aerocontrol._validation.real_array`)."""
+    if _is_matrix(value):
+        return value
     array = real_array(value, name)
     if array.ndim == 1:
         raise ShapeError(
@@ -42,7 +60,7 @@ def _matrix(value: object, name: str) -> FloatArray:
         )
     if array.ndim != 2:
         raise ShapeError(f"{name} must be a 2-D matrix, got an array of shape {array.shape}")
-    return np.array(array, dtype=np.float64, order="C")
+    return array
 
 
 #: Default C = I and D = 0 up to this many entries are made once and shared (read-only).
@@ -56,6 +74,12 @@ def _constant(rows: int, columns: int, identity: bool) -> FloatArray:
     if rows * columns <= _SHARED_CONSTANT_MAX_ENTRIES:
         return _shared_constant(rows, columns, identity)
     return _made_constant(rows, columns, identity)
+
+
+def identity(order: int) -> FloatArray:
+    """The identity of ``order`` (read-only; shared up to
+    :data:`_SHARED_CONSTANT_MAX_ENTRIES` entries)."""
+    return _constant(order, order, identity=True)
 
 
 @functools.lru_cache(maxsize=256)
@@ -386,6 +410,43 @@ def as_state_space(model: System, name: str = "sys") -> StateSpace:
         f"{name} must be a StateSpace, a tuple (A, B) or (A, B, C, D), or an object with A, B, "
         f"C and D attributes, got {type(model).__name__}"
     )
+
+
+def plant_arrays(
+    model: System, name: str = "sys"
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, float]:
+    """(A, B, C, D, dt) of ``model``, without building a :class:`StateSpace` from a tuple: for
+    a function that passes the matrices to the core once, where the read-only copies a model
+    makes cost more than the work on a small one.
+
+    A StateSpace gives its own matrices and any other system (python-control's) is converted
+    by :func:`as_state_space`. A tuple ``(A, B)`` or ``(A, B, C, D)`` gives its arrays as they
+    are (float64 views: no copy; a 1-D B as one column; C = I and D = 0 where absent, as
+    StateSpace makes them, shared and read-only), continuous (dt = 0.0). Given C and D are
+    checked against A and B here (the core's ``check_model``, as StateSpace checks them); the
+    A and B of an ``(A, B)`` tuple are not: the caller must pass them to a core function, which
+    checks its arguments by name (shapes and finiteness) as StateSpace would.
+    """
+    if isinstance(model, StateSpace):
+        return model.A, model.B, model.C, model.D, period(model)
+    if isinstance(model, (tuple, list)) and len(model) in (2, 4):
+        A = matrix_view(model[0], "A")
+        B = model[1]
+        if not _is_matrix(B):
+            B = real_array(B, "B")
+            B = matrix_view(B.reshape(-1, 1) if B.ndim == 1 else B, "B")
+        given = len(model) == 4 and (model[2] is not None or model[3] is not None)
+        C = _constant(A.shape[0], A.shape[0], True)
+        if len(model) == 4 and model[2] is not None:
+            C = matrix_view(model[2], "C")
+        D = _constant(C.shape[0], B.shape[1], False)
+        if len(model) == 4 and model[3] is not None:
+            D = matrix_view(model[3], "D")
+        if given:
+            _core.check_model(A, B, C, D)
+        return A, B, C, D, 0.0
+    sys = as_state_space(model, name)
+    return sys.A, sys.B, sys.C, sys.D, period(sys)
 
 
 def plant_pair(
