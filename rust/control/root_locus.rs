@@ -36,7 +36,7 @@
 //! with the open-loop poles p_i, the zeros z_j and the gain K of c (sI - A)^-1 b from
 //! [`transfer::transfer_channels`], and S_p = Σ 1/(s - p_i), S_z = Σ 1/(s - z_j). Each
 //! approximation x_i moves by 1 / (χ'/χ(x_i) - Σ_{j≠i} 1/(x_i - x_j)) (Aberth 1973, eq. 2),
-//! and stops once |1 + R(x_i)| <= η (1 + |R(x_i)|), η = 32 (n + m + 1) u: x_i is then a root of
+//! and stops once |1 + R(x_i)| <= η max(1, |R(x_i)|), η = 32 (n + m + 1) u: x_i is then a root of
 //! the factored χ_g with its factors perturbed by O(η). The iteration keeps the real
 //! structure: a real pole is iterated on the real axis, a complex pair as its upper member
 //! (its conjugate counted in the sums). Every run starts at a gain solved by the QR
@@ -505,10 +505,15 @@ impl Factored {
     }
 }
 
-/// |1 + R| / (1 + |R|): a point where R(x) = r is a root of the factored χ_g with its factors
-/// perturbed by about this much (relative).
-fn residual(r: c64) -> f64 {
-    modulus(r + 1.0) / (1.0 + modulus(r))
+/// Whether |1 + R| <= η max(1, |R|) (squared, without a root or a division): a point where
+/// R(x) = r is then a root of the factored χ_g with its factors perturbed by O(η) (relative).
+#[inline]
+fn is_root(r: c64, eta: f64) -> bool {
+    if r.re.abs().max(r.im.abs()) > 1e150 {
+        return false; // |1 + R| is |R| to rounding: far from a root, and the squares overflow
+    }
+    let one_plus = (r.re + 1.0) * (r.re + 1.0) + r.im * r.im;
+    one_plus <= eta * eta * (r.re * r.re + r.im * r.im).max(1.0)
 }
 
 /// |z|, by a square root where |z|^2 stays in the normal range.
@@ -642,7 +647,7 @@ fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<b
             let Some(r) = factored.r(xi, g) else {
                 return false;
             };
-            if residual(r) <= eta {
+            if is_root(r, eta) {
                 *converged = true;
                 continue;
             }

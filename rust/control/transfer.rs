@@ -296,9 +296,9 @@ fn quotient(x: c64, y: c64) -> c64 {
 
 /// The roots by increasing modulus (an overflowing modulus is infinite).
 fn by_modulus(roots: &[c64]) -> Vec<c64> {
-    let mut sorted = roots.to_vec();
-    sorted.sort_by(|x, y| x.norm().total_cmp(&y.norm()));
-    sorted
+    let mut keyed: Vec<(f64, c64)> = roots.iter().map(|r| (r.norm(), *r)).collect();
+    keyed.sort_by(|x, y| x.0.total_cmp(&y.0));
+    keyed.into_iter().map(|(_, r)| r).collect()
 }
 
 /// `start` Π(point - multiply_i) / Π(point - divide_j), renormalised after each factor (the
@@ -719,13 +719,14 @@ fn best_points(roots: &[c64], dt: f64, centre: f64) -> (c64, c64) {
         let middle = points.len() / 2;
         return (points[middle], points[middle + 1]);
     }
-    // min |p - r|^2 / |p|^2 over the roots: the relative distance, squared (no hypot).
+    // min |p - r|^2 / |p|^2 over the roots: the relative distance, squared (no hypot; one
+    // division, which as a monotone rounding gives the same value as dividing each term).
     let distance = |p: c64| {
-        let size = p.norm_sqr();
-        roots
+        let nearest = roots
             .iter()
-            .map(|r| (p - r).norm_sqr() / size)
-            .fold(f64::INFINITY, f64::min)
+            .map(|r| (p - r).norm_sqr())
+            .fold(f64::INFINITY, f64::min);
+        nearest / p.norm_sqr()
     };
     let (mut first, mut second) = (
         (f64::NEG_INFINITY, points[0]),
