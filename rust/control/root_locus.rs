@@ -587,6 +587,9 @@ impl Continuation {
         let Some((g1, last)) = &self.last else {
             return false;
         };
+        if factored.fixed.len() + last.len() != out.len() {
+            return false;
+        }
         let x = &mut self.work;
         x.clone_from(last);
         if let Some((g0, before)) = &self.before {
