@@ -212,10 +212,15 @@ pub fn root_locus(
         Vec::new()
     };
     // The factored form costs about as much as a few gains' QR iterations.
-    let factored = if gains.len() >= MIN_CONTINUED {
-        Factored::of(a, &bv, &cv)?
-    } else {
+    // A failure of the fast path (its eigenvalues, say) only forgoes the continuation.
+    let factored = if gains.len() < MIN_CONTINUED {
         None
+    } else {
+        match Factored::of(a, &bv, &cv) {
+            Ok(factored) => factored,
+            Err(Error::Interrupted) => return Err(Error::Interrupted),
+            Err(_) => None,
+        }
     };
     // Runs of consecutive gains, a few per thread: each starts with the QR iteration.
     let runs = (rayon::current_num_threads() * 4).max(1);
