@@ -7,6 +7,7 @@ import math
 import warnings
 
 import control
+import mpmath
 import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
@@ -1246,3 +1247,83 @@ def test_discrete_margins_in_badly_scaled_states() -> None:
         assert m.gain_margin == pytest.approx(gm, rel=1e-8)
         assert m.phase_margin == pytest.approx(pm, abs=1e-7)
         assert m.closed_loop_stable
+
+
+def _mpmath_locus_roots(num: list[float], den: list[float], k: float) -> np.ndarray:
+    """The roots of den(s) + k num(s) at 50 digits (coefficients highest power first)."""
+    with mpmath.workdps(50):
+        padded = [0.0] * (len(den) - len(num)) + list(num)
+        coefficients = [
+            mpmath.mpf(d) + mpmath.mpf(k) * mpmath.mpf(v) for d, v in zip(den, padded, strict=True)
+        ]
+        roots = mpmath.polyroots(coefficients, maxsteps=200, extraprec=200)
+    return np.sort_complex(np.array([complex(r) for r in roots]))
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="root_locus at high gain of a relative-degree-3 loop: the unbalanced "
+    "controller-Hessenberg QR (single gain and continuation alike) gives poles wrong by "
+    "1.3e-6 relative where numpy's eigvals is accurate to 7e-16",
+)
+def test_root_locus_high_gain_relative_degree_three_against_mpmath() -> None:
+    """2 (s + 3)/((s + 1)^3 (s + 5)) at k = 8.84e7 and 1e8: poles about -563, -3 and
+    279 ± 486j. Oracle: mpmath's polyroots of (s + 1)^3 (s + 5) + 2 k (s + 3) at 50 digits;
+    numpy's eigvals of A - k B C agrees with it to 1e-15 (relative to the largest pole)."""
+    loop = aerocontrol.zpk([-3.0], [-1.0, -1.0, -1.0, -5.0], 2.0)
+    den = [float(c) for c in np.poly([-1.0, -1.0, -1.0, -5.0])]
+    gains = np.logspace(-8, 8, 1500)
+    dense = root_locus(loop, gains).poles
+    for i in (1494, 1499):
+        k = float(gains[i])
+        exact = _mpmath_locus_roots([2.0, 6.0], den, k)
+        scale = float(np.max(np.abs(exact)))
+        ours = np.linalg.eigvals(loop.A - k * loop.B @ loop.C)
+        assert np.max(np.abs(np.sort_complex(ours) - exact)) <= 1e-14 * scale
+        for poles in (dense[i], root_locus(loop, [k]).poles[0]):
+            assert np.max(np.abs(np.sort_complex(poles) - exact)) <= 1e-12 * scale
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="root_locus of a loop with A and C scaled by 1e-100 (B of order 1): at k = 1 the "
+    "poles come out -2e-100 and 0 for -2.5e-100 ± 1.32e-100j (2% wrong at 1e-60, 4e-9 at 1e-30)",
+)
+def test_root_locus_of_a_loop_scaled_by_1e_minus_100() -> None:
+    """2 (s + 3)/((s + 1)(s + 2)) realised by zpk, with A and C multiplied by 1e-100: the
+    closed loop is 1e-100 times that of the unscaled loop, whose poles at k = 1 are
+    s^2 + 5 s + 8 = 0, -2.5 ± j√7/2 (a closed form)."""
+    base = aerocontrol.zpk([-3.0], [-1.0, -2.0], 2.0)
+    loop = aerocontrol.StateSpace(base.A * 1e-100, base.B, base.C * 1e-100)
+    exact = np.array([complex(-2.5, -math.sqrt(7) / 2), complex(-2.5, math.sqrt(7) / 2)])
+    assert np.allclose(np.sort_complex(np.linalg.eigvals(loop.A - loop.B @ loop.C)) * 1e100, exact)
+    for poles in (
+        root_locus(loop, [1.0]).poles[0],
+        root_locus(loop, np.linspace(0.5, 1.0, 200)).poles[-1],
+    ):
+        np.testing.assert_allclose(np.sort_complex(poles) * 1e100, exact, rtol=1e-12)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="root_locus of 1/(s + 1)^4 (a Jordan chain) at k = 9.29e7 by one gain (the QR "
+    "path, also every run's first gain of a dense call) is 3.4e-5 off (relative), while the "
+    "dense call's continuation there is 2e-16 off: a gain's poles depend on the other gains",
+)
+def test_root_locus_of_a_jordan_chain_at_high_gain_closed_form() -> None:
+    """x' = J x + e4 u, y = x1 with J the 4 x 4 Jordan block at -1: 1 + k/(s + 1)^4 = 0, so
+    s = -1 + k^(1/4) e^(jπ(2l + 1)/4) (a closed form), about 98 in modulus at k = 9.29e7;
+    numpy's eigvals of A - k B C is within 1e-15 of it (relative)."""
+    A = np.diag(-np.ones(4)) + np.diag(np.ones(3), 1)
+    B, C = np.eye(4)[:, 3:], np.eye(4)[:1]
+    loop = aerocontrol.StateSpace(A, B, C)
+    gains = np.logspace(-8, 8, 1500)
+    k = float(gains[1496])
+    exact = np.sort_complex(-1 + k**0.25 * np.exp(1j * np.pi * (2 * np.arange(4) + 1) / 4))
+    scale = float(np.max(np.abs(exact)))
+    ours = np.sort_complex(np.linalg.eigvals(A - k * B @ C))
+    assert np.max(np.abs(ours - exact)) <= 1e-14 * scale
+    dense = root_locus(loop, gains).poles[1496]
+    assert np.max(np.abs(dense - exact)) <= 1e-14 * scale
+    single = root_locus(loop, [k]).poles[0]
+    assert np.max(np.abs(single - exact)) <= 1e-12 * scale
