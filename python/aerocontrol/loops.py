@@ -100,7 +100,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._balance import balanced_matrices, balanced_matrix, balanced_states
+from ._balance import balanced_loop, balanced_matrix, balanced_states
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
@@ -226,10 +226,9 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     Aberth's iteration on the factored characteristic polynomial from gain to gain, each
     gain's poles verified against the traces of the closed loop and its square, and the QR
     iteration wherever that fails; see ``rust/control/root_locus.rs``) on the loop with its
-    states balanced
-    (:func:`balanced_states`): the QR is not balanced itself, so its errors are relative to
-    the matrix it is given, and states scaled by 10^±6 gave poles wrong by 1800 times their
-    size. Where a term of a matrix (A, or g B C with
+    states balanced (:func:`~aerocontrol._balance.balanced_loop`): the QR is not balanced
+    itself, so its errors are relative to the matrix it is given, and states scaled by 10^±6
+    gave poles wrong by 1800 times their size. Where a term of a matrix (A, or g B C with
     g = k/(1 + k D), bounded by |g| max|B| max|C|) exceeds 2^RESCALE_EXPONENT, the matrix is
     formed divided by the power of two 2^e nearest its size, from B and C normalised by
     powers of two (so that neither B C nor g B C overflows), and its eigenvalues multiplied by
@@ -238,7 +237,7 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     n = model.n_states
     if n == 0:
         return np.zeros((k.size, 0), np.complex128)
-    A, B, C = balanced_matrices(model.A, model.B, model.C)
+    A, B, C = balanced_loop(model.A, model.B, model.C)
     g = _closed_loop_gains(model, k)
     size_A, size_B, size_C = _log2_size(A), _log2_size(B), _log2_size(C)
     largest = float(np.max(np.abs(g)))
