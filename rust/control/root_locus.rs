@@ -216,7 +216,6 @@ pub fn root_locus(
     } else {
         Vec::new()
     };
-    // The factored form costs about as much as a few gains' QR iterations.
     // A failure of the fast path (its eigenvalues, say) only forgoes the continuation.
     let factored = match Factored::of(a, &bv, &cv) {
         Ok(factored) => factored,
