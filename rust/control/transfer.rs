@@ -719,10 +719,19 @@ fn best_points(roots: &[c64], dt: f64, centre: f64) -> (c64, c64) {
         let middle = points.len() / 2;
         return (points[middle], points[middle + 1]);
     }
+    // Every point lies in the upper half-plane, where a root below the real axis is no nearer
+    // than its conjugate, also after rounding (|Im p + b| >= |Im p - b| for b >= 0): such a
+    // root is left out when its conjugate is one of the roots, which leaves every minimum as
+    // it is.
+    let nearer: Vec<c64> = roots
+        .iter()
+        .filter(|r| r.im >= 0.0 || !roots.contains(&r.conj()))
+        .copied()
+        .collect();
     // min |p - r|^2 / |p|^2 over the roots: the relative distance, squared (no hypot; one
     // division, which as a monotone rounding gives the same value as dividing each term).
     let distance = |p: c64| {
-        let nearest = roots
+        let nearest = nearer
             .iter()
             .map(|r| (p - r).norm_sqr())
             .fold(f64::INFINITY, f64::min);
