@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import aircraft, batch, chapter, design, exceptions, handling, plotting, report
+from . import aircraft, batch, chapter, design, exceptions, handling, plotting, report, robustness
 from .controllability import (
     Controllability,
     controllability,
@@ -251,6 +251,7 @@ __all__ = [
     "report",
     "riccati_difference",
     "riccati_ode",
+    "robustness",
     "root_locus",
     "schur",
     "second_order",

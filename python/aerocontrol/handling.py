@@ -81,7 +81,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ._validation import check_choice, real_scalar
 from .exceptions import InvalidArgumentError, NonFiniteError, ShapeError
@@ -97,6 +97,7 @@ __all__ = [
     "Requirement",
     "assess",
     "compare",
+    "level_arrays",
     "margin_requirement",
     "margins_check",
 ]
@@ -113,6 +114,8 @@ CATEGORIES: tuple[str, ...] = ("A", "B", "C")
 _OSCILLATORY = frozenset({"short period", "phugoid", "dutch roll"})
 _CLASS_ALIASES = {"II": "II-L"}
 _LN2 = math.log(2.0)
+
+FloatArray = NDArray[np.float64]
 
 _REFERENCES = {
     "short period": f"{SPECIFICATION} 3.2.2.1.2, Table IV",
@@ -671,6 +674,131 @@ def _spiral(lam: NDArray[np.complex128], category: str) -> Requirement:
     t2 = _time_to_double(float(lam[0].real))
     limits = SPIRAL_MIN_TIME_TO_DOUBLE[category]
     return _requirement("spiral", "time to double", t2, [(f"> {m:g} s", t2 > m) for m in limits])
+
+
+# --- Many aircraft at once ------------------------------------------------------------------
+
+
+def level_arrays(
+    modes: Mapping[str, ArrayLike], aircraft_class: str, category: str
+) -> dict[str, NDArray[np.int8]]:
+    """The Level of each mode of k aircraft at once: what :func:`assess` gives, mode by mode
+    (the worst Level of the mode's quantities), on arrays.
+
+    Parameters
+    ----------
+    modes : mapping of str to array_like
+        Mode name to its eigenvalues: shape (k, 2) for "short period", "phugoid" and "dutch
+        roll" (a conjugate pair or two real roots per aircraft), (k,) for "roll" and "spiral".
+    aircraft_class, category : str
+        As for :func:`assess`.
+
+    Returns
+    -------
+    dict of str to ndarray of int8, shape (k,)
+        The Level (1 to 4) of each mode given.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from aerocontrol.handling import level_arrays
+    >>> dutch_roll = np.array([[-0.08066 + 0.7433j, -0.08066 - 0.7433j],
+    ...                        [-0.3 + 0.7j, -0.3 - 0.7j]])
+    >>> level_arrays({"dutch roll": dutch_roll}, "III", "C")["dutch roll"]
+    array([2, 1], dtype=int8)
+    """
+    cls = _aircraft_class(aircraft_class)
+    cat = _category(category)
+    levels: dict[str, NDArray[np.int8]] = {}
+    for key, value in modes.items():
+        mode = _mode_name(key, "modes")
+        lam = np.asarray(value, dtype=np.complex128)
+        oscillatory = mode in _OSCILLATORY
+        if lam.ndim != (2 if oscillatory else 1) or (oscillatory and lam.shape[1] != 2):
+            expected = "(k, 2)" if oscillatory else "(k,)"
+            raise ShapeError(f"modes[{key!r}] must have shape {expected}, got {lam.shape}")
+        if not np.isfinite(lam).all():
+            raise NonFiniteError(f"modes[{key!r}] must be finite")
+        levels[mode] = _mode_levels(mode, lam, cls, cat)
+    return levels
+
+
+def _pair_arrays(lam: NDArray[np.complex128]) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """:func:`_pair` on k pairs: (ω_n, ζ, ζ ω_n)."""
+    l1, l2 = lam[:, 0], lam[:, 1]
+    wn2 = (l1 * l2).real
+    zw = -0.5 * (l1 + l2).real
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wn = np.where(wn2 > 0, np.sqrt(np.abs(wn2)), np.where(wn2 == 0, 0.0, np.nan))
+        zeta = np.where(
+            wn2 > 0,
+            zw / np.where(wn2 > 0, wn, 1.0),
+            np.where((wn2 == 0) & (zw != 0), np.copysign(np.inf, zw), np.nan),
+        )
+    return wn, zeta, zw
+
+
+def _time_to_double_arrays(growth: FloatArray) -> FloatArray:
+    with np.errstate(divide="ignore"):
+        return np.where(growth > 0, _LN2 / np.where(growth > 0, growth, 1.0), np.inf)
+
+
+def _first_met(checks: Sequence[NDArray[np.bool_] | None], count: int) -> NDArray[np.int8]:
+    """The first Level (1-3) whose check is met (None: no limit, met), else 4."""
+    level = np.full(count, 4, dtype=np.int8)
+    for k in range(len(checks), 0, -1):
+        met = checks[k - 1]
+        level = np.where(True if met is None else met, np.int8(k), level).astype(np.int8)
+    return level
+
+
+def _mode_levels(
+    mode: str, lam: NDArray[np.complex128], aircraft_class: str, category: str
+) -> NDArray[np.int8]:
+    count = lam.shape[0]
+    if mode == "short period":
+        _, zeta, _ = _pair_arrays(lam)
+        checks = [
+            zeta >= low if high is None else (low <= zeta) & (zeta <= high)
+            for low, high in SHORT_PERIOD_ZETA[category]
+        ]
+        return _first_met(checks, count)
+    if mode == "phugoid":
+        _, zeta, _ = _pair_arrays(lam)
+        level1, level2 = PHUGOID_MIN_ZETA
+        t2 = _time_to_double_arrays(lam.real.max(axis=1))
+        damping = _first_met([zeta >= level1, zeta >= level2, None], count)
+        doubling = _first_met([t2 == np.inf, t2 == np.inf, t2 >= PHUGOID_MIN_TIME_TO_DOUBLE], count)
+        return np.maximum(damping, doubling)
+    if mode == "dutch roll":
+        wn, zeta, zw = _pair_arrays(lam)
+        rows = (DUTCH_ROLL_LEVEL1[category, aircraft_class], DUTCH_ROLL_LEVEL2, DUTCH_ROLL_LEVEL3)
+        capped = aircraft_class == "III"
+        cap = DUTCH_ROLL_CLASS_III_MAX_REQUIRED_ZETA
+        zeta_checks: list[NDArray[np.bool_] | None] = []
+        zw_checks: list[NDArray[np.bool_] | None] = []
+        wn_checks: list[NDArray[np.bool_] | None] = []
+        for min_zeta, min_zw, min_wn in rows:
+            zeta_checks.append(zeta > min_zeta)
+            if min_zw is None:
+                zw_checks.append(None)
+            elif capped:
+                zw_checks.append((zw > min_zw) | (zeta >= cap))
+            else:
+                zw_checks.append(zw > min_zw)
+            wn_checks.append(wn > min_wn)
+        levels: NDArray[np.int8] = np.maximum.reduce(
+            [_first_met(c, count) for c in (zeta_checks, zw_checks, wn_checks)]
+        )
+        return levels
+    if mode == "roll":
+        root = lam.real
+        with np.errstate(divide="ignore"):
+            tau = np.where(root < 0, -1.0 / np.where(root < 0, root, -1.0), np.inf)
+        limits = ROLL_MODE_MAX_TIME_CONSTANT[category, aircraft_class]
+        return _first_met([tau <= m for m in limits], count)
+    t2 = _time_to_double_arrays(lam.real)
+    return _first_met([t2 > m for m in SPIRAL_MIN_TIME_TO_DOUBLE[category]], count)
 
 
 # --- Text ------------------------------------------------------------------------------------

@@ -45,6 +45,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .._validation import real_scalar
 from ..exceptions import InvalidArgumentError
@@ -60,6 +61,7 @@ __all__ = [
     "LATERAL_DERIVATIVES",
     "LONGITUDINAL_DERIVATIVES",
     "PLAUSIBLE_RANGES",
+    "SAMPLED_FIELDS",
     "Aircraft",
     "AircraftDataError",
     "available",
@@ -68,6 +70,13 @@ __all__ = [
 
 LONGITUDINAL_STATES = ("u/u0", "alpha", "q", "theta")
 LATERAL_STATES = ("beta", "p", "phi", "r")
+
+#: The fields of an :class:`Aircraft` besides its derivatives that
+#: :meth:`Aircraft.model_stack` can vary: mass, the stability-axis inertias, the speed u0 and
+#: the density.
+SAMPLED_FIELDS = ("mass", "Ix", "Iy", "Iz", "Ixz", "speed", "density")
+
+FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -146,14 +155,17 @@ class Aircraft:
 
     def dimensional_longitudinal(self) -> dict[str, float]:
         """Xu, Xw, Xde, Zu, Zw, Zwdot, Zq, Zde, Mu, Mw, Mwdot, Mq, Mde: the chapter's (6.48)."""
-        c = self.derivatives
+        return self._dimensional_longitudinal(_Values(self, {}))
+
+    def _dimensional_longitudinal(self, v: _Values) -> dict[str, Any]:
+        c = v.derivatives
         rho, u0, S, cbar, m, Iy, M = (
-            self.density,
-            self.speed,
+            v["density"],
+            v["speed"],
             self.S,
             self.cbar,
-            self.mass,
-            self.Iy,
+            v["mass"],
+            v["Iy"],
             self.mach,
         )
         force = rho * S * u0 / (2 * m)
@@ -179,8 +191,11 @@ class Aircraft:
     def dimensional_lateral(self) -> dict[str, float]:
         """Yv, Yp, Yr, Ydr, Yda, Lv, Lp, Lr, Ldr, Lda, Nv, Np, Nr, Ndr, Nda and the product-of-
         inertia factors ix = Ixz/Ix, iz = Ixz/Iz: the chapter's (6.148)-(6.149)."""
-        c = self.derivatives
-        rho, u0, S, b, m = self.density, self.speed, self.S, self.b, self.mass
+        return self._dimensional_lateral(_Values(self, {}))
+
+    def _dimensional_lateral(self, v: _Values) -> dict[str, Any]:
+        c = v.derivatives
+        rho, u0, S, b, m = v["density"], v["speed"], self.S, self.b, v["mass"]
         values = {
             "Yv": rho * u0 * S / (2 * m) * c["Cy_beta"],
             "Yp": rho * u0 * S * b / (4 * m) * c["Cy_p"],
@@ -188,7 +203,7 @@ class Aircraft:
             "Ydr": rho * u0**2 * S / (2 * m) * c["Cy_dr"],
             "Yda": rho * u0**2 * S / (2 * m) * c["Cy_da"],
         }
-        for letter, inertia in (("L", self.Ix), ("N", self.Iz)):
+        for letter, inertia in (("L", v["Ix"]), ("N", v["Iz"])):
             coefficient = "Cl" if letter == "L" else "Cn"
             values[f"{letter}v"] = rho * u0 * S * b / (2 * inertia) * c[f"{coefficient}_beta"]
             for rate in ("p", "r"):
@@ -199,8 +214,8 @@ class Aircraft:
                 values[f"{letter}{surface}"] = (
                     rho * u0**2 * S * b / (2 * inertia) * c[f"{coefficient}_{surface}"]
                 )
-        values["ix"] = self.Ixz / self.Ix
-        values["iz"] = self.Ixz / self.Iz
+        values["ix"] = v["Ixz"] / v["Ix"]
+        values["iz"] = v["Ixz"] / v["Iz"]
         return {key: value + 0.0 for key, value in values.items()}
 
     # ------------------------------------------------------------------------------------
@@ -209,15 +224,20 @@ class Aircraft:
 
     def longitudinal(self) -> StateSpace:
         """The longitudinal model (6.49): x = (u/u0, α, q, θ), input the elevator δe (rad)."""
-        # Rows as Python floats (the same double-precision operations as numpy's, without a
-        # numpy call per row), one array at the end.
-        d = self.dimensional_longitudinal()
-        u0, g, theta0 = self.speed, self.gravity, self.theta0
+        A, B = self._longitudinal_matrices(_Values(self, {}))
+        return StateSpace(A, B, state_names=list(LONGITUDINAL_STATES), input_names=["elevator"])
+
+    def _longitudinal_matrices(self, v: _Values) -> tuple[FloatArray, FloatArray]:
+        # Rows as Python floats for one model (the same double-precision operations as
+        # numpy's, without a numpy call per row), or as arrays of sampled values; one array at
+        # the end.
+        d = self._dimensional_longitudinal(v)
+        u0, g, theta0 = v["speed"], self.gravity, self.theta0
         surge = [d["Xu"], d["Xw"], 0.0, -g * math.cos(theta0) / u0]
-        if d["Zwdot"] == 1.0:  # (1 - Zẇ) dα/dt: the α equation would have no dα/dt
+        if np.any(d["Zwdot"] == 1.0):  # (1 - Zẇ) dα/dt: the α equation would have no dα/dt
             raise AircraftDataError(
                 f"{self.name}: the longitudinal model is singular: 1 - Zẇ = 0 with "
-                f"CL_alphadot = {self.derivatives['CL_alphadot']:g}"
+                f"CL_alphadot = {self.derivatives['CL_alphadot']:g}" + v.where(d["Zwdot"] == 1.0)
             )
         scale = 1.0 / (1.0 - d["Zwdot"])
         heave = [
@@ -234,21 +254,26 @@ class Aircraft:
         ]
         pitch_control = d["Mde"] + alpha_rate * heave_control
         # (+ 0.0 turns the negative zeros of -g sin 0 and -CD_de = -0 into zeros.)
-        A = np.array([surge, heave, pitch, [0.0, 0.0, 1.0, 0.0]]) + 0.0
-        B = np.array([[d["Xde"] / u0], [heave_control], [pitch_control], [0.0]]) + 0.0
-        return StateSpace(A, B, state_names=list(LONGITUDINAL_STATES), input_names=["elevator"])
+        A = _assemble([surge, heave, pitch, [0.0, 0.0, 1.0, 0.0]])
+        B = _assemble([[d["Xde"] / u0], [heave_control], [pitch_control], [0.0]])
+        return A, B
 
     def lateral(self) -> StateSpace:
         """The lateral-directional model (6.150): x = (β, p, φ, r), inputs (rudder, aileron) in
         rad, the order of the chapter's LQR example (6.224)."""
-        # Rows as Python floats, as in longitudinal().
-        d = self.dimensional_lateral()
-        u0, g, theta0 = self.speed, self.gravity, self.theta0
+        A, B = self._lateral_matrices(_Values(self, {}))
+        return StateSpace(A, B, state_names=list(LATERAL_STATES), input_names=["rudder", "aileron"])
+
+    def _lateral_matrices(self, v: _Values) -> tuple[FloatArray, FloatArray]:
+        # Rows as Python floats or arrays, as in _longitudinal_matrices().
+        d = self._dimensional_lateral(v)
+        u0, g, theta0 = v["speed"], self.gravity, self.theta0
         ix, iz = d["ix"], d["iz"]
         coupling = 1.0 - ix * iz
-        if not coupling > 0.0:  # Ix Iz > Ixz^2, checked by the loader, lost to rounding
+        if not np.all(coupling > 0.0):  # Ix Iz > Ixz^2, checked by the loader, lost to rounding
             raise AircraftDataError(
-                f"{self.name}: the lateral model is singular: 1 - Ixz^2/(Ix Iz) = {coupling:g}"
+                f"{self.name}: the lateral model is singular: 1 - Ixz^2/(Ix Iz) = "
+                f"{np.min(coupling):g}" + v.where(~(coupling > 0.0))
             )
         roll = [u0 * d["Lv"], d["Lp"], 0.0, d["Lr"]]
         yaw = [u0 * d["Nv"], d["Np"], 0.0, d["Nr"]]
@@ -258,7 +283,7 @@ class Aircraft:
         def combined(first: list[float], second: list[float], factor: float) -> list[float]:
             return [(x + factor * y) / coupling for x, y in zip(first, second, strict=True)]
 
-        A = np.array(
+        A = _assemble(
             [
                 [d["Yv"], d["Yp"] / u0, g * math.cos(theta0) / u0, d["Yr"] / u0 - 1.0],
                 combined(roll, yaw, ix),
@@ -266,7 +291,7 @@ class Aircraft:
                 combined(yaw, roll, iz),
             ]
         )
-        B = np.array(
+        B = _assemble(
             [
                 [d["Ydr"] / u0, d["Yda"] / u0],
                 combined(roll_control, yaw_control, ix),
@@ -274,8 +299,61 @@ class Aircraft:
                 combined(yaw_control, roll_control, iz),
             ]
         )
-        A, B = A + 0.0, B + 0.0
-        return StateSpace(A, B, state_names=list(LATERAL_STATES), input_names=["rudder", "aileron"])
+        return A, B
+
+    def model_stack(
+        self, axis: str, values: Mapping[str, ArrayLike]
+    ) -> tuple[FloatArray, FloatArray]:
+        """The state matrices of many variants of this aircraft at once: A of shape (k, 4, 4)
+        and B of shape (k, 4, inputs), the i-th built from the i-th entry of each array in
+        ``values`` and this aircraft's own value of everything else.
+
+        ``values`` maps names to arrays of k values: any nondimensional derivative
+        (:data:`LONGITUDINAL_DERIVATIVES`, :data:`LATERAL_DERIVATIVES`) or one of
+        :data:`SAMPLED_FIELDS` ("mass", "Ix", "Iy", "Iz", "Ixz", "speed", "density"). The
+        formulas are those of :meth:`longitudinal` and :meth:`lateral`, the same operations in
+        the same order evaluated on arrays, so each model equals, bitwise, the one built from
+        an aircraft with those values. Nothing is re-trimmed: a sampled mass or speed leaves
+        CL and CD as they are (a perturbation of the model, not another flight condition; for
+        that, use :meth:`at`).
+
+        Parameters
+        ----------
+        axis : {"longitudinal", "lateral"}
+        values : mapping of str to array_like, each of shape (k,)
+
+        Returns
+        -------
+        (A, B) : tuple of ndarray
+            Of shapes (k, 4, 4) and (k, 4, 1) (longitudinal) or (k, 4, 2) (lateral).
+
+        Raises
+        ------
+        InvalidArgumentError
+            An unknown name, or arrays that are not 1-D of one length, or not finite.
+        AircraftDataError
+            A sample whose model is singular (1 - Zẇ = 0, or Ixz² >= Ix Iz); the message
+            names the first such sample.
+
+        Examples
+        --------
+        >>> from aerocontrol import aircraft
+        >>> b747 = aircraft.load("b747-cruise")
+        >>> A, B = b747.model_stack("lateral", {"Cn_beta": [0.1, 0.2, 0.3]})
+        >>> A.shape, B.shape
+        ((3, 4, 4), (3, 4, 2))
+        >>> bool((A[0] == b747.lateral().A).all())   # a value changed: another model
+        False
+        """
+        if axis not in ("longitudinal", "lateral"):
+            raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
+        sampled = _Values(self, values)
+        build = self._longitudinal_matrices if axis == "longitudinal" else self._lateral_matrices
+        A, B = build(sampled)
+        count = sampled.count
+        A = np.ascontiguousarray(np.broadcast_to(A, (count, 4, 4)))
+        B = np.ascontiguousarray(np.broadcast_to(B, (count, 4, B.shape[-1])))
+        return A, B
 
     def modes(self, axis: str) -> Modes:
         """The modes of the longitudinal or lateral model, named ("phugoid", "short period";
@@ -439,3 +517,69 @@ def load(name_or_path: str | Path = "b747-approach") -> Aircraft:
     """
     text, origin = read_source(name_or_path)
     return Aircraft.from_dict(parse_toml(text, origin), origin)
+
+
+class _Values:
+    """The values a model is built from: the aircraft's own, or arrays of k sampled values in
+    their place (:meth:`Aircraft.model_stack`)."""
+
+    def __init__(self, aircraft: Aircraft, values: Mapping[str, ArrayLike]) -> None:
+        self._aircraft = aircraft
+        self._sampled: dict[str, FloatArray] = {}
+        self.count = 1
+        counts = set()
+        for name, value in values.items():
+            if name not in aircraft.derivatives and name not in SAMPLED_FIELDS:
+                raise InvalidArgumentError(
+                    f"values: {name!r} is neither a derivative of {aircraft.name} nor one of "
+                    f"{', '.join(SAMPLED_FIELDS)}"
+                )
+            array = np.asarray(value, dtype=np.float64)
+            if array.ndim != 1:
+                raise InvalidArgumentError(
+                    f"values[{name!r}] must be 1-D (one value per model), got shape {array.shape}"
+                )
+            if not np.isfinite(array).all():
+                raise InvalidArgumentError(f"values[{name!r}] must be finite")
+            counts.add(array.size)
+            self._sampled[name] = array
+        if len(counts) > 1:
+            raise InvalidArgumentError(
+                f"values: the arrays must have one length, got lengths {sorted(counts)}"
+            )
+        if counts:
+            self.count = counts.pop()
+        self.derivatives: Mapping[str, Any] = (
+            {
+                **aircraft.derivatives,
+                **{k: v for k, v in self._sampled.items() if k not in SAMPLED_FIELDS},
+            }
+            if self._sampled
+            else aircraft.derivatives
+        )
+
+    def __getitem__(self, name: str) -> Any:
+        """A field's sampled values, else the aircraft's own (a float)."""
+        if name in self._sampled:
+            return self._sampled[name]
+        return getattr(self._aircraft, name)
+
+    def where(self, bad: Any) -> str:
+        """ " (sample i)" naming the first sample flagged in ``bad``; "" for one model."""
+        if not self._sampled:
+            return ""
+        first = int(np.flatnonzero(np.broadcast_to(bad, (self.count,)))[0])
+        return f" (sample {first} of the values)"
+
+
+def _assemble(rows: list[list[Any]]) -> FloatArray:
+    """The matrix of ``rows`` (floats, or arrays of k values: then a stack of k matrices),
+    + 0.0 turning negative zeros into zeros."""
+    if all(isinstance(value, float) for row in rows for value in row):
+        return np.array(rows) + 0.0
+    shape = np.broadcast_shapes(*(np.shape(value) for row in rows for value in row))
+    out = np.empty((*shape, len(rows), len(rows[0])))
+    for i, row in enumerate(rows):
+        for j, value in enumerate(row):
+            out[..., i, j] = value
+    return out + 0.0

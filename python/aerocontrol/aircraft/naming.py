@@ -18,12 +18,12 @@ Keys are lower case ("short period", "phugoid", "dutch roll", "roll", "spiral",
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import InvalidArgumentError
 from ..modal import Modes
 
-__all__ = ["DISPLAY_NAMES", "classify_modes", "name_modes"]
+__all__ = ["DISPLAY_NAMES", "classify_mode_stack", "classify_modes", "name_modes"]
 
 DISPLAY_NAMES = {
     "short period": "short period",
@@ -78,6 +78,103 @@ def classify_modes(modes: Modes | ArrayLike, axis: str) -> dict[str, tuple[compl
             "coupled roll-spiral needs the eigenvectors, so pass aerocontrol.modes(A)"
         )
     return _two_pairs(modes)
+
+
+def classify_mode_stack(
+    eigenvalues: ArrayLike, axis: str, A: ArrayLike | None = None
+) -> tuple[dict[str, NDArray[np.complex128]], NDArray[np.bool_]]:
+    """:func:`classify_modes` for the eigenvalues of k models at once, shape (k, 4).
+
+    Returns the modes, "short period" and "phugoid" or "dutch roll", "roll" and "spiral", as
+    arrays of shape (k, 2) (pairs, ordered as :func:`classify_modes` orders them) or (k,),
+    and a mask of the models left unresolved, whose entries here are NaN: lateral models
+    whose eigenvalues form two complex pairs (telling the Dutch roll from the coupled
+    roll-spiral needs the eigenvectors: :func:`classify_modes` of :func:`aerocontrol.modes`
+    decides them), and longitudinal models whose two smallest eigenvalues are neither a
+    conjugate pair nor two real roots (a split short period and a phugoid of interleaved
+    magnitudes: no mode is defined by magnitude). Given the state matrices ``A`` (k, 4, 4),
+    the Dutch roll of a lateral model with two complex pairs is the pair whose eigenvector has
+    the larger sideslip share, as :func:`classify_modes` decides it (the eigenvectors from the
+    adjugate of A - λI, whose columns span its null space); its roll and spiral stay NaN.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from aerocontrol import aircraft, linalg
+    >>> A, _ = aircraft.load().model_stack("lateral", {"Cn_beta": [0.1, 0.2]})
+    >>> named, unresolved = classify_mode_stack(linalg.eigenvalues(A), "lateral")
+    >>> named["dutch roll"].shape, named["roll"].shape, unresolved.tolist()
+    ((2, 2), (2,), [False, False])
+    """
+    values = np.asarray(eigenvalues, dtype=np.complex128)
+    if values.ndim != 2 or values.shape[1] != 4:
+        raise InvalidArgumentError(
+            f"eigenvalues must have shape (k, 4) (4 per aircraft model), got {values.shape}"
+        )
+    rows = np.arange(values.shape[0])[:, np.newaxis]
+    by_size = values[rows, np.argsort(np.abs(values), axis=1, kind="stable")]
+    if axis == "longitudinal":
+        named = {"phugoid": _pairs(by_size[:, :2]), "short period": _pairs(by_size[:, 2:])}
+        split = (by_size.imag != 0.0).sum(axis=1) == 2
+        unresolved = split & ((by_size[:, 0].imag == 0.0) != (by_size[:, 1].imag == 0.0))
+        return _unset(named, unresolved), unresolved
+    if axis != "lateral":
+        raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
+    is_complex = by_size.imag != 0.0
+    count = is_complex.sum(axis=1)
+    # The real roots first, each group in order of magnitude: with one pair, (spiral, roll,
+    # pair); with four real roots, (spiral, two of the Dutch roll, roll).
+    ordered = by_size[rows, np.argsort(is_complex, axis=1, kind="stable")]
+    one_pair = (count == 2)[:, np.newaxis]
+    dutch_roll = np.where(one_pair, ordered[:, 2:], ordered[:, 1:3])
+    roll = np.where(one_pair[:, 0], ordered[:, 1], ordered[:, 3])
+    named = {"spiral": ordered[:, 0].copy(), "dutch roll": _pairs(dutch_roll), "roll": roll}
+    coupled = count == 4
+    named = _unset(named, coupled)
+    if A is not None and coupled.any():
+        matrices = np.asarray(A, dtype=np.float64)[coupled]
+        upper = values[coupled]
+        # The two members with Im > 0, in the order of the eigenvalues given.
+        upper = upper[
+            np.arange(upper.shape[0])[:, np.newaxis],
+            np.argsort(upper.imag <= 0, axis=1, kind="stable"),
+        ][:, :2]
+        shares = np.stack([_sideslip_share(matrices, upper[:, k]) for k in range(2)], axis=1)
+        dutch = np.where(shares[:, 0] >= shares[:, 1], upper[:, 0], upper[:, 1])
+        named["dutch roll"][coupled] = np.stack([dutch, dutch.conj()], axis=1)
+    return named, coupled
+
+
+def _sideslip_share(A: NDArray[np.float64], lam: NDArray[np.complex128]) -> NDArray[np.float64]:
+    """|v_β| / ||v|| of the eigenvector v of each A (k, 4, 4) for its eigenvalue λ (k,): the
+    column of largest norm of adj(A - λI) (rank one for a simple eigenvalue)."""
+    M = A - lam[:, np.newaxis, np.newaxis] * np.eye(4)
+    columns = np.empty(M.shape, dtype=np.complex128)
+    rows = np.arange(4)
+    for i in range(4):
+        for j in range(4):
+            minor = M[:, rows != j][:, :, rows != i]
+            columns[:, i, j] = (-1) ** (i + j) * np.linalg.det(minor)
+    norms = np.linalg.norm(columns, axis=1)  # (k, columns)
+    best = columns[np.arange(M.shape[0]), :, np.argmax(norms, axis=1)]
+    share: NDArray[np.float64] = np.abs(best[:, 0]) / np.maximum(
+        np.linalg.norm(best, axis=1), np.finfo(float).tiny
+    )
+    return share
+
+
+def _unset(
+    named: dict[str, NDArray[np.complex128]], unresolved: NDArray[np.bool_]
+) -> dict[str, NDArray[np.complex128]]:
+    for value in named.values():
+        value[unresolved] = np.nan
+    return named
+
+
+def _pairs(values: NDArray[np.complex128]) -> NDArray[np.complex128]:
+    """:func:`_pair` on k rows of two roots."""
+    swap = values[:, 0].imag < values[:, 1].imag
+    return np.where(swap[:, np.newaxis], values[:, ::-1], values)
 
 
 def _pair(values: list[complex]) -> tuple[complex, ...]:

@@ -1,0 +1,328 @@
+"""Stochastic robustness (aerocontrol.robustness) and the array kernels under it: models built
+in bulk (Aircraft.model_stack), modes named in bulk (classify_mode_stack) and Levels on arrays
+(handling.level_arrays), each against its one-aircraft counterpart; Clopper-Pearson intervals
+against scipy's beta quantiles; Monte Carlo runs against a sample-by-sample recomputation, and
+bitwise identical however the chunks are run (one process, chunk order, a Dask cluster)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+import scipy.stats
+
+import aerocontrol
+from aerocontrol import aircraft, batch, design, linalg
+from aerocontrol.aircraft.naming import classify_mode_stack, classify_modes
+from aerocontrol.exceptions import InvalidArgumentError, ShapeError
+from aerocontrol.handling import assess, level_arrays
+from aerocontrol.robustness import (
+    LogNormal,
+    Lqr,
+    Normal,
+    Uncertainty,
+    Uniform,
+    clopper_pearson,
+    monte_carlo,
+)
+
+AXES = ("longitudinal", "lateral")
+
+
+def _scattered(plane: aircraft.Aircraft, count: int, spread: float, seed: int) -> dict:
+    rng = np.random.default_rng(seed)
+    values = {
+        k: v * (1 + spread * rng.standard_normal(count)) for k, v in plane.derivatives.items()
+    }
+    for name in ("mass", "Ix", "Iy", "Iz", "speed", "density"):
+        values[name] = getattr(plane, name) * np.exp(0.05 * rng.standard_normal(count))
+    return values
+
+
+@pytest.mark.parametrize("name", aircraft.available())
+@pytest.mark.parametrize("axis", AXES)
+def test_model_stack_is_each_model_bitwise(name: str, axis: str) -> None:
+    plane = aircraft.load(name)
+    values = _scattered(plane, 6, 0.2, 1)
+    A, B = plane.model_stack(axis, values)
+    assert A.shape == (6, 4, 4) and B.shape == (6, 4, 1 if axis == "longitudinal" else 2)
+    for i in range(6):
+        derivatives = {**plane.derivatives, **{k: float(values[k][i]) for k in plane.derivatives}}
+        fields = {k: float(v[i]) for k, v in values.items() if k not in plane.derivatives}
+        one = getattr(dataclasses.replace(plane, derivatives=derivatives, **fields), axis)()
+        np.testing.assert_array_equal(A[i], one.A)
+        np.testing.assert_array_equal(B[i], one.B)
+    nominal_A, nominal_B = plane.model_stack(axis, {})
+    np.testing.assert_array_equal(nominal_A[0], getattr(plane, axis)().A)
+    np.testing.assert_array_equal(nominal_B[0], getattr(plane, axis)().B)
+
+
+def test_model_stack_refuses_bad_values() -> None:
+    plane = aircraft.load("b747-cruise")
+    with pytest.raises(InvalidArgumentError, match="'wingspan' is neither"):
+        plane.model_stack("lateral", {"wingspan": [1.0]})
+    with pytest.raises(InvalidArgumentError, match="one length"):
+        plane.model_stack("lateral", {"Cn_beta": [0.1, 0.2], "Cl_p": [0.1]})
+    with pytest.raises(InvalidArgumentError, match=r"values\['Cn_beta'\] must be 1-D"):
+        plane.model_stack("lateral", {"Cn_beta": [[0.1]]})
+    with pytest.raises(InvalidArgumentError, match="finite"):
+        plane.model_stack("lateral", {"Cn_beta": [np.nan]})
+    with pytest.raises(InvalidArgumentError, match="axis"):
+        plane.model_stack("vertical", {})
+    with pytest.raises(aircraft.AircraftDataError, match="sample 1 of the values"):
+        plane.model_stack("lateral", {"Ixz": [0.0, 1e9]})
+
+
+@pytest.mark.parametrize("name", aircraft.available())
+@pytest.mark.parametrize("axis", AXES)
+def test_levels_in_bulk_are_those_of_assess(name: str, axis: str) -> None:
+    # 40 % scatter on every derivative: stable and unstable, oscillatory and split modes.
+    plane = aircraft.load(name)
+    A, _ = plane.model_stack(axis, _scattered(plane, 400, 0.4, 2))
+    eigenvalues = linalg.eigenvalues(A)
+    named, unresolved = classify_mode_stack(eigenvalues, axis)
+    known = ~unresolved
+    levels = level_arrays(
+        {k: v[known] for k, v in named.items()}, plane.aircraft_class, plane.category
+    )
+    for j, i in enumerate(np.flatnonzero(known)):
+        one = assess(classify_modes(eigenvalues[i], axis), plane.aircraft_class, plane.category)
+        assert {mode: int(levels[mode][j]) for mode in one.levels} == one.levels
+    # The 4 levels all occur over the aircraft and both axes; here at least two.
+    assert len({int(v) for value in levels.values() for v in value}) >= 2
+
+
+def test_coupled_roll_spiral_is_named_as_classify_modes_names_it() -> None:
+    # The regulator with Q = I couples roll and spiral into one oscillation: the Dutch roll is
+    # the pair with the larger sideslip share of its eigenvector.
+    plane = aircraft.load("b747-cruise")
+    A, B = plane.model_stack("lateral", _scattered(plane, 300, 0.3, 3))
+    closed = A - B @ batch.solve_care_batch(A, B, np.eye(4), np.eye(2)).K
+    eigenvalues = linalg.eigenvalues(closed)
+    named, unresolved = classify_mode_stack(eigenvalues, "lateral", closed)
+    assert unresolved.sum() > 100
+    for i in np.flatnonzero(unresolved):
+        pair = classify_modes(aerocontrol.modes(closed[i]), "lateral")["dutch roll"]
+        assert named["dutch roll"][i, 0] == pytest.approx(pair[0], rel=1e-12)
+        assert np.isnan(named["roll"][i]) and np.isnan(named["spiral"][i])
+
+
+def test_level_arrays_refuses_bad_input() -> None:
+    with pytest.raises(ShapeError, match=r"\(k, 2\)"):
+        level_arrays({"dutch roll": np.zeros(3)}, "III", "B")
+    with pytest.raises(InvalidArgumentError, match="not a mode"):
+        level_arrays({"yaw": np.zeros(3)}, "III", "B")
+    with pytest.raises(InvalidArgumentError, match="finite"):
+        level_arrays({"roll": np.array([np.nan])}, "III", "B")
+
+
+@pytest.mark.parametrize(
+    ("count", "samples"),
+    [(0, 10), (1, 10), (10, 10), (3, 1000), (500, 1000), (7, 1_000_000), (999_990, 1_000_000)],
+)
+@pytest.mark.parametrize("confidence", [0.9, 0.95, 0.99])
+def test_clopper_pearson_against_scipy(count: int, samples: int, confidence: float) -> None:
+    estimate = clopper_pearson(count, samples, confidence)
+    alpha = 1 - confidence
+    low = scipy.stats.beta.ppf(alpha / 2, count, samples - count + 1) if count else 0.0
+    high = (
+        scipy.stats.beta.ppf(1 - alpha / 2, count + 1, samples - count) if count < samples else 1.0
+    )
+    assert estimate.value == count / samples
+    # 1e-8: ln B(a, b) from lgamma values of about 1e7 at a million samples (1e-9 relative).
+    assert estimate.low == pytest.approx(low, rel=1e-8, abs=1e-300)
+    assert estimate.high == pytest.approx(high, rel=1e-8)
+
+
+def test_clopper_pearson_refuses_bad_counts() -> None:
+    for count, samples in ((-1, 10), (11, 10), (0, 0)):
+        with pytest.raises(InvalidArgumentError, match="count"):
+            clopper_pearson(count, samples)
+    with pytest.raises(InvalidArgumentError, match="confidence"):
+        clopper_pearson(1, 10, 1.0)
+
+
+def test_distributions_and_correlation() -> None:
+    plane = aircraft.load("b747-cruise")
+    uncertainty = Uncertainty(
+        {"Cn_beta": Normal(0.1), "Cl_p": Uniform(0.3), "Iz": LogNormal(0.05)},
+        correlations={("Cn_beta", "Cl_p"): 0.6},
+    )
+    run = aerocontrol.robustness._Run(plane, uncertainty, "lateral", None, 50_000, 7, 50_000, 1)
+    z = run.draws(0)
+    values = run.values(z)
+    # The copula's draws have the correlation asked for (standard error 0.0036 here).
+    assert np.corrcoef(z[:, 0], z[:, 1])[0, 1] == pytest.approx(0.6, abs=0.02)
+    nominal = plane.derivatives
+    assert np.std(values["Cn_beta"]) == pytest.approx(0.1 * abs(nominal["Cn_beta"]), rel=0.02)
+    bound = 0.3 * abs(nominal["Cl_p"])
+    assert np.all(np.abs(values["Cl_p"] - nominal["Cl_p"]) <= bound)
+    # Uniform: the variance of U(-h, h) is h^2 / 3.
+    assert np.var(values["Cl_p"]) == pytest.approx(bound**2 / 3, rel=0.03)
+    assert np.median(values["Iz"]) == pytest.approx(plane.Iz, rel=0.002)
+
+
+def test_uncertainty_refuses_bad_input() -> None:
+    with pytest.raises(InvalidArgumentError, match="at least one"):
+        Uncertainty({})
+    with pytest.raises(InvalidArgumentError, match="Normal, Uniform or LogNormal"):
+        Uncertainty({"Cn_beta": 0.1})  # type: ignore[dict-item]
+    with pytest.raises(InvalidArgumentError, match="spread"):
+        Uncertainty({"Cn_beta": Normal(-0.1)})
+    with pytest.raises(InvalidArgumentError, match="not a pair"):
+        Uncertainty({"Cn_beta": Normal(0.1)}, correlations={("Cn_beta", "Cn_r"): 0.5})
+    with pytest.raises(InvalidArgumentError, match=r"in \(-1, 1\)"):
+        Uncertainty(
+            {"Cn_beta": Normal(0.1), "Cn_r": Normal(0.1)}, correlations={("Cn_beta", "Cn_r"): 1}
+        )
+    three = {"a": Normal(0.1), "b": Normal(0.1), "c": Normal(0.1)}
+    with pytest.raises(InvalidArgumentError, match="positive definite"):
+        Uncertainty(three, correlations={("a", "b"): 0.9, ("b", "c"): 0.9, ("a", "c"): -0.9})
+
+
+_LATERAL = Uncertainty(
+    {"Cn_beta": Normal(0.25), "Cn_r": Normal(0.25), "Cl_beta": Normal(0.2), "Iz": LogNormal(0.1)},
+    correlations={("Cn_beta", "Cn_r"): 0.3},
+)
+
+
+def _gains() -> np.ndarray:
+    k = design.dutch_roll_damper(aircraft.load("b747-cruise")).k
+    return np.vstack([k, np.zeros(4)])
+
+
+def test_monte_carlo_agrees_with_each_sample_judged_alone() -> None:
+    plane = aircraft.load("b747-cruise")
+    result = monte_carlo(plane, _LATERAL, 300, _gains(), seed=11, chunk_size=128)
+    run = aerocontrol.robustness._Run(plane, _LATERAL, "lateral", None, 300, 11, 128, 1)
+    checked = 0
+    for index in range(run.chunk_count):
+        start, _ = run.chunk_bounds(index)
+        values = run.values(run.draws(index))
+        for row in range(0, len(next(iter(values.values()))), 17):
+            fields = {k: float(v[row]) for k, v in values.items() if k == "Iz"}
+            derivatives = {
+                **plane.derivatives,
+                **{k: float(v[row]) for k, v in values.items() if k != "Iz"},
+            }
+            one = dataclasses.replace(plane, derivatives=derivatives, **fields)
+            sys = one.lateral()
+            for outcome, A in (
+                (result.open_loop, sys.A),
+                (result.closed_loop, sys.A - sys.B @ _gains()),
+            ):
+                assert outcome is not None
+                modes = aerocontrol.modes(A)
+                try:
+                    expected = assess(
+                        classify_modes(modes, "lateral"), one.aircraft_class, one.category
+                    ).levels
+                except InvalidArgumentError:  # a coupled roll-spiral: not judged
+                    continue
+                got = outcome.levels[start + row]
+                assert dict(zip(result.modes, got.tolist(), strict=True)) == expected
+                assert outcome.stable[start + row] == bool(np.all(modes.eigenvalues.real < 0))
+                checked += 1
+    assert checked >= 30
+    failed = (result.closed_loop.levels > 1).any(axis=1)  # type: ignore[union-attr]
+    np.testing.assert_array_equal(result.failed, failed)
+
+
+def _same(a: aerocontrol.robustness.MonteCarlo, b: aerocontrol.robustness.MonteCarlo) -> None:
+    for loop in ("open_loop", "closed_loop"):
+        x, y = getattr(a, loop), getattr(b, loop)
+        for key in ("levels", "stable", "unresolved", "max_real"):
+            np.testing.assert_array_equal(getattr(x, key), getattr(y, key))
+    np.testing.assert_array_equal(a.failed, b.failed)
+    np.testing.assert_array_equal(a.failures_by_bin, b.failures_by_bin)
+    np.testing.assert_array_equal(a.samples_by_bin, b.samples_by_bin)
+
+
+class _ReversedClient:
+    """A stand-in for a Dask client that runs the chunks last to first."""
+
+    def map(self, function, runs, indices, pure):  # type: ignore[no-untyped-def]
+        return [function(r, i) for r, i in reversed(list(zip(runs, indices, strict=True)))][::-1]
+
+    def gather(self, futures):  # type: ignore[no-untyped-def]
+        return futures
+
+
+def test_monte_carlo_is_reproducible_and_independent_of_chunk_order() -> None:
+    plane = aircraft.load("b747-cruise")
+    first = monte_carlo(plane, _LATERAL, 5000, _gains(), seed=5, chunk_size=1000)
+    again = monte_carlo(plane, _LATERAL, 5000, _gains(), seed=5, chunk_size=1000)
+    reordered = monte_carlo(
+        plane, _LATERAL, 5000, _gains(), seed=5, chunk_size=1000, client=_ReversedClient()
+    )
+    _same(first, again)
+    _same(first, reordered)
+    other = monte_carlo(plane, _LATERAL, 5000, _gains(), seed=6, chunk_size=1000)
+    assert not np.array_equal(first.open_loop.max_real, other.open_loop.max_real)
+    # The first chunk's samples are the first samples of a longer run.
+    longer = monte_carlo(plane, _LATERAL, 7000, _gains(), seed=5, chunk_size=1000)
+    np.testing.assert_array_equal(longer.open_loop.max_real[:5000], first.open_loop.max_real)
+
+
+def test_monte_carlo_on_a_dask_cluster_is_bitwise_the_local_run() -> None:
+    distributed = pytest.importorskip("distributed")
+    plane = aircraft.load("b747-cruise")
+    local = monte_carlo(plane, _LATERAL, 6000, Lqr(1.0), seed=9, chunk_size=1500)
+    with (
+        distributed.LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            env={"RAYON_NUM_THREADS": "1"},
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        remote = monte_carlo(
+            plane, _LATERAL, 6000, Lqr(1.0), seed=9, chunk_size=1500, client=client
+        )
+    _same(local, remote)
+
+
+def test_monte_carlo_results() -> None:
+    plane = aircraft.load("b747-cruise")
+    result = monte_carlo(plane, _LATERAL, 4000, _gains(), seed=2)
+    # The bare 747 in cruise has a Level 2 Dutch roll (zeta = 0.035 < 0.08) whatever the
+    # scatter; the damper makes it Level 1 in nearly every sample.
+    assert result.probability("level", "dutch roll", 1, loop="open").high < 0.01
+    assert result.probability("level", "dutch roll", 1, loop="closed").low > 0.9
+    estimate = result.probability("unstable", loop="open")
+    assert estimate.count == int((~result.open_loop.stable).sum())
+    assert estimate.low <= estimate.value <= estimate.high
+    ranking = result.sensitivity()
+    assert sorted(name for name, _ in ranking) == sorted(_LATERAL.names)
+    assert [s for _, s in ranking] == sorted((s for _, s in ranking), reverse=True)
+    assert result.samples_by_bin.sum() == 4000 * len(_LATERAL.names)
+    assert result.failures_by_bin.sum(axis=1).tolist() == [int(result.failed.sum())] * 4
+    text = str(result)
+    assert "P(dutch roll Level 1)" in text and "sensitivity" in text
+
+
+def test_monte_carlo_refuses_bad_arguments() -> None:
+    plane = aircraft.load("b747-cruise")
+    for kwargs, message in (
+        ({"samples": 0}, "samples"),
+        ({"samples": 10, "seed": -1}, "seed"),
+        ({"samples": 10, "chunk_size": 0}, "chunk_size"),
+        ({"samples": 10, "required_level": 4}, "required_level"),
+        ({"samples": 10, "axis": "vertical"}, "axis"),
+    ):
+        with pytest.raises(InvalidArgumentError, match=message):
+            monte_carlo(plane, _LATERAL, **kwargs)  # type: ignore[arg-type]
+    with pytest.raises(ShapeError, match=r"\(2, 4\)"):
+        monte_carlo(plane, _LATERAL, 10, np.zeros((1, 4)))
+    with pytest.raises(InvalidArgumentError, match="'Cx' is neither"):
+        monte_carlo(plane, Uncertainty({"Cx": Normal(0.1)}), 10)
+    with pytest.raises(InvalidArgumentError, match="aircraft"):
+        monte_carlo("b747", _LATERAL, 10)  # type: ignore[arg-type]
+    result = monte_carlo(plane, _LATERAL, 10)
+    with pytest.raises(InvalidArgumentError, match="no controller"):
+        result.probability("unstable", loop="closed")
+    with pytest.raises(InvalidArgumentError, match="event"):
+        result.probability("broken")
