@@ -215,13 +215,19 @@ def test_monte_carlo_agrees_with_each_sample_judged_alone() -> None:
                 assert outcome is not None
                 modes = aerocontrol.modes(A)
                 try:
-                    expected = assess(
+                    judged = assess(
                         classify_modes(modes, "lateral"), one.aircraft_class, one.category
-                    ).levels
+                    )
                 except InvalidArgumentError:  # a coupled roll-spiral: not judged
                     continue
                 got = outcome.levels[start + row]
-                assert dict(zip(result.modes, got.tolist(), strict=True)) == expected
+                assert dict(zip(result.modes, got.tolist(), strict=True)) == judged.levels
+                for requirement in judged.requirements:
+                    key = f"{requirement.mode}: {requirement.quantity}"
+                    if key in outcome.quantities:  # (zeta*omega_n is not kept)
+                        assert outcome.quantities[key][start + row] == pytest.approx(
+                            requirement.value, rel=1e-12, nan_ok=True
+                        )
                 assert outcome.stable[start + row] == bool(np.all(modes.eigenvalues.real < 0))
                 checked += 1
     assert checked >= 30
@@ -234,19 +240,28 @@ def _same(a: aerocontrol.robustness.MonteCarlo, b: aerocontrol.robustness.MonteC
         x, y = getattr(a, loop), getattr(b, loop)
         for key in ("levels", "stable", "unresolved", "max_real"):
             np.testing.assert_array_equal(getattr(x, key), getattr(y, key))
+        assert x.quantities.keys() == y.quantities.keys()
+        for key in x.quantities:
+            np.testing.assert_array_equal(x.quantities[key], y.quantities[key])
     np.testing.assert_array_equal(a.failed, b.failed)
     np.testing.assert_array_equal(a.failures_by_bin, b.failures_by_bin)
     np.testing.assert_array_equal(a.samples_by_bin, b.samples_by_bin)
+
+
+class _Done:
+    def __init__(self, value: object) -> None:
+        self.value = value
+
+    def result(self) -> object:
+        return self.value
 
 
 class _ReversedClient:
     """A stand-in for a Dask client that runs the chunks last to first."""
 
     def map(self, function, runs, indices, pure):  # type: ignore[no-untyped-def]
-        return [function(r, i) for r, i in reversed(list(zip(runs, indices, strict=True)))][::-1]
-
-    def gather(self, futures):  # type: ignore[no-untyped-def]
-        return futures
+        pairs = reversed(list(zip(runs, indices, strict=True)))
+        return [_Done(function(r, i)) for r, i in pairs][::-1]
 
 
 def test_monte_carlo_is_reproducible_and_independent_of_chunk_order() -> None:
@@ -326,3 +341,56 @@ def test_monte_carlo_refuses_bad_arguments() -> None:
         result.probability("unstable", loop="closed")
     with pytest.raises(InvalidArgumentError, match="event"):
         result.probability("broken")
+
+
+def test_level_limits_are_the_tables() -> None:
+    from aerocontrol import handling
+
+    assert handling.level_limits("dutch roll", "zeta", "III", "C") == [
+        (1, 0.08),
+        (2, 0.02),
+        (3, 0.0),
+    ]
+    assert handling.level_limits("roll", "time constant", "IV", "A") == [
+        (1, 1.0),
+        (2, 1.4),
+        (3, 10.0),
+    ]
+    assert handling.level_limits("short period", "zeta", "III", "B")[:2] == [(1, 0.3), (1, 2.0)]
+    with pytest.raises(InvalidArgumentError, match="no Level limits"):
+        handling.level_limits("roll", "zeta", "III", "B")
+
+
+def test_robustness_plots() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from aerocontrol import plotting
+
+    plane = aircraft.load("b747-cruise")
+    result = monte_carlo(plane, _LATERAL, 3000, _gains(), seed=4)
+    ax = plotting.plot_robustness_histogram(result, "dutch roll", "zeta")
+    # The three Level limits of Table VI on zeta (Class III, Category B): 0.08, 0.02, 0.
+    assert sorted(line.get_xdata()[0] for line in ax.get_lines()) == [0.0, 0.02, 0.08]
+    assert (
+        sum(patch.get_height() for patch in ax.patches)
+        == np.isfinite(
+            result.closed_loop.quantities["dutch roll: zeta"]  # type: ignore[union-attr]
+        ).sum()
+    )
+    ax = plotting.plot_probability_convergence(result, "level", "dutch roll", 1)
+    estimate = ax.get_lines()[0].get_ydata()[-1]
+    assert estimate == result.probability("level", "dutch roll", 1).value
+    ax = plotting.plot_sensitivity(result)
+    assert len(ax.patches) == 2 * len(_LATERAL.names)
+    # The most influential parameter at the top.
+    by_height = sorted(
+        zip(ax.get_yticks(), (t.get_text() for t in ax.get_yticklabels()), strict=True),
+        reverse=True,
+    )
+    assert [name for _, name in by_height] == [name for name, _ in result.sensitivity()]
+    with pytest.raises(InvalidArgumentError, match="no quantity"):
+        plotting.plot_robustness_histogram(result, "dutch roll", "zeta*omega_n")
+    plt.close("all")

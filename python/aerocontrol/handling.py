@@ -98,8 +98,10 @@ __all__ = [
     "assess",
     "compare",
     "level_arrays",
+    "level_limits",
     "margin_requirement",
     "margins_check",
+    "mode_quantities",
 ]
 
 SPECIFICATION = "MIL-F-8785C"
@@ -723,6 +725,81 @@ def level_arrays(
     return levels
 
 
+def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
+    """The quantities :func:`assess` judges a mode by, for k aircraft at once: "omega_n" and
+    "zeta" of an oscillatory mode (eigenvalues (k, 2); NaN for two real roots of opposite
+    sign), "time constant" τ_R = -1/λ of the roll mode and "time to double" T2 = ln 2 / λ of
+    the spiral (eigenvalues (k,); inf for a roll mode that does not converge or a spiral that
+    does not grow).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from aerocontrol.handling import mode_quantities
+    >>> q = mode_quantities("dutch roll", np.array([[-0.08066 + 0.7433j, -0.08066 - 0.7433j]]))
+    >>> np.round(q["zeta"], 4), np.round(q["omega_n"], 4)
+    (array([0.1079]), array([0.7477]))
+    """
+    name = _mode_name(mode, "mode")
+    lam = np.asarray(eigenvalues, dtype=np.complex128)
+    if name in _OSCILLATORY:
+        if lam.ndim != 2 or lam.shape[1] != 2:
+            raise ShapeError(f"eigenvalues of the {name} must have shape (k, 2), got {lam.shape}")
+        wn, zeta, _ = _pair_arrays(lam)
+        return {"omega_n": wn, "zeta": zeta}
+    if lam.ndim != 1:
+        raise ShapeError(f"eigenvalues of the {name} must have shape (k,), got {lam.shape}")
+    if name == "roll":
+        return {"time constant": _roll_time_constant(lam.real)}
+    return {"time to double": _time_to_double_arrays(lam.real)}
+
+
+def level_limits(
+    mode: str, quantity: str, aircraft_class: str, category: str
+) -> list[tuple[int, float]]:
+    """The limits of each Level on one quantity of :func:`mode_quantities`, as (Level, value)
+    pairs: the bounds that :func:`assess` compares the quantity with (the minimum or the
+    maximum; for the short period both ends of each band), for lines on a histogram.
+
+    Examples
+    --------
+    >>> from aerocontrol.handling import level_limits
+    >>> level_limits("spiral", "time to double", "III", "B")
+    [(1, 20.0), (2, 8.0), (3, 4.0)]
+    """
+    cls = _aircraft_class(aircraft_class)
+    cat = _category(category)
+    name = _mode_name(mode, "mode")
+    limits: list[tuple[int, float | None]]
+    if (name, quantity) == ("short period", "zeta"):
+        limits = [
+            (k, bound)
+            for k, (low, high) in enumerate(SHORT_PERIOD_ZETA[cat], start=1)
+            for bound in (low, high)
+        ]
+    elif (name, quantity) == ("phugoid", "zeta"):
+        limits = list(enumerate(PHUGOID_MIN_ZETA, start=1))
+    elif (name, quantity) == ("phugoid", "time to double"):
+        limits = [(3, PHUGOID_MIN_TIME_TO_DOUBLE)]
+    elif name == "dutch roll" and quantity in ("zeta", "zeta*omega_n", "omega_n"):
+        column = ("zeta", "zeta*omega_n", "omega_n").index(quantity)
+        rows = (DUTCH_ROLL_LEVEL1[cat, cls], DUTCH_ROLL_LEVEL2, DUTCH_ROLL_LEVEL3)
+        limits = [(k, row[column]) for k, row in enumerate(rows, start=1)]
+    elif (name, quantity) == ("roll", "time constant"):
+        limits = list(enumerate(ROLL_MODE_MAX_TIME_CONSTANT[cat, cls], start=1))
+    elif (name, quantity) == ("spiral", "time to double"):
+        limits = list(enumerate(SPIRAL_MIN_TIME_TO_DOUBLE[cat], start=1))
+    else:
+        raise InvalidArgumentError(f"the {name} has no Level limits on {quantity!r}")
+    return [(k, float(value)) for k, value in limits if value is not None]
+
+
+def _roll_time_constant(root: FloatArray) -> FloatArray:
+    with np.errstate(divide="ignore"):
+        tau: FloatArray = np.where(root < 0, -1.0 / np.where(root < 0, root, -1.0), np.inf)
+    return tau
+
+
 def _pair_arrays(lam: NDArray[np.complex128]) -> tuple[FloatArray, FloatArray, FloatArray]:
     """:func:`_pair` on k pairs: (ω_n, ζ, ζ ω_n)."""
     l1, l2 = lam[:, 0], lam[:, 1]
@@ -792,9 +869,7 @@ def _mode_levels(
         )
         return levels
     if mode == "roll":
-        root = lam.real
-        with np.errstate(divide="ignore"):
-            tau = np.where(root < 0, -1.0 / np.where(root < 0, root, -1.0), np.inf)
+        tau = _roll_time_constant(lam.real)
         limits = ROLL_MODE_MAX_TIME_CONSTANT[category, aircraft_class]
         return _first_met([tau <= m for m in limits], count)
     t2 = _time_to_double_arrays(lam.real)

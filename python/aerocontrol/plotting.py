@@ -50,6 +50,7 @@ if TYPE_CHECKING:
     from .loops import NicholsResponse, NyquistResponse, RootLocus
     from .modal import Modes
     from .responses import TimeResponse
+    from .robustness import MonteCarlo
 
 __all__ = [
     "closed_loop_gain_contour",
@@ -65,7 +66,10 @@ __all__ = [
     "plot_nyquist",
     "plot_open_closed",
     "plot_penalty",
+    "plot_probability_convergence",
+    "plot_robustness_histogram",
     "plot_root_locus",
+    "plot_sensitivity",
     "plot_time_response",
     "plot_time_scales",
     "plot_with_controls",
@@ -968,4 +972,100 @@ def plot_modes(modes: Modes, ax: Axes | None = None, marker: str = "x", suffix: 
     ax.axvline(0.0, color="black", linewidth=0.8)
     ax.axhline(0.0, color="black", linewidth=0.8)
     _finish(ax, "real part (1/s)", "imaginary part (rad/s)", "modes")
+    return ax
+
+
+# --- Stochastic robustness ---------------------------------------------------------------------
+
+
+def plot_robustness_histogram(
+    result: MonteCarlo,
+    mode: str,
+    quantity: str,
+    loop: str = "auto",
+    ax: Axes | None = None,
+    bins: int = 60,
+) -> Axes:
+    """The distribution of one mode quantity over the samples of a Monte Carlo run (e.g.
+    ``"dutch roll", "zeta"``), with the MIL-F-8785C limit of each Level as a vertical line.
+    Non-finite values (a split mode's ζ, a spiral that does not grow) are counted in the title.
+    Returns the axes."""
+    from .handling import level_limits
+
+    key = f"{mode}: {quantity}"
+    outcome = result.outcome(loop)
+    if key not in outcome.quantities:
+        raise InvalidArgumentError(
+            f"no quantity {key!r} in this run; it has {', '.join(outcome.quantities)}"
+        )
+    values = outcome.quantities[key]
+    finite = values[np.isfinite(values)]
+    ax = _new_axes() if ax is None else ax
+    ax.hist(finite, bins=bins, color="tab:blue", alpha=0.75)
+    for level, bound in level_limits(mode, quantity, result.aircraft_class, result.category):
+        ax.axvline(
+            bound,
+            color=_LEVEL_COLOURS[level],
+            linestyle="--",
+            label=f"Level {level} limit {bound:g}",
+        )
+    hidden = values.size - finite.size
+    title = f"{mode} {quantity}: {values.size} samples"
+    if hidden:
+        title += f" ({hidden} not finite, not shown)"
+    _finish(ax, quantity, "samples", title)
+    return ax
+
+
+def plot_probability_convergence(
+    result: MonteCarlo,
+    event: str = "failed",
+    mode: str | None = None,
+    level: int = 1,
+    loop: str = "auto",
+    ax: Axes | None = None,
+    points: int = 60,
+) -> Axes:
+    """The estimate of a probability (as :meth:`MonteCarlo.probability` takes it) against the
+    number of samples used, with its 95 % Clopper-Pearson band: how many samples the estimate
+    needed. Returns the axes."""
+    from .robustness import clopper_pearson
+
+    indicator = result.indicator(event, mode, level, loop)
+    counts = np.cumsum(indicator)
+    sizes = np.unique(np.geomspace(min(10, indicator.size), indicator.size, points).astype(int))
+    estimates = [clopper_pearson(int(counts[n - 1]), int(n)) for n in sizes]
+    ax = _new_axes() if ax is None else ax
+    ax.fill_between(
+        sizes,
+        [e.low for e in estimates],
+        [e.high for e in estimates],
+        alpha=0.25,
+        label="95 % interval",
+    )
+    ax.plot(sizes, [e.value for e in estimates], label="estimate")
+    ax.set_xscale("log")
+    what = event if event != "level" else f"{mode} Level {level} or better"
+    _finish(ax, "samples", "probability", f"P({what})")
+    return ax
+
+
+def plot_sensitivity(result: MonteCarlo, ax: Axes | None = None) -> Axes:
+    """A tornado chart: for each uncertain parameter, the failure rate among the samples in
+    the lowest and in the highest tenth of its draw, as bars from the overall failure rate,
+    the parameter the failures depend on most at the top. Returns the axes."""
+    ranking = [name for name, _ in result.sensitivity()]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rates = result.failures_by_bin / result.samples_by_bin
+    overall = float(result.failed.mean())
+    ax = _new_axes() if ax is None else ax
+    rows = np.arange(len(ranking))[::-1]
+    index = [result.parameters.index(name) for name in ranking]
+    low = rates[index, 0] - overall
+    high = rates[index, -1] - overall
+    ax.barh(rows, low, left=overall, color="tab:blue", label="lowest tenth of the draw")
+    ax.barh(rows, high, left=overall, color="tab:red", alpha=0.7, label="highest tenth")
+    ax.axvline(overall, color="black", linewidth=0.8)
+    ax.set_yticks(rows, ranking)
+    _finish(ax, "failure rate", "", f"sensitivity of P(failed) = {overall:.3g}")
     return ax

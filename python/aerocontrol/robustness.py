@@ -35,7 +35,7 @@ True
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -47,7 +47,7 @@ from ._validation import real_array, real_scalar
 from .aircraft.model import SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
 from .exceptions import InvalidArgumentError, ShapeError
-from .handling import level_arrays
+from .handling import level_arrays, mode_quantities
 
 __all__ = [
     "CHUNK_SIZE",
@@ -72,6 +72,9 @@ CHUNK_SIZE = 1 << 16
 #: The number of bins of each parameter's standard-normal draw over which the failure rate is
 #: counted for the sensitivity ranking: deciles.
 SENSITIVITY_BINS = 10
+
+#: The prefix of a mode quantity's key among a chunk's arrays.
+_QUANTITY = "quantity: "
 
 _AXIS_MODES = {
     "lateral": ("dutch roll", "roll", "spiral"),
@@ -207,13 +210,19 @@ class Uncertainty:
 
 @dataclass(frozen=True)
 class Lqr:
-    """The linear-quadratic regulator re-designed for every sample: u = -K x with K of
-    A^T X + X A - X B (cR)^-1 B^T X + Q = 0 (the chapter's (6.222)-(6.226); Q and R identities
-    when not given), solved for all samples of a chunk in one parallel call."""
+    """The linear-quadratic regulator re-designed for every sample: u = -K x minimising
+    J = ∫ x^T Q x + (1/c²) u^T R u dt, the chapter's (6.224)-(6.227) as ``aerocontrol lqr``
+    and :func:`aerocontrol.batch.lqr_sweep` weight it (Q and R identities when not given),
+    solved for all samples of a chunk in one parallel call."""
 
     c: float = 1.0
     Q: ArrayLike | None = None
     R: ArrayLike | None = None
+
+    def __post_init__(self) -> None:
+        c = real_scalar(self.c, "c")
+        if not (math.isfinite(c) and c > 0.0):
+            raise InvalidArgumentError(f"c must be a positive finite weight, got {c}")
 
 
 def _closed_loop(
@@ -224,7 +233,7 @@ def _closed_loop(
         n, m = A.shape[-1], B.shape[-1]
         Q = np.eye(n) if controller.Q is None else real_array(controller.Q, "Q")
         R = np.eye(m) if controller.R is None else real_array(controller.R, "R")
-        solution = batch.solve_care_batch(A, B, Q, controller.c * R)
+        solution = batch.solve_care_batch(A, B, Q, R / controller.c**2)
         return A - np.einsum("kij,kjl->kil", B, solution.K), solution.closed_loop_poles
     closed = A - np.einsum("kij,jl->kil", B, controller)
     return closed, linalg.eigenvalues(closed)
@@ -283,17 +292,23 @@ def _judge(
     mode_names = _AXIS_MODES[run.axis]
     named, unresolved = classify_mode_stack(eigenvalues, run.axis, A)
     levels = np.full((A.shape[0], len(mode_names)), 4, dtype=np.int8)
+    out: dict[str, NDArray[Any]] = {}
     for k, name in enumerate(mode_names):
         known = ~np.isnan(named[name]).reshape(A.shape[0], -1).any(axis=1)
         judged = level_arrays(
             {name: named[name][known]}, run.aircraft.aircraft_class, run.aircraft.category
         )
         levels[known, k] = judged[name]
+        for quantity, values in mode_quantities(name, named[name][known]).items():
+            column = np.full(A.shape[0], np.nan)
+            column[known] = values
+            out[f"{_QUANTITY}{name}: {quantity}"] = column
     return {
         "levels": levels,
         "stable": (eigenvalues.real < 0.0).all(axis=1),
         "unresolved": unresolved,
         "max_real": eigenvalues.real.max(axis=1),
+        **out,
     }
 
 
@@ -451,6 +466,11 @@ class LoopOutcome:
     Level 4."""
     max_real: FloatArray
     """(samples,): the largest real part of the eigenvalues."""
+    quantities: dict[str, FloatArray]
+    """(samples,) each: the quantities the Levels judge, "dutch roll: zeta", "dutch roll:
+    omega_n", "roll: time constant", "spiral: time to double" (lateral) or "short period:
+    zeta", ..., "phugoid: omega_n" (longitudinal), as
+    :func:`aerocontrol.handling.mode_quantities` gives them; NaN for an unresolved mode."""
 
 
 @dataclass(frozen=True)
@@ -458,6 +478,8 @@ class MonteCarlo:
     """The result of :func:`monte_carlo`."""
 
     aircraft: str
+    aircraft_class: str
+    category: str
     axis: str
     parameters: tuple[str, ...]
     modes: tuple[str, ...]
@@ -485,24 +507,30 @@ class MonteCarlo:
         """The probability of ``event``: "unstable", "failed", or "level" (``mode`` meets
         ``level`` or better), for the closed loop if there is one (``loop="auto"``) or the
         loop named ("open", "closed"), with its Clopper-Pearson interval."""
-        outcome = self._loop(loop)
+        count = int(self.indicator(event, mode, level, loop).sum())
+        return clopper_pearson(count, self.samples, confidence)
+
+    def indicator(
+        self, event: str, mode: str | None = None, level: int = 1, loop: str = "auto"
+    ) -> NDArray[np.bool_]:
+        """Per sample, whether ``event`` happened (as :meth:`probability` counts it)."""
+        outcome = self.outcome(loop)
         if event == "unstable":
-            count = int((~outcome.stable).sum())
-        elif event == "failed":
-            count = int(self.failed.sum())
-        elif event == "level":
+            return ~outcome.stable
+        if event == "failed":
+            return self.failed
+        if event == "level":
             if mode not in self.modes:
                 raise InvalidArgumentError(f"mode must be one of {self.modes}, got {mode!r}")
             if level not in (1, 2, 3):
                 raise InvalidArgumentError(f"level must be 1, 2 or 3, got {level!r}")
-            count = int((outcome.levels[:, self.modes.index(mode)] <= level).sum())
-        else:
-            raise InvalidArgumentError(
-                f"event must be 'unstable', 'failed' or 'level', got {event!r}"
-            )
-        return clopper_pearson(count, self.samples, confidence)
+            met: NDArray[np.bool_] = outcome.levels[:, self.modes.index(mode)] <= level
+            return met
+        raise InvalidArgumentError(f"event must be 'unstable', 'failed' or 'level', got {event!r}")
 
-    def _loop(self, loop: str) -> LoopOutcome:
+    def outcome(self, loop: str = "auto") -> LoopOutcome:
+        """The open loop (``"open"``), the closed loop (``"closed"``), or the closed loop if
+        there is one (``"auto"``)."""
         if loop == "open" or (loop == "auto" and self.closed_loop is None):
             return self.open_loop
         if loop in ("closed", "auto"):
@@ -539,11 +567,17 @@ class MonteCarlo:
 
 
 def _outcome(parts: Sequence[dict[str, NDArray[Any]]], prefix: str) -> LoopOutcome:
+    def joined(key: str) -> NDArray[Any]:
+        return np.concatenate([part[f"{prefix}_{key}"] for part in parts])
+
+    start = f"{prefix}_{_QUANTITY}"
+    names = [key[len(start) :] for key in parts[0] if key.startswith(start)]
     return LoopOutcome(
-        **{
-            key: np.concatenate([part[f"{prefix}_{key}"] for part in parts])
-            for key in ("levels", "stable", "unresolved", "max_real")
-        }
+        levels=joined("levels"),
+        stable=joined("stable"),
+        unresolved=joined("unresolved"),
+        max_real=joined("max_real"),
+        quantities={name: joined(_QUANTITY + name) for name in names},
     )
 
 
@@ -558,6 +592,7 @@ def monte_carlo(
     required_level: int = 1,
     chunk_size: int = CHUNK_SIZE,
     client: Any = None,
+    progress: Callable[[int, int], object] | None = None,
 ) -> MonteCarlo:
     """Stochastic robustness by Monte Carlo evaluation: draw ``samples`` variants of
     ``aircraft`` from ``uncertainty``, and judge each one's modes (stability, MIL-F-8785C
@@ -581,7 +616,11 @@ def monte_carlo(
         Samples per chunk (the unit of work and of the draws); part of the result's identity.
     client : dask.distributed.Client, optional
         Run the chunks on this Dask cluster (``pip install aerocontrol[distributed]``); only
-        arrays of per-sample judgements come back.
+        arrays of per-sample judgements come back. Start the workers with one thread each and
+        ``RAYON_NUM_THREADS`` set to the cores each may use, so that they do not
+        oversubscribe the machine.
+    progress : callable, optional
+        Called as ``progress(samples_done, samples)`` after each chunk (for a progress bar).
 
     Returns
     -------
@@ -629,13 +668,29 @@ def monte_carlo(
             )
     run = _Run(aircraft, uncertainty, axis, gains, samples, int(seed), chunk_size, required_level)
     indices = range(run.chunk_count)
+    done = 0
+
+    def advanced(index: int) -> None:
+        nonlocal done
+        start, stop = run.chunk_bounds(index)
+        done += stop - start
+        if progress is not None:
+            progress(done, samples)
+
+    parts: list[dict[str, NDArray[Any]]] = []
     if client is None:
-        parts = [_run_chunk(run, i) for i in indices]
+        for i in indices:
+            parts.append(_run_chunk(run, i))
+            advanced(i)
     else:
         futures = client.map(_run_chunk, [run] * run.chunk_count, list(indices), pure=False)
-        parts = client.gather(futures)
+        for i, future in enumerate(futures):  # in chunk order; the cluster runs them all
+            parts.append(future.result())
+            advanced(i)
     return MonteCarlo(
         aircraft=aircraft.name,
+        aircraft_class=aircraft.aircraft_class,
+        category=aircraft.category,
         axis=axis,
         parameters=uncertainty.names,
         modes=_AXIS_MODES[axis],
