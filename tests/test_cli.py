@@ -90,7 +90,7 @@ def test_lqr_prints_the_gain_of_the_chapters_regulator(
 
 
 def test_help_everywhere(capsys: pytest.CaptureFixture[str]) -> None:
-    for argv in ([], ["report"], ["aircraft"], ["modes"], ["lqr"]):
+    for argv in ([], ["report"], ["aircraft"], ["modes"], ["lqr"], ["robustness"]):
         status, out, _ = _run(capsys, *argv, "--help")
         assert status == 0 and out.startswith("usage: aerocontrol")
     status, out, _ = _run(capsys, "--version")
@@ -458,3 +458,44 @@ def test_damper_command() -> None:
     assert bad.stderr.splitlines() == [
         "aerocontrol: error: --washout applies to the yaw damper only (see aerocontrol --help)"
     ]
+
+
+def test_robustness_prints_the_probabilities_of_the_api(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from aerocontrol.aircraft.tables import LATERAL_DERIVATIVES
+    from aerocontrol.robustness import Normal, Uncertainty, monte_carlo
+
+    status, out, err = _run(
+        capsys, "robustness", "b747-cruise", "--samples", "3000", "--controller", "damper"
+    )
+    assert status == 0 and err == ""
+    plane = aerocontrol.aircraft.load("b747-cruise")
+    uncertainty = Uncertainty(
+        {name: Normal(0.15) for name in LATERAL_DERIVATIVES if plane.derivatives[name] != 0.0}
+    )
+    gains = np.vstack([aerocontrol.design.dutch_roll_damper(plane).k, np.zeros(4)])
+    result = monte_carlo(plane, uncertainty, 3000, gains, seed=0)
+    lines = out.splitlines()
+    assert lines[0] == plane.summary()
+    assert str(result) in out
+    assert lines[-1].startswith("3000 samples in ")
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--samples", "0"], "--samples must be a positive number, got 0"),
+        (["--seed", "-1"], "--seed must be >= 0, got -1"),
+        (["--sigma", "nan"], "--sigma must be a number >= 0, got nan"),
+        (["--c", "0"], "--c must lie between"),
+        (["--controller", "damper", "--axis", "longitudinal"], "lateral Dutch roll damper"),
+        (["--controller", "pid"], "argument --controller: invalid choice: 'pid'"),
+    ],
+)
+def test_robustness_refuses_bad_options(
+    capsys: pytest.CaptureFixture[str], argv: list[str], message: str
+) -> None:
+    got, out, err = _run(capsys, "robustness", *argv)
+    assert got == 2 and message in err and out == ""
+    assert err.count("\n") == 1 and "Traceback" not in err

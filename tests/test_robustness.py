@@ -7,6 +7,7 @@ bitwise identical however the chunks are run (one process, chunk order, a Dask c
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -394,3 +395,61 @@ def test_robustness_plots() -> None:
     with pytest.raises(InvalidArgumentError, match="no quantity"):
         plotting.plot_robustness_histogram(result, "dutch roll", "zeta*omega_n")
     plt.close("all")
+
+
+_DECLARED = """
+[uncertainty]
+Cn_beta = { distribution = "normal", sigma = 0.2 }
+Cl_p = { distribution = "uniform", half_width = 0.3 }
+Iz = { distribution = "lognormal", sigma = 0.05 }
+speed = { distribution = "normal", sigma = 5.0, relative = false }
+correlations = [["Cn_beta", "Cl_p", 0.5]]
+"""
+
+
+def _with_uncertainty(tmp_path, table: str):  # type: ignore[no-untyped-def]
+    shipped = aircraft.reader.resources.files("aerocontrol.aircraft.data")
+    text = shipped.joinpath("b747-cruise.toml").read_text(encoding="utf-8")
+    path = tmp_path / "plane.toml"
+    path.write_text(text + table, encoding="utf-8")
+    return path
+
+
+def test_uncertainty_declared_in_the_aircraft_file(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    plane = aircraft.load(_with_uncertainty(tmp_path, _DECLARED))
+    assert Uncertainty.of(plane) == Uncertainty(
+        {
+            "Cn_beta": Normal(0.2),
+            "Cl_p": Uniform(0.3),
+            "Iz": LogNormal(0.05),
+            "speed": Normal(5.0, relative=False),
+        },
+        correlations={("Cn_beta", "Cl_p"): 0.5},
+    )
+    # The same flight condition elsewhere keeps the declaration.
+    assert Uncertainty.of(plane.at(mach=0.7)) == Uncertainty.of(plane)
+    with pytest.raises(InvalidArgumentError, match="declares no"):
+        Uncertainty.of(aircraft.load("b747-cruise"))
+
+
+@pytest.mark.parametrize(
+    ("entry", "message"),
+    [
+        ('Cx = { distribution = "normal", sigma = 0.2 }', "Cx is neither a derivative"),
+        ('Cn_beta = { distribution = "gauss", sigma = 0.2 }', "distribution must be one of"),
+        ('Cn_beta = { distribution = "normal", sigma = -1 }', "sigma must be a finite number"),
+        ('Cn_beta = { distribution = "uniform", sigma = 0.1 }', "unknown key(s) sigma"),
+        ("Cn_beta = 0.2", "must be an inline table"),
+        ('Iz = { distribution = "lognormal", sigma = 0.1, relative = false }', "is relative"),
+        ('Cn_beta = { distribution = "normal", sigma = 0.1, relative = 1 }', "true or false"),
+        (
+            'Cn_beta = { distribution = "normal", sigma = 0.1 }\n'
+            'correlations = [["Cn_beta", "Cl_p", 0.5]]',
+            "correlations: each entry",
+        ),
+    ],
+)
+def test_bad_uncertainty_tables_are_named(tmp_path, entry: str, message: str) -> None:  # type: ignore[no-untyped-def]
+    path = _with_uncertainty(tmp_path, f"\n[uncertainty]\n{entry}\n")
+    with pytest.raises(aircraft.AircraftDataError, match=re.escape(message)):
+        aircraft.load(path)

@@ -176,6 +176,35 @@ class Uncertainty:
                 )
         self.cholesky()  # checks the correlations
 
+    @classmethod
+    def of(cls, plane: Aircraft) -> Uncertainty:
+        """The uncertainty an aircraft file declares in its [uncertainty] table::
+
+            [uncertainty]
+            Cn_beta = { distribution = "normal", sigma = 0.2 }       # relative: ±20 % at 1σ
+            Cl_p = { distribution = "uniform", half_width = 0.3 }
+            Iz = { distribution = "lognormal", sigma = 0.05 }
+            speed = { distribution = "normal", sigma = 5.0, relative = false }   # ft/s or m/s
+            correlations = [["Cn_beta", "Cl_p", 0.5]]
+
+        Raises InvalidArgumentError if the aircraft declares none.
+        """
+        if not isinstance(plane, Aircraft):
+            raise InvalidArgumentError(f"plane must be an Aircraft, got {type(plane).__name__}")
+        if not plane.uncertainty:
+            raise InvalidArgumentError(f"{plane.name} declares no [uncertainty]")
+        kinds: dict[str, Callable[[float, bool], Distribution]] = {
+            "normal": lambda spread, relative: Normal(spread, relative),
+            "uniform": lambda spread, relative: Uniform(spread, relative),
+            "lognormal": lambda spread, relative: LogNormal(spread),
+        }
+        distributions = {
+            name: kinds[entry["distribution"]](entry["spread"], entry["relative"])
+            for name, entry in plane.uncertainty["parameters"].items()
+        }
+        correlations = {(a, b): rho for a, b, rho in plane.uncertainty["correlations"]}
+        return cls(distributions, correlations)
+
     @property
     def names(self) -> tuple[str, ...]:
         """The uncertain parameters, in the order given."""

@@ -132,6 +132,11 @@ class Aircraft:
     and, per mode ("short_period", "phugoid", "dutch_roll", "roll", "spiral"), its quantities
     and an optional ``tolerance`` of its own that replaces the file-level one."""
     sources: Mapping[str, str] = field(default_factory=dict)
+    uncertainty: Mapping[str, Any] = field(default_factory=dict)
+    """The file's [uncertainty] table, validated (empty without one): ``"parameters"`` maps
+    each uncertain parameter to its ``"distribution"``, ``"spread"`` and ``"relative"``, and
+    ``"correlations"`` lists (a, b, rho); :meth:`aerocontrol.robustness.Uncertainty.of` turns
+    it into an Uncertainty."""
 
     # ------------------------------------------------------------------------------------
     # Construction

@@ -81,7 +81,13 @@ _TABLES = (
     "lateral",
     "published",
     "sources",
+    "uncertainty",
 )
+#: The distributions of an [uncertainty] entry and the key of each one's spread.
+UNCERTAINTY_SPREADS = {"normal": "sigma", "uniform": "half_width", "lognormal": "sigma"}
+#: What besides the derivatives an [uncertainty] table may scatter (as
+#: ``Aircraft.model_stack`` can vary it).
+UNCERTAIN_FIELDS = ("mass", "Ix", "Iy", "Iz", "Ixz", "speed", "density")
 _FLIGHT_KEYS = ("speed", "mach", "altitude", "density", "theta0_deg", "alpha0_deg")
 _OSCILLATORY = ("omega_n", "zeta")
 _APERIODIC = ("time_constant", "time_to_half", "time_to_double")
@@ -186,6 +192,7 @@ def aircraft_fields(data: Mapping[str, Any], origin: str = "<dict>") -> dict[str
         sources = {
             str(key): reader.text(table, "sources", str(key), _SOURCE_LIMIT) for key in table
         }
+    uncertainty = reader.uncertainty(tuple(derivatives)) if "uncertainty" in data else {}
     reader.only_tables(_TABLES)
     return dict(
         name=name,
@@ -211,6 +218,7 @@ def aircraft_fields(data: Mapping[str, Any], origin: str = "<dict>") -> dict[str
         derivatives=derivatives,
         published=published,
         sources=sources,
+        uncertainty=uncertainty,
     )
 
 
@@ -341,6 +349,75 @@ class _Reader:
                 f"{self.origin}: [{name}] {key} must be one of {listed}, got {shown(value)}"
             )
         return str(value)
+
+    def uncertainty(self, derivatives: tuple[str, ...]) -> dict[str, Any]:
+        """The [uncertainty] table: per uncertain parameter (a derivative, or one of
+        :data:`UNCERTAIN_FIELDS`) an inline table ``{distribution = "normal", sigma = 0.2}``
+        ("uniform": ``half_width``; ``relative = false`` for a spread in the parameter's
+        units), and an optional ``correlations = [["Cn_beta", "Cn_r", 0.5], ...]``. Returns
+        ``{"parameters": {name: {"distribution", "spread", "relative"}}, "correlations":
+        [(a, b, rho), ...]}``."""
+        table = self.table("uncertainty", required=())
+        where = f"{self.origin}: [uncertainty]"
+        allowed = (*derivatives, *UNCERTAIN_FIELDS)
+        parameters: dict[str, dict[str, Any]] = {}
+        for key, entry in table.items():
+            if key == "correlations":
+                continue
+            if key not in allowed:
+                raise AircraftDataError(
+                    f"{where} {_keys([str(key)])} is neither a derivative nor one of "
+                    f"{', '.join(UNCERTAIN_FIELDS)}"
+                )
+            if not isinstance(entry, Mapping):
+                raise AircraftDataError(
+                    f'{where} {key} must be an inline table such as {{distribution = "normal", '
+                    f"sigma = 0.1}}, got {shown(entry)}"
+                )
+            distribution = self.choice(
+                entry, f"uncertainty.{key}", "distribution", tuple(UNCERTAINTY_SPREADS)
+            )
+            spread_key = UNCERTAINTY_SPREADS[distribution]
+            self.only(entry, f"uncertainty.{key}", ("distribution", spread_key, "relative"))
+            spread = entry.get(spread_key)
+            if (
+                isinstance(spread, bool)
+                or not isinstance(spread, (int, float))
+                or not (math.isfinite(spread) and spread >= 0)
+            ):
+                raise AircraftDataError(
+                    f"{where} {key}: {spread_key} must be a finite number >= 0, got {shown(spread)}"
+                )
+            relative = entry.get("relative", True)
+            if not isinstance(relative, bool):
+                raise AircraftDataError(
+                    f"{where} {key}: relative must be true or false, got {shown(relative)}"
+                )
+            if distribution == "lognormal" and not relative:
+                raise AircraftDataError(f"{where} {key}: a lognormal scatter is relative")
+            parameters[str(key)] = {
+                "distribution": distribution,
+                "spread": float(spread),
+                "relative": relative,
+            }
+        correlations: list[tuple[str, str, float]] = []
+        for item in table.get("correlations", []):
+            if not (
+                isinstance(item, list)
+                and len(item) == 3
+                and item[0] in parameters
+                and item[1] in parameters
+                and item[0] != item[1]
+                and isinstance(item[2], (int, float))
+                and not isinstance(item[2], bool)
+                and -1.0 < item[2] < 1.0
+            ):
+                raise AircraftDataError(
+                    f'{where} correlations: each entry is ["A", "B", rho], A and B two of the '
+                    f"uncertain parameters and -1 < rho < 1; got {shown(item)}"
+                )
+            correlations.append((item[0], item[1], float(item[2])))
+        return {"parameters": parameters, "correlations": correlations}
 
     def published(self) -> dict[str, Any]:
         """[published]: an optional relative ``tolerance`` and, per mode, its quantities and an
