@@ -130,6 +130,7 @@ from .riccati import (
     solve_lyapunov,
 )
 from .statespace import StateSpace, as_state_space
+from .threads import get_num_threads, limit_threads, set_num_threads
 from .transfer import (
     Factor,
     TransferFunction,
@@ -225,12 +226,14 @@ __all__ = [
     "frequency_response",
     "gain",
     "gain_for_damping",
+    "get_num_threads",
     "handling",
     "impulse_response",
     "initial_response",
     "is_controllable",
     "is_observable",
     "kalman",
+    "limit_threads",
     "lqe",
     "lqg",
     "lqr",
@@ -257,6 +260,7 @@ __all__ = [
     "second_order",
     "sensitivity",
     "series",
+    "set_num_threads",
     "solve_care",
     "solve_dare",
     "solve_lyapunov",

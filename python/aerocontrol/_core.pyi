@@ -32,6 +32,7 @@ __all__ = [
     "expm_pade_choice",
     "factored_response",
     "frequency_response",
+    "get_num_threads",
     "grid_step",
     "inverse_bilinear",
     "krylov_matrix",
@@ -44,6 +45,7 @@ __all__ = [
     "riccati_ode",
     "root_locus",
     "schur",
+    "set_num_threads",
     "simulate",
     "simulate_models",
     "solve_care",
@@ -62,6 +64,8 @@ ILL_CONDITIONED_CONTROLLABILITY: float
 POLE_ERROR_WARNING: float
 PRODUCT_WORKSPACE_BYTES: int
 
+def set_num_threads(count: int, /) -> None: ...
+def get_num_threads() -> int: ...
 def exception_classes() -> list[str]: ...
 def eigenvalues(a: ArrayLike, /) -> NDArray[np.complex128]: ...
 def qz(

@@ -94,7 +94,7 @@ fn riccati_batch_arrays<'py>(
             rcond: new_array_data(&rcond),
         }
     };
-    let threads = rayon::current_num_threads();
+    let threads = crate::platform::threads::num_threads();
     let cost = match kind {
         RiccatiKind::Continuous { .. } => care_cost(n),
         RiccatiKind::Discrete => dare_cost(n, m),

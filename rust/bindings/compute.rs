@@ -24,6 +24,7 @@ use crate::error::Error;
 use crate::platform::interrupt::{self, Token};
 use crate::platform::memory::{self, SMALL_PRODUCT_MAX_ORDER};
 use crate::platform::parallel::PARALLEL_MIN_ORDER;
+use crate::platform::threads;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -111,16 +112,20 @@ where
     let on_pool = rayon::current_thread_index().is_some();
     let here = on_pool || cost.flops < INTERRUPTIBLE_MIN_FLOPS;
     let outcome = if cost.flops < DETACH_MIN_FLOPS && small_products {
+        // (Not moved to a chosen pool: with the GIL held, a callback into Python from its
+        // thread would wait for the GIL forever.)
         guarded(f)?
     } else if here
         && (small_products || on_pool || py.detach(memory::ensure_product_workspace).is_ok())
     {
         py.detach(|| {
-            guarded(|| {
-                if !small_products {
-                    memory::ensure_product_workspace()?;
-                }
-                f()
+            threads::install(|| {
+                guarded(|| {
+                    if !small_products {
+                        memory::ensure_product_workspace()?;
+                    }
+                    f()
+                })
             })
         })?
     } else {
@@ -155,7 +160,7 @@ where
         let (sender, receiver) = sync_channel(1);
         let job_token = &token;
         let mut interruption: Option<PyErr> = None;
-        let job = rayon::in_place_scope(|scope| {
+        let job = threads::in_place_scope(|scope| {
             scope.spawn(move |_| {
                 let job = match small_products {
                     false => memory::ensure_product_workspace().err(),
@@ -200,4 +205,23 @@ where
         Job::NoWorkspace(_, error) => Ok(Err(error)),
     };
     outcome?.map_err(|e| to_py_err(py, e))
+}
+
+/// Runs parallel work on `count` threads from now on (0: rayon's global pool, of
+/// `RAYON_NUM_THREADS` or one thread per core).
+#[pyfunction]
+pub fn set_num_threads(py: Python<'_>, count: usize) -> PyResult<()> {
+    threads::set_num_threads(count).map_err(|e| to_py_err(py, e))
+}
+
+/// The number of threads parallel work runs on.
+#[pyfunction]
+pub fn get_num_threads() -> usize {
+    threads::num_threads()
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
+    Ok(())
 }

@@ -35,7 +35,7 @@ fn frequency_response<'py>(
     // A Hessenberg reduction, then per frequency a Hessenberg solve with m right-hand sides
     // (in complex arithmetic) and the product with C.
     let per_frequency = 8.0 * (n * n * m.max(1) + p * n * m) as f64 + 1.0;
-    let threads = rayon::current_num_threads() as f64;
+    let threads = crate::platform::threads::num_threads() as f64;
     let cost = Cost {
         flops: 10.0 * (n as f64).powi(3) + omega.len() as f64 * per_frequency,
         bytes: (8.0 + 4.0 * threads) * (n * n.max(m)) as f64 * 8.0,

@@ -84,7 +84,7 @@ fn expm<'py>(py: Python<'py>, a: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAr
             let out = new_array(py, a.shape())?;
             // SAFETY: `out` is new and not visible to Python until returned.
             let data = unsafe { new_array_data(&out) };
-            let threads = rayon::current_num_threads() as f64;
+            let threads = crate::platform::threads::num_threads() as f64;
             let cost =
                 Cost::of(expm_flops(rows), EXPM_TEMPORARIES * threads, rows).times(stack.len());
             compute(py, cost, || crate::control::batch::expm_batch(stack, data))?;
@@ -431,7 +431,7 @@ fn eigenvalues<'py>(
             let out = new_array::<c64>(py, &[count, rows])?;
             // SAFETY: `out` is new and not visible to Python until returned.
             let data = unsafe { new_array_data(&out) };
-            let threads = rayon::current_num_threads() as f64;
+            let threads = crate::platform::threads::num_threads() as f64;
             let single = schur_cost(rows);
             let cost = Cost {
                 bytes: single.bytes * threads,

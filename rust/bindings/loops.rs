@@ -112,7 +112,7 @@ fn root_locus<'py>(
     // SAFETY: new and not visible to Python until returned.
     let data = unsafe { new_array_data(&out) };
     // Per gain the double-shift QR iteration of a Hessenberg matrix (about 10 n^3 flops).
-    let threads = rayon::current_num_threads() as f64;
+    let threads = crate::platform::threads::num_threads() as f64;
     let cost = Cost {
         flops: 10.0 * (n as f64).powi(3) * (gains.len() as f64 + 2.0),
         bytes: 3.0 * threads * (n * n) as f64 * 8.0,

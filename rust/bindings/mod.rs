@@ -47,6 +47,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     placement::register(m)?;
     riccati::register(m)?;
     batch::register(m)?;
+    compute::register(m)?;
     m.add(
         "EXACT_NORM_MAX_ORDER",
         crate::linalg::expm::EXACT_NORM_MAX_ORDER,

@@ -19,11 +19,12 @@
 //! buffer, so that a thread that cannot have it fails with [`Error::OutOfMemory`] before the
 //! computation starts.
 
+use super::threads;
 use crate::error::Error;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use std::cell::Cell;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::{Mutex, OnceLock};
 
 /// Requests `bytes` of memory and releases them at once; `Err(Error::OutOfMemory)` if the system
@@ -148,20 +149,25 @@ pub fn ensure_product_workspace() -> Result<(), Error> {
     Ok(())
 }
 
-/// Whether every thread of rayon's global pool holds faer's product workspace (once true, true
-/// for the life of the pool).
-static POOL_PRODUCT_WORKSPACE: AtomicBool = AtomicBool::new(false);
-
-/// [`ensure_product_workspace`] on every thread of rayon's global pool, for a computation whose
-/// faer kernels may run in parallel. Call it from outside the pool.
+/// [`ensure_product_workspace`] on every thread of the pool parallel work runs on
+/// ([`threads`]), for a computation whose faer kernels may run in parallel. Call it from
+/// outside the pool. Once done, a pool's flag stays true for its life.
 pub fn ensure_pool_product_workspace() -> Result<(), Error> {
-    if POOL_PRODUCT_WORKSPACE.load(Ordering::Acquire) {
+    let chosen = threads::chosen();
+    let flag = chosen
+        .as_ref()
+        .map_or(&threads::GLOBAL_PRODUCT_WORKSPACE, |pool| {
+            &pool.product_workspace
+        });
+    if flag.load(Ordering::Acquire) {
         return Ok(());
     }
-    rayon::broadcast(|_| ensure_product_workspace())
-        .into_iter()
-        .collect::<Result<Vec<()>, Error>>()?;
-    POOL_PRODUCT_WORKSPACE.store(true, Ordering::Release);
+    let outcomes = match &chosen {
+        Some(pool) => pool.threads.broadcast(|_| ensure_product_workspace()),
+        None => rayon::broadcast(|_| ensure_product_workspace()),
+    };
+    outcomes.into_iter().collect::<Result<Vec<()>, Error>>()?;
+    flag.store(true, Ordering::Release);
     Ok(())
 }
 
@@ -169,5 +175,8 @@ pub fn ensure_pool_product_workspace() -> Result<(), Error> {
 /// holds its product workspace ([`ensure_pool_product_workspace`]); otherwise they run on the
 /// computing thread alone.
 pub fn parallel_products_allowed() -> bool {
-    POOL_PRODUCT_WORKSPACE.load(Ordering::Acquire)
+    threads::chosen().map_or_else(
+        || threads::GLOBAL_PRODUCT_WORKSPACE.load(Ordering::Acquire),
+        |pool| pool.product_workspace.load(Ordering::Acquire),
+    )
 }

@@ -1,6 +1,7 @@
 //! What the numerical code needs from the machine: run-time choice of vectorised kernels, scratch
 //! matrices, the allocator of the Python extension, interruption of long computations, memory
-//! requested so that a shortage is an error, and the plumbing of parallel loops.
+//! requested so that a shortage is an error, the plumbing of parallel loops, and the number of
+//! threads they run on.
 
 #[cfg(feature = "small-block-allocator")]
 pub mod allocator;
@@ -9,3 +10,4 @@ pub mod interrupt;
 pub mod memory;
 pub mod parallel;
 pub mod pool;
+pub mod threads;

@@ -1,0 +1,76 @@
+"""How many threads aerocontrol's parallel work runs on.
+
+By default, rayon's pool: ``RAYON_NUM_THREADS`` threads if that is set when the first parallel
+computation starts, else one per core. :func:`set_num_threads` changes it for the process from
+then on (computations already running finish on the threads they started on);
+:func:`limit_threads` changes it for a ``with`` block. A process that runs several computations
+side by side (a Dask worker with several task threads, a multiprocessing pool) gives each a
+share of the cores, so that together they do not oversubscribe the machine.
+
+Small problems run on the calling thread whatever the setting; batches and large problems are
+the ones that spread over threads.
+
+Examples
+--------
+>>> import aerocontrol
+>>> with aerocontrol.limit_threads(1):
+...     aerocontrol.get_num_threads()
+1
+"""
+
+from __future__ import annotations
+
+import contextlib
+import operator
+from collections.abc import Iterator
+
+from . import _core
+from .exceptions import InvalidArgumentError
+
+__all__ = ["get_num_threads", "limit_threads", "set_num_threads"]
+
+_chosen: int | None = None
+
+
+def _count(count: object) -> int:
+    try:
+        value = operator.index(count)  # type: ignore[arg-type]
+    except TypeError:
+        raise InvalidArgumentError(
+            f"count must be a positive int or None, got {type(count).__name__}"
+        ) from None
+    if isinstance(count, bool) or value <= 0:
+        raise InvalidArgumentError(f"count must be a positive int or None, got {count!r}")
+    return value
+
+
+def set_num_threads(count: int | None) -> None:
+    """Run aerocontrol's parallel work on ``count`` threads from now on; None returns to the
+    default (``RAYON_NUM_THREADS``, else one thread per core).
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``count`` is not a positive int or None, or that many threads cannot be started.
+    """
+    global _chosen
+    value = None if count is None else _count(count)
+    _core.set_num_threads(0 if value is None else value)
+    _chosen = value
+
+
+def get_num_threads() -> int:
+    """The number of threads aerocontrol's parallel work runs on now."""
+    return _core.get_num_threads()
+
+
+@contextlib.contextmanager
+def limit_threads(count: int | None) -> Iterator[None]:
+    """:func:`set_num_threads` for a ``with`` block; the earlier setting comes back after it
+    (also when the block raises)."""
+    earlier = _chosen
+    set_num_threads(count)
+    try:
+        yield
+    finally:
+        set_num_threads(earlier)

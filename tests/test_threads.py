@@ -1,0 +1,59 @@
+"""The thread count of parallel work (aerocontrol.threads): set, limited for a block and
+restored, results independent of it, and bad counts refused by name."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import aerocontrol
+from aerocontrol.exceptions import InvalidArgumentError
+
+
+def _named_threads() -> int:
+    """Threads of this process named by aerocontrol's chosen pools (Linux)."""
+    tasks = Path(f"/proc/{os.getpid()}/task")
+    return sum((task / "comm").read_text().startswith("aerocontrol-") for task in tasks.iterdir())
+
+
+def test_limit_threads_sets_and_restores() -> None:
+    default = aerocontrol.get_num_threads()
+    with aerocontrol.limit_threads(3):
+        assert aerocontrol.get_num_threads() == 3
+        with aerocontrol.limit_threads(1):
+            assert aerocontrol.get_num_threads() == 1
+        assert aerocontrol.get_num_threads() == 3
+    assert aerocontrol.get_num_threads() == default
+    with pytest.raises(RuntimeError), aerocontrol.limit_threads(2):
+        raise RuntimeError("inside")
+    assert aerocontrol.get_num_threads() == default
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs Linux /proc")
+def test_a_chosen_pool_runs_the_work_on_its_threads() -> None:
+    stack = np.random.default_rng(0).standard_normal((20_000, 4, 4))
+    with aerocontrol.limit_threads(3):
+        aerocontrol.linalg.eigenvalues(stack)
+        assert _named_threads() == 3
+    # The pool is gone with the setting (its threads end once it is dropped).
+    aerocontrol.linalg.eigenvalues(stack)
+
+
+def test_results_do_not_depend_on_the_thread_count() -> None:
+    rng = np.random.default_rng(1)
+    stack = rng.standard_normal((5_000, 6, 6))
+    reference = aerocontrol.linalg.eigenvalues(stack)
+    exponentials = aerocontrol.expm(stack * 0.1)
+    for count in (1, 2, 3):
+        with aerocontrol.limit_threads(count):
+            np.testing.assert_array_equal(aerocontrol.linalg.eigenvalues(stack), reference)
+            np.testing.assert_array_equal(aerocontrol.expm(stack * 0.1), exponentials)
+
+
+@pytest.mark.parametrize("count", [0, -1, 1.5, "2", True])
+def test_bad_counts_are_refused(count: object) -> None:
+    with pytest.raises(InvalidArgumentError, match="count must be a positive int"):
+        aerocontrol.set_num_threads(count)  # type: ignore[arg-type]
