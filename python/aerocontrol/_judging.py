@@ -59,7 +59,7 @@ def judge_stack(
         named,
         levels,
         known,
-        (eigenvalues.real < 0.0).all(axis=1),
+        np.asarray((eigenvalues.real < 0.0).all(axis=1)),
         unresolved,
         eigenvalues.real.max(axis=1),
     )
