@@ -1082,7 +1082,7 @@ def _panels(ax: Any, count: int, name: str, shape: tuple[int, int]) -> list[Axes
     """``count`` axes: new ones in a grid of ``shape`` when ``ax`` is None, else the given
     ones (any sequence or array of axes, flattened)."""
     if ax is None:
-        ax = _new_axes(*shape, figsize=(3.2 * shape[1], 2.6 * shape[0]), squeeze=False)
+        ax = _new_axes(*shape, figsize=(3.2 * shape[1], 2.6 * shape[0]))
     panels = list(np.ravel(np.asarray(ax, dtype=object)))
     if len(panels) != count:
         raise InvalidArgumentError(f"{name} must hold {count} matplotlib axes, got {len(panels)}")
