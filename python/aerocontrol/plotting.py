@@ -1106,6 +1106,16 @@ def plot_gain_schedule(schedule: GainSchedule, ax: Any = None, weight: int = 0) 
 
     ``ax`` is None (a new grid of panels) or inputs x 4 axes (any sequence or array, in
     row-major order). Returns the axes as a list.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, plotting
+    >>> from aerocontrol.schedule import gain_schedule
+    >>> s = gain_schedule(aircraft.load(), [0, 10000], [0.2, 0.3], design="damper")
+    >>> panels = plotting.plot_gain_schedule(s, ax=Figure().subplots(2, 4))
+    >>> len(panels), len(panels[0].get_lines()), panels[0].get_xlabel()
+    (8, 2, 'Mach number')
     """
     k = _weight_index(weight, schedule.weights)
     rows, columns = schedule.gains.shape[-2:]
@@ -1143,6 +1153,17 @@ def plot_envelope_levels(envelope: Envelope, ax: Any = None, weight: int = 0) ->
 
     ``ax`` is None (new axes, one per mode in a row) or one axes per mode, in the order of
     ``envelope.levels``. Returns the axes as a list.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, plotting
+    >>> from aerocontrol.schedule import gain_schedule
+    >>> s = gain_schedule(aircraft.load(), [0, 10000], [0.2, 0.3], design="damper", zeta=0.1)
+    >>> envelope = s.evaluate([0, 5000, 10000], [0.2, 0.25, 0.3])
+    >>> panels = plotting.plot_envelope_levels(envelope, ax=Figure().subplots(1, 3))
+    >>> [panel.get_title() for panel in panels]
+    ['dutch roll, W = 564032 lbf', 'roll, W = 564032 lbf', 'spiral, W = 564032 lbf']
     """
     k = _weight_index(weight, envelope.weights)
     names = list(envelope.levels)
