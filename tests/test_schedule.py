@@ -86,7 +86,7 @@ def test_lqr_gains_at_grid_points_are_the_one_condition_design(
     for i, j, k in np.ndindex(3, 3, 3):
         condition = PLANE.at(ALTITUDES[i], MACHS[j], WEIGHTS[k])
         sys = condition.lateral() if axis == "lateral" else condition.longitudinal()
-        K, _, _ = aerocontrol.lqr(sys.A, sys.B, Q_, c * R_)
+        K, _, _ = aerocontrol.lqr(sys.A, sys.B, Q_, R_ / c**2)
         assert _relative(schedule.gains[i, j, k], K) < 1e-12, (i, j, k)
 
 
@@ -236,7 +236,7 @@ def test_bad_arguments_raise_named_errors(
 
 @pytest.mark.parametrize(
     ("kind", "options"),
-    [("damper", {"zeta": 0.1}), ("lqr", {"c": 0.01}), ("lqr", {"axis": "longitudinal"})],
+    [("damper", {"zeta": 0.1}), ("lqr", {"c": 10.0}), ("lqr", {"axis": "longitudinal"})],
 )
 def test_levels_at_grid_points_are_assess_of_each_closed_loop(
     kind: str, options: dict[str, object]
@@ -263,7 +263,7 @@ def test_levels_at_grid_points_are_assess_of_each_closed_loop(
     assert again.failures == envelope.failures
     if kind == "damper":  # the checks met more than one Level
         assert {1, 2, 3} <= seen
-    if options.get("c") == 0.01:  # and coupled roll-spiral modes, not assessed
+    if options.get("c") == 10.0:  # and coupled roll-spiral modes, not assessed
         assert envelope.failures and 0 in seen
 
 
@@ -290,7 +290,7 @@ def test_levels_between_grid_points_use_the_interpolated_gains() -> None:
 def test_evaluate_on_chunks_and_on_a_dask_cluster_is_bitwise_the_local_run(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    schedule = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS, c=0.01)
+    schedule = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS, c=10.0)
     grids = (np.linspace(0.0, 20000.0, 5), np.linspace(0.2, 0.45, 7), [480e3, 600e3])
     whole = schedule.evaluate(*grids)
     monkeypatch.setattr(schedule_module, "CHUNK_SIZE", 9)  # 70 conditions in 8 chunks
@@ -307,7 +307,7 @@ def test_evaluate_on_chunks_and_on_a_dask_cluster_is_bitwise_the_local_run(
         distributed.Client(cluster) as client,
     ):
         remote = schedule.evaluate(*grids, client=client)
-        designed = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS, c=0.01, client=client)
+        designed = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS, c=10.0, client=client)
     for other in (chunked, remote):
         for mode in whole.levels:
             np.testing.assert_array_equal(other.levels[mode], whole.levels[mode])

@@ -1078,6 +1078,9 @@ def plot_sensitivity(result: MonteCarlo, ax: Axes | None = None) -> Axes:
     return ax
 
 
+# --- Gain schedules over the envelope ------------------------------------------------------
+
+
 def _panels(ax: Any, count: int, name: str, shape: tuple[int, int]) -> list[Axes]:
     """``count`` axes: new ones in a grid of ``shape`` when ``ax`` is None, else the given
     ones (any sequence or array of axes, flattened)."""

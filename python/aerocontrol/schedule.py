@@ -4,9 +4,9 @@ between the design points.
 
 At each grid condition (the aircraft moved by :meth:`Aircraft.at`, as
 :func:`aerocontrol.aircraft.envelope_sweep` builds its conditions) a gain K is designed,
-u = -K x: the linear-quadratic regulator of A^T X + X A - X B (cR)^-1 B^T X + Q = 0,
-K = (cR)^-1 B^T X (the chapter's (6.222)-(6.226), with the control weight cR as
-:class:`aerocontrol.robustness.Lqr` takes it), all conditions solved in one batch call, or the
+u = -K x: the linear-quadratic regulator minimising J = ∫ x^T Q x + (1/c²) u^T R u dt (the
+chapter's (6.224)-(6.227), weighted as :func:`aerocontrol.batch.lqr_sweep` and
+:class:`aerocontrol.robustness.Lqr` weight it), all conditions solved in one batch call, or the
 Dutch-roll damper of (6.156) by Bass-Gura (:func:`aerocontrol.design.dutch_roll_damper`).
 
 Between the grid points the schedule interpolates each gain entry multilinearly: with t_i the
@@ -383,13 +383,14 @@ def gain_schedule(
         A strictly increasing 1-D grid of weights in the file's force unit; the file's
         weight when None.
     design : {"lqr", "damper"}
-        "lqr": the regulator of A^T X + X A - X B (cR)^-1 B^T X + Q = 0 (6.222)-(6.226),
-        K = (cR)^-1 B^T X, every condition's Riccati equation solved in one parallel call
+        "lqr": the regulator minimising J = ∫ x^T Q x + (1/c²) u^T R u dt (6.224)-(6.227),
+        K = c² R^-1 B^T X, every condition's Riccati equation solved in one parallel call
         (:func:`aerocontrol.batch.solve_care_batch`). "damper" (lateral only): the Dutch-roll
         damper through the rudder (6.156), by Bass-Gura (6.145)
         (:func:`aerocontrol.design.dutch_roll_damper`), the aileron row of K zero.
     c : float
-        The LQR control weight's factor (positive).
+        The LQR weight c (positive): R/c² weights the control, so a large c makes control
+        cheap.
     Q, R : array_like, optional
         The LQR weights, 4 x 4 and inputs x inputs; identities when None ((6.225)-(6.226)).
     axis : {"lateral", "longitudinal"}
@@ -457,7 +458,7 @@ def gain_schedule(
             raise ShapeError(f"Q must be 4 x 4, got shape {Q_matrix.shape}")
         if R_matrix.shape != (m, m):
             raise ShapeError(f"R must be {m} x {m} for the {axis} model, got {R_matrix.shape}")
-        K = batch.solve_care_batch(A, B, Q_matrix, weight * R_matrix).K
+        K = batch.solve_care_batch(A, B, Q_matrix, R_matrix / weight**2).K
     else:
         K = np.zeros((len(moved), m, 4))
         rudder = input_names.index("rudder")
