@@ -15,7 +15,18 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import aircraft, batch, chapter, design, exceptions, handling, plotting, report, robustness
+from . import (
+    aircraft,
+    batch,
+    chapter,
+    design,
+    exceptions,
+    handling,
+    plotting,
+    report,
+    robustness,
+    schedule,
+)
 from .controllability import (
     Controllability,
     controllability,
@@ -256,6 +267,7 @@ __all__ = [
     "riccati_ode",
     "robustness",
     "root_locus",
+    "schedule",
     "schur",
     "second_order",
     "sensitivity",

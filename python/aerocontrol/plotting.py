@@ -24,6 +24,9 @@ function                       the chapter's figure
 :func:`plot_nichols`           the Nichols chart of a loop, with closed-loop gain and phase
                                contours
 :func:`plot_modes`             the eigenvalues in the complex plane, by mode
+:func:`plot_levels`            MIL-F-8785C Levels over a grid of flight conditions
+:func:`plot_envelope_levels`   the Levels of each mode over the envelope, an image per mode
+:func:`plot_gain_schedule`     a gain schedule's entries against Mach, a line per altitude
 =============================  ===============================================================
 
 States, inputs and outputs with the names of the aircraft models (``u/u0``, ``alpha``, ...,
@@ -46,11 +49,13 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.legend import Legend
 
+    from .aircraft.envelope import Envelope
     from .frequency import FrequencyResponse
     from .loops import NicholsResponse, NyquistResponse, RootLocus
     from .modal import Modes
     from .responses import TimeResponse
     from .robustness import MonteCarlo
+    from .schedule import GainSchedule
 
 __all__ = [
     "closed_loop_gain_contour",
@@ -59,7 +64,9 @@ __all__ = [
     "penalty_terms",
     "plot_bode",
     "plot_compared",
+    "plot_envelope_levels",
     "plot_gain_root_locus",
+    "plot_gain_schedule",
     "plot_levels",
     "plot_modes",
     "plot_nichols",
@@ -1069,3 +1076,108 @@ def plot_sensitivity(result: MonteCarlo, ax: Axes | None = None) -> Axes:
     ax.set_yticks(rows, ranking)
     _finish(ax, "failure rate", "", f"sensitivity of P(failed) = {overall:.3g}")
     return ax
+
+
+# --- Gain schedules over the envelope ------------------------------------------------------
+
+
+def _panels(ax: Any, count: int, name: str, shape: tuple[int, int]) -> list[Axes]:
+    """``count`` axes: new ones in a grid of ``shape`` when ``ax`` is None, else the given
+    ones (any sequence or array of axes, flattened)."""
+    if ax is None:
+        ax = _new_axes(*shape, figsize=(3.2 * shape[1], 2.6 * shape[0]))
+    panels = list(np.ravel(np.asarray(ax, dtype=object)))
+    if len(panels) != count:
+        raise InvalidArgumentError(f"{name} must hold {count} matplotlib axes, got {len(panels)}")
+    return panels
+
+
+def _weight_index(weight: int, weights: FloatArray) -> int:
+    if isinstance(weight, bool) or not isinstance(weight, (int, np.integer)):
+        raise InvalidArgumentError(f"weight must be an index into the weights, got {weight!r}")
+    if not -len(weights) <= weight < len(weights):
+        raise InvalidArgumentError(
+            f"weight must index the {len(weights)} weights of the grid, got {weight}"
+        )
+    return int(weight) % len(weights)
+
+
+def plot_gain_schedule(schedule: GainSchedule, ax: Any = None, weight: int = 0) -> Any:
+    """A gain schedule (:func:`aerocontrol.schedule.gain_schedule`) over the envelope: each
+    entry K[i, j] of u = -K x in a panel of its own (rows inputs, columns states), against
+    Mach, a line per altitude of the grid, at the grid's ``weight``-th weight.
+
+    ``ax`` is None (a new grid of panels) or inputs x 4 axes (any sequence or array, in
+    row-major order). Returns the axes as a list.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, plotting
+    >>> from aerocontrol.schedule import gain_schedule
+    >>> s = gain_schedule(aircraft.load(), [0, 10000], [0.2, 0.3], design="damper")
+    >>> panels = plotting.plot_gain_schedule(s, ax=Figure().subplots(2, 4))
+    >>> len(panels), len(panels[0].get_lines()), panels[0].get_xlabel()
+    (8, 2, 'Mach number')
+    """
+    k = _weight_index(weight, schedule.weights)
+    rows, columns = schedule.gains.shape[-2:]
+    panels = _panels(ax, rows * columns, "ax", (rows, columns))
+    length, force = schedule.closed_loop.length_unit, schedule.closed_loop.force_unit
+    states = schedule.state_names
+    for index, panel in enumerate(panels):
+        i, j = divmod(index, columns)
+        for a, altitude in enumerate(schedule.altitudes):
+            panel.plot(
+                schedule.machs,
+                _drawable(panel, schedule.gains[a, :, k, i, j]),
+                "o-",
+                markersize=3,
+                label=f"{altitude:g} {length}",
+            )
+        _finish(
+            panel,
+            "Mach number",
+            f"K[{schedule.input_names[i]}, {states[j]}]",
+            f"{schedule.input_names[i]} from {label(states[j])}",
+        )
+        panel.title.set_fontsize("small")
+    panels[0].figure.suptitle(
+        f"{schedule.design} gains, W = {schedule.weights[k]:g} {force}", fontsize="medium"
+    )
+    return panels
+
+
+def plot_envelope_levels(envelope: Envelope, ax: Any = None, weight: int = 0) -> Any:
+    """The MIL-F-8785C Levels of an :class:`~aerocontrol.aircraft.Envelope` (an envelope
+    sweep, or a gain schedule's closed loop evaluated by
+    :meth:`~aerocontrol.schedule.GainSchedule.evaluate`): an image per mode over Mach (x) and
+    altitude (y) (:func:`plot_levels`), at the grid's ``weight``-th weight.
+
+    ``ax`` is None (new axes, one per mode in a row) or one axes per mode, in the order of
+    ``envelope.levels``. Returns the axes as a list.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, plotting
+    >>> from aerocontrol.schedule import gain_schedule
+    >>> s = gain_schedule(aircraft.load(), [0, 10000], [0.2, 0.3], design="damper", zeta=0.1)
+    >>> envelope = s.evaluate([0, 5000, 10000], [0.2, 0.25, 0.3])
+    >>> panels = plotting.plot_envelope_levels(envelope, ax=Figure().subplots(1, 3))
+    >>> [panel.get_title() for panel in panels]
+    ['dutch roll, W = 564032 lbf', 'roll, W = 564032 lbf', 'spiral, W = 564032 lbf']
+    """
+    k = _weight_index(weight, envelope.weights)
+    names = list(envelope.levels)
+    panels = _panels(ax, len(names), "ax", (1, len(names)))
+    for panel, mode in zip(panels, names, strict=True):
+        plot_levels(
+            envelope.machs,
+            envelope.altitudes,
+            envelope.levels[mode][:, :, k],
+            ax=panel,
+            title=f"{mode}, W = {envelope.weights[k]:g} {envelope.force_unit}",
+        )
+        panel.set_ylabel(f"altitude ({envelope.length_unit})")
+    return panels

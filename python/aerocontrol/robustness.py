@@ -43,11 +43,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import batch, linalg
+from ._judging import AXIS_MODES, judge_stack
 from ._validation import real_array, real_scalar
 from .aircraft.model import SAMPLED_FIELDS, Aircraft
-from .aircraft.naming import classify_mode_stack
 from .exceptions import InvalidArgumentError, ShapeError
-from .handling import level_arrays, mode_quantities
+from .handling import mode_quantities
 
 __all__ = [
     "CHUNK_SIZE",
@@ -76,10 +76,7 @@ SENSITIVITY_BINS = 10
 #: The prefix of a mode quantity's key among a chunk's arrays.
 _QUANTITY = "quantity: "
 
-_AXIS_MODES = {
-    "lateral": ("dutch roll", "roll", "spiral"),
-    "longitudinal": ("short period", "phugoid"),
-}
+_AXIS_MODES = AXIS_MODES
 
 
 # --- Distributions ----------------------------------------------------------------------------
@@ -318,25 +315,21 @@ def _judge(
     run: _Run, A: FloatArray, eigenvalues: NDArray[np.complex128]
 ) -> dict[str, NDArray[Any]]:
     """Stability, Levels and mode quantities of a chunk's models."""
-    mode_names = _AXIS_MODES[run.axis]
-    named, unresolved = classify_mode_stack(eigenvalues, run.axis, A)
-    levels = np.full((A.shape[0], len(mode_names)), 4, dtype=np.int8)
+    judged = judge_stack(
+        A, eigenvalues, run.axis, run.aircraft.aircraft_class, run.aircraft.category
+    )
     out: dict[str, NDArray[Any]] = {}
-    for k, name in enumerate(mode_names):
-        known = ~np.isnan(named[name]).reshape(A.shape[0], -1).any(axis=1)
-        judged = level_arrays(
-            {name: named[name][known]}, run.aircraft.aircraft_class, run.aircraft.category
-        )
-        levels[known, k] = judged[name]
-        for quantity, values in mode_quantities(name, named[name][known]).items():
+    for k, name in enumerate(_AXIS_MODES[run.axis]):
+        known = judged.known[:, k]
+        for quantity, values in mode_quantities(name, judged.named[name][known]).items():
             column = np.full(A.shape[0], np.nan)
             column[known] = values
             out[f"{_QUANTITY}{name}: {quantity}"] = column
     return {
-        "levels": levels,
-        "stable": (eigenvalues.real < 0.0).all(axis=1),
-        "unresolved": unresolved,
-        "max_real": eigenvalues.real.max(axis=1),
+        "levels": judged.levels,
+        "stable": judged.stable,
+        "unresolved": judged.unresolved,
+        "max_real": judged.max_real,
         **out,
     }
 
