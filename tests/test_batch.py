@@ -197,3 +197,39 @@ def test_place_batch_checks_shapes_of_an_empty_batch() -> None:
     B)."""
     with pytest.raises(aerocontrol.ShapeError, match="B must have as many rows as A"):
         aerocontrol.batch.place_batch(np.zeros((0, 1, 1)), np.zeros((1, 2, 2)), [[-1.0]])
+
+
+def test_batches_on_a_dask_cluster_are_bitwise_the_local_ones(
+    dask_client: object, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from aerocontrol import batch as batch_module
+
+    monkeypatch.setattr(batch_module, "DISTRIBUTED_CHUNK", 64)  # 300 problems in 5 chunks
+    sys = aerocontrol.aircraft.load().lateral()
+    rng = np.random.default_rng(4)
+    A = np.repeat(sys.A[np.newaxis], 300, axis=0)
+    A[:, 3, 0] *= 1 + 0.1 * rng.standard_normal(300)
+    local = aerocontrol.batch.solve_care_batch(A, sys.B, np.eye(4), np.eye(2))
+    remote = aerocontrol.batch.solve_care_batch(A, sys.B, np.eye(4), np.eye(2), client=dask_client)
+    for name in ("X", "K", "closed_loop_poles", "residual", "rcond"):
+        np.testing.assert_array_equal(getattr(remote, name), getattr(local, name))
+    weights = np.geomspace(1e-2, 10, 200)
+    sweep = aerocontrol.batch.lqr_sweep(sys, weights=weights)
+    remote_sweep = aerocontrol.batch.lqr_sweep(sys, weights=weights, client=dask_client)
+    np.testing.assert_array_equal(remote_sweep.K, sweep.K)
+    np.testing.assert_array_equal(remote_sweep.poles, sweep.poles)
+    sampled = aerocontrol.c2d(sys, 0.1)
+    np.testing.assert_array_equal(
+        aerocontrol.batch.dlqr_sweep(sampled, weights=weights, client=dask_client).K,
+        aerocontrol.batch.dlqr_sweep(sampled, weights=weights).K,
+    )
+    # The first failing problem is named by its index in the whole batch (chunk 3, row 5).
+    R = np.repeat(np.eye(2)[np.newaxis], 300, axis=0)
+    R[197] = 0.0
+    with pytest.raises(
+        aerocontrol.exceptions.AerocontrolError, match="problem 197 of the batch"
+    ) as info:
+        aerocontrol.batch.solve_care_batch(A, sys.B, np.eye(4), R, client=dask_client)
+    assert info.value.batch_index == 197  # type: ignore[attr-defined]
+    with pytest.raises(aerocontrol.exceptions.AerocontrolError, match="problem 197 of the batch"):
+        aerocontrol.batch.solve_care_batch(A, sys.B, np.eye(4), R)

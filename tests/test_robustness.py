@@ -281,24 +281,22 @@ def test_monte_carlo_is_reproducible_and_independent_of_chunk_order() -> None:
     np.testing.assert_array_equal(longer.open_loop.max_real[:5000], first.open_loop.max_real)
 
 
-def test_monte_carlo_on_a_dask_cluster_is_bitwise_the_local_run() -> None:
-    distributed = pytest.importorskip("distributed")
+def test_monte_carlo_on_a_dask_cluster_is_bitwise_the_local_run(dask_client: object) -> None:
     plane = aircraft.load("b747-cruise")
     local = monte_carlo(plane, _LATERAL, 6000, Lqr(1.0), seed=9, chunk_size=1500)
-    with (
-        distributed.LocalCluster(
-            n_workers=2,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            env={"RAYON_NUM_THREADS": "1"},
-        ) as cluster,
-        distributed.Client(cluster) as client,
-    ):
-        remote = monte_carlo(
-            plane, _LATERAL, 6000, Lqr(1.0), seed=9, chunk_size=1500, client=client
-        )
+    seen: list[int] = []
+    remote = monte_carlo(
+        plane,
+        _LATERAL,
+        6000,
+        Lqr(1.0),
+        seed=9,
+        chunk_size=1500,
+        client=dask_client,
+        progress=lambda done, total: seen.append(done),
+    )
     _same(local, remote)
+    assert seen == [1500, 3000, 4500, 6000]
 
 
 def test_monte_carlo_results() -> None:

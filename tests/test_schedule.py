@@ -288,26 +288,15 @@ def test_levels_between_grid_points_use_the_interpolated_gains() -> None:
 
 
 def test_evaluate_on_chunks_and_on_a_dask_cluster_is_bitwise_the_local_run(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, dask_client: object
 ) -> None:
     schedule = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS, c=10.0)
     grids = (np.linspace(0.0, 20000.0, 5), np.linspace(0.2, 0.45, 7), [480e3, 600e3])
     whole = schedule.evaluate(*grids)
     monkeypatch.setattr(schedule_module, "CHUNK_SIZE", 9)  # 70 conditions in 8 chunks
     chunked = schedule.evaluate(*grids)
-    distributed = pytest.importorskip("distributed")
-    with (
-        distributed.LocalCluster(
-            n_workers=2,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            env={"RAYON_NUM_THREADS": "1"},
-        ) as cluster,
-        distributed.Client(cluster) as client,
-    ):
-        remote = schedule.evaluate(*grids, client=client)
-        designed = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS, c=10.0, client=client)
+    remote = schedule.evaluate(*grids, client=dask_client)
+    designed = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS, c=10.0, client=dask_client)
     for other in (chunked, remote):
         for mode in whole.levels:
             np.testing.assert_array_equal(other.levels[mode], whole.levels[mode])

@@ -14,20 +14,25 @@ solves it alone, so the results are bitwise the one-at-a-time results).
 
 An error in one problem raises the exception of that problem with its index ("problem 7 of
 the batch: ..."), the lowest failing index when several fail; nothing partial is returned.
+
+:func:`solve_care_batch`, :func:`solve_dare_batch`, :func:`lqr_sweep` and :func:`dlqr_sweep`
+take an optional ``client`` (a ``dask.distributed.Client``): the batch is cut into chunks of
+:data:`DISTRIBUTED_CHUNK` problems, each solved by the same kernel on a worker, and joined in
+order, so the result is bitwise the local one.
 """
 
 from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, real_array
-from .exceptions import IllConditionedWarning, InvalidArgumentError, ShapeError
+from .exceptions import AerocontrolError, IllConditionedWarning, InvalidArgumentError, ShapeError
 from .placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
 from .riccati import RCOND_WARNING, RESIDUAL_WARNING
 from .statespace import as_state_space, is_system, require_continuous
@@ -36,6 +41,7 @@ if TYPE_CHECKING:
     from ._typing import SystemObject
 
 __all__ = [
+    "DISTRIBUTED_CHUNK",
     "CareBatch",
     "DareBatch",
     "LqrSweep",
@@ -48,6 +54,9 @@ __all__ = [
 ]
 
 ComplexArray = NDArray[np.complex128]
+
+#: Problems per task when a batch runs on a Dask cluster (``client=``).
+DISTRIBUTED_CHUNK = 4096
 
 
 @dataclass(frozen=True, eq=False)
@@ -209,6 +218,59 @@ def _stack(value: object, name: str) -> FloatArray:
     return array
 
 
+def _solved(
+    kernel: str, stacks: tuple[FloatArray, ...], extra: tuple[Any, ...], client: Any
+) -> Any:
+    """The core's ``kernel`` on the stacks (each of one matrix, shared, or k of them): in one
+    call, or with a Dask ``client`` in chunks of :data:`DISTRIBUTED_CHUNK` problems, joined in
+    order (the first failing problem's error raised with its index in the whole batch)."""
+    if client is None:
+        return getattr(_core, kernel)(*stacks, *extra)
+    count = max(len(stack) for stack in stacks)
+    for name, stack in zip("ABQR", stacks, strict=True):
+        if len(stack) not in (1, count):
+            raise ShapeError(
+                f"{name} holds {len(stack)} matrices; the batch has {count} problems (give one "
+                "matrix, shared, or one per problem)"
+            )
+    starts = list(range(0, count, DISTRIBUTED_CHUNK)) or [0]
+    futures = client.map(
+        _solved_chunk,
+        [kernel] * len(starts),
+        [stacks] * len(starts),
+        [extra] * len(starts),
+        starts,
+        [start + DISTRIBUTED_CHUNK for start in starts],
+        pure=False,
+    )
+    parts = [future.result() for future in futures]
+    for start, part in zip(starts, parts, strict=True):
+        if isinstance(part, AerocontrolError):
+            index = start + int(getattr(part, "batch_index", 0))
+            message = str(part).replace(
+                f"problem {getattr(part, 'batch_index', 0)} of the batch",
+                f"problem {index} of the batch",
+                1,
+            )
+            error = type(part)(message)
+            error.__dict__.update(part.__dict__)
+            error.batch_index = index
+            raise error
+    return tuple(np.concatenate(arrays) for arrays in zip(*parts, strict=True))
+
+
+def _solved_chunk(
+    kernel: str, stacks: tuple[FloatArray, ...], extra: tuple[Any, ...], start: int, stop: int
+) -> Any:
+    """Problems start to stop of :func:`_solved`, run on a worker: their results, or their
+    error (returned, so that the caller can name the problem in the whole batch)."""
+    chunk = tuple(stack if len(stack) == 1 else stack[start:stop] for stack in stacks)
+    try:
+        return getattr(_core, kernel)(*chunk, *extra)
+    except AerocontrolError as error:
+        return error
+
+
 def _warn(flagged: NDArray[np.intp], what: str) -> None:
     """One IllConditionedWarning naming the flagged problems (the first ten)."""
     if flagged.size:
@@ -219,14 +281,21 @@ def _warn(flagged: NDArray[np.intp], what: str) -> None:
 
 
 def solve_care_batch(
-    A: ArrayLike, B: ArrayLike, Q: ArrayLike, R: ArrayLike, refine: bool = True
+    A: ArrayLike,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike,
+    refine: bool = True,
+    client: Any = None,
 ) -> CareBatch:
     """Solve A_i^T X_i + X_i A_i - X_i B_i R_i^-1 B_i^T X_i + Q_i = 0 for every problem i of a
     batch, in parallel.
 
     Each of A (k, n, n), B (k, n, m), Q (k, n, n) and R (k, m, m) is a 3-D stack of k
     matrices or a single matrix shared by every problem. The method, checks and diagnostics
-    are those of :func:`aerocontrol.solve_care` (without the cross weight and E).
+    are those of :func:`aerocontrol.solve_care` (without the cross weight and E). With a Dask
+    ``client``, the batch is solved in chunks on the cluster, bitwise as here (see the module
+    notes).
 
     Raises
     ------
@@ -255,11 +324,8 @@ def solve_care_batch(
     >>> batch.K.shape, bool(np.all(batch.closed_loop_poles.real < 0))
     ((500, 2, 4), True)
     """
-    batch = CareBatch(
-        *_core.care_batch(
-            _stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"), bool(refine)
-        )
-    )
+    stacks = (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
+    batch = CareBatch(*_solved("care_batch", stacks, (bool(refine),), client))
     _warn(
         np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING)),
         f"of the {len(batch)} Riccati solutions may be inaccurate (rcond(U11) < "
@@ -268,7 +334,9 @@ def solve_care_batch(
     return batch
 
 
-def solve_dare_batch(A: ArrayLike, B: ArrayLike, Q: ArrayLike, R: ArrayLike) -> DareBatch:
+def solve_dare_batch(
+    A: ArrayLike, B: ArrayLike, Q: ArrayLike, R: ArrayLike, client: Any = None
+) -> DareBatch:
     """Solve A_i^T X_i A_i - X_i - A_i^T X_i B_i (R_i + B_i^T X_i B_i)^-1 B_i^T X_i A_i + Q_i = 0
     for every problem i of a batch, in parallel, each exactly as :func:`aerocontrol.solve_dare`
     solves it alone (without the cross weight and E).
@@ -288,9 +356,8 @@ def solve_dare_batch(A: ArrayLike, B: ArrayLike, Q: ArrayLike, R: ArrayLike) -> 
     >>> batch.K.shape, bool(np.all(abs(batch.closed_loop_poles) < 1))
     ((200, 2, 4), True)
     """
-    batch = DareBatch(
-        *_core.dare_batch(_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
-    )
+    stacks = (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
+    batch = DareBatch(*_solved("dare_batch", stacks, (), client))
     _warn(
         np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING)),
         f"of the {len(batch)} discrete Riccati solutions may be inaccurate (rcond(U11) < "
@@ -305,6 +372,7 @@ def dlqr_sweep(
     Q: ArrayLike | None = None,
     R: ArrayLike | None = None,
     weights: ArrayLike | None = None,
+    client: Any = None,
 ) -> LqrSweep:
     """The discrete regulator of one sampled model for each weight c:
     J = Σ x_k^T Q x_k + (1/c²) u_k^T R u_k, as :func:`lqr_sweep` for continuous models, all
@@ -317,7 +385,7 @@ def dlqr_sweep(
     >>> sweep.K.shape, bool(np.all(abs(sweep.poles) < 1))
     ((100, 2, 4), True)
     """
-    return _sweep("dlqr_sweep", True, sys_or_A, B, Q, R, weights)
+    return _sweep("dlqr_sweep", True, sys_or_A, B, Q, R, weights, client)
 
 
 def lqr_sweep(
@@ -326,6 +394,7 @@ def lqr_sweep(
     Q: ArrayLike | None = None,
     R: ArrayLike | None = None,
     weights: ArrayLike | None = None,
+    client: Any = None,
 ) -> LqrSweep:
     """The regulator of one model for each weight c: J = ∫ x^T Q x + (1/c²) η^T R η dt
     ((6.224)-(6.227); R/c² is the control weight), all solved in one parallel call.
@@ -343,7 +412,7 @@ def lqr_sweep(
     >>> sweep.K.shape, sweep.poles.shape
     ((1000, 2, 4), (1000, 4))
     """
-    return _sweep("lqr_sweep", False, sys_or_A, B, Q, R, weights)
+    return _sweep("lqr_sweep", False, sys_or_A, B, Q, R, weights, client)
 
 
 def _sweep(
@@ -354,6 +423,7 @@ def _sweep(
     Q: ArrayLike | None,
     R: ArrayLike | None,
     weights: ArrayLike | None,
+    client: Any,
 ) -> LqrSweep:
     """The sweep of :func:`lqr_sweep` (continuous) or :func:`dlqr_sweep` (discrete)."""
     if is_system(sys_or_A):
@@ -405,5 +475,5 @@ def _sweep(
             error.argument = "weights"
             raise error
     solve = solve_dare_batch if discrete else solve_care_batch
-    batch = solve(A_matrix, B_matrix, Q_matrix, R_stack)
+    batch = solve(A_matrix, B_matrix, Q_matrix, R_stack, client=client)
     return LqrSweep(c, batch.K, batch.closed_loop_poles, batch.X, batch.residual, batch.rcond)
