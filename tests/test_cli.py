@@ -499,3 +499,30 @@ def test_robustness_refuses_bad_options(
     got, out, err = _run(capsys, "robustness", *argv)
     assert got == 2 and message in err and out == ""
     assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_robustness_writes_its_page_under_the_report_folder_rules(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    out = tmp_path / "robust"
+    argv = ("robustness", "b747-cruise", "--samples", "2000", "--controller", "lqr")
+    status, text, err = _run(capsys, *argv, "--out", str(out))
+    assert status == 0 and err == ""
+    assert text.splitlines()[-1] == f"report: {out / 'report.html'}"
+    names = sorted(p.name for p in (out / "figures").iterdir())
+    assert names == ["robustness-convergence-sensitivity.png", "robustness-distributions.png"]
+    page = (out / "report.md").read_text(encoding="utf-8")
+    # The regulator (Q = I, c = 1) couples roll and spiral in these samples: said, not hidden.
+    assert "roll and spiral coupled: not assessed, Level 4" in page
+    assert "dutch roll Level 1 or better" in page
+    # Run again: the earlier page is replaced; a folder of the user's is refused.
+    status, text, _ = _run(capsys, *argv, "--out", str(out))
+    assert status == 0 and "replacing the earlier report" in text
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("mine")
+    status, text, err = _run(capsys, *argv, "--out", str(mine))
+    assert status == 1 and "notes.txt" not in text and err.startswith("aerocontrol")
+    assert (mine / "notes.txt").read_text() == "mine" and sorted(mine.iterdir()) == [
+        mine / "notes.txt"
+    ]

@@ -451,3 +451,22 @@ def test_bad_uncertainty_tables_are_named(tmp_path, entry: str, message: str) ->
     path = _with_uncertainty(tmp_path, f"\n[uncertainty]\n{entry}\n")
     with pytest.raises(aircraft.AircraftDataError, match=re.escape(message)):
         aircraft.load(path)
+
+
+def test_the_values_of_failing_samples_are_drawn_again() -> None:
+    plane = aircraft.load("b747-cruise")
+    result = monte_carlo(plane, _LATERAL, 3000, _gains(), seed=8, chunk_size=700)
+    failing = np.flatnonzero(result.failed)
+    assert 0 < failing.size < 3000
+    values = result.values(failing)
+    run = aerocontrol.robustness._Run(plane, _LATERAL, "lateral", None, 3000, 8, 700, 1)
+    everything = {
+        name: np.concatenate([run.values(run.draws(i))[name] for i in range(run.chunk_count)])
+        for name in _LATERAL.names
+    }
+    for name in _LATERAL.names:
+        np.testing.assert_array_equal(values[name], everything[name][failing])
+    with pytest.raises(InvalidArgumentError, match="indices must lie"):
+        result.values([3000])
+    with pytest.raises(InvalidArgumentError, match="1-D array"):
+        result.values([0.5])

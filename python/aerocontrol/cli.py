@@ -221,6 +221,19 @@ def _parser() -> argparse.ArgumentParser:
         help="run the chunks on the Dask cluster at this scheduler address "
         "(pip install aerocontrol[distributed])",
     )
+    robustness.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="also write the page with the plots into this folder (report.html, report.md, "
+        "figures/), under the rules of 'aerocontrol report'",
+    )
+    robustness.add_argument(
+        "--force",
+        action="store_true",
+        help="with --out: also write into a non-empty folder that holds no earlier report, "
+        "beside its files (none of them is ever replaced)",
+    )
     return parser
 
 
@@ -229,6 +242,9 @@ def _robustness(arguments: argparse.Namespace) -> int:
 
     from .aircraft.tables import LATERAL_DERIVATIVES, LONGITUDINAL_DERIVATIVES
     from .design import dutch_roll_damper
+    from .report.build import write_document
+    from .report.document import Report
+    from .report.robustness import robustness_report
     from .robustness import Lqr, Normal, Uncertainty, monte_carlo
 
     if arguments.samples <= 0:
@@ -282,26 +298,35 @@ def _robustness(arguments: argparse.Namespace) -> int:
             flush=True,
         )
 
-    print(plane.summary())
-    try:
-        result = monte_carlo(
-            plane,
-            uncertainty,
-            arguments.samples,
-            controller,
-            axis=arguments.axis,
-            seed=arguments.seed,
-            client=client,
-            progress=progress,
-        )
-    finally:
-        if client is not None:
-            client.close()
-    if show:
-        print(file=sys.stderr)
-    elapsed = time.perf_counter() - start
-    print(f"\n{result}")
-    print(f"\n{result.samples} samples in {elapsed:.1f} s")
+    def run(_: object = None) -> Report:
+        print(plane.summary())
+        try:
+            result = monte_carlo(
+                plane,
+                uncertainty,
+                arguments.samples,
+                controller,
+                axis=arguments.axis,
+                seed=arguments.seed,
+                client=client,
+                progress=progress,
+            )
+        finally:
+            if client is not None:
+                client.close()
+        if show:
+            print(file=sys.stderr)
+        elapsed = time.perf_counter() - start
+        print(f"\n{result}")
+        print(f"\n{result.samples} samples in {elapsed:.1f} s")
+        title = f"aerocontrol {__version__}: stochastic robustness of {plane.name}"
+        return robustness_report(result, uncertainty, title)
+
+    if arguments.out is None:
+        run()
+    else:
+        path = write_document(run, arguments.out, print, force=arguments.force)
+        print(f"report: {path}")
     return 0
 
 

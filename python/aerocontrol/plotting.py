@@ -1008,7 +1008,13 @@ def plot_robustness_histogram(
     values = outcome.quantities[key]
     finite = values[np.isfinite(values)]
     ax = _new_axes() if ax is None else ax
-    ax.hist(finite, bins=bins, color="tab:blue", alpha=0.75)
+    spread = finite.size and finite.min() > 0 and finite.max() > 100 * finite.min()
+    if spread:  # times to double near a neutral spiral: decades apart, on a log axis
+        edges: Any = np.geomspace(finite.min(), finite.max(), bins + 1)
+        ax.set_xscale("log")
+    else:
+        edges = bins
+    ax.hist(finite, bins=edges, color="tab:blue", alpha=0.75)
     for level, bound in level_limits(mode, quantity, result.aircraft_class, result.category):
         ax.axvline(
             bound,
@@ -1017,10 +1023,11 @@ def plot_robustness_histogram(
             label=f"Level {level} limit {bound:g}",
         )
     hidden = values.size - finite.size
-    title = f"{mode} {quantity}: {values.size} samples"
+    title = f"{mode}: {values.size} samples"
     if hidden:
-        title += f" ({hidden} not finite, not shown)"
-    _finish(ax, quantity, "samples", title)
+        title += f", {hidden} not shown (mode unresolved, or inf)"
+    unit = {"omega_n": "rad/s", "time constant": "s", "time to double": "s"}.get(quantity)
+    _finish(ax, f"{quantity} ({unit})" if unit else quantity, "samples", title)
     return ax
 
 

@@ -517,6 +517,42 @@ class MonteCarlo:
     failures_by_bin: NDArray[np.int64]
     """(parameters, 10): failures among the samples in each decile of a parameter's draw."""
     samples_by_bin: NDArray[np.int64]
+    source: _Run = field(repr=False, compare=False)
+    """What the run drew from (to draw a sample's values again: :meth:`values`)."""
+
+    def values(self, indices: ArrayLike) -> dict[str, FloatArray]:
+        """The uncertain parameters' values of the samples ``indices`` (for instance
+        ``np.flatnonzero(result.failed)``), drawn again from the seed: name to array.
+
+        Examples
+        --------
+        >>> import numpy as np, aerocontrol
+        >>> from aerocontrol.robustness import Normal, Uncertainty, monte_carlo
+        >>> plane = aerocontrol.aircraft.load("b747-cruise")
+        >>> result = monte_carlo(plane, Uncertainty({"Cn_beta": Normal(0.5)}), 1000, seed=3)
+        >>> failing = result.values(np.flatnonzero(result.failed)[:3])
+        >>> failing["Cn_beta"].shape
+        (3,)
+        """
+        wanted = np.asarray(indices)
+        if wanted.ndim != 1 or not np.issubdtype(wanted.dtype, np.integer):
+            raise InvalidArgumentError(
+                f"indices must be a 1-D array of sample indices, got {wanted.dtype} of shape "
+                f"{wanted.shape}"
+            )
+        if wanted.size and (wanted.min() < 0 or wanted.max() >= self.samples):
+            raise InvalidArgumentError(
+                f"indices must lie in [0, {self.samples}), got {wanted.min()} to {wanted.max()}"
+            )
+        run = self.source
+        out = {name: np.empty(wanted.size) for name in self.parameters}
+        chunks = wanted // run.chunk_size
+        for chunk in np.unique(chunks):
+            rows = np.flatnonzero(chunks == chunk)
+            drawn = run.values(run.draws(int(chunk)))
+            for name in self.parameters:
+                out[name][rows] = drawn[name][wanted[rows] - int(chunk) * run.chunk_size]
+        return out
 
     def probability(
         self,
@@ -526,9 +562,11 @@ class MonteCarlo:
         loop: str = "auto",
         confidence: float = 0.95,
     ) -> Estimate:
-        """The probability of ``event``: "unstable", "failed", or "level" (``mode`` meets
-        ``level`` or better), for the closed loop if there is one (``loop="auto"``) or the
-        loop named ("open", "closed"), with its Clopper-Pearson interval."""
+        """The probability of ``event``: "unstable", "unresolved" (modes that are not the
+        classical ones, such as a coupled roll-spiral, whose roll and spiral count as Level
+        4), "failed", or "level" (``mode`` meets ``level`` or better), for the closed loop if
+        there is one (``loop="auto"``) or the loop named ("open", "closed"), with its
+        Clopper-Pearson interval."""
         count = int(self.indicator(event, mode, level, loop).sum())
         return clopper_pearson(count, self.samples, confidence)
 
@@ -541,6 +579,8 @@ class MonteCarlo:
             return ~outcome.stable
         if event == "failed":
             return self.failed
+        if event == "unresolved":
+            return outcome.unresolved
         if event == "level":
             if mode not in self.modes:
                 raise InvalidArgumentError(f"mode must be one of {self.modes}, got {mode!r}")
@@ -548,7 +588,9 @@ class MonteCarlo:
                 raise InvalidArgumentError(f"level must be 1, 2 or 3, got {level!r}")
             met: NDArray[np.bool_] = outcome.levels[:, self.modes.index(mode)] <= level
             return met
-        raise InvalidArgumentError(f"event must be 'unstable', 'failed' or 'level', got {event!r}")
+        raise InvalidArgumentError(
+            f"event must be 'unstable', 'unresolved', 'failed' or 'level', got {event!r}"
+        )
 
     def outcome(self, loop: str = "auto") -> LoopOutcome:
         """The open loop (``"open"``), the closed loop (``"closed"``), or the closed loop if
@@ -724,6 +766,7 @@ def monte_carlo(
         failed=np.concatenate([part["failed"] for part in parts]),
         failures_by_bin=np.sum([part["bin_failed"] for part in parts], axis=0),
         samples_by_bin=np.sum([part["bin_total"] for part in parts], axis=0),
+        source=run,
     )
 
 

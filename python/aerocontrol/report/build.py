@@ -28,7 +28,7 @@ from .folder import ReportFolder
 from .render import png_images
 from .signals import termination_exits
 
-__all__ = ["build_report", "write_report"]
+__all__ = ["build_report", "write_document", "write_report"]
 
 
 def build_report(
@@ -112,12 +112,24 @@ def write_report(
     running either again replaces that report.
     """
     aircraft = plane if isinstance(plane, Aircraft) else load(plane)
+    return write_document(lambda say: build_report(aircraft, say), out, progress, force)
+
+
+def write_document(
+    build: Callable[[Callable[[str], None]], Report],
+    out: str | Path,
+    progress: Callable[[str], None] | None = None,
+    force: bool = False,
+) -> Path:
+    """Build a report (``build(say)``) and write it into the folder ``out`` under the rules
+    of :func:`write_report` (the folder is checked before anything is built). Returns the
+    path of ``report.html``."""
     say = progress if progress is not None else (lambda line: None)
     folder = ReportFolder(Path(out), force=force)
     with termination_exits():
         folder.prepare()
         try:
-            report = build_report(aircraft, say)
+            report = build(say)
             earlier = " (replacing the earlier report)" if folder.replacing else ""
             say(f"writing {len(report.figures)} figures and the report{earlier}")
             folder.write(_render(report, say))
