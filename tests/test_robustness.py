@@ -470,3 +470,44 @@ def test_the_values_of_failing_samples_are_drawn_again() -> None:
         result.values([3000])
     with pytest.raises(InvalidArgumentError, match="1-D array"):
         result.values([0.5])
+
+
+def test_the_damper_is_designed_again_for_every_sample() -> None:
+    from aerocontrol.robustness import Damper
+
+    plane = aircraft.load("b747-cruise")
+    result = monte_carlo(plane, _LATERAL, 2000, Damper(0.3), seed=12, chunk_size=512)
+    closed, opened = result.closed_loop, result.open_loop
+    assert closed is not None
+    acted = closed.controlled
+    assert acted.mean() > 0.95 and not opened.controlled.any()
+    # (6.156): the Dutch roll at zeta = 0.3 and its own omega_n, roll and spiral kept.
+    q, q0 = closed.quantities, opened.quantities
+    np.testing.assert_allclose(q["dutch roll: zeta"][acted], 0.3, rtol=1e-9)
+    np.testing.assert_allclose(
+        q["dutch roll: omega_n"][acted], q0["dutch roll: omega_n"][acted], rtol=1e-9
+    )
+    for key in ("roll: time constant", "spiral: time to double"):
+        np.testing.assert_allclose(q[key][acted], q0[key][acted], rtol=1e-7)
+    # A sample without an oscillating Dutch roll keeps its open loop.
+    np.testing.assert_array_equal(closed.levels[~acted], opened.levels[~acted])
+    # Sample by sample: the damper of design.dutch_roll_damper on that sample's model.
+    run = aerocontrol.robustness._Run(plane, _LATERAL, "lateral", None, 2000, 12, 512, 1)
+    values = run.values(run.draws(0))
+    for row in np.flatnonzero(acted[:512])[::50]:
+        derivatives = {
+            **plane.derivatives,
+            **{k: float(v[row]) for k, v in values.items() if k != "Iz"},
+        }
+        one = dataclasses.replace(plane, derivatives=derivatives, Iz=float(values["Iz"][row]))
+        sys = one.lateral()
+        k = design.dutch_roll_damper(sys, zeta=0.3).k
+        A = sys.A - np.outer(sys.B[:, 0], k)
+        expected = assess(classify_modes(aerocontrol.modes(A), "lateral"), "III", "B").levels
+        assert dict(zip(result.modes, closed.levels[row].tolist(), strict=True)) == expected
+    with pytest.raises(InvalidArgumentError, match="lateral"):
+        monte_carlo(plane, _LATERAL, 10, Damper(), axis="longitudinal")
+    with pytest.raises(InvalidArgumentError, match="zeta"):
+        Damper(1.2)
+    with pytest.raises(InvalidArgumentError, match="surface"):
+        Damper(0.3, "elevator")

@@ -46,11 +46,13 @@ from . import batch, linalg
 from ._judging import AXIS_MODES, judge_stack
 from ._validation import real_array, real_scalar
 from .aircraft.model import SAMPLED_FIELDS, Aircraft
+from .aircraft.naming import classify_mode_stack
 from .exceptions import InvalidArgumentError, ShapeError
 from .handling import mode_quantities
 
 __all__ = [
     "CHUNK_SIZE",
+    "Damper",
     "Estimate",
     "LogNormal",
     "LoopOutcome",
@@ -251,18 +253,70 @@ class Lqr:
             raise InvalidArgumentError(f"c must be a positive finite weight, got {c}")
 
 
+@dataclass(frozen=True)
+class Damper:
+    """The chapter's Dutch roll damper re-designed for every sample: state feedback through
+    one surface that moves the sample's own Dutch roll to the damping ratio ``zeta`` at its
+    natural frequency and keeps its roll and spiral roots ((6.156), by Bass-Gura (6.145)), all
+    samples of a chunk in one parallel call (:func:`aerocontrol.batch.place_batch`). Lateral
+    models only. A sample whose Dutch roll is not an oscillation (split into two real roots,
+    or coupled with roll and spiral) has no such damper: its closed loop is its open loop,
+    and :attr:`LoopOutcome.controlled` is False for it."""
+
+    zeta: float = 0.30
+    surface: str = "rudder"
+
+    def __post_init__(self) -> None:
+        zeta = real_scalar(self.zeta, "zeta")
+        if not 0.0 < zeta < 1.0:
+            raise InvalidArgumentError(f"zeta must lie in (0, 1), got {zeta}")
+        if self.surface not in ("rudder", "aileron"):
+            raise InvalidArgumentError(
+                f"surface must be 'rudder' or 'aileron', got {self.surface!r}"
+            )
+
+
 def _closed_loop(
-    A: FloatArray, B: FloatArray, controller: FloatArray | Lqr
-) -> tuple[FloatArray, NDArray[np.complex128]]:
-    """The closed-loop matrices A - B K of a chunk and their eigenvalues."""
+    A: FloatArray,
+    B: FloatArray,
+    controller: FloatArray | Lqr | Damper,
+    open_eigenvalues: NDArray[np.complex128],
+) -> tuple[FloatArray, NDArray[np.complex128], NDArray[np.bool_]]:
+    """The closed-loop matrices A - B K of a chunk, their eigenvalues, and which samples the
+    controller acts on."""
+    everywhere = np.ones(A.shape[0], dtype=bool)
     if isinstance(controller, Lqr):
         n, m = A.shape[-1], B.shape[-1]
         Q = np.eye(n) if controller.Q is None else real_array(controller.Q, "Q")
         R = np.eye(m) if controller.R is None else real_array(controller.R, "R")
         solution = batch.solve_care_batch(A, B, Q, R / controller.c**2)
-        return A - np.einsum("kij,kjl->kil", B, solution.K), solution.closed_loop_poles
+        closed = A - np.einsum("kij,kjl->kil", B, solution.K)
+        return closed, solution.closed_loop_poles, everywhere
+    if isinstance(controller, Damper):
+        named, _ = classify_mode_stack(open_eigenvalues, "lateral", A)
+        dutch = named["dutch roll"][:, 0]
+        designed = (
+            np.isfinite(dutch)
+            & (dutch.imag != 0.0)
+            & np.isfinite(named["roll"])
+            & np.isfinite(named["spiral"])
+        )
+        K = np.zeros((A.shape[0], B.shape[-1], A.shape[-1]))
+        if designed.any():
+            wn = np.abs(dutch[designed])
+            zeta = controller.zeta
+            pole = -zeta * wn + 1j * wn * math.sqrt(1.0 - zeta * zeta)
+            poles = np.stack(
+                [pole, pole.conj(), named["roll"][designed], named["spiral"][designed]], axis=1
+            )
+            column = ("rudder", "aileron").index(controller.surface)
+            one_input = B[designed][:, :, column : column + 1]
+            placed = batch.place_batch(A[designed], one_input, poles, "bass-gura")
+            K[designed, column] = placed.K[:, 0]
+        closed = A - np.einsum("kij,kjl->kil", B, K)
+        return closed, linalg.eigenvalues(closed), designed
     closed = A - np.einsum("kij,jl->kil", B, controller)
-    return closed, linalg.eigenvalues(closed)
+    return closed, linalg.eigenvalues(closed), everywhere
 
 
 # --- One chunk --------------------------------------------------------------------------------
@@ -275,7 +329,7 @@ class _Run:
     aircraft: Aircraft
     uncertainty: Uncertainty
     axis: str
-    controller: FloatArray | Lqr | None
+    controller: FloatArray | Lqr | Damper | None
     samples: int
     seed: int
     chunk_size: int
@@ -339,11 +393,14 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
     each parameter's draw."""
     z = run.draws(index)
     A, B = run.aircraft.model_stack(run.axis, run.values(z))
-    out = {f"open_{k}": v for k, v in _judge(run, A, linalg.eigenvalues(A)).items()}
+    eigenvalues = linalg.eigenvalues(A)
+    out = {f"open_{k}": v for k, v in _judge(run, A, eigenvalues).items()}
+    out["open_controlled"] = np.zeros(A.shape[0], dtype=bool)
     failed = (out["open_levels"] > run.required_level).any(axis=1)
     if run.controller is not None:
-        closed, poles = _closed_loop(A, B, run.controller)
+        closed, poles, controlled = _closed_loop(A, B, run.controller, eigenvalues)
         out.update({f"closed_{k}": v for k, v in _judge(run, closed, poles).items()})
+        out["closed_controlled"] = controlled
         failed = (out["closed_levels"] > run.required_level).any(axis=1)
     # Decile bins of each standard-normal draw (edges Φ^-1(k / 10)).
     edges = np.array([_normal_quantile(k / SENSITIVITY_BINS) for k in range(1, SENSITIVITY_BINS)])
@@ -439,7 +496,7 @@ class Estimate:
     def __str__(self) -> str:
         return (
             f"{self.value:.4g} ({self.count} of {self.samples}; {self.confidence:.0%} interval "
-            f"[{self.low:.4g}, {self.high:.4g}])"
+            f"[{self.low:.6g}, {self.high:.6g}])"
         )
 
 
@@ -493,6 +550,9 @@ class LoopOutcome:
     omega_n", "roll: time constant", "spiral: time to double" (lateral) or "short period:
     zeta", ..., "phugoid: omega_n" (longitudinal), as
     :func:`aerocontrol.handling.mode_quantities` gives them; NaN for an unresolved mode."""
+    controlled: NDArray[np.bool_]
+    """(samples,): the controller acts on the sample (False in the open loop, and where a
+    :class:`Damper` has no Dutch roll oscillation to damp)."""
 
 
 @dataclass(frozen=True)
@@ -642,6 +702,7 @@ def _outcome(parts: Sequence[dict[str, NDArray[Any]]], prefix: str) -> LoopOutco
         unresolved=joined("unresolved"),
         max_real=joined("max_real"),
         quantities={name: joined(_QUANTITY + name) for name in names},
+        controlled=joined("controlled"),
     )
 
 
@@ -649,7 +710,7 @@ def monte_carlo(
     aircraft: Aircraft,
     uncertainty: Uncertainty,
     samples: int,
-    controller: ArrayLike | Lqr | None = None,
+    controller: ArrayLike | Lqr | Damper | None = None,
     *,
     axis: str = "lateral",
     seed: int = 0,
@@ -667,9 +728,9 @@ def monte_carlo(
     aircraft : Aircraft
     uncertainty : Uncertainty
     samples : int
-    controller : array_like (inputs, 4), Lqr or None
+    controller : array_like (inputs, 4), Lqr, Damper or None
         Fixed state-feedback gains K (u = -K x, the same for every sample), or a design rule
-        re-run per sample (:class:`Lqr`).
+        re-run per sample (:class:`Lqr`, :class:`Damper`).
     axis : {"lateral", "longitudinal"}
     seed : int
         The root of every draw: the same seed gives the same result, bitwise, however the
@@ -719,8 +780,10 @@ def monte_carlo(
         raise InvalidArgumentError(f"seed must be a nonnegative int, got {seed!r}")
     if required_level not in (1, 2, 3):
         raise InvalidArgumentError(f"required_level must be 1, 2 or 3, got {required_level!r}")
-    gains: FloatArray | Lqr | None = None
-    if isinstance(controller, Lqr):
+    gains: FloatArray | Lqr | Damper | None = None
+    if isinstance(controller, Damper) and axis != "lateral":
+        raise InvalidArgumentError("controller: a Damper damps the Dutch roll of the lateral model")
+    if isinstance(controller, (Lqr, Damper)):
         gains = controller
     elif controller is not None:
         gains = real_array(controller, "controller")
