@@ -35,11 +35,16 @@ def test_limit_threads_sets_and_restores() -> None:
 @pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs Linux /proc")
 def test_a_chosen_pool_runs_the_work_on_its_threads() -> None:
     stack = np.random.default_rng(0).standard_normal((20_000, 4, 4))
+    before = _named_threads()
     with aerocontrol.limit_threads(3):
         aerocontrol.linalg.eigenvalues(stack)
-        assert _named_threads() == 3
-    # The pool is gone with the setting (its threads end once it is dropped).
-    aerocontrol.linalg.eigenvalues(stack)
+        started = _named_threads()
+        assert started - before in (0, 3)  # 0: a pool of 3 was started earlier and is kept
+    # Choosing a count again reuses its pool: a block in a loop starts no threads.
+    for _ in range(50):
+        with aerocontrol.limit_threads(3):
+            aerocontrol.linalg.eigenvalues(stack[:100])
+    assert _named_threads() == started
 
 
 def test_results_do_not_depend_on_the_thread_count() -> None:
@@ -57,3 +62,13 @@ def test_results_do_not_depend_on_the_thread_count() -> None:
 def test_bad_counts_are_refused(count: object) -> None:
     with pytest.raises(InvalidArgumentError, match="count must be a positive int"):
         aerocontrol.set_num_threads(count)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("count", [10**6, 2**70])
+def test_counts_that_would_exhaust_the_machine_are_refused(count: int) -> None:
+    # Four threads per core at most (and at least 256): a million would start a million.
+    before = aerocontrol.get_num_threads()
+    with pytest.raises(InvalidArgumentError, match="count must be at most"):
+        aerocontrol.set_num_threads(count)
+    assert aerocontrol.get_num_threads() == before
+    assert _named_threads() < 300 if Path("/proc/self/task").is_dir() else True

@@ -51,11 +51,15 @@ def set_num_threads(count: int | None) -> None:
     Raises
     ------
     InvalidArgumentError
-        ``count`` is not a positive int or None, or that many threads cannot be started.
+        ``count`` is not a positive int or None, exceeds four threads per core (and 256), or
+        that many threads cannot be started.
     """
     global _chosen
     value = None if count is None else _count(count)
-    _core.set_num_threads(0 if value is None else value)
+    try:
+        _core.set_num_threads(0 if value is None else value)
+    except OverflowError:  # beyond the machine's integers: beyond the limit too
+        _core.set_num_threads(2**32)  # raises the limit's own InvalidArgumentError
     _chosen = value
 
 

@@ -9,7 +9,7 @@
 
 use crate::error::Error;
 use std::sync::atomic::AtomicBool;
-use std::sync::{Arc, RwLock};
+use std::sync::{Arc, Mutex, RwLock};
 
 /// A pool of threads chosen by [`set_num_threads`].
 pub struct Pool {
@@ -31,29 +31,72 @@ pub fn chosen() -> Option<Arc<Pool>> {
         .clone()
 }
 
+/// The most threads [`set_num_threads`] starts: four per core, and at least 256 (more only
+/// oversubscribe the cores, and starting millions would exhaust the machine).
+pub fn max_threads() -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    cores.saturating_mul(4).max(256)
+}
+
 /// Runs parallel work on `count` threads from now on; 0 returns to rayon's global pool.
 /// Computations already running finish on the pool they started on.
 pub fn set_num_threads(count: usize) -> Result<(), Error> {
+    let most = max_threads();
+    if count > most {
+        return Err(Error::InvalidArgument {
+            arg: "count",
+            message: format!(
+                "count must be at most {most} (four threads per core, at least 256), got {count}"
+            ),
+        });
+    }
     let pool = if count == 0 {
         None
     } else {
-        let threads = rayon::ThreadPoolBuilder::new()
-            .num_threads(count)
-            .thread_name(|index| format!("aerocontrol-{index}"))
-            .build()
-            .map_err(|error| Error::InvalidArgument {
-                arg: "count",
-                message: format!("cannot start {count} threads: {error}"),
-            })?;
-        Some(Arc::new(Pool {
-            threads,
-            product_workspace: AtomicBool::new(false),
-        }))
+        Some(pool_of(count)?)
     };
     *CHOSEN
         .write()
         .unwrap_or_else(|poisoned| poisoned.into_inner()) = pool;
     Ok(())
+}
+
+/// The pools started so far, at most [`KEPT_POOLS`], the most recently chosen last: choosing
+/// a count again (a `with limit_threads(n)` block in a loop) reuses its pool and the threads'
+/// product workspaces instead of starting new threads.
+static STARTED: Mutex<Vec<Arc<Pool>>> = Mutex::new(Vec::new());
+const KEPT_POOLS: usize = 4;
+
+/// A pool of `count` threads: one started before, else a new one.
+fn pool_of(count: usize) -> Result<Arc<Pool>, Error> {
+    let mut started = STARTED
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    let pool = match started
+        .iter()
+        .position(|pool| pool.threads.current_num_threads() == count)
+    {
+        Some(position) => started.remove(position),
+        None => {
+            let threads = rayon::ThreadPoolBuilder::new()
+                .num_threads(count)
+                .thread_name(|index| format!("aerocontrol-{index}"))
+                .build()
+                .map_err(|error| Error::InvalidArgument {
+                    arg: "count",
+                    message: format!("cannot start {count} threads: {error}"),
+                })?;
+            Arc::new(Pool {
+                threads,
+                product_workspace: AtomicBool::new(false),
+            })
+        }
+    };
+    started.push(Arc::clone(&pool));
+    if started.len() > KEPT_POOLS {
+        started.remove(0);
+    }
+    Ok(pool)
 }
 
 /// The number of threads parallel work started now would run on.
@@ -101,6 +144,8 @@ mod tests {
         });
         assert_eq!(seen, Some(3));
         set_num_threads(0).unwrap();
+        assert_eq!(num_threads(), rayon::current_num_threads());
+        assert!(set_num_threads(max_threads() + 1).is_err());
         assert_eq!(num_threads(), rayon::current_num_threads());
     }
 }
