@@ -226,6 +226,10 @@ def _solved(
     order (the first failing problem's error raised with its index in the whole batch)."""
     if client is None:
         return getattr(_core, kernel)(*stacks, *extra)
+    if any(len(stack) == 0 for stack in stacks):
+        # No problem to solve (k = 0): the core's empty result, as without a client (whose
+        # shape checks, with a shared matrix of one, it makes).
+        return getattr(_core, kernel)(*stacks, *extra)
     count = max(len(stack) for stack in stacks)
     for name, stack in zip("ABQR", stacks, strict=True):
         if len(stack) not in (1, count):

@@ -44,8 +44,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import batch, linalg
 from ._judging import AXIS_MODES, judge_stack
-from ._validation import real_array, real_scalar
-from .aircraft.model import SAMPLED_FIELDS, Aircraft
+from ._validation import check_finite, real_array, real_scalar
+from .aircraft.model import _POSITIVE_FIELDS, SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
 from .exceptions import InvalidArgumentError, ShapeError
 from .handling import mode_quantities
@@ -157,6 +157,17 @@ class Uncertainty:
     correlations: Mapping[tuple[str, str], float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        for argument, given in (
+            ("distributions", self.distributions),
+            ("correlations", self.correlations),
+        ):
+            if not isinstance(given, Mapping):
+                raise InvalidArgumentError(
+                    f"uncertainty: {argument} must be a mapping (a dict), got "
+                    f"{type(given).__name__}"
+                )
+            # A copy: the caller's dict, changed later, changes neither this nor a run's draws.
+            object.__setattr__(self, argument, dict(given))
         if not self.distributions:
             raise InvalidArgumentError("uncertainty: give at least one uncertain parameter")
         for name, distribution in self.distributions.items():
@@ -166,6 +177,11 @@ class Uncertainty:
                 raise InvalidArgumentError(
                     f"uncertainty[{name!r}] must be a Normal, Uniform or LogNormal, got "
                     f"{type(distribution).__name__}"
+                )
+            relative = getattr(distribution, "relative", True)
+            if not isinstance(relative, (bool, np.bool_)):
+                raise InvalidArgumentError(
+                    f"uncertainty[{name!r}]: relative must be True or False, got {relative!r}"
                 )
             spread = next(iter(vars(distribution).values()))
             spread = real_scalar(spread, f"uncertainty[{name!r}]")
@@ -213,6 +229,7 @@ class Uncertainty:
         """The lower Cholesky factor L of the draws' correlation matrix (z = L ε)."""
         names = self.names
         matrix = np.eye(len(names))
+        given: set[tuple[int, int]] = set()
         for pair, value in self.correlations.items():
             if not (isinstance(pair, tuple) and len(pair) == 2 and all(p in names for p in pair)):
                 raise InvalidArgumentError(
@@ -224,6 +241,11 @@ class Uncertainty:
                 raise InvalidArgumentError(
                     f"correlations[{pair!r}] must be in (-1, 1) between two parameters, got {rho}"
                 )
+            if (min(i, j), max(i, j)) in given:  # ("a", "b") and ("b", "a"): which one holds?
+                raise InvalidArgumentError(
+                    f"correlations: the pair {pair!r} is given twice (in either order)"
+                )
+            given.add((min(i, j), max(i, j)))
             matrix[i, j] = matrix[j, i] = rho
         try:
             return np.asarray(np.linalg.cholesky(matrix), dtype=np.float64)
@@ -249,8 +271,24 @@ class Lqr:
 
     def __post_init__(self) -> None:
         c = real_scalar(self.c, "c")
-        if not (math.isfinite(c) and c > 0.0):
-            raise InvalidArgumentError(f"c must be a positive finite weight, got {c}")
+        # The control weight is R / c²: c² itself must be a positive finite number (a c of
+        # 1e200 or 1e-200 squares to inf or 0).
+        if not (math.isfinite(c) and c > 0.0 and 0.0 < c * c < math.inf):
+            raise InvalidArgumentError(
+                f"c must be a positive finite weight whose square is a positive finite number, "
+                f"got {c}"
+            )
+        object.__setattr__(self, "c", c)
+        for name in ("Q", "R"):
+            given = getattr(self, name)
+            if given is not None:
+                # Checked now, and copied: an array changed by the caller later changes nothing.
+                matrix = np.array(real_array(given, name))
+                if matrix.ndim != 2 or matrix.shape[0] != matrix.shape[1]:
+                    raise ShapeError(f"{name} must be a square matrix, got shape {matrix.shape}")
+                check_finite(matrix, name)
+                matrix.setflags(write=False)
+                object.__setattr__(self, name, matrix)
 
 
 @dataclass(frozen=True)
@@ -289,7 +327,7 @@ def _closed_loop(
         n, m = A.shape[-1], B.shape[-1]
         Q = np.eye(n) if controller.Q is None else real_array(controller.Q, "Q")
         R = np.eye(m) if controller.R is None else real_array(controller.R, "R")
-        solution = batch.solve_care_batch(A, B, Q, R / controller.c**2)
+        solution = batch.solve_care_batch(A, B, Q, R / (controller.c * controller.c))
         closed = A - np.einsum("kij,kjl->kil", B, solution.K)
         return closed, solution.closed_loop_poles, everywhere
     if isinstance(controller, Damper):
@@ -353,16 +391,34 @@ class _Run:
             return np.asarray(epsilon @ self.uncertainty.cholesky().T)
         return epsilon
 
-    def values(self, z: FloatArray) -> dict[str, FloatArray]:
+    def values(self, z: FloatArray, start: int = 0) -> dict[str, FloatArray]:
+        """The parameters' values for the draws ``z`` of the samples from ``start`` on.
+
+        Raises InvalidArgumentError naming the parameter and the first sample whose value is
+        not finite (a spread so wide that the value overflows), or not positive for a mass,
+        inertia, speed or density (a normal or uniform scatter reaching zero: a log-normal
+        one never does)."""
         out = {}
         for k, (name, distribution) in enumerate(self.uncertainty.distributions.items()):
-            nominal = (
-                getattr(self.aircraft, name)
-                if name in SAMPLED_FIELDS
-                else self.aircraft.derivatives[name]
-            )
-            out[name] = distribution.values(float(nominal), z[:, k])
+            with np.errstate(over="ignore", invalid="ignore"):
+                values = distribution.values(_nominal(self.aircraft, name), z[:, k])
+            bad = ~np.isfinite(values)
+            problem = "is not finite"
+            if not bad.any() and name in _POSITIVE_FIELDS:
+                bad, problem = ~(values > 0.0), "is not positive (use a LogNormal scatter)"
+            if bad.any():
+                first = int(np.flatnonzero(bad)[0])
+                raise InvalidArgumentError(
+                    f"uncertainty[{name!r}]: the value of sample {start + first} {problem}: "
+                    f"{values[first]:g}"
+                )
+            out[name] = values
         return out
+
+
+def _nominal(plane: Aircraft, name: str) -> float:
+    """The aircraft's own value of an uncertain parameter."""
+    return float(getattr(plane, name) if name in SAMPLED_FIELDS else plane.derivatives[name])
 
 
 def _judge(
@@ -392,7 +448,7 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
     """One chunk: draw, build, judge (open and closed loop), and count failures per bin of
     each parameter's draw."""
     z = run.draws(index)
-    A, B = run.aircraft.model_stack(run.axis, run.values(z))
+    A, B = run.aircraft.model_stack(run.axis, run.values(z, run.chunk_bounds(index)[0]))
     eigenvalues = linalg.eigenvalues(A)
     out = {f"open_{k}": v for k, v in _judge(run, A, eigenvalues).items()}
     out["open_controlled"] = np.zeros(A.shape[0], dtype=bool)
@@ -432,20 +488,35 @@ def _normal_quantile(p: float) -> float:
 
 
 def _log_beta(a: float, b: float) -> float:
+    """ln B(a, b). For an integer min(a, b) = s up to 10^6 (a rare event, or a rare non-event,
+    the interval's parameters being integers), exactly as ln Γ(s) - Σ_{i<s} ln(t + i) with
+    t the other one, Γ(t) / Γ(t + s) = 1 / Π (t + i): lgamma of a large t would lose its
+    last digits to cancellation (ln Γ(10^12) ≈ 3·10^13)."""
+    small, large = min(a, b), max(a, b)
+    if small == int(small) and small <= 1e6 and large > 1e6:
+        steps = np.arange(int(small), dtype=np.float64) / large
+        return math.lgamma(small) - (small * math.log(large) + math.fsum(np.log1p(steps)))
     return math.lgamma(a) + math.lgamma(b) - math.lgamma(a + b)
 
 
-def _incomplete_beta(x: float, a: float, b: float) -> float:
+def _incomplete_beta(
+    x: float, a: float, b: float, log_beta: float | None = None, y: float | None = None
+) -> float:
     """The regularized incomplete beta function I_x(a, b): its continued fraction (DLMF 8.17.22)
     evaluated by the modified Lentz method, on the side of the mean where it converges fast
-    (I_x(a, b) = 1 - I_{1-x}(b, a))."""
+    (I_x(a, b) = 1 - I_{1-x}(b, a)). ``y`` is 1 - x, exact where x is not (the swapped side):
+    the logarithms are taken of whichever of x and y is not rounded, so that b ln(1 - x)
+    keeps its digits for a tiny x and a huge b (10^12 samples)."""
     if x <= 0.0:
         return 0.0
     if x >= 1.0:
         return 1.0
+    log_beta = _log_beta(a, b) if log_beta is None else log_beta  # B(a, b) = B(b, a)
+    y = 1.0 - x if y is None else y
     if x > (a + 1.0) / (a + b + 2.0):
-        return 1.0 - _incomplete_beta(1.0 - x, b, a)
-    front = math.exp(a * math.log(x) + b * math.log1p(-x) - _log_beta(a, b)) / a
+        return 1.0 - _incomplete_beta(y, b, a, log_beta, x)
+    log_x, log_y = (math.log(x), math.log1p(-x)) if x <= 0.5 else (math.log1p(-y), math.log(y))
+    front = math.exp(a * log_x + b * log_y - log_beta) / a
     tiny = 1e-300
     f, c, d = 1.0, 1.0, 0.0
     for i in range(0, 100_000):
@@ -470,11 +541,12 @@ def _incomplete_beta(x: float, a: float, b: float) -> float:
 def _beta_quantile(q: float, a: float, b: float) -> float:
     """The q-quantile of Beta(a, b), by bisection on I_x(a, b)."""
     low, high = 0.0, 1.0
+    log_beta = _log_beta(a, b)
     for _ in range(200):
         middle = 0.5 * (low + high)
         if middle in (low, high):
             break
-        if _incomplete_beta(middle, a, b) < q:
+        if _incomplete_beta(middle, a, b, log_beta) < q:
             low = middle
         else:
             high = middle
@@ -511,6 +583,9 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
     >>> e.low, round(e.high, 5)
     (0.0, 0.00368)
     """
+    for name, value in (("count", count), ("samples", samples)):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+            raise InvalidArgumentError(f"{name} must be an int, got {value!r}")
     count = int(count)
     samples = int(samples)
     if samples <= 0 or not 0 <= count <= samples:
@@ -609,7 +684,7 @@ class MonteCarlo:
         chunks = wanted // run.chunk_size
         for chunk in np.unique(chunks):
             rows = np.flatnonzero(chunks == chunk)
-            drawn = run.values(run.draws(int(chunk)))
+            drawn = run.values(run.draws(int(chunk)), run.chunk_bounds(int(chunk))[0])
             for name in self.parameters:
                 out[name][rows] = drawn[name][wanted[rows] - int(chunk) * run.chunk_size]
         return out
@@ -644,8 +719,7 @@ class MonteCarlo:
         if event == "level":
             if mode not in self.modes:
                 raise InvalidArgumentError(f"mode must be one of {self.modes}, got {mode!r}")
-            if level not in (1, 2, 3):
-                raise InvalidArgumentError(f"level must be 1, 2 or 3, got {level!r}")
+            level = _level(level, "level")
             met: NDArray[np.bool_] = outcome.levels[:, self.modes.index(mode)] <= level
             return met
         raise InvalidArgumentError(
@@ -766,7 +840,7 @@ def monte_carlo(
         raise InvalidArgumentError(
             f"uncertainty must be an Uncertainty, got {type(uncertainty).__name__}"
         )
-    if axis not in _AXIS_MODES:
+    if not isinstance(axis, str) or axis not in _AXIS_MODES:
         raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
     for name in uncertainty.names:
         if name not in aircraft.derivatives and name not in SAMPLED_FIELDS:
@@ -774,19 +848,39 @@ def monte_carlo(
                 f"uncertainty: {name!r} is neither a derivative of {aircraft.name} nor one of "
                 f"{', '.join(SAMPLED_FIELDS)}"
             )
+        distribution = uncertainty.distributions[name]
+        relative = getattr(distribution, "relative", True)  # LogNormal: relative to the nominal
+        spread = next(iter(vars(distribution).values()))
+        if relative and spread != 0.0 and _nominal(aircraft, name) == 0.0:
+            # A scatter relative to a nominal value of zero would leave it at zero: not what
+            # an uncertain parameter means.
+            raise InvalidArgumentError(
+                f"uncertainty[{name!r}]: a scatter relative to {aircraft.name}'s value 0 is no "
+                "scatter; give it in the parameter's units (Normal or Uniform with "
+                "relative=False)"
+            )
     samples = _positive_int(samples, "samples")
     chunk_size = _positive_int(chunk_size, "chunk_size")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidArgumentError(f"seed must be a nonnegative int, got {seed!r}")
-    if required_level not in (1, 2, 3):
-        raise InvalidArgumentError(f"required_level must be 1, 2 or 3, got {required_level!r}")
+    required_level = _level(required_level, "required_level")
     gains: FloatArray | Lqr | Damper | None = None
     if isinstance(controller, Damper) and axis != "lateral":
         raise InvalidArgumentError("controller: a Damper damps the Dutch roll of the lateral model")
+    if isinstance(controller, Lqr):
+        inputs = 1 if axis == "longitudinal" else 2
+        for name, size in (("Q", 4), ("R", inputs)):
+            weight = getattr(controller, name)
+            if weight is not None and weight.shape != (size, size):
+                raise ShapeError(
+                    f"controller.{name} must be {size} x {size} for the {axis} model, got shape "
+                    f"{weight.shape}"
+                )
     if isinstance(controller, (Lqr, Damper)):
         gains = controller
     elif controller is not None:
-        gains = real_array(controller, "controller")
+        gains = np.array(real_array(controller, "controller"))  # a copy, C-ordered
+        check_finite(gains, "controller")
         inputs = 1 if axis == "longitudinal" else 2
         if gains.shape != (inputs, 4):
             raise ShapeError(
@@ -831,6 +925,15 @@ def monte_carlo(
         samples_by_bin=np.sum([part["bin_total"] for part in parts], axis=0),
         source=run,
     )
+
+
+def _level(value: object, name: str) -> int:
+    """A MIL-F-8785C Level, 1, 2 or 3 (an int, not a bool or an array), by name."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise InvalidArgumentError(f"{name} must be 1, 2 or 3, got {value!r}")
+    if value not in (1, 2, 3):
+        raise InvalidArgumentError(f"{name} must be 1, 2 or 3, got {value!r}")
+    return int(value)
 
 
 def _positive_int(value: object, name: str) -> int:

@@ -430,9 +430,9 @@ def gain_schedule(
     """
     if not isinstance(plane, Aircraft):
         raise InvalidArgumentError(f"plane must be an Aircraft, got {type(plane).__name__}")
-    if axis not in AXIS_MODES:
+    if not isinstance(axis, str) or axis not in AXIS_MODES:
         raise InvalidArgumentError(f"axis must be 'lateral' or 'longitudinal', got {axis!r}")
-    if design not in DESIGNS:
+    if not isinstance(design, str) or design not in DESIGNS:
         raise InvalidArgumentError(f"design must be one of {DESIGNS}, got {design!r}")
     if design == "damper" and axis != "lateral":
         raise InvalidArgumentError(
@@ -450,15 +450,18 @@ def gain_schedule(
     input_names, state_names = tuple(model.input_names), tuple(model.state_names)
     if design == "lqr":
         weight = real_scalar(c, "c")
-        if not 0.0 < weight < np.inf:
-            raise InvalidArgumentError(f"c must be positive and finite, got {c!r}")
+        if not (0.0 < weight < np.inf and 0.0 < weight * weight < np.inf):
+            # R / c²: c² too must be a positive finite number (1e200 or 1e-200 is not).
+            raise InvalidArgumentError(
+                f"c must be positive and finite, with a positive finite square, got {c!r}"
+            )
         Q_matrix = np.eye(4) if Q is None else real_array(Q, "Q")
         R_matrix = np.eye(m) if R is None else real_array(R, "R")
         if Q_matrix.shape != (4, 4):
             raise ShapeError(f"Q must be 4 x 4, got shape {Q_matrix.shape}")
         if R_matrix.shape != (m, m):
             raise ShapeError(f"R must be {m} x {m} for the {axis} model, got {R_matrix.shape}")
-        K = batch.solve_care_batch(A, B, Q_matrix, R_matrix / weight**2).K
+        K = batch.solve_care_batch(A, B, Q_matrix, R_matrix / (weight * weight)).K
     else:
         K = np.zeros((len(moved), m, 4))
         rudder = input_names.index("rudder")

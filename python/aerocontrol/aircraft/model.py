@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .._validation import real_scalar
+from .._validation import real_array, real_scalar
 from ..exceptions import InvalidArgumentError
 from ..modal import Modes, modes
 from ..statespace import StateSpace
@@ -75,6 +75,9 @@ LATERAL_STATES = ("beta", "p", "phi", "r")
 #: :meth:`Aircraft.model_stack` can vary: mass, the stability-axis inertias, the speed u0 and
 #: the density.
 SAMPLED_FIELDS = ("mass", "Ix", "Iy", "Iz", "Ixz", "speed", "density")
+
+#: The sampled fields that must be positive (all but the product of inertia Ixz).
+_POSITIVE_FIELDS = ("mass", "Ix", "Iy", "Iz", "speed", "density")
 
 FloatArray = NDArray[np.float64]
 
@@ -335,7 +338,10 @@ class Aircraft:
         Raises
         ------
         InvalidArgumentError
-            An unknown name, or arrays that are not 1-D of one length, or not finite.
+            An unknown name, or arrays that are not 1-D of one length, or not finite; a mass,
+            inertia (Ix, Iy, Iz), speed or density that is not positive (the sample named).
+        NotRealError
+            Values that are not real numbers.
         AircraftDataError
             A sample whose model is singular (1 - Zẇ = 0, or Ixz² >= Ix Iz); the message
             names the first such sample.
@@ -533,19 +539,31 @@ class _Values:
         self._sampled: dict[str, FloatArray] = {}
         self.count = 1
         counts = set()
+        if not isinstance(values, Mapping):
+            raise InvalidArgumentError(
+                f"values must be a mapping of names to arrays, got {type(values).__name__}"
+            )
         for name, value in values.items():
             if name not in aircraft.derivatives and name not in SAMPLED_FIELDS:
                 raise InvalidArgumentError(
                     f"values: {name!r} is neither a derivative of {aircraft.name} nor one of "
                     f"{', '.join(SAMPLED_FIELDS)}"
                 )
-            array = np.asarray(value, dtype=np.float64)
+            array = real_array(value, f"values[{name!r}]")
             if array.ndim != 1:
                 raise InvalidArgumentError(
                     f"values[{name!r}] must be 1-D (one value per model), got shape {array.shape}"
                 )
             if not np.isfinite(array).all():
                 raise InvalidArgumentError(f"values[{name!r}] must be finite")
+            if name in _POSITIVE_FIELDS and not (array > 0.0).all():
+                # A mass, inertia, speed or density of zero or less has no model (a division
+                # by it, or a sign-flipped one): named, never a warning or a mirrored model.
+                first = int(np.flatnonzero(~(array > 0.0))[0])
+                raise InvalidArgumentError(
+                    f"values[{name!r}] must be positive, got {array[first]:g} (sample {first} "
+                    "of the values)"
+                )
             counts.add(array.size)
             self._sampled[name] = array
         if len(counts) > 1:

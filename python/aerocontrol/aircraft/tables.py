@@ -401,10 +401,18 @@ class _Reader:
                 "relative": relative,
             }
         correlations: list[tuple[str, str, float]] = []
-        for item in table.get("correlations", []):
+        listed = table.get("correlations", [])
+        if not isinstance(listed, list):
+            raise AircraftDataError(
+                f'{where} correlations must be a list of ["A", "B", rho] entries, got '
+                f"{shown(listed)}"
+            )
+        pairs: set[frozenset[str]] = set()
+        for item in listed:
             if not (
                 isinstance(item, list)
                 and len(item) == 3
+                and all(isinstance(name, str) for name in item[:2])
                 and item[0] in parameters
                 and item[1] in parameters
                 and item[0] != item[1]
@@ -416,6 +424,11 @@ class _Reader:
                     f'{where} correlations: each entry is ["A", "B", rho], A and B two of the '
                     f"uncertain parameters and -1 < rho < 1; got {shown(item)}"
                 )
+            if frozenset(item[:2]) in pairs:  # given twice, in either order: which one holds?
+                raise AircraftDataError(
+                    f"{where} correlations: the pair {item[0]}, {item[1]} is given twice"
+                )
+            pairs.add(frozenset(item[:2]))
             correlations.append((item[0], item[1], float(item[2])))
         return {"parameters": parameters, "correlations": correlations}
 
