@@ -233,3 +233,22 @@ def test_batches_on_a_dask_cluster_are_bitwise_the_local_ones(
     assert info.value.batch_index == 197  # type: ignore[attr-defined]
     with pytest.raises(aerocontrol.exceptions.AerocontrolError, match="problem 197 of the batch"):
         aerocontrol.batch.solve_care_batch(A, sys.B, np.eye(4), R)
+
+
+class _UnusedClient:
+    """A Dask client stand-in that fails if any work is sent to it."""
+
+    def map(self, *args: object, **kwargs: object) -> None:
+        raise AssertionError("an empty batch sent work to the cluster")
+
+
+def test_an_empty_batch_with_a_client_is_the_local_empty_batch() -> None:
+    sys = aerocontrol.aircraft.load().lateral()
+    empty = np.zeros((0, 4, 4))
+    local = aerocontrol.batch.solve_care_batch(empty, np.zeros((0, 4, 2)), np.eye(4), np.eye(2))
+    remote = aerocontrol.batch.solve_care_batch(
+        empty, np.zeros((0, 4, 2)), np.eye(4), np.eye(2), client=_UnusedClient()
+    )
+    assert remote.K.shape == local.K.shape == (0, 2, 4)
+    sweep = aerocontrol.batch.lqr_sweep(sys, weights=[], client=_UnusedClient())
+    assert sweep.K.shape == aerocontrol.batch.lqr_sweep(sys, weights=[]).K.shape

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -445,6 +446,22 @@ def test_uncertainty_declared_in_the_aircraft_file(tmp_path) -> None:  # type: i
             'correlations = [["Cn_beta", "Cl_p", 0.5]]',
             "correlations: each entry",
         ),
+        (
+            'Cn_beta = { distribution = "normal", sigma = 0.1 }\ncorrelations = 5',
+            "correlations must be a list",
+        ),
+        (
+            'Cn_beta = { distribution = "normal", sigma = 0.1 }\n'
+            'Cn_r = { distribution = "normal", sigma = 0.1 }\n'
+            'correlations = [[["Cn_beta"], "Cn_r", 0.5]]',
+            "correlations: each entry",
+        ),
+        (
+            'Cn_beta = { distribution = "normal", sigma = 0.1 }\n'
+            'Cn_r = { distribution = "normal", sigma = 0.1 }\n'
+            'correlations = [["Cn_beta", "Cn_r", 0.5], ["Cn_r", "Cn_beta", -0.5]]',
+            "the pair Cn_r, Cn_beta is given twice",
+        ),
     ],
 )
 def test_bad_uncertainty_tables_are_named(tmp_path, entry: str, message: str) -> None:  # type: ignore[no-untyped-def]
@@ -511,3 +528,148 @@ def test_the_damper_is_designed_again_for_every_sample() -> None:
         Damper(1.2)
     with pytest.raises(InvalidArgumentError, match="surface"):
         Damper(0.3, "elevator")
+
+
+# --- Hostile input (regressions) -------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["mass", "Ix", "Iz", "speed", "density"])
+def test_model_stack_refuses_nonpositive_sampled_fields(name: str) -> None:
+    plane = aircraft.load("b747-cruise")
+    own = getattr(plane, name)
+    for bad in (0.0, -own):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # no division warning first
+            with pytest.raises(
+                InvalidArgumentError, match=rf"values\['{name}'\] must be positive.*sample 1"
+            ):
+                plane.model_stack("lateral", {name: [own, bad]})
+
+
+def test_model_stack_names_values_that_are_not_real_numbers() -> None:
+    plane = aircraft.load("b747-cruise")
+    for bad in (["a"], [1 + 1j]):
+        with pytest.raises(aerocontrol.exceptions.NotRealError, match=r"values\['mass'\]"):
+            plane.model_stack("lateral", {"mass": bad})
+    with pytest.raises(InvalidArgumentError, match="values must be a mapping"):
+        plane.model_stack("lateral", [("mass", [1.0])])  # type: ignore[arg-type]
+
+
+def test_a_scatter_reaching_a_nonpositive_mass_is_named_with_its_sample() -> None:
+    plane = aircraft.load("b747-cruise")
+    uncertainty = Uncertainty({"mass": Normal(0.5)})
+    run = aerocontrol.robustness._Run(plane, uncertainty, "lateral", None, 2000, 1, 500, 1)
+    first = min(
+        c * 500 + int(np.flatnonzero(plane.mass * (1 + 0.5 * run.draws(c)[:, 0]) <= 0)[0])
+        for c in range(4)
+        if (plane.mass * (1 + 0.5 * run.draws(c)[:, 0]) <= 0).any()
+    )
+    with pytest.raises(
+        InvalidArgumentError, match=rf"uncertainty\['mass'\].*sample {first} is not positive"
+    ):
+        monte_carlo(plane, uncertainty, 2000, seed=1, chunk_size=500)
+    # A log-normal scatter of the same width never reaches zero.
+    result = monte_carlo(plane, Uncertainty({"mass": LogNormal(0.5)}), 2000, seed=1)
+    assert result.samples == 2000
+
+
+def test_an_overflowing_draw_is_named_not_warned() -> None:
+    plane = aircraft.load("b747-cruise")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InvalidArgumentError, match=r"uncertainty\['mass'\].*not finite"):
+            monte_carlo(plane, Uncertainty({"mass": LogNormal(400.0)}), 200, seed=1)
+        with pytest.raises(InvalidArgumentError, match=r"uncertainty\['Cn_beta'\].*not finite"):
+            monte_carlo(plane, Uncertainty({"Cn_beta": Normal(1e308, relative=False)}), 200)
+
+
+def test_a_relative_scatter_of_a_zero_derivative_is_refused() -> None:
+    plane = aircraft.load("b747-cruise")
+    assert plane.derivatives["Cy_p"] == 0.0
+    for distribution in (Normal(0.3), Uniform(0.3), LogNormal(0.3)):
+        with pytest.raises(InvalidArgumentError, match=r"uncertainty\['Cy_p'\].*relative=False"):
+            monte_carlo(plane, Uncertainty({"Cy_p": distribution}), 10)
+    # In the parameter's units it scatters: the values are 0 + 0.01 z.
+    result = monte_carlo(plane, Uncertainty({"Cy_p": Normal(0.01, relative=False)}), 10, seed=2)
+    z = result.source.draws(0)[:, 0]
+    np.testing.assert_array_equal(result.values(np.arange(10))["Cy_p"], 0.01 * z)
+
+
+def test_uncertainty_is_a_copy_and_refuses_repeated_pairs() -> None:
+    given = {"Cn_beta": Normal(0.2), "Cn_r": Normal(0.1)}
+    correlations = {("Cn_beta", "Cn_r"): 0.5}
+    uncertainty = Uncertainty(given, correlations)
+    given["Cl_p"] = Normal(0.1)
+    correlations[("Cn_beta", "Cn_r")] = -0.9
+    assert uncertainty.names == ("Cn_beta", "Cn_r")
+    assert uncertainty.cholesky()[1, 0] == 0.5
+    with pytest.raises(InvalidArgumentError, match="given twice"):
+        Uncertainty(given, {("Cn_beta", "Cn_r"): 0.5, ("Cn_r", "Cn_beta"): -0.5})
+    for bad in ([("Cn_beta", Normal(0.2))], None):
+        with pytest.raises(InvalidArgumentError, match="distributions must be a mapping"):
+            Uncertainty(bad)  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgumentError, match="correlations must be a mapping"):
+        Uncertainty(given, [("Cn_beta", "Cn_r", 0.5)])  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgumentError, match="relative must be True or False"):
+        Uncertainty({"Cn_beta": Normal(0.2, relative="no")})  # type: ignore[arg-type]
+
+
+def test_lqr_checks_its_weights_when_made() -> None:
+    for c in (1e200, 1e-200):  # c² overflows to inf, or underflows to 0
+        with pytest.raises(InvalidArgumentError, match="c must be a positive finite weight"):
+            Lqr(c=c)
+    with pytest.raises(ShapeError, match="Q must be a square matrix"):
+        Lqr(Q=np.ones((4, 3)))
+    with pytest.raises(aerocontrol.exceptions.NonFiniteError, match="R must be finite"):
+        Lqr(R=np.full((2, 2), np.nan))
+    Q = np.eye(4)
+    controller = Lqr(Q=Q)
+    Q[0, 0] = 1e6  # the caller's array, changed later, changes nothing
+    assert controller.Q[0, 0] == 1.0  # type: ignore[index]
+    plane = aircraft.load("b747-cruise")
+    with pytest.raises(ShapeError, match=r"controller.R must be 1 x 1 for the longitudinal"):
+        monte_carlo(
+            plane, Uncertainty({"Cm_alpha": Normal(0.1)}), 10, Lqr(R=np.eye(2)), axis="longitudinal"
+        )
+
+
+def test_levels_and_axes_that_are_not_plain_values_are_named() -> None:
+    plane = aircraft.load("b747-cruise")
+    uncertainty = Uncertainty({"Cn_beta": Normal(0.2)})
+    for level in (True, np.array([1, 2]), 1.5):
+        with pytest.raises(InvalidArgumentError, match="required_level must be 1, 2 or 3"):
+            monte_carlo(plane, uncertainty, 10, required_level=level)  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgumentError, match="axis must be"):
+        monte_carlo(plane, uncertainty, 10, axis=["lateral"])  # type: ignore[arg-type]
+    result = monte_carlo(plane, uncertainty, 10)
+    with pytest.raises(InvalidArgumentError, match="level must be 1, 2 or 3"):
+        result.probability("level", "roll", level=np.array([1, 2]))  # type: ignore[arg-type]
+    assert result.probability("level", "roll", level=np.int64(2)).samples == 10
+    gains = np.asfortranarray(np.ones((2, 4), dtype=np.int32))
+    with pytest.raises(aerocontrol.exceptions.NonFiniteError, match="controller must be finite"):
+        monte_carlo(plane, uncertainty, 10, np.full((2, 4), np.nan))
+    np.testing.assert_array_equal(
+        monte_carlo(plane, uncertainty, 10, gains).closed_loop.max_real,  # type: ignore[union-attr]
+        monte_carlo(plane, uncertainty, 10, np.ones((2, 4))).closed_loop.max_real,  # type: ignore[union-attr]
+    )
+
+
+@pytest.mark.parametrize(
+    ("count", "samples", "tolerance"),
+    [(0, 10**12, 1e-5), (1, 10**12, 1e-8), (3, 10**10, 1e-8), (100_000, 10**9, 1e-10)],
+)
+def test_clopper_pearson_for_rare_events_in_huge_runs(
+    count: int, samples: int, tolerance: float
+) -> None:
+    estimate = clopper_pearson(count, samples)
+    high = scipy.stats.beta.ppf(0.975, count + 1, samples - count)
+    assert estimate.high == pytest.approx(high, rel=tolerance)
+    if count:
+        low = scipy.stats.beta.ppf(0.025, count, samples - count + 1)
+        assert estimate.low == pytest.approx(low, rel=tolerance)
+
+
+@pytest.mark.parametrize("count", [2.7, None, "3", float("nan"), True])
+def test_clopper_pearson_refuses_counts_that_are_not_ints(count: object) -> None:
+    with pytest.raises(InvalidArgumentError, match="count must be an int"):
+        clopper_pearson(count, 10)  # type: ignore[arg-type]

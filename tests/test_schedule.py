@@ -208,6 +208,9 @@ def test_conditions_outside_the_grid_raise_naming_the_argument_and_range() -> No
         ({"c": 0.0}, InvalidArgumentError, "c must be positive"),
         ({"c": np.inf}, InvalidArgumentError, "c must be positive"),
         ({"c": [1.0, 2.0]}, ShapeError, "c must be a scalar"),
+        ({"c": 1e200}, InvalidArgumentError, "c must be positive"),  # c² overflows
+        ({"c": 1e-200}, InvalidArgumentError, "c must be positive"),  # c² underflows to 0
+        ({"axis": ["lateral"]}, InvalidArgumentError, "axis must be"),
         ({"Q": np.eye(3)}, ShapeError, "Q must be 4 x 4"),
         ({"R": np.eye(1)}, ShapeError, "R must be 2 x 2"),
         ({"altitudes": [0.0, 20000.0, 8000.0]}, InvalidArgumentError, "altitudes must be strictly"),
