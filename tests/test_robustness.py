@@ -673,3 +673,14 @@ def test_clopper_pearson_for_rare_events_in_huge_runs(
 def test_clopper_pearson_refuses_counts_that_are_not_ints(count: object) -> None:
     with pytest.raises(InvalidArgumentError, match="count must be an int"):
         clopper_pearson(count, 10)  # type: ignore[arg-type]
+
+
+def test_a_singular_sample_is_named_by_its_index_in_the_run() -> None:
+    plane = aircraft.load("b747-cruise")
+    uncertainty = Uncertainty({"Ixz": Normal(8e6, relative=False)})
+    run = aerocontrol.robustness._Run(plane, uncertainty, "lateral", None, 4000, 2, 1000, 1)
+    ixz = np.concatenate([plane.Ixz + 8e6 * run.draws(c)[:, 0] for c in range(4)])
+    singular = np.flatnonzero(ixz**2 >= plane.Ix * plane.Iz)
+    assert singular.size and singular[0] >= 1000  # in a later chunk: the index is the run's
+    with pytest.raises(aircraft.AircraftDataError, match=rf"\(sample {singular[0]} of the run\)"):
+        monte_carlo(plane, uncertainty, 4000, seed=2, chunk_size=1000)

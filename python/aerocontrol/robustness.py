@@ -35,6 +35,7 @@ True
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
@@ -47,6 +48,7 @@ from ._judging import AXIS_MODES, judge_stack
 from ._validation import check_finite, real_array, real_scalar
 from .aircraft.model import _POSITIVE_FIELDS, SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
+from .aircraft.schema import AircraftDataError
 from .exceptions import InvalidArgumentError, ShapeError
 from .handling import mode_quantities
 
@@ -448,7 +450,16 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
     """One chunk: draw, build, judge (open and closed loop), and count failures per bin of
     each parameter's draw."""
     z = run.draws(index)
-    A, B = run.aircraft.model_stack(run.axis, run.values(z, run.chunk_bounds(index)[0]))
+    start = run.chunk_bounds(index)[0]
+    try:
+        A, B = run.aircraft.model_stack(run.axis, run.values(z, start))
+    except AircraftDataError as error:  # a singular sample: named by its index in the run
+        message = re.sub(
+            r"\(sample (\d+) of the values\)",
+            lambda found: f"(sample {start + int(found.group(1))} of the run)",
+            str(error),
+        )
+        raise type(error)(message) from None
     eigenvalues = linalg.eigenvalues(A)
     out = {f"open_{k}": v for k, v in _judge(run, A, eigenvalues).items()}
     out["open_controlled"] = np.zeros(A.shape[0], dtype=bool)
