@@ -684,3 +684,21 @@ def test_a_singular_sample_is_named_by_its_index_in_the_run() -> None:
     assert singular.size and singular[0] >= 1000  # in a later chunk: the index is the run's
     with pytest.raises(aircraft.AircraftDataError, match=rf"\(sample {singular[0]} of the run\)"):
         monte_carlo(plane, uncertainty, 4000, seed=2, chunk_size=1000)
+
+
+@pytest.mark.parametrize("samples", [1, 10, 1000, 10**6, 10**12])
+def test_clopper_pearson_at_the_edges_is_the_closed_form(samples: int) -> None:
+    # No event in N samples: the upper end 1 - (alpha/2)^(1/N) (the "rule of three" for
+    # large N, 3/N at 95 %), to rounding; all N: the mirror image.
+    alpha = 0.05
+    edge = (
+        1.0 - (alpha / 2) ** (1.0 / samples)
+        if samples < 10**6
+        else -np.expm1(np.log(alpha / 2) / samples)
+    )
+    none = clopper_pearson(0, samples)
+    assert none.low == 0.0 and none.high == pytest.approx(edge, rel=1e-14)
+    every = clopper_pearson(samples, samples)
+    assert every.high == 1.0 and every.low == pytest.approx(1.0 - edge, rel=1e-15)
+    if samples >= 10**6:
+        assert none.high == pytest.approx(-np.log(alpha / 2) / samples, rel=1e-5)

@@ -608,8 +608,17 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
     if not 0.0 < confidence < 1.0:
         raise InvalidArgumentError(f"confidence must be in (0, 1), got {confidence}")
     alpha = 1.0 - confidence
-    low = 0.0 if count == 0 else _beta_quantile(alpha / 2, count, samples - count + 1)
-    high = 1.0 if count == samples else _beta_quantile(1 - alpha / 2, count + 1, samples - count)
+    # At count 0 (and count = samples) the quantile has the closed form 1 - (α/2)^(1/N)
+    # (and (α/2)^(1/N)): B(q; 1, N) = 1 - (1 - q)^(1/N), exact where the continued fraction
+    # loses digits next to the mean of a huge run.
+    edge = -math.expm1(math.log(alpha / 2) / samples)  # 1 - (α/2)^(1/N)
+    if count == 0:
+        low, high = 0.0, edge
+    elif count == samples:
+        low, high = 1.0 - edge, 1.0
+    else:
+        low = _beta_quantile(alpha / 2, count, samples - count + 1)
+        high = _beta_quantile(1 - alpha / 2, count + 1, samples - count)
     return Estimate(count, samples, count / samples, low, high, confidence)
 
 
