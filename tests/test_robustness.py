@@ -298,6 +298,32 @@ def test_monte_carlo_on_a_dask_cluster_is_bitwise_the_local_run(dask_client: obj
     )
     _same(local, remote)
     assert seen == [1500, 3000, 4500, 6000]
+    # Each chunk on a chosen pool of two threads of its worker (kept there for the next
+    # chunk: its threads are counted in /proc): the same numbers.
+    limited = monte_carlo(
+        plane,
+        _LATERAL,
+        6000,
+        Lqr(1.0),
+        seed=9,
+        chunk_size=1500,
+        client=dask_client,
+        worker_threads=2,
+    )
+    _same(local, limited)
+
+    def pool_threads() -> int:
+        import os
+        from pathlib import Path
+
+        tasks = Path(f"/proc/{os.getpid()}/task")
+        return sum((t / "comm").read_text().startswith("aerocontrol-") for t in tasks.iterdir())
+
+    counts = dask_client.run(pool_threads)  # type: ignore[attr-defined]
+    # (A worker the scheduler gave no chunk has no pool.)
+    assert set(counts.values()) <= {0, 2} and 2 in counts.values()
+    with pytest.raises(InvalidArgumentError, match="worker_threads"):
+        monte_carlo(plane, _LATERAL, 10, worker_threads=0)
 
 
 def test_monte_carlo_results() -> None:

@@ -374,6 +374,7 @@ class _Run:
     seed: int
     chunk_size: int
     required_level: int
+    worker_threads: int | None = None
 
     def chunk_bounds(self, index: int) -> tuple[int, int]:
         start = index * self.chunk_size
@@ -444,6 +445,17 @@ def _judge(
         "max_real": judged.max_real,
         **out,
     }
+
+
+def _run_chunk_on_worker(run: _Run, index: int) -> dict[str, NDArray[Any]]:
+    """:func:`_run_chunk` on a Dask worker, its parallel work on ``run.worker_threads``
+    threads when given."""
+    if run.worker_threads is None:
+        return _run_chunk(run, index)
+    from .threads import limit_threads
+
+    with limit_threads(run.worker_threads):
+        return _run_chunk(run, index)
 
 
 def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
@@ -812,6 +824,7 @@ def monte_carlo(
     chunk_size: int = CHUNK_SIZE,
     client: Any = None,
     progress: Callable[[int, int], object] | None = None,
+    worker_threads: int | None = None,
 ) -> MonteCarlo:
     """Stochastic robustness by Monte Carlo evaluation: draw ``samples`` variants of
     ``aircraft`` from ``uncertainty``, and judge each one's modes (stability, MIL-F-8785C
@@ -840,6 +853,10 @@ def monte_carlo(
         oversubscribe the machine.
     progress : callable, optional
         Called as ``progress(samples_done, samples)`` after each chunk (for a progress bar).
+    worker_threads : int, optional
+        With a ``client``: each chunk's parallel work runs on this many threads of its worker
+        (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
+        machine. The setting is per process: give it with workers of one task thread each.
 
     Returns
     -------
@@ -907,7 +924,19 @@ def monte_carlo(
                 f"controller gains must have shape ({inputs}, 4) for the {axis} model, got "
                 f"{gains.shape}"
             )
-    run = _Run(aircraft, uncertainty, axis, gains, samples, int(seed), chunk_size, required_level)
+    if worker_threads is not None:
+        worker_threads = _positive_int(worker_threads, "worker_threads")
+    run = _Run(
+        aircraft,
+        uncertainty,
+        axis,
+        gains,
+        samples,
+        int(seed),
+        chunk_size,
+        required_level,
+        worker_threads,
+    )
     indices = range(run.chunk_count)
     done = 0
 
@@ -924,7 +953,9 @@ def monte_carlo(
             parts.append(_run_chunk(run, i))
             advanced(i)
     else:
-        futures = client.map(_run_chunk, [run] * run.chunk_count, list(indices), pure=False)
+        futures = client.map(
+            _run_chunk_on_worker, [run] * run.chunk_count, list(indices), pure=False
+        )
         for i, future in enumerate(futures):  # in chunk order; the cluster runs them all
             parts.append(future.result())
             advanced(i)
