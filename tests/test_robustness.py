@@ -285,32 +285,25 @@ def test_monte_carlo_is_reproducible_and_independent_of_chunk_order() -> None:
 def test_monte_carlo_on_a_dask_cluster_is_bitwise_the_local_run(dask_client: object) -> None:
     plane = aircraft.load("b747-cruise")
     local = monte_carlo(plane, _LATERAL, 6000, Lqr(1.0), seed=9, chunk_size=1500)
+
+    def on_cluster(**options: object) -> aerocontrol.robustness.MonteCarlo:
+        return monte_carlo(
+            plane,
+            _LATERAL,
+            6000,
+            Lqr(1.0),
+            seed=9,
+            chunk_size=1500,
+            client=dask_client,
+            **options,  # type: ignore[arg-type]
+        )
+
     seen: list[int] = []
-    remote = monte_carlo(
-        plane,
-        _LATERAL,
-        6000,
-        Lqr(1.0),
-        seed=9,
-        chunk_size=1500,
-        client=dask_client,
-        progress=lambda done, total: seen.append(done),
-    )
-    _same(local, remote)
+    _same(local, on_cluster(progress=lambda done, total: seen.append(done)))
     assert seen == [1500, 3000, 4500, 6000]
     # Each chunk on a chosen pool of two threads of its worker (kept there for the next
     # chunk: its threads are counted in /proc): the same numbers.
-    limited = monte_carlo(
-        plane,
-        _LATERAL,
-        6000,
-        Lqr(1.0),
-        seed=9,
-        chunk_size=1500,
-        client=dask_client,
-        worker_threads=2,
-    )
-    _same(local, limited)
+    _same(local, on_cluster(worker_threads=2))
 
     def pool_threads() -> int:
         import os

@@ -34,6 +34,7 @@ True
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections.abc import Callable, Mapping, Sequence
@@ -482,7 +483,7 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
         out["closed_controlled"] = controlled
         failed = (out["closed_levels"] > run.required_level).any(axis=1)
     # Decile bins of each standard-normal draw (edges Φ^-1(k / 10)).
-    edges = np.array([_normal_quantile(k / SENSITIVITY_BINS) for k in range(1, SENSITIVITY_BINS)])
+    edges = _decile_edges()
     bins = np.searchsorted(edges, z)  # (samples, parameters)
     parameters = z.shape[1]
     flat = bins + SENSITIVITY_BINS * np.arange(parameters)
@@ -491,6 +492,12 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
     out["bin_failed"] = np.bincount(flat[failed].ravel(), minlength=size).reshape(parameters, -1)
     out["failed"] = np.asarray(failed)
     return out
+
+
+@functools.cache
+def _decile_edges() -> FloatArray:
+    """Φ^-1(k / 10), k = 1..9: the edges of the sensitivity bins (computed once)."""
+    return np.array([_normal_quantile(k / SENSITIVITY_BINS) for k in range(1, SENSITIVITY_BINS)])
 
 
 def _normal_quantile(p: float) -> float:
