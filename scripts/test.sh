@@ -10,7 +10,8 @@
 # ruff format --check; one abi3 wheel; cargo clippy --all-targets -D warnings
 # (with the Python bindings); cargo test without features (as the README's cargo test) and with
 # the extension's allocator; pytest (which also runs mypy --strict and stubtest on the package,
-# the doctests, and the property suite within its CI budget).
+# the doctests, and the property suite within its CI budget); the documentation site
+# (scripts/docs.sh).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -24,12 +25,12 @@ rm -rf "$venv"
 "$venv/bin/python" -m pip install --quiet --upgrade pip
 
 echo "== build and install aerocontrol with its test dependencies"
-"$venv/bin/python" -m pip install --quiet ".[test]"
+"$venv/bin/python" -m pip install --quiet ".[test,docs]"
 
 echo "== style: cargo fmt, ruff"
 cargo fmt --all --check
-"$venv/bin/ruff" check python tests benches scripts
-"$venv/bin/ruff" format --check python tests benches scripts
+"$venv/bin/ruff" check python tests benches scripts examples docs
+"$venv/bin/ruff" format --check python tests benches scripts examples docs
 
 echo "== one abi3 wheel"
 rm -rf "$root/dist"
@@ -65,5 +66,8 @@ fi
 echo "== pytest"
 # Run from outside the source tree so that the installed package, not python/, is tested.
 (cd "$root/tests" && "$venv/bin/python" -m pytest -p no:cacheprovider "$root/tests")
+
+echo "== documentation site (warnings are errors, every reference resolves, the gallery runs)"
+PYTHON="$venv/bin/python" bash "$root/scripts/docs.sh"
 
 echo "== all checks and tests passed (cargo: $cargo_passed)"
