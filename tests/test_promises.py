@@ -1,5 +1,5 @@
-"""The guarantees of README's "What aerocontrol promises" that concern computations: memory
-layouts, Ctrl-C, the GIL, memory limits, zero-size work and overflow.
+"""The guarantees of "What aerocontrol promises" (docs/promises.md) that concern computations:
+memory layouts, Ctrl-C, the GIL, memory limits, zero-size work and overflow.
 
 Interrupts and memory limits are tested in child processes, so that a failure (an abort, a hang)
 cannot take the test session with it.
