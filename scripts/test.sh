@@ -6,8 +6,8 @@
 #   bash scripts/test.sh            # from anywhere; uses python3 on PATH
 #   PYTHON=python3.12 bash scripts/test.sh
 #
-# Steps: a fresh venv with the package and its test dependencies; cargo fmt --check, ruff check,
-# ruff format --check; one abi3 wheel; cargo clippy --all-targets -D warnings
+# Steps: a fresh venv; one abi3 wheel, installed with the test and docs dependencies; cargo fmt
+# --check, ruff check, ruff format --check; cargo clippy --all-targets -D warnings
 # (with the Python bindings); cargo test without features (as the README's cargo test) and with
 # the extension's allocator; pytest (which also runs mypy --strict and stubtest on the package,
 # the doctests, and the property suite within its CI budget); the documentation site
@@ -24,15 +24,7 @@ rm -rf "$venv"
 "$python" -m venv "$venv"
 "$venv/bin/python" -m pip install --quiet --upgrade pip
 
-echo "== build and install aerocontrol with its test dependencies"
-"$venv/bin/python" -m pip install --quiet ".[test,docs]"
-
-echo "== style: cargo fmt, ruff"
-cargo fmt --all --check
-"$venv/bin/ruff" check python tests benches scripts examples docs
-"$venv/bin/ruff" format --check python tests benches scripts examples docs
-
-echo "== one abi3 wheel"
+echo "== build one abi3 wheel, and install it with the test and documentation dependencies"
 rm -rf "$root/dist"
 "$venv/bin/python" -m pip wheel --quiet --no-deps --wheel-dir "$root/dist" .
 wheels=("$root"/dist/aerocontrol-*.whl)
@@ -41,6 +33,12 @@ if [ "${#wheels[@]}" -ne 1 ] || [[ "${wheels[0]}" != *abi3* ]]; then
     exit 1
 fi
 echo "${wheels[0]##*/}"
+"$venv/bin/python" -m pip install --quiet "${wheels[0]}[test,docs]"
+
+echo "== style: cargo fmt, ruff"
+cargo fmt --all --check
+"$venv/bin/ruff" check python tests benches scripts examples docs
+"$venv/bin/ruff" format --check python tests benches scripts examples docs
 
 echo "== cargo clippy"
 # PYO3_PYTHON: the bindings' build script needs an interpreter.
