@@ -1,7 +1,7 @@
 """Sphinx extension: the API reference pages, written from the package's ``__all__`` lists.
 
-Every public name of :mod:`aerocontrol` and of its public submodules gets an entry (an
-autosummary table whose rows link to a generated page per name), grouped by the module that
+Every public name of :mod:`aerocontrol` and of its public submodules gets an entry (a row of
+the module page's summary table, and its documentation below), grouped by the module that
 defines it, so that a name added to ``__all__`` is documented without editing the site, and
 the build fails (``-W``) when one has no docstring to show.
 """
@@ -49,21 +49,32 @@ def _groups(name: str) -> dict[str, list[str]]:
     return groups
 
 
+def _directive(module: str, public: str) -> list[str]:
+    """The autodoc entry of one name: its whole documentation on the module's page."""
+    value = getattr(importlib.import_module(module), public)
+    if inspect.isclass(value) and issubclass(value, BaseException):
+        return [f".. autoexception:: {public}", "   :show-inheritance:", ""]
+    if inspect.isclass(value):
+        return [f".. autoclass:: {public}", "   :members:", "   :undoc-members:", ""]
+    if callable(value):
+        return [f".. autofunction:: {public}", ""]
+    return [f".. autodata:: {public}", "   :no-value:", ""]
+
+
 def _page(name: str, title: str) -> str:
+    """One page per module: a summary table of its names, then each name's documentation
+    (one page per module, not per name, keeps the site's navigation small)."""
     lines = [title, "=" * len(title), "", f".. automodule:: {name}", "   :no-members:", ""]
     for home, names in sorted(_groups(name).items()):
+        ordered = sorted(names, key=str.lower)
         if name == "aerocontrol":
             heading = f"From ``{home}``"
             lines += [heading, "-" * len(heading), "", _summary(importlib.import_module(home)), ""]
-        lines += [
-            f".. currentmodule:: {name}",
-            "",
-            ".. autosummary::",
-            "   :toctree: generated",
-            "",
-        ]
-        lines += [f"   {public}" for public in sorted(names, key=str.lower)]
+        lines += [f".. currentmodule:: {name}", "", ".. autosummary::", ""]
+        lines += [f"   {public}" for public in ordered]
         lines.append("")
+        for public in ordered:
+            lines += _directive(name, public)
     return "\n".join(lines)
 
 

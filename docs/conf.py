@@ -38,7 +38,6 @@ extensions = [
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "_inventories", "gallery/*.ipynb", "gallery/*.py", "**.zip"]
-templates_path = ["_templates"]
 
 # Every reference must resolve (scripts/docs.sh adds -W -n).
 nitpicky = True
@@ -49,7 +48,7 @@ numpydoc_class_members_toctree = False
 # Signatures without annotations: the docstrings' Parameters say the types in words.
 autodoc_typehints = "none"
 autodoc_default_options = {"members": False}
-autosummary_generate = True
+autosummary_generate = False
 autosummary_imported_members = False
 
 # Offline inventories (docs/_inventories/README.md); projects without one are not linked.

@@ -10,6 +10,6 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 python=${PYTHON:-python3}
 out="$root/docs/_build/html"
-rm -rf "$out" "$root/docs/api/generated" "$root/docs/gallery"
+rm -rf "$out" "$root/docs/gallery"
 MPLBACKEND=Agg "$python" -m sphinx -W --keep-going -n -q -b html "$root/docs" "$out"
 echo "documentation: $out/index.html"
