@@ -31,6 +31,7 @@ __all__ = [
     "UNCERTAIN_FIELDS",
     "Key",
     "json_schema",
+    "schema_text",
     "shipped_json_schema",
 ]
 
@@ -285,8 +286,8 @@ def _published_schema() -> dict[str, Any]:
     }
 
 
-def _uncertainty_schema() -> dict[str, Any]:
-    parameters = (*LONGITUDINAL_DERIVATIVES, *LATERAL_DERIVATIVES, *UNCERTAIN_FIELDS)
+def _scatter_schema() -> dict[str, Any]:
+    """The schema of one entry of [uncertainty] (``$defs/scatter``)."""
     branches = []
     for distribution, spread in UNCERTAINTY_SPREADS.items():
         branch: dict[str, Any] = {
@@ -301,12 +302,16 @@ def _uncertainty_schema() -> dict[str, Any]:
         if distribution == "lognormal":
             branch["properties"]["relative"] = {"const": True}
         branches.append(branch)
-    entry = {
+    return {
         "type": "object",
         "description": "the parameter's distribution and spread (relative to its value "
         "unless relative = false)",
         "oneOf": branches,
     }
+
+
+def _uncertainty_schema() -> dict[str, Any]:
+    parameters = (*LONGITUDINAL_DERIVATIVES, *LATERAL_DERIVATIVES, *UNCERTAIN_FIELDS)
     correlation = {
         "type": "array",
         "prefixItems": [
@@ -321,7 +326,7 @@ def _uncertainty_schema() -> dict[str, Any]:
         "type": "object",
         "description": TABLES["uncertainty"],
         "properties": {
-            **{name: entry for name in parameters},
+            **{name: {"$ref": "#/$defs/scatter"} for name in parameters},
             "correlations": {
                 "type": "array",
                 "description": 'correlation coefficients, ["A", "B", rho] with -1 < rho < 1',
@@ -415,6 +420,7 @@ def json_schema() -> dict[str, Any]:
         "required": list(REQUIRED_TABLES),
         "additionalProperties": False,
         "allOf": [_bounds(units) for units in UNIT_NAMES],
+        "$defs": {"scatter": _scatter_schema()},
     }
 
 
@@ -445,3 +451,25 @@ def shipped_json_schema() -> dict[str, Any]:
     text = resources.files(__package__).joinpath(SCHEMA_FILE).read_text(encoding="utf-8")
     loaded: dict[str, Any] = json.loads(text)
     return loaded
+
+
+def schema_text() -> str:
+    """:func:`json_schema` as the text of the shipped file (indented, non-ASCII kept, one
+    newline at the end): what ``aerocontrol schema`` prints.
+
+    Returns
+    -------
+    str
+        The JSON text.
+
+    Raises
+    ------
+    None
+
+    Examples
+    --------
+    >>> import json
+    >>> json.loads(schema_text()) == json_schema()
+    True
+    """
+    return json.dumps(json_schema(), indent=2, ensure_ascii=False) + "\n"

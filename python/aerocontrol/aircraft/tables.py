@@ -57,7 +57,9 @@ _GRAVITY = {"english": 32.174, "si": 9.80665}
 _NAN = math.nan
 
 
-def aircraft_fields(data: Mapping[str, Any], origin: str = "<dict>") -> dict[str, Any]:
+def aircraft_fields(
+    data: Mapping[str, Any], origin: str = "<dict>", text: str = ""
+) -> dict[str, Any]:
     """The keyword arguments of :class:`~aerocontrol.aircraft.Aircraft` from the tables of an
     aircraft file, every key checked (:meth:`Aircraft.from_dict
     <aerocontrol.aircraft.Aircraft.from_dict>` builds the aircraft from them).
@@ -68,6 +70,8 @@ def aircraft_fields(data: Mapping[str, Any], origin: str = "<dict>") -> dict[str
         The tables of the file, as :func:`~aerocontrol.aircraft.reader.parse_toml` reads them.
     origin : str
         The name of the file in errors.
+    text : str
+        The text of the file, for the line of the error (without it, the line is None).
 
     Returns
     -------
@@ -86,7 +90,7 @@ def aircraft_fields(data: Mapping[str, Any], origin: str = "<dict>") -> dict[str
     >>> fields["name"], fields["S"]
     ('Navion, level flight', 184.0)
     """
-    reader = _Reader(data, origin, {})
+    reader = _Reader(data, origin, key_lines(text) if text else {})
     fields = reader.read()
     if reader.first is not None:
         raise reader.first
@@ -132,11 +136,14 @@ def table_problems(
     >>> table_problems(parse_toml(text, origin), origin, text)
     []
     >>> text = text.replace("Cm_q = -9.96", "Cm_qq = -9.96").replace("S = 184.0", "S = -1")
-    >>> for problem in table_problems(parse_toml(text, origin), origin, text):
-    ...     print(problem.line, problem.key, "|", problem.hint)
-    67 geometry.S | the wing area must be positive
-    81 longitudinal.Cm_q | did you mean Cm_qq? (or add Cm_q = ..., pitch damping ...)
-    81 longitudinal.Cm_qq | did you mean Cm_q?
+    >>> found = table_problems(parse_toml(text, origin), origin, text)
+    >>> for problem in found:
+    ...     print(problem.line, problem.key)
+    62 geometry.S
+    66 longitudinal.Cm_q
+    77 longitudinal.Cm_qq
+    >>> found[2].hint
+    'did you mean Cm_q?'
     """
     reader = _Reader(data, origin, key_lines(text) if text else {})
     reader.read()
@@ -369,13 +376,14 @@ class _Reader:
             if name in ("longitudinal", "lateral"):
                 note = " (write 0.0 for a derivative the source does not give)"
             parts = []
+            known = FILE_KEYS.get(name, {})
             for key in missing:
-                spec = FILE_KEYS.get(name, {}).get(key)
-                what = f" ({spec.description})" if spec is not None else ""
-                hint = f"add {key} = ...{what} to [{name}]{note}"
-                typo = _similar(key, tuple(str(k) for k in table if k not in FILE_KEYS[name]))
-                if typo and name in FILE_KEYS:
-                    hint = f"is {typo} meant to be {key}? or {hint}"
+                spec = known.get(key)
+                what = f": {spec.description}" if spec is not None else ""
+                hint = f"add {key} = ... to [{name}]{what}{note}"
+                typo = _similar(key, tuple(str(k) for k in table if k not in known))
+                if typo:
+                    hint = f"is {typo} meant to be {key}? else {hint}"
                 parts.append(self.part(f"[{name}] is missing {key}", f"{name}.{key}", hint))
             self.problem(
                 f"[{name}] is missing {', '.join(missing)}{note}", f"{name}.{missing[0]}", "", parts
