@@ -465,3 +465,41 @@ def test_the_shipped_schema_file_is_the_generated_one(capsys: pytest.CaptureFixt
     first = aircraft.json_schema()
     first["properties"].clear()
     assert aircraft.json_schema()["properties"]
+
+
+def test_uncertainty_and_published_problems_are_each_reported(tmp_path: Path) -> None:
+    uncertainty = (
+        "\n[uncertainty]\n"
+        'Cn_bta = { distribution = "normal", sigma = 0.1 }\n'
+        'Cl_p = { distribution = "normal", sigma = -0.1 }\n'
+        'Cn_r = { distribution = "lognormal", sigma = 0.1, relative = false }\n'
+        'Cl_r = { distribution = "gaussian", sigma = 0.1 }\n'
+    )
+    path, lines = _broken(
+        tmp_path,
+        "navion",
+        ("spiral = { time_constant = 114.16 }", "spiral = { time_constant = -114.16 }"),
+        (
+            "phugoid = { omega_n = 0.2137, zeta = 0.0801 }",
+            "phugoid = { omega_n = 0.2137, zeta = 0 }",
+        ),
+        (
+            "alpha0_deg = 0.6 ",
+            "alpha0_deg = 95.0 ",
+        ),  # checked though the inertias are stability-axis
+        ("\n[sources]\n", f"{uncertainty}\n[sources]\n"),
+    )
+    found = aircraft.problems(path)
+    assert [(p.line, p.key) for p in found] == [
+        (_line_of(lines, "alpha0_deg = 95.0"), "flight.alpha0_deg"),
+        (_line_of(lines, "phugoid = "), "published.phugoid.zeta"),
+        (_line_of(lines, "spiral = "), "published.spiral.time_constant"),
+        (_line_of(lines, "Cn_bta = "), "uncertainty.Cn_bta"),
+        (_line_of(lines, "Cl_p = { d"), "uncertainty.Cl_p.sigma"),
+        (_line_of(lines, "Cn_r = { d"), "uncertainty.Cn_r.relative"),
+        (_line_of(lines, "Cl_r = { d"), "uncertainty.Cl_r.distribution"),
+    ]
+    assert found[0].hint == "is the value mistyped?"
+    assert "outside the plausible range -89 to 89 deg" in str(found[0])
+    assert found[3].hint == "did you mean Cn_beta?"
+    assert found[6].hint == "write one of 'normal', 'uniform', 'lognormal'"

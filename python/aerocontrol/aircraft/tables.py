@@ -295,6 +295,8 @@ class _Reader:
             else:
                 alpha0 = self.number(flight, "flight", "alpha0_deg")
                 Ix, Iz, Ixz = body_to_stability(Ix, Iz, Ixz, math.radians(alpha0))
+        elif "alpha0_deg" in flight:  # not used, but a number of the file all the same
+            self.number(flight, "flight", "alpha0_deg")
         if _finite(Ix, Iz, Ixz) and Ix * Iz <= Ixz**2:
             self.problem(
                 f"[mass] the inertia tensor must be positive definite, but "
