@@ -44,6 +44,14 @@ class Key:
     name), ``"string"`` (at most ``limit`` characters) or ``"choice"`` (one of ``choices``);
     ``required`` is True, False, or the name of a group of keys of which exactly one is given
     (``"speed|mach"``).
+
+    Examples
+    --------
+    >>> speed = FILE_KEYS["flight"]["speed"]
+    >>> speed.kind, speed.required, speed.positive
+    ('number', 'speed|mach', True)
+    >>> [key for key, spec in FILE_KEYS["mass"].items() if spec.required is True]
+    ['Ix', 'Iy', 'Iz', 'Ixz', 'axes']
     """
 
     description: str
@@ -63,37 +71,37 @@ _CATEGORIES = ("A", "B", "C")
 _LONGITUDINAL = {
     "CL": "trim lift coefficient",
     "CD": "trim drag coefficient",
-    "CL_alpha": "lift-curve slope dCL/dα (per rad)",
-    "CL_alphadot": "dCL/d(α̇ c̄/2u0) (per rad); positive when a rising α raises the lift",
-    "CL_q": "dCL/d(q c̄/2u0) (per rad)",
+    "CL_alpha": "lift-curve slope dCL/dα",
+    "CL_alphadot": "dCL/d(α̇ c̄/2u0); positive when a rising α raises the lift",
+    "CL_q": "dCL/d(q c̄/2u0)",
     "CL_M": "dCL/dM, the lift's change with Mach number (0 if the source does not give it)",
-    "CD_alpha": "dCD/dα (per rad)",
+    "CD_alpha": "dCD/dα",
     "CD_M": "dCD/dM (0 if the source does not give it)",
-    "Cm_alpha": "pitch stiffness dCm/dα (per rad); negative for a statically stable airplane",
-    "Cm_alphadot": "dCm/d(α̇ c̄/2u0) (per rad)",
-    "Cm_q": "pitch damping dCm/d(q c̄/2u0) (per rad); negative",
+    "Cm_alpha": "pitch stiffness dCm/dα; negative for a statically stable airplane",
+    "Cm_alphadot": "dCm/d(α̇ c̄/2u0)",
+    "Cm_q": "pitch damping dCm/d(q c̄/2u0); negative",
     "Cm_M": "dCm/dM (0 if the source does not give it)",
-    "CL_de": "dCL/dδe (per rad), δe positive trailing edge down",
-    "CD_de": "dCD/dδe (per rad)",
-    "Cm_de": "elevator power dCm/dδe (per rad), δe positive trailing edge down; negative",
+    "CL_de": "dCL/dδe, δe positive trailing edge down",
+    "CD_de": "dCD/dδe",
+    "Cm_de": "elevator power dCm/dδe, δe positive trailing edge down; negative",
 }
 _LATERAL = {
-    "Cy_beta": "side force dCy/dβ (per rad)",
-    "Cy_p": "dCy/d(p b/2u0) (per rad)",
-    "Cy_r": "dCy/d(r b/2u0) (per rad)",
-    "Cl_beta": "dihedral effect dCl/dβ (per rad); negative for a stable airplane",
-    "Cl_p": "roll damping dCl/d(p b/2u0) (per rad); negative",
-    "Cl_r": "dCl/d(r b/2u0) (per rad)",
-    "Cn_beta": "weathercock stability dCn/dβ (per rad); positive for a stable airplane",
-    "Cn_p": "dCn/d(p b/2u0) (per rad)",
-    "Cn_r": "yaw damping dCn/d(r b/2u0) (per rad); negative",
-    "Cy_dr": "dCy/dδr (per rad)",
-    "Cl_dr": "dCl/dδr (per rad)",
-    "Cn_dr": "rudder power dCn/dδr (per rad)",
-    "Cy_da": "dCy/dδa (per rad)",
-    "Cl_da": "aileron power dCl/dδa (per rad); positive when a positive δa rolls the right "
+    "Cy_beta": "side force dCy/dβ",
+    "Cy_p": "dCy/d(p b/2u0)",
+    "Cy_r": "dCy/d(r b/2u0)",
+    "Cl_beta": "dihedral effect dCl/dβ; negative for a stable airplane",
+    "Cl_p": "roll damping dCl/d(p b/2u0); negative",
+    "Cl_r": "dCl/d(r b/2u0)",
+    "Cn_beta": "weathercock stability dCn/dβ; positive for a stable airplane",
+    "Cn_p": "dCn/d(p b/2u0)",
+    "Cn_r": "yaw damping dCn/d(r b/2u0); negative",
+    "Cy_dr": "dCy/dδr",
+    "Cl_dr": "dCl/dδr",
+    "Cn_dr": "rudder power dCn/dδr",
+    "Cy_da": "dCy/dδa",
+    "Cl_da": "aileron power dCl/dδa; positive when a positive δa rolls the right "
     "wing down, as in the shipped files",
-    "Cn_da": "adverse or proverse yaw dCn/dδa (per rad)",
+    "Cn_da": "adverse or proverse yaw dCn/dδa",
 }
 LONGITUDINAL_DERIVATIVES = tuple(_LONGITUDINAL)
 """The longitudinal coefficients and derivatives (per radian) an aircraft file must give."""
@@ -120,11 +128,11 @@ PUBLISHED_MODES = {
 also carry its own relative ``tolerance``, which then replaces the file-level ``tolerance``."""
 
 _PUBLISHED_QUANTITIES = {
-    "omega_n": "undamped natural frequency (rad/s)",
+    "omega_n": "undamped natural frequency",
     "zeta": "damping ratio (negative for an unstable oscillation, never 0)",
-    "time_constant": "time constant -1/λ of the real root (s)",
-    "time_to_half": "time to half amplitude ln 2 / -λ of a stable root (s)",
-    "time_to_double": "time to double amplitude ln 2 / λ of an unstable root (s)",
+    "time_constant": "time constant -1/λ of the real root",
+    "time_to_half": "time to half amplitude ln 2 / -λ of a stable root",
+    "time_to_double": "time to double amplitude ln 2 / λ of an unstable root",
     "tolerance": "relative tolerance of this mode's checks, replacing the file-level one",
 }
 
@@ -388,7 +396,7 @@ def json_schema() -> dict[str, Any]:
     """
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
-        "$id": "https://github.com/aerocontrol/aerocontrol/aircraft.schema.json",
+        "$id": "urn:aerocontrol:aircraft-file",
         "title": "aerocontrol aircraft file",
         "description": "One aircraft at one flight condition (a TOML file read by "
         "aerocontrol.aircraft.load): nondimensional derivatives per radian in stability axes, "
