@@ -6,6 +6,9 @@
 ``--out DIR [--force]``                (default ./aerocontrol-report; see ``report --help``)
 ``aerocontrol aircraft``               the shipped aircraft
 ``aerocontrol modes AIRCRAFT``         the modes and their MIL-F-8785C Levels
+``aerocontrol check FILE.toml``        every problem of an aircraft file (key, line, hint),
+                                       or its modes and Levels if it is valid
+``aerocontrol schema``                 the JSON Schema of the aircraft file (draft 2020-12)
 ``aerocontrol lqr AIRCRAFT --c 1.0``   the lateral (or ``--axis longitudinal``) regulator
 ``aerocontrol damper AIRCRAFT``        a yaw (or ``--loop pitch``) damper and its margins
 ``aerocontrol --debug COMMAND ...``    a traceback instead of the one-line error
@@ -40,8 +43,10 @@ from typing import Any, NoReturn
 import numpy as np
 
 from . import __version__, handling
-from .aircraft.model import Aircraft, available, load
+from .aircraft.keys import schema_text
+from .aircraft.model import Aircraft, available, load, problems
 from .aircraft.naming import classify_modes, name_modes
+from .aircraft.schema import AircraftDataError
 from .exceptions import AerocontrolError
 from .modal import modes
 from .riccati import solve_care
@@ -133,6 +138,28 @@ def _parser() -> argparse.ArgumentParser:
         description="The longitudinal and lateral-directional modes and their Levels.",
     )
     modes_command.add_argument("aircraft", nargs="?", default=DEFAULT_AIRCRAFT, help=aircraft_help)
+
+    check = commands.add_parser(
+        "check",
+        parents=[common],
+        help="validate an aircraft file: every problem, or its modes and Levels",
+        description="Reads an aircraft file and prints every problem, one a line: "
+        "FILE:LINE: KEY: what is wrong (hint: how to mend it), with exit status 1; a valid "
+        "file prints its flight condition, its modes and their MIL-F-8785C Levels (as "
+        "'aerocontrol modes'). A file that is not valid TOML has one problem, where the "
+        "parser stopped.",
+    )
+    check.add_argument("aircraft", metavar="FILE.toml", help=aircraft_help)
+
+    commands.add_parser(
+        "schema",
+        parents=[common],
+        help="print the JSON Schema of the aircraft file (for editors)",
+        description="The JSON Schema (draft 2020-12) of the aircraft file, generated from the "
+        "reader's definitions: every key with its unit, sign convention and description, "
+        "which keys are required and the plausible ranges. The same text ships as "
+        "aerocontrol/aircraft/aircraft.schema.json.",
+    )
 
     lqr = commands.add_parser(
         "lqr",
@@ -394,6 +421,34 @@ def _modes(arguments: argparse.Namespace) -> int:
     return 0
 
 
+def _problem_line(problem: AircraftDataError) -> str:
+    """One problem of ``check`` on one line: FILE:LINE: KEY: message (hint: ...)."""
+    message = str(problem)
+    origin, _, body = message.partition(": ")
+    if not body:
+        origin, body = "", message
+    where = f"{origin}:{problem.line}" if problem.line is not None else origin
+    key = f"{problem.key}: " if problem.key else ""
+    hint = f" (hint: {problem.hint})" if problem.hint else ""
+    return _one_line(f"{where}: {key}{body}{hint}" if where else f"{key}{body}{hint}")
+
+
+def _check(arguments: argparse.Namespace) -> int:
+    found = problems(arguments.aircraft)
+    if found:
+        for problem in found:
+            print(_problem_line(problem))
+        count = len(found)
+        print(f"{count} problem{'s' if count > 1 else ''}")
+        return 1
+    return _modes(arguments)
+
+
+def _schema(_: argparse.Namespace) -> int:
+    sys.stdout.write(schema_text())
+    return 0
+
+
 def _lqr(arguments: argparse.Namespace) -> int:
     c = arguments.c
     if not (math.isfinite(c) and c > 0):
@@ -441,6 +496,8 @@ _COMMANDS = {
     "report": _report,
     "aircraft": _aircraft,
     "modes": _modes,
+    "check": _check,
+    "schema": _schema,
     "lqr": _lqr,
     "damper": _damper,
     "robustness": _robustness,

@@ -13,6 +13,8 @@ it), so every call here is one the package really accepts.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -269,6 +271,9 @@ aerocontrol.lqg(
 # --- Batches and the design studies ----------------------------------------------------------
 
 b747 = aircraft.load("b747-approach")
+assert_type(aircraft.problems("navion"), list[aircraft.AircraftDataError])
+assert_type(aircraft.problems(Path("plane.toml"))[0].line, int | None)
+assert_type(aircraft.json_schema(), dict[str, Any])
 plane = b747.lateral()
 zetas, wn_dr = np.linspace(0.15, 0.6, 10), 0.74767
 dutch = -zetas * wn_dr + 1j * wn_dr * np.sqrt(1 - zetas**2)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from .atmosphere import Atmosphere, standard_atmosphere
 from .envelope import Envelope, envelope_sweep
+from .keys import json_schema
 from .model import (
     LATERAL_DERIVATIVES,
     LONGITUDINAL_DERIVATIVES,
@@ -25,6 +26,7 @@ from .model import (
     AircraftDataError,
     available,
     load,
+    problems,
 )
 from .naming import classify_modes, name_modes
 from .reader import AIRCRAFT_FILE_LIMIT
@@ -45,7 +47,9 @@ __all__ = [
     "body_to_stability",
     "classify_modes",
     "envelope_sweep",
+    "json_schema",
     "load",
     "name_modes",
+    "problems",
     "standard_atmosphere",
 ]

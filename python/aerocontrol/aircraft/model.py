@@ -55,7 +55,7 @@ from .atmosphere import standard_atmosphere
 from .naming import name_modes
 from .reader import available, parse_toml, read_source
 from .schema import PLAUSIBLE_RANGES, UNIT_NAMES, AircraftDataError, check_range
-from .tables import LATERAL_DERIVATIVES, LONGITUDINAL_DERIVATIVES, aircraft_fields
+from .tables import LATERAL_DERIVATIVES, LONGITUDINAL_DERIVATIVES, aircraft_fields, table_problems
 
 __all__ = [
     "LATERAL_DERIVATIVES",
@@ -66,6 +66,7 @@ __all__ = [
     "AircraftDataError",
     "available",
     "load",
+    "problems",
 ]
 
 LONGITUDINAL_STATES = ("u/u0", "alpha", "q", "theta")
@@ -527,7 +528,66 @@ def load(name_or_path: str | Path = "b747-approach") -> Aircraft:
     -1.0994
     """
     text, origin = read_source(name_or_path)
-    return Aircraft.from_dict(parse_toml(text, origin), origin)
+    return _from_text(text, origin)
+
+
+def _from_text(text: str, origin: str) -> Aircraft:
+    """The aircraft of an aircraft file's text; errors carry their line in it."""
+    return Aircraft(**aircraft_fields(parse_toml(text, origin), origin, text))
+
+
+def problems(name_or_path: str | Path = "b747-approach") -> list[AircraftDataError]:
+    """Every problem of a shipped aircraft or an aircraft file, where :func:`load` raises only
+    the first: ``aerocontrol check``.
+
+    A file that cannot be read or is not valid TOML has one problem (the parser stops at its
+    first error; its line is the parser's). Otherwise every problem of its tables, one per key,
+    in the order of the file (:func:`~aerocontrol.aircraft.tables.table_problems`): unknown
+    keys and tables (with the known key each most resembles), missing ones, values of the
+    wrong type, sign or range (:data:`PLAUSIBLE_RANGES`, in the file's units), and numbers
+    inconsistent with each other or with the units. A file whose tables are valid but whose
+    models are singular (1 - Zẇ = 0) has that one problem.
+
+    Parameters
+    ----------
+    name_or_path : str or Path
+        A shipped identifier (see :func:`available`) or the path of a ``.toml`` file.
+
+    Returns
+    -------
+    list of AircraftDataError
+        Each with its ``key`` (dotted, ``"mass.weight"``), ``line`` in the file (None where
+        there is none: a missing table, an unreadable file) and ``hint``; empty if the file
+        loads.
+
+    Raises
+    ------
+    None
+        Every problem is returned, none raised.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> aircraft.problems("navion")
+    []
+    >>> [(problem.line, problem.hint) for problem in aircraft.problems("concorde.toml")]
+    [(None, '')]
+    """
+    try:
+        text, origin = read_source(name_or_path)
+        data = parse_toml(text, origin)
+    except AircraftDataError as error:
+        return [error]
+    found = table_problems(data, origin, text)
+    if found:
+        return found
+    try:
+        plane = Aircraft.from_dict(data, origin)
+        plane.longitudinal()
+        plane.lateral()
+    except AircraftDataError as error:
+        return [error]
+    return []
 
 
 class _Values:

@@ -29,6 +29,7 @@ __all__ = [
     "AIRCRAFT_FILE_LIMIT",
     "available",
     "decode_text",
+    "key_lines",
     "parse_toml",
     "read_aircraft_file",
     "read_source",
@@ -117,6 +118,7 @@ def decode_text(data: bytes, origin: str) -> str:
 
 _INTEGER = re.compile(r"[0-9][0-9_]*")
 _KEY_BEFORE = re.compile(r"([A-Za-z0-9_\-]+)\s*=\s*[+-]?$")
+_AT_LINE = re.compile(r"\bline (\d+)")
 
 
 def parse_toml(text: str, origin: str) -> dict[str, Any]:
@@ -127,7 +129,13 @@ def parse_toml(text: str, origin: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         message = " ".join(str(error).split())
-        raise AircraftDataError(f"{origin}: not valid TOML: {message}") from None
+        at = _AT_LINE.search(message)
+        raise AircraftDataError(
+            f"{origin}: not valid TOML: {message}",
+            line=int(at.group(1)) if at else None,
+            hint="mend the TOML syntax at that line (a value after every '=', quotes around "
+            "text, each key once per table); the parser stops at its first error",
+        ) from None
     except RecursionError:
         raise AircraftDataError(
             f"{origin}: not valid TOML for an aircraft: arrays or tables nested too deeply"
@@ -135,7 +143,11 @@ def parse_toml(text: str, origin: str) -> dict[str, Any]:
     except ValueError:
         # The parser's int() refused an integer of more digits than Python converts
         # (sys.get_int_max_str_digits(), 4300 by default).
-        raise AircraftDataError(f"{origin}: {_longest_integer(text)}") from None
+        message = _longest_integer(text)
+        at = _AT_LINE.search(message)
+        raise AircraftDataError(
+            f"{origin}: {message}", line=int(at.group(1)) if at else None
+        ) from None
 
 
 def _longest_integer(text: str) -> str:
@@ -153,6 +165,76 @@ def _longest_integer(text: str) -> str:
         f"line {line}: {named}an integer of {digits} digits is outside the plausible range "
         "of every quantity"
     )
+
+
+_HEADER = re.compile(r"\s*\[\s*([^\[\]#=,]+?)\s*\]\s*(?:#.*)?$")
+_ASSIGNED = re.compile(
+    r"\s*((?:[A-Za-z0-9_\-]+|\"[^\"]*\"|'[^']*')(?:\s*\.\s*(?:[A-Za-z0-9_\-]+|\"[^\"]*\"|'[^']*'))*)\s*="
+)
+_INLINE_KEY = re.compile(r"[{,]\s*([A-Za-z0-9_\-]+|\"[^\"]*\"|'[^']*')\s*=")
+
+
+def _dotted(key: str) -> str:
+    """A TOML key as a dotted path: whitespace around dots and the quotes of parts dropped."""
+    parts = re.findall(r"\"([^\"]*)\"|'([^']*)'|([^.\s]+)", key)
+    return ".".join(next(part for part in groups if part) for groups in parts)
+
+
+def key_lines(text: str) -> dict[str, int]:
+    """The line (1-based) of every table and key of a TOML document, by dotted path.
+
+    ``[published]`` maps ``"published"``, ``Cm_q = -20.8`` under ``[longitudinal]`` maps
+    ``"longitudinal.Cm_q"``, and the keys of an inline table such as ``roll = {
+    time_constant = 0.8 }`` map ``"published.roll"`` and ``"published.roll.time_constant"``
+    to the line of the inline table. Lines inside multi-line strings are skipped; a key given
+    twice (invalid TOML, which the parser refuses) keeps its first line.
+
+    Parameters
+    ----------
+    text : str
+        The TOML document.
+
+    Returns
+    -------
+    dict of str to int
+        The line of each dotted path.
+
+    Raises
+    ------
+    None
+
+    Examples
+    --------
+    >>> lines = key_lines("[mass]\\nIx = 1.0  # slug ft^2\\n[published]\\nroll = { zeta = 1 }")
+    >>> lines["mass.Ix"], lines["published"], lines["published.roll.zeta"]
+    (2, 3, 4)
+    """
+    lines: dict[str, int] = {}
+    table = ""
+    quote: str | None = None
+    for number, line in enumerate(text.splitlines(), start=1):
+        if quote is not None:  # inside a multi-line string
+            if line.count(quote) % 2 == 1:
+                quote = None
+            continue
+        header = _HEADER.match(line)
+        if header:
+            table = _dotted(header.group(1))
+            lines.setdefault(table, number)
+            continue
+        assigned = _ASSIGNED.match(line)
+        if not assigned:
+            continue
+        path = f"{table}.{_dotted(assigned.group(1))}" if table else _dotted(assigned.group(1))
+        lines.setdefault(path, number)
+        rest = line[assigned.end() :]
+        for marker in ('"""', "'''"):
+            if rest.count(marker) % 2 == 1:
+                quote = marker
+        if rest.lstrip().startswith("{"):
+            for inner in _INLINE_KEY.finditer(rest):
+                lines.setdefault(f"{path}.{_dotted(inner.group(1))}", number)
+    return lines
 
 
 def read_toml(path: str | os.PathLike[str] | Path) -> dict[str, Any]:

@@ -84,7 +84,28 @@ class AircraftDataError(InvalidArgumentError):
     """An aircraft file or table is malformed: unreadable (not a regular file, too large, not
     UTF-8, not TOML), an unknown or missing key, a value of the wrong type or sign or outside
     its plausible range, or numbers inconsistent with the declared units. The message is one
-    line and names the file and the key."""
+    line and names the file and the key.
+
+    ``key`` is the dotted key of the problem (``"mass.weight"``, ``"published.roll"``, a
+    table's name for a whole table), ``line`` its line in the file (1-based; for a missing
+    key, the line of its table) and ``hint`` how to mend it; each is None or ``""`` where the
+    reader cannot tell (an unreadable file, a dict without a file).
+
+    Examples
+    --------
+    >>> error = AircraftDataError("plane.toml: [mass] is missing Ix", "mass.Ix", 12, "add Ix")
+    >>> str(error), error.key, error.line, error.hint
+    ('plane.toml: [mass] is missing Ix', 'mass.Ix', 12, 'add Ix')
+    """
+
+    def __init__(
+        self, message: str, key: str | None = None, line: int | None = None, hint: str = ""
+    ) -> None:
+        super().__init__(message)
+        self.key, self.line, self.hint = key, line, hint
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (str(self), self.key, self.line, self.hint))
 
 
 @dataclass(frozen=True)
