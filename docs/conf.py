@@ -33,6 +33,7 @@ extensions = [
     "myst_parser",
     "sphinx_gallery.gen_gallery",
     "api_pages",
+    "aircraft_keys",
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
