@@ -3,26 +3,26 @@
 Every error subclasses a built-in, so ``except ValueError`` and
 ``except numpy.linalg.LinAlgError`` keep working:
 
-============================  ===========================================================
-class                         raised when
-============================  ===========================================================
-``ShapeError``                an argument has the wrong shape or its dimensions disagree
-``NonFiniteError``            an argument contains NaN or an infinity
-``InvalidArgumentError``      any other out-of-domain argument (a step that is not positive,
-                              an unknown method name); base of the two above
-``NotRealError``              an argument is complex (``TypeError``): real matrices only
-``AerocontrolLinAlgError``    a numerical condition makes the problem unsolvable
-``ConvergenceError``          an iteration reached its limit (an ``AerocontrolLinAlgError``)
-``SingularMatrixError``       a matrix to invert has a zero eigenvalue (likewise)
-``UncontrollableError``       a pair (A, B) has a mode that no feedback can move (likewise)
-``NoStabilizingSolutionError``  a Riccati equation has no stabilising solution (likewise)
-``IllConditionedError``       a step would lose every digit and was refused (likewise)
-``NoContinuousEquivalentError``  a discrete model has no real continuous model behind it under
-                              the method asked (likewise, and an ``InvalidArgumentError``
-                              naming the model: the argument is outside ``d2c``'s domain)
-``NotPositiveDefiniteError``  a weight such as R is not symmetric positive definite
-                              (an ``InvalidArgumentError``)
-============================  ===========================================================
+================================  ===========================================================
+class                             raised when
+================================  ===========================================================
+``ShapeError``                    an argument has the wrong shape or its dimensions disagree
+``NonFiniteError``                an argument contains NaN or an infinity
+``InvalidArgumentError``          any other out-of-domain argument (a step that is not positive,
+                                  an unknown method name); base of the two above
+``NotRealError``                  an argument is complex (``TypeError``): real matrices only
+``AerocontrolLinAlgError``        a numerical condition makes the problem unsolvable
+``ConvergenceError``              an iteration reached its limit (an ``AerocontrolLinAlgError``)
+``SingularMatrixError``           a matrix to invert has a zero eigenvalue (likewise)
+``UncontrollableError``           a pair (A, B) has a mode that no feedback can move (likewise)
+``NoStabilizingSolutionError``    a Riccati equation has no stabilising solution (likewise)
+``IllConditionedError``           a step would lose every digit and was refused (likewise)
+``NoContinuousEquivalentError``   a discrete model has no real continuous model behind it under
+                                  the method asked (likewise, and an ``InvalidArgumentError``
+                                  naming the model: the argument is outside ``d2c``'s domain)
+``NotPositiveDefiniteError``      a weight such as R is not symmetric positive definite
+                                  (an ``InvalidArgumentError``)
+================================  ===========================================================
 
 Warnings (``AerocontrolWarning`` and subclasses) report results that were computed but deserve
 care: overflow, underflow, ill-conditioning, bounds that leave a gap (``LooseBoundWarning``).

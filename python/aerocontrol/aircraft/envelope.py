@@ -1,8 +1,9 @@
 """The flight envelope swept in one call: a grid of flight conditions (altitude, Mach, weight)
 -> the models -> the modes -> the MIL-F-8785C Levels.
 
-Each condition is the aircraft file's condition moved by :meth:`Aircraft.at` (standard
-atmosphere, trimmed CL, CD from the polar, the other derivatives held), or the aircraft a
+Each condition is the aircraft file's condition moved by
+:meth:`~aerocontrol.aircraft.Aircraft.at` (standard atmosphere, trimmed CL, CD from the polar, the
+other derivatives held), or the aircraft a
 caller's ``derivatives`` function returns for it (for derivatives tabulated over Mach, say).
 """
 
@@ -137,8 +138,9 @@ def envelope_sweep(
     """The modes and MIL-F-8785C Levels of ``plane`` at every combination of the given
     altitudes, Mach numbers and weights (each defaults to the file's own value).
 
-    ``derivatives``, if given, receives each condition's aircraft (from :meth:`Aircraft.at`)
-    and returns the aircraft to analyse there, e.g. with Mach-dependent derivatives put in
+    ``derivatives``, if given, receives each condition's aircraft (from
+    :meth:`~aerocontrol.aircraft.Aircraft.at`) and returns the aircraft to analyse there, e.g.
+    with Mach-dependent derivatives put in
     with ``dataclasses.replace``.
 
     A condition that fails is recorded in ``failures`` with its reason (Level 0) and the
@@ -146,7 +148,7 @@ def envelope_sweep(
     (:data:`~aerocontrol.aircraft.PLAUSIBLE_RANGES`, e.g. ``machs=[1e300]``) or outside the
     standard atmosphere, arithmetic that overflows, a model whose modes cannot be computed or
     named, or any of these raised by ``derivatives`` (the exceptions of
-    :data:`CONDITION_FAILURES`). What is wrong with the call as a whole raises at once:
+    ``CONDITION_FAILURES``). What is wrong with the call as a whole raises at once:
     ``plane`` not an Aircraft, a grid that is not a non-empty 1-D array of real numbers or
     holds NaN or an infinity (a grid point that is not a number is no flight condition),
     ``derivatives`` returning something other than an Aircraft, and any other exception of

@@ -2,7 +2,7 @@
 and its description. The reader (:mod:`~aerocontrol.aircraft.tables`) takes the keys it
 accepts and requires from here, and :func:`json_schema` generates the JSON Schema of the
 format from the same definitions, with the units of :data:`~aerocontrol.aircraft.schema.
-UNIT_NAMES` and the bounds of :data:`~aerocontrol.aircraft.schema.PLAUSIBLE_RANGES`, so that
+UNIT_NAMES` and the bounds of :data:`~aerocontrol.aircraft.PLAUSIBLE_RANGES`, so that
 neither can drift from what the reader does.
 
 Derivatives are per radian in stability axes, the rate derivatives with respect to the
@@ -369,7 +369,7 @@ def json_schema() -> dict[str, Any]:
 
     Every key the reader accepts, its type, its description with its unit and sign
     convention, which keys are required (and the pairs of which exactly one is given), and
-    the bounds of :data:`~aerocontrol.aircraft.schema.PLAUSIBLE_RANGES`: unitless bounds on
+    the bounds of :data:`~aerocontrol.aircraft.PLAUSIBLE_RANGES`: unitless bounds on
     the key, and the bounds of a dimensional number (a speed, a weight, an inertia) under
     ``allOf`` in one ``if``/``then`` per unit system of ``[aircraft] units``, the units named
     in ``x-units``. Checks that need arithmetic (the density within 0.5 to 2 times the

@@ -90,8 +90,8 @@ class Aircraft:
     longitudinal and lateral-directional models follow.
 
     Build one with :func:`load` (a shipped aircraft or a TOML file) or
-    :meth:`Aircraft.from_dict`. All quantities are in the file's units (``"english"``: ft, slug,
-    lbf; ``"si"``: m, kg, N), inertias in stability axes.
+    :meth:`~aerocontrol.aircraft.Aircraft.from_dict`. All quantities are in the file's units
+    (``"english"``: ft, slug, lbf; ``"si"``: m, kg, N), inertias in stability axes.
 
     Examples
     --------
@@ -496,10 +496,10 @@ def load(name_or_path: str | Path = "b747-approach") -> Aircraft:
 
     The file is read only if it is a regular file (a symbolic link only to a regular file: a
     FIFO, a device, a socket or a folder is refused without being read) of at most
-    :data:`~aerocontrol.aircraft.reader.AIRCRAFT_FILE_LIMIT` bytes (1 MiB), in UTF-8, and
+    :data:`~aerocontrol.aircraft.AIRCRAFT_FILE_LIMIT` bytes (1 MiB), in UTF-8, and
     valid TOML. Every number must be a finite real within its plausible range
     (:data:`PLAUSIBLE_RANGES`, in the file's units; the table is in
-    :mod:`aerocontrol.aircraft.schema`), for example
+    ``aerocontrol.aircraft.schema``), for example
 
     ==================  ========================  ==========================
     key                 SI                        English
@@ -542,7 +542,7 @@ def problems(name_or_path: str | Path = "b747-approach") -> list[AircraftDataErr
 
     A file that cannot be read or is not valid TOML has one problem (the parser stops at its
     first error; its line is the parser's). Otherwise every problem of its tables, one per key,
-    in the order of the file (:func:`~aerocontrol.aircraft.tables.table_problems`): unknown
+    in the order of the file (``aerocontrol.aircraft.tables.table_problems``): unknown
     keys and tables (with the known key each most resembles), missing ones, values of the
     wrong type, sign or range (:data:`PLAUSIBLE_RANGES`, in the file's units), and numbers
     inconsistent with each other or with the units. A file whose tables are valid but whose

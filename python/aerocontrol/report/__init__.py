@@ -20,30 +20,30 @@ contained: the figures are embedded) and ``report.md`` with ``figures/*.png``. T
    gain difference, the continuous cost); an LQG regulator at 50 Hz with sideslip not
    measured (a Kalman filter from p, r, φ), its closed-loop poles and its response beside
    full-state feedback;
-6a. stability augmentation by output feedback: a yaw damper (yaw rate to rudder through an
+7. stability augmentation by output feedback: a yaw damper (yaw rate to rudder through an
    actuator, with and without a washout) and a pitch damper designed on the root locus, their
    margins against MIL-F-9490D (Table I as widely quoted, every cell unverified), the root
    locus and the response to a rudder pulse beside the open loop's;
-7. the Levels after augmentation, and the open-loop Levels over Mach and altitude around the
+8. the Levels after augmentation, and the open-loop Levels over Mach and altitude around the
    file's condition;
-8. for the embedded 747, the chapter's small examples (controllability (6.75-6.88), Figures 6.4
+9. for the embedded 747, the chapter's small examples (controllability (6.75-6.88), Figures 6.4
    and 6.8) and its printed numbers beside ours, among them the static check (6.52-6.55).
 
 A design that does not apply to an aircraft (for example a lateral model without an
 oscillatory Dutch roll) is reported as such and the rest of the report goes on.
 
-The package's modules, for a contributor: :mod:`~aerocontrol.report.build` (the two entry
-points), :mod:`~aerocontrol.report.document` and :mod:`~aerocontrol.report.render` (the
-document and its Markdown, HTML and PNG forms), :mod:`~aerocontrol.report.context` and
-:mod:`~aerocontrol.report.formatting` (what the sections share), one module per section
-(:mod:`~aerocontrol.report.models`, :mod:`~aerocontrol.report.modes`,
-:mod:`~aerocontrol.report.responses`, :mod:`~aerocontrol.report.damper`,
-:mod:`~aerocontrol.report.regulator`, :mod:`~aerocontrol.report.digital`,
-:mod:`~aerocontrol.report.sas`, :mod:`~aerocontrol.report.levels`,
-:mod:`~aerocontrol.report.envelope`, :mod:`~aerocontrol.report.chapter_check`), and the output
-folder: :mod:`~aerocontrol.report.folder` (the rules and ``ReportFolder``),
-:mod:`~aerocontrol.report.manifest`, :mod:`~aerocontrol.report.staging`,
-:mod:`~aerocontrol.report.descriptors` and :mod:`~aerocontrol.report.signals`. The public API
+The package's modules, for a contributor: ``build`` (the two entry
+points), ``document`` and ``render`` (the
+document and its Markdown, HTML and PNG forms), ``context`` and
+``formatting`` (what the sections share), one module per section
+(``models``, ``modes``,
+``responses``, ``damper``,
+``regulator``, ``digital``,
+``sas``, ``levels``,
+``envelope``, ``chapter_check``), and the output
+folder: ``folder`` (the rules and ``ReportFolder``),
+``manifest``, ``staging``,
+``descriptors`` and ``signals``. The public API
 is what this package exports.
 
 Examples
