@@ -2,9 +2,9 @@
 -> the models -> the modes -> the MIL-F-8785C Levels.
 
 Each condition is the aircraft file's condition moved by
-:meth:`~aerocontrol.aircraft.Aircraft.at` (standard atmosphere, trimmed CL, CD from the polar, the
-other derivatives held), or the aircraft a
-caller's ``derivatives`` function returns for it (for derivatives tabulated over Mach, say).
+:meth:`~aerocontrol.aircraft.Aircraft.at` (standard atmosphere, trimmed CL, CD from the polar,
+the other derivatives held), or the aircraft a caller's ``derivatives`` function returns for it
+(for derivatives tabulated over Mach, say).
 """
 
 from __future__ import annotations
@@ -140,8 +140,7 @@ def envelope_sweep(
 
     ``derivatives``, if given, receives each condition's aircraft (from
     :meth:`~aerocontrol.aircraft.Aircraft.at`) and returns the aircraft to analyse there, e.g.
-    with Mach-dependent derivatives put in
-    with ``dataclasses.replace``.
+    with Mach-dependent derivatives put in with ``dataclasses.replace``.
 
     A condition that fails is recorded in ``failures`` with its reason (Level 0) and the
     sweep goes on: a Mach number, altitude or weight outside its plausible range
