@@ -712,7 +712,7 @@ def riccati_difference(
     under rounding where the weights are. Where A and B K are far larger than A - B K the
     rounding of that difference can swamp S_k in any double-precision form; the estimate of
     that error is returned (``error_estimate``) and warned about. A long horizon converges to
-:func:`solve_dare`'s X.
+    :func:`solve_dare`'s X.
 
     Parameters
     ----------
