@@ -201,6 +201,16 @@ def discretize(
         :func:`c2d` turns them into a discrete :class:`~aerocontrol.StateSpace` (and has the
         bilinear and matched methods).
 
+    Raises
+    ------
+    InvalidArgumentError
+        ``dt`` is not positive and finite, or so large that A dt overflows; ``method`` is not
+        "zoh" or "foh" (a method of :func:`c2d` is named as such).
+    ShapeError
+        A is not square, or B has not n rows.
+    NonFiniteError, NotRealError
+        A or B contains NaN or an infinity, or is complex.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -426,6 +436,23 @@ def d2c(
         is computed with a warning.
 
     First-order hold and matched pole-zero have no inverse here.
+
+    Parameters
+    ----------
+    sys : StateSpace, or another discrete system
+        A discrete model (``dt`` > 0; a continuous one is refused).
+    method : str
+        ``"zoh"`` (default), ``"tustin"``, ``"bilinear"``, ``"euler"``, ``"backward_diff"`` or
+        ``"gbt"``: the method ``sys`` was discretised by.
+    prewarp : float, optional
+        Frequency in rad/s (below π/dt) at which Tustin's map was made exact; Tustin's only.
+    alpha : float, optional
+        The weight of ``method="gbt"``, between 0 and 1; "gbt" only.
+
+    Returns
+    -------
+    StateSpace
+        The continuous model (``dt`` = 0), with the names of ``sys``.
 
     Raises
     ------
