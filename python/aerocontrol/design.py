@@ -209,6 +209,8 @@ def critical_weight(
     InvalidArgumentError
         ``bounds`` not 0 < low < high finite; ``mode`` not an oscillatory lateral mode; or the
         mode does not become critically damped within ``bounds``.
+    ShapeError
+        Q or R is not of the plant's size.
     AerocontrolError
         A regulator of the grid fails (NoStabilizingSolutionError, ...).
 

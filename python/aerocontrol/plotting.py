@@ -467,8 +467,8 @@ def plot_with_controls(
         K has not one column per state.
     InvalidArgumentError
         ``response`` is out of range.
-    NonFiniteError, NotRealError
-        K is not finite, or complex.
+    NotRealError
+        K is complex or not numeric (entries beyond the doubles are not drawn).
 
     Examples
     --------
@@ -600,8 +600,8 @@ def penalty_terms(
         K has not one column per state, Q is not n x n or R not m x m.
     InvalidArgumentError
         ``response`` is out of range.
-    NonFiniteError, NotRealError
-        K, Q or R is not finite, or complex.
+    NotRealError
+        K, Q or R is complex or not numeric (a non-finite entry gives non-finite terms).
 
     Examples
     --------
@@ -792,8 +792,8 @@ def plot_root_locus(
     ------
     ShapeError
         ``poles`` is not (len(weights), n).
-    NonFiniteError, NotRealError
-        ``weights`` is not finite, or complex.
+    NotRealError
+        ``weights`` is complex or not numeric.
 
     Examples
     --------
@@ -1436,8 +1436,8 @@ def plot_levels(
     ------
     ShapeError
         ``levels`` is not (len(altitudes), len(machs)).
-    NonFiniteError, NotRealError
-        ``machs`` or ``altitudes`` is not finite, or complex.
+    NotRealError
+        ``machs`` or ``altitudes`` is complex or not numeric.
 
     Examples
     --------
