@@ -2294,8 +2294,8 @@ def best_damping_gain(
         An open-loop pole whose branch is tracked; default the least-damped oscillatory
         closed-loop mode at each gain.
     gains : array_like (k,), optional
-        The non-negative gains searched; default 0 and 400 gains over six decades about 1/|L|
-        at the loop's modes.
+        The non-negative gains searched; default 0 and 400 gains over six decades about
+        1/abs(L) at the loop's modes.
 
     Returns
     -------
@@ -2374,8 +2374,8 @@ def gain_for_damping(
         An open-loop pole whose branch is tracked; default the least-damped oscillatory
         closed-loop mode at each gain.
     gains : array_like (k,), optional
-        The non-negative gains searched; default 0 and 400 gains over six decades about 1/|L|
-        at the loop's modes.
+        The non-negative gains searched; default 0 and 400 gains over six decades about
+        1/abs(L) at the loop's modes.
 
     Returns
     -------

@@ -1654,7 +1654,7 @@ def plot_probability_convergence(
     Raises
     ------
     InvalidArgumentError
-        An unknown event, mode or loop, as :meth:`MonteCarlo.probability`.
+        An unknown event, mode or loop, as ``MonteCarlo.probability`` refuses them.
 
     Examples
     --------
@@ -1839,8 +1839,7 @@ def plot_envelope_levels(envelope: Envelope, ax: Any = None, weight: int = 0) ->
     Parameters
     ----------
     envelope : Envelope
-        From :func:`aerocontrol.aircraft.envelope_sweep` or
-        :meth:`~aerocontrol.schedule.GainSchedule.evaluate`.
+        From :func:`aerocontrol.aircraft.envelope_sweep` or a gain schedule's ``evaluate``.
     ax : sequence or array of matplotlib.axes.Axes, optional
         One axes per mode (default a new row).
     weight : int, optional

@@ -165,9 +165,9 @@ def _systems(sys: Systems) -> tuple[list[StateSpace], bool]:
 def default_time_grid(sys: Systems) -> FloatArray:
     """The default grid of the responses (see the module documentation).
 
-    A step of 1/(20 |λ|max), a final time of 7 time constants 1/|σ| of the slowest decaying
-    mode (10/|λ|min when no mode decays), at most 100,001 samples; a discrete model steps by
-    its dt.
+    A step of a twentieth of 1/ρ_max, ρ_max the largest modulus of an eigenvalue, and a final
+    time of 7 time constants -1/σ of the slowest decaying mode (σ its real part; 10/ρ_min when
+    no mode decays), at most 100,001 samples; a discrete model steps by its dt.
 
     Parameters
     ----------
@@ -183,8 +183,8 @@ def default_time_grid(sys: Systems) -> FloatArray:
     Raises
     ------
     InvalidArgumentError
-        An eigenvalue is so large (|λ| > 2e306) that the step 1/(20 |λ|) would not be a normal
-        double, or ||A||_1 is so far beyond the modes (a nilpotent A of 1e149) that a step
+        An eigenvalue is so large (modulus ρ > 2e306) that the step 1/(20 ρ) would not be a
+        normal double, or ||A||_1 is so far beyond the modes (a nilpotent A of 1e149) that a step
         with h ||A||_1 <= 2^52 needs more than 100,001 samples to the final time: give the
         grid T instead. Also a list of models of different sampling periods.
     NotRealError
@@ -192,7 +192,7 @@ def default_time_grid(sys: Systems) -> FloatArray:
     ShapeError
         The models of a list differ in size, or the matrices disagree in size.
     NonFiniteError
-        A matrix or an input weight contains NaN or an infinity.
+        A matrix contains NaN or an infinity.
 
     Examples
     --------
