@@ -1537,7 +1537,7 @@ def zpk(
     zeros than poles (an improper model) is refused.
 
     No coefficient of a section is formed as the product of two roots: the constant r1 r2 (or
-    |r|²) is kept as a mantissa and a power of two and enters the realisation divided by a
+    abs(r)²) is kept as a mantissa and a power of two and enters the realisation divided by a
     power of two t near its square root (``_section``), so that roots anywhere up to about
     6e307 in modulus, and down to the smallest doubles, are realised, and sections of very
     different sizes are chained in states scaled by powers of two (as :func:`series`). A
@@ -1992,7 +1992,7 @@ def pade_delay(
     With x = sT the approximant is P(-x)/P(x), P(x) = Σ_k c_k x^k,
     c_k = (2n - k)! n! / ((2n)! k! (n - k)!) (Golub and Van Loan, §9.3.1), computed exactly in
     rational arithmetic; its balanced observable form in x is then scaled to seconds. An
-    all-pass: |G(jω)| = 1 at every frequency, with the phase -ωT at low frequency.
+    all-pass: abs(G(jω)) = 1 at every frequency, with the phase -ωT at low frequency.
 
     Parameters
     ----------

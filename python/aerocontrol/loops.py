@@ -1817,21 +1817,21 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
 
     * Loop at a time: loop i broken with the others closed, L_i from the input of loop i to
       its output (state space, by :func:`~aerocontrol.feedback`), whose sensitivity is
-      S_ii. Its margin is 1/sup_ω |S_ii + (σ - 1)/2|: for σ = 0, on the default grid, the
+      S_ii. Its margin is 1/sup_ω abs(S_ii + (σ - 1)/2): for σ = 0, on the default grid, the
       disk margin of :func:`stability_margins` (L∞ norm by the Hamiltonian iteration); for
       σ ≠ 0, the peak on the grid refined by zooming. Each loop's classical margins are
-      returned too (:attr:`DiskMargins.loops`).
+      returned too (``DiskMargins.loops``).
     * Multiloop: μ has no closed form for p >= 2; at each frequency an upper bound,
       min over positive diagonal D of σ̄(D M D^-1) (Osborne's scaling, then damped Newton
       steps on a smoothed σ̄, a convex problem in log D), and a lower bound from the power
-      method (|λ| of M U, U diagonal unitary) are computed. The upper bound is μ itself for
+      method (abs(λ) of M U, U diagonal unitary) are computed. The upper bound is μ itself for
       p <= 3 (Packard and Doyle 1993). The peak is refined by zooming in frequency. The
       margin returned is the guaranteed one, 1/sup μ_upper; both bounds are reported, and a
       gap beyond MU_GAP_TOLERANCE warns (LooseBoundWarning). For p = 1 the multiloop
       margin is the loop's disk margin.
 
     The loop's states are first balanced by a diagonal similarity of powers of two (exact,
-    the same L; :func:`balanced_states`), so that states scaled by 10^±6 give the margins
+    the same L; ``balanced_states``), so that states scaled by 10^±6 give the margins
     of the well-scaled loop. The results are checked: the destabilising perturbation of the
     lower bound must make I + L(jω) F singular (I - M Δ where L has a pole at ω;
     AerocontrolLinAlgError otherwise), and the lower bound may not exceed the upper. A
@@ -2282,7 +2282,7 @@ def best_damping_gain(
     by continuity along the locus.
 
     The damping is computed on a grid of gains (``gains``, or 0 and 400 gains over six
-    decades about 1/|L| at the loop's modes), then refined by golden-section search between
+    decades about 1/abs(L) at the loop's modes), then refined by golden-section search between
     the best grid gain's neighbours. A gain at which a closed-loop pole is unstable is never
     chosen (its damping counts as -1).
 
@@ -3048,7 +3048,7 @@ def nyquist(loop: System, omega: ArrayLike | None = None) -> NyquistResponse:
 
     Roots within √u ||A||_F of the boundary (the error of a double integrator's computed
     eigenvalues) are taken to lie on it: open-loop ones are indented and do not count in P;
-    closed-loop ones make the loop :attr:`~NyquistResponse.marginal`, its curve passes
+    closed-loop ones make the loop ``marginal``, its curve passes
     through -1 and N is None (the result is still returned, for the plot).
 
     Parameters

@@ -283,7 +283,7 @@ def charpoly(A: ArrayLike) -> FloatArray:
     computed, so ill-conditioned eigenvalues do not spoil the coefficients (for the Frank
     matrix of order 12 the result is exact, where multiplying out its computed eigenvalues
     errs by 1e-7 relatively). Accuracy: each a_k carries an absolute error of a modest
-    multiple of u e_k(|λ|) on typical matrices (e_k the elementary symmetric function of the
+    multiple of u e_k(abs(λ)) on typical matrices (e_k the elementary symmetric function of the
     eigenvalue moduli; measured against 80-digit arithmetic on random, graded and non-normal
     matrices of orders 2 to 10); a coefficient that is small only by cancellation is
     correspondingly less accurate relatively. Never formed from powers of A (the Krylov or

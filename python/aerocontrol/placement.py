@@ -209,7 +209,7 @@ def place(
     """Pole placement for one or several inputs, by Kautsky-Nichols-Van Dooren method 0.
 
     The eigenvector of each pole is chosen in its admissible subspace to make the closed-loop
-    eigenvector matrix X as well conditioned as the method can (|det X| maximised column by
+    eigenvector matrix X as well conditioned as the method can (abs(det X) maximised column by
     column, sweeps until it grows by less than 1e-3 relatively, at most 100); a robustly
     placed pole moves little under perturbations of A and B. ``eigenvector_condition`` reports
     κ_2(X).

@@ -1051,13 +1051,13 @@ def plot_nyquist(
     critical point -1 (a red +) and, with ``unit_circle``, the unit circle (dotted: its
     crossings are the gain crossovers). The title gives P, N and Z. Returns the axes.
 
-    Radii beyond ``max_magnitude`` (R) are compressed: a point with |L| = r > R is drawn at
+    Radii beyond ``max_magnitude`` (R) are compressed: a point with abs(L) = r > R is drawn at
     radius R (1 + x/(1 + x)), x = ln(r/R), at its true angle. The map is continuous with
     slope 1 at R, logarithmic in r and bounded by 2R, so the large arcs that are the images of
-    the indentations around poles on the imaginary axis (|L| of 1e4 to 1e12 and more) are
+    the indentations around poles on the imaginary axis (abs(L) of 1e4 to 1e12 and more) are
     drawn between R and 2R and the curve closes as it does in the plane: its encirclements of
     -1 can be counted on the plot. (python-control and MATLAB clip such arcs at a
-    ``max_curve_magnitude`` instead.) The circle |L| = R is drawn, dotted, when a point is
+    ``max_curve_magnitude`` instead.) The circle abs(L) = R is drawn, dotted, when a point is
     compressed.
 
     Parameters
@@ -1264,7 +1264,7 @@ def plot_nichols(
 ) -> Axes:
     """The Nichols chart of a :class:`~aerocontrol.loops.NicholsResponse`: open-loop gain (dB)
     against phase (degrees), the critical points (-180° + k 360°, 0 dB) as red +, and with
-    ``grid`` the contours of constant closed-loop gain |T| (``gains_db``) and phase ∠T
+    ``grid`` the contours of constant closed-loop gain abs(T) (``gains_db``) and phase ∠T
     (``phases_deg``, in (-360°, 0°)) of T = L/(1 + L), dotted (from
     :func:`closed_loop_gain_contour` and :func:`closed_loop_phase_contour`, the phase
     contours over the closed-loop gains from the least of ``gains_db`` to 20 dB beyond the
@@ -1625,7 +1625,7 @@ def plot_probability_convergence(
     ax: Axes | None = None,
     points: int = 60,
 ) -> Axes:
-    """The estimate of a probability (as :meth:`MonteCarlo.probability` takes it) against the
+    """The estimate of a probability (as ``MonteCarlo.probability`` takes it) against the
     number of samples used, with its 95 % Clopper-Pearson band: how many samples the estimate
     needed. Returns the axes.
 
@@ -1830,7 +1830,7 @@ def plot_gain_schedule(schedule: GainSchedule, ax: Any = None, weight: int = 0) 
 def plot_envelope_levels(envelope: Envelope, ax: Any = None, weight: int = 0) -> Any:
     """The MIL-F-8785C Levels of an :class:`~aerocontrol.aircraft.Envelope` (an envelope
     sweep, or a gain schedule's closed loop evaluated by
-    :meth:`~aerocontrol.schedule.GainSchedule.evaluate`): an image per mode over Mach (x) and
+    ``GainSchedule.evaluate``): an image per mode over Mach (x) and
     altitude (y) (:func:`plot_levels`), at the grid's ``weight``-th weight.
 
     ``ax`` is None (new axes, one per mode in a row) or one axes per mode, in the order of

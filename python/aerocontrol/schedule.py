@@ -371,7 +371,7 @@ def gain_schedule(
 ) -> GainSchedule:
     """A state-feedback gain u = -K x designed at every condition of an altitude x Mach
     (x weight) grid, the conditions those of :func:`aerocontrol.aircraft.envelope_sweep`
-    (:meth:`Aircraft.at`).
+    (``Aircraft.at``).
 
     Parameters
     ----------
@@ -396,7 +396,7 @@ def gain_schedule(
     axis : {"lateral", "longitudinal"}
     client : dask.distributed.Client, optional
         Judge the closed loops at the grid conditions in chunks on this Dask cluster (as
-        :meth:`GainSchedule.evaluate`); the design itself is one batch call.
+        ``GainSchedule.evaluate``); the design itself is one batch call.
     zeta : float
         The damper's Dutch-roll damping ratio.
 
@@ -409,7 +409,7 @@ def gain_schedule(
     InvalidArgumentError
         ``plane`` not an Aircraft, an unknown ``design`` or ``axis``, the damper asked of the
         longitudinal axis, ``c`` not positive, a grid not strictly increasing or not finite,
-        a condition outside the plausible ranges (:meth:`Aircraft.at`); a condition whose
+        a condition outside the plausible ranges (``Aircraft.at``); a condition whose
         design fails raises that design's error (e.g. NoStabilizingSolutionError, naming the
         problem of the batch).
     ShapeError
