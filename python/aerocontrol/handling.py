@@ -39,9 +39,9 @@ given here cannot decide it, so it is left to the caller:
 * Table VI's first row, ζ_d >= 0.4 and ω_nd >= 1.0 for Class IV in the Category A phases
   air-to-air combat (CO) and ground attack (GA): the API takes the Category, not the Flight
   Phase, so Class IV Category A is judged by the general Category A row (ζ_d > 0.19).
-* Table VI's increase of the minimum ζ_d ω_nd when ω_nd² |φ/β|_d > 20 (rad/s)², which needs
+* Table VI's increase of the minimum ζ_d ω_nd when ω_nd² abs(φ/β)_d > 20 (rad/s)², which needs
   the Dutch roll's mode shape, and the exemption of Class III from the minimum ω_nd "subject to
-  approval by the procuring activity" (Table VI, note **).
+  approval by the procuring activity" (Table VI, note ``**``).
 * The short-period frequency limits of 3.2.2.1.1 (Figures 1-3, against n/α), and Table IV's
   note that the Level 3 minimum may be reduced above 20,000 ft if the procuring activity
   approves.
@@ -334,7 +334,7 @@ def assess(modes: Mapping[str, object], aircraft_class: str, category: str) -> H
     * phugoid: "zeta" (Level 1 ζ >= 0.04, Level 2 ζ >= 0) and "time to double" (Level 3
       T2 >= 55 s), so a divergent phugoid (ζ < 0) is Level 3 if T2 >= 55 s and 4 otherwise;
     * dutch roll: "zeta", "zeta*omega_n" and "omega_n" against Table VI (for Class III a
-      ζ >= 0.7 meets the ζ ω_n minimum, Table VI note *);
+      ζ >= 0.7 meets the ζ ω_n minimum, Table VI note ``*``);
     * roll: "time constant" against Table VII;
     * spiral: "time to double" against Table VIII (a stable spiral: inf, Level 1).
 
