@@ -154,8 +154,18 @@ def place_batch(A: ArrayLike, B: ArrayLike, poles: ArrayLike, method: str = "knv
         problem.
     method : "knv" (default, any m), "bass-gura" or "ackermann" (one input)
 
+    Returns
+    -------
+    PlaceBatch
+        ``K`` (k, m, n), ``achieved_poles`` (k, n), ``max_relative_error`` (k,) and
+        ``condition`` (k,): κ(V) of the single-input formulas or κ_2(X) of the robust method.
+
     Raises
     ------
+    InvalidArgumentError
+        ``method`` is not one of the three.
+    ShapeError
+        A stack that is neither one matrix nor k of them, or ``poles`` not (n,) or (k, n).
     AerocontrolError
         The first failing problem's own error (UncontrollableError, InvalidArgumentError for
         a pole without its conjugate, ...), its message starting "problem i of the batch".
@@ -301,6 +311,24 @@ def solve_care_batch(
     ``client``, the batch is solved in chunks on the cluster, bitwise as here (see the module
     notes).
 
+    Parameters
+    ----------
+    A : array_like (n, n) or (k, n, n)
+    B : array_like (n, m) or (k, n, m)
+    Q : array_like (n, n) or (k, n, n)
+    R : array_like (m, m) or (k, m, m)
+    refine : bool, optional
+        Newton refinement, as :func:`aerocontrol.solve_care` (default True).
+    client : dask.distributed.Client, optional
+        Solve in chunks on the Dask cluster, bitwise as here (default None: this machine's
+        threads).
+
+    Returns
+    -------
+    CareBatch
+        ``X`` (k, n, n), ``K`` (k, m, n), ``closed_loop_poles`` (k, n), and the ``residual``
+        and ``rcond`` of each problem (k,).
+
     Raises
     ------
     ShapeError
@@ -348,6 +376,35 @@ def solve_dare_batch(
     The stacks are as in :func:`solve_care_batch`: each of A, B, Q and R one matrix shared by
     every problem or k of them.
 
+    Parameters
+    ----------
+    A : array_like (n, n) or (k, n, n)
+    B : array_like (n, m) or (k, n, m)
+    Q : array_like (n, n) or (k, n, n)
+    R : array_like (m, m) or (k, m, m)
+    client : dask.distributed.Client, optional
+        Solve in chunks on the Dask cluster, bitwise as here (default None: this machine's
+        threads).
+
+    Returns
+    -------
+    DareBatch
+        ``X`` (k, n, n), ``K`` (k, m, n), ``closed_loop_poles`` (k, n, inside the unit
+        circle), and the ``residual`` and ``rcond`` of each problem (k,).
+
+    Raises
+    ------
+    ShapeError
+        A stack that is neither one matrix nor k matrices, or shapes that disagree.
+    AerocontrolError
+        The first failing problem's own error (NoStabilizingSolutionError,
+        SingularMatrixError, ...), its message starting "problem i of the batch".
+
+    Warns
+    -----
+    IllConditionedWarning
+        Naming the problems whose rcond(E U11) < 1e-8 or residual > 1e-8.
+
     Examples
     --------
     The 747's lateral regulator on a 50 Hz flight computer, over 200 weights:
@@ -382,6 +439,42 @@ def dlqr_sweep(
     J = Σ x_k^T Q x_k + (1/c²) u_k^T R u_k, as :func:`lqr_sweep` for continuous models, all
     solved in one parallel call (:func:`solve_dare_batch`).
 
+    Parameters
+    ----------
+    sys_or_A : StateSpace or array_like (n, n)
+        The sampled model (then B is not given), or its A.
+    B : array_like (n, m) or (n,), optional
+        Required with a matrix A.
+    Q : array_like (n, n), optional
+        The state weight (default the identity).
+    R : array_like (m, m), optional
+        The control weight before division by c² (default the identity).
+    weights : array_like (k,)
+        The weights c, positive and finite. Required.
+    client : dask.distributed.Client, optional
+        Solve in chunks on the Dask cluster, bitwise as here (default None: this machine's
+        threads).
+
+    Returns
+    -------
+    LqrSweep
+        The ``weights`` (k,), gains ``K`` (k, m, n), closed-loop ``poles`` (k, n), Riccati
+        solutions ``X`` (k, n, n), and the ``residual`` and ``rcond`` of each (k,).
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``weights`` missing, not positive and finite, or so extreme that R / c² leaves the
+        range of doubles; B missing with a matrix, or given with a system; a model of the
+        other time base (a continuous system, dt = 0: use :func:`lqr_sweep`).
+    ShapeError
+        ``weights`` not 1-D, R not one matrix, or shapes that disagree.
+    AerocontrolError
+        The first failing weight's own error (NoStabilizingSolutionError, ...), its message
+        starting "problem i of the batch".
+
+    Examples
+    --------
     >>> import numpy as np, aerocontrol
     >>> A, B = aerocontrol.chapter.boeing747_lateral()
     >>> sampled = aerocontrol.c2d(aerocontrol.StateSpace(A, B), 0.1)
@@ -407,6 +500,40 @@ def lqr_sweep(
     R default to identities, as in the chapter. Returns the gains (k, m, n), the closed-loop
     poles (k, n) (each row as :func:`aerocontrol.lqr` returns its E), X, the residuals and the
     weights.
+
+    Parameters
+    ----------
+    sys_or_A : StateSpace or array_like (n, n)
+        The model (then B is not given), or its A.
+    B : array_like (n, m) or (n,), optional
+        Required with a matrix A.
+    Q : array_like (n, n), optional
+        The state weight (default the identity).
+    R : array_like (m, m), optional
+        The control weight before division by c² (default the identity).
+    weights : array_like (k,)
+        The weights c, positive and finite. Required.
+    client : dask.distributed.Client, optional
+        Solve in chunks on the Dask cluster, bitwise as here (default None: this machine's
+        threads).
+
+    Returns
+    -------
+    LqrSweep
+        The ``weights`` (k,), gains ``K`` (k, m, n), closed-loop ``poles`` (k, n), Riccati
+        solutions ``X`` (k, n, n), and the ``residual`` and ``rcond`` of each (k,).
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``weights`` missing, not positive and finite, or so extreme that R / c² leaves the
+        range of doubles; B missing with a matrix, or given with a system; a model of the
+        other time base (a discrete system: use :func:`dlqr_sweep`).
+    ShapeError
+        ``weights`` not 1-D, R not one matrix, or shapes that disagree.
+    AerocontrolError
+        The first failing weight's own error (NoStabilizingSolutionError, ...), its message
+        starting "problem i of the batch".
 
     Examples
     --------

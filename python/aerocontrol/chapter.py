@@ -28,6 +28,18 @@ def boeing747_longitudinal() -> tuple[FloatArray, FloatArray]:
 
     State x = (u/u0, α, q, θ) (6.50), input the elevator δe (rad); matrices (6.49).
 
+    Returns
+    -------
+    A : ndarray (4, 4)
+        The plant matrix (6.49), 1/s.
+    B : ndarray (4, 1)
+        The elevator column (6.49).
+
+    Raises
+    ------
+    None
+        The matrices are constants; nothing is checked or raised.
+
     Examples
     --------
     >>> A, B = boeing747_longitudinal()
@@ -51,6 +63,18 @@ def boeing747_lateral() -> tuple[FloatArray, FloatArray]:
 
     State x = (β, p, φ, r) (6.151); plant matrix (6.150), rudder column (6.158), aileron
     column (6.163); inputs (δr, δa) in rad, as in the LQR example (6.224).
+
+    Returns
+    -------
+    A : ndarray (4, 4)
+        The plant matrix (6.150), 1/s.
+    B : ndarray (4, 2)
+        The rudder (6.158) and aileron (6.163) columns.
+
+    Raises
+    ------
+    None
+        The matrices are constants; nothing is checked or raised.
 
     Examples
     --------
@@ -85,6 +109,16 @@ def boeing747_damper_closed_loops() -> dict[str, FloatArray]:
     same ω_n, roll and spiral roots kept, (6.156)): rudder feedback (6.162) and aileron
     feedback (6.165), as printed, in the state x = (β, p, φ, r).
 
+    Returns
+    -------
+    dict of str to ndarray (4, 4)
+        ``"rudder"``: (6.162); ``"aileron"``: (6.165).
+
+    Raises
+    ------
+    None
+        The matrices are constants; nothing is checked or raised.
+
     Examples
     --------
     >>> closed = boeing747_damper_closed_loops()
@@ -113,6 +147,16 @@ def boeing747_damper_closed_loops() -> dict[str, FloatArray]:
 def controllability_example() -> tuple[FloatArray, FloatArray]:
     """The controllability example (6.75): A = [[0, 1], [-2, -3]], B = [0, 1]^T.
 
+    Returns
+    -------
+    A : ndarray (2, 2)
+    B : ndarray (2, 1)
+
+    Raises
+    ------
+    None
+        The matrices are constants; nothing is checked or raised.
+
     Examples
     --------
     >>> A, B = controllability_example()
@@ -126,5 +170,21 @@ def state_feedback_example() -> tuple[FloatArray, FloatArray]:
     """The state feedback example (6.95): A = [[-3, 8], [0, 0]], B = [0, 4]^T.
 
     A is singular (a zero eigenvalue): the chapter's step formula (6.43) fails for it.
+
+    Returns
+    -------
+    A : ndarray (2, 2)
+    B : ndarray (2, 1)
+
+    Raises
+    ------
+    None
+        The matrices are constants; nothing is checked or raised.
+
+    Examples
+    --------
+    >>> A, B = state_feedback_example()
+    >>> np.linalg.eigvals(A)
+    array([-3.,  0.])
     """
     return np.array([[-3.0, 8.0], [0.0, 0.0]]), np.array([[0.0], [4.0]])

@@ -54,6 +54,29 @@ def ctrb(A: ArrayLike, B: ArrayLike) -> FloatArray:
     For hand analysis and the companion form; decide controllability with
     :func:`is_controllable`, not with the rank of V.
 
+    Parameters
+    ----------
+    A : array_like (n, n)
+    B : array_like (n, m)
+
+    Returns
+    -------
+    ndarray (n, n m)
+        V, its k-th block of m columns A^k B.
+
+    Raises
+    ------
+    ShapeError
+        A is not square, or B is not 2-D with n rows.
+    NonFiniteError, NotRealError
+        A or B contains NaN or an infinity, or is complex.
+
+    See Also
+    --------
+    controllability : the verdict, by the staircase form and the modal test.
+
+    Examples
+    --------
     >>> import aerocontrol
     >>> aerocontrol.ctrb([[0, 1], [-2, -3]], [[0], [1]])      # (6.81)
     array([[ 0.,  1.],
@@ -65,6 +88,27 @@ def ctrb(A: ArrayLike, B: ArrayLike) -> FloatArray:
 def obsv(A: ArrayLike, C: ArrayLike) -> FloatArray:
     """The observability matrix [C; CA; ...; CA^{n-1}] (6.89), np x n.
 
+    As with :func:`ctrb`, decide observability with :func:`is_observable`, not with the rank.
+
+    Parameters
+    ----------
+    A : array_like (n, n)
+    C : array_like (p, n)
+
+    Returns
+    -------
+    ndarray (n p, n)
+        Its k-th block of p rows C A^k.
+
+    Raises
+    ------
+    ShapeError
+        A is not square, or C is not 2-D with n columns.
+    NonFiniteError, NotRealError
+        A or C contains NaN or an infinity, or is complex.
+
+    Examples
+    --------
     >>> import aerocontrol
     >>> aerocontrol.obsv([[-3, 8], [0, 0]], [[1, 0]])
     array([[ 1.,  0.],
@@ -181,6 +225,22 @@ def controllability(
         about 5x faster at n = 64 but blind to an uncontrollable mode that dominates the
         controllable ones (see the module documentation).
 
+    Returns
+    -------
+    Controllability
+        The verdict ``controllable`` (also its truth value), the ``uncontrollable_eigenvalues``,
+        the tolerance, the staircase form Z^T A Z, Z^T B with Z and its block sizes, and the
+        modal measure ||w_k^T B|| per eigenvalue (6.61).
+
+    Raises
+    ------
+    ShapeError
+        A is not square, or B is not 2-D with n rows (also when B is missing with a plain A).
+    NonFiniteError, NotRealError
+        A or B contains NaN or an infinity, or is complex (``tol`` not a number: NotRealError).
+    InvalidArgumentError
+        ``method`` is not "full" or "staircase", or ``tol`` is negative or not finite.
+
     Examples
     --------
     >>> import aerocontrol
@@ -201,11 +261,42 @@ def observability(
     tol: float | None = None,
     method: str = "full",
 ) -> Controllability:
-    """The observability of (A, C), by duality with :func:`controllability`.
+    """The observability of (A, C), by duality with :func:`controllability`: (A, C) is
+    observable if and only if (A^T, C^T) is controllable (6.89).
 
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n), StateSpace, (A, C) tuple, or object with A and C
+    C : array_like (p, n), optional (required with a plain A)
+    tol : float, optional
+        Rank tolerance; default n ε max(||A||_F, ||C||_F), ε = 2^-52.
+    method : "full" (default) or "staircase"
+        As :func:`controllability`.
+
+    Returns
+    -------
+    Controllability
+        ``kind`` "observability": the verdict ``controllable`` (read: observable), the
+        unobservable eigenvalues, the staircase form (Z^T A Z block lower triangular, C Z)
+        and the modal measure ||C v_k|| per eigenvalue.
+
+    Raises
+    ------
+    ShapeError
+        A is not square, or C is not 2-D with n columns (also when C is missing with a plain
+        A).
+    NonFiniteError, NotRealError
+        A or C contains NaN or an infinity, or is complex.
+    InvalidArgumentError
+        ``method`` is not "full" or "staircase", or ``tol`` is negative or not finite.
+
+    Examples
+    --------
     >>> import aerocontrol
     >>> aerocontrol.observability([[-3, 8], [0, 0]], [[1, 0]]).controllable
     True
+    >>> print(aerocontrol.observability([[-3, 8], [0, 0]], [[0, 1]]))
+    not observable: eigenvalues -3+0j (tolerance 3.79e-15)
     """
     A, C = plant_pair(A_or_sys, C, "C")
     return _analyse(A, C, tol, method, dual=True)
@@ -221,9 +312,40 @@ def is_controllable(
     """Whether every mode of (A, B) can be moved by state feedback (see
     :func:`controllability`).
 
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n), StateSpace, (A, B) tuple, or object with A and B
+    B : array_like (n, m), optional (required with a plain A)
+    tol : float, optional
+        Rank tolerance; default n ε max(||A||_F, ||B||_F), ε = 2^-52.
+    method : "full" (default) or "staircase"
+        As :func:`controllability`.
+
+    Returns
+    -------
+    bool
+        True when no eigenvalue is uncontrollable; the verdict of :func:`controllability`
+        without building its result.
+
+    Raises
+    ------
+    ShapeError
+        A is not square, or B is not 2-D with n rows.
+    NonFiniteError, NotRealError
+        A or B contains NaN or an infinity, or is complex.
+    InvalidArgumentError
+        ``method`` is not "full" or "staircase", or ``tol`` is negative or not finite.
+
+    Examples
+    --------
+    The chapter's (6.84): B = [-1, 1]^T cannot move the eigenvalue -2.
+
     >>> import aerocontrol
     >>> aerocontrol.is_controllable([[0, 1], [-2, -3]], [[-1], [1]])
     False
+    >>> A, B = aerocontrol.chapter.boeing747_lateral()
+    >>> aerocontrol.is_controllable(A, B[:, :1])          # the 747's lateral axes, rudder alone
+    True
     """
     A, B = plant_pair(A_or_sys, B, "B")
     return _verdict(A, B, tol, method, dual=False)
@@ -237,6 +359,34 @@ def is_observable(
     method: str = "full",
 ) -> bool:
     """Whether every mode of (A, C) shows in the output (see :func:`observability`).
+
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n), StateSpace, (A, C) tuple, or object with A and C
+    C : array_like (p, n), optional (required with a plain A)
+    tol : float, optional
+        Rank tolerance; default n ε max(||A||_F, ||C||_F), ε = 2^-52.
+    method : "full" (default) or "staircase"
+        As :func:`controllability`.
+
+    Returns
+    -------
+    bool
+        True when no eigenvalue is unobservable.
+
+    Raises
+    ------
+    ShapeError
+        A is not square, or C is not 2-D with n columns (also when C is missing with a plain
+        A).
+    NonFiniteError, NotRealError
+        A or C contains NaN or an infinity, or is complex.
+    InvalidArgumentError
+        ``method`` is not "full" or "staircase", or ``tol`` is negative or not finite.
+
+    Examples
+    --------
+    Measuring the second state alone misses the mode at -3:
 
     >>> import aerocontrol
     >>> aerocontrol.is_observable([[-3, 8], [0, 0]], [[0, 1]])

@@ -64,6 +64,30 @@ def dutch_roll_damper(
     ``zeta`` at the same natural frequency and keeps the roll and spiral roots (6.156), by
     Bass-Gura (6.145).
 
+    Parameters
+    ----------
+    plane_or_sys : Aircraft or StateSpace
+        The aircraft (its lateral model is used) or a lateral model x = (β, p, φ, r) with
+        named inputs.
+    zeta : float, optional
+        The Dutch roll's new damping ratio, non-negative (default 0.30, the chapter's).
+    surface : str, optional
+        The input fed back, "rudder" (default) or "aileron".
+
+    Returns
+    -------
+    Placement
+        The single-input design: ``k`` (6.159), ``K`` (1 x 4), the closed loop and the
+        achieved poles (:func:`~aerocontrol.place_bass_gura`).
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``plane_or_sys`` is neither an Aircraft nor a StateSpace, ``surface`` is not one of
+        its inputs, or ``zeta`` is negative or not finite.
+    UncontrollableError
+        The surface cannot move a lateral mode.
+
     Examples
     --------
     >>> import numpy as np
@@ -99,6 +123,41 @@ def lqr_root_locus(
 
     Q and R default to identities (the chapter's (6.225)-(6.226)). The weights are solved in
     one parallel call (:func:`aerocontrol.batch.lqr_sweep`).
+
+    Parameters
+    ----------
+    sys : StateSpace
+        The continuous plant.
+    weights : array_like (k,)
+        The control weights c (R/c² is the control weight), positive and finite.
+    Q : array_like (n, n), optional
+        The state weight (default the identity).
+    R : array_like (m, m), optional
+        The control weight before division by c² (default the identity).
+
+    Returns
+    -------
+    ndarray (k, n) of complex128
+        The closed-loop eigenvalues for each c.
+
+    Raises
+    ------
+    InvalidArgumentError
+        A weight is not positive and finite, or ``sys`` is discrete.
+    ShapeError
+        ``weights`` is not 1-D, or Q or R disagrees in size with the plant.
+    AerocontrolError
+        The first failing weight's own error (NoStabilizingSolutionError, ...), as
+        :func:`aerocontrol.batch.lqr_sweep`.
+
+    Examples
+    --------
+    At c = 1 the 747's lateral regulator (6.224)-(6.227), as :func:`aerocontrol.lqr` gives it:
+
+    >>> import numpy as np
+    >>> from aerocontrol import aircraft, design
+    >>> np.round(design.lqr_root_locus(aircraft.load().lateral(), [1.0])[0], 4)
+    array([-0.3141+0.8153j, -0.3141-0.8153j, -0.4236+0.j    , -1.2443+0.j    ])
     """
     return lqr_sweep(sys, Q=Q, R=R, weights=weights).poles
 
@@ -126,6 +185,34 @@ def critical_weight(
     The measure g(c) = ((λ1 - λ2) / 2)², negative while the pair is complex (-ω_d²) and positive
     once it has split, is bracketed on a logarithmic grid of c within ``bounds`` and its first
     sign change refined by bisection in log c.
+
+    Parameters
+    ----------
+    sys : StateSpace
+        The continuous lateral model.
+    mode : str, optional
+        The oscillatory lateral mode, "dutch roll" (default).
+    Q : array_like (n, n), optional
+        The state weight (default the identity, (6.225)).
+    R : array_like (m, m), optional
+        The control weight before division by c² (default the identity, (6.226)).
+    bounds : (float, float), optional
+        The range of c searched, 0 < low < high (default (1e-3, 1e3)).
+
+    Returns
+    -------
+    float
+        The weight c, to a relative 1e-12.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``bounds`` not 0 < low < high finite; ``mode`` not an oscillatory lateral mode; or the
+        mode does not become critically damped within ``bounds``.
+    ShapeError
+        Q or R is not of the plant's size.
+    AerocontrolError
+        A regulator of the grid fails (NoStabilizingSolutionError, ...).
 
     Examples
     --------
@@ -209,6 +296,12 @@ def sampled_weights(
     SampledWeights
         (Q, R, N), W symmetrised.
 
+    Raises
+    ------
+    InvalidArgumentError
+        ``sys`` is discrete, ``dt`` is not a positive finite period, or Q or R is not of the
+        plant's size.
+
     Examples
     --------
     A double integrator with the velocity weighted, v(t_k + τ) = v_k + η_k τ: the cost of one
@@ -264,6 +357,17 @@ def sampled_data_lqr(
     (MATLAB's ``lqrd``): :func:`~aerocontrol.dlqr` of the zero-order-hold plant
     (:func:`~aerocontrol.c2d`) with the weights of :func:`sampled_weights`.
 
+    Parameters
+    ----------
+    sys : StateSpace
+        The continuous plant.
+    dt : float
+        The sampling period in seconds, positive.
+    Q : array_like (n, n), optional
+        The continuous state weight (default the identity, (6.225)).
+    R : array_like (m, m), optional
+        The continuous control weight (default the identity, (6.226)).
+
     Returns
     -------
     K : ndarray (m, n)
@@ -274,6 +378,14 @@ def sampled_data_lqr(
     E : ndarray (n,) of complex128
         The closed-loop eigenvalues z, inside the unit circle; ln(z)/dt are the continuous
         roots they sample.
+
+    Raises
+    ------
+    InvalidArgumentError
+        As :func:`sampled_weights`: ``sys`` discrete, ``dt`` not positive and finite, or Q or R
+        of the wrong size.
+    NoStabilizingSolutionError, SingularMatrixError
+        As :func:`~aerocontrol.dlqr`: the sampled plant is not stabilisable.
 
     Examples
     --------
@@ -388,6 +500,31 @@ def yaw_damper(
     does not oppose a steady turn and leaves the spiral mode nearly where it was; without
     it the feedback of r moves the spiral root.
 
+    Parameters
+    ----------
+    plane_or_sys : Aircraft or StateSpace
+        The aircraft (its lateral model is used) or a lateral model with the output "r" and
+        the input "rudder".
+    washout_tau : float or None, optional
+        The washout's time constant in seconds, positive (default 3 s); None for no washout.
+    bandwidth : float, optional
+        The actuator's bandwidth in rad/s, positive (default 10).
+
+    Returns
+    -------
+    Damper
+        The ``loop`` L (k = 1), the ``design`` (gain and damping, a
+        :class:`~aerocontrol.DampingDesign`), the ``margins`` of k L and their ``check``
+        against MIL-F-9490D, the ``open_loop`` (actuator and aircraft) and the ``closed_loop``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``plane_or_sys`` is neither an Aircraft nor a StateSpace (or lacks "r" or "rudder"),
+        ``washout_tau`` is not positive, or ``bandwidth`` is not positive.
+    AerocontrolLinAlgError
+        The loop closed with the best gain is unstable.
+
     Examples
     --------
     >>> from aerocontrol import aircraft, design
@@ -413,6 +550,29 @@ def pitch_damper(
     """A pitch damper: pitch rate q fed back to the elevator through a first-order actuator,
     at the gain that gives the short period, tracked along the locus, its best damping (the
     phugoid is left to the pilot), with its margins against MIL-F-9490D.
+
+    Parameters
+    ----------
+    plane_or_sys : Aircraft or StateSpace
+        The aircraft (its longitudinal model is used) or a longitudinal model with the output
+        "q" and the input "elevator".
+    bandwidth : float, optional
+        The actuator's bandwidth in rad/s, positive (default 10).
+
+    Returns
+    -------
+    Damper
+        The ``loop`` L (k = 1), the ``design`` (gain and damping, a
+        :class:`~aerocontrol.DampingDesign`), the ``margins`` of k L and their ``check``
+        against MIL-F-9490D, the ``open_loop`` (actuator and aircraft) and the ``closed_loop``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``plane_or_sys`` is neither an Aircraft nor a StateSpace, or lacks "q" or "elevator";
+        ``bandwidth`` is not positive.
+    AerocontrolLinAlgError
+        The loop closed with the best gain is unstable.
 
     Examples
     --------

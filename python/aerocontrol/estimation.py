@@ -388,6 +388,18 @@ def lqe(
     A P + P A^T - (P C^T + G NN) RN^-1 (C P + NN^T G^T) + G QN G^T = 0, and
     L = (P C^T + G NN) RN^-1.
 
+    Parameters
+    ----------
+    sys_or_A : StateSpace or array_like (n, n)
+        A system (its B is G, its C the measurement), or the plant matrix A.
+    *args : array_like
+        With a system: ``QN, RN[, NN]``. With a matrix: ``G, C, QN, RN[, NN]``: G (n, g) how
+        the process noise enters, C (p, n), the process noise covariance QN (g, g), the
+        measurement noise covariance RN (p, p) (positive definite), the cross covariance
+        NN (g, p).
+    NN : array_like (g, p), optional
+        The cross covariance, by keyword (default zero).
+
     Returns
     -------
     L : ndarray (n, p)
@@ -453,6 +465,17 @@ def dlqe(
     A P A^T - P - (A P C^T + G NN)(C P C^T + RN)^-1 (C P A^T + NN^T G^T) + G QN G^T = 0,
     and L = (A P C^T + G NN)(C P C^T + RN)^-1. RN need not be definite, only C P C^T + RN
     nonsingular.
+
+    Parameters
+    ----------
+    sys_or_A : StateSpace or array_like (n, n)
+        A discrete-time system (its B is G, its C the measurement), or the transition matrix A.
+    *args : array_like
+        With a system: ``QN, RN[, NN]``. With a matrix: ``G, C, QN, RN[, NN]``: G (n, g), C
+        (p, n), the process noise covariance QN (g, g), the measurement noise covariance
+        RN (p, p), the cross covariance NN (g, p).
+    NN : array_like (g, p), optional
+        The cross covariance, by keyword (default zero).
 
     Returns
     -------
@@ -891,11 +914,24 @@ def lqg(
     NN : array_like (g, p), optional
         The noises' cross covariance.
 
+    Returns
+    -------
+    LqgDesign
+        The gains ``K`` and ``L``, the Riccati solutions ``S`` and ``P``, the ``compensator``
+        (y to η, states x̂), the ``closed_loop`` with the plant (states (x, x̂)) and the
+        regulator, estimator and closed-loop poles.
+
     Raises
     ------
-    As :func:`~aerocontrol.lqr` (for the regulator: (A, B) not stabilisable) and :func:`lqe`
-    (for the filter: (C, A) not detectable); NoStabilizingSolutionError if the computed
-    closed loop is not stable; InvalidArgumentError for a discrete-time python-control model.
+    IllConditionedError, NoStabilizingSolutionError
+        As :func:`~aerocontrol.lqr` for the regulator ((A, B) not stabilisable) and
+        :func:`lqe` for the filter ((C, A) not detectable); NoStabilizingSolutionError also if
+        the computed closed loop is not stable.
+    ShapeError, NonFiniteError, NotPositiveDefiniteError
+        A weight or covariance of the wrong size or not finite, R not symmetric, or RN not
+        positive definite (named).
+    InvalidArgumentError
+        A discrete-time model (an aerocontrol or python-control model with dt > 0).
 
     Examples
     --------

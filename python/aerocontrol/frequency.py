@@ -104,6 +104,28 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
     A frequency at an imaginary-axis pole (a pole on the unit circle, for a discrete model)
     gives infinite or NaN entries.
 
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, or system object
+        Without C and D the outputs are the states.
+    omega : array_like (k,) or float, rad/s
+        The frequencies (any real values; G(-jω) is the conjugate of G(jω)).
+
+    Returns
+    -------
+    FrequencyResponse
+        ``omega`` (k,) and ``response`` (k, p, m) of complex G, with ``magnitude``,
+        ``magnitude_db``, ``phase`` (unwrapped, rad), ``phase_deg`` and ``plot()``.
+
+    Raises
+    ------
+    ShapeError
+        ``omega`` is not 1-D (or a number), or the model's matrices disagree in size.
+    NonFiniteError
+        A frequency or a matrix entry is NaN or infinite.
+    NotRealError
+        ``sys`` is not a model, or ``omega`` or a matrix is complex.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -143,7 +165,36 @@ def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> Flo
     the fastest nonzero natural frequency of the modes (0.01 to 100 rad/s when every
     eigenvalue is zero; at most 1e308). For a discrete model: from a tenth of the slowest
     natural frequency of s = ln(z)/dt (or a thousandth of the Nyquist frequency, if lower) to
-    the Nyquist frequency π/dt."""
+    the Nyquist frequency π/dt.
+
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, or system object
+        Without C and D the outputs are the states.
+    count : int, optional
+        The number of frequencies, at least 1 (default 1000).
+
+    Returns
+    -------
+    ndarray (count,), rad/s
+        The frequencies, log-spaced and increasing.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``count`` is not a positive integer.
+    NotRealError, NonFiniteError, ShapeError
+        ``sys`` is not a model, or its matrices are complex, not finite or of inconsistent
+        sizes.
+
+    Examples
+    --------
+    Modes at 1 and 100 rad/s: the grid spans 0.1 to 1000 rad/s.
+
+    >>> import aerocontrol
+    >>> aerocontrol.default_frequency_grid(([[-1.0, 0.0], [0.0, -100.0]], [[1.0], [1.0]]), 5)
+    array([1.e-01, 1.e+00, 1.e+01, 1.e+02, 1.e+03])
+    """
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
         raise InvalidArgumentError(f"count must be a positive integer, got {count!r}")
     model = as_state_space(sys)
@@ -166,6 +217,32 @@ def bode(sys: System, omega: ArrayLike | None = None) -> FrequencyResponse:
     """The frequency response for a Bode plot: ``.magnitude_db``, ``.phase_deg`` (unwrapped),
     ``.plot()``. Without ``omega``, the default grid of :func:`default_frequency_grid`.
 
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, or system object
+        Without C and D the outputs are the states.
+    omega : array_like (k,), rad/s, optional
+        The frequencies; default :func:`default_frequency_grid` (1000 frequencies).
+
+    Returns
+    -------
+    FrequencyResponse
+        ``omega`` (k,) and ``response`` (k, p, m) of complex G, with ``magnitude``,
+        ``magnitude_db``, ``phase`` (unwrapped, rad), ``phase_deg`` and ``plot()``.
+
+    Raises
+    ------
+    ShapeError
+        ``omega`` is not 1-D (or a number), or the model's matrices disagree in size.
+    NonFiniteError
+        A frequency or a matrix entry is NaN or infinite.
+    NotRealError
+        ``sys`` is not a model, or ``omega`` or a matrix is complex.
+
+    See Also
+    --------
+    frequency_response : the same response at given frequencies.
+
     Examples
     --------
     >>> import aerocontrol
@@ -173,6 +250,12 @@ def bode(sys: System, omega: ArrayLike | None = None) -> FrequencyResponse:
     >>> b = aerocontrol.bode((A, B))
     >>> b.magnitude_db.shape
     (1000, 4, 1)
+
+    2 / (s + 2) at its corner frequency: -3.01 dB and -45°.
+
+    >>> b = aerocontrol.bode(([[-2.0]], [[2.0]]), [2.0])
+    >>> round(float(b.magnitude_db[0, 0, 0]), 2), round(float(b.phase_deg[0, 0, 0]), 2)
+    (-3.01, -45.0)
     """
     frequencies = default_frequency_grid(sys) if omega is None else omega
     return frequency_response(sys, frequencies)

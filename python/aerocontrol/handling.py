@@ -39,9 +39,9 @@ given here cannot decide it, so it is left to the caller:
 * Table VI's first row, ζ_d >= 0.4 and ω_nd >= 1.0 for Class IV in the Category A phases
   air-to-air combat (CO) and ground attack (GA): the API takes the Category, not the Flight
   Phase, so Class IV Category A is judged by the general Category A row (ζ_d > 0.19).
-* Table VI's increase of the minimum ζ_d ω_nd when ω_nd² |φ/β|_d > 20 (rad/s)², which needs
+* Table VI's increase of the minimum ζ_d ω_nd when ω_nd² abs(φ/β)_d > 20 (rad/s)², which needs
   the Dutch roll's mode shape, and the exemption of Class III from the minimum ω_nd "subject to
-  approval by the procuring activity" (Table VI, note **).
+  approval by the procuring activity" (Table VI, note ``**``).
 * The short-period frequency limits of 3.2.2.1.1 (Figures 1-3, against n/α), and Table IV's
   note that the Level 3 minimum may be reduced above 20,000 ft if the procuring activity
   approves.
@@ -334,7 +334,7 @@ def assess(modes: Mapping[str, object], aircraft_class: str, category: str) -> H
     * phugoid: "zeta" (Level 1 ζ >= 0.04, Level 2 ζ >= 0) and "time to double" (Level 3
       T2 >= 55 s), so a divergent phugoid (ζ < 0) is Level 3 if T2 >= 55 s and 4 otherwise;
     * dutch roll: "zeta", "zeta*omega_n" and "omega_n" against Table VI (for Class III a
-      ζ >= 0.7 meets the ζ ω_n minimum, Table VI note *);
+      ζ >= 0.7 meets the ζ ω_n minimum, Table VI note ``*``);
     * roll: "time constant" against Table VII;
     * spiral: "time to double" against Table VIII (a stable spiral: inf, Level 1).
 
@@ -411,6 +411,13 @@ def compare(before: HandlingQualities, after: HandlingQualities) -> str:
     ----------
     before, after : HandlingQualities
         Assessments for the same airplane Class and Flight Phase Category.
+
+    Returns
+    -------
+    str
+        The table: a title line, then mode, Level before, Level after and the change
+        ("improved", "same", "worse"; "-" and no change for a mode assessed only once), and a
+        note on Level 4 where one appears.
 
     Raises
     ------
@@ -700,6 +707,15 @@ def level_arrays(
     dict of str to ndarray of int8, shape (k,)
         The Level (1 to 4) of each mode given.
 
+    Raises
+    ------
+    InvalidArgumentError
+        A key is not a mode name, or ``aircraft_class`` or ``category`` is unknown.
+    ShapeError
+        A mode's eigenvalues are not (k, 2) (oscillatory) or (k,) (roll, spiral).
+    NonFiniteError
+        An eigenvalue is NaN or infinite.
+
     Examples
     --------
     >>> import numpy as np
@@ -732,6 +748,26 @@ def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
     the spiral (eigenvalues (k,); inf for a roll mode that does not converge or a spiral that
     does not grow).
 
+    Parameters
+    ----------
+    mode : str
+        "short period", "phugoid", "dutch roll", "roll" or "spiral".
+    eigenvalues : array_like (k, 2) or (k,) of complex
+        The mode's roots for each of k aircraft: a pair (oscillatory modes) or one root (roll,
+        spiral).
+
+    Returns
+    -------
+    dict of str to ndarray (k,)
+        "omega_n" (rad/s) and "zeta"; "time constant" (s); or "time to double" (s).
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``mode`` is not a mode.
+    ShapeError
+        ``eigenvalues`` is not (k, 2) for an oscillatory mode or (k,) for roll and spiral.
+
     Examples
     --------
     >>> import numpy as np
@@ -739,6 +775,8 @@ def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
     >>> q = mode_quantities("dutch roll", np.array([[-0.08066 + 0.7433j, -0.08066 - 0.7433j]]))
     >>> np.round(q["zeta"], 4), np.round(q["omega_n"], 4)
     (array([0.1079]), array([0.7477]))
+    >>> mode_quantities("spiral", [-0.04641, 0.01])        # T2 = ln 2 / λ; inf if it decays
+    {'time to double': array([        inf, 69.31471806])}
     """
     name = _mode_name(mode, "mode")
     lam = np.asarray(eigenvalues, dtype=np.complex128)
@@ -760,6 +798,30 @@ def level_limits(
     """The limits of each Level on one quantity of :func:`mode_quantities`, as (Level, value)
     pairs: the bounds that :func:`assess` compares the quantity with (the minimum or the
     maximum; for the short period both ends of each band), for lines on a histogram.
+
+    Parameters
+    ----------
+    mode : str
+        "short period", "phugoid", "dutch roll", "roll" or "spiral".
+    quantity : str
+        The quantity: "zeta" (short period, phugoid, Dutch roll), "zeta*omega_n" or "omega_n"
+        (Dutch roll), "time to double" (phugoid, spiral), "time constant" (roll).
+    aircraft_class : str
+        The airplane Class, "I", "II-C", "II-L" (or "II"), "III" or "IV".
+    category : str
+        The Flight Phase Category, "A", "B" or "C".
+
+    Returns
+    -------
+    list of (int, float)
+        (Level, bound) pairs, in the units of :func:`mode_quantities` (rad/s, s); a Level
+        without a bound on the quantity is left out.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``mode`` is not a mode, the mode has no limits on ``quantity``, or
+        ``aircraft_class`` or ``category`` is unknown.
 
     Examples
     --------
@@ -1016,6 +1078,33 @@ def margin_requirement(
     inf when the model has none); f >= ``aeroelastic_hz``. A frequency exactly on an edge
     takes the higher row.
 
+    Parameters
+    ----------
+    frequency_hz : float
+        The loop mode's frequency f_M, Hz, finite and non-negative.
+    airspeed : str, optional
+        The table's column: "below Vo_min", "Vo_min to Vo_max" (default), "at V_L" or
+        "at 1.15 V_L".
+    aeroelastic_hz : float, optional
+        The first aeroelastic mode, Hz, above 0.06 Hz (default inf: none).
+
+    Returns
+    -------
+    gain_margin_db : float
+        The gain margin required, dB.
+    phase_margin_deg : float
+        The phase margin required, degrees.
+    row : str
+        The row of the table that applies.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``airspeed`` is not a column, ``frequency_hz`` is negative, or ``aeroelastic_hz`` is
+        not above 0.06 Hz.
+    NonFiniteError
+        ``frequency_hz`` or ``aeroelastic_hz`` is NaN (or ``frequency_hz`` infinite).
+
     Examples
     --------
     >>> from aerocontrol.handling import margin_requirement
@@ -1089,6 +1178,31 @@ def margins_check(
     the requirement in magnitude (a phase margin of -58° is a lead of 58° that destabilises).
     The closed loop must also be stable (from its poles); that is the whole requirement at
     1.15 V_L. A loop without crossovers has infinite margins and passes them.
+
+    Parameters
+    ----------
+    loops : mapping of str to model or StabilityMargins
+        Loop name to the loop L (one input, one output) or its margins; at least one.
+    airspeed : str, optional
+        The table's column, as :func:`margin_requirement` (default "Vo_min to Vo_max").
+    aeroelastic_hz : float, optional
+        The first aeroelastic mode, Hz, above 0.06 Hz (default inf: none).
+
+    Returns
+    -------
+    MarginsCheck
+        A row per requirement (closed-loop stability, each gain and phase margin) with value,
+        frequency, requirement and verdict; ``passed`` by loop, ``print`` shows the table.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``loops`` is empty or not a mapping, ``airspeed`` is not a column, or
+        ``aeroelastic_hz`` is not above 0.06 Hz.
+    NotRealError
+        A loop is neither a model nor a StabilityMargins.
+    ShapeError
+        A loop has not one input and one output.
 
     Examples
     --------

@@ -482,6 +482,29 @@ def series(sys1: System, sys2: System, *systems: System) -> StateSpace:
     The model has the inputs of the first, the outputs of the last and the states of all, with
     their names. The same as python-control's ``series(sys1, sys2)`` (``sys2 * sys1``).
 
+    Parameters
+    ----------
+    sys1, sys2 : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        The first model and the one after it.
+    *systems : models
+        Further models, in order.
+
+    Returns
+    -------
+    StateSpace
+        The cascade, with the inputs of ``sys1``, the outputs of the last model and the states
+        of all.
+
+    Raises
+    ------
+    ShapeError
+        A model has not as many inputs as the one before it has outputs.
+    NotRealError
+        An argument is not a model.
+    InvalidArgumentError
+        The models are not on one time base (continuous and discrete, or two sampling
+        periods): bring them to one first (c2d, d2c).
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -554,6 +577,28 @@ def parallel(sys1: System, sys2: System, *systems: System) -> StateSpace:
     names of the inputs and outputs are those of ``sys1``. The same as python-control's
     ``parallel``.
 
+    Parameters
+    ----------
+    sys1, sys2 : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        Models of the same numbers of inputs and outputs.
+    *systems : models
+        Further models to add.
+
+    Returns
+    -------
+    StateSpace
+        The sum, with the names of ``sys1``'s inputs and outputs and the states of all.
+
+    Raises
+    ------
+    ShapeError
+        The models differ in their numbers of inputs or outputs.
+    NotRealError
+        An argument is not a model.
+    InvalidArgumentError
+        The models are not on one time base (continuous and discrete, or two sampling
+        periods): bring them to one first (c2d, d2c).
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -600,6 +645,23 @@ def append(*systems: System) -> StateSpace:
     """The models side by side, unconnected: inputs, outputs and states stacked in order,
     A, B, C, D block diagonal, the names kept. The same as python-control's ``append``.
 
+    Parameters
+    ----------
+    *systems : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        One model or more.
+
+    Returns
+    -------
+    StateSpace
+        The block-diagonal model.
+
+    Raises
+    ------
+    InvalidArgumentError
+        No model is given, or the models are not on one time base.
+    NotRealError
+        An argument is not a model.
+
     Examples
     --------
     >>> import aerocontrol
@@ -641,6 +703,38 @@ def feedback(sys1: System, sys2: System | None = None, sign: float = -1) -> Stat
     IllConditionedWarning with its condition number. A loop whose products leave the range
     of doubles is formed in states scaled by powers of two chosen on the closed loop's own
     entries (see the module's documentation). The same as python-control's ``feedback``.
+
+    Parameters
+    ----------
+    sys1 : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        The forward path.
+    sys2 : model, optional
+        The return path, with as many inputs as ``sys1`` has outputs and as many outputs as it
+        has inputs; default unity feedback.
+    sign : {-1, +1}, optional
+        -1 (default) for negative feedback, +1 for positive.
+
+    Returns
+    -------
+    StateSpace
+        The closed loop from r to y1, states (x1, x2), with ``sys1``'s inputs and outputs.
+
+    Raises
+    ------
+    SingularMatrixError
+        F = I - sign·D2·D1 is singular: an algebraic loop.
+    ShapeError
+        ``sys2`` does not fit ``sys1``, or unity feedback around a model with more outputs
+        than inputs (or fewer).
+    InvalidArgumentError
+        ``sign`` is not -1 or +1, or the models are not on one time base.
+    NotRealError
+        An argument is not a model.
+
+    Warns
+    -----
+    IllConditionedWarning
+        F is nearly singular (its condition number is given).
 
     Examples
     --------
@@ -746,6 +840,25 @@ def summing_junction(
     """A static comparator: ``output`` = the sum of ``inputs``, a name written ``"-name"``
     entering with a minus sign (as python-control's ``summing_junction``). The inputs are named
     without their signs.
+
+    Parameters
+    ----------
+    inputs : str or sequence of str
+        The names of the summed signals, a leading "-" for those subtracted; at least one.
+    output : str
+        The name of the sum.
+    dt : float, optional
+        The sampling period in seconds of a discrete model (default None).
+
+    Returns
+    -------
+    StateSpace
+        A model with no states and D a row of ±1.
+
+    Raises
+    ------
+    InvalidArgumentError
+        No input is given, ``output`` is not a string, or a bad ``dt``.
 
     Examples
     --------
@@ -1159,6 +1272,36 @@ def tf(
     improper num/den (degree of num above that of den) has no state-space model and is
     refused.
 
+    Parameters
+    ----------
+    num : array_like (k,)
+        The numerator's coefficients, highest power first; degree at most that of ``den``.
+    den : array_like (l,)
+        The denominator's coefficients, highest power first, not all zero.
+    dt : float, optional
+        The sampling period in seconds of a discrete model (default None: continuous; 0 is
+        continuous too).
+    input_names, output_names : str or sequence of str, optional
+        The names of the input and the output (default "u0" and "y0", as
+        :class:`~aerocontrol.StateSpace` gives).
+    state_names : str or sequence of str, optional
+        The names of the states, one per state.
+
+    Returns
+    -------
+    StateSpace
+        The model, of order deg(den), one input and one output.
+
+    Raises
+    ------
+    InvalidArgumentError
+        num/den is improper, den is zero, ``dt`` is negative or not finite, or a name is not a
+        string.
+    ShapeError
+        num or den is not 1-D, or a sequence of names has the wrong length.
+    NonFiniteError, NotRealError
+        A coefficient is NaN or infinite, or complex.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -1394,12 +1537,45 @@ def zpk(
     zeros than poles (an improper model) is refused.
 
     No coefficient of a section is formed as the product of two roots: the constant r1 r2 (or
-    |r|²) is kept as a mantissa and a power of two and enters the realisation divided by a
+    abs(r)²) is kept as a mantissa and a power of two and enters the realisation divided by a
     power of two t near its square root (``_section``), so that roots anywhere up to about
     6e307 in modulus, and down to the smallest doubles, are realised, and sections of very
     different sizes are chained in states scaled by powers of two (as :func:`series`). A
     section beyond that (roots of 1e308, or zeros and poles whose products are more than
     2^2045 apart) is refused with InvalidArgumentError naming ``z`` or ``p``.
+
+    Parameters
+    ----------
+    z : array_like (q,)
+        The zeros; complex ones in conjugate pairs; at most as many as the poles.
+    p : array_like (n,)
+        The poles; complex ones in conjugate pairs.
+    k : float
+        The gain (of the highest power of s in the numerator).
+    dt : float, optional
+        The sampling period in seconds of a discrete model (default None: continuous).
+    input_names, output_names : str or sequence of str, optional
+        The names of the input and the output (default "u0" and "y0", as
+        :class:`~aerocontrol.StateSpace` gives).
+    state_names : str or sequence of str, optional
+        The names of the states, one per state.
+
+    Returns
+    -------
+    StateSpace
+        The model, of order len(p), one input and one output.
+
+    Raises
+    ------
+    InvalidArgumentError
+        More zeros than poles, a complex root without its conjugate, a section beyond the
+        range of doubles (naming ``z`` or ``p``), or a bad ``dt``.
+    NonFiniteError, NotRealError
+        A root or the gain is NaN or infinite, or the gain is complex.
+    ShapeError
+        A sequence of names of the wrong length.
+    InvalidArgumentError
+        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -1499,6 +1675,29 @@ def gain(
     A model without states fits any time base in an interconnection; ``dt`` marks it all the
     same.
 
+    Parameters
+    ----------
+    K : float or array_like (p, m)
+        The gain.
+    input_names, output_names : str or sequence of str, optional
+        One name per input (column of K) and per output (row).
+    dt : float, optional
+        The sampling period in seconds of a discrete model (default None).
+
+    Returns
+    -------
+    StateSpace
+        A model with no states and D = K.
+
+    Raises
+    ------
+    ShapeError
+        K is neither a scalar nor 2-D, or a sequence of names has the wrong length.
+    NonFiniteError, NotRealError
+        K contains NaN or an infinity, or is complex.
+    InvalidArgumentError
+        A bad ``dt``, or a name that is not a string.
+
     Examples
     --------
     >>> import aerocontrol
@@ -1537,6 +1736,34 @@ def first_order_lag(
 
     The state is the output divided by ``gain`` (x' = (u - x)/tau, y = gain·x).
 
+    Parameters
+    ----------
+    tau : float
+        The time constant in seconds, positive.
+    gain : float, optional
+        The gain at rest (default 1).
+    input_names, output_names : str or sequence of str, optional
+        The names of the input and the output (default "u0" and "y0", as
+        :class:`~aerocontrol.StateSpace` gives).
+    state_names : str or sequence of str, optional
+        The names of the states, one per state.
+
+    Returns
+    -------
+    StateSpace
+        The model, continuous, one input and one output, of the stated order.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``tau`` is not positive.
+    NonFiniteError, NotRealError
+        ``tau`` or ``gain`` is not finite, or complex.
+    ShapeError
+        A sequence of names of the wrong length.
+    InvalidArgumentError
+        A name that is not a string (or a sequence of them).
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -1568,6 +1795,32 @@ def actuator(
 ) -> StateSpace:
     """A first-order actuator of ``bandwidth`` rad/s (positive): bandwidth/(s + bandwidth),
     unit gain at rest; its state is the surface deflection.
+
+    Parameters
+    ----------
+    bandwidth : float
+        The bandwidth (the pole's magnitude) in rad/s, positive.
+    input_names, output_names : str or sequence of str, optional
+        The names of the input and the output (default "u0" and "y0", as
+        :class:`~aerocontrol.StateSpace` gives).
+    state_names : str or sequence of str, optional
+        The names of the states, one per state.
+
+    Returns
+    -------
+    StateSpace
+        The model, continuous, one input and one output, of the stated order.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``bandwidth`` is not positive.
+    NonFiniteError, NotRealError
+        ``bandwidth`` is not finite, or complex.
+    ShapeError
+        A sequence of names of the wrong length.
+    InvalidArgumentError
+        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -1602,6 +1855,32 @@ def washout(
 
     The state is the input lagged by ``tau`` and the output is the input minus it
     (x' = (u - x)/tau, y = u - x).
+
+    Parameters
+    ----------
+    tau : float
+        The time constant in seconds, positive.
+    input_names, output_names : str or sequence of str, optional
+        The names of the input and the output (default "u0" and "y0", as
+        :class:`~aerocontrol.StateSpace` gives).
+    state_names : str or sequence of str, optional
+        The names of the states, one per state.
+
+    Returns
+    -------
+    StateSpace
+        The model, continuous, one input and one output, of the stated order.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``tau`` is not positive.
+    NonFiniteError, NotRealError
+        ``tau`` is not finite, or complex.
+    ShapeError
+        A sequence of names of the wrong length.
+    InvalidArgumentError
+        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -1639,6 +1918,34 @@ def second_order(
 
     The states are the output y and its rate divided by ω_n (x1' = ω_n x2,
     x2' = ω_n (u - x1) - 2ζω_n x2), which keeps the matrices of size ω_n.
+
+    Parameters
+    ----------
+    omega_n : float
+        The natural frequency in rad/s, positive.
+    zeta : float
+        The damping ratio, non-negative.
+    input_names, output_names : str or sequence of str, optional
+        The names of the input and the output (default "u0" and "y0", as
+        :class:`~aerocontrol.StateSpace` gives).
+    state_names : str or sequence of str, optional
+        The names of the states, one per state.
+
+    Returns
+    -------
+    StateSpace
+        The model, continuous, one input and one output, of the stated order.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``omega_n`` is not positive or ``zeta`` is negative.
+    NonFiniteError, NotRealError
+        An argument is not finite, or complex.
+    ShapeError
+        A sequence of names of the wrong length.
+    InvalidArgumentError
+        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -1685,7 +1992,36 @@ def pade_delay(
     With x = sT the approximant is P(-x)/P(x), P(x) = Σ_k c_k x^k,
     c_k = (2n - k)! n! / ((2n)! k! (n - k)!) (Golub and Van Loan, §9.3.1), computed exactly in
     rational arithmetic; its balanced observable form in x is then scaled to seconds. An
-    all-pass: |G(jω)| = 1 at every frequency, with the phase -ωT at low frequency.
+    all-pass: abs(G(jω)) = 1 at every frequency, with the phase -ωT at low frequency.
+
+    Parameters
+    ----------
+    T : float
+        The delay in seconds, positive.
+    order : int, optional
+        The degree of numerator and denominator, 1 (default) to 20.
+    input_names, output_names : str or sequence of str, optional
+        The names of the input and the output (default "u0" and "y0", as
+        :class:`~aerocontrol.StateSpace` gives).
+    state_names : str or sequence of str, optional
+        The names of the states, one per state.
+
+    Returns
+    -------
+    StateSpace
+        The approximant, continuous, of ``order`` states.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``T`` is not positive, or ``order`` is not an integer from 1 to 20 (beyond 20 the
+        realisation loses digits).
+    NonFiniteError, NotRealError
+        ``T`` is not finite, or complex.
+    ShapeError
+        A sequence of names of the wrong length.
+    InvalidArgumentError
+        A name that is not a string (or a sequence of them).
 
     Examples
     --------

@@ -201,6 +201,16 @@ def discretize(
         :func:`c2d` turns them into a discrete :class:`~aerocontrol.StateSpace` (and has the
         bilinear and matched methods).
 
+    Raises
+    ------
+    InvalidArgumentError
+        ``dt`` is not positive and finite, or so large that A dt overflows; ``method`` is not
+        "zoh" or "foh" (a method of :func:`c2d` is named as such).
+    ShapeError
+        A is not square, or B has not n rows.
+    NonFiniteError, NotRealError
+        A or B contains NaN or an infinity, or is complex.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -410,10 +420,10 @@ def d2c(
         unchanged. The logarithm is real only if Ad has no eigenvalue on the closed negative
         real axis: e^{A dt} never has one, so such a model (a pole at z <= 0, such as a
         one-step delay z = 0) has no continuous equivalent and is refused. Each pole
-        z = |z| e^{jθ} becomes s = (ln|z| + jθ)/dt with |θ| < π: the samples are equally
+        z = r e^{jθ} (r > 0) becomes s = (ln r + jθ)/dt with -π < θ < π: the samples are equally
         those of s + 2πjk/dt for every integer k (aliasing), and the principal one is chosen.
-        When |θ| > 0.9 π (:data:`NYQUIST_FRACTION_WARNING`: a continuous frequency above 90 %
-        of the Nyquist frequency π/dt) the choice is doubtful: the alias (2π - |θ|)/dt is
+        When abs(θ) > 0.9 π (``NYQUIST_FRACTION_WARNING``: a continuous frequency above 90 %
+        of the Nyquist frequency π/dt) the choice is doubtful: the alias (2π - abs(θ))/dt is
         near, and the real logarithm of the pair z, z̄ is sensitive to A by the factor
         θ / sin θ, which grows without bound as θ → π. It is computed, with a warning.
     ``"tustin"`` (``"bilinear"``), ``"euler"``, ``"backward_diff"``, ``"gbt"``
@@ -426,6 +436,23 @@ def d2c(
         is computed with a warning.
 
     First-order hold and matched pole-zero have no inverse here.
+
+    Parameters
+    ----------
+    sys : StateSpace, or another discrete system
+        A discrete model (``dt`` > 0; a continuous one is refused).
+    method : str
+        ``"zoh"`` (default), ``"tustin"``, ``"bilinear"``, ``"euler"``, ``"backward_diff"`` or
+        ``"gbt"``: the method ``sys`` was discretised by.
+    prewarp : float, optional
+        Frequency in rad/s (below π/dt) at which Tustin's map was made exact; Tustin's only.
+    alpha : float, optional
+        The weight of ``method="gbt"``, between 0 and 1; "gbt" only.
+
+    Returns
+    -------
+    StateSpace
+        The continuous model (``dt`` = 0), with the names of ``sys``.
 
     Raises
     ------
@@ -968,7 +995,7 @@ def schur(
     ----------
     A : array_like (n, n), real and finite
     select : None, "lhp", "rhp", "iuc", "ouc", or a callable
-        The eigenvalues to put first: Re < 0, Re > 0, |λ| < 1, |λ| > 1, or those for which
+        The eigenvalues to put first: Re < 0, Re > 0, abs(λ) < 1, abs(λ) > 1, or those for which
         ``select(λ)`` is true (called with the member of a complex pair that has Im > 0; the
         pair moves together).
 
@@ -1077,7 +1104,7 @@ def qz(
     ----------
     A, B : array_like (n, n), real and finite
     select : None, "lhp", "rhp", "iuc", "ouc", or a callable
-        The eigenvalues to put first: Re λ < 0, Re λ > 0, |λ| < 1, |λ| > 1 (λ = α/β; an
+        The eigenvalues to put first: Re λ < 0, Re λ > 0, abs(λ) < 1, abs(λ) > 1 (λ = α/β; an
         infinite eigenvalue counts as outside the unit circle and in neither half plane), or
         those for which ``select(alpha, beta)`` is true (as scipy.linalg.ordqz's ``sort``; for
         a complex pair it is called with the member with Im > 0, and the pair moves together).

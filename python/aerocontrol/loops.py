@@ -1081,6 +1081,26 @@ def sensitivity(loop: System) -> StateSpace:
     feedback; the state space of :func:`~aerocontrol.feedback` (unity forward, L in the
     return path).
 
+    Parameters
+    ----------
+    loop : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        The open loop L, one input and one output (continuous or discrete).
+
+    Returns
+    -------
+    StateSpace
+        S, of the loop's order and time base.
+
+    Raises
+    ------
+    ShapeError
+        ``loop`` has not one input and one output (select the channel with
+        ``loop[output, input]``).
+    NotRealError
+        ``loop`` is not a model.
+    SingularMatrixError
+        1 + D = 0: an algebraic loop.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -1097,6 +1117,26 @@ def sensitivity(loop: System) -> StateSpace:
 def complementary_sensitivity(loop: System) -> StateSpace:
     """T = L/(1 + L): the closed loop from the reference to the output, negative feedback
     (:func:`~aerocontrol.feedback` with unity return). S + T = 1.
+
+    Parameters
+    ----------
+    loop : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        The open loop L, one input and one output (continuous or discrete).
+
+    Returns
+    -------
+    StateSpace
+        T, of the loop's order and time base.
+
+    Raises
+    ------
+    ShapeError
+        ``loop`` has not one input and one output (select the channel with
+        ``loop[output, input]``).
+    NotRealError
+        ``loop`` is not a model.
+    SingularMatrixError
+        1 + D = 0: an algebraic loop.
 
     Examples
     --------
@@ -1777,21 +1817,21 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
 
     * Loop at a time: loop i broken with the others closed, L_i from the input of loop i to
       its output (state space, by :func:`~aerocontrol.feedback`), whose sensitivity is
-      S_ii. Its margin is 1/sup_ω |S_ii + (σ - 1)/2|: for σ = 0, on the default grid, the
+      S_ii. Its margin is 1/sup_ω abs(S_ii + (σ - 1)/2): for σ = 0, on the default grid, the
       disk margin of :func:`stability_margins` (L∞ norm by the Hamiltonian iteration); for
       σ ≠ 0, the peak on the grid refined by zooming. Each loop's classical margins are
-      returned too (:attr:`DiskMargins.loops`).
+      returned too (``DiskMargins.loops``).
     * Multiloop: μ has no closed form for p >= 2; at each frequency an upper bound,
       min over positive diagonal D of σ̄(D M D^-1) (Osborne's scaling, then damped Newton
       steps on a smoothed σ̄, a convex problem in log D), and a lower bound from the power
-      method (|λ| of M U, U diagonal unitary) are computed. The upper bound is μ itself for
+      method (abs(λ) of M U, U diagonal unitary) are computed. The upper bound is μ itself for
       p <= 3 (Packard and Doyle 1993). The peak is refined by zooming in frequency. The
       margin returned is the guaranteed one, 1/sup μ_upper; both bounds are reported, and a
       gap beyond MU_GAP_TOLERANCE warns (LooseBoundWarning). For p = 1 the multiloop
       margin is the loop's disk margin.
 
     The loop's states are first balanced by a diagonal similarity of powers of two (exact,
-    the same L; :func:`balanced_states`), so that states scaled by 10^±6 give the margins
+    the same L; ``balanced_states``), so that states scaled by 10^±6 give the margins
     of the well-scaled loop. The results are checked: the destabilising perturbation of the
     lower bound must make I + L(jω) F singular (I - M Δ where L has a pole at ω;
     AerocontrolLinAlgError otherwise), and the lower bound may not exceed the upper. A
@@ -2039,6 +2079,32 @@ def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
     """The closed-loop poles of 1 + k L(s) = 0 for each gain k of ``gains`` (negative
     feedback for k > 0), as the eigenvalues of A - k B (1 + k D)⁻¹ C.
 
+    Parameters
+    ----------
+    loop : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        The open loop L, one input and one output (continuous or discrete).
+    gains : array_like (k,)
+        The gains, a non-empty 1-D array (negative gains: positive feedback).
+
+    Returns
+    -------
+    RootLocus
+        ``gains`` and ``poles`` of shape (k, n), each row the sorted closed-loop
+        eigenvalues, with the loop, its ``dt`` and ``plot()``.
+
+    Raises
+    ------
+    ShapeError
+        ``loop`` has not one input and one output (select the channel with
+        ``loop[output, input]``).
+    NotRealError
+        ``loop`` is not a model.
+        Also ``gains`` not a non-empty 1-D array.
+    NonFiniteError
+        A gain is NaN or infinite.
+    SingularMatrixError
+        1 + k D = 0 at a gain of ``gains``: an algebraic loop (named).
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -2216,17 +2282,56 @@ def best_damping_gain(
     by continuity along the locus.
 
     The damping is computed on a grid of gains (``gains``, or 0 and 400 gains over six
-    decades about 1/|L| at the loop's modes), then refined by golden-section search between
+    decades about 1/abs(L) at the loop's modes), then refined by golden-section search between
     the best grid gain's neighbours. A gain at which a closed-loop pole is unstable is never
     chosen (its damping counts as -1).
 
+    Parameters
+    ----------
+    loop : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        The open loop L, one input and one output (continuous or discrete).
+    mode : complex, optional
+        An open-loop pole whose branch is tracked; default the least-damped oscillatory
+        closed-loop mode at each gain.
+    gains : array_like (k,), optional
+        The non-negative gains searched; default 0 and 400 gains over six decades about
+        1/abs(L) at the loop's modes.
+
+    Returns
+    -------
+    DampingDesign
+        The ``gain``, the mode's ``damping_ratio`` (of s = ln(z)/dt for a discrete loop; 1
+        when no pole oscillates) and ``pole``, and the ``closed_loop_poles``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``mode`` is not a finite complex number, or a gain is negative.
+    ShapeError
+        ``loop`` has not one input and one output (select the channel with
+        ``loop[output, input]``).
+    NotRealError
+        ``loop`` is not a model.
+        Also ``gains`` not a non-empty 1-D array.
+    SingularMatrixError
+        1 + k D = 0 at a searched gain: an algebraic loop.
+
+    See Also
+    --------
+    gain_for_damping : the smallest gain that gives a chosen damping ratio.
+
     Examples
     --------
+    A lightly damped pair -0.1 ± j with a lead zero at -2 and a pole at -20,
+    20 k (s + 2)/((s² + 0.2 s + 1.01)(s + 20)): the best gain makes every closed-loop pole
+    real (ζ counts as 1).
+
     >>> import numpy as np, aerocontrol
-    >>> # k (s + 1)/(s² (s + 10))... here simply k/(s² + 0.2 s + 1) with a lead (s + 2):
     >>> loop = aerocontrol.zpk([-2.0], [-0.1 + 1j, -0.1 - 1j, -20.0], 20.0)
     >>> best = aerocontrol.best_damping_gain(loop, mode=-0.1 + 1j)
     >>> best.damping_ratio > 0.7
+    True
+    >>> bool(np.all(best.closed_loop_poles.imag == 0))
     True
     """
     model = _siso(loop)
@@ -2258,6 +2363,45 @@ def gain_for_damping(
     damping crosses ``zeta`` (rising, as a damper's, or falling, as a high-gain loop's) is
     refined by Brent's method. A damping that no gain of the grid reaches is refused, naming
     the nearest one.
+
+    Parameters
+    ----------
+    loop : StateSpace, TransferFunction, (A, B, C, D) tuple, or system object
+        The open loop L, one input and one output (continuous or discrete).
+    zeta : float
+        The damping ratio wanted, in (-1, 1).
+    mode : complex, optional
+        An open-loop pole whose branch is tracked; default the least-damped oscillatory
+        closed-loop mode at each gain.
+    gains : array_like (k,), optional
+        The non-negative gains searched; default 0 and 400 gains over six decades about
+        1/abs(L) at the loop's modes.
+
+    Returns
+    -------
+    DampingDesign
+        The ``gain``, the mode's ``damping_ratio`` (``zeta`` to about 1e-10), its ``pole``
+        and the ``closed_loop_poles``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``zeta`` outside (-1, 1) or not finite; no gain of the grid reaches ``zeta`` (the
+        nearest damping and its gain are named); ``mode`` not a finite complex number; a
+        negative gain.
+    ShapeError
+        ``loop`` has not one input and one output (select the channel with
+        ``loop[output, input]``).
+    NotRealError
+        ``loop`` is not a model.
+    SingularMatrixError
+        1 + k D = 0 at a searched gain: an algebraic loop.
+
+    Warns
+    -----
+    IllConditionedWarning
+        The damping ratio jumps at the gain found (from one mode to another) and is not
+        ``zeta`` there.
 
     Examples
     --------
@@ -2904,7 +3048,7 @@ def nyquist(loop: System, omega: ArrayLike | None = None) -> NyquistResponse:
 
     Roots within √u ||A||_F of the boundary (the error of a double integrator's computed
     eigenvalues) are taken to lie on it: open-loop ones are indented and do not count in P;
-    closed-loop ones make the loop :attr:`~NyquistResponse.marginal`, its curve passes
+    closed-loop ones make the loop ``marginal``, its curve passes
     through -1 and N is None (the result is still returned, for the plot).
 
     Parameters

@@ -199,6 +199,22 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
     mode_names : list of str, optional
         Names for the modes in mode order, for the table.
 
+    Returns
+    -------
+    Modes
+        Per mode (a conjugate pair once), ordered by increasing natural frequency: the
+        eigenvalue, natural frequency, damping ratio, damped frequency, period, times to half
+        (double) amplitude, cycles to half and time constant; with all n eigenvalues, the
+        modal matrix P and its condition number, P^-1 B (6.61) for a system, and the
+        characteristic polynomial.
+
+    Raises
+    ------
+    ShapeError
+        A is not square, or ``mode_names`` does not name every mode.
+    NonFiniteError, NotRealError
+        A contains NaN or an infinity, or is complex or not numeric.
+
     Examples
     --------
     >>> import aerocontrol
@@ -267,15 +283,38 @@ def charpoly(A: ArrayLike) -> FloatArray:
     computed, so ill-conditioned eigenvalues do not spoil the coefficients (for the Frank
     matrix of order 12 the result is exact, where multiplying out its computed eigenvalues
     errs by 1e-7 relatively). Accuracy: each a_k carries an absolute error of a modest
-    multiple of u e_k(|λ|) on typical matrices (e_k the elementary symmetric function of the
+    multiple of u e_k(abs(λ)) on typical matrices (e_k the elementary symmetric function of the
     eigenvalue moduli; measured against 80-digit arithmetic on random, graded and non-normal
     matrices of orders 2 to 10); a coefficient that is small only by cancellation is
     correspondingly less accurate relatively. Never formed from powers of A (the Krylov or
     Faddeev-LeVerrier recurrences lose digits geometrically with n).
 
+    Parameters
+    ----------
+    A : array_like (n, n)
+
+    Returns
+    -------
+    ndarray (n + 1,)
+        [1, a_1, ..., a_n].
+
+    Raises
+    ------
+    ShapeError
+        A is not square.
+    NonFiniteError, NotRealError
+        A contains NaN or an infinity, or is complex.
+
+    References
+    ----------
+    R. Rehman and I. C. F. Ipsen, "La Budde's method for computing characteristic
+    polynomials", 2011.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
+    >>> aerocontrol.charpoly([[0, 1], [-2, -3]])     # λ² + 3λ + 2
+    array([1., 3., 2.])
     >>> A, _ = aerocontrol.chapter.boeing747_lateral()
     >>> np.round(aerocontrol.charpoly(A), 4)    # (6.155)
     array([1.    , 1.4385, 0.8222, 0.7232, 0.0319])

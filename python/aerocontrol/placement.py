@@ -98,13 +98,34 @@ def place_bass_gura(
     Parameters
     ----------
     A_or_sys : array_like (n, n), or a system with A and a single-input B
+        With a system, the poles come second: ``place_bass_gura(sys, poles)``.
     b : array_like (n,) or (n, 1)
     poles : sequence of n numbers; complex ones in conjugate pairs
+        Any multiplicity is accepted.
+
+    Returns
+    -------
+    Placement
+        The gain ``K`` (1 x n) and the vector ``k`` of η = -k^T x (6.91), the closed loop
+        A - b k^T (6.93), the requested and achieved poles, their largest relative error and
+        κ_1(V) (``controllability_condition``).
 
     Raises
     ------
     UncontrollableError
         naming the eigenvalues that b cannot move.
+    InvalidArgumentError
+        b has more than one column (use :func:`place`), a pole is not a number, or a complex
+        pole has no conjugate among the poles.
+    ShapeError
+        A is not square, b has not n rows, or ``poles`` is not a 1-D sequence of n numbers.
+    NonFiniteError, NotRealError
+        A, b or a pole is NaN or infinite, or A or b is complex.
+
+    Warns
+    -----
+    IllConditionedWarning
+        κ(V) >= 1e8, or an achieved pole misses by more than 1e-6 relatively.
 
     Examples
     --------
@@ -131,6 +152,46 @@ def place_ackermann(
     evaluated by Horner's rule on vectors, so φ(A) is never formed. Same arguments as
     :func:`place_bass_gura`, and the same gains in exact arithmetic.
 
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n), or a system with A and a single-input B
+        With a system, the poles come second: ``place_ackermann(sys, poles)``.
+    b : array_like (n,) or (n, 1)
+    poles : sequence of n numbers; complex ones in conjugate pairs
+        Any multiplicity is accepted.
+
+    Returns
+    -------
+    Placement
+        The gain ``K`` (1 x n) and the vector ``k``, the closed loop A - b k^T, the requested
+        and achieved poles, their largest relative error and κ_1(V).
+
+    Raises
+    ------
+    UncontrollableError
+        naming the eigenvalues that b cannot move.
+    InvalidArgumentError
+        b has more than one column (use :func:`place`), a pole is not a number, or a complex
+        pole has no conjugate among the poles.
+    ShapeError
+        A is not square, b has not n rows, or ``poles`` is not a 1-D sequence of n numbers.
+    NonFiniteError, NotRealError
+        A, b or a pole is NaN or infinite, or A or b is complex.
+
+    Warns
+    -----
+    IllConditionedWarning
+        κ(V) >= 1e8, or an achieved pole misses by more than 1e-6 relatively.
+
+    See Also
+    --------
+    place_bass_gura : the chapter's formula (6.145), the same gains.
+
+    Examples
+    --------
+    s^2 + 3 s + 2 to (s + 5)(s + 6) = s^2 + 11 s + 30: this A is in companion form, so
+    k = [30 - 2, 11 - 3].
+
     >>> import aerocontrol
     >>> design = aerocontrol.place_ackermann([[0, 1], [-2, -3]], [0, 1], [-5, -6])
     >>> design.k
@@ -148,7 +209,7 @@ def place(
     """Pole placement for one or several inputs, by Kautsky-Nichols-Van Dooren method 0.
 
     The eigenvector of each pole is chosen in its admissible subspace to make the closed-loop
-    eigenvector matrix X as well conditioned as the method can (|det X| maximised column by
+    eigenvector matrix X as well conditioned as the method can (abs(det X) maximised column by
     column, sweeps until it grows by less than 1e-3 relatively, at most 100); a robustly
     placed pole moves little under perturbations of A and B. ``eigenvector_condition`` reports
     κ_2(X).
@@ -156,8 +217,34 @@ def place(
     Parameters
     ----------
     A_or_sys : array_like (n, n), or a system with A and B
+        With a system, the poles come second: ``place(sys, poles)``.
     B : array_like (n, m), full column rank, no zero column
     poles : sequence of n numbers; complex ones in conjugate pairs; each at most rank(B) times
+
+    Returns
+    -------
+    Placement
+        The gain ``K`` (m x n) of η = -K x, the closed loop A - B K, the requested and
+        achieved poles, their largest relative error, the sweeps taken (``iterations``,
+        ``converged``) and κ_2(X) (``eigenvector_condition``).
+
+    Raises
+    ------
+    UncontrollableError
+        naming the eigenvalues that B cannot move.
+    InvalidArgumentError
+        B has a zero column or dependent columns, a pole is repeated more than rank(B) times,
+        a pole is not a number, or a complex pole has no conjugate among the poles.
+    ShapeError
+        A is not square, B is not 2-D with n rows, or ``poles`` is not a 1-D sequence of n
+        numbers.
+    NonFiniteError, NotRealError
+        A, B or a pole is NaN or infinite, or A or B is complex.
+
+    Warns
+    -----
+    IllConditionedWarning
+        An achieved pole misses by more than 1e-6 relatively.
 
     Examples
     --------
@@ -192,11 +279,40 @@ class CompanionForm:
 def companion_form(A_or_sys: ArrayLike | System, b: ArrayLike | None = None) -> CompanionForm:
     """The first companion form of a controllable single-input pair (6.116)-(6.145).
 
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n), or a system with A and a single-input B
+    b : array_like (n,) or (n, 1), optional
+        Required with a matrix A; taken from the system otherwise.
+
+    Returns
+    -------
+    CompanionForm
+        V (6.125), W (6.131), T = (VW)^-1 (6.144), the companion form T A T^-1 (6.116) and
+        the coefficients [1, a_1, ..., a_n] of det(λI - A) (6.106).
+
+    Raises
+    ------
+    UncontrollableError
+        (A, b) is not controllable (the eigenvalues b cannot move are named): T does not exist.
+    InvalidArgumentError
+        b has more than one column.
+    ShapeError
+        A is not square or b has not n rows.
+    NonFiniteError, NotRealError
+        A or b contains NaN or an infinity, or is complex.
+
+    Examples
+    --------
+    det(λI - A) = λ^2 + 3 λ + 2:
+
     >>> import aerocontrol
     >>> form = aerocontrol.companion_form([[0, 1], [-2, -3]], [0, 1])
     >>> form.companion
     array([[-3., -2.],
            [ 1.,  0.]])
+    >>> form.coefficients
+    array([1., 3., 2.])
     """
     A, b = plant_pair(A_or_sys, b, "B")
     result = _core.companion_form(A, b)
@@ -255,7 +371,19 @@ def augment_mode(
 
     Returns
     -------
-    ndarray of complex, length n: the open-loop eigenvalues with the chosen ones replaced.
+    ndarray (n,) of complex128
+        The open-loop eigenvalues with the chosen ones replaced.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``mode`` names no mode, is out of range or is of another type; ``omega_n`` is not
+        positive and finite; ``zeta`` is negative or not finite, or given for a real mode;
+        the system has no states; or the system is discrete (place z = e^{s dt} instead).
+    ShapeError
+        A is not square.
+    NonFiniteError, NotRealError
+        A contains NaN or an infinity, or is complex.
 
     Examples
     --------
@@ -264,6 +392,11 @@ def augment_mode(
     >>> poles = aerocontrol.augment_mode(A, 1, zeta=0.30)           # the Dutch roll
     >>> np.round(np.poly(poles).real, 4)                            # (6.156)
     array([1.    , 1.7258, 1.1891, 0.7396, 0.0319])
+
+    A real mode moves to -omega_n:
+
+    >>> aerocontrol.augment_mode([[0, 1], [-2, -3]], 0, omega_n=4.0)      # poles -1, -2
+    array([-4.+0.j, -2.+0.j])
     """
     analysis = sys_or_A if isinstance(sys_or_A, Modes) else modes(_plant_matrix(sys_or_A))
     k = _select_mode(analysis, mode)

@@ -102,6 +102,23 @@ def label(name: str) -> str:
     """The legend label of a variable: its description and unit for the aircraft models'
     names, the name itself otherwise.
 
+    Parameters
+    ----------
+    name : str
+        A state, input or output name (``"alpha"``, ``"rudder"``, ...).
+
+    Returns
+    -------
+    str
+        "description (unit)" for a known name, the name itself otherwise.
+
+    Raises
+    ------
+    None
+        Any name is accepted.
+
+    Examples
+    --------
     >>> label("alpha"), label("u/u0"), label("x3")
     ('angle of attack α (rad)', 'speed u/u0', 'x3')
     """
@@ -222,6 +239,36 @@ def plot_time_response(
     ``suffix`` (appended to the legend labels) and ``linestyle`` tell two responses apart on
     the same axes, as Figure 6.4 shows the original system and the one with feedback.
 
+    Parameters
+    ----------
+    result : TimeResponse
+        A response of :func:`~aerocontrol.step_response`, :func:`~aerocontrol.initial_response`
+        or another response function.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    signal : {"states", "outputs"}, optional
+        What to draw (default "states").
+    response : int, optional
+        Which response of a result with several (default 0).
+    t_max : float, optional
+        The last time drawn, s (default the whole grid).
+    title : str, optional
+        The title (default the response's kind, and its name if there are several).
+    suffix : str, optional
+        Appended to each legend label (default "").
+    linestyle : str, optional
+        The matplotlib line style (default "-").
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``signal`` is not "states" or "outputs", or ``response`` is out of range.
+
     Examples
     --------
     >>> import matplotlib
@@ -259,6 +306,43 @@ def plot_time_scales(
 
     Compute the response on a grid fine enough for the short scale and long enough for the
     long one, e.g. ``T=np.arange(0, 500.0, 0.02)``.
+
+    Parameters
+    ----------
+    result : TimeResponse
+        A response of :func:`~aerocontrol.step_response`, :func:`~aerocontrol.initial_response`
+        or another response function.
+    short : float
+        The short time scale, s, between 0 and the response's final time.
+    axes : pair of matplotlib.axes.Axes, optional
+        The two axes to draw on (default a new pair side by side, by pyplot).
+    signal : {"states", "outputs"}, optional
+        What to draw (default "states").
+    response : int, optional
+        Which response of a result with several (default 0).
+
+    Returns
+    -------
+    (matplotlib.axes.Axes, matplotlib.axes.Axes)
+        The pair drawn on.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``short`` is not between 0 and the final time, ``axes`` is not a pair of axes,
+        ``signal`` is not "states" or "outputs", or ``response`` is out of range.
+
+    Examples
+    --------
+    The 747's elevator step response: the first 10 s and 200 s.
+
+    >>> import numpy as np
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, plotting, step_response
+    >>> r = step_response(aircraft.load().longitudinal(), T=np.arange(0, 200.0, 0.1))
+    >>> short, long = plotting.plot_time_scales(r, 10.0, axes=Figure().subplots(1, 2))
+    >>> short.get_title(), long.get_title()
+    ('short period scale', 'phugoid scale')
     """
     if not 0 < short < result.t[-1]:
         raise InvalidArgumentError(
@@ -281,7 +365,47 @@ def plot_open_closed(
     signal: str = "states",
 ) -> tuple[Axes, Axes]:
     """The open-loop response beside the closed-loop one on a common scale (Figures 6.4-6.6).
-    Returns the pair of axes."""
+    Returns the pair of axes.
+
+    Parameters
+    ----------
+    open_loop, closed_loop : TimeResponse
+        The two responses (their first response is drawn).
+    axes : pair of matplotlib.axes.Axes, optional
+        The two axes to draw on (default a new pair side by side, by pyplot).
+    titles : (str, str), optional
+        The two titles (default "(a) open loop", "(b) closed loop").
+    signal : {"states", "outputs"}, optional
+        What to draw (default "states").
+
+    Returns
+    -------
+    (matplotlib.axes.Axes, matplotlib.axes.Axes)
+        The pair drawn on.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``axes`` is not a pair of axes, or ``signal`` is not "states" or "outputs".
+
+    Examples
+    --------
+    The 747's lateral motion from β = 0.1 rad, open and with the LQR of (6.224), c = 1:
+
+    >>> import numpy as np, aerocontrol
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import plotting
+    >>> lat = aerocontrol.aircraft.load().lateral()
+    >>> K, _, _ = aerocontrol.lqr(lat.A, lat.B, np.eye(4), np.eye(2))
+    >>> closed = aerocontrol.StateSpace(lat.A - lat.B @ K, lat.B, state_names=lat.state_names,
+    ...                                 input_names=lat.input_names)
+    >>> T = np.arange(0, 20.0, 0.05)
+    >>> o = aerocontrol.initial_response(lat, [0.1, 0, 0, 0], T=T)
+    >>> c = aerocontrol.initial_response(closed, [0.1, 0, 0, 0], T=T)
+    >>> a, b = plotting.plot_open_closed(o, c, axes=Figure().subplots(1, 2))
+    >>> a.get_title(), b.get_title(), a.get_ylim() == b.get_ylim()
+    ('(a) open loop', '(b) closed loop', True)
+    """
     first, second = _pair(
         _new_axes(1, 2, figsize=(11, 4), sharey=True) if axes is None else axes, "axes"
     )
@@ -318,6 +442,49 @@ def plot_with_controls(
     """A regulated response with the control deflections η = -K x (6.230) that produce it,
     dashed, on the same axes (Figures 6.9, 6.10). ``result`` is a response of the closed loop
     A - B K whose input names (if it has one per row of K) name the controls. Returns the axes.
+
+    Parameters
+    ----------
+    result : TimeResponse
+        A response of the closed loop.
+    K : array_like (m, n) or (n,)
+        The state-feedback gain.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    response : int, optional
+        Which response of a result with several (default 0).
+    title : str, optional
+        The title (default the response's kind).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    ShapeError
+        K has not one column per state.
+    InvalidArgumentError
+        ``response`` is out of range.
+    NotRealError
+        K is complex or not numeric (entries beyond the doubles are not drawn).
+
+    Examples
+    --------
+    The 747's lateral regulator (6.224), c = 1, from β = 0.1 rad (Figure 6.9):
+
+    >>> import numpy as np, aerocontrol
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import plotting
+    >>> lat = aerocontrol.aircraft.load().lateral()
+    >>> K, _, _ = aerocontrol.lqr(lat.A, lat.B, np.eye(4), np.eye(2))
+    >>> closed = aerocontrol.StateSpace(lat.A - lat.B @ K, lat.B, state_names=lat.state_names,
+    ...                                 input_names=lat.input_names)
+    >>> c = aerocontrol.initial_response(closed, [0.1, 0, 0, 0], T=np.arange(0, 20.0, 0.05))
+    >>> ax = plotting.plot_with_controls(c, K, ax=Figure().subplots())
+    >>> [line.get_label() for line in ax.get_lines()][4:]
+    ['rudder δr (rad)', 'aileron δa (rad)']
     """
     gain = _gain(K, result)
     states = result.states(_response_index(result, response))
@@ -342,6 +509,27 @@ def plot_compared(
     response and the name of the state or output to draw (states first); the labels in
     ``held`` are drawn as a staircase (the samples of a discrete model, held until the next).
     The y label is the first variable's. Returns the axes.
+
+    Parameters
+    ----------
+    curves : mapping of str to (TimeResponse, str)
+        Legend label to (response, state or output name).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    held : iterable of str, optional
+        The labels drawn as a staircase (default none).
+    title : str, optional
+        The title (default none).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    InvalidArgumentError
+        A curve names a variable that is neither a state nor an output of its response.
 
     Examples
     --------
@@ -385,6 +573,47 @@ def penalty_terms(
     η^T R η with η = -K x (the terms of J, (6.198); R includes the weight 1/c²).
 
     The integral of their sum over a long response is J = x0^T S x0.
+
+    Parameters
+    ----------
+    result : TimeResponse
+        A response of the closed loop A - B K.
+    K : array_like (m, n) or (n,)
+        The state-feedback gain.
+    Q : array_like (n, n)
+        The state weight.
+    R : array_like (m, m)
+        The control weight (including 1/c²).
+    response : int, optional
+        Which response of a result with several (default 0).
+
+    Returns
+    -------
+    state_term : ndarray (k,)
+        x^T Q x at each time.
+    control_term : ndarray (k,)
+        η^T R η at each time; infinite (or NaN) where a term overflows.
+
+    Raises
+    ------
+    ShapeError
+        K has not one column per state, Q is not n x n or R not m x m.
+    InvalidArgumentError
+        ``response`` is out of range.
+    NotRealError
+        K, Q or R is complex or not numeric (a non-finite entry gives non-finite terms).
+
+    Examples
+    --------
+    x' = -2 x from x(0) = 1 (the loop x' = -x + η, η = -x): x = e^{-2t}, so
+    x^T Q x = e^{-4t} and η^T R η = 3 e^{-4t} for Q = 1, R = 3.
+
+    >>> import numpy as np, aerocontrol
+    >>> from aerocontrol import plotting
+    >>> x = aerocontrol.initial_response(([[-2.0]], [[1.0]]), [1.0], T=[0.0, 0.5, 1.0])
+    >>> state, control = plotting.penalty_terms(x, [[1.0]], [[1.0]], [[3.0]])
+    >>> np.round(state, 6), np.round(control, 6)
+    (array([1.      , 0.135335, 0.018316]), array([3.      , 0.406006, 0.054947]))
     """
     gain = _gain(K, result)
     states = result.states(_response_index(result, response))
@@ -414,6 +643,50 @@ def plot_penalty(
     """x^T Q x above the axis and -η^T R η below it along a regulated response, the area
     between them shaded: it is the performance index J (Figure 6.11). The legend gives J by
     the trapezoidal rule. Call once per design on the same axes to compare. Returns the axes.
+
+    Parameters
+    ----------
+    result : TimeResponse
+        A response of the closed loop A - B K.
+    K : array_like (m, n) or (n,)
+        The state-feedback gain.
+    Q : array_like (n, n)
+        The state weight.
+    R : array_like (m, m)
+        The control weight (including 1/c²).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    name : str, optional
+        The design's name, prefixed to the legend labels (default "").
+    response : int, optional
+        Which response of a result with several (default 0).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    ShapeError
+        K has not one column per state, Q is not n x n or R not m x m.
+    InvalidArgumentError
+        ``response`` is out of range.
+
+    Examples
+    --------
+    The 747's lateral regulator (6.224), c = 1, from β = 0.1 rad: J = x0^T S x0 = 0.0709.
+
+    >>> import numpy as np, aerocontrol
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import plotting
+    >>> lat = aerocontrol.aircraft.load().lateral()
+    >>> K, S, _ = aerocontrol.lqr(lat.A, lat.B, np.eye(4), np.eye(2))
+    >>> closed = aerocontrol.StateSpace(lat.A - lat.B @ K, lat.B)
+    >>> c = aerocontrol.initial_response(closed, [0.1, 0, 0, 0], T=np.arange(0, 20.0, 0.05))
+    >>> ax = plotting.plot_penalty(c, K, np.eye(4), np.eye(2), ax=Figure().subplots())
+    >>> ax.get_lines()[0].get_label(), round(float(S[0, 0] * 0.1**2), 4)
+    ("x'Qx (J = 0.07089)", 0.0709)
     """
     state_term, control_term = penalty_terms(result, K, Q, R, response)
     with np.errstate(over="ignore", invalid="ignore"):  # J beyond the doubles: said so
@@ -494,6 +767,47 @@ def plot_root_locus(
     :func:`aerocontrol.design.lqr_root_locus`), a symbol per value in ``marked`` (at the
     nearest computed weight; its colour runs from dark to light as the weight grows), or an
     open circle at the smallest weight when none is marked. Returns the axes.
+
+    Parameters
+    ----------
+    weights : array_like (k,)
+        The weights.
+    poles : array_like (k, n)
+        The closed-loop roots at each weight.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    marked : sequence of float, optional
+        Weights to mark (at the nearest computed one).
+    weight_name : str, optional
+        The weight's symbol in the legend (default "c").
+    title : str, optional
+        The title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    ShapeError
+        ``poles`` is not (len(weights), n).
+    NotRealError
+        ``weights`` is complex or not numeric.
+
+    Examples
+    --------
+    The 747's lateral regulator over c (Figure 6.12), c = 1 marked:
+
+    >>> import numpy as np
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, design, plotting
+    >>> lat = aircraft.load().lateral()
+    >>> c = np.geomspace(1e-2, 10, 50)
+    >>> ax = plotting.plot_root_locus(c, design.lqr_root_locus(lat, c), ax=Figure().subplots(),
+    ...                               marked=[1.0])
+    >>> [line.get_label() for line in ax.get_lines() if not line.get_label().startswith("_")]
+    ['c = 1.04811']
     """
     from matplotlib import colormaps
 
@@ -552,6 +866,42 @@ def plot_gain_root_locus(
     ``marked``, and a grid of constant damping ratio (rays, labelled ζ) and natural frequency
     (arcs, labelled ω_n). A discrete locus is drawn in the z-plane with the unit circle.
     Returns the axes.
+
+    Parameters
+    ----------
+    locus : RootLocus
+        From :func:`aerocontrol.root_locus`.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    marked : sequence of float, optional
+        Gains to mark (at the nearest computed one).
+    zetas : sequence of float, optional
+        The damping ratios of the grid's rays (default 0.1 ... 0.9).
+    title : str, optional
+        The title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    None
+        A :class:`~aerocontrol.loops.RootLocus` is consistent by construction.
+
+    Examples
+    --------
+    k/(s(s + 2)), k = 4 marked (poles -1 ± j√3, ζ = 0.5):
+
+    >>> import numpy as np, aerocontrol
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import plotting
+    >>> loop = aerocontrol.zpk([], [0.0, -2.0], 1.0)
+    >>> locus = aerocontrol.root_locus(loop, np.linspace(0, 10, 51))
+    >>> ax = plotting.plot_gain_root_locus(locus, ax=Figure().subplots(), marked=[4.0])
+    >>> [line.get_label() for line in ax.get_lines() if not line.get_label().startswith("_")]
+    ['k = 4', 'open-loop poles']
     """
     ax = plot_root_locus(
         locus.gains,
@@ -605,7 +955,37 @@ def plot_bode(
     result: FrequencyResponse, ax: Iterable[Axes] | None = None, output: int = 0, input: int = 0
 ) -> tuple[Axes, Axes]:
     """Magnitude (dB) and phase (degrees) against frequency (rad/s, log scale) of one
-    input-output pair, on a pair of axes. Returns the pair."""
+    input-output pair, on a pair of axes. Returns the pair.
+
+    Parameters
+    ----------
+    result : FrequencyResponse
+        From :func:`aerocontrol.bode` or :func:`aerocontrol.frequency_response`.
+    ax : pair of matplotlib.axes.Axes, optional
+        Magnitude and phase axes (default a new pair, one above the other).
+    output, input : int, optional
+        The channel (default 0, 0).
+
+    Returns
+    -------
+    (matplotlib.axes.Axes, matplotlib.axes.Axes)
+        The magnitude and phase axes.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``output`` or ``input`` is out of range, or ``ax`` is not a pair of axes.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> import aerocontrol
+    >>> from aerocontrol import plotting
+    >>> b = aerocontrol.bode(([[-2.0]], [[2.0]]))                  # 2/(s + 2)
+    >>> magnitude, phase = plotting.plot_bode(b, ax=Figure().subplots(2, 1))
+    >>> magnitude.get_ylabel(), phase.get_ylabel(), phase.get_xlabel()
+    ('magnitude (dB)', 'phase (deg)', 'frequency (rad/s)')
+    """
     for value, names, argument in (
         (output, result.output_names, "output"),
         (input, result.input_names, "input"),
@@ -671,14 +1051,35 @@ def plot_nyquist(
     critical point -1 (a red +) and, with ``unit_circle``, the unit circle (dotted: its
     crossings are the gain crossovers). The title gives P, N and Z. Returns the axes.
 
-    Radii beyond ``max_magnitude`` (R) are compressed: a point with |L| = r > R is drawn at
+    Radii beyond ``max_magnitude`` (R) are compressed: a point with abs(L) = r > R is drawn at
     radius R (1 + x/(1 + x)), x = ln(r/R), at its true angle. The map is continuous with
     slope 1 at R, logarithmic in r and bounded by 2R, so the large arcs that are the images of
-    the indentations around poles on the imaginary axis (|L| of 1e4 to 1e12 and more) are
+    the indentations around poles on the imaginary axis (abs(L) of 1e4 to 1e12 and more) are
     drawn between R and 2R and the curve closes as it does in the plane: its encirclements of
     -1 can be counted on the plot. (python-control and MATLAB clip such arcs at a
-    ``max_curve_magnitude`` instead.) The circle |L| = R is drawn, dotted, when a point is
+    ``max_curve_magnitude`` instead.) The circle abs(L) = R is drawn, dotted, when a point is
     compressed.
+
+    Parameters
+    ----------
+    result : NyquistResponse
+        From :func:`aerocontrol.nyquist`.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    unit_circle : bool, optional
+        Draw the unit circle (default False).
+    max_magnitude : float, optional
+        The radius R beyond which radii are compressed, positive (default 20).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``max_magnitude`` is not positive and finite.
 
     Examples
     --------
@@ -777,6 +1178,25 @@ def closed_loop_gain_contour(gain_db: float, count: int = 721) -> tuple[FloatArr
     M = 10^(gain_db/20), θ over the circle (θ = 0 left out for M = 1, where L = ∞). NaN
     separates the pieces where the phase wraps.
 
+    Parameters
+    ----------
+    gain_db : float
+        The closed-loop gain, dB.
+    count : int, optional
+        The points on the circle of θ (default 721).
+
+    Returns
+    -------
+    phase : ndarray, deg
+        The open-loop phases, in (-360°, 0°], NaN between pieces.
+    gain : ndarray, dB
+        The open-loop gains.
+
+    Raises
+    ------
+    None
+        The arguments are not checked (a NaN gives NaN points).
+
     Examples
     --------
     >>> import numpy as np
@@ -798,7 +1218,39 @@ def closed_loop_phase_contour(
     """The open-loop (phase in (-360°, 0°], gain in dB) at which the closed loop
     T = L/(1 + L) has the phase ``phase_deg`` (in (-360°, 0°)): L = T/(1 - T) for
     T = m e^{j phase}, the closed-loop gain 20 log10 m from ``low_db`` to ``high_db`` (L then
-    runs from about ``low_db`` at that phase towards the critical point -1)."""
+    runs from about ``low_db`` at that phase towards the critical point -1).
+
+    Parameters
+    ----------
+    phase_deg : float
+        The closed-loop phase, degrees, in (-360°, 0°).
+    low_db, high_db : float, optional
+        The range of closed-loop gains, dB (default -20 to 32).
+    count : int, optional
+        The points (default 721).
+
+    Returns
+    -------
+    phase : ndarray, deg
+        The open-loop phases, in (-360°, 0°], NaN between pieces.
+    gain : ndarray, dB
+        The open-loop gains.
+
+    Raises
+    ------
+    None
+        The arguments are not checked (:func:`plot_nichols` checks its phases).
+
+    Examples
+    --------
+    Every point of the contour ∠T = -90° has T = L/(1 + L) at -90°:
+
+    >>> import numpy as np
+    >>> phase, gain = closed_loop_phase_contour(-90.0)
+    >>> L = 10 ** (gain / 20) * np.exp(1j * np.radians(phase))
+    >>> bool(np.allclose(np.degrees(np.angle(L / (1 + L))), -90.0))
+    True
+    """
     magnitudes = np.logspace(float(low_db) / 20.0, float(high_db) / 20.0, count)
     return _open_loop_points(magnitudes * np.exp(1j * math.radians(float(phase_deg))))
 
@@ -812,7 +1264,7 @@ def plot_nichols(
 ) -> Axes:
     """The Nichols chart of a :class:`~aerocontrol.loops.NicholsResponse`: open-loop gain (dB)
     against phase (degrees), the critical points (-180° + k 360°, 0 dB) as red +, and with
-    ``grid`` the contours of constant closed-loop gain |T| (``gains_db``) and phase ∠T
+    ``grid`` the contours of constant closed-loop gain abs(T) (``gains_db``) and phase ∠T
     (``phases_deg``, in (-360°, 0°)) of T = L/(1 + L), dotted (from
     :func:`closed_loop_gain_contour` and :func:`closed_loop_phase_contour`, the phase
     contours over the closed-loop gains from the least of ``gains_db`` to 20 dB beyond the
@@ -820,6 +1272,30 @@ def plot_nichols(
     nearest the curve's gain crossover. The curve is broken where its phase steps by more
     than 90° between neighbouring frequencies: across a pole on the imaginary axis, where the
     gain passes through infinity. Returns the axes.
+
+    Parameters
+    ----------
+    result : NicholsResponse
+        From :func:`aerocontrol.nichols`.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    grid : bool, optional
+        Draw the closed-loop contours (default True).
+    gains_db : sequence of float, optional
+        The closed-loop gains of the contours, dB (default -20 ... 12).
+    phases_deg : sequence of float, optional
+        The closed-loop phases of the contours, degrees, each in (-360°, 0°) (default -5 ...
+        -355).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    InvalidArgumentError
+        A phase of ``phases_deg`` outside (-360°, 0°).
 
     Examples
     --------
@@ -936,7 +1412,44 @@ def plot_levels(
 ) -> Axes:
     """MIL-F-8785C Levels over a grid of flight conditions: one cell per (Mach, altitude),
     coloured and labelled by its Level (0: not assessed). ``levels`` is (len(altitudes),
-    len(machs)). Returns the axes."""
+    len(machs)). Returns the axes.
+
+    Parameters
+    ----------
+    machs : array_like (j,)
+        The Mach numbers of the columns.
+    altitudes : array_like (i,)
+        The altitudes of the rows.
+    levels : array_like (i, j) of int
+        The Level of each condition, 0 (not assessed) to 4 (worse than Level 3).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    title : str, optional
+        The title (default "Levels").
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    ShapeError
+        ``levels`` is not (len(altitudes), len(machs)).
+    NotRealError
+        ``machs`` or ``altitudes`` is complex or not numeric.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import plotting
+    >>> ax = plotting.plot_levels([0.2, 0.3], [0, 10000], [[1, 2], [1, 3]],
+    ...                           ax=Figure().subplots())
+    >>> [text.get_text() for text in ax.texts]
+    ['1', '2', '1', '3']
+    >>> [patch.get_label() for patch in ax.get_legend().legend_handles]
+    ['Level 1', 'Level 2', 'Level 3']
+    """
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
 
@@ -967,7 +1480,40 @@ def plot_levels(
 def plot_modes(modes: Modes, ax: Axes | None = None, marker: str = "x", suffix: str = "") -> Axes:
     """The eigenvalues in the complex plane (rad/s), one marker and label per mode; give
     ``marker`` and ``suffix`` (appended to the labels) to overlay two sets, e.g. open and
-    closed loop."""
+    closed loop.
+
+    Parameters
+    ----------
+    modes : Modes
+        From :func:`aerocontrol.modes`.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    marker : str, optional
+        The matplotlib marker (default "x").
+    suffix : str, optional
+        Appended to each label (default "").
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    None
+        Any :class:`~aerocontrol.Modes` is drawn (values beyond the doubles are not drawn).
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> import aerocontrol
+    >>> from aerocontrol import plotting
+    >>> A, _ = aerocontrol.chapter.boeing747_lateral()
+    >>> m = aerocontrol.modes(A, mode_names=["spiral", "dutch roll", "roll"])
+    >>> ax = plotting.plot_modes(m, ax=Figure().subplots())
+    >>> [line.get_label() for line in ax.get_lines()][:3]
+    ['spiral', 'dutch roll', 'roll']
+    """
     ax = _new_axes() if ax is None else ax
     for k, name in enumerate(modes.mode_names):
         lam = modes.eigenvalue[k]
@@ -996,7 +1542,46 @@ def plot_robustness_histogram(
     """The distribution of one mode quantity over the samples of a Monte Carlo run (e.g.
     ``"dutch roll", "zeta"``), with the MIL-F-8785C limit of each Level as a vertical line.
     Non-finite values (a split mode's ζ, a spiral that does not grow) are counted in the title.
-    Returns the axes."""
+    Returns the axes.
+
+    Parameters
+    ----------
+    result : MonteCarlo
+        From :func:`aerocontrol.robustness.monte_carlo`.
+    mode : str
+        The mode ("dutch roll", "roll", "spiral", "short period", "phugoid").
+    quantity : str
+        Its quantity ("zeta", "omega_n", "time constant", "time to double").
+    loop : {"auto", "open", "closed"}, optional
+        The loop (default the closed loop if there is one).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    bins : int, optional
+        The histogram's bins (default 60).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    InvalidArgumentError
+        The run has no quantity "mode: quantity", or ``loop`` is not one of the three (or
+        "closed" for a run without a controller).
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, plotting
+    >>> from aerocontrol.robustness import Normal, Uncertainty, monte_carlo
+    >>> run = monte_carlo(aircraft.load("b747-cruise"),
+    ...                   Uncertainty({"Cn_beta": Normal(0.5), "Cn_r": Normal(0.2)}), 500, seed=3)
+    >>> ax = plotting.plot_robustness_histogram(run, "dutch roll", "zeta",
+    ...                                         ax=Figure().subplots())
+    >>> ax.get_title(), [line.get_label() for line in ax.get_lines()]
+    ('dutch roll: 500 samples', ['Level 1 limit 0.08', 'Level 2 limit 0.02', 'Level 3 limit 0'])
+    """
     from .handling import level_limits
 
     key = f"{mode}: {quantity}"
@@ -1040,9 +1625,47 @@ def plot_probability_convergence(
     ax: Axes | None = None,
     points: int = 60,
 ) -> Axes:
-    """The estimate of a probability (as :meth:`MonteCarlo.probability` takes it) against the
+    """The estimate of a probability (as ``MonteCarlo.probability`` takes it) against the
     number of samples used, with its 95 % Clopper-Pearson band: how many samples the estimate
-    needed. Returns the axes."""
+    needed. Returns the axes.
+
+    Parameters
+    ----------
+    result : MonteCarlo
+        From :func:`aerocontrol.robustness.monte_carlo`.
+    event : {"failed", "unstable", "unresolved", "level"}, optional
+        The event (default "failed").
+    mode : str, optional
+        The mode of a "level" event.
+    level : int, optional
+        The Level of a "level" event (default 1).
+    loop : {"auto", "open", "closed"}, optional
+        The loop (default the closed loop if there is one).
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+    points : int, optional
+        The sample sizes drawn, log-spaced (default 60).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    InvalidArgumentError
+        An unknown event, mode or loop, as ``MonteCarlo.probability`` refuses them.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, plotting
+    >>> from aerocontrol.robustness import Normal, Uncertainty, monte_carlo
+    >>> run = monte_carlo(aircraft.load("b747-cruise"),
+    ...                   Uncertainty({"Cn_beta": Normal(0.5), "Cn_r": Normal(0.2)}), 500, seed=3)
+    >>> plotting.plot_probability_convergence(run, ax=Figure().subplots()).get_title()
+    'P(failed)'
+    """
     from .robustness import clopper_pearson
 
     indicator = result.indicator(event, mode, level, loop)
@@ -1067,7 +1690,36 @@ def plot_probability_convergence(
 def plot_sensitivity(result: MonteCarlo, ax: Axes | None = None) -> Axes:
     """A tornado chart: for each uncertain parameter, the failure rate among the samples in
     the lowest and in the highest tenth of its draw, as bars from the overall failure rate,
-    the parameter the failures depend on most at the top. Returns the axes."""
+    the parameter the failures depend on most at the top. Returns the axes.
+
+    Parameters
+    ----------
+    result : MonteCarlo
+        From :func:`aerocontrol.robustness.monte_carlo`.
+    ax : matplotlib.axes.Axes, optional
+        The axes to draw on (default new axes, by pyplot).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    None
+        Any run is drawn (a decile without samples has no bar).
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> from aerocontrol import aircraft, plotting
+    >>> from aerocontrol.robustness import Normal, Uncertainty, monte_carlo
+    >>> run = monte_carlo(aircraft.load("b747-cruise"),
+    ...                   Uncertainty({"Cn_beta": Normal(0.5), "Cn_r": Normal(0.2)}), 500, seed=3)
+    >>> ax = plotting.plot_sensitivity(run, ax=Figure().subplots())
+    >>> [tick.get_text() for tick in ax.get_yticklabels()]
+    ['Cn_beta', 'Cn_r']
+    """
     ranking = [name for name, _ in result.sensitivity()]
     with np.errstate(invalid="ignore", divide="ignore"):
         rates = result.failures_by_bin / result.samples_by_bin
@@ -1117,6 +1769,26 @@ def plot_gain_schedule(schedule: GainSchedule, ax: Any = None, weight: int = 0) 
     ``ax`` is None (a new grid of panels) or inputs x 4 axes (any sequence or array, in
     row-major order). Returns the axes as a list.
 
+    Parameters
+    ----------
+    schedule : GainSchedule
+        From :func:`aerocontrol.schedule.gain_schedule`.
+    ax : sequence or array of matplotlib.axes.Axes, optional
+        inputs x 4 axes (default a new grid).
+    weight : int, optional
+        The index of the grid's weight (default 0; negative from the end).
+
+    Returns
+    -------
+    list of matplotlib.axes.Axes
+        The panels, row-major.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``weight`` is not an index into the weights, or ``ax`` does not hold one axes per
+        entry of K.
+
     Examples
     --------
     >>> from matplotlib.figure import Figure
@@ -1158,11 +1830,31 @@ def plot_gain_schedule(schedule: GainSchedule, ax: Any = None, weight: int = 0) 
 def plot_envelope_levels(envelope: Envelope, ax: Any = None, weight: int = 0) -> Any:
     """The MIL-F-8785C Levels of an :class:`~aerocontrol.aircraft.Envelope` (an envelope
     sweep, or a gain schedule's closed loop evaluated by
-    :meth:`~aerocontrol.schedule.GainSchedule.evaluate`): an image per mode over Mach (x) and
+    ``GainSchedule.evaluate``): an image per mode over Mach (x) and
     altitude (y) (:func:`plot_levels`), at the grid's ``weight``-th weight.
 
     ``ax`` is None (new axes, one per mode in a row) or one axes per mode, in the order of
     ``envelope.levels``. Returns the axes as a list.
+
+    Parameters
+    ----------
+    envelope : Envelope
+        From :func:`aerocontrol.aircraft.envelope_sweep` or a gain schedule's ``evaluate``.
+    ax : sequence or array of matplotlib.axes.Axes, optional
+        One axes per mode (default a new row).
+    weight : int, optional
+        The index of the grid's weight (default 0; negative from the end).
+
+    Returns
+    -------
+    list of matplotlib.axes.Axes
+        One panel per mode.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``weight`` is not an index into the weights, or ``ax`` does not hold one axes per
+        mode.
 
     Examples
     --------

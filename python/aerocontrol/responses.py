@@ -165,10 +165,44 @@ def _systems(sys: Systems) -> tuple[list[StateSpace], bool]:
 def default_time_grid(sys: Systems) -> FloatArray:
     """The default grid of the responses (see the module documentation).
 
-    Raises InvalidArgumentError when an eigenvalue is so large (|λ| > 2e306) that the step
-    1/(20 |λ|) would not be a normal double, or when ||A||_1 is so far beyond the modes (a
-    nilpotent A of 1e149) that a step with h ||A||_1 <= 2^52 needs more than 100,001 samples
-    to the final time: give the grid T instead."""
+    A step of a twentieth of 1/ρ_max, ρ_max the largest modulus of an eigenvalue, and a final
+    time of 7 time constants -1/σ of the slowest decaying mode (σ its real part; 10/ρ_min when
+    no mode decays), at most 100,001 samples; a discrete model steps by its dt.
+
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, system object, or list of them
+        One model, or a list of models of one size and one sampling period (one response
+        each, on a leading axis). Without C and D the output is the state.
+
+    Returns
+    -------
+    ndarray (k,), s
+        The times, uniform, from 0.
+
+    Raises
+    ------
+    InvalidArgumentError
+        An eigenvalue is so large (modulus ρ > 2e306) that the step 1/(20 ρ) would not be a
+        normal double, or ||A||_1 is so far beyond the modes (a nilpotent A of 1e149) that a step
+        with h ||A||_1 <= 2^52 needs more than 100,001 samples to the final time: give the
+        grid T instead. Also a list of models of different sampling periods.
+    NotRealError
+        ``sys`` is not a model (a number, a string), or a matrix is complex.
+    ShapeError
+        The models of a list differ in size, or the matrices disagree in size.
+    NonFiniteError
+        A matrix contains NaN or an infinity.
+
+    Examples
+    --------
+    x' = -x: steps of 1/20 s to 7 time constants.
+
+    >>> import aerocontrol
+    >>> t = aerocontrol.default_time_grid(([[-1.0]], [[1.0]]))
+    >>> len(t), float(t[1]), float(t[-1])
+    (141, 0.05, 7.0)
+    """
     models, _ = _systems(sys)
     dt = _sampling_period(models)
     if dt > 0.0:
@@ -527,6 +561,41 @@ def impulse_response(
     Equal to the free response from x(0) = B η0. Without ``eta0`` a multi-input system gives
     one response per input.
 
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, system object, or list of them
+        One model, or a list of models of one size and one sampling period (one response
+        each, on a leading axis). Without C and D the output is the state.
+    T : array_like (k,) or float, s, optional
+        A uniform grid starting at 0, a final time, or None (default) for the default grid
+        (:func:`default_time_grid`).
+    eta0 : array_like (m,) or (r, m), optional
+        The input weights η0, one vector or r of them; default 1 for a single input, the m
+        unit vectors (one response per input) for several.
+
+    Returns
+    -------
+    TimeResponse
+        ``t`` (k,), states ``x`` (k, n), outputs ``y`` (k, p) and inputs ``u``, with a
+        leading response axis (r, k, ...) for several responses or models.
+
+    Raises
+    ------
+    InvalidArgumentError
+        T is not uniform, does not start at 0, is not a positive finite final time, is not a
+        multiple of a discrete model's dt, or its step is too long for A; a list mixes
+        sampling periods; or the default grid cannot be made (an eigenvalue beyond 2e306:
+        give T).
+        Also x(0) = B η0 overflowing.
+    ShapeError
+        ``eta0`` has not one weight per input.
+    NotRealError
+        ``sys`` is not a model (a number, a string), or a matrix is complex.
+    ShapeError
+        The models of a list differ in size, or the matrices disagree in size.
+    NonFiniteError
+        A matrix or an input weight contains NaN or an infinity.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -591,6 +660,47 @@ def doublet_response(
 
     Equal to the free response from x(0) = A B η0. Continuous models only: a doublet has no
     sampled equivalent.
+
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, system object, or list of them
+        One model, or a list of models of one size and one sampling period (one response
+        each, on a leading axis). Without C and D the output is the state.
+    T : array_like (k,) or float, s, optional
+        A uniform grid starting at 0, a final time, or None (default) for the default grid
+        (:func:`default_time_grid`).
+    eta0 : array_like (m,) or (r, m), optional
+        The input weights η0, one vector or r of them; default 1 for a single input, the m
+        unit vectors (one response per input) for several.
+
+    Returns
+    -------
+    TimeResponse
+        ``t`` (k,), states ``x`` (k, n), outputs ``y`` (k, p) and inputs ``u``, with a
+        leading response axis (r, k, ...) for several responses or models.
+
+    Raises
+    ------
+    InvalidArgumentError
+        A discrete model (use :func:`forced_response`); x(0) = A B η0 overflows; or T is not
+        uniform, does not start at 0, or is not a positive finite final time.
+    ShapeError
+        ``eta0`` has not one weight per input.
+    NotRealError
+        ``sys`` is not a model (a number, a string), or a matrix is complex.
+    ShapeError
+        The models of a list differ in size, or the matrices disagree in size.
+    NonFiniteError
+        A matrix or an input weight contains NaN or an infinity.
+
+    Examples
+    --------
+    x' = -x + η, y = x: the doublet response is y = -e^{-t}.
+
+    >>> import numpy as np, aerocontrol
+    >>> r = aerocontrol.doublet_response(([[-1.0]], [[1.0]], [[1.0]], [[0.0]]), T=[0, 1, 2])
+    >>> np.round(r.y[:, 0], 6)
+    array([-1.      , -0.367879, -0.135335])
     """
     models, _ = _systems(sys)
     if _sampling_period(models) > 0.0:
@@ -629,6 +739,51 @@ def initial_response(sys: Systems, x0: ArrayLike, T: ArrayLike | None = None) ->
     x[k] = A^k x0.
 
     ``x0`` is one initial state (n,) or several (r, n), computed in one call.
+
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, system object, or list of them
+        One model, or a list of models of one size and one sampling period (one response
+        each, on a leading axis). Without C and D the output is the state.
+    x0 : array_like (n,) or (r, n)
+        The initial state, or r of them.
+    T : array_like (k,) or float, s, optional
+        A uniform grid starting at 0, a final time, or None (default) for the default grid
+        (:func:`default_time_grid`).
+
+    Returns
+    -------
+    TimeResponse
+        ``t`` (k,), states ``x`` (k, n), outputs ``y`` (k, p) and inputs ``u``, with a
+        leading response axis (r, k, ...) for several responses or models.
+
+    Raises
+    ------
+    ShapeError
+        ``x0`` has not n values per state.
+    InvalidArgumentError
+        T is not uniform, does not start at 0, is not a positive finite final time, is not a
+        multiple of a discrete model's dt, or its step is too long for A; a list mixes
+        sampling periods; or the default grid cannot be made (an eigenvalue beyond 2e306:
+        give T).
+    NotRealError
+        ``sys`` is not a model (a number, a string), or a matrix is complex.
+    ShapeError
+        The models of a list differ in size, or the matrices disagree in size.
+    NonFiniteError
+        A matrix or an input weight contains NaN or an infinity.
+
+    Examples
+    --------
+    x' = -x from x(0) = 1 and 2: y = x0 e^{-t}.
+
+    >>> import numpy as np, aerocontrol
+    >>> r = aerocontrol.initial_response(([[-1.0]], [[1.0]]), [[1.0], [2.0]], T=[0, 1, 2])
+    >>> r.x.shape
+    (2, 3, 1)
+    >>> np.round(r.x[:, :, 0], 6)
+    array([[1.      , 0.367879, 0.135335],
+           [2.      , 0.735759, 0.270671]])
     """
     models, _ = _systems(sys)
     n = models[0].n_states
@@ -652,6 +807,40 @@ def step_response(
     integrator), where the chapter's x(t) = (e^{At} - I) A^-1 B η0 (6.43) cannot be used. A
     discrete model steps x[k+1] = A x[k] + B η0 from x[0] = 0 (scipy.signal.dstep's).
 
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, system object, or list of them
+        One model, or a list of models of one size and one sampling period (one response
+        each, on a leading axis). Without C and D the output is the state.
+    T : array_like (k,) or float, s, optional
+        A uniform grid starting at 0, a final time, or None (default) for the default grid
+        (:func:`default_time_grid`).
+    eta0 : array_like (m,) or (r, m), optional
+        The input weights η0, one vector or r of them; default 1 for a single input, the m
+        unit vectors (one response per input) for several.
+
+    Returns
+    -------
+    TimeResponse
+        ``t`` (k,), states ``x`` (k, n), outputs ``y`` (k, p) and inputs ``u``, with a
+        leading response axis (r, k, ...) for several responses or models.
+
+    Raises
+    ------
+    InvalidArgumentError
+        T is not uniform, does not start at 0, is not a positive finite final time, is not a
+        multiple of a discrete model's dt, or its step is too long for A; a list mixes
+        sampling periods; or the default grid cannot be made (an eigenvalue beyond 2e306:
+        give T).
+    ShapeError
+        ``eta0`` has not one weight per input.
+    NotRealError
+        ``sys`` is not a model (a number, a string), or a matrix is complex.
+    ShapeError
+        The models of a list differ in size, or the matrices disagree in size.
+    NonFiniteError
+        A matrix or an input weight contains NaN or an infinity.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -659,6 +848,12 @@ def step_response(
     >>> r = aerocontrol.step_response((A, B), T=np.linspace(0, 8000, 4001), eta0=[np.pi / 180])
     >>> np.round(r.x[-1], 4)                                      # (6.51)
     array([ 0.046 , -0.0186,  0.    , -0.016 ])
+
+    x' = -x + η: y = 1 - e^{-t}.
+
+    >>> r = aerocontrol.step_response(([[-1.0]], [[1.0]], [[1.0]], [[0.0]]), T=[0, 1, 2])
+    >>> np.round(r.y[:, 0], 6)
+    array([0.      , 0.632121, 0.864665])
     """
     models, several_models = _systems(sys)
     first = models[0]
@@ -702,8 +897,9 @@ def forced_response(
 
     Parameters
     ----------
-    sys : system
-    T : array_like, shape (k,)
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, or system object
+        One model.
+    T : array_like, shape (k,), s
         Uniform time grid starting at 0.
     u : array_like, shape (k,), (k, m) or (r, k, m)
         Input samples: one input, several inputs, or r input histories at once.
@@ -712,6 +908,23 @@ def forced_response(
         Input held constant between samples (zero-order hold) or linear between them
         (first-order hold, as scipy.signal.lsim's default interpolation). A discrete model
         takes one input per sample, T steps by its dt, and "foh" is refused.
+
+    Returns
+    -------
+    TimeResponse
+        ``t`` (k,), states ``x`` (k, n), outputs ``y`` (k, p) and inputs ``u``, with a
+        leading response axis (r, k, ...) for several responses or models.
+
+    Raises
+    ------
+    ShapeError
+        A list of models, T not 1-D, u not of shape (k,), (k, m) or (r, k, m), or x0 not of
+        n values per response (or not one per input history).
+    InvalidArgumentError
+        ``method`` is not "zoh" or "foh" ("foh" with a discrete model), T is not uniform or
+        does not start at 0, or T does not step by a discrete model's dt.
+    NotRealError, NonFiniteError
+        ``sys`` is not a model, or an argument is complex, NaN or infinite.
 
     Examples
     --------
@@ -802,6 +1015,31 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     [2e-17, -0.5]] has the eigenvalue 1.4e-17, and -A^-1 B of 9e16 for B = (1, 1)); an
     integrator whose zeros are zeros is refused.
 
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, or system object
+    eta0 : array_like (m,), or float for a single input
+        The step's input weights.
+
+    Returns
+    -------
+    ndarray (n,)
+        x∞.
+
+    Raises
+    ------
+    SingularMatrixError
+        A (for a discrete model A - I) is singular, even equilibrated.
+    ShapeError
+        ``eta0`` is not 1-D with one value per input.
+    NotRealError, NonFiniteError
+        ``sys`` is not a model, or an argument is complex, NaN or infinite.
+
+    Warns
+    -----
+    NumericalOverflowWarning
+        x∞ overflows double precision.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -888,6 +1126,27 @@ def dc_gain(sys: System) -> FloatArray:
     an eigenvalue within 100 n u ||A|| of zero, the solve is made again with the rows and
     columns of A scaled by powers of two (exact) to entries of size 1, and only an A whose
     equilibrated matrix is singular too is refused (see :func:`steady_state`).
+
+    Parameters
+    ----------
+    sys : StateSpace, (A, B) or (A, B, C, D) tuple, or system object
+
+    Returns
+    -------
+    ndarray (p, m)
+        The DC gain; entry (i, j) is output i's steady value per unit step of input j.
+
+    Raises
+    ------
+    SingularMatrixError
+        A (for a discrete model I - A) is singular, even equilibrated: an integrator.
+    NotRealError, NonFiniteError
+        ``sys`` is not a model, or a matrix is complex, NaN or infinite.
+
+    Warns
+    -----
+    NumericalOverflowWarning
+        The gain overflows double precision.
 
     Examples
     --------

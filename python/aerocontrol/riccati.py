@@ -121,11 +121,24 @@ def solve_care(
         from its stable deflating subspace, with the same checks (no refinement).
     S : array_like (n, m), optional; the cross weight (python-control's N)
     E : array_like (n, n), optional; nonsingular
-    refine : bool
+    refine : bool, optional
         Newton refinement (default True).
+
+    Returns
+    -------
+    CareSolution
+        The stabilising solution ``X``, the gain ``K``, the closed-loop eigenvalues, the
+        relative residual, rcond(U11) and the number of Newton steps taken.
 
     Raises
     ------
+    ShapeError
+        A, Q or E is not square, or B, R, S disagree in size with A (the message names the
+        argument).
+    NonFiniteError
+        An argument contains NaN or an infinity.
+    NotRealError
+        An argument is complex or not numeric.
     NotPositiveDefiniteError
         R is not symmetric.
     InvalidArgumentError
@@ -206,7 +219,19 @@ def lqr(
     """The linear-quadratic regulator, called and returning as python-control's ``lqr``.
 
     ``lqr(sys, Q, R)``, ``lqr(A, B, Q, R)`` or ``lqr(A, B, Q, R, N)`` minimise
-    J = ∫ (x^T Q x + η^T R η + 2 x^T N η) dt for x' = A x + B η.
+    J = ∫ (x^T Q x + η^T R η + 2 x^T N η) dt (6.190) for x' = A x + B η; K = R^-1 (B^T S + N^T)
+    (6.200) with S the stabilising solution of the algebraic Riccati equation (6.199).
+
+    Parameters
+    ----------
+    sys_or_A : StateSpace or array_like (n, n)
+        A continuous-time system (its A and B are used), or the plant matrix A.
+    *args : array_like
+        With a system: ``Q, R[, N]``. With a matrix: ``B, Q, R[, N]``: B (n, m), the state
+        weight Q (n, n), the control weight R (m, m) (positive definite), the cross weight
+        N (n, m).
+    N : array_like (n, m), optional
+        The cross weight, by keyword (default none, i.e. zero).
 
     Returns
     -------
@@ -217,14 +242,44 @@ def lqr(
     E : ndarray (n,) of complex128
         The closed-loop eigenvalues, eig(A - B K).
 
-    See :func:`solve_care` for the method, the errors and the diagnostics (which ``lqr``
-    drops, as python-control does; call :func:`solve_care` to see them).
+    Raises
+    ------
+    InvalidArgumentError
+        The wrong number of matrices, N given both by position and by keyword, or R singular.
+        Also a discrete-time system (use :func:`dlqr`).
+    ShapeError, NonFiniteError, NotRealError, NotPositiveDefiniteError
+        As :func:`solve_care`: a matrix of the wrong size, with NaN or infinite entries,
+        complex, or an R that is not symmetric.
+    NoStabilizingSolutionError
+        Some undamped mode is neither controllable nor penalised by Q.
+    IllConditionedError
+        (A, B) is not stabilisable or (Q, A) not detectable.
+
+    Warns
+    -----
+    IllConditionedWarning
+        As :func:`solve_care`.
+
+    See Also
+    --------
+    solve_care : the method, the errors and the diagnostics (which ``lqr`` drops, as
+        python-control does; call :func:`solve_care` to see them).
+
+    Examples
+    --------
+    The 747's lateral regulator (6.224)-(6.227), c = 1:
 
     >>> import numpy as np, aerocontrol
     >>> A, B = aerocontrol.chapter.boeing747_lateral()
-    >>> K, S, E = aerocontrol.lqr(A, B, np.eye(4), np.eye(2))      # (6.224)-(6.227), c = 1
+    >>> K, S, E = aerocontrol.lqr(A, B, np.eye(4), np.eye(2))
     >>> bool(np.all(E.real < 0))
     True
+
+    The chapter's inverted pendulum (6.218), γ = 1, c = 1:
+
+    >>> K, S, E = aerocontrol.lqr([[0, 1], [1, 0]], [[0], [1]], np.diag([1.0, 0.0]), [[1.0]])
+    >>> np.round(K, 6)
+    array([[2.414214, 2.197368]])
     """
     A, B, Q, R, N = _regulator_arguments("lqr", sys_or_A, args, N)
     result = _solve_care(A, B, Q, R, N, None, True, "N")
@@ -286,8 +341,20 @@ def solve_dare(
     S : array_like (n, m), optional; the cross weight (python-control's N)
     E : array_like (n, n), optional
 
+    Returns
+    -------
+    DareSolution
+        The stabilising solution ``X``, the gain ``K``, the closed-loop eigenvalues (inside
+        the unit circle), the relative residual, rcond(E U11) and the Newton steps taken.
+
     Raises
     ------
+    ShapeError
+        A, Q or E is not square, or B, R, S disagree in size with A.
+    NonFiniteError
+        An argument contains NaN or an infinity.
+    NotRealError
+        An argument is complex or not numeric.
     NoStabilizingSolutionError
         The pencil has eigenvalues on the unit circle (a mode on it is neither controllable
         nor penalised), its stable subspace is not a graph, or the computed closed loop is not
@@ -344,6 +411,17 @@ def dlqr(
     ``dlqr(sys, Q, R)``, ``dlqr(A, B, Q, R)`` or ``dlqr(A, B, Q, R, N)`` minimise
     J = Σ (x_k^T Q x_k + u_k^T R u_k + 2 x_k^T N u_k) for x_{k+1} = A x_k + B u_k.
 
+    Parameters
+    ----------
+    sys_or_A : StateSpace or array_like (n, n)
+        A discrete-time system (its A and B are used; a continuous one, dt = 0, is refused),
+        or the transition matrix A.
+    *args : array_like
+        With a system: ``Q, R[, N]``. With a matrix: ``B, Q, R[, N]``: B (n, m), the state
+        weight Q (n, n), the control weight R (m, m), the cross weight N (n, m).
+    N : array_like (n, m), optional
+        The cross weight, by keyword (default none, i.e. zero).
+
     Returns
     -------
     K : ndarray (m, n)
@@ -353,13 +431,43 @@ def dlqr(
     E : ndarray (n,) of complex128
         The closed-loop eigenvalues, eig(A - B K), inside the unit circle.
 
-    See :func:`solve_dare` for the method, the errors and the diagnostics.
+    Raises
+    ------
+    InvalidArgumentError
+        The wrong number of matrices, N given both by position and by keyword, or a
+        continuous-time system (use :func:`lqr`).
+    ShapeError, NonFiniteError, NotRealError
+        As :func:`solve_dare`: a matrix of the wrong size, with NaN or infinite entries, or
+        complex.
+    NoStabilizingSolutionError
+        A mode on the unit circle is neither controllable nor penalised, (A, B) is not
+        stabilisable, or the computed closed loop is not inside the unit circle.
+    SingularMatrixError
+        R + B^T S B is singular.
 
+    Warns
+    -----
+    IllConditionedWarning
+        As :func:`solve_dare`.
+
+    See Also
+    --------
+    solve_dare : the method, the errors and the diagnostics.
+
+    Examples
+    --------
     >>> import numpy as np, aerocontrol
     >>> A = np.array([[1.0, 0.1], [0.0, 1.0]]); B = np.array([[0.005], [0.1]])
     >>> K, S, E = aerocontrol.dlqr(A, B, np.eye(2), [[1.0]])
     >>> bool(np.all(abs(E) < 1)), K.shape
     (True, (1, 2))
+
+    The scalar x_{k+1} = 2 x_k + u_k, Q = R = 1: S = 2 + √5 solves S^2 - 4 S - 1 = 0 and
+    K = 2 S / (1 + S):
+
+    >>> K, S, E = aerocontrol.dlqr([[2.0]], [[1.0]], [[1.0]], [[1.0]])
+    >>> round(float(S[0, 0]), 10), round(float(K[0, 0]), 10)
+    (4.2360679775, 1.6180339887)
     """
     A, B, Q, R, N = _regulator_arguments("dlqr", sys_or_A, args, N)
     solution = _solve_dare(A, B, Q, R, N, None, "N")
@@ -435,14 +543,56 @@ def riccati_ode(
 
     Parameters
     ----------
-    t : array_like (k,), strictly increasing; t[-1] is the final time t_f.
-    Sf : array_like (n, n), optional; the terminal weight S(t_f).
+    A_or_sys : array_like (n, n) or StateSpace
+        The plant matrix A, or a continuous-time system (then the arguments that follow shift
+        one place left: ``Q, R, t[, Sf]``).
+    B : array_like (n, m)
+        The input matrix (with a system: Q).
+    Q : array_like (n, n)
+        The state weight, symmetric positive semidefinite (with a system: R).
+    R : array_like (m, m)
+        The control weight, symmetric positive definite (with a system: t). Required.
+    t : array_like (k,), s
+        The time grid, strictly increasing; t[-1] is the final time t_f. Required.
+    Sf : array_like (n, n), optional
+        The terminal weight S(t_f) (default 0).
 
+    Returns
+    -------
+    RiccatiSolution
+        ``t``, S(t_k) of shape (k, n, n), K(t_k) = R^-1 B^T S(t_k) of shape (k, m, n) and the
+        number of transition-matrix steps taken.
+
+    Raises
+    ------
+    InvalidArgumentError
+        R or t missing, t not 1-D or not strictly increasing, or a discrete-time system (use
+        :func:`riccati_difference`).
+    ShapeError
+        A, Q, Sf not square, or B, R, Sf disagreeing in size with A (named).
+    NonFiniteError, NotRealError
+        An argument contains NaN or an infinity, or is complex.
+    NotPositiveDefiniteError
+        R is not symmetric positive definite.
+
+    See Also
+    --------
+    lqr_finite : the gains K(t) alone.
+    solve_care : the algebraic equation (6.199) that a long horizon converges to.
+
+    Examples
+    --------
     >>> import numpy as np, aerocontrol
     >>> sol = aerocontrol.riccati_ode([[0, 1], [1, 0]], [[0], [1]], np.diag([1.0, 0]), [[1.0]],
     ...                                np.linspace(0, 20, 5))
     >>> np.round(sol.K[0], 6)            # the algebraic (steady-state) gain, t_f - t = 20
     array([[2.414214, 2.197368]])
+
+    The integrator x' = u with Q = R = 1 has S(t) = tanh(t_f - t):
+
+    >>> sol = aerocontrol.riccati_ode([[0.0]], [[1.0]], [[1.0]], [[1.0]], [0.0, 1.0, 2.0])
+    >>> np.round(sol.S[:, 0, 0], 6), np.round(np.tanh([2.0, 1.0, 0.0]), 6)
+    (array([0.964028, 0.761594, 0.      ]), array([0.964028, 0.761594, 0.      ]))
     """
     A: ArrayLike  # the system's plant matrix or the caller's
     if is_system(A_or_sys):
@@ -479,7 +629,43 @@ def lqr_finite(
     Sf: ArrayLike | None = None,
 ) -> FloatArray:
     """The time-varying gain K(t) = R^-1 B^T S(t) of the finite-horizon regulator (6.200), shape
-    (len(t), m, n); arguments as :func:`riccati_ode`."""
+    (len(t), m, n); arguments as :func:`riccati_ode`.
+
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n) or StateSpace
+        The plant matrix A, or a continuous-time system (then the arguments that follow shift
+        one place left: ``Q, R, t[, Sf]``).
+    B : array_like (n, m)
+        The input matrix (with a system: Q).
+    Q : array_like (n, n)
+        The state weight (with a system: R).
+    R : array_like (m, m)
+        The control weight, symmetric positive definite (with a system: t). Required.
+    t : array_like (k,), s
+        The time grid, strictly increasing; t[-1] is the final time t_f. Required.
+    Sf : array_like (n, n), optional
+        The terminal weight S(t_f) (default 0, (6.197)).
+
+    Returns
+    -------
+    ndarray (k, m, n)
+        K(t_k) on the grid; the control is η = -K(t) x.
+
+    Raises
+    ------
+    InvalidArgumentError, ShapeError, NonFiniteError, NotRealError, NotPositiveDefiniteError
+        As :func:`riccati_ode`.
+
+    Examples
+    --------
+    The integrator x' = u with Q = R = 1: K(t) = tanh(t_f - t), zero at t_f.
+
+    >>> import numpy as np, aerocontrol
+    >>> K = aerocontrol.lqr_finite([[0.0]], [[1.0]], [[1.0]], [[1.0]], [0.0, 1.0, 2.0])
+    >>> K.shape, np.round(K[:, 0, 0], 6)
+    ((3, 1, 1), array([0.964028, 0.761594, 0.      ]))
+    """
     gains: FloatArray = riccati_ode(A_or_sys, B, Q, R, t, Sf).K
     return gains
 
@@ -528,8 +714,39 @@ def riccati_difference(
     that error is returned (``error_estimate``) and warned about. A long horizon converges to
     :func:`solve_dare`'s X.
 
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n) or StateSpace
+        The transition matrix A, or a discrete-time system (then the arguments that follow
+        shift one place left: ``Q, R, steps[, Sf]``).
+    B : array_like (n, m)
+        The input matrix (with a system: Q).
+    Q : array_like (n, n)
+        The state weight (with a system: R).
+    R : array_like (m, m)
+        The control weight (with a system: steps). Required.
+    steps : int
+        The horizon N, a non-negative integer. Required.
+    Sf : array_like (n, n), optional
+        The terminal weight S_N (default 0).
+    N : array_like (n, m), optional
+        The cross weight (default 0).
+
+    Returns
+    -------
+    RiccatiDifferenceSolution
+        S_0 .. S_N of shape (N + 1, n, n), K_0 .. K_{N-1} of shape (N, m, n), the smallest
+        rcond(R + B^T S_{k+1} B) and the largest estimated relative error of a step.
+
     Raises
     ------
+    InvalidArgumentError
+        R or steps missing, steps not a non-negative integer (a bool or a float is refused),
+        or a continuous-time system (dt = 0: use :func:`riccati_ode`).
+    ShapeError
+        A, Q, Sf not square, or B, R, Sf, N disagreeing in size with A (named).
+    NonFiniteError, NotRealError
+        An argument contains NaN or an infinity, or is complex.
     IllConditionedError
         R + B^T S_{k+1} B is singular to working precision at some step (named), or S_k
         leaves the range of doubles.
@@ -540,6 +757,13 @@ def riccati_difference(
         rcond(R + B^T S_{k+1} B) < 1e-8 at some step (the gains may have lost digits), or the
         error estimate is above 1e-8 (S_k may have).
 
+    See Also
+    --------
+    dlqr_finite : the gains K_k alone.
+    solve_dare : the algebraic equation a long horizon converges to.
+
+    Examples
+    --------
     >>> import aerocontrol
     >>> sol = aerocontrol.riccati_difference([[2.0]], [[1.0]], [[1.0]], [[1.0]], 4)
     >>> [round(float(s), 12) for s in sol.S[:, 0, 0]]     # (5 s + 1) / (1 + s) backward from 0
@@ -611,6 +835,44 @@ def dlqr_finite(
     """The time-varying gains K_0 .. K_{N-1} of the discrete finite-horizon regulator, shape
     (steps, m, n); arguments as :func:`riccati_difference`.
 
+    Parameters
+    ----------
+    A_or_sys : array_like (n, n) or StateSpace
+        The transition matrix A, or a discrete-time system (then the arguments that follow
+        shift one place left: ``Q, R, steps[, Sf]``).
+    B : array_like (n, m)
+        The input matrix (with a system: Q).
+    Q : array_like (n, n)
+        The state weight (with a system: R).
+    R : array_like (m, m)
+        The control weight (with a system: steps). Required.
+    steps : int
+        The horizon N, a non-negative integer. Required.
+    Sf : array_like (n, n), optional
+        The terminal weight S_N (default 0).
+    N : array_like (n, m), optional
+        The cross weight (default 0).
+
+    Returns
+    -------
+    ndarray (steps, m, n)
+        K_0 .. K_{N-1}; the control is u_k = -K_k x_k.
+
+    Raises
+    ------
+    InvalidArgumentError, ShapeError, NonFiniteError, NotRealError, IllConditionedError
+        As :func:`riccati_difference`.
+
+    Warns
+    -----
+    IllConditionedWarning
+        As :func:`riccati_difference`.
+
+    Examples
+    --------
+    x_{k+1} = 2 x_k + u_k, Q = R = 1, three steps: K_k = 2 S_{k+1} / (1 + S_{k+1}) with
+    S = 3, 1, 0.
+
     >>> import aerocontrol
     >>> aerocontrol.dlqr_finite([[2.0]], [[1.0]], [[1.0]], [[1.0]], 3)[:, 0, 0].tolist()
     [1.5, 1.0, 0.0]
@@ -627,8 +889,34 @@ def solve_lyapunov(A: ArrayLike, Q: ArrayLike) -> FloatArray:
     eigenvalues of A add up to zero; that case raises ``IllConditionedError``. For a stable A
     and Q = C^T C, X is the observability Gramian of (C, A^T).
 
+    Parameters
+    ----------
+    A : array_like (n, n)
+        Real, with no two eigenvalues adding up to zero.
+    Q : array_like (n, n)
+        Real, usually symmetric.
+
+    Returns
+    -------
+    ndarray (n, n)
+        X, symmetric when Q is.
+
+    Raises
+    ------
+    ShapeError
+        A or Q is not square, or their sizes differ.
+    NonFiniteError, NotRealError
+        A or Q contains NaN or an infinity, or is complex.
+    IllConditionedError
+        Two eigenvalues of A add up to zero to working precision (a mode on the imaginary
+        axis, or a pair mirrored about it): the solution is not unique.
+
+    Notes
+    -----
     Note the sign: scipy.linalg.solve_continuous_lyapunov(A, Q) solves A X + X A^T = Q.
 
+    Examples
+    --------
     >>> import numpy as np, aerocontrol
     >>> aerocontrol.solve_lyapunov([[-1.0, 0.0], [0.0, -3.0]], [[2.0, 4.0], [4.0, 6.0]])
     array([[1., 1.],

@@ -2,7 +2,7 @@
 altitude x Mach (x weight) grid, the gains as tables, and the control law they make flown
 between the design points.
 
-At each grid condition (the aircraft moved by :meth:`Aircraft.at`, as
+At each grid condition (the aircraft moved by ``Aircraft.at``, as
 :func:`aerocontrol.aircraft.envelope_sweep` builds its conditions) a gain K is designed,
 u = -K x: the linear-quadratic regulator minimising J = ∫ x^T Q x + (1/c²) u^T R u dt (the
 chapter's (6.224)-(6.227), weighted as :func:`aerocontrol.batch.lqr_sweep` and
@@ -15,7 +15,7 @@ fraction of its grid cell a coordinate covers,
     K(h, M, W) = Σ_corners Π_i (t_i or 1 - t_i) K_corner,                                (1)
 
 linear along each grid axis, equal to the table at the grid points and exact for a table
-that is itself linear in each coordinate. :meth:`GainSchedule.evaluate` flies the
+that is itself linear in each coordinate. ``GainSchedule.evaluate`` flies the
 interpolated law over a finer grid and judges the closed loop A - B K(h, M, W) against
 MIL-F-8785C (3.2, 3.3), the models, eigenvalues, modes and Levels computed in bulk.
 
@@ -371,7 +371,7 @@ def gain_schedule(
 ) -> GainSchedule:
     """A state-feedback gain u = -K x designed at every condition of an altitude x Mach
     (x weight) grid, the conditions those of :func:`aerocontrol.aircraft.envelope_sweep`
-    (:meth:`Aircraft.at`).
+    (``Aircraft.at``).
 
     Parameters
     ----------
@@ -396,7 +396,7 @@ def gain_schedule(
     axis : {"lateral", "longitudinal"}
     client : dask.distributed.Client, optional
         Judge the closed loops at the grid conditions in chunks on this Dask cluster (as
-        :meth:`GainSchedule.evaluate`); the design itself is one batch call.
+        ``GainSchedule.evaluate``); the design itself is one batch call.
     zeta : float
         The damper's Dutch-roll damping ratio.
 
@@ -409,7 +409,7 @@ def gain_schedule(
     InvalidArgumentError
         ``plane`` not an Aircraft, an unknown ``design`` or ``axis``, the damper asked of the
         longitudinal axis, ``c`` not positive, a grid not strictly increasing or not finite,
-        a condition outside the plausible ranges (:meth:`Aircraft.at`); a condition whose
+        a condition outside the plausible ranges (``Aircraft.at``); a condition whose
         design fails raises that design's error (e.g. NoStabilizingSolutionError, naming the
         problem of the batch).
     ShapeError

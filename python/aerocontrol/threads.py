@@ -48,11 +48,33 @@ def set_num_threads(count: int | None) -> None:
     """Run aerocontrol's parallel work on ``count`` threads from now on; None returns to the
     default (``RAYON_NUM_THREADS``, else one thread per core).
 
+    Parameters
+    ----------
+    count : int or None
+        The number of threads, positive, at most four per core (and at least 256 allowed);
+        None for the default.
+
+    Returns
+    -------
+    None
+
     Raises
     ------
     InvalidArgumentError
         ``count`` is not a positive int or None, exceeds four threads per core (and 256), or
         that many threads cannot be started.
+
+    See Also
+    --------
+    limit_threads : the same for a ``with`` block only.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> with aerocontrol.limit_threads(None):       # the earlier setting comes back after
+    ...     aerocontrol.set_num_threads(1)
+    ...     aerocontrol.get_num_threads()
+    1
     """
     global _chosen
     value = None if count is None else _count(count)
@@ -64,14 +86,57 @@ def set_num_threads(count: int | None) -> None:
 
 
 def get_num_threads() -> int:
-    """The number of threads aerocontrol's parallel work runs on now."""
+    """The number of threads aerocontrol's parallel work runs on now.
+
+    Returns
+    -------
+    int
+        The threads of the pool: the count set by :func:`set_num_threads` or
+        :func:`limit_threads`, else ``RAYON_NUM_THREADS``, else one per core.
+
+    Raises
+    ------
+    None
+        It only reads the setting.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> with aerocontrol.limit_threads(2):
+    ...     aerocontrol.get_num_threads()
+    2
+    """
     return _core.get_num_threads()
 
 
 @contextlib.contextmanager
 def limit_threads(count: int | None) -> Iterator[None]:
     """:func:`set_num_threads` for a ``with`` block; the earlier setting comes back after it
-    (also when the block raises)."""
+    (also when the block raises).
+
+    Parameters
+    ----------
+    count : int or None
+        The number of threads inside the block, as :func:`set_num_threads`; None for the
+        default.
+
+    Returns
+    -------
+    contextlib.AbstractContextManager[None]
+        A context manager; ``with limit_threads(n):`` runs its block on n threads.
+
+    Raises
+    ------
+    InvalidArgumentError
+        As :func:`set_num_threads`, on entering the block (the setting is then unchanged).
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> with aerocontrol.limit_threads(1):
+    ...     aerocontrol.get_num_threads()
+    1
+    """
     earlier = _chosen
     set_num_threads(count)
     try:

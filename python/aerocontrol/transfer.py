@@ -548,6 +548,20 @@ def transmission_zeros(sys: System, tol: float | None = None) -> ComplexArray:
         part as computed, never NaN), with a NumericalOverflowWarning, and takes its place in
         the same order: a real part of -inf first, +inf last.
 
+    Raises
+    ------
+    InvalidArgumentError
+        ``tol`` is negative or not finite.
+    NotRealError
+        ``sys`` is not a model, or a matrix is complex.
+    NonFiniteError, ShapeError
+        A matrix contains NaN or an infinity, or the matrices disagree in size.
+
+    Warns
+    -----
+    NumericalOverflowWarning
+        A zero has a part beyond the range of doubles.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -1137,6 +1151,16 @@ def transfer_function(
         ``numerator``, ``denominator``, ``zeros``, ``poles``, ``gain``, and the factored
         form (``print``).
 
+    Raises
+    ------
+    InvalidArgumentError
+        ``output`` or ``input`` names no signal, is out of range, is of another type, or is
+        omitted for a model with several outputs (inputs).
+    NotRealError
+        ``sys`` is not a model, or a matrix is complex.
+    NonFiniteError, ShapeError
+        A matrix contains NaN or an infinity, or the matrices disagree in size.
+
     Examples
     --------
     >>> import numpy as np, aerocontrol
@@ -1371,6 +1395,13 @@ def transfer_matrix(sys: System) -> TransferMatrix:
     TransferMatrix
         ``g[output, input]`` a :class:`TransferFunction`, ``g(s)`` the values, of shape
         (outputs, inputs) + the shape of ``s``.
+
+    Raises
+    ------
+    NotRealError
+        ``sys`` is not a model, or a matrix is complex.
+    NonFiniteError, ShapeError
+        A matrix contains NaN or an infinity, or the matrices disagree in size.
 
     Examples
     --------
