@@ -48,7 +48,6 @@ numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 # Signatures without annotations: the docstrings' Parameters say the types in words.
 autodoc_typehints = "none"
-autodoc_default_options = {"members": False}
 autosummary_generate = False
 autosummary_imported_members = False
 
