@@ -1042,3 +1042,29 @@ def test_d2c_refuses_a_continuous_model_beyond_the_doubles_by_name() -> None:
             aerocontrol.d2c(sampled, "tustin")
     assert caught.value.argument == "sys"
     assert not isinstance(caught.value, aerocontrol.NonFiniteError)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda sys: aerocontrol.dlqr(sys, np.eye(2), 1.0),
+        lambda sys: aerocontrol.dlqe(sys, np.eye(1), np.eye(1)),
+        lambda sys: aerocontrol.riccati_difference(sys, np.eye(2), [[1.0]], 5),
+        lambda sys: aerocontrol.batch.dlqr_sweep(sys, Q=np.eye(2), R=[[1.0]], weights=[1.0]),
+        lambda sys: aerocontrol.kalman(sys, np.eye(1), np.eye(1), dt=0.1),
+    ],
+    ids=["dlqr", "dlqe", "riccati_difference", "dlqr_sweep", "kalman"],
+)
+def test_discrete_designs_refuse_a_model_marked_continuous(call: Any) -> None:
+    A, B = np.array([[1.0, 0.1], [0.0, 1.0]]), np.array([[0.005], [0.1]])
+    C = np.array([[1.0, 0.0]])
+    scipy_signal = pytest.importorskip("scipy.signal")
+    for continuous in (
+        StateSpace(A, B, C, dt=0),
+        control.ss(A, B, C, 0),
+        scipy_signal.StateSpace(A, B, C, np.zeros((1, 1))),
+    ):
+        with pytest.raises(InvalidArgumentError, match="discrete-time"):
+            call(continuous)
+    call(StateSpace(A, B, C, dt=0.1))  # a sampled model is designed for
+    call(scipy_signal.StateSpace(A, B, C, np.zeros((1, 1)), dt=0.1))

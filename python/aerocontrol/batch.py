@@ -35,7 +35,7 @@ from ._validation import FloatArray, real_array
 from .exceptions import AerocontrolError, IllConditionedWarning, InvalidArgumentError, ShapeError
 from .placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
 from .riccati import RCOND_WARNING, RESIDUAL_WARNING
-from .statespace import as_state_space, is_system, require_continuous
+from .statespace import as_state_space, is_system, require_continuous, require_discrete
 
 if TYPE_CHECKING:
     from ._typing import SystemObject
@@ -563,10 +563,8 @@ def _sweep(
         sys = as_state_space(sys_or_A)
         if not discrete:
             require_continuous(sys, name, "use dlqr_sweep")
-        elif sys.dt == 0:
-            raise InvalidArgumentError(
-                f"{name} needs a discrete-time system, got a continuous one (dt = 0); use lqr_sweep"
-            )
+        else:
+            require_discrete(sys_or_A, name, "use lqr_sweep, or discretise the model first (c2d)")
         A_matrix, B_matrix = sys.A, sys.B
     else:
         if B is None:

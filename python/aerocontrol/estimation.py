@@ -52,7 +52,13 @@ from .exceptions import (
 )
 from .placement import POLE_ERROR_WARNING, place
 from .riccati import CareSolution, DareSolution, solve_care, solve_dare
-from .statespace import StateSpace, as_state_space, is_system
+from .statespace import (
+    StateSpace,
+    as_state_space,
+    is_continuous_model,
+    is_system,
+    require_discrete,
+)
 
 if TYPE_CHECKING:
     from ._typing import System, SystemObject
@@ -507,10 +513,8 @@ def dlqe(
     >>> round(float(L[0, 0]), 12), round(float(E[0].real), 12)
     (0.61803398875, 0.38196601125)
     """
-    if is_system(sys_or_A) and getattr(sys_or_A, "dt", None) == 0:
-        raise InvalidArgumentError(
-            "dlqe needs a discrete-time system, got a continuous one (dt = 0); use lqe"
-        )
+    if is_system(sys_or_A):
+        require_discrete(sys_or_A, "dlqe", "use lqe, or discretise the model first (c2d)")
     model = _estimator_arguments("dlqe", sys_or_A, args, NN)
     solution = _solve_filter(model, True)
     return solution.L, solution.P, solution.poles
@@ -618,11 +622,10 @@ def _sampling_time(sys: object, dt: object) -> tuple[bool, float | None]:
         error = InvalidArgumentError(f"dt must be a positive sampling period, got {period}")
         error.argument, error.value = "dt", period
         raise error
-    if is_system(sys) and getattr(sys, "dt", None) == 0:
+    if is_system(sys) and is_continuous_model(sys):
         raise InvalidArgumentError(
-            "sys is a continuous-time model (dt = 0): dt marks the given matrices as "
-            "discrete-time, it does not discretise them; discretise the model first "
-            "(aerocontrol.discretize)"
+            "sys is a continuous-time model: dt marks the given matrices as discrete-time, it "
+            "does not discretise them; discretise the model first (aerocontrol.c2d)"
         )
     if own_dt is not None and own_dt != period:
         raise InvalidArgumentError(f"dt = {period} disagrees with the model's dt = {own_dt}")

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError
-from .statespace import as_state_space, is_system, require_continuous
+from .statespace import as_state_space, is_system, require_continuous, require_discrete
 
 if TYPE_CHECKING:
     from ._typing import SystemObject
@@ -489,10 +489,8 @@ def _regulator_arguments(
         sys = as_state_space(sys_or_A)
         if name == "lqr":
             require_continuous(sys, "lqr", "use dlqr for the discrete regulator")
-        elif getattr(sys_or_A, "dt", None) == 0:
-            raise InvalidArgumentError(
-                "dlqr needs a discrete-time system, got a continuous one (dt = 0); use lqr"
-            )
+        else:
+            require_discrete(sys_or_A, "dlqr", "use lqr, or discretise the model first (c2d)")
         A, B, Q, R = sys.A, sys.B, args[0], args[1]
         weights_given = 2
     else:
@@ -773,11 +771,7 @@ def riccati_difference(
     """
     A: ArrayLike  # the system's plant matrix or the caller's
     if is_system(A_or_sys):
-        if getattr(A_or_sys, "dt", None) == 0:
-            raise InvalidArgumentError(
-                "riccati_difference needs a discrete-time system, got a continuous one "
-                "(dt = 0); use riccati_ode"
-            )
+        require_discrete(A_or_sys, "riccati_difference", "use riccati_ode")
         sys = as_state_space(A_or_sys)
         # riccati_difference(sys, Q, R, steps, Sf, N): every argument shifts one place left.
         horizon: object = R

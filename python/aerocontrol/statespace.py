@@ -348,6 +348,26 @@ def require_continuous(model: StateSpace, function: str, instead: str) -> None:
         )
 
 
+def is_continuous_model(value: object) -> bool:
+    """Whether a model object is marked continuous-time: ``dt = 0`` (a :class:`StateSpace` or
+    python-control's), or a continuous scipy.signal system (whose ``dt`` is None). ``dt =
+    None`` elsewhere leaves the time base unsaid, as in python-control: such a model is taken
+    as continuous by the continuous functions and is not refused by the discrete ones."""
+    dt = getattr(value, "dt", None)
+    if dt is None:
+        return type(value).__module__.startswith("scipy.signal")
+    return not isinstance(dt, bool) and dt == 0
+
+
+def require_discrete(model: object, function: str, instead: str) -> None:
+    """Refuses a model marked continuous in a discrete-time design function, which would
+    otherwise solve the discrete problem for the matrices of the continuous one."""
+    if is_continuous_model(model):
+        raise InvalidArgumentError(
+            f"{function} needs a discrete-time system, got one marked continuous-time; {instead}"
+        )
+
+
 def continuous_eigenvalues(model: StateSpace) -> NDArray[np.complex128]:
     """The eigenvalues of A for a continuous model; for a discrete one, those of the equivalent
     continuous model, s = ln(z) / dt (principal logarithm: a real z < 0 gives the Nyquist
