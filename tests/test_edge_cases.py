@@ -7,6 +7,8 @@ exception.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,7 @@ from aerocontrol import (
     IllConditionedWarning,
     InvalidArgumentError,
     NumericalOverflowWarning,
+    ShapeError,
 )
 
 
@@ -95,3 +98,24 @@ def test_method_must_be_one_of_the_names() -> None:
         aerocontrol.discretize(A, B, 0.1, method=np.array(["zoh", "foh"]))  # type: ignore[arg-type]
     d = aerocontrol.discretize(A, B, 0.1, method=np.str_("foh"))  # type: ignore[arg-type]
     assert d.method == "foh" and type(d.method) is str
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda names: aerocontrol.summing_junction(names, "e"),
+        lambda names: aerocontrol.modes(np.diag([-1.0, -2.0]), mode_names=names),
+        lambda names: aerocontrol.StateSpace(np.eye(2), np.ones((2, 1)), state_names=names),
+    ],
+    ids=["summing_junction", "modes", "StateSpace"],
+)
+def test_names_are_strings_or_sequences_of_strings(call: Any) -> None:
+    for bad in (3, [1, 2], 2.5, [b"a", b"b"]):
+        with pytest.raises(InvalidArgumentError, match="must be a string or a sequence of strings"):
+            call(bad)
+
+
+def test_one_string_is_one_name() -> None:
+    with pytest.raises(ShapeError, match="mode_names must name 2 modes, got 1"):
+        aerocontrol.modes(np.diag([-1.0, -2.0]), mode_names="ab")
+    assert aerocontrol.summing_junction("-r", "e").input_names == ("r",)

@@ -63,7 +63,7 @@ from .exceptions import (
     ShapeError,
     SingularMatrixError,
 )
-from .statespace import StateSpace, as_state_space, period
+from .statespace import StateSpace, as_state_space, name_sequence, period
 
 if TYPE_CHECKING:
     from ._typing import System
@@ -867,7 +867,7 @@ def summing_junction(
     >>> error.input_names, error.output_names, error.D
     (('r command', 'r washed'), ('e',), array([[ 1., -1.]]))
     """
-    specs = (inputs,) if isinstance(inputs, str) else tuple(inputs)
+    specs = name_sequence(inputs, "inputs")
     if not specs:
         raise InvalidArgumentError("summing_junction needs at least one input")
     names, signs = [], []

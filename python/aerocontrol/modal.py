@@ -42,7 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, ShapeError
-from .statespace import is_system, plant_arrays
+from .statespace import is_system, name_sequence, plant_arrays
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -236,9 +236,9 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
     if mode_names is None:
         names = _default_names(count)
     else:
-        if len(mode_names) != count:
-            raise ShapeError(f"mode_names must name {count} modes, got {len(mode_names)}")
-        names = tuple(mode_names)
+        names = name_sequence(mode_names, "mode_names")
+        if len(names) != count:
+            raise ShapeError(f"mode_names must name {count} modes, got {len(names)}")
     singular = bool(result["modal_matrix_is_singular"])
     if singular:
         warnings.warn(

@@ -15,7 +15,7 @@ from __future__ import annotations
 import functools
 import operator
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
@@ -100,17 +100,25 @@ def _default_names(prefix: str, count: int) -> tuple[str, ...]:
     return tuple(f"{prefix}{i}" for i in range(count))
 
 
+def name_sequence(given: object, argument: str) -> tuple[str, ...]:
+    """Signal or mode names as given: one string is one name, else a sequence of strings;
+    anything else is InvalidArgumentError naming ``argument``."""
+    if isinstance(given, str):
+        return (given,)
+    names: tuple[object, ...] | None = None
+    if isinstance(given, Iterable):
+        names = tuple(given)
+    if names is None or not all(isinstance(name, str) for name in names):
+        raise InvalidArgumentError(
+            f"{argument} must be a string or a sequence of strings, got {given!r:.80}"
+        )
+    return cast("tuple[str, ...]", names)
+
+
 def _names(given: Sequence[str] | None, count: int, prefix: str, argument: str) -> tuple[str, ...]:
     if given is None:
         return _default_names(prefix, count)
-    if isinstance(given, str):
-        given = [given]
-    try:
-        names = tuple(str(name) for name in given)
-    except TypeError:
-        raise InvalidArgumentError(
-            f"{argument} must be a string or a sequence of strings, got {type(given).__name__}"
-        ) from None
+    names = name_sequence(given, argument)
     if len(names) != count:
         raise ShapeError(f"{argument} must have {count} names, got {len(names)}")
     return names
