@@ -4,6 +4,7 @@ penalty terms integrate to the performance index."""
 from __future__ import annotations
 
 import warnings
+from typing import Any
 
 import matplotlib
 
@@ -15,7 +16,7 @@ import pytest
 import scipy.linalg
 
 import aerocontrol
-from aerocontrol import plotting
+from aerocontrol import InvalidArgumentError, NotRealError, plotting
 from aerocontrol.design import lqr_root_locus
 
 A, B = aerocontrol.chapter.boeing747_longitudinal()
@@ -254,3 +255,23 @@ def test_values_that_cannot_be_drawn_are_masked_with_a_note() -> None:
     first = drawn.get_lines()[0].get_ydata()
     assert np.isnan(first[0]) and np.array_equal(first[1:], response.states()[1:, 0])
     assert response.states()[0, 0] == 1e301  # the result itself is not changed
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: plotting.closed_loop_gain_contour(3.0, count=0),
+        lambda: plotting.closed_loop_gain_contour(3.0, count=2.5),
+        lambda: plotting.closed_loop_phase_contour(-90.0, count=True),
+    ],
+)
+def test_nichols_contours_refuse_a_bad_count(call: Any) -> None:
+    with pytest.raises(InvalidArgumentError, match="count must be a positive int"):
+        call()
+
+
+def test_nichols_contours_refuse_a_non_number() -> None:
+    with pytest.raises(NotRealError, match="gain_db"):
+        plotting.closed_loop_gain_contour("3 dB")  # type: ignore[arg-type]
+    with pytest.raises(NotRealError, match="phase_deg"):
+        plotting.closed_loop_phase_contour(1j)  # type: ignore[arg-type]

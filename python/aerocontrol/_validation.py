@@ -91,6 +91,16 @@ def finite_or_warn(values: ArrayT, what: str, *, stacklevel: int = 3) -> ArrayT:
     return values
 
 
+def positive_int(value: object, name: str) -> int:
+    """``value`` as a positive int (a Python or numpy integer, not a bool), or
+    InvalidArgumentError naming ``name``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise InvalidArgumentError(f"{name} must be a positive int, got {value!r:.80}")
+    if value <= 0:
+        raise InvalidArgumentError(f"{name} must be a positive int, got {value!r}")
+    return int(value)
+
+
 def check_choice(value: object, name: str, choices: tuple[str, ...]) -> str:
     """``value`` if it is one of ``choices``, else InvalidArgumentError naming ``name``."""
     if not isinstance(value, str) or value not in choices:

@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._validation import FloatArray, real_array
+from ._validation import FloatArray, positive_int, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
 
 if TYPE_CHECKING:
@@ -1194,8 +1194,10 @@ def closed_loop_gain_contour(gain_db: float, count: int = 721) -> tuple[FloatArr
 
     Raises
     ------
-    None
-        The arguments are not checked (a NaN gives NaN points).
+    InvalidArgumentError
+        ``count`` is not a positive int.
+    NotRealError
+        ``gain_db`` is not a real number.
 
     Examples
     --------
@@ -1205,8 +1207,8 @@ def closed_loop_gain_contour(gain_db: float, count: int = 721) -> tuple[FloatArr
     >>> bool(np.allclose(L[np.isfinite(L)].real, -0.5))
     True
     """
-    magnitude = 10.0 ** (float(gain_db) / 20.0)
-    theta = np.linspace(0.0, 2.0 * math.pi, count)
+    magnitude = 10.0 ** (real_scalar(gain_db, "gain_db") / 20.0)
+    theta = np.linspace(0.0, 2.0 * math.pi, positive_int(count, "count"))
     if magnitude == 1.0:
         theta = theta[1:-1]
     return _open_loop_points(magnitude * np.exp(1j * theta))
@@ -1238,8 +1240,10 @@ def closed_loop_phase_contour(
 
     Raises
     ------
-    None
-        The arguments are not checked (:func:`plot_nichols` checks its phases).
+    InvalidArgumentError
+        ``count`` is not a positive int.
+    NotRealError
+        ``phase_deg``, ``low_db`` or ``high_db`` is not a real number.
 
     Examples
     --------
@@ -1251,8 +1255,10 @@ def closed_loop_phase_contour(
     >>> bool(np.allclose(np.degrees(np.angle(L / (1 + L))), -90.0))
     True
     """
-    magnitudes = np.logspace(float(low_db) / 20.0, float(high_db) / 20.0, count)
-    return _open_loop_points(magnitudes * np.exp(1j * math.radians(float(phase_deg))))
+    low, high = real_scalar(low_db, "low_db"), real_scalar(high_db, "high_db")
+    magnitudes = np.logspace(low / 20.0, high / 20.0, positive_int(count, "count"))
+    phase = math.radians(real_scalar(phase_deg, "phase_deg"))
+    return _open_loop_points(magnitudes * np.exp(1j * phase))
 
 
 def plot_nichols(

@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import batch, linalg
 from ._judging import AXIS_MODES, judge_stack
-from ._validation import check_finite, real_array, real_scalar
+from ._validation import check_finite, positive_int, real_array, real_scalar
 from .aircraft.model import _POSITIVE_FIELDS, SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
 from .aircraft.schema import AircraftDataError
@@ -903,8 +903,8 @@ def monte_carlo(
                 "scatter; give it in the parameter's units (Normal or Uniform with "
                 "relative=False)"
             )
-    samples = _positive_int(samples, "samples")
-    chunk_size = _positive_int(chunk_size, "chunk_size")
+    samples = positive_int(samples, "samples")
+    chunk_size = positive_int(chunk_size, "chunk_size")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidArgumentError(f"seed must be a nonnegative int, got {seed!r}")
     required_level = _level(required_level, "required_level")
@@ -932,7 +932,7 @@ def monte_carlo(
                 f"{gains.shape}"
             )
     if worker_threads is not None:
-        worker_threads = _positive_int(worker_threads, "worker_threads")
+        worker_threads = positive_int(worker_threads, "worker_threads")
     run = _Run(
         aircraft,
         uncertainty,
@@ -991,10 +991,4 @@ def _level(value: object, name: str) -> int:
         raise InvalidArgumentError(f"{name} must be 1, 2 or 3, got {value!r}")
     if value not in (1, 2, 3):
         raise InvalidArgumentError(f"{name} must be 1, 2 or 3, got {value!r}")
-    return int(value)
-
-
-def _positive_int(value: object, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value <= 0:
-        raise InvalidArgumentError(f"{name} must be a positive int, got {value!r}")
     return int(value)

@@ -21,10 +21,12 @@ Examples
 from __future__ import annotations
 
 import contextlib
-import operator
 from collections.abc import Iterator
 
+import numpy as np
+
 from . import _core
+from ._validation import positive_int
 from .exceptions import InvalidArgumentError
 
 __all__ = ["get_num_threads", "limit_threads", "set_num_threads"]
@@ -33,15 +35,11 @@ _chosen: int | None = None
 
 
 def _count(count: object) -> int:
-    try:
-        value = operator.index(count)  # type: ignore[arg-type]
-    except TypeError:
+    if count is not None and not isinstance(count, (int, np.integer)):
         raise InvalidArgumentError(
             f"count must be a positive int or None, got {type(count).__name__}"
-        ) from None
-    if isinstance(count, bool) or value <= 0:
-        raise InvalidArgumentError(f"count must be a positive int or None, got {count!r}")
-    return value
+        )
+    return positive_int(count, "count")
 
 
 def set_num_threads(count: int | None) -> None:
