@@ -233,6 +233,47 @@ def test_batches_on_a_dask_cluster_are_bitwise_the_local_ones(
     assert info.value.batch_index == 197  # type: ignore[attr-defined]
     with pytest.raises(aerocontrol.exceptions.AerocontrolError, match="problem 197 of the batch"):
         aerocontrol.batch.solve_care_batch(A, sys.B, np.eye(4), R)
+    # Each chunk on a pool of two threads of its worker (the pool robustness's test counts):
+    # the same numbers, for every entry point.
+    threaded = aerocontrol.batch.solve_care_batch(
+        A, sys.B, np.eye(4), np.eye(2), client=dask_client, worker_threads=2
+    )
+    np.testing.assert_array_equal(threaded.X, local.X)
+    np.testing.assert_array_equal(
+        aerocontrol.batch.lqr_sweep(sys, weights=weights, client=dask_client, worker_threads=2).K,
+        sweep.K,
+    )
+    np.testing.assert_array_equal(
+        aerocontrol.batch.dlqr_sweep(
+            sampled, weights=weights, client=dask_client, worker_threads=2
+        ).K,
+        aerocontrol.batch.dlqr_sweep(sampled, weights=weights).K,
+    )
+    np.testing.assert_array_equal(
+        aerocontrol.batch.solve_dare_batch(
+            sampled.A, sampled.B, np.eye(4), np.eye(2), client=dask_client, worker_threads=2
+        ).X,
+        aerocontrol.batch.solve_dare_batch(sampled.A, sampled.B, np.eye(4), np.eye(2)).X,
+    )
+
+
+@pytest.mark.parametrize("threads", [0, -1, 1.5, True, "2"])
+def test_worker_threads_is_a_positive_int(threads: object) -> None:
+    sys = aerocontrol.aircraft.load().lateral()
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="worker_threads must be a positive"):
+        aerocontrol.batch.lqr_sweep(
+            sys,
+            weights=[1.0],
+            client=_UnusedClient(),
+            worker_threads=threads,  # type: ignore[arg-type]
+        )
+
+
+def test_worker_threads_needs_a_client() -> None:
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="give it with a client"):
+        aerocontrol.batch.solve_care_batch(
+            -np.eye(2), np.eye(2), np.eye(2), np.eye(2), worker_threads=2
+        )
 
 
 class _UnusedClient:

@@ -23,6 +23,7 @@ order, so the result is bitwise the local one.
 
 from __future__ import annotations
 
+import contextlib
 import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -31,11 +32,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._validation import FloatArray, real_array
+from ._validation import FloatArray, positive_int, real_array
 from .exceptions import AerocontrolError, IllConditionedWarning, InvalidArgumentError, ShapeError
 from .placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
 from .riccati import RCOND_WARNING, RESIDUAL_WARNING
 from .statespace import as_state_space, is_system, require_continuous, require_discrete
+from .threads import limit_threads
 
 if TYPE_CHECKING:
     from ._typing import SystemObject
@@ -229,11 +231,23 @@ def _stack(value: object, name: str) -> FloatArray:
 
 
 def _solved(
-    kernel: str, stacks: tuple[FloatArray, ...], extra: tuple[Any, ...], client: Any
+    kernel: str,
+    stacks: tuple[FloatArray, ...],
+    extra: tuple[Any, ...],
+    client: Any,
+    worker_threads: int | None,
 ) -> Any:
     """The core's ``kernel`` on the stacks (each of one matrix, shared, or k of them): in one
-    call, or with a Dask ``client`` in chunks of :data:`DISTRIBUTED_CHUNK` problems, joined in
-    order (the first failing problem's error raised with its index in the whole batch)."""
+    call, or with a Dask ``client`` in chunks of :data:`DISTRIBUTED_CHUNK` problems, each on
+    ``worker_threads`` threads of its worker when given, joined in order (the first failing
+    problem's error raised with its index in the whole batch)."""
+    if worker_threads is not None:
+        worker_threads = positive_int(worker_threads, "worker_threads")
+        if client is None:
+            raise InvalidArgumentError(
+                "worker_threads sets the threads of a Dask worker's chunk: give it with a "
+                "client (on this machine, use aerocontrol.limit_threads)"
+            )
     if client is None:
         return getattr(_core, kernel)(*stacks, *extra)
     if any(len(stack) == 0 for stack in stacks):
@@ -255,6 +269,7 @@ def _solved(
         [extra] * len(starts),
         starts,
         [start + DISTRIBUTED_CHUNK for start in starts],
+        [worker_threads] * len(starts),
         pure=False,
     )
     parts = [future.result() for future in futures]
@@ -274,13 +289,21 @@ def _solved(
 
 
 def _solved_chunk(
-    kernel: str, stacks: tuple[FloatArray, ...], extra: tuple[Any, ...], start: int, stop: int
+    kernel: str,
+    stacks: tuple[FloatArray, ...],
+    extra: tuple[Any, ...],
+    start: int,
+    stop: int,
+    worker_threads: int | None,
 ) -> Any:
-    """Problems start to stop of :func:`_solved`, run on a worker: their results, or their
-    error (returned, so that the caller can name the problem in the whole batch)."""
+    """Problems start to stop of :func:`_solved`, run on a worker (on ``worker_threads``
+    threads when given): their results, or their error (returned, so that the caller can name
+    the problem in the whole batch)."""
     chunk = tuple(stack if len(stack) == 1 else stack[start:stop] for stack in stacks)
+    threads = contextlib.nullcontext() if worker_threads is None else limit_threads(worker_threads)
     try:
-        return getattr(_core, kernel)(*chunk, *extra)
+        with threads:
+            return getattr(_core, kernel)(*chunk, *extra)
     except AerocontrolError as error:
         return error
 
@@ -301,6 +324,7 @@ def solve_care_batch(
     R: ArrayLike,
     refine: bool = True,
     client: Any = None,
+    worker_threads: int | None = None,
 ) -> CareBatch:
     """Solve A_i^T X_i + X_i A_i - X_i B_i R_i^-1 B_i^T X_i + Q_i = 0 for every problem i of a
     batch, in parallel.
@@ -322,6 +346,10 @@ def solve_care_batch(
     client : dask.distributed.Client, optional
         Solve in chunks on the Dask cluster, bitwise as here (default None: this machine's
         threads).
+    worker_threads : int, optional
+        With a ``client``: each chunk's parallel work runs on this many threads of its worker
+        (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
+        machine. The setting is per process: give it with workers of one task thread each.
 
     Returns
     -------
@@ -357,7 +385,7 @@ def solve_care_batch(
     ((500, 2, 4), True)
     """
     stacks = (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
-    batch = CareBatch(*_solved("care_batch", stacks, (bool(refine),), client))
+    batch = CareBatch(*_solved("care_batch", stacks, (bool(refine),), client, worker_threads))
     _warn(
         np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING)),
         f"of the {len(batch)} Riccati solutions may be inaccurate (rcond(U11) < "
@@ -367,7 +395,12 @@ def solve_care_batch(
 
 
 def solve_dare_batch(
-    A: ArrayLike, B: ArrayLike, Q: ArrayLike, R: ArrayLike, client: Any = None
+    A: ArrayLike,
+    B: ArrayLike,
+    Q: ArrayLike,
+    R: ArrayLike,
+    client: Any = None,
+    worker_threads: int | None = None,
 ) -> DareBatch:
     """Solve A_i^T X_i A_i - X_i - A_i^T X_i B_i (R_i + B_i^T X_i B_i)^-1 B_i^T X_i A_i + Q_i = 0
     for every problem i of a batch, in parallel, each exactly as :func:`aerocontrol.solve_dare`
@@ -385,6 +418,10 @@ def solve_dare_batch(
     client : dask.distributed.Client, optional
         Solve in chunks on the Dask cluster, bitwise as here (default None: this machine's
         threads).
+    worker_threads : int, optional
+        With a ``client``: each chunk's parallel work runs on this many threads of its worker
+        (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
+        machine. The setting is per process: give it with workers of one task thread each.
 
     Returns
     -------
@@ -418,7 +455,7 @@ def solve_dare_batch(
     ((200, 2, 4), True)
     """
     stacks = (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
-    batch = DareBatch(*_solved("dare_batch", stacks, (), client))
+    batch = DareBatch(*_solved("dare_batch", stacks, (), client, worker_threads))
     _warn(
         np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING)),
         f"of the {len(batch)} discrete Riccati solutions may be inaccurate (rcond(U11) < "
@@ -434,6 +471,7 @@ def dlqr_sweep(
     R: ArrayLike | None = None,
     weights: ArrayLike | None = None,
     client: Any = None,
+    worker_threads: int | None = None,
 ) -> LqrSweep:
     """The discrete regulator of one sampled model for each weight c:
     J = Σ x_k^T Q x_k + (1/c²) u_k^T R u_k, as :func:`lqr_sweep` for continuous models, all
@@ -454,6 +492,10 @@ def dlqr_sweep(
     client : dask.distributed.Client, optional
         Solve in chunks on the Dask cluster, bitwise as here (default None: this machine's
         threads).
+    worker_threads : int, optional
+        With a ``client``: each chunk's parallel work runs on this many threads of its worker
+        (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
+        machine. The setting is per process: give it with workers of one task thread each.
 
     Returns
     -------
@@ -482,7 +524,7 @@ def dlqr_sweep(
     >>> sweep.K.shape, bool(np.all(abs(sweep.poles) < 1))
     ((100, 2, 4), True)
     """
-    return _sweep("dlqr_sweep", True, sys_or_A, B, Q, R, weights, client)
+    return _sweep("dlqr_sweep", True, sys_or_A, B, Q, R, weights, client, worker_threads)
 
 
 def lqr_sweep(
@@ -492,6 +534,7 @@ def lqr_sweep(
     R: ArrayLike | None = None,
     weights: ArrayLike | None = None,
     client: Any = None,
+    worker_threads: int | None = None,
 ) -> LqrSweep:
     """The regulator of one model for each weight c: J = ∫ x^T Q x + (1/c²) η^T R η dt
     ((6.224)-(6.227); R/c² is the control weight), all solved in one parallel call.
@@ -516,6 +559,10 @@ def lqr_sweep(
     client : dask.distributed.Client, optional
         Solve in chunks on the Dask cluster, bitwise as here (default None: this machine's
         threads).
+    worker_threads : int, optional
+        With a ``client``: each chunk's parallel work runs on this many threads of its worker
+        (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
+        machine. The setting is per process: give it with workers of one task thread each.
 
     Returns
     -------
@@ -543,7 +590,7 @@ def lqr_sweep(
     >>> sweep.K.shape, sweep.poles.shape
     ((1000, 2, 4), (1000, 4))
     """
-    return _sweep("lqr_sweep", False, sys_or_A, B, Q, R, weights, client)
+    return _sweep("lqr_sweep", False, sys_or_A, B, Q, R, weights, client, worker_threads)
 
 
 def _sweep(
@@ -555,6 +602,7 @@ def _sweep(
     R: ArrayLike | None,
     weights: ArrayLike | None,
     client: Any,
+    worker_threads: int | None,
 ) -> LqrSweep:
     """The sweep of :func:`lqr_sweep` (continuous) or :func:`dlqr_sweep` (discrete)."""
     if is_system(sys_or_A):
@@ -604,5 +652,7 @@ def _sweep(
             error.argument = "weights"
             raise error
     solve = solve_dare_batch if discrete else solve_care_batch
-    batch = solve(A_matrix, B_matrix, Q_matrix, R_stack, client=client)
+    batch = solve(
+        A_matrix, B_matrix, Q_matrix, R_stack, client=client, worker_threads=worker_threads
+    )
     return LqrSweep(c, batch.K, batch.closed_loop_poles, batch.X, batch.residual, batch.rcond)
