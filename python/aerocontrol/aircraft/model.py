@@ -319,7 +319,7 @@ class Aircraft:
 
         ``values`` maps names to arrays of k values: any nondimensional derivative
         (:data:`LONGITUDINAL_DERIVATIVES`, :data:`LATERAL_DERIVATIVES`) or one of
-        :data:`SAMPLED_FIELDS` ("mass", "Ix", "Iy", "Iz", "Ixz", "speed", "density"). The
+        ``SAMPLED_FIELDS`` ("mass", "Ix", "Iy", "Iz", "Ixz", "speed", "density"). The
         formulas are those of :meth:`longitudinal` and :meth:`lateral`, the same operations in
         the same order evaluated on arrays, so each model equals, bitwise, the one built from
         an aircraft with those values. Nothing is re-trimmed: a sampled mass or speed leaves
