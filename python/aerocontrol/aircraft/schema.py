@@ -45,8 +45,9 @@ time_to_double
 published tolerance         1e-12 to 1                                            relative
 ==========================  ======================  ============================  =============
 
-The same ranges bound the conditions :meth:`~aerocontrol.aircraft.Aircraft.at` moves an aircraft to (altitude, Mach
-and weight), so an envelope sweep records an implausible condition as a failure.
+The same ranges bound the conditions :meth:`~aerocontrol.aircraft.Aircraft.at` moves an
+aircraft to (altitude, Mach and weight), so an envelope sweep records an implausible condition
+as a failure.
 
 >>> from aerocontrol.aircraft.schema import PLAUSIBLE_RANGES
 >>> PLAUSIBLE_RANGES["weight"].bounds("english")
