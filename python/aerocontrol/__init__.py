@@ -16,6 +16,7 @@ from __future__ import annotations
 from importlib.metadata import PackageNotFoundError, version
 
 from . import (
+    accelerate,
     aircraft,
     batch,
     chapter,
@@ -27,6 +28,7 @@ from . import (
     robustness,
     schedule,
 )
+from .accelerate import accelerate_control, accelerated_control, restore_control
 from .controllability import (
     Controllability,
     controllability,
@@ -202,6 +204,9 @@ __all__ = [
     "TransferMatrix",
     "UncontrollableError",
     "__version__",
+    "accelerate",
+    "accelerate_control",
+    "accelerated_control",
     "actuator",
     "aircraft",
     "append",
@@ -263,6 +268,7 @@ __all__ = [
     "plotting",
     "qz",
     "report",
+    "restore_control",
     "riccati_difference",
     "riccati_ode",
     "robustness",

@@ -150,9 +150,9 @@ def accelerate_control() -> None:
             _installed[name] = _replacement_of[id(original)]
         for module in _control_modules():
             for attribute, value in list(vars(module).items()):
-                replacement = _replacement_of.get(id(value))
-                if replacement is not None and _original_of.get(id(replacement)) is value:
-                    setattr(module, attribute, replacement)
+                patch = _replacement_of.get(id(value))
+                if patch is not None and _original_of.get(id(patch)) is value:
+                    setattr(module, attribute, patch)
 
 
 def restore_control() -> None:
@@ -318,7 +318,7 @@ def _no_options(kwargs: dict[str, Any], *allowed: str) -> None:
 
 
 def _checked_riccati(
-    A: object, B: object, Q: object, R: object, S: object, names: tuple[str, ...]
+    A: Any, B: Any, Q: Any, R: Any, S: Any, names: tuple[str, ...]
 ) -> tuple[Any, Any, Any, Any, Any]:
     """A, B, Q, R (default I) and S as python-control's ``care``/``dare`` convert and check
     them (``names``: its names of A, B, Q, R, S in errors)."""
@@ -338,12 +338,12 @@ def _checked_riccati(
 
 
 def _care(
-    A: object,
-    B: object,
-    Q: object,
-    R: object = None,
-    S: object = None,
-    E: object = None,
+    A: Any,
+    B: Any,
+    Q: Any,
+    R: Any = None,
+    S: Any = None,
+    E: Any = None,
     stabilizing: bool = True,
     method: str | None = None,
     _As: str = "A",
@@ -361,12 +361,12 @@ def _care(
 
 
 def _dare(
-    A: object,
-    B: object,
-    Q: object,
-    R: object,
-    S: object = None,
-    E: object = None,
+    A: Any,
+    B: Any,
+    Q: Any,
+    R: Any,
+    S: Any = None,
+    E: Any = None,
     stabilizing: bool = True,
     method: str | None = None,
     _As: str = "A",
@@ -417,18 +417,17 @@ def _dlqr(*args: Any, **kwargs: Any) -> tuple[Any, Any, Any]:
     return K, X, poles
 
 
-def _delegate(name: str, args: tuple[Any, ...], kwargs: dict[str, Any]) -> Any:
+def _delegate(name: str, args: tuple[Any, ...], kwargs: dict[str, Any]) -> tuple[Any, Any, Any]:
     """The installed replacement of ``name`` (python-control's ``lqr`` of a discrete system
     calls ``dlqr``, ``lqe`` calls ``dlqe``)."""
     function = _installed.get(name)
     if function is None:
         raise _Fallback
-    return function(*args, **kwargs)
+    K, S, E = function(*args, **kwargs)
+    return K, S, E
 
 
-def _estimator(
-    args: tuple[Any, ...], kwargs: dict[str, Any]
-) -> tuple[Any, Any, Any, Any, Any]:
+def _estimator(args: tuple[Any, ...], kwargs: dict[str, Any]) -> tuple[Any, Any, Any, Any, Any]:
     """(A, G, C, QN, RN) of python-control's ``lqe``/``dlqe`` call, checked by its rules."""
     _no_options(kwargs, "method")
     if len(args) < 3:
@@ -463,9 +462,7 @@ def _dlqe(*args: Any, **kwargs: Any) -> tuple[Any, Any, Any]:
     return estimation.dlqe(A, G, C, QN, RN)
 
 
-def _lyap(
-    A: object, Q: object, C: object = None, E: object = None, method: str | None = None
-) -> Any:
+def _lyap(A: Any, Q: Any, C: Any = None, E: Any = None, method: str | None = None) -> Any:
     if C is not None or E is not None or method is not None:
         raise _Fallback
     check = _private("control.mateqn", "_check_shape")
@@ -477,7 +474,7 @@ def _lyap(
     return riccati.solve_lyapunov(A, Q)
 
 
-def _pair(A: object, second: object, name: str, axis: int) -> tuple[Any, Any]:
+def _pair(A: Any, second: Any, name: str, axis: int) -> tuple[Any, Any]:
     """A (square) and B (``axis`` 0: a 1-D B is a column, rows checked) or C (``axis`` 1: a
     row, columns checked) by python-control's ``_ssmatrix``."""
     ssmatrix = _private("control.statesp", "_ssmatrix")
@@ -489,7 +486,7 @@ def _pair(A: object, second: object, name: str, axis: int) -> tuple[Any, Any]:
     return A, ssmatrix(second, cols=n, name=name)
 
 
-def _place(A: object, B: object, p: object) -> Any:
+def _place(A: Any, B: Any, p: Any) -> Any:
     ssmatrix = _private("control.statesp", "_ssmatrix")
     A = ssmatrix(A, square=True, name="A")
     B = ssmatrix(B, axis=0, rows=A.shape[0])
@@ -498,7 +495,7 @@ def _place(A: object, B: object, p: object) -> Any:
     return placement.place(A, B, poles).K
 
 
-def _place_acker(A: object, B: object, poles: object) -> Any:
+def _place_acker(A: Any, B: Any, poles: Any) -> Any:
     A, B = _pair(A, B, "B", axis=0)
     wanted = np.asarray(poles)
     if B.shape[1] != 1 or wanted.ndim != 1:
@@ -506,21 +503,19 @@ def _place_acker(A: object, B: object, poles: object) -> Any:
     return placement.place_ackermann(A, B, wanted).k
 
 
-def _krylov(
-    function: Callable[[Any, Any], Any], A: object, second: object, t: object, name: str
-) -> Any:
+def _krylov(function: Callable[[Any, Any], Any], A: Any, second: Any, t: Any, name: str) -> Any:
     A, second = _pair(A, second, name, axis=0 if name == "B" else 1)
     n = A.shape[0]
-    if n == 0 or (t is not None and t < n):  # type: ignore[operator]
+    if n == 0 or (t is not None and t < n):
         raise _Fallback
     return function(A, second)
 
 
-def _ctrb(A: object, B: object, t: object = None) -> Any:
+def _ctrb(A: Any, B: Any, t: Any = None) -> Any:
     return _krylov(ctrb, A, B, t, "B")
 
 
-def _obsv(A: object, C: object, t: object = None) -> Any:
+def _obsv(A: Any, C: Any, t: Any = None) -> Any:
     return _krylov(obsv, A, C, t, "C")
 
 
