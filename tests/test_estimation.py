@@ -653,7 +653,8 @@ def test_bad_arguments_are_named() -> None:
         ((A, G, C, np.eye(3), RN), ShapeError, "QN", r"QN must be 2 x 2 \(G has 2 columns\)"),
         ((A, G, C, QN, np.eye(2)), ShapeError, "RN", r"RN must be 3 x 3 \(C has 3 rows\)"),
         ((A, G, C, QN, RN, np.ones((3, 2))), ShapeError, "NN", "NN must be 2 x 3"),
-        ((A, G, C[0], QN, RN), ShapeError, "C", "C must be a 2-D matrix"),
+        ((A[0], G, C, QN, RN), ShapeError, "A", "A must be a 2-D matrix"),  # 1-D: ambiguous
+        ((A, G, C[None], QN, RN), ShapeError, "C", "C must be a 2-D matrix"),
         ((A, G, C, [[1.0, 0.5], [0.0, 1.0]], RN), InvalidArgumentError, "QN", "QN must be sym"),
         ((A, G, C, QN, np.diag([1.0, -1.0, 1.0])), NotPositiveDefiniteError, "RN", "RN must"),
         ((A, G, C, QN, np.diag([1.0, np.nan, 1.0])), NonFiniteError, "RN", r"RN\[1, 1\] is NaN"),

@@ -52,6 +52,57 @@ def real_array(value: object, name: str) -> FloatArray:
     return array
 
 
+#: How a 1-D array given for a matrix argument is read, by the argument's role (as
+#: python-control reads it): an input matrix (B, G, b) as one column, an output matrix (C, c)
+#: as one row. Any other matrix has no single reading of a vector and refuses one by name.
+VECTOR_ROLES: dict[str, str] = {"B": "column", "G": "column", "b": "column", "C": "row", "c": "row"}
+
+
+def as_matrix(value: object, name: str, vector: str | None = None) -> FloatArray:
+    """``value`` as a 2-D array for the matrix argument ``name``, or ShapeError naming it.
+
+    The one reading of array-likes as matrices that every function taking A, B, C, D or a
+    weight shares, accepting what python-control accepts where the meaning is unambiguous:
+
+    * a 2-D ndarray is returned as it is (no copy; the core reads any dtype and layout);
+      ``numpy.matrix`` is read as its plain array;
+    * a scalar is the 1 x 1 matrix (A = -1 of a first-order system);
+    * a 1-D array is a column (``vector="column"``) or a row (``"row"``); by default the
+      role is that of the argument's name (:data:`VECTOR_ROLES`: B and G are columns, C a
+      row), and any other argument refuses a vector with a ShapeError naming it;
+    * anything of more dimensions is refused by name, and what is not an array of real
+      numbers as :func:`real_array` refuses it.
+    """
+    if type(value) is np.ndarray and value.ndim == 2:
+        return value
+    if isinstance(value, np.matrix):
+        value = value.view(np.ndarray)
+    array = real_array(value, name)
+    if array.ndim == 2:
+        return array
+    if array.ndim == 0:
+        return array.reshape(1, 1)
+    role = VECTOR_ROLES.get(name) if vector is None else vector
+    if array.ndim == 1 and role == "column":
+        return array.reshape(-1, 1)
+    if array.ndim == 1 and role == "row":
+        return array.reshape(1, -1)
+    if array.ndim == 1:
+        raise _shape_error(
+            name,
+            f"{name} must be a 2-D matrix, got an array of shape {array.shape}; a vector is "
+            f"ambiguous here: write a single column as {name}.reshape(-1, 1) or a single row "
+            f"as {name}.reshape(1, -1)",
+        )
+    raise _shape_error(name, f"{name} must be a 2-D matrix, got an array of shape {array.shape}")
+
+
+def _shape_error(name: str, message: str) -> ShapeError:
+    error = ShapeError(message)
+    error.argument = name
+    return error
+
+
 def real_scalar(value: object, name: str) -> float:
     """``value`` as a Python float, rejecting arrays, complex numbers and non-numbers by name."""
     array = real_array(value, name)

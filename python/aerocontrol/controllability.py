@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._validation import FloatArray, check_choice, real_scalar
-from .statespace import plant_pair
+from .statespace import matrix_view, plant_pair
 
 if TYPE_CHECKING:
     from ._typing import System
@@ -56,8 +56,8 @@ def ctrb(A: ArrayLike, B: ArrayLike) -> FloatArray:
 
     Parameters
     ----------
-    A : array_like (n, n)
-    B : array_like (n, m)
+    A : array_like (n, n); a scalar is 1 x 1
+    B : array_like (n, m); a 1-D B is a single input (a column)
 
     Returns
     -------
@@ -67,7 +67,7 @@ def ctrb(A: ArrayLike, B: ArrayLike) -> FloatArray:
     Raises
     ------
     ShapeError
-        A is not square, or B is not 2-D with n rows.
+        A is not square, or B does not have n rows.
     NonFiniteError, NotRealError
         A or B contains NaN or an infinity, or is complex.
 
@@ -82,7 +82,7 @@ def ctrb(A: ArrayLike, B: ArrayLike) -> FloatArray:
     array([[ 0.,  1.],
            [ 1., -3.]])
     """
-    return _core.krylov_matrix(A, B, False)
+    return _core.krylov_matrix(matrix_view(A, "A"), matrix_view(B, "B"), False)
 
 
 def obsv(A: ArrayLike, C: ArrayLike) -> FloatArray:
@@ -92,8 +92,8 @@ def obsv(A: ArrayLike, C: ArrayLike) -> FloatArray:
 
     Parameters
     ----------
-    A : array_like (n, n)
-    C : array_like (p, n)
+    A : array_like (n, n); a scalar is 1 x 1
+    C : array_like (p, n); a 1-D C is a single output (a row)
 
     Returns
     -------
@@ -103,7 +103,7 @@ def obsv(A: ArrayLike, C: ArrayLike) -> FloatArray:
     Raises
     ------
     ShapeError
-        A is not square, or C is not 2-D with n columns.
+        A is not square, or C does not have n columns.
     NonFiniteError, NotRealError
         A or C contains NaN or an infinity, or is complex.
 
@@ -114,7 +114,7 @@ def obsv(A: ArrayLike, C: ArrayLike) -> FloatArray:
     array([[ 1.,  0.],
            [-3.,  8.]])
     """
-    return _core.krylov_matrix(A, C, True)
+    return _core.krylov_matrix(matrix_view(A, "A"), matrix_view(C, "C"), True)
 
 
 @dataclass(frozen=True, eq=False)
@@ -330,7 +330,7 @@ def is_controllable(
     Raises
     ------
     ShapeError
-        A is not square, or B is not 2-D with n rows.
+        A is not square, or B does not have n rows.
     NonFiniteError, NotRealError
         A or B contains NaN or an infinity, or is complex.
     InvalidArgumentError

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, TypeVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._validation import FloatArray, real_array, real_scalar
+from ._validation import FloatArray, as_matrix, real_array, real_scalar
 from .controllability import observability
 from .exceptions import (
     AerocontrolError,
@@ -87,20 +87,19 @@ SYMMETRY_TOLERANCE = 1e-12
 def _matrix(value: object, name: str, scalar_ok: bool = False) -> FloatArray:
     """``value`` as a finite, C-ordered 2-D float64 array (a copy when it was not one: the
     caller's array is never written, and every layout gives the same bits), or the error
-    naming ``name`` (also in its ``argument``). With ``scalar_ok`` a scalar or a vector of
-    one number is a 1 x 1 matrix."""
+    naming ``name`` (also in its ``argument``). Scalars, vectors (a 1-D G a column, a 1-D C a
+    row) and ``numpy.matrix`` are read by :func:`~aerocontrol._validation.as_matrix`; with
+    ``scalar_ok`` a vector of one number is a 1 x 1 matrix too."""
     try:
+        if isinstance(value, np.matrix):
+            value = value.view(np.ndarray)
         array = real_array(value, name)
+        if scalar_ok and array.ndim < 2 and array.size == 1:
+            array = array.reshape(1, 1)
+        array = real_array(as_matrix(array, name), name)
     except AerocontrolError as refused:
         refused.argument = name
         raise
-    if scalar_ok and array.ndim < 2 and array.size == 1:
-        array = array.reshape(1, 1)
-    if array.ndim != 2:
-        hint = "; write a single row or column as a 2-D array" if array.ndim == 1 else ""
-        raise _shape_error(
-            name, f"{name} must be a 2-D matrix, got an array of shape {array.shape}{hint}"
-        )
     bad = np.argwhere(~np.isfinite(array))
     if bad.size:
         row, column = (int(k) for k in bad[0])

@@ -76,14 +76,42 @@ def _describe(design: Placement) -> str:
 
 def _poles(poles: object) -> ComplexArray:
     """Requested poles as a contiguous complex vector (the core calls this for anything that
-    is not one already)."""
+    is not one already). As python-control reads them, a single number is one pole and a 2-D
+    array of one row or one column (``numpy.matrix`` included) is the list of its entries;
+    any other 2-D array is refused by name."""
+    if isinstance(poles, np.matrix):
+        poles = poles.view(np.ndarray)
     try:
         array = np.asarray(poles, dtype=np.complex128)
     except (TypeError, ValueError) as error:
         raise InvalidArgumentError(f"poles must be numbers: {error}") from None
+    if array.ndim == 0 or (array.ndim == 2 and 1 in array.shape):
+        array = array.reshape(-1)
     if array.ndim != 1:
-        raise ShapeError(f"poles must be a 1-D sequence, got an array of shape {array.shape}")
+        raise ShapeError(
+            f"poles must be a 1-D sequence (or one row or column), got an array of shape "
+            f"{array.shape}"
+        )
     return np.ascontiguousarray(array)
+
+
+def _placement_arguments(
+    A_or_sys: ArrayLike | System, B: ArrayLike | None, poles: ArrayLike | None
+) -> tuple[FloatArray, FloatArray, ArrayLike]:
+    """(A, B, poles) of ``place*(A, B, poles)`` or ``place*(sys, poles)``: A and B read as
+    matrices (a 1-D B a column), the poles as a vector (:func:`_poles`)."""
+    if poles is None:
+        A, B_given = plant_pair(A_or_sys, None, "B")
+        A, B_matrix = plant_pair(A, B_given, "B")
+        poles = B
+    else:
+        A, B_matrix = plant_pair(A_or_sys, B, "B")
+    if isinstance(poles, np.ndarray) and poles.dtype == np.complex128 and poles.ndim != 1:
+        # The core reads a complex128 array as it is; anything else it converts by _poles
+        # itself, after copying A and B (a conversion that runs the caller's code cannot
+        # change them under it).
+        poles = _poles(poles)
+    return cast("FloatArray", A), cast("FloatArray", B_matrix), poles
 
 
 def place_bass_gura(
@@ -137,10 +165,7 @@ def place_bass_gura(
     >>> np.round(design.k, 5)                                # (6.102)
     array([16.49844,  8.0875 ])
     """
-    if poles is None:
-        A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
-    # Now the matrices; a system or None still here is refused by the core, by name.
-    return _core.place(cast("ArrayLike", A_or_sys), cast("ArrayLike", b), poles, "bass-gura")
+    return _core.place(*_placement_arguments(A_or_sys, b, poles), "bass-gura")
 
 
 def place_ackermann(
@@ -197,10 +222,7 @@ def place_ackermann(
     >>> design.k
     array([28.,  8.])
     """
-    if poles is None:
-        A_or_sys, b, poles = *plant_pair(A_or_sys, None, "B"), b
-    # Now the matrices; a system or None still here is refused by the core, by name.
-    return _core.place(cast("ArrayLike", A_or_sys), cast("ArrayLike", b), poles, "ackermann")
+    return _core.place(*_placement_arguments(A_or_sys, b, poles), "ackermann")
 
 
 def place(
@@ -254,10 +276,7 @@ def place(
     >>> design.K.shape, bool(design.max_relative_error < 1e-12)
     ((2, 4), True)
     """
-    if poles is None:
-        A_or_sys, B, poles = *plant_pair(A_or_sys, None, "B"), B
-    # Now the matrices; a system or None still here is refused by the core, by name.
-    return _core.place(cast("ArrayLike", A_or_sys), cast("ArrayLike", B), poles, "knv0")
+    return _core.place(*_placement_arguments(A_or_sys, B, poles), "knv0")
 
 
 @dataclass(frozen=True, eq=False)

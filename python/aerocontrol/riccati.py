@@ -32,7 +32,13 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError
-from .statespace import as_state_space, is_system, require_continuous, require_discrete
+from .statespace import (
+    as_state_space,
+    is_system,
+    matrix_view,
+    require_continuous,
+    require_discrete,
+)
 
 if TYPE_CHECKING:
     from ._typing import SystemObject
@@ -112,8 +118,8 @@ def solve_care(
 
     Parameters
     ----------
-    A, Q : array_like (n, n)
-    B : array_like (n, m)
+    A, Q : array_like (n, n); a scalar is 1 x 1
+    B : array_like (n, m); a 1-D B is a single input (a column)
     R : array_like (m, m), symmetric and nonsingular
         Positive definite: the Hamiltonian method above. Indefinite (as the H-infinity
         equations have): the extended Hamiltonian pencil of order 2n + m, compressed and
@@ -190,10 +196,11 @@ def _solve_care(
     """The native solve, as (X, K, poles, residual, rcond, steps), warning (at the caller of
     :func:`solve_care` or :func:`lqr`) when the solution may be inaccurate. ``cross`` is the
     caller's name of the cross weight (N for lqr), used in errors."""
-    # The core shapes the weights (a scalar R as 1 x 1, as numpy.atleast_2d).
+    # The core shapes the weights (a scalar R as 1 x 1, as numpy.atleast_2d); A and B are
+    # read here (a scalar as 1 x 1, a 1-D B as a column).
     result: tuple[FloatArray, FloatArray, ComplexArray, float, float, int] = _core.solve_care(
-        A,
-        B,
+        matrix_view(A, "A"),
+        matrix_view(B, "B"),
         Q,
         R,
         S,
@@ -335,8 +342,8 @@ def solve_dare(
 
     Parameters
     ----------
-    A, Q : array_like (n, n)
-    B : array_like (n, m)
+    A, Q : array_like (n, n); a scalar is 1 x 1
+    B : array_like (n, m); a 1-D B is a single input (a column)
     R : array_like (m, m), symmetric
     S : array_like (n, m), optional; the cross weight (python-control's N)
     E : array_like (n, n), optional
@@ -390,7 +397,7 @@ def _solve_dare(
 ) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
     """The native solve, warning (at the caller of :func:`solve_dare` or :func:`dlqr`) when
     the solution may be inaccurate; ``cross`` names the cross weight in errors (N for dlqr)."""
-    result = _core.solve_dare(A, B, Q, R, S, E, cross == "N")
+    result = _core.solve_dare(matrix_view(A, "A"), matrix_view(B, "B"), Q, R, S, E, cross == "N")
     residual, rcond = result[3], result[4]
     if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
         warnings.warn(
@@ -608,8 +615,8 @@ def riccati_ode(
     if times.ndim != 1:
         raise InvalidArgumentError(f"t must be 1-D, got an array of shape {times.shape}")
     S, K, substeps = _core.riccati_ode(
-        A,
-        B,
+        matrix_view(A, "A"),
+        matrix_view(B, "B"),
         Q,
         R,
         times,
@@ -784,8 +791,8 @@ def riccati_difference(
         )
     count = _steps(horizon)
     S, K, rcond, error_estimate = _core.riccati_difference(
-        A,
-        B,
+        matrix_view(A, "A"),
+        matrix_view(B, "B"),
         Q,
         R,
         count,
@@ -916,5 +923,5 @@ def solve_lyapunov(A: ArrayLike, Q: ArrayLike) -> FloatArray:
     array([[1., 1.],
            [1., 1.]])
     """
-    X: FloatArray = _core.solve_lyapunov(A, Q)
+    X: FloatArray = _core.solve_lyapunov(matrix_view(A, "A"), matrix_view(Q, "Q"))
     return X

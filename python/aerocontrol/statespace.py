@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._validation import FloatArray, real_array, real_scalar
+from ._validation import FloatArray, as_matrix, real_array, real_scalar
 from .exceptions import InvalidArgumentError, NotRealError, NumericalOverflowWarning, ShapeError
 
 if TYPE_CHECKING:
@@ -33,8 +33,18 @@ if TYPE_CHECKING:
 __all__ = ["StateSpace", "as_state_space"]
 
 
-def _matrix(value: object, name: str) -> FloatArray:
-    return np.array(matrix_view(value, name), dtype=np.float64, order="C")
+def _matrix(value: object, name: str, vector: str | None = None) -> FloatArray:
+    return np.array(matrix_view(value, name, vector), dtype=np.float64, order="C")
+
+
+def _feedthrough(D: object, outputs: int, inputs: int) -> FloatArray:
+    """D of a model with ``outputs`` outputs and ``inputs`` inputs: a vector is a row of a
+    single-output model or a column of a single-input one (ambiguous otherwise), and a scalar
+    zero is the zero matrix, as python-control reads them."""
+    if not _is_matrix(D) and np.ndim(D) == 0 and real_scalar(D, "D") == 0.0:
+        return _constant(outputs, inputs, identity=False)
+    vector = "row" if outputs == 1 else "column" if inputs == 1 else None
+    return matrix_view(D, "D", vector)
 
 
 def _is_matrix(value: object) -> TypeIs[FloatArray]:
@@ -47,20 +57,14 @@ def _is_matrix(value: object) -> TypeIs[FloatArray]:
     )
 
 
-def matrix_view(value: object, name: str) -> FloatArray:
+def matrix_view(value: object, name: str, vector: str | None = None) -> FloatArray:
     """``value`` as a 2-D float64 array, or ShapeError naming ``name``: the array itself when
-    it is one already (no copy; see :func:`~aerocontrol._validation.real_array`)."""
+    it is one already (no copy; see :func:`~aerocontrol._validation.real_array`). Scalars,
+    vectors and ``numpy.matrix`` are read by :func:`~aerocontrol._validation.as_matrix` (a
+    1-D B a column, a 1-D C a row, by the argument's role or ``vector``)."""
     if _is_matrix(value):
         return value
-    array = real_array(value, name)
-    if array.ndim == 1:
-        raise ShapeError(
-            f"{name} must be a 2-D matrix, got an array of shape {array.shape}; "
-            f"write a single column as {name}.reshape(-1, 1)"
-        )
-    if array.ndim != 2:
-        raise ShapeError(f"{name} must be a 2-D matrix, got an array of shape {array.shape}")
-    return array
+    return real_array(as_matrix(value, name, vector), name)
 
 
 #: Default C = I and D = 0 up to this many entries are made once and shared (read-only).
@@ -150,13 +154,19 @@ class StateSpace:
     Parameters
     ----------
     A : array_like, shape (n, n)
-        Plant matrix.
+        Plant matrix; a scalar is a first-order system's 1 x 1 A.
     B : array_like, shape (n, m) or (n,)
-        Control matrix; a 1-D B is a single input.
-    C : array_like, shape (p, n), optional
-        Output matrix; the identity (every state is an output) when omitted.
+        Control matrix; a 1-D B is a single input (a column).
+    C : array_like, shape (p, n) or (n,), optional
+        Output matrix; a 1-D C is a single output (a row); the identity (every state is an
+        output) when omitted.
     D : array_like, shape (p, m), optional
-        Feedthrough; zero when omitted.
+        Feedthrough; zero when omitted (or given as the scalar 0). A 1-D D is the row of a
+        single-output model or the column of a single-input one.
+
+    Scalars, vectors and ``numpy.matrix`` are read as python-control reads them
+    (:func:`~aerocontrol._validation.as_matrix`); a vector where no reading is unambiguous is
+    refused by name.
     state_names, input_names, output_names : sequence of str, optional
         Names used in tables, plots and legends (defaults x0..., u0..., y0...; the outputs take
         the state names when C is the default identity).
@@ -210,12 +220,14 @@ class StateSpace:
     ) -> None:
         self.dt = None if dt is None else sampling_period(dt)
         A = _matrix(A, "A")
-        B_array = real_array(B, "B")
-        B = _matrix(B_array.reshape(-1, 1) if B_array.ndim == 1 else B_array, "B")
+        B = _matrix(B, "B")
         n, m = A.shape[0], B.shape[1]
         identity_output = C is None
         C = _constant(n, n, identity=True) if identity_output else _matrix(C, "C")
-        D = _constant(C.shape[0], m, identity=False) if D is None else _matrix(D, "D")
+        if D is None:
+            D = _constant(C.shape[0], m, identity=False)
+        else:
+            D = np.array(_feedthrough(D, C.shape[0], m), dtype=np.float64, order="C")
         _core.check_model(A, B, C, D)
         for matrix in (A, B, C, D):
             matrix.setflags(write=False)
@@ -459,17 +471,14 @@ def plant_arrays(
         return model.A, model.B, model.C, model.D, period(model)
     if isinstance(model, (tuple, list)) and len(model) in (2, 4):
         A = matrix_view(model[0], "A")
-        B = model[1]
-        if not _is_matrix(B):
-            B = real_array(B, "B")
-            B = matrix_view(B.reshape(-1, 1) if B.ndim == 1 else B, "B")
+        B = matrix_view(model[1], "B")
         given = len(model) == 4 and (model[2] is not None or model[3] is not None)
         C = _constant(A.shape[0], A.shape[0], True)
         if len(model) == 4 and model[2] is not None:
             C = matrix_view(model[2], "C")
         D = _constant(C.shape[0], B.shape[1], False)
         if len(model) == 4 and model[3] is not None:
-            D = matrix_view(model[3], "D")
+            D = _feedthrough(model[3], C.shape[0], B.shape[1])
         if given:
             _core.check_model(A, B, C, D)
         return A, B, C, D, 0.0
@@ -483,8 +492,9 @@ def plant_pair(
     """(A, B) or (A, C): the two matrices when ``second`` is given, else taken from a system,
     an (A, B) tuple or any object with the attributes (``attribute`` names the second one)."""
     if second is not None:
-        # With both given the first is the plant matrix; a system there is refused by the core.
-        return cast("ArrayLike", A_or_sys), second
+        # With both given the first is the plant matrix (a system there is refused by name);
+        # a vector for the second is a column of B or a row of C, by its role.
+        return matrix_view(A_or_sys, "A"), matrix_view(second, attribute)
     if isinstance(A_or_sys, (tuple, list)) or is_system(A_or_sys):
         sys = as_state_space(A_or_sys)
         return sys.A, getattr(sys, attribute)
