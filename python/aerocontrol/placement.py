@@ -111,7 +111,7 @@ def _placement_arguments(
         # itself, after copying A and B (a conversion that runs the caller's code cannot
         # change them under it).
         poles = _poles(poles)
-    return cast("FloatArray", A), cast("FloatArray", B_matrix), poles
+    return cast("FloatArray", A), cast("FloatArray", B_matrix), cast("ArrayLike", poles)
 
 
 def place_bass_gura(

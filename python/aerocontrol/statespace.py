@@ -13,10 +13,11 @@ importing python-control); :func:`as_state_space` does the conversion.
 from __future__ import annotations
 
 import functools
+import importlib
 import operator
 import warnings
 from collections.abc import Iterable, Sequence
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -41,8 +42,10 @@ def _feedthrough(D: object, outputs: int, inputs: int) -> FloatArray:
     """D of a model with ``outputs`` outputs and ``inputs`` inputs: a vector is a row of a
     single-output model or a column of a single-input one (ambiguous otherwise), and a scalar
     zero is the zero matrix, as python-control reads them."""
-    if not _is_matrix(D) and np.ndim(D) == 0 and real_scalar(D, "D") == 0.0:
-        return _constant(outputs, inputs, identity=False)
+    if not _is_matrix(D):
+        D = real_array(D, "D")
+        if D.ndim == 0 and float(D) == 0.0:
+            return _constant(outputs, inputs, identity=False)
     vector = "row" if outputs == 1 else "column" if inputs == 1 else None
     return matrix_view(D, "D", vector)
 
@@ -299,6 +302,140 @@ class StateSpace:
         """The number of outputs p."""
         return int(self.C.shape[0])
 
+    def to_control(self) -> Any:
+        """This model as python-control's ``StateSpace`` (python-control imported only here).
+
+        The matrices are copied; the state, input and output names become python-control's
+        labels, and ``dt`` is kept as it is (None, 0 or the sampling period), so that
+        :meth:`from_control` gives back an equal model.
+
+        Returns
+        -------
+        control.StateSpace
+
+        Raises
+        ------
+        ImportError
+            python-control is not installed.
+
+        Examples
+        --------
+        >>> import aerocontrol
+        >>> lateral = aerocontrol.aircraft.load("b747-approach").lateral()
+        >>> sys = lateral.to_control()
+        >>> type(sys).__name__, sys.input_labels
+        ('StateSpace', ['rudder', 'aileron'])
+        >>> aerocontrol.StateSpace.from_control(sys).input_names
+        ('rudder', 'aileron')
+        """
+        control = _optional_import("control", "python-control", "StateSpace.to_control")
+        return control.ss(
+            np.array(self.A),
+            np.array(self.B),
+            np.array(self.C),
+            np.array(self.D),
+            dt=self.dt,
+            states=list(self.state_names),
+            inputs=list(self.input_names),
+            outputs=list(self.output_names),
+        )
+
+    @classmethod
+    def from_control(cls, sys: object) -> StateSpace:
+        """A model from python-control's ``StateSpace`` (or any of its LTI systems, realised
+        by ``control.ss``), with its labels as names and its ``dt`` (None, 0 or the period).
+
+        Parameters
+        ----------
+        sys : control.StateSpace or control.TransferFunction
+
+        Returns
+        -------
+        StateSpace
+
+        Raises
+        ------
+        ImportError
+            python-control is not installed.
+        NotRealError
+            ``sys`` is not a python-control system.
+        InvalidArgumentError
+            its ``dt`` is True (a discrete system of unspecified period).
+
+        Examples
+        --------
+        >>> import control, aerocontrol
+        >>> sys = aerocontrol.StateSpace.from_control(control.tf([1], [1, 2, 3], dt=0.1))
+        >>> sys.n_states, sys.dt
+        (2, 0.1)
+        """
+        control = _optional_import("control", "python-control", "StateSpace.from_control")
+        if isinstance(sys, control.LTI) and not isinstance(sys, control.StateSpace):
+            sys = control.ss(sys)
+        if not isinstance(sys, control.StateSpace):
+            raise NotRealError(f"sys must be a python-control system, got {type(sys).__name__}")
+        return as_state_space(sys)
+
+    def to_scipy(self) -> Any:
+        """This model as ``scipy.signal.StateSpace`` (scipy imported only here): continuous
+        for ``dt`` None or 0, else discrete with ``dt`` (scipy keeps no names).
+
+        Returns
+        -------
+        scipy.signal.StateSpace
+
+        Raises
+        ------
+        ImportError
+            scipy is not installed.
+
+        Examples
+        --------
+        >>> import aerocontrol
+        >>> sys = aerocontrol.StateSpace([[0.9]], [[0.1]], dt=0.05).to_scipy()
+        >>> type(sys).__name__, sys.dt
+        ('StateSpaceDiscrete', 0.05)
+        """
+        signal = _optional_import("scipy.signal", "scipy", "StateSpace.to_scipy")
+        matrices = (np.array(self.A), np.array(self.B), np.array(self.C), np.array(self.D))
+        if self.is_discrete:
+            return signal.StateSpace(*matrices, dt=period(self))
+        return signal.StateSpace(*matrices)
+
+    @classmethod
+    def from_scipy(cls, sys: object) -> StateSpace:
+        """A model from ``scipy.signal``'s ``StateSpace`` (or any of its ``lti``/``dlti``
+        systems, realised by their ``to_ss``), continuous or discrete with its ``dt``.
+
+        Parameters
+        ----------
+        sys : scipy.signal.StateSpace, TransferFunction or ZerosPolesGain
+
+        Returns
+        -------
+        StateSpace
+
+        Raises
+        ------
+        ImportError
+            scipy is not installed.
+        NotRealError
+            ``sys`` is not a scipy.signal system.
+
+        Examples
+        --------
+        >>> import scipy.signal, aerocontrol
+        >>> sys = aerocontrol.StateSpace.from_scipy(scipy.signal.TransferFunction([1], [1, 1]))
+        >>> sys.A, sys.dt is None
+        (array([[-1.]]), True)
+        """
+        signal = _optional_import("scipy.signal", "scipy", "StateSpace.from_scipy")
+        if isinstance(sys, (signal.lti, signal.dlti)) and not isinstance(sys, signal.StateSpace):
+            sys = sys.to_ss()
+        if not isinstance(sys, signal.StateSpace):
+            raise NotRealError(f"sys must be a scipy.signal system, got {type(sys).__name__}")
+        return as_state_space(sys)
+
     def __repr__(self) -> str:
         return (
             f"StateSpace(n_states={self.n_states}, n_inputs={self.n_inputs}, "
@@ -306,6 +443,16 @@ class StateSpace:
             f"inputs={list(self.input_names)}"
             + (f", dt={period(self):g})" if self.is_discrete else ")")
         )
+
+
+def _optional_import(module: str, package: str, caller: str) -> Any:
+    """``module``, imported when first needed, or ImportError naming the package to install."""
+    try:
+        return importlib.import_module(module)
+    except ImportError as error:
+        raise ImportError(
+            f"{caller} needs {package}, which is not installed (pip install {package}): {error}"
+        ) from error
 
 
 def signal_indices(key: object, names: Sequence[str], what: str) -> list[int]:
