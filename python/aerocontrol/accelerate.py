@@ -56,7 +56,13 @@ from . import estimation, placement, riccati
 from .controllability import ctrb, obsv
 from .exceptions import AerocontrolError
 
-__all__ = ["accelerate_control", "accelerated_control", "kernel_calls", "restore_control"]
+__all__ = [
+    "accelerate_control",
+    "accelerated_control",
+    "is_accelerated",
+    "kernel_calls",
+    "restore_control",
+]
 
 _Function = Callable[..., Any]
 
