@@ -189,6 +189,12 @@ def restore_control() -> None:
 def is_accelerated() -> bool:
     """Whether python-control's ``lqr`` is aerocontrol's now (see :func:`accelerate_control`).
 
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
     >>> import aerocontrol
     >>> aerocontrol.accelerate.is_accelerated()
     False
@@ -233,6 +239,14 @@ def kernel_calls() -> dict[str, dict[str, int]]:
     """Per replaced function, the calls aerocontrol answered (``"aerocontrol"``) and those
     passed to python-control's original (``"fallback"``), since the process started.
 
+    Returns
+    -------
+    dict
+        ``{name: {"aerocontrol": count, "fallback": count}}`` for every replaced function,
+        by python-control's name (``place_acker`` counts ``acker`` too).
+
+    Examples
+    --------
     >>> import aerocontrol
     >>> sorted(aerocontrol.accelerate.kernel_calls())[:3]
     ['care', 'ctrb', 'dare']
