@@ -26,6 +26,7 @@ MODULES = {
     "aerocontrol.plotting": "aerocontrol.plotting: figures",
     "aerocontrol.report": "aerocontrol.report: the report",
     "aerocontrol.exceptions": "aerocontrol.exceptions: errors and warnings",
+    "aerocontrol.accelerate": "aerocontrol.accelerate: python-control on aerocontrol's kernels",
 }
 
 

@@ -167,9 +167,8 @@ class StateSpace:
         Feedthrough; zero when omitted (or given as the scalar 0). A 1-D D is the row of a
         single-output model or the column of a single-input one.
 
-    Scalars, vectors and ``numpy.matrix`` are read as python-control reads them
-    (:func:`~aerocontrol._validation.as_matrix`); a vector where no reading is unambiguous is
-    refused by name.
+    Scalars, vectors and ``numpy.matrix`` are read as python-control reads them; a vector
+    where no reading is unambiguous is refused by name.
     state_names, input_names, output_names : sequence of str, optional
         Names used in tables, plots and legends (defaults x0..., u0..., y0...; the outputs take
         the state names when C is the default identity).
