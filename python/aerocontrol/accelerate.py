@@ -128,6 +128,10 @@ def accelerate_control() -> None:
     harmless: it only patches modules imported since (a name bound to an original function);
     :func:`restore_control` undoes it exactly.
 
+    Returns
+    -------
+    None
+
     Raises
     ------
     ImportError
@@ -166,6 +170,15 @@ def restore_control() -> None:
     aerocontrol's (in every imported module of python-control, those imported since
     included). Harmless when nothing is patched.
 
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    None
+        It only puts back the functions it replaced (python-control is not imported).
+
     Examples
     --------
     >>> import control, aerocontrol
@@ -193,6 +206,11 @@ def is_accelerated() -> bool:
     -------
     bool
 
+    Raises
+    ------
+    None
+        It only looks at ``control.statefbk.lqr``.
+
     Examples
     --------
     >>> import aerocontrol
@@ -208,6 +226,11 @@ def accelerated_control() -> Iterator[None]:
     """A ``with`` block in which python-control runs on aerocontrol's kernels
     (:func:`accelerate_control` on entry; :func:`restore_control` on exit unless it was
     accelerated before the block).
+
+    Returns
+    -------
+    contextlib.AbstractContextManager[None]
+        ``with accelerated_control():`` runs its block on aerocontrol's kernels.
 
     Raises
     ------
@@ -244,6 +267,11 @@ def kernel_calls() -> dict[str, dict[str, int]]:
     dict
         ``{name: {"aerocontrol": count, "fallback": count}}`` for every replaced function,
         by python-control's name (``place_acker`` counts ``acker`` too).
+
+    Raises
+    ------
+    None
+        It only reads the counters.
 
     Examples
     --------
