@@ -606,6 +606,27 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
     """The estimate count / samples and its exact (Clopper-Pearson) interval (1), its ends to
     about 1e-9 relative at a million samples (ln B(a, b) from lgamma values near 1e7).
 
+    Parameters
+    ----------
+    count : int
+        The samples in which the event happened, 0 <= count <= samples.
+    samples : int
+        The samples drawn, positive.
+    confidence : float, optional
+        The confidence of the two-sided interval, in (0, 1) (default 0.95).
+
+    Returns
+    -------
+    Estimate
+        ``value`` = count / samples and the interval [``low``, ``high``], each end the
+        quantile of a beta distribution (B(α/2; k, N - k + 1) and B(1 - α/2; k + 1, N - k),
+        α = 1 - confidence; closed forms at k = 0 and k = N).
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``count`` or ``samples`` not an int or out of order, ``confidence`` outside (0, 1).
+
     Examples
     --------
     >>> from aerocontrol.robustness import clopper_pearson
@@ -875,6 +896,18 @@ def monte_carlo(
         A bad argument (named), or an uncertain parameter the aircraft does not have.
     ShapeError
         Gains of the wrong shape.
+
+    Examples
+    --------
+    The 747's Dutch roll with Cn_beta known to 30 %: open loop it misses Level 1 in about one
+    sample of 4000, and it is never unstable.
+
+    >>> from aerocontrol import aircraft
+    >>> from aerocontrol.robustness import Normal, Uncertainty, monte_carlo
+    >>> run = monte_carlo(aircraft.load(), Uncertainty({"Cn_beta": Normal(0.3)}), 4000,
+    ...                   axis="lateral", seed=1)
+    >>> print(run.probability("unstable"))
+    0 (0 of 4000; 95% interval [0, 0.000921795])
     """
     if not isinstance(aircraft, Aircraft):
         raise InvalidArgumentError(

@@ -565,6 +565,34 @@ def as_state_space(model: System, name: str = "sys") -> StateSpace:
     (continuous), or any object with ``A``, ``B``, ``C``, ``D`` attributes, such as
     python-control's StateSpace (its names and its sampling period ``dt`` are taken too when it
     has them; python-control's ``dt=True``, an unspecified period, is refused).
+
+    Parameters
+    ----------
+    model : StateSpace, tuple or system object
+        The model.
+    name : str, optional
+        The argument's name in error messages (default "sys").
+
+    Returns
+    -------
+    StateSpace
+        The model itself, or a new one with the given matrices.
+
+    Raises
+    ------
+    ShapeError
+        A sequence of other than 2 or 4 matrices, or matrices whose shapes disagree.
+    NotRealError
+        ``model`` is none of these, or a matrix is complex.
+    InvalidArgumentError
+        A sampling period that is not a positive number (``dt=True``).
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> sys = aerocontrol.as_state_space(([[0.0, 1.0], [-2.0, -3.0]], [[0.0], [1.0]]))
+    >>> sys.n_states, sys.n_inputs, sys.dt
+    (2, 1, None)
     """
     if isinstance(model, StateSpace):
         return model

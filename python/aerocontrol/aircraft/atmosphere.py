@@ -89,8 +89,30 @@ class Atmosphere:
 def standard_atmosphere(altitude: float, units: str = "si") -> Atmosphere:
     """The 1976 standard atmosphere at a geometric ``altitude`` (m; ft if ``units="english"``).
 
-    Raises InvalidArgumentError for an altitude outside -5 km .. 86 km (the standard's range;
-    below sea level the first layer is extended, as is customary).
+    Parameters
+    ----------
+    altitude : float
+        Geometric altitude, m (ft with ``units="english"``), -5 km to 86 km.
+    units : {"si", "english"}, optional
+        The units of the altitude and of the result (default "si").
+
+    Returns
+    -------
+    Atmosphere
+        The temperature, pressure, density and speed of sound there, in ``units``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        An altitude outside -5 km .. 86 km (the standard's range; below sea level the first
+        layer is extended, as is customary), or unknown ``units``.
+
+    Examples
+    --------
+    >>> from aerocontrol.aircraft import standard_atmosphere
+    >>> air = standard_atmosphere(11000.0)                 # the tropopause
+    >>> round(air.density, 4), round(air.speed_of_sound, 2)
+    (0.3648, 295.15)
     """
     if units not in ("si", "english"):
         raise InvalidArgumentError(f"units must be 'si' or 'english', got {units!r}")

@@ -154,6 +154,27 @@ def envelope_sweep(
     ``derivatives`` (a TypeError or KeyError is a bug in it, not a property of the
     condition).
 
+    Parameters
+    ----------
+    plane : Aircraft
+        The aircraft whose condition is moved.
+    altitudes, machs, weights : array_like (k,), optional
+        The grid, in the file's units (default: the file's own value, a grid of one).
+    derivatives : callable, optional
+        ``derivatives(aircraft) -> Aircraft``: the aircraft to analyse at each condition.
+
+    Returns
+    -------
+    Envelope
+        ``levels`` and ``eigenvalues`` per mode over the (altitude, Mach, weight) grid, the
+        worst Level, and the ``failures`` with their reasons.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``plane`` not an Aircraft, a grid that is empty, not 1-D, not real or not finite, or
+        ``derivatives`` returning something other than an Aircraft.
+
     Examples
     --------
     >>> import numpy as np

@@ -514,11 +514,25 @@ def load(name_or_path: str | Path = "b747-approach") -> Aircraft:
     Cm_q, Cl_p          -1,000 to 1,000 per rad
     ==================  ========================  ==========================
 
-    Raises AircraftDataError (a ``ValueError``) for an unknown identifier, a missing,
-    unreadable, oversized or non-UTF-8 file, malformed TOML (including nesting too deep for
-    the parser and integers of thousands of digits), or a table that does not validate; the
-    message is one line and names the file and the key (and, for a number out of range, the
-    value and the range).
+    Parameters
+    ----------
+    name_or_path : str or Path, optional
+        A shipped aircraft's identifier (default "b747-approach", the chapter's 747) or the
+        path of an aircraft file.
+
+    Returns
+    -------
+    Aircraft
+        The aircraft, its quantities in the file's units.
+
+    Raises
+    ------
+    AircraftDataError
+        (A ``ValueError``.) An unknown identifier, a missing, unreadable, oversized or
+        non-UTF-8 file, malformed TOML (including nesting too deep for the parser and integers
+        of thousands of digits), or a table that does not validate; the message is one line
+        and names the file and the key (and, for a number out of range, the value and the
+        range). ``aerocontrol check FILE.toml`` lists every problem at once.
 
     Examples
     --------

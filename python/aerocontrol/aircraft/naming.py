@@ -41,6 +41,25 @@ def classify_modes(modes: Modes | ArrayLike, axis: str) -> dict[str, tuple[compl
     ``modes`` is a :class:`~aerocontrol.Modes` or the 4 eigenvalues themselves (then a lateral
     model with two complex pairs, which needs the eigenvectors, raises InvalidArgumentError).
 
+    Parameters
+    ----------
+    modes : Modes or array_like (4,)
+        The modes of the model (:func:`aerocontrol.modes`), or its four eigenvalues.
+    axis : {"longitudinal", "lateral"}
+        The model's axis.
+
+    Returns
+    -------
+    dict of str to tuple of complex
+        Each mode's eigenvalues by name: "short period" and "phugoid" (longitudinal), "dutch
+        roll", "roll" and "spiral", or "roll-spiral" for a coupled oscillation (lateral).
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``axis`` is neither, the model has not 4 states, or a lateral model with two complex
+        pairs is given by its eigenvalues alone.
+
     Examples
     --------
     >>> from aerocontrol import aircraft
@@ -212,7 +231,31 @@ def _two_pairs(modes: Modes) -> dict[str, tuple[complex, ...]]:
 
 def name_modes(modes: Modes, axis: str) -> tuple[str, ...]:
     """Display names for the entries of ``modes`` (one per mode, in its order); a mode split into
-    two real roots gives both entries its name with "(1)" and "(2)"."""
+    two real roots gives both entries its name with "(1)" and "(2)".
+
+    Parameters
+    ----------
+    modes : Modes
+        The modes of a 4-state model (:func:`aerocontrol.modes`).
+    axis : {"longitudinal", "lateral"}
+        The model's axis.
+
+    Returns
+    -------
+    tuple of str
+        One display name per entry of ``modes``.
+
+    Raises
+    ------
+    InvalidArgumentError
+        As :func:`classify_modes`.
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> from aerocontrol import aircraft
+    >>> aircraft.name_modes(aerocontrol.modes(aircraft.load().lateral()), "lateral")
+    ('spiral', 'Dutch roll', 'roll')"""
     classified = classify_modes(modes, axis)
     names = []
     for value in modes.eigenvalue:

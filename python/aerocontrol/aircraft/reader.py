@@ -243,7 +243,24 @@ def read_toml(path: str | os.PathLike[str] | Path) -> dict[str, Any]:
 
 
 def available() -> tuple[str, ...]:
-    """The identifiers of the shipped aircraft, sorted (``load`` takes any of them)."""
+    """The identifiers of the shipped aircraft, sorted (``load`` takes any of them).
+
+    Returns
+    -------
+    tuple of str
+        The identifiers, the names of the shipped files without ``.toml``.
+
+    Raises
+    ------
+    None
+        The shipped files are listed from the installed package.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> aircraft.available()[:3]
+    ('b747-20kft', 'b747-approach', 'b747-cruise')
+    """
     return tuple(
         sorted(
             entry.name.removesuffix(".toml")

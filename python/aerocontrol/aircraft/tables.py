@@ -154,7 +154,34 @@ def body_to_stability(
     Ix: float, Iz: float, Ixz: float, alpha0: float
 ) -> tuple[float, float, float]:
     """(Ix, Iz, Ixz) rotated from body axes into stability axes, α0 the angle of attack of the
-    body x axis (rad, positive nose up)."""
+    body x axis (rad, positive nose up).
+
+    Ix' = Ix cos²α0 + Iz sin²α0 - Ixz sin 2α0, Iz' = Ix sin²α0 + Iz cos²α0 + Ixz sin 2α0,
+    Ixz' = (Ix - Iz)/2 sin 2α0 + Ixz cos 2α0 (the rotation of the inertia tensor about y).
+
+    Parameters
+    ----------
+    Ix, Iz, Ixz : float
+        The moments and product of inertia in body axes (any consistent unit).
+    alpha0 : float
+        The trim angle of attack of the body x axis, rad.
+
+    Returns
+    -------
+    tuple of float
+        (Ix, Iz, Ixz) in stability axes; Iy is the same in both.
+
+    Raises
+    ------
+    None
+        The arguments are taken as floats (the reader checks them first).
+
+    Examples
+    --------
+    >>> import math
+    >>> from aerocontrol.aircraft import body_to_stability
+    >>> [round(v, 1) for v in body_to_stability(1000.0, 2000.0, 0.0, math.radians(10.0))]
+    [1030.2, 1969.8, -171.0]"""
     c2, s2 = math.cos(alpha0) ** 2, math.sin(alpha0) ** 2
     sin2, cos2 = math.sin(2 * alpha0), math.cos(2 * alpha0)
     return (

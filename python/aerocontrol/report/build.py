@@ -36,7 +36,34 @@ def build_report(
 ) -> Report:
     """Run the analyses on an aircraft (an :class:`~aerocontrol.aircraft.Aircraft`, a shipped
     identifier or a TOML path) and collect them as a :class:`Report`. ``progress`` receives
-    one line per step."""
+    one line per step.
+
+    Parameters
+    ----------
+    plane : Aircraft or str, optional
+        The aircraft (default "b747-approach", the chapter's 747).
+    progress : callable, optional
+        ``progress(line)`` after each section.
+
+    Returns
+    -------
+    Report
+        The sections' headings, paragraphs, tables and figures, in order.
+
+    Raises
+    ------
+    AircraftDataError
+        The aircraft cannot be loaded. A design that does not apply to the aircraft is
+        reported in the document, not raised.
+
+    Examples
+    --------
+    >>> from aerocontrol.report import build_report
+    >>> lines = []
+    >>> document = build_report(progress=lines.append)     # the 747: a few seconds
+    >>> lines[0][:35]
+    'models: Boeing 747, powered approach'
+"""
     aircraft = plane if isinstance(plane, Aircraft) else load(plane)
     say = progress if progress is not None else (lambda line: None)
     report = Report(f"aerocontrol {_version()}: {aircraft.name}")
@@ -95,6 +122,22 @@ def write_report(
     exactly what it did: the staging folder, its files, the folders it created (if empty);
     the earlier report's files, kept as backups until the end, are put back. Another run
     writing into the same folder at the same time is refused.
+
+    Parameters
+    ----------
+    plane : Aircraft or str, optional
+        The aircraft (default "b747-approach", the chapter's 747).
+    out : str or Path, optional
+        The folder (default "aerocontrol-report").
+    progress : callable, optional
+        ``progress(line)`` after each section.
+    force : bool, optional
+        Write beside the files of a folder that holds no earlier report (default False).
+
+    Returns
+    -------
+    Path
+        The path of ``report.html``.
 
     Raises
     ------
