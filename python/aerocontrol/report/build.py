@@ -61,7 +61,7 @@ def build_report(
     >>> from aerocontrol.report import build_report
     >>> lines = []
     >>> document = build_report(progress=lines.append)     # the 747: a few seconds
-    >>> lines[0][:35]
+    >>> lines[0][:36]
     'models: Boeing 747, powered approach'
 """
     aircraft = plane if isinstance(plane, Aircraft) else load(plane)
