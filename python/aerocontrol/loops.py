@@ -101,6 +101,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._balance import balanced_loop, balanced_matrix, balanced_states
+from ._results import Result, Tabular
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
@@ -599,7 +600,7 @@ def _separated(omega: FloatArray) -> FloatArray:
 
 
 @dataclass(frozen=True, eq=False)
-class StabilityMargins:
+class StabilityMargins(Result):
     """The margins of a SISO loop, negative feedback (1 + L = 0); ``print`` shows a table.
 
     Single values are the critical ones (as python-control's ``stability_margins``): the gain
@@ -653,24 +654,51 @@ class StabilityMargins:
         """±2 arctan(α/2) in degrees: the phase change at unit gain the disk allows."""
         return _disk_phase_margin(self.disk_margin, 0.0)
 
+    def _cells(self) -> tuple[str, list[tuple[str, str, str, str]]]:
+        """The closed loop's line, and (margin, value, unit, frequency) per margin."""
+        status = "stable" if self.closed_loop_stable else "UNSTABLE"
+        title = (
+            f"closed loop {status}: {self.open_loop_unstable_poles} unstable open-loop poles, "
+            f"{self.encirclements} counterclockwise encirclements of -1"
+        )
+        rows = [
+            ("gain margin", f"{_db(gm):+.3f}", "dB", f"{w:.5g}")
+            for gm, w in zip(self.gain_margins, self.phase_crossovers, strict=True)
+        ]
+        rows += [
+            ("phase margin", f"{pm:+.3f}", "deg", f"{w:.5g}")
+            for pm, w in zip(self.phase_margins, self.gain_crossovers, strict=True)
+        ]
+        rows.append(("delay margin", f"{self.delay_margin:.5g}", "s", ""))
+        low, high = self.disk_gain_margin
+        rows.append(
+            (
+                "disk margin",
+                f"alpha = {self.disk_margin:.4g}: gain {_db(low):+.2f}/{_db(high):+.2f} dB, "
+                f"phase ±{self.disk_phase_margin:.2f} deg",
+                "",
+                f"{self.disk_frequency:.4g}",
+            )
+        )
+        return title, rows
+
     def table(self) -> str:
         """The margins and the closed loop, one line each."""
-        status = "stable" if self.closed_loop_stable else "UNSTABLE"
-        lines = [
-            f"closed loop {status}: {self.open_loop_unstable_poles} unstable open-loop poles, "
-            f"{self.encirclements} counterclockwise encirclements of -1",
-        ]
-        for gm, w in zip(self.gain_margins, self.phase_crossovers, strict=True):
-            lines.append(f"gain margin   {_db(gm):+9.3f} dB  at {w:.5g} rad/s")
-        for pm, w in zip(self.phase_margins, self.gain_crossovers, strict=True):
-            lines.append(f"phase margin  {pm:+9.3f} deg at {w:.5g} rad/s")
-        lines.append(f"delay margin  {self.delay_margin:.5g} s")
-        low, high = self.disk_gain_margin
-        lines.append(
-            f"disk margin   alpha = {self.disk_margin:.4g}: gain {_db(low):+.2f}/{_db(high):+.2f} "
-            f"dB, phase ±{self.disk_phase_margin:.2f} deg (at {self.disk_frequency:.4g} rad/s)"
-        )
+        title, rows = self._cells()
+        lines = [title]
+        for name, value, unit, frequency in rows:
+            if name == "delay margin":
+                lines.append(f"{name:<14}{value} {unit}")
+            elif name == "disk margin":
+                lines.append(f"{name:<14}{value} (at {frequency} rad/s)")
+            else:
+                lines.append(f"{name:<14}{value:>9} {unit:<3} at {frequency} rad/s")
         return "\n".join(lines)
+
+    def _tables(self) -> list[Tabular]:
+        title, rows = self._cells()
+        cells = [(name, f"{value} {unit}".rstrip(), frequency) for name, value, unit, frequency in rows]
+        return [Tabular(title, ("margin", "value", "at (rad/s)"), cells)]
 
     def __str__(self) -> str:
         return self.table()

@@ -51,6 +51,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _core
+from ._results import Result, Tabular
 from ._validation import FloatArray, finite_or_warn, real_scalar
 from .exceptions import (
     ConvergenceError,
@@ -646,7 +647,7 @@ def _format_factors(factors: list[Factor], variable: str, digits: int) -> str:
 
 
 @dataclass(frozen=True, eq=False)
-class TransferFunction:
+class TransferFunction(Result):
     """One channel G(s) = K Π(s - z_i)/Π(s - p_j) of a model (in z for a discrete model).
 
     ``print(tf)`` shows the factored "aircraft" form, (s + 1/T) for a real root -1/T and
@@ -725,20 +726,35 @@ class TransferFunction:
         top = gain if numerator == "1" else f"{gain} {numerator}"
         return f"{top} / {denominator}" if denominator != "1" else top
 
-    def __str__(self) -> str:
-        lines = [f"{self.output_name}/{self.input_name}({self.variable}) = {self.aircraft_form()}"]
+    def _cells(self) -> list[tuple[str, str, str]]:
+        """(zero or pole, root, its time constant or ζ and ω) per factor, as text."""
+        rows = []
         for what, factors in (("zero", self.zero_factors), ("pole", self.pole_factors)):
             for f in factors:
                 if len(f.roots) == 1:
                     tau = f"T = {f.time_constant:.4g} s" if math.isfinite(f.time_constant) else ""
-                    lines.append(f"  {what} {f.roots[0].real:.6g} {tau}".rstrip())
+                    rows.append((what, f"{f.roots[0].real:.6g}", tau))
                 else:
                     r = f.roots[0]
-                    lines.append(
-                        f"  {what}s {r.real:.6g} ± {r.imag:.6g}j: "
-                        f"zeta = {f.zeta:.4g}, omega = {f.omega:.4g} rad/s"
+                    rows.append(
+                        (
+                            f"{what}s",
+                            f"{r.real:.6g} ± {r.imag:.6g}j",
+                            f"zeta = {f.zeta:.4g}, omega = {f.omega:.4g} rad/s",
+                        )
                     )
+        return rows
+
+    def __str__(self) -> str:
+        lines = [f"{self.output_name}/{self.input_name}({self.variable}) = {self.aircraft_form()}"]
+        for what, root, detail in self._cells():
+            separator = ":" if what.endswith("s") else ""
+            lines.append(f"  {what} {root}{separator} {detail}".rstrip())
         return "\n".join(lines)
+
+    def _tables(self) -> list[Tabular]:
+        title = f"{self.output_name}/{self.input_name}({self.variable}) = {self.aircraft_form()}"
+        return [Tabular(title, ("factor", "root", "characteristics"), self._cells())]
 
 
 def _evaluation_points(
