@@ -21,7 +21,7 @@ import base64
 import dataclasses
 import html
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any, ClassVar, NamedTuple, TypeVar
 
 import numpy as np
@@ -60,21 +60,35 @@ JSON_FORMAT = "aerocontrol result JSON, version 1"
 _NON_FINITE = {"NaN": math.nan, "Infinity": math.inf, "-Infinity": -math.inf}
 
 #: The classes :meth:`Result.from_dict` may build, by name: the results and the records they
-#: hold (filled in by :func:`register` and :func:`attach`), and each class's name.
+#: hold (filled in by :func:`register`), each class's name, and for a class that is not a
+#: dataclass its fields and how it is built from them.
 _REGISTRY: dict[str, type] = {}
 _NAMES: dict[type, str] = {}
+_FIELDS: dict[type, tuple[str, ...]] = {}
+_BUILDERS: dict[type, Callable[[Mapping[str, Any]], Any]] = {}
 
 T = TypeVar("T")
 
 
-def register(cls: type[T], name: str | None = None) -> type[T]:
-    """Let :meth:`Result.from_dict` build ``cls`` (a dataclass) by ``name`` (its class name by
-    default; a record whose class name another class has needs its own)."""
+def register(
+    cls: type[T],
+    name: str | None = None,
+    fields: tuple[str, ...] | None = None,
+    build: Callable[[Mapping[str, Any]], T] | None = None,
+) -> type[T]:
+    """Let :meth:`Result.from_dict` build ``cls`` by ``name`` (its class name by default; a
+    record whose class name another class has needs its own). A class that is not a dataclass
+    gives its ``fields`` (what ``==`` compares and the JSON form holds) and ``build``, which
+    makes an instance from them."""
     name = cls.__name__ if name is None else name
     if _REGISTRY.get(name, cls) is not cls:
         raise RuntimeError(f"two result classes named {name!r}")  # pragma: no cover
     _REGISTRY[name] = cls
     _NAMES[cls] = name
+    if fields is not None:
+        _FIELDS[cls] = fields
+    if build is not None:
+        _BUILDERS[cls] = build
     return cls
 
 
@@ -165,23 +179,23 @@ def tables_markdown(tables: Sequence[Tabular], png: bytes | None = None) -> str:
 
 def field_names(value: object) -> tuple[str, ...]:
     """The fields that make up a result's or a record's value (those that take part in ``==``)."""
-    names: tuple[str, ...] | None = getattr(type(value), "_result_fields", None)
+    names = _FIELDS.get(type(value))
     if names is not None:
         return names
     return tuple(f.name for f in dataclasses.fields(value) if f.compare)  # type: ignore[arg-type]
 
 
-def _all_fields(value: object) -> tuple[str, ...]:
+def _all_fields_of(cls: type) -> tuple[str, ...]:
     """Every field a result holds (also those left out of ``==``), for the JSON form."""
-    names: tuple[str, ...] | None = getattr(type(value), "_result_fields", None)
+    names = _FIELDS.get(cls)
     if names is not None:
         return names
-    return tuple(f.name for f in dataclasses.fields(value))  # type: ignore[arg-type]
+    return tuple(f.name for f in dataclasses.fields(cls))
 
 
 def _is_record(value: object) -> bool:
-    return (dataclasses.is_dataclass(value) and not isinstance(value, type)) or hasattr(
-        type(value), "_result_fields"
+    return type(value) in _FIELDS or (
+        dataclasses.is_dataclass(value) and not isinstance(value, type)
     )
 
 
@@ -272,7 +286,9 @@ def encode(value: Any) -> Any:
     if _is_record(value) and type(value) in _NAMES:
         return {
             "type": _NAMES[type(value)],
-            "fields": {name: encode(getattr(value, name)) for name in _all_fields(value)},
+            "fields": {
+                name: encode(getattr(value, name)) for name in _all_fields_of(type(value))
+            },
         }
     raise InvalidArgumentError(f"a {type(value).__name__} has no JSON form")
 
@@ -338,21 +354,14 @@ def build(cls: type[T], fields: Mapping[str, Any]) -> T:
         raise InvalidArgumentError(
             f"data: a {cls.__name__} has the fields {sorted(expected)}, got {sorted(fields)}"
         )
-    constructor = getattr(cls, "_from_fields", None)
-    if constructor is not None:
-        built: T = constructor(fields)
+    builder = _BUILDERS.get(cls)
+    if builder is not None:
+        built: T = builder(fields)
         return built
     instance = object.__new__(cls)
     for name, field_value in fields.items():
         object.__setattr__(instance, name, field_value)
     return instance
-
-
-def _all_fields_of(cls: type) -> tuple[str, ...]:
-    names: tuple[str, ...] | None = getattr(cls, "_result_fields", None)
-    if names is not None:
-        return names
-    return tuple(f.name for f in dataclasses.fields(cls))
 
 
 # ----- the base class -------------------------------------------------------------------------
@@ -477,13 +486,24 @@ def attach(cls: type, names: tuple[str, ...]) -> None:
     """Give a class that cannot derive from :class:`Result` (the core's Placement) the same
     equality, JSON form and notebook display; ``names`` are its fields, in the order its
     constructor takes them, and ``cls._tables`` must be set."""
-    setattr(cls, "_result_fields", names)
-    setattr(cls, "_from_fields", classmethod(lambda c, f: c(*(f[name] for name in names))))
-    setattr(cls, "__eq__", _eq)
-    setattr(cls, "__hash__", None)
-    setattr(cls, "_png", lambda self: None)
-    setattr(cls, "_repr_html_", _repr_html)
-    setattr(cls, "_repr_markdown_", _repr_markdown)
-    setattr(cls, "to_dict", _to_dict)
+    register(cls, fields=names, build=lambda fields: cls(*(fields[name] for name in names)))
+    for attribute in ("__eq__", "__hash__", "_png", "_repr_html_", "_repr_markdown_"):
+        setattr(cls, attribute, getattr(Result, attribute))
+    setattr(cls, "to_dict", Result.to_dict)
     setattr(cls, "from_dict", classmethod(_from_dict))
-    register(cls)
+
+
+def register_model(model: type) -> None:
+    """Let results hold a :class:`~aerocontrol.StateSpace` (a damper's loop, an LQG design's
+    compensator): compared by its matrices, names and ``dt``, rebuilt by its constructor.
+    Called by the modules of those results with the class (which this module does not import,
+    so that the model's own module may use any other)."""
+    names = ("A", "B", "C", "D", "state_names", "input_names", "output_names", "dt")
+
+    def build(fields: Mapping[str, Any]) -> Any:
+        return model(
+            *(fields[name] for name in names[:4]),
+            **{name: fields[name] for name in names[4:]},
+        )
+
+    register(model, fields=names, build=build)

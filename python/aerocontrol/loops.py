@@ -1210,8 +1210,8 @@ def _disk_phase_margin(alpha: float, skew: float) -> float:
     return math.degrees(2.0 * math.atan(alpha / math.sqrt(4.0 - (alpha * skew) ** 2)))
 
 
-@dataclass(frozen=True)
-class DiskMargin:
+@dataclass(frozen=True, eq=False)
+class DiskMargin(Result):
     """A disk margin α of skew σ: the loop stays stable for every multiplicative gain and phase
     change f (in every loop at once, independently, for a multiloop margin) in the disk
 
@@ -1254,7 +1254,7 @@ class DiskMargin:
 
 
 @dataclass(frozen=True, eq=False)
-class DiskMargins:
+class DiskMargins(Result):
     """Loop-at-a-time and multiloop disk margins of a square MIMO loop; ``print`` shows a
     table.
 
@@ -2051,7 +2051,7 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
-class RootLocus:
+class RootLocus(Result):
     """The closed-loop poles of 1 + k L(s) = 0 over the gains k."""
 
     gains: FloatArray
@@ -2160,8 +2160,8 @@ def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
     )
 
 
-@dataclass(frozen=True)
-class DampingDesign:
+@dataclass(frozen=True, eq=False)
+class DampingDesign(Result):
     """A gain of a root-locus design and the mode it sets."""
 
     gain: float
@@ -2942,7 +2942,7 @@ def _half_contour(
 
 
 @dataclass(frozen=True, eq=False)
-class NyquistResponse:
+class NyquistResponse(Result):
     """The Nyquist curve of a SISO loop, negative feedback (1 + L = 0), and its count of
     encirclements of -1 checked against the open- and closed-loop poles; ``print`` shows P, N,
     Z and the verdict.
@@ -3183,7 +3183,7 @@ def nyquist(loop: System, omega: ArrayLike | None = None) -> NyquistResponse:
 
 
 @dataclass(frozen=True, eq=False)
-class NicholsResponse:
+class NicholsResponse(Result):
     """The open-loop gain (dB) against the phase (degrees) of a SISO loop over frequency, for
     the Nichols chart; ``print`` shows the ranges."""
 

@@ -96,7 +96,7 @@ def _placement_tables(design: Placement) -> list[Tabular]:
     ]
 
 
-setattr(Placement, "_tables", _placement_tables)
+Placement._tables = _placement_tables  # type: ignore[attr-defined]
 attach(
     Placement,
     (
