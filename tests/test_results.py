@@ -265,7 +265,7 @@ def test_equality_takes_nan_as_equal_to_nan_and_compares_values() -> None:
     assert any(math.isnan(r.value) for r in hq.requirements)
     assert pickle.loads(pickle.dumps(hq)) == hq
     # A new computation of the same modes is equal; other modes are not.
-    A, B = _lateral()
+    A, _ = _lateral()
     assert aerocontrol.modes(A) == aerocontrol.modes(A)
     assert aerocontrol.modes(A) != aerocontrol.modes(A, ["spiral", "dutch roll", "roll"])
     assert aerocontrol.modes(A) != aerocontrol.modes(np.diag([-1.0, -2.0, -3.0, -4.0]))
@@ -366,8 +366,15 @@ def test_the_tables_are_the_text_tables_cells() -> None:
     modes = aerocontrol.modes(A, ["spiral", "dutch roll", "roll"])
     rows = [line.split() for line in modes.table().splitlines()[2:]]
     cells = _cells(modes._repr_html_())
-    assert cells[:7] == ["mode", "eigenvalue", "damping", "freq (rad/s)", "period (s)",
-                         "t½ / t₂ (s)", "τ (s)"]
+    assert cells[:7] == [
+        "mode",
+        "eigenvalue",
+        "damping",
+        "freq (rad/s)",
+        "period (s)",
+        "t½ / t₂ (s)",
+        "τ (s)",
+    ]
     assert cells[7:14] == ["spiral", "-0.046425", "1.0000", "0.0464", "-", "14.93", "21.54"]
     assert rows[0] == cells[7:14]
     hq = _built("HandlingQualities")
@@ -417,7 +424,10 @@ def test_the_report_and_its_sections_show_in_a_notebook() -> None:
 
     report = build_report("b747-approach")
     sections = report.sections()
-    assert [s.title for s in sections][:2] == ["Aircraft and flight condition", "Modes and handling qualities"]
+    assert [s.title for s in sections][:2] == [
+        "Aircraft and flight condition",
+        "Modes and handling qualities",
+    ]
     assert sum(len(s.blocks) for s in sections) + len(sections) == len(report.blocks)
     modes = sections[1]
     markup = modes._repr_html_()

@@ -251,7 +251,7 @@ def _encode_scalar(value: Any) -> Any:
     if isinstance(value, (int, np.integer)):
         return int(value)
     if isinstance(value, (complex, np.complexfloating)):
-        return {"re": _encode_float(value.real), "im": _encode_float(value.imag)}
+        return {"re": _encode_float(float(value.real)), "im": _encode_float(float(value.imag))}
     return _encode_float(float(value))
 
 
@@ -286,9 +286,7 @@ def encode(value: Any) -> Any:
     if _is_record(value) and type(value) in _NAMES:
         return {
             "type": _NAMES[type(value)],
-            "fields": {
-                name: encode(getattr(value, name)) for name in _all_fields_of(type(value))
-            },
+            "fields": {name: encode(getattr(value, name)) for name in _all_fields_of(type(value))},
         }
     raise InvalidArgumentError(f"a {type(value).__name__} has no JSON form")
 
@@ -367,18 +365,8 @@ def build(cls: type[T], fields: Mapping[str, Any]) -> T:
 # ----- the base class -------------------------------------------------------------------------
 
 
-def _eq(self: Any, other: object) -> bool:
-    if type(other) is not type(self):
-        return NotImplemented
-    return all(same(getattr(self, name), getattr(other, name)) for name in field_names(self))
-
-
-def _to_dict(self: Any) -> dict[str, Any]:
-    encoded: dict[str, Any] = encode(self)
-    return encoded
-
-
 def _from_dict(cls: type[T], data: Mapping[str, Any]) -> T:
+    """:meth:`Result.from_dict` (also the core's Placement's, see :func:`attach`)."""
     if not isinstance(data, Mapping) or set(data) != {"type", "fields"}:
         raise InvalidArgumentError(
             "data must be a dict with the keys 'type' and 'fields', as to_dict() gives"
@@ -389,14 +377,6 @@ def _from_dict(cls: type[T], data: Mapping[str, Any]) -> T:
     return result
 
 
-def _repr_html(self: Any) -> str:
-    return tables_html(self._tables(), self._png())
-
-
-def _repr_markdown(self: Any) -> str:
-    return tables_markdown(self._tables(), self._png())
-
-
 class Result:
     """The base of the result classes (see the module's documentation)."""
 
@@ -404,7 +384,10 @@ class Result:
     __hash__: ClassVar[None] = None  # type: ignore[assignment]
 
     def __eq__(self, other: object) -> bool:
-        return _eq(self, other)
+        """Field by field (see the module's documentation); results of other classes differ."""
+        if type(other) is not type(self):
+            return NotImplemented
+        return all(same(getattr(self, n), getattr(other, n)) for n in field_names(self))
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -420,11 +403,11 @@ class Result:
 
     def _repr_html_(self) -> str:
         """The result as HTML tables, for Jupyter."""
-        return _repr_html(self)
+        return tables_html(self._tables(), self._png())
 
     def _repr_markdown_(self) -> str:
         """The result as Markdown tables, for Jupyter."""
-        return _repr_markdown(self)
+        return tables_markdown(self._tables(), self._png())
 
     def to_dict(self) -> dict[str, Any]:
         """The result as plain Python types for JSON (see :data:`JSON_FORMAT`).
@@ -451,7 +434,8 @@ class Result:
         >>> aerocontrol.Modes.from_dict(json.loads(text)) == m
         True
         """
-        return _to_dict(self)
+        encoded: dict[str, Any] = encode(self)
+        return encoded
 
     @classmethod
     def from_dict(cls: type[T], data: Mapping[str, Any]) -> T:
@@ -487,10 +471,11 @@ def attach(cls: type, names: tuple[str, ...]) -> None:
     equality, JSON form and notebook display; ``names`` are its fields, in the order its
     constructor takes them, and ``cls._tables`` must be set."""
     register(cls, fields=names, build=lambda fields: cls(*(fields[name] for name in names)))
-    for attribute in ("__eq__", "__hash__", "_png", "_repr_html_", "_repr_markdown_"):
-        setattr(cls, attribute, getattr(Result, attribute))
-    setattr(cls, "to_dict", Result.to_dict)
-    setattr(cls, "from_dict", classmethod(_from_dict))
+    shared = ("__eq__", "__hash__", "_png", "_repr_html_", "_repr_markdown_", "to_dict")
+    methods = {name: getattr(Result, name) for name in shared}
+    methods["from_dict"] = classmethod(_from_dict)
+    for attribute, method in methods.items():
+        setattr(cls, attribute, method)
 
 
 def register_model(model: type) -> None:

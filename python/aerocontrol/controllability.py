@@ -173,7 +173,14 @@ class Controllability(Result):
             f"{self.controllable_order}, staircase blocks {list(self.block_sizes)}, smallest "
             f"pivot {self.smallest_pivot:.4g}"
         ]
-        return [Tabular(str(self), ("eigenvalue", measure, "by the inputs" if word == "reached" else "by the outputs"), rows, notes)]
+        return [
+            Tabular(
+                str(self),
+                ("eigenvalue", measure, "by the inputs" if word == "reached" else "by the outputs"),
+                rows,
+                notes,
+            )
+        ]
 
 
 def _core_analysis(

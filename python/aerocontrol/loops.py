@@ -697,7 +697,9 @@ class StabilityMargins(Result):
 
     def _tables(self) -> list[Tabular]:
         title, rows = self._cells()
-        cells = [(name, f"{value} {unit}".rstrip(), frequency) for name, value, unit, frequency in rows]
+        cells = [
+            (name, f"{value} {unit}".rstrip(), frequency) for name, value, unit, frequency in rows
+        ]
         return [Tabular(title, ("margin", "value", "at (rad/s)"), cells)]
 
     def __str__(self) -> str:

@@ -95,7 +95,7 @@ class Modes(Result):
 
     def _cells(self) -> list[tuple[str, ...]]:
         """The table's rows as text: name, eigenvalue, ζ, ω_n, period, t½ (or t₂) and τ."""
-        rows = []
+        rows: list[tuple[str, ...]] = []
         for k in range(len(self)):
             lam = self.eigenvalue[k]
             if self.oscillatory[k] and lam.imag != 0:
@@ -128,13 +128,15 @@ class Modes(Result):
     def table(self) -> str:
         """The table that ``str()`` prints."""
         widths = (14, 26, 10, 14, 12, 14, 10)
-        header = (*self._HEADER, "tau (s)")
-        lines = [f"{header[0]:<14}" + "".join(f"{h:>{w}}" for h, w in zip(header[1:], widths[1:]))]
-        lines.append("-" * len(lines[0]))
-        for row in self._cells():
-            lines.append(
-                f"{row[0]:<14}" + "".join(f"{c:>{w}}" for c, w in zip(row[1:], widths[1:]))
+
+        def line(cells: tuple[str, ...]) -> str:
+            return f"{cells[0]:<14}" + "".join(
+                f"{cell:>{width}}" for cell, width in zip(cells[1:], widths[1:], strict=True)
             )
+
+        lines = [line((*self._HEADER, "tau (s)"))]
+        lines.append("-" * len(lines[0]))
+        lines += [line(row) for row in self._cells()]
         return "\n".join(lines)
 
     def _tables(self) -> list[Tabular]:

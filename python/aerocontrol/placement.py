@@ -77,9 +77,7 @@ def _describe(design: Placement) -> str:
 
 def _placement_tables(design: Placement) -> list[Tabular]:
     """The gains and the requested and achieved poles as tables, formatted as ``str`` does."""
-    gain = [
-        (f"u{i + 1}", *(format_number(v, 6) for v in row)) for i, row in enumerate(design.K)
-    ]
+    gain = [(f"u{i + 1}", *(format_number(v, 6) for v in row)) for i, row in enumerate(design.K)]
     header = ("K", *(f"x{j + 1}" for j in range(design.K.shape[1])))
     poles = [
         (f"{complex(want):.6g}", f"{complex(got):.6g}")

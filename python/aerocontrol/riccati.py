@@ -101,9 +101,7 @@ def _solution_tables(solution: CareSolution | DareSolution, kind: str) -> list[T
         f"{kind} algebraic Riccati equation: relative residual {solution.residual:.2e}, "
         f"rcond {solution.rcond:.2e}, {solution.refinement_steps} Newton step(s)"
     )
-    gain = [
-        (f"u{i + 1}", *(format_number(v, 6) for v in row)) for i, row in enumerate(solution.K)
-    ]
+    gain = [(f"u{i + 1}", *(format_number(v, 6) for v in row)) for i, row in enumerate(solution.K)]
     header = ("K", *(f"x{j + 1}" for j in range(solution.K.shape[1])))
     poles = [(format_complex(complex(p), 6),) for p in solution.closed_loop_poles]
     return [Tabular(title, header, gain), Tabular("", ("closed-loop poles",), poles)]

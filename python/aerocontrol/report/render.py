@@ -106,9 +106,7 @@ def html_body(title: str, blocks: Sequence[Any], images: dict[str, bytes]) -> st
 
 def html(title: str, blocks: Sequence[Any], images: dict[str, bytes]) -> str:
     """The blocks as one HTML page; ``images`` maps file names to PNG bytes, embedded."""
-    return _HTML_PAGE.format(
-        title=html_text.escape(title), body=html_body(title, blocks, images)
-    )
+    return _HTML_PAGE.format(title=html_text.escape(title), body=html_body(title, blocks, images))
 
 
 _HTML_PAGE = """<!DOCTYPE html>
