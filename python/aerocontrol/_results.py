@@ -9,7 +9,7 @@ core's :class:`~aerocontrol.Placement` through :func:`attach`). It gives them
   compares equal to the one sent. Results hold arrays, so they are not hashable;
 * :meth:`Result.to_dict` and :meth:`Result.from_dict`: a form made of plain Python types that
   :func:`json.dumps` writes as strict JSON (no NaN or Infinity tokens), read back to an equal
-  object (the encoding is described under :data:`JSON_FORMAT`);
+  object (the encoding is described under :meth:`Result.to_dict`);
 * ``_repr_html_`` and ``_repr_markdown_`` for Jupyter: the tables the class's ``_tables``
   gives, the cells formatted as its text ``table()`` or ``str()`` formats them, every string
   escaped (:func:`html_table`, :func:`markdown_table`).
@@ -29,33 +29,20 @@ import numpy as np
 from .exceptions import InvalidArgumentError
 
 __all__ = [
-    "JSON_FORMAT",
     "Result",
     "Tabular",
     "attach",
+    "decode",
+    "encode",
+    "field_names",
     "format_complex",
     "format_number",
     "html_table",
     "markdown_table",
+    "register",
+    "register_model",
+    "same",
 ]
-
-#: The JSON form of :meth:`Result.to_dict`, value by value:
-#:
-#: ======================  ==================================================================
-#: None, bool, int, str    themselves (a str that reads "NaN", "Infinity" or "-Infinity" as
-#:                         ``{"str": text}``)
-#: float                   a number; NaN, inf and -inf as the strings "NaN", "Infinity",
-#:                         "-Infinity"
-#: complex                 ``{"re": float, "im": float}`` (in arrays too)
-#: numpy array             ``{"ndarray": [...], "dtype": "float64", "shape": [n, m]}``: the
-#:                         elements flattened in row-major (C) order, each encoded as above
-#: tuple                   a JSON list
-#: list                    ``{"list": [...]}``
-#: dict                    ``{"dict": {key: value}}`` with str keys, else
-#:                         ``{"items": [[key, value], ...]}``
-#: a result or a record    ``{"type": "Modes", "fields": {name: value, ...}}``
-#: ======================  ==================================================================
-JSON_FORMAT = "aerocontrol result JSON, version 1"
 
 _NON_FINITE = {"NaN": math.nan, "Infinity": math.inf, "-Infinity": -math.inf}
 
@@ -256,7 +243,7 @@ def _encode_scalar(value: Any) -> Any:
 
 
 def encode(value: Any) -> Any:
-    """``value`` in the JSON form of :data:`JSON_FORMAT`."""
+    """``value`` in the JSON form (see :meth:`Result.to_dict`)."""
     if value is None or isinstance(value, (bool, np.bool_)):
         return None if value is None else bool(value)
     if isinstance(value, str):
@@ -310,7 +297,7 @@ def _decode_element(value: Any, kind: str) -> Any:
 
 
 def decode(value: Any) -> Any:
-    """The value whose JSON form (:data:`JSON_FORMAT`) is ``value``."""
+    """The value whose JSON form (see :meth:`Result.to_dict`) is ``value``."""
     if value is None or isinstance(value, (bool, int, float)):
         return value
     if isinstance(value, str):
@@ -410,20 +397,42 @@ class Result:
         return tables_markdown(self._tables(), self._png())
 
     def to_dict(self) -> dict[str, Any]:
-        """The result as plain Python types for JSON (see :data:`JSON_FORMAT`).
+        """The result as plain Python types for JSON.
 
-        ``json.dumps(result.to_dict())`` is strict JSON, and ``type(result).from_dict`` reads
-        it back to an equal result.
+        ``json.dumps(result.to_dict())`` is strict JSON (no NaN or Infinity tokens), and
+        ``type(result).from_dict`` reads it back to an equal result.
 
         Returns
         -------
         dict
-            ``{"type": class name, "fields": {field: value}}``.
+            ``{"type": class name, "fields": {field: value}}``, every field of the result
+            (also those ``==`` leaves out, such as the run a MonteCarlo drew from).
 
         Raises
         ------
         InvalidArgumentError
             A field holds a value that has no JSON form.
+
+        Notes
+        -----
+        Each value is written as follows:
+
+        ======================  ==============================================================
+        None, bool, int, str    themselves (a str that reads "NaN", "Infinity" or "-Infinity"
+                                as ``{"str": text}``)
+        float                   a number; NaN, inf and -inf as the strings "NaN",
+                                "Infinity", "-Infinity"
+        complex                 ``{"re": float, "im": float}``, in arrays too
+        numpy array             ``{"ndarray": [...], "dtype": "float64", "shape": [n, m]}``:
+                                the elements in row-major (C) order, each written as above
+        tuple                   a list
+        list                    ``{"list": [...]}``
+        dict                    ``{"dict": {key: value}}`` with str keys, else
+                                ``{"items": [[key, value], ...]}``
+        a result or a record    ``{"type": "Modes", "fields": {name: value, ...}}``; records
+                                are the objects results hold (a Requirement, an Aircraft,
+                                a StateSpace, ...)
+        ======================  ==============================================================
 
         Examples
         --------
