@@ -395,6 +395,19 @@ def test_every_string_is_escaped() -> None:
         ),
     )
     assert "y&amp;/&lt;u&gt;(s)" in tf._repr_html_()
+    # A result without a table of its own shows its text, escaped, or its fields.
+    bode = _built("FrequencyResponse")
+    assert "<pre>" in bode._repr_html_() and "elevator -&gt; q: peak" in bode._repr_html_()
+    assert "```\nfrequency response: " in bode._repr_markdown_()
+    discrete = _built("Discretization")
+    assert _cells(discrete._repr_html_())[:6] == [
+        "field",
+        "value",
+        "Phi",
+        "float64 array of shape (4, 4)",
+        "Gamma0",
+        "[" + ", ".join(f"{v:.6g}" for v in discrete.Gamma0.ravel()) + "]",
+    ]
 
 
 def test_a_time_response_shows_a_small_plot_without_pyplot() -> None:

@@ -99,12 +99,13 @@ def format_complex(value: complex, digits: int = 5) -> str:
 
 class Tabular(NamedTuple):
     """One table of a result as text cells: a title, the column names, the rows, and notes
-    printed under it."""
+    printed under it; or, with ``text``, preformatted text instead of the table."""
 
     title: str
     header: Sequence[str]
     rows: Sequence[Sequence[str]]
     notes: Sequence[str] = ()
+    text: str = ""
 
 
 def html_table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
@@ -128,6 +129,43 @@ def markdown_table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
     return "\n".join(lines)
 
 
+def _longest_run(text: str, character: str) -> int:
+    """The length of the longest run of ``character`` in ``text``."""
+    longest = run = 0
+    for c in text:
+        run = run + 1 if c == character else 0
+        longest = max(longest, run)
+    return longest
+
+
+def _summary(value: Any) -> str:
+    """A field's value in one cell: a short array or a number as text, a long array by its
+    shape and dtype."""
+    if isinstance(value, np.ndarray):
+        if value.size <= 8 and value.dtype.kind in "biufc":
+            return "[" + ", ".join(_summary(v) for v in value.ravel().tolist()) + "]"
+        return f"{value.dtype.name} array of shape {value.shape}"
+    if isinstance(value, (bool, np.bool_)) or value is None:
+        return str(value)
+    if isinstance(value, (float, np.floating)):
+        return format_number(float(value), 6)
+    if isinstance(value, (complex, np.complexfloating)):
+        return format_complex(complex(value), 6)
+    if isinstance(value, (tuple, list)) and len(value) > 8:
+        return f"{len(value)} items"
+    return str(value)
+
+
+def default_tables(result: Any) -> list[Tabular]:
+    """A result without a table of its own: its text (when it has a ``str`` of its own), else
+    one row per field."""
+    name = type(result).__name__
+    if getattr(type(result), "__str__", None) is not object.__str__:
+        return [Tabular(name, (), (), text=str(result))]
+    rows = [(field, _summary(getattr(result, field))) for field in field_names(result)]
+    return [Tabular(name, ("field", "value"), rows)]
+
+
 def png_data_uri(png: bytes) -> str:
     """``data:image/png;base64,...`` for embedding a PNG in HTML or Markdown."""
     return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
@@ -140,7 +178,10 @@ def tables_html(tables: Sequence[Tabular], png: bytes | None = None) -> str:
     for table in tables:
         if table.title:
             parts.append(f"<p><strong>{escape(table.title)}</strong></p>")
-        parts.append(html_table(table.header, table.rows))
+        if table.text:
+            parts.append(f"<pre>{escape(table.text)}</pre>")
+        else:
+            parts.append(html_table(table.header, table.rows))
         parts += [f"<p>{escape(note)}</p>" for note in table.notes]
     if png is not None:
         parts.append(f'<img alt="plot" src="{png_data_uri(png)}">')
@@ -154,7 +195,11 @@ def tables_markdown(tables: Sequence[Tabular], png: bytes | None = None) -> str:
     for table in tables:
         if table.title:
             parts.append(f"**{table.title}**")
-        parts.append(markdown_table(table.header, table.rows))
+        if table.text:
+            fence = "`" * max(3, _longest_run(table.text, "`") + 1)
+            parts.append(f"{fence}\n{table.text}\n{fence}")
+        else:
+            parts.append(markdown_table(table.header, table.rows))
         parts += list(table.notes)
     if png is not None:
         parts.append(f"![plot]({png_data_uri(png)})")
@@ -382,7 +427,7 @@ class Result:
 
     def _tables(self) -> list[Tabular]:
         """The tables a notebook shows (the text ``table()``'s cells)."""
-        return [Tabular(type(self).__name__, ("", ""), [(str(self), "")])]
+        return default_tables(self)
 
     def _png(self) -> bytes | None:
         """A small plot shown under the tables, or None."""
