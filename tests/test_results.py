@@ -21,7 +21,7 @@ import pytest
 
 import aerocontrol
 from aerocontrol import aircraft, batch, design, handling
-from aerocontrol._results import Result, field_names, same
+from aerocontrol._results import Result, _all_fields_of, build, field_names, same
 from aerocontrol.exceptions import InvalidArgumentError
 from aerocontrol.robustness import Damper, Lqr, Normal, Uncertainty, Uniform, monte_carlo
 
@@ -93,6 +93,9 @@ FACTORIES: dict[str, Callable[[], Any]] = {
     "StabilityMargins": lambda: aerocontrol.stability_margins(_loop()),
     "TransferFunction": lambda: aerocontrol.transfer_function(
         aircraft.load().longitudinal(), "q", "elevator"
+    ),
+    "TransferMatrix": lambda: aerocontrol.transfer_matrix(
+        aircraft.load("b747-cruise").lateral()[["p", "r"], :]
     ),
     "Controllability": lambda: aerocontrol.controllability(_lateral()[0], _lateral()[1][:, :1]),
     "Envelope": lambda: aircraft.envelope_sweep(
@@ -222,14 +225,9 @@ def _modified(result: Any) -> Any:
 
 
 def _rebuilt(result: Any, fields: dict[str, Any]) -> Any:
-    data = result.to_dict()
-    replaced = type(result).from_dict(data)  # a copy holding every field (also compare=False)
-    if isinstance(result, aerocontrol.Placement):
-        names = field_names(result)
-        return type(result)(*(fields[name] for name in names))
-    for name, value in fields.items():
-        object.__setattr__(replaced, name, value)
-    return replaced
+    """A result of the same class holding ``fields`` and the result's other fields."""
+    every = {name: getattr(result, name) for name in _all_fields_of(type(result))}
+    return build(type(result), {**every, **fields})
 
 
 @pytest.mark.parametrize("case", sorted(FACTORIES))
@@ -276,6 +274,25 @@ def test_equality_takes_nan_as_equal_to_nan_and_compares_values() -> None:
     assert same(np.array([np.nan, 1.0]), np.array([np.nan, 1.0]))
     assert same(complex(np.nan, 1.0), complex(np.nan, 1.0))
     assert not same(complex(np.nan, 1.0), complex(np.nan, 2.0))
+
+
+def test_lazy_values_survive_pickling() -> None:
+    # A root locus computes its open loop's transfer function on first use and keeps it; a
+    # transfer matrix makes its channels on first use.
+    locus = aerocontrol.root_locus(_loop(), np.geomspace(0.01, 10.0, 5))
+    zeros = locus.open_loop_zeros
+    copy = pickle.loads(pickle.dumps(locus))
+    assert "_transfer" in vars(copy)
+    np.testing.assert_array_equal(copy.open_loop_zeros, zeros)
+    assert copy == locus
+    fresh = aerocontrol.transfer_matrix(aircraft.load("b747-cruise").lateral())
+    used = aerocontrol.transfer_matrix(aircraft.load("b747-cruise").lateral())
+    assert str(used["r", "rudder"]).startswith("r/rudder(s) = ")
+    assert pickle.loads(pickle.dumps(fresh)) == used
+    np.testing.assert_array_equal(
+        pickle.loads(pickle.dumps(used))(1j * np.array([0.1, 1.0])),
+        fresh(1j * np.array([0.1, 1.0])),
+    )
 
 
 def test_results_are_not_hashable() -> None:

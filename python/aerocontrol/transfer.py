@@ -51,7 +51,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _core
-from ._results import Result, Tabular
+from ._results import Result, Tabular, register
 from ._validation import FloatArray, finite_or_warn, real_scalar
 from .exceptions import (
     ConvergenceError,
@@ -1276,7 +1276,7 @@ def _reference_channel(
     )
 
 
-class TransferMatrix:
+class TransferMatrix(Result):
     """Every channel of a model, computed in one call: ``g[output, input]`` is a channel's
     :class:`TransferFunction` (by name or index), ``g(s)`` the values of all channels.
 
@@ -1345,6 +1345,13 @@ class TransferMatrix:
         """(outputs, inputs)."""
         return len(self.output_names), len(self.input_names)
 
+    @property
+    def channels(self) -> tuple[TransferFunction, ...]:
+        """Every channel's :class:`TransferFunction`, output by output (each input's in turn);
+        what ``==`` compares besides the poles, the denominator, ``dt`` and the names."""
+        p, m = self.shape
+        return tuple(self._channel(i, j) for i in range(p) for j in range(m))
+
     def _channel(self, i: int, j: int) -> TransferFunction:
         index = i * len(self.input_names) + j
         channel = self._channels[index]
@@ -1392,6 +1399,22 @@ class TransferMatrix:
             f"TransferMatrix(outputs={list(self.output_names)}, inputs={list(self.input_names)}, "
             f"poles={self.poles!r})"
         )
+
+
+# Equality and the JSON form by the channels (computed on first use, so not the same objects
+# in two equal matrices).
+register(
+    TransferMatrix,
+    fields=("poles", "denominator", "dt", "output_names", "input_names", "channels"),
+    build=lambda fields: TransferMatrix(
+        fields["poles"],
+        fields["denominator"],
+        fields["dt"],
+        fields["output_names"],
+        fields["input_names"],
+        list(fields["channels"]),
+    ),
+)
 
 
 def transfer_matrix(sys: System) -> TransferMatrix:
