@@ -1347,8 +1347,9 @@ class TransferMatrix(Result):
 
     @property
     def channels(self) -> tuple[TransferFunction, ...]:
-        """Every channel's :class:`TransferFunction`, output by output (each input's in turn);
-        what ``==`` compares besides the poles, the denominator, ``dt`` and the names."""
+        """Every channel's :class:`~aerocontrol.TransferFunction`, output by output (each
+        input's in turn); what ``==`` compares besides the poles, the denominator, ``dt`` and
+        the names."""
         p, m = self.shape
         return tuple(self._channel(i, j) for i in range(p) for j in range(m))
 
