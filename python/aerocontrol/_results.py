@@ -398,7 +398,7 @@ def build(cls: type[T], fields: Mapping[str, Any]) -> T:
 
 
 def _from_dict(cls: type[T], data: Mapping[str, Any]) -> T:
-    """:meth:`Result.from_dict` (also the core's Placement's, see :func:`attach`)."""
+    """The result of class ``cls`` whose JSON form is ``data`` (``Result.from_dict``)."""
     if not isinstance(data, Mapping) or set(data) != {"type", "fields"}:
         raise InvalidArgumentError(
             "data must be a dict with the keys 'type' and 'fields', as to_dict() gives"
@@ -527,7 +527,7 @@ def attach(cls: type, names: tuple[str, ...]) -> None:
     register(cls, fields=names, build=lambda fields: cls(*(fields[name] for name in names)))
     shared = ("__eq__", "__hash__", "_png", "_repr_html_", "_repr_markdown_", "to_dict")
     methods = {name: getattr(Result, name) for name in shared}
-    methods["from_dict"] = classmethod(_from_dict)
+    methods["from_dict"] = classmethod(vars(Result)["from_dict"].__func__)
     for attribute, method in methods.items():
         setattr(cls, attribute, method)
 
