@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._results import Result, Tabular, attach, format_number
+from ._results import Result, Tabular, attach
 from ._validation import FloatArray, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
 from .modal import Modes, modes
@@ -77,7 +77,11 @@ def _describe(design: Placement) -> str:
 
 def _placement_tables(design: Placement) -> list[Tabular]:
     """The gains and the requested and achieved poles as tables, formatted as ``str`` does."""
-    gain = [(f"u{i + 1}", *(format_number(v, 6) for v in row)) for i, row in enumerate(design.K)]
+    # K's entries as ``str`` prints them: numpy's array2string of the whole K at precision 6
+    # (one notation for every entry), split into its entries.
+    text = np.array2string(design.K, precision=6, threshold=design.K.size + 1)
+    entries = np.array(text.replace("[", " ").replace("]", " ").split()).reshape(design.K.shape)
+    gain = [(f"u{i + 1}", *row) for i, row in enumerate(entries.tolist())]
     header = ("K", *(f"x{j + 1}" for j in range(design.K.shape[1])))
     poles = [
         (f"{complex(want):.6g}", f"{complex(got):.6g}")
