@@ -242,10 +242,25 @@ def test_a_result_pickles_to_an_equal_result(case: str) -> None:
     assert result != changed
 
 
+def _plain_types(value: Any) -> set[type]:
+    """The types of every value inside ``value`` (containers included)."""
+    found = {type(value)}
+    if isinstance(value, dict):
+        assert all(type(key) is str for key in value)
+        for item in value.values():
+            found |= _plain_types(item)
+    elif isinstance(value, list):
+        for item in value:
+            found |= _plain_types(item)
+    return found
+
+
 @pytest.mark.parametrize("case", sorted(FACTORIES))
 def test_a_result_goes_to_strict_json_and_back(case: str) -> None:
     result = _built(case)
-    text = json.dumps(result.to_dict(), allow_nan=False)
+    data = result.to_dict()
+    assert _plain_types(data) <= {dict, list, str, int, float, bool, type(None)}
+    text = json.dumps(data, allow_nan=False)
     back = type(result).from_dict(json.loads(text))
     assert back == result
     assert type(back) is type(result)
