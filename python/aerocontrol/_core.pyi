@@ -3,8 +3,8 @@
 Private: call the wrappers in the aerocontrol package, which convert and check arguments.
 """
 
-from collections.abc import Callable
-from typing import Any, final
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -228,6 +228,15 @@ class Placement:
     def eigenvector_condition(self) -> float: ...
     @property
     def k(self) -> NDArray[np.float64]: ...
+    # Set by aerocontrol.placement (aerocontrol._results.attach): equality field by field,
+    # the JSON form and the notebook display of the other results.
+    __hash__: ClassVar[None]  # type: ignore[assignment]
+    def __eq__(self, other: object) -> bool: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Placement: ...
+    def _repr_html_(self) -> str: ...
+    def _repr_markdown_(self) -> str: ...
 
 def place(a: ArrayLike, b: ArrayLike, poles: ArrayLike, method: str, /) -> Placement: ...
 def schur(

@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._results import Result
 from ._validation import FloatArray, positive_int, real_array
 from .exceptions import AerocontrolError, IllConditionedWarning, InvalidArgumentError, ShapeError
 from .placement import ILL_CONDITIONED_CONTROLLABILITY, POLE_ERROR_WARNING
@@ -62,7 +63,7 @@ DISTRIBUTED_CHUNK = 4096
 
 
 @dataclass(frozen=True, eq=False)
-class CareBatch:
+class CareBatch(Result):
     """The solutions of a batch of Riccati equations, problem index first."""
 
     X: FloatArray
@@ -81,7 +82,7 @@ class CareBatch:
 
 
 @dataclass(frozen=True, eq=False)
-class DareBatch:
+class DareBatch(Result):
     """The solutions of a batch of discrete Riccati equations, problem index first."""
 
     X: FloatArray
@@ -101,7 +102,7 @@ class DareBatch:
 
 
 @dataclass(frozen=True, eq=False)
-class LqrSweep:
+class LqrSweep(Result):
     """The regulator of one model for each weight c of a sweep (Figure 6.12)."""
 
     weights: FloatArray
@@ -122,7 +123,7 @@ class LqrSweep:
 
 
 @dataclass(frozen=True, eq=False)
-class PlaceBatch:
+class PlaceBatch(Result):
     """State-feedback designs η = -K_i x over a batch, problem index first."""
 
     K: FloatArray

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._results import Result, Tabular
 from ._validation import FloatArray, check_choice, real_scalar
 from .statespace import matrix_view, plant_pair
 
@@ -118,7 +119,7 @@ def obsv(A: ArrayLike, C: ArrayLike) -> FloatArray:
 
 
 @dataclass(frozen=True, eq=False)
-class Controllability:
+class Controllability(Result):
     """The controllability of (A, B), or the observability of (A, C).
 
     ``controllable`` is the verdict; ``uncontrollable_eigenvalues`` are the modes that feedback
@@ -155,6 +156,31 @@ class Controllability:
             return f"{word} (tolerance {self.tolerance:.2e})"
         listed = ", ".join(f"{complex(e):.6g}" for e in self.uncontrollable_eigenvalues)
         return f"not {word}: eigenvalues {listed} (tolerance {self.tolerance:.2e})"
+
+    def _tables(self) -> list[Tabular]:
+        measure = "||w_k^T B||" if self.kind == "controllability" else "||C v_k||"
+        word = "reached" if self.kind == "controllability" else "seen"
+        rows = [
+            (
+                f"{complex(e):.6g}",
+                f"{m:.4g}",
+                word if m > self.tolerance else f"not {word}",
+            )
+            for e, m in zip(self.eigenvalues, self.modal_measure, strict=False)
+        ]
+        notes = [
+            f"order of the {'controllable' if word == 'reached' else 'observable'} subspace "
+            f"{self.controllable_order}, staircase blocks {list(self.block_sizes)}, smallest "
+            f"pivot {self.smallest_pivot:.4g}"
+        ]
+        return [
+            Tabular(
+                str(self),
+                ("eigenvalue", measure, "by the inputs" if word == "reached" else "by the outputs"),
+                rows,
+                notes,
+            )
+        ]
 
 
 def _core_analysis(

@@ -16,6 +16,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._results import Result, register_model
 from ._validation import real_array, real_scalar
 from .aircraft.model import Aircraft
 from .aircraft.naming import classify_modes
@@ -43,6 +44,9 @@ __all__ = [
     "sampled_weights",
     "yaw_damper",
 ]
+
+# The designs hold their models (JSON form and equality of the results).
+register_model(StateSpace)
 
 ComplexArray = NDArray[np.complex128]
 
@@ -415,7 +419,7 @@ DAMPER_WASHOUT = 3.0
 
 
 @dataclass(frozen=True, eq=False)
-class Damper:
+class Damper(Result):
     """A rate damper designed on the root locus: the loop, the gain, its margins against
     MIL-F-9490D and the closed loop.
 

@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, TypeVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._results import Result, register_model
 from ._validation import FloatArray, as_matrix, real_array, real_scalar
 from .controllability import observability
 from .exceptions import (
@@ -72,6 +73,9 @@ __all__ = [
     "lqg",
     "place_observer",
 ]
+
+# The designs hold their models (JSON form and equality of the results).
+register_model(StateSpace)
 
 ComplexArray = NDArray[np.complex128]
 _Result = TypeVar("_Result")
@@ -523,7 +527,7 @@ def dlqe(
 
 
 @dataclass(frozen=True, eq=False, repr=False)
-class KalmanFilter:
+class KalmanFilter(Result):
     """A stationary Kalman filter and its estimator, from :func:`kalman`.
 
     Continuous time (``discrete`` False): x̂' = A x̂ + B u + L (y - C x̂ - D u), with
@@ -837,7 +841,7 @@ def place_observer(
 
 
 @dataclass(frozen=True, eq=False, repr=False)
-class LqgDesign:
+class LqgDesign(Result):
     """A continuous-time LQG compensator and its loop with the plant, from :func:`lqg`.
 
     The compensator is the Kalman filter driven by the regulator's own command,

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._balance import balanced_matrices
+from ._results import Result
 from ._validation import FloatArray, real_array
 from .exceptions import InvalidArgumentError, ShapeError
 from .statespace import as_state_space, continuous_eigenvalues, grid_frequencies, period
@@ -36,7 +37,7 @@ DEFAULT_FREQUENCIES = 1000
 
 
 @dataclass(frozen=True, eq=False)
-class FrequencyResponse:
+class FrequencyResponse(Result):
     """G(jω) at the frequencies ``omega`` (rad/s): ``response`` is (len(omega), p, m)."""
 
     omega: FloatArray

@@ -83,6 +83,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._results import Result, Tabular, register
 from ._validation import check_choice, real_scalar
 from .exceptions import InvalidArgumentError, NonFiniteError, ShapeError
 
@@ -193,6 +194,7 @@ SPIRAL_MIN_TIME_TO_DOUBLE: dict[str, tuple[float, float, float]] = {
 }
 
 
+@register
 @dataclass(frozen=True)
 class Requirement:
     """One quantity of one mode, judged against the limits of the specification.
@@ -225,8 +227,8 @@ class Requirement:
     """Paragraph and table of the specification."""
 
 
-@dataclass(frozen=True)
-class HandlingQualities:
+@dataclass(frozen=True, eq=False)
+class HandlingQualities(Result):
     """The Levels of the assessed modes for one airplane Class and Flight Phase Category.
 
     Examples
@@ -285,12 +287,7 @@ class HandlingQualities:
         """The Level of each assessed mode, in the order of ``MODES``."""
         return {mode: self.level(mode) for mode in self.modes}
 
-    def table(self) -> str:
-        """A plain-text table: mode, quantity, value, Level, limits and reference per row.
-
-        The title names the specification, Class and Category; the reference column gives the
-        paragraph and table of MIL-F-8785C; a Level 4 row adds a line that explains it.
-        """
+    def _tables(self) -> list[Tabular]:
         header = ("mode", "quantity", "value", "level", "limits", "reference")
         rows = [
             (
@@ -307,10 +304,23 @@ class HandlingQualities:
             f"{SPECIFICATION} handling qualities: Class {self.aircraft_class}, "
             f"Flight Phase Category {self.category}"
         )
-        lines = [title, *_columns(header, rows, wrap={4: 40})]
-        if any(r.level == 4 for r in self.requirements):
-            lines.append("level 4: worse than Level 3 (no Level's limit is met)")
-        return "\n".join(lines)
+        notes = (
+            ["level 4: worse than Level 3 (no Level's limit is met)"]
+            if any(r.level == 4 for r in self.requirements)
+            else []
+        )
+        return [Tabular(title, header, rows, notes)]
+
+    def table(self) -> str:
+        """A plain-text table: mode, quantity, value, Level, limits and reference per row.
+
+        The title names the specification, Class and Category; the reference column gives the
+        paragraph and table of MIL-F-8785C; a Level 4 row adds a line that explains it.
+        """
+        (table,) = self._tables()
+        return "\n".join(
+            [table.title, *_columns(table.header, table.rows, wrap={4: 40}), *table.notes]
+        )
 
     def __str__(self) -> str:
         return self.table()
@@ -1130,8 +1140,8 @@ def margin_requirement(
     return gm, pm, _BANDS[band]
 
 
-@dataclass(frozen=True)
-class MarginsCheck:
+@dataclass(frozen=True, eq=False)
+class MarginsCheck(Result):
     """A pass/fail table of loop margins against MIL-F-9490D; ``print`` shows it."""
 
     airspeed: str
@@ -1146,13 +1156,18 @@ class MarginsCheck:
             result[row[0]] = result.get(row[0], True) and row[5]
         return result
 
-    def table(self) -> str:
+    def _tables(self) -> list[Tabular]:
         header = ("loop", "quantity", "value", "at", "required", "verdict")
         rows = [(*row[:5], "pass" if row[5] else "FAIL") for row in self.rows]
         title = (
             f"{MARGIN_SPECIFICATION} 3.1.3.6 margins, airspeed {self.airspeed} ({_MARGIN_STATUS})"
         )
-        return "\n".join([title, *_columns(header, rows)])
+        return [Tabular(title, header, rows)]
+
+    def table(self) -> str:
+        """A plain-text table: loop, quantity, value, frequency, requirement and verdict."""
+        (table,) = self._tables()
+        return "\n".join([table.title, *_columns(table.header, table.rows)])
 
     def __str__(self) -> str:
         return self.table()

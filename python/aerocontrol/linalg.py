@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._results import Result
 from ._validation import FloatArray, check_choice, real_array, real_scalar
 from .exceptions import (
     IllConditionedWarning,
@@ -144,8 +145,8 @@ def transition_matrix(A: ArrayLike, t: ArrayLike) -> FloatArray:
     return _core.transition_matrices(A, times)
 
 
-@dataclass(frozen=True)
-class Discretization:
+@dataclass(frozen=True, eq=False)
+class Discretization(Result):
     """The matrices that advance x' = Ax + Bη exactly over one step of length ``dt``.
 
     Zero-order hold (η constant over the step)::

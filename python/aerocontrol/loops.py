@@ -101,6 +101,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._balance import balanced_loop, balanced_matrix, balanced_states
+from ._results import Result, Tabular
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
@@ -599,7 +600,7 @@ def _separated(omega: FloatArray) -> FloatArray:
 
 
 @dataclass(frozen=True, eq=False)
-class StabilityMargins:
+class StabilityMargins(Result):
     """The margins of a SISO loop, negative feedback (1 + L = 0); ``print`` shows a table.
 
     Single values are the critical ones (as python-control's ``stability_margins``): the gain
@@ -653,24 +654,53 @@ class StabilityMargins:
         """±2 arctan(α/2) in degrees: the phase change at unit gain the disk allows."""
         return _disk_phase_margin(self.disk_margin, 0.0)
 
+    def _cells(self) -> tuple[str, list[tuple[str, str, str, str]]]:
+        """The closed loop's line, and (margin, value, unit, frequency) per margin."""
+        status = "stable" if self.closed_loop_stable else "UNSTABLE"
+        title = (
+            f"closed loop {status}: {self.open_loop_unstable_poles} unstable open-loop poles, "
+            f"{self.encirclements} counterclockwise encirclements of -1"
+        )
+        rows = [
+            ("gain margin", f"{_db(gm):+.3f}", "dB", f"{w:.5g}")
+            for gm, w in zip(self.gain_margins, self.phase_crossovers, strict=True)
+        ]
+        rows += [
+            ("phase margin", f"{pm:+.3f}", "deg", f"{w:.5g}")
+            for pm, w in zip(self.phase_margins, self.gain_crossovers, strict=True)
+        ]
+        rows.append(("delay margin", f"{self.delay_margin:.5g}", "s", ""))
+        low, high = self.disk_gain_margin
+        rows.append(
+            (
+                "disk margin",
+                f"alpha = {self.disk_margin:.4g}: gain {_db(low):+.2f}/{_db(high):+.2f} dB, "
+                f"phase ±{self.disk_phase_margin:.2f} deg",
+                "",
+                f"{self.disk_frequency:.4g}",
+            )
+        )
+        return title, rows
+
     def table(self) -> str:
         """The margins and the closed loop, one line each."""
-        status = "stable" if self.closed_loop_stable else "UNSTABLE"
-        lines = [
-            f"closed loop {status}: {self.open_loop_unstable_poles} unstable open-loop poles, "
-            f"{self.encirclements} counterclockwise encirclements of -1",
-        ]
-        for gm, w in zip(self.gain_margins, self.phase_crossovers, strict=True):
-            lines.append(f"gain margin   {_db(gm):+9.3f} dB  at {w:.5g} rad/s")
-        for pm, w in zip(self.phase_margins, self.gain_crossovers, strict=True):
-            lines.append(f"phase margin  {pm:+9.3f} deg at {w:.5g} rad/s")
-        lines.append(f"delay margin  {self.delay_margin:.5g} s")
-        low, high = self.disk_gain_margin
-        lines.append(
-            f"disk margin   alpha = {self.disk_margin:.4g}: gain {_db(low):+.2f}/{_db(high):+.2f} "
-            f"dB, phase ±{self.disk_phase_margin:.2f} deg (at {self.disk_frequency:.4g} rad/s)"
-        )
+        title, rows = self._cells()
+        lines = [title]
+        for name, value, unit, frequency in rows:
+            if name == "delay margin":
+                lines.append(f"{name:<14}{value} {unit}")
+            elif name == "disk margin":
+                lines.append(f"{name:<14}{value} (at {frequency} rad/s)")
+            else:
+                lines.append(f"{name:<14}{value:>9} {unit:<3} at {frequency} rad/s")
         return "\n".join(lines)
+
+    def _tables(self) -> list[Tabular]:
+        title, rows = self._cells()
+        cells = [
+            (name, f"{value} {unit}".rstrip(), frequency) for name, value, unit, frequency in rows
+        ]
+        return [Tabular(title, ("margin", "value", "at (rad/s)"), cells)]
 
     def __str__(self) -> str:
         return self.table()
@@ -1182,8 +1212,8 @@ def _disk_phase_margin(alpha: float, skew: float) -> float:
     return math.degrees(2.0 * math.atan(alpha / math.sqrt(4.0 - (alpha * skew) ** 2)))
 
 
-@dataclass(frozen=True)
-class DiskMargin:
+@dataclass(frozen=True, eq=False)
+class DiskMargin(Result):
     """A disk margin α of skew σ: the loop stays stable for every multiplicative gain and phase
     change f (in every loop at once, independently, for a multiloop margin) in the disk
 
@@ -1226,7 +1256,7 @@ class DiskMargin:
 
 
 @dataclass(frozen=True, eq=False)
-class DiskMargins:
+class DiskMargins(Result):
     """Loop-at-a-time and multiloop disk margins of a square MIMO loop; ``print`` shows a
     table.
 
@@ -2023,7 +2053,7 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
-class RootLocus:
+class RootLocus(Result):
     """The closed-loop poles of 1 + k L(s) = 0 over the gains k."""
 
     gains: FloatArray
@@ -2132,8 +2162,8 @@ def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
     )
 
 
-@dataclass(frozen=True)
-class DampingDesign:
+@dataclass(frozen=True, eq=False)
+class DampingDesign(Result):
     """A gain of a root-locus design and the mode it sets."""
 
     gain: float
@@ -2914,7 +2944,7 @@ def _half_contour(
 
 
 @dataclass(frozen=True, eq=False)
-class NyquistResponse:
+class NyquistResponse(Result):
     """The Nyquist curve of a SISO loop, negative feedback (1 + L = 0), and its count of
     encirclements of -1 checked against the open- and closed-loop poles; ``print`` shows P, N,
     Z and the verdict.
@@ -3155,7 +3185,7 @@ def nyquist(loop: System, omega: ArrayLike | None = None) -> NyquistResponse:
 
 
 @dataclass(frozen=True, eq=False)
-class NicholsResponse:
+class NicholsResponse(Result):
     """The open-loop gain (dB) against the phase (degrees) of a SISO loop over frequency, for
     the Nichols chart; ``print`` shows the ranges."""
 

@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._results import Result, Tabular
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, ShapeError
 from .statespace import is_system, name_sequence, plant_arrays
@@ -55,7 +56,7 @@ ComplexArray = NDArray[np.complex128]
 
 
 @dataclass(frozen=True, eq=False)
-class Modes:
+class Modes(Result):
     """The modes of a plant matrix, ordered by increasing natural frequency.
 
     Per-mode arrays (one entry per mode; a conjugate pair counts once, by its member with
@@ -90,13 +91,11 @@ class Modes:
     def __len__(self) -> int:
         return len(self.eigenvalue)
 
-    def table(self) -> str:
-        """The table that ``str()`` prints."""
-        header = (
-            f"{'mode':<14}{'eigenvalue':>26}{'damping':>10}{'freq (rad/s)':>14}"
-            f"{'period (s)':>12}{'t½ / t₂ (s)':>14}{'tau (s)':>10}"
-        )
-        lines = [header, "-" * len(header)]
+    _HEADER = ("mode", "eigenvalue", "damping", "freq (rad/s)", "period (s)", "t½ / t₂ (s)")
+
+    def _cells(self) -> list[tuple[str, ...]]:
+        """The table's rows as text: name, eigenvalue, ζ, ω_n, period, t½ (or t₂) and τ."""
+        rows: list[tuple[str, ...]] = []
         for k in range(len(self)):
             lam = self.eigenvalue[k]
             if self.oscillatory[k] and lam.imag != 0:
@@ -113,12 +112,35 @@ class Modes:
             period = f"{self.period[k]:.4g}" if np.isfinite(self.period[k]) else "-"
             tau = f"{self.time_constant[k]:.4g}" if np.isfinite(self.time_constant[k]) else "-"
             zeta = self.damping_ratio[k]
-            lines.append(
-                f"{self.mode_names[k]:<14}{pole:>26}"
-                f"{(f'{zeta:.4f}' if np.isfinite(zeta) else '-'):>10}"
-                f"{self.natural_frequency[k]:>14.4f}{period:>12}{timing:>14}{tau:>10}"
+            rows.append(
+                (
+                    self.mode_names[k],
+                    pole,
+                    f"{zeta:.4f}" if np.isfinite(zeta) else "-",
+                    f"{self.natural_frequency[k]:.4f}",
+                    period,
+                    timing,
+                    tau,
+                )
             )
+        return rows
+
+    def table(self) -> str:
+        """The table that ``str()`` prints."""
+        widths = (14, 26, 10, 14, 12, 14, 10)
+
+        def line(cells: tuple[str, ...]) -> str:
+            return f"{cells[0]:<14}" + "".join(
+                f"{cell:>{width}}" for cell, width in zip(cells[1:], widths[1:], strict=True)
+            )
+
+        lines = [line((*self._HEADER, "tau (s)"))]
+        lines.append("-" * len(lines[0]))
+        lines += [line(row) for row in self._cells()]
         return "\n".join(lines)
+
+    def _tables(self) -> list[Tabular]:
+        return [Tabular("modes", (*self._HEADER, "τ (s)"), self._cells())]
 
     def __str__(self) -> str:
         return self.table()

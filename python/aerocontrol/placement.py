@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._results import Result, Tabular, attach
 from ._validation import FloatArray, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
 from .modal import Modes, modes
@@ -72,6 +73,47 @@ def _describe(design: Placement) -> str:
         lines.append(f"{complex(want):>28.6g}{complex(got):>28.6g}")
     lines.append(f"largest relative pole error {design.max_relative_error:.2e}")
     return "\n".join(lines)
+
+
+def _placement_tables(design: Placement) -> list[Tabular]:
+    """The gains and the requested and achieved poles as tables, formatted as ``str`` does."""
+    # K's entries as ``str`` prints them: numpy's array2string of the whole K at precision 6
+    # (one notation for every entry), split into its entries.
+    text = np.array2string(design.K, precision=6, threshold=design.K.size + 1)
+    entries = np.array(text.replace("[", " ").replace("]", " ").split()).reshape(design.K.shape)
+    gain = [(f"u{i + 1}", *row) for i, row in enumerate(entries.tolist())]
+    header = ("K", *(f"x{j + 1}" for j in range(design.K.shape[1])))
+    poles = [
+        (f"{complex(want):.6g}", f"{complex(got):.6g}")
+        for want, got in zip(design.poles, design.achieved_poles, strict=True)
+    ]
+    return [
+        Tabular(f"pole placement ({design.method})", header, gain),
+        Tabular(
+            "",
+            ("requested", "achieved"),
+            poles,
+            [f"largest relative pole error {design.max_relative_error:.2e}"],
+        ),
+    ]
+
+
+Placement._tables = _placement_tables  # type: ignore[attr-defined]
+attach(
+    Placement,
+    (
+        "K",
+        "closed_loop",
+        "poles",
+        "achieved_poles",
+        "max_relative_error",
+        "iterations",
+        "converged",
+        "method",
+        "controllability_condition",
+        "eigenvector_condition",
+    ),
+)
 
 
 def _poles(poles: object) -> ComplexArray:
@@ -280,7 +322,7 @@ def place(
 
 
 @dataclass(frozen=True, eq=False)
-class CompanionForm:
+class CompanionForm(Result):
     """The transformation z = T x to the first companion form (6.116)-(6.145)."""
 
     V: FloatArray

@@ -9,6 +9,7 @@ each line in a legend, and returns what it drew on. Nothing needs a display: giv
 function                       the chapter's figure
 =============================  ===============================================================
 :func:`plot_time_response`     one response, states or outputs against time
+:func:`response_png`           a small picture of a response, for a notebook
 :func:`plot_time_scales`       one response at two time scales, short period and phugoid
                                (Figures 6.1, 6.2)
 :func:`plot_open_closed`       open loop beside closed loop (Figures 6.4, 6.5, 6.6)
@@ -80,6 +81,7 @@ __all__ = [
     "plot_time_response",
     "plot_time_scales",
     "plot_with_controls",
+    "response_png",
 ]
 
 # The aircraft models' variable names: what they are, and their unit.
@@ -291,6 +293,59 @@ def plot_time_response(
             title += f": {result.response_names[response]}"
     _finish(ax, "time (s)", _axis_label(names, signal), title)
     return ax
+
+
+def response_png(result: TimeResponse, width: float = 5.0, height: float = 2.6) -> bytes:
+    """A small PNG of the states of the first response (``width`` x ``height`` inches at 72
+    dpi), as a notebook shows a :class:`~aerocontrol.TimeResponse` under its table.
+
+    Drawn on a ``matplotlib.figure.Figure`` with the Agg canvas, never through pyplot: no
+    window opens, the current backend and pyplot's figures are left alone, and the figure is
+    released once the PNG is written.
+
+    Parameters
+    ----------
+    result : TimeResponse
+        The response to draw (states of its first response).
+    width, height : float
+        The size of the picture in inches.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``width`` or ``height`` is not a positive finite number.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft, step_response
+    >>> png = response_png(step_response(aircraft.load().longitudinal(), T=20.0))
+    >>> png[1:4]
+    b'PNG'
+    """
+    import io
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    for name, value in (("width", width), ("height", height)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise InvalidArgumentError(f"{name} must be a positive number of inches, got {value!r}")
+    figure = Figure(figsize=(width, height), dpi=72, layout="constrained")
+    FigureCanvasAgg(figure)
+    ax = figure.subplots()
+    plot_time_response(result, ax=ax)
+    legend = ax.get_legend()
+    if legend is not None:
+        legend.set(loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png")
+    figure.clear()
+    return buffer.getvalue()
 
 
 def plot_time_scales(

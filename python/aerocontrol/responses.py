@@ -52,6 +52,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import _core, _scaling
+from ._results import Result, Tabular
 from ._validation import FloatArray, check_choice, check_finite, finite_or_warn, real_array
 from .exceptions import (
     InvalidArgumentError,
@@ -89,7 +90,7 @@ MAX_DEFAULT_SAMPLES = 100_001
 
 
 @dataclass(frozen=True, eq=False)
-class TimeResponse:
+class TimeResponse(Result):
     """States, outputs and inputs of one or several responses on a uniform time grid.
 
     With a single response ``x`` is (len(t), n); with several, (r, len(t), n), and likewise
@@ -120,19 +121,41 @@ class TimeResponse:
         """The (len(t), p) outputs of one response."""
         return self.y if self.y.ndim == 2 else self.y[response]
 
-    def __str__(self) -> str:
-        lines = [
+    def _cells(self) -> tuple[str, list[tuple[str, str, str, str]]]:
+        """The title, and (response, state, final value, peak |x|) per state, as text."""
+        title = (
             f"{self.kind} response: {self.n_responses} response(s), {len(self.t)} samples, "
             f"t = 0 ... {self.t[-1]:g} s (step {self.t[1] - self.t[0]:g} s)"
-        ]
+        )
+        rows = []
         for r in range(self.n_responses):
             x = self.states(r)
-            lines.append(f"  {self.response_names[r]}: final state")
             for name, value, peak in zip(
                 self.state_names, x[-1], np.abs(x).max(axis=0), strict=True
             ):
-                lines.append(f"    {name:<14} {value:+.6g}   (peak |x| {peak:.4g})")
+                rows.append((self.response_names[r], name, f"{value:+.6g}", f"{peak:.4g}"))
+        return title, rows
+
+    def __str__(self) -> str:
+        title, rows = self._cells()
+        lines = [title]
+        for k, (response, name, value, peak) in enumerate(rows):
+            if k == 0 or rows[k - 1][0] != response:
+                lines.append(f"  {response}: final state")
+            lines.append(f"    {name:<14} {value}   (peak |x| {peak})")
         return "\n".join(lines)
+
+    def _tables(self) -> list[Tabular]:
+        title, rows = self._cells()
+        return [Tabular(title, ("response", "state", "final", "peak |x|"), rows)]
+
+    def _png(self) -> bytes | None:
+        """The states of the first response, small (:func:`~aerocontrol.plotting.response_png`)."""
+        if self.n_responses == 0 or len(self.t) < 2:
+            return None
+        from .plotting import response_png
+
+        return response_png(self)
 
     def plot(self, ax: Axes | None = None, signal: str = "states", response: int = 0) -> Axes:
         """Plot the states (or ``signal="outputs"``) of one response against time."""

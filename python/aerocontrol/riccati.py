@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._results import Result, Tabular, format_complex, format_number
 from ._validation import FloatArray, real_array
 from .exceptions import IllConditionedWarning, InvalidArgumentError
 from .statespace import (
@@ -69,7 +70,7 @@ RESIDUAL_WARNING = 1e-8
 
 
 @dataclass(frozen=True, eq=False)
-class CareSolution:
+class CareSolution(Result):
     """The stabilising solution of a continuous algebraic Riccati equation.
 
     The equation is A^T X E + E^T X A - (E^T X B + S) R^-1 (B^T X E + S^T) + Q = 0 (6.228),
@@ -89,6 +90,21 @@ class CareSolution:
     subspace's basis: small means X is sensitive."""
     refinement_steps: int
     """Newton steps taken after the Schur solution."""
+
+    def _tables(self) -> list[Tabular]:
+        return _solution_tables(self, "continuous")
+
+
+def _solution_tables(solution: CareSolution | DareSolution, kind: str) -> list[Tabular]:
+    """The gain K and the closed-loop poles of a Riccati solution, for a notebook."""
+    title = (
+        f"{kind} algebraic Riccati equation: relative residual {solution.residual:.2e}, "
+        f"rcond {solution.rcond:.2e}, {solution.refinement_steps} Newton step(s)"
+    )
+    gain = [(f"u{i + 1}", *(format_number(v, 6) for v in row)) for i, row in enumerate(solution.K)]
+    header = ("K", *(f"x{j + 1}" for j in range(solution.K.shape[1])))
+    poles = [(format_complex(complex(p), 6),) for p in solution.closed_loop_poles]
+    return [Tabular(title, header, gain), Tabular("", ("closed-loop poles",), poles)]
 
 
 def solve_care(
@@ -294,7 +310,7 @@ def lqr(
 
 
 @dataclass(frozen=True, eq=False)
-class DareSolution:
+class DareSolution(Result):
     """The stabilising solution of a discrete algebraic Riccati equation.
 
     The equation is A^T X A - E^T X E - (A^T X B + S)(R + B^T X B)^-1 (B^T X A + S^T) + Q = 0,
@@ -314,6 +330,9 @@ class DareSolution:
     subspace's basis): small means X is sensitive."""
     refinement_steps: int
     """Newton steps taken after the pencil's solution."""
+
+    def _tables(self) -> list[Tabular]:
+        return _solution_tables(self, "discrete")
 
 
 def solve_dare(
@@ -513,7 +532,7 @@ def _regulator_arguments(
 
 
 @dataclass(frozen=True, eq=False)
-class RiccatiSolution:
+class RiccatiSolution(Result):
     """S(t) and K(t) of the finite-horizon regulator on a time grid (6.196)-(6.200)."""
 
     t: FloatArray
@@ -676,7 +695,7 @@ def lqr_finite(
 
 
 @dataclass(frozen=True, eq=False)
-class RiccatiDifferenceSolution:
+class RiccatiDifferenceSolution(Result):
     """S_k and K_k of the discrete finite-horizon regulator over N steps."""
 
     S: FloatArray

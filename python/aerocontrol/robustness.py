@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import batch, linalg
 from ._judging import AXIS_MODES, judge_stack
+from ._results import Result, Tabular, register
 from ._validation import check_finite, positive_int, real_array, real_scalar
 from .aircraft.model import _POSITIVE_FIELDS, SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
@@ -70,6 +71,9 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
+# A run's aircraft is part of its result's JSON form (MonteCarlo.to_dict).
+register(Aircraft)
+
 #: Samples per chunk: each chunk draws from its own child seed, so the result does not depend
 #: on how the chunks are spread over cores or machines.
 CHUNK_SIZE = 1 << 16
@@ -93,6 +97,7 @@ def _standard_normal_cdf(z: FloatArray) -> FloatArray:
     return 0.5 * values
 
 
+@register
 @dataclass(frozen=True)
 class Normal:
     """A normal scatter of standard deviation ``sigma``: of the nominal value's magnitude
@@ -107,6 +112,7 @@ class Normal:
         return nominal + (self.sigma * scale) * z
 
 
+@register
 @dataclass(frozen=True)
 class Uniform:
     """A uniform scatter over nominal ± ``half_width`` (of the nominal's magnitude when
@@ -120,6 +126,7 @@ class Uniform:
         return nominal + (self.half_width * scale) * (2.0 * _standard_normal_cdf(z) - 1.0)
 
 
+@register
 @dataclass(frozen=True)
 class LogNormal:
     """A log-normal scatter about the nominal value (its median): nominal · e^(sigma z), which
@@ -135,6 +142,7 @@ class Distribution(Protocol):
     def values(self, nominal: float, z: FloatArray) -> FloatArray: ...
 
 
+@register
 @dataclass(frozen=True)
 class Uncertainty:
     """The uncertain parameters: a distribution per name (a nondimensional derivative, or one of
@@ -261,6 +269,7 @@ class Uncertainty:
 # --- Controllers --------------------------------------------------------------------------------
 
 
+@register
 @dataclass(frozen=True)
 class Lqr:
     """The linear-quadratic regulator re-designed for every sample: u = -K x minimising
@@ -294,6 +303,7 @@ class Lqr:
                 object.__setattr__(self, name, matrix)
 
 
+@functools.partial(register, name="robustness.Damper")
 @dataclass(frozen=True)
 class Damper:
     """The chapter's Dutch roll damper re-designed for every sample: state feedback through
@@ -363,6 +373,7 @@ def _closed_loop(
 # --- One chunk --------------------------------------------------------------------------------
 
 
+@functools.partial(register, name="robustness.Run")
 @dataclass(frozen=True)
 class _Run:
     """Everything a chunk needs (shipped to a Dask worker as it is)."""
@@ -583,6 +594,7 @@ def _beta_quantile(q: float, a: float, b: float) -> float:
     return 0.5 * (low + high)
 
 
+@register
 @dataclass(frozen=True)
 class Estimate:
     """A probability estimated from ``count`` of ``samples``, with its Clopper-Pearson interval
@@ -665,6 +677,7 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
 # --- Results ----------------------------------------------------------------------------------
 
 
+@register
 @dataclass(frozen=True)
 class LoopOutcome:
     """The judgement of every sample of one loop (open or closed)."""
@@ -690,8 +703,8 @@ class LoopOutcome:
     :class:`Damper` has no Dutch roll oscillation to damp)."""
 
 
-@dataclass(frozen=True)
-class MonteCarlo:
+@dataclass(frozen=True, eq=False)
+class MonteCarlo(Result):
     """The result of :func:`monte_carlo`."""
 
     aircraft: str
@@ -807,21 +820,48 @@ class MonteCarlo:
         order = np.argsort(-spread, kind="stable")
         return [(self.parameters[k], float(spread[k])) for k in order]
 
-    def __str__(self) -> str:
-        lines = [
+    def _cells(self) -> tuple[str, list[tuple[str, str, str]], list[tuple[str, str]]]:
+        """The title, (loop, event, estimate) per probability, and (parameter, spread) by
+        decreasing failure-rate spread, as text."""
+        title = (
             f"Monte Carlo: {self.aircraft}, {self.axis}, {self.samples} samples (seed "
             f"{self.seed}), parameters {', '.join(self.parameters)}"
-        ]
+        )
         loops = [("open loop", "open")] + ([("closed loop", "closed")] if self.closed_loop else [])
+        rows = []
         for label, loop in loops:
-            lines.append(f"  {label}: P(unstable) = {self.probability('unstable', loop=loop)}")
+            rows.append((label, "P(unstable)", str(self.probability("unstable", loop=loop))))
             for mode in self.modes:
                 estimate = self.probability("level", mode, 1, loop=loop)
-                lines.append(f"    P({mode} Level 1) = {estimate}")
-        lines.append(f"  P(failed) = {self.probability('failed')}")
-        ranked = ", ".join(f"{name} {spread:.3g}" for name, spread in self.sensitivity())
-        lines.append(f"  sensitivity (failure-rate spread over deciles): {ranked}")
+                rows.append((label, f"P({mode} Level 1)", str(estimate)))
+        rows.append(("", "P(failed)", str(self.probability("failed"))))
+        ranked = [(name, f"{spread:.3g}") for name, spread in self.sensitivity()]
+        return title, rows, ranked
+
+    def __str__(self) -> str:
+        title, rows, ranked = self._cells()
+        lines = [title]
+        for k, (label, event, estimate) in enumerate(rows):
+            if not label:
+                lines.append(f"  {event} = {estimate}")
+            elif k == 0 or rows[k - 1][0] != label:
+                lines.append(f"  {label}: {event} = {estimate}")
+            else:
+                lines.append(f"    {event} = {estimate}")
+        listed = ", ".join(f"{name} {spread}" for name, spread in ranked)
+        lines.append(f"  sensitivity (failure-rate spread over deciles): {listed}")
         return "\n".join(lines)
+
+    def _tables(self) -> list[Tabular]:
+        title, rows, ranked = self._cells()
+        return [
+            Tabular(title, ("loop", "event", "probability (interval)"), rows),
+            Tabular(
+                "sensitivity: failure-rate spread over the deciles of each parameter",
+                ("parameter", "spread"),
+                ranked,
+            ),
+        ]
 
 
 def _outcome(parts: Sequence[dict[str, NDArray[Any]]], prefix: str) -> LoopOutcome:

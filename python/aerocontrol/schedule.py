@@ -44,6 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import batch, linalg
 from ._judging import AXIS_MODES, judge_stack
+from ._results import Result
 from ._validation import real_array, real_scalar
 from .aircraft.envelope import Envelope, _grid
 from .aircraft.model import Aircraft
@@ -176,7 +177,7 @@ def _increasing(grid: FloatArray, name: str) -> FloatArray:
 
 
 @dataclass(frozen=True, eq=False)
-class GainSchedule:
+class GainSchedule(Result):
     """State-feedback gains u = -K x designed over a grid of flight conditions, from
     :func:`gain_schedule`. Arrays are indexed [altitude, Mach, weight]."""
 

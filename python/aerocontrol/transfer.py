@@ -51,6 +51,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import _core
+from ._results import Result, Tabular, register
 from ._validation import FloatArray, finite_or_warn, real_scalar
 from .exceptions import (
     ConvergenceError,
@@ -646,7 +647,7 @@ def _format_factors(factors: list[Factor], variable: str, digits: int) -> str:
 
 
 @dataclass(frozen=True, eq=False)
-class TransferFunction:
+class TransferFunction(Result):
     """One channel G(s) = K Π(s - z_i)/Π(s - p_j) of a model (in z for a discrete model).
 
     ``print(tf)`` shows the factored "aircraft" form, (s + 1/T) for a real root -1/T and
@@ -725,20 +726,35 @@ class TransferFunction:
         top = gain if numerator == "1" else f"{gain} {numerator}"
         return f"{top} / {denominator}" if denominator != "1" else top
 
-    def __str__(self) -> str:
-        lines = [f"{self.output_name}/{self.input_name}({self.variable}) = {self.aircraft_form()}"]
+    def _cells(self) -> list[tuple[str, str, str]]:
+        """(zero or pole, root, its time constant or ζ and ω) per factor, as text."""
+        rows = []
         for what, factors in (("zero", self.zero_factors), ("pole", self.pole_factors)):
             for f in factors:
                 if len(f.roots) == 1:
                     tau = f"T = {f.time_constant:.4g} s" if math.isfinite(f.time_constant) else ""
-                    lines.append(f"  {what} {f.roots[0].real:.6g} {tau}".rstrip())
+                    rows.append((what, f"{f.roots[0].real:.6g}", tau))
                 else:
                     r = f.roots[0]
-                    lines.append(
-                        f"  {what}s {r.real:.6g} ± {r.imag:.6g}j: "
-                        f"zeta = {f.zeta:.4g}, omega = {f.omega:.4g} rad/s"
+                    rows.append(
+                        (
+                            f"{what}s",
+                            f"{r.real:.6g} ± {r.imag:.6g}j",
+                            f"zeta = {f.zeta:.4g}, omega = {f.omega:.4g} rad/s",
+                        )
                     )
+        return rows
+
+    def __str__(self) -> str:
+        lines = [f"{self.output_name}/{self.input_name}({self.variable}) = {self.aircraft_form()}"]
+        for what, root, detail in self._cells():
+            separator = ":" if what.endswith("s") else ""
+            lines.append(f"  {what} {root}{separator} {detail}".rstrip())
         return "\n".join(lines)
+
+    def _tables(self) -> list[Tabular]:
+        title = f"{self.output_name}/{self.input_name}({self.variable}) = {self.aircraft_form()}"
+        return [Tabular(title, ("factor", "root", "characteristics"), self._cells())]
 
 
 def _evaluation_points(
@@ -1260,7 +1276,7 @@ def _reference_channel(
     )
 
 
-class TransferMatrix:
+class TransferMatrix(Result):
     """Every channel of a model, computed in one call: ``g[output, input]`` is a channel's
     :class:`TransferFunction` (by name or index), ``g(s)`` the values of all channels.
 
@@ -1329,6 +1345,14 @@ class TransferMatrix:
         """(outputs, inputs)."""
         return len(self.output_names), len(self.input_names)
 
+    @property
+    def channels(self) -> tuple[TransferFunction, ...]:
+        """Every channel's :class:`~aerocontrol.TransferFunction`, output by output (each
+        input's in turn); what ``==`` compares besides the poles, the denominator, ``dt`` and
+        the names."""
+        p, m = self.shape
+        return tuple(self._channel(i, j) for i in range(p) for j in range(m))
+
     def _channel(self, i: int, j: int) -> TransferFunction:
         index = i * len(self.input_names) + j
         channel = self._channels[index]
@@ -1376,6 +1400,22 @@ class TransferMatrix:
             f"TransferMatrix(outputs={list(self.output_names)}, inputs={list(self.input_names)}, "
             f"poles={self.poles!r})"
         )
+
+
+# Equality and the JSON form by the channels (computed on first use, so not the same objects
+# in two equal matrices).
+register(
+    TransferMatrix,
+    fields=("poles", "denominator", "dt", "output_names", "input_names", "channels"),
+    build=lambda fields: TransferMatrix(
+        fields["poles"],
+        fields["denominator"],
+        fields["dt"],
+        fields["output_names"],
+        fields["input_names"],
+        list(fields["channels"]),
+    ),
+)
 
 
 def transfer_matrix(sys: System) -> TransferMatrix:

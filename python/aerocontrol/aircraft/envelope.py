@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import handling
+from .._results import Result, Tabular
 from .._validation import real_array
 from ..exceptions import AerocontrolError, AerocontrolWarning, InvalidArgumentError, ShapeError
 from ..modal import modes
@@ -43,7 +44,7 @@ CONDITION_FAILURES: tuple[type[BaseException], ...] = (
 
 
 @dataclass(frozen=True, eq=False)
-class Envelope:
+class Envelope(Result):
     """The Levels of each mode over a grid of flight conditions.
 
     Arrays are indexed [altitude, Mach, weight].
@@ -75,19 +76,40 @@ class Envelope:
     def shape(self) -> tuple[int, int, int]:
         return (len(self.altitudes), len(self.machs), len(self.weights))
 
-    def table(self) -> str:
-        """One row per condition: altitude, Mach, weight and each mode's Level."""
+    def _cells(self) -> tuple[list[str], list[list[str]]]:
+        """The header and one row per condition: altitude, Mach, weight, each mode's Level
+        and the worst."""
         modes_ = list(self.levels)
         header = ["altitude", "Mach", "weight", *modes_, "worst"]
-        lines = ["  ".join(f"{h:>12}" for h in header)]
         worst = self.worst
+        rows = []
         for index in np.ndindex(self.shape):
             i, j, k = index
-            cells = [f"{self.altitudes[i]:12g}", f"{self.machs[j]:12.3g}", f"{self.weights[k]:12g}"]
-            cells += [f"{self.levels[m][index]:>12d}" for m in modes_]
-            cells.append(f"{worst[index]:>12d}")
-            lines.append("  ".join(cells))
-        return "\n".join(lines)
+            cells = [f"{self.altitudes[i]:g}", f"{self.machs[j]:.3g}", f"{self.weights[k]:g}"]
+            cells += [f"{self.levels[m][index]:d}" for m in modes_]
+            cells.append(f"{worst[index]:d}")
+            rows.append(cells)
+        return header, rows
+
+    def table(self) -> str:
+        """One row per condition: altitude, Mach, weight and each mode's Level."""
+        header, rows = self._cells()
+        return "\n".join("  ".join(f"{cell:>12}" for cell in row) for row in [header, *rows])
+
+    def _tables(self) -> list[Tabular]:
+        header, rows = self._cells()
+        header[0] += f" ({self.length_unit})"
+        header[2] += f" ({self.force_unit})"
+        title = (
+            f"MIL-F-8785C Levels over the envelope: Class {self.aircraft_class}, Flight Phase "
+            f"Category {self.category} (0: not assessed)"
+        )
+        notes = [
+            f"not assessed at altitude {self.altitudes[i]:g}, Mach {self.machs[j]:.3g}, weight "
+            f"{self.weights[k]:g}: {reason}"
+            for (i, j, k), reason in self.failures.items()
+        ]
+        return [Tabular(title, header, rows, notes)]
 
     def plot(self, ax: Any = None, mode: str | None = None, weight: int = 0) -> Any:
         """The Levels over Mach (x) and altitude (y) at one weight of the grid: the worst over

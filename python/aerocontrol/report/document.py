@@ -44,3 +44,38 @@ class Report:
     def html(self, images: dict[str, bytes]) -> str:
         """The report as one HTML page; ``images`` maps file names to PNG bytes, embedded."""
         return render.html(self.title, self.blocks, images)
+
+    def sections(self) -> list[Report]:
+        """The report's sections, each a report of its own: a level-2 heading (the title)
+        and the blocks up to the next one; blocks before the first heading are left out.
+
+        Returns
+        -------
+        list of Report
+            One per section, in order; a notebook shows each as the whole report is shown.
+
+        Examples
+        --------
+        >>> from aerocontrol.report import build_report
+        >>> sections = build_report("b747-approach").sections()
+        >>> [section.title for section in sections[:3]]
+        ['Aircraft and flight condition', 'Modes and handling qualities', 'Responses']
+        """
+        found: list[Report] = []
+        for block in self.blocks:
+            if isinstance(block, Heading) and block.level <= 2:
+                found.append(Report(block.text))
+            elif found:
+                found[-1].blocks.append(block)
+        return found
+
+    def _images(self) -> dict[str, bytes]:
+        return render.png_images(self.figures, lambda _: None)
+
+    def _repr_html_(self) -> str:
+        """The report as HTML (the page's body, figures embedded), for Jupyter."""
+        return render.html_body(self.title, self.blocks, self._images())
+
+    def _repr_markdown_(self) -> str:
+        """The report as Markdown (figures embedded as data URIs), for Jupyter."""
+        return render.markdown(self.title, self.blocks, "", self._images())

@@ -10,22 +10,9 @@ from typing import Any
 
 import numpy as np
 
+from .._results import format_complex, format_number
+
 __all__ = ["format_complex", "format_number", "format_vector", "new_figure", "nice_ceiling"]
-
-
-def format_number(value: float, digits: int = 4) -> str:
-    """``value`` to ``digits`` significant digits; "-" for NaN, "∞" or "-∞" for infinities."""
-    if not math.isfinite(value):
-        return "-" if math.isnan(value) else ("∞" if value > 0 else "-∞")
-    return f"{value:.{digits}g}"
-
-
-def format_complex(value: complex, digits: int = 5) -> str:
-    """``value`` as "a + bj" or "a - bj" to ``digits`` significant digits; a real one as "a"."""
-    if value.imag == 0.0:
-        return f"{value.real:.{digits}g}"
-    sign = "+" if value.imag > 0 else "-"
-    return f"{value.real:.{digits}g} {sign} {abs(value.imag):.{digits}g}j"
 
 
 def format_vector(values: Any, digits: int = 4) -> str:

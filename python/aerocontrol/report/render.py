@@ -10,14 +10,24 @@ base64 PNG so that the page needs no other file.
 
 from __future__ import annotations
 
-import base64
 import html as html_text
 import io
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["Figure", "Heading", "Paragraph", "Table", "html", "markdown", "png_images"]
+from .._results import html_table, markdown_table, png_data_uri
+
+__all__ = [
+    "Figure",
+    "Heading",
+    "Paragraph",
+    "Table",
+    "html",
+    "html_body",
+    "markdown",
+    "png_images",
+]
 
 
 @dataclass
@@ -41,11 +51,19 @@ class Table:
 class Figure:
     name: str
     caption: str
-    figure: Any
+    figure: Any = field(compare=False)
+    """The matplotlib figure (not compared: a report is equal to its unpickled copy, whose
+    figures are new objects, when its names and captions are)."""
 
 
-def markdown(title: str, blocks: Sequence[Any], figure_folder: str) -> str:
-    """The blocks in Markdown under the title, the figures linked from ``figure_folder``."""
+def markdown(
+    title: str,
+    blocks: Sequence[Any],
+    figure_folder: str,
+    images: dict[str, bytes] | None = None,
+) -> str:
+    """The blocks in Markdown under the title, the figures linked from ``figure_folder``, or
+    embedded when ``images`` maps their file names to PNG bytes."""
     lines = [f"# {title}", ""]
     for block in blocks:
         if isinstance(block, Heading):
@@ -53,19 +71,21 @@ def markdown(title: str, blocks: Sequence[Any], figure_folder: str) -> str:
         elif isinstance(block, Paragraph):
             lines += [block.text, ""]
         elif isinstance(block, Table):
-            lines.append("| " + " | ".join(block.header) + " |")
-            lines.append("|" + "|".join(" --- " for _ in block.header) + "|")
-            for row in block.rows:
-                lines.append("| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |")
-            lines.append("")
+            lines += [markdown_table(block.header, block.rows), ""]
         else:
-            lines += [f"![{block.caption}]({figure_folder}/{block.name}.png)", ""]
+            target = (
+                png_data_uri(images[f"{block.name}.png"])
+                if images is not None
+                else f"{figure_folder}/{block.name}.png"
+            )
+            lines += [f"![{block.caption}]({target})", ""]
             lines += [f"*{block.caption}*", ""]
     return "\n".join(lines)
 
 
-def html(title: str, blocks: Sequence[Any], images: dict[str, bytes]) -> str:
-    """The blocks as one HTML page; ``images`` maps file names to PNG bytes, embedded."""
+def html_body(title: str, blocks: Sequence[Any], images: dict[str, bytes]) -> str:
+    """The blocks as HTML elements (a fragment, as a notebook shows it); ``images`` maps file
+    names to PNG bytes, embedded."""
     escape = html_text.escape
     body = [f"<h1>{escape(title)}</h1>"]
     for block in blocks:
@@ -74,20 +94,19 @@ def html(title: str, blocks: Sequence[Any], images: dict[str, bytes]) -> str:
         elif isinstance(block, Paragraph):
             body.append(f"<p>{escape(block.text)}</p>")
         elif isinstance(block, Table):
-            head = "".join(f"<th>{escape(cell)}</th>" for cell in block.header)
-            rows = "".join(
-                "<tr>" + "".join(f"<td>{escape(cell)}</td>" for cell in row) + "</tr>"
-                for row in block.rows
-            )
-            body.append(f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>")
+            body.append(html_table(block.header, block.rows))
         else:
-            data = base64.b64encode(images[f"{block.name}.png"]).decode("ascii")
             caption = escape(block.caption)
             body.append(
-                f'<figure><img alt="{caption}" src="data:image/png;base64,{data}">'
+                f'<figure><img alt="{caption}" src="{png_data_uri(images[f"{block.name}.png"])}">'
                 f"<figcaption>{caption}</figcaption></figure>"
             )
-    return _HTML_PAGE.format(title=escape(title), body="\n".join(body))
+    return "\n".join(body)
+
+
+def html(title: str, blocks: Sequence[Any], images: dict[str, bytes]) -> str:
+    """The blocks as one HTML page; ``images`` maps file names to PNG bytes, embedded."""
+    return _HTML_PAGE.format(title=html_text.escape(title), body=html_body(title, blocks, images))
 
 
 _HTML_PAGE = """<!DOCTYPE html>
