@@ -63,7 +63,7 @@ def build_report(
     >>> document = build_report(progress=lines.append)     # the 747: a few seconds
     >>> lines[0][:36]
     'models: Boeing 747, powered approach'
-"""
+    """
     aircraft = plane if isinstance(plane, Aircraft) else load(plane)
     say = progress if progress is not None else (lambda line: None)
     report = Report(f"aerocontrol {_version()}: {aircraft.name}")
