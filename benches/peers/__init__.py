@@ -4,7 +4,7 @@
 (what a case is, agreement, timing, thread settings, the text, JSON and Markdown reports),
 :mod:`peers.inputs` (input builders several case files share) and one case file per
 aerocontrol module: ``linalg``, ``responses``, ``frequency``, ``loops``, ``modal``, ``placement``,
-``controllability``, ``riccati`` and ``batch``.
+``controllability``, ``riccati``, ``batch`` and ``accelerate``.
 
 Coverage
 --------
@@ -17,7 +17,8 @@ root_locus over 1000 gains, transfer_function of every channel [loops]; modes, c
 [modal]; place_bass_gura, place_ackermann,
 place, companion_form [placement]; is_controllable, is_observable, controllability, ctrb, obsv
 [controllability]; lqr, solve_care (with S and E), riccati_ode, lqr_finite, solve_lyapunov
-[riccati]; batch.lqr_sweep, batch.solve_care_batch [batch]. Where a size is capped (single-input
+[riccati]; batch.lqr_sweep, batch.solve_care_batch [batch]; python-control's lqr, lqe, place, ctrb and dlqr
+accelerated by accelerate_control against as installed [accelerate]. Where a size is capped (single-input
 placement and the companion form: conditioning; KNV0 placement and the Riccati ODE: the peer's time
 and accuracy) the group's docstring says why. Not here, having no peer: bode (frequency_response on
 a default grid), default_time_grid, default_frequency_grid, augment_mode, the design module
@@ -53,6 +54,7 @@ MODULES = (
     "controllability",
     "riccati",
     "batch",
+    "accelerate",
 )
 """The case files, in the order a run goes through them."""
 

@@ -104,9 +104,9 @@ def _matrix(value: object, name: str, scalar_ok: bool = False) -> FloatArray:
     except AerocontrolError as refused:
         refused.argument = name
         raise
-    bad = np.argwhere(~np.isfinite(array))
-    if bad.size:
-        row, column = (int(k) for k in bad[0])
+    finite = np.isfinite(array)
+    if not finite.all():
+        row, column = (int(k) for k in np.argwhere(~finite)[0])
         entry = float(array[row, column])
         shown = "NaN" if np.isnan(entry) else str(entry)
         error = NonFiniteError(f"{name} must be finite, but {name}[{row}, {column}] is {shown}")
@@ -129,8 +129,10 @@ def _square(matrix: FloatArray, name: str, order: int, why: str) -> None:
 
 def _symmetric(matrix: FloatArray, name: str) -> None:
     """``matrix`` must be symmetric to the Riccati solvers' tolerance."""
-    asymmetry = float(np.max(np.abs(matrix - matrix.T), initial=0.0))
-    scale = float(np.max(np.abs(matrix), initial=0.0))
+    if matrix.size == 0:
+        return
+    asymmetry = float(np.abs(matrix - matrix.T).max())
+    scale = float(np.abs(matrix).max())
     if asymmetry > SYMMETRY_TOLERANCE * scale:
         error = InvalidArgumentError(
             f"{name} must be symmetric (a covariance), but max|{name} - {name}^T| = "
