@@ -8,22 +8,22 @@ aerocontrol module: ``linalg``, ``responses``, ``frequency``, ``loops``, ``modal
 
 Coverage
 --------
-Every public numerical operation that has a peer in scipy, python-control (with slycot) or numpy, at
-n = 4 (the 747 where it is natural), 16, 64 and 256 (expm also 8 and 1024; the batch API on 1000
-problems): expm (one matrix and a stack), transition_matrix, discretize, schur (plain and reordered)
-[linalg]; the step, impulse, doublet, initial-condition and forced responses, steady_state, dc_gain
-[responses]; frequency_response [frequency]; stability_margins of the 747 dampers' loops,
-root_locus over 1000 gains, transfer_function of every channel [loops]; modes, charpoly
-[modal]; place_bass_gura, place_ackermann,
-place, companion_form [placement]; is_controllable, is_observable, controllability, ctrb, obsv
-[controllability]; lqr, solve_care (with S and E), riccati_ode, lqr_finite, solve_lyapunov
-[riccati]; batch.lqr_sweep, batch.solve_care_batch [batch]; python-control's lqr, lqe,
-place, ctrb and dlqr accelerated by accelerate_control against as installed [accelerate].
-Where a size is capped (single-input placement and the companion form: conditioning; KNV0 placement and the Riccati ODE: the peer's time
-and accuracy) the group's docstring says why. Not here, having no peer: bode (frequency_response on
-a default grid), default_time_grid, default_frequency_grid, augment_mode, the design module
-(compositions of the above), the aircraft module (atmosphere, models; envelope_sweep is timed by
-benches/batch_scaling.py), handling and the report.
+Every public numerical operation that has a peer in scipy, python-control (with slycot) or
+numpy, at n = 4 (the 747 where it is natural), 16, 64 and 256 (expm also 8 and 1024; the batch
+API on 1000 problems): expm (one matrix and a stack), transition_matrix, discretize, schur
+(plain and reordered) [linalg]; the step, impulse, doublet, initial-condition and forced
+responses, steady_state, dc_gain [responses]; frequency_response [frequency]; stability_margins
+of the 747 dampers' loops, root_locus over 1000 gains, transfer_function of every channel
+[loops]; modes, charpoly [modal]; place_bass_gura, place_ackermann, place, companion_form
+[placement]; is_controllable, is_observable, controllability, ctrb, obsv [controllability]; lqr,
+solve_care (with S and E), riccati_ode, lqr_finite, solve_lyapunov [riccati]; batch.lqr_sweep,
+batch.solve_care_batch [batch]; python-control's lqr, lqe, place, ctrb and dlqr accelerated by
+accelerate_control against as installed [accelerate]. Where a size is capped (single-input
+placement and the companion form: conditioning; KNV0 placement and the Riccati ODE: the peer's
+time and accuracy) the group's docstring says why. Not here, having no peer: bode
+(frequency_response on a default grid), default_time_grid, default_frequency_grid, augment_mode,
+the design module (compositions of the above), the aircraft module (atmosphere, models;
+envelope_sweep is timed by benches/batch_scaling.py), handling and the report.
 
 Adding a case
 -------------
