@@ -4,7 +4,6 @@ scripts/docs.sh.)"""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import pytest
@@ -16,11 +15,11 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 NOTEBOOKS = sorted(path.name for path in (EXAMPLES / "notebooks").glob("*.ipynb"))
 
 
-def _run(name: str) -> str:
-    """Execute the notebook in a fresh kernel; the text of its outputs."""
+def _run(name: str, monkeypatch: pytest.MonkeyPatch) -> str:
+    """Execute the notebook in a fresh kernel (which inherits this environment, restored
+    after the test); the text of its outputs."""
     book = nbformat.read(EXAMPLES / "notebooks" / name, as_version=4)
-    env = {"MPLBACKEND": "module://matplotlib_inline.backend_inline"}
-    os.environ.update(env)
+    monkeypatch.setenv("MPLBACKEND", "module://matplotlib_inline.backend_inline")
     nbclient.NotebookClient(book, timeout=300, kernel_name="python3").execute()
     texts = []
     for cell in book.cells:
@@ -48,7 +47,7 @@ def test_there_is_a_notebook_per_design_study() -> None:
         ("robustness.ipynb", ["closed loop: Dutch roll meets Level 1 with probability 1 "]),
     ],
 )
-def test_notebook_runs(name: str, expected: list[str]) -> None:
-    text = _run(name)
+def test_notebook_runs(name: str, expected: list[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    text = _run(name, monkeypatch)
     for line in expected:
         assert line in text, (line, text[:2000])
