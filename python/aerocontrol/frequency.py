@@ -47,12 +47,12 @@ class FrequencyResponse(Result):
 
     @property
     def magnitude(self) -> FloatArray:
-        """|G(jω)|."""
+        """abs(G(jω)), the magnitude."""
         return np.abs(self.response)
 
     @property
     def magnitude_db(self) -> FloatArray:
-        """20 log10 |G(jω)| in decibels."""
+        """20 log10 abs(G(jω)) in decibels."""
         with np.errstate(divide="ignore"):
             return 20.0 * np.log10(self.magnitude)
 

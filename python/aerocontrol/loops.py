@@ -621,9 +621,9 @@ class StabilityMargins(Result):
     disk_margin: float
     """α of the balanced disk margin (σ = 0); 0 if the closed loop is unstable."""
     disk_frequency: float
-    """Where |S - T|/2 peaks (rad/s)."""
+    """Where abs(S - T)/2 peaks (rad/s)."""
     stability_margin: float
-    """min |1 + L(jω)|, the distance from the Nyquist plot to -1 (1/||S||∞)."""
+    """min abs(1 + L(jω)), the distance from the Nyquist plot to -1 (1/||S||∞)."""
     stability_frequency: float
     gain_margins: FloatArray
     phase_crossovers: FloatArray
@@ -1217,13 +1217,13 @@ class DiskMargin(Result):
     """A disk margin α of skew σ: the loop stays stable for every multiplicative gain and phase
     change f (in every loop at once, independently, for a multiloop margin) in the disk
 
-        D(α, σ) = {(1 + (1 - σ) δ/2)/(1 - (1 + σ) δ/2) : |δ| < α},
+        D(α, σ) = {(1 + (1 - σ) δ/2)/(1 - (1 + σ) δ/2) : abs(δ) < α},
 
     whose real intercepts are :attr:`gain_margin` and which holds the phase changes up to
     ±:attr:`phase_margin` at unit gain (Seiler, Packard and Gahinet 2020)."""
 
     alpha: float
-    """α = 1/sup_ω |S + (σ - 1)/2| (a structured singular value for a multiloop margin); 0
+    """α = 1/sup_ω abs(S + (σ - 1)/2) (a structured singular value for a multiloop margin); 0
     when the closed loop is unstable."""
     skew: float
     """σ: 0 balances gain increase and decrease; σ > 0 favours increase, σ < 0 decrease."""
@@ -3194,7 +3194,7 @@ class NicholsResponse(Result):
     response: ComplexArray
     """L(jω) (L(e^{jω dt}))."""
     gain_db: FloatArray
-    """20 log10 |L| (∞ at a pole on the axis, -∞ at a zero)."""
+    """20 log10 abs(L) (∞ at a pole on the axis, -∞ at a zero)."""
     phase_deg: FloatArray
     """∠L in degrees, continuous along the Nyquist contour with indentations to the right of
     the poles and zeros on the axis (so the phase steps by -180° per pole and +180° per zero

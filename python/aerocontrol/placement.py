@@ -114,6 +114,16 @@ attach(
         "eigenvector_condition",
     ),
 )
+# The core's docstring of this field reads as a substitution in reStructuredText.
+setattr(  # noqa: B010 - the stub declares a read-only property
+    Placement,
+    "max_relative_error",
+    property(
+        vars(Placement)["max_relative_error"].__get__,
+        doc="max abs(achieved - requested) / abs(requested) (relative to ||A - BK||_F for a "
+        "pole at 0).",
+    ),
+)
 
 
 def _poles(poles: object) -> ComplexArray:

@@ -322,7 +322,7 @@ class DareSolution(Result):
     K: FloatArray
     """The optimal gain (R + B^T X B)^-1 (B^T X A + S^T), m x n."""
     closed_loop_poles: ComplexArray
-    """The eigenvalues of (A - B K, E), all with |z| < 1."""
+    """The eigenvalues of (A - B K, E), all with abs(z) < 1."""
     residual: float
     """||Res||_F / (||Q||_F + ||A^T X A||_F + ||E^T X E||_F + ||(B^T X A + S^T)^T K||_F)."""
     rcond: float

@@ -63,7 +63,8 @@ DESIGNS = ("lqr", "damper")
 #: result does not depend on it, each condition being judged on its own).
 CHUNK_SIZE = 4096
 
-#: The fields of a condition's aircraft that :meth:`Aircraft.at` changes and the models read.
+#: The fields of a condition's aircraft that :meth:`~aerocontrol.aircraft.Aircraft.at` changes
+#: and the models read.
 _CONDITION_FIELDS = ("mass", "speed", "density")
 
 
@@ -72,7 +73,8 @@ def _models(
 ) -> tuple[FloatArray, FloatArray, list[Aircraft]]:
     """The state matrices A (k, 4, 4) and B (k, 4, inputs) at k conditions (rows altitude,
     Mach, weight), each equal, bitwise, to ``plane.at(...)``'s own model (the aircraft moved
-    by :meth:`Aircraft.at`, the matrices built in one :meth:`Aircraft.model_stack` call)."""
+    by :meth:`~aerocontrol.aircraft.Aircraft.at`, the matrices built in one
+    :meth:`~aerocontrol.aircraft.Aircraft.model_stack` call)."""
     moved = [plane.at(float(h), float(m), float(w)) for h, m, w in conditions]
     values = {name: np.array([getattr(a, name) for a in moved]) for name in _CONDITION_FIELDS}
     for name in ("CL", "CD"):
@@ -182,7 +184,8 @@ class GainSchedule(Result):
     :func:`gain_schedule`. Arrays are indexed [altitude, Mach, weight]."""
 
     plane: Aircraft
-    """The aircraft whose conditions (:meth:`Aircraft.at`) the gains were designed at."""
+    """The aircraft whose conditions (:meth:`~aerocontrol.aircraft.Aircraft.at`) the gains were
+    designed at."""
     axis: str
     design: str
     """The design rule: "lqr" or "damper"."""
@@ -297,8 +300,8 @@ class GainSchedule(Result):
     ) -> Envelope:
         """The closed-loop MIL-F-8785C Levels (3.2, 3.3) over a grid of conditions, typically
         finer than the design grid, with the interpolated gains (1): at each condition the
-        model of :meth:`Aircraft.at`, the loop A - B K closed with the gains of
-        :meth:`gains_at`, its eigenvalues, modes and Levels, all computed in bulk.
+        model of :meth:`~aerocontrol.aircraft.Aircraft.at`, the loop A - B K closed with the gains
+        of :meth:`gains_at`, its eigenvalues, modes and Levels, all computed in bulk.
 
         Parameters
         ----------
@@ -320,7 +323,7 @@ class GainSchedule(Result):
         ------
         InvalidArgumentError
             A grid value outside the schedule's range (named), or not finite; a condition
-            outside the plausible ranges (:meth:`Aircraft.at`).
+            outside the plausible ranges (:meth:`~aerocontrol.aircraft.Aircraft.at`).
         ShapeError
             A grid that is not a non-empty 1-D array.
 

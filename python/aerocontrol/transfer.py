@@ -592,9 +592,9 @@ class Factor:
     zeta: float
     """Damping ratio of a pair (for a discrete model: of s = ln(z)/dt); NaN for a real root."""
     omega: float
-    """ω of a pair (rad/s; for a discrete model of s = ln(z)/dt); |root| for a real one."""
+    """ω of a pair (rad/s; for a discrete model of s = ln(z)/dt); abs(root) for a real one."""
     time_constant: float
-    """T of a real root -1/T (s; continuous only): 1/|root|, inf for a root at 0."""
+    """T of a real root -1/T (s; continuous only): 1/abs(root), inf for a root at 0."""
 
     @property
     def coefficients(self) -> FloatArray:
@@ -671,8 +671,8 @@ class TransferFunction(Result):
     input_name: str
     scaled_gain: tuple[float, int] | None = field(default=None, repr=False)
     """K as (mantissa, exponent), K = mantissa 2^exponent, where K itself lies beyond the
-    doubles (``gain`` is then infinite): :meth:`__call__` evaluates G from it. None when
-    ``gain`` is K."""
+    doubles (``gain`` is then infinite): calling the function, ``G(s)``, evaluates G from it.
+    None when ``gain`` is K."""
 
     @property
     def variable(self) -> str:
@@ -681,12 +681,12 @@ class TransferFunction(Result):
 
     @property
     def zero_factors(self) -> list[Factor]:
-        """The numerator's factors: real zeros by |z|, then pairs by ω."""
+        """The numerator's factors: real zeros by abs(z), then pairs by ω."""
         return _factors(self.zeros, self.dt)
 
     @property
     def pole_factors(self) -> list[Factor]:
-        """The denominator's factors: real poles by |p|, then pairs by ω."""
+        """The denominator's factors: real poles by abs(p), then pairs by ω."""
         return _factors(self.poles, self.dt)
 
     def __call__(self, s: complex | ComplexArray) -> complex | ComplexArray:
