@@ -159,6 +159,36 @@ class Discretization(Result):
 
     with Phi = e^{A dt}, Gamma0 = ∫_0^dt e^{Aτ} dτ B and
     Gamma1 = (1/dt) ∫_0^dt e^{Aτ} (dt - τ) dτ B.
+
+    Attributes
+    ----------
+    Phi : ndarray (n, n)
+        e^{A dt}, the transition matrix over one step.
+    Gamma0 : ndarray (n, m)
+        ∫_0^dt e^{Aτ} dτ B.
+    Gamma1 : ndarray (n, m) or None
+        (1/dt) ∫_0^dt e^{Aτ} (dt - τ) dτ B for ``method="foh"``; None for ``"zoh"``.
+    dt : float
+        The step (s).
+    method : str
+        The hold: ``"zoh"`` or ``"foh"``.
+
+    Examples
+    --------
+    The double integrator over 0.1 s: Phi = [[1, dt], [0, 1]], Gamma0 = [dt^2/2, dt] and
+    Gamma1 = [dt^2/6, dt/2]:
+
+    >>> import numpy as np, aerocontrol
+    >>> step = aerocontrol.discretize([[0, 1], [0, 0]], [[0], [1]], 0.1, "foh")
+    >>> step.Phi
+    array([[1. , 0.1],
+           [0. , 1. ]])
+    >>> np.round(step.Gamma0, 6)
+    array([[0.005],
+           [0.1  ]])
+    >>> np.round(step.Gamma1, 6)
+    array([[0.001667],
+           [0.05    ]])
     """
 
     Phi: FloatArray

@@ -333,7 +333,35 @@ def place(
 
 @dataclass(frozen=True, eq=False)
 class CompanionForm(Result):
-    """The transformation z = T x to the first companion form (6.116)-(6.145)."""
+    """The transformation z = T x to the first companion form (6.116)-(6.145).
+
+    Attributes
+    ----------
+    V : ndarray (n, n)
+        The controllability matrix [b, A b, ..., A^(n-1) b] (6.125).
+    W : ndarray (n, n)
+        The upper triangular Toeplitz matrix of the coefficients (6.131).
+    T : ndarray (n, n)
+        (VW)^-1 (6.144), so that z = T x.
+    companion : ndarray (n, n)
+        T A T^-1, the first companion form (6.116), built from the coefficients: first row
+        [-a_1, ..., -a_n], ones on the subdiagonal.
+    coefficients : ndarray (n + 1,)
+        [1, a_1, ..., a_n] of det(λI - A) (6.106).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> form = aerocontrol.companion_form([[-1, 0], [0, -2]], [1, 1])
+    >>> form.coefficients                                 # (λ + 1)(λ + 2)
+    array([1., 3., 2.])
+    >>> np.round(form.companion, 6)
+    array([[-3., -2.],
+           [ 1.,  0.]])
+    >>> np.round(form.T, 6)
+    array([[-1.,  2.],
+           [ 1., -1.]])
+    """
 
     V: FloatArray
     """The controllability matrix (6.125)."""
