@@ -1220,7 +1220,34 @@ class DiskMargin(Result):
         D(α, σ) = {(1 + (1 - σ) δ/2)/(1 - (1 + σ) δ/2) : abs(δ) < α},
 
     whose real intercepts are :attr:`gain_margin` and which holds the phase changes up to
-    ±:attr:`phase_margin` at unit gain (Seiler, Packard and Gahinet 2020)."""
+    ±:attr:`phase_margin` at unit gain (Seiler, Packard and Gahinet 2020).
+
+    Attributes
+    ----------
+    alpha : float
+        α = 1/sup_ω abs(S + (σ - 1)/2) (a structured singular value for a multiloop margin); 0
+        when the closed loop is unstable.
+    skew : float
+        σ: 0 balances gain increase and decrease; σ > 0 favours increase, σ < 0 decrease.
+    frequency : float
+        Where the peak is (rad/s; ∞ as ω → ∞, NaN when the closed loop is unstable).
+    gain_margin : tuple of float
+        [γ_min, γ_max]: the gains (factors) the loop tolerates with no phase change.
+    gain_margin_db : tuple of float
+        ``gain_margin`` in dB.
+    phase_margin : float
+        ± this many degrees of phase change at unit gain are tolerated.
+
+    Examples
+    --------
+    The integrator loop 1/s has S - T = (s - 1)/(s + 1), of modulus 1 at every frequency, so
+    α = 2: any gain increase or decrease, and ±90°:
+
+    >>> import aerocontrol
+    >>> disk = aerocontrol.disk_margins(aerocontrol.zpk([], [0.0], 1.0)).loop_at_a_time[0]
+    >>> disk.alpha, disk.gain_margin, disk.phase_margin
+    (2.0, (0.0, inf), 90.0)
+    """
 
     alpha: float
     """α = 1/sup_ω abs(S + (σ - 1)/2) (a structured singular value for a multiloop margin); 0
@@ -1263,7 +1290,48 @@ class DiskMargins(Result):
     The multiloop margin is computed within bounds (a structured singular value): its
     :attr:`multiloop` α is the guaranteed one (from the upper bound of μ), and
     :attr:`multiloop_bounds` gives it with the α of a destabilising perturbation found (from
-    the lower bound), which the true margin cannot exceed."""
+    the lower bound), which the true margin cannot exceed.
+
+    Attributes
+    ----------
+    skew : float
+        σ of every disk (0 balances gain increase and decrease).
+    names : tuple of str
+        The loop break points: the loop's input names.
+    loop_at_a_time : tuple of DiskMargin
+        The disk margin of each loop broken with the others closed.
+    multiloop : DiskMargin
+        Simultaneous independent changes f_i in D(α, σ) in every loop: α = 1/sup_ω μ̄, the
+        guaranteed (lower) bound of the margin.
+    multiloop_bounds : tuple of float
+        (α guaranteed, α of ``worst_perturbation``): the true multiloop margin lies between them.
+    worst_perturbation : ndarray (p,), complex
+        The gains f_i that put a closed-loop pole at j ``worst_frequency``: the certificate that
+        the margin is no larger (ones when the closed loop is unstable; NaN when μ = 0).
+    worst_frequency : float
+        The frequency of ``worst_perturbation`` (rad/s).
+    frequencies : ndarray (k,)
+        The frequencies (rad/s, increasing; ∞ last for a continuous loop on the default grid) at
+        which the bounds of μ were computed.
+    mu_upper, mu_lower : ndarray (k,)
+        Upper and lower bounds of μ_Δ(S + (σ - 1)/2 I) at each frequency.
+    loops : tuple of StabilityMargins
+        The classical margins of each loop broken with the others closed
+        (:func:`~aerocontrol.stability_margins`).
+    closed_loop_poles : ndarray (n,), complex
+        The poles of the loop closed as u = -y (rad/s, or z for a discrete loop).
+    closed_loop_stable : bool
+        Whether every closed-loop pole is in the open left half plane (inside the unit circle).
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> margins = aerocontrol.disk_margins(aerocontrol.zpk([], [0.0], 1.0))     # 1/s
+    >>> margins.names, margins.closed_loop_stable
+    (('u0',), True)
+    >>> margins.multiloop.alpha, margins.multiloop_bounds        # one loop: α = 2 both ways
+    (2.0, (2.0, 2.0))
+    """
 
     skew: float
     names: tuple[str, ...]
@@ -2164,7 +2232,31 @@ def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
 
 @dataclass(frozen=True, eq=False)
 class DampingDesign(Result):
-    """A gain of a root-locus design and the mode it sets."""
+    """A gain of a root-locus design and the mode it sets.
+
+    Attributes
+    ----------
+    gain : float
+        The loop gain k of the design (the loop is closed as 1 + k L(s) = 0).
+    damping_ratio : float
+        ζ of the mode (of s = ln(z)/dt for a discrete loop); 1 when no pole oscillates.
+    pole : complex
+        The mode's closed-loop pole (Im ≥ 0; rad/s, or z for a discrete loop); NaN when no pole
+        oscillates.
+    closed_loop_poles : ndarray (n,), complex
+        Every closed-loop pole at ``gain``.
+
+    Examples
+    --------
+    k/(s(s + 2)) closes to s² + 2s + k: ζ = 1/√k, so ζ = 0.5 at k = 4, with the poles -1 ± j√3:
+
+    >>> import numpy as np, aerocontrol
+    >>> design = aerocontrol.gain_for_damping(aerocontrol.zpk([], [0.0, -2.0], 1.0), 0.5)
+    >>> round(design.gain, 10), round(design.damping_ratio, 10)
+    (4.0, 0.5)
+    >>> complex(np.round(design.pole, 6))
+    (-1+1.732051j)
+    """
 
     gain: float
     damping_ratio: float

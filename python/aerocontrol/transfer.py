@@ -585,7 +585,34 @@ def transmission_zeros(sys: System, tol: float | None = None) -> ComplexArray:
 @dataclass(frozen=True)
 class Factor:
     """One factor of a factored polynomial: (s - root) or, for a complex pair,
-    (s² + 2ζω s + ω²) (in z for a discrete model)."""
+    (s² + 2ζω s + ω²) (in z for a discrete model).
+
+    Attributes
+    ----------
+    roots : tuple of complex
+        One real root, or the pair (Im > 0 first).
+    zeta : float
+        Damping ratio of a pair (for a discrete model: of s = ln(z)/dt); NaN for a real root.
+    omega : float
+        ω of a pair (rad/s; for a discrete model of s = ln(z)/dt); abs(root) for a real one.
+    time_constant : float
+        T of a real root -1/T (s; continuous only): 1/abs(root), inf for a root at 0; NaN for a
+        pair.
+    coefficients : ndarray (2,) or (3,)
+        The monic factor, highest power first.
+
+    Examples
+    --------
+    The poles of 5/((s + 1)(s² + 2s + 5)): a real root at -1 and a pair of ω = √5, ζ = 1/√5:
+
+    >>> import numpy as np, aerocontrol
+    >>> g = aerocontrol.transfer_function(aerocontrol.zpk([], [-1, -1 + 2j, -1 - 2j], 5.0), 0, 0)
+    >>> real, pair = g.pole_factors
+    >>> real.time_constant, real.coefficients
+    (1.0, array([1., 1.]))
+    >>> round(pair.zeta, 6), round(pair.omega, 6), np.round(pair.coefficients, 6)
+    (0.447214, 2.236068, array([1., 2., 5.]))
+    """
 
     roots: tuple[complex, ...]
     """One real root, or the pair (Im > 0 first)."""
