@@ -2122,7 +2122,37 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
 
 @dataclass(frozen=True, eq=False)
 class RootLocus(Result):
-    """The closed-loop poles of 1 + k L(s) = 0 over the gains k."""
+    """The closed-loop poles of 1 + k L(s) = 0 over the gains k.
+
+    Attributes
+    ----------
+    gains : ndarray (k,)
+        The gains k.
+    poles : ndarray (k, n), complex
+        The eigenvalues of A - k B (1 + k D)⁻¹ C for each gain, each row sorted.
+    dt : float
+        The sampling period (s), 0 for a continuous loop.
+    loop : StateSpace
+        The open loop L.
+    open_loop_poles : ndarray, complex
+        The poles of L's transfer function (computed on first use).
+    open_loop_zeros : ndarray, complex
+        The zeros of L's transfer function (computed on first use).
+
+    Examples
+    --------
+    k/(s(s + 2)) closes to s² + 2s + k: poles 0 and -2 at k = 0, a double pole at -1 at
+    k = 1, -1 ± 2j at k = 5:
+
+    >>> import numpy as np, aerocontrol
+    >>> locus = aerocontrol.root_locus(aerocontrol.zpk([], [0.0, -2.0], 1.0), [0.0, 1.0, 5.0])
+    >>> np.round(locus.poles, 6)
+    array([[-2.+0.j,  0.+0.j],
+           [-1.+0.j, -1.+0.j],
+           [-1.-2.j, -1.+2.j]])
+    >>> locus.open_loop_zeros.size
+    0
+    """
 
     gains: FloatArray
     poles: ComplexArray
@@ -3048,6 +3078,57 @@ class NyquistResponse(Result):
     in P; the image of such an indentation is a large arc, turning clockwise by 180° times the
     poles' multiplicity. The arrays hold the half ω ≥ 0: the half ω ≤ 0 is its mirror image,
     the complex conjugate (:attr:`closed_curve` joins them).
+
+    Attributes
+    ----------
+    omega : ndarray (k,)
+        The frequencies asked for (rad/s, increasing), or by default every frequency of the
+        contour's points on the axis.
+    response : ndarray (k,), complex
+        L(jω) (L(e^{jω dt})) at ``omega``; infinite (or huge) at a pole on the axis.
+    contour : ndarray, complex
+        The half ω ≥ 0 of the Nyquist contour in order, in the loop's variable (s, or z),
+        indentations included.
+    curve : ndarray, complex
+        L on ``contour``: the half ω ≥ 0 of the Nyquist curve (ending at L(j∞) = D).
+    indented : ndarray, bool
+        Which points of ``contour`` lie on an indentation.
+    indentations : tuple of (float, float, int)
+        (ω0 in rad/s, radius ε in rad/s, number of poles) of each indentation.
+    open_loop_unstable_poles : int
+        P: open-loop poles in the open right half plane (outside the unit circle).
+    encirclements : int or None
+        N: counterclockwise encirclements of -1 by the closed curve, P - Z; None when the curve
+        passes through -1 (``marginal``).
+    closed_loop_unstable_poles : int
+        Z: closed-loop poles (eigenvalues of A - B (1 + D)⁻¹ C) in the open right half plane
+        (outside the unit circle).
+    closed_loop_poles : ndarray (n,), complex
+        All closed-loop poles.
+    boundary_poles : ndarray, complex
+        The closed-loop poles on the imaginary axis (the unit circle); empty unless ``marginal``.
+    dt : float
+        The sampling period (s), 0 for a continuous loop.
+    loop : StateSpace
+        The loop L.
+    marginal : bool
+        True when closed-loop poles lie on the stability boundary: N is then not defined.
+    closed_loop_stable : bool
+        Every closed-loop pole in the open left half plane (inside the unit circle).
+    closed_curve : ndarray, complex
+        The whole closed Nyquist curve: the mirror half (ω from -∞ to 0), then the half ω ≥ 0.
+
+    Examples
+    --------
+    10 (s + 2)/((s - 1)(s + 5)) has P = 1 and circles -1 once counterclockwise, so Z = 0: the
+    closed loop s² + 14 s + 15 has the poles -7 ± √34:
+
+    >>> import numpy as np, aerocontrol
+    >>> r = aerocontrol.nyquist(aerocontrol.zpk([-2.0], [1.0, -5.0], 10.0))
+    >>> r.open_loop_unstable_poles, r.encirclements, r.closed_loop_unstable_poles
+    (1, 1, 0)
+    >>> np.round(r.closed_loop_poles.real, 6), r.closed_loop_stable
+    (array([-12.830952,  -1.169048]), True)
     """
 
     omega: FloatArray

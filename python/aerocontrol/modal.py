@@ -80,11 +80,11 @@ class Modes(Result):
     period : ndarray (k,)
         2π/ω_d (s); inf for a real mode.
     time_to_half, time_to_double : ndarray (k,)
-        ln 2 / abs(Re λ) (s) for a decaying (growing) mode; inf otherwise.
+        ln 2 / abs(Re λ) (s) for a decaying (growing) mode; NaN otherwise.
     cycles_to_half : ndarray (k,)
-        ``time_to_half`` / ``period``.
+        ``time_to_half`` / ``period``; NaN for a real mode.
     time_constant : ndarray (k,)
-        -1/λ of a real mode (s); NaN for a pair.
+        1/abs(λ) of a real mode (s); NaN for a pair.
     modal_matrix : ndarray (n, n), complex, or None
         P, unit eigenvectors as columns in the order of ``eigenvalues``; None if A is defective.
     modal_matrix_condition : float

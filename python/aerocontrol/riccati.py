@@ -595,7 +595,31 @@ def _regulator_arguments(
 
 @dataclass(frozen=True, eq=False)
 class RiccatiSolution(Result):
-    """S(t) and K(t) of the finite-horizon regulator on a time grid (6.196)-(6.200)."""
+    """S(t) and K(t) of the finite-horizon regulator on a time grid (6.196)-(6.200).
+
+    Attributes
+    ----------
+    t : ndarray (k,)
+        The times (s), increasing; S(t[-1]) = Sf.
+    S : ndarray (k, n, n)
+        S(t_k), symmetric.
+    K : ndarray (k, m, n)
+        K(t_k) = R^-1 B^T S(t_k) (6.200).
+    substeps : int
+        Steps of the transition-matrix recursion over the horizon (each interval of t is
+        divided so that the Hamiltonian's modes grow by at most e across a step).
+
+    Examples
+    --------
+    For x' = u with Q = R = 1 and S(2) = 0, -S' = 1 - S² gives S(t) = tanh(2 - t):
+
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.riccati_ode([[0.0]], [[1.0]], [[1.0]], [[1.0]], [0.0, 1.0, 2.0])
+    >>> np.round(sol.S[:, 0, 0], 6), np.round(np.tanh([2.0, 1.0, 0.0]), 6)
+    (array([0.964028, 0.761594, 0.      ]), array([0.964028, 0.761594, 0.      ]))
+    >>> sol.K.shape
+    (3, 1, 1)
+    """
 
     t: FloatArray
     """The times, increasing; S(t[-1]) = Sf."""
@@ -758,7 +782,30 @@ def lqr_finite(
 
 @dataclass(frozen=True, eq=False)
 class RiccatiDifferenceSolution(Result):
-    """S_k and K_k of the discrete finite-horizon regulator over N steps."""
+    """S_k and K_k of the discrete finite-horizon regulator over N steps.
+
+    Attributes
+    ----------
+    S : ndarray (N + 1, n, n)
+        S_0 .. S_N, symmetric; S_N = Sf. x_k^T S_k x_k is the optimal cost from step k to the end.
+    K : ndarray (N, m, n)
+        K_0 .. K_{N-1}: u_k = -K_k x_k.
+    rcond : float
+        The smallest reciprocal condition number of R + B^T S_{k+1} B over the horizon (the
+        matrix each gain solves with); 1 when N = 0.
+    error_estimate : float
+        The largest estimated relative error of a step S_k from the rounding of A - B K_k.
+
+    Examples
+    --------
+    x[k+1] = 2 x[k] + u[k], Q = R = 1, S_3 = 0: S_k = (5 S_{k+1} + 1)/(S_{k+1} + 1) and
+    K_k = 2 S_{k+1}/(S_{k+1} + 1), backward from 0:
+
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.riccati_difference([[2.0]], [[1.0]], [[1.0]], [[1.0]], 3)
+    >>> np.round(sol.S[:, 0, 0], 12), np.round(sol.K[:, 0, 0], 12)
+    (array([4., 3., 1., 0.]), array([1.5, 1. , 0. ]))
+    """
 
     S: FloatArray
     """S_0 .. S_N, shape (N + 1, n, n), symmetric; S_N = Sf. x_k^T S_k x_k is the optimal cost
