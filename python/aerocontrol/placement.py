@@ -124,6 +124,52 @@ setattr(  # noqa: B010 - the stub declares a read-only property
         "pole at 0).",
     ),
 )
+Placement.__doc__ = """A state-feedback design η = -K x (6.91), from :func:`place`,
+:func:`place_ackermann` or :func:`place_bass_gura`.
+
+Attributes
+----------
+K : ndarray (m, n)
+    The gain: η = -K x places the eigenvalues of A - B K.
+k : ndarray (n,)
+    The gain vector of a single-input design (the chapter's k^T = ``K[0]``).
+closed_loop : ndarray (n, n)
+    A - B K (6.93).
+poles : ndarray (n,), complex
+    The requested poles.
+achieved_poles : ndarray (n,), complex
+    The eigenvalues of A - B K, matched to ``poles``.
+max_relative_error : float
+    max abs(achieved - requested) / abs(requested) (relative to ||A - BK||_F for a pole
+    at 0).
+iterations : int
+    Sweeps of the robust method (0 for a direct one).
+converged : bool
+    Whether the robust method's sweeps converged.
+method : str
+    The method that computed K.
+controllability_condition : float
+    κ_1(V) of the controllability matrix, from the single-input formulas (NaN for the
+    robust method).
+eigenvector_condition : float
+    κ_2(X) of the closed loop's eigenvectors, from the robust method: large means the placed
+    poles are sensitive.
+
+Examples
+--------
+The double integrator placed at -1 and -2: A - B K has the characteristic polynomial
+s² + 3 s + 2, so K = [2, 3]:
+
+>>> import numpy as np, aerocontrol
+>>> design = aerocontrol.place([[0, 1], [0, 0]], [[0], [1]], [-1.0, -2.0])
+>>> design.K, design.k
+(array([[2., 3.]]), array([2., 3.]))
+>>> design.closed_loop
+array([[ 0.,  1.],
+       [-2., -3.]])
+>>> design.achieved_poles, bool(design.max_relative_error < 1e-14)
+(array([-1.+0.j, -2.+0.j]), True)
+"""
 
 
 def _poles(poles: object) -> ComplexArray:
