@@ -680,6 +680,42 @@ class TransferFunction(Result):
     ``print(tf)`` shows the factored "aircraft" form, (s + 1/T) for a real root -1/T and
     (s² + 2(ζ)(ω)s + (ω)²) for a pair, as flight dynamics texts print a numerator N(s) over
     the characteristic polynomial Δ(s).
+
+    Attributes
+    ----------
+    numerator : ndarray (m + 1,)
+        K Π(s - z_i), highest power first.
+    denominator : ndarray (n + 1,)
+        det(sI - A) = Π(s - p_j), monic, highest power first.
+    zeros : ndarray (m,), complex
+        The finite zeros of the channel's pencil, sorted.
+    poles : ndarray (n,), complex
+        The eigenvalues of A (all n), sorted.
+    gain : float
+        K, the leading coefficient of the numerator (the high-frequency gain over s^(n - m)).
+    dt : float
+        0.0 for a continuous model, else the sampling period in seconds.
+    output_name, input_name : str
+        The channel's output and input.
+    scaled_gain : tuple of (float, int), or None
+        K as (mantissa, exponent), K = mantissa 2^exponent, where K itself lies beyond the
+        doubles (``gain`` is then infinite); None when ``gain`` is K.
+    variable : str
+        "s", or "z" for a discrete model.
+    zero_factors, pole_factors : list of Factor
+        The numerator's and the denominator's factors: real roots by modulus, then pairs by ω.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> g = aerocontrol.transfer_function(aerocontrol.zpk([-3.0], [-1.0, -2.0], 2.0), 0, 0)
+    >>> np.round(g.numerator, 12), g.denominator                  # 2 (s + 3) / (s² + 3s + 2)
+    (array([2., 6.]), array([1., 3., 2.]))
+    >>> print(g)
+    y0/u0(s) = 2 (s + 3) / (s + 1)(s + 2)
+      zero -3 T = 0.3333 s
+      pole -1 T = 1 s
+      pole -2 T = 0.5 s
     """
 
     numerator: FloatArray
@@ -1309,6 +1345,21 @@ class TransferMatrix(Result):
 
     The channels share the poles and the denominator det(sI - A); each has its own zeros and
     gain, computed as :func:`transfer_function` computes them.
+
+    Attributes
+    ----------
+    poles : ndarray (n,), complex
+        The eigenvalues of A, sorted: the poles every channel shares.
+    denominator : ndarray (n + 1,)
+        det(sI - A), monic, highest power first.
+    dt : float
+        0.0 for a continuous model, else the sampling period in seconds.
+    output_names, input_names : tuple of str
+        The model's outputs and inputs.
+    shape : tuple of int
+        (outputs, inputs).
+    channels : tuple of TransferFunction
+        Every channel, output by output (each input's in turn).
 
     Examples
     --------
