@@ -28,15 +28,7 @@ MODULES = (
 
 #: name -> the sections it still lacks.
 KNOWN_GAPS: dict[str, set[str]] = {
-    "aerocontrol.robustness.Damper": {"Examples", "Parameters or Attributes"},
-    "aerocontrol.robustness.Estimate": {"Examples", "Parameters or Attributes"},
-    "aerocontrol.robustness.LogNormal": {"Examples", "Parameters or Attributes"},
-    "aerocontrol.robustness.LoopOutcome": {"Examples", "Parameters or Attributes"},
-    "aerocontrol.robustness.Lqr": {"Examples", "Parameters or Attributes"},
-    "aerocontrol.robustness.MonteCarlo": {"Examples", "Parameters or Attributes"},
-    "aerocontrol.robustness.Normal": {"Examples", "Parameters or Attributes"},
     "aerocontrol.robustness.Uncertainty": {"Parameters or Attributes"},
-    "aerocontrol.robustness.Uniform": {"Examples", "Parameters or Attributes"},
     "aerocontrol.schedule.GainSchedule": {"Examples", "Parameters or Attributes"},
 }
 
