@@ -205,6 +205,15 @@ class Uncertainty:
     correlation), ``{("Cn_beta", "Cn_r"): 0.5}``. The correlation matrix must be positive
     definite.
 
+    Attributes
+    ----------
+    distributions : Mapping[str, Normal or Uniform or LogNormal]
+        The distribution of each uncertain parameter (a copy of the mapping given).
+    correlations : Mapping[tuple of (str, str), float]
+        The correlation of two parameters' standard-normal draws, in (-1, 1); empty by default.
+    names : tuple of str
+        The uncertain parameters, in the order given.
+
     Examples
     --------
     >>> from aerocontrol.robustness import LogNormal, Normal, Uncertainty, Uniform

@@ -181,7 +181,48 @@ def _increasing(grid: FloatArray, name: str) -> FloatArray:
 @dataclass(frozen=True, eq=False)
 class GainSchedule(Result):
     """State-feedback gains u = -K x designed over a grid of flight conditions, from
-    :func:`gain_schedule`. Arrays are indexed [altitude, Mach, weight]."""
+    :func:`gain_schedule`. Arrays are indexed [altitude, Mach, weight].
+
+    Attributes
+    ----------
+    plane : Aircraft
+        The aircraft whose conditions (:meth:`~aerocontrol.aircraft.Aircraft.at`) the gains were
+        designed at.
+    axis : str
+        "lateral" or "longitudinal".
+    design : str
+        The design rule: "lqr" or "damper".
+    altitudes : ndarray (a,)
+        The grid's altitudes (ft or m, the aircraft's units).
+    machs : ndarray (b,)
+        The grid's Mach numbers.
+    weights : ndarray (c,)
+        The grid's weights (lbf or N); the aircraft's own weight by default.
+    input_names : tuple of str
+        The rows of each gain matrix.
+    state_names : tuple of str
+        Its columns.
+    gains : ndarray (a, b, c, inputs, 4)
+        K at each grid condition.
+    closed_loop : Envelope
+        The closed loops' Levels at the grid conditions.
+    shape : tuple of int
+        (a, b, c).
+
+    Examples
+    --------
+    Each gain is the regulator of the aircraft moved to its condition:
+
+    >>> import numpy as np, aerocontrol
+    >>> from aerocontrol.schedule import gain_schedule
+    >>> b747 = aerocontrol.aircraft.load()
+    >>> s = gain_schedule(b747, altitudes=[0, 10000], machs=[0.2, 0.3])
+    >>> s.shape, s.input_names, s.state_names
+    ((2, 2, 1), ('rudder', 'aileron'), ('beta', 'p', 'phi', 'r'))
+    >>> K, _, _ = aerocontrol.lqr(b747.at(10000, 0.3).lateral(), np.eye(4), np.eye(2))
+    >>> bool(np.allclose(s.gains[1, 1, 0], K, rtol=1e-12, atol=0))
+    True
+    """
 
     plane: Aircraft
     """The aircraft whose conditions (:meth:`~aerocontrol.aircraft.Aircraft.at`) the gains were
