@@ -1273,8 +1273,8 @@ class DiskMargin(Result):
 
         D(α, σ) = {(1 + (1 - σ) δ/2)/(1 - (1 + σ) δ/2) : abs(δ) < α},
 
-    whose real intercepts are :attr:`gain_margin` and which holds the phase changes up to
-    ±:attr:`phase_margin` at unit gain (Seiler, Packard and Gahinet 2020).
+    whose real intercepts are :attr:`gain_margin` and which holds the phase changes of up to
+    :attr:`phase_margin` either way at unit gain (Seiler, Packard and Gahinet 2020).
 
     Attributes
     ----------
