@@ -64,7 +64,32 @@ DISTRIBUTED_CHUNK = 4096
 
 @dataclass(frozen=True, eq=False)
 class CareBatch(Result):
-    """The solutions of a batch of Riccati equations, problem index first."""
+    """The solutions of a batch of Riccati equations, problem index first.
+
+    Attributes
+    ----------
+    X : ndarray (k, n, n)
+        The stabilising solutions.
+    K : ndarray (k, m, n)
+        The gains R^-1 B^T X (6.200).
+    closed_loop_poles : ndarray (k, n), complex
+        eig(A - B K) of each problem, as :func:`aerocontrol.lqr` returns its E.
+    residual : ndarray (k,)
+        The relative residual of each equation.
+    rcond : ndarray (k,)
+        rcond(U11) of each problem: small means X is sensitive.
+
+    Examples
+    --------
+    x' = u with Q = 1 and R = r: X = √r, K = 1/√r:
+
+    >>> import numpy as np
+    >>> from aerocontrol import batch
+    >>> ones, R = np.ones((2, 1, 1)), np.array([[[1.0]], [[4.0]]])
+    >>> sol = batch.solve_care_batch(np.zeros((2, 1, 1)), ones, ones, R)
+    >>> len(sol), np.round(sol.X.ravel(), 12), np.round(sol.K.ravel(), 12)
+    (2, array([1., 2.]), array([1. , 0.5]))
+    """
 
     X: FloatArray
     """The stabilising solutions, (k, n, n)."""
@@ -83,7 +108,35 @@ class CareBatch(Result):
 
 @dataclass(frozen=True, eq=False)
 class DareBatch(Result):
-    """The solutions of a batch of discrete Riccati equations, problem index first."""
+    """The solutions of a batch of discrete Riccati equations, problem index first.
+
+    Attributes
+    ----------
+    X : ndarray (k, n, n)
+        The stabilising solutions.
+    K : ndarray (k, m, n)
+        The gains (R + B^T X B)^-1 B^T X A.
+    closed_loop_poles : ndarray (k, n), complex
+        eig(A - B K) of each problem, inside the unit circle, as :func:`aerocontrol.dlqr` returns
+        its E.
+    residual : ndarray (k,)
+        The relative residual of each equation.
+    rcond : ndarray (k,)
+        rcond(U11) of each problem: small means X is sensitive.
+
+    Examples
+    --------
+    x[k+1] = a x[k] + u[k] with Q = R = 1: X² - a² X - 1 = 0, so for a = 1 X is the golden ratio
+    (1 + √5)/2, for a = 2, 2 + √5:
+
+    >>> import numpy as np
+    >>> from aerocontrol import batch
+    >>> A = np.array([[[1.0]], [[2.0]]])
+    >>> ones = np.ones((2, 1, 1))
+    >>> sol = batch.solve_dare_batch(A, ones, ones, ones)
+    >>> np.round(sol.X.ravel(), 6), np.round(sol.K.ravel(), 6)
+    (array([1.618034, 4.236068]), array([0.618034, 1.618034]))
+    """
 
     X: FloatArray
     """The stabilising solutions, (k, n, n)."""
@@ -103,7 +156,35 @@ class DareBatch(Result):
 
 @dataclass(frozen=True, eq=False)
 class LqrSweep(Result):
-    """The regulator of one model for each weight c of a sweep (Figure 6.12)."""
+    """The regulator of one model for each weight c of a sweep (Figure 6.12).
+
+    Attributes
+    ----------
+    weights : ndarray (k,)
+        The weights c of J = ∫ x^T Q x + (1/c²) η^T R η dt (6.224)-(6.227).
+    K : ndarray (k, m, n)
+        The gains.
+    poles : ndarray (k, n), complex
+        The closed-loop eigenvalues: the root locus over c.
+    X : ndarray (k, n, n)
+        The Riccati solutions.
+    residual : ndarray (k,)
+        The relative residual of each equation.
+    rcond : ndarray (k,)
+        rcond(U11) of each problem.
+
+    Examples
+    --------
+    x' = η with Q = R = 1: X = 1/c, K = c, the pole at -c:
+
+    >>> import numpy as np
+    >>> from aerocontrol import batch
+    >>> sweep = batch.lqr_sweep([[0.0]], [[1.0]], [[1.0]], [[1.0]], weights=[1.0, 4.0])
+    >>> np.round(sweep.X.ravel(), 12), np.round(sweep.K.ravel(), 12)
+    (array([1.  , 0.25]), array([1., 4.]))
+    >>> np.round(sweep.poles.ravel().real, 12)
+    array([-1., -4.])
+    """
 
     weights: FloatArray
     """The weights c, (k,)."""
@@ -124,7 +205,33 @@ class LqrSweep(Result):
 
 @dataclass(frozen=True, eq=False)
 class PlaceBatch(Result):
-    """State-feedback designs η = -K_i x over a batch, problem index first."""
+    """State-feedback designs η = -K_i x over a batch, problem index first.
+
+    Attributes
+    ----------
+    K : ndarray (k, m, n)
+        The gains.
+    achieved_poles : ndarray (k, n), complex
+        The eigenvalues of A_i - B_i K_i in the order of the requested poles (conjugate pairs
+        adjacent, Im > 0 first).
+    max_relative_error : ndarray (k,)
+        The largest relative error of an achieved pole, per problem.
+    condition : ndarray (k,)
+        κ(V) of the single-input formulas or κ_2(X) of the robust method, per problem.
+
+    Examples
+    --------
+    The double integrator placed at (-1, -2) and at (-2, -3): K = [2, 3] and [6, 5]:
+
+    >>> import numpy as np
+    >>> from aerocontrol import batch
+    >>> A = np.tile([[0.0, 1.0], [0.0, 0.0]], (2, 1, 1))
+    >>> B = np.tile([[0.0], [1.0]], (2, 1, 1))
+    >>> designs = batch.place_batch(A, B, [[-1.0, -2.0], [-2.0, -3.0]])
+    >>> np.round(designs.K[:, 0], 12)
+    array([[2., 3.],
+           [6., 5.]])
+    """
 
     K: FloatArray
     """The gains, (k, m, n)."""

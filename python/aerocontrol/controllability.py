@@ -126,6 +126,45 @@ class Controllability(Result):
     (or measurement) cannot reach. The staircase form is Z^T A Z (``staircase_A``) and Z^T B
     (``staircase_B``; for observability C Z, and ``staircase_A`` is then block lower
     triangular).
+
+    Attributes
+    ----------
+    controllable : bool
+        The verdict (also the truth value of the result).
+    uncontrollable_eigenvalues : ndarray, complex
+        The eigenvalues of A that feedback (or measurement) cannot reach.
+    tolerance : float
+        The tolerance the staircase and the modal test compared norms with.
+    controllable_order : int
+        Dimension of the controllable (observable) subspace found by the staircase.
+    block_sizes : tuple of int
+        The sizes of the staircase's blocks.
+    smallest_pivot : float
+        The smallest norm the staircase accepted as nonzero: how near it came to stopping.
+    eigenvalues : ndarray (n,), complex
+        Eigenvalues of A (empty for ``method="staircase"``).
+    modal_measure : ndarray (n,)
+        ||w_k^T B|| per eigenvalue (||C v_k|| for observability); <= ``tolerance`` means
+        unreachable.
+    staircase_A : ndarray (n, n)
+        Z^T A Z, block upper (for observability lower) triangular.
+    staircase_B : ndarray (n, m)
+        Z^T B (for observability C Z, (p, n)).
+    Z : ndarray (n, n)
+        The orthogonal transformation.
+    kind : str
+        ``"controllability"`` or ``"observability"``.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> result = aerocontrol.controllability([[-1, 0], [0, -2]], [[1], [0]])
+    >>> result.controllable, result.controllable_order
+    (False, 1)
+    >>> result.uncontrollable_eigenvalues                # the mode the input does not reach
+    array([-2.+0.j])
+    >>> np.round(result.modal_measure, 6)
+    array([1., 0.])
     """
 
     controllable: bool

@@ -255,7 +255,29 @@ def critical_weight(
 
 class SampledWeights(NamedTuple):
     """The weights of the discrete regulator whose cost is the continuous one, from
-    :func:`sampled_weights`."""
+    :func:`sampled_weights`.
+
+    Attributes
+    ----------
+    Q : ndarray (n, n)
+        The weight of x_k.
+    R : ndarray (m, m)
+        The weight of the held command η_k.
+    N : ndarray (n, m)
+        The cross weight of x_k and η_k.
+
+    Examples
+    --------
+    The double integrator's rate weighted over a hold of T = 0.5 s: Q = diag(0, T),
+    N = [0, T²/2], R = T + T³/3:
+
+    >>> import numpy as np, aerocontrol
+    >>> from aerocontrol import design
+    >>> sys = aerocontrol.StateSpace([[0.0, 1.0], [0.0, 0.0]], [[0.0], [1.0]])
+    >>> Q, R, N = design.sampled_weights(sys, 0.5, Q=np.diag([0.0, 1.0]), R=[[1.0]])
+    >>> np.round(np.diag(Q), 12), np.round(N.ravel(), 12), np.round(R, 12)
+    (array([0. , 0.5]), array([0.   , 0.125]), array([[0.54166667]]))
+    """
 
     Q: NDArray[np.float64]
     """n x n, the weight of x_k."""
@@ -425,7 +447,36 @@ class Damper(Result):
 
     The feedback is surface command = sign·k·filter(rate) + pilot command, with the loop
     L = -sign·filter·(rate/surface)·actuator broken at the surface command (negative feedback
-    1 + k L = 0)."""
+    1 + k L = 0).
+
+    Attributes
+    ----------
+    name : str
+        The damper: "yaw damper" or "pitch damper".
+    loop : StateSpace
+        L for k = 1 (actuator, plant channel, sign, washout).
+    design : DampingDesign
+        The gain k and the damping it gives the mode.
+    margins : StabilityMargins
+        The margins of k·L.
+    check : MarginsCheck
+        The margins against MIL-F-9490D 3.1.3.6 (:func:`~aerocontrol.handling.margins_check`).
+    open_loop : StateSpace
+        Actuator and aircraft, from the surface command to every state.
+    closed_loop : StateSpace
+        The same with the damper engaged.
+    washout : float or None
+        The washout's time constant (s), None without one.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft, design
+    >>> damper = design.yaw_damper(aircraft.load("b747-cruise"))
+    >>> damper.name, damper.washout, round(damper.design.gain, 2)
+    ('yaw damper', 3.0, 1.49)
+    >>> round(damper.margins.gain_margin_db, 2), damper.check.passed
+    (12.61, {'yaw damper': True})
+    """
 
     name: str
     loop: StateSpace

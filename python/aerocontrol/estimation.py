@@ -547,6 +547,47 @@ class KalmanFilter(Result):
     ``estimator_D``) = (A - L C, [B - L D, L], I, 0): its input is [u; y], its state and
     output x̂ (x̂[k|k-1] in discrete time). For a discrete filter the current estimate is
     (I - M C) x̂[k|k-1] + M (y[k] - D u[k]).
+
+    Attributes
+    ----------
+    P : ndarray (n, n)
+        The steady-state covariance of the estimation error (discrete time: of x[k] - x̂[k|k-1],
+        the a priori covariance).
+    closed_loop_poles : ndarray (n,), complex
+        The estimator's poles, eig(A - L C) (L the predictor gain in discrete time).
+    estimator_A : ndarray (n, n)
+        A - L C.
+    estimator_B : ndarray (n, m + p)
+        [B - L D, L]: the inputs are the known inputs u, then the outputs y.
+    estimator_C : ndarray (n, n)
+        The identity: the estimator's output is its state.
+    estimator_D : ndarray (n, m + p)
+        Zero.
+    discrete : bool
+        Whether the filter is a discrete-time one.
+    dt : float or None
+        The sampling period of a discrete filter (s) when known; None for a continuous one.
+    gain : ndarray (n, p)
+        L of the continuous filter (refused for a discrete one).
+    filter_gain : ndarray (n, p)
+        M of the discrete filter's measurement update x̂[k|k].
+    predictor_gain : ndarray (n, p)
+        L of the discrete filter's one-step prediction x̂[k+1|k] (python-control's ``dlqe``
+        gain).
+    posterior_covariance : ndarray (n, n)
+        (I - M C) P, the covariance of x[k] - x̂[k|k] of the discrete filter.
+
+    Examples
+    --------
+    x' = -x + w, y = x + v with unit intensities: P solves 1 - 2P - P² = 0, so P = L = √2 - 1
+    and the estimator's pole is -√2:
+
+    >>> import numpy as np, aerocontrol
+    >>> kf = aerocontrol.kalman(([[-1.0]], [[1.0]], [[1.0]]), [[1.0]], [[1.0]])
+    >>> np.round(kf.P, 6), np.round(kf.gain, 6)
+    (array([[0.414214]]), array([[0.414214]]))
+    >>> np.round(kf.closed_loop_poles.real, 6), kf.estimator_B.shape
+    (array([-1.414214]), (1, 2))
     """
 
     P: FloatArray
@@ -853,6 +894,41 @@ class LqgDesign(Result):
 
     In the closed loop, with e = x - x̂, x' = (A - B K) x + B K e and e' = (A - L C) e: the
     poles are those of the regulator and of the filter (the separation principle).
+
+    Attributes
+    ----------
+    K : ndarray (m, n)
+        The regulator's gain (as :func:`~aerocontrol.lqr`).
+    L : ndarray (n, p)
+        The Kalman filter's gain (as :func:`~aerocontrol.lqe`).
+    S : ndarray (n, n)
+        The regulator's Riccati solution.
+    P : ndarray (n, n)
+        The filter's Riccati solution (the error covariance).
+    compensator : StateSpace
+        The compensator from the plant's outputs y to its inputs u, with states x̂.
+    closed_loop : StateSpace
+        The plant and compensator in feedback, state (x, x̂), input d added to the plant's input
+        (u = -K x̂ + d), outputs (y, u).
+    regulator_poles : ndarray (n,), complex
+        eig(A - B K).
+    estimator_poles : ndarray (n,), complex
+        eig(A - L C).
+    closed_loop_poles : ndarray (2n,), complex
+        The regulator's poles, then the estimator's: the poles of the closed loop.
+
+    Examples
+    --------
+    The unstable x' = x + u, y = x with unit weights and intensities: both Riccati equations
+    read 1 + 2X - X² = 0, so K = L = 1 + √2 and every closed-loop pole is at -√2:
+
+    >>> import numpy as np, aerocontrol
+    >>> plant = aerocontrol.StateSpace([[1.0]], [[1.0]], [[1.0]])
+    >>> design = aerocontrol.lqg(plant, [[1.0]], [[1.0]], [[1.0]], [[1.0]])
+    >>> np.round(design.K, 6), np.round(design.L, 6)
+    (array([[2.414214]]), array([[2.414214]]))
+    >>> np.round(design.closed_loop_poles.real, 6)
+    array([-1.414214, -1.414214])
     """
 
     K: FloatArray

@@ -199,6 +199,23 @@ SPIRAL_MIN_TIME_TO_DOUBLE: dict[str, tuple[float, float, float]] = {
 class Requirement:
     """One quantity of one mode, judged against the limits of the specification.
 
+    Attributes
+    ----------
+    mode : str
+        The mode: "short period", "phugoid", "dutch roll", "roll" or "spiral".
+    quantity : str
+        "zeta", "zeta*omega_n", "omega_n", "time constant" or "time to double".
+    value : float
+        The mode's value of the quantity (rad/s or s); inf where it never happens (the time to
+        double of a mode that does not grow), NaN where it is undefined.
+    level : int
+        1, 2 or 3: the best Level whose limit the value meets; 4: worse than Level 3.
+    limits : str
+        The limits that applied for Levels 1, 2 and 3, as text ("none": no limit at that
+        Level).
+    reference : str
+        Paragraph and table of the specification.
+
     Examples
     --------
     >>> from aerocontrol.handling import assess
@@ -230,6 +247,20 @@ class Requirement:
 @dataclass(frozen=True, eq=False)
 class HandlingQualities(Result):
     """The Levels of the assessed modes for one airplane Class and Flight Phase Category.
+
+    Attributes
+    ----------
+    aircraft_class : str
+        One of ``AIRCRAFT_CLASSES`` ("II" was stored as "II-L").
+    category : str
+        The Flight Phase Category, "A", "B" or "C".
+    requirements : tuple of Requirement
+        Every quantity judged, modes in the order of ``MODES``.
+    modes : tuple of str
+        The modes assessed, in the order of ``MODES``.
+    levels : dict of str to int
+        The Level of each assessed mode (the worst over its requirements; 4: worse than
+        Level 3).
 
     Examples
     --------
@@ -1142,7 +1173,30 @@ def margin_requirement(
 
 @dataclass(frozen=True, eq=False)
 class MarginsCheck(Result):
-    """A pass/fail table of loop margins against MIL-F-9490D; ``print`` shows it."""
+    """A pass/fail table of loop margins against MIL-F-9490D; ``print`` shows it.
+
+    Attributes
+    ----------
+    airspeed : str
+        The column of the margin table (``AIRSPEEDS``) the loops were judged in.
+    rows : tuple of (str, str, str, str, str, bool)
+        (loop, quantity, value, at frequency, required, passed), one per requirement:
+        closed-loop stability, then each gain and phase margin.
+    passed : dict of str to bool
+        Whether each loop meets every requirement.
+
+    Examples
+    --------
+    k/(s(s + 1)(s + 2)) at k = 4 is stable, but with 3.52 dB of gain margin, not 6:
+
+    >>> import aerocontrol
+    >>> from aerocontrol.handling import margins_check
+    >>> check = margins_check({"k = 4": aerocontrol.zpk([], [0, -1, -2], 4.0)})
+    >>> check.airspeed, check.passed
+    ('Vo_min to Vo_max', {'k = 4': False})
+    >>> [row[1:3] for row in check.rows]
+    [('closed loop', 'stable'), ('gain margin', '+3.52 dB'), ('phase margin', '+11.4 deg')]
+    """
 
     airspeed: str
     rows: tuple[tuple[str, str, str, str, str, bool], ...]

@@ -159,6 +159,36 @@ class Discretization(Result):
 
     with Phi = e^{A dt}, Gamma0 = ∫_0^dt e^{Aτ} dτ B and
     Gamma1 = (1/dt) ∫_0^dt e^{Aτ} (dt - τ) dτ B.
+
+    Attributes
+    ----------
+    Phi : ndarray (n, n)
+        e^{A dt}, the transition matrix over one step.
+    Gamma0 : ndarray (n, m)
+        ∫_0^dt e^{Aτ} dτ B.
+    Gamma1 : ndarray (n, m) or None
+        (1/dt) ∫_0^dt e^{Aτ} (dt - τ) dτ B for ``method="foh"``; None for ``"zoh"``.
+    dt : float
+        The step (s).
+    method : str
+        The hold: ``"zoh"`` or ``"foh"``.
+
+    Examples
+    --------
+    The double integrator over 0.1 s: Phi = [[1, dt], [0, 1]], Gamma0 = [dt^2/2, dt] and
+    Gamma1 = [dt^2/6, dt/2]:
+
+    >>> import numpy as np, aerocontrol
+    >>> step = aerocontrol.discretize([[0, 1], [0, 0]], [[0], [1]], 0.1, "foh")
+    >>> step.Phi
+    array([[1. , 0.1],
+           [0. , 1. ]])
+    >>> np.round(step.Gamma0, 6)
+    array([[0.005],
+           [0.1  ]])
+    >>> np.round(step.Gamma1, 6)
+    array([[0.001667],
+           [0.05    ]])
     """
 
     Phi: FloatArray
@@ -1046,7 +1076,33 @@ def eigenvalues(A: ArrayLike) -> ComplexArray:
 
 class GeneralizedSchur(NamedTuple):
     """The generalized real Schur form (A, B) = Q (AA, BB) Z^T, in the order of
-    ``scipy.linalg.ordqz``'s results: ``AA, BB, alpha, beta, Q, Z = qz(A, B)`` unpacks it."""
+    ``scipy.linalg.ordqz``'s results: ``AA, BB, alpha, beta, Q, Z = qz(A, B)`` unpacks it.
+
+    Attributes
+    ----------
+    AA : ndarray (n, n)
+        Quasi-upper-triangular: 1 x 1 blocks and 2 x 2 blocks for complex pairs.
+    BB : ndarray (n, n)
+        Upper triangular with a nonnegative diagonal, diagonal under AA's 2 x 2 blocks.
+    alpha : ndarray (n,), complex
+        The eigenvalues are alpha / beta, in the order of the diagonal.
+    beta : ndarray (n,)
+        Nonnegative; 0 for an infinite eigenvalue (B singular).
+    Q, Z : ndarray (n, n)
+        Orthogonal; with ``select``, the leading ``selected`` columns of Z span the right
+        deflating subspace of the selected eigenvalues.
+    selected : int
+        The number of leading eigenvalues chosen by ``select`` (n without it).
+
+    Examples
+    --------
+    The pencil (diag(1, -2), diag(2, 1)) has the eigenvalues 1/2 and -2; "lhp" moves -2 first:
+
+    >>> import numpy as np, aerocontrol
+    >>> form = aerocontrol.qz(np.diag([1.0, -2.0]), np.diag([2.0, 1.0]), "lhp")
+    >>> form.alpha / form.beta, form.selected
+    (array([-2. +0.j,  0.5+0.j]), 1)
+    """
 
     AA: FloatArray
     """Quasi-upper-triangular: 1 x 1 blocks and 2 x 2 blocks for complex pairs."""

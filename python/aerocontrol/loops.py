@@ -606,6 +606,60 @@ class StabilityMargins(Result):
     Single values are the critical ones (as python-control's ``stability_margins``): the gain
     margin closest to 0 dB, the phase margin of least magnitude; the arrays hold every
     crossover, by increasing frequency.
+
+    Attributes
+    ----------
+    gain_margin : float
+        The critical gain margin (factor; ∞ without a phase crossover).
+    gain_margin_db : float
+        The critical gain margin in dB (negative: a gain reduction margin).
+    phase_crossover : float
+        Its frequency (rad/s; NaN without one).
+    phase_margin : float
+        The critical phase margin (degrees, signed; ∞ without a gain crossover).
+    gain_crossover : float
+        Its frequency (rad/s; NaN without one).
+    delay_margin : float
+        The critical delay margin (s); 0 if the closed loop is unstable, ∞ without a gain
+        crossover above 0.
+    disk_margin : float
+        α of the balanced disk margin (σ = 0); 0 if the closed loop is unstable.
+    disk_frequency : float
+        Where abs(S - T)/2 peaks (rad/s).
+    disk_gain_margin : tuple of float
+        The gain range [(2 - α)/(2 + α), (2 + α)/(2 - α)] of the disk margin.
+    disk_phase_margin : float
+        ±2 arctan(α/2) in degrees: the phase change at unit gain the disk allows.
+    stability_margin : float
+        min abs(1 + L(jω)), the distance from the Nyquist plot to -1 (1/||S||∞).
+    stability_frequency : float
+        Where that minimum is (rad/s).
+    gain_margins, phase_crossovers : ndarray (g,)
+        Every gain margin (factor) and its phase crossover (rad/s), by increasing frequency.
+    phase_margins, gain_crossovers : ndarray (c,)
+        Every phase margin (degrees) and its gain crossover (rad/s), by increasing frequency.
+    delay_margins : ndarray
+        (PM_i in rad, in [0, 2π))/ω_i at each gain crossover above 0 (s).
+    closed_loop_poles : ndarray (n,), complex
+        The poles of the loop closed with negative unit feedback.
+    closed_loop_stable : bool
+        Whether every closed-loop pole is in the open left half plane (inside the unit circle).
+    open_loop_unstable_poles : int
+        P: open-loop poles in the open right half plane (outside the unit circle).
+    encirclements : int
+        Counterclockwise encirclements of -1 by the Nyquist plot: P - Z.
+
+    Examples
+    --------
+    2/(s(s + 1)(s + 2)) crosses -180° at ω = √2, where abs(L) = 1/3: a gain margin of 3
+    (9.54 dB):
+
+    >>> import numpy as np, aerocontrol
+    >>> m = aerocontrol.stability_margins(aerocontrol.zpk([], [0.0, -1.0, -2.0], 2.0))
+    >>> round(m.gain_margin, 10), round(m.gain_margin_db, 4), round(m.phase_crossover**2, 10)
+    (3.0, 9.5424, 2.0)
+    >>> m.closed_loop_stable, m.encirclements
+    (True, 0)
     """
 
     gain_margin: float
@@ -621,9 +675,9 @@ class StabilityMargins(Result):
     disk_margin: float
     """α of the balanced disk margin (σ = 0); 0 if the closed loop is unstable."""
     disk_frequency: float
-    """Where |S - T|/2 peaks (rad/s)."""
+    """Where abs(S - T)/2 peaks (rad/s)."""
     stability_margin: float
-    """min |1 + L(jω)|, the distance from the Nyquist plot to -1 (1/||S||∞)."""
+    """min abs(1 + L(jω)), the distance from the Nyquist plot to -1 (1/||S||∞)."""
     stability_frequency: float
     gain_margins: FloatArray
     phase_crossovers: FloatArray
@@ -1217,13 +1271,40 @@ class DiskMargin(Result):
     """A disk margin α of skew σ: the loop stays stable for every multiplicative gain and phase
     change f (in every loop at once, independently, for a multiloop margin) in the disk
 
-        D(α, σ) = {(1 + (1 - σ) δ/2)/(1 - (1 + σ) δ/2) : |δ| < α},
+        D(α, σ) = {(1 + (1 - σ) δ/2)/(1 - (1 + σ) δ/2) : abs(δ) < α},
 
-    whose real intercepts are :attr:`gain_margin` and which holds the phase changes up to
-    ±:attr:`phase_margin` at unit gain (Seiler, Packard and Gahinet 2020)."""
+    whose real intercepts are :attr:`gain_margin` and which holds the phase changes of up to
+    :attr:`phase_margin` either way at unit gain (Seiler, Packard and Gahinet 2020).
+
+    Attributes
+    ----------
+    alpha : float
+        α = 1/sup_ω abs(S + (σ - 1)/2) (a structured singular value for a multiloop margin); 0
+        when the closed loop is unstable.
+    skew : float
+        σ: 0 balances gain increase and decrease; σ > 0 favours increase, σ < 0 decrease.
+    frequency : float
+        Where the peak is (rad/s; ∞ as ω → ∞, NaN when the closed loop is unstable).
+    gain_margin : tuple of float
+        [γ_min, γ_max]: the gains (factors) the loop tolerates with no phase change.
+    gain_margin_db : tuple of float
+        ``gain_margin`` in dB.
+    phase_margin : float
+        ± this many degrees of phase change at unit gain are tolerated.
+
+    Examples
+    --------
+    The integrator loop 1/s has S - T = (s - 1)/(s + 1), of modulus 1 at every frequency, so
+    α = 2: any gain increase or decrease, and ±90°:
+
+    >>> import aerocontrol
+    >>> disk = aerocontrol.disk_margins(aerocontrol.zpk([], [0.0], 1.0)).loop_at_a_time[0]
+    >>> disk.alpha, disk.gain_margin, disk.phase_margin
+    (2.0, (0.0, inf), 90.0)
+    """
 
     alpha: float
-    """α = 1/sup_ω |S + (σ - 1)/2| (a structured singular value for a multiloop margin); 0
+    """α = 1/sup_ω abs(S + (σ - 1)/2) (a structured singular value for a multiloop margin); 0
     when the closed loop is unstable."""
     skew: float
     """σ: 0 balances gain increase and decrease; σ > 0 favours increase, σ < 0 decrease."""
@@ -1263,7 +1344,48 @@ class DiskMargins(Result):
     The multiloop margin is computed within bounds (a structured singular value): its
     :attr:`multiloop` α is the guaranteed one (from the upper bound of μ), and
     :attr:`multiloop_bounds` gives it with the α of a destabilising perturbation found (from
-    the lower bound), which the true margin cannot exceed."""
+    the lower bound), which the true margin cannot exceed.
+
+    Attributes
+    ----------
+    skew : float
+        σ of every disk (0 balances gain increase and decrease).
+    names : tuple of str
+        The loop break points: the loop's input names.
+    loop_at_a_time : tuple of DiskMargin
+        The disk margin of each loop broken with the others closed.
+    multiloop : DiskMargin
+        Simultaneous independent changes f_i in D(α, σ) in every loop: α = 1/sup_ω μ̄, the
+        guaranteed (lower) bound of the margin.
+    multiloop_bounds : tuple of float
+        (α guaranteed, α of ``worst_perturbation``): the true multiloop margin lies between them.
+    worst_perturbation : ndarray (p,), complex
+        The gains f_i that put a closed-loop pole at j ``worst_frequency``: the certificate that
+        the margin is no larger (ones when the closed loop is unstable; NaN when μ = 0).
+    worst_frequency : float
+        The frequency of ``worst_perturbation`` (rad/s).
+    frequencies : ndarray (k,)
+        The frequencies (rad/s, increasing; ∞ last for a continuous loop on the default grid) at
+        which the bounds of μ were computed.
+    mu_upper, mu_lower : ndarray (k,)
+        Upper and lower bounds of μ_Δ(S + (σ - 1)/2 I) at each frequency.
+    loops : tuple of StabilityMargins
+        The classical margins of each loop broken with the others closed
+        (:func:`~aerocontrol.stability_margins`).
+    closed_loop_poles : ndarray (n,), complex
+        The poles of the loop closed as u = -y (rad/s, or z for a discrete loop).
+    closed_loop_stable : bool
+        Whether every closed-loop pole is in the open left half plane (inside the unit circle).
+
+    Examples
+    --------
+    >>> import aerocontrol
+    >>> margins = aerocontrol.disk_margins(aerocontrol.zpk([], [0.0], 1.0))     # 1/s
+    >>> margins.names, margins.closed_loop_stable
+    (('u0',), True)
+    >>> margins.multiloop.alpha, margins.multiloop_bounds        # one loop: α = 2 both ways
+    (2.0, (2.0, 2.0))
+    """
 
     skew: float
     names: tuple[str, ...]
@@ -2054,7 +2176,37 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
 
 @dataclass(frozen=True, eq=False)
 class RootLocus(Result):
-    """The closed-loop poles of 1 + k L(s) = 0 over the gains k."""
+    """The closed-loop poles of 1 + k L(s) = 0 over the gains k.
+
+    Attributes
+    ----------
+    gains : ndarray (k,)
+        The gains k.
+    poles : ndarray (k, n), complex
+        The eigenvalues of A - k B (1 + k D)⁻¹ C for each gain, each row sorted.
+    dt : float
+        The sampling period (s), 0 for a continuous loop.
+    loop : StateSpace
+        The open loop L.
+    open_loop_poles : ndarray, complex
+        The poles of L's transfer function (computed on first use).
+    open_loop_zeros : ndarray, complex
+        The zeros of L's transfer function (computed on first use).
+
+    Examples
+    --------
+    k/(s(s + 2)) closes to s² + 2s + k: poles 0 and -2 at k = 0, a double pole at -1 at
+    k = 1, -1 ± 2j at k = 5:
+
+    >>> import numpy as np, aerocontrol
+    >>> locus = aerocontrol.root_locus(aerocontrol.zpk([], [0.0, -2.0], 1.0), [0.0, 1.0, 5.0])
+    >>> np.round(locus.poles, 6)
+    array([[-2.+0.j,  0.+0.j],
+           [-1.+0.j, -1.+0.j],
+           [-1.-2.j, -1.+2.j]])
+    >>> locus.open_loop_zeros.size
+    0
+    """
 
     gains: FloatArray
     poles: ComplexArray
@@ -2164,7 +2316,31 @@ def root_locus(loop: System, gains: ArrayLike) -> RootLocus:
 
 @dataclass(frozen=True, eq=False)
 class DampingDesign(Result):
-    """A gain of a root-locus design and the mode it sets."""
+    """A gain of a root-locus design and the mode it sets.
+
+    Attributes
+    ----------
+    gain : float
+        The loop gain k of the design (the loop is closed as 1 + k L(s) = 0).
+    damping_ratio : float
+        ζ of the mode (of s = ln(z)/dt for a discrete loop); 1 when no pole oscillates.
+    pole : complex
+        The mode's closed-loop pole (Im ≥ 0; rad/s, or z for a discrete loop); NaN when no pole
+        oscillates.
+    closed_loop_poles : ndarray (n,), complex
+        Every closed-loop pole at ``gain``.
+
+    Examples
+    --------
+    k/(s(s + 2)) closes to s² + 2s + k: ζ = 1/√k, so ζ = 0.5 at k = 4, with the poles -1 ± j√3:
+
+    >>> import numpy as np, aerocontrol
+    >>> design = aerocontrol.gain_for_damping(aerocontrol.zpk([], [0.0, -2.0], 1.0), 0.5)
+    >>> round(design.gain, 10), round(design.damping_ratio, 10)
+    (4.0, 0.5)
+    >>> complex(np.round(design.pole, 6))
+    (-1+1.732051j)
+    """
 
     gain: float
     damping_ratio: float
@@ -2956,6 +3132,57 @@ class NyquistResponse(Result):
     in P; the image of such an indentation is a large arc, turning clockwise by 180° times the
     poles' multiplicity. The arrays hold the half ω ≥ 0: the half ω ≤ 0 is its mirror image,
     the complex conjugate (:attr:`closed_curve` joins them).
+
+    Attributes
+    ----------
+    omega : ndarray (k,)
+        The frequencies asked for (rad/s, increasing), or by default every frequency of the
+        contour's points on the axis.
+    response : ndarray (k,), complex
+        L(jω) (L(e^{jω dt})) at ``omega``; infinite (or huge) at a pole on the axis.
+    contour : ndarray, complex
+        The half ω ≥ 0 of the Nyquist contour in order, in the loop's variable (s, or z),
+        indentations included.
+    curve : ndarray, complex
+        L on ``contour``: the half ω ≥ 0 of the Nyquist curve (ending at L(j∞) = D).
+    indented : ndarray, bool
+        Which points of ``contour`` lie on an indentation.
+    indentations : tuple of (float, float, int)
+        (ω0 in rad/s, radius ε in rad/s, number of poles) of each indentation.
+    open_loop_unstable_poles : int
+        P: open-loop poles in the open right half plane (outside the unit circle).
+    encirclements : int or None
+        N: counterclockwise encirclements of -1 by the closed curve, P - Z; None when the curve
+        passes through -1 (``marginal``).
+    closed_loop_unstable_poles : int
+        Z: closed-loop poles (eigenvalues of A - B (1 + D)⁻¹ C) in the open right half plane
+        (outside the unit circle).
+    closed_loop_poles : ndarray (n,), complex
+        All closed-loop poles.
+    boundary_poles : ndarray, complex
+        The closed-loop poles on the imaginary axis (the unit circle); empty unless ``marginal``.
+    dt : float
+        The sampling period (s), 0 for a continuous loop.
+    loop : StateSpace
+        The loop L.
+    marginal : bool
+        True when closed-loop poles lie on the stability boundary: N is then not defined.
+    closed_loop_stable : bool
+        Every closed-loop pole in the open left half plane (inside the unit circle).
+    closed_curve : ndarray, complex
+        The whole closed Nyquist curve: the mirror half (ω from -∞ to 0), then the half ω ≥ 0.
+
+    Examples
+    --------
+    10 (s + 2)/((s - 1)(s + 5)) has P = 1 and circles -1 once counterclockwise, so Z = 0: the
+    closed loop s² + 14 s + 15 has the poles -7 ± √34:
+
+    >>> import numpy as np, aerocontrol
+    >>> r = aerocontrol.nyquist(aerocontrol.zpk([-2.0], [1.0, -5.0], 10.0))
+    >>> r.open_loop_unstable_poles, r.encirclements, r.closed_loop_unstable_poles
+    (1, 1, 0)
+    >>> np.round(r.closed_loop_poles.real, 6), r.closed_loop_stable
+    (array([-12.830952,  -1.169048]), True)
     """
 
     omega: FloatArray
@@ -3187,14 +3414,39 @@ def nyquist(loop: System, omega: ArrayLike | None = None) -> NyquistResponse:
 @dataclass(frozen=True, eq=False)
 class NicholsResponse(Result):
     """The open-loop gain (dB) against the phase (degrees) of a SISO loop over frequency, for
-    the Nichols chart; ``print`` shows the ranges."""
+    the Nichols chart; ``print`` shows the ranges.
+
+    Attributes
+    ----------
+    omega : ndarray (k,)
+        Frequencies (rad/s, increasing).
+    response : ndarray (k,), complex
+        L(jω) (L(e^{jω dt}) for a discrete loop).
+    gain_db : ndarray (k,)
+        20 log10 abs(L) (∞ at a pole on the axis, -∞ at a zero).
+    phase_deg : ndarray (k,)
+        ∠L in degrees, continuous along the Nyquist contour.
+    dt : float
+        The sampling period (s); 0 for a continuous loop.
+    loop : StateSpace
+        The loop L.
+
+    Examples
+    --------
+    2/(s(s + 1)(s + 2)) crosses -180° at ω = √2, where L = -1/3 (gain margin 9.54 dB):
+
+    >>> import numpy as np, aerocontrol
+    >>> n = aerocontrol.nichols(aerocontrol.zpk([], [0.0, -1.0, -2.0], 2.0), [np.sqrt(2.0)])
+    >>> np.round(n.gain_db, 4), np.round(n.phase_deg, 6)
+    (array([-9.5424]), array([-180.]))
+    """
 
     omega: FloatArray
     """Frequencies (rad/s, increasing)."""
     response: ComplexArray
     """L(jω) (L(e^{jω dt}))."""
     gain_db: FloatArray
-    """20 log10 |L| (∞ at a pole on the axis, -∞ at a zero)."""
+    """20 log10 abs(L) (∞ at a pole on the axis, -∞ at a zero)."""
     phase_deg: FloatArray
     """∠L in degrees, continuous along the Nyquist contour with indentations to the right of
     the poles and zeros on the axis (so the phase steps by -180° per pole and +180° per zero

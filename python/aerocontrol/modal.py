@@ -62,6 +62,50 @@ class Modes(Result):
     Per-mode arrays (one entry per mode; a conjugate pair counts once, by its member with
     Im λ > 0) sit beside the full eigenvalue list and the modal matrix. ``print(modes)`` shows
     a table like MATLAB's ``damp``, with time to half (or double) amplitude.
+
+    Attributes
+    ----------
+    eigenvalues : ndarray (n,), complex
+        All n eigenvalues, each conjugate pair adjacent (Im > 0 first), in mode order.
+    eigenvalue : ndarray (k,), complex
+        One eigenvalue per mode (rad/s).
+    oscillatory : ndarray (k,), bool
+        Whether the mode is a complex pair.
+    natural_frequency : ndarray (k,)
+        ω_n = abs(λ) (rad/s).
+    damping_ratio : ndarray (k,)
+        ζ = -Re λ / ω_n.
+    damped_frequency : ndarray (k,)
+        ω_d = Im λ (rad/s); 0 for a real mode.
+    period : ndarray (k,)
+        2π/ω_d (s); inf for a real mode.
+    time_to_half, time_to_double : ndarray (k,)
+        ln 2 / abs(Re λ) (s) for a decaying (growing) mode; NaN otherwise.
+    cycles_to_half : ndarray (k,)
+        ``time_to_half`` / ``period``; NaN for a real mode.
+    time_constant : ndarray (k,)
+        1/abs(λ) of a real mode (s); NaN for a pair.
+    modal_matrix : ndarray (n, n), complex, or None
+        P, unit eigenvectors as columns in the order of ``eigenvalues``; None if A is defective.
+    modal_matrix_condition : float
+        κ₂(P); above 1e8 P counts as singular.
+    modal_input : ndarray (n, m), complex, or None
+        P^-1 B (6.61), when B was given and P is not singular.
+    characteristic_polynomial : ndarray (n + 1,)
+        Coefficients of det(λI - A), highest power first.
+    mode_names : tuple of str
+        Labels for the table: 'mode 1', ... (aircraft models name them).
+
+    Examples
+    --------
+    x'' + 0.4 x' + 4 x = 0: ω_n = 2 rad/s, ζ = 0.1, ω_d = √3.96, t½ = ln 2 / 0.2:
+
+    >>> import numpy as np, aerocontrol
+    >>> m = aerocontrol.modes([[0.0, 1.0], [-4.0, -0.4]])
+    >>> m.natural_frequency, np.round(m.damping_ratio, 6), np.round(m.damped_frequency, 6)
+    (array([2.]), array([0.1]), array([1.989975]))
+    >>> np.round(m.time_to_half, 6), m.characteristic_polynomial
+    (array([3.465736]), array([1. , 0.4, 4. ]))
     """
 
     eigenvalues: ComplexArray

@@ -114,6 +114,62 @@ attach(
         "eigenvector_condition",
     ),
 )
+# The core's docstring of this field reads as a substitution in reStructuredText.
+setattr(  # noqa: B010 - the stub declares a read-only property
+    Placement,
+    "max_relative_error",
+    property(
+        vars(Placement)["max_relative_error"].__get__,
+        doc="max abs(achieved - requested) / abs(requested) (relative to ||A - BK||_F for a "
+        "pole at 0).",
+    ),
+)
+Placement.__doc__ = """A state-feedback design η = -K x (6.91), from :func:`place`,
+:func:`place_ackermann` or :func:`place_bass_gura`.
+
+Attributes
+----------
+K : ndarray (m, n)
+    The gain: η = -K x places the eigenvalues of A - B K.
+k : ndarray (n,)
+    The gain vector of a single-input design (the chapter's k^T = ``K[0]``).
+closed_loop : ndarray (n, n)
+    A - B K (6.93).
+poles : ndarray (n,), complex
+    The requested poles.
+achieved_poles : ndarray (n,), complex
+    The eigenvalues of A - B K, matched to ``poles``.
+max_relative_error : float
+    max abs(achieved - requested) / abs(requested) (relative to ||A - BK||_F for a pole
+    at 0).
+iterations : int
+    Sweeps of the robust method (0 for a direct one).
+converged : bool
+    Whether the robust method's sweeps converged.
+method : str
+    The method that computed K.
+controllability_condition : float
+    κ_1(V) of the controllability matrix, from the single-input formulas (NaN for the
+    robust method).
+eigenvector_condition : float
+    κ_2(X) of the closed loop's eigenvectors, from the robust method: large means the placed
+    poles are sensitive.
+
+Examples
+--------
+The double integrator placed at -1 and -2: A - B K has the characteristic polynomial
+s² + 3 s + 2, so K = [2, 3]:
+
+>>> import numpy as np, aerocontrol
+>>> design = aerocontrol.place([[0, 1], [0, 0]], [[0], [1]], [-1.0, -2.0])
+>>> design.K, design.k
+(array([[2., 3.]]), array([2., 3.]))
+>>> design.closed_loop
+array([[ 0.,  1.],
+       [-2., -3.]])
+>>> design.achieved_poles, bool(design.max_relative_error < 1e-14)
+(array([-1.+0.j, -2.+0.j]), True)
+"""
 
 
 def _poles(poles: object) -> ComplexArray:
@@ -323,7 +379,35 @@ def place(
 
 @dataclass(frozen=True, eq=False)
 class CompanionForm(Result):
-    """The transformation z = T x to the first companion form (6.116)-(6.145)."""
+    """The transformation z = T x to the first companion form (6.116)-(6.145).
+
+    Attributes
+    ----------
+    V : ndarray (n, n)
+        The controllability matrix [b, A b, ..., A^(n-1) b] (6.125).
+    W : ndarray (n, n)
+        The upper triangular Toeplitz matrix of the coefficients (6.131).
+    T : ndarray (n, n)
+        (VW)^-1 (6.144), so that z = T x.
+    companion : ndarray (n, n)
+        T A T^-1, the first companion form (6.116), built from the coefficients: first row
+        [-a_1, ..., -a_n], ones on the subdiagonal.
+    coefficients : ndarray (n + 1,)
+        [1, a_1, ..., a_n] of det(λI - A) (6.106).
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> form = aerocontrol.companion_form([[-1, 0], [0, -2]], [1, 1])
+    >>> form.coefficients                                 # (λ + 1)(λ + 2)
+    array([1., 3., 2.])
+    >>> np.round(form.companion, 6)
+    array([[-3., -2.],
+           [ 1.,  0.]])
+    >>> np.round(form.T, 6)
+    array([[-1.,  2.],
+           [ 1., -1.]])
+    """
 
     V: FloatArray
     """The controllability matrix (6.125)."""

@@ -96,6 +96,38 @@ class TimeResponse(Result):
     With a single response ``x`` is (len(t), n); with several, (r, len(t), n), and likewise
     ``y`` and ``u`` (r is 0 for the impulse or step responses of a model without inputs).
     ``u`` is None for free, impulse and doublet responses.
+
+    Attributes
+    ----------
+    t : ndarray (k,)
+        The times (s), uniformly spaced.
+    x : ndarray (k, n) or (r, k, n)
+        The states.
+    y : ndarray (k, p) or (r, k, p)
+        The outputs.
+    u : ndarray (k, m) or (r, k, m), or None
+        The inputs; None for free, impulse and doublet responses.
+    kind : str
+        What the response is: ``"step"``, ``"impulse"``, ``"doublet"``, ``"initial"`` or
+        ``"forced"``.
+    state_names, input_names, output_names : tuple of str
+        The model's names of its states, inputs and outputs.
+    response_names : tuple of str
+        One label per response (the input driven, the model index, or 'response k').
+    n_responses : int
+        The number of responses r (1 for a single one).
+
+    Examples
+    --------
+    The unit step response of x' = -x + u, y = x is 1 - e^-t:
+
+    >>> import numpy as np, aerocontrol
+    >>> r = aerocontrol.step_response(aerocontrol.StateSpace([[-1.0]], [[1.0]], [[1.0]]),
+    ...                               [0.0, 1.0, 2.0])
+    >>> r.kind, r.n_responses, r.x.shape
+    ('step', 1, (3, 1))
+    >>> np.round(r.y[:, 0], 6), np.round(1 - np.exp(-r.t), 6)
+    (array([0.      , 0.632121, 0.864665]), array([0.      , 0.632121, 0.864665]))
     """
 
     t: FloatArray

@@ -75,6 +75,39 @@ class CareSolution(Result):
 
     The equation is A^T X E + E^T X A - (E^T X B + S) R^-1 (B^T X E + S^T) + Q = 0 (6.228),
     with E = I and S = 0 by default.
+
+    Attributes
+    ----------
+    X : ndarray (n, n)
+        The stabilising solution, symmetric.
+    K : ndarray (m, n)
+        The optimal gain R^-1 (B^T X E + S^T) (6.200); u = -K x.
+    closed_loop_poles : ndarray (n,), complex
+        The eigenvalues of (A - B K, E) (rad/s), all with Re < 0; pairs adjacent, Im > 0 first.
+    residual : float
+        The relative residual ||Res||_F / (||Q||_F + 2 ||A^T X E||_F + ||(E^T X B + S) K||_F);
+        above ``RESIDUAL_WARNING`` (1e-8) the solution is flagged.
+    rcond : float
+        Reciprocal 1-norm condition number of U11, the top half of the stable invariant
+        subspace's basis: small means X is sensitive (flagged below ``RCOND_WARNING``, 1e-8).
+    refinement_steps : int
+        Newton steps taken after the Schur solution.
+
+    Examples
+    --------
+    The double integrator with Q = I and R = 1 has X = [[√3, 1], [1, √3]] and K = [1, √3]:
+
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.solve_care([[0, 1], [0, 0]], [[0], [1]], np.eye(2), [[1.0]])
+    >>> np.round(sol.X, 6)
+    array([[1.732051, 1.      ],
+           [1.      , 1.732051]])
+    >>> np.round(sol.K, 6)
+    array([[1.      , 1.732051]])
+    >>> np.round(sol.closed_loop_poles, 6)              # s^2 + √3 s + 1 = 0
+    array([-0.866025+0.5j, -0.866025-0.5j])
+    >>> bool(sol.residual < 1e-14)
+    True
     """
 
     X: FloatArray
@@ -315,6 +348,35 @@ class DareSolution(Result):
 
     The equation is A^T X A - E^T X E - (A^T X B + S)(R + B^T X B)^-1 (B^T X A + S^T) + Q = 0,
     with E = I and S = 0 by default.
+
+    Attributes
+    ----------
+    X : ndarray (n, n)
+        The stabilising solution, symmetric.
+    K : ndarray (m, n)
+        The optimal gain (R + B^T X B)^-1 (B^T X A + S^T); u[k] = -K x[k].
+    closed_loop_poles : ndarray (n,), complex
+        The eigenvalues of (A - B K, E), all with modulus below 1.
+    residual : float
+        The relative residual ||Res||_F / (||Q||_F + ||A^T X A||_F + ||E^T X E||_F +
+        ||(B^T X A + S^T)^T K||_F); above ``RESIDUAL_WARNING`` (1e-8) the solution is flagged.
+    rcond : float
+        Reciprocal 1-norm condition number of E U11 (U11 the top half of the stable deflating
+        subspace's basis): small means X is sensitive.
+    refinement_steps : int
+        Newton steps taken after the Schur solution.
+
+    Examples
+    --------
+    For the scalar x[k+1] = 2 x[k] + u[k] with Q = R = 1, X solves x^2 - 4x - 1 = 0 and the gain
+    is the golden ratio:
+
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.solve_dare([[2.0]], [[1.0]], [[1.0]], [[1.0]])
+    >>> np.round(sol.X, 6), np.round(sol.K, 6)               # 2 + √5, (1 + √5)/2
+    (array([[4.236068]]), array([[1.618034]]))
+    >>> np.round(sol.closed_loop_poles.real, 6)
+    array([0.381966])
     """
 
     X: FloatArray
@@ -322,7 +384,7 @@ class DareSolution(Result):
     K: FloatArray
     """The optimal gain (R + B^T X B)^-1 (B^T X A + S^T), m x n."""
     closed_loop_poles: ComplexArray
-    """The eigenvalues of (A - B K, E), all with |z| < 1."""
+    """The eigenvalues of (A - B K, E), all with abs(z) < 1."""
     residual: float
     """||Res||_F / (||Q||_F + ||A^T X A||_F + ||E^T X E||_F + ||(B^T X A + S^T)^T K||_F)."""
     rcond: float
@@ -533,7 +595,31 @@ def _regulator_arguments(
 
 @dataclass(frozen=True, eq=False)
 class RiccatiSolution(Result):
-    """S(t) and K(t) of the finite-horizon regulator on a time grid (6.196)-(6.200)."""
+    """S(t) and K(t) of the finite-horizon regulator on a time grid (6.196)-(6.200).
+
+    Attributes
+    ----------
+    t : ndarray (k,)
+        The times (s), increasing; S(t[-1]) = Sf.
+    S : ndarray (k, n, n)
+        S(t_k), symmetric.
+    K : ndarray (k, m, n)
+        K(t_k) = R^-1 B^T S(t_k) (6.200).
+    substeps : int
+        Steps of the transition-matrix recursion over the horizon (each interval of t is
+        divided so that the Hamiltonian's modes grow by at most e across a step).
+
+    Examples
+    --------
+    For x' = u with Q = R = 1 and S(2) = 0, -S' = 1 - S² gives S(t) = tanh(2 - t):
+
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.riccati_ode([[0.0]], [[1.0]], [[1.0]], [[1.0]], [0.0, 1.0, 2.0])
+    >>> np.round(sol.S[:, 0, 0], 6), np.round(np.tanh([2.0, 1.0, 0.0]), 6)
+    (array([0.964028, 0.761594, 0.      ]), array([0.964028, 0.761594, 0.      ]))
+    >>> sol.K.shape
+    (3, 1, 1)
+    """
 
     t: FloatArray
     """The times, increasing; S(t[-1]) = Sf."""
@@ -696,7 +782,30 @@ def lqr_finite(
 
 @dataclass(frozen=True, eq=False)
 class RiccatiDifferenceSolution(Result):
-    """S_k and K_k of the discrete finite-horizon regulator over N steps."""
+    """S_k and K_k of the discrete finite-horizon regulator over N steps.
+
+    Attributes
+    ----------
+    S : ndarray (N + 1, n, n)
+        S_0 .. S_N, symmetric; S_N = Sf. x_k^T S_k x_k is the optimal cost from step k to the end.
+    K : ndarray (N, m, n)
+        K_0 .. K_{N-1}: u_k = -K_k x_k.
+    rcond : float
+        The smallest reciprocal condition number of R + B^T S_{k+1} B over the horizon (the
+        matrix each gain solves with); 1 when N = 0.
+    error_estimate : float
+        The largest estimated relative error of a step S_k from the rounding of A - B K_k.
+
+    Examples
+    --------
+    x[k+1] = 2 x[k] + u[k], Q = R = 1, S_3 = 0: S_k = (5 S_{k+1} + 1)/(S_{k+1} + 1) and
+    K_k = 2 S_{k+1}/(S_{k+1} + 1), backward from 0:
+
+    >>> import numpy as np, aerocontrol
+    >>> sol = aerocontrol.riccati_difference([[2.0]], [[1.0]], [[1.0]], [[1.0]], 3)
+    >>> np.round(sol.S[:, 0, 0], 12), np.round(sol.K[:, 0, 0], 12)
+    (array([4., 3., 1., 0.]), array([1.5, 1. , 0. ]))
+    """
 
     S: FloatArray
     """S_0 .. S_N, shape (N + 1, n, n), symmetric; S_N = Sf. x_k^T S_k x_k is the optimal cost

@@ -101,7 +101,26 @@ def _standard_normal_cdf(z: FloatArray) -> FloatArray:
 @dataclass(frozen=True)
 class Normal:
     """A normal scatter of standard deviation ``sigma``: of the nominal value's magnitude
-    (``relative``, the default: 0.1 is ±10 % at one sigma) or in the parameter's units."""
+    (``relative``, the default: 0.1 is ±10 % at one sigma) or in the parameter's units.
+
+    Attributes
+    ----------
+    sigma : float
+        The standard deviation: of the nominal value's magnitude when ``relative``, else in the
+        parameter's units.
+    relative : bool
+        Whether ``sigma`` is relative to the nominal value's magnitude (default True).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from aerocontrol.robustness import Normal
+    >>> z = np.array([-1.0, 0.0, 1.0])                   # standard-normal draws
+    >>> np.round(Normal(0.1).values(-2.0, z), 12)     # ±10 % of abs(-2) at one sigma
+    array([-2.2, -2. , -1.8])
+    >>> np.round(Normal(0.1, relative=False).values(-2.0, z), 12)
+    array([-2.1, -2. , -1.9])
+    """
 
     sigma: float
     relative: bool = True
@@ -116,7 +135,26 @@ class Normal:
 @dataclass(frozen=True)
 class Uniform:
     """A uniform scatter over nominal ± ``half_width`` (of the nominal's magnitude when
-    ``relative``), drawn as Φ(z) of the parameter's standard-normal draw."""
+    ``relative``), drawn as Φ(z) of the parameter's standard-normal draw.
+
+    Attributes
+    ----------
+    half_width : float
+        The half width of the interval: of the nominal value's magnitude when ``relative``, else
+        in the parameter's units.
+    relative : bool
+        Whether ``half_width`` is relative to the nominal value's magnitude (default True).
+
+    Examples
+    --------
+    The draws z = 0 and ±∞ map to the centre and the ends, z = 1 to 2 Φ(1) - 1 = 0.682689 of
+    the half width:
+
+    >>> import numpy as np
+    >>> from aerocontrol.robustness import Uniform
+    >>> np.round(Uniform(0.5).values(2.0, np.array([-np.inf, 0.0, 1.0, np.inf])), 6)
+    array([1.      , 2.      , 2.682689, 3.      ])
+    """
 
     half_width: float
     relative: bool = True
@@ -130,7 +168,21 @@ class Uniform:
 @dataclass(frozen=True)
 class LogNormal:
     """A log-normal scatter about the nominal value (its median): nominal · e^(sigma z), which
-    keeps the sign of the nominal value (for masses, inertias and damping derivatives)."""
+    keeps the sign of the nominal value (for masses, inertias and damping derivatives).
+
+    Attributes
+    ----------
+    sigma : float
+        The standard deviation of the logarithm: nominal · e^(sigma z) for a standard-normal
+        draw z.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from aerocontrol.robustness import LogNormal
+    >>> np.round(LogNormal(0.1).values(-2.0, np.array([-1.0, 0.0, 1.0])), 6)
+    array([-1.809675, -2.      , -2.210342])
+    """
 
     sigma: float
 
@@ -152,6 +204,15 @@ class Uncertainty:
     correlation of two parameters' draws (a Gaussian copula: for normal parameters, their
     correlation), ``{("Cn_beta", "Cn_r"): 0.5}``. The correlation matrix must be positive
     definite.
+
+    Attributes
+    ----------
+    distributions : Mapping[str, Normal or Uniform or LogNormal]
+        The distribution of each uncertain parameter (a copy of the mapping given).
+    correlations : Mapping[tuple of (str, str), float]
+        The correlation of two parameters' standard-normal draws, in (-1, 1); empty by default.
+    names : tuple of str
+        The uncertain parameters, in the order given.
 
     Examples
     --------
@@ -275,7 +336,26 @@ class Lqr:
     """The linear-quadratic regulator re-designed for every sample: u = -K x minimising
     J = ∫ x^T Q x + (1/c²) u^T R u dt, the chapter's (6.224)-(6.227) as ``aerocontrol lqr``
     and :func:`aerocontrol.batch.lqr_sweep` weight it (Q and R identities when not given),
-    solved for all samples of a chunk in one parallel call."""
+    solved for all samples of a chunk in one parallel call.
+
+    Attributes
+    ----------
+    c : float
+        The weight c: the control weight is R/c² (default 1).
+    Q : ndarray (n, n) or None
+        The state weight; None for the identity.
+    R : ndarray (m, m) or None
+        The control weight before division by c²; None for the identity.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> from aerocontrol.robustness import Lqr, Normal, Uncertainty, monte_carlo
+    >>> run = monte_carlo(aircraft.load(), Uncertainty({"Cn_beta": Normal(0.3)}), 1000, Lqr(c=1.0),
+    ...                   axis="lateral", seed=1)
+    >>> bool(run.closed_loop.stable.all()), int(run.failed.sum())
+    (True, 0)
+    """
 
     c: float = 1.0
     Q: ArrayLike | None = None
@@ -312,7 +392,24 @@ class Damper:
     samples of a chunk in one parallel call (:func:`aerocontrol.batch.place_batch`). Lateral
     models only. A sample whose Dutch roll is not an oscillation (split into two real roots,
     or coupled with roll and spiral) has no such damper: its closed loop is its open loop,
-    and :attr:`LoopOutcome.controlled` is False for it."""
+    and :attr:`LoopOutcome.controlled` is False for it.
+
+    Attributes
+    ----------
+    zeta : float
+        The Dutch roll damping ratio the damper sets, in (0, 1) (default 0.30).
+    surface : str
+        The surface it acts through: "rudder" (default) or "aileron".
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> from aerocontrol.robustness import Damper, Normal, Uncertainty, monte_carlo
+    >>> run = monte_carlo(aircraft.load(), Uncertainty({"Cn_beta": Normal(0.3)}), 1000, Damper(),
+    ...                   axis="lateral", seed=1)
+    >>> bool(run.open_loop.controlled.any()), bool(run.closed_loop.controlled.all())
+    (False, True)
+    """
 
     zeta: float = 0.30
     surface: str = "rudder"
@@ -598,7 +695,28 @@ def _beta_quantile(q: float, a: float, b: float) -> float:
 @dataclass(frozen=True)
 class Estimate:
     """A probability estimated from ``count`` of ``samples``, with its Clopper-Pearson interval
-    at ``confidence``."""
+    at ``confidence``.
+
+    Attributes
+    ----------
+    count : int
+        The samples that had the event.
+    samples : int
+        All samples.
+    value : float
+        count / samples.
+    low, high : float
+        The Clopper-Pearson interval of the probability at ``confidence``.
+    confidence : float
+        The interval's confidence level, e.g. 0.95.
+
+    Examples
+    --------
+    >>> from aerocontrol.robustness import clopper_pearson
+    >>> e = clopper_pearson(0, 1000)           # no event in 1000: at most 0.37 %
+    >>> e.value, e.low, round(e.high, 5), e.confidence
+    (0.0, 0.0, 0.00368, 0.95)
+    """
 
     count: int
     samples: int
@@ -680,7 +798,40 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
 @register
 @dataclass(frozen=True)
 class LoopOutcome:
-    """The judgement of every sample of one loop (open or closed)."""
+    """The judgement of every sample of one loop (open or closed).
+
+    Attributes
+    ----------
+    levels : ndarray (samples, modes) of int8
+        The MIL-F-8785C Level of each mode (4: worse than Level 3, or a mode that could not be
+        judged), modes in the order of :attr:`MonteCarlo.modes`.
+    stable : ndarray (samples,) of bool
+        Every eigenvalue in the open left half-plane.
+    unresolved : ndarray (samples,) of bool
+        Models whose modes are not the classical ones, whose roll and spiral (or both
+        longitudinal modes) are Level 4.
+    max_real : ndarray (samples,)
+        The largest real part of the eigenvalues (1/s).
+    quantities : dict of str to ndarray (samples,)
+        The quantities the Levels judge ("dutch roll: zeta", "roll: time constant", ...), as
+        :func:`aerocontrol.handling.mode_quantities` gives them; NaN for an unresolved mode.
+    controlled : ndarray (samples,) of bool
+        The controller acts on the sample (False in the open loop, and where a ``Damper`` has
+        no Dutch roll oscillation to damp).
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> from aerocontrol.robustness import Damper, Normal, Uncertainty, monte_carlo
+    >>> run = monte_carlo(aircraft.load(), Uncertainty({"Cn_beta": Normal(0.3)}), 1000, Damper(),
+    ...                   axis="lateral", seed=1)
+    >>> run.modes
+    ('dutch roll', 'roll', 'spiral')
+    >>> int((run.open_loop.levels[:, 0] > 1).sum()), int((run.closed_loop.levels[:, 0] > 1).sum())
+    (999, 0)
+    >>> sorted(run.open_loop.quantities)[:2]
+    ['dutch roll: omega_n', 'dutch roll: zeta']
+    """
 
     levels: NDArray[np.int8]
     """(samples, modes): the MIL-F-8785C Level of each mode (4: worse than Level 3, or a mode
@@ -705,7 +856,48 @@ class LoopOutcome:
 
 @dataclass(frozen=True, eq=False)
 class MonteCarlo(Result):
-    """The result of :func:`monte_carlo`."""
+    """The result of :func:`monte_carlo`.
+
+    Attributes
+    ----------
+    aircraft : str
+        The aircraft's name.
+    aircraft_class, category : str
+        The MIL-F-8785C Class and Flight Phase Category the Levels were judged for.
+    axis : str
+        "lateral" or "longitudinal".
+    parameters : tuple of str
+        The uncertain parameters, in the order of ``failures_by_bin``.
+    modes : tuple of str
+        The modes judged, in the order of the columns of each ``LoopOutcome.levels``.
+    samples : int
+        The number of samples.
+    seed : int
+        The seed of the draws.
+    required_level : int
+        The worst Level that does not count as a failure.
+    open_loop : LoopOutcome
+        The judgement of every sample without the controller.
+    closed_loop : LoopOutcome or None
+        The judgement with the controller; None without one.
+    failed : ndarray (samples,) of bool
+        A mode worse than ``required_level`` (of the closed loop when there is a controller).
+    failures_by_bin : ndarray (parameters, 10) of int
+        Failures among the samples in each decile of a parameter's draw.
+    samples_by_bin : ndarray (parameters, 10) of int
+        The samples in each decile.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> from aerocontrol.robustness import Damper, Normal, Uncertainty, monte_carlo
+    >>> run = monte_carlo(aircraft.load(), Uncertainty({"Cn_beta": Normal(0.3)}), 1000, Damper(),
+    ...                   axis="lateral", seed=1)
+    >>> run.parameters, run.samples, int(run.failed.sum())
+    (('Cn_beta',), 1000, 0)
+    >>> int(run.samples_by_bin.sum())
+    1000
+    """
 
     aircraft: str
     aircraft_class: str

@@ -63,7 +63,8 @@ DESIGNS = ("lqr", "damper")
 #: result does not depend on it, each condition being judged on its own).
 CHUNK_SIZE = 4096
 
-#: The fields of a condition's aircraft that :meth:`Aircraft.at` changes and the models read.
+#: The fields of a condition's aircraft that :meth:`~aerocontrol.aircraft.Aircraft.at` changes
+#: and the models read.
 _CONDITION_FIELDS = ("mass", "speed", "density")
 
 
@@ -72,7 +73,8 @@ def _models(
 ) -> tuple[FloatArray, FloatArray, list[Aircraft]]:
     """The state matrices A (k, 4, 4) and B (k, 4, inputs) at k conditions (rows altitude,
     Mach, weight), each equal, bitwise, to ``plane.at(...)``'s own model (the aircraft moved
-    by :meth:`Aircraft.at`, the matrices built in one :meth:`Aircraft.model_stack` call)."""
+    by :meth:`~aerocontrol.aircraft.Aircraft.at`, the matrices built in one
+    :meth:`~aerocontrol.aircraft.Aircraft.model_stack` call)."""
     moved = [plane.at(float(h), float(m), float(w)) for h, m, w in conditions]
     values = {name: np.array([getattr(a, name) for a in moved]) for name in _CONDITION_FIELDS}
     for name in ("CL", "CD"):
@@ -179,10 +181,52 @@ def _increasing(grid: FloatArray, name: str) -> FloatArray:
 @dataclass(frozen=True, eq=False)
 class GainSchedule(Result):
     """State-feedback gains u = -K x designed over a grid of flight conditions, from
-    :func:`gain_schedule`. Arrays are indexed [altitude, Mach, weight]."""
+    :func:`gain_schedule`. Arrays are indexed [altitude, Mach, weight].
+
+    Attributes
+    ----------
+    plane : Aircraft
+        The aircraft whose conditions (:meth:`~aerocontrol.aircraft.Aircraft.at`) the gains were
+        designed at.
+    axis : str
+        "lateral" or "longitudinal".
+    design : str
+        The design rule: "lqr" or "damper".
+    altitudes : ndarray (a,)
+        The grid's altitudes (ft or m, the aircraft's units).
+    machs : ndarray (b,)
+        The grid's Mach numbers.
+    weights : ndarray (c,)
+        The grid's weights (lbf or N); the aircraft's own weight by default.
+    input_names : tuple of str
+        The rows of each gain matrix.
+    state_names : tuple of str
+        Its columns.
+    gains : ndarray (a, b, c, inputs, 4)
+        K at each grid condition.
+    closed_loop : Envelope
+        The closed loops' Levels at the grid conditions.
+    shape : tuple of int
+        (a, b, c).
+
+    Examples
+    --------
+    Each gain is the regulator of the aircraft moved to its condition:
+
+    >>> import numpy as np, aerocontrol
+    >>> from aerocontrol.schedule import gain_schedule
+    >>> b747 = aerocontrol.aircraft.load()
+    >>> s = gain_schedule(b747, altitudes=[0, 10000], machs=[0.2, 0.3])
+    >>> s.shape, s.input_names, s.state_names
+    ((2, 2, 1), ('rudder', 'aileron'), ('beta', 'p', 'phi', 'r'))
+    >>> K, _, _ = aerocontrol.lqr(b747.at(10000, 0.3).lateral(), np.eye(4), np.eye(2))
+    >>> bool(np.allclose(s.gains[1, 1, 0], K, rtol=1e-12, atol=0))
+    True
+    """
 
     plane: Aircraft
-    """The aircraft whose conditions (:meth:`Aircraft.at`) the gains were designed at."""
+    """The aircraft whose conditions (:meth:`~aerocontrol.aircraft.Aircraft.at`) the gains were
+    designed at."""
     axis: str
     design: str
     """The design rule: "lqr" or "damper"."""
@@ -297,8 +341,8 @@ class GainSchedule(Result):
     ) -> Envelope:
         """The closed-loop MIL-F-8785C Levels (3.2, 3.3) over a grid of conditions, typically
         finer than the design grid, with the interpolated gains (1): at each condition the
-        model of :meth:`Aircraft.at`, the loop A - B K closed with the gains of
-        :meth:`gains_at`, its eigenvalues, modes and Levels, all computed in bulk.
+        model of :meth:`~aerocontrol.aircraft.Aircraft.at`, the loop A - B K closed with the gains
+        of :meth:`gains_at`, its eigenvalues, modes and Levels, all computed in bulk.
 
         Parameters
         ----------
@@ -320,7 +364,7 @@ class GainSchedule(Result):
         ------
         InvalidArgumentError
             A grid value outside the schedule's range (named), or not finite; a condition
-            outside the plausible ranges (:meth:`Aircraft.at`).
+            outside the plausible ranges (:meth:`~aerocontrol.aircraft.Aircraft.at`).
         ShapeError
             A grid that is not a non-empty 1-D array.
 

@@ -585,16 +585,43 @@ def transmission_zeros(sys: System, tol: float | None = None) -> ComplexArray:
 @dataclass(frozen=True)
 class Factor:
     """One factor of a factored polynomial: (s - root) or, for a complex pair,
-    (s² + 2ζω s + ω²) (in z for a discrete model)."""
+    (s² + 2ζω s + ω²) (in z for a discrete model).
+
+    Attributes
+    ----------
+    roots : tuple of complex
+        One real root, or the pair (Im > 0 first).
+    zeta : float
+        Damping ratio of a pair (for a discrete model: of s = ln(z)/dt); NaN for a real root.
+    omega : float
+        ω of a pair (rad/s; for a discrete model of s = ln(z)/dt); abs(root) for a real one.
+    time_constant : float
+        T of a real root -1/T (s; continuous only): 1/abs(root), inf for a root at 0; NaN for a
+        pair.
+    coefficients : ndarray (2,) or (3,)
+        The monic factor, highest power first.
+
+    Examples
+    --------
+    The poles of 5/((s + 1)(s² + 2s + 5)): a real root at -1 and a pair of ω = √5, ζ = 1/√5:
+
+    >>> import numpy as np, aerocontrol
+    >>> g = aerocontrol.transfer_function(aerocontrol.zpk([], [-1, -1 + 2j, -1 - 2j], 5.0), 0, 0)
+    >>> real, pair = g.pole_factors
+    >>> real.time_constant, real.coefficients
+    (1.0, array([1., 1.]))
+    >>> round(pair.zeta, 6), round(pair.omega, 6), np.round(pair.coefficients, 6)
+    (0.447214, 2.236068, array([1., 2., 5.]))
+    """
 
     roots: tuple[complex, ...]
     """One real root, or the pair (Im > 0 first)."""
     zeta: float
     """Damping ratio of a pair (for a discrete model: of s = ln(z)/dt); NaN for a real root."""
     omega: float
-    """ω of a pair (rad/s; for a discrete model of s = ln(z)/dt); |root| for a real one."""
+    """ω of a pair (rad/s; for a discrete model of s = ln(z)/dt); abs(root) for a real one."""
     time_constant: float
-    """T of a real root -1/T (s; continuous only): 1/|root|, inf for a root at 0."""
+    """T of a real root -1/T (s; continuous only): 1/abs(root), inf for a root at 0."""
 
     @property
     def coefficients(self) -> FloatArray:
@@ -653,6 +680,42 @@ class TransferFunction(Result):
     ``print(tf)`` shows the factored "aircraft" form, (s + 1/T) for a real root -1/T and
     (s² + 2(ζ)(ω)s + (ω)²) for a pair, as flight dynamics texts print a numerator N(s) over
     the characteristic polynomial Δ(s).
+
+    Attributes
+    ----------
+    numerator : ndarray (m + 1,)
+        K Π(s - z_i), highest power first.
+    denominator : ndarray (n + 1,)
+        det(sI - A) = Π(s - p_j), monic, highest power first.
+    zeros : ndarray (m,), complex
+        The finite zeros of the channel's pencil, sorted.
+    poles : ndarray (n,), complex
+        The eigenvalues of A (all n), sorted.
+    gain : float
+        K, the leading coefficient of the numerator (the high-frequency gain over s^(n - m)).
+    dt : float
+        0.0 for a continuous model, else the sampling period in seconds.
+    output_name, input_name : str
+        The channel's output and input.
+    scaled_gain : tuple of (float, int), or None
+        K as (mantissa, exponent), K = mantissa 2^exponent, where K itself lies beyond the
+        doubles (``gain`` is then infinite); None when ``gain`` is K.
+    variable : str
+        "s", or "z" for a discrete model.
+    zero_factors, pole_factors : list of Factor
+        The numerator's and the denominator's factors: real roots by modulus, then pairs by ω.
+
+    Examples
+    --------
+    >>> import numpy as np, aerocontrol
+    >>> g = aerocontrol.transfer_function(aerocontrol.zpk([-3.0], [-1.0, -2.0], 2.0), 0, 0)
+    >>> np.round(g.numerator, 12), g.denominator                  # 2 (s + 3) / (s² + 3s + 2)
+    (array([2., 6.]), array([1., 3., 2.]))
+    >>> print(g)
+    y0/u0(s) = 2 (s + 3) / (s + 1)(s + 2)
+      zero -3 T = 0.3333 s
+      pole -1 T = 1 s
+      pole -2 T = 0.5 s
     """
 
     numerator: FloatArray
@@ -671,8 +734,8 @@ class TransferFunction(Result):
     input_name: str
     scaled_gain: tuple[float, int] | None = field(default=None, repr=False)
     """K as (mantissa, exponent), K = mantissa 2^exponent, where K itself lies beyond the
-    doubles (``gain`` is then infinite): :meth:`__call__` evaluates G from it. None when
-    ``gain`` is K."""
+    doubles (``gain`` is then infinite): calling the function, ``G(s)``, evaluates G from it.
+    None when ``gain`` is K."""
 
     @property
     def variable(self) -> str:
@@ -681,12 +744,12 @@ class TransferFunction(Result):
 
     @property
     def zero_factors(self) -> list[Factor]:
-        """The numerator's factors: real zeros by |z|, then pairs by ω."""
+        """The numerator's factors: real zeros by abs(z), then pairs by ω."""
         return _factors(self.zeros, self.dt)
 
     @property
     def pole_factors(self) -> list[Factor]:
-        """The denominator's factors: real poles by |p|, then pairs by ω."""
+        """The denominator's factors: real poles by abs(p), then pairs by ω."""
         return _factors(self.poles, self.dt)
 
     def __call__(self, s: complex | ComplexArray) -> complex | ComplexArray:
@@ -1282,6 +1345,21 @@ class TransferMatrix(Result):
 
     The channels share the poles and the denominator det(sI - A); each has its own zeros and
     gain, computed as :func:`transfer_function` computes them.
+
+    Attributes
+    ----------
+    poles : ndarray (n,), complex
+        The eigenvalues of A, sorted: the poles every channel shares.
+    denominator : ndarray (n + 1,)
+        det(sI - A), monic, highest power first.
+    dt : float
+        0.0 for a continuous model, else the sampling period in seconds.
+    output_names, input_names : tuple of str
+        The model's outputs and inputs.
+    shape : tuple of int
+        (outputs, inputs).
+    channels : tuple of TransferFunction
+        Every channel, output by output (each input's in turn).
 
     Examples
     --------

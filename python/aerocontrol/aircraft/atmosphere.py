@@ -72,7 +72,28 @@ _BASE_PRESSURES = _layer_pressures()
 
 @dataclass(frozen=True)
 class Atmosphere:
-    """The state of the standard atmosphere at one altitude, in the units asked for."""
+    """The state of the standard atmosphere at one altitude, in the units asked for.
+
+    Attributes
+    ----------
+    altitude : float
+        Geopotential altitude (m, or ft).
+    temperature : float
+        Temperature (K, in both unit systems).
+    pressure : float
+        Static pressure (Pa, or lbf/ft^2).
+    density : float
+        Air density (kg/m^3, or slug/ft^3).
+    speed_of_sound : float
+        The speed of sound (m/s, or ft/s).
+
+    Examples
+    --------
+    >>> from aerocontrol.aircraft import standard_atmosphere
+    >>> air = standard_atmosphere(0.0)                     # the standard sea level
+    >>> air.temperature, air.pressure, round(air.density, 6), round(air.speed_of_sound, 3)
+    (288.15, 101325.0, 1.225, 340.294)
+    """
 
     altitude: float
     """Geopotential altitude (m, or ft)."""

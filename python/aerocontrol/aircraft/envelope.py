@@ -48,6 +48,47 @@ class Envelope(Result):
     """The Levels of each mode over a grid of flight conditions.
 
     Arrays are indexed [altitude, Mach, weight].
+
+    Attributes
+    ----------
+    altitudes : ndarray (a,)
+        The altitudes of the grid (``length_unit``).
+    machs : ndarray (b,)
+        The Mach numbers of the grid.
+    weights : ndarray (c,)
+        The weights of the grid (``force_unit``).
+    aircraft_class : str
+        MIL-F-8785C class the Levels were judged for.
+    category : str
+        MIL-F-8785C flight-phase category the Levels were judged for.
+    length_unit : str
+        The unit of the altitudes ("ft" or "m").
+    force_unit : str
+        The unit of the weights ("lbf" or "N").
+    levels : dict of str to ndarray (a, b, c) of int
+        The Level of each mode (1-4) at each condition; 0 where it was not assessed.
+    eigenvalues : dict of str to ndarray (a, b, c), complex
+        Each mode's eigenvalue with Im >= 0 (rad/s; the larger real root of a split pair).
+    failures : dict of (int, int, int) to str
+        Conditions whose model or modes could not be assessed, with the reason.
+    worst : ndarray (a, b, c) of int
+        The worst Level over the modes at each condition (0 where none was assessed).
+    shape : tuple of int
+        (a, b, c).
+
+    Examples
+    --------
+    The 747 at the chapter's condition alone (sea level, M = 0.25, 564,032 lbf):
+
+    >>> from aerocontrol import aircraft
+    >>> env = aircraft.envelope_sweep(aircraft.load(), altitudes=[0], machs=[0.25],
+    ...                               weights=[564032])
+    >>> env.shape, env.length_unit, env.force_unit
+    ((1, 1, 1), 'ft', 'lbf')
+    >>> {mode: int(level[0, 0, 0]) for mode, level in env.levels.items()}
+    {'short period': 1, 'phugoid': 2, 'dutch roll': 2, 'roll': 1, 'spiral': 1}
+    >>> int(env.worst[0, 0, 0]), env.failures
+    (2, {})
     """
 
     altitudes: NDArray[np.float64]

@@ -93,6 +93,57 @@ class Aircraft:
     :meth:`~aerocontrol.aircraft.Aircraft.from_dict`. All quantities are in the file's units
     (``"english"``: ft, slug, lbf; ``"si"``: m, kg, N), inertias in stability axes.
 
+    Attributes
+    ----------
+    name : str
+        The aircraft and condition, as a title ("Boeing 747, powered approach").
+    identifier : str
+        The name :func:`~aerocontrol.aircraft.load` knows it by ("b747-approach").
+    description : str
+        One line on the flight condition.
+    aircraft_class : str
+        MIL-F-8785C class: "I", "II-C", "II-L", "III" or "IV".
+    category : str
+        MIL-F-8785C flight-phase category of this condition: "A", "B" or "C".
+    units : str
+        ``"english"`` (ft, slug, lbf) or ``"si"`` (m, kg, N).
+    speed : float
+        Flight speed u0 (ft/s or m/s).
+    altitude : float
+        Altitude (ft or m).
+    density : float
+        Air density ρ (slug/ft³ or kg/m³).
+    mach : float
+        Mach number.
+    theta0 : float
+        Equilibrium flight-path angle Θ0 (rad).
+    mass : float
+        Mass (slug or kg).
+    gravity : float
+        g (ft/s² or m/s²).
+    Ix, Iy, Iz, Ixz : float
+        Inertias in stability axes (slug ft² or kg m²).
+    S : float
+        Wing area (ft² or m²).
+    cbar : float
+        Mean aerodynamic chord c̄ (ft or m).
+    b : float
+        Wing span (ft or m).
+    derivatives : Mapping[str, float]
+        The nondimensional stability and control derivatives by name ("CL_alpha", "Cm_q",
+        "Cn_dr", ...).
+    published : Mapping[str, Any]
+        The source's own mode characteristics, validated: an optional relative ``tolerance``
+        and, per mode ("short_period", "phugoid", "dutch_roll", "roll", "spiral"), its
+        quantities and an optional ``tolerance`` of its own.
+    sources : Mapping[str, str]
+        Where each group of the file's values comes from.
+    uncertainty : Mapping[str, Any]
+        The file's [uncertainty] table, validated (empty without one);
+        :meth:`aerocontrol.robustness.Uncertainty.of` turns it into an Uncertainty.
+    dynamic_pressure : float
+        q̄ = ρ u0² / 2 (lbf/ft² or Pa).
+
     Examples
     --------
     >>> import numpy as np

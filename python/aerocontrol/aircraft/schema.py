@@ -111,7 +111,26 @@ class AircraftDataError(InvalidArgumentError):
 
 @dataclass(frozen=True)
 class PlausibleRange:
-    """The values a quantity may take, ``low <= value <= high``, in each unit system."""
+    """The values a quantity may take, ``low <= value <= high``, in each unit system.
+
+    Attributes
+    ----------
+    low, high : float
+        The bounds in SI units (``si_unit``).
+    si_unit : str
+        The SI unit ("" for a dimensionless quantity).
+    english_low, english_high : float or None
+        The bounds in English units, or None where they are the SI ones.
+    english_unit : str or None
+        The English unit, or None where it is the SI one.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> speed = aircraft.PLAUSIBLE_RANGES["speed"]
+    >>> speed.bounds("si"), speed.bounds("english")
+    ((0.5, 3500.0, 'm/s'), (1.5, 11500.0, 'ft/s'))
+    """
 
     low: float
     high: float

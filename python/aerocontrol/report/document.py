@@ -15,7 +15,28 @@ __all__ = ["Report"]
 
 @dataclass
 class Report:
-    """A report as a list of blocks, rendered to Markdown and to self-contained HTML."""
+    """A report as a list of blocks, rendered to Markdown and to self-contained HTML.
+
+    Attributes
+    ----------
+    title : str
+        The report's title, its level-1 heading.
+    blocks : list
+        The headings, paragraphs, tables and figures, in order.
+    figures : list of (str, matplotlib.figure.Figure)
+        (file name, figure) of every figure, in order.
+
+    Examples
+    --------
+    >>> from aerocontrol.report import Report
+    >>> report = Report("Yaw damper")
+    >>> report.heading("Gain")
+    >>> report.table(["mode", "Level"], [["dutch roll", "1"]])
+    >>> report.markdown().splitlines()
+    ['# Yaw damper', '', '## Gain', '', '| mode | Level |', '| --- | --- |', '| dutch roll | 1 |']
+    >>> report.figures
+    []
+    """
 
     title: str
     blocks: list[Any] = field(default_factory=list)
