@@ -114,16 +114,6 @@ attach(
         "eigenvector_condition",
     ),
 )
-# The core's docstring of this field reads as a substitution in reStructuredText.
-setattr(  # noqa: B010 - the stub declares a read-only property
-    Placement,
-    "max_relative_error",
-    property(
-        vars(Placement)["max_relative_error"].__get__,
-        doc="max abs(achieved - requested) / abs(requested) (relative to ||A - BK||_F for a "
-        "pole at 0).",
-    ),
-)
 Placement.__doc__ = """A state-feedback design η = -K x (6.91), from :func:`place`,
 :func:`place_ackermann` or :func:`place_bass_gura`.
 

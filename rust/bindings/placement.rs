@@ -95,7 +95,8 @@ struct PlacementResult {
     /// The eigenvalues of the computed A - B K, matched to ``poles``.
     #[pyo3(get)]
     achieved_poles: Py<PyArrayDyn<c64>>,
-    /// max |achieved - requested| / |requested| (relative to ||A - BK||_F for a pole at 0).
+    /// max abs(achieved - requested) / abs(requested) (relative to ||A - BK||_F for a pole
+    /// at 0).
     #[pyo3(get)]
     max_relative_error: f64,
     /// Sweeps of the robust method; 0 for the single-input formulas.
