@@ -1569,13 +1569,12 @@ def zpk(
     ------
     InvalidArgumentError
         More zeros than poles, a complex root without its conjugate, a section beyond the
-        range of doubles (naming ``z`` or ``p``), or a bad ``dt``.
+        range of doubles (naming ``z`` or ``p``), a bad ``dt``, or a name that is not a
+        string (or a sequence of them).
     NonFiniteError, NotRealError
         A root or the gain is NaN or infinite, or the gain is complex.
     ShapeError
         A sequence of names of the wrong length.
-    InvalidArgumentError
-        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -1756,13 +1755,12 @@ def first_order_lag(
     Raises
     ------
     InvalidArgumentError
-        ``tau`` is not positive.
+        ``tau`` is not positive, or a name is not a string (or a sequence of
+        them).
     NonFiniteError, NotRealError
         ``tau`` or ``gain`` is not finite, or complex.
     ShapeError
         A sequence of names of the wrong length.
-    InvalidArgumentError
-        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -1814,13 +1812,12 @@ def actuator(
     Raises
     ------
     InvalidArgumentError
-        ``bandwidth`` is not positive.
+        ``bandwidth`` is not positive, or a name is not a string (or a sequence of
+        them).
     NonFiniteError, NotRealError
         ``bandwidth`` is not finite, or complex.
     ShapeError
         A sequence of names of the wrong length.
-    InvalidArgumentError
-        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -1874,13 +1871,12 @@ def washout(
     Raises
     ------
     InvalidArgumentError
-        ``tau`` is not positive.
+        ``tau`` is not positive, or a name is not a string (or a sequence of
+        them).
     NonFiniteError, NotRealError
         ``tau`` is not finite, or complex.
     ShapeError
         A sequence of names of the wrong length.
-    InvalidArgumentError
-        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -1939,13 +1935,12 @@ def second_order(
     Raises
     ------
     InvalidArgumentError
-        ``omega_n`` is not positive or ``zeta`` is negative.
+        ``omega_n`` is not positive or ``zeta`` is negative, or a name is not a string (or
+        a sequence of them).
     NonFiniteError, NotRealError
         An argument is not finite, or complex.
     ShapeError
         A sequence of names of the wrong length.
-    InvalidArgumentError
-        A name that is not a string (or a sequence of them).
 
     Examples
     --------
@@ -2015,13 +2010,11 @@ def pade_delay(
     ------
     InvalidArgumentError
         ``T`` is not positive, or ``order`` is not an integer from 1 to 20 (beyond 20 the
-        realisation loses digits).
+        realisation loses digits), or a name is not a string (or a sequence of them).
     NonFiniteError, NotRealError
         ``T`` is not finite, or complex.
     ShapeError
         A sequence of names of the wrong length.
-    InvalidArgumentError
-        A name that is not a string (or a sequence of them).
 
     Examples
     --------
