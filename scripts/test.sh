@@ -8,8 +8,8 @@
 #
 # Steps: a fresh venv; one abi3 wheel, installed with the test and docs dependencies; cargo fmt
 # --check, ruff check, ruff format --check; cargo clippy --all-targets -D warnings
-# (with the Python bindings); cargo test without features (as the README's cargo test) and with
-# the extension's allocator; pytest (which also runs mypy --strict and stubtest on the package,
+# (with the Python bindings); cargo test without features (as the README's cargo test, with the
+# allocator's unit tests); pytest (which also runs mypy --strict and stubtest on the package,
 # the doctests, and the property suite within its CI budget); the documentation site
 # (scripts/docs.sh).
 set -euo pipefail
@@ -52,10 +52,10 @@ run_cargo_test() {
     cargo_passed=$((cargo_passed + $(grep -Eo 'test result: ok\. [0-9]+ passed' "$log" | awk '{s += $4} END {print s + 0}')))
     rm -f "$log"
 }
-echo "== cargo test (no features, as a Rust user runs it)"
+# One run, as a Rust user runs it: the allocator's own tests are in it, and pytest runs every
+# kernel under that allocator through the extension.
+echo "== cargo test"
 run_cargo_test
-echo "== cargo test (with the Python extension's allocator)"
-run_cargo_test --features small-block-allocator
 if [ "$cargo_passed" -eq 0 ]; then
     echo "cargo test ran no test" >&2
     exit 1

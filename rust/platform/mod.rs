@@ -3,7 +3,8 @@
 //! requested so that a shortage is an error, the plumbing of parallel loops, and the number of
 //! threads they run on.
 
-#[cfg(feature = "small-block-allocator")]
+// Compiled for the unit tests too: they call the allocator directly, without installing it.
+#[cfg(any(test, feature = "small-block-allocator"))]
 pub mod allocator;
 pub mod dispatch;
 pub mod interrupt;
