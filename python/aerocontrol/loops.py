@@ -304,8 +304,12 @@ def _unstable(roots: ComplexArray, discrete: bool) -> NDArray[np.bool_]:
     return np.abs(roots) > 1.0 if discrete else roots.real > 0.0
 
 
-def _stable(roots: ComplexArray, discrete: bool) -> bool:
-    return bool(np.all(np.abs(roots) < 1.0) if discrete else np.all(roots.real < 0.0))
+def _unstable_count(roots: ComplexArray, discrete: bool) -> int:
+    """The number of roots strictly outside the stability region (scalar arithmetic: a
+    loop's few poles)."""
+    if discrete:
+        return sum(math.hypot(r.real, r.imag) > 1.0 for r in roots.tolist())
+    return sum(r.real > 0.0 for r in roots.tolist())
 
 
 def _eigenvalues(A: FloatArray) -> ComplexArray:
@@ -819,15 +823,15 @@ def stability_margins(loop: System) -> StabilityMargins:
     d = float(model.D[0, 0])
     if abs(1.0 + d) <= 8 * _EPS * max(1.0, abs(d)):
         _refuse_algebraic(model)
-    exponent = _frequency_exponent(model)
-    sizes = (_log2_size(model.B), _log2_size(model.C))
+    size_B, size_C = _log2_size(model.B), _log2_size(model.C)
+    exponent = _frequency_exponent(model, size_B, size_C)
     try:
-        if exponent or max(sizes) > RESCALE_EXPONENT:
+        if exponent or max(size_B, size_C) > RESCALE_EXPONENT:
             margins = _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
             # The open-loop poles of the slowed loop, A 2^-e, may underflow (a pole 1.3e-301
             # beside B C of 1.6e148 became 0, not unstable): counted from A itself.
-            unstable_open = int(np.sum(_eigenvalues(model.A).real > 0.0))
-            unstable_closed = int(np.sum(margins.closed_loop_poles.real > 0.0))
+            unstable_open = _unstable_count(_eigenvalues(model.A), False)
+            unstable_closed = _unstable_count(margins.closed_loop_poles, False)
             return dataclasses.replace(
                 margins,
                 open_loop_unstable_poles=unstable_open,
@@ -842,14 +846,12 @@ def stability_margins(loop: System) -> StabilityMargins:
         return _grid_margins(model)
 
 
-def _frequency_exponent(model: StateSpace) -> int:
+def _frequency_exponent(model: StateSpace, size_B: float, size_C: float) -> int:
     """e such that the loop's matrices (A, and B C/(1 + D) of the closed loop) are of size
-    about 2^e, where that is beyond 2^RESCALE_EXPONENT; else 0."""
+    about 2^e, where that is beyond 2^RESCALE_EXPONENT; else 0 (``size_B``, ``size_C``: the
+    :func:`_log2_size` of B and C)."""
     d = float(model.D[0, 0])
-    size = max(
-        _log2_size(model.A),
-        _log2_size(model.B) + _log2_size(model.C) - math.log2(abs(1.0 + d)),
-    )
+    size = max(_log2_size(model.A), size_B + size_C - math.log2(abs(1.0 + d)))
     return round(size) if size > RESCALE_EXPONENT else 0
 
 
@@ -927,30 +929,20 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
         # the phase crossovers, so the grid search decides.
         return _grid_margins(model)
-    stable = _closed_loop_stable(closed, False, closed_size)
-    unstable_open = int(np.sum(open_poles.real > 0.0))
-    unstable_closed = int(np.sum(closed.real > 0.0))
-    negative = phase_values.real < 0.0
-    with np.errstate(divide="ignore"):
-        gains = 1.0 / _magnitude(phase_values[negative])
-    phase_w = phase_w[negative]
-    shifted = 180.0 + np.degrees(np.angle(gain_values))
-    phases = shifted - 360.0 * np.round(shifted / 360.0)
-    phases[phases == -180.0] = 180.0
-    positive = gain_w > 0
-    delays = np.radians(phases[positive] % 360.0) / gain_w[positive]
+    phase_crossings = [
+        (w, value)
+        for w, value in zip(phase_w.tolist(), phase_values.tolist(), strict=True)
+        if value.real < 0.0
+    ]
     return _assemble(
-        gains,
-        phase_w,
-        phases,
-        gain_w,
-        delays,
+        phase_crossings,
+        list(zip(gain_w.tolist(), gain_values.tolist(), strict=True)),
         disk=(float(disk_w), float(disk_peak)),
         stability=(float(stab_w), 1.0 / float(sensitivity_peak)),
         closed=closed,
-        stable=stable,
-        unstable_open=unstable_open,
-        unstable_closed=unstable_closed,
+        stable=_closed_loop_stable(closed, False, closed_size),
+        unstable_open=_unstable_count(open_poles, False),
+        unstable_closed=_unstable_count(closed, False),
     )
 
 
@@ -962,8 +954,8 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
     closed = _closed_loop_poles(model, np.ones(1))[0]
     open_poles = _eigenvalues(model.A)
     stable = _closed_loop_stable(closed, discrete, _balanced_size(_closed_matrix(model)))
-    unstable_open = int(np.sum(_unstable(open_poles, discrete)))
-    unstable_closed = int(np.sum(_unstable(closed, discrete)))
+    unstable_open = _unstable_count(open_poles, discrete)
+    unstable_closed = _unstable_count(closed, discrete)
 
     response = _Response(model)
     omega = _grid(model)
@@ -994,9 +986,7 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
             and abs(value.imag) <= 1e-12 * math.hypot(value.real, value.imag)
         ):
             phase_w.append(float(w))
-    phase_w = sorted(set(phase_w))
-    with np.errstate(divide="ignore"):
-        gains = 1.0 / _magnitude(np.array([response.one(w) for w in phase_w], np.complex128))
+    phase_crossings = [(w, response.one(w)) for w in sorted(set(phase_w))]
 
     # Gain crossovers: log|L| changes sign.
     def log_magnitude(w: float) -> float:
@@ -1008,13 +998,7 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
         gain_w.append(
             float(_brent(log_magnitude, omega[i], omega[i + 1], logs[i], logs[i + 1], 0.0))
         )
-    gain_w = sorted(set(gain_w))
-    phases = np.array(
-        [_wrap_degrees(180.0 + math.degrees(float(np.angle(response.one(w))))) for w in gain_w]
-    )
-    delays = np.array(
-        [math.radians(pm % 360.0) / w for pm, w in zip(phases, gain_w, strict=True) if w > 0]
-    )
+    gain_crossings = [(w, response.one(w)) for w in sorted(set(gain_w))]
 
     # |S - T|/2 = |1 - L|/(2|1 + L|) and |1 + L|, peak and minimum refined.
     def half_difference(w: FloatArray) -> FloatArray:
@@ -1036,11 +1020,8 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
     stab_w, stab_peak = _extremum(omega, -_magnitude(1 + values), distance)
 
     result = _assemble(
-        gains,
-        np.array(phase_w),
-        phases,
-        np.array(gain_w),
-        delays,
+        phase_crossings,
+        gain_crossings,
         disk=(disk_w, disk_peak),
         stability=(stab_w, -stab_peak),
         closed=closed,
@@ -1053,11 +1034,8 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
 
 
 def _assemble(
-    gains: FloatArray,
-    phase_w: FloatArray,
-    phases: FloatArray,
-    gain_w: FloatArray,
-    delays: FloatArray,
+    phase_crossings: list[tuple[float, complex]],
+    gain_crossings: list[tuple[float, complex]],
     *,
     disk: tuple[float, float],
     stability: tuple[float, float],
@@ -1066,22 +1044,40 @@ def _assemble(
     unstable_open: int,
     unstable_closed: int,
 ) -> StabilityMargins:
-    """The result object: the critical margins picked from every crossover's."""
+    """The result object from the crossovers (ω, L) by increasing ω: the phase crossovers
+    where L < 0 give the gain margins 1/|L|, the gain crossovers (|L| = 1) the phase margins
+    180° + ∠L in (-180°, 180°] and the delay margins (phase margin mod 360°)/ω; the critical
+    margins are picked from these. Formed in scalar arithmetic: the arrays hold a few values,
+    and numpy's calls on them cost more than the core's whole computation."""
     disk_w, disk_peak = disk
-    if gains.size:
-        critical = int(np.argmin(np.abs(np.log(gains))))
-        gm, w_gm = float(gains[critical]), float(phase_w[critical])
+    gains = [_inverse_modulus(value) for _, value in phase_crossings]
+    phases = [
+        _wrap_degrees(180.0 + math.degrees(math.atan2(value.imag, value.real)))
+        for _, value in gain_crossings
+    ]
+    delays = [
+        math.radians(pm % 360.0) / w
+        for (w, _), pm in zip(gain_crossings, phases, strict=True)
+        if w > 0
+    ]
+    if gains:
+        # The gain margin nearest 0 dB (the first of equals).
+        critical = min(
+            range(len(gains)),
+            key=lambda i: abs(math.log(gains[i])) if gains[i] > 0.0 else math.inf,
+        )
+        gm, w_gm = gains[critical], phase_crossings[critical][0]
     else:
         gm, w_gm = math.inf, math.nan
-    if phases.size:
-        critical = int(np.argmin(np.abs(phases)))
-        pm, w_pm = float(phases[critical]), float(gain_w[critical])
+    if phases:
+        critical = min(range(len(phases)), key=lambda i: abs(phases[i]))
+        pm, w_pm = phases[critical], gain_crossings[critical][0]
     else:
         pm, w_pm = math.inf, math.nan
     if not stable:
         delay, alpha = 0.0, 0.0
     else:
-        delay = float(delays.min()) if delays.size else math.inf
+        delay = min(delays, default=math.inf)
         alpha = 1.0 / disk_peak if disk_peak > 0 else math.inf
     return StabilityMargins(
         gain_margin=gm,
@@ -1093,16 +1089,22 @@ def _assemble(
         disk_frequency=disk_w,
         stability_margin=stability[1],
         stability_frequency=stability[0],
-        gain_margins=gains,
-        phase_crossovers=phase_w,
-        phase_margins=phases,
-        gain_crossovers=gain_w,
-        delay_margins=delays,
+        gain_margins=np.array(gains, np.float64),
+        phase_crossovers=np.array([w for w, _ in phase_crossings], np.float64),
+        phase_margins=np.array(phases, np.float64),
+        gain_crossovers=np.array([w for w, _ in gain_crossings], np.float64),
+        delay_margins=np.array(delays, np.float64),
         closed_loop_poles=np.sort_complex(closed),
         closed_loop_stable=stable,
         open_loop_unstable_poles=unstable_open,
         encirclements=unstable_open - unstable_closed,
     )
+
+
+def _inverse_modulus(value: complex) -> float:
+    """1/|value|: infinite at 0, 0 where |value| exceeds the doubles."""
+    modulus = math.hypot(value.real, value.imag)
+    return 1.0 / modulus if modulus > 0.0 else math.inf
 
 
 def _extremum(
@@ -2748,13 +2750,18 @@ def _closed_loop_stable(closed: ComplexArray, discrete: bool, size: float) -> bo
     matrix's (:func:`_balanced_size`, or the core's): a mode at the origin that the loop does
     not reach (a pole of L cancelled by a zero there) stays at 0, computed as ±1e-16 or so,
     and its sign is rounding, so such a loop is not stable rather than stable or unstable by
-    chance."""
-    if not _stable(closed, discrete):
+    chance. (A NaN pole is neither inside nor on the boundary: not stable.)"""
+    roots = closed.tolist()
+    if discrete:
+        distances = [math.hypot(r.real, r.imag) - 1.0 for r in roots]  # from the circle
+    else:
+        distances = [r.real for r in roots]
+    if not all(x < 0.0 for x in distances):
         return False
     if not math.isfinite(size):  # B C beyond the range of doubles: the poles' own size
-        size = float(np.max(_magnitude(closed), initial=0.0))
+        size = max((math.hypot(r.real, r.imag) for r in roots), default=0.0)
     tolerance = _boundary_tolerance(size, discrete)
-    return not bool(np.any(_on_boundary(closed, discrete, tolerance)))
+    return not any(abs(x) <= tolerance for x in distances)
 
 
 def _matrix_size(M: FloatArray) -> float:

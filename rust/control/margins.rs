@@ -78,7 +78,6 @@ use crate::error::Error;
 use crate::linalg::balance::{balanced_states, nearest_power_of_two};
 use crate::linalg::norm::frobenius_norm;
 use crate::linalg::schur::eigenvalues;
-use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
 
 /// A crossover: the frequency and the loop's value there.
@@ -663,42 +662,36 @@ pub fn loop_margins(
     // S = 1/(1 + L) and (1 - L)/(2 (1 + L)) = S - 1/2 share the closed loop's realisation.
     let bs: Vec<f64> = bv.iter().map(|v| v / denominator).collect();
     let cs: Vec<f64> = cv.iter().map(|v| -v / denominator).collect();
-    // The crossovers and the two peaks are independent: two tasks (a few tens of µs each at
-    // n = 6, well above rayon's cost of a join).
-    let context = ParallelContext::capture(0);
-    let (crossovers, peaks) = rayon::join(
-        || {
-            context.run(|| {
-                let gain = this.gain_crossovers()?;
-                let phase = this.phase_crossovers(&open_loop_poles)?;
-                Ok((gain, phase))
-            })
-        },
-        || {
-            context.run(|| {
-                let mut closed_response = strictly_proper_evaluator(closed.as_ref(), &bs, &cs)?;
-                let mut response = |w: f64| closed_response.siso(w);
-                let (s_d, disk_d) = (1.0 / denominator, 1.0 / denominator - 0.5);
-                let sensitivity = peak(
-                    closed.as_ref(),
-                    &bs,
-                    &cs,
-                    s_d,
-                    &closed_loop_poles,
-                    &mut response,
-                )?;
-                let disk = peak(
-                    closed.as_ref(),
-                    &bs,
-                    &cs,
-                    disk_d,
-                    &closed_loop_poles,
-                    &mut response,
-                )?;
-                Ok((sensitivity, disk))
-            })
-        },
-    );
+    // The crossovers and the two peaks are independent, but each is a few tens of µs at n = 6:
+    // split between two threads, the worker left spinning after the join slowed the caller's
+    // Python (on a sibling hyperthread) by more than the split saved.
+    let crossovers = (|| {
+        let gain = this.gain_crossovers()?;
+        let phase = this.phase_crossovers(&open_loop_poles)?;
+        Ok::<_, Error>((gain, phase))
+    })();
+    let peaks = (|| {
+        let mut closed_response = strictly_proper_evaluator(closed.as_ref(), &bs, &cs)?;
+        let mut response = |w: f64| closed_response.siso(w);
+        let (s_d, disk_d) = (1.0 / denominator, 1.0 / denominator - 0.5);
+        let sensitivity = peak(
+            closed.as_ref(),
+            &bs,
+            &cs,
+            s_d,
+            &closed_loop_poles,
+            &mut response,
+        )?;
+        let disk = peak(
+            closed.as_ref(),
+            &bs,
+            &cs,
+            disk_d,
+            &closed_loop_poles,
+            &mut response,
+        )?;
+        Ok::<_, Error>((sensitivity, disk))
+    })();
     let ((gain_crossovers, (phase_crossovers, degenerate)), (sensitivity, disk)) =
         (crossovers?, peaks?);
 
