@@ -501,6 +501,18 @@ def test_robustness_refuses_bad_options(
     assert err.count("\n") == 1 and "Traceback" not in err
 
 
+def test_robustness_too_large_for_memory_is_one_line_after_the_first_chunk(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from aerocontrol import robustness
+
+    monkeypatch.setattr(robustness, "_available_memory", lambda: 2.0**20)
+    status, out, err = _run(capsys, "robustness", "b747-cruise", "--samples", "10000000000")
+    assert status != 0 and "Traceback" not in err
+    assert "out of memory (samples=10,000,000,000 keeps" in err
+    assert err.count("\n") == 1
+
+
 def test_robustness_writes_its_page_under_the_report_folder_rules(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:

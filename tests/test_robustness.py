@@ -7,6 +7,7 @@ bitwise identical however the chunks are run (one process, chunk order, a Dask c
 from __future__ import annotations
 
 import dataclasses
+import os
 import re
 import warnings
 
@@ -15,7 +16,7 @@ import pytest
 import scipy.stats
 
 import aerocontrol
-from aerocontrol import aircraft, batch, design, linalg
+from aerocontrol import aircraft, batch, design, linalg, robustness
 from aerocontrol.aircraft.naming import classify_mode_stack, classify_modes
 from aerocontrol.exceptions import InvalidArgumentError, ShapeError
 from aerocontrol.handling import assess, level_arrays
@@ -721,3 +722,82 @@ def test_clopper_pearson_at_the_edges_is_the_closed_form(samples: int) -> None:
     assert every.high == 1.0 and every.low == pytest.approx(1.0 - edge, rel=1e-15)
     if samples >= 10**6:
         assert none.high == pytest.approx(-np.log(alpha / 2) / samples, rel=1e-5)
+
+
+class _LazyClient:
+    """A stand-in for a Dask client whose futures run their chunk when asked for the result,
+    and which records the futures it is asked to cancel."""
+
+    def __init__(self) -> None:
+        self.ran: list[int] = []
+        self.cancelled: list[object] = []
+
+    def map(self, function, runs, indices, pure):  # type: ignore[no-untyped-def]
+        client = self
+
+        class Future:
+            def __init__(self, run: object, index: int) -> None:
+                self.run, self.index = run, index
+
+            def result(self):  # type: ignore[no-untyped-def]
+                client.ran.append(self.index)
+                return function(self.run, self.index)
+
+        return [Future(r, i) for r, i in zip(runs, indices, strict=True)]
+
+    def cancel(self, futures: list[object]) -> None:
+        self.cancelled.extend(futures)
+
+
+def test_a_run_whose_results_cannot_fit_is_refused_after_its_first_chunk(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    plane = aircraft.load("b747-cruise")
+    done: list[int] = []
+    # What the first chunk measures is what the whole run keeps: its arrays' bytes per sample.
+    run = monte_carlo(plane, _LATERAL, 3000, _gains(), seed=2, chunk_size=1000)
+    kept = sum(
+        a.nbytes
+        for loop in (run.open_loop, run.closed_loop)
+        if loop is not None
+        for a in (loop.levels, loop.stable, loop.unresolved, loop.max_real, loop.controlled)
+    )
+    kept += sum(
+        a.nbytes
+        for loop in (run.open_loop, run.closed_loop)
+        if loop is not None
+        for a in loop.quantities.values()
+    )
+    kept += run.failed.nbytes
+    part = robustness._run_chunk(run.source, 0)
+    measured = sum(a.nbytes for k, a in part.items() if not k.startswith("bin_")) / 1000
+    assert measured * 3000 == pytest.approx(kept, rel=1e-12)
+    # Refused with the sizes named, before the second chunk runs, locally and on a cluster.
+    monkeypatch.setattr(robustness, "_available_memory", lambda: 2.0 * measured * 10**5)
+    with pytest.raises(MemoryError, match=r"samples=200,000 keeps \d+ bytes of results per"):
+        monte_carlo(
+            plane,
+            _LATERAL,
+            200_000,
+            _gains(),
+            chunk_size=1000,
+            progress=lambda n, total: done.append(n),
+        )
+    assert done == []
+    client = _LazyClient()
+    with pytest.raises(MemoryError, match="samples=200,000"):
+        monte_carlo(plane, _LATERAL, 200_000, _gains(), chunk_size=1000, client=client)
+    assert client.ran == [0] and len(client.cancelled) == 200
+    # Half of that fits.
+    fits = monte_carlo(plane, _LATERAL, 100_000, _gains(), chunk_size=50_000)
+    assert fits.samples == 100_000
+    monkeypatch.setattr(robustness, "_available_memory", lambda: None)  # not known: run
+    assert monte_carlo(plane, _LATERAL, 2000, chunk_size=1000).samples == 2000
+
+
+def test_available_memory_is_positive_and_below_the_machine() -> None:
+    available = robustness._available_memory()
+    if available is None:
+        pytest.skip("neither /proc/meminfo nor a cgroup limit on this system")
+    total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    assert 0 < available <= total

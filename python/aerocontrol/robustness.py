@@ -1128,6 +1128,9 @@ def monte_carlo(
         A bad argument (named), or an uncertain parameter the aircraft does not have.
     ShapeError
         Gains of the wrong shape.
+    MemoryError
+        The per-sample results of ``samples`` would not fit in the memory left (measured
+        after the first chunk, before the others run).
 
     Examples
     --------
@@ -1223,6 +1226,8 @@ def monte_carlo(
     if client is None:
         for i in indices:
             parts.append(_run_chunk(run, i))
+            if i == 0:
+                _check_results_fit(parts[0], run)
             advanced(i)
     else:
         futures = client.map(
@@ -1230,6 +1235,12 @@ def monte_carlo(
         )
         for i, future in enumerate(futures):  # in chunk order; the cluster runs them all
             parts.append(future.result())
+            if i == 0:
+                try:
+                    _check_results_fit(parts[0], run)
+                except MemoryError:
+                    client.cancel(futures)
+                    raise
             advanced(i)
     return MonteCarlo(
         aircraft=aircraft.name,
@@ -1248,6 +1259,50 @@ def monte_carlo(
         samples_by_bin=np.sum([part["bin_total"] for part in parts], axis=0),
         source=run,
     )
+
+
+def _check_results_fit(part: Mapping[str, NDArray[Any]], run: _Run) -> None:
+    """MemoryError, before the other chunks run, when the run's per-sample results (measured
+    on its first chunk, ``part``) would not fit in the memory this process may still use: the
+    chunks' arrays and the joined ones are both held for a moment, so twice their size."""
+    rows = run.chunk_bounds(0)[1]
+    per_sample = sum(
+        array.nbytes for key, array in part.items() if not key.startswith("bin_")
+    ) / max(rows, 1)
+    needed = 2.0 * per_sample * run.samples
+    available = _available_memory()
+    if available is not None and needed > available:
+        raise MemoryError(
+            f"samples={run.samples:,} keeps {per_sample:.0f} bytes of results per sample, "
+            f"about {needed / 2**30:,.1f} GiB with the joining of the chunks, and this process "
+            f"may use about {available / 2**30:,.1f} GiB more: run fewer samples (the "
+            "probabilities' intervals narrow as 1/sqrt(samples)), or several runs of other "
+            "seeds"
+        )
+
+
+def _available_memory() -> float | None:
+    """The bytes of memory this process may still take: the kernel's MemAvailable, less
+    where a cgroup's limit is nearer; None where neither is known (not Linux)."""
+    available: float | None = None
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    available = float(line.split()[1]) * 1024.0
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        with open("/sys/fs/cgroup/memory.max", encoding="ascii") as limit_file:
+            limit = limit_file.read().strip()
+        with open("/sys/fs/cgroup/memory.current", encoding="ascii") as current_file:
+            current = float(current_file.read().strip())
+        if limit != "max":
+            room = float(limit) - current
+            available = room if available is None else min(available, room)
+    except (OSError, ValueError):
+        pass
+    return available
 
 
 def _level(value: object, name: str) -> int:
