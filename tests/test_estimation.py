@@ -247,11 +247,17 @@ def kalman_recursion(
     W = G @ QN @ G.T
     S = np.zeros((A.shape[0], C.shape[0])) if NN is None else G @ NN
     P = W.copy()
+    # Until the step is 0 to 1e-16, or has not shrunk in 200 iterations (rounding's floor).
+    smallest, since = np.inf, 0
     for _ in range(100_000):
         innovation = C @ P @ C.T + RN
         L = (A @ P @ C.T + S) @ np.linalg.inv(innovation)
         P_next = symmetric(A @ P @ A.T + W - L @ innovation @ L.T)
-        if np.linalg.norm(P_next - P) <= 1e-16 * np.linalg.norm(P):
+        step = np.linalg.norm(P_next - P)
+        if step <= 1e-16 * np.linalg.norm(P):
+            break
+        smallest, since = (step, 0) if step < smallest else (smallest, since + 1)
+        if since == 200:
             break
         P = P_next
     innovation = C @ P @ C.T + RN
