@@ -140,14 +140,23 @@ pub(crate) fn balanced_hessenberg<O: Order>(mut h: Square<O>) -> (Square<O>, f64
 }
 
 /// Householder reduction to upper Hessenberg form in place, H = Q^T A Q; `q` (the identity on
-/// entry) becomes Q. Reflector k maps column k below the subdiagonal onto e_{k+1}.
+/// entry) becomes Q. Reflector k maps column k below the subdiagonal onto e_{k+1}. Any order
+/// (the reflectors on the stack up to [`UNBLOCKED_HESSENBERG_MAX_ORDER`], on the heap beyond);
+/// above that order faer's blocked reduction is faster, where the caller can take it.
 pub(crate) fn reduce_to_hessenberg<O: Order>(h: &mut Square<O>, mut q: Option<&mut Square<O>>) {
     clear_upper_avx_state();
     let n = h.nrows();
-    let mut w = [0.0; UNBLOCKED_HESSENBERG_MAX_ORDER];
+    let mut on_stack = [0.0; UNBLOCKED_HESSENBERG_MAX_ORDER];
+    let mut on_heap = Vec::new();
+    let buffer: &mut [f64] = if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
+        &mut on_stack
+    } else {
+        on_heap.resize(n, 0.0);
+        &mut on_heap
+    };
     for k in 0..n.saturating_sub(2) {
         let length = n - k - 1;
-        let w = &mut w[..length];
+        let w = &mut buffer[..length];
         for (r, x) in w.iter_mut().enumerate() {
             *x = h[(k + 1 + r, k)];
         }
@@ -171,6 +180,26 @@ pub(crate) fn reduce_to_hessenberg<O: Order>(h: &mut Square<O>, mut q: Option<&m
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_plain_reduction_reconstructs_at_every_order() {
+        use crate::linalg::matrix::from_faer;
+        // Past the stack buffer's order too (the root locus reduces loops of any order).
+        for n in [1usize, 2, 32, 33, 34, 40, 70] {
+            let a = Mat::from_fn(n, n, |i, j| ((i * 7 + j * 13) % 17) as f64 / 8.0 - 1.0);
+            let mut h = from_faer(a.as_ref());
+            let mut q = from_faer(Mat::<f64>::identity(n, n).as_ref());
+            reduce_to_hessenberg(&mut h, Some(&mut q));
+            let (h, q) = (h.to_faer(), q.to_faer());
+            for j in 0..n {
+                for i in j + 2..n {
+                    assert_eq!(h[(i, j)], 0.0);
+                }
+            }
+            let residual = (&q * &h * q.transpose() - &a).norm_l2() / a.norm_l2().max(1.0);
+            assert!(residual < 1e-14, "n={n}: {residual}");
+        }
+    }
 
     #[test]
     fn reconstructs_and_is_orthogonal() {
