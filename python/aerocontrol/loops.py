@@ -2420,6 +2420,10 @@ class _Objective:
             return -1.0  # a gain that leaves the closed loop unstable is never the best
         return zeta
 
+    def damping(self, k: float) -> float:
+        """ζ(k) itself, whether or not another pole is unstable (for gain_for_damping)."""
+        return self.pole(k)[0]
+
 
 #: Decades of the default gain grid on each side of 1/|L| at the loop's modes.
 GAIN_DECADES = 3.0
@@ -2565,7 +2569,10 @@ def gain_for_damping(
     """The smallest gain k ≥ 0 of 1 + k L(s) = 0 at which the least-damped oscillatory mode
     (or the mode tracked from the open-loop pole ``mode``) has damping ratio ``zeta``.
 
-    The damping ratio counts as 1 where no pole oscillates. The first grid interval where the
+    The damping ratio counts as 1 where no pole oscillates. It is that mode's alone: another
+    pole may leave the closed loop unstable at the gain found (an unstable real pole, as an
+    aircraft's spiral mode, beside the Dutch roll a damper is for; and a negative ``zeta`` is
+    itself an unstable mode), so check ``closed_loop_poles``. The first grid interval where the
     damping crosses ``zeta`` (rising, as a damper's, or falling, as a high-gain loop's) is
     refined by Brent's method. A damping that no gain of the grid reaches is refused, naming
     the nearest one.
@@ -2624,7 +2631,7 @@ def gain_for_damping(
     tracked = _mode(mode)
     k = _search_gains(model, gains)
     objective = _Objective(model, tracked, k)
-    values = np.array([objective(float(g)) for g in k]) - target
+    values = np.array([objective.damping(float(g)) for g in k]) - target
     if values[0] == 0:
         z, pole, poles = objective.pole(float(k[0]))
         return DampingDesign(float(k[0]), z, pole, poles)
@@ -2638,7 +2645,7 @@ def gain_for_damping(
     j = int(crossed[0]) + 1
 
     def shifted(g: float) -> float:
-        return objective(g) - target
+        return objective.damping(g) - target
 
     found = _brent(
         shifted, float(k[j - 1]), float(k[j]), float(values[j - 1]), float(values[j]), 0.0
