@@ -762,6 +762,37 @@ def test_gain_for_damping_closed_forms() -> None:
         gain_for_damping(loop, 0.9, mode=pole, gains=[0.0, 0.1, 0.2])  # ζ at most 0.1
 
 
+@pytest.mark.parametrize("dt", [1e13, 1e100, 1e-13])
+def test_margins_of_a_discrete_loop_sampled_every_1e13_seconds(dt: float) -> None:
+    """Found by a hostile-input hunt: the default grid of a discrete loop counted every root
+    ln(z)/dt below 1e-12 rad/s as at the origin (a threshold in rad/s), so for dt of 1e13 s
+    the grid spanned only θ = ω dt of 0.314 to π: the gain crossover at θ = 0.0625 was missed
+    (phase margin ∞, silently), the stability margin 0.95 for 0.534 and disk_margins raised.
+
+    2/(s (s + 1)) held at 0.05 (the matrices of scipy's cont2discrete) with its period
+    changed: margins are the same in θ. Oracle: python-control's stability_margins of the loop
+    at dt = 1 (GM 20.16806, PM 36.88134° at θ = 0.0624747, min |1 + L| = 0.5339826 at
+    θ = 0.076855), frequencies scaled by 1/dt; the disk margin that of dt = 1."""
+    A = np.array([[1.0, 0.04877057549928599], [0.0, 0.951229424500714]])
+    B = np.array([[0.00245884900142802], [0.09754115099857198]])
+    loop = aerocontrol.StateSpace(A, B, [[1.0, 0.0]], [[0.0]], dt=dt)
+    m = stability_margins(loop)
+    assert m.gain_margin == pytest.approx(20.168060160150446, rel=1e-8)
+    assert m.phase_margin == pytest.approx(36.88134203394145, rel=1e-8)
+    assert m.gain_crossover * dt == pytest.approx(0.062474738618995544, rel=1e-8)
+    assert m.stability_margin == pytest.approx(0.5339825697213723, rel=1e-8)
+    assert m.stability_frequency * dt == pytest.approx(0.07685522990698192, rel=1e-5)
+    reference = aerocontrol.disk_margins(
+        aerocontrol.StateSpace(A, B, [[1.0, 0.0]], [[0.0]], dt=1.0)
+    )
+    margins = aerocontrol.disk_margins(loop)
+    assert margins.multiloop.alpha == pytest.approx(reference.multiloop.alpha, rel=1e-9)
+    assert m.disk_margin == pytest.approx(reference.multiloop.alpha, rel=1e-9)
+    assert margins.multiloop.frequency * dt == pytest.approx(
+        reference.multiloop.frequency, rel=1e-5
+    )
+
+
 def _cubic_gain_for_damping(a2: float, a1: float, a0: float, zeta: float) -> list[float]:
     """The gains k of s³ + a2 s² + a1 s + a0 + k = 0 with a pair of damping ratio ζ, by hand:
     the pair -ζω ± jω√(1 - ζ²) and the real root r = -a2 + 2ζω (the sum of the roots) give

@@ -519,8 +519,12 @@ def _grid(model: StateSpace) -> FloatArray:
     dt = period(model) if model.is_discrete else 0.0
     roots = np.concatenate([g.poles, g.zeros])
     if dt:
+        # In radians per sample (θ = ω dt), the grid scaled to rad/s at the end: the
+        # thresholds below are relative to max(scale, 1), which in rad/s made the grid depend
+        # on the unit of time (sampled every 1e13 s, every root counted as at the origin and
+        # the grid spanned θ of 0.314 to π only: a gain crossover at θ = 0.06 was missed).
         nonzero = roots[roots != 0]
-        s = np.log(nonzero.astype(np.complex128)) / dt
+        s = np.log(nonzero.astype(np.complex128))
     else:
         s = roots
     sizes = np.abs(s[np.isfinite(s)])
@@ -552,6 +556,8 @@ def _grid(model: StateSpace) -> FloatArray:
                 )
             if math.isfinite(log_k0):
                 low = min(low, 2.0 ** min(log_k0 / q, 1023.0) / 100.0)
+    if dt:
+        return _clustered_grid(s, low, high, 1.0) / dt
     return _clustered_grid(s, low, high, dt)
 
 
@@ -1871,7 +1877,8 @@ def _default_frequencies(model: StateSpace, closed: ComplexArray) -> FloatArray:
     """0, the grid of :func:`_clustered_grid` over two decades beyond the open- and
     closed-loop poles (where S varies), and ∞ for a continuous loop."""
     dt = period(model) if model.is_discrete else 0.0
-    s = _continuous(np.concatenate([_eigenvalues(model.A), closed]), dt)
+    # A discrete loop's grid in radians per sample (θ = ω dt), as :func:`_grid`'s.
+    s = _continuous(np.concatenate([_eigenvalues(model.A), closed]), 1.0 if dt else 0.0)
     sizes = _magnitude(s[np.isfinite(s)])
     scale = float(sizes.max(initial=0.0))
     nonzero = sizes[sizes > 1e-12 * max(scale, 1.0)]
@@ -1880,7 +1887,7 @@ def _default_frequencies(model: StateSpace, closed: ComplexArray) -> FloatArray:
         if nonzero.size
         else (1e-2, 1e2)
     )
-    grid = _clustered_grid(s, low, high, dt)
+    grid = _clustered_grid(s, low, high, 1.0) / dt if dt else _clustered_grid(s, low, high, 0.0)
     ends = [np.zeros(1), grid] + ([] if dt else [np.full(1, math.inf)])
     return np.asarray(np.concatenate(ends), dtype=np.float64)
 
