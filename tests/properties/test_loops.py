@@ -760,18 +760,14 @@ def _order_forty_loop() -> tuple[np.ndarray, ...]:
     return A, np.ones((n, 1)), C, np.zeros((1, 1))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="root-locus-order-above-33: the core's controller_hessenberg (rust/control/"
-    "root_locus.rs) runs the unblocked reduce_to_hessenberg, whose reflector buffer holds 32 "
-    "entries, at every order: a panic (RuntimeError 'range end index 39 out of range for slice "
-    "of length 32') for any SISO loop of 34 states or more",
-)
 @pytest.mark.parametrize(
     "function", ["stability_margins", "disk_margins", "root_locus", "nyquist", "gain_for_damping"]
 )
-def test_known_defect_loop_of_forty_states(function: str) -> None:
-    """Closed forms of L = 2/(s + 1): |L(jω)| = 1 at ω = √3, a phase margin of 180° - 60°;
+def test_regression_loop_of_forty_states(function: str) -> None:
+    """Found by a hostile-input hunt: the core's controller-Hessenberg form (the root locus,
+    the margins' closed-loop poles) panicked for a SISO loop of 34 states or more (its
+    reflector buffer held 32 entries; RuntimeError, not an aerocontrol error).
+    Closed forms of L = 2/(s + 1): |L(jω)| = 1 at ω = √3, a phase margin of 180° - 60°;
     the closed loop's poles -3 and -2.5, ..., -40.5; 1 + k L = 0 at s = -1 - 2k. (At 33
     states, the largest order the core reduces, these hold to 1e-13.)"""
     loop = _order_forty_loop()
