@@ -762,6 +762,87 @@ def test_gain_for_damping_closed_forms() -> None:
         gain_for_damping(loop, 0.9, mode=pole, gains=[0.0, 0.1, 0.2])  # ζ at most 0.1
 
 
+@pytest.mark.parametrize("dt", [1e13, 1e100, 1e-13])
+def test_margins_of_a_discrete_loop_sampled_every_1e13_seconds(dt: float) -> None:
+    """Found by a hostile-input hunt: the default grid of a discrete loop counted every root
+    ln(z)/dt below 1e-12 rad/s as at the origin (a threshold in rad/s), so for dt of 1e13 s
+    the grid spanned only θ = ω dt of 0.314 to π: the gain crossover at θ = 0.0625 was missed
+    (phase margin ∞, silently), the stability margin 0.95 for 0.534 and disk_margins raised.
+
+    2/(s (s + 1)) held at 0.05 (the matrices of scipy's cont2discrete) with its period
+    changed: margins are the same in θ. Oracle: python-control's stability_margins of the loop
+    at dt = 1 (GM 20.16806, PM 36.88134° at θ = 0.0624747, min |1 + L| = 0.5339826 at
+    θ = 0.076855), frequencies scaled by 1/dt; the disk margin that of dt = 1."""
+    A = np.array([[1.0, 0.04877057549928599], [0.0, 0.951229424500714]])
+    B = np.array([[0.00245884900142802], [0.09754115099857198]])
+    loop = aerocontrol.StateSpace(A, B, [[1.0, 0.0]], [[0.0]], dt=dt)
+    m = stability_margins(loop)
+    assert m.gain_margin == pytest.approx(20.168060160150446, rel=1e-8)
+    assert m.phase_margin == pytest.approx(36.88134203394145, rel=1e-8)
+    assert m.gain_crossover * dt == pytest.approx(0.062474738618995544, rel=1e-8)
+    assert m.stability_margin == pytest.approx(0.5339825697213723, rel=1e-8)
+    assert m.stability_frequency * dt == pytest.approx(0.07685522990698192, rel=1e-5)
+    reference = aerocontrol.disk_margins(
+        aerocontrol.StateSpace(A, B, [[1.0, 0.0]], [[0.0]], dt=1.0)
+    )
+    margins = aerocontrol.disk_margins(loop)
+    assert margins.multiloop.alpha == pytest.approx(reference.multiloop.alpha, rel=1e-9)
+    assert m.disk_margin == pytest.approx(reference.multiloop.alpha, rel=1e-9)
+    assert margins.multiloop.frequency * dt == pytest.approx(
+        reference.multiloop.frequency, rel=1e-5
+    )
+
+
+def _cubic_gain_for_damping(a2: float, a1: float, a0: float, zeta: float) -> list[float]:
+    """The gains k of s³ + a2 s² + a1 s + a0 + k = 0 with a pair of damping ratio ζ, by hand:
+    the pair -ζω ± jω√(1 - ζ²) and the real root r = -a2 + 2ζω (the sum of the roots) give
+    (1 - 4ζ²) ω² + 2 a2 ζ ω - a1 = 0 (the sum of the pairwise products), then
+    k = -r ω² - a0 (the product)."""
+    roots = np.roots([1.0 - 4.0 * zeta**2, 2.0 * a2 * zeta, -a1])
+    omegas = sorted(float(w.real) for w in roots if abs(w.imag) == 0.0 and w.real > 0.0)
+    return sorted((a2 - 2.0 * zeta * w) * w**2 - a0 for w in omegas)
+
+
+@pytest.mark.parametrize(
+    ("zeros", "poles", "zeta", "coefficients"),
+    [
+        # An unstable real pole (a spiral mode) beside the pair -1 ± j√3: (s - 1)(s² + 2s + 4).
+        ([], [1.0, -1.0 + 1j * math.sqrt(3.0), -1.0 - 1j * math.sqrt(3.0)], 0.45, (1, 2, -4)),
+        # The closed loop unstable below k = 2.5, where the pair (0.6 reached at k = 4.05) is
+        # real: (s - 0.5)(s² + 4s + 5).
+        ([], [0.5, -2.0 + 1j, -2.0 - 1j], 0.6, (3.5, 3.0, -2.5)),
+        # A negative ζ, an unstable pair: s (s + 1)(s + 2), ζ = 0 at k = 6.
+        ([], [0.0, -1.0, -2.0], -0.1, (3.0, 2.0, 0.0)),
+    ],
+)
+def test_gain_for_damping_of_a_mode_beside_an_unstable_pole(
+    zeros: list[complex], poles: list[complex], zeta: float, coefficients: tuple[float, ...]
+) -> None:
+    """Found by a hostile-input hunt: the damping of a gain at which another pole is unstable
+    counted as -1 (best_damping_gain's objective), so the damping ratio the docstring promises
+    was refused as not reached (the first two) or the stability boundary returned with a
+    warning (the last: k = 6, ζ = 0). The smallest gain of the closed form (a cubic's roots by
+    hand), to 1e-9."""
+    expected = min(k for k in _cubic_gain_for_damping(*coefficients, zeta) if k > 0.0)
+    loop = aerocontrol.zpk(zeros, poles, 1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        design = gain_for_damping(loop, zeta)
+    assert design.gain == pytest.approx(expected, rel=1e-9)
+    assert design.damping_ratio == pytest.approx(zeta, abs=1e-9)
+    # The closed-loop poles of 1 + k L = 0 at that gain, from the characteristic polynomial.
+    characteristic = np.poly(poles).real + np.concatenate([[0.0] * 3, [design.gain]])
+    assert np.allclose(
+        np.sort_complex(design.closed_loop_poles),
+        np.sort_complex(np.roots(characteristic)),
+        rtol=1e-9,
+        atol=1e-9,
+    )
+    if zeta != 0.6:  # (the pair of the second meets the real axis: no branch to track)
+        tracked = gain_for_damping(loop, zeta, mode=complex(poles[1]))
+        assert tracked.gain == pytest.approx(expected, rel=1e-9)
+
+
 def test_best_damping_gain_against_dense_search() -> None:
     loop = _yaw_loop(3.0)
     plane = aerocontrol.aircraft.load("b747-cruise").lateral()

@@ -523,8 +523,12 @@ def _grid(model: StateSpace) -> FloatArray:
     dt = period(model) if model.is_discrete else 0.0
     roots = np.concatenate([g.poles, g.zeros])
     if dt:
+        # In radians per sample (θ = ω dt), the grid scaled to rad/s at the end: the
+        # thresholds below are relative to max(scale, 1), which in rad/s made the grid depend
+        # on the unit of time (sampled every 1e13 s, every root counted as at the origin and
+        # the grid spanned θ of 0.314 to π only: a gain crossover at θ = 0.06 was missed).
         nonzero = roots[roots != 0]
-        s = np.log(nonzero.astype(np.complex128)) / dt
+        s = np.log(nonzero.astype(np.complex128))
     else:
         s = roots
     sizes = np.abs(s[np.isfinite(s)])
@@ -556,6 +560,8 @@ def _grid(model: StateSpace) -> FloatArray:
                 )
             if math.isfinite(log_k0):
                 low = min(low, 2.0 ** min(log_k0 / q, 1023.0) / 100.0)
+    if dt:
+        return _clustered_grid(s, low, high, 1.0) / dt
     return _clustered_grid(s, low, high, dt)
 
 
@@ -1873,7 +1879,8 @@ def _default_frequencies(model: StateSpace, closed: ComplexArray) -> FloatArray:
     """0, the grid of :func:`_clustered_grid` over two decades beyond the open- and
     closed-loop poles (where S varies), and ∞ for a continuous loop."""
     dt = period(model) if model.is_discrete else 0.0
-    s = _continuous(np.concatenate([_eigenvalues(model.A), closed]), dt)
+    # A discrete loop's grid in radians per sample (θ = ω dt), as :func:`_grid`'s.
+    s = _continuous(np.concatenate([_eigenvalues(model.A), closed]), 1.0 if dt else 0.0)
     sizes = _magnitude(s[np.isfinite(s)])
     scale = float(sizes.max(initial=0.0))
     nonzero = sizes[sizes > 1e-12 * max(scale, 1.0)]
@@ -1882,7 +1889,7 @@ def _default_frequencies(model: StateSpace, closed: ComplexArray) -> FloatArray:
         if nonzero.size
         else (1e-2, 1e2)
     )
-    grid = _clustered_grid(s, low, high, dt)
+    grid = _clustered_grid(s, low, high, 1.0) / dt if dt else _clustered_grid(s, low, high, 0.0)
     ends = [np.zeros(1), grid] + ([] if dt else [np.full(1, math.inf)])
     return np.asarray(np.concatenate(ends), dtype=np.float64)
 
@@ -2422,6 +2429,10 @@ class _Objective:
             return -1.0  # a gain that leaves the closed loop unstable is never the best
         return zeta
 
+    def damping(self, k: float) -> float:
+        """ζ(k) itself, whether or not another pole is unstable (for gain_for_damping)."""
+        return self.pole(k)[0]
+
 
 #: Decades of the default gain grid on each side of 1/|L| at the loop's modes.
 GAIN_DECADES = 3.0
@@ -2567,7 +2578,10 @@ def gain_for_damping(
     """The smallest gain k ≥ 0 of 1 + k L(s) = 0 at which the least-damped oscillatory mode
     (or the mode tracked from the open-loop pole ``mode``) has damping ratio ``zeta``.
 
-    The damping ratio counts as 1 where no pole oscillates. The first grid interval where the
+    The damping ratio counts as 1 where no pole oscillates. It is that mode's alone: another
+    pole may leave the closed loop unstable at the gain found (an unstable real pole, as an
+    aircraft's spiral mode, beside the Dutch roll a damper is for; and a negative ``zeta`` is
+    itself an unstable mode), so check ``closed_loop_poles``. The first grid interval where the
     damping crosses ``zeta`` (rising, as a damper's, or falling, as a high-gain loop's) is
     refined by Brent's method. A damping that no gain of the grid reaches is refused, naming
     the nearest one.
@@ -2626,7 +2640,7 @@ def gain_for_damping(
     tracked = _mode(mode)
     k = _search_gains(model, gains)
     objective = _Objective(model, tracked, k)
-    values = np.array([objective(float(g)) for g in k]) - target
+    values = np.array([objective.damping(float(g)) for g in k]) - target
     if values[0] == 0:
         z, pole, poles = objective.pole(float(k[0]))
         return DampingDesign(float(k[0]), z, pole, poles)
@@ -2640,7 +2654,7 @@ def gain_for_damping(
     j = int(crossed[0]) + 1
 
     def shifted(g: float) -> float:
-        return objective(g) - target
+        return objective.damping(g) - target
 
     found = _brent(
         shifted, float(k[j - 1]), float(k[j]), float(values[j - 1]), float(values[j]), 0.0

@@ -750,6 +750,51 @@ def test_known_defect_frequency_point_overflow() -> None:
         )
 
 
+def _order_forty_loop() -> tuple[np.ndarray, ...]:
+    """L = 2/(s + 1) as a loop of 40 states: A = diag(-1, -2.5, -3.5, ..., -40.5), B = 1,
+    C = 2 e_1 (the other 39 modes unobservable, apart from every closed-loop pole below)."""
+    n = 40
+    A = np.diag(np.append(-1.0, 0.5 - np.arange(3.0, n + 2.0)))
+    C = np.zeros((1, n))
+    C[0, 0] = 2.0
+    return A, np.ones((n, 1)), C, np.zeros((1, 1))
+
+
+@pytest.mark.parametrize(
+    "function", ["stability_margins", "disk_margins", "root_locus", "nyquist", "gain_for_damping"]
+)
+def test_regression_loop_of_forty_states(function: str) -> None:
+    """Found by a hostile-input hunt: the core's controller-Hessenberg form (the root locus,
+    the margins' closed-loop poles) panicked for a SISO loop of 34 states or more (its
+    reflector buffer held 32 entries; RuntimeError, not an aerocontrol error).
+    Closed forms of L = 2/(s + 1): |L(jω)| = 1 at ω = √3, a phase margin of 180° - 60°;
+    the closed loop's poles -3 and -2.5, ..., -40.5; 1 + k L = 0 at s = -1 - 2k. (At 33
+    states, the largest order the core reduces, these hold to 1e-13.)"""
+    loop = _order_forty_loop()
+    rest = 0.5 - np.arange(3.0, 42.0)
+    if function == "stability_margins":
+        margins = aerocontrol.stability_margins(loop)
+        assert margins.gain_crossover == pytest.approx(math.sqrt(3.0), rel=1e-12)
+        assert margins.phase_margin == pytest.approx(120.0, rel=1e-12)
+        poles = np.sort(margins.closed_loop_poles.real)
+        assert np.allclose(poles, np.sort(np.append(rest, -3.0)), rtol=1e-12)
+    elif function == "disk_margins":
+        # |S - T|/2 = |1 - L|/|1 + L| / 2 = |s - 1|/|s + 3| / 2 peaks at ω = ∞ (1/2): α = 2.
+        assert aerocontrol.disk_margins(loop).multiloop.alpha == pytest.approx(2.0, rel=1e-9)
+    elif function == "root_locus":
+        locus = aerocontrol.root_locus(loop, [0.5, 2.0])
+        for k, row in zip([0.5, 2.0], locus.poles, strict=True):
+            expected = np.sort(np.append(rest, -1.0 - 2.0 * k))
+            assert np.allclose(np.sort(row.real), expected, rtol=1e-12)
+            assert np.all(row.imag == 0.0)
+    elif function == "nyquist":
+        response = aerocontrol.nyquist(loop)
+        assert response.encirclements == 0
+    else:
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="not reached"):
+            aerocontrol.gain_for_damping(loop, 0.5)
+
+
 def test_regression_phase_crossover_of_badly_scaled_states() -> None:
     """Found by an oracle hunt: the core's loop_margins missed this phase crossover (gain
     margin inf, silently), its doubled system's zeros off the axis by more than the axis
