@@ -507,7 +507,7 @@ def test_robustness_too_large_for_memory_is_one_line_after_the_first_chunk(
     from aerocontrol import robustness
 
     monkeypatch.setattr(robustness, "_available_memory", lambda: 2.0**20)
-    status, out, err = _run(capsys, "robustness", "b747-cruise", "--samples", "10000000000")
+    status, _out, err = _run(capsys, "robustness", "b747-cruise", "--samples", "10000000000")
     assert status != 0 and "Traceback" not in err
     assert "out of memory (samples=10,000,000,000 keeps" in err
     assert err.count("\n") == 1
