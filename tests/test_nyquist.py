@@ -652,3 +652,49 @@ def test_unstable_closed_loop_of_badly_scaled_states_is_not_marginal() -> None:
     assert result.open_loop_unstable_poles == 0
     assert result.encirclements == -1
     assert not result.closed_loop_stable
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.3, 0.9273, 2.0, 3.0])
+@pytest.mark.parametrize("discrete", [False, True])
+def test_a_double_pole_on_the_boundary_is_counted_alike_in_any_coordinates(
+    angle: float, discrete: bool
+) -> None:
+    """1/s² (the discrete double integrator, poles at z = 1) after a lag, in states rotated by
+    the angle: its poles come out ±1e-8 or so off the boundary, on a side set by the rotation.
+    On the boundary to their accuracy, they are neither P nor Z, and stability_margins and
+    nyquist count alike: P = 0, and N = -Z."""
+    Q = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+    if discrete:
+        A, dt, lag = np.array([[1.0, 1.0], [0.0, 1.0]]), 0.1, [[0.5]]
+    else:
+        A, dt, lag = np.array([[0.0, 1.0], [0.0, 0.0]]), None, [[-10.0]]
+    double = aerocontrol.StateSpace(Q @ A @ Q.T, Q @ [[0.0], [1.0]], [[1.0, 0.0]] @ Q.T, dt=dt)
+    loop = aerocontrol.series(double, aerocontrol.StateSpace(lag, [[1.0]], [[2.0]], dt=dt))
+    margins = aerocontrol.stability_margins(loop)
+    curve = aerocontrol.nyquist(loop)
+    assert margins.open_loop_unstable_poles == curve.open_loop_unstable_poles == 0
+    assert margins.encirclements == curve.encirclements == -curve.closed_loop_unstable_poles
+    # The closed loop: s²(s + 10) + 2 = 0, or (z - 1)²(z - 0.5) + 2 = 0 (numpy's roots).
+    if discrete:
+        expected = int(np.sum(np.abs(np.roots([1.0, -2.5, 2.0, 1.5])) > 1.0))
+    else:
+        expected = int(np.sum(np.roots([1.0, 10.0, 0.0, 2.0]).real > 0.0))
+    assert expected == 2
+    assert curve.closed_loop_unstable_poles == expected and not margins.closed_loop_stable
+
+
+@pytest.mark.parametrize("scale", [1e-9, 1.0, 1e6, 1e9, 1e12])
+def test_an_unstable_pole_in_badly_scaled_states_is_counted(scale: float) -> None:
+    """3/((s - 0.001)(s + 2)) with its second state scaled: ||A|| grows to 1e12, and a tolerance
+    of √u ||A|| (1.5e4) put the pole at +0.001 on the axis: P = N = 0, silently. Counted from
+    the balanced loop: P = 1, N = 1, Z = 0 at every scale (the closed loop s² + 1.999 s + 2.998
+    is stable)."""
+    T = np.diag([1.0, scale])
+    A = T @ np.array([[0.001, 0.0], [1.0, -2.0]]) @ np.linalg.inv(T)
+    loop = aerocontrol.StateSpace(A, T @ [[1.0], [0.0]], [[0.0, 3.0]] @ np.linalg.inv(T))
+    curve = aerocontrol.nyquist(loop)
+    margins = aerocontrol.stability_margins(loop)
+    counts = (curve.open_loop_unstable_poles, curve.encirclements, curve.closed_loop_unstable_poles)
+    assert counts == (1, 1, 0)
+    assert (margins.open_loop_unstable_poles, margins.encirclements) == (1, 1)
+    assert margins.closed_loop_stable

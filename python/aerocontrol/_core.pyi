@@ -141,6 +141,7 @@ def loop_margins(
     NDArray[np.complex128],
     bool,
     float,
+    float,
 ]: ...
 def root_locus(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, gains: ArrayLike, /

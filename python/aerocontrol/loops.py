@@ -89,6 +89,7 @@ ACM 7(4), 1960 (its start).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import warnings
 from collections.abc import Callable
@@ -304,12 +305,18 @@ def _unstable(roots: ComplexArray, discrete: bool) -> NDArray[np.bool_]:
     return np.abs(roots) > 1.0 if discrete else roots.real > 0.0
 
 
-def _unstable_count(roots: ComplexArray, discrete: bool) -> int:
-    """The number of roots strictly outside the stability region (scalar arithmetic: a
-    loop's few poles)."""
-    if discrete:
-        return sum(math.hypot(r.real, r.imag) > 1.0 for r in roots.tolist())
-    return sum(r.real > 0.0 for r in roots.tolist())
+def _unstable_count(
+    roots: ComplexArray, discrete: bool, size: float, matrix: Callable[[], FloatArray]
+) -> int:
+    """The number of roots outside the stability region and not on its boundary
+    (:func:`_boundary_flags` with the balanced ``size`` of their ``matrix``): a root on the
+    boundary to its accuracy is on the side rounding put it, which is not a property of the
+    loop (the double integrator 1/s² in rotated coordinates has its poles computed as
+    ±1.5e-8, and was counted one unstable pole or none by the rotation). As :func:`nyquist`
+    counts P and Z. Scalar arithmetic: a loop's few poles."""
+    distances = _outward_distances(roots, discrete)
+    flags = _boundary_flags(roots, distances, discrete, size, matrix)
+    return sum(x > 0.0 and not on for x, on in zip(distances, flags, strict=True))
 
 
 def _eigenvalues(A: FloatArray) -> ComplexArray:
@@ -836,8 +843,11 @@ def stability_margins(loop: System) -> StabilityMargins:
             margins = _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
             # The open-loop poles of the slowed loop, A 2^-e, may underflow (a pole 1.3e-301
             # beside B C of 1.6e148 became 0, not unstable): counted from A itself.
-            unstable_open = _unstable_count(_eigenvalues(model.A), False)
-            unstable_closed = _unstable_count(margins.closed_loop_poles, False)
+            open_matrix = balanced_states(model).A
+            unstable_open = _unstable_count(
+                _eigenvalues(open_matrix), False, _balanced_size(open_matrix), lambda: open_matrix
+            )
+            unstable_closed = margins.open_loop_unstable_poles - margins.encirclements
             return dataclasses.replace(
                 margins,
                 open_loop_unstable_poles=unstable_open,
@@ -930,6 +940,7 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         open_poles,
         degenerate,
         closed_size,
+        open_size,
     ) = _core.loop_margins(model.A, model.B, model.C, model.D)
     if degenerate:
         # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
@@ -940,15 +951,16 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         for w, value in zip(phase_w.tolist(), phase_values.tolist(), strict=True)
         if value.real < 0.0
     ]
+    closed_matrix = functools.partial(_closed_matrix, model)
     return _assemble(
         phase_crossings,
         list(zip(gain_w.tolist(), gain_values.tolist(), strict=True)),
         disk=(float(disk_w), float(disk_peak)),
         stability=(float(stab_w), 1.0 / float(sensitivity_peak)),
         closed=closed,
-        stable=_closed_loop_stable(closed, False, closed_size),
-        unstable_open=_unstable_count(open_poles, False),
-        unstable_closed=_unstable_count(closed, False),
+        stable=_closed_loop_stable(closed, False, closed_size, closed_matrix),
+        unstable_open=_unstable_count(open_poles, False, open_size, lambda: model.A),
+        unstable_closed=_unstable_count(closed, False, closed_size, closed_matrix),
     )
 
 
@@ -958,10 +970,15 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
     a loop real on the whole imaginary axis (its phase-crossover pencil is singular)."""
     discrete = model.is_discrete
     closed = _closed_loop_poles(model, np.ones(1))[0]
-    open_poles = _eigenvalues(model.A)
-    stable = _closed_loop_stable(closed, discrete, _balanced_size(_closed_matrix(model)))
-    unstable_open = _unstable_count(open_poles, discrete)
-    unstable_closed = _unstable_count(closed, discrete)
+    open_matrix = balanced_states(model).A
+    open_poles = _eigenvalues(open_matrix)
+    closed_matrix = _closed_matrix(model)
+    closed_size = _balanced_size(closed_matrix)
+    stable = _closed_loop_stable(closed, discrete, closed_size, lambda: closed_matrix)
+    unstable_open = _unstable_count(
+        open_poles, discrete, _balanced_size(open_matrix), lambda: open_matrix
+    )
+    unstable_closed = _unstable_count(closed, discrete, closed_size, lambda: closed_matrix)
 
     response = _Response(model)
     omega = _grid(model)
@@ -2053,7 +2070,9 @@ def disk_margins(loop: System, omega: ArrayLike | None = None, skew: float = 0.0
     sensitivity = _Sensitivity(model, sigma)
     A_closed = sensitivity.model.A
     closed = _backward_stable_eigenvalues(A_closed, _eigenvalues(A_closed))
-    stable = _closed_loop_stable(closed, model.is_discrete, _balanced_size(A_closed))
+    stable = _closed_loop_stable(
+        closed, model.is_discrete, _balanced_size(A_closed), lambda: A_closed
+    )
     loops = tuple(stability_margins(_broken_loop(model, i)) for i in range(p))
     names = model.input_names
     if not stable:
@@ -2758,24 +2777,67 @@ def _closed_matrix(model: StateSpace) -> FloatArray:
         )
 
 
-def _closed_loop_stable(closed: ComplexArray, discrete: bool, size: float) -> bool:
+def _closed_loop_stable(
+    closed: ComplexArray, discrete: bool, size: float, matrix: Callable[[], FloatArray]
+) -> bool:
     """Whether every closed-loop pole lies strictly inside the stability region, none of them
-    on its boundary to :func:`_boundary_tolerance` of ``size``, the balanced closed-loop
-    matrix's (:func:`_balanced_size`, or the core's): a mode at the origin that the loop does
-    not reach (a pole of L cancelled by a zero there) stays at 0, computed as ±1e-16 or so,
-    and its sign is rounding, so such a loop is not stable rather than stable or unstable by
-    chance. (A NaN pole is neither inside nor on the boundary: not stable.)"""
-    roots = closed.tolist()
-    if discrete:
-        distances = [math.hypot(r.real, r.imag) - 1.0 for r in roots]  # from the circle
-    else:
-        distances = [r.real for r in roots]
+    on its boundary (:func:`_boundary_flags` with ``size``, the balanced closed-loop matrix's
+    (:func:`_balanced_size`, or the core's), and the closed-loop ``matrix``): a mode at the
+    origin that the loop does not reach (a pole of L cancelled by a zero there) stays at 0,
+    computed as ±1e-16 or so, and its sign is rounding, so such a loop is not stable rather
+    than stable or unstable by chance. (A NaN pole is neither inside nor on the boundary: not
+    stable.)"""
+    distances = _outward_distances(closed, discrete)
     if not all(x < 0.0 for x in distances):
         return False
-    if not math.isfinite(size):  # B C beyond the range of doubles: the poles' own size
-        size = max((math.hypot(r.real, r.imag) for r in roots), default=0.0)
+    return not any(_boundary_flags(closed, distances, discrete, size, matrix))
+
+
+def _outward_distances(roots: ComplexArray, discrete: bool) -> list[float]:
+    """Each root's signed distance outward from the stability boundary: Re s, or |z| - 1."""
+    if discrete:
+        return [math.hypot(r.real, r.imag) - 1.0 for r in roots.tolist()]
+    return [r.real for r in roots.tolist()]
+
+
+def _boundary_flags(
+    roots: ComplexArray,
+    distances: list[float],
+    discrete: bool,
+    size: float,
+    matrix: Callable[[], FloatArray],
+) -> list[bool]:
+    """Which roots (eigenvalues of ``matrix``, at the outward ``distances``) lie on the
+    stability boundary to their accuracy: within :func:`_boundary_tolerance` of ``size`` (the
+    error of a double root, the worst a flight loop has), and, for those, within their
+    first-order error bound n u ||M|| κ(λ) in the balanced coordinates M the eigenvalues are
+    computed in, with κ(λ) = 1/|yᴴx| from the left and right singular vectors of M - λI
+    (Golub & Van Loan, Matrix Computations, §7.2.2). A defective root (the double
+    integrator's, κ ~ 1/√u) stays on the boundary; a simple one in badly scaled coordinates
+    (+0.001 beside an entry of 1e6, √u ||M|| = 0.015) is off it, as it is computed. The
+    ``matrix`` is formed only when a root is near the boundary; where it is not finite, the
+    tolerance alone decides. A size beyond the doubles (B C overflows) is replaced by the
+    roots' own."""
+    if not math.isfinite(size):
+        size = max((math.hypot(r.real, r.imag) for r in roots.tolist()), default=0.0)
     tolerance = _boundary_tolerance(size, discrete)
-    return not any(abs(x) <= tolerance for x in distances)
+    flags = [abs(x) <= tolerance for x in distances]
+    if not any(flags):
+        return flags
+    formed = matrix()
+    if not np.all(np.isfinite(formed)):
+        return flags
+    balanced = balanced_matrix(formed)
+    n = balanced.shape[0]
+    unit = n * _EPS * _matrix_size(balanced)
+    for i in (i for i, flag in enumerate(flags) if flag):
+        shifted = balanced - roots[i] * np.eye(n)
+        if not np.all(np.isfinite(shifted)):
+            continue
+        left, _, right = np.linalg.svd(shifted)
+        overlap = abs(complex(np.vdot(left[:, -1], right[-1].conj())))
+        flags[i] = overlap == 0.0 or abs(distances[i]) <= unit / overlap
+    return flags
 
 
 def _matrix_size(M: FloatArray) -> float:
@@ -3080,18 +3142,27 @@ class _Poles:
 
 
 def _poles(model: StateSpace, closed_loop: bool) -> _Poles:
-    """The open- and closed-loop poles and which lie on the stability boundary. The open-loop
-    poles and their tolerance come from A (whose eigenvalues the core balances itself); the
-    closed-loop ones from the loop with its states balanced (:func:`balanced_states`), and
-    their tolerance from the size of that closed loop: the core's root-locus QR is unbalanced,
-    so its errors are relative to the matrix it is given, and a tolerance from the unbalanced
-    size (2e11 for states scaled by 10^±6) counted a closed-loop pole at +0.37 as on the
-    axis."""
+    """The open- and closed-loop poles and which lie on the stability boundary
+    (:func:`_boundary_flags`), all from the loop with its states balanced with B and C
+    (:func:`balanced_states`), as :func:`stability_margins` computes them: a tolerance from
+    the unbalanced size (1e6 for states scaled by 10^±6) put an open-loop pole at +0.001 on
+    the axis, and P and N at 0; and the closed-loop poles' tolerance from the size of that
+    closed loop: the core's root-locus QR is unbalanced, so its errors are relative to the
+    matrix it is given, and a tolerance from the unbalanced size (2e11 for states scaled by
+    10^±6) counted a closed-loop pole at +0.37 as on the axis."""
     discrete = model.is_discrete
+    model = balanced_states(model)
     open_poles = _eigenvalues(model.A)
-    tolerance = _boundary_tolerance(_matrix_size(model.A), discrete)
+    open_size = _balanced_size(model.A)
+    open_matrix = model.A
+    open_boundary = _boundary_flags(
+        open_poles,
+        _outward_distances(open_poles, discrete),
+        discrete,
+        open_size,
+        lambda: open_matrix,
+    )
     if closed_loop:
-        model = balanced_states(model)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NumericalOverflowWarning)
             closed = _closed_loop_poles(model, np.ones(1))[0]
@@ -3100,20 +3171,22 @@ def _poles(model: StateSpace, closed_loop: bool) -> _Poles:
                 "nyquist: the closed-loop poles overflow double precision, so the unstable "
                 "ones (Z) cannot be counted"
             )
-        with np.errstate(over="ignore", invalid="ignore"):
-            matrix = model.A - np.outer(model.B[:, 0], model.C[0]) / (1.0 + float(model.D[0, 0]))
-        size = _matrix_size(matrix)
-        if not math.isfinite(size):
-            size = float(np.max(_magnitude(closed), initial=0.0))
-        closed_tolerance = _boundary_tolerance(size, discrete)
+        matrix = _closed_matrix(model)
+        closed_boundary = _boundary_flags(
+            closed,
+            _outward_distances(closed, discrete),
+            discrete,
+            _matrix_size(matrix),
+            lambda: matrix,
+        )
     else:
-        closed, closed_tolerance = np.zeros(0, np.complex128), 0.0
+        closed, closed_boundary = np.zeros(0, np.complex128), []
     return _Poles(
         open=open_poles,
-        open_boundary=_on_boundary(open_poles, discrete, tolerance),
+        open_boundary=np.array(open_boundary, dtype=np.bool_),
         closed=closed,
-        closed_boundary=_on_boundary(closed, discrete, closed_tolerance),
-        tolerance=tolerance,
+        closed_boundary=np.array(closed_boundary, dtype=np.bool_),
+        tolerance=_boundary_tolerance(open_size, discrete),
     )
 
 

@@ -23,13 +23,14 @@ type MarginsOutput<'py> = (
     Bound<'py, PyArrayDyn<c64>>,
     bool,
     f64,
+    f64,
 );
 
 /// The crossovers of the continuous SISO loop L(s) = C (sI - A)^-1 B + D by eigenvalue
 /// methods (`control/margins.rs`): (gain-crossover ω, L there, phase-crossover ω, L there,
 /// (ω, max |1 - L|/(2|1 + L|)), (ω, max 1/|1 + L|), closed-loop poles, open-loop poles,
-/// degenerate, the balanced closed loop's Frobenius norm), every gain margin verified by a
-/// closed-loop pole.
+/// degenerate, the Frobenius norms of the closed loop and of A each balanced alone), every
+/// gain margin verified by a closed-loop pole.
 #[pyfunction]
 #[pyo3(signature = (a, b, c, d, /))]
 fn loop_margins<'py>(
@@ -77,6 +78,7 @@ fn loop_margins<'py>(
         )?,
         margins.degenerate,
         margins.closed_loop_size,
+        margins.open_loop_size,
     );
     outputs.finish()?;
     Ok(result)

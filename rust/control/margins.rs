@@ -116,6 +116,8 @@ pub struct LoopMargins {
     /// ||A - B (1 + d)^-1 C||_F of the closed loop balanced alone ([`balanced_states`]): the
     /// size the closed-loop poles' errors are relative to (the boundary tolerance).
     pub closed_loop_size: f64,
+    /// ||A||_F of A balanced alone: the size the open-loop poles' errors are relative to.
+    pub open_loop_size: f64,
 }
 
 /// Relative distance from the imaginary axis within which an eigenvalue is a candidate.
@@ -721,6 +723,8 @@ pub fn loop_margins(
     let empty = Mat::<f64>::zeros(n, 0);
     let closed_balanced = balanced_states(closed.as_ref(), empty.as_ref(), empty.transpose())
         .map_or(closed, |(m, _, _)| m);
+    let open_size = balanced_states(a, empty.as_ref(), empty.transpose())
+        .map_or_else(|| frobenius_norm(a), |(m, _, _)| frobenius_norm(m.as_ref()));
     Ok(LoopMargins {
         gain_crossovers,
         phase_crossovers,
@@ -730,6 +734,7 @@ pub fn loop_margins(
         open_loop_poles,
         degenerate,
         closed_loop_size: frobenius_norm(closed_balanced.as_ref()),
+        open_loop_size: open_size,
     })
 }
 
