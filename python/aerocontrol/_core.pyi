@@ -25,6 +25,7 @@ __all__ = [
     "companion_form",
     "controllability",
     "dare_batch",
+    "dc_gain",
     "discretize",
     "eigenvalues",
     "exception_classes",
@@ -125,6 +126,7 @@ def simulate_models(
 def steady_state(
     a: ArrayLike, b: ArrayLike, eta0: ArrayLike, warn: bool, /
 ) -> NDArray[np.float64]: ...
+def dc_gain(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /) -> NDArray[np.float64]: ...
 def balance_states(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...

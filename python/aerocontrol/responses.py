@@ -1223,6 +1223,12 @@ def dc_gain(sys: System) -> FloatArray:
     aerocontrol.exceptions.SingularMatrixError: A is singular: it has the eigenvalue 0 ...
     """
     A, B, C, D, dt = plant_arrays(sys)
+    if not dt:
+        try:
+            gain: FloatArray = _core.dc_gain(A, B, C, D)  # one call: a small model's cost
+            return gain
+        except SingularMatrixError:
+            pass  # singular, or merely badly scaled: the equilibrated solve below decides
     # Every input's steady state from one factorisation; one warning, for the gain.
     weights = identity(B.shape[1])
     states = (
@@ -1231,5 +1237,5 @@ def dc_gain(sys: System) -> FloatArray:
         else _equilibrated_solve(A, B, weights, False)
     )
     with np.errstate(over="ignore", invalid="ignore"):
-        gain: FloatArray = C @ states + D
+        gain = C @ states + D
     return finite_or_warn(gain, "the DC gain")

@@ -7,8 +7,9 @@ use super::errors::to_py_err;
 use super::linalg::{discretize_cost, hold_from_method};
 use super::statespace::ModelArgs;
 use crate::control::responses::{
-    Input, Model, OUTPUT_PRODUCT_MIN_ORDER, Sampling, simulate_models_sampled_into,
-    simulate_sampled_into, steady_state as steady_state_core, uniform_grid_step,
+    Input, Model, OUTPUT_PRODUCT_MIN_ORDER, Sampling, dc_gain as dc_gain_core,
+    simulate_models_sampled_into, simulate_sampled_into, steady_state as steady_state_core,
+    uniform_grid_step,
 };
 use crate::error::Error;
 use faer::MatRef;
@@ -289,7 +290,33 @@ fn steady_state<'py>(
     Ok(out)
 }
 
+/// D - C A^-1 B, the DC gain (p x m) of a continuous model, from one LU factorisation; the
+/// error of a singular A names its eigenvalue at zero. A gain that overflows comes with a
+/// NumericalOverflowWarning.
+#[pyfunction]
+#[pyo3(signature = (a, b, c, d, /))]
+fn dc_gain<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    d: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let args = ModelArgs::convert(py, a, b, c, d)?;
+    let model = args.model().map_err(|e| to_py_err(py, e))?;
+    let n = model.a.nrows();
+    let cost = Cost::of(2.0 * (n as f64).powi(3), 3.0, n);
+    let gain = compute(py, cost, || {
+        dc_gain_core(model.a, model.b, model.c, model.d)
+    })?;
+    let mut outputs = Outputs::new(py);
+    let out = outputs.matrix("the DC gain", gain.as_ref())?;
+    outputs.finish()?;
+    Ok(out)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(dc_gain, m)?)?;
     m.add_function(wrap_pyfunction!(grid_step, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_models, m)?)?;

@@ -23,7 +23,7 @@
 use crate::control::discretize::{Discretization, Hold, discretize};
 use crate::control::frequency::check_state_space;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_positive};
-use crate::linalg::norm::{LinearOperator, one_norm_estimate};
+use crate::linalg::norm::{LinearOperator, one_norm_estimate, triangular_inverse_norm_bound};
 use crate::platform::interrupt;
 use crate::platform::parallel::{ParallelContext, chunks, par_chunks};
 use faer::linalg::matmul::matmul;
@@ -496,14 +496,21 @@ pub fn steady_state(
     let lu = a.partial_piv_lu();
     let mut x = -(b * eta0);
     lu.solve_in_place(x.as_mut());
-    // A has an eigenvalue within `tolerance` of zero only if σ_min(A) <= tolerance. The
-    // 1-norm estimate of A^-1 (Higham & Tisseur 2000; O(n^2) per step with the LU factors)
-    // bounds σ_min(A) >= 1 / (sqrt(n) ||A^-1||_1); the factor 10 covers the estimate's
-    // underestimation, which is within a factor 3 in practice. Only when that does not clear
-    // A are its eigenvalues computed, to name the one at zero.
+    // A has an eigenvalue within `tolerance` of zero only if σ_min(A) <= tolerance, and
+    // σ_min(A) >= 1 / (sqrt(n) ||A^-1||_inf). With A = P^T L U, ||A^-1||_inf is at most the
+    // product of the comparison-matrix bounds of U^-1 and L^-1 (two O(n^2) substitutions),
+    // which clears a matrix far from singular at once; where that bound is too loose, the
+    // 1-norm estimate of A^-1 (Higham & Tisseur 2000; O(n^2) per step with the LU factors;
+    // ||A^-1||_1 in place of ||A^-1||_inf, the same bound through A^T), with a factor 10 for
+    // the estimate's underestimation, within a factor 3 in practice. Only when neither
+    // clears A are its eigenvalues computed, to name the one at zero.
     let tolerance = SINGULAR_EIGENVALUE * n as f64 * f64::EPSILON * a.norm_max();
-    let inverse_norm = one_norm_estimate(&Inverse(&lu), 2);
-    let cleared = x.is_all_finite() && 10.0 * (n as f64).sqrt() * inverse_norm * tolerance < 1.0;
+    let root_n = (n as f64).sqrt();
+    let bound =
+        triangular_inverse_norm_bound(lu.U(), false) * triangular_inverse_norm_bound(lu.L(), true);
+    let cleared = x.is_all_finite()
+        && (root_n * bound * tolerance < 1.0
+            || 10.0 * root_n * one_norm_estimate(&Inverse(&lu), 2) * tolerance < 1.0);
     if !cleared {
         let (eigenvalues, _) = crate::control::modal::eigen(a)?;
         if let Some(lambda) = eigenvalues.iter().find(|l| l.norm() <= tolerance) {
@@ -515,6 +522,22 @@ pub fn steady_state(
         }
     }
     Ok(x)
+}
+
+/// The DC gain D - C A^-1 B (p x m): the steady output per unit step of each input, from the
+/// steady states (6.45) of [`steady_state`] for the m unit steps at once (one LU
+/// factorisation), with its error naming the eigenvalue that makes A singular.
+pub fn dc_gain(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    d: MatRef<'_, f64>,
+) -> Result<Mat<f64>, Error> {
+    check_state_space(a, b, c, d)?;
+    let states = steady_state(a, b, Mat::<f64>::identity(b.ncols(), b.ncols()).as_ref())?;
+    let mut gain = d.to_owned();
+    matmul(gain.as_mut(), Accum::Add, c, states.as_ref(), 1.0, Par::Seq);
+    Ok(gain)
 }
 
 /// An eigenvalue of A within this many n u ||A||_max of zero makes A singular for
