@@ -42,14 +42,17 @@ def balanced_loop(
     A: FloatArray, B: FloatArray, C: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """:func:`balanced_matrices` for the closed loops A - g B C of a SISO loop: balanced once,
-    then again with B and C each brought to the size of the balanced A by a power of two (the
-    split of the loop's gain between B and C does not change A - g B C, but it steers the
+    then again with B and C each brought by a power of two to the size of A balanced alone
+    (the split of the loop's gain between B and C does not change A - g B C, but it steers the
     balancing: A and C of 1e-60 beside B of 1 balanced to a QR that lost 2% of the poles),
-    the second scaling then undone on B and C (exact)."""
+    the second scaling then undone on B and C (exact). The size is that of A balanced alone,
+    the scale of its eigenvalues, not of A balanced with B and C: at 1e-100, B had steered
+    that one to entries of 1e-75 beside eigenvalues of 1e-100, and B and C brought to 1e-75
+    steered the second balancing as much (poles 6e-5 off)."""
     A1, B1, C1 = balanced_matrices(A, B, C)
     if A1 is A:  # not finite, or no states
         return A1, B1, C1
-    size_A = float(np.max(np.abs(A1), initial=0.0))
+    size_A = float(np.max(np.abs(balanced_matrix(A1)), initial=0.0))
     if size_A == 0.0:
         size_A = math.sqrt(float(np.max(np.abs(B1)))) * math.sqrt(float(np.max(np.abs(C1))))
     p, q = _normalising_exponent(B1, size_A), _normalising_exponent(C1, size_A)
