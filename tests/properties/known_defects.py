@@ -70,6 +70,32 @@ ZEROS_DROPPED = known_defect(
 )
 
 
+def _poles_far_apart(args: dict[str, Any]) -> bool:
+    """Nonzero eigenvalues of A whose moduli span more than 1e12."""
+    A = _models_of(args)[0][0]
+    if A.shape[0] < 2 or not np.all(np.isfinite(A)):
+        return False
+    moduli = np.abs(np.linalg.eigvals(A))
+    moduli = moduli[moduli > 0]
+    return bool(moduli.size) and float(np.max(moduli)) > 1e12 * float(np.min(moduli))
+
+
+ZEROS_SNAPPED = known_defect(
+    "zeros-snapped-to-origin",
+    {"transmission_zeros", "transfer_function", "transfer_matrix"},
+    "a finite zero at the scale of the small poles of a model whose poles lie 1e15 or more "
+    "apart is returned as 0: both the reference path (transfer._scaled_pencil_zeros, "
+    "'zeros[np.abs(zeros) <= tolerance] = 0.0') and the core's fast path "
+    "(rust/control/transfer.rs, step 3, 'Zeros within tol of the origin are 0') set to 0 a "
+    "zero below the rank tolerance of the pencil scaled to its largest pole, though QZ "
+    "resolves it there (1/(s + 1) + 1e15/(s + 1e15) has the zero -2, scipy's QZ of the "
+    "Rosenbrock pencil -2, the unsnapped value -2; aerocontrol 0, and transfer_function's G(j) "
+    "off by 1.41 beside |G| = 1.58, silently); both must change together, or "
+    "transmission_zeros and transfer_function disagree",
+    _poles_far_apart,
+)
+
+
 def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
 
