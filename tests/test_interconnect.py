@@ -280,6 +280,12 @@ def test_time_bases_must_agree() -> None:
         aerocontrol.series(continuous, sampled)
     with pytest.raises(InvalidArgumentError, match=r"dt = 0.1 s\) but sys2 is discrete \(dt = 0.2"):
         aerocontrol.feedback(sampled, other)
+    # Periods that differ in the 17th digit are told apart (:g printed 0.1 for both).
+    nearly = _random(2, 1, 1, seed=3, dt=0.1 * (1 + 1e-15))
+    with pytest.raises(
+        InvalidArgumentError, match=r"\(dt = 0.1 s\) .*\(dt = 0.10000000000000012 s\)"
+    ):
+        aerocontrol.series(sampled, nearly)
     with pytest.raises(InvalidArgumentError, match=r"systems\[0\] is discrete"):
         aerocontrol.connect([sampled, continuous])
     # A static model fits either time base, and the result takes the dynamic one's.

@@ -211,7 +211,8 @@ def _time_base(models: Sequence[StateSpace], labels: Sequence[str], function: st
         if period(model) != period(first):
 
             def describe(m: StateSpace) -> str:
-                return f"discrete (dt = {period(m):g} s)" if m.is_discrete else "continuous"
+                # repr, not :g: periods that differ in the 7th digit read the same in :g.
+                return f"discrete (dt = {period(m)!r} s)" if m.is_discrete else "continuous"
 
             raise InvalidArgumentError(
                 f"{function}: {first_label} is {describe(first)} but {label} is "
