@@ -96,6 +96,27 @@ ZEROS_SNAPPED = known_defect(
 )
 
 
+def _entry_spread(A: np.ndarray) -> float:
+    """The ratio of the largest to the smallest nonzero |entry| of A (1 for none)."""
+    entries = np.abs(A[np.isfinite(A) & (A != 0)])
+    return float(np.max(entries) / np.min(entries)) if entries.size else 1.0
+
+
+POLES_OF_GRADED_COMPANION = known_defect(
+    "poles-of-graded-companion",
+    {"transfer_function", "transfer_matrix"},
+    "the eigenvalues of a 2 x 2 block [[0, -a], [b, -c]] with c much larger than "
+    "sqrt(a b) (two real poles far apart: tf's companion form of 1e-20 s^2 + s + 1, zpk's "
+    "quadratic of two real poles that hold a zero) lose the small one: poles -1e20 and 0 for "
+    "-1e20 and -1, so that transfer_function's G(0.3 + 0.7j) is off by 131 % and G(0) is "
+    "infinite, silently. The realisation itself is exact (a solve of C (sI - A)^-1 B is right "
+    "to 1e-16); the core's eigenvalues, as LAPACK's dhseqr on this ordering, are backward "
+    "stable only normwise (u ||A|| = 1e4 here); LAPACK on the block with its states reversed "
+    "(the large entry first) finds -1",
+    lambda args: _entry_spread(_models_of(args)[0][0]) > 1e8,
+)
+
+
 def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
 

@@ -28,7 +28,7 @@ import aerocontrol
 from aerocontrol.exceptions import NumericalUnderflowWarning
 
 from .harness import Warned, exercise, plain
-from .known_defects import ZEROS_DROPPED, ZEROS_SNAPPED
+from .known_defects import POLES_OF_GRADED_COMPANION, ZEROS_DROPPED, ZEROS_SNAPPED
 from .oracles import (
     SLACK,
     TINY,
@@ -443,6 +443,20 @@ def test_known_defect_zeros_snapped_to_the_origin() -> None:
         np.testing.assert_allclose(channel.zeros, [-2.0], rtol=1e-12)
         expected = 1.0 / (1j + 1.0) + 1e15 / (1j + 1e15)
         assert abs(channel(1j) - expected) <= 1e-12 * abs(expected)
+
+
+@pytest.mark.xfail(strict=True, reason="poles-of-graded-companion: a small pole beside a large one")
+def test_known_defect_poles_of_a_graded_companion_form() -> None:
+    """1/(1e-20 s^2 + s + 1): poles -1e20 and -1 to 1e-20 (closed form, and mpmath's
+    polyroots); aerocontrol returned -1e20 and 0 (see known_defects.POLES_OF_GRADED_COMPANION).
+    """
+    model = aerocontrol.tf([1.0], [1e-20, 1.0, 1.0])
+    with POLES_OF_GRADED_COMPANION.reproducing():
+        channel = aerocontrol.transfer_function(model)
+        np.testing.assert_allclose(np.sort(channel.poles.real), [-1e20, -1.0], rtol=1e-12)
+        s = 0.3 + 0.7j
+        expected = 1.0 / (1e-20 * s * s + s + 1.0)
+        assert abs(channel(s) - expected) <= 1e-12 * abs(expected)
 
 
 def test_regression_zeros_oracle_spurious_qz_zero() -> None:
