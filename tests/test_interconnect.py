@@ -160,6 +160,12 @@ def test_selection_matches_python_control_indexing() -> None:
         (("r", 1.0), "an input selection must be a name, an index, a slice or a list"),
         ("r", r"select signals as sys\[outputs, inputs\]"),
         (("r", "rudder", 0), r"select signals as sys\[outputs, inputs\]"),
+        # Slices as Python slices lists, but refused by name: a bare TypeError for name or
+        # float bounds, ValueError for a zero step, and a bool bound taken as 0 or 1.
+        ((slice("beta", "phi"), 0), "an output slice must have integer bounds"),
+        ((slice(0.0, 2), 0), "an output slice must have integer bounds"),
+        ((slice(True, 3), 0), "an output slice must have integer bounds"),
+        (("r", slice(None, None, 0)), "an input slice must have a nonzero step"),
     ],
 )
 def test_selection_refuses_what_it_cannot_find(key: object, message: str) -> None:
