@@ -180,11 +180,14 @@ def test_interpolation_is_linear_along_each_axis_and_broadcasts() -> None:
 
 def test_conditions_outside_the_grid_raise_naming_the_argument_and_range() -> None:
     schedule = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS)
-    with pytest.raises(InvalidArgumentError, match=r"altitude must lie .*\[0, 20000\].* -1"):
+    with pytest.raises(InvalidArgumentError, match=r"altitude must lie .*\[0.0, 20000.0\].* -1"):
         schedule.gains_at(-1.0, 0.3, 5e5)
+    # Just outside: the value as given, not 20000 (:g) beside the range's 20000.
+    with pytest.raises(InvalidArgumentError, match=r"20000.0\], got 20000.0001$"):
+        schedule.gains_at(20000.0001, 0.3, 5e5)
     with pytest.raises(InvalidArgumentError, match=r"mach must lie .*\[0.2, 0.45\].* 0.5"):
         schedule.gains_at(1000.0, [0.3, 0.5], 5e5)
-    with pytest.raises(InvalidArgumentError, match=r"weight must lie .*\[450000, 650000\]"):
+    with pytest.raises(InvalidArgumentError, match=r"weight must lie .*\[450000.0, 650000.0\]"):
         schedule.gains_at(1000.0, 0.3, 7e5)
     with pytest.raises(InvalidArgumentError, match="mach must be finite"):
         schedule.gains_at(1000.0, np.nan, 5e5)

@@ -260,9 +260,10 @@ class GainSchedule(Result):
                 continue
             outside = (x < grid[0]) | (x > grid[-1])
             if outside.any():
+                # repr, not :g: 10000.0001 read as 10000, inside [0, 10000].
                 raise InvalidArgumentError(
-                    f"{name} must lie in the schedule's grid [{grid[0]:g}, {grid[-1]:g}], got "
-                    f"{x[outside].ravel()[0]:g}"
+                    f"{name} must lie in the schedule's grid [{float(grid[0])!r}, "
+                    f"{float(grid[-1])!r}], got {float(x[outside].ravel()[0])!r}"
                 )
             i = np.clip(np.searchsorted(grid, x, side="right") - 1, 0, len(grid) - 2)
             lower.append(i)

@@ -460,7 +460,7 @@ def signal_indices(key: object, names: Sequence[str], what: str) -> list[int]:
     indices. An unknown or ambiguous name, an index out of range and anything else are
     refused by name."""
     if isinstance(key, slice):
-        return list(range(len(names)))[key]
+        return list(range(len(names)))[_index_slice(key, what)]
     if isinstance(key, (str, int, np.integer)):
         return [_signal_index(key, names, what)]
     if isinstance(key, (list, tuple, np.ndarray)):
@@ -469,6 +469,23 @@ def signal_indices(key: object, names: Sequence[str], what: str) -> list[int]:
         f"an {what} selection must be a name, an index, a slice or a list of them, "
         f"got {type(key).__name__}"
     )
+
+
+def _index_slice(key: slice, what: str) -> slice:
+    """``key`` if its bounds and step are integers or None and its step is not zero; else
+    InvalidArgumentError. Python's slicing raised a bare TypeError for sys["a":"c", :] or a
+    float bound, and ValueError for a zero step; and took a bool bound as 0 or 1, which a
+    single index refuses."""
+    for part in (key.start, key.stop, key.step):
+        if part is not None and (
+            isinstance(part, (bool, np.bool_)) or not isinstance(part, (int, np.integer))
+        ):
+            raise InvalidArgumentError(
+                f"an {what} slice must have integer bounds (select names with a list), got {key!r}"
+            )
+    if key.step == 0:
+        raise InvalidArgumentError(f"an {what} slice must have a nonzero step, got {key!r}")
+    return key
 
 
 def _signal_index(item: object, names: Sequence[str], what: str) -> int:

@@ -70,6 +70,53 @@ ZEROS_DROPPED = known_defect(
 )
 
 
+def _poles_far_apart(args: dict[str, Any]) -> bool:
+    """Nonzero eigenvalues of A whose moduli span more than 1e12."""
+    A = _models_of(args)[0][0]
+    if A.shape[0] < 2 or not np.all(np.isfinite(A)):
+        return False
+    moduli = np.abs(np.linalg.eigvals(A))
+    moduli = moduli[moduli > 0]
+    return bool(moduli.size) and float(np.max(moduli)) > 1e12 * float(np.min(moduli))
+
+
+ZEROS_SNAPPED = known_defect(
+    "zeros-snapped-to-origin",
+    {"transmission_zeros", "transfer_function", "transfer_matrix"},
+    "a finite zero at the scale of the small poles of a model whose poles lie 1e15 or more "
+    "apart is returned as 0: both the reference path (transfer._scaled_pencil_zeros, "
+    "'zeros[np.abs(zeros) <= tolerance] = 0.0') and the core's fast path "
+    "(rust/control/transfer.rs, step 3, 'Zeros within tol of the origin are 0') set to 0 a "
+    "zero below the rank tolerance of the pencil scaled to its largest pole, though QZ "
+    "resolves it there (1/(s + 1) + 1e15/(s + 1e15) has the zero -2, scipy's QZ of the "
+    "Rosenbrock pencil -2, the unsnapped value -2; aerocontrol 0, and transfer_function's G(j) "
+    "off by 1.41 beside |G| = 1.58, silently); both must change together, or "
+    "transmission_zeros and transfer_function disagree",
+    _poles_far_apart,
+)
+
+
+def _entry_spread(A: np.ndarray) -> float:
+    """The ratio of the largest to the smallest nonzero |entry| of A (1 for none)."""
+    entries = np.abs(A[np.isfinite(A) & (A != 0)])
+    return float(np.max(entries) / np.min(entries)) if entries.size else 1.0
+
+
+POLES_OF_GRADED_COMPANION = known_defect(
+    "poles-of-graded-companion",
+    {"transfer_function", "transfer_matrix"},
+    "the eigenvalues of a 2 x 2 block [[0, -a], [b, -c]] with c much larger than "
+    "sqrt(a b) (two real poles far apart: tf's companion form of 1e-20 s^2 + s + 1, zpk's "
+    "quadratic of two real poles that hold a zero) lose the small one: poles -1e20 and 0 for "
+    "-1e20 and -1, so that transfer_function's G(0.3 + 0.7j) is off by 131 % and G(0) is "
+    "infinite, silently. The realisation itself is exact (a solve of C (sI - A)^-1 B is right "
+    "to 1e-16); the core's eigenvalues, as LAPACK's dhseqr on this ordering, are backward "
+    "stable only normwise (u ||A|| = 1e4 here); LAPACK on the block with its states reversed "
+    "(the large entry first) finds -1",
+    lambda args: _entry_spread(_models_of(args)[0][0]) > 1e8,
+)
+
+
 def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
 

@@ -28,7 +28,7 @@ import aerocontrol
 from aerocontrol.exceptions import NumericalUnderflowWarning
 
 from .harness import Warned, exercise, plain
-from .known_defects import ZEROS_DROPPED
+from .known_defects import POLES_OF_GRADED_COMPANION, ZEROS_DROPPED, ZEROS_SNAPPED
 from .oracles import (
     SLACK,
     TINY,
@@ -429,6 +429,34 @@ def test_known_defect_zeros_at_two_scales() -> None:
             {"sys": plain((A, B, C, D))},
             _zeros_oracle(True),
         )
+
+
+@pytest.mark.xfail(strict=True, reason="zeros-snapped-to-origin: a small zero beside a large pole")
+def test_known_defect_zeros_snapped_to_the_origin() -> None:
+    """1/(s + 1) + 1e15/(s + 1e15) = ((1 + 1e15) s + 2e15) / ((s + 1)(s + 1e15)): the zero
+    -2e15/(1e15 + 1) = -2 to 1e-15 (closed form; scipy's QZ of the Rosenbrock pencil gives
+    -2 too). aerocontrol returned 0 from both paths (see known_defects.ZEROS_SNAPPED)."""
+    model = (np.diag([-1.0, -1e15]), np.array([[1.0], [1e15]]), np.ones((1, 2)), np.zeros((1, 1)))
+    with ZEROS_SNAPPED.reproducing():
+        np.testing.assert_allclose(aerocontrol.transmission_zeros(model), [-2.0], rtol=1e-12)
+        channel = aerocontrol.transfer_function(model)
+        np.testing.assert_allclose(channel.zeros, [-2.0], rtol=1e-12)
+        expected = 1.0 / (1j + 1.0) + 1e15 / (1j + 1e15)
+        assert abs(channel(1j) - expected) <= 1e-12 * abs(expected)
+
+
+@pytest.mark.xfail(strict=True, reason="poles-of-graded-companion: a small pole beside a large one")
+def test_known_defect_poles_of_a_graded_companion_form() -> None:
+    """1/(1e-20 s^2 + s + 1): poles -1e20 and -1 to 1e-20 (closed form, and mpmath's
+    polyroots); aerocontrol returned -1e20 and 0 (see known_defects.POLES_OF_GRADED_COMPANION).
+    """
+    model = aerocontrol.tf([1.0], [1e-20, 1.0, 1.0])
+    with POLES_OF_GRADED_COMPANION.reproducing():
+        channel = aerocontrol.transfer_function(model)
+        np.testing.assert_allclose(np.sort(channel.poles.real), [-1e20, -1.0], rtol=1e-12)
+        s = 0.3 + 0.7j
+        expected = 1.0 / (1e-20 * s * s + s + 1.0)
+        assert abs(channel(s) - expected) <= 1e-12 * abs(expected)
 
 
 def test_regression_zeros_oracle_spurious_qz_zero() -> None:
