@@ -11,6 +11,7 @@ with scipy; case 2 has a complex B, which aerocontrol (real matrices only) refus
 from __future__ import annotations
 
 import os
+import pathlib
 import warnings
 from typing import Any
 
@@ -33,7 +34,7 @@ EPS = np.finfo(float).eps
 def _darex_cases() -> list[tuple[Any, ...]]:
     """(A, B, Q, R) of the 19 DAREX cases, from scipy's installed test module."""
     tests = os.path.join(os.path.dirname(scipy.__file__), "linalg", "tests")
-    source = open(os.path.join(tests, "test_solvers.py"), encoding="utf-8").read()
+    source = pathlib.Path(tests, "test_solvers.py").read_text(encoding="utf-8")
     start = source.index("class TestSolveDiscreteAre")
     end = source.index("    # Makes the minimum precision", start)
     namespace: dict[str, Any] = {

@@ -12,6 +12,7 @@ marks 5 of them as known failures of its solver.
 from __future__ import annotations
 
 import os
+import pathlib
 import warnings
 from typing import Any
 
@@ -38,7 +39,7 @@ EPS = np.finfo(float).eps
 def _carex_cases() -> list[tuple[Any, ...]]:
     """(A, B, Q, R) of the 20 CAREX cases, from scipy's installed test module."""
     tests = os.path.join(os.path.dirname(scipy.__file__), "linalg", "tests")
-    source = open(os.path.join(tests, "test_solvers.py"), encoding="utf-8").read()
+    source = pathlib.Path(tests, "test_solvers.py").read_text(encoding="utf-8")
     start = source.index("class TestSolveContinuousAre")
     end = source.index("    # Makes the minimum precision", start)
     namespace: dict[str, Any] = {
