@@ -1130,9 +1130,8 @@ def test_zpk_real_poles_far_apart_keep_their_sizes(
     and -1e20 (numpy's eigvals and transfer_function alike), so that transfer_function's
     G(0.3 + 0.7j) was off by 131 % and its G(0) infinite, silently. A pair of real poles that
     holds no zero is now two first-order sections (A triangular), and so is a pair far apart
-    holding a zero no smaller than the smaller pole ((s + 5)/(s + 1) and 1/(s + 1e20); the
-    zero -5 itself is still lost by transmission_zeros, see the known defect
-    zeros-snapped-to-origin, so its G is checked by frequency_response). Oracles: the poles given
+    holding a zero no smaller than the smaller pole ((s + 5)/(s + 1) and 1/(s + 1e20)).
+    Oracles: the poles given
     (the eigenvalues of A, and transfer_function's, to 1e-14; measured 3e-16) and
     k Π(s - z)/Π(s - p) at 40 digits (transfer_function's G and frequency_response, to
     1e-13; measured 6e-16)."""
@@ -1143,11 +1142,12 @@ def test_zpk_real_poles_far_apart_keep_their_sizes(
     np.testing.assert_allclose(np.sort_complex(np.linalg.eigvals(g.A)), expected_poles, rtol=1e-14)
     channel = aerocontrol.transfer_function(g)
     np.testing.assert_allclose(np.sort_complex(channel.poles), expected_poles, rtol=1e-14)
+    expected_zeros = np.sort_complex(np.array(zeros, complex))
+    np.testing.assert_allclose(np.sort_complex(channel.zeros), expected_zeros, rtol=1e-13)
     omegas = [0.0, 0.7, 2.0]
     response = aerocontrol.frequency_response(g, omegas).response[:, 0, 0]
-    snapped = bool(zeros) and min(map(abs, zeros)) < 1e-12 * max(map(abs, poles))
     for s, value in zip([0.3 + 0.7j, *(1j * w for w in omegas)], [None, *response], strict=True):
         expected = _zpk_reference(zeros, poles, k, s)
-        for got in (None if snapped else channel(s), value):
+        for got in (channel(s), value):
             if got is not None:
                 assert abs(got - expected) <= 1e-13 * abs(expected), (s, got, expected)

@@ -325,6 +325,7 @@ def _scaled_pencil_zeros(
     is infinite to the tolerance) of the pencil, scaled to unit size by a power of two 2^e
     (the zeros of (2^-e A, 2^-e B, 2^-e C, 2^-e D) are 2^-e times those of (A, B, C, D),
     exactly), reduced, and its regular part's generalized eigenvalues scaled back."""
+    given = (A, B, C, D)
     log_size = _log2_norm(A, B, C, D)  # ||S|| itself may overflow (entries near 1e308)
     e = math.floor(log_size) + 1 if math.isfinite(log_size) else 0
     A, B, C, D = (np.ldexp(M, -e) for M in (A, B, C, D))
@@ -354,10 +355,44 @@ def _scaled_pencil_zeros(
     Af = np.hstack([A, B]) @ W[:, :n]
     Bf = W[:n, :n]
     zeros = _regular_pencil_zeros(Af, Bf, ratio)
-    zeros[np.abs(zeros) <= tolerance] = 0.0  # a zero at the origin, to rounding (a washout)
+    near = np.abs(zeros) <= tolerance
+    # At the caller's tolerance, a zero within it is the origin (the caller's rank decision).
+    if np.any(near) and (tol is not None or _singular_at_origin(*given)):
+        zeros[near] = 0.0  # a zero at the origin, to rounding (a washout)
     zeros = _scaled_by_power_of_two(zeros, e)
     finite_or_warn(zeros, "a transmission zero")
     return zeros, rank, limit
+
+
+#: Multiples of (n + m) u within which the smallest singular value of the equilibrated system
+#: matrix at the origin makes it singular (:func:`_singular_at_origin`).
+ORIGIN_SINGULARITY = 100.0
+
+
+def _singular_at_origin(A: FloatArray, B: FloatArray, C: FloatArray, D: FloatArray) -> bool:
+    """Whether the system matrix at the origin, S0 = [[A, B], [C, D]], loses rank there: for a
+    square model, S0 singular to rounding once each row and then each column is scaled by a
+    power of two to largest magnitude 1 (as LAPACK's DGEEQU), σ_min <= 100 (n + m) u σ_max. A
+    computed zero within the rank tolerance of the origin is the origin only then (a washout's,
+    computed as 1e-17); otherwise it is a zero at the scale of small poles beside large ones,
+    which the pencil scaled to the large ones puts below its tolerance: 1/(s + 1) +
+    1e15/(s + 1e15) has the zero -2, which was returned as 0. The core's fast path
+    (``singular_at_origin`` in ``rust/control/transfer.rs``) applies the same test. A
+    non-square model (whose zeros are rank drops below the normal rank) keeps the rank
+    tolerance alone."""
+    if B.shape[1] != C.shape[0]:
+        return True
+    S0 = np.block([[A, B], [C, D]])
+    with np.errstate(over="ignore", under="ignore"):
+        _, rows = np.frexp(np.max(np.abs(S0), axis=1, initial=0.0))
+        S0 = np.ldexp(S0, -rows[:, None])
+        _, columns = np.frexp(np.max(np.abs(S0), axis=0, initial=0.0))
+        S0 = np.ldexp(S0, -columns[None, :])
+    if not np.all(np.isfinite(S0)):
+        return True
+    sigma = np.linalg.svd(S0, compute_uv=False)
+    size = S0.shape[0]
+    return bool(sigma[-1] <= ORIGIN_SINGULARITY * size * np.finfo(float).eps * sigma[0])
 
 
 def _scaled_by_power_of_two(values: ComplexArray, exponent: int) -> ComplexArray:

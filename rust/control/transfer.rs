@@ -25,7 +25,7 @@
 //!    eigenvalues of the compressed pencil (Af, Bf) = ([A b] W, W_11) by QZ (W a reflection with
 //!    [c d] W = ±||[c d]|| e_N); beyond, deferred (a zero far beyond the system's scale, which
 //!    the reference takes from the better of two QZ forms). Zeros within tol of the origin are
-//!    0 (a washout's). The same reduction on the unequilibrated S must find no more zeros
+//!    0 (a washout's) where the equilibrated system matrix at the origin is singular. The same reduction on the unequilibrated S must find no more zeros
 //!    (the reference then adds those beyond the equilibrated pencil's reach), else deferred.
 //! 4. **Gain** K = d where d != 0 and there are n zeros; otherwise K = G(s0) Π(s0 - p)/Π(s0 - z)
 //!    at the point s0 = jω (z = e^{jωh}) of a grid farthest from every root (as
@@ -189,6 +189,43 @@ fn exponent_of(x: f64) -> i64 {
         exponent_of(x * two_to(64)) - 64
     } else {
         biased - 1022
+    }
+}
+
+/// Multiples of (n + 1) u within which the smallest singular value of the equilibrated
+/// system matrix at the origin makes it singular ([`singular_at_origin`]).
+const ORIGIN_SINGULARITY: f64 = 100.0;
+
+/// Whether the system matrix at the origin, S0 = [[A, b], [c, d]], is singular to rounding once
+/// each row and then each column is scaled by a power of two to largest magnitude 1 (as
+/// LAPACK's DGEEQU): σ_min <= 100 (n + 1) u σ_max. A computed zero within the rank tolerance of
+/// the origin is the origin only then (a washout's, computed as 1e-17); otherwise it is a zero
+/// at the scale of small poles beside large ones, which the pencil scaled to the large ones
+/// puts below its tolerance: 1/(s + 1) + 1e15/(s + 1e15) has the zero -2, which was returned
+/// as 0. `transfer._singular_at_origin` is the reference path's.
+fn singular_at_origin(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> bool {
+    let n = a.nrows();
+    let mut s0 = Mat::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
+        (true, true) => a[(i, j)],
+        (true, false) => b[i],
+        (false, true) => c[j],
+        (false, false) => d,
+    });
+    for i in 0..=n {
+        let e = exponent_of((0..=n).fold(0.0, |m: f64, j| m.max(s0[(i, j)].abs())));
+        for j in 0..=n {
+            s0[(i, j)] = ldexp_any(s0[(i, j)], -e);
+        }
+    }
+    for j in 0..=n {
+        let e = exponent_of((0..=n).fold(0.0, |m: f64, i| m.max(s0[(i, j)].abs())));
+        for i in 0..=n {
+            s0[(i, j)] = ldexp_any(s0[(i, j)], -e);
+        }
+    }
+    match s0.singular_values() {
+        Ok(sigma) => sigma[n] <= ORIGIN_SINGULARITY * (n + 1) as f64 * f64::EPSILON * sigma[0],
+        Err(_) => true, // no verdict: the rank tolerance alone, as before
     }
 }
 
@@ -804,8 +841,9 @@ fn channel(
         return Ok(None);
     }
     let scale = frequency + e;
+    let at_origin = zeros.iter().any(|z| z.norm() <= tol) && singular_at_origin(a, b, c, d);
     for z in &mut zeros {
-        if z.norm() <= tol {
+        if at_origin && z.norm() <= tol {
             *z = c64::new(0.0, 0.0);
         }
         *z = c64::new(ldexp_any(z.re, scale), ldexp_any(z.im, scale));
