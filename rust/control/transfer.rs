@@ -229,11 +229,19 @@ fn singular_at_origin(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> bool 
     // (σ_min(S0) <= ||L||_2 σ_min(U) <= (n + 1) min |u_ii|, |l_ij| <= 1): a small pivot is a
     // singular S0, at a fraction of the SVD's cost (the reference path takes the SVD).
     let lu = s0.full_piv_lu();
-    let pivots = lu.U().diagonal().column_vector().iter().map(|u| u.abs());
-    let (smallest, largest) = pivots.fold((f64::INFINITY, 0.0_f64), |(lo, hi), u| {
-        (lo.min(u), hi.max(u))
-    });
-    !(smallest > ORIGIN_SINGULARITY * (n + 1) as f64 * f64::EPSILON * largest)
+    let pivots: Vec<f64> = lu
+        .U()
+        .diagonal()
+        .column_vector()
+        .iter()
+        .map(|u| u.abs())
+        .collect();
+    if pivots.iter().any(|u| u.is_nan()) {
+        return true; // no verdict: the rank tolerance alone, as before
+    }
+    let smallest = pivots.iter().fold(f64::INFINITY, |m, &u| m.min(u));
+    let largest = pivots.iter().fold(0.0_f64, |m, &u| m.max(u));
+    smallest <= ORIGIN_SINGULARITY * (n + 1) as f64 * f64::EPSILON * largest
 }
 
 /// A complex value m 2^e, m of largest part in [1/2, 1) (or 0, or not finite).
@@ -955,6 +963,31 @@ mod tests {
         let expected = [2.0, 7.0, 7.0];
         for (x, y) in g.numerator.iter().zip(expected) {
             assert!((x - y).abs() <= 32.0 * f64::EPSILON * y, "{x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn the_origin_is_a_zero_only_where_the_system_matrix_is_singular_there() {
+        // 1/(s + 1) + L/(s + L): the zero -2 L/(L + 1), far inside the rank tolerance of the
+        // pencil scaled to L, but S0 equilibrated is [[-1, 0, 1], [0, -1, 1], [1, 1, 0]]-like.
+        for large in [1.0, 1e5, 1e15, 1e100] {
+            let a = faer::mat![[-1.0, 0.0], [0.0, -large]];
+            assert!(!singular_at_origin(
+                a.as_ref(),
+                &[1.0, large],
+                &[1.0, 1.0],
+                0.0
+            ));
+        }
+        // A washout s/(s + 1) = 1 - 1/(s + 1), at any scale of its state: S0 singular.
+        for scale in [1.0, 1e-100, 1e100] {
+            let a = faer::mat![[-1.0]];
+            assert!(singular_at_origin(
+                a.as_ref(),
+                &[scale],
+                &[-1.0 / scale],
+                1.0
+            ));
         }
     }
 
