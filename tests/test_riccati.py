@@ -338,8 +338,15 @@ def test_R_must_be_symmetric_and_nonsingular() -> None:
     A, B, Q = -np.eye(2), np.eye(2), np.eye(2)
     with pytest.raises(NotPositiveDefiniteError, match="R must be symmetric"):
         aerocontrol.solve_care(A, B, Q, [[1.0, 0.5], [0.0, 1.0]])
-    with pytest.raises(aerocontrol.InvalidArgumentError, match="R must be nonsingular"):
-        aerocontrol.solve_care(A, B, Q, [[1.0, 0.0], [0.0, 0.0]])
+    # An exactly singular R has the reciprocal condition number 0 (the message said NaN).
+    for R in ([[1.0, 0.0], [0.0, 0.0]], np.zeros((2, 2))):
+        with pytest.raises(
+            aerocontrol.InvalidArgumentError,
+            match=r"R must be nonsingular .* reciprocal condition number is 0\.0e0",
+        ):
+            aerocontrol.solve_care(A, B, Q, R)
+        with pytest.raises(aerocontrol.InvalidArgumentError, match=r"number is 0\.0e0"):
+            aerocontrol.lqr(A, B, Q, R)
 
 
 def test_indefinite_R_by_the_extended_pencil() -> None:

@@ -48,8 +48,14 @@ pub(crate) fn solve_care_indefinite(
     // R must be invertible (the gain is R^-1 (B^T X E + S^T)).
     let r_norm = one_norm(r.as_ref());
     let r_inverse = solve_with_inverse(r.clone().as_mut(), Mat::<f64>::zeros(m, 0).as_ref());
-    let r_rcond = 1.0 / (r_norm * one_norm(r_inverse.as_ref()));
-    if m > 0 && (!r_inverse.is_all_finite() || r_rcond.is_nan() || r_rcond <= f64::EPSILON) {
+    // An inverse that is not finite is that of an exactly singular R: rcond 0 (not the NaN
+    // of inf / inf, which the message printed).
+    let r_rcond = if r_inverse.is_all_finite() {
+        1.0 / (r_norm * one_norm(r_inverse.as_ref()))
+    } else {
+        0.0
+    };
+    if m > 0 && (r_rcond.is_nan() || r_rcond <= f64::EPSILON) {
         return Err(Error::InvalidArgument {
             arg: "R",
             message: format!(
