@@ -4,7 +4,7 @@ Private: call the wrappers in the aerocontrol package, which convert and check a
 """
 
 from collections.abc import Callable, Mapping
-from typing import Any, ClassVar, final
+from typing import Any, ClassVar, TypeAlias, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -15,6 +15,7 @@ __all__ = [
     "ILL_CONDITIONED_CONTROLLABILITY",
     "POLE_ERROR_WARNING",
     "PRODUCT_WORKSPACE_BYTES",
+    "RESCALE_EXPONENT",
     "SMALL_MAX_ORDER",
     "Placement",
     "balance_states",
@@ -59,6 +60,7 @@ __all__ = [
 ]
 
 EXACT_NORM_MAX_ORDER: int
+RESCALE_EXPONENT: float
 SMALL_MAX_ORDER: int
 FMA_KERNELS: bool
 ILL_CONDITIONED_CONTROLLABILITY: float
@@ -130,9 +132,8 @@ def dc_gain(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /) -> NDArra
 def balance_states(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
-def loop_margins(
-    a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /
-) -> tuple[
+
+_LoopMarginsOutput: TypeAlias = tuple[
     NDArray[np.float64],
     NDArray[np.complex128],
     NDArray[np.float64],
@@ -144,7 +145,11 @@ def loop_margins(
     bool,
     float,
     float,
-]: ...
+]
+
+def loop_margins(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /
+) -> _LoopMarginsOutput | None: ...
 def root_locus(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, gains: ArrayLike, /
 ) -> NDArray[np.complex128]: ...

@@ -168,7 +168,7 @@ def _siso(loop: System, name: str = "loop") -> StateSpace:
 #: formed divided by a power of two and their eigenvalues (frequencies) multiplied back: the
 #: core squares entries (Hamiltonians, norms), so it works within the square root of the range
 #: of doubles.
-RESCALE_EXPONENT = 256.0
+RESCALE_EXPONENT = _core.RESCALE_EXPONENT
 
 
 def _log2_size(M: FloatArray) -> float:
@@ -309,14 +309,29 @@ def _unstable_count(
     roots: ComplexArray, discrete: bool, size: float, matrix: Callable[[], FloatArray]
 ) -> int:
     """The number of roots outside the stability region and not on its boundary
-    (:func:`_boundary_flags` with the balanced ``size`` of their ``matrix``): a root on the
+    (:func:`_census`)."""
+    return _census(roots, discrete, size, matrix)[0]
+
+
+def _census(
+    roots: ComplexArray, discrete: bool, size: float, matrix: Callable[[], FloatArray]
+) -> tuple[int, bool]:
+    """(the number of roots outside the stability region and not on its boundary, whether
+    every root lies strictly inside it and none on its boundary), both from
+    :func:`_boundary_flags` with the balanced ``size`` of their ``matrix``: a root on the
     boundary to its accuracy is on the side rounding put it, which is not a property of the
     loop (the double integrator 1/s² in rotated coordinates has its poles computed as
     ±1.5e-8, and was counted one unstable pole or none by the rotation). As :func:`nyquist`
-    counts P and Z. Scalar arithmetic: a loop's few poles."""
+    counts P and Z. A NaN root is neither outside nor inside. Scalar arithmetic: a loop's few
+    poles."""
     distances = _outward_distances(roots, discrete)
     flags = _boundary_flags(roots, distances, discrete, size, matrix)
-    return sum(x > 0.0 and not on for x, on in zip(distances, flags, strict=True))
+    unstable, inside = 0, True
+    for x, on in zip(distances, flags, strict=True):
+        if on or not x < 0.0:
+            inside = False
+            unstable += x > 0.0 and not on
+    return unstable, inside
 
 
 def _eigenvalues(A: FloatArray) -> ComplexArray:
@@ -836,24 +851,30 @@ def stability_margins(loop: System) -> StabilityMargins:
     d = float(model.D[0, 0])
     if abs(1.0 + d) <= 8 * _EPS * max(1.0, abs(d)):
         _refuse_algebraic(model)
-    size_B, size_C = _log2_size(model.B), _log2_size(model.C)
-    exponent = _frequency_exponent(model, size_B, size_C)
     try:
-        if exponent or max(size_B, size_C) > RESCALE_EXPONENT:
-            margins = _in_frequency_units(_continuous_margins(_slowed(model, exponent)), exponent)
-            # The open-loop poles of the slowed loop, A 2^-e, may underflow (a pole 1.3e-301
-            # beside B C of 1.6e148 became 0, not unstable): counted from A itself.
-            open_matrix = balanced_states(model).A
-            unstable_open = _unstable_count(
-                _eigenvalues(open_matrix), False, _balanced_size(open_matrix), lambda: open_matrix
-            )
-            unstable_closed = margins.open_loop_unstable_poles - margins.encirclements
-            return dataclasses.replace(
-                margins,
-                open_loop_unstable_poles=unstable_open,
-                encirclements=unstable_open - unstable_closed,
-            )
-        return _continuous_margins(model)
+        core = _core.loop_margins(model.A, model.B, model.C, model.D)
+        if core is not None:
+            return _continuous_margins(model, core)
+        # A term beyond 2^RESCALE_EXPONENT: the core took no step.
+        size_B, size_C = _log2_size(model.B), _log2_size(model.C)
+        exponent = _frequency_exponent(model, size_B, size_C)
+        slowed = _slowed(model, exponent)
+        core = _core.loop_margins(slowed.A, slowed.B, slowed.C, slowed.D)
+        if core is None:
+            return _grid_margins(model)
+        margins = _in_frequency_units(_continuous_margins(slowed, core), exponent)
+        # The open-loop poles of the slowed loop, A 2^-e, may underflow (a pole 1.3e-301
+        # beside B C of 1.6e148 became 0, not unstable): counted from A itself.
+        open_matrix = balanced_states(model).A
+        unstable_open = _unstable_count(
+            _eigenvalues(open_matrix), False, _balanced_size(open_matrix), lambda: open_matrix
+        )
+        unstable_closed = margins.open_loop_unstable_poles - margins.encirclements
+        return dataclasses.replace(
+            margins,
+            open_loop_unstable_poles=unstable_open,
+            encirclements=unstable_open - unstable_closed,
+        )
     except NonFiniteError:
         # The loop is finite (checked above), so this is an overflow inside the core's
         # pencils: B and C near 1e154 beside D near 1e308 (after the balancing of _slowed)
@@ -927,8 +948,9 @@ def _in_frequency_units(margins: StabilityMargins, exponent: int) -> StabilityMa
     return result
 
 
-def _continuous_margins(model: StateSpace) -> StabilityMargins:
-    """:func:`stability_margins` of a continuous loop by the core's eigenvalue methods."""
+def _continuous_margins(model: StateSpace, core: _core._LoopMarginsOutput) -> StabilityMargins:
+    """:func:`stability_margins` of a continuous loop from the core's eigenvalue methods'
+    results on it, ``core``."""
     (
         gain_w,
         gain_values,
@@ -941,7 +963,7 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         degenerate,
         closed_size,
         open_size,
-    ) = _core.loop_margins(model.A, model.B, model.C, model.D)
+    ) = core
     if degenerate:
         # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
         # the phase crossovers, so the grid search decides.
@@ -951,16 +973,18 @@ def _continuous_margins(model: StateSpace) -> StabilityMargins:
         for w, value in zip(phase_w.tolist(), phase_values.tolist(), strict=True)
         if value.real < 0.0
     ]
-    closed_matrix = functools.partial(_closed_matrix, model)
+    unstable_closed, stable = _census(
+        closed, False, closed_size, functools.partial(_closed_matrix, model)
+    )
     return _assemble(
         phase_crossings,
         list(zip(gain_w.tolist(), gain_values.tolist(), strict=True)),
-        disk=(float(disk_w), float(disk_peak)),
-        stability=(float(stab_w), 1.0 / float(sensitivity_peak)),
+        disk=(disk_w, disk_peak),
+        stability=(stab_w, 1.0 / sensitivity_peak),
         closed=closed,
-        stable=_closed_loop_stable(closed, False, closed_size, closed_matrix),
+        stable=stable,
         unstable_open=_unstable_count(open_poles, False, open_size, lambda: model.A),
-        unstable_closed=_unstable_count(closed, False, closed_size, closed_matrix),
+        unstable_closed=unstable_closed,
     )
 
 
@@ -1067,7 +1091,8 @@ def _assemble(
     unstable_open: int,
     unstable_closed: int,
 ) -> StabilityMargins:
-    """The result object from the crossovers (ω, L) by increasing ω: the phase crossovers
+    """The result object from the crossovers (ω, L) by increasing ω and the ``closed``-loop
+    poles sorted as ``numpy.sort_complex``: the phase crossovers
     where L < 0 give the gain margins 1/|L|, the gain crossovers (|L| = 1) the phase margins
     180° + ∠L in (-180°, 180°] and the delay margins (phase margin mod 360°)/ω; the critical
     margins are picked from these. Formed in scalar arithmetic: the arrays hold a few values,
@@ -1117,7 +1142,7 @@ def _assemble(
         phase_margins=np.array(phases, np.float64),
         gain_crossovers=np.array([w for w, _ in gain_crossings], np.float64),
         delay_margins=np.array(delays, np.float64),
-        closed_loop_poles=np.sort_complex(closed),
+        closed_loop_poles=closed,
         closed_loop_stable=stable,
         open_loop_unstable_poles=unstable_open,
         encirclements=unstable_open - unstable_closed,
@@ -2781,16 +2806,13 @@ def _closed_loop_stable(
     closed: ComplexArray, discrete: bool, size: float, matrix: Callable[[], FloatArray]
 ) -> bool:
     """Whether every closed-loop pole lies strictly inside the stability region, none of them
-    on its boundary (:func:`_boundary_flags` with ``size``, the balanced closed-loop matrix's
+    on its boundary (:func:`_census` with ``size``, the balanced closed-loop matrix's
     (:func:`_balanced_size`, or the core's), and the closed-loop ``matrix``): a mode at the
     origin that the loop does not reach (a pole of L cancelled by a zero there) stays at 0,
     computed as ±1e-16 or so, and its sign is rounding, so such a loop is not stable rather
     than stable or unstable by chance. (A NaN pole is neither inside nor on the boundary: not
     stable.)"""
-    distances = _outward_distances(closed, discrete)
-    if not all(x < 0.0 for x in distances):
-        return False
-    return not any(_boundary_flags(closed, distances, discrete, size, matrix))
+    return _census(closed, discrete, size, matrix)[1]
 
 
 def _outward_distances(roots: ComplexArray, discrete: bool) -> list[float]:

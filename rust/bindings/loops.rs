@@ -4,7 +4,7 @@ use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::statespace::ModelArgs;
-use crate::control::margins::{Crossover, loop_margins as loop_margins_core};
+use crate::control::margins::{Crossover, loop_margins as loop_margins_core, within_range};
 use crate::control::root_locus::root_locus as root_locus_core;
 use crate::error::Error;
 use crate::linalg::balance::balanced_states;
@@ -30,7 +30,9 @@ type MarginsOutput<'py> = (
 /// methods (`control/margins.rs`): (gain-crossover ω, L there, phase-crossover ω, L there,
 /// (ω, max |1 - L|/(2|1 + L|)), (ω, max 1/|1 + L|), closed-loop poles, open-loop poles,
 /// degenerate, the Frobenius norms of the closed loop and of A each balanced alone), every
-/// gain margin verified by a closed-loop pole.
+/// gain margin verified by a closed-loop pole, the closed-loop poles sorted as
+/// `numpy.sort_complex`; None, before any work, for a loop with a term beyond
+/// 2^RESCALE_EXPONENT ([`within_range`]), which the caller slows first.
 #[pyfunction]
 #[pyo3(signature = (a, b, c, d, /))]
 fn loop_margins<'py>(
@@ -39,9 +41,15 @@ fn loop_margins<'py>(
     b: &Bound<'py, PyAny>,
     c: &Bound<'py, PyAny>,
     d: &Bound<'py, PyAny>,
-) -> PyResult<MarginsOutput<'py>> {
+) -> PyResult<Option<MarginsOutput<'py>>> {
     let args = ModelArgs::convert(py, a, b, c, d)?;
     let model = args.model().map_err(|e| to_py_err(py, e))?;
+    if model.d.nrows() == 1
+        && model.d.ncols() == 1
+        && !within_range(model.a, model.b, model.c, model.d[(0, 0)])
+    {
+        return Ok(None);
+    }
     let n = model.a.nrows();
     // A few eigenvalue problems of order 2n (Hamiltonians) and a QZ of order 2n + 1, each
     // about 25 (2n)^3 flops, and some hundred O(n^2) evaluations.
@@ -81,7 +89,7 @@ fn loop_margins<'py>(
         margins.open_loop_size,
     );
     outputs.finish()?;
-    Ok(result)
+    Ok(Some(result))
 }
 
 /// The closed-loop poles of the SISO loop (A, b, c) at each closed-loop gain g of `gains`: the

@@ -53,6 +53,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         crate::linalg::expm::EXACT_NORM_MAX_ORDER,
     )?;
     m.add("SMALL_MAX_ORDER", crate::linalg::expm::SMALL_MAX_ORDER)?;
+    m.add(
+        "RESCALE_EXPONENT",
+        crate::control::margins::RESCALE_EXPONENT,
+    )?;
     m.add("FMA_KERNELS", crate::platform::dispatch::fma_available())?;
     m.add(
         "ILL_CONDITIONED_CONTROLLABILITY",

@@ -45,7 +45,7 @@
 //! Boyd-Balakrishnan / Bruinsma-Steinbuch iteration: a lower bound γ from ω = 0, ω = ∞ and the
 //! frequencies of the poles; the imaginary eigenvalues jω_i of the Hamiltonian of G/γ' with
 //! γ' = (1 + 2ε) γ (ε = 1e-8); in the interval [ω_i, ω_i+1] whose midpoint is highest, the
-//! maximum by Brent's method (golden section and parabolic interpolation, to 1e-12 in ω)
+//! maximum by Brent's method (golden section and parabolic interpolation, to 1e-8 in ω)
 //! is the new γ; until no imaginary
 //! eigenvalue remains (usually the second Hamiltonian). The disk margin's transfer is
 //! (1 - L)/(2 (1 + L)) = S - 1/2, with S = 1/(1 + L) realised as
@@ -76,7 +76,7 @@ use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::control::root_locus;
 use crate::error::Error;
 use crate::linalg::balance::{balanced_states, nearest_power_of_two};
-use crate::linalg::norm::frobenius_norm;
+use crate::linalg::norm::{frobenius_norm, max_abs};
 use crate::linalg::schur::eigenvalues;
 use faer::{Mat, MatRef, c64};
 
@@ -106,7 +106,8 @@ pub struct LoopMargins {
     pub disk: Peak,
     /// max |S| = 1/min |1 + L|.
     pub sensitivity: Peak,
-    /// Eigenvalues of A - B (1 + d)^-1 C, by [`root_locus::closed_loop_poles`] (normwise backward stable).
+    /// Eigenvalues of A - B (1 + d)^-1 C, by [`root_locus::closed_loop_poles`] (normwise
+    /// backward stable), sorted by real part, then imaginary part (as `numpy.sort_complex`).
     pub closed_loop_poles: Vec<c64>,
     /// Eigenvalues of A.
     pub open_loop_poles: Vec<c64>,
@@ -127,14 +128,26 @@ const CROSSOVER_TOLERANCE: f64 = 1e-8;
 /// ε of the L∞ iteration: γ' = (1 + 2ε) γ.
 const PEAK_TOLERANCE: f64 = 1e-8;
 
-fn max_abs(x: MatRef<'_, f64>) -> f64 {
-    let mut m = 0.0f64;
-    for j in 0..x.ncols() {
-        for i in 0..x.nrows() {
-            m = m.max(x[(i, j)].abs());
+/// The log2 of the largest term [`loop_margins`] takes as given: it squares entries (the
+/// Hamiltonians, norms), so it works within the square root of the range of doubles. A loop
+/// with a larger term is first slowed by a power of two (`loops.py`'s `_slowed`: its
+/// frequencies divided by 2^e, exactly).
+pub const RESCALE_EXPONENT: f64 = 256.0;
+
+/// Whether [`loop_margins`] takes the loop (A, B, C, d) as given (1 + d != 0): max|A|, max|B|,
+/// max|C| and the closed loop's term max|B| max|C| / |1 + d| all at most 2^[`RESCALE_EXPONENT`].
+pub fn within_range(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>, d: f64) -> bool {
+    let log2 = |m: MatRef<'_, f64>| {
+        let largest = max_abs(m);
+        if largest > 0.0 {
+            largest.log2()
+        } else {
+            f64::NEG_INFINITY
         }
-    }
-    m
+    };
+    let (size_a, size_b, size_c) = (log2(a), log2(b), log2(c));
+    let closed = size_b + size_c - (1.0 + d).abs().log2();
+    size_a.max(size_b).max(size_c).max(closed) <= RESCALE_EXPONENT
 }
 
 /// The eigenvalues of the Hamiltonian of 1 - G(-s) G(s) for G = (A, B, C, d), r = 1 - d^2 != 0.
@@ -418,7 +431,10 @@ impl Loop<'_> {
 }
 
 /// (ω, f(ω)) at a maximum of f on [lo, hi] by Brent's method (golden section with
-/// successive parabolic interpolation; Brent 1973, ch. 5, procedure localmin), to 1e-12 of ω.
+/// successive parabolic interpolation; Brent 1973, ch. 5, procedure localmin), to 1e-8 of ω:
+/// near a smooth maximum f changes by a relative u over a relative step of about √u, so no
+/// evaluation tells closer points apart (Brent's tolerance must be at least √u |x|), and the
+/// value found is already within rounding of the maximum's (the best point met is kept).
 fn golden_maximum(f: &mut impl FnMut(f64) -> f64, mut lo: f64, mut hi: f64) -> (f64, f64) {
     let golden = (3.0 - 5f64.sqrt()) / 2.0;
     let mut g = |x: f64| {
@@ -432,7 +448,7 @@ fn golden_maximum(f: &mut impl FnMut(f64) -> f64, mut lo: f64, mut hi: f64) -> (
     let (mut d, mut e) = (0.0f64, 0.0f64);
     for _ in 0..100 {
         let middle = 0.5 * (lo + hi);
-        let tol = 1e-12 * x.abs() + 1e-300;
+        let tol = 1e-8 * x.abs() + 1e-300;
         let tol2 = 2.0 * tol;
         if (x - middle).abs() <= tol2 - 0.5 * (hi - lo) {
             break;
@@ -725,6 +741,8 @@ pub fn loop_margins(
         .map_or(closed, |(m, _, _)| m);
     let open_size = balanced_states(a, empty.as_ref(), empty.transpose())
         .map_or_else(|| frobenius_norm(a), |(m, _, _)| frobenius_norm(m.as_ref()));
+    let mut closed_loop_poles = closed_loop_poles;
+    root_locus::sort(&mut closed_loop_poles);
     Ok(LoopMargins {
         gain_crossovers,
         phase_crossovers,
@@ -795,6 +813,44 @@ mod tests {
             .find(|x| (x.omega - w).abs() <= 1e-9 * w)
             .expect("the phase crossover");
         assert!((found.value - l).norm() <= 1e-9 * l.norm());
+    }
+
+    #[test]
+    fn range_of_the_loop_taken_as_given() {
+        // 2^256 is the limit for max|A|, max|B|, max|C| and max|B| max|C| / |1 + d|.
+        let (a, b, c, d) = canonical(&[1.0], &[1.0, 3.0, 2.0, 0.0], 0.0);
+        let d0 = d[(0, 0)];
+        assert!(within_range(a.as_ref(), b.as_ref(), c.as_ref(), d0));
+        let big = |m: &Mat<f64>, e: i32| {
+            Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)] * 2f64.powi(e))
+        };
+        assert!(within_range(
+            big(&a, 254).as_ref(),
+            b.as_ref(),
+            c.as_ref(),
+            d0
+        ));
+        assert!(!within_range(
+            big(&a, 258).as_ref(),
+            b.as_ref(),
+            c.as_ref(),
+            d0
+        ));
+        // B and C of 2^130 each: their product 2^260 is the closed loop's term; with
+        // 1 + d = 2^10 it is back within range.
+        let (bb, cb) = (big(&b, 130), big(&c, 130));
+        assert!(!within_range(a.as_ref(), bb.as_ref(), cb.as_ref(), d0));
+        assert!(within_range(a.as_ref(), bb.as_ref(), cb.as_ref(), 1023.0));
+        // B of 2^300 beside C of 2^-300: the product is 1, B alone is beyond.
+        assert!(!within_range(
+            a.as_ref(),
+            big(&b, 300).as_ref(),
+            big(&c, -300).as_ref(),
+            d0
+        ));
+        // A zero B (L = d): no closed-loop term.
+        let zero = Mat::<f64>::zeros(3, 1);
+        assert!(within_range(a.as_ref(), zero.as_ref(), c.as_ref(), d0));
     }
 
     #[test]

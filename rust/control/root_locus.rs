@@ -171,7 +171,7 @@ fn sorted(mut values: Vec<c64>) -> Vec<c64> {
 }
 
 /// Sorts by real part, then imaginary part (as `numpy.sort_complex`).
-fn sort(values: &mut [c64]) {
+pub(crate) fn sort(values: &mut [c64]) {
     values.sort_unstable_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
 }
 
