@@ -149,8 +149,10 @@ fn closed_loop_eigenvalues<O: Order>(
 }
 
 /// The eigenvalues of A - g b c (A n x n, b and c of length n) by the controller-Hessenberg
-/// form (see the module's documentation): normwise backward stable, and the same as
-/// [`root_locus`] gives at that gain.
+/// form (see the module's documentation): normwise backward stable, the QR iteration's poles
+/// at that gain before [`root_locus`]'s continuation polishes them (which can move a pole
+/// small beside ||A|| by more than its size: see the known defect
+/// closed-loop-poles-of-graded-loops in the tests).
 pub fn closed_loop_poles(
     a: MatRef<'_, f64>,
     b: &[f64],

@@ -220,6 +220,25 @@ FREQUENCY_POINT_OVERFLOW = known_defect(
 )
 
 
+def _loop_poles_far_apart(args: dict[str, Any]) -> bool:
+    """The open-loop poles of the ``loop`` argument span more than 1e12 in modulus."""
+    return "loop" in args and _poles_far_apart(args)
+
+
+CLOSED_LOOP_POLES_OF_GRADED_LOOPS = known_defect(
+    "closed-loop-poles-of-graded-loops",
+    {"stability_margins", "disk_margins"},
+    "the closed-loop poles of a loop whose poles lie 1e15 or more apart are computed "
+    "normwise (the controller-Hessenberg QR of the core's loop_margins, and the boundary "
+    "test n u ||M|| kappa of loops.py): L = 1/(s + 2^60) + 1/(s + 1) closes to poles near "
+    "-2^60 and -2, stable, with min |1 + L| = 1 at infinity; stability_margins gives the "
+    "small pole as +64 and the loop unstable, and at 2^50 the pole -1.875, counted on the "
+    "axis, with stability and disk margins 0 (root_locus and nyquist, which polish the QR's "
+    "poles on the factored characteristic polynomial, find -2 and Z = 0)",
+    _loop_poles_far_apart,
+)
+
+
 def _tolerance_beyond_the_scaled_doubles(args: dict[str, Any]) -> bool:
     """A tolerance given whose ratio to the largest entry of A and B (or C) is beyond the
     doubles."""

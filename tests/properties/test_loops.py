@@ -28,7 +28,7 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning, NumericalOverflowWarning
 
 from .harness import Arg, Warned, exercise, plain
-from .known_defects import FREQUENCY_POINT_OVERFLOW
+from .known_defects import CLOSED_LOOP_POLES_OF_GRADED_LOOPS, FREQUENCY_POINT_OVERFLOW
 from .oracles import (
     SLACK,
     TINY,
@@ -753,6 +753,21 @@ def test_known_defect_frequency_point_overflow() -> None:
             _nyquist_oracle,
             nonfinite_by_definition=("contour", "response"),
         )
+
+
+@pytest.mark.xfail(strict=True, reason="closed-loop-poles-of-graded-loops: poles 1e15 apart")
+def test_known_defect_closed_loop_poles_of_graded_loops() -> None:
+    """A defect of the native core (see ``known_defects.py``): L = 1/(s + 2^e) + 1/(s + 1)
+    closes to poles near -2^e and -2 (the closed-loop matrix [[-2^e - 1, -1], [-1, -2]] is
+    symmetric), and min |1 + L| = 1 at infinity (Re 1/(jω + 1) >= 0)."""
+    with CLOSED_LOOP_POLES_OF_GRADED_LOOPS.reproducing():
+        for e in (50, 60):
+            loop = (np.diag([-(2.0**e), -1.0]), np.ones((2, 1)), np.ones((1, 2)), np.zeros((1, 1)))
+            margins = aerocontrol.stability_margins(loop)
+            small = margins.closed_loop_poles[np.argmin(np.abs(margins.closed_loop_poles))]
+            assert abs(small - (-2.0)) <= 1e-9
+            assert margins.closed_loop_stable
+            assert margins.stability_margin == pytest.approx(1.0, rel=1e-9)
 
 
 def _order_forty_loop() -> tuple[np.ndarray, ...]:
