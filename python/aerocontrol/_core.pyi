@@ -25,6 +25,7 @@ __all__ = [
     "check_model",
     "companion_form",
     "controllability",
+    "controllability_verdict",
     "dare_batch",
     "dc_gain",
     "discretize",
@@ -186,14 +187,11 @@ def frequency_response(
 def modal_analysis(a: ArrayLike, b: ArrayLike | None, /) -> dict[str, Any]: ...
 def krylov_matrix(a: ArrayLike, b: ArrayLike, dual: bool, /) -> NDArray[np.float64]: ...
 def controllability(
-    a: ArrayLike,
-    b: ArrayLike,
-    tol: float | None,
-    modal_test: bool,
-    with_transformation: bool,
-    dual: bool,
-    /,
+    a: ArrayLike, b: ArrayLike, tol: float | None, modal_test: bool, dual: bool, /
 ) -> dict[str, Any]: ...
+def controllability_verdict(
+    a: ArrayLike, b: ArrayLike, tol: float | None, modal_test: bool, dual: bool, /
+) -> bool: ...
 def charpoly(a: ArrayLike, /) -> NDArray[np.float64]: ...
 def companion_form(a: ArrayLike, b: ArrayLike, /) -> dict[str, Any]: ...
 

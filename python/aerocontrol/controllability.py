@@ -22,7 +22,7 @@ the dual: (A, C) is observable if and only if (A^T, C^T) is controllable.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -222,25 +222,20 @@ class Controllability(Result):
         ]
 
 
-def _core_analysis(
-    A: ArrayLike,
-    second: ArrayLike,
-    tol: float | None,
-    method: str,
-    dual: bool,
-    transformation: bool,
-) -> dict[str, Any]:
-    """The core's analysis of the pair (see ``rust/bindings/controllability.rs``), with
-    ``method`` and ``tol`` checked by name."""
+def _checked_options(method: str, tol: float | None) -> tuple[bool, float | None]:
+    """(whether to run the modal test, the tolerance) with ``method`` and ``tol`` checked by
+    name."""
     check_choice(method, "method", _METHODS)
-    tolerance = None if tol is None else real_scalar(tol, "tol")
-    return _core.controllability(A, second, tolerance, method == "full", transformation, dual)
+    return method == "full", None if tol is None else real_scalar(tol, "tol")
 
 
 def _analyse(
     A: ArrayLike, second: ArrayLike, tol: float | None, method: str, dual: bool
 ) -> Controllability:
-    result = _core_analysis(A, second, tol, method, dual, True)
+    """The core's analysis of the pair (see ``rust/bindings/controllability.rs``) as the
+    result object."""
+    modal_test, tolerance = _checked_options(method, tol)
+    result = _core.controllability(A, second, tolerance, modal_test, dual)
     unreachable = result["uncontrollable_eigenvalues"]
     # The frozen dataclass's __init__ sets each field through object.__setattr__, which costs
     # half of the staircase of a 4-state pair; filling the instance dictionary directly is the
@@ -264,10 +259,10 @@ def _analyse(
 
 
 def _verdict(A: ArrayLike, second: ArrayLike, tol: float | None, method: str, dual: bool) -> bool:
-    """The verdict of :func:`_analyse` (no uncontrollable eigenvalue), without the staircase's
-    transformation Z and the result object."""
-    result = _core_analysis(A, second, tol, method, dual, False)
-    return len(result["uncontrollable_eigenvalues"]) == 0
+    """The verdict of :func:`_analyse` (no uncontrollable eigenvalue), without the staircase
+    form, its transformation Z or the result object."""
+    modal_test, tolerance = _checked_options(method, tol)
+    return _core.controllability_verdict(A, second, tolerance, modal_test, dual)
 
 
 def controllability(

@@ -8,6 +8,7 @@ use super::modal::eigen_cost;
 use crate::control::controllability::{
     controllability as controllability_core, ctrb, observability as observability_core, obsv,
 };
+use faer::MatRef;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -59,31 +60,22 @@ fn krylov_matrix<'py>(
 
 /// The controllability of (A, B) (or with `dual` the observability of (A, C)) as a dict.
 #[pyfunction]
-#[pyo3(signature = (a, b, tol, modal_test, with_transformation, dual, /))]
+#[pyo3(signature = (a, b, tol, modal_test, dual, /))]
 fn controllability<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     b: &Bound<'py, PyAny>,
     tol: Option<f64>,
     modal_test: bool,
-    with_transformation: bool,
     dual: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (a, b) = pair(py, a, b, dual)?;
     let (a, b) = (|| Ok((a.matrix()?, b.matrix()?)))().map_err(|e| to_py_err(py, e))?;
-    let n = a.nrows();
-    let width = if dual { b.nrows() } else { b.ncols() };
-    let staircase = Cost::of(10.0 * (n as f64).powi(3), 6.0, n.max(width));
-    let cost = if modal_test {
-        staircase.then(eigen_cost(n))
-    } else {
-        staircase
-    };
-    let analysis = compute(py, cost, || {
+    let analysis = compute(py, cost(a.nrows(), b, modal_test, dual), || {
         if dual {
-            observability_core(a, b, tol, modal_test, with_transformation)
+            observability_core(a, b, tol, modal_test, true)
         } else {
-            controllability_core(a, b, tol, modal_test, with_transformation)
+            controllability_core(a, b, tol, modal_test, true)
         }
     })?;
     let mut outputs = Outputs::new(py);
@@ -126,8 +118,45 @@ fn controllability<'py>(
     Ok(result)
 }
 
+/// Whether (A, B) is controllable (with `dual`, (A, C) observable): the verdict of
+/// [`controllability`] (no uncontrollable eigenvalue) without its form, transformation or
+/// arrays.
+#[pyfunction]
+#[pyo3(signature = (a, b, tol, modal_test, dual, /))]
+fn controllability_verdict(
+    py: Python<'_>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
+    tol: Option<f64>,
+    modal_test: bool,
+    dual: bool,
+) -> PyResult<bool> {
+    let (a, b) = pair(py, a, b, dual)?;
+    let (a, b) = (|| Ok((a.matrix()?, b.matrix()?)))().map_err(|e| to_py_err(py, e))?;
+    let analysis = compute(py, cost(a.nrows(), b, modal_test, dual), || {
+        if dual {
+            observability_core(a, b, tol, modal_test, false)
+        } else {
+            controllability_core(a, b, tol, modal_test, false)
+        }
+    })?;
+    Ok(analysis.is_complete())
+}
+
+/// The staircase's cost, and the eigenvectors' with the modal test.
+fn cost(n: usize, second: MatRef<'_, f64>, modal_test: bool, dual: bool) -> Cost {
+    let width = if dual { second.nrows() } else { second.ncols() };
+    let staircase = Cost::of(10.0 * (n as f64).powi(3), 6.0, n.max(width));
+    if modal_test {
+        staircase.then(eigen_cost(n))
+    } else {
+        staircase
+    }
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(krylov_matrix, m)?)?;
     m.add_function(wrap_pyfunction!(controllability, m)?)?;
+    m.add_function(wrap_pyfunction!(controllability_verdict, m)?)?;
     Ok(())
 }

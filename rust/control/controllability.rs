@@ -395,6 +395,13 @@ impl Reduction {
             BlockColumn::Inputs => (true, (0..self.b.ncols()).collect()),
             BlockColumn::States(first, end) => (false, (first..end).collect()),
         };
+        // Below the rows already reduced the form is block Hessenberg: rows start.. of A are
+        // zero in the columns before this block column, and of B once its block is compressed.
+        // A reflection of those rows leaves the zeros as they are, so it skips them.
+        let first_column = match block_column {
+            BlockColumn::Inputs => 0,
+            BlockColumn::States(first, _) => first,
+        };
         let mut rank = 0;
         while start + rank < n && !unused.is_empty() {
             let row = start + rank;
@@ -416,8 +423,11 @@ impl Reduction {
             if tau != 0.0 {
                 w[0] = 1.0;
                 let w = self.w.as_ref().subrows(0, n - row);
-                reflect_rows(self.a.as_mut(), row, w, tau, self.row_work.as_mut());
-                reflect_rows(self.b.as_mut(), row, w, tau, self.row_work.as_mut());
+                let right = self.a.as_mut().subcols_mut(first_column, n - first_column);
+                reflect_rows(right, row, w, tau, self.row_work.as_mut());
+                if in_b {
+                    reflect_rows(self.b.as_mut(), row, w, tau, self.row_work.as_mut());
+                }
                 reflect_columns(self.a.as_mut(), row, w, tau, self.column_work.as_mut());
                 if self.z.nrows() > 0 {
                     reflect_columns(self.z.as_mut(), row, w, tau, self.column_work.as_mut());
