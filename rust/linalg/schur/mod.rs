@@ -84,11 +84,13 @@
 //! the computed eigenvalues of badly scaled matrices such as models in mixed units. The Schur
 //! form itself is not balanced, since its Z must be orthogonal.
 
+mod eigenvectors;
 mod form;
 mod francis;
 pub(crate) mod multishift;
 pub mod reorder;
 
+pub use eigenvectors::schur_eigenvectors;
 pub use form::{RealSchur, StandardBlock, quasi_triangular_eigenvalues, standardize_block};
 pub use francis::Spectrum;
 pub(crate) use francis::{Finished, Until, francis_qr, francis_qr_until};
