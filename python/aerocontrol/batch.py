@@ -744,8 +744,18 @@ def _sweep(
     R_matrix = np.eye(m) if R is None else np.atleast_2d(real_array(R, "R"))
     if R_matrix.ndim != 2:
         raise ShapeError(f"R must be one m x m matrix, got shape {R_matrix.shape}")
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-        R_stack = R_matrix[np.newaxis] / (c * c)[:, np.newaxis, np.newaxis]
+    # R / c², as lqr(A, B, Q, R / c**2) forms it, where c² is a normal double; where c²
+    # underflows into the subnormals (losing digits) or overflows, R / c / c, which is an
+    # ordinary double whenever R / c² is one.
+    with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+        square = c * c
+        normal = np.isfinite(square) & (square >= np.finfo(np.float64).tiny)
+        scale = c[:, np.newaxis, np.newaxis]
+        R_stack = np.where(
+            normal[:, np.newaxis, np.newaxis],
+            R_matrix[np.newaxis] / square[:, np.newaxis, np.newaxis],
+            R_matrix[np.newaxis] / scale / scale,
+        )
     if np.all(np.isfinite(R_matrix)):
         # R / c^2 overflowed, or a nonzero entry of R underflowed to zero.
         lost = ~np.all(np.isfinite(R_stack), axis=(1, 2)) | np.any(
