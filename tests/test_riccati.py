@@ -537,6 +537,21 @@ def test_riccati_ode_rejects_a_bad_grid() -> None:
         aerocontrol.riccati_ode(A, B, np.eye(4), np.eye(2), [0.0, np.inf])
 
 
+def test_riccati_ode_refuses_a_terminal_weight_that_is_not_symmetric() -> None:
+    """S(t_f) = Sf: a nonsymmetric Sf is refused by name, as riccati_difference refuses it,
+    not replaced by its symmetric part (Sf = [[1, 2], [0, 1]] once gave S(t_f) = [[1, 1],
+    [1, 1]]); an Sf symmetric to rounding is accepted and returned as S(t_f) to 1e-15."""
+    A, B, Q, R = -np.eye(2), np.ones((2, 1)), np.eye(2), np.eye(1)
+    for solve in (aerocontrol.riccati_ode, aerocontrol.lqr_finite):
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="Sf must be symmetric"):
+            solve(A, B, Q, R, [0.0, 1.0], [[1.0, 2.0], [0.0, 1.0]])
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="Sf must be symmetric"):
+        aerocontrol.riccati_difference(0.5 * A, B, Q, R, 1, [[1.0, 2.0], [0.0, 1.0]])
+    nearly = np.array([[2.0, 1.0], [1.0 + 1e-15, 3.0]])
+    sol = aerocontrol.riccati_ode(A, B, Q, R, [0.0, 1.0], nearly)
+    np.testing.assert_allclose(sol.S[-1], nearly, rtol=1e-15, atol=1e-15)
+
+
 @pytest.mark.parametrize("a", [1e6, 1e8, 1e12])
 def test_riccati_ode_work_is_bounded_by_the_transient(a: float) -> None:
     """A plant fast against the horizon: S(t) settles on the algebraic solution after a few

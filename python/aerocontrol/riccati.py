@@ -676,8 +676,8 @@ def riccati_ode(
     Raises
     ------
     InvalidArgumentError
-        R or t missing, t not 1-D or not strictly increasing, or a discrete-time system (use
-        :func:`riccati_difference`).
+        R or t missing, t not 1-D or not strictly increasing, Q or Sf not symmetric (to 1e-12
+        of its largest entry), or a discrete-time system (use :func:`riccati_difference`).
     ShapeError
         A, Q, Sf not square, or B, R, Sf disagreeing in size with A (named).
     NonFiniteError, NotRealError
@@ -719,6 +719,8 @@ def riccati_ode(
     times = np.atleast_1d(real_array(t, "t"))
     if times.ndim != 1:
         raise InvalidArgumentError(f"t must be 1-D, got an array of shape {times.shape}")
+    if Sf is not None:
+        _require_symmetric_terminal_weight(Sf)
     S, K, substeps = _core.riccati_ode(
         matrix_view(A, "A"),
         matrix_view(B, "B"),
@@ -728,6 +730,26 @@ def riccati_ode(
         Sf,
     )
     return RiccatiSolution(np.array(times, dtype=np.float64), S, K, substeps)
+
+
+def _require_symmetric_terminal_weight(Sf: ArrayLike) -> None:
+    """Refuse a terminal weight that is not symmetric, as :func:`riccati_difference` does
+    (to 1e-12 of its largest entry): S(t_f) = Sf is a symmetric solution of (6.196), and
+    the Hamiltonian propagation of [I; Sf] would otherwise return a symmetrized S(t_f) that
+    is not Sf. The core checks the shape and finiteness of anything else."""
+    matrix = real_array(Sf, "Sf")
+    if matrix.ndim != 2 or matrix.shape[0] != matrix.shape[1] or matrix.size == 0:
+        return
+    with np.errstate(invalid="ignore", over="ignore"):
+        asymmetry = float(np.max(np.abs(matrix - matrix.T)))
+        scale = float(np.max(np.abs(matrix)))
+    if asymmetry > 1e-12 * scale:  # False for NaN, refused by the core by name
+        error = InvalidArgumentError(
+            f"Sf must be symmetric, but max|Sf - Sf^T| = {asymmetry:.3e} is more than 1e-12 "
+            f"times max|Sf| = {scale:.3e}"
+        )
+        error.argument = "Sf"
+        raise error
 
 
 def lqr_finite(
