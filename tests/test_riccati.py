@@ -552,6 +552,26 @@ def test_riccati_ode_refuses_a_terminal_weight_that_is_not_symmetric() -> None:
     np.testing.assert_allclose(sol.S[-1], nearly, rtol=1e-15, atol=1e-15)
 
 
+def test_riccati_ode_warns_of_a_finite_escape_with_an_indefinite_weight() -> None:
+    """-dS/dt = -2 S - S² + q with A = -1, B = R = 1: for q = -5, S(t_f) = 0 the solution is
+    S = -1 - 2 tan(2 (t_f - t) - atan(1/2)), which escapes to -inf at t_f - t = 1.017; the
+    grid value past it (t_f - t = 2) is the continuation through the pole, so an indefinite
+    Q (or Sf) is warned of, while the values before the escape match the closed form to 1e-12.
+    Semidefinite weights (Q = 1, Sf of a rounding-negative eigenvalue) are not warned of."""
+    tau = np.array([2.0, 1.0, 0.0])
+    closed = -1.0 - 2.0 * np.tan(2.0 * tau - np.arctan(0.5))
+    for solve in (aerocontrol.riccati_ode, aerocontrol.lqr_finite):
+        with pytest.warns(aerocontrol.IllConditionedWarning, match="Q is not positive semi"):
+            result = solve([[-1.0]], [[1.0]], [[-5.0]], [[1.0]], 2.0 - tau)
+        values = result.S if isinstance(result, aerocontrol.RiccatiSolution) else result
+        np.testing.assert_allclose(values[1:, 0, 0], closed[1:], rtol=1e-12, atol=1e-14)
+    with pytest.warns(aerocontrol.IllConditionedWarning, match="Sf is not positive semi"):
+        aerocontrol.riccati_ode([[-1.0]], [[1.0]], [[1.0]], [[1.0]], [0.0, 1.0], [[-10.0]])
+    rounding = np.array([[1.0, 1.0], [1.0, 1.0 - 1e-17]])
+    sol = aerocontrol.riccati_ode(-np.eye(2), np.eye(2), np.eye(2), np.eye(2), [0, 1.0], rounding)
+    np.testing.assert_allclose(sol.S[-1], rounding, rtol=0, atol=1e-15)
+
+
 @pytest.mark.parametrize("a", [1e6, 1e8, 1e12])
 def test_riccati_ode_work_is_bounded_by_the_transient(a: float) -> None:
     """A plant fast against the horizon: S(t) settles on the algebraic solution after a few

@@ -685,6 +685,12 @@ def riccati_ode(
     NotPositiveDefiniteError
         R is not symmetric positive definite.
 
+    Warns
+    -----
+    IllConditionedWarning
+        Q or Sf is not positive semidefinite: S(t) may then escape to infinity in finite
+        time, and the values beyond the escape are not a solution.
+
     See Also
     --------
     lqr_finite : the gains K(t) alone.
@@ -729,7 +735,34 @@ def riccati_ode(
         times,
         Sf,
     )
+    indefinite = [name for name, weight in (("Q", Q), ("Sf", Sf)) if _indefinite(weight)]
+    if indefinite:
+        warnings.warn(
+            f"{' and '.join(indefinite)} {'is' if len(indefinite) == 1 else 'are'} not positive "
+            "semidefinite, so S(t) may escape to infinity in finite time: before the first "
+            "such time S is the solution of (6.196), after it the values are its continuation "
+            "through the pole, not a solution of the terminal-value problem (check S)",
+            IllConditionedWarning,
+            stacklevel=2,
+        )
     return RiccatiSolution(np.array(times, dtype=np.float64), S, K, substeps)
+
+
+def _indefinite(weight: ArrayLike | None) -> bool:
+    """Whether the symmetric ``weight`` (checked by the core) has an eigenvalue below
+    -n u max|weight| (rounding of a semidefinite one is not indefinite). With Q and Sf
+    positive semidefinite, S(t) is a cost to go, bounded by that of the zero control, and
+    cannot escape to infinity (chapter (6.196)-(6.197)); otherwise it can (the scalar
+    -dS/dt = -5 - 2 S - S², S(t_f) = 0 has a pole at t_f - 1.017)."""
+    if weight is None:
+        return False
+    matrix = real_array(weight, "weight")
+    matrix = matrix.reshape(1, 1) if matrix.ndim == 0 else matrix
+    if matrix.ndim != 2 or matrix.size == 0:
+        return False
+    size = float(np.max(np.abs(matrix)))
+    lowest = float(np.linalg.eigvalsh((matrix + matrix.T) / 2)[0])
+    return bool(lowest < -matrix.shape[0] * np.finfo(np.float64).eps * size)
 
 
 def _require_symmetric_terminal_weight(Sf: ArrayLike) -> None:
@@ -788,6 +821,11 @@ def lqr_finite(
     ------
     InvalidArgumentError, ShapeError, NonFiniteError, NotRealError, NotPositiveDefiniteError
         As :func:`riccati_ode`.
+
+    Warns
+    -----
+    IllConditionedWarning
+        As :func:`riccati_ode` (Q or Sf not positive semidefinite).
 
     Examples
     --------
