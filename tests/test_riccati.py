@@ -479,6 +479,49 @@ def test_lyapunov_against_scipy(n: int) -> None:
     np.testing.assert_array_equal(X, X.T)
 
 
+def _lyapunov_50_digits(A: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """X of A X + X A^T + Q = 0 by the Kronecker form (I ⊗ A + A ⊗ I) vec X = -vec Q,
+    solved in 50-digit arithmetic."""
+    n = A.shape[0]
+    with mpmath.workdps(50):
+        M = mpmath.matrix(n * n, n * n)
+        rhs = mpmath.matrix(n * n, 1)
+        for i in range(n):
+            for j in range(n):
+                rhs[i * n + j] = -mpmath.mpf(float(Q[i, j]))
+                for k in range(n):
+                    M[i * n + j, k * n + j] += mpmath.mpf(float(A[i, k]))
+                    M[i * n + j, i * n + k] += mpmath.mpf(float(A[j, k]))
+        x = mpmath.lu_solve(M, rhs)
+        return np.array([[float(x[i * n + j]) for j in range(n)] for i in range(n)])
+
+
+def test_lyapunov_of_states_scaled_far_apart_is_accurate_entrywise() -> None:
+    """States scaled by 1e-6 and 1e6 (X = T X0 T of A = T A0 T^-1, Q = T Q0 T): every entry
+    of X to 1e-12 relatively of the 50-digit solution (unbalanced, Bartels-Stewart had them
+    wrong in the third digit, 1.3e-3, and scipy has 9e-4), for every memory layout, and the
+    arguments are not modified."""
+    rng = np.random.default_rng(8)
+    A0 = rng.standard_normal((5, 5)) - 3.0 * np.eye(5)
+    Q0 = rng.standard_normal((5, 5))
+    T = np.diag([1e-6, 1.0, 1e6, 1.0, 1.0])
+    A, Q = T @ A0 @ np.linalg.inv(T), T @ (Q0 + Q0.T) @ T
+    Q = (Q + Q.T) / 2.0  # exactly symmetric
+    exact = _lyapunov_50_digits(A, Q)
+    saved = A.copy(), Q.copy()
+    for A_given, Q_given in ((A, Q), (np.asfortranarray(A), Q[::-1, ::-1].copy()[::-1, ::-1])):
+        X = aerocontrol.solve_lyapunov(A_given, Q_given)
+        np.testing.assert_allclose(X, exact, rtol=1e-12, atol=0)
+        np.testing.assert_array_equal(X, X.T)
+    np.testing.assert_array_equal(A, saved[0])
+    np.testing.assert_array_equal(Q, saved[1])
+    # a nonsymmetric Q: the same accuracy
+    Q = T @ Q0 @ T
+    np.testing.assert_allclose(
+        aerocontrol.solve_lyapunov(A, Q), _lyapunov_50_digits(A, Q), rtol=1e-11, atol=0
+    )
+
+
 def test_lyapunov_singular_is_refused() -> None:
     with pytest.raises(IllConditionedError, match="Lyapunov"):
         aerocontrol.solve_lyapunov([[0.0, 1.0], [-1.0, 0.0]], np.eye(2))
