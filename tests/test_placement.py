@@ -445,3 +445,32 @@ def test_augment_mode_selects_and_changes_one_mode() -> None:
 def test_an_empty_system_has_nothing_to_place(placer) -> None:
     design = placer(np.zeros((0, 0)), np.zeros((0, 1)), [])
     assert design.K.shape == (1, 0) and design.max_relative_error == 0.0
+
+
+def test_a_system_given_with_its_second_matrix_is_refused_by_name() -> None:
+    """place(sys, B, poles) and the controllability functions with a system and a matrix:
+    the system has its own B (or C), and the call is refused by an InvalidArgumentError
+    naming it (it was a NotRealError saying that A has dtype object); the system alone
+    gives the gain of the matrices, k = (4, 2) for the poles -2, -3 of (6.81)'s pair."""
+    A, b = np.array([[0.0, 1.0], [-2.0, -3.0]]), np.array([[0.0], [1.0]])
+    sys = aerocontrol.StateSpace(A, b)
+    calls = [
+        lambda: aerocontrol.place(sys, b, [-2.0, -3.0]),
+        lambda: aerocontrol.place_bass_gura(sys, b, [-2.0, -3.0]),
+        lambda: aerocontrol.place_ackermann(sys, b, [-2.0, -3.0]),
+        lambda: aerocontrol.companion_form(sys, b),
+        lambda: aerocontrol.controllability(sys, b),
+        lambda: aerocontrol.is_controllable(sys, b),
+    ]
+    for call in calls:
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="has its own B") as info:
+            call()
+        assert info.value.argument == "B"
+    for call in (
+        lambda: aerocontrol.observability(sys, [[1.0, 0.0]]),
+        lambda: aerocontrol.is_observable(sys, [[1.0, 0.0]]),
+    ):
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="has its own C"):
+            call()
+    for place in (aerocontrol.place, aerocontrol.place_bass_gura, aerocontrol.place_ackermann):
+        np.testing.assert_allclose(place(sys, [-2.0, -3.0]).K, [[4.0, 2.0]], rtol=1e-12)

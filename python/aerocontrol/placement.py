@@ -231,8 +231,8 @@ def place_bass_gura(
     UncontrollableError
         naming the eigenvalues that b cannot move.
     InvalidArgumentError
-        b has more than one column (use :func:`place`), a pole is not a number, or a complex
-        pole has no conjugate among the poles.
+        b has more than one column (use :func:`place`), a pole is not a number, a complex
+        pole has no conjugate among the poles, or b is given with a system.
     ShapeError
         A is not square, b has not n rows, or ``poles`` is not a 1-D sequence of n numbers.
     NonFiniteError, NotRealError
@@ -284,8 +284,8 @@ def place_ackermann(
     UncontrollableError
         naming the eigenvalues that b cannot move.
     InvalidArgumentError
-        b has more than one column (use :func:`place`), a pole is not a number, or a complex
-        pole has no conjugate among the poles.
+        b has more than one column (use :func:`place`), a pole is not a number, a complex
+        pole has no conjugate among the poles, or b is given with a system.
     ShapeError
         A is not square, b has not n rows, or ``poles`` is not a 1-D sequence of n numbers.
     NonFiniteError, NotRealError
@@ -344,7 +344,8 @@ def place(
         naming the eigenvalues that B cannot move.
     InvalidArgumentError
         B has a zero column or dependent columns, a pole is repeated more than rank(B) times,
-        a pole is not a number, or a complex pole has no conjugate among the poles.
+        a pole is not a number, a complex pole has no conjugate among the poles, or B is
+        given with a system.
     ShapeError
         A is not square, B is not 2-D with n rows, or ``poles`` is not a 1-D sequence of n
         numbers.
@@ -431,7 +432,7 @@ def companion_form(A_or_sys: ArrayLike | System, b: ArrayLike | None = None) -> 
     UncontrollableError
         (A, b) is not controllable (the eigenvalues b cannot move are named): T does not exist.
     InvalidArgumentError
-        b has more than one column.
+        b has more than one column, or is given with a system.
     ShapeError
         A is not square or b has not n rows.
     NonFiniteError, NotRealError
