@@ -334,6 +334,21 @@ def test_undamped_mode_unseen_and_unmoved_has_no_stabilising_solution() -> None:
         aerocontrol.solve_care([[0.0, 1.0], [-1.0, 0.0]], [[0.0], [1.0]], np.zeros((2, 2)), [[1.0]])
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="care-rcond-nan-in-message: core (rust/control/riccati/care.rs, the U11 check): "
+    "rcond = 1 / (||U11|| ||U11^-1||) is NaN when the solve breaks down (inf / inf), and the "
+    "refusal prints 'rcond = NaN' instead of 0",
+)
+def test_known_defect_singular_U11_refusal_says_rcond_0() -> None:
+    """An unstable mode that B cannot move: (A, B) is not stabilisable, U11 is exactly
+    singular, and the refusal names its reciprocal condition number 0 (as R's refusal
+    does), not NaN."""
+    with pytest.raises(aerocontrol.IllConditionedError, match=r"rcond = 0\.0") as refusal:
+        aerocontrol.lqr([[1.0, 0.0], [0.0, -1.0]], [[0.0], [1.0]], np.eye(2), [[1.0]])
+    assert "NaN" not in str(refusal.value)
+
+
 def test_R_must_be_symmetric_and_nonsingular() -> None:
     A, B, Q = -np.eye(2), np.eye(2), np.eye(2)
     with pytest.raises(NotPositiveDefiniteError, match="R must be symmetric"):
