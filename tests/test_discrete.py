@@ -324,6 +324,28 @@ def test_d2c_equals_scipy_logm_of_the_block_matrix() -> None:
         assert _relative(back.B, logarithm[:n, n:]) < 1e-12, name
 
 
+@pytest.mark.parametrize("scale", [1e3, 1e6, 1e8])
+def test_d2c_zoh_of_states_scaled_far_apart(scale: float) -> None:
+    """States scaled by 1/scale, 1 and scale (A = T A0 T^-1, B = T B0): the samples Ad, Bd
+    are the blocks of e^{[[A, B], [0, 0]] dt} in 50-digit arithmetic, rounded, and d2c gives
+    back every entry of A and B to 1e-12 relatively (the logarithm of the unbalanced block
+    matrix had entries of A wrong at 6e-10 for 1e3, and failed its own check beyond)."""
+    mpmath = pytest.importorskip("mpmath")
+    rng = np.random.default_rng(31)
+    A0, B0 = rng.standard_normal((3, 3)) - np.eye(3), rng.standard_normal((3, 1))
+    T = np.diag([1.0 / scale, 1.0, scale])
+    A, B = T @ A0 @ np.linalg.inv(T), T @ B0
+    dt = 0.1
+    with mpmath.workdps(50):
+        block = mpmath.matrix(np.block([[A, B], [np.zeros((1, 4))]]).tolist()) * dt
+        exact = mpmath.expm(block)
+        samples = np.array([[float(exact[i, j]) for j in range(4)] for i in range(4)])
+    discrete = aerocontrol.StateSpace(samples[:3, :3], samples[:3, 3:], np.ones((1, 3)), dt=dt)
+    back = aerocontrol.d2c(discrete)
+    np.testing.assert_allclose(back.A, A, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(back.B, B, rtol=1e-12, atol=0)
+
+
 @pytest.mark.parametrize("method", ["tustin", "euler", "backward_diff"])
 @pytest.mark.parametrize("prewarp", [None, 2.0])
 def test_d2c_undoes_the_bilinear_transformations(method: str, prewarp: float | None) -> None:

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, _scaling
 from ._results import Result
 from ._validation import FloatArray, check_choice, real_array, real_scalar
 from .exceptions import (
@@ -447,10 +447,13 @@ def d2c(
 
     ``"zoh"``
         A dt and B dt are the blocks of the principal logarithm of [[Ad, Bd], [0, I]]
-        (inverse scaling and squaring on the real Schur form, in the core); C and D are
-        unchanged. The logarithm is real only if Ad has no eigenvalue on the closed negative
-        real axis: e^{A dt} never has one, so such a model (a pole at z <= 0, such as a
-        one-step delay z = 0) has no continuous equivalent and is refused. Each pole
+        (inverse scaling and squaring on the real Schur form, in the core), of the block
+        matrix balanced first by an exact diagonal similarity of powers of two over the
+        states and inputs (log(D^-1 M D) = D^-1 log(M) D), so that states scaled far apart
+        keep their digits; C and D are unchanged. The logarithm is real only if Ad has no
+        eigenvalue on the closed negative real axis: e^{A dt} never has one, so such a model
+        (a pole at z <= 0, such as a one-step delay z = 0) has no continuous equivalent and
+        is refused. Each pole
         z = r e^{jθ} (r > 0) becomes s = (ln r + jθ)/dt with -π < θ < π: the samples are equally
         those of s + 2πjk/dt for every integer k (aliasing), and the principal one is chosen.
         When abs(θ) > 0.9 π (``NYQUIST_FRACTION_WARNING``: a continuous frequency above 90 %
@@ -539,7 +542,7 @@ def d2c(
             )
         _check_zoh_logarithm(model.A, period(model))
         try:
-            A, B = _core.undiscretize_zoh(model.A, model.B, period(model))
+            A, B = _undiscretized_zoh(model.A, model.B, period(model))
         except InvalidArgumentError as error:
             if error.argument != "A":
                 raise
@@ -560,6 +563,42 @@ def d2c(
     _refuse_continuous_overflow((A, B, C, D))
     _check_bilinear_condition(model.A, weight, chosen)
     return _named_like(model, A, B, C, D, 0.0)
+
+
+def _undiscretized_zoh(Ad: FloatArray, Bd: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
+    """A and B of the principal logarithm of M = [[Ad, Bd], [0, I]] (the core's
+    ``undiscretize_zoh``), of M balanced first: with D = diag(2^e) over the states and the
+    inputs (:func:`~aerocontrol._scaling.balancing_exponents`, the largest off-diagonal
+    entries evened out), log(D^-1 M D) = D^-1 log(M) D, so A = D_x A' D_x^-1 and
+    B = D_x B' D_u^-1 exactly. The logarithm's errors are relative to ||M||: unbalanced, a
+    model whose states are scaled by 1e±3 came back with entries of A wrong at 1e-9, and
+    one scaled by 1e±6 failed the logarithm's check. Without a scaling that changes anything
+    (or one that would push an entry out of the normal doubles), M as given."""
+    n, m = Bd.shape if Bd.ndim == 2 else (0, 0)
+    exponents = None
+    if n > 1 and Ad.shape == (n, n) and np.all(np.isfinite(Ad)) and np.all(np.isfinite(Bd)):
+        M = np.block([[Ad, Bd], [np.zeros((m, n)), np.eye(m)]])
+        sizes = _scaling.log2_sizes(M)
+        np.fill_diagonal(sizes, -np.inf)
+        found, _ = _scaling.balancing_exponents(sizes, outside=False)
+        shift = found[np.newaxis, :] - found[:, np.newaxis]
+        scaled = (_scaling.log2_sizes(M) + shift)[M != 0.0]
+        if np.any(found) and (scaled.size == 0 or (scaled.min() > -1000 and scaled.max() < 1000)):
+            exponents = found.astype(np.int64)
+    if exponents is None:
+        A, B = _core.undiscretize_zoh(Ad, Bd, dt)
+        return A, B
+    states, inputs = exponents[:n], exponents[n:]
+    A, B = _core.undiscretize_zoh(
+        np.ldexp(Ad, states[np.newaxis, :] - states[:, np.newaxis]),
+        np.ldexp(Bd, inputs[np.newaxis, :] - states[:, np.newaxis]),
+        dt,
+    )
+    with np.errstate(over="ignore", under="ignore"):  # an overflow is refused by the caller
+        return (
+            np.ldexp(A, states[:, np.newaxis] - states[np.newaxis, :]),
+            np.ldexp(B, states[:, np.newaxis] - inputs[np.newaxis, :]),
+        )
 
 
 def _refuse_continuous_overflow(matrices: tuple[ArrayLike, ...]) -> None:
