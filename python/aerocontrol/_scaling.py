@@ -37,6 +37,12 @@ IntArray = NDArray[np.int64]
 SWEEPS = 100
 
 
+#: A diagonal balancing (of d2c's block matrix, of solve_lyapunov's A) is applied where its
+#: exponents span at least this many powers of two (states scaled apart by about 1e3 or
+#: more); below, it would change the results only by rounding.
+BALANCING_SPREAD = 10
+
+
 def log2_sizes(M: NDArray[np.floating[Any]]) -> FloatArray:
     """log2 |M| entry by entry: -inf for a zero entry, inf for an infinite one."""
     with np.errstate(divide="ignore"):

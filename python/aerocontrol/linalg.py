@@ -572,8 +572,10 @@ def _undiscretized_zoh(Ad: FloatArray, Bd: FloatArray, dt: float) -> tuple[Float
     entries evened out), log(D^-1 M D) = D^-1 log(M) D, so A = D_x A' D_x^-1 and
     B = D_x B' D_u^-1 exactly. The logarithm's errors are relative to ||M||: unbalanced, a
     model whose states are scaled by 1e±3 came back with entries of A wrong at 1e-9, and
-    one scaled by 1e±6 failed the logarithm's check. Without a scaling that changes anything
-    (or one that would push an entry out of the normal doubles), M as given."""
+    one scaled by 1e±6 failed the logarithm's check. Where the scaling spans fewer than
+    ``_scaling.BALANCING_SPREAD`` powers of two (a model scaled well enough, whose logarithm
+    it would change only by rounding), or would push an entry out of the normal doubles, M
+    as given."""
     n, m = Bd.shape if Bd.ndim == 2 else (0, 0)
     exponents = None
     if n > 1 and Ad.shape == (n, n) and np.all(np.isfinite(Ad)) and np.all(np.isfinite(Bd)):
@@ -583,7 +585,8 @@ def _undiscretized_zoh(Ad: FloatArray, Bd: FloatArray, dt: float) -> tuple[Float
         found, _ = _scaling.balancing_exponents(sizes, outside=False)
         shift = found[np.newaxis, :] - found[:, np.newaxis]
         scaled = (_scaling.log2_sizes(M) + shift)[M != 0.0]
-        if np.any(found) and (scaled.size == 0 or (scaled.min() > -1000 and scaled.max() < 1000)):
+        in_range = scaled.size == 0 or (scaled.min() > -1000 and scaled.max() < 1000)
+        if np.ptp(found) >= _scaling.BALANCING_SPREAD and in_range:
             exponents = found.astype(np.int64)
     if exponents is None:
         A, B = _core.undiscretize_zoh(Ad, Bd, dt)
