@@ -176,6 +176,42 @@ def similarity(
         )
 
 
+def state_balancing(
+    A: FloatArray,
+    inputs: tuple[FloatArray, ...] = (),
+    outputs: tuple[FloatArray, ...] = (),
+    weights: tuple[FloatArray, ...] = (),
+) -> IntArray | None:
+    """Exponents e of T = diag(2^e) that balance A (its largest scaled off-diagonal entries
+    evened out, :func:`balancing_exponents`), for the exact similarity T^-1 A T of a method
+    whose errors are relative to ||A||; None where A is balanced well enough (e spans fewer
+    than ``BALANCING_SPREAD`` powers of two), A is not a finite square matrix of order 2 or
+    more, or a scaled entry would leave the normal doubles: of A, of the ``inputs`` (n x m,
+    scaled as T^-1 B), the ``outputs`` (p x n, as C T) and the ``weights`` (n x n, as
+    T^-1 Q T^-1)."""
+    n = A.shape[0] if A.ndim == 2 else 0
+    if n < 2 or A.shape != (n, n) or not np.all(np.isfinite(A)):
+        return None
+    given = (*inputs, *outputs, *weights)
+    if not all(np.all(np.isfinite(M)) for M in given):
+        return None
+    sizes = log2_sizes(A)
+    np.fill_diagonal(sizes, -math.inf)
+    exponents, _ = balancing_exponents(sizes, outside=False)
+    if np.ptp(exponents) < BALANCING_SPREAD:
+        return None
+    e = exponents.astype(np.float64)
+    shifted = [log2_sizes(A) + e[np.newaxis, :] - e[:, np.newaxis]]
+    shifted += [log2_sizes(B) - e[:, np.newaxis] for B in inputs]
+    shifted += [log2_sizes(C) + e[np.newaxis, :] for C in outputs]
+    shifted += [log2_sizes(Q) - e[:, np.newaxis] - e[np.newaxis, :] for Q in weights]
+    for sizes_of in shifted:
+        finite = sizes_of[np.isfinite(sizes_of)]
+        if finite.size and (finite.min() < -1020.0 or finite.max() > 1020.0):
+            return None
+    return exponents.astype(np.int64)
+
+
 def matching_equilibration(M: FloatArray) -> tuple[IntArray, IntArray] | None:
     """Row and column exponents r, s with every |M_ij| 2^(r_i + s_j) at most about 1 and those
     of a transversal (one entry in each row and column) about 1; None if M has no transversal

@@ -338,8 +338,10 @@ def c2d(
     ``"tustin"`` (or ``"bilinear"``), ``"euler"``, ``"backward_diff"``, ``"gbt"``
         The generalized bilinear transformation s ← (z - 1) / (dt (α z + 1 - α)) with α = 1/2,
         0, 1, or ``alpha``: Ad = M^-1 (I + (1 - α) dt A), Bd = M^-1 dt B, Cd = C M^-1,
-        Dd = D + α C Bd with M = I - α dt A. ``prewarp`` (rad/s, below π/dt) replaces dt by
-        2 tan(ω dt/2)/ω in Tustin's map, so that the frequency responses agree at ω.
+        Dd = D + α C Bd with M = I - α dt A (of the states balanced first by an exact
+        diagonal similarity of powers of two where they are scaled far apart; the map
+        commutes with it). ``prewarp`` (rad/s, below π/dt) replaces dt by 2 tan(ω dt/2)/ω in
+        Tustin's map, so that the frequency responses agree at ω.
     ``"matched"``
         Matched pole-zero (single input, single output): each pole and finite zero s maps to
         e^{s dt}, and the gain matches the continuous one at low frequency (the DC gain when
@@ -410,8 +412,36 @@ def c2d(
         return _discrete_like(model, matrices, step)
     weight = _bilinear_weight(chosen, alpha)
     warped = _warped_step(chosen, weight, step, prewarp)
-    Ad, Bd, Cd, Dd = _core.bilinear(model.A, model.B, model.C, model.D, warped, weight)
+    Ad, Bd, Cd, Dd = _balanced_bilinear(_core.bilinear, model, warped, weight)
     return _discrete_like(model, (Ad, Bd, Cd, Dd), step)
+
+
+def _balanced_bilinear(
+    transform: Callable[..., tuple[FloatArray, FloatArray, FloatArray, FloatArray]],
+    model: StateSpace,
+    step: float,
+    weight: float,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The core's (inverse) bilinear transformation of ``model``'s matrices, of the states
+    balanced first where that changes them (:func:`~aerocontrol._scaling.state_balancing`):
+    both maps commute with a similarity T (A, B, C, D to T^-1 A T, T^-1 B, C T, D, exact for
+    T = diag(2^e)), and their solves with I - α dt A and α Ad + (1 - α) I have errors
+    relative to the norm of A: unbalanced, states scaled by 1e±6 were refused as having an
+    eigenvalue at 1 / (α dt)."""
+    A, B, C, D = model.A, model.B, model.C, model.D
+    exponents = _scaling.state_balancing(A, (B,), (C,))
+    if exponents is None:
+        return transform(A, B, C, D, step, weight)
+    e = exponents
+    Ab, Bb, Cb = _scaling.similarity(A, B, C, e)
+    Ad, Bd, Cd, Dd = transform(Ab, Bb, Cb, D, step, weight)
+    with np.errstate(over="ignore", under="ignore"):  # an overflow is refused by the caller
+        return (
+            np.ldexp(Ad, e[:, np.newaxis] - e[np.newaxis, :]),
+            np.ldexp(Bd, e[:, np.newaxis]),
+            np.ldexp(Cd, -e[np.newaxis, :]),
+            Dd,
+        )
 
 
 def _discrete_like(model: StateSpace, matrices: tuple[FloatArray, ...], dt: float) -> StateSpace:
@@ -554,7 +584,7 @@ def d2c(
     try:
         with warnings.catch_warnings():  # a result beyond the doubles is refused below
             warnings.simplefilter("ignore", NumericalOverflowWarning)
-            A, B, C, D = _core.inverse_bilinear(model.A, model.B, model.C, model.D, warped, weight)
+            A, B, C, D = _balanced_bilinear(_core.inverse_bilinear, model, warped, weight)
     except InvalidArgumentError as error:
         if error.argument != "A":
             raise
@@ -695,6 +725,9 @@ def _check_bilinear_condition(A: FloatArray, weight: float, method: str) -> None
     of a scalar -1 + 1e-10 and 1 is well conditioned but has lost ten digits in the sum.)"""
     if A.shape[0] == 0 or weight == 0.0:
         return
+    exponents = _scaling.state_balancing(A)
+    if exponents is not None:  # the measure of the balanced A, as the inverse solves it
+        A = np.ldexp(A, exponents[np.newaxis, :] - exponents[:, np.newaxis])
     denominator = weight * A + (1.0 - weight) * np.eye(A.shape[0])
     smallest = float(np.linalg.svd(denominator, compute_uv=False)[-1])
     largest = float(np.linalg.svd(A, compute_uv=False)[0])

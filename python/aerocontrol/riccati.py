@@ -1136,36 +1136,13 @@ def solve_lyapunov(A: ArrayLike, Q: ArrayLike) -> FloatArray:
 
 
 def _lyapunov_balancing(A: FloatArray, Q: FloatArray) -> NDArray[np.int64] | None:
-    """Exponents e of the diagonal similarity T = diag(2^e) that balances A (its largest
-    scaled off-diagonal entries evened out, :func:`~aerocontrol._scaling.balancing_exponents`),
-    or None where A is balanced well enough (the exponents span fewer than
-    ``_scaling.BALANCING_SPREAD`` powers of two), the arguments are not finite square
-    matrices of one size (the core refuses them by name), or a scaled entry of A or Q would
-    leave the normal doubles (the scaling must be exact). Bartels-Stewart's errors are
-    relative to ||A|| and ||X||: unbalanced, a model whose states are scaled by 1e±6 has
-    entries of X wrong in the third digit (the same model in balanced coordinates has them
-    to 1e-15)."""
-    n = A.shape[0]
-    if (
-        A.ndim != 2
-        or Q.ndim != 2
-        or A.shape != (n, n)
-        or Q.shape != (n, n)
-        or n < 2
-        or not (np.all(np.isfinite(A)) and np.all(np.isfinite(Q)))
-    ):
+    """Exponents e of the diagonal similarity T = diag(2^e) that balances A
+    (:func:`~aerocontrol._scaling.state_balancing`), or None where A is balanced well enough,
+    the arguments are not finite square matrices of one size (the core refuses them by
+    name), or a scaled entry of A or Q would leave the normal doubles (the scaling must be
+    exact). Bartels-Stewart's errors are relative to ||A|| and ||X||: unbalanced, a model
+    whose states are scaled by 1e±6 has entries of X wrong in the third digit (the same
+    model in balanced coordinates has them to 1e-15)."""
+    if A.ndim != 2 or Q.shape != A.shape:
         return None
-    sizes = _scaling.log2_sizes(A)
-    np.fill_diagonal(sizes, -np.inf)
-    exponents, _ = _scaling.balancing_exponents(sizes, outside=False)
-    if np.ptp(exponents) < _scaling.BALANCING_SPREAD:  # scaled well enough already
-        return None
-    shifts = (
-        (_scaling.log2_sizes(A), exponents[np.newaxis, :] - exponents[:, np.newaxis]),
-        (_scaling.log2_sizes(Q), -(exponents[:, np.newaxis] + exponents[np.newaxis, :])),
-    )
-    for sizes_of, shift in shifts:
-        scaled = (sizes_of + shift)[np.isfinite(sizes_of)]
-        if scaled.size and (scaled.min() < -1020.0 or scaled.max() > 1020.0):
-            return None
-    return exponents.astype(np.int64)
+    return _scaling.state_balancing(A, weights=(Q,))
