@@ -41,6 +41,7 @@ SWEEPS = 100
 #: exponents span at least this many powers of two (states scaled apart by about 1e3 or
 #: more); below, it would change the results only by rounding.
 BALANCING_SPREAD = 10
+_SPREAD_RATIO = 2.0**BALANCING_SPREAD
 
 
 def log2_sizes(M: NDArray[np.floating[Any]]) -> FloatArray:
@@ -190,9 +191,15 @@ def state_balancing(
     scaled as T^-1 B), the ``outputs`` (p x n, as C T) and the ``weights`` (n x n, as
     T^-1 Q T^-1)."""
     n = A.shape[0] if A.ndim == 2 else 0
-    if n < 2 or A.shape != (n, n) or not np.all(np.isfinite(A)):
+    if n < 2 or A.shape != (n, n):
         return None
-    given = (*inputs, *outputs, *weights)
+    # First the cheap test (a few microseconds, beside a placement of 4 states in 8): the
+    # nonzero entries within 2^10 of each other are scaled well enough. NaN fails it.
+    magnitudes = np.abs(A)
+    nonzero = magnitudes[magnitudes > 0.0]
+    if nonzero.size < 2 or not nonzero.max() >= _SPREAD_RATIO * nonzero.min():
+        return None
+    given = (A, *inputs, *outputs, *weights)
     if not all(np.all(np.isfinite(M)) for M in given):
         return None
     sizes = log2_sizes(A)
