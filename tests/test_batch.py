@@ -293,3 +293,21 @@ def test_an_empty_batch_with_a_client_is_the_local_empty_batch() -> None:
     assert remote.K.shape == local.K.shape == (0, 2, 4)
     sweep = aerocontrol.batch.lqr_sweep(sys, weights=[], client=_UnusedClient())
     assert sweep.K.shape == aerocontrol.batch.lqr_sweep(sys, weights=[]).K.shape
+
+
+def test_sweep_weight_whose_square_is_subnormal_or_overflows() -> None:
+    """R / c² is formed without squaring c where c² leaves the normal doubles: for c = 3e-162
+    (c² subnormal, 2 digits) and R = 1e-20 the control weight is 1.11e303, and the gain of
+    the regulator of two stable lags with that weight is B^T X / R to 1e-12 of
+    lqr(A, B, Q, R / c / c); for c = 1e150 (c² = inf) and R = 1e290, R / c² = 1e-10 is
+    solved, not refused as out of range."""
+    A, B = np.diag([-1.0, -2.0]), np.ones((2, 1))
+    for c, R in ((3e-162, 1e-20), (1e-160, 1e-30), (1e150, 1e290)):
+        sweep = lqr_sweep(A, B, np.eye(2), [[R]], weights=[c])
+        K, X, _ = aerocontrol.lqr(A, B, np.eye(2), [[R / c / c]])
+        np.testing.assert_allclose(sweep.K[0], K, rtol=1e-12, atol=0)
+        np.testing.assert_allclose(sweep.X[0], X, rtol=1e-12, atol=0)
+    # the oracle: scipy's Riccati solution for R / c² = 1e-10, of normal size
+    reference = scipy.linalg.solve_continuous_are(A, B, np.eye(2), [[1e-10]])
+    sweep = lqr_sweep(A, B, np.eye(2), [[1e290]], weights=[1e150])
+    np.testing.assert_allclose(sweep.X[0], reference, rtol=1e-9)

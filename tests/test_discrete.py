@@ -324,6 +324,64 @@ def test_d2c_equals_scipy_logm_of_the_block_matrix() -> None:
         assert _relative(back.B, logarithm[:n, n:]) < 1e-12, name
 
 
+@pytest.mark.parametrize("scale", [1e3, 1e6, 1e8])
+def test_d2c_zoh_of_states_scaled_far_apart(scale: float) -> None:
+    """States scaled by 1/scale, 1 and scale (A = T A0 T^-1, B = T B0): the samples Ad, Bd
+    are the blocks of e^{[[A, B], [0, 0]] dt} in 50-digit arithmetic, rounded, and d2c gives
+    back every entry of A and B to 1e-12 relatively (the logarithm of the unbalanced block
+    matrix had entries of A wrong at 6e-10 for 1e3, and failed its own check beyond)."""
+    mpmath = pytest.importorskip("mpmath")
+    rng = np.random.default_rng(31)
+    A0, B0 = rng.standard_normal((3, 3)) - np.eye(3), rng.standard_normal((3, 1))
+    T = np.diag([1.0 / scale, 1.0, scale])
+    A, B = T @ A0 @ np.linalg.inv(T), T @ B0
+    dt = 0.1
+    with mpmath.workdps(50):
+        block = mpmath.matrix(np.block([[A, B], [np.zeros((1, 4))]]).tolist()) * dt
+        exact = mpmath.expm(block)
+        samples = np.array([[float(exact[i, j]) for j in range(4)] for i in range(4)])
+    discrete = aerocontrol.StateSpace(samples[:3, :3], samples[:3, 3:], np.ones((1, 3)), dt=dt)
+    back = aerocontrol.d2c(discrete)
+    np.testing.assert_allclose(back.A, A, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(back.B, B, rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("scale", [1e3, 1e6, 1e8])
+def test_bilinear_of_states_scaled_far_apart(scale: float) -> None:
+    """Tustin's map of states scaled by 1/scale, 1 and scale, against the formulas of c2d's
+    docstring in 50-digit arithmetic: every entry of Ad, Bd, Cd to 1e-13 relatively, and
+    d2c's inverse of the exact samples gives A, B, C back to 1e-13, without a warning (the
+    solve with I - dt A / 2 refused the model scaled by 1e6 as having an eigenvalue at
+    2 / dt = 20, and d2c warned of an eigenvalue 0.86 "near -1")."""
+    mpmath = pytest.importorskip("mpmath")
+    rng = np.random.default_rng(31)
+    A0, B0, C0 = (
+        rng.standard_normal((3, 3)) - np.eye(3),
+        rng.standard_normal((3, 1)),
+        rng.standard_normal((1, 3)),
+    )
+    T = np.diag([1.0 / scale, 1.0, scale])
+    A, B, C = T @ A0 @ np.linalg.inv(T), T @ B0, C0 @ np.linalg.inv(T)
+    dt = 0.1
+
+    def doubles(M: Any) -> np.ndarray:
+        return np.array([[float(M[i, j]) for j in range(M.cols)] for i in range(M.rows)])
+
+    with mpmath.workdps(50):
+        Am, Bm, Cm = (mpmath.matrix(M.tolist()) for M in (A, B, C))
+        inverse = (mpmath.eye(3) - Am * dt / 2) ** -1
+        Ad = doubles(inverse * (mpmath.eye(3) + Am * dt / 2))
+        Bd, Cd = doubles(inverse * Bm * dt), doubles(Cm * inverse)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sampled = aerocontrol.c2d((A, B, C, np.zeros((1, 1))), dt, "tustin")
+        back = aerocontrol.d2c(aerocontrol.StateSpace(Ad, Bd, Cd, sampled.D, dt=dt), "tustin")
+    for got, exact in ((sampled.A, Ad), (sampled.B, Bd), (sampled.C, Cd)):
+        np.testing.assert_allclose(got, exact, rtol=1e-13, atol=0)
+    for got, exact in ((back.A, A), (back.B, B), (back.C, C)):
+        np.testing.assert_allclose(got, exact, rtol=1e-13, atol=0)
+
+
 @pytest.mark.parametrize("method", ["tustin", "euler", "backward_diff"])
 @pytest.mark.parametrize("prewarp", [None, 2.0])
 def test_d2c_undoes_the_bilinear_transformations(method: str, prewarp: float | None) -> None:

@@ -119,3 +119,25 @@ def test_one_string_is_one_name() -> None:
     with pytest.raises(ShapeError, match="mode_names must name 2 modes, got 1"):
         aerocontrol.modes(np.diag([-1.0, -2.0]), mode_names="ab")
     assert aerocontrol.summing_junction("-r", "e").input_names == ("r",)
+
+
+def test_a_bool_is_no_scalar_argument() -> None:
+    """True given for a tolerance, a weight or a frequency is refused by name, as dt=True and
+    a thread count of True are (numpy reads it as 1: tol=True gave the verdict for the
+    tolerance 1, alpha=True the backward difference); the numbers 1 and 1.0 still work, and
+    give what True gave."""
+    A, b = np.array([[0.0, 1.0], [-2.0, -3.0]]), np.array([[0.0], [1.0]])
+    model = (A, b, [[1.0, 0.0]], [[0.0]])
+    calls = {
+        "tol": lambda value: aerocontrol.is_controllable(A, b, tol=value),
+        "alpha": lambda value: aerocontrol.c2d(model, 0.1, "gbt", alpha=value),
+        "prewarp": lambda value: aerocontrol.c2d(model, 0.1, "tustin", prewarp=value),
+        "omega_n": lambda value: aerocontrol.augment_mode(A, 0, omega_n=value),
+    }
+    for name, call in calls.items():
+        for flag in (True, np.bool_(True)):
+            with pytest.raises(aerocontrol.InvalidArgumentError, match=f"{name} must be a number"):
+                call(flag)
+    assert aerocontrol.is_controllable(A, b, tol=1.0) is False  # sigma_min of the pair < 1
+    backward = aerocontrol.c2d(model, 0.1, "backward_diff")
+    np.testing.assert_array_equal(aerocontrol.c2d(model, 0.1, "gbt", alpha=1).A, backward.A)

@@ -334,6 +334,21 @@ def test_undamped_mode_unseen_and_unmoved_has_no_stabilising_solution() -> None:
         aerocontrol.solve_care([[0.0, 1.0], [-1.0, 0.0]], [[0.0], [1.0]], np.zeros((2, 2)), [[1.0]])
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="care-rcond-nan-in-message: core (rust/control/riccati/care.rs, the U11 check): "
+    "rcond = 1 / (||U11|| ||U11^-1||) is NaN when the solve breaks down (inf / inf), and the "
+    "refusal prints 'rcond = NaN' instead of 0",
+)
+def test_known_defect_singular_U11_refusal_says_rcond_0() -> None:
+    """An unstable mode that B cannot move: (A, B) is not stabilisable, U11 is exactly
+    singular, and the refusal names its reciprocal condition number 0 (as R's refusal
+    does), not NaN."""
+    with pytest.raises(aerocontrol.IllConditionedError, match=r"rcond = 0\.0") as refusal:
+        aerocontrol.lqr([[1.0, 0.0], [0.0, -1.0]], [[0.0], [1.0]], np.eye(2), [[1.0]])
+    assert "NaN" not in str(refusal.value)
+
+
 def test_R_must_be_symmetric_and_nonsingular() -> None:
     A, B, Q = -np.eye(2), np.eye(2), np.eye(2)
     with pytest.raises(NotPositiveDefiniteError, match="R must be symmetric"):
@@ -479,6 +494,49 @@ def test_lyapunov_against_scipy(n: int) -> None:
     np.testing.assert_array_equal(X, X.T)
 
 
+def _lyapunov_50_digits(A: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """X of A X + X A^T + Q = 0 by the Kronecker form (I ⊗ A + A ⊗ I) vec X = -vec Q,
+    solved in 50-digit arithmetic."""
+    n = A.shape[0]
+    with mpmath.workdps(50):
+        M = mpmath.matrix(n * n, n * n)
+        rhs = mpmath.matrix(n * n, 1)
+        for i in range(n):
+            for j in range(n):
+                rhs[i * n + j] = -mpmath.mpf(float(Q[i, j]))
+                for k in range(n):
+                    M[i * n + j, k * n + j] += mpmath.mpf(float(A[i, k]))
+                    M[i * n + j, i * n + k] += mpmath.mpf(float(A[j, k]))
+        x = mpmath.lu_solve(M, rhs)
+        return np.array([[float(x[i * n + j]) for j in range(n)] for i in range(n)])
+
+
+def test_lyapunov_of_states_scaled_far_apart_is_accurate_entrywise() -> None:
+    """States scaled by 1e-6 and 1e6 (X = T X0 T of A = T A0 T^-1, Q = T Q0 T): every entry
+    of X to 1e-12 relatively of the 50-digit solution (unbalanced, Bartels-Stewart had them
+    wrong in the third digit, 1.3e-3, and scipy has 9e-4), for every memory layout, and the
+    arguments are not modified."""
+    rng = np.random.default_rng(8)
+    A0 = rng.standard_normal((5, 5)) - 3.0 * np.eye(5)
+    Q0 = rng.standard_normal((5, 5))
+    T = np.diag([1e-6, 1.0, 1e6, 1.0, 1.0])
+    A, Q = T @ A0 @ np.linalg.inv(T), T @ (Q0 + Q0.T) @ T
+    Q = (Q + Q.T) / 2.0  # exactly symmetric
+    exact = _lyapunov_50_digits(A, Q)
+    saved = A.copy(), Q.copy()
+    for A_given, Q_given in ((A, Q), (np.asfortranarray(A), Q[::-1, ::-1].copy()[::-1, ::-1])):
+        X = aerocontrol.solve_lyapunov(A_given, Q_given)
+        np.testing.assert_allclose(X, exact, rtol=1e-12, atol=0)
+        np.testing.assert_array_equal(X, X.T)
+    np.testing.assert_array_equal(A, saved[0])
+    np.testing.assert_array_equal(Q, saved[1])
+    # a nonsymmetric Q: the same accuracy
+    Q = T @ Q0 @ T
+    np.testing.assert_allclose(
+        aerocontrol.solve_lyapunov(A, Q), _lyapunov_50_digits(A, Q), rtol=1e-11, atol=0
+    )
+
+
 def test_lyapunov_singular_is_refused() -> None:
     with pytest.raises(IllConditionedError, match="Lyapunov"):
         aerocontrol.solve_lyapunov([[0.0, 1.0], [-1.0, 0.0]], np.eye(2))
@@ -535,6 +593,41 @@ def test_riccati_ode_rejects_a_bad_grid() -> None:
         aerocontrol.riccati_ode(A, B, np.eye(4), np.eye(2), [0.0, 2.0, 1.0])
     with pytest.raises(aerocontrol.NonFiniteError, match="t"):
         aerocontrol.riccati_ode(A, B, np.eye(4), np.eye(2), [0.0, np.inf])
+
+
+def test_riccati_ode_refuses_a_terminal_weight_that_is_not_symmetric() -> None:
+    """S(t_f) = Sf: a nonsymmetric Sf is refused by name, as riccati_difference refuses it,
+    not replaced by its symmetric part (Sf = [[1, 2], [0, 1]] once gave S(t_f) = [[1, 1],
+    [1, 1]]); an Sf symmetric to rounding is accepted and returned as S(t_f) to 1e-15."""
+    A, B, Q, R = -np.eye(2), np.ones((2, 1)), np.eye(2), np.eye(1)
+    for solve in (aerocontrol.riccati_ode, aerocontrol.lqr_finite):
+        with pytest.raises(aerocontrol.InvalidArgumentError, match="Sf must be symmetric"):
+            solve(A, B, Q, R, [0.0, 1.0], [[1.0, 2.0], [0.0, 1.0]])
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="Sf must be symmetric"):
+        aerocontrol.riccati_difference(0.5 * A, B, Q, R, 1, [[1.0, 2.0], [0.0, 1.0]])
+    nearly = np.array([[2.0, 1.0], [1.0 + 1e-15, 3.0]])
+    sol = aerocontrol.riccati_ode(A, B, Q, R, [0.0, 1.0], nearly)
+    np.testing.assert_allclose(sol.S[-1], nearly, rtol=1e-15, atol=1e-15)
+
+
+def test_riccati_ode_warns_of_a_finite_escape_with_an_indefinite_weight() -> None:
+    """-dS/dt = -2 S - S² + q with A = -1, B = R = 1: for q = -5, S(t_f) = 0 the solution is
+    S = -1 - 2 tan(2 (t_f - t) - atan(1/2)), which escapes to -inf at t_f - t = 1.017; the
+    grid value past it (t_f - t = 2) is the continuation through the pole, so an indefinite
+    Q (or Sf) is warned of, while the values before the escape match the closed form to 1e-12.
+    Semidefinite weights (Q = 1, Sf of a rounding-negative eigenvalue) are not warned of."""
+    tau = np.array([2.0, 1.0, 0.0])
+    closed = -1.0 - 2.0 * np.tan(2.0 * tau - np.arctan(0.5))
+    for solve in (aerocontrol.riccati_ode, aerocontrol.lqr_finite):
+        with pytest.warns(aerocontrol.IllConditionedWarning, match="Q is not positive semi"):
+            result = solve([[-1.0]], [[1.0]], [[-5.0]], [[1.0]], 2.0 - tau)
+        values = result.S if isinstance(result, aerocontrol.RiccatiSolution) else result
+        np.testing.assert_allclose(values[1:, 0, 0], closed[1:], rtol=1e-12, atol=1e-14)
+    with pytest.warns(aerocontrol.IllConditionedWarning, match="Sf is not positive semi"):
+        aerocontrol.riccati_ode([[-1.0]], [[1.0]], [[1.0]], [[1.0]], [0.0, 1.0], [[-10.0]])
+    rounding = np.array([[1.0, 1.0], [1.0, 1.0 - 1e-17]])
+    sol = aerocontrol.riccati_ode(-np.eye(2), np.eye(2), np.eye(2), np.eye(2), [0, 1.0], rounding)
+    np.testing.assert_allclose(sol.S[-1], rounding, rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize("a", [1e6, 1e8, 1e12])

@@ -4,6 +4,7 @@ restored, results independent of it, and bad counts refused by name."""
 from __future__ import annotations
 
 import os
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -68,7 +69,46 @@ def test_bad_counts_are_refused(count: object) -> None:
 def test_counts_that_would_exhaust_the_machine_are_refused(count: int) -> None:
     # Four threads per core at most (and at least 256): a million would start a million.
     before = aerocontrol.get_num_threads()
-    with pytest.raises(InvalidArgumentError, match="count must be at most"):
+    with pytest.raises(InvalidArgumentError, match="count must be at most") as refused:
         aerocontrol.set_num_threads(count)
+    assert str(refused.value).endswith(f"got {count}")  # the count given, not 2^32
     assert aerocontrol.get_num_threads() == before
     assert _named_threads() < 300 if Path("/proc/self/task").is_dir() else True
+
+
+def test_blocks_of_two_threads_that_overlap_restore_the_setting() -> None:
+    """Thread 1 enters limit_threads(1), thread 2 enters limit_threads(3), thread 1 leaves,
+    then thread 2: the setting is 3 while thread 2's block is open, and the one from before
+    both when it closes (each block restored the setting it found, so thread 2 once restored
+    thread 1's 1 and left the process on one thread)."""
+    before = aerocontrol.get_num_threads()
+    entered_1, entered_2, left_1 = threading.Event(), threading.Event(), threading.Event()
+    seen: dict[str, int] = {}
+
+    def first() -> None:
+        with aerocontrol.limit_threads(1):
+            entered_1.set()
+            entered_2.wait(10)
+        left_1.set()
+
+    def second() -> None:
+        entered_1.wait(10)
+        with aerocontrol.limit_threads(3):
+            entered_2.set()
+            left_1.wait(10)
+            seen["inside"] = aerocontrol.get_num_threads()
+
+    threads = [threading.Thread(target=first), threading.Thread(target=second)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(20)
+    assert seen == {"inside": 3}
+    assert aerocontrol.get_num_threads() == before
+    # Nested blocks of one thread, and a count set inside a block, restore as before.
+    with aerocontrol.limit_threads(2):
+        aerocontrol.set_num_threads(3)
+        with aerocontrol.limit_threads(1):
+            assert aerocontrol.get_num_threads() == 1
+        assert aerocontrol.get_num_threads() == 3
+    assert aerocontrol.get_num_threads() == before

@@ -104,7 +104,15 @@ def _shape_error(name: str, message: str) -> ShapeError:
 
 
 def real_scalar(value: object, name: str) -> float:
-    """``value`` as a Python float, rejecting arrays, complex numbers and non-numbers by name."""
+    """``value`` as a Python float, rejecting arrays, complex numbers, non-numbers and bools
+    by name (True is no tolerance, weight or frequency: numpy would read it as 1, and
+    ``tol=True`` gave a verdict for the tolerance 1 without a word)."""
+    if isinstance(value, (bool, np.bool_)) or (
+        isinstance(value, np.ndarray) and value.dtype == np.bool_
+    ):
+        error = InvalidArgumentError(f"{name} must be a number, got the bool {value!r}")
+        error.argument = name
+        raise error
     array = real_array(value, name)
     if array.ndim != 0:
         raise ShapeError(f"{name} must be a scalar, got an array of shape {array.shape}")

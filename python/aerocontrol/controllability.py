@@ -299,7 +299,8 @@ def controllability(
     NonFiniteError, NotRealError
         A or B contains NaN or an infinity, or is complex (``tol`` not a number: NotRealError).
     InvalidArgumentError
-        ``method`` is not "full" or "staircase", or ``tol`` is negative or not finite.
+        ``method`` is not "full" or "staircase", ``tol`` is negative or not finite, or a
+        system is given with a second matrix (it has its own).
 
     Examples
     --------
@@ -348,7 +349,8 @@ def observability(
     NonFiniteError, NotRealError
         A or C contains NaN or an infinity, or is complex.
     InvalidArgumentError
-        ``method`` is not "full" or "staircase", or ``tol`` is negative or not finite.
+        ``method`` is not "full" or "staircase", ``tol`` is negative or not finite, or a
+        system is given with a second matrix (it has its own).
 
     Examples
     --------
@@ -394,7 +396,8 @@ def is_controllable(
     NonFiniteError, NotRealError
         A or B contains NaN or an infinity, or is complex.
     InvalidArgumentError
-        ``method`` is not "full" or "staircase", or ``tol`` is negative or not finite.
+        ``method`` is not "full" or "staircase", ``tol`` is negative or not finite, or a
+        system is given with a second matrix (it has its own).
 
     Examples
     --------
@@ -442,7 +445,8 @@ def is_observable(
     NonFiniteError, NotRealError
         A or C contains NaN or an infinity, or is complex.
     InvalidArgumentError
-        ``method`` is not "full" or "staircase", or ``tol`` is negative or not finite.
+        ``method`` is not "full" or "staircase", ``tol`` is negative or not finite, or a
+        system is given with a second matrix (it has its own).
 
     Examples
     --------

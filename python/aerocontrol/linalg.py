@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, _scaling
 from ._results import Result
 from ._validation import FloatArray, check_choice, real_array, real_scalar
 from .exceptions import (
@@ -338,8 +338,10 @@ def c2d(
     ``"tustin"`` (or ``"bilinear"``), ``"euler"``, ``"backward_diff"``, ``"gbt"``
         The generalized bilinear transformation s ← (z - 1) / (dt (α z + 1 - α)) with α = 1/2,
         0, 1, or ``alpha``: Ad = M^-1 (I + (1 - α) dt A), Bd = M^-1 dt B, Cd = C M^-1,
-        Dd = D + α C Bd with M = I - α dt A. ``prewarp`` (rad/s, below π/dt) replaces dt by
-        2 tan(ω dt/2)/ω in Tustin's map, so that the frequency responses agree at ω.
+        Dd = D + α C Bd with M = I - α dt A (of the states balanced first by an exact
+        diagonal similarity of powers of two where they are scaled far apart; the map
+        commutes with it). ``prewarp`` (rad/s, below π/dt) replaces dt by 2 tan(ω dt/2)/ω in
+        Tustin's map, so that the frequency responses agree at ω.
     ``"matched"``
         Matched pole-zero (single input, single output): each pole and finite zero s maps to
         e^{s dt}, and the gain matches the continuous one at low frequency (the DC gain when
@@ -410,8 +412,36 @@ def c2d(
         return _discrete_like(model, matrices, step)
     weight = _bilinear_weight(chosen, alpha)
     warped = _warped_step(chosen, weight, step, prewarp)
-    Ad, Bd, Cd, Dd = _core.bilinear(model.A, model.B, model.C, model.D, warped, weight)
+    Ad, Bd, Cd, Dd = _balanced_bilinear(_core.bilinear, model, warped, weight)
     return _discrete_like(model, (Ad, Bd, Cd, Dd), step)
+
+
+def _balanced_bilinear(
+    transform: Callable[..., tuple[FloatArray, FloatArray, FloatArray, FloatArray]],
+    model: StateSpace,
+    step: float,
+    weight: float,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The core's (inverse) bilinear transformation of ``model``'s matrices, of the states
+    balanced first where that changes them (:func:`~aerocontrol._scaling.state_balancing`):
+    both maps commute with a similarity T (A, B, C, D to T^-1 A T, T^-1 B, C T, D, exact for
+    T = diag(2^e)), and their solves with I - α dt A and α Ad + (1 - α) I have errors
+    relative to the norm of A: unbalanced, states scaled by 1e±6 were refused as having an
+    eigenvalue at 1 / (α dt)."""
+    A, B, C, D = model.A, model.B, model.C, model.D
+    exponents = _scaling.state_balancing(A, (B,), (C,))
+    if exponents is None:
+        return transform(A, B, C, D, step, weight)
+    e = exponents
+    Ab, Bb, Cb = _scaling.similarity(A, B, C, e)
+    Ad, Bd, Cd, Dd = transform(Ab, Bb, Cb, D, step, weight)
+    with np.errstate(over="ignore", under="ignore"):  # an overflow is refused by the caller
+        return (
+            np.ldexp(Ad, e[:, np.newaxis] - e[np.newaxis, :]),
+            np.ldexp(Bd, e[:, np.newaxis]),
+            np.ldexp(Cd, -e[np.newaxis, :]),
+            Dd,
+        )
 
 
 def _discrete_like(model: StateSpace, matrices: tuple[FloatArray, ...], dt: float) -> StateSpace:
@@ -447,10 +477,13 @@ def d2c(
 
     ``"zoh"``
         A dt and B dt are the blocks of the principal logarithm of [[Ad, Bd], [0, I]]
-        (inverse scaling and squaring on the real Schur form, in the core); C and D are
-        unchanged. The logarithm is real only if Ad has no eigenvalue on the closed negative
-        real axis: e^{A dt} never has one, so such a model (a pole at z <= 0, such as a
-        one-step delay z = 0) has no continuous equivalent and is refused. Each pole
+        (inverse scaling and squaring on the real Schur form, in the core), of the block
+        matrix balanced first by an exact diagonal similarity of powers of two over the
+        states and inputs (log(D^-1 M D) = D^-1 log(M) D), so that states scaled far apart
+        keep their digits; C and D are unchanged. The logarithm is real only if Ad has no
+        eigenvalue on the closed negative real axis: e^{A dt} never has one, so such a model
+        (a pole at z <= 0, such as a one-step delay z = 0) has no continuous equivalent and
+        is refused. Each pole
         z = r e^{jθ} (r > 0) becomes s = (ln r + jθ)/dt with -π < θ < π: the samples are equally
         those of s + 2πjk/dt for every integer k (aliasing), and the principal one is chosen.
         When abs(θ) > 0.9 π (``NYQUIST_FRACTION_WARNING``: a continuous frequency above 90 %
@@ -539,7 +572,7 @@ def d2c(
             )
         _check_zoh_logarithm(model.A, period(model))
         try:
-            A, B = _core.undiscretize_zoh(model.A, model.B, period(model))
+            A, B = _undiscretized_zoh(model.A, model.B, period(model))
         except InvalidArgumentError as error:
             if error.argument != "A":
                 raise
@@ -551,7 +584,7 @@ def d2c(
     try:
         with warnings.catch_warnings():  # a result beyond the doubles is refused below
             warnings.simplefilter("ignore", NumericalOverflowWarning)
-            A, B, C, D = _core.inverse_bilinear(model.A, model.B, model.C, model.D, warped, weight)
+            A, B, C, D = _balanced_bilinear(_core.inverse_bilinear, model, warped, weight)
     except InvalidArgumentError as error:
         if error.argument != "A":
             raise
@@ -560,6 +593,45 @@ def d2c(
     _refuse_continuous_overflow((A, B, C, D))
     _check_bilinear_condition(model.A, weight, chosen)
     return _named_like(model, A, B, C, D, 0.0)
+
+
+def _undiscretized_zoh(Ad: FloatArray, Bd: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
+    """A and B of the principal logarithm of M = [[Ad, Bd], [0, I]] (the core's
+    ``undiscretize_zoh``), of M balanced first: with D = diag(2^e) over the states and the
+    inputs (:func:`~aerocontrol._scaling.balancing_exponents`, the largest off-diagonal
+    entries evened out), log(D^-1 M D) = D^-1 log(M) D, so A = D_x A' D_x^-1 and
+    B = D_x B' D_u^-1 exactly. The logarithm's errors are relative to ||M||: unbalanced, a
+    model whose states are scaled by 1e±3 came back with entries of A wrong at 1e-9, and
+    one scaled by 1e±6 failed the logarithm's check. Where the scaling spans fewer than
+    ``_scaling.BALANCING_SPREAD`` powers of two (a model scaled well enough, whose logarithm
+    it would change only by rounding), or would push an entry out of the normal doubles, M
+    as given."""
+    n, m = Bd.shape if Bd.ndim == 2 else (0, 0)
+    exponents = None
+    if n > 1 and Ad.shape == (n, n) and np.all(np.isfinite(Ad)) and np.all(np.isfinite(Bd)):
+        M = np.block([[Ad, Bd], [np.zeros((m, n)), np.eye(m)]])
+        sizes = _scaling.log2_sizes(M)
+        np.fill_diagonal(sizes, -np.inf)
+        found, _ = _scaling.balancing_exponents(sizes, outside=False)
+        shift = found[np.newaxis, :] - found[:, np.newaxis]
+        scaled = (_scaling.log2_sizes(M) + shift)[M != 0.0]
+        in_range = scaled.size == 0 or (scaled.min() > -1000 and scaled.max() < 1000)
+        if np.ptp(found) >= _scaling.BALANCING_SPREAD and in_range:
+            exponents = found.astype(np.int64)
+    if exponents is None:
+        A, B = _core.undiscretize_zoh(Ad, Bd, dt)
+        return A, B
+    states, inputs = exponents[:n], exponents[n:]
+    A, B = _core.undiscretize_zoh(
+        np.ldexp(Ad, states[np.newaxis, :] - states[:, np.newaxis]),
+        np.ldexp(Bd, inputs[np.newaxis, :] - states[:, np.newaxis]),
+        dt,
+    )
+    with np.errstate(over="ignore", under="ignore"):  # an overflow is refused by the caller
+        return (
+            np.ldexp(A, states[:, np.newaxis] - states[np.newaxis, :]),
+            np.ldexp(B, states[:, np.newaxis] - inputs[np.newaxis, :]),
+        )
 
 
 def _refuse_continuous_overflow(matrices: tuple[ArrayLike, ...]) -> None:
@@ -653,6 +725,9 @@ def _check_bilinear_condition(A: FloatArray, weight: float, method: str) -> None
     of a scalar -1 + 1e-10 and 1 is well conditioned but has lost ten digits in the sum.)"""
     if A.shape[0] == 0 or weight == 0.0:
         return
+    exponents = _scaling.state_balancing(A)
+    if exponents is not None:  # the measure of the balanced A, as the inverse solves it
+        A = np.ldexp(A, exponents[np.newaxis, :] - exponents[:, np.newaxis])
     denominator = weight * A + (1.0 - weight) * np.eye(A.shape[0])
     smallest = float(np.linalg.svd(denominator, compute_uv=False)[-1])
     largest = float(np.linalg.svd(A, compute_uv=False)[0])

@@ -13,7 +13,11 @@ The control law η = -K x + η' (6.91) turns x' = A x + B η into x' = (A - B K)
 Every function returns a :class:`Placement` with K (m x n), A - BK, the achieved poles and
 their largest relative error. The single-input formulas are only as accurate as the
 controllability matrix V is well conditioned; they warn (``IllConditionedWarning``) when
-κ(V) >= 1e8 or an achieved pole misses by more than 1e-6 relatively.
+κ(V) >= 1e8 or an achieved pole misses by more than 1e-6 relatively. A pair whose states are
+scaled far apart (entries of A spanning more than 2^10 and a balancing that moves them) is
+placed in balanced coordinates, T^-1 A T and T^-1 B with T diagonal of powers of two (exact),
+and K = K' T^-1 (the same closed-loop poles; κ and the errors are those of the balanced
+problem); :func:`aerocontrol.batch.place_batch` balances each problem alike.
 
 :func:`augment_mode` builds the chapter's design request (6.156): the pole set that moves one
 mode (the Dutch roll to ζ = 0.30 at its ω_n, say) and keeps every other pole.
@@ -21,13 +25,14 @@ mode (the Dutch roll to ζ = 0.30 at its ω_n, say) and keeps every other pole.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, _scaling
 from ._results import Result, Tabular, attach
 from ._validation import FloatArray, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
@@ -202,6 +207,47 @@ def _placement_arguments(
     return cast("FloatArray", A), cast("FloatArray", B_matrix), cast("ArrayLike", poles)
 
 
+def _placement_balancing(A: FloatArray, B: FloatArray) -> NDArray[np.int64] | None:
+    """The exponents e of T = diag(2^e) balancing the states of (A, B)
+    (:func:`~aerocontrol._scaling.state_balancing`), or None: a pair scaled well enough, or
+    one the core refuses by shape."""
+    if B.ndim == 2 and A.ndim == 2 and B.shape[0] == A.shape[0]:
+        return _scaling.state_balancing(A, (B,))
+    return None
+
+
+def _balanced_place(
+    A: FloatArray, B: FloatArray, poles: ArrayLike, method: str, exponents: NDArray[np.int64]
+) -> Placement:
+    """The core's placement of (A, B) with the states balanced first (T = diag(2^e), exact):
+    with A' = T^-1 A T and B' = T^-1 B, the gain K' of the same poles gives K = K' T^-1 and
+    A - B K = T (A' - B' K') T^-1, while the methods' errors are relative to the size of A'
+    rather than of A (states scaled by 1e±6 came back with poles 147 % off, or were refused
+    as uncontrollable). The conditions reported are those of the balanced problem, which are
+    the ones that bound the errors; the core's warnings point at the public function's
+    caller."""
+    e = exponents
+    A_balanced, B_balanced, _ = _scaling.similarity(A, B, np.zeros((0, A.shape[0])), e)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        design = _core.place(A_balanced, B_balanced, poles, method)
+    for warning in caught:
+        warnings.warn(warning.message, warning.category, stacklevel=3)
+    with np.errstate(over="ignore", under="ignore"):
+        return Placement(
+            np.ldexp(design.K, -e[np.newaxis, :]),
+            np.ldexp(design.closed_loop, e[:, np.newaxis] - e[np.newaxis, :]),
+            design.poles,
+            design.achieved_poles,
+            design.max_relative_error,
+            design.iterations,
+            design.converged,
+            design.method,
+            design.controllability_condition,
+            design.eigenvector_condition,
+        )
+
+
 def place_bass_gura(
     A_or_sys: ArrayLike | System, b: ArrayLike | None = None, poles: ArrayLike | None = None
 ) -> Placement:
@@ -231,8 +277,8 @@ def place_bass_gura(
     UncontrollableError
         naming the eigenvalues that b cannot move.
     InvalidArgumentError
-        b has more than one column (use :func:`place`), a pole is not a number, or a complex
-        pole has no conjugate among the poles.
+        b has more than one column (use :func:`place`), a pole is not a number, a complex
+        pole has no conjugate among the poles, or b is given with a system.
     ShapeError
         A is not square, b has not n rows, or ``poles`` is not a 1-D sequence of n numbers.
     NonFiniteError, NotRealError
@@ -253,7 +299,11 @@ def place_bass_gura(
     >>> np.round(design.k, 5)                                # (6.102)
     array([16.49844,  8.0875 ])
     """
-    return _core.place(*_placement_arguments(A_or_sys, b, poles), "bass-gura")
+    A, B_matrix, requested = _placement_arguments(A_or_sys, b, poles)
+    exponents = _placement_balancing(A, B_matrix)
+    if exponents is None:  # the core's warnings point at this function's caller
+        return _core.place(A, B_matrix, requested, "bass-gura")
+    return _balanced_place(A, B_matrix, requested, "bass-gura", exponents)
 
 
 def place_ackermann(
@@ -284,8 +334,8 @@ def place_ackermann(
     UncontrollableError
         naming the eigenvalues that b cannot move.
     InvalidArgumentError
-        b has more than one column (use :func:`place`), a pole is not a number, or a complex
-        pole has no conjugate among the poles.
+        b has more than one column (use :func:`place`), a pole is not a number, a complex
+        pole has no conjugate among the poles, or b is given with a system.
     ShapeError
         A is not square, b has not n rows, or ``poles`` is not a 1-D sequence of n numbers.
     NonFiniteError, NotRealError
@@ -310,7 +360,11 @@ def place_ackermann(
     >>> design.k
     array([28.,  8.])
     """
-    return _core.place(*_placement_arguments(A_or_sys, b, poles), "ackermann")
+    A, B_matrix, requested = _placement_arguments(A_or_sys, b, poles)
+    exponents = _placement_balancing(A, B_matrix)
+    if exponents is None:  # the core's warnings point at this function's caller
+        return _core.place(A, B_matrix, requested, "ackermann")
+    return _balanced_place(A, B_matrix, requested, "ackermann", exponents)
 
 
 def place(
@@ -344,7 +398,8 @@ def place(
         naming the eigenvalues that B cannot move.
     InvalidArgumentError
         B has a zero column or dependent columns, a pole is repeated more than rank(B) times,
-        a pole is not a number, or a complex pole has no conjugate among the poles.
+        a pole is not a number, a complex pole has no conjugate among the poles, or B is
+        given with a system.
     ShapeError
         A is not square, B is not 2-D with n rows, or ``poles`` is not a 1-D sequence of n
         numbers.
@@ -364,7 +419,11 @@ def place(
     >>> design.K.shape, bool(design.max_relative_error < 1e-12)
     ((2, 4), True)
     """
-    return _core.place(*_placement_arguments(A_or_sys, B, poles), "knv0")
+    A, B_matrix, requested = _placement_arguments(A_or_sys, B, poles)
+    exponents = _placement_balancing(A, B_matrix)
+    if exponents is None:  # the core's warnings point at this function's caller
+        return _core.place(A, B_matrix, requested, "knv0")
+    return _balanced_place(A, B_matrix, requested, "knv0", exponents)
 
 
 @dataclass(frozen=True, eq=False)
@@ -431,7 +490,7 @@ def companion_form(A_or_sys: ArrayLike | System, b: ArrayLike | None = None) -> 
     UncontrollableError
         (A, b) is not controllable (the eigenvalues b cannot move are named): T does not exist.
     InvalidArgumentError
-        b has more than one column.
+        b has more than one column, or is given with a system.
     ShapeError
         A is not square or b has not n rows.
     NonFiniteError, NotRealError

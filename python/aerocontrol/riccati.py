@@ -29,10 +29,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, _scaling
 from ._results import Result, Tabular, format_complex, format_number
 from ._validation import FloatArray, real_array
-from .exceptions import IllConditionedWarning, InvalidArgumentError
+from .exceptions import IllConditionedWarning, InvalidArgumentError, NumericalOverflowWarning
 from .statespace import (
     as_state_space,
     is_system,
@@ -676,14 +676,20 @@ def riccati_ode(
     Raises
     ------
     InvalidArgumentError
-        R or t missing, t not 1-D or not strictly increasing, or a discrete-time system (use
-        :func:`riccati_difference`).
+        R or t missing, t not 1-D or not strictly increasing, Q or Sf not symmetric (to 1e-12
+        of its largest entry), or a discrete-time system (use :func:`riccati_difference`).
     ShapeError
         A, Q, Sf not square, or B, R, Sf disagreeing in size with A (named).
     NonFiniteError, NotRealError
         An argument contains NaN or an infinity, or is complex.
     NotPositiveDefiniteError
         R is not symmetric positive definite.
+
+    Warns
+    -----
+    IllConditionedWarning
+        Q or Sf is not positive semidefinite: S(t) may then escape to infinity in finite
+        time, and the values beyond the escape are not a solution.
 
     See Also
     --------
@@ -719,6 +725,8 @@ def riccati_ode(
     times = np.atleast_1d(real_array(t, "t"))
     if times.ndim != 1:
         raise InvalidArgumentError(f"t must be 1-D, got an array of shape {times.shape}")
+    if Sf is not None:
+        _require_symmetric_terminal_weight(Sf)
     S, K, substeps = _core.riccati_ode(
         matrix_view(A, "A"),
         matrix_view(B, "B"),
@@ -727,7 +735,54 @@ def riccati_ode(
         times,
         Sf,
     )
+    indefinite = [name for name, weight in (("Q", Q), ("Sf", Sf)) if _indefinite(weight)]
+    if indefinite:
+        warnings.warn(
+            f"{' and '.join(indefinite)} {'is' if len(indefinite) == 1 else 'are'} not positive "
+            "semidefinite, so S(t) may escape to infinity in finite time: before the first "
+            "such time S is the solution of (6.196), after it the values are its continuation "
+            "through the pole, not a solution of the terminal-value problem (check S)",
+            IllConditionedWarning,
+            stacklevel=2,
+        )
     return RiccatiSolution(np.array(times, dtype=np.float64), S, K, substeps)
+
+
+def _indefinite(weight: ArrayLike | None) -> bool:
+    """Whether the symmetric ``weight`` (checked by the core) has an eigenvalue below
+    -n u max|weight| (rounding of a semidefinite one is not indefinite). With Q and Sf
+    positive semidefinite, S(t) is a cost to go, bounded by that of the zero control, and
+    cannot escape to infinity (chapter (6.196)-(6.197)); otherwise it can (the scalar
+    -dS/dt = -5 - 2 S - S², S(t_f) = 0 has a pole at t_f - 1.017)."""
+    if weight is None:
+        return False
+    matrix = real_array(weight, "weight")
+    matrix = matrix.reshape(1, 1) if matrix.ndim == 0 else matrix
+    if matrix.ndim != 2 or matrix.size == 0:
+        return False
+    size = float(np.max(np.abs(matrix)))
+    lowest = float(np.linalg.eigvalsh((matrix + matrix.T) / 2)[0])
+    return bool(lowest < -matrix.shape[0] * np.finfo(np.float64).eps * size)
+
+
+def _require_symmetric_terminal_weight(Sf: ArrayLike) -> None:
+    """Refuse a terminal weight that is not symmetric, as :func:`riccati_difference` does
+    (to 1e-12 of its largest entry): S(t_f) = Sf is a symmetric solution of (6.196), and
+    the Hamiltonian propagation of [I; Sf] would otherwise return a symmetrized S(t_f) that
+    is not Sf. The core checks the shape and finiteness of anything else."""
+    matrix = real_array(Sf, "Sf")
+    if matrix.ndim != 2 or matrix.shape[0] != matrix.shape[1] or matrix.size == 0:
+        return
+    with np.errstate(invalid="ignore", over="ignore"):
+        asymmetry = float(np.max(np.abs(matrix - matrix.T)))
+        scale = float(np.max(np.abs(matrix)))
+    if asymmetry > 1e-12 * scale:  # False for NaN, refused by the core by name
+        error = InvalidArgumentError(
+            f"Sf must be symmetric, but max|Sf - Sf^T| = {asymmetry:.3e} is more than 1e-12 "
+            f"times max|Sf| = {scale:.3e}"
+        )
+        error.argument = "Sf"
+        raise error
 
 
 def lqr_finite(
@@ -766,6 +821,11 @@ def lqr_finite(
     ------
     InvalidArgumentError, ShapeError, NonFiniteError, NotRealError, NotPositiveDefiniteError
         As :func:`riccati_ode`.
+
+    Warns
+    -----
+    IllConditionedWarning
+        As :func:`riccati_ode` (Q or Sf not positive semidefinite).
 
     Examples
     --------
@@ -1014,9 +1074,12 @@ def solve_lyapunov(A: ArrayLike, Q: ArrayLike) -> FloatArray:
     """The solution X of the continuous Lyapunov equation A X + X A^T + Q = 0.
 
     Bartels-Stewart: with A = U T U^T, T Y + Y T^T = -U^T Q U is solved block by block from
-    the bottom right, and X = U Y U^T (symmetric when Q is). The solution is unique unless two
-    eigenvalues of A add up to zero; that case raises ``IllConditionedError``. For a stable A
-    and Q = C^T C, X is the observability Gramian of (C, A^T).
+    the bottom right, and X = U Y U^T (symmetric when Q is). A is first balanced by an exact
+    diagonal similarity D of powers of two (A = D Â D^-1, then X = D X̂ D for the equation in
+    Â and D^-1 Q D^-1), so that states scaled far apart keep every entry of X accurate. The
+    solution is unique unless two eigenvalues of A add up to zero; that case raises
+    ``IllConditionedError``. For a stable A and Q = C^T C, X is the observability Gramian of
+    (C, A^T).
 
     Parameters
     ----------
@@ -1051,5 +1114,35 @@ def solve_lyapunov(A: ArrayLike, Q: ArrayLike) -> FloatArray:
     array([[1., 1.],
            [1., 1.]])
     """
-    X: FloatArray = _core.solve_lyapunov(matrix_view(A, "A"), matrix_view(Q, "Q"))
+    A_matrix, Q_matrix = matrix_view(A, "A"), matrix_view(Q, "Q")
+    exponents = _lyapunov_balancing(A_matrix, Q_matrix)
+    if exponents is None:
+        X: FloatArray = _core.solve_lyapunov(A_matrix, Q_matrix)
+        return X
+    # A = T Â T^-1 with T = diag(2^e): X = T Y T^T where Â Y + Y Â^T + T^-1 Q T^-T = 0.
+    twice = exponents[:, np.newaxis] + exponents[np.newaxis, :]
+    balanced = np.ldexp(A_matrix, exponents[np.newaxis, :] - exponents[:, np.newaxis])
+    Y = _core.solve_lyapunov(balanced, np.ldexp(Q_matrix, -twice))
+    with np.errstate(over="ignore"):
+        X = np.ldexp(Y, twice)
+    if np.all(np.isfinite(Y)) and not np.all(np.isfinite(X)):
+        warnings.warn(
+            "the result overflowed double precision: X has infinite entries (the states of A "
+            "are scaled far apart)",
+            NumericalOverflowWarning,
+            stacklevel=2,
+        )
     return X
+
+
+def _lyapunov_balancing(A: FloatArray, Q: FloatArray) -> NDArray[np.int64] | None:
+    """Exponents e of the diagonal similarity T = diag(2^e) that balances A
+    (:func:`~aerocontrol._scaling.state_balancing`), or None where A is balanced well enough,
+    the arguments are not finite square matrices of one size (the core refuses them by
+    name), or a scaled entry of A or Q would leave the normal doubles (the scaling must be
+    exact). Bartels-Stewart's errors are relative to ||A|| and ||X||: unbalanced, a model
+    whose states are scaled by 1e±6 has entries of X wrong in the third digit (the same
+    model in balanced coordinates has them to 1e-15)."""
+    if A.ndim != 2 or Q.shape != A.shape:
+        return None
+    return _scaling.state_balancing(A, weights=(Q,))

@@ -683,8 +683,16 @@ def plant_pair(
     """(A, B) or (A, C): the two matrices when ``second`` is given, else taken from a system,
     an (A, B) tuple or any object with the attributes (``attribute`` names the second one)."""
     if second is not None:
-        # With both given the first is the plant matrix (a system there is refused by name);
-        # a vector for the second is a column of B or a row of C, by its role.
+        # With both given the first is the plant matrix (a system there is refused by name:
+        # it carries its own second matrix); a vector for the second is a column of B or a
+        # row of C, by its role.
+        if is_system(A_or_sys):
+            error = InvalidArgumentError(
+                f"A_or_sys is a system, which has its own {attribute}; give the system "
+                f"without {attribute}, or the matrices A and {attribute}"
+            )
+            error.argument = attribute
+            raise error
         return matrix_view(A_or_sys, "A"), matrix_view(second, attribute)
     if isinstance(A_or_sys, (tuple, list)) or is_system(A_or_sys):
         sys = as_state_space(A_or_sys)

@@ -21,6 +21,7 @@ Examples
 from __future__ import annotations
 
 import contextlib
+import threading
 from collections.abc import Iterator
 
 import numpy as np
@@ -32,6 +33,10 @@ from .exceptions import InvalidArgumentError
 __all__ = ["get_num_threads", "limit_threads", "set_num_threads"]
 
 _chosen: int | None = None
+#: The open ``limit_threads`` blocks of all threads, in the order they were entered, each
+#: the one-element list of the setting that comes back when it closes.
+_blocks: list[list[int | None]] = []
+_blocks_lock = threading.RLock()
 
 
 def _count(count: object) -> int:
@@ -79,7 +84,10 @@ def set_num_threads(count: int | None) -> None:
     try:
         _core.set_num_threads(0 if value is None else value)
     except OverflowError:  # beyond the machine's integers: beyond the limit too
-        _core.set_num_threads(2**32)  # raises the limit's own InvalidArgumentError
+        try:
+            _core.set_num_threads(2**32)  # raises the limit's own InvalidArgumentError
+        except InvalidArgumentError as error:  # which names 2^32, not the count given
+            raise InvalidArgumentError(str(error).replace(f"got {2**32}", f"got {value}")) from None
     _chosen = value
 
 
@@ -110,7 +118,9 @@ def get_num_threads() -> int:
 @contextlib.contextmanager
 def limit_threads(count: int | None) -> Iterator[None]:
     """:func:`set_num_threads` for a ``with`` block; the earlier setting comes back after it
-    (also when the block raises).
+    (also when the block raises). The setting is the process's: while blocks of several
+    threads are open, the latest entered of them sets it, and when the last closes, the
+    setting from before the first comes back (in whatever order they close).
 
     Parameters
     ----------
@@ -135,9 +145,23 @@ def limit_threads(count: int | None) -> Iterator[None]:
     ...     aerocontrol.get_num_threads()
     1
     """
-    earlier = _chosen
-    set_num_threads(count)
+    block: list[int | None] = []  # the setting before the block: its own, or passed on
+    with _blocks_lock:
+        earlier = _chosen
+        set_num_threads(count)  # a refused count leaves the setting and the blocks unchanged
+        block.append(earlier)
+        _blocks.append(block)
     try:
         yield
     finally:
-        set_num_threads(earlier)
+        with _blocks_lock:
+            position = next(i for i, open_block in enumerate(_blocks) if open_block is block)
+            del _blocks[position]
+            if position == len(_blocks):  # the latest block: its earlier setting comes back
+                set_num_threads(block[0])
+            else:
+                # Blocks of several threads that overlap without nesting (one entered, another
+                # entered, the first left): the later block keeps the setting, and inherits
+                # the one to come back when it closes, so that the setting from before the
+                # first block comes back when the last closes, in whatever order they close.
+                _blocks[position][0] = block[0]

@@ -290,3 +290,27 @@ def test_known_defect_controllability_tolerance_beyond_the_scaled_doubles() -> N
             _through_models(_analysis_oracle(False, False), "B"),
             nonfinite_by_definition=("smallest_pivot",),
         )
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="uncontrollable-eigenvalues-beyond-n: core; the full method lists the staircase's "
+    "uncontrollable block (not eigenvalues of A) and, beside them, every eigenvalue the modal "
+    "test flags, so a badly scaled pair gets more than n 'uncontrollable eigenvalues'",
+)
+def test_known_defect_uncontrollable_eigenvalues_beyond_the_order() -> None:
+    """A pair of order 2, states scaled by 1e5 (the similarity of a well-scaled controllable
+    pair): the staircase's uncontrollable block has the eigenvalue -0.2577, which is no
+    eigenvalue of A (0.8635 ± 0.6537j, by numpy), and the modal test, under the tolerance
+    5.8e-6, flags both eigenvalues (measure 5.4e-6); the list has 3 entries. Whatever the
+    verdict, the uncontrollable eigenvalues are at most n eigenvalues of A (to 1e-6
+    relatively), and the full method agrees with is_controllable."""
+    A = np.array([[0.822, 3.3e-11], [-1.3e10, 0.905]])
+    B = np.array([[4.46e-6], [-53700.0]])
+    analysis = aerocontrol.controllability(A, B)
+    listed = np.asarray(analysis.uncontrollable_eigenvalues)
+    eigenvalues = np.linalg.eigvals(A)
+    assert listed.size <= 2
+    for value in listed:
+        assert np.min(np.abs(eigenvalues - value)) <= 1e-6 * max(abs(value), 1.0)
+    assert analysis.controllable == aerocontrol.is_controllable(A, B)

@@ -8,9 +8,11 @@ the perturbation bound of the coefficients.
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -171,3 +173,28 @@ def test_modes_of_tiny_matrices() -> None:
         _modes_oracle,
         nonfinite_by_definition=BY_DEFINITION,
     )
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="modal-eigen-unbalanced: core (rust/control/modal.rs, eigen): faer's evd of A "
+    "without a diagonal balancing, so states scaled by 1e±6 give eigenvalues off by 3e-4 "
+    "(aerocontrol.linalg.eigenvalues of the same A is right to 3e-16), and a false 'repeated "
+    "eigenvalue without a full set of eigenvectors' warning",
+)
+def test_known_defect_modes_of_states_scaled_far_apart() -> None:
+    """A random stable 3-state A with its states scaled by 1e-6, 1 and 1e6 (A = T A0 T^-1):
+    the modes' eigenvalues are those of A0 to 1e-12 relatively (numpy's eigvals of A0), as
+    aerocontrol.linalg.eigenvalues(A) gives them."""
+    rng = np.random.default_rng(5)
+    A0 = rng.standard_normal((3, 3)) - np.eye(3)
+    T = np.diag([1e-6, 1.0, 1e6])
+    A = T @ A0 @ np.linalg.inv(T)
+    exact = np.sort_complex(np.linalg.eigvals(A0))
+    np.testing.assert_allclose(
+        np.sort_complex(aerocontrol.linalg.eigenvalues(A)), exact, rtol=1e-12
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        found = aerocontrol.modes(A).eigenvalues
+    np.testing.assert_allclose(np.sort_complex(found), exact, rtol=1e-12)
