@@ -334,13 +334,7 @@ def test_undamped_mode_unseen_and_unmoved_has_no_stabilising_solution() -> None:
         aerocontrol.solve_care([[0.0, 1.0], [-1.0, 0.0]], [[0.0], [1.0]], np.zeros((2, 2)), [[1.0]])
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="care-rcond-nan-in-message: core (rust/control/riccati/care.rs, the U11 check): "
-    "rcond = 1 / (||U11|| ||U11^-1||) is NaN when the solve breaks down (inf / inf), and the "
-    "refusal prints 'rcond = NaN' instead of 0",
-)
-def test_known_defect_singular_U11_refusal_says_rcond_0() -> None:
+def test_singular_U11_refusal_says_rcond_0() -> None:
     """An unstable mode that B cannot move: (A, B) is not stabilisable, U11 is exactly
     singular, and the refusal names its reciprocal condition number 0 (as R's refusal
     does), not NaN."""

@@ -772,10 +772,16 @@ fn hamiltonian_solution_in<O: Order>(
     }
     solve_in_place(factors.as_faer_mut(), combined.as_faer_mut(), Par::Seq);
     let inverse_transposed = DMatrix::from_fn(n, n, |i, j| combined[(i, n + j)]);
-    let rcond =
-        1.0 / (one_norm(u11.as_faer()) * one_norm(inverse_transposed.as_faer().transpose()));
     let broke_down = !combined.as_slice().iter().all(|x| x.is_finite());
-    if broke_down || rcond.is_nan() || rcond <= n as f64 * f64::EPSILON {
+    // A solve that broke down (an exactly singular U11: inf / inf) has rcond 0.
+    let rcond = match 1.0
+        / (one_norm(u11.as_faer()) * one_norm(inverse_transposed.as_faer().transpose()))
+    {
+        _ if broke_down => 0.0,
+        value if value.is_nan() => 0.0,
+        value => value,
+    };
+    if rcond <= n as f64 * f64::EPSILON {
         return Err(Error::IllConditioned {
             message: format!(
                 "the stable invariant subspace of the Hamiltonian is not the graph of a matrix \
