@@ -11,6 +11,7 @@ import os
 import re
 import warnings
 
+import mpmath
 import numpy as np
 import pytest
 import scipy.stats
@@ -683,10 +684,70 @@ def test_clopper_pearson_for_rare_events_in_huge_runs(
 ) -> None:
     estimate = clopper_pearson(count, samples)
     high = scipy.stats.beta.ppf(0.975, count + 1, samples - count)
-    assert estimate.high == pytest.approx(high, rel=tolerance)
+    # abs=0: pytest.approx's default abs=1e-12 would pass any end below 1e-12.
+    assert estimate.high == pytest.approx(high, rel=tolerance, abs=0.0)
     if count:
         low = scipy.stats.beta.ppf(0.025, count, samples - count + 1)
-        assert estimate.low == pytest.approx(low, rel=tolerance)
+        assert estimate.low == pytest.approx(low, rel=tolerance, abs=0.0)
+
+
+def _binomial_lower_tail_mpmath(x: mpmath.mpf, n: int, k: int) -> mpmath.mpf:
+    """P(Binomial(n, x) <= k) at mpmath's precision, term by term."""
+    term = mpmath.exp(n * mpmath.log1p(-x))
+    total = term
+    odds = x / (1 - x)
+    for j in range(k):
+        term *= (n - j) * odds / (j + 1)
+        total += term
+    return total
+
+
+@pytest.mark.parametrize(
+    ("count", "samples", "confidence"),
+    [
+        (1, 10**12, 0.95),
+        (2, 10**12, 0.95),
+        (7, 10**12, 0.5),
+        (100, 10**12, 0.99),
+        (2, 10**9, 0.95),
+        (2, 100_000, 1 - 1e-12),
+        (3, 10, 0.95),
+    ],
+)
+def test_clopper_pearson_upper_end_against_mpmath(
+    count: int, samples: int, confidence: float
+) -> None:
+    # The oracle: for integers, the upper end h solves P(Binomial(N, h) <= k) = alpha/2
+    # (1 - I_h(k + 1, N - k), DLMF 8.17.5), by bisection at 40 digits, alpha = 1 - confidence
+    # exactly (the double given). The continued fraction stalled at 1e-6 relative for
+    # N = 10^12 (its steps below its stopping test), and 1 - alpha/2 rounded lost 1e-5 of a
+    # confidence of 1 - 10^-12.
+    with mpmath.workdps(40):
+        tail = (1 - mpmath.mpf(confidence)) / 2
+        low, high = mpmath.mpf(0), mpmath.mpf(1)
+        for _ in range(160):
+            middle = (low + high) / 2
+            if _binomial_lower_tail_mpmath(middle, samples, count) > tail:
+                low = middle
+            else:
+                high = middle
+        expected = float((low + high) / 2)
+    assert clopper_pearson(count, samples, confidence).high == pytest.approx(
+        expected, rel=1e-13, abs=0.0
+    )
+
+
+@pytest.mark.parametrize("samples", [1, 2, 5])
+def test_clopper_pearson_all_events_at_a_tiny_alpha(samples: int) -> None:
+    # k = N: the lower end is (alpha/2)^(1/N) itself (Beta(N, 1)'s quantile); 1 - (1 -
+    # (alpha/2)^(1/N)) lost four digits at N = 1, alpha = 1e-12.
+    confidence = 1 - 1e-12
+    alpha = 1 - confidence  # exact in doubles (Sterbenz)
+    expected = float(mpmath.power(mpmath.mpf(alpha) / 2, mpmath.mpf(1) / samples))
+    estimate = clopper_pearson(samples, samples, confidence)
+    # 1e-14: the power's exponent 1/N rounded, times ln(alpha/2) = -28.
+    assert estimate.low == pytest.approx(expected, rel=1e-14, abs=0.0)
+    assert estimate.high == 1.0
 
 
 @pytest.mark.parametrize("count", [2.7, None, "3", float("nan"), True])

@@ -676,15 +676,61 @@ def _incomplete_beta(
     raise ArithmeticError(f"the incomplete beta function I_{x}({a}, {b}) did not converge")
 
 
-def _beta_quantile(q: float, a: float, b: float) -> float:
-    """The q-quantile of Beta(a, b), by bisection on I_x(a, b)."""
+#: The most terms of a binomial tail summed term by term (:func:`_binomial_lower_tail`).
+_BINOMIAL_TERMS = 10_000
+
+
+def _binomial_lower_tail(x: float, n: int, k: int) -> float:
+    """P(X <= k) for X ~ Binomial(n, x), the sum of its k + 1 terms (fsum), each term from the
+    one before by the ratio (n - j) / (j + 1) · x / (1 - x) in logarithms: for integers,
+    1 - I_x(k + 1, n - k) (DLMF 8.17.5), without the subtraction and without the continued
+    fraction, which converges in O(sqrt(n)) steps of relative size far below its stopping
+    test when one parameter is huge (n = 10^12)."""
+    if x <= 0.0:
+        return 1.0
+    if x >= 1.0:
+        return 0.0 if k < n else 1.0
+    log_odds = math.log(x) - math.log1p(-x)
+    log_term = n * math.log1p(-x)  # ln P(X = 0)
+    carry = 0.0  # the running logarithm's rounding errors (Neumaier's compensated sum): it
+    # starts near -n x, far larger than the terms near the quantile
+    terms = [math.exp(log_term)]
+    for j in range(k):
+        step = math.log((n - j) / (j + 1)) + log_odds
+        total = log_term + step
+        if abs(log_term) >= abs(step):
+            carry += (log_term - total) + step
+        else:
+            carry += (step - total) + log_term
+        log_term = total
+        terms.append(math.exp(log_term + carry))
+    return min(math.fsum(terms), 1.0)
+
+
+def _beta_quantile(q: float, a: float, b: float, upper: bool = False) -> float:
+    """The x at which I_x(a, b) = q, or, ``upper``, at which the upper tail 1 - I_x(a, b) = q
+    (the tail probability given itself, not 1 - q rounded: q = α/2 of a confidence of
+    1 - 10^-12 keeps its digits), by bisection. For integers a and b with a <= 10^4 the
+    upper tail is the binomial sum P(Binomial(a + b - 1, x) <= a - 1) where b > 10^6 or
+    q < 10^-4."""
     low, high = 0.0, 1.0
     log_beta = _log_beta(a, b)
-    for _ in range(200):
+    # The sum where the continued fraction stalls (b > 10^6) or 1 - I_x would lose the tail's
+    # digits (q < 10^-4); elsewhere the continued fraction is as exact and faster.
+    summed = (
+        upper and a == int(a) and b == int(b) and a <= _BINOMIAL_TERMS and (b > 1e6 or q < 1e-4)
+    )
+    for _ in range(2000):
         middle = 0.5 * (low + high)
         if middle in (low, high):
             break
-        if _incomplete_beta(middle, a, b, log_beta) < q:
+        if summed:
+            below = _binomial_lower_tail(middle, int(a + b - 1), int(a - 1)) > q
+        elif upper:
+            below = 1.0 - _incomplete_beta(middle, a, b, log_beta) > q
+        else:
+            below = _incomplete_beta(middle, a, b, log_beta) < q
+        if below:
             low = middle
         else:
             high = middle
@@ -781,14 +827,15 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
     # At count 0 (and count = samples) the quantile has the closed form 1 - (α/2)^(1/N)
     # (and (α/2)^(1/N)): B(q; 1, N) = 1 - (1 - q)^(1/N), exact where the continued fraction
     # loses digits next to the mean of a huge run.
-    edge = -math.expm1(math.log(alpha / 2) / samples)  # 1 - (α/2)^(1/N)
+    # (α/2)^(1/N) itself, not 1 - edge: at N = 1 and α = 10^-12 that would lose four digits.
+    root = math.log(alpha / 2) / samples
     if count == 0:
-        low, high = 0.0, edge
+        low, high = 0.0, -math.expm1(root)  # 1 - (α/2)^(1/N)
     elif count == samples:
-        low, high = 1.0 - edge, 1.0
+        low, high = (alpha / 2) ** (1.0 / samples), 1.0
     else:
         low = _beta_quantile(alpha / 2, count, samples - count + 1)
-        high = _beta_quantile(1 - alpha / 2, count + 1, samples - count)
+        high = _beta_quantile(alpha / 2, count + 1, samples - count, upper=True)
     return Estimate(count, samples, count / samples, low, high, confidence)
 
 
