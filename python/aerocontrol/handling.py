@@ -606,8 +606,11 @@ def _eigenvalues(modes: object) -> dict[str, NDArray[np.complex128]]:
 def _pair(lam: NDArray[np.complex128]) -> tuple[float, float, float]:
     """(ω_n, ζ, ζ ω_n) of two roots; ω_n and ζ NaN for real roots of opposite sign."""
     l1, l2 = complex(lam[0]), complex(lam[1])
-    wn2 = (l1 * l2).real
-    zw = -0.5 * (l1 + l2).real
+    # Re(λ1 λ2) as two products and a difference, operation by operation as in
+    # _pair_arrays: numpy's complex product may fuse them (FMA) where Python's does not, and
+    # an ω_n one ulp apart would put a mode on either side of a limit (ω_n > 0.4).
+    wn2 = l1.real * l2.real - l1.imag * l2.imag
+    zw = -0.5 * (l1.real + l2.real)
     if wn2 > 0:
         wn = math.sqrt(wn2)
         return wn, zw / wn, zw
@@ -751,7 +754,10 @@ def level_arrays(
     Raises
     ------
     InvalidArgumentError
-        A key is not a mode name, or ``aircraft_class`` or ``category`` is unknown.
+        ``modes`` not a mapping, a key that is not a mode name, ``aircraft_class`` or
+        ``category`` unknown, eigenvalues that are not numbers, an oscillatory pair that is
+        not a conjugate pair or two real roots, or a complex roll or spiral root (as
+        :func:`assess` refuses them, naming the first aircraft).
     ShapeError
         A mode's eigenvalues are not (k, 2) (oscillatory) or (k,) (roll, spiral).
     NonFiniteError
@@ -768,16 +774,14 @@ def level_arrays(
     """
     cls = _aircraft_class(aircraft_class)
     cat = _category(category)
+    if not isinstance(modes, Mapping):
+        raise InvalidArgumentError(
+            f"modes must be a mapping from mode name to eigenvalues, got {type(modes).__name__}"
+        )
     levels: dict[str, NDArray[np.int8]] = {}
     for key, value in modes.items():
         mode = _mode_name(key, "modes")
-        lam = np.asarray(value, dtype=np.complex128)
-        oscillatory = mode in _OSCILLATORY
-        if lam.ndim != (2 if oscillatory else 1) or (oscillatory and lam.shape[1] != 2):
-            expected = "(k, 2)" if oscillatory else "(k,)"
-            raise ShapeError(f"modes[{key!r}] must have shape {expected}, got {lam.shape}")
-        if not np.isfinite(lam).all():
-            raise NonFiniteError(f"modes[{key!r}] must be finite")
+        lam = _eigenvalue_arrays(value, f"modes[{key!r}]", mode)
         levels[mode] = _mode_levels(mode, lam, cls, cat)
     return levels
 
@@ -805,9 +809,12 @@ def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
     Raises
     ------
     InvalidArgumentError
-        ``mode`` is not a mode.
+        ``mode`` is not a mode; eigenvalues that are not numbers, an oscillatory pair that is
+        not a conjugate pair or two real roots, or a complex roll or spiral root.
     ShapeError
         ``eigenvalues`` is not (k, 2) for an oscillatory mode or (k,) for roll and spiral.
+    NonFiniteError
+        A NaN or infinite eigenvalue (a NaN root is no roll time constant of inf).
 
     Examples
     --------
@@ -820,14 +827,10 @@ def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
     {'time to double': array([        inf, 69.31471806])}
     """
     name = _mode_name(mode, "mode")
-    lam = np.asarray(eigenvalues, dtype=np.complex128)
+    lam = _eigenvalue_arrays(eigenvalues, f"eigenvalues of the {name}", name)
     if name in _OSCILLATORY:
-        if lam.ndim != 2 or lam.shape[1] != 2:
-            raise ShapeError(f"eigenvalues of the {name} must have shape (k, 2), got {lam.shape}")
         wn, zeta, _ = _pair_arrays(lam)
         return {"omega_n": wn, "zeta": zeta}
-    if lam.ndim != 1:
-        raise ShapeError(f"eigenvalues of the {name} must have shape (k,), got {lam.shape}")
     if name == "roll":
         return {"time constant": _roll_time_constant(lam.real)}
     return {"time to double": _time_to_double_arrays(lam.real)}
@@ -897,6 +900,46 @@ def level_limits(
     return [(k, float(value)) for k, value in limits if value is not None]
 
 
+def _eigenvalue_arrays(value: object, label: str, mode: str) -> NDArray[np.complex128]:
+    """The eigenvalues of k aircraft for one mode, checked as :func:`assess` checks one
+    aircraft's: numbers (InvalidArgumentError), of shape (k, 2) or (k,) (ShapeError), finite
+    (NonFiniteError), conjugate pairs or two real roots for an oscillatory mode and real roots
+    for roll and spiral, to 1e-9 of their size (InvalidArgumentError naming the first)."""
+    try:
+        array = np.asarray(value)
+    except ValueError as error:  # ragged nested sequences
+        raise ShapeError(f"{label} must be a rectangular array of numbers: {error}") from None
+    if array.dtype.kind not in "biufc":
+        raise InvalidArgumentError(f"{label} must be an array of numbers, got dtype {array.dtype}")
+    lam = array.astype(np.complex128)
+    oscillatory = mode in _OSCILLATORY
+    if lam.ndim != (2 if oscillatory else 1) or (oscillatory and lam.shape[1] != 2):
+        expected = "(k, 2)" if oscillatory else "(k,)"
+        raise ShapeError(f"{label} must have shape {expected}, got {lam.shape}")
+    if not np.isfinite(lam).all():
+        raise NonFiniteError(f"{label} must be finite")
+    if oscillatory:
+        l1, l2 = lam[:, 0], lam[:, 1]
+        scale = np.maximum(np.abs(l1), np.abs(l2))
+        real_pair = (l1.imag == 0) & (l2.imag == 0)
+        bad = ~real_pair & (np.abs(l1 - l2.conj()) > 1e-9 * scale)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InvalidArgumentError(
+                f"{label}[{i}] must be a conjugate pair or two real roots, got "
+                f"{complex(l1[i])} and {complex(l2[i])}"
+            )
+    else:
+        bad = np.abs(lam.imag) > 1e-9 * np.abs(lam)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InvalidArgumentError(
+                f"{label}[{i}] must be real, got {complex(lam[i])}: a complex roll or spiral "
+                "root is a coupled roll-spiral oscillation (3.3.1.4), which is not assessed"
+            )
+    return lam
+
+
 def _roll_time_constant(root: FloatArray) -> FloatArray:
     with np.errstate(divide="ignore"):
         tau: FloatArray = np.where(root < 0, -1.0 / np.where(root < 0, root, -1.0), np.inf)
@@ -906,8 +949,9 @@ def _roll_time_constant(root: FloatArray) -> FloatArray:
 def _pair_arrays(lam: NDArray[np.complex128]) -> tuple[FloatArray, FloatArray, FloatArray]:
     """:func:`_pair` on k pairs: (ω_n, ζ, ζ ω_n)."""
     l1, l2 = lam[:, 0], lam[:, 1]
-    wn2 = (l1 * l2).real
-    zw = -0.5 * (l1 + l2).real
+    # Real operations only (see _pair): the same doubles as assess gives, bitwise.
+    wn2 = l1.real * l2.real - l1.imag * l2.imag
+    zw = -0.5 * (l1.real + l2.real)
     with np.errstate(invalid="ignore", divide="ignore"):
         wn = np.where(wn2 > 0, np.sqrt(np.abs(wn2)), np.where(wn2 == 0, 0.0, np.nan))
         zeta = np.where(
