@@ -691,6 +691,13 @@ def test_clopper_pearson_for_rare_events_in_huge_runs(
         assert estimate.low == pytest.approx(low, rel=tolerance, abs=0.0)
 
 
+def test_a_progress_that_is_not_callable_is_refused_before_the_first_chunk() -> None:
+    # It was a TypeError after the first chunk had run (minutes, for a big chunk).
+    plane = aircraft.load("b747-cruise")
+    with pytest.raises(InvalidArgumentError, match="progress must be callable or None, got 3"):
+        monte_carlo(plane, Uncertainty({"Cn_beta": Normal(0.1)}), 10, progress=3)  # type: ignore[arg-type]
+
+
 def _binomial_lower_tail_mpmath(x: mpmath.mpf, n: int, k: int) -> mpmath.mpf:
     """P(Binomial(n, x) <= k) at mpmath's precision, term by term."""
     term = mpmath.exp(n * mpmath.log1p(-x))

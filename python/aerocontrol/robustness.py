@@ -47,7 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import batch, linalg
 from ._judging import AXIS_MODES, judge_stack
 from ._results import Result, Tabular, register
-from ._validation import check_finite, positive_int, real_array, real_scalar
+from ._validation import check_finite, optional_callable, positive_int, real_array, real_scalar
 from .aircraft.model import _POSITIVE_FIELDS, SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
 from .aircraft.schema import AircraftDataError
@@ -1172,7 +1172,8 @@ def monte_carlo(
     Raises
     ------
     InvalidArgumentError
-        A bad argument (named), or an uncertain parameter the aircraft does not have.
+        A bad argument (named; ``progress`` neither callable nor None), or an uncertain
+        parameter the aircraft does not have.
     ShapeError
         Gains of the wrong shape.
     MemoryError
@@ -1220,6 +1221,7 @@ def monte_carlo(
             )
     samples = positive_int(samples, "samples")
     chunk_size = positive_int(chunk_size, "chunk_size")
+    optional_callable(progress, "progress")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidArgumentError(f"seed must be a nonnegative int, got {seed!r}")
     required_level = _level(required_level, "required_level")
