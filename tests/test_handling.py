@@ -844,3 +844,24 @@ def test_array_forms_refuse_what_assess_refuses(
     # What they accept they judge as assess does: an exact real pair and a real root.
     assert level_arrays({"roll": np.array([-1.0 + 0.0j])}, "III", "B")["roll"].tolist() == [1]
     assert mode_quantities("roll", np.array([-0.5]))["time constant"].tolist() == [2.0]
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200, 1e-160, 1.0, 1e160, 1e200, 1e300])
+def test_pairs_of_any_magnitude_keep_their_frequency_and_damping(scale: float) -> None:
+    """Roots -s ± s j: ω_n = √2 s and ζ = 1/√2 at every s (closed form, to 4e-16), with no
+    overflow warning. ω_n² = Re(λ1 λ2) overflowed to inf beyond s = 1e154 (ζ 0: Level 4 for
+    a Level 1 Dutch roll) and underflowed to 0 below 1e-162 (ζ inf)."""
+    import warnings
+
+    from aerocontrol.handling import level_arrays, mode_quantities
+
+    lam = np.array([[-scale + scale * 1j, -scale - scale * 1j], [-2.0 * scale, -0.5 * scale]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        quantities = mode_quantities("dutch roll", lam)
+        levels = level_arrays({"dutch roll": lam}, "III", "B")["dutch roll"]
+        single = assess({"dutch roll": list(lam[0])}, "III", "B")
+    np.testing.assert_allclose(quantities["omega_n"], [math.sqrt(2) * scale, scale], rtol=4e-16)
+    np.testing.assert_allclose(quantities["zeta"], [1 / math.sqrt(2), 1.25], rtol=4e-16)
+    expected = 1 if scale > 1.0 else (4 if scale < 1.0 else 1)  # ω_n > 0.4 rad/s needed
+    assert levels[0] == single.level("dutch roll") == expected

@@ -604,20 +604,11 @@ def _eigenvalues(modes: object) -> dict[str, NDArray[np.complex128]]:
 
 
 def _pair(lam: NDArray[np.complex128]) -> tuple[float, float, float]:
-    """(ω_n, ζ, ζ ω_n) of two roots; ω_n and ζ NaN for real roots of opposite sign."""
-    l1, l2 = complex(lam[0]), complex(lam[1])
-    # Re(λ1 λ2) as two products and a difference, operation by operation as in
-    # _pair_arrays: numpy's complex product may fuse them (FMA) where Python's does not, and
-    # an ω_n one ulp apart would put a mode on either side of a limit (ω_n > 0.4).
-    wn2 = l1.real * l2.real - l1.imag * l2.imag
-    zw = -0.5 * (l1.real + l2.real)
-    if wn2 > 0:
-        wn = math.sqrt(wn2)
-        return wn, zw / wn, zw
-    if wn2 == 0:
-        zeta = math.copysign(math.inf, zw) if zw != 0 else math.nan
-        return 0.0, zeta, zw
-    return math.nan, math.nan, zw
+    """(ω_n, ζ, ζ ω_n) of two roots; ω_n and ζ NaN for real roots of opposite sign: the
+    doubles :func:`_pair_arrays` gives (one computation, so assess and level_arrays agree
+    to the bit at every limit)."""
+    wn, zeta, zw = _pair_arrays(np.asarray(lam, dtype=np.complex128).reshape(1, 2))
+    return float(wn[0]), float(zeta[0]), float(zw[0])
 
 
 def _time_to_double(growth: float) -> float:
@@ -948,17 +939,26 @@ def _roll_time_constant(root: FloatArray) -> FloatArray:
 
 def _pair_arrays(lam: NDArray[np.complex128]) -> tuple[FloatArray, FloatArray, FloatArray]:
     """:func:`_pair` on k pairs: (ω_n, ζ, ζ ω_n)."""
-    l1, l2 = lam[:, 0], lam[:, 1]
-    # Real operations only (see _pair): the same doubles as assess gives, bitwise.
-    wn2 = l1.real * l2.real - l1.imag * l2.imag
-    zw = -0.5 * (l1.real + l2.real)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        wn = np.where(wn2 > 0, np.sqrt(np.abs(wn2)), np.where(wn2 == 0, 0.0, np.nan))
+    # Each pair scaled by a power of two, 2^-e with 2^e about its largest part: exact, so the
+    # doubles are those of the unscaled formulas wherever those neither overflow nor
+    # underflow, and ω_n² of roots of 1e200 (or 1e-200) is no inf (or 0).
+    parts = np.abs(np.stack([lam.real, lam.imag], axis=-1)).reshape(lam.shape[0], -1)
+    exponent = np.frexp(parts.max(axis=1, initial=0.0))[1]
+    r1, i1 = np.ldexp(lam[:, 0].real, -exponent), np.ldexp(lam[:, 0].imag, -exponent)
+    r2, i2 = np.ldexp(lam[:, 1].real, -exponent), np.ldexp(lam[:, 1].imag, -exponent)
+    # Re(λ1 λ2) by real operations: numpy's complex product may fuse them (FMA), and an ω_n
+    # one ulp apart would put a mode on either side of a limit (ω_n > 0.4).
+    wn2 = r1 * r2 - i1 * i2
+    zw_scaled = -0.5 * (r1 + r2)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        wn_scaled = np.where(wn2 > 0, np.sqrt(np.abs(wn2)), np.where(wn2 == 0, 0.0, np.nan))
         zeta = np.where(
             wn2 > 0,
-            zw / np.where(wn2 > 0, wn, 1.0),
-            np.where((wn2 == 0) & (zw != 0), np.copysign(np.inf, zw), np.nan),
+            zw_scaled / np.where(wn2 > 0, wn_scaled, 1.0),
+            np.where((wn2 == 0) & (zw_scaled != 0), np.copysign(np.inf, zw_scaled), np.nan),
         )
+        wn = np.ldexp(wn_scaled, exponent)
+        zw = np.ldexp(zw_scaled, exponent)
     return wn, zeta, zw
 
 
