@@ -691,6 +691,19 @@ def test_clopper_pearson_for_rare_events_in_huge_runs(
         assert estimate.low == pytest.approx(low, rel=tolerance, abs=0.0)
 
 
+@pytest.mark.parametrize(("count", "samples"), [(3, 10**18), (10**7, 10**15), (1, 10**12 + 1)])
+def test_clopper_pearson_refuses_runs_beyond_max_samples(count: int, samples: int) -> None:
+    # 3 of 10^18 gave the interval [5.6e-17, 8.8e-18] (1 - x rounded to 1: low above high),
+    # 10^7 of 10^15 one 1e-3 off that did not hold the estimate 1e-8, and 10^17 of 10^18 an
+    # ArithmeticError: refused by name.
+    with pytest.raises(InvalidArgumentError, match="samples must be at most 1e"):
+        clopper_pearson(count, samples)
+    with pytest.raises(InvalidArgumentError, match="samples must be at most 1e"):
+        monte_carlo(aircraft.load("b747-cruise"), Uncertainty({"Cn_beta": Normal(0.1)}), samples)
+    edge = clopper_pearson(count, robustness.MAX_SAMPLES)  # the largest run taken
+    assert 0.0 < edge.low < edge.value < edge.high < 1.0
+
+
 def test_a_progress_that_is_not_callable_is_refused_before_the_first_chunk() -> None:
     # It was a TypeError after the first chunk had run (minutes, for a big chunk).
     plane = aircraft.load("b747-cruise")

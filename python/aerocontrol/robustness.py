@@ -51,11 +51,12 @@ from ._validation import check_finite, optional_callable, positive_int, real_arr
 from .aircraft.model import _POSITIVE_FIELDS, SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
 from .aircraft.schema import AircraftDataError
-from .exceptions import InvalidArgumentError, ShapeError
+from .exceptions import ConvergenceError, InvalidArgumentError, ShapeError
 from .handling import mode_quantities
 
 __all__ = [
     "CHUNK_SIZE",
+    "MAX_SAMPLES",
     "Damper",
     "Estimate",
     "LogNormal",
@@ -673,7 +674,7 @@ def _incomplete_beta(
         f *= c * d
         if abs(1.0 - c * d) < 1e-15:
             return front * (f - 1.0)
-    raise ArithmeticError(f"the incomplete beta function I_{x}({a}, {b}) did not converge")
+    raise ConvergenceError(f"the incomplete beta function I_{x}({a}, {b}) did not converge")
 
 
 #: The most terms of a binomial tail summed term by term (:func:`_binomial_lower_tail`).
@@ -778,16 +779,24 @@ class Estimate:
         )
 
 
+#: The most samples :func:`clopper_pearson` takes: beyond, an end below 1e-16 has 1 - x = 1
+#: in doubles, and the continued fraction's error grows past 1e-3 of the interval's width.
+MAX_SAMPLES = 10**12
+
+
 def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estimate:
     """The estimate count / samples and its exact (Clopper-Pearson) interval (1), its ends to
-    about 1e-9 relative at a million samples (ln B(a, b) from lgamma values near 1e7).
+    about 1e-9 relative at a million samples (ln B(a, b) from lgamma values near 1e7); up to
+    :data:`MAX_SAMPLES` = 10^12 samples, to 1e-12 relative where the count is within 10^4 of
+    0 or of ``samples``, and to 1e-3 of the interval's width for other counts (the continued
+    fraction converging in O(sqrt(samples)) steps).
 
     Parameters
     ----------
     count : int
         The samples in which the event happened, 0 <= count <= samples.
     samples : int
-        The samples drawn, positive.
+        The samples drawn, positive, at most :data:`MAX_SAMPLES`.
     confidence : float, optional
         The confidence of the two-sided interval, in (0, 1) (default 0.95).
 
@@ -801,7 +810,8 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
     Raises
     ------
     InvalidArgumentError
-        ``count`` or ``samples`` not an int or out of order, ``confidence`` outside (0, 1).
+        ``count`` or ``samples`` not an int or out of order, ``samples`` above
+        :data:`MAX_SAMPLES`, ``confidence`` outside (0, 1).
 
     Examples
     --------
@@ -819,6 +829,13 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
         raise InvalidArgumentError(
             f"count and samples must satisfy 0 <= count <= samples, samples > 0; got "
             f"{count} of {samples}"
+        )
+    if samples > MAX_SAMPLES:
+        # 3 of 10^18 gave [5.6e-17, 8.8e-18] (1 - x rounded to 1), 10^7 of 10^15 an interval
+        # 1e-3 off that did not hold the estimate, 10^17 of 10^18 an ArithmeticError.
+        raise InvalidArgumentError(
+            f"samples must be at most {MAX_SAMPLES:.0e} for an interval computed in doubles, "
+            f"got {samples}"
         )
     confidence = real_scalar(confidence, "confidence")
     if not 0.0 < confidence < 1.0:
@@ -1220,6 +1237,8 @@ def monte_carlo(
                 "relative=False)"
             )
     samples = positive_int(samples, "samples")
+    if samples > MAX_SAMPLES:  # no interval for its probabilities (clopper_pearson)
+        raise InvalidArgumentError(f"samples must be at most {MAX_SAMPLES:.0e}, got {samples}")
     chunk_size = positive_int(chunk_size, "chunk_size")
     optional_callable(progress, "progress")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
