@@ -704,6 +704,43 @@ def test_clopper_pearson_refuses_runs_beyond_max_samples(count: int, samples: in
     assert 0.0 < edge.low < edge.value < edge.high < 1.0
 
 
+def test_a_failed_design_names_the_sample_by_its_index_in_the_run() -> None:
+    """An Lqr re-design that has no solution for one sample was reported as "problem 63 of the
+    batch", its index in its chunk (the fifth, of 100 samples): it is sample 463 of the run.
+    Oracle: that sample's own regulator (aerocontrol.lqr on its model) has no stabilising
+    solution, and every sample before it has one (one batch call over them)."""
+    plane = aircraft.load("b747-cruise")
+    uncertainty = Uncertainty({"Cn_beta": Normal(1.0), "Cl_p": Normal(1.0)})
+    Q = np.diag([1.0, 1.0, 1.0, -2.0])
+    with pytest.raises(
+        aerocontrol.NoStabilizingSolutionError, match=r"^sample 463 of the run: "
+    ) as caught:
+        monte_carlo(plane, uncertainty, 2000, Lqr(Q=Q), seed=1, chunk_size=100)
+    assert caught.value.batch_index == 463
+    run = robustness._Run(plane, uncertainty, "lateral", None, 2000, 1, 100, 1)
+    draws = np.vstack([run.draws(c) for c in range(5)])
+    A, B = plane.model_stack("lateral", run.values(draws))
+    batch.solve_care_batch(A[:463], B[:463], Q, np.eye(2))  # the samples before it: solved
+    with pytest.raises(aerocontrol.NoStabilizingSolutionError):
+        aerocontrol.lqr(
+            aerocontrol.StateSpace(A[463], B[463], np.eye(4), np.zeros((4, 2))), Q, np.eye(2)
+        )
+
+
+def test_a_failed_damper_names_the_sample_among_all_of_its_chunk() -> None:
+    """The Damper places poles for the samples with a Dutch roll oscillation only: a failure
+    of the second of those is the chunk's third sample (the first has none), not "problem 1"."""
+    plane = aircraft.load("b747-cruise")
+    A, B = plane.model_stack("lateral", {"Cn_beta": np.full(3, plane.derivatives["Cn_beta"])})
+    B = B.copy()
+    B[2, :, 0] = 0.0  # no rudder: no damper through it
+    eigenvalues = linalg.eigenvalues(A)
+    eigenvalues[0] = [-1.0, -2.0, -3.0, -4.0]  # no oscillation: not designed
+    with pytest.raises(aerocontrol.AerocontrolError, match=r"^problem 2 of the batch") as caught:
+        robustness._closed_loop(A, B, robustness.Damper(), eigenvalues)
+    assert caught.value.batch_index == 2
+
+
 def test_a_progress_that_is_not_callable_is_refused_before_the_first_chunk() -> None:
     # It was a TypeError after the first chunk had run (minutes, for a big chunk).
     plane = aircraft.load("b747-cruise")

@@ -51,7 +51,7 @@ from ._validation import check_finite, optional_callable, positive_int, real_arr
 from .aircraft.model import _POSITIVE_FIELDS, SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
 from .aircraft.schema import AircraftDataError
-from .exceptions import ConvergenceError, InvalidArgumentError, ShapeError
+from .exceptions import AerocontrolError, ConvergenceError, InvalidArgumentError, ShapeError
 from .handling import mode_quantities
 
 __all__ = [
@@ -460,7 +460,15 @@ def _closed_loop(
             )
             column = ("rudder", "aileron").index(controller.surface)
             one_input = B[designed][:, :, column : column + 1]
-            placed = batch.place_batch(A[designed], one_input, poles, "bass-gura")
+            try:
+                placed = batch.place_batch(A[designed], one_input, poles, "bass-gura")
+            except AerocontrolError as error:  # its problem among the designed: the chunk's
+                if error.batch_index is None:
+                    raise
+                rows = np.flatnonzero(designed)
+                raise _renumbered(
+                    error, int(rows[error.batch_index]), "problem {} of the batch"
+                ) from None
             K[designed, column] = placed.K[:, 0]
         closed = A - np.einsum("kij,kjl->kil", B, K)
         return closed, linalg.eigenvalues(closed), designed
@@ -587,7 +595,12 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
     out["open_controlled"] = np.zeros(A.shape[0], dtype=bool)
     failed = (out["open_levels"] > run.required_level).any(axis=1)
     if run.controller is not None:
-        closed, poles, controlled = _closed_loop(A, B, run.controller, eigenvalues)
+        try:
+            closed, poles, controlled = _closed_loop(A, B, run.controller, eigenvalues)
+        except AerocontrolError as error:  # a sample's design failed: named by its index in the run
+            if error.batch_index is None:
+                raise
+            raise _renumbered(error, start + error.batch_index, "sample {} of the run") from None
         out.update({f"closed_{k}": v for k, v in _judge(run, closed, poles).items()})
         out["closed_controlled"] = controlled
         failed = (out["closed_levels"] > run.required_level).any(axis=1)
@@ -601,6 +614,19 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
     out["bin_failed"] = np.bincount(flat[failed].ravel(), minlength=size).reshape(parameters, -1)
     out["failed"] = np.asarray(failed)
     return out
+
+
+def _renumbered(error: AerocontrolError, index: int, phrase: str) -> AerocontrolError:
+    """``error`` (of a batch kernel, "problem i of the batch") with ``phrase`` filled with
+    ``index`` for the problem, and ``index`` as its batch_index: a failed design of a sample
+    named by where it is, not by its place in the batch (one chunk, or the Damper's designed
+    samples of one)."""
+    local = error.batch_index
+    message = str(error).replace(f"problem {local} of the batch", phrase.format(index), 1)
+    renamed = type(error)(message)
+    renamed.__dict__.update(error.__dict__)
+    renamed.batch_index = index
+    return renamed
 
 
 @functools.cache
@@ -1196,6 +1222,11 @@ def monte_carlo(
     MemoryError
         The per-sample results of ``samples`` would not fit in the memory left (measured
         after the first chunk, before the others run).
+    AerocontrolError
+        A sample whose :class:`Lqr` or :class:`Damper` design fails raises that design's
+        error (NoStabilizingSolutionError, ...), its message starting "sample i of the run"
+        and its ``batch_index`` i (:meth:`MonteCarlo.values` of a rerun without it draws
+        the same values).
 
     Examples
     --------
