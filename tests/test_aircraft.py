@@ -768,6 +768,7 @@ def test_an_aircraft_made_directly_is_checked(change: dict[str, object], match: 
 
 def test_an_aircraft_made_directly_checks_its_derivatives() -> None:
     navion = aircraft.load("navion")
+    assert dataclasses.replace(navion, aircraft_class="II").aircraft_class == "II-L"
     derivatives = dict(navion.derivatives)
     with pytest.raises(
         aircraft.AircraftDataError, match=r"derivatives\['Cn_beta'\] must be finite"

@@ -234,7 +234,7 @@ class Aircraft:
     def __post_init__(self) -> None:
         """The checks a constructor call or ``dataclasses.replace`` gets (a file's values
         were checked, with their ranges, when read): AircraftDataError naming the field for
-        a Class, Category or units not among the choices, a quantity that is not a finite
+        a Class ("II" is taken as "II-L"), Category or units not among the choices, a quantity that is not a finite
         real number or, for the speed, density, Mach number, mass, g, inertias Ix, Iy, Iz and
         the geometry, not positive, and derivatives that are not every one of
         LONGITUDINAL_DERIVATIVES and LATERAL_DERIVATIVES, each a finite real number. Without
@@ -244,6 +244,8 @@ class Aircraft:
                 raise AircraftDataError(
                     f"Aircraft: {name} must be a str, got {getattr(self, name)!r:.80}"
                 )
+        if self.aircraft_class == "II":  # as the file and handling.assess take it (1.3.1)
+            object.__setattr__(self, "aircraft_class", "II-L")
         for name, choices in (
             ("aircraft_class", ("I", "II-C", "II-L", "III", "IV")),
             ("category", ("A", "B", "C")),
