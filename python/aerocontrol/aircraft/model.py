@@ -234,11 +234,12 @@ class Aircraft:
     def __post_init__(self) -> None:
         """The checks a constructor call or ``dataclasses.replace`` gets (a file's values
         were checked, with their ranges, when read): AircraftDataError naming the field for
-        a Class ("II" is taken as "II-L"), Category or units not among the choices, a quantity that is not a finite
-        real number or, for the speed, density, Mach number, mass, g, inertias Ix, Iy, Iz and
-        the geometry, not positive, and derivatives that are not every one of
-        LONGITUDINAL_DERIVATIVES and LATERAL_DERIVATIVES, each a finite real number. Without
-        them a negative mass or speed gave a model silently, Ix = 0 a ZeroDivisionError."""
+        a Class ("II" is taken as "II-L"), Category or units not among the choices, a
+        quantity that is not a finite real number or, for the speed, density, Mach number,
+        mass, g, inertias Ix, Iy, Iz and the geometry, not positive, and derivatives that are
+        not every one of LONGITUDINAL_DERIVATIVES and LATERAL_DERIVATIVES, each a finite real
+        number. Without them a negative mass or speed gave a model silently, Ix = 0 a
+        ZeroDivisionError."""
         for name in ("name", "identifier", "description"):
             if not isinstance(getattr(self, name), str):
                 raise AircraftDataError(
