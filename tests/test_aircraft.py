@@ -736,3 +736,56 @@ def test_at_a_file_at_zero_lift_holds_the_drag() -> None:
     level = dataclasses.replace(b747, derivatives={**b747.derivatives, "CL": 0.0})
     moved = level.at(altitude=5_000.0)
     assert moved.derivatives["CL"] == 0.0 and moved.derivatives["CD"] == b747.derivatives["CD"]
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        ({"mass": -1.0}, "mass must be positive, got -1.0"),
+        ({"speed": -176.0}, "speed must be positive"),
+        ({"speed": math.nan}, "speed must be finite"),
+        ({"density": 0.0}, "density must be positive"),
+        ({"Ix": 0.0}, "Ix must be positive"),  # was a ZeroDivisionError
+        ({"Iz": math.inf}, "Iz must be finite"),
+        ({"S": -184.0}, "S must be positive"),
+        ({"mass": "2750"}, "mass must be a real number"),  # was a TypeError
+        ({"Ixz": True}, "Ixz must be a real number"),
+        ({"aircraft_class": "V"}, "aircraft_class must be one of"),
+        ({"category": "b"}, "category must be one of"),
+        ({"units": "SI"}, "units must be one of"),
+        ({"name": None}, "name must be a str"),
+        ({"derivatives": [("Cn_beta", 0.1)]}, "derivatives must be a mapping"),
+    ],
+)
+def test_an_aircraft_made_directly_is_checked(change: dict[str, object], match: str) -> None:
+    """The constructor and dataclasses.replace check what a file's reader checks (names,
+    finiteness, signs): a negative mass or speed gave a model silently (its Dutch roll
+    unstable), Ix = 0 a ZeroDivisionError, a str a TypeError."""
+    navion = aircraft.load("navion")
+    with pytest.raises(aircraft.AircraftDataError, match=match):
+        dataclasses.replace(navion, **change)  # type: ignore[arg-type]
+
+
+def test_an_aircraft_made_directly_checks_its_derivatives() -> None:
+    navion = aircraft.load("navion")
+    assert dataclasses.replace(navion, aircraft_class="II").aircraft_class == "II-L"
+    derivatives = dict(navion.derivatives)
+    with pytest.raises(
+        aircraft.AircraftDataError, match=r"derivatives\['Cn_beta'\] must be finite"
+    ):
+        dataclasses.replace(navion, derivatives={**derivatives, "Cn_beta": math.nan})
+    with pytest.raises(aircraft.AircraftDataError, match="derivatives is missing Cn_beta"):
+        dataclasses.replace(
+            navion, derivatives={k: v for k, v in derivatives.items() if k != "Cn_beta"}
+        )
+    with pytest.raises(aircraft.AircraftDataError, match=r"unknown key.*'Cn_Beta'"):
+        dataclasses.replace(navion, derivatives={**derivatives, "Cn_Beta": 0.1})
+    with pytest.raises(aircraft.AircraftDataError, match=r"must be a real number, got '0\.1'"):
+        dataclasses.replace(navion, derivatives={**derivatives, "Cn_beta": "0.1"})
+    # numpy and int values are numbers: the same model as the file's, bitwise.
+    same = dataclasses.replace(
+        navion,
+        mass=np.float64(navion.mass),
+        derivatives={**derivatives, "Cn_beta": np.float64(derivatives["Cn_beta"])},
+    )
+    np.testing.assert_array_equal(same.lateral().A, navion.lateral().A)

@@ -485,7 +485,9 @@ def test_robustness_prints_the_probabilities_of_the_api(
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--samples", "0"], "--samples must be a positive number, got 0"),
+        (["--samples", "0"], "--samples must be a positive number up to 1e+12, got 0"),
+        # Beyond MAX_SAMPLES no interval is computed: refused before the run, not after it.
+        (["--samples", "10000000000000"], "--samples must be a positive number up to 1e+12"),
         (["--seed", "-1"], "--seed must be >= 0, got -1"),
         (["--sigma", "nan"], "--sigma must be a number >= 0, got nan"),
         (["--c", "0"], "--c must lie between"),

@@ -476,6 +476,12 @@ def test_unobservable_pair_is_refused_by_name() -> None:
         aerocontrol.place_observer(A, [[1.0, 1.0]], [-1, -2, -3])
     with pytest.raises(InvalidArgumentError, match="place_observer needs"):
         aerocontrol.place_observer(A, [[1.0, 1.0, 1.0]])
+    # A pole repeated beyond the outputs' rank: the refusal named "B", which the caller never
+    # gave; it says that B is C^T, and keeps naming the poles as the argument at fault.
+    with pytest.raises(InvalidArgumentError, match=r"its B is C\^T\)$") as repeated:
+        aerocontrol.place_observer(A, [[1.0, 1.0, 1.0]], [-1, -1, -1])
+    assert "repeated 3 times, but B has rank 1" in str(repeated.value)
+    assert repeated.value.argument == "poles"
 
 
 def test_ill_conditioned_observer_warns_as_place_does() -> None:

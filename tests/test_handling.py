@@ -782,3 +782,86 @@ def test_margins_check_bad_arguments() -> None:
         margins_check({})
     with pytest.raises(InvalidArgumentError, match="non-empty mapping"):
         margins_check([("L", loop)])  # type: ignore[arg-type]
+
+
+def test_assess_and_level_arrays_agree_bitwise_next_to_the_limits() -> None:
+    """Pairs built at the Table VI minimum ω_n = 0.4 rad/s, ζ_d = 0.08 and the Table IV ζ_sp
+    limits: assess (one aircraft) and level_arrays / mode_quantities (k at once) must give the
+    same ω_n and ζ to the bit, and so the same Level. numpy's complex product rounded Re(λ1 λ2)
+    differently from Python's (fused), so ω_n = 0.4 was Level 4 by assess and 1 by
+    level_arrays. Oracle for ω_n: sqrt of the exact Re(λ1 λ2) of the given doubles, to 1 ulp."""
+    from fractions import Fraction
+
+    from aerocontrol.handling import level_arrays, mode_quantities
+
+    rng = np.random.default_rng(7)
+    zetas = np.concatenate([[0.08, 0.15, 0.19, 0.25, 0.35, 0.7], rng.uniform(0.01, 0.99, 60)])
+    pairs = np.array([pair(float(z), wn) for z in zetas for wn in (0.4, 1.0, 0.35 / 0.19)])
+    arrays = mode_quantities("dutch roll", pairs)
+    for cls, cat in COLUMNS:
+        for mode in ("dutch roll", "short period", "phugoid"):
+            bulk = level_arrays({mode: pairs}, cls, cat)[mode]
+            one = [assess({mode: list(p)}, cls, cat).level(mode) for p in pairs]
+            assert bulk.tolist() == one, (mode, cls, cat)
+    for p, wn, zeta in zip(pairs, arrays["omega_n"], arrays["zeta"], strict=True):
+        single = {
+            r.quantity: r.value for r in assess({"dutch roll": list(p)}, "III", "B").requirements
+        }
+        assert single["omega_n"] == wn and single["zeta"] == zeta
+        exact = Fraction(p[0].real) * Fraction(p[1].real) - Fraction(p[0].imag) * Fraction(
+            p[1].imag
+        )
+        assert abs(wn - math.sqrt(float(exact))) <= math.ulp(wn)
+
+
+@pytest.mark.parametrize(
+    ("mode", "eigenvalues", "error", "match"),
+    [
+        ("roll", [math.nan], NonFiniteError, "finite"),
+        ("spiral", [-0.1, math.inf], NonFiniteError, "finite"),
+        ("dutch roll", [[math.nan, math.nan]], NonFiniteError, "finite"),
+        ("roll", [-1.0 + 2.0j], InvalidArgumentError, r"\[0\] must be real"),
+        ("spiral", [-0.1, 0.2 + 0.3j], InvalidArgumentError, r"\[1\] must be real"),
+        ("dutch roll", [[-1 + 1j, -3 + 2j]], InvalidArgumentError, r"\[0\] must be a conjugate"),
+        ("roll", ["x"], InvalidArgumentError, "array of numbers"),
+        ("dutch roll", [[1, 2], [3]], ShapeError, "rectangular"),
+    ],
+)
+def test_array_forms_refuse_what_assess_refuses(
+    mode: str, eigenvalues: object, error: type[Exception], match: str
+) -> None:
+    """level_arrays and mode_quantities refuse, naming the argument, what assess refuses: a
+    NaN roll root gave a time constant of inf, a NaN spiral a stable spiral, a complex roll
+    root and a non-conjugate pair were judged by their real parts, a string was a ValueError."""
+    from aerocontrol.handling import level_arrays, mode_quantities
+
+    with pytest.raises(error, match=match):
+        level_arrays({mode: eigenvalues}, "III", "B")
+    with pytest.raises(error, match=match):
+        mode_quantities(mode, eigenvalues)
+    with pytest.raises(InvalidArgumentError, match="modes must be a mapping"):
+        level_arrays([(mode, eigenvalues)], "III", "B")  # type: ignore[arg-type]
+    # What they accept they judge as assess does: an exact real pair and a real root.
+    assert level_arrays({"roll": np.array([-1.0 + 0.0j])}, "III", "B")["roll"].tolist() == [1]
+    assert mode_quantities("roll", np.array([-0.5]))["time constant"].tolist() == [2.0]
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200, 1e-160, 1.0, 1e160, 1e200, 1e300])
+def test_pairs_of_any_magnitude_keep_their_frequency_and_damping(scale: float) -> None:
+    """Roots -s ± s j: ω_n = √2 s and ζ = 1/√2 at every s (closed form, to 4e-16), with no
+    overflow warning. ω_n² = Re(λ1 λ2) overflowed to inf beyond s = 1e154 (ζ 0: Level 4 for
+    a Level 1 Dutch roll) and underflowed to 0 below 1e-162 (ζ inf)."""
+    import warnings
+
+    from aerocontrol.handling import level_arrays, mode_quantities
+
+    lam = np.array([[-scale + scale * 1j, -scale - scale * 1j], [-2.0 * scale, -0.5 * scale]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        quantities = mode_quantities("dutch roll", lam)
+        levels = level_arrays({"dutch roll": lam}, "III", "B")["dutch roll"]
+        single = assess({"dutch roll": list(lam[0])}, "III", "B")
+    np.testing.assert_allclose(quantities["omega_n"], [math.sqrt(2) * scale, scale], rtol=4e-16)
+    np.testing.assert_allclose(quantities["zeta"], [1 / math.sqrt(2), 1.25], rtol=4e-16)
+    expected = 1 if scale > 1.0 else (4 if scale < 1.0 else 1)  # ω_n > 0.4 rad/s needed
+    assert levels[0] == single.level("dutch roll") == expected

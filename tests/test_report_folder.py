@@ -422,6 +422,32 @@ def test_a_folder_that_is_not_one_is_one_clear_error(
     assert _snapshot(tmp_path) == before
 
 
+@pytest.mark.parametrize(
+    ("arguments", "match"),
+    [
+        ({"progress": 3}, "progress must be callable or None, got 3"),
+        ({"progress": "print"}, "progress must be callable or None"),
+        ({"out": 3}, "out must be a folder's path"),
+        ({"out": b"bytes"}, "out must be a folder's path"),
+    ],
+)
+def test_a_bad_progress_or_out_is_refused_before_anything_is_written(
+    tiny: Callable[..., None],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    arguments: dict[str, object],
+    match: str,
+) -> None:
+    """A progress that is not callable was a TypeError at the first section's line (after
+    the folder was prepared), an int ``out`` a TypeError from pathlib: both are named
+    InvalidArgumentErrors now, before the folder is touched."""
+    monkeypatch.chdir(tmp_path)  # a bad ``out`` must not leave a folder in the working directory
+    before = _snapshot(tmp_path)
+    with pytest.raises(aerocontrol.InvalidArgumentError, match=match):
+        write_report(**{"out": tmp_path / "out", **arguments})  # type: ignore[arg-type]
+    assert _snapshot(tmp_path) == before
+
+
 @pytest.mark.skipif(os.geteuid() == 0, reason="root may write into any folder")
 def test_an_unwritable_folder_is_refused_before_the_analyses(
     tiny: Callable[..., None], tmp_path: Path

@@ -11,6 +11,7 @@ import os
 import re
 import warnings
 
+import mpmath
 import numpy as np
 import pytest
 import scipy.stats
@@ -683,10 +684,127 @@ def test_clopper_pearson_for_rare_events_in_huge_runs(
 ) -> None:
     estimate = clopper_pearson(count, samples)
     high = scipy.stats.beta.ppf(0.975, count + 1, samples - count)
-    assert estimate.high == pytest.approx(high, rel=tolerance)
+    # abs=0: pytest.approx's default abs=1e-12 would pass any end below 1e-12.
+    assert estimate.high == pytest.approx(high, rel=tolerance, abs=0.0)
     if count:
         low = scipy.stats.beta.ppf(0.025, count, samples - count + 1)
-        assert estimate.low == pytest.approx(low, rel=tolerance)
+        assert estimate.low == pytest.approx(low, rel=tolerance, abs=0.0)
+
+
+@pytest.mark.parametrize(("count", "samples"), [(3, 10**18), (10**7, 10**15), (1, 10**12 + 1)])
+def test_clopper_pearson_refuses_runs_beyond_max_samples(count: int, samples: int) -> None:
+    # 3 of 10^18 gave the interval [5.6e-17, 8.8e-18] (1 - x rounded to 1: low above high),
+    # 10^7 of 10^15 one 1e-3 off that did not hold the estimate 1e-8, and 10^17 of 10^18 an
+    # ArithmeticError: refused by name.
+    with pytest.raises(InvalidArgumentError, match="samples must be at most 1e"):
+        clopper_pearson(count, samples)
+    with pytest.raises(InvalidArgumentError, match="samples must be at most 1e"):
+        monte_carlo(aircraft.load("b747-cruise"), Uncertainty({"Cn_beta": Normal(0.1)}), samples)
+    edge = clopper_pearson(count, robustness.MAX_SAMPLES)  # the largest run taken
+    assert 0.0 < edge.low < edge.value < edge.high < 1.0
+
+
+def test_a_failed_design_names_the_sample_by_its_index_in_the_run() -> None:
+    """An Lqr re-design that has no solution for one sample was reported as "problem 63 of the
+    batch", its index in its chunk (the fifth, of 100 samples): it is sample 463 of the run.
+    Oracle: that sample's own regulator (aerocontrol.lqr on its model) has no stabilising
+    solution, and every sample before it has one (one batch call over them)."""
+    plane = aircraft.load("b747-cruise")
+    uncertainty = Uncertainty({"Cn_beta": Normal(1.0), "Cl_p": Normal(1.0)})
+    Q = np.diag([1.0, 1.0, 1.0, -2.0])
+    with pytest.raises(
+        aerocontrol.NoStabilizingSolutionError, match=r"^sample 463 of the run: "
+    ) as caught:
+        monte_carlo(plane, uncertainty, 2000, Lqr(Q=Q), seed=1, chunk_size=100)
+    assert caught.value.batch_index == 463
+    run = robustness._Run(plane, uncertainty, "lateral", None, 2000, 1, 100, 1)
+    draws = np.vstack([run.draws(c) for c in range(5)])
+    A, B = plane.model_stack("lateral", run.values(draws))
+    batch.solve_care_batch(A[:463], B[:463], Q, np.eye(2))  # the samples before it: solved
+    with pytest.raises(aerocontrol.NoStabilizingSolutionError):
+        aerocontrol.lqr(
+            aerocontrol.StateSpace(A[463], B[463], np.eye(4), np.zeros((4, 2))), Q, np.eye(2)
+        )
+
+
+def test_a_failed_damper_names_the_sample_among_all_of_its_chunk() -> None:
+    """The Damper places poles for the samples with a Dutch roll oscillation only: a failure
+    of the second of those is the chunk's third sample (the first has none), not "problem 1"."""
+    plane = aircraft.load("b747-cruise")
+    A, B = plane.model_stack("lateral", {"Cn_beta": np.full(3, plane.derivatives["Cn_beta"])})
+    B = B.copy()
+    B[2, :, 0] = 0.0  # no rudder: no damper through it
+    eigenvalues = linalg.eigenvalues(A)
+    eigenvalues[0] = [-1.0, -2.0, -3.0, -4.0]  # no oscillation: not designed
+    with pytest.raises(aerocontrol.AerocontrolError, match=r"^problem 2 of the batch") as caught:
+        robustness._closed_loop(A, B, robustness.Damper(), eigenvalues)
+    assert caught.value.batch_index == 2
+
+
+def test_a_progress_that_is_not_callable_is_refused_before_the_first_chunk() -> None:
+    # It was a TypeError after the first chunk had run (minutes, for a big chunk).
+    plane = aircraft.load("b747-cruise")
+    with pytest.raises(InvalidArgumentError, match="progress must be callable or None, got 3"):
+        monte_carlo(plane, Uncertainty({"Cn_beta": Normal(0.1)}), 10, progress=3)  # type: ignore[arg-type]
+
+
+def _binomial_lower_tail_mpmath(x: mpmath.mpf, n: int, k: int) -> mpmath.mpf:
+    """P(Binomial(n, x) <= k) at mpmath's precision, term by term."""
+    term = mpmath.exp(n * mpmath.log1p(-x))
+    total = term
+    odds = x / (1 - x)
+    for j in range(k):
+        term *= (n - j) * odds / (j + 1)
+        total += term
+    return total
+
+
+@pytest.mark.parametrize(
+    ("count", "samples", "confidence"),
+    [
+        (1, 10**12, 0.95),
+        (2, 10**12, 0.95),
+        (7, 10**12, 0.5),
+        (100, 10**12, 0.99),
+        (2, 10**9, 0.95),
+        (2, 100_000, 1 - 1e-12),
+        (3, 10, 0.95),
+    ],
+)
+def test_clopper_pearson_upper_end_against_mpmath(
+    count: int, samples: int, confidence: float
+) -> None:
+    # The oracle: for integers, the upper end h solves P(Binomial(N, h) <= k) = alpha/2
+    # (1 - I_h(k + 1, N - k), DLMF 8.17.5), by bisection at 40 digits, alpha = 1 - confidence
+    # exactly (the double given). The continued fraction stalled at 1e-6 relative for
+    # N = 10^12 (its steps below its stopping test), and 1 - alpha/2 rounded lost 1e-5 of a
+    # confidence of 1 - 10^-12.
+    with mpmath.workdps(40):
+        tail = (1 - mpmath.mpf(confidence)) / 2
+        low, high = mpmath.mpf(0), mpmath.mpf(1)
+        for _ in range(160):
+            middle = (low + high) / 2
+            if _binomial_lower_tail_mpmath(middle, samples, count) > tail:
+                low = middle
+            else:
+                high = middle
+        expected = float((low + high) / 2)
+    assert clopper_pearson(count, samples, confidence).high == pytest.approx(
+        expected, rel=1e-13, abs=0.0
+    )
+
+
+@pytest.mark.parametrize("samples", [1, 2, 5])
+def test_clopper_pearson_all_events_at_a_tiny_alpha(samples: int) -> None:
+    # k = N: the lower end is (alpha/2)^(1/N) itself (Beta(N, 1)'s quantile); 1 - (1 -
+    # (alpha/2)^(1/N)) lost four digits at N = 1, alpha = 1e-12.
+    confidence = 1 - 1e-12
+    alpha = 1 - confidence  # exact in doubles (Sterbenz)
+    expected = float(mpmath.power(mpmath.mpf(alpha) / 2, mpmath.mpf(1) / samples))
+    estimate = clopper_pearson(samples, samples, confidence)
+    # 1e-14: the power's exponent 1/N rounded, times ln(alpha/2) = -28.
+    assert estimate.low == pytest.approx(expected, rel=1e-14, abs=0.0)
+    assert estimate.high == 1.0
 
 
 @pytest.mark.parametrize("count", [2.7, None, "3", float("nan"), True])

@@ -160,6 +160,14 @@ def positive_int(value: object, name: str) -> int:
     return int(value)
 
 
+def optional_callable(value: object, name: str) -> None:
+    """InvalidArgumentError naming ``name`` unless ``value`` is None or callable: checked
+    before the work whose progress it reports starts, not at its first call (after a chunk
+    of a Monte Carlo run, or a report's first section)."""
+    if value is not None and not callable(value):
+        raise InvalidArgumentError(f"{name} must be callable or None, got {value!r:.80}")
+
+
 def check_choice(value: object, name: str, choices: tuple[str, ...]) -> str:
     """``value`` if it is one of ``choices``, else InvalidArgumentError naming ``name``."""
     if not isinstance(value, str) or value not in choices:

@@ -272,10 +272,12 @@ def _robustness(arguments: argparse.Namespace) -> int:
     from .report.build import write_document
     from .report.document import Report
     from .report.robustness import robustness_report
-    from .robustness import Lqr, Normal, Uncertainty, monte_carlo
+    from .robustness import MAX_SAMPLES, Lqr, Normal, Uncertainty, monte_carlo
 
-    if arguments.samples <= 0:
-        raise _UsageError(f"--samples must be a positive number, got {arguments.samples}")
+    if not 0 < arguments.samples <= MAX_SAMPLES:
+        raise _UsageError(
+            f"--samples must be a positive number up to {MAX_SAMPLES:.0e}, got {arguments.samples}"
+        )
     if arguments.seed < 0:
         raise _UsageError(f"--seed must be >= 0, got {arguments.seed}")
     sigma, c = arguments.sigma, arguments.c

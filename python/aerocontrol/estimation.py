@@ -859,7 +859,14 @@ def place_observer(
             raise unobservable from error
         except InvalidArgumentError as error:
             if error.argument != "B":
-                raise
+                # A refusal of the poles names the dual placement's B ("B has rank 1"):
+                # say which matrix of the caller's that is.
+                dual = type(error)(
+                    f"{error} (the observer's poles are placed as state feedback for "
+                    "(A^T, C^T): its B is C^T)"
+                )
+                dual.__dict__.update(error.__dict__)
+                raise dual from error
             refused = type(error)(
                 f"C is refused: its transpose is the input matrix of the dual placement, "
                 f"which reported: {error}"

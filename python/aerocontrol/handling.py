@@ -604,17 +604,11 @@ def _eigenvalues(modes: object) -> dict[str, NDArray[np.complex128]]:
 
 
 def _pair(lam: NDArray[np.complex128]) -> tuple[float, float, float]:
-    """(ω_n, ζ, ζ ω_n) of two roots; ω_n and ζ NaN for real roots of opposite sign."""
-    l1, l2 = complex(lam[0]), complex(lam[1])
-    wn2 = (l1 * l2).real
-    zw = -0.5 * (l1 + l2).real
-    if wn2 > 0:
-        wn = math.sqrt(wn2)
-        return wn, zw / wn, zw
-    if wn2 == 0:
-        zeta = math.copysign(math.inf, zw) if zw != 0 else math.nan
-        return 0.0, zeta, zw
-    return math.nan, math.nan, zw
+    """(ω_n, ζ, ζ ω_n) of two roots; ω_n and ζ NaN for real roots of opposite sign: the
+    doubles :func:`_pair_arrays` gives (one computation, so assess and level_arrays agree
+    to the bit at every limit)."""
+    wn, zeta, zw = _pair_arrays(np.asarray(lam, dtype=np.complex128).reshape(1, 2))
+    return float(wn[0]), float(zeta[0]), float(zw[0])
 
 
 def _time_to_double(growth: float) -> float:
@@ -751,7 +745,10 @@ def level_arrays(
     Raises
     ------
     InvalidArgumentError
-        A key is not a mode name, or ``aircraft_class`` or ``category`` is unknown.
+        ``modes`` not a mapping, a key that is not a mode name, ``aircraft_class`` or
+        ``category`` unknown, eigenvalues that are not numbers, an oscillatory pair that is
+        not a conjugate pair or two real roots, or a complex roll or spiral root (as
+        :func:`assess` refuses them, naming the first aircraft).
     ShapeError
         A mode's eigenvalues are not (k, 2) (oscillatory) or (k,) (roll, spiral).
     NonFiniteError
@@ -768,16 +765,14 @@ def level_arrays(
     """
     cls = _aircraft_class(aircraft_class)
     cat = _category(category)
+    if not isinstance(modes, Mapping):
+        raise InvalidArgumentError(
+            f"modes must be a mapping from mode name to eigenvalues, got {type(modes).__name__}"
+        )
     levels: dict[str, NDArray[np.int8]] = {}
     for key, value in modes.items():
         mode = _mode_name(key, "modes")
-        lam = np.asarray(value, dtype=np.complex128)
-        oscillatory = mode in _OSCILLATORY
-        if lam.ndim != (2 if oscillatory else 1) or (oscillatory and lam.shape[1] != 2):
-            expected = "(k, 2)" if oscillatory else "(k,)"
-            raise ShapeError(f"modes[{key!r}] must have shape {expected}, got {lam.shape}")
-        if not np.isfinite(lam).all():
-            raise NonFiniteError(f"modes[{key!r}] must be finite")
+        lam = _eigenvalue_arrays(value, f"modes[{key!r}]", mode)
         levels[mode] = _mode_levels(mode, lam, cls, cat)
     return levels
 
@@ -805,9 +800,12 @@ def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
     Raises
     ------
     InvalidArgumentError
-        ``mode`` is not a mode.
+        ``mode`` is not a mode; eigenvalues that are not numbers, an oscillatory pair that is
+        not a conjugate pair or two real roots, or a complex roll or spiral root.
     ShapeError
         ``eigenvalues`` is not (k, 2) for an oscillatory mode or (k,) for roll and spiral.
+    NonFiniteError
+        A NaN or infinite eigenvalue (a NaN root is no roll time constant of inf).
 
     Examples
     --------
@@ -820,14 +818,10 @@ def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
     {'time to double': array([        inf, 69.31471806])}
     """
     name = _mode_name(mode, "mode")
-    lam = np.asarray(eigenvalues, dtype=np.complex128)
+    lam = _eigenvalue_arrays(eigenvalues, f"eigenvalues of the {name}", name)
     if name in _OSCILLATORY:
-        if lam.ndim != 2 or lam.shape[1] != 2:
-            raise ShapeError(f"eigenvalues of the {name} must have shape (k, 2), got {lam.shape}")
         wn, zeta, _ = _pair_arrays(lam)
         return {"omega_n": wn, "zeta": zeta}
-    if lam.ndim != 1:
-        raise ShapeError(f"eigenvalues of the {name} must have shape (k,), got {lam.shape}")
     if name == "roll":
         return {"time constant": _roll_time_constant(lam.real)}
     return {"time to double": _time_to_double_arrays(lam.real)}
@@ -897,6 +891,46 @@ def level_limits(
     return [(k, float(value)) for k, value in limits if value is not None]
 
 
+def _eigenvalue_arrays(value: object, label: str, mode: str) -> NDArray[np.complex128]:
+    """The eigenvalues of k aircraft for one mode, checked as :func:`assess` checks one
+    aircraft's: numbers (InvalidArgumentError), of shape (k, 2) or (k,) (ShapeError), finite
+    (NonFiniteError), conjugate pairs or two real roots for an oscillatory mode and real roots
+    for roll and spiral, to 1e-9 of their size (InvalidArgumentError naming the first)."""
+    try:
+        array = np.asarray(value)
+    except ValueError as error:  # ragged nested sequences
+        raise ShapeError(f"{label} must be a rectangular array of numbers: {error}") from None
+    if array.dtype.kind not in "biufc":
+        raise InvalidArgumentError(f"{label} must be an array of numbers, got dtype {array.dtype}")
+    lam = array.astype(np.complex128)
+    oscillatory = mode in _OSCILLATORY
+    if lam.ndim != (2 if oscillatory else 1) or (oscillatory and lam.shape[1] != 2):
+        expected = "(k, 2)" if oscillatory else "(k,)"
+        raise ShapeError(f"{label} must have shape {expected}, got {lam.shape}")
+    if not np.isfinite(lam).all():
+        raise NonFiniteError(f"{label} must be finite")
+    if oscillatory:
+        l1, l2 = lam[:, 0], lam[:, 1]
+        scale = np.maximum(np.abs(l1), np.abs(l2))
+        real_pair = (l1.imag == 0) & (l2.imag == 0)
+        bad = ~real_pair & (np.abs(l1 - l2.conj()) > 1e-9 * scale)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InvalidArgumentError(
+                f"{label}[{i}] must be a conjugate pair or two real roots, got "
+                f"{complex(l1[i])} and {complex(l2[i])}"
+            )
+    else:
+        bad = np.abs(lam.imag) > 1e-9 * np.abs(lam)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InvalidArgumentError(
+                f"{label}[{i}] must be real, got {complex(lam[i])}: a complex roll or spiral "
+                "root is a coupled roll-spiral oscillation (3.3.1.4), which is not assessed"
+            )
+    return lam
+
+
 def _roll_time_constant(root: FloatArray) -> FloatArray:
     with np.errstate(divide="ignore"):
         tau: FloatArray = np.where(root < 0, -1.0 / np.where(root < 0, root, -1.0), np.inf)
@@ -905,16 +939,26 @@ def _roll_time_constant(root: FloatArray) -> FloatArray:
 
 def _pair_arrays(lam: NDArray[np.complex128]) -> tuple[FloatArray, FloatArray, FloatArray]:
     """:func:`_pair` on k pairs: (ω_n, ζ, ζ ω_n)."""
-    l1, l2 = lam[:, 0], lam[:, 1]
-    wn2 = (l1 * l2).real
-    zw = -0.5 * (l1 + l2).real
-    with np.errstate(invalid="ignore", divide="ignore"):
-        wn = np.where(wn2 > 0, np.sqrt(np.abs(wn2)), np.where(wn2 == 0, 0.0, np.nan))
+    # Each pair scaled by a power of two, 2^-e with 2^e about its largest part: exact, so the
+    # doubles are those of the unscaled formulas wherever those neither overflow nor
+    # underflow, and ω_n² of roots of 1e200 (or 1e-200) is no inf (or 0).
+    parts = np.abs(np.stack([lam.real, lam.imag], axis=-1)).reshape(lam.shape[0], -1)
+    exponent = np.frexp(parts.max(axis=1, initial=0.0))[1]
+    r1, i1 = np.ldexp(lam[:, 0].real, -exponent), np.ldexp(lam[:, 0].imag, -exponent)
+    r2, i2 = np.ldexp(lam[:, 1].real, -exponent), np.ldexp(lam[:, 1].imag, -exponent)
+    # Re(λ1 λ2) by real operations: numpy's complex product may fuse them (FMA), and an ω_n
+    # one ulp apart would put a mode on either side of a limit (ω_n > 0.4).
+    wn2 = r1 * r2 - i1 * i2
+    zw_scaled = -0.5 * (r1 + r2)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        wn_scaled = np.where(wn2 > 0, np.sqrt(np.abs(wn2)), np.where(wn2 == 0, 0.0, np.nan))
         zeta = np.where(
             wn2 > 0,
-            zw / np.where(wn2 > 0, wn, 1.0),
-            np.where((wn2 == 0) & (zw != 0), np.copysign(np.inf, zw), np.nan),
+            zw_scaled / np.where(wn2 > 0, wn_scaled, 1.0),
+            np.where((wn2 == 0) & (zw_scaled != 0), np.copysign(np.inf, zw_scaled), np.nan),
         )
+        wn = np.ldexp(wn_scaled, exponent)
+        zw = np.ldexp(zw_scaled, exponent)
     return wn, zeta, zw
 
 

@@ -47,15 +47,16 @@ from numpy.typing import ArrayLike, NDArray
 from . import batch, linalg
 from ._judging import AXIS_MODES, judge_stack
 from ._results import Result, Tabular, register
-from ._validation import check_finite, positive_int, real_array, real_scalar
+from ._validation import check_finite, optional_callable, positive_int, real_array, real_scalar
 from .aircraft.model import _POSITIVE_FIELDS, SAMPLED_FIELDS, Aircraft
 from .aircraft.naming import classify_mode_stack
 from .aircraft.schema import AircraftDataError
-from .exceptions import InvalidArgumentError, ShapeError
+from .exceptions import AerocontrolError, ConvergenceError, InvalidArgumentError, ShapeError
 from .handling import mode_quantities
 
 __all__ = [
     "CHUNK_SIZE",
+    "MAX_SAMPLES",
     "Damper",
     "Estimate",
     "LogNormal",
@@ -459,7 +460,15 @@ def _closed_loop(
             )
             column = ("rudder", "aileron").index(controller.surface)
             one_input = B[designed][:, :, column : column + 1]
-            placed = batch.place_batch(A[designed], one_input, poles, "bass-gura")
+            try:
+                placed = batch.place_batch(A[designed], one_input, poles, "bass-gura")
+            except AerocontrolError as error:  # its problem among the designed: the chunk's
+                if error.batch_index is None:
+                    raise
+                rows = np.flatnonzero(designed)
+                raise _renumbered(
+                    error, int(rows[error.batch_index]), "problem {} of the batch"
+                ) from None
             K[designed, column] = placed.K[:, 0]
         closed = A - np.einsum("kij,kjl->kil", B, K)
         return closed, linalg.eigenvalues(closed), designed
@@ -586,7 +595,12 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
     out["open_controlled"] = np.zeros(A.shape[0], dtype=bool)
     failed = (out["open_levels"] > run.required_level).any(axis=1)
     if run.controller is not None:
-        closed, poles, controlled = _closed_loop(A, B, run.controller, eigenvalues)
+        try:
+            closed, poles, controlled = _closed_loop(A, B, run.controller, eigenvalues)
+        except AerocontrolError as error:  # a sample's design failed: named by its index in the run
+            if error.batch_index is None:
+                raise
+            raise _renumbered(error, start + error.batch_index, "sample {} of the run") from None
         out.update({f"closed_{k}": v for k, v in _judge(run, closed, poles).items()})
         out["closed_controlled"] = controlled
         failed = (out["closed_levels"] > run.required_level).any(axis=1)
@@ -600,6 +614,19 @@ def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
     out["bin_failed"] = np.bincount(flat[failed].ravel(), minlength=size).reshape(parameters, -1)
     out["failed"] = np.asarray(failed)
     return out
+
+
+def _renumbered(error: AerocontrolError, index: int, phrase: str) -> AerocontrolError:
+    """``error`` (of a batch kernel, "problem i of the batch") with ``phrase`` filled with
+    ``index`` for the problem, and ``index`` as its batch_index: a failed design of a sample
+    named by where it is, not by its place in the batch (one chunk, or the Damper's designed
+    samples of one)."""
+    local = error.batch_index
+    message = str(error).replace(f"problem {local} of the batch", phrase.format(index), 1)
+    renamed = type(error)(message)
+    renamed.__dict__.update(error.__dict__)
+    renamed.batch_index = index
+    return renamed
 
 
 @functools.cache
@@ -673,18 +700,64 @@ def _incomplete_beta(
         f *= c * d
         if abs(1.0 - c * d) < 1e-15:
             return front * (f - 1.0)
-    raise ArithmeticError(f"the incomplete beta function I_{x}({a}, {b}) did not converge")
+    raise ConvergenceError(f"the incomplete beta function I_{x}({a}, {b}) did not converge")
 
 
-def _beta_quantile(q: float, a: float, b: float) -> float:
-    """The q-quantile of Beta(a, b), by bisection on I_x(a, b)."""
+#: The most terms of a binomial tail summed term by term (:func:`_binomial_lower_tail`).
+_BINOMIAL_TERMS = 10_000
+
+
+def _binomial_lower_tail(x: float, n: int, k: int) -> float:
+    """P(X <= k) for X ~ Binomial(n, x), the sum of its k + 1 terms (fsum), each term from the
+    one before by the ratio (n - j) / (j + 1) · x / (1 - x) in logarithms: for integers,
+    1 - I_x(k + 1, n - k) (DLMF 8.17.5), without the subtraction and without the continued
+    fraction, which converges in O(sqrt(n)) steps of relative size far below its stopping
+    test when one parameter is huge (n = 10^12)."""
+    if x <= 0.0:
+        return 1.0
+    if x >= 1.0:
+        return 0.0 if k < n else 1.0
+    log_odds = math.log(x) - math.log1p(-x)
+    log_term = n * math.log1p(-x)  # ln P(X = 0)
+    carry = 0.0  # the running logarithm's rounding errors (Neumaier's compensated sum): it
+    # starts near -n x, far larger than the terms near the quantile
+    terms = [math.exp(log_term)]
+    for j in range(k):
+        step = math.log((n - j) / (j + 1)) + log_odds
+        total = log_term + step
+        if abs(log_term) >= abs(step):
+            carry += (log_term - total) + step
+        else:
+            carry += (step - total) + log_term
+        log_term = total
+        terms.append(math.exp(log_term + carry))
+    return min(math.fsum(terms), 1.0)
+
+
+def _beta_quantile(q: float, a: float, b: float, upper: bool = False) -> float:
+    """The x at which I_x(a, b) = q, or, ``upper``, at which the upper tail 1 - I_x(a, b) = q
+    (the tail probability given itself, not 1 - q rounded: q = α/2 of a confidence of
+    1 - 10^-12 keeps its digits), by bisection. For integers a and b with a <= 10^4 the
+    upper tail is the binomial sum P(Binomial(a + b - 1, x) <= a - 1) where b > 10^6 or
+    q < 10^-4."""
     low, high = 0.0, 1.0
     log_beta = _log_beta(a, b)
-    for _ in range(200):
+    # The sum where the continued fraction stalls (b > 10^6) or 1 - I_x would lose the tail's
+    # digits (q < 10^-4); elsewhere the continued fraction is as exact and faster.
+    summed = (
+        upper and a == int(a) and b == int(b) and a <= _BINOMIAL_TERMS and (b > 1e6 or q < 1e-4)
+    )
+    for _ in range(2000):
         middle = 0.5 * (low + high)
         if middle in (low, high):
             break
-        if _incomplete_beta(middle, a, b, log_beta) < q:
+        if summed:
+            below = _binomial_lower_tail(middle, int(a + b - 1), int(a - 1)) > q
+        elif upper:
+            below = 1.0 - _incomplete_beta(middle, a, b, log_beta) > q
+        else:
+            below = _incomplete_beta(middle, a, b, log_beta) < q
+        if below:
             low = middle
         else:
             high = middle
@@ -732,16 +805,24 @@ class Estimate:
         )
 
 
+#: The most samples :func:`clopper_pearson` takes: beyond, an end below 1e-16 has 1 - x = 1
+#: in doubles, and the continued fraction's error grows past 1e-3 of the interval's width.
+MAX_SAMPLES = 10**12
+
+
 def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estimate:
     """The estimate count / samples and its exact (Clopper-Pearson) interval (1), its ends to
-    about 1e-9 relative at a million samples (ln B(a, b) from lgamma values near 1e7).
+    about 1e-9 relative at a million samples (ln B(a, b) from lgamma values near 1e7); up to
+    :data:`MAX_SAMPLES` = 10^12 samples, to 1e-12 relative where the count is within 10^4 of
+    0 or of ``samples``, and to 1e-3 of the interval's width for other counts (the continued
+    fraction converging in O(sqrt(samples)) steps).
 
     Parameters
     ----------
     count : int
         The samples in which the event happened, 0 <= count <= samples.
     samples : int
-        The samples drawn, positive.
+        The samples drawn, positive, at most :data:`MAX_SAMPLES`.
     confidence : float, optional
         The confidence of the two-sided interval, in (0, 1) (default 0.95).
 
@@ -755,7 +836,8 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
     Raises
     ------
     InvalidArgumentError
-        ``count`` or ``samples`` not an int or out of order, ``confidence`` outside (0, 1).
+        ``count`` or ``samples`` not an int or out of order, ``samples`` above
+        :data:`MAX_SAMPLES`, ``confidence`` outside (0, 1).
 
     Examples
     --------
@@ -774,6 +856,13 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
             f"count and samples must satisfy 0 <= count <= samples, samples > 0; got "
             f"{count} of {samples}"
         )
+    if samples > MAX_SAMPLES:
+        # 3 of 10^18 gave [5.6e-17, 8.8e-18] (1 - x rounded to 1), 10^7 of 10^15 an interval
+        # 1e-3 off that did not hold the estimate, 10^17 of 10^18 an ArithmeticError.
+        raise InvalidArgumentError(
+            f"samples must be at most {MAX_SAMPLES:.0e} for an interval computed in doubles, "
+            f"got {samples}"
+        )
     confidence = real_scalar(confidence, "confidence")
     if not 0.0 < confidence < 1.0:
         raise InvalidArgumentError(f"confidence must be in (0, 1), got {confidence}")
@@ -781,14 +870,15 @@ def clopper_pearson(count: int, samples: int, confidence: float = 0.95) -> Estim
     # At count 0 (and count = samples) the quantile has the closed form 1 - (α/2)^(1/N)
     # (and (α/2)^(1/N)): B(q; 1, N) = 1 - (1 - q)^(1/N), exact where the continued fraction
     # loses digits next to the mean of a huge run.
-    edge = -math.expm1(math.log(alpha / 2) / samples)  # 1 - (α/2)^(1/N)
+    # (α/2)^(1/N) itself, not 1 - edge: at N = 1 and α = 10^-12 that would lose four digits.
+    root = math.log(alpha / 2) / samples
     if count == 0:
-        low, high = 0.0, edge
+        low, high = 0.0, -math.expm1(root)  # 1 - (α/2)^(1/N)
     elif count == samples:
-        low, high = 1.0 - edge, 1.0
+        low, high = (alpha / 2) ** (1.0 / samples), 1.0
     else:
         low = _beta_quantile(alpha / 2, count, samples - count + 1)
-        high = _beta_quantile(1 - alpha / 2, count + 1, samples - count)
+        high = _beta_quantile(alpha / 2, count + 1, samples - count, upper=True)
     return Estimate(count, samples, count / samples, low, high, confidence)
 
 
@@ -1125,12 +1215,18 @@ def monte_carlo(
     Raises
     ------
     InvalidArgumentError
-        A bad argument (named), or an uncertain parameter the aircraft does not have.
+        A bad argument (named; ``progress`` neither callable nor None), or an uncertain
+        parameter the aircraft does not have.
     ShapeError
         Gains of the wrong shape.
     MemoryError
         The per-sample results of ``samples`` would not fit in the memory left (measured
         after the first chunk, before the others run).
+    AerocontrolError
+        A sample whose :class:`Lqr` or :class:`Damper` design fails raises that design's
+        error (NoStabilizingSolutionError, ...), its message starting "sample i of the run"
+        and its ``batch_index`` i (:meth:`MonteCarlo.values` of a rerun without it draws
+        the same values).
 
     Examples
     --------
@@ -1172,7 +1268,10 @@ def monte_carlo(
                 "relative=False)"
             )
     samples = positive_int(samples, "samples")
+    if samples > MAX_SAMPLES:  # no interval for its probabilities (clopper_pearson)
+        raise InvalidArgumentError(f"samples must be at most {MAX_SAMPLES:.0e}, got {samples}")
     chunk_size = positive_int(chunk_size, "chunk_size")
+    optional_callable(progress, "progress")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidArgumentError(f"seed must be a nonnegative int, got {seed!r}")
     required_level = _level(required_level, "required_level")

@@ -82,6 +82,40 @@ _POSITIVE_FIELDS = ("mass", "Ix", "Iy", "Iz", "speed", "density")
 
 FloatArray = NDArray[np.float64]
 
+#: The numeric fields an Aircraft checks when it is made, and those of them that must be
+#: positive.
+_CHECKED_FIELDS = (
+    "speed",
+    "altitude",
+    "density",
+    "mach",
+    "theta0",
+    "mass",
+    "gravity",
+    "Ix",
+    "Iy",
+    "Iz",
+    "Ixz",
+    "S",
+    "cbar",
+    "b",
+)
+_POSITIVE_CONSTRUCTION_FIELDS = frozenset(_CHECKED_FIELDS) - {"altitude", "theta0", "Ixz"}
+
+
+def _check_quantity(value: object, name: str, positive: bool) -> None:
+    """AircraftDataError naming ``name`` unless ``value`` is a finite real number (a Python
+    or numpy int or float, not a bool), positive when ``positive``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+        value, (int, float, np.integer, np.floating)
+    ):
+        raise AircraftDataError(f"Aircraft: {name} must be a real number, got {value!r:.80}")
+    number = float(value)
+    if not math.isfinite(number):
+        raise AircraftDataError(f"Aircraft: {name} must be finite, got {number}")
+    if positive and not number > 0.0:
+        raise AircraftDataError(f"Aircraft: {name} must be positive, got {number}")
+
 
 @dataclass(frozen=True)
 class Aircraft:
@@ -196,6 +230,50 @@ class Aircraft:
     # ------------------------------------------------------------------------------------
     # Construction
     # ------------------------------------------------------------------------------------
+
+    def __post_init__(self) -> None:
+        """The checks a constructor call or ``dataclasses.replace`` gets (a file's values
+        were checked, with their ranges, when read): AircraftDataError naming the field for
+        a Class ("II" is taken as "II-L"), Category or units not among the choices, a
+        quantity that is not a finite real number or, for the speed, density, Mach number,
+        mass, g, inertias Ix, Iy, Iz and the geometry, not positive, and derivatives that are
+        not every one of LONGITUDINAL_DERIVATIVES and LATERAL_DERIVATIVES, each a finite real
+        number. Without them a negative mass or speed gave a model silently, Ix = 0 a
+        ZeroDivisionError."""
+        for name in ("name", "identifier", "description"):
+            if not isinstance(getattr(self, name), str):
+                raise AircraftDataError(
+                    f"Aircraft: {name} must be a str, got {getattr(self, name)!r:.80}"
+                )
+        if self.aircraft_class == "II":  # as the file and handling.assess take it (1.3.1)
+            object.__setattr__(self, "aircraft_class", "II-L")
+        for name, choices in (
+            ("aircraft_class", ("I", "II-C", "II-L", "III", "IV")),
+            ("category", ("A", "B", "C")),
+            ("units", ("english", "si")),
+        ):
+            value = getattr(self, name)
+            if not isinstance(value, str) or value not in choices:
+                listed = ", ".join(repr(c) for c in choices)
+                raise AircraftDataError(f"Aircraft: {name} must be one of {listed}, got {value!r}")
+        for name in _CHECKED_FIELDS:
+            _check_quantity(getattr(self, name), name, name in _POSITIVE_CONSTRUCTION_FIELDS)
+        derivatives = self.derivatives
+        if not isinstance(derivatives, Mapping):
+            raise AircraftDataError(
+                f"Aircraft: derivatives must be a mapping of name to value, got "
+                f"{type(derivatives).__name__}"
+            )
+        expected = (*LONGITUDINAL_DERIVATIVES, *LATERAL_DERIVATIVES)
+        missing = [key for key in expected if key not in derivatives]
+        unknown = [key for key in derivatives if key not in expected]
+        if missing or unknown:
+            parts = ([f"is missing {', '.join(missing)}"] if missing else []) + (
+                [f"has unknown key(s) {', '.join(map(repr, unknown))}"] if unknown else []
+            )
+            raise AircraftDataError(f"Aircraft: derivatives {' and '.join(parts)}")
+        for key in expected:
+            _check_quantity(derivatives[key], f"derivatives[{key!r}]", False)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], origin: str = "<dict>") -> Aircraft:

@@ -5,11 +5,13 @@ report's own files are and undoes the run on any failure or interrupt."""
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 
+from .._validation import optional_callable
 from ..aircraft.model import Aircraft, load
-from ..exceptions import OutputFolderError
+from ..exceptions import InvalidArgumentError, OutputFolderError
 from . import (
     chapter_check,
     damper,
@@ -55,6 +57,8 @@ def build_report(
     AircraftDataError
         The aircraft cannot be loaded. A design that does not apply to the aircraft is
         reported in the document, not raised.
+    InvalidArgumentError
+        ``progress`` is neither callable nor None (before anything is built).
 
     Examples
     --------
@@ -64,6 +68,7 @@ def build_report(
     >>> lines[0][:36]
     'models: Boeing 747, powered approach'
     """
+    optional_callable(progress, "progress")
     aircraft = plane if isinstance(plane, Aircraft) else load(plane)
     say = progress if progress is not None else (lambda line: None)
     report = Report(f"aerocontrol {_version()}: {aircraft.name}")
@@ -143,6 +148,9 @@ def write_report(
     ------
     AircraftDataError
         The aircraft cannot be loaded (nothing is written).
+    InvalidArgumentError
+        ``progress`` is neither callable nor None, or ``out`` is not a str or Path (nothing
+        is written).
     OutputFolderError
         An ``OSError``: ``out`` cannot be used (not empty and no earlier report, a changed
         or unlisted file in the way, a bad manifest, another run, not a folder, not
@@ -154,6 +162,7 @@ def write_report(
     ./navion-report; ``aerocontrol report navion --out navion-report`` does the same, and
     running either again replaces that report.
     """
+    optional_callable(progress, "progress")
     aircraft = plane if isinstance(plane, Aircraft) else load(plane)
     return write_document(lambda say: build_report(aircraft, say), out, progress, force)
 
@@ -167,6 +176,9 @@ def write_document(
     """Build a report (``build(say)``) and write it into the folder ``out`` under the rules
     of :func:`write_report` (the folder is checked before anything is built). Returns the
     path of ``report.html``."""
+    optional_callable(progress, "progress")
+    if not isinstance(out, (str, os.PathLike)) or isinstance(out, bytes):
+        raise InvalidArgumentError(f"out must be a folder's path (str or Path), got {out!r:.80}")
     say = progress if progress is not None else (lambda line: None)
     folder = ReportFolder(Path(out), force=force)
     with termination_exits():
