@@ -43,6 +43,10 @@ SWEEPS = 100
 BALANCING_SPREAD = 10
 _SPREAD_RATIO = 2.0**BALANCING_SPREAD
 
+#: Matrices of at most this many entries take state_balancing's first test in scalar
+#: arithmetic.
+_SCALAR_TEST_MAX_ENTRIES = 64
+
 
 def log2_sizes(M: NDArray[np.floating[Any]]) -> FloatArray:
     """log2 |M| entry by entry: -inf for a zero entry, inf for an infinite one."""
@@ -193,12 +197,19 @@ def state_balancing(
     n = A.shape[0] if A.ndim == 2 else 0
     if n < 2 or A.shape != (n, n):
         return None
-    # First the cheap test (a few microseconds, beside a placement of 4 states in 8): the
-    # nonzero entries within 2^10 of each other are scaled well enough. NaN fails it.
-    magnitudes = np.abs(A)
-    nonzero = magnitudes[magnitudes > 0.0]
-    if nonzero.size < 2 or not nonzero.max() >= _SPREAD_RATIO * nonzero.min():
-        return None
+    # First the cheap test: the nonzero entries within 2^10 of each other are scaled well
+    # enough (NaN is left out: the finiteness check below refuses it). In scalar arithmetic
+    # up to order 8 (about 1.5 us, where numpy's five calls cost 5.6 us beside a placement of
+    # 4 states in 3).
+    if A.size <= _SCALAR_TEST_MAX_ENTRIES:
+        values = [m for m in map(abs, A.ravel().tolist()) if m > 0.0]
+        if len(values) < 2 or not max(values) >= _SPREAD_RATIO * min(values):
+            return None
+    else:
+        magnitudes = np.abs(A)
+        nonzero = magnitudes[magnitudes > 0.0]
+        if nonzero.size < 2 or not nonzero.max() >= _SPREAD_RATIO * nonzero.min():
+            return None
     given = (A, *inputs, *outputs, *weights)
     if not all(np.all(np.isfinite(M)) for M in given):
         return None
