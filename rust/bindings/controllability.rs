@@ -6,9 +6,9 @@ use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
 use super::modal::eigen_cost;
 use crate::control::controllability::{
-    controllability as controllability_core, ctrb, observability as observability_core, obsv,
+    Controllability, controllability as controllability_core, ctrb,
+    observability as observability_core, obsv,
 };
-use faer::MatRef;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -69,15 +69,7 @@ fn controllability<'py>(
     modal_test: bool,
     dual: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (a, b) = pair(py, a, b, dual)?;
-    let (a, b) = (|| Ok((a.matrix()?, b.matrix()?)))().map_err(|e| to_py_err(py, e))?;
-    let analysis = compute(py, cost(a.nrows(), b, modal_test, dual), || {
-        if dual {
-            observability_core(a, b, tol, modal_test, true)
-        } else {
-            controllability_core(a, b, tol, modal_test, true)
-        }
-    })?;
+    let analysis = analyse(py, a, b, tol, modal_test, dual, true)?;
     let mut outputs = Outputs::new(py);
     let result = PyDict::new(py);
     let staircase = &analysis.staircase;
@@ -131,27 +123,38 @@ fn controllability_verdict(
     modal_test: bool,
     dual: bool,
 ) -> PyResult<bool> {
-    let (a, b) = pair(py, a, b, dual)?;
-    let (a, b) = (|| Ok((a.matrix()?, b.matrix()?)))().map_err(|e| to_py_err(py, e))?;
-    let analysis = compute(py, cost(a.nrows(), b, modal_test, dual), || {
-        if dual {
-            observability_core(a, b, tol, modal_test, false)
-        } else {
-            controllability_core(a, b, tol, modal_test, false)
-        }
-    })?;
-    Ok(analysis.is_complete())
+    Ok(analyse(py, a, b, tol, modal_test, dual, false)?.is_complete())
 }
 
-/// The staircase's cost, and the eigenvectors' with the modal test.
-fn cost(n: usize, second: MatRef<'_, f64>, modal_test: bool, dual: bool) -> Cost {
+/// The core's analysis of the converted pair (the observability of (A, C) with `dual`), the
+/// staircase's transformation formed when asked; the GIL released by the cost of the
+/// staircase, and of the eigenvectors with the modal test.
+fn analyse(
+    py: Python<'_>,
+    a: &Bound<'_, PyAny>,
+    second: &Bound<'_, PyAny>,
+    tol: Option<f64>,
+    modal_test: bool,
+    dual: bool,
+    with_transformation: bool,
+) -> PyResult<Controllability> {
+    let (a, second) = pair(py, a, second, dual)?;
+    let (a, second) = (|| Ok((a.matrix()?, second.matrix()?)))().map_err(|e| to_py_err(py, e))?;
+    let n = a.nrows();
     let width = if dual { second.nrows() } else { second.ncols() };
     let staircase = Cost::of(10.0 * (n as f64).powi(3), 6.0, n.max(width));
-    if modal_test {
+    let cost = if modal_test {
         staircase.then(eigen_cost(n))
     } else {
         staircase
-    }
+    };
+    compute(py, cost, || {
+        if dual {
+            observability_core(a, second, tol, modal_test, with_transformation)
+        } else {
+            controllability_core(a, second, tol, modal_test, with_transformation)
+        }
+    })
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

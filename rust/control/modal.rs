@@ -141,25 +141,14 @@ impl ModalAnalysis {
 pub fn eigen(a: MatRef<'_, f64>) -> Result<(Vec<c64>, Mat<c64>), Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
-    let n = a.nrows();
     let scale = crate::linalg::balance::range_scale(a);
     let mut balanced = from_faer(a);
     if scale != 1.0 {
         balanced.as_mut_slice().iter_mut().for_each(|x| *x /= scale);
     }
+    // D^-1 A D = Z T Z^T: the eigenvectors of A are D Z x.
     let d = balance(&mut balanced);
-    let (values, mut vectors) = schur_eigenvectors(&real_schur(balanced.as_faer())?);
-    if d.iter().any(|&f| f != 1.0) {
-        for j in 0..n {
-            for (i, &f) in d.iter().enumerate() {
-                vectors[(i, j)] *= f;
-            }
-            let norm = vectors.col(j).norm_l2();
-            for i in 0..n {
-                vectors[(i, j)] /= norm;
-            }
-        }
-    }
+    let (values, vectors) = schur_eigenvectors(&real_schur(balanced.as_faer())?, &d);
     Ok((values.into_iter().map(|v| v * scale).collect(), vectors))
 }
 

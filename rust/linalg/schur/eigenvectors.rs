@@ -30,8 +30,9 @@ const LARGE: f64 = 3.273390607896142e150; // 2^500
 const RESCALE: f64 = 3.054936363499605e-151; // 2^-500
 
 /// The eigenvalues of A = Z T Z^T in the order of T's diagonal (each conjugate pair adjacent,
-/// Im > 0 first) and the unit eigenvectors of A as columns, in the same order.
-pub fn schur_eigenvectors(schur: &RealSchur) -> (Vec<c64>, Mat<c64>) {
+/// Im > 0 first) and the unit eigenvectors of D A D^-1 as columns, in the same order, for D
+/// the diagonal `scaling` (empty: the identity; a balancing's, to undo it).
+pub fn schur_eigenvectors(schur: &RealSchur, scaling: &[f64]) -> (Vec<c64>, Mat<c64>) {
     let t = schur.t.as_ref();
     let n = t.nrows();
     let largest = (0..n)
@@ -103,7 +104,8 @@ pub fn schur_eigenvectors(schur: &RealSchur) -> (Vec<c64>, Mat<c64>) {
         1.0,
         Par::Seq,
     );
-    let mut vectors = Mat::from_fn(n, n, |i, j| c64::new(v_re[(i, j)], v_im[(i, j)]));
+    let row = |i: usize| scaling.get(i).copied().unwrap_or(1.0);
+    let mut vectors = Mat::from_fn(n, n, |i, j| c64::new(v_re[(i, j)], v_im[(i, j)]) * row(i));
     for j in 0..n {
         let norm = vectors.col(j).norm_l2();
         if norm > 0.0 {
@@ -187,6 +189,7 @@ fn solve_two(m: [[c64; 2]; 2], r: [c64; 2], small: f64) -> (c64, c64) {
 mod tests {
     use super::*;
     use crate::linalg::schur::real_schur;
+    use crate::test_matrices::seeded_square;
 
     fn residual(a: &Mat<f64>, values: &[c64], vectors: &Mat<c64>) -> f64 {
         let n = a.nrows();
@@ -202,16 +205,9 @@ mod tests {
 
     #[test]
     fn eigenvectors_satisfy_a_v_equals_v_lambda() {
-        let mut state = 7u64;
-        let mut random = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64) / (1u64 << 53) as f64 - 0.5
-        };
         for n in [1, 2, 3, 4, 7, 16, 40, 90] {
-            let a = Mat::from_fn(n, n, |_, _| random());
-            let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap());
+            let a = seeded_square(n, 7 + n as u64);
+            let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]);
             let size = a.norm_l2();
             assert!(residual(&a, &values, &vectors) <= 100.0 * n as f64 * f64::EPSILON * size);
             for j in 0..n {
@@ -234,7 +230,7 @@ mod tests {
                 0.0
             }
         });
-        let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap());
+        let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]);
         assert!(
             values
                 .iter()
@@ -256,7 +252,7 @@ mod tests {
         // [[0, -2], [0.5, 0]]: λ = ±i, the eigenvector of i proportional to [2, -i]; the
         // conjugate pair in order, the second vector the first's conjugate.
         let a = Mat::from_fn(2, 2, |i, j| [[0.0, -2.0], [0.5, 0.0]][i][j]);
-        let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap());
+        let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]);
         assert!((values[0] - c64::new(0.0, 1.0)).norm() <= 1e-15);
         assert_eq!(values[1], values[0].conj());
         assert!(residual(&a, &values, &vectors) <= 1e-15);
