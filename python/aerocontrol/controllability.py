@@ -17,6 +17,14 @@ verdict of :func:`controllability` comes from two tests that cover each other's 
 Both use the tolerance ``tol = n ε max(||A||_F, ||B||_F)`` (ε = 2^-52) unless given: a mode
 declared uncontrollable is within about tol of being exactly uncontrollable. Observability is
 the dual: (A, C) is observable if and only if (A^T, C^T) is controllable.
+
+Controllability does not depend on the coordinates, but both tests are accurate to ε times the
+norm of the pair: where A's states are scaled apart (a state's largest off-diagonal entries in
+its row and its column more than 2^10 apart: units 10^3 or more apart), both run on the pair
+(T A T^-1, T B) with T diagonal, of powers of two (exact), that balances the rows of [A B]
+against the columns of A, and the tolerance, the measures and the form are those of that
+pair. With the modal test, the uncontrollable eigenvalues listed are eigenvalues of A, each at
+most once (the staircase's A_u stands for the eigenvalues of A nearest its own).
 """
 
 from __future__ import annotations
@@ -125,7 +133,9 @@ class Controllability(Result):
     ``controllable`` is the verdict; ``uncontrollable_eigenvalues`` are the modes that feedback
     (or measurement) cannot reach. The staircase form is Z^T A Z (``staircase_A``) and Z^T B
     (``staircase_B``; for observability C Z, and ``staircase_A`` is then block lower
-    triangular).
+    triangular), with Z orthogonal; where the states were balanced first (see the module's
+    documentation), Z = T^-1 Q (for observability T Q) with Q orthogonal, and the form is
+    Z^-1 A Z, Z^-1 B.
 
     Attributes
     ----------
@@ -147,11 +157,11 @@ class Controllability(Result):
         ||w_k^T B|| per eigenvalue (||C v_k|| for observability); <= ``tolerance`` means
         unreachable.
     staircase_A : ndarray (n, n)
-        Z^T A Z, block upper (for observability lower) triangular.
+        Z^-1 A Z (Z^T A Z), block upper (for observability lower) triangular.
     staircase_B : ndarray (n, m)
-        Z^T B (for observability C Z, (p, n)).
+        Z^-1 B (for observability C Z, (p, n)).
     Z : ndarray (n, n)
-        The orthogonal transformation.
+        The transformation: orthogonal, or T^-1 Q (T Q) for states balanced first.
     kind : str
         ``"controllability"`` or ``"observability"``.
 
@@ -182,7 +192,7 @@ class Controllability(Result):
     staircase_A: FloatArray
     staircase_B: FloatArray
     Z: FloatArray
-    """The orthogonal transformation."""
+    """The transformation: orthogonal, or T^-1 Q (T Q) for states balanced first."""
     kind: str
     """"controllability" or "observability"."""
 
@@ -279,7 +289,8 @@ def controllability(
     A_or_sys : array_like (n, n), StateSpace, (A, B) tuple, or object with A and B
     B : array_like (n, m), optional (required with a plain A)
     tol : float, optional
-        Rank tolerance; default n ε max(||A||_F, ||B||_F), ε = 2^-52.
+        Rank tolerance; default n ε max(||A||_F, ||B||_F), ε = 2^-52, of the pair
+        with its states balanced where they are scaled apart (see the module).
     method : "full" (default) or "staircase"
         "full" runs the staircase form and the modal PBH test; "staircase" only the first,
         about 5x faster at n = 64 but blind to an uncontrollable mode that dominates the
@@ -330,7 +341,8 @@ def observability(
     A_or_sys : array_like (n, n), StateSpace, (A, C) tuple, or object with A and C
     C : array_like (p, n), optional (required with a plain A)
     tol : float, optional
-        Rank tolerance; default n ε max(||A||_F, ||C||_F), ε = 2^-52.
+        Rank tolerance; default n ε max(||A||_F, ||C||_F), ε = 2^-52, of the pair
+        with its states balanced where they are scaled apart (see the module).
     method : "full" (default) or "staircase"
         As :func:`controllability`.
 
@@ -379,7 +391,8 @@ def is_controllable(
     A_or_sys : array_like (n, n), StateSpace, (A, B) tuple, or object with A and B
     B : array_like (n, m), optional (required with a plain A)
     tol : float, optional
-        Rank tolerance; default n ε max(||A||_F, ||B||_F), ε = 2^-52.
+        Rank tolerance; default n ε max(||A||_F, ||B||_F), ε = 2^-52, of the pair
+        with its states balanced where they are scaled apart (see the module).
     method : "full" (default) or "staircase"
         As :func:`controllability`.
 
@@ -428,7 +441,8 @@ def is_observable(
     A_or_sys : array_like (n, n), StateSpace, (A, C) tuple, or object with A and C
     C : array_like (p, n), optional (required with a plain A)
     tol : float, optional
-        Rank tolerance; default n ε max(||A||_F, ||C||_F), ε = 2^-52.
+        Rank tolerance; default n ε max(||A||_F, ||C||_F), ε = 2^-52, of the pair
+        with its states balanced where they are scaled apart (see the module).
     method : "full" (default) or "staircase"
         As :func:`controllability`.
 

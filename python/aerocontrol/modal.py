@@ -88,7 +88,11 @@ class Modes(Result):
     modal_matrix : ndarray (n, n), complex, or None
         P, unit eigenvectors as columns in the order of ``eigenvalues``; None if A is defective.
     modal_matrix_condition : float
-        κ₂(P); above 1e8 P counts as singular.
+        κ₂(P), in the model's units. P counts as singular (None, with a warning) when the
+        modal matrix of A with its states balanced (D⁻¹AD, D diagonal of powers of two) has
+        κ₂ above 1e8: how near A is to a defective matrix in any units of the states, where
+        κ₂(P) also grows with their spread (1e12 for simple, well-separated eigenvalues of
+        states in units 10^±6 apart).
     modal_input : ndarray (n, m), complex, or None
         P^-1 B (6.61), when B was given and P is not singular.
     characteristic_polynomial : ndarray (n + 1,)
@@ -124,7 +128,7 @@ class Modes(Result):
     modal_matrix: ComplexArray | None
     """P, unit eigenvectors as columns in the order of ``eigenvalues``; None if A is defective."""
     modal_matrix_condition: float
-    """κ₂(P); above 1e8 P counts as singular."""
+    """κ₂(P) in the model's units (P counts as singular by its balanced states' modal matrix)."""
     modal_input: ComplexArray | None
     """P^-1 B (6.61), when B was given and P is not singular."""
     characteristic_polynomial: FloatArray
@@ -309,7 +313,8 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
     if singular:
         warnings.warn(
             f"the modal matrix P is singular (condition number "
-            f"{result['modal_matrix_condition']:.2e}): A has a repeated eigenvalue without a "
+            f"{result['balanced_modal_matrix_condition']:.2e} with the states balanced): A has "
+            "a repeated eigenvalue without a "
             "full set of eigenvectors, so there is no modal decomposition; modal_matrix and "
             "modal_input are None",
             IllConditionedWarning,

@@ -81,6 +81,10 @@ fn modal_analysis<'py>(
     )?;
     result.set_item("modal_matrix_condition", analysis.modal_matrix_condition)?;
     result.set_item(
+        "balanced_modal_matrix_condition",
+        analysis.balanced_modal_matrix_condition,
+    )?;
+    result.set_item(
         "modal_matrix_is_singular",
         analysis.modal_matrix_is_singular(),
     )?;

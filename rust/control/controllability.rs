@@ -57,12 +57,21 @@
 //! repeated eigenvalue whose eigenspace is only partly reachable (A = I, B = [1, 1]^T), which
 //! the staircase finds at once. The verdict is "controllable" only when both agree.
 //!
+//! # Balanced states
+//!
+//! Both tests are accurate to u times the norm of the pair. Where A's states are scaled apart
+//! (units 10^3 or more apart), both run on the pair (T A T^-1, T B) balanced by a diagonal T of
+//! powers of two ([`balanced_pair`]), which is exact and changes no verdict; the tolerance,
+//! the measures and the form are those of that pair, and the transformation is Z = T^-1 Q.
+//!
 //! Observability is the dual: (A, C) is observable if and only if (A^T, C^T) is controllable,
 //! and the unobservable eigenvalues of (A, C) are the uncontrollable ones of (A^T, C^T).
 
 use crate::control::modal::eigen;
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::linalg::balance::{range_scale, scale_for_largest};
+use crate::linalg::balance::{
+    balanced_states_with_scaling, range_scale, scale_for_largest, states_scaled_apart,
+};
 use crate::linalg::dense::view_product_into;
 use crate::linalg::householder::reflector;
 use crate::linalg::norm::{frobenius_norm, max_abs, vector_norm};
@@ -130,12 +139,13 @@ pub(crate) fn krylov_blocks(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> 
 /// The staircase form of a pair (see the module documentation).
 #[derive(Debug, Clone)]
 pub struct Staircase {
-    /// Z^T A Z: block upper triangular for controllability; for observability the transpose of
-    /// the dual form, block lower triangular.
+    /// Z^-1 A Z: block upper triangular for controllability; for observability the transpose
+    /// of the dual form, block lower triangular.
     pub a: Mat<f64>,
-    /// Z^T B (controllability) or C Z (observability).
+    /// Z^-1 B (controllability) or C Z (observability).
     pub b: Mat<f64>,
-    /// The orthogonal transformation (empty when it was not requested).
+    /// The transformation (empty when it was not requested): orthogonal, or T^-1 Q (T Q for
+    /// observability) with Q orthogonal where the states were balanced first.
     pub z: Mat<f64>,
     /// The ranks r_1, r_2, ... of the staircase blocks; they sum to the controllable order.
     pub block_sizes: Vec<usize>,
@@ -158,7 +168,8 @@ impl Staircase {
 }
 
 /// The controllability staircase form of (A, B); `tolerance` overrides the default rank
-/// tolerance n u max(||A||_F, ||B||_F). Z is accumulated only `with_transformation`.
+/// tolerance n u max(||A||_F, ||B||_F) of the balanced pair (see [`balanced_pair`]). Z is
+/// accumulated only `with_transformation`.
 pub fn controllability_staircase(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -169,7 +180,7 @@ pub fn controllability_staircase(
     check_finite(a, "A")?;
     check_rows(b, "B", a.nrows(), "A")?;
     check_finite(b, "B")?;
-    staircase(a, b, tolerance, with_transformation)
+    Ok(balanced_staircase(a, b, tolerance, with_transformation, Duality::Primal)?.0)
 }
 
 /// The observability staircase form of (A, C), by duality.
@@ -180,12 +191,82 @@ pub fn observability_staircase(
     with_transformation: bool,
 ) -> Result<Staircase, Error> {
     check_output_pair(a, c)?;
-    let dual = staircase(a.transpose(), c.transpose(), tolerance, with_transformation)?;
-    Ok(Staircase {
+    Ok(dual_form(
+        balanced_staircase(
+            a.transpose(),
+            c.transpose(),
+            tolerance,
+            with_transformation,
+            Duality::Dual,
+        )?
+        .0,
+    ))
+}
+
+/// The observability form from the staircase of the dual pair (A^T, C^T): its transpose.
+fn dual_form(dual: Staircase) -> Staircase {
+    Staircase {
         a: dual.a.transpose().to_owned(),
         b: dual.b.transpose().to_owned(),
         ..dual
-    })
+    }
+}
+
+/// Whether a staircase is of a pair (A, B) itself or of the dual (A^T, C^T) of a pair (A, C).
+#[derive(Clone, Copy, PartialEq)]
+enum Duality {
+    Primal,
+    Dual,
+}
+
+/// (T A T^-1, T B) and the diagonal of T: the states of the pair balanced by powers of two
+/// (`linalg/balance.rs`'s Osborne iteration on the rows of [A B] and the columns of A), where
+/// A's states are scaled apart ([`states_scaled_apart`]); None where they are not (the pair
+/// is analysed as given) or the scaling would not be exact. Controllability does not depend
+/// on the coordinates, but the staircase's reflections and the modal test's unit eigenvectors
+/// are accurate to u times the norm of the pair they are given: states in units 10^6 apart put
+/// errors of the large states' size into the small states' entries, and a controllable pair
+/// came out uncontrollable, with a staircase eigenvalue that A does not have.
+fn balanced_pair(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Option<(Mat<f64>, Mat<f64>, Vec<f64>)> {
+    if !states_scaled_apart(a) {
+        return None;
+    }
+    let outputs = Mat::<f64>::zeros(0, a.nrows());
+    balanced_states_with_scaling(a, b, outputs.as_ref()).map(|(a, b, _, t)| (a, b, t))
+}
+
+/// A pair (A, B) of a plant matrix and its inputs (or the dual (A^T, C^T)).
+type Pair = (Mat<f64>, Mat<f64>);
+
+/// The staircase of the pair (A, B) (the dual pair, for observability) balanced first
+/// ([`balanced_pair`]), its transformation Z taken back to the pair's own coordinates, with
+/// the pair it was computed from (for the modal test). The form is then Z^-1 A Z: Z = T^-1 Q
+/// for controllability, and for the dual Z = T Q, which makes the transposed form
+/// Z^-1 A Z of (A, C) (Q the staircase's orthogonal transformation).
+fn balanced_staircase(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    tolerance: Option<f64>,
+    with_transformation: bool,
+    duality: Duality,
+) -> Result<(Staircase, Option<Pair>), Error> {
+    let Some((a_balanced, b_balanced, t)) = balanced_pair(a, b) else {
+        return Ok((staircase(a, b, tolerance, with_transformation)?, None));
+    };
+    let mut form = staircase(
+        a_balanced.as_ref(),
+        b_balanced.as_ref(),
+        tolerance,
+        with_transformation,
+    )?;
+    if with_transformation {
+        let q = &form.z;
+        form.z = Mat::from_fn(q.nrows(), q.ncols(), |i, j| match duality {
+            Duality::Primal => q[(i, j)] / t[i],
+            Duality::Dual => q[(i, j)] * t[i],
+        });
+    }
+    Ok((form, Some((a_balanced, b_balanced))))
 }
 
 /// The controllability (or observability) verdict of [`controllability`].
@@ -213,7 +294,8 @@ impl Controllability {
 }
 
 /// The controllability of (A, B) by the staircase form and, with `modal_test`, the modal PBH
-/// test (see the module documentation); `tolerance` overrides n u max(||A||_F, ||B||_F).
+/// test (see the module documentation), both on the balanced pair ([`balanced_pair`]);
+/// `tolerance` overrides n u max(||A||_F, ||B||_F) of that pair.
 pub fn controllability(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -221,8 +303,16 @@ pub fn controllability(
     modal_test: bool,
     with_transformation: bool,
 ) -> Result<Controllability, Error> {
-    let staircase = controllability_staircase(a, b, tolerance, with_transformation)?;
-    combine_with_modal_test(staircase, a.transpose(), b.transpose(), modal_test)
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    check_rows(b, "B", a.nrows(), "A")?;
+    check_finite(b, "B")?;
+    let (form, balanced) =
+        balanced_staircase(a, b, tolerance, with_transformation, Duality::Primal)?;
+    let (a, b) = balanced
+        .as_ref()
+        .map_or((a, b), |(a, b)| (a.as_ref(), b.as_ref()));
+    combine_with_modal_test(form, a.transpose(), b.transpose(), modal_test)
 }
 
 /// The observability of (A, C): the controllability of the dual pair (A^T, C^T).
@@ -233,13 +323,37 @@ pub fn observability(
     modal_test: bool,
     with_transformation: bool,
 ) -> Result<Controllability, Error> {
-    let staircase = observability_staircase(a, c, tolerance, with_transformation)?;
-    combine_with_modal_test(staircase, a, c, modal_test)
+    check_output_pair(a, c)?;
+    let (form, balanced) = balanced_staircase(
+        a.transpose(),
+        c.transpose(),
+        tolerance,
+        with_transformation,
+        Duality::Dual,
+    )?;
+    // The modal test of the dual pair (A^T, C^T) takes the eigenvectors of its transpose.
+    let (a_dual, c_dual) = balanced
+        .as_ref()
+        .map_or((a.transpose(), c.transpose()), |(a, c)| {
+            (a.as_ref(), c.as_ref())
+        });
+    combine_with_modal_test(
+        dual_form(form),
+        a_dual.transpose(),
+        c_dual.transpose(),
+        modal_test,
+    )
 }
 
 /// Adds the modal test to a staircase verdict. The eigenvectors of `a_dual` (A^T for
 /// controllability) are the left eigenvectors of the pair's plant matrix; `coupling_dual`
 /// (B^T) maps them to the measures.
+///
+/// The uncontrollable eigenvalues are then eigenvalues λ_k of A, each at most once: each
+/// eigenvalue of the staircase's A_u stands for the nearest λ_k not yet taken (A_u's are
+/// eigenvalues of a nearby pair, and a mode the staircase deflates is one of A's), and the
+/// modes the modal test flags are added where the staircase did not take them. So at most n
+/// are listed, whatever the two tests' rounding.
 fn combine_with_modal_test(
     staircase: Staircase,
     a_dual: MatRef<'_, f64>,
@@ -247,33 +361,52 @@ fn combine_with_modal_test(
     modal_test: bool,
 ) -> Result<Controllability, Error> {
     let tolerance = staircase.tolerance;
-    let mut uncontrollable = staircase.uncontrollable_eigenvalues.clone();
-    let (mut eigenvalues, mut modal_measure) = (Vec::new(), Vec::new());
-    if modal_test {
-        let (values, vectors) = eigen(a_dual)?;
-        // ||w^T B|| = s ||w^T (B / s)|| for the power of two s of B's largest entry, with the
-        // norm scaled, so that neither the products nor their squares leave the range.
-        let scale = range_scale(coupling_dual);
-        for (k, &lambda) in values.iter().enumerate() {
+    if !modal_test {
+        return Ok(Controllability {
+            uncontrollable_eigenvalues: staircase.uncontrollable_eigenvalues.clone(),
+            staircase,
+            eigenvalues: Vec::new(),
+            modal_measure: Vec::new(),
+            tolerance,
+        });
+    }
+    let (eigenvalues, vectors) = eigen(a_dual)?;
+    // ||w^T B|| = s ||w^T (B / s)|| for the power of two s of B's largest entry, with the
+    // norm scaled, so that neither the products nor their squares leave the range.
+    let scale = range_scale(coupling_dual);
+    let modal_measure: Vec<f64> = (0..eigenvalues.len())
+        .map(|k| {
             let vector = vectors.col(k);
-            let products: Vec<c64> = (0..coupling_dual.nrows())
-                .map(|r| {
-                    let row = coupling_dual.row(r);
-                    row.iter()
-                        .zip(vector.iter())
-                        .map(|(&x, v)| v * (x / scale))
-                        .sum()
-                })
-                .collect();
-            let measure = vector_norm(products.iter().flat_map(|p| [p.re, p.im])) * scale;
-            modal_measure.push(measure);
-            // Add what the staircase missed (at most once per computed eigenvalue).
-            let near = |mu: &c64| (mu - lambda).norm() <= 1e-6 * lambda.norm().max(1.0);
-            if measure <= tolerance && !staircase.uncontrollable_eigenvalues.iter().any(near) {
-                uncontrollable.push(lambda);
-            }
+            let products = (0..coupling_dual.nrows()).map(|r| {
+                coupling_dual
+                    .row(r)
+                    .iter()
+                    .zip(vector.iter())
+                    .map(|(&x, v)| v * (x / scale))
+                    .sum::<c64>()
+            });
+            vector_norm(products.flat_map(|p| [p.re, p.im])) * scale
+        })
+        .collect();
+    let mut taken = vec![false; eigenvalues.len()];
+    let mut uncontrollable = Vec::with_capacity(eigenvalues.len());
+    for mu in &staircase.uncontrollable_eigenvalues {
+        let nearest = (0..eigenvalues.len())
+            .filter(|&k| !taken[k])
+            .min_by(|&i, &j| {
+                (eigenvalues[i] - mu)
+                    .norm()
+                    .total_cmp(&(eigenvalues[j] - mu).norm())
+            });
+        if let Some(k) = nearest {
+            taken[k] = true;
+            uncontrollable.push(eigenvalues[k]);
         }
-        eigenvalues = values;
+    }
+    for (k, &measure) in modal_measure.iter().enumerate() {
+        if measure <= tolerance && !taken[k] {
+            uncontrollable.push(eigenvalues[k]);
+        }
     }
     Ok(Controllability {
         staircase,
@@ -313,6 +446,9 @@ pub(crate) fn staircase(
     let (a, b) = (scaled(a), scaled(b));
     let default =
         n as f64 * f64::EPSILON * frobenius_norm(a.as_ref()).max(frobenius_norm(b.as_ref()));
+    let given = tolerance;
+    // A given tolerance over s may overflow (1e300 beside entries of 1e-151): every norm is
+    // then below it, as it is below the given one in the pair's own units, which is reported.
     let tolerance = tolerance.map_or(default, |t| t / scale);
     let z_order = if with_transformation { n } else { 0 };
     let mut reduction = Reduction {
@@ -360,7 +496,7 @@ pub(crate) fn staircase(
         block_sizes,
         controllable_order: start,
         uncontrollable_eigenvalues,
-        tolerance: tolerance * scale,
+        tolerance: given.unwrap_or(tolerance * scale),
         smallest_pivot: reduction.smallest_pivot * scale,
     })
 }
@@ -619,6 +755,34 @@ mod tests {
         let (a, b) = planted(64, 2, [-5.0, 6.0], 3);
         let staircase_only = controllability(a.as_ref(), b.as_ref(), None, false, false).unwrap();
         assert!(staircase_only.is_complete());
+    }
+
+    #[test]
+    fn states_scaled_apart_are_balanced_first() {
+        // A planted pair with its states scaled by 10^±6 (D A D^-1, D B): the same two
+        // uncontrollable eigenvalues as the pair itself, each listed once, and Z a similarity
+        // to the form (Z^-1 A Z, Z^-1 B); the observability of the transposed pair likewise.
+        let (a, b) = planted(6, 1, [-0.5, 0.25], 5);
+        let d = [1e6, 1.0, 1e-6, 1e3, 1e-3, 1.0];
+        let scaled_a = Mat::from_fn(6, 6, |i, j| a[(i, j)] * d[i] / d[j]);
+        let scaled_b = Mat::from_fn(6, 1, |i, j| b[(i, j)] * d[i]);
+        assert!(states_scaled_apart(scaled_a.as_ref()));
+        for (x, y) in [(&a, &b), (&scaled_a, &scaled_b)] {
+            let verdict = controllability(x.as_ref(), y.as_ref(), None, true, true).unwrap();
+            let found = sorted_real_parts(&verdict.uncontrollable_eigenvalues);
+            assert_eq!(found.len(), 2);
+            assert!((found[0] + 0.5).abs() < 1e-9 && (found[1] - 0.25).abs() < 1e-9);
+            let z = verdict.staircase.z.as_ref();
+            let residual = x.as_ref() * z - z * verdict.staircase.a.as_ref();
+            assert!(frobenius_norm(residual.as_ref()) <= 1e-12 * frobenius_norm(x.as_ref()));
+            let residual = y.as_ref() - z * verdict.staircase.b.as_ref();
+            assert!(frobenius_norm(residual.as_ref()) <= 1e-12 * frobenius_norm(y.as_ref()));
+            let dual = observability(x.transpose(), y.transpose(), None, true, true).unwrap();
+            assert_eq!(dual.uncontrollable_eigenvalues.len(), 2);
+            let z = dual.staircase.z.as_ref();
+            let residual = x.transpose() * z - z * dual.staircase.a.as_ref();
+            assert!(frobenius_norm(residual.as_ref()) <= 1e-12 * frobenius_norm(x.as_ref()));
+        }
     }
 
     #[test]

@@ -31,6 +31,7 @@
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::balance;
 use crate::linalg::matrix::{FaerView, from_faer};
+use crate::linalg::norm::vector_norm;
 use crate::linalg::schur::{real_schur, schur_eigenvectors};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, c64};
@@ -112,6 +113,11 @@ pub struct ModalAnalysis {
     pub modal_matrix: Mat<c64>,
     /// κ_2(P) = σ_max / σ_min; infinite when P is exactly singular.
     pub modal_matrix_condition: f64,
+    /// κ_2(P_b) of the modal matrix P_b of A with its states balanced (D^-1 A D, as [`eigen`]
+    /// balances it): how near A is to a defective matrix, in any units of its states (κ_2(P)
+    /// grows with their spread: 1.3e12 for three simple, well-separated eigenvalues of states
+    /// in units 10^±6 apart). Infinite when P_b is exactly singular.
+    pub balanced_modal_matrix_condition: f64,
     /// P^-1 B (6.61), when B was given and P is not singular.
     pub modal_input: Option<Mat<c64>>,
     /// Coefficients of det(λI - A), highest power first: [1, a_1, ..., a_n].
@@ -119,11 +125,11 @@ pub struct ModalAnalysis {
 }
 
 impl ModalAnalysis {
-    /// Whether P is too ill-conditioned to be a modal matrix (a defective or nearly defective
-    /// eigenvalue).
+    /// Whether P is too ill-conditioned to be a modal matrix in any units of the states (a
+    /// defective or nearly defective eigenvalue): by the balanced modal matrix's condition.
     pub fn modal_matrix_is_singular(&self) -> bool {
-        self.modal_matrix_condition.is_nan()
-            || self.modal_matrix_condition >= SINGULAR_MODAL_MATRIX_CONDITION
+        self.balanced_modal_matrix_condition.is_nan()
+            || self.balanced_modal_matrix_condition >= SINGULAR_MODAL_MATRIX_CONDITION
     }
 }
 
@@ -139,6 +145,14 @@ impl ModalAnalysis {
 /// those of A, the eigenvalues are multiplied back), so that the back substitution's products
 /// and its pivot threshold stay well inside the normal range.
 pub fn eigen(a: MatRef<'_, f64>) -> Result<(Vec<c64>, Mat<c64>), Error> {
+    eigen_and_balancing(a).map(|(values, vectors, _)| (values, vectors))
+}
+
+/// The eigenvalues, the unit eigenvectors and the diagonal of the balancing D of [`eigen`].
+type EigenAndBalancing = (Vec<c64>, Mat<c64>, Vec<f64>);
+
+/// [`eigen`] with the diagonal of its balancing D (D^-1 A D balanced).
+fn eigen_and_balancing(a: MatRef<'_, f64>) -> Result<EigenAndBalancing, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let scale = crate::linalg::balance::range_scale(a);
@@ -149,7 +163,7 @@ pub fn eigen(a: MatRef<'_, f64>) -> Result<(Vec<c64>, Mat<c64>), Error> {
     // D^-1 A D = Z T Z^T: the eigenvectors of A are D Z x.
     let d = balance(&mut balanced);
     let (values, vectors) = schur_eigenvectors(&real_schur(balanced.as_faer())?, &d);
-    Ok((values.into_iter().map(|v| v * scale).collect(), vectors))
+    Ok((values.into_iter().map(|v| v * scale).collect(), vectors, d))
 }
 
 /// The coefficients of prod (λ - λ_i), highest power first, multiplied out in real arithmetic
@@ -222,7 +236,7 @@ pub fn modal_analysis(
     a: MatRef<'_, f64>,
     b: Option<MatRef<'_, f64>>,
 ) -> Result<ModalAnalysis, Error> {
-    let (values, vectors) = eigen(a)?;
+    let (values, vectors, balancing) = eigen_and_balancing(a)?;
     if let Some(b) = b {
         check_rows(b, "B", a.nrows(), "A")?;
         check_finite(b, "B")?;
@@ -265,21 +279,49 @@ pub fn modal_analysis(
         };
         position += if mode.oscillatory { 2 } else { 1 };
     }
+    // P = D P_b S with P_b the unit eigenvectors of the balanced D^-1 A D and S diagonal (the
+    // columns' norms): P^-1 B = S^-1 P_b^-1 D^-1 B, solved with the better conditioned P_b.
+    let mut balanced_modal = Mat::from_fn(n, n, |i, j| modal_matrix[(i, j)] / balancing[i]);
+    let column_norms: Vec<f64> = (0..n)
+        .map(|j| {
+            let parts: Vec<f64> = balanced_modal
+                .col(j)
+                .iter()
+                .flat_map(|v| [v.re, v.im])
+                .collect();
+            let norm = vector_norm(parts.iter().copied());
+            balanced_modal
+                .col_mut(j)
+                .iter_mut()
+                .for_each(|v| *v /= norm);
+            norm
+        })
+        .collect();
     let modal_matrix_condition = condition_number(&modal_matrix, &eigenvalues);
+    let balanced_modal_matrix_condition = if balancing.iter().all(|&d| d == 1.0) {
+        modal_matrix_condition
+    } else {
+        condition_number(&balanced_modal, &eigenvalues)
+    };
     let characteristic_polynomial = polynomial_from_roots(&eigenvalues);
     let mut analysis = ModalAnalysis {
         eigenvalues,
         modes,
         modal_matrix,
         modal_matrix_condition,
+        balanced_modal_matrix_condition,
         modal_input: None,
         characteristic_polynomial,
     };
     if let Some(b) = b
         && !analysis.modal_matrix_is_singular()
     {
-        let rhs = Mat::from_fn(n, b.ncols(), |i, j| c64::new(b[(i, j)], 0.0));
-        analysis.modal_input = Some(analysis.modal_matrix.partial_piv_lu().solve(&rhs));
+        let rhs = Mat::from_fn(n, b.ncols(), |i, j| c64::new(b[(i, j)] / balancing[i], 0.0));
+        let mut input = balanced_modal.partial_piv_lu().solve(&rhs);
+        for (i, norm) in column_norms.iter().enumerate() {
+            input.row_mut(i).iter_mut().for_each(|v| *v /= *norm);
+        }
+        analysis.modal_input = Some(input);
     }
     Ok(analysis)
 }
@@ -370,6 +412,28 @@ mod tests {
         assert!(analysis.modal_input.is_none());
         assert!(analysis.modes[0].damping_ratio.is_nan());
         assert_eq!(analysis.characteristic_polynomial, vec![1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn states_scaled_apart_are_not_defective() {
+        // Three simple eigenvalues (-0.8647 and -2.5676 ± 0.4082i, by numpy) in states scaled
+        // by 10^±6: P in those units has κ_2 near 4e11, the balanced one a few units; P^-1 B
+        // is formed, and P (P^-1 B) = B.
+        let base = [[-1.0, 0.5, -0.25], [0.3, -2.0, 0.75], [0.2, -0.4, -3.0]];
+        let t = [1e-6, 1.0, 1e6];
+        let a = Mat::from_fn(3, 3, |i, j| base[i][j] * t[i] / t[j]);
+        let b = Mat::from_fn(3, 1, |i, _| t[i]);
+        let analysis = modal_analysis(a.as_ref(), Some(b.as_ref())).unwrap();
+        assert!(analysis.modal_matrix_condition > 1e10);
+        assert!(analysis.balanced_modal_matrix_condition < 1e2);
+        assert!(!analysis.modal_matrix_is_singular());
+        let input = analysis.modal_input.unwrap();
+        for (i, &ti) in t.iter().enumerate() {
+            let row: c64 = (0..3)
+                .map(|k| analysis.modal_matrix[(i, k)] * input[(k, 0)])
+                .sum();
+            assert!((row - c64::new(ti, 0.0)).norm() <= 1e-12 * ti, "{row:?}");
+        }
     }
 
     #[test]

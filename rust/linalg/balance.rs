@@ -63,8 +63,21 @@ pub(crate) fn balanced_states(
     b: MatRef<'_, f64>,
     c: MatRef<'_, f64>,
 ) -> Option<(Mat<f64>, Mat<f64>, Mat<f64>)> {
+    balanced_states_with_scaling(a, b, c).map(|(a, b, c, _)| (a, b, c))
+}
+
+/// (T A T^-1, T B, C T^-1) and the diagonal of T.
+pub(crate) type ScaledStates = (Mat<f64>, Mat<f64>, Mat<f64>, Vec<f64>);
+
+/// [`balanced_states`] with the diagonal of T.
+pub(crate) fn balanced_states_with_scaling(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+) -> Option<ScaledStates> {
     let n = a.nrows();
     let (mut a2, mut b2, mut c2) = (a.to_owned(), b.to_owned(), c.to_owned());
+    let mut scaling = vec![1.0; n];
     for _ in 0..100 {
         let mut changed = false;
         for i in 0..n {
@@ -95,6 +108,7 @@ pub(crate) fn balanced_states(
                 continue;
             }
             changed = true;
+            scaling[i] *= f;
             let f_inverse = 1.0 / f;
             for j in (0..n).filter(|&j| j != i) {
                 a2[(i, j)] *= f;
@@ -119,7 +133,27 @@ pub(crate) fn balanced_states(
             })
         })
     };
-    (exact(a, &a2) && exact(b, &b2) && exact(c, &c2)).then_some((a2, b2, c2))
+    (exact(a, &a2) && exact(b, &b2) && exact(c, &c2)).then_some((a2, b2, c2, scaling))
+}
+
+/// Whether some state of A is scaled apart from the others: its row's and its column's
+/// largest off-diagonal magnitudes (both nonzero) more than 2^10 apart. A diagonal similarity
+/// T A T^-1 multiplies state i's row by t_i and divides its column by it, so states measured in
+/// units 10^3 or more apart fail the test, while a matrix of one scale whose entries spread
+/// over decades (a random one) passes it. The test costs one pass over A, where the balancing
+/// costs several.
+pub(crate) fn states_scaled_apart(a: MatRef<'_, f64>) -> bool {
+    const SPREAD: f64 = 1024.0;
+    let n = a.nrows();
+    (0..n).any(|i| {
+        let (mut row, mut column) = (0.0f64, 0.0f64);
+        for k in (0..n).filter(|&k| k != i) {
+            row = row.max(a[(i, k)].abs());
+            column = column.max(a[(k, i)].abs());
+        }
+        let (low, high) = (row.min(column), row.max(column));
+        low > 0.0 && high > SPREAD * low
+    })
 }
 
 /// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):

@@ -239,35 +239,6 @@ CLOSED_LOOP_POLES_OF_GRADED_LOOPS = known_defect(
 )
 
 
-def _tolerance_beyond_the_scaled_doubles(args: dict[str, Any]) -> bool:
-    """A tolerance given whose ratio to the largest entry of A and B (or C) is beyond the
-    doubles."""
-    tol = args.get("tol")
-    if tol is None or not np.isfinite(float(tol)) or float(tol) <= 0:
-        return False
-    sizes = [
-        float(np.max(np.abs(np.asarray(value, dtype=float)), initial=0.0))
-        for key, value in args.items()
-        if key in ("A_or_sys", "B", "C") and value is not None and np.ndim(value) == 2
-    ]
-    sizes += [float(np.max(np.abs(M), initial=0.0)) for model in _models_of(args) for M in model]
-    largest = max(sizes, default=0.0)
-    with np.errstate(over="ignore", divide="ignore"):
-        return bool(float(tol) / max(largest, np.finfo(float).tiny) > np.finfo(float).max)
-
-
-CONTROLLABILITY_TOLERANCE_OVERFLOW = known_defect(
-    "controllability-tolerance-overflow",
-    {"controllability", "observability", "is_controllable", "is_observable"},
-    "the core's controllability reports the tolerance it was given as inf, without a "
-    "warning, when the tolerance over the size of A and B is beyond the doubles: A = "
-    "[[1.26e-151]], B with no columns, tol = 1e300 gives tolerance inf (A = [[1]] gives "
-    "1e300): the tolerance is scaled with the problem and overflows",
-    _tolerance_beyond_the_scaled_doubles,
-    "'.tolerance'",
-)
-
-
 def _badly_scaled_state_matrix(args: dict[str, Any]) -> bool:
     """An A whose largest and smallest nonzero entries differ by more than 1e12 (states
     scaled by 10^±6 or so)."""

@@ -2,8 +2,9 @@
 (aerocontrol.controllability).
 
 Oracles: the Krylov blocks A V_k against numpy's products; the staircase form by its
-definition (Z orthogonal, Z^T A Z and Z^T B, nothing below the staircase but what the rank
-decisions judged negligible, within the tolerance); each mode
+definition (Z = T^-1 Q for the pair's state balancing T, Q orthogonal, Q^T A Q and Q^T B of the
+balanced pair, nothing below the staircase but what the rank decisions judged negligible,
+within the tolerance); each mode
 declared uncontrollable by the Popov-Belevitch-Hautus test, sigma_min([A - λI, B]) within the
 tolerance the verdict used; pairs planted exactly uncontrollable declared so; the verdict of
 is_controllable and is_observable equal to that of the full analysis; observability as the
@@ -22,7 +23,6 @@ from hypothesis import strategies as st
 import aerocontrol
 
 from .harness import Warned, exercise, plain
-from .known_defects import CONTROLLABILITY_TOLERANCE_OVERFLOW
 from .oracles import SLACK, TINY, U, assert_spectrum, finite, norm, quietly, silenced
 from .strategies import (
     canonical,
@@ -97,6 +97,22 @@ def _pbh_distance(A: np.ndarray, X: np.ndarray, eigenvalue: complex) -> float:
     return float(np.linalg.svd(stacked, compute_uv=False)[-1]) if n else 0.0
 
 
+def _balancing_of(Z: np.ndarray, dual: bool) -> np.ndarray:
+    """The diagonal T of the pair's state balancing from the staircase's transformation
+    Z = T^-1 Q (controllability) or T Q (observability), Q orthogonal: Z Z^T = T^∓2, diagonal,
+    and T of powers of two (the identity where the states were not scaled apart)."""
+    n = Z.shape[0]
+    gram = Z @ Z.T
+    if not finite(gram) or n == 0:
+        return np.ones(n)
+    diagonal = np.sqrt(np.diag(gram))
+    off = gram - np.diag(np.diag(gram))
+    assert np.all(np.abs(off) <= SLACK * n * U * np.outer(diagonal, diagonal)), "Z Z^T diagonal"
+    powers = np.exp2(np.round(np.log2(diagonal)))
+    assert np.all(np.abs(diagonal - powers) <= SLACK * n * U * powers), "T of powers of two"
+    return powers if dual else 1.0 / powers
+
+
 def _analysis_oracle(dual: bool, planted: bool) -> Any:
     def oracle(result: Any, args: dict[str, Any], warned: Warned) -> None:
         A, X = _pair(args, "C" if dual else "B")
@@ -105,6 +121,15 @@ def _analysis_oracle(dual: bool, planted: bool) -> Any:
         n = A.shape[0]
         assert result.kind == ("observability" if dual else "controllability")
         assert result.controllable == (len(result.uncontrollable_eigenvalues) == 0)
+        SA, SB, Z = result.staircase_A, result.staircase_B, result.Z
+        if dual:
+            SA, SB = SA.T, SB.T
+        # Both tests run on the pair (T A T^-1, T B) of balanced states (T = I unless A's
+        # states are scaled apart); the orthogonal Q of the staircase is T Z or T^-1 Z.
+        T = _balancing_of(Z, dual)
+        if not np.all(T == 1.0):
+            A, X = T[:, None] * A / T[None, :], T[:, None] * X
+            Z = (T[:, None] * Z) if not dual else Z / T[:, None]
         tol = result.tolerance
         if args["tol"] is None:  # n ε max(||A||_F, ||B||_F), ε = 2u
             with silenced():
@@ -112,11 +137,8 @@ def _analysis_oracle(dual: bool, planted: bool) -> Any:
             assert abs(tol - default) <= 8 * U * default, f"tolerance {tol}, not {default}"
         else:
             assert tol == float(args["tol"])
-        # The staircase: Z orthogonal, Z^T A Z and Z^T B (transposed for observability), exact
+        # The staircase: Q orthogonal, Q^T A Q and Q^T B (transposed for observability), exact
         # zeros below the steps and under the controllable part.
-        SA, SB, Z = result.staircase_A, result.staircase_B, result.Z
-        if dual:
-            SA, SB = SA.T, SB.T
         order = result.controllable_order
         assert sum(result.block_sizes) == order <= n
         assert Z.shape == (n, n) and SA.shape == (n, n) and SB.shape == X.shape
@@ -274,37 +296,34 @@ def test_controllability_extreme_entries(example: str) -> None:
     assert outcome.result.controllable, "a controllable pair was declared uncontrollable"
 
 
-@pytest.mark.xfail(strict=True, reason="controllability-tolerance-overflow: core")
-def test_known_defect_controllability_tolerance_beyond_the_scaled_doubles() -> None:
+def test_regression_controllability_tolerance_beyond_the_scaled_doubles() -> None:
+    """A tolerance whose ratio to the pair's size is beyond the doubles (1e300 beside
+    1.26e-151) is reported as given, not as the overflow of its scaled copy (it was inf)."""
     arguments = {
         "A_or_sys": plain(np.array([[1.257302210933933e-151]])),
         "B": plain(np.zeros((1, 0))),
         "tol": plain(1e300),
         "method": plain("full"),
     }
-    with CONTROLLABILITY_TOLERANCE_OVERFLOW.reproducing():
-        exercise(
-            "controllability",
-            aerocontrol.controllability,
-            arguments,
-            _through_models(_analysis_oracle(False, False), "B"),
-            nonfinite_by_definition=("smallest_pivot",),
-        )
+    outcome = exercise(
+        "controllability",
+        aerocontrol.controllability,
+        arguments,
+        _through_models(_analysis_oracle(False, False), "B"),
+        nonfinite_by_definition=("smallest_pivot",),
+    )
+    assert outcome.result.tolerance == 1e300
+    assert not outcome.result.controllable
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="uncontrollable-eigenvalues-beyond-n: core; the full method lists the staircase's "
-    "uncontrollable block (not eigenvalues of A) and, beside them, every eigenvalue the modal "
-    "test flags, so a badly scaled pair gets more than n 'uncontrollable eigenvalues'",
-)
-def test_known_defect_uncontrollable_eigenvalues_beyond_the_order() -> None:
+def test_regression_uncontrollable_eigenvalues_within_the_order() -> None:
     """A pair of order 2, states scaled by 1e5 (the similarity of a well-scaled controllable
-    pair): the staircase's uncontrollable block has the eigenvalue -0.2577, which is no
+    pair): the staircase's uncontrollable block had the eigenvalue -0.2577, which is no
     eigenvalue of A (0.8635 ± 0.6537j, by numpy), and the modal test, under the tolerance
-    5.8e-6, flags both eigenvalues (measure 5.4e-6); the list has 3 entries. Whatever the
+    5.8e-6, flagged both eigenvalues (measure 5.4e-6); the list had 3 entries. Whatever the
     verdict, the uncontrollable eigenvalues are at most n eigenvalues of A (to 1e-6
-    relatively), and the full method agrees with is_controllable."""
+    relatively), and the full method agrees with is_controllable. Balanced first, the pair
+    is controllable, as its unscaled original."""
     A = np.array([[0.822, 3.3e-11], [-1.3e10, 0.905]])
     B = np.array([[4.46e-6], [-53700.0]])
     analysis = aerocontrol.controllability(A, B)
@@ -314,23 +333,14 @@ def test_known_defect_uncontrollable_eigenvalues_beyond_the_order() -> None:
     for value in listed:
         assert np.min(np.abs(eigenvalues - value)) <= 1e-6 * max(abs(value), 1.0)
     assert analysis.controllable == aerocontrol.is_controllable(A, B)
+    assert analysis.controllable
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "controllability-badly-scaled-states: core; the pair A = [[0.1, -0.1, 0.6], [0.1, -0.5, "
-        "0.4], [1.3, 0.9, -0.7]], B = [-1.3, -0.6, 0]^T with its states scaled by D = "
-        "diag(1e6, 1, 1e-6) (D A D^-1, D B) is declared uncontrollable with 5 uncontrollable "
-        "eigenvalues for 3 states (-0.222 from the staircase, which is no eigenvalue of A, and "
-        "all three eigenvalues again from the modal test); expected: controllable, as the "
-        "unscaled pair is (PBH measures >= 0.14, Krylov sigma_min 0.11): the tolerance "
-        "n eps max(||A||_F, ||B||_F) = 4.0e-4 is not invariant under the state scaling, the "
-        "unit left eigenvectors' measures all fall below it, and combine_with_modal_test adds "
-        "them to the staircase's eigenvalue without a bound of n"
-    ),
-)
-def test_known_defect_controllability_of_badly_scaled_states() -> None:
+def test_regression_controllability_of_badly_scaled_states() -> None:
+    """A controllable pair with its states scaled by D = diag(1e6, 1, 1e-6) (D A D^-1, D B)
+    was declared uncontrollable with 5 uncontrollable eigenvalues for 3 states: the default
+    tolerance n ε max(||A||_F, ||B||_F) = 4.0e-4 is not invariant under the scaling, and the
+    unit left eigenvectors' measures all fell below it."""
     A = np.array([[0.1, -0.1, 0.6], [0.1, -0.5, 0.4], [1.3, 0.9, -0.7]])
     B = np.array([[-1.3], [-0.6], [0.0]])
     # The oracle, in the unscaled coordinates: every left eigenvector reaches B, and the
@@ -345,3 +355,43 @@ def test_known_defect_controllability_of_badly_scaled_states() -> None:
     hidden = scaled.uncontrollable_eigenvalues
     assert len(hidden) <= 3, f"{len(hidden)} uncontrollable eigenvalues for 3 states: {hidden}"
     assert scaled.controllable
+
+
+@pytest.mark.parametrize("dual", [False, True])
+@pytest.mark.parametrize("seed", range(12))
+def test_regression_verdicts_invariant_under_state_scaling(seed: int, dual: bool) -> None:
+    """The class of the two regressions above: a pair (controllable, or with one planted
+    uncontrollable mode, by an orthogonal similarity of a block triangular pair) and the same
+    pair with its states scaled by D of 10^±6 (D A D^-1, D B; for observability A, C D^-1)
+    get the same verdict, and the same uncontrollable eigenvalue (to 1e-8 relatively); the
+    transformation satisfies Z^-1 A Z = the form, Z^-1 B (C Z) = its input (output) block."""
+    rng = np.random.default_rng(seed)
+    n, m = int(rng.integers(3, 7)), int(rng.integers(1, 3))
+    planted = seed % 2 == 1
+    A = rng.standard_normal((n, n))
+    X = rng.standard_normal((n, m))
+    hidden = -0.5 - seed / 10.0
+    if planted:
+        A[-1, :] = 0.0
+        A[-1, -1] = hidden
+        X[-1, :] = 0.0
+        Q, _ = np.linalg.qr(rng.standard_normal((n, n)))
+        A, X = Q @ A @ Q.T, Q @ X
+    if dual:
+        A, X = A.T.copy(), X.T.copy()
+    d = np.exp(rng.uniform(-6.0, 6.0, n) * np.log(10.0))
+    scaled_A = d[:, None] * A / d[None, :]
+    scaled_X = X / d[None, :] if dual else d[:, None] * X
+    analyse = aerocontrol.observability if dual else aerocontrol.controllability
+    given, scaled = analyse(A, X), analyse(scaled_A, scaled_X)
+    assert given.controllable == scaled.controllable == (not planted)
+    if planted:
+        assert len(scaled.uncontrollable_eigenvalues) == 1
+        assert abs(scaled.uncontrollable_eigenvalues[0] - hidden) <= 1e-8 * abs(hidden)
+    Z = scaled.Z
+    size = np.linalg.norm(np.linalg.solve(Z, scaled_A @ Z))
+    assert np.linalg.norm(np.linalg.solve(Z, scaled_A @ Z) - scaled.staircase_A) <= 1e-12 * size
+    block = scaled_X @ Z if dual else np.linalg.solve(Z, scaled_X)
+    assert np.linalg.norm(block - scaled.staircase_B) <= 1e-12 * np.linalg.norm(block)
+    verdict = aerocontrol.is_observable if dual else aerocontrol.is_controllable
+    assert verdict(scaled_A, scaled_X) == (not planted)
