@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _scaling
+from . import _core
 from ._results import Result
 from ._validation import FloatArray, positive_int, real_array
 from .exceptions import AerocontrolError, IllConditionedWarning, InvalidArgumentError, ShapeError
@@ -309,11 +309,9 @@ def place_batch(A: ArrayLike, B: ArrayLike, poles: ArrayLike, method: str = "knv
     if requested.ndim not in (1, 2):
         raise ShapeError(f"poles must be (n,) or (k, n), got shape {requested.shape}")
     requested = np.ascontiguousarray(np.atleast_2d(requested))
-    A_stack, B_stack, exponents = _balanced_stacks(_stack(A, "A"), _stack(B, "B"))
-    batch = PlaceBatch(*_core.place_batch(A_stack, B_stack, requested, _METHODS[method]))
-    for i, e in exponents.items():  # K_i = K_i' T_i^-1 of the problems balanced
-        rows = slice(None) if len(A_stack) == len(B_stack) == 1 else i  # one A, B for all
-        batch.K[rows] = np.ldexp(batch.K[rows], -e[np.newaxis, :])
+    batch = PlaceBatch(
+        *_core.place_batch(_stack(A, "A"), _stack(B, "B"), requested, _METHODS[method])
+    )
     single_input = method != "knv"
     flagged = np.flatnonzero(
         (batch.max_relative_error > POLE_ERROR_WARNING)
@@ -325,43 +323,6 @@ def place_batch(A: ArrayLike, B: ArrayLike, poles: ArrayLike, method: str = "knv
         f"{POLE_ERROR_WARNING:.0e} relatively, or an ill-conditioned controllability matrix)",
     )
     return batch
-
-
-def _balanced_stacks(
-    A: FloatArray, B: FloatArray
-) -> tuple[FloatArray, FloatArray, dict[int, NDArray[np.int64]]]:
-    """The stacks of :func:`place_batch` with each problem's states balanced as the single
-    placement functions balance them (``placement._balanced_place``), so that each problem
-    is placed exactly as alone; and the exponents e of the problems balanced (their gains
-    are K' T^-1, T = diag(2^e)). Stacks the core will refuse by shape, as given."""
-    if A.ndim != 3 or B.ndim != 3 or A.shape[1:] != (A.shape[1], A.shape[1]):
-        return A, B, {}
-    if B.shape[1] != A.shape[1] or (len(A) != len(B) and 1 not in (len(A), len(B))):
-        return A, B, {}
-    count, n = max(len(A), len(B)), A.shape[1]
-    if n < 2 or count == 0:
-        return A, B, {}
-    # The cheap test of _scaling.state_balancing, over the stack at once.
-    magnitudes = np.abs(A)
-    largest = magnitudes.max(axis=(1, 2))
-    smallest = np.min(magnitudes, axis=(1, 2), where=magnitudes > 0.0, initial=np.inf)
-    with np.errstate(invalid="ignore", over="ignore"):
-        spread = np.flatnonzero(largest >= 2.0**_scaling.BALANCING_SPREAD * smallest)
-    flagged = set(spread.tolist())
-    found: dict[int, NDArray[np.int64]] = {}
-    for i in range(count):
-        a, b = (i if len(A) > 1 else 0), (i if len(B) > 1 else 0)
-        if a in flagged:
-            exponents = _scaling.state_balancing(A[a], (B[b],))
-            if exponents is not None:
-                found[i] = exponents
-    if not found:
-        return A, B, {}
-    A_full = np.array(np.broadcast_to(A, (count, n, n)))
-    B_full = np.array(np.broadcast_to(B, (count, n, B.shape[2])))
-    for i, e in found.items():
-        A_full[i], B_full[i], _ = _scaling.similarity(A_full[i], B_full[i], np.zeros((0, n)), e)
-    return A_full, B_full, found
 
 
 def _stack(value: object, name: str) -> FloatArray:

@@ -14,10 +14,11 @@ Every function returns a :class:`Placement` with K (m x n), A - BK, the achieved
 their largest relative error. The single-input formulas are only as accurate as the
 controllability matrix V is well conditioned; they warn (``IllConditionedWarning``) when
 κ(V) >= 1e8 or an achieved pole misses by more than 1e-6 relatively. A pair whose states are
-scaled far apart (entries of A spanning more than 2^10 and a balancing that moves them) is
-placed in balanced coordinates, T^-1 A T and T^-1 B with T diagonal of powers of two (exact),
-and K = K' T^-1 (the same closed-loop poles; κ and the errors are those of the balanced
-problem); :func:`aerocontrol.batch.place_batch` balances each problem alike.
+scaled far apart (a state's largest off-diagonal entries of A in its row and its column more
+than 2^10 apart: units 10^3 or more apart) is placed by the core in balanced coordinates,
+T A T^-1 and T B with T diagonal of powers of two (exact), and K = K' T (the same closed-loop
+poles; κ and the errors are those of the balanced problem);
+:func:`aerocontrol.batch.place_batch` balances each problem alike.
 
 :func:`augment_mode` builds the chapter's design request (6.156): the pole set that moves one
 mode (the Dutch roll to ζ = 0.30 at its ω_n, say) and keeps every other pole.
@@ -25,19 +26,25 @@ mode (the Dutch roll to ζ = 0.30 at its ω_n, say) and keeps every other pole.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _scaling
+from . import _core
 from ._results import Result, Tabular, attach
 from ._validation import FloatArray, real_array, real_scalar
 from .exceptions import InvalidArgumentError, ShapeError
 from .modal import Modes, modes
-from .statespace import StateSpace, as_state_space, is_system, plant_pair, require_continuous
+from .statespace import (
+    StateSpace,
+    as_state_space,
+    is_float_matrix,
+    is_system,
+    plant_pair,
+    require_continuous,
+)
 
 if TYPE_CHECKING:
     from ._typing import ModeKey, System
@@ -193,7 +200,11 @@ def _placement_arguments(
 ) -> tuple[FloatArray, FloatArray, ArrayLike]:
     """(A, B, poles) of ``place*(A, B, poles)`` or ``place*(sys, poles)``: A and B read as
     matrices (a 1-D B a column), the poles as a vector (:func:`_poles`)."""
-    if poles is None:
+    A: ArrayLike
+    B_matrix: ArrayLike
+    if poles is not None and is_float_matrix(A_or_sys) and is_float_matrix(B):
+        A, B_matrix = A_or_sys, B  # the common call, of two float matrices: no conversion
+    elif poles is None:
         A, B_given = plant_pair(A_or_sys, None, "B")
         A, B_matrix = plant_pair(A, B_given, "B")
         poles = B
@@ -205,47 +216,6 @@ def _placement_arguments(
         # change them under it).
         poles = _poles(poles)
     return cast("FloatArray", A), cast("FloatArray", B_matrix), cast("ArrayLike", poles)
-
-
-def _placement_balancing(A: FloatArray, B: FloatArray) -> NDArray[np.int64] | None:
-    """The exponents e of T = diag(2^e) balancing the states of (A, B)
-    (:func:`~aerocontrol._scaling.state_balancing`), or None: a pair scaled well enough, or
-    one the core refuses by shape."""
-    if B.ndim == 2 and A.ndim == 2 and B.shape[0] == A.shape[0]:
-        return _scaling.state_balancing(A, (B,))
-    return None
-
-
-def _balanced_place(
-    A: FloatArray, B: FloatArray, poles: ArrayLike, method: str, exponents: NDArray[np.int64]
-) -> Placement:
-    """The core's placement of (A, B) with the states balanced first (T = diag(2^e), exact):
-    with A' = T^-1 A T and B' = T^-1 B, the gain K' of the same poles gives K = K' T^-1 and
-    A - B K = T (A' - B' K') T^-1, while the methods' errors are relative to the size of A'
-    rather than of A (states scaled by 1e±6 came back with poles 147 % off, or were refused
-    as uncontrollable). The conditions reported are those of the balanced problem, which are
-    the ones that bound the errors; the core's warnings point at the public function's
-    caller."""
-    e = exponents
-    A_balanced, B_balanced, _ = _scaling.similarity(A, B, np.zeros((0, A.shape[0])), e)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        design = _core.place(A_balanced, B_balanced, poles, method)
-    for warning in caught:
-        warnings.warn(warning.message, warning.category, stacklevel=3)
-    with np.errstate(over="ignore", under="ignore"):
-        return Placement(
-            np.ldexp(design.K, -e[np.newaxis, :]),
-            np.ldexp(design.closed_loop, e[:, np.newaxis] - e[np.newaxis, :]),
-            design.poles,
-            design.achieved_poles,
-            design.max_relative_error,
-            design.iterations,
-            design.converged,
-            design.method,
-            design.controllability_condition,
-            design.eigenvector_condition,
-        )
 
 
 def place_bass_gura(
@@ -300,10 +270,7 @@ def place_bass_gura(
     array([16.49844,  8.0875 ])
     """
     A, B_matrix, requested = _placement_arguments(A_or_sys, b, poles)
-    exponents = _placement_balancing(A, B_matrix)
-    if exponents is None:  # the core's warnings point at this function's caller
-        return _core.place(A, B_matrix, requested, "bass-gura")
-    return _balanced_place(A, B_matrix, requested, "bass-gura", exponents)
+    return _core.place(A, B_matrix, requested, "bass-gura")
 
 
 def place_ackermann(
@@ -361,10 +328,7 @@ def place_ackermann(
     array([28.,  8.])
     """
     A, B_matrix, requested = _placement_arguments(A_or_sys, b, poles)
-    exponents = _placement_balancing(A, B_matrix)
-    if exponents is None:  # the core's warnings point at this function's caller
-        return _core.place(A, B_matrix, requested, "ackermann")
-    return _balanced_place(A, B_matrix, requested, "ackermann", exponents)
+    return _core.place(A, B_matrix, requested, "ackermann")
 
 
 def place(
@@ -420,10 +384,7 @@ def place(
     ((2, 4), True)
     """
     A, B_matrix, requested = _placement_arguments(A_or_sys, B, poles)
-    exponents = _placement_balancing(A, B_matrix)
-    if exponents is None:  # the core's warnings point at this function's caller
-        return _core.place(A, B_matrix, requested, "knv0")
-    return _balanced_place(A, B_matrix, requested, "knv0", exponents)
+    return _core.place(A, B_matrix, requested, "knv0")
 
 
 @dataclass(frozen=True, eq=False)

@@ -42,7 +42,7 @@ def _feedthrough(D: object, outputs: int, inputs: int) -> FloatArray:
     """D of a model with ``outputs`` outputs and ``inputs`` inputs: a vector is a row of a
     single-output model or a column of a single-input one (ambiguous otherwise), and a scalar
     zero is the zero matrix, as python-control reads them."""
-    if not _is_matrix(D):
+    if not is_float_matrix(D):
         D = real_array(D, "D")
         if D.ndim == 0 and float(D) == 0.0:
             return _constant(outputs, inputs, identity=False)
@@ -50,7 +50,7 @@ def _feedthrough(D: object, outputs: int, inputs: int) -> FloatArray:
     return matrix_view(D, "D", vector)
 
 
-def _is_matrix(value: object) -> TypeIs[FloatArray]:
+def is_float_matrix(value: object) -> TypeIs[FloatArray]:
     """Whether ``value`` is already what :func:`matrix_view` makes of it."""
     return (
         type(value) is np.ndarray
@@ -65,7 +65,7 @@ def matrix_view(value: object, name: str, vector: str | None = None) -> FloatArr
     it is one already (no copy; see :func:`~aerocontrol._validation.real_array`). Scalars,
     vectors and ``numpy.matrix`` are read by :func:`~aerocontrol._validation.as_matrix` (a
     1-D B a column, a 1-D C a row, by the argument's role or ``vector``)."""
-    if _is_matrix(value):
+    if is_float_matrix(value):
         return value
     return real_array(as_matrix(value, name, vector), name)
 

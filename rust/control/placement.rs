@@ -48,7 +48,9 @@
 use crate::control::controllability::{controllability, controllability_staircase, krylov_blocks};
 use crate::control::modal::polynomial_from_roots;
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
-use crate::linalg::balance::{range_scale, scale_for_largest};
+use crate::linalg::balance::{
+    balanced_states_with_scaling, range_scale, scale_for_largest, states_scaled_apart,
+};
 use crate::linalg::charpoly::charpoly;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
@@ -236,22 +238,60 @@ pub fn companion_form(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<Companio
     })
 }
 
-/// Single-input pole placement by the Bass–Gura formula (6.145).
+/// Single-input pole placement by the Bass–Gura formula (6.145), on balanced states
+/// ([`on_balanced_states`]).
 pub fn place_bass_gura(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     poles: &[c64],
 ) -> Result<Placement, Error> {
-    place_single_input(a, b, poles, Method::BassGura)
+    on_balanced_states(a, b, |a, b| {
+        place_single_input(a, b, poles, Method::BassGura)
+    })
 }
 
-/// Single-input pole placement by Ackermann's formula.
+/// Single-input pole placement by Ackermann's formula, on balanced states
+/// ([`on_balanced_states`]).
 pub fn place_ackermann(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     poles: &[c64],
 ) -> Result<Placement, Error> {
-    place_single_input(a, b, poles, Method::Ackermann)
+    on_balanced_states(a, b, |a, b| {
+        place_single_input(a, b, poles, Method::Ackermann)
+    })
+}
+
+/// The design `placer` makes for (A, B), made for the pair with its states balanced where A's
+/// states are scaled apart (`linalg/balance.rs`'s states_scaled_apart: units 10^3 or more
+/// apart): with A' = T A T^-1 and B' = T B (T diagonal, of powers of two: exact), the gain K'
+/// of the same poles gives K = K' T and A - B K = T^-1 (A' - B' K') T, while the methods'
+/// errors are relative to the size of A' rather than of A (states scaled by 1e±6 came back
+/// with poles 147 % off, or were refused as uncontrollable). The conditions reported are
+/// those of the balanced problem, which bound the errors.
+fn on_balanced_states(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    placer: impl FnOnce(MatRef<'_, f64>, MatRef<'_, f64>) -> Result<Placement, Error>,
+) -> Result<Placement, Error> {
+    if a.nrows() != a.ncols() || b.nrows() != a.nrows() || !states_scaled_apart(a) {
+        return placer(a, b);
+    }
+    let outputs = Mat::<f64>::zeros(0, a.nrows());
+    let Some((a2, b2, _, t)) = balanced_states_with_scaling(a, b, outputs.as_ref()) else {
+        return placer(a, b);
+    };
+    let mut design = placer(a2.as_ref(), b2.as_ref())?;
+    let n = t.len();
+    for j in 0..n {
+        for i in 0..design.gain.nrows() {
+            design.gain[(i, j)] *= t[j];
+        }
+        for i in 0..n {
+            design.closed_loop[(i, j)] *= t[j] / t[i];
+        }
+    }
+    Ok(design)
 }
 
 fn place_single_input(
@@ -500,8 +540,14 @@ fn gain_overflow(what: &str) -> Error {
     }
 }
 
-/// Multi-input pole placement by the robust method of Kautsky, Nichols & Van Dooren.
+/// Multi-input pole placement by the robust method of Kautsky, Nichols & Van Dooren, on
+/// balanced states ([`on_balanced_states`]).
 pub fn place(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64]) -> Result<Placement, Error> {
+    on_balanced_states(a, b, |a, b| place_robust(a, b, poles))
+}
+
+/// [`place`] of the pair as given.
+fn place_robust(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64]) -> Result<Placement, Error> {
     check_plant(a, b)?;
     let (n, m) = (a.nrows(), b.ncols());
     let poles = normalize_poles(poles, n)?;
@@ -868,6 +914,45 @@ mod tests {
         assert!(design.max_relative_error < 1e-7);
         let error = place(a.as_ref(), b.as_ref(), &real(&[-1.0, -1.0, -1.0, -3.0])).unwrap_err();
         assert!(error.to_string().contains("repeated 3 times"), "{error}");
+    }
+
+    #[test]
+    fn states_scaled_apart_are_balanced_first() {
+        // The 747 with rudder and aileron in states scaled by 10^±6 (D A D^-1, D B): every
+        // method places the requested poles (to 1e-9 relatively), and the single-input gains
+        // (unique) are K = K0 D^-1 for the gain K0 of the unscaled pair.
+        let a = lateral();
+        let b = mat![
+            [0.0182, 0.0],
+            [0.0868, -0.2266],
+            [0.0, 0.0],
+            [-0.2440, 0.0027]
+        ];
+        let d = [1e6, 1e-6, 1.0, 1e3];
+        let scaled_a = Mat::from_fn(4, 4, |i, j| a[(i, j)] * d[i] / d[j]);
+        let scaled_b = Mat::from_fn(4, 2, |i, j| b[(i, j)] * d[i]);
+        assert!(states_scaled_apart(scaled_a.as_ref()));
+        let poles = dutch_roll_request(a.as_ref());
+        let placers: [(crate::control::batch::Placer, usize); 3] =
+            [(place_bass_gura, 1), (place_ackermann, 1), (place, 2)];
+        for (placer, m) in placers {
+            let given = placer(a.as_ref(), b.as_ref().subcols(0, m), &poles).unwrap();
+            let scaled =
+                placer(scaled_a.as_ref(), scaled_b.as_ref().subcols(0, m), &poles).unwrap();
+            assert!(
+                scaled.max_relative_error < 1e-9,
+                "{}",
+                scaled.max_relative_error
+            );
+            if m > 1 {
+                continue;
+            }
+            let size = frobenius_norm(given.gain.as_ref());
+            for (j, &dj) in d.iter().enumerate() {
+                let expected = given.gain[(0, j)] / dj;
+                assert!((scaled.gain[(0, j)] - expected).abs() <= 1e-9 * size / dj);
+            }
+        }
     }
 
     #[test]
