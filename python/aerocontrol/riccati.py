@@ -29,10 +29,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _scaling
+from . import _core
 from ._results import Result, Tabular, format_complex, format_number
 from ._validation import FloatArray, real_array
-from .exceptions import IllConditionedWarning, InvalidArgumentError, NumericalOverflowWarning
+from .exceptions import IllConditionedWarning, InvalidArgumentError
 from .statespace import (
     as_state_space,
     is_system,
@@ -1074,9 +1074,10 @@ def solve_lyapunov(A: ArrayLike, Q: ArrayLike) -> FloatArray:
     """The solution X of the continuous Lyapunov equation A X + X A^T + Q = 0.
 
     Bartels-Stewart: with A = U T U^T, T Y + Y T^T = -U^T Q U is solved block by block from
-    the bottom right, and X = U Y U^T (symmetric when Q is). A is first balanced by an exact
-    diagonal similarity D of powers of two (A = D Â D^-1, then X = D X̂ D for the equation in
-    Â and D^-1 Q D^-1), so that states scaled far apart keep every entry of X accurate. The
+    the bottom right, and X = U Y U^T (symmetric when Q is). Where A's states are scaled far
+    apart (units 10^3 or more apart), A is first balanced by an exact diagonal similarity D of
+    powers of two (A = D Â D^-1, then X = D X̂ D for the equation in Â and D^-1 Q D^-1), so
+    that every entry of X stays accurate. The
     solution is unique unless two eigenvalues of A add up to zero; that case raises
     ``IllConditionedError``. For a stable A and Q = C^T C, X is the observability Gramian of
     (C, A^T).
@@ -1114,35 +1115,5 @@ def solve_lyapunov(A: ArrayLike, Q: ArrayLike) -> FloatArray:
     array([[1., 1.],
            [1., 1.]])
     """
-    A_matrix, Q_matrix = matrix_view(A, "A"), matrix_view(Q, "Q")
-    exponents = _lyapunov_balancing(A_matrix, Q_matrix)
-    if exponents is None:
-        X: FloatArray = _core.solve_lyapunov(A_matrix, Q_matrix)
-        return X
-    # A = T Â T^-1 with T = diag(2^e): X = T Y T^T where Â Y + Y Â^T + T^-1 Q T^-T = 0.
-    twice = exponents[:, np.newaxis] + exponents[np.newaxis, :]
-    balanced = np.ldexp(A_matrix, exponents[np.newaxis, :] - exponents[:, np.newaxis])
-    Y = _core.solve_lyapunov(balanced, np.ldexp(Q_matrix, -twice))
-    with np.errstate(over="ignore"):
-        X = np.ldexp(Y, twice)
-    if np.all(np.isfinite(Y)) and not np.all(np.isfinite(X)):
-        warnings.warn(
-            "the result overflowed double precision: X has infinite entries (the states of A "
-            "are scaled far apart)",
-            NumericalOverflowWarning,
-            stacklevel=2,
-        )
+    X: FloatArray = _core.solve_lyapunov(matrix_view(A, "A"), matrix_view(Q, "Q"))
     return X
-
-
-def _lyapunov_balancing(A: FloatArray, Q: FloatArray) -> NDArray[np.int64] | None:
-    """Exponents e of the diagonal similarity T = diag(2^e) that balances A
-    (:func:`~aerocontrol._scaling.state_balancing`), or None where A is balanced well enough,
-    the arguments are not finite square matrices of one size (the core refuses them by
-    name), or a scaled entry of A or Q would leave the normal doubles (the scaling must be
-    exact). Bartels-Stewart's errors are relative to ||A|| and ||X||: unbalanced, a model
-    whose states are scaled by 1e±6 has entries of X wrong in the third digit (the same
-    model in balanced coordinates has them to 1e-15)."""
-    if A.ndim != 2 or Q.shape != A.shape:
-        return None
-    return _scaling.state_balancing(A, weights=(Q,))
