@@ -9,6 +9,7 @@ from typing import Any
 
 import control
 import numpy as np
+import scipy.linalg
 import slycot
 
 import aerocontrol
@@ -43,6 +44,27 @@ def _verdict_slycot(A: Any, B: Any) -> Any:
     default rank tolerance n² u max(||A||_F, ||B||_F); controllable when ncont = n."""
     n, m = B.shape
     return np.array([slycot.ab01nd(n, m, A, B)[2] == n])
+
+
+def _modal_test(A: Any, B: Any) -> bool:
+    """The chapter's modal (PBH) test as ours runs it: no unit left eigenvector w of A with
+    ||w^H B|| <= n ε max(||A||_F, ||B||_F) (scipy's eig with the left eigenvectors)."""
+    n = A.shape[0]
+    _, left = scipy.linalg.eig(A, left=True, right=False)
+    tolerance = n * 2.0**-52 * max(np.linalg.norm(A), np.linalg.norm(B))
+    return bool(np.all(np.linalg.norm(left.conj().T @ B, axis=1) > tolerance))
+
+
+def _verdict_composite(A: Any, B: Any) -> Any:
+    """What the full verdict computes, from the peers: AB01ND's staircase and the modal test
+    on numpy's eigenvectors (:func:`_modal_test`)."""
+    n, m = B.shape
+    return np.array([slycot.ab01nd(n, m, A, B)[2] == n and _modal_test(A, B)])
+
+
+def _observable_composite(A: Any, C: Any) -> Any:
+    """:func:`_verdict_composite` of the dual pair (A^T, C^T)."""
+    return _verdict_composite(A.T.copy(), C.T.copy())
 
 
 def _observable_full(A: Any, C: Any) -> Any:
@@ -107,8 +129,10 @@ def controllability_cases() -> list[Case]:
 
     * is_controllable: the 747 lateral (both inputs) and random single-input pairs (n = 16,
       64, 256; all controllable). Peers: python-control's ctrb with numpy's matrix_rank, and
-      SLICOT's staircase AB01ND (through slycot). The rank answers False at n = 64 (rank 61)
-      and 256: the rows report that disagreement, which is the point of not using the rank.
+      SLICOT's staircase AB01ND (through slycot); for the full verdict (staircase and modal
+      test) also the peers' composite that gives the same information, AB01ND and the modal
+      test on scipy's left eigenvectors. The rank answers False at n = 64 (rank 61) and 256:
+      the rows report that disagreement, which is the point of not using the rank.
     * is_observable: the dual, the 747 lateral seen through r alone and random single-output
       pairs; the same peers on obsv and on (A^T, C^T). The rank of obsv again answers False
       at n = 64 and 256.
@@ -137,6 +161,11 @@ def controllability_cases() -> list[Case]:
                             target=target if n == 64 else None,
                         ),
                         Peer("slycot ab01nd", _verdict_slycot),
+                        *(
+                            [Peer("ab01nd + scipy eig PBH", _verdict_composite)]
+                            if method == "full"
+                            else []
+                        ),
                     ],
                 )
             )
@@ -151,6 +180,7 @@ def controllability_cases() -> list[Case]:
                 peers=[
                     Peer("control.obsv + matrix_rank", _observable_rank),
                     Peer("slycot ab01nd(A^T, C^T)", _observable_slycot),
+                    Peer("ab01nd + scipy eig PBH (A^T, C^T)", _observable_composite),
                 ],
             )
         )
