@@ -37,6 +37,10 @@ use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
 use rayon::prelude::*;
 
+/// 2^600: |s| / σ (σ the power of two A is divided by) beyond which G(s) is taken from its
+/// expansion at infinity ([`HessenbergModel::far`]).
+const FAR: f64 = 4.149515568880993e180;
+
 /// Checks A (n x n), B (n x m), C (p x n) and D (p x m) of a state-space model.
 pub fn check_state_space(
     a: MatRef<'_, f64>,
@@ -125,6 +129,94 @@ impl HessenbergModel {
         })
     }
 
+    /// G at the point s: by the Hessenberg solve at s / σ, or where |s| / σ exceeds
+    /// [`FAR`] by the leading term of G's expansion at infinity
+    /// ([`HessenbergModel::far`]).
+    fn evaluate(&self, point: c64, ws: &mut Workspace, g: &mut [c64]) {
+        if point.norm() / self.sigma > FAR {
+            self.far(point, g);
+        } else {
+            let s = if self.sigma == 1.0 {
+                point
+            } else {
+                point / self.sigma
+            };
+            evaluate_frequency(self, s, ws, g);
+        }
+    }
+
+    /// G(s) far beyond A's scale, from its expansion at infinity
+    ///
+    /// ```text
+    ///     G(s) = D + Σ_k C A^k B / s^(k+1) = D + (γ β / σ) Σ_k M_k t^(k+1),   t = σ / s,
+    /// ```
+    ///
+    /// M_k = C' A'^k B' the Markov parameters of the scaled model (A' = A / σ, largest entry
+    /// about 1 or at most 2^100). With |t| < 1 / [`FAR`] = 2^-600, each term is below the one
+    /// before by n 2^100 |t| or less, so each entry of G - D is its first nonzero term to
+    /// rounding (none among the first n: G = D there, by Cayley-Hamilton). Solving at s / σ
+    /// instead overflowed s / σ for |s| beyond σ 2^1024 (G = D returned), or took the
+    /// solution B' / (s / σ) below the normal doubles (G = 0 for -1.26e-201j).
+    /// t^(k+1) is formed as 2^((e_σ - E)(k+1)) / v^(k+1) with s = 2^E v, 1 <= |v| < 2, and the
+    /// power of two applied last (exactly), so that no intermediate leaves the doubles.
+    fn far(&self, point: c64, g: &mut [c64]) {
+        let (n, m, p) = (self.n, self.m, self.p);
+        let e = point.norm().log2().floor();
+        let v = c64::new(
+            times_power_of_two(point.re, -e),
+            times_power_of_two(point.im, -e),
+        );
+        let step = self.sigma.log2() - e;
+        let inverse = c64::new(1.0, 0.0) / v;
+        for (g, &d) in g.iter_mut().zip(&self.d) {
+            *g = c64::new(d, 0.0);
+        }
+        let mut pending = vec![true; p * m];
+        // V = H^k (Q^T B') column by column; M_k = (C' Q) V.
+        let mut columns = self.b.clone();
+        let mut power = inverse;
+        for k in 0..n {
+            for column in 0..m {
+                let x = &columns[column * n..(column + 1) * n];
+                for i in 0..p {
+                    let entry = i * m + column;
+                    if !pending[entry] {
+                        continue;
+                    }
+                    let markov: f64 = self.c[i * n..(i + 1) * n]
+                        .iter()
+                        .zip(x)
+                        .map(|(c, x)| c * x)
+                        .sum();
+                    if markov != 0.0 {
+                        let term = power * markov;
+                        let scale = self.exponent + step * (k + 1) as f64;
+                        g[entry] += c64::new(
+                            times_power_of_two(term.re, scale),
+                            times_power_of_two(term.im, scale),
+                        );
+                        pending[entry] = false;
+                    }
+                }
+            }
+            if !pending.contains(&true) {
+                break;
+            }
+            power *= inverse;
+            for column in 0..m {
+                let x = columns[column * n..(column + 1) * n].to_vec();
+                for i in 0..n {
+                    let row = &self.h[i * n..(i + 1) * n];
+                    columns[column * n + i] = row[i.saturating_sub(1)..]
+                        .iter()
+                        .zip(&x[i.saturating_sub(1)..])
+                        .map(|(h, x)| h * x)
+                        .sum();
+                }
+            }
+        }
+    }
+
     /// Scratch for one evaluation at a time.
     fn workspace(&self) -> Workspace {
         let (n, m) = (self.n, self.m);
@@ -166,12 +258,7 @@ impl FrequencyEvaluator {
 
     /// G(s) (p x m, row-major) at the complex point s: infinite or NaN entries at a pole.
     pub fn at(&mut self, point: c64) -> &[c64] {
-        let s = if self.model.sigma == 1.0 {
-            point
-        } else {
-            point / self.model.sigma
-        };
-        evaluate_frequency(&self.model, s, &mut self.workspace, &mut self.g);
+        self.model.evaluate(point, &mut self.workspace, &mut self.g);
         &self.g
     }
 
@@ -411,7 +498,6 @@ fn transfer_function_into(
         return Ok(());
     }
     let model = HessenbergModel::new(a, b, c, d)?;
-    let sigma = model.sigma;
     let workspace = || model.workspace();
     // The evaluations multiply by their own kernels, not faer's.
     let context = ParallelContext::capture(0);
@@ -421,9 +507,7 @@ fn transfer_function_into(
         .with_min_len(32)
         .try_for_each_init(workspace, |ws, (&w, g)| {
             context.run(|| {
-                let s = point(w);
-                let s = if sigma == 1.0 { s } else { s / sigma };
-                evaluate_frequency(&model, s, ws, g);
+                model.evaluate(point(w), ws, g);
                 Ok(())
             })
         })
@@ -502,6 +586,39 @@ mod tests {
         let value = g[0][(0, 0)];
         assert!((value.norm() - 1.0 / 8f64.sqrt()).abs() < 1e-16);
         assert!((value.arg().to_degrees() + 45.0).abs() < 1e-13);
+    }
+
+    #[test]
+    fn points_far_beyond_a_tiny_state_matrix() {
+        // A = [[0, a], [-a, 0]] with a = 1e-200, B = b e_2, C = c e_1^T: G(s) = c a b / (s^2 + a^2)
+        // (relative degree 2: C B = 0), -1e-100 at s = 1e100 j, where jω / σ overflows; and a
+        // first-order 0.126 / (s - 1.26e-151) at ω = 1e200, -1.26e-201j, where it underflowed.
+        let (a, b, c) = (1e-200, 1e150, 1e150);
+        let g = frequency_response(
+            mat![[0.0, a], [-a, 0.0]].as_ref(),
+            mat![[0.0], [b]].as_ref(),
+            mat![[c, 0.0]].as_ref(),
+            mat![[0.0]].as_ref(),
+            &[1e100],
+        )
+        .unwrap();
+        let value = g[0][(0, 0)];
+        assert!(
+            (value.re + 1e-100).abs() <= 1e-15 * 1e-100 && value.im == 0.0,
+            "{value}"
+        );
+        let (pole, gain) = (1.257302210933933e-151, 0.1257302210933933);
+        let g = frequency_response(
+            mat![[pole]].as_ref(),
+            mat![[gain]].as_ref(),
+            mat![[1.0]].as_ref(),
+            mat![[0.0]].as_ref(),
+            &[1e200],
+        )
+        .unwrap();
+        // b / (jω - a) = -b (a + jω) / (a^2 + ω^2): its real part, -b a / ω^2, underflows.
+        let expected = c64::new(0.0, -gain / 1e200);
+        assert!((g[0][(0, 0)] - expected).norm() <= 1e-15 * expected.norm());
     }
 
     #[test]

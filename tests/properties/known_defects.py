@@ -171,55 +171,6 @@ QZ_ALL_INFINITE = known_defect(
 )
 
 
-def _tiny_entry_beside_a_huge_frequency(args: dict[str, Any]) -> bool:
-    """A nonzero entry of A below 2^-1022 times the largest frequency (their ratio subnormal
-    or zero)."""
-    models = _models_of(args)
-    omega = args.get("omega")
-    if not models or omega is None:
-        return False
-    A = models[0][0]
-    entries = np.abs(A[A != 0])
-    largest = float(np.max(np.abs(np.asarray(omega, dtype=float)), initial=0.0))
-    return bool(entries.size) and float(np.min(entries)) < np.finfo(float).tiny * largest
-
-
-FREQUENCY_SUBNORMAL_RATIO = known_defect(
-    "frequency-response-subnormal-ratio",
-    {"frequency_response", "bode"},
-    "the core's frequency_response of A = [[a]] with a nonzero and |a| / ω below the normal "
-    "doubles returns 0 where G(jω) = b c / (jω - a) is a normal double: a = 1.26e-151, "
-    "B = 0.126, C = 1 at ω = 1e200 gives 0 for -1.26e-201j (a = 1e-200 at ω = 1e150: 0 for "
-    "-1e-150j); a = 0, or a ratio in the normal range, is right",
-    _tiny_entry_beside_a_huge_frequency,
-    "G(j",
-)
-
-
-def _tiny_state_matrix(args: dict[str, Any]) -> bool:
-    """A nonzero A whose largest entry is below 1e-250, so that σ 2^1024 (σ the power of two
-    the core scales A by) is below about 1e58 rad/s, within the frequencies a loop of the
-    suite's B and C reaches."""
-    models = _models_of(args)
-    if not models:
-        return False
-    largest = float(np.max(np.abs(models[0][0]), initial=0.0))
-    return 0.0 < largest < 1e-250
-
-
-FREQUENCY_POINT_OVERFLOW = known_defect(
-    "frequency-point-overflow",
-    {"nyquist", "nichols", "frequency_response", "bode"},
-    "the frequency response of a model whose A is tiny but not zero: the core holds A / σ, "
-    "σ the power of two of A's largest entry, and divides the point s by σ too, which "
-    "overflows to infinity for |s| beyond σ 2^1024, and G is then D: A with one entry 1e-300 "
-    "and B, C of ones gives G(j1e10) = 0, not -3e-10j (rust/control/frequency.rs, "
-    "FrequencyEvaluator::at and frequency_response_into); the Nyquist curve of such a loop "
-    "(a triple integrator perturbed by 1e-308, C of 1e149) is 0 beyond 1e131 rad/s",
-    _tiny_state_matrix,
-)
-
-
 def _loop_poles_far_apart(args: dict[str, Any]) -> bool:
     """The open-loop poles of the ``loop`` argument span more than 1e12 in modulus."""
     return "loop" in args and _poles_far_apart(args)

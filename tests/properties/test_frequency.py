@@ -17,7 +17,6 @@ from hypothesis import strategies as st
 import aerocontrol
 
 from .harness import Arg, Warned, exercise, plain
-from .known_defects import FREQUENCY_SUBNORMAL_RATIO
 from .oracles import SLACK, TINY, U, eigenvalue_conditions, finite, norm, quietly, silenced
 from .oracles import condition as condition_number
 from .strategies import (
@@ -231,16 +230,23 @@ def test_regression_grid_oracle_of_a_defective_zero_eigenvalue() -> None:
     assert outcome.result[0] < 1e-6 and outcome.result[-1] == pytest.approx(20.0, rel=1e-6)
 
 
-@pytest.mark.xfail(strict=True, reason="frequency-response-subnormal-ratio: core")
-def test_known_defect_frequency_response_of_a_tiny_pole_at_a_huge_frequency() -> None:
-    model = (np.array([[1.257302210933933e-151]]), np.array([[0.1257302210933933]]))
-    with FREQUENCY_SUBNORMAL_RATIO.reproducing():
-        exercise(
-            "frequency_response",
-            aerocontrol.frequency_response,
-            {"sys": plain(model), "omega": plain(np.array([0.0, 1e200, 1e300]))},
-            _frequency_oracle,
-        )
+def test_regression_frequency_response_of_a_tiny_pole_at_a_huge_frequency() -> None:
+    """A = [[1.26e-151]], B = 0.126, C = 1: G(jω) = B C / (jω - a) = -1.26e-201j at ω = 1e200
+    and -1.26e-301j at 1e300 (to 1e-15), normal doubles, was 0 (the core's solve at
+    jω / σ, σ the power of two of A's largest entry, overflowed or underflowed; the point is
+    now beyond 2^600 σ and G is the leading term of its expansion at infinity)."""
+    a, b = 1.257302210933933e-151, 0.1257302210933933
+    model = (np.array([[a]]), np.array([[b]]))
+    outcome = exercise(
+        "frequency_response",
+        aerocontrol.frequency_response,
+        {"sys": plain(model), "omega": plain(np.array([0.0, 1e200, 1e300]))},
+        _frequency_oracle,
+    )
+    response = outcome.result.response[:, 0, 0]
+    for w, value in zip((1e200, 1e300), response[1:], strict=True):
+        assert value == pytest.approx(b / complex(-a, w), rel=1e-15)
+    assert response[0] == pytest.approx(-b / a, rel=1e-15)
 
 
 def test_regression_frequency_oracle_of_a_response_below_its_factors() -> None:

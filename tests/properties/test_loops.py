@@ -28,7 +28,7 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning, NumericalOverflowWarning
 
 from .harness import Arg, Warned, exercise, plain
-from .known_defects import CLOSED_LOOP_POLES_OF_GRADED_LOOPS, FREQUENCY_POINT_OVERFLOW
+from .known_defects import CLOSED_LOOP_POLES_OF_GRADED_LOOPS
 from .oracles import (
     SLACK,
     TINY,
@@ -738,21 +738,26 @@ def test_nyquist_and_nichols(data: st.DataObject) -> None:
             assert outcome.error is not None, f"{name} accepted omega {given_omega}"
 
 
-@pytest.mark.xfail(strict=True, reason="frequency-point-overflow: ω / max|A| beyond 2^1024")
-def test_known_defect_frequency_point_overflow() -> None:
-    """A defect of the native core found by the suite (see ``known_defects.py``)."""
+def test_regression_frequency_point_beyond_the_scaled_range() -> None:
+    """A triple integrator perturbed by 1e-308 (A[2, 0]), C of 1e149: the core divided the
+    point jω by σ (the power of two of A's largest entry), which overflowed beyond 1e131 rad/s,
+    and the Nyquist curve was 0 there. The curve is checked by the suite's oracle, and at
+    ω = 1e200, far beyond A's scale, L(jω) = C B / (jω) to 1e-15 (the next term of the
+    expansion at infinity, C A B / (jω)^2, is below 1e-400 of it)."""
     A = np.zeros((3, 3))
     A[2, 0] = 1e-308
     B = np.array([[0.1257302210933933], [-0.1321048632913019], [0.6404226504432821]])
     C = np.array([[1.2573022109339329e149, -1.3210486329130188e149, 6.4042265044328201e149]])
-    with FREQUENCY_POINT_OVERFLOW.reproducing():
-        exercise(
-            "nyquist",
-            aerocontrol.nyquist,
-            {"loop": plain((A, B, C, np.zeros((1, 1))))},
-            _nyquist_oracle,
-            nonfinite_by_definition=("contour", "response"),
-        )
+    loop = (A, B, C, np.zeros((1, 1)))
+    exercise(
+        "nyquist",
+        aerocontrol.nyquist,
+        {"loop": plain(loop)},
+        _nyquist_oracle,
+        nonfinite_by_definition=("contour", "response"),
+    )
+    far = aerocontrol.frequency_response(loop, np.array([1e200])).response[0, 0, 0]
+    assert far == pytest.approx(float((C @ B)[0, 0]) / 1e200j, rel=1e-15)
 
 
 @pytest.mark.xfail(strict=True, reason="closed-loop-poles-of-graded-loops: poles 1e15 apart")
