@@ -228,20 +228,57 @@ fn singular_at_origin(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> bool 
     // The smallest pivot of Gaussian elimination with complete pivoting bounds σ_min above
     // (σ_min(S0) <= ||L||_2 σ_min(U) <= (n + 1) min |u_ii|, |l_ij| <= 1): a small pivot is a
     // singular S0, at a fraction of the SVD's cost (the reference path takes the SVD).
-    let lu = s0.full_piv_lu();
-    let pivots: Vec<f64> = lu
-        .U()
-        .diagonal()
-        .column_vector()
-        .iter()
-        .map(|u| u.abs())
-        .collect();
+    let pivots = complete_pivots(s0);
     if pivots.iter().any(|u| u.is_nan()) {
         return true; // no verdict: the rank tolerance alone, as before
     }
     let smallest = pivots.iter().fold(f64::INFINITY, |m, &u| m.min(u));
     let largest = pivots.iter().fold(0.0_f64, |m, &u| m.max(u));
     smallest <= ORIGIN_SINGULARITY * (n + 1) as f64 * f64::EPSILON * largest
+}
+
+/// The magnitudes |u_kk| of the pivots of Gaussian elimination with complete pivoting on M
+/// (square): at step k the largest |m_ij| of the trailing block (the first in column order)
+/// is brought to (k, k), then m_ij -= (m_ik / m_kk) m_kj below and right of it. The pivots
+/// after a zero one are 0.
+fn complete_pivots(mut m: Mat<f64>) -> Vec<f64> {
+    let size = m.nrows();
+    let mut pivots = Vec::with_capacity(size);
+    for k in 0..size {
+        let (mut row, mut col, mut largest) = (k, k, -1.0f64);
+        for j in k..size {
+            for i in k..size {
+                let x = m[(i, j)].abs();
+                if x > largest || x.is_nan() {
+                    (row, col, largest) = (i, j, x);
+                }
+            }
+        }
+        if largest.is_nan() || largest == 0.0 {
+            pivots.push(largest);
+            pivots.resize(size, 0.0);
+            break;
+        }
+        for j in 0..size {
+            let t = m[(k, j)];
+            m[(k, j)] = m[(row, j)];
+            m[(row, j)] = t;
+        }
+        for i in 0..size {
+            let t = m[(i, k)];
+            m[(i, k)] = m[(i, col)];
+            m[(i, col)] = t;
+        }
+        let pivot = m[(k, k)];
+        pivots.push(pivot.abs());
+        for i in k + 1..size {
+            let l = m[(i, k)] / pivot;
+            for j in k + 1..size {
+                m[(i, j)] -= l * m[(k, j)];
+            }
+        }
+    }
+    pivots
 }
 
 /// A complex value m 2^e, m of largest part in [1/2, 1) (or 0, or not finite).
@@ -391,9 +428,12 @@ pub fn factored_response(
 /// of squares and products of entries directly: 2^±250.
 const ENTRY_RANGE: (f64, f64) = (5.527147875260445e-76, 1.8092513943330656e75);
 
-/// The integer nearest -log2(norm) / 2, ties to even (Python's round); 0 for a zero norm.
+/// The integer nearest -log2(norm) / 2, ties to even (Python's round); 0 for a zero norm, and
+/// without a logarithm for a norm within [0.51, 1.96] (|log2| / 2 below 0.49 there).
 fn half_exponent(norm: f64) -> i64 {
-    if norm > 0.0 {
+    if (0.51..=1.96).contains(&norm) {
+        0
+    } else if norm > 0.0 {
         -((norm.log2() / 2.0).round_ties_even() as i64)
     } else {
         0
@@ -471,7 +511,13 @@ fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
             if row == 0.0 || col == 0.0 {
                 continue;
             }
-            let k = ((col.log2() - row.log2()) / 4.0).round_ties_even() as i64;
+            // k = 0 without logarithms where col / row lies within [1/3.9, 3.9] (|log2| / 4
+            // below 0.491 there).
+            let k = if col <= 3.9 * row && row <= 3.9 * col {
+                0
+            } else {
+                ((col.log2() - row.log2()) / 4.0).round_ties_even() as i64
+            };
             if k != 0 {
                 for j in (0..n).filter(|&j| j != i) {
                     scale(&mut s.a[(i, j)], k);
@@ -520,10 +566,14 @@ fn unit_scaled(mut s: Siso) -> (Siso, i64) {
     (s, e)
 }
 
-/// x 2^e for any finite x (renormalised first, then [`ldexp`]).
+/// x 2^e for any finite x, rounded once: one multiplication by 2^e where that is a normal
+/// double, else renormalised first, then [`ldexp`].
 fn ldexp_any(x: f64, e: i64) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return x;
+    }
+    if (-1022..=1023).contains(&e) {
+        return x * two_to(e);
     }
     let k = exponent_of(x);
     ldexp(ldexp(x, -k), e + k)
@@ -781,20 +831,21 @@ fn best_points(roots: &[c64], dt: f64, centre: f64) -> (c64, c64) {
         .copied()
         .collect();
     // min |p - r|^2 / |p|^2 over the roots: the relative distance, squared (no hypot; one
-    // division, which as a monotone rounding gives the same value as dividing each term).
-    let distance = |p: c64| {
-        let nearest = nearer
-            .iter()
-            .map(|r| (p - r).norm_sqr())
-            .fold(f64::INFINITY, f64::min);
-        nearest / p.norm_sqr()
-    };
+    // division, which as a monotone rounding gives the same value as dividing each term). The
+    // minimum is exact, so it is taken root by root over every point at once (independent
+    // comparisons, not one chain per point).
+    let mut nearest = vec![f64::INFINITY; points.len()];
+    for r in &nearer {
+        for (m, p) in nearest.iter_mut().zip(&points) {
+            *m = m.min((p - r).norm_sqr());
+        }
+    }
     let (mut first, mut second) = (
         (f64::NEG_INFINITY, points[0]),
         (f64::NEG_INFINITY, points[1]),
     );
-    for p in points {
-        let value = distance(p);
+    for (p, m) in points.into_iter().zip(nearest) {
+        let value = m / p.norm_sqr();
         if value > first.0 {
             second = first;
             first = (value, p);
@@ -989,6 +1040,29 @@ mod tests {
                 1.0
             ));
         }
+    }
+
+    #[test]
+    fn complete_pivots_of_known_matrices() {
+        // [[1, 2], [3, 4]]: pivot 4, then 1 - 2·3/4 = ... with rows and columns swapped:
+        // [[4, 3], [2, 1]] -> 1 - (2/4)·3 = -0.5; |det| = 4 · 0.5 = 2.
+        let m = faer::mat![[1.0, 2.0], [3.0, 4.0]];
+        assert_eq!(complete_pivots(m), vec![4.0, 0.5]);
+        // A rank-one matrix: the second pivot is 0 to rounding, a zero matrix all 0.
+        let m = Mat::from_fn(3, 3, |i, j| (i + 1) as f64 * (j + 2) as f64);
+        let pivots = complete_pivots(m);
+        assert_eq!(pivots[0], 12.0);
+        assert!(pivots[1] <= 4.0 * f64::EPSILON * 12.0 && pivots[2] <= 4.0 * f64::EPSILON * 12.0);
+        assert_eq!(complete_pivots(Mat::zeros(2, 2)), vec![0.0, 0.0]);
+        // The product of the pivots is |det| (a permuted triangular factorisation).
+        let m = faer::mat![[2.0, -1.0, 0.5], [0.25, 3.0, 1.0], [-1.5, 0.75, 4.0]];
+        let det: f64 =
+            2.0 * (3.0 * 4.0 - 0.75) + 1.0 * (0.25 * 4.0 + 1.5) + 0.5 * (0.25 * 0.75 + 4.5);
+        let product: f64 = complete_pivots(m).iter().product();
+        assert!(
+            (product - det.abs()).abs() <= 16.0 * f64::EPSILON * det.abs(),
+            "{product} {det}"
+        );
     }
 
     #[test]
