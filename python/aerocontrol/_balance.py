@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from . import _core
@@ -25,41 +23,6 @@ def balanced_matrices(
     ):
         return A, B, C
     return _core.balance_states(A, B, C)
-
-
-def _normalising_exponent(M: FloatArray, target: float) -> int:
-    """e with 2^e max|M| near ``target``; 0 where M or the target is 0, or where 2^e M would
-    have a nonzero entry outside the normal doubles (the scaling must be exact both ways)."""
-    magnitudes = np.abs(M[M != 0.0])
-    if not target > 0.0 or magnitudes.size == 0:
-        return 0
-    largest, smallest = math.log2(float(magnitudes.max())), math.log2(float(magnitudes.min()))
-    e = round(math.log2(target) - largest)
-    return e if -1000.0 < smallest + e and largest + e < 1000.0 else 0
-
-
-def balanced_loop(
-    A: FloatArray, B: FloatArray, C: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """:func:`balanced_matrices` for the closed loops A - g B C of a SISO loop: balanced once,
-    then again with B and C each brought by a power of two to the size of A balanced alone
-    (the split of the loop's gain between B and C does not change A - g B C, but it steers the
-    balancing: A and C of 1e-60 beside B of 1 balanced to a QR that lost 2% of the poles),
-    the second scaling then undone on B and C (exact). The size is that of A balanced alone,
-    the scale of its eigenvalues, not of A balanced with B and C: at 1e-100, B had steered
-    that one to entries of 1e-75 beside eigenvalues of 1e-100, and B and C brought to 1e-75
-    steered the second balancing as much (poles 6e-5 off)."""
-    A1, B1, C1 = balanced_matrices(A, B, C)
-    if A1 is A:  # not finite, or no states
-        return A1, B1, C1
-    size_A = float(np.max(np.abs(balanced_matrix(A1)), initial=0.0))
-    if size_A == 0.0:
-        size_A = math.sqrt(float(np.max(np.abs(B1)))) * math.sqrt(float(np.max(np.abs(C1))))
-    p, q = _normalising_exponent(B1, size_A), _normalising_exponent(C1, size_A)
-    if p == 0 and q == 0:
-        return A1, B1, C1
-    A2, B2, C2 = _core.balance_states(A1, np.ldexp(B1, p), np.ldexp(C1, q))
-    return A2, np.ldexp(B2, -p), np.ldexp(C2, -q)
 
 
 def balanced_states(model: StateSpace) -> StateSpace:

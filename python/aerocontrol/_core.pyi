@@ -19,6 +19,7 @@ __all__ = [
     "SMALL_MAX_ORDER",
     "Placement",
     "balance_states",
+    "balanced_loop",
     "bilinear",
     "care_batch",
     "charpoly",
@@ -40,6 +41,7 @@ __all__ = [
     "inverse_bilinear",
     "krylov_matrix",
     "loop_margins",
+    "loop_root_locus",
     "modal_analysis",
     "place",
     "place_batch",
@@ -133,6 +135,9 @@ def dc_gain(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /) -> NDArra
 def balance_states(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
+def balanced_loop(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, /
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
 
 _LoopMarginsOutput: TypeAlias = tuple[
     NDArray[np.float64],
@@ -154,6 +159,9 @@ def loop_margins(
 def root_locus(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, gains: ArrayLike, /
 ) -> NDArray[np.complex128]: ...
+def loop_root_locus(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, d: float, gains: ArrayLike, /
+) -> NDArray[np.complex128] | None: ...
 def transfer_channels(
     a: ArrayLike,
     b: ArrayLike,

@@ -122,6 +122,8 @@ def real_scalar(value: object, name: str) -> float:
 def check_finite(values: FloatArray, name: str) -> FloatArray:
     """``values``, or NonFiniteError naming ``name`` and its first NaN or infinite entry (the
     check the core makes of its own arguments, for arguments used only in Python)."""
+    if np.isfinite(values).all():
+        return values
     bad = np.argwhere(~np.isfinite(values))
     if bad.size:
         entry = [int(k) for k in bad[0]]

@@ -101,7 +101,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._balance import balanced_loop, balanced_matrix, balanced_states
+from ._balance import balanced_matrix, balanced_states
 from ._results import Result, Tabular
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
@@ -222,16 +222,17 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     """The eigenvalues of A - k B (1 + k D)^-1 C for each gain, each row sorted; the gains are
     free of algebraic loops (:func:`_refuse_algebraic`).
 
-    The poles of every gain come from one parallel call of the core (``_core.root_locus``:
-    one controller-Hessenberg form of (A, B, C) and the QR iteration of a gain's Hessenberg
-    matrix, normwise backward stable, at the first gain of each run of gains; from there
-    Aberth's iteration on the factored characteristic polynomial from gain to gain, each
-    gain's poles verified against the traces of the closed loop and its square, and the QR
-    iteration wherever that fails; see ``rust/control/root_locus.rs``) on the loop with its
-    states balanced (:func:`~aerocontrol._balance.balanced_loop`): the QR is not balanced
-    itself, so its errors are relative to the matrix it is given, and states scaled by 10^±6
-    gave poles wrong by 1800 times their size. Where a term of a matrix (A, or g B C with
-    g = k/(1 + k D), bounded by |g| max|B| max|C|) exceeds 2^RESCALE_EXPONENT, the matrix is
+    The poles of every gain come from one parallel call of the core (``_core.loop_root_locus``,
+    which forms the gains g = k/(1 + k D) itself: one controller-Hessenberg form of (A, B, C)
+    and the QR iteration of a gain's Hessenberg matrix, normwise backward stable, at the first
+    gain of each run of gains; from there Aberth's iteration on the factored characteristic
+    polynomial from gain to gain, each gain's poles verified against the traces of the closed
+    loop and its square, and the QR iteration wherever that fails; see
+    ``rust/control/root_locus.rs``) on the loop with its states balanced for the closed loops
+    (``_core.balanced_loop``, ``rust/linalg/balance.rs``): the QR is not balanced itself, so
+    its errors are relative to the matrix it is given, and states scaled by 10^±6 gave poles
+    wrong by 1800 times their size. Where a term of a matrix (A, or g B C, bounded by
+    |g| max|B| max|C|) exceeds 2^RESCALE_EXPONENT, the matrix is
     formed divided by the power of two 2^e nearest its size, from B and C normalised by
     powers of two (so that neither B C nor g B C overflows), and its eigenvalues multiplied by
     2^e: exact but for the underflow of terms far below the largest. Poles beyond the range
@@ -239,15 +240,12 @@ def _closed_loop_poles(model: StateSpace, k: FloatArray) -> ComplexArray:
     n = model.n_states
     if n == 0:
         return np.zeros((k.size, 0), np.complex128)
-    A, B, C = balanced_loop(model.A, model.B, model.C)
+    located = _core.loop_root_locus(model.A, model.B, model.C, float(model.D[0, 0]), k)
+    if located is not None:  # every term in range, each row sorted by the core
+        return located
+    A, B, C = _core.balanced_loop(model.A, model.B, model.C)
     g = _closed_loop_gains(model, k)
     size_A, size_B, size_C = _log2_size(A), _log2_size(B), _log2_size(C)
-    largest = float(np.max(np.abs(g)))
-    if math.isfinite(largest) and math.isfinite(size_B + size_C):
-        # Every term in range (the test below, for every gain at once): one call of the core.
-        size = math.log2(largest) if largest > 0.0 else -math.inf
-        if max(size_A, size + size_B + size_C, size_B + size_C) <= RESCALE_EXPONENT:
-            return _core.root_locus(A, B, C, g)  # each row sorted by the core
     mantissa, power = _closed_loop_gain_parts(model, k)
     if not math.isfinite(size_B + size_C):  # B C = 0: the loop does not move the poles
         g = np.zeros_like(g)

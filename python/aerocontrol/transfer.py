@@ -1491,7 +1491,6 @@ class TransferMatrix(Result):
         shape (outputs, inputs) + the shape of ``s``."""
         value = np.asarray(s, dtype=np.complex128)
         points = value.reshape(-1)
-        p, m = self.shape
         result, finite = _core.factored_response(
             self._mantissas, self._exponents, self._zeros, self.poles, points
         )
@@ -1502,7 +1501,7 @@ class TransferMatrix(Result):
                 NumericalOverflowWarning,
                 stacklevel=2,
             )
-        return np.asarray(result.reshape((p, m, *value.shape)))
+        return result.reshape((len(self.output_names), len(self.input_names), *value.shape))
 
     def __str__(self) -> str:
         return "\n".join(

@@ -5,9 +5,11 @@ use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::statespace::ModelArgs;
 use crate::control::margins::{Crossover, loop_margins as loop_margins_core, within_range};
-use crate::control::root_locus::root_locus as root_locus_core;
+use crate::control::root_locus::{
+    loop_root_locus as loop_root_locus_core, root_locus as root_locus_core,
+};
 use crate::error::Error;
-use crate::linalg::balance::balanced_states;
+use crate::linalg::balance::{balanced_loop as balanced_loop_core, balanced_states};
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -136,6 +138,119 @@ fn root_locus<'py>(
     Ok(out)
 }
 
+/// The closed-loop poles of 1 + k L(s) = 0 for the open loop L = (A, B, C, D) (one input, one
+/// output) at each loop gain k of `gains`, in one call (`control/root_locus.rs`,
+/// loop_root_locus): the states balanced for the closed loops (`linalg/balance.rs`,
+/// balanced_loop), g = k (1 + k D)^-1, then the poles as [`root_locus`] computes them, a (k, n)
+/// complex array, each row sorted as `numpy.sort_complex`; None, before the poles, where a
+/// term of a closed loop may exceed 2^RESCALE_EXPONENT (the caller scales those first).
+#[pyfunction]
+#[pyo3(signature = (a, b, c, d, gains, /))]
+fn loop_root_locus<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+    d: f64,
+    gains: &Bound<'py, PyAny>,
+) -> PyResult<Option<Bound<'py, PyArrayDyn<c64>>>> {
+    let a = Real::convert(py, a, "A")?;
+    let b = Real::convert(py, b, "B")?;
+    let c = Real::convert(py, c, "C")?;
+    let gains = Real::convert(py, gains, "gains")?;
+    let (a, b, c) = (
+        a.matrix().map_err(|e| to_py_err(py, e))?,
+        b.matrix().map_err(|e| to_py_err(py, e))?,
+        c.matrix().map_err(|e| to_py_err(py, e))?,
+    );
+    let gains = gains
+        .vector("a 1-D array of gains")
+        .map_err(|e| to_py_err(py, e))?;
+    let n = a.nrows();
+    let out = new_array::<c64>(py, &[gains.len(), n])?;
+    // SAFETY: new and not visible to Python until returned.
+    let data = unsafe { new_array_data(&out) };
+    let threads = crate::platform::threads::num_threads() as f64;
+    let cost = Cost {
+        flops: 10.0 * (n as f64).powi(3) * (gains.len() as f64 + 2.0),
+        bytes: 3.0 * threads * (n * n) as f64 * 8.0,
+        order: n,
+    };
+    if !compute(py, cost, || loop_root_locus_core(a, b, c, d, gains, data))? {
+        return Ok(None);
+    }
+    let mut outputs = Outputs::new(py);
+    // SAFETY: as above; the computation is over.
+    outputs.check_complex("the closed-loop poles", unsafe { new_array_data(&out) });
+    outputs.finish()?;
+    Ok(Some(out))
+}
+
+/// The loop (A, B, C) with its states balanced for the closed loops A - g B C
+/// (`linalg/balance.rs`, balanced_loop): two balancings of [[A, B], [C, 0]] by diagonal
+/// similarities of powers of two, the second with B and C brought to the size of A balanced
+/// alone, then scaled back; (A, B, C) as given with no states or an entry not finite.
+#[pyfunction]
+#[pyo3(signature = (a, b, c, /))]
+#[allow(clippy::type_complexity)]
+fn balanced_loop<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    c: &Bound<'py, PyAny>,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+)> {
+    let a = Real::convert(py, a, "A")?;
+    let b = Real::convert(py, b, "B")?;
+    let c = Real::convert(py, c, "C")?;
+    let (a, b, c) = (
+        a.matrix().map_err(|e| to_py_err(py, e))?,
+        b.matrix().map_err(|e| to_py_err(py, e))?,
+        c.matrix().map_err(|e| to_py_err(py, e))?,
+    );
+    check_system_shapes(py, a, b, c)?;
+    let (am, bm, cm) = balanced_loop_core(a, b, c);
+    let mut outputs = Outputs::new(py);
+    let result = (
+        outputs.matrix("A", am.as_ref())?,
+        outputs.matrix("B", bm.as_ref())?,
+        outputs.matrix("C", cm.as_ref())?,
+    );
+    outputs.finish()?;
+    Ok(result)
+}
+
+/// InvalidArgumentError unless A is n x n, B n x m and C p x n.
+fn check_system_shapes(
+    py: Python<'_>,
+    a: faer::MatRef<'_, f64>,
+    b: faer::MatRef<'_, f64>,
+    c: faer::MatRef<'_, f64>,
+) -> PyResult<()> {
+    let n = a.nrows();
+    if a.ncols() != n || b.nrows() != n || c.ncols() != n {
+        return Err(to_py_err(
+            py,
+            Error::InvalidArgument {
+                arg: "A",
+                message: format!(
+                    "A must be n x n, B n x m and C p x n, got A {} x {}, B {} x {} and C {} x {}",
+                    a.nrows(),
+                    a.ncols(),
+                    b.nrows(),
+                    b.ncols(),
+                    c.nrows(),
+                    c.ncols()
+                ),
+            },
+        ));
+    }
+    Ok(())
+}
+
 /// The system (A, B, C) with its states balanced by a diagonal similarity of powers of two,
 /// (T A T^-1, T B, C T^-1) (`linalg/balance.rs`, balanced_states): the same transfer matrix,
 /// the rows and columns of [[A, B], [C, 0]] of one size; (A, B, C) as given where the scaling
@@ -161,24 +276,7 @@ fn balance_states<'py>(
         b.matrix().map_err(|e| to_py_err(py, e))?,
         c.matrix().map_err(|e| to_py_err(py, e))?,
     );
-    let n = a.nrows();
-    if a.ncols() != n || b.nrows() != n || c.ncols() != n {
-        return Err(to_py_err(
-            py,
-            Error::InvalidArgument {
-                arg: "A",
-                message: format!(
-                    "A must be n x n, B n x m and C p x n, got A {} x {}, B {} x {} and C {} x {}",
-                    a.nrows(),
-                    a.ncols(),
-                    b.nrows(),
-                    b.ncols(),
-                    c.nrows(),
-                    c.ncols()
-                ),
-            },
-        ));
-    }
+    check_system_shapes(py, a, b, c)?;
     let (am, bm, cm) =
         balanced_states(a, b, c).unwrap_or_else(|| (a.to_owned(), b.to_owned(), c.to_owned()));
     let mut outputs = Outputs::new(py);
@@ -193,6 +291,8 @@ fn balance_states<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(balance_states, m)?)?;
+    m.add_function(wrap_pyfunction!(balanced_loop, m)?)?;
+    m.add_function(wrap_pyfunction!(loop_root_locus, m)?)?;
     m.add_function(wrap_pyfunction!(loop_margins, m)?)?;
     m.add_function(wrap_pyfunction!(root_locus, m)?)?;
     Ok(())

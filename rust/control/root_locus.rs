@@ -63,14 +63,16 @@
 //! Computation 27(122), 339-344, 1973; D. A. Bini, "Numerical computation of polynomial zeros
 //! by means of Aberth's method", Numerical Algorithms 13, 179-200, 1996 (the stopping rule).
 
+use crate::control::margins::RESCALE_EXPONENT;
 use crate::control::transfer::transfer_channels;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
-use crate::linalg::balance::range_scale;
+use crate::linalg::balance::{balanced_loop, range_scale};
 use crate::linalg::hessenberg::reduce_to_hessenberg;
 use crate::linalg::householder::reflector;
 use crate::linalg::matrix::{
     FaerView, Order, Square, Transformations, from_faer_in, identity_in, with_order,
 };
+use crate::linalg::norm::max_abs;
 use crate::linalg::schur::{Spectrum, eigenvalues, francis_qr, quasi_triangular_eigenvalues};
 use crate::platform::parallel::ParallelContext;
 use faer::{MatRef, c64};
@@ -177,19 +179,9 @@ pub(crate) fn sort(values: &mut [c64]) {
     values.sort_unstable_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
 }
 
-/// The closed-loop poles of the SISO loop (A n x n, b n x 1, c 1 x n) at each closed-loop gain
-/// g of `gains` (the eigenvalues of A - g b c), written into `out` (n per gain, sorted by real
-/// part, then imaginary part, as `numpy.sort_complex`), in parallel over chunks of gains. See
-/// the module's documentation.
-pub fn root_locus(
-    a: MatRef<'_, f64>,
-    b: MatRef<'_, f64>,
-    c: MatRef<'_, f64>,
-    gains: &[f64],
-    out: &mut [c64],
-) -> Result<(), Error> {
+/// InvalidArgument unless A is n x n, b n x 1 and c 1 x n.
+fn check_loop(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<(), Error> {
     check_square(a, "A")?;
-    check_finite(a, "A")?;
     let n = a.nrows();
     if b.nrows() != n || b.ncols() != 1 || c.nrows() != 1 || c.ncols() != n {
         return Err(Error::InvalidArgument {
@@ -204,6 +196,23 @@ pub fn root_locus(
             ),
         });
     }
+    Ok(())
+}
+
+/// The closed-loop poles of the SISO loop (A n x n, b n x 1, c 1 x n) at each closed-loop gain
+/// g of `gains` (the eigenvalues of A - g b c), written into `out` (n per gain, sorted by real
+/// part, then imaginary part, as `numpy.sort_complex`), in parallel over chunks of gains. See
+/// the module's documentation.
+pub fn root_locus(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    gains: &[f64],
+    out: &mut [c64],
+) -> Result<(), Error> {
+    check_loop(a, b, c)?;
+    check_finite(a, "A")?;
+    let n = a.nrows();
     check_finite(b, "B")?;
     check_finite(c, "C")?;
     check_finite_values(gains, "gains")?;
@@ -265,6 +274,68 @@ pub fn root_locus(
                 })
             })
     })
+}
+
+/// The closed-loop gain g = k (1 + k d)^-1 of the loop gain k, formed as 1 / (1/k + d) where
+/// k d overflows (as `loops._closed_loop_gains`).
+pub fn closed_loop_gain(k: f64, d: f64) -> f64 {
+    let denominator = 1.0 + k * d;
+    if denominator.is_finite() {
+        k / denominator
+    } else {
+        1.0 / (1.0 / k + d)
+    }
+}
+
+/// log2 of the largest |entry| of M; -inf for a zero or empty M (as `loops._log2_size`).
+fn log2_size(m: MatRef<'_, f64>) -> f64 {
+    let largest = max_abs(m);
+    if largest > 0.0 {
+        largest.log2()
+    } else {
+        f64::NEG_INFINITY
+    }
+}
+
+/// The root locus of the open loop L = (A, b, c, d) (A n x n, b n x 1, c 1 x n) at the loop
+/// gains `gains` (1 + k L = 0), as `aerocontrol.root_locus` takes it in one call: the states
+/// balanced for the closed loops ([`balanced_loop`]), each closed-loop gain
+/// g = k (1 + k d)^-1 ([`closed_loop_gain`]), then [`root_locus`] of the balanced loop at the
+/// gains g, into `out`. Returns false, with `out` untouched, where a term of a closed loop may
+/// exceed 2^[`RESCALE_EXPONENT`]: max(log2 max|A|, log2 max|g| + log2 max|b| + log2 max|c|,
+/// log2 max|b| + log2 max|c|) above it, a g not finite, or b c = 0 (the caller scales those
+/// closed loops by powers of two first).
+pub fn loop_root_locus(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    d: f64,
+    gains: &[f64],
+    out: &mut [c64],
+) -> Result<bool, Error> {
+    check_loop(a, b, c)?;
+    check_finite_values(gains, "gains")?;
+    let (a, b, c) = balanced_loop(a, b, c);
+    let closed: Vec<f64> = gains.iter().map(|&k| closed_loop_gain(k, d)).collect();
+    let (size_a, size_b, size_c) = (
+        log2_size(a.as_ref()),
+        log2_size(b.as_ref()),
+        log2_size(c.as_ref()),
+    );
+    if !(closed.iter().all(|g| g.is_finite()) && (size_b + size_c).is_finite()) {
+        return Ok(false);
+    }
+    let largest = closed.iter().fold(0.0f64, |m, g| m.max(g.abs()));
+    let size = if largest > 0.0 {
+        largest.log2()
+    } else {
+        f64::NEG_INFINITY
+    };
+    if size_a.max(size + size_b + size_c).max(size_b + size_c) > RESCALE_EXPONENT {
+        return Ok(false);
+    }
+    root_locus(a.as_ref(), b.as_ref(), c.as_ref(), &closed, out)?;
+    Ok(true)
 }
 
 /// Gains per run of the continuation, at least (each run starts with a QR iteration).
@@ -814,6 +885,62 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The loop's root locus in one call: the states balanced, the closed-loop gains formed
+    /// from the loop gains and d, against the eigenvalues of A - k b (1 + k d)^-1 c formed
+    /// directly; a loop whose closed-loop terms leave the range is left to the caller.
+    #[test]
+    fn the_loop_root_locus_balances_and_forms_the_closed_loop_gains() {
+        // States scaled by 10^±4: unbalanced, the closed loops have entries of 1e8 beside 1e-8.
+        let n = 4;
+        let s = [1e4, 1e-4, 1.0, 10.0];
+        let a = Mat::from_fn(n, n, |i, j| {
+            let x = ((i * 7 + j * 13) % 17) as f64 / 8.0 - 1.0;
+            (if i == j { x - 2.0 } else { x }) * s[i] / s[j]
+        });
+        let b = Mat::from_fn(n, 1, |i, _| (((i * 5 + 3) % 7) as f64 / 3.0 - 1.0) * s[i]);
+        let c = Mat::from_fn(1, n, |_, j| (((j * 3 + 1) % 5) as f64 / 2.0 - 1.0) / s[j]);
+        let d = 0.25;
+        let gains: Vec<f64> = (0..60).map(|i| -1.5 + 0.1 * i as f64).collect();
+        let mut out = vec![c64::new(0.0, 0.0); gains.len() * n];
+        let done =
+            loop_root_locus(a.as_ref(), b.as_ref(), c.as_ref(), d, &gains, &mut out).unwrap();
+        assert!(done);
+        for (k, gain) in gains.iter().enumerate() {
+            let g = gain / (1.0 + gain * d);
+            assert_eq!(closed_loop_gain(*gain, d), g);
+            let closed = Mat::from_fn(n, n, |i, j| a[(i, j)] - g * b[(i, 0)] * c[(0, j)]);
+            let expected = sorted(eigenvalues(closed.as_ref()).unwrap());
+            let scale = expected.iter().fold(1.0f64, |m, x| m.max(x.norm()));
+            for (x, y) in out[k * n..(k + 1) * n].iter().zip(&expected) {
+                assert!((x - y).norm() <= 1e-9 * scale, "k={gain}: {x} vs {y}");
+            }
+        }
+        // k d overflows: g = 1 / (1/k + d), finite.
+        assert_eq!(closed_loop_gain(1e300, 1e10), 1.0 / (1e-300 + 1e10));
+        // A closed-loop term beyond 2^RESCALE_EXPONENT, and b c = 0: left to the caller.
+        let mut untouched = vec![c64::new(7.0, 0.0); n];
+        let large = loop_root_locus(
+            a.as_ref(),
+            b.as_ref(),
+            c.as_ref(),
+            0.0,
+            &[1e100],
+            &mut untouched,
+        );
+        assert!(!large.unwrap());
+        let zero = Mat::<f64>::zeros(1, n);
+        let none = loop_root_locus(
+            a.as_ref(),
+            b.as_ref(),
+            zero.as_ref(),
+            0.0,
+            &[1.0],
+            &mut untouched,
+        );
+        assert!(!none.unwrap());
+        assert!(untouched.iter().all(|x| *x == c64::new(7.0, 0.0)));
     }
 
     #[test]

@@ -100,12 +100,13 @@ pub fn transfer_channels(
         Vec::new()
     };
     let denominator = polynomial(&poles, 1.0).unwrap_or_default();
+    let shared = Shared::of(a, dt, &poles);
     let mut out = Vec::with_capacity(channels.len());
     for &(i, j) in channels {
         crate::platform::interrupt::check()?;
         let bv: Vec<f64> = (0..n).map(|k| b[(k, j)]).collect();
         let cv: Vec<f64> = (0..n).map(|k| c[(i, k)]).collect();
-        out.push(channel(a, &bv, &cv, d[(i, j)], dt, &poles)?);
+        out.push(channel(a, &bv, &cv, d[(i, j)], dt, &poles, &shared)?);
     }
     Ok(Transfer {
         poles,
@@ -228,20 +229,57 @@ fn singular_at_origin(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> bool 
     // The smallest pivot of Gaussian elimination with complete pivoting bounds σ_min above
     // (σ_min(S0) <= ||L||_2 σ_min(U) <= (n + 1) min |u_ii|, |l_ij| <= 1): a small pivot is a
     // singular S0, at a fraction of the SVD's cost (the reference path takes the SVD).
-    let lu = s0.full_piv_lu();
-    let pivots: Vec<f64> = lu
-        .U()
-        .diagonal()
-        .column_vector()
-        .iter()
-        .map(|u| u.abs())
-        .collect();
+    let pivots = complete_pivots(s0);
     if pivots.iter().any(|u| u.is_nan()) {
         return true; // no verdict: the rank tolerance alone, as before
     }
     let smallest = pivots.iter().fold(f64::INFINITY, |m, &u| m.min(u));
     let largest = pivots.iter().fold(0.0_f64, |m, &u| m.max(u));
     smallest <= ORIGIN_SINGULARITY * (n + 1) as f64 * f64::EPSILON * largest
+}
+
+/// The magnitudes |u_kk| of the pivots of Gaussian elimination with complete pivoting on M
+/// (square): at step k the largest |m_ij| of the trailing block (the first in column order)
+/// is brought to (k, k), then m_ij -= (m_ik / m_kk) m_kj below and right of it. The pivots
+/// after a zero one are 0.
+fn complete_pivots(mut m: Mat<f64>) -> Vec<f64> {
+    let size = m.nrows();
+    let mut pivots = Vec::with_capacity(size);
+    for k in 0..size {
+        let (mut row, mut col, mut largest) = (k, k, -1.0f64);
+        for j in k..size {
+            for i in k..size {
+                let x = m[(i, j)].abs();
+                if x > largest || x.is_nan() {
+                    (row, col, largest) = (i, j, x);
+                }
+            }
+        }
+        if largest.is_nan() || largest == 0.0 {
+            pivots.push(largest);
+            pivots.resize(size, 0.0);
+            break;
+        }
+        for j in 0..size {
+            let t = m[(k, j)];
+            m[(k, j)] = m[(row, j)];
+            m[(row, j)] = t;
+        }
+        for i in 0..size {
+            let t = m[(i, k)];
+            m[(i, k)] = m[(i, col)];
+            m[(i, col)] = t;
+        }
+        let pivot = m[(k, k)];
+        pivots.push(pivot.abs());
+        for i in k + 1..size {
+            let l = m[(i, k)] / pivot;
+            for j in k + 1..size {
+                m[(i, j)] -= l * m[(k, j)];
+            }
+        }
+    }
+    pivots
 }
 
 /// A complex value m 2^e, m of largest part in [1/2, 1) (or 0, or not finite).
@@ -391,9 +429,12 @@ pub fn factored_response(
 /// of squares and products of entries directly: 2^±250.
 const ENTRY_RANGE: (f64, f64) = (5.527147875260445e-76, 1.8092513943330656e75);
 
-/// The integer nearest -log2(norm) / 2, ties to even (Python's round); 0 for a zero norm.
+/// The integer nearest -log2(norm) / 2, ties to even (Python's round); 0 for a zero norm, and
+/// without a logarithm for a norm within [0.51, 1.96] (|log2| / 2 below 0.49 there).
 fn half_exponent(norm: f64) -> i64 {
-    if norm > 0.0 {
+    if (0.51..=1.96).contains(&norm) {
+        0
+    } else if norm > 0.0 {
         -((norm.log2() / 2.0).round_ties_even() as i64)
     } else {
         0
@@ -471,7 +512,13 @@ fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
             if row == 0.0 || col == 0.0 {
                 continue;
             }
-            let k = ((col.log2() - row.log2()) / 4.0).round_ties_even() as i64;
+            // k = 0 without logarithms where col / row lies within [1/3.9, 3.9] (|log2| / 4
+            // below 0.491 there).
+            let k = if col <= 3.9 * row && row <= 3.9 * col {
+                0
+            } else {
+                ((col.log2() - row.log2()) / 4.0).round_ties_even() as i64
+            };
             if k != 0 {
                 for j in (0..n).filter(|&j| j != i) {
                     scale(&mut s.a[(i, j)], k);
@@ -520,10 +567,14 @@ fn unit_scaled(mut s: Siso) -> (Siso, i64) {
     (s, e)
 }
 
-/// x 2^e for any finite x (renormalised first, then [`ldexp`]).
+/// x 2^e for any finite x, rounded once: one multiplication by 2^e where that is a normal
+/// double, else renormalised first, then [`ldexp`].
 fn ldexp_any(x: f64, e: i64) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return x;
+    }
+    if (-1022..=1023).contains(&e) {
+        return x * two_to(e);
     }
     let k = exponent_of(x);
     ldexp(ldexp(x, -k), e + k)
@@ -726,28 +777,32 @@ fn response(s: &Siso, point: c64) -> Option<c64> {
     Some(ShiftedLu::new(s.a.as_ref(), point)?.response(&s.b, &s.c, s.d))
 }
 
-/// The mean log10 of the roots' finite, nonzero moduli (0 without one): the centre of the grid
-/// of evaluation points, as `transfer._evaluation_points` takes it.
-fn log_centre(roots: &[c64]) -> f64 {
-    let logs: Vec<f64> = roots
+/// log10 of the roots' finite, nonzero moduli, in their order.
+fn log_moduli(roots: &[c64]) -> Vec<f64> {
+    roots
         .iter()
         .map(|r| r.norm())
         .filter(|m| m.is_finite() && *m != 0.0)
         .map(f64::log10)
-        .collect();
-    if logs.is_empty() {
+        .collect()
+}
+
+/// The mean of the zeros' and then the poles' log10 moduli ([`log_moduli`]; 0 without one):
+/// the centre of the grid of evaluation points, as `transfer._evaluation_points` takes it.
+fn log_centre(zero_logs: &[f64], pole_logs: &[f64]) -> f64 {
+    let count = zero_logs.len() + pole_logs.len();
+    if count == 0 {
         0.0
     } else {
-        logs.iter().sum::<f64>() / logs.len() as f64
+        zero_logs.iter().chain(pole_logs).sum::<f64>() / count as f64
     }
 }
 
-/// The two points of the grid of `transfer._evaluation_points` farthest from the roots (by
-/// relative distance to the nearest), best first, ties in grid order: s = jω at 31 frequencies
+/// The grid of `transfer._evaluation_points`: s = jω at 31 frequencies
 /// 10^(centre - 1.5 + k/10), or z = e^{jθ} at 19 angles of the unit circle for a discrete
-/// model; without roots, the middle of the grid and the point after it.
-fn best_points(roots: &[c64], dt: f64, centre: f64) -> (c64, c64) {
-    let points: Vec<c64> = if dt > 0.0 {
+/// model.
+fn grid(dt: f64, centre: f64) -> Vec<c64> {
+    if dt > 0.0 {
         (0..19)
             .map(|k| {
                 let theta = (0.05 + 0.05 * k as f64) * std::f64::consts::PI;
@@ -766,35 +821,38 @@ fn best_points(roots: &[c64], dt: f64, centre: f64) -> (c64, c64) {
                 point
             })
             .collect()
-    };
-    if roots.is_empty() {
-        let middle = points.len() / 2;
-        return (points[middle], points[middle + 1]);
     }
-    // Every point lies in the upper half-plane, where a root below the real axis is no nearer
-    // than its conjugate, also after rounding (|Im p + b| >= |Im p - b| for b >= 0): such a
-    // root is left out when its conjugate is one of the roots, which leaves every minimum as
-    // it is.
-    let nearer: Vec<c64> = roots
+}
+
+/// `nearest[k]` lowered to min |p_k - r|^2 over the roots r, for the points p_k of a grid.
+/// Every point lies in the upper half-plane, where a root below the real axis is no nearer than
+/// its conjugate, also after rounding (|Im p + b| >= |Im p - b| for b >= 0): such a root is
+/// left out when its conjugate is one of `roots`, which leaves every minimum as it is (so the
+/// minima over two sets of roots, each filtered so, are those over their union). The minimum
+/// is exact, so it is taken root by root over every point at once (independent comparisons,
+/// not one chain per point).
+fn lower_to_nearest(points: &[c64], roots: &[c64], nearest: &mut [f64]) {
+    for r in roots
         .iter()
         .filter(|r| r.im >= 0.0 || !roots.contains(&r.conj()))
-        .copied()
-        .collect();
-    // min |p - r|^2 / |p|^2 over the roots: the relative distance, squared (no hypot; one
-    // division, which as a monotone rounding gives the same value as dividing each term).
-    let distance = |p: c64| {
-        let nearest = nearer
-            .iter()
-            .map(|r| (p - r).norm_sqr())
-            .fold(f64::INFINITY, f64::min);
-        nearest / p.norm_sqr()
-    };
+    {
+        for (m, p) in nearest.iter_mut().zip(points) {
+            *m = m.min((p - r).norm_sqr());
+        }
+    }
+}
+
+/// The two points of a grid farthest from the roots by relative distance to the nearest,
+/// min |p - r|^2 / |p|^2 (`nearest`: the numerators; no hypot, and one division, which as a
+/// monotone rounding gives the same value as dividing each term), best first, ties in grid
+/// order.
+fn farthest_two(points: &[c64], nearest: &[f64]) -> (c64, c64) {
     let (mut first, mut second) = (
         (f64::NEG_INFINITY, points[0]),
         (f64::NEG_INFINITY, points[1]),
     );
-    for p in points {
-        let value = distance(p);
+    for (&p, &m) in points.iter().zip(nearest) {
+        let value = m / p.norm_sqr();
         if value > first.0 {
             second = first;
             first = (value, p);
@@ -805,6 +863,57 @@ fn best_points(roots: &[c64], dt: f64, centre: f64) -> (c64, c64) {
     (first.1, second.1)
 }
 
+/// The two points of the grid ([`grid`]) farthest from the zeros and the poles (the poles'
+/// minima `pole_nearest` over `points`, None to take them here), best first; without roots,
+/// the middle of the grid and the point after it.
+fn best_points(
+    points: &[c64],
+    zeros: &[c64],
+    poles: &[c64],
+    pole_nearest: Option<&[f64]>,
+) -> (c64, c64) {
+    if zeros.is_empty() && poles.is_empty() {
+        let middle = points.len() / 2;
+        return (points[middle], points[middle + 1]);
+    }
+    let mut nearest = match pole_nearest {
+        Some(minima) => minima.to_vec(),
+        None => {
+            let mut minima = vec![f64::INFINITY; points.len()];
+            lower_to_nearest(points, poles, &mut minima);
+            minima
+        }
+    };
+    lower_to_nearest(points, zeros, &mut nearest);
+    farthest_two(points, &nearest)
+}
+
+/// What the channels of a model share: the poles by modulus, their log10 moduli, and for a
+/// continuous model the check grid (around max|A|, else around 1) with each point's minimum
+/// over the poles ([`lower_to_nearest`]).
+struct Shared {
+    sorted_poles: Vec<c64>,
+    pole_logs: Vec<f64>,
+    check: Option<(Vec<c64>, Vec<f64>)>,
+}
+
+impl Shared {
+    fn of(a: MatRef<'_, f64>, dt: f64, poles: &[c64]) -> Self {
+        let check = (dt.is_nan() || dt <= 0.0).then(|| {
+            let size = max_abs(a);
+            let points = grid(dt, if size > 0.0 { size.log10() } else { 0.0 });
+            let mut nearest = vec![f64::INFINITY; points.len()];
+            lower_to_nearest(&points, poles, &mut nearest);
+            (points, nearest)
+        });
+        Shared {
+            sorted_poles: by_modulus(poles),
+            pole_logs: log_moduli(poles),
+            check,
+        }
+    }
+}
+
 /// One channel (see the module's documentation), None when deferred.
 fn channel(
     a: MatRef<'_, f64>,
@@ -813,6 +922,7 @@ fn channel(
     d: f64,
     dt: f64,
     poles: &[c64],
+    shared: &Shared,
 ) -> Result<Option<Channel>, Error> {
     let n = a.nrows();
     let given = Siso {
@@ -874,18 +984,17 @@ fn channel(
         d
     } else {
         // G(point) = 2^-(o + i) 2^e G_s(point 2^-(f + e)) on the equilibrated system.
-        let roots: Vec<c64> = zeros.iter().chain(poles).copied().collect();
-        let (first, next) = best_points(&roots, dt, log_centre(&roots));
+        let centre = log_centre(&log_moduli(&zeros), &shared.pole_logs);
+        let (first, next) = best_points(&grid(dt, centre), &zeros, poles, None);
         // The check point is the best of another grid (around max|A|, else around 1): the
         // next point of the same grid shares the first's rounding where the terms of
         // c (sI - A)^-1 b cancel. A discrete model's one grid is the unit circle.
-        let check = if dt > 0.0 {
-            next
-        } else {
-            let size = max_abs(a);
-            let (best, after) =
-                best_points(&roots, dt, if size > 0.0 { size.log10() } else { 0.0 });
-            if best != first { best } else { after }
+        let check = match &shared.check {
+            None => next,
+            Some((points, pole_nearest)) => {
+                let (best, after) = best_points(points, &zeros, poles, Some(pole_nearest));
+                if best != first { best } else { after }
+            }
         };
         let at = |point: c64| -> Option<Scaled> {
             let value = response(
@@ -895,11 +1004,11 @@ fn channel(
             let part = value.re.abs().max(value.im.abs());
             (part.is_finite() && part >= f64::MIN_POSITIVE).then(|| Scaled::new(value, e - units))
         };
-        let (sorted_zeros, sorted_poles) = (by_modulus(&zeros), by_modulus(poles));
+        let (sorted_zeros, sorted_poles) = (by_modulus(&zeros), &shared.sorted_poles[..]);
         let Some(g0) = at(first) else {
             return Ok(None);
         };
-        let k = factored(g0, first, &sorted_poles, &sorted_zeros).value().re;
+        let k = factored(g0, first, sorted_poles, &sorted_zeros).value().re;
         if !(k.is_finite() && k.abs() >= f64::MIN_POSITIVE) {
             return Ok(None);
         }
@@ -908,7 +1017,7 @@ fn channel(
             return Ok(None);
         };
         let start = Scaled::new(c64::new(k, 0.0), 0);
-        let mut factored_value = factored(start, check, &sorted_zeros, &sorted_poles);
+        let mut factored_value = factored(start, check, &sorted_zeros, sorted_poles);
         factored_value.divided_by(g1);
         let ratio = factored_value.value();
         let agrees = (ratio - 1.0).norm() <= 1e-8; // false for NaN
@@ -989,6 +1098,69 @@ mod tests {
                 1.0
             ));
         }
+    }
+
+    #[test]
+    fn complete_pivots_of_known_matrices() {
+        // [[1, 2], [3, 4]]: pivot 4, then 1 - 2·3/4 = ... with rows and columns swapped:
+        // [[4, 3], [2, 1]] -> 1 - (2/4)·3 = -0.5; |det| = 4 · 0.5 = 2.
+        let m = faer::mat![[1.0, 2.0], [3.0, 4.0]];
+        assert_eq!(complete_pivots(m), vec![4.0, 0.5]);
+        // A rank-one matrix: the second pivot is 0 to rounding, a zero matrix all 0.
+        let m = Mat::from_fn(3, 3, |i, j| (i + 1) as f64 * (j + 2) as f64);
+        let pivots = complete_pivots(m);
+        assert_eq!(pivots[0], 12.0);
+        assert!(pivots[1] <= 4.0 * f64::EPSILON * 12.0 && pivots[2] <= 4.0 * f64::EPSILON * 12.0);
+        assert_eq!(complete_pivots(Mat::zeros(2, 2)), vec![0.0, 0.0]);
+        // The product of the pivots is |det| (a permuted triangular factorisation).
+        let m = faer::mat![[2.0, -1.0, 0.5], [0.25, 3.0, 1.0], [-1.5, 0.75, 4.0]];
+        let det: f64 =
+            2.0 * (3.0 * 4.0 - 0.75) + 1.0 * (0.25 * 4.0 + 1.5) + 0.5 * (0.25 * 0.75 + 4.5);
+        let product: f64 = complete_pivots(m).iter().product();
+        assert!(
+            (product - det.abs()).abs() <= 16.0 * f64::EPSILON * det.abs(),
+            "{product} {det}"
+        );
+    }
+
+    #[test]
+    fn best_points_split_between_zeros_and_poles() {
+        // The poles' minima taken once (as for the shared check grid) and the zeros' added give
+        // the points of the minimum over every root, conjugates below the axis included.
+        let poles = [
+            c64::new(-0.5, 0.0),
+            c64::new(-0.03, -0.9),
+            c64::new(-0.03, 0.9),
+            c64::new(-2.0, 0.0),
+        ];
+        let zeros = [c64::new(0.1, -0.4), c64::new(0.1, 0.4), c64::new(0.0, 0.0)];
+        for centre in [-1.0, 0.0, 0.3] {
+            let points = grid(0.0, centre);
+            let mut pole_nearest = vec![f64::INFINITY; points.len()];
+            lower_to_nearest(&points, &poles, &mut pole_nearest);
+            let split = best_points(&points, &zeros, &poles, Some(&pole_nearest));
+            assert_eq!(split, best_points(&points, &zeros, &poles, None));
+            let all: Vec<f64> = points
+                .iter()
+                .map(|p| {
+                    zeros
+                        .iter()
+                        .chain(&poles)
+                        .map(|r| (p - r).norm_sqr())
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect();
+            assert_eq!(split, farthest_two(&points, &all));
+            // The first is a point of the grid no nearer to a root than any other.
+            let value = |q: c64| all[points.iter().position(|p| *p == q).unwrap()] / q.norm_sqr();
+            assert!(points.iter().all(|p| value(*p) <= value(split.0)));
+        }
+        // Without roots: the middle of the grid and the point after it.
+        let points = grid(0.0, 0.0);
+        assert_eq!(
+            best_points(&points, &[], &[], None),
+            (points[15], points[16])
+        );
     }
 
     #[test]

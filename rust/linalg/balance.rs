@@ -156,6 +156,103 @@ pub(crate) fn states_scaled_apart(a: MatRef<'_, f64>) -> bool {
     })
 }
 
+/// [`balanced_states`], or the system as given where that scaling is not exact.
+fn balanced_or_given(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
+    balanced_states(a, b, c).unwrap_or_else(|| (a.to_owned(), b.to_owned(), c.to_owned()))
+}
+
+/// The largest |entry| of M (0 for an empty M).
+fn largest_magnitude(m: &Mat<f64>) -> f64 {
+    max_abs(m.as_ref())
+}
+
+/// The exponent e with 2^e max|M| nearest `target` (e = round(log2 target - log2 max|M|), ties
+/// to even); 0 where M or the target is 0, or where 2^e M would have a nonzero entry outside
+/// 2^±1000 (the scaling must be exact both ways).
+fn normalising_exponent(m: &Mat<f64>, target: f64) -> i64 {
+    let magnitudes = (0..m.ncols())
+        .flat_map(|j| (0..m.nrows()).map(move |i| (i, j)))
+        .map(|(i, j)| m[(i, j)].abs())
+        .filter(|x| *x != 0.0);
+    let (smallest, largest) =
+        magnitudes.fold((f64::INFINITY, 0.0f64), |(s, l), x| (s.min(x), l.max(x)));
+    if target.is_nan() || target <= 0.0 || largest == 0.0 {
+        return 0;
+    }
+    let (largest, smallest) = (largest.log2(), smallest.log2());
+    let e = (target.log2() - largest).round_ties_even();
+    if -1000.0 < smallest + e && largest + e < 1000.0 {
+        e as i64
+    } else {
+        0
+    }
+}
+
+/// M 2^e, exactly (every nonzero entry of the result is a normal double).
+fn scaled(m: &Mat<f64>, e: i64) -> Mat<f64> {
+    Mat::from_fn(m.nrows(), m.ncols(), |i, j| {
+        times_power_of_two(m[(i, j)], e as f64)
+    })
+}
+
+/// The states of a loop (A, B, C) balanced for the closed loops A - g B C
+/// (`aerocontrol.loops`'s root locus and margins): [`balanced_states`] once, then again with B
+/// and C each multiplied by the power of two 2^p, 2^q that brings its largest entry nearest
+/// the size of A balanced alone (max|D^-1 A D| with [`balanced_states`] of A without inputs and
+/// outputs; sqrt(max|B|) sqrt(max|C|) where that is 0), that scaling then undone on B and C:
+///
+/// ```text
+///     (T A T^-1, 2^-p T (2^p B), (C 2^q) T^-1 2^-q),
+/// ```
+///
+/// the same A - g B C for every g (exact: powers of two). The split of the loop's gain between
+/// B and C does not change A - g B C, but it steers the balancing: A and C of 1e-60 beside B of
+/// 1 balanced to a QR that lost 2% of the poles. The size is that of A balanced alone, the
+/// scale of its eigenvalues, not of A balanced with B and C: at 1e-100, B had steered that one
+/// to entries of 1e-75 beside eigenvalues of 1e-100, and B and C brought to 1e-75 steered the
+/// second balancing as much (poles 6e-5 off). The loop as given where it has no states or an
+/// entry is not finite; each balancing as given where its scaling would not be exact.
+pub(crate) fn balanced_loop(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+) -> (Mat<f64>, Mat<f64>, Mat<f64>) {
+    let finite =
+        |m: MatRef<'_, f64>| (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite()));
+    let n = a.nrows();
+    if n == 0 || !(finite(a) && finite(b) && finite(c)) {
+        return (a.to_owned(), b.to_owned(), c.to_owned());
+    }
+    let (a1, b1, c1) = balanced_or_given(a, b, c);
+    let alone = balanced_or_given(
+        a1.as_ref(),
+        Mat::zeros(n, 0).as_ref(),
+        Mat::zeros(0, n).as_ref(),
+    )
+    .0;
+    let mut size = largest_magnitude(&alone);
+    if size == 0.0 {
+        size = largest_magnitude(&b1).sqrt() * largest_magnitude(&c1).sqrt();
+    }
+    let (p, q) = (
+        normalising_exponent(&b1, size),
+        normalising_exponent(&c1, size),
+    );
+    if p == 0 && q == 0 {
+        return (a1, b1, c1);
+    }
+    let (a2, b2, c2) = balanced_or_given(
+        a1.as_ref(),
+        scaled(&b1, p).as_ref(),
+        scaled(&c1, q).as_ref(),
+    );
+    (a2, scaled(&b2, -p), scaled(&c2, -q))
+}
+
 /// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
 /// row and column i are scaled until their off-diagonal 2-norms are within a factor of two, and
 /// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more. Returns
@@ -235,6 +332,42 @@ mod tests {
             }
             assert_eq!(c2[(0, i)], c[(0, i)] / t);
         }
+    }
+
+    #[test]
+    fn balanced_loop_scales_b_and_c_to_the_size_of_a() {
+        // A of 1e-60 (states scaled by 10^±3) beside B of 1 and C of 1e-60: B and C are brought
+        // to the size of A balanced alone for the second balancing, then scaled back, so that
+        // A - g B C is unchanged for every g (exact: T and the split are powers of two).
+        let s = [1e3, 1e-3, 1.0];
+        let base = [[-1.0, 2.0, 0.5], [-3.0, -2.0, 1.0], [0.25, -1.0, -4.0]];
+        let a = Mat::from_fn(3, 3, |i, j| 1e-60 * base[i][j] * s[i] / s[j]);
+        let b = Mat::from_fn(3, 1, |i, _| [1.0, 0.5, -1.0][i] * s[i]);
+        let c = Mat::from_fn(1, 3, |_, j| 1e-60 * [1.0, -2.0, 0.5][j] / s[j]);
+        let (a2, b2, c2) = balanced_loop(a.as_ref(), b.as_ref(), c.as_ref());
+        for i in 0..3 {
+            // T_ii = b2_i / b_i, a power of two, and T A T^-1, C T^-1 exactly.
+            let t = b2[(i, 0)] / b[(i, 0)];
+            assert_eq!(t, 2f64.powi(t.log2().round() as i32));
+            for j in 0..3 {
+                let tj = b2[(j, 0)] / b[(j, 0)];
+                assert_eq!(a2[(i, j)], a[(i, j)] * t / tj);
+            }
+            assert_eq!(c2[(0, i)], c[(0, i)] / t);
+        }
+        // The balanced A has rows and columns of one size (within 2^2 of each other).
+        let largest = max_abs(a2.as_ref());
+        let smallest = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .filter(|(i, j)| i != j)
+            .map(|(i, j)| a2[(i, j)].abs())
+            .fold(f64::INFINITY, f64::min);
+        assert!(largest / smallest < 256.0, "{largest} {smallest}");
+        // Not finite, or no states: as given.
+        let mut bad = a.clone();
+        bad[(0, 0)] = f64::NAN;
+        let (a3, b3, _) = balanced_loop(bad.as_ref(), b.as_ref(), c.as_ref());
+        assert!(a3[(0, 0)].is_nan() && a3[(0, 1)] == a[(0, 1)] && b3 == b);
     }
 
     #[test]
