@@ -516,10 +516,11 @@ class _ScaledRiccati:
     """The caller's A, B, Q, S and E (for the residual in the caller's equation)."""
 
 
-def _log2_size(M: FloatArray) -> float | None:
-    """round(log2 max |M_ij|), or None for a matrix without a nonzero entry."""
-    size = float(np.max(np.abs(M), initial=0.0))
-    return float(np.round(np.log2(size))) if size > 0.0 else None
+def _log2_size(sizes: FloatArray) -> float | None:
+    """round(max sizes_ij) for log2 sizes (-inf for a zero entry, as
+    :func:`~aerocontrol._scaling.log2_sizes`), or None where every entry is zero."""
+    largest = float(np.max(sizes, initial=-np.inf))
+    return float(np.round(largest)) if np.isfinite(largest) else None
 
 
 def _riccati_scaling(
@@ -567,12 +568,12 @@ def _riccati_scaling(
     pattern = A if E_matrix is None else np.abs(A) + np.abs(E_matrix)
     balancing = _scaling.state_balancing(pattern)
     e = np.zeros(n, dtype=np.int64) if balancing is None else balancing
-    with np.errstate(over="ignore", under="ignore"):
-        shift = _log2_size(np.ldexp(B, -e[:, np.newaxis]))
-        c = 0 if shift is None else int(shift)
-        e = e + c
-        Q_size = _log2_size(np.ldexp(Q_matrix, e[:, np.newaxis] + e[np.newaxis, :]))
-        R_size = _log2_size(R_matrix)
+    # The sizes in log2, where the scaled matrices themselves could over- or underflow.
+    shift = _log2_size(_scaling.log2_sizes(B) - e[:, np.newaxis])
+    c = 0 if shift is None else int(shift)
+    e = e + c
+    Q_size = _log2_size(_scaling.log2_sizes(Q_matrix) + e[:, np.newaxis] + e[np.newaxis, :])
+    R_size = _log2_size(_scaling.log2_sizes(R_matrix))
     k = -int(Q_size) if Q_size is not None else -int(R_size) if R_size is not None else 0
     if (
         balancing is None
