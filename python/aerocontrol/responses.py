@@ -1056,7 +1056,8 @@ def forced_response(
 
 def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     """The state a step η0 settles to, x∞ = -A^-1 B η0 (6.45), for a stable system; for a
-    discrete model, x∞ = (I - A)^-1 B η0.
+    discrete model, x∞ = (I - A)^-1 B η0. An unstable system has none, and is refused
+    (:func:`dc_gain` gives the output of the equilibrium -A^-1 B η0 whatever the stability).
 
     Raises SingularMatrixError naming the zero eigenvalue when A is singular (an integrator
     has no steady state); for a discrete model, the eigenvalue 1 of A. The core refuses an A
@@ -1083,6 +1084,9 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
 
     Raises
     ------
+    InvalidArgumentError
+        ``sys`` is unstable: an eigenvalue with Re s > 1e-12 |s| (for a discrete model,
+        |z| > 1: s = ln(z)/dt); the step then never settles.
     SingularMatrixError
         A (for a discrete model A - I) is singular, even equilibrated.
     ShapeError
@@ -1111,7 +1115,42 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
             f"eta0 must be a 1-D array of one value per input, got an array of shape "
             f"{weights.shape}"
         )
-    return _steady_state(A, B, dt, weights) if dt else _equilibrated_solve(A, B, weights, True)
+    x = _steady_state(A, B, dt, weights) if dt else _equilibrated_solve(A, B, weights, True)
+    _require_settling(A, dt)  # after the solve: a singular A is refused as such
+    return x
+
+
+#: A mode counts as unstable where Re s > UNSTABLE_MARGIN |s| (s = ln(z)/dt for a discrete
+#: model): an undamped mode computed with a real part of rounding size is not one.
+UNSTABLE_MARGIN = 1e-12
+
+
+def _require_settling(A: FloatArray, dt: float) -> None:
+    """InvalidArgumentError naming ``sys`` where a mode of A grows (Re s > 1e-12 |s|; for a
+    discrete model s = ln(z)/dt, |z| > 1): x∞ = -A^-1 B η0 is then an equilibrium that a step
+    never reaches. The margin is relative to each mode's own modulus, so that the slow mode
+    of a stiff model (-1e-7 beside -1e6) and a decaying mode of a badly scaled one (-1.25 ±
+    2e231 j) pass, and an undamped mode whose real part is rounding (±1e-17 beside j) is not
+    called unstable. A zero eigenvalue is left to the solve, which refuses it as singular."""
+    if A.shape[0] == 0:
+        return
+    eigenvalues = _core.eigenvalues(A)
+    if dt:
+        eigenvalues = eigenvalues[eigenvalues != 0]
+        eigenvalues = np.log(eigenvalues) / dt
+    with np.errstate(over="ignore", invalid="ignore"):
+        growing = eigenvalues.real > UNSTABLE_MARGIN * np.abs(eigenvalues)
+    if not np.any(growing):
+        return
+    worst = eigenvalues[growing][np.argmax(eigenvalues.real[growing])]
+    mode = f"z = {complex(np.exp(worst * dt)):.6g}" if dt else f"s = {complex(worst):.6g}"
+    error = InvalidArgumentError(
+        f"sys is unstable (a mode at {mode}), so a step never settles and has no steady "
+        "state (-A^-1 B η0 is an equilibrium it grows away from; dc_gain gives the output "
+        "there)"
+    )
+    error.argument = "sys"
+    raise error
 
 
 def _steady_state(
