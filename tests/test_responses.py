@@ -534,8 +534,13 @@ def test_default_grids_refuse_eigenvalues_beyond_double_precision() -> None:
     omega = aerocontrol.default_frequency_grid(huge)
     assert np.all(np.isfinite(omega)) and omega[0] == pytest.approx(1e307) and omega[-1] == 1e308
     # Just below the limit the grid keeps its 100,001 samples at most.
-    t = aerocontrol.default_time_grid(aerocontrol.StateSpace(np.diag([-1e300, -1e-11]), [[0], [0]]))
+    t = aerocontrol.default_time_grid(aerocontrol.StateSpace(np.diag([-1e300, -1e299]), [[0], [0]]))
     assert len(t) <= aerocontrol.responses.MAX_DEFAULT_SAMPLES
+    # Beside a slow mode (7 time constants: 7e11 s) the steps e^(hA) allows (h of 4.5e-285 s)
+    # would need more samples than that: refused by name.
+    slow = aerocontrol.StateSpace(np.diag([-1e300, -1e-11]), [[0], [0]])
+    with pytest.raises(InvalidArgumentError, match="give the grid T"):
+        aerocontrol.default_time_grid(slow)
 
 
 def test_a_number_is_not_a_model() -> None:
@@ -767,3 +772,31 @@ def test_steady_state_of_a_stable_or_undamped_model(A: np.ndarray, dt: float | N
     np.testing.assert_allclose(
         aerocontrol.steady_state(model, [1.0]), -np.linalg.solve(M, B[:, 0]), rtol=1e-14
     )
+
+
+@pytest.mark.parametrize(
+    ("A", "slowest"),
+    [
+        (np.diag([-1e6, -1e-7]), 1e-7),  # the slow mode 1e-13 of the fast one
+        (np.array([[-1e6, 1.0], [0.0, -1e-7]]), 1e-7),
+        (np.diag([-1.0, -1e-13]), 1e-13),
+        (np.array([[-1e3, 0.0, 0.0], [0.0, -1e-10, 2e-10], [0.0, -2e-10, -1e-10]]), 1e-10),
+    ],
+)
+def test_default_grid_reaches_the_slowest_mode_of_a_stiff_model(
+    A: np.ndarray, slowest: float
+) -> None:
+    """Found by a hunt: a decaying mode slower than 1e-12 of the fastest was taken as an
+    integrator (the eigenvalues of A resolve it only to u ||A||), so the default grid ended at
+    7 time constants of the fast mode and the step response was cut before the slow mode
+    moved (x = 7e-6 of 1e7). Now 7 time constants of the slowest decaying mode, 7 / 1e-7 s
+    (the step grown to fit 100,001 samples), as the module promises; the response's last
+    sample within 1 % of -A^-1 B (e^-7 = 0.09 % of a slow real mode remains, and of the
+    oscillating pair about 0.3 %)."""
+    n = A.shape[0]
+    B = np.ones((n, 1))
+    t = aerocontrol.default_time_grid((A, B))
+    assert t[-1] == pytest.approx(7.0 / slowest, rel=1e-9)
+    assert len(t) == 100_001
+    x = aerocontrol.step_response((A, B)).x[-1]
+    np.testing.assert_allclose(x, -np.linalg.solve(A, B[:, 0]), rtol=1e-2)

@@ -43,6 +43,7 @@ share their sampling period.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -222,7 +223,10 @@ def default_time_grid(sys: Systems) -> FloatArray:
 
     A step of a twentieth of 1/ρ_max, ρ_max the largest modulus of an eigenvalue, and a final
     time of 7 time constants -1/σ of the slowest decaying mode (σ its real part; 10/ρ_min when
-    no mode decays), at most 100,001 samples; a discrete model steps by its dt.
+    no mode decays), at most 100,001 samples; a discrete model steps by its dt. A decaying
+    mode slower than 1e-12 ρ_max, which the eigenvalues of A do not resolve from an
+    integrator, is found from the largest eigenvalues of A^-1 (for a discrete model, of
+    (A - I)^-1) where A is nonsingular.
 
     Parameters
     ----------
@@ -331,12 +335,49 @@ def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
             f"the default time grid: the fastest mode (|λ| = {fastest:.3g}) needs a step "
             f"of {step:.3g}, below the normal doubles; give the grid T"
         )
-    decaying = -eigenvalues.real[eigenvalues.real < -1e-12 * fastest]
+    resolved = eigenvalues.real < -1e-12 * fastest
+    decaying = -eigenvalues.real[resolved]
+    if not np.all(resolved):
+        # Modes within 1e-12 |λ|max of the imaginary axis, where the eigenvalues of A are
+        # rounding: those that decay, found from the largest eigenvalues of A^-1.
+        decaying = np.concatenate([decaying, *(_slow_decay_rates(m, fastest) for m in models)])
     final = 7.0 / decaying.min() if decaying.size else 10.0 / nonzero.min()
     final = max(final, 100 * step)
-    if final / step > MAX_DEFAULT_SAMPLES - 1:
+    with np.errstate(over="ignore"):  # 7e11 s over a step of 5e-302 s: inf, beyond the cap
+        ratio = final / step
+    if ratio > MAX_DEFAULT_SAMPLES - 1:
         step = final / (MAX_DEFAULT_SAMPLES - 1)
     return step, final
+
+
+def _slow_decay_rates(model: StateSpace, fastest: float) -> FloatArray:
+    """The decay rates -Re λ of the model's modes slower than 1e-12 ``fastest`` (for a
+    discrete model, of s = ln(z)/dt), which the eigenvalues of A (errors of u ||A||) do not
+    resolve, where they decay: the eigenvalues of M = A (discrete: A - I) are 1/μ for μ
+    those of M^-1, whose largest are resolved to a relative u. M^-1 is solved as the
+    steady state is (equilibrated where the core refuses M); a singular M (an integrator)
+    has no slow mode that decays to find, and gives none. A mode is taken as decaying where
+    Re λ < -1e-12 |λ| (an undamped one with a real part of rounding is not)."""
+    n = model.n_states
+    if n == 0:
+        return np.zeros(0)
+    dt = period(model)
+    M = model.A - np.eye(n) if dt else model.A
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            inverse = -_equilibrated_solve(M, np.eye(n), np.eye(n), False)
+    except SingularMatrixError:
+        return np.zeros(0)
+    if not np.all(np.isfinite(inverse)):
+        return np.zeros(0)
+    mu = _core.eigenvalues(inverse)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        slow = 1.0 / mu[mu != 0]
+        if dt:
+            slow = np.log1p(slow) / dt
+    keep = (np.abs(slow) < 1e-12 * fastest) & (slow.real < -1e-12 * np.abs(slow))
+    return np.asarray(-slow.real[keep], dtype=np.float64)
 
 
 def _grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, float]:
