@@ -42,6 +42,16 @@ def test_root_locus_and_critical_weight_use_the_sweep() -> None:
     np.testing.assert_array_equal(poles, lqr_sweep(LATERAL, weights=WEIGHTS).poles)
 
 
+def test_critical_weight_bounds_beyond_the_doubles_are_named() -> None:
+    """Found by a hunt: bounds (1e-300, 1e300) were refused as "weights[0] = 1e-300 is out
+    of range", naming an argument critical_weight does not have. Now named bounds; the
+    default bounds still give the chapter's c = 9.7727 (to 1e-4)."""
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="bounds") as caught:
+        aerocontrol.design.critical_weight(LATERAL, bounds=(1e-300, 1e300))
+    assert caught.value.argument == "bounds"
+    assert aerocontrol.design.critical_weight(LATERAL) == pytest.approx(9.7727, abs=1e-4)
+
+
 def test_monte_carlo_stack_with_shared_weights() -> None:
     """A stack of plants, one B, Q and R shared by all: each equals its single solve."""
     rng = np.random.default_rng(7)

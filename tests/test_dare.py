@@ -493,6 +493,7 @@ def test_scaled_states_and_weights(seed: int, t: list[float], alpha: float) -> N
     K, X, poles = aerocontrol.dlqr(A, B, Q, R)
     np.testing.assert_array_equal(K, solution.K)
     np.testing.assert_array_equal(X, solution.X)
+    np.testing.assert_array_equal(poles, solution.closed_loop_poles)
 
 
 def test_scaled_equation_with_cross_weight_and_descriptor() -> None:

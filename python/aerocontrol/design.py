@@ -212,8 +212,9 @@ def critical_weight(
     Raises
     ------
     InvalidArgumentError
-        ``bounds`` not 0 < low < high finite; ``mode`` not an oscillatory lateral mode; or the
-        mode does not become critically damped within ``bounds``.
+        ``bounds`` not 0 < low < high finite, or so wide that R / c^2 leaves the doubles;
+        ``mode`` not an oscillatory lateral mode; or the mode does not become critically
+        damped within ``bounds``.
     ShapeError
         Q or R is not of the plant's size.
     AerocontrolError
@@ -238,7 +239,18 @@ def critical_weight(
         return _split(lqr(sys.A, sys.B, Q_matrix, R_matrix / c**2)[2], mode)
 
     grid = np.geomspace(low, high, 61)
-    values = [_split(poles, mode) for poles in lqr_sweep(sys, Q=Q, R=R, weights=grid).poles]
+    try:
+        sweep = lqr_sweep(sys, Q=Q, R=R, weights=grid)
+    except InvalidArgumentError as error:
+        if getattr(error, "argument", None) != "weights":
+            raise
+        refused = InvalidArgumentError(
+            f"bounds ({low:g}, {high:g}) reach weights c for which R / c^2 leaves the range "
+            "of double precision (narrow the bounds, or scale R)"
+        )
+        refused.argument = "bounds"
+        raise refused from error
+    values = [_split(poles, mode) for poles in sweep.poles]
     for k in range(len(grid) - 1):
         if values[k] < 0 <= values[k + 1]:
             a, b = math.log(grid[k]), math.log(grid[k + 1])
