@@ -161,3 +161,29 @@ def _scaled(
     """T A T⁻¹, T B, C T⁻¹ with T = diag(10^e): the same model in badly scaled states."""
     t = 10.0 ** np.array(exponents, dtype=float)
     return A * (t[:, None] / t[None, :]), B * t[:, None], C / t[None, :]
+
+
+@pytest.mark.parametrize(
+    ("A", "dt", "slowest", "fastest"),
+    [
+        (np.diag([-1e6, -1e-7]), None, 1e-7, 1e6),
+        (np.array([[-1e6, 1.0], [0.0, -1e-7]]), None, 1e-7, 1e6),
+        (np.diag([-1.0, -1e-13]), None, 1e-13, 1.0),
+        # z = 1 - 1e-14: s = ln(z)/dt = -1.0000000000000049e-13 rad/s
+        (np.diag([0.5, 1.0 - 1e-14]), 0.1, -np.log1p(-1e-14) / 0.1, np.pi / 0.1),
+    ],
+)
+def test_default_frequency_grid_reaches_the_slowest_mode_of_a_stiff_model(
+    A: np.ndarray, dt: float | None, slowest: float, fastest: float
+) -> None:
+    """Found by a hunt: a mode slower than 1e-12 of the fastest (or of the Nyquist frequency)
+    was taken as zero, so the grid started at a tenth of the fast mode (1e5 rad/s for modes
+    of 1e-7 and 1e6) and missed the slow corner, where the gain is 1e7. Now from a tenth of
+    the slowest natural frequency, as promised (the closed forms above, to 1e-6: the grid's
+    ends are 10^(log10 ω ∓ 1))."""
+    n = A.shape[0]
+    model = aerocontrol.StateSpace(A, np.ones((n, 1)), np.ones((1, n)), np.zeros((1, 1)), dt=dt)
+    omega = aerocontrol.default_frequency_grid(model)
+    assert omega[0] == pytest.approx(slowest / 10.0, rel=1e-6)
+    upper = fastest if dt else fastest * 10.0
+    assert omega[-1] == pytest.approx(upper, rel=1e-6)

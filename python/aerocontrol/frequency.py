@@ -24,6 +24,7 @@ from ._balance import balanced_matrices
 from ._results import Result
 from ._validation import FloatArray, real_array
 from .exceptions import InvalidArgumentError, ShapeError
+from .responses import slow_modes
 from .statespace import as_state_space, continuous_eigenvalues, grid_frequencies, period
 
 if TYPE_CHECKING:
@@ -195,7 +196,9 @@ def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> Flo
     the fastest nonzero natural frequency of the modes (0.01 to 100 rad/s when every
     eigenvalue is zero; at most 1e308). For a discrete model: from a tenth of the slowest
     natural frequency of s = ln(z)/dt (or a thousandth of the Nyquist frequency, if lower) to
-    the Nyquist frequency π/dt.
+    the Nyquist frequency π/dt. A mode slower than 1e-12 of the fastest (or of the Nyquist
+    frequency), which the eigenvalues of A do not resolve from zero, is found from the
+    eigenvalues of A^-1 (discrete: (A - I)^-1) where that matrix is nonsingular.
 
     Parameters
     ----------
@@ -233,9 +236,15 @@ def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> Flo
         s = continuous_eigenvalues(model)
         magnitudes = np.abs(s[np.isfinite(s)])
         nonzero = magnitudes[magnitudes > 1e-12 * nyquist]
+        if nonzero.size < magnitudes.size:  # modes below 1e-12 of it: resolved from (A - I)^-1
+            nonzero = np.concatenate([nonzero, np.abs(slow_modes(model, nyquist))])
         low = min(nonzero.min() / 10, nyquist / 1000) if nonzero.size else nyquist / 1000
         return np.logspace(np.log10(low), np.log10(nyquist), int(count))
-    _, nonzero = grid_frequencies([model], "the default frequency grid")
+    eigenvalues, nonzero = grid_frequencies([model], "the default frequency grid")
+    if nonzero.size < eigenvalues.size and nonzero.size:
+        # Modes below 1e-12 of the fastest, which the eigenvalues of A do not resolve from
+        # zero: resolved from A^-1 where A is nonsingular.
+        nonzero = np.concatenate([nonzero, np.abs(slow_modes(model, float(nonzero.max())))])
     if nonzero.size == 0:
         return np.logspace(-2.0, 2.0, int(count))
     return np.logspace(

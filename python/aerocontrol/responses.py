@@ -50,7 +50,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal, cast
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _scaling
 from ._results import Result, Tabular
@@ -350,17 +350,17 @@ def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
     return step, final
 
 
-def _slow_decay_rates(model: StateSpace, fastest: float) -> FloatArray:
-    """The decay rates -Re λ of the model's modes slower than 1e-12 ``fastest`` (for a
-    discrete model, of s = ln(z)/dt), which the eigenvalues of A (errors of u ||A||) do not
-    resolve, where they decay: the eigenvalues of M = A (discrete: A - I) are 1/μ for μ
-    those of M^-1, whose largest are resolved to a relative u. M^-1 is solved as the
-    steady state is (equilibrated where the core refuses M); a singular M (an integrator)
-    has no slow mode that decays to find, and gives none. A mode is taken as decaying where
-    Re λ < -1e-12 |λ| (an undamped one with a real part of rounding is not)."""
+def slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
+    """The model's nonzero modes slower than 1e-12 ``fastest`` (continuous eigenvalues; for a
+    discrete model s = ln(z)/dt), which the eigenvalues of A (errors of u ||A||) do not
+    resolve from zero: the eigenvalues of M = A (discrete: A - I) are 1/μ for μ those of
+    M^-1, whose largest are resolved to a relative u. M^-1 is solved as the steady state is
+    (equilibrated where the core refuses M); a singular M (an integrator) gives none, as its
+    slow modes cannot be told from the integrator's zero."""
     n = model.n_states
+    none = np.zeros(0, dtype=np.complex128)
     if n == 0:
-        return np.zeros(0)
+        return none
     dt = period(model)
     M = model.A - np.eye(n) if dt else model.A
     try:
@@ -368,16 +368,24 @@ def _slow_decay_rates(model: StateSpace, fastest: float) -> FloatArray:
             warnings.simplefilter("ignore")
             inverse = -_equilibrated_solve(M, np.eye(n), np.eye(n), False)
     except SingularMatrixError:
-        return np.zeros(0)
+        return none
     if not np.all(np.isfinite(inverse)):
-        return np.zeros(0)
+        return none
     mu = _core.eigenvalues(inverse)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         slow = 1.0 / mu[mu != 0]
         if dt:
             slow = np.log1p(slow) / dt
-    keep = (np.abs(slow) < 1e-12 * fastest) & (slow.real < -1e-12 * np.abs(slow))
-    return np.asarray(-slow.real[keep], dtype=np.float64)
+    keep = np.isfinite(slow) & (slow != 0) & (np.abs(slow) < 1e-12 * fastest)
+    return np.asarray(slow[keep], dtype=np.complex128)
+
+
+def _slow_decay_rates(model: StateSpace, fastest: float) -> FloatArray:
+    """The decay rates -Re λ of the :func:`slow_modes` that decay (Re λ < -1e-12 |λ|: an
+    undamped one with a real part of rounding does not)."""
+    slow = slow_modes(model, fastest)
+    decaying = slow.real < -1e-12 * np.abs(slow)
+    return np.asarray(-slow.real[decaying], dtype=np.float64)
 
 
 def _grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, float]:
