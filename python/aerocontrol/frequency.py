@@ -24,7 +24,7 @@ from ._balance import balanced_matrices
 from ._results import Result
 from ._validation import FloatArray, real_array
 from .exceptions import InvalidArgumentError, ShapeError
-from .responses import slow_modes
+from .responses import _slow_modes
 from .statespace import as_state_space, continuous_eigenvalues, grid_frequencies, period
 
 if TYPE_CHECKING:
@@ -237,14 +237,14 @@ def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> Flo
         magnitudes = np.abs(s[np.isfinite(s)])
         nonzero = magnitudes[magnitudes > 1e-12 * nyquist]
         if nonzero.size < magnitudes.size:  # modes below 1e-12 of it: resolved from (A - I)^-1
-            nonzero = np.concatenate([nonzero, np.abs(slow_modes(model, nyquist))])
+            nonzero = np.concatenate([nonzero, np.abs(_slow_modes(model, nyquist))])
         low = min(nonzero.min() / 10, nyquist / 1000) if nonzero.size else nyquist / 1000
         return np.logspace(np.log10(low), np.log10(nyquist), int(count))
     eigenvalues, nonzero = grid_frequencies([model], "the default frequency grid")
     if nonzero.size < eigenvalues.size and nonzero.size:
         # Modes below 1e-12 of the fastest, which the eigenvalues of A do not resolve from
         # zero: resolved from A^-1 where A is nonsingular.
-        nonzero = np.concatenate([nonzero, np.abs(slow_modes(model, float(nonzero.max())))])
+        nonzero = np.concatenate([nonzero, np.abs(_slow_modes(model, float(nonzero.max())))])
     if nonzero.size == 0:
         return np.logspace(-2.0, 2.0, int(count))
     return np.logspace(

@@ -350,7 +350,7 @@ def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
     return step, final
 
 
-def slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
+def _slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
     """The model's nonzero modes slower than 1e-12 ``fastest`` (continuous eigenvalues; for a
     discrete model s = ln(z)/dt), which the eigenvalues of A (errors of u ||A||) do not
     resolve from zero: the eigenvalues of M = A (discrete: A - I) are 1/μ for μ those of
@@ -381,9 +381,9 @@ def slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
 
 
 def _slow_decay_rates(model: StateSpace, fastest: float) -> FloatArray:
-    """The decay rates -Re λ of the :func:`slow_modes` that decay (Re λ < -1e-12 |λ|: an
+    """The decay rates -Re λ of the ``_slow_modes`` that decay (Re λ < -1e-12 |λ|: an
     undamped one with a real part of rounding does not)."""
-    slow = slow_modes(model, fastest)
+    slow = _slow_modes(model, fastest)
     decaying = slow.real < -1e-12 * np.abs(slow)
     return np.asarray(-slow.real[decaying], dtype=np.float64)
 
