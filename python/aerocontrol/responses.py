@@ -1186,7 +1186,11 @@ def _require_settling(A: FloatArray, dt: float) -> None:
     eigenvalues = _core.eigenvalues(A)
     if dt:
         eigenvalues = eigenvalues[eigenvalues != 0]
+        if not eigenvalues.size or float(np.abs(eigenvalues).max()) <= 1.0:
+            return
         eigenvalues = np.log(eigenvalues) / dt
+    elif float(eigenvalues.real.max()) <= 0.0:
+        return
     with np.errstate(over="ignore", invalid="ignore"):
         growing = eigenvalues.real > UNSTABLE_MARGIN * np.abs(eigenvalues)
     if not np.any(growing):

@@ -21,6 +21,7 @@ S(t_f) = S_f, or, for an infinite horizon, the algebraic equation (6.199).
 
 from __future__ import annotations
 
+import math
 import operator
 import warnings
 from dataclasses import dataclass
@@ -523,6 +524,35 @@ def _log2_size(sizes: FloatArray) -> float | None:
     return float(np.round(largest)) if np.isfinite(largest) else None
 
 
+def _largest_entry(M: FloatArray) -> float:
+    """max |M_ij| (0 for no entries), in scalar arithmetic up to 64 entries (numpy's calls
+    cost a good part of a 4-state solve). A NaN may be passed over: the callers check
+    finiteness before they scale."""
+    if M.size <= 64:
+        return max(map(abs, M.ravel().tolist()), default=0.0)
+    return float(np.max(np.abs(M), initial=0.0))
+
+
+def _scaled_well(B: FloatArray, Q: FloatArray, R: FloatArray) -> bool:
+    """The quick test of :func:`_riccati_scaling` for a balanced A: max |B| within 2^10 of 1
+    and max |Q| (or max |R|, for Q = 0) within 2^20 of 1 after the shift of all states that
+    brings B to 1; True also where an entry is not finite (the core refuses it by name)."""
+    b = _largest_entry(B)
+    if not math.isfinite(b):
+        return True
+    c = round(math.log2(b)) if b > 0.0 else 0
+    if abs(c) >= _scaling.BALANCING_SPREAD:
+        return False
+    q = _largest_entry(Q)
+    weight = q if q > 0.0 else _largest_entry(R)
+    if not math.isfinite(weight):
+        return True
+    if weight == 0.0:
+        return True
+    size = math.log2(weight) + (2 * c if q > 0.0 else 0)
+    return abs(round(size)) < 2 * _scaling.BALANCING_SPREAD
+
+
 def _riccati_scaling(
     A: FloatArray,
     B: FloatArray,
@@ -562,11 +592,13 @@ def _riccati_scaling(
         or (E_matrix is not None and E_matrix.shape != (n, n))
     ):
         return None
+    pattern = A if E_matrix is None else np.abs(A) + np.abs(E_matrix)
+    balancing = _scaling.state_balancing(pattern)
+    if balancing is None and _scaled_well(B, Q_matrix, R_matrix):
+        return None
     given = [A, B, Q_matrix, R_matrix] + [M for M in (S_matrix, E_matrix) if M is not None]
     if not all(np.all(np.isfinite(M)) for M in given):
         return None
-    pattern = A if E_matrix is None else np.abs(A) + np.abs(E_matrix)
-    balancing = _scaling.state_balancing(pattern)
     e = np.zeros(n, dtype=np.int64) if balancing is None else balancing
     # The sizes in log2, where the scaled matrices themselves could over- or underflow.
     shift = _log2_size(_scaling.log2_sizes(B) - e[:, np.newaxis])
