@@ -326,7 +326,7 @@ def place_batch(A: ArrayLike, B: ArrayLike, poles: ArrayLike, method: str = "knv
 
 
 def _scaled_riccati_stacks(
-    stacks: tuple[FloatArray, ...],
+    stacks: tuple[FloatArray, ...], discrete: bool
 ) -> tuple[tuple[FloatArray, ...], dict[int, Any]]:
     """The stacks of :func:`solve_care_batch` and :func:`solve_dare_batch` with each problem
     scaled as the single solves scale it (``riccati._riccati_scaling``: the states balanced,
@@ -348,14 +348,15 @@ def _scaled_riccati_stacks(
         largest = magnitudes.max(axis=(1, 2))
         smallest = np.min(magnitudes, axis=(1, 2), where=magnitudes > 0.0, initial=np.inf)
         flagged = largest >= 2.0**_scaling.BALANCING_SPREAD * smallest
-        for M, limit in ((B, _scaling.BALANCING_SPREAD), (Q, 2 * _scaling.BALANCING_SPREAD)):
+        far = ((B, _scaling.BALANCING_SPREAD), (Q, 2 * _scaling.BALANCING_SPREAD))
+        for M, limit in far if discrete else ():
             size = np.abs(np.log2(np.abs(M).max(axis=(1, 2), initial=0.0)))
             flagged = flagged | ((size >= limit) & np.isfinite(size))
     flagged = np.broadcast_to(flagged, (count,)) if flagged.size == 1 else flagged
     found: dict[int, Any] = {}
     for i in np.flatnonzero(flagged).tolist():
         a, b, q, r = (M[i if len(M) > 1 else 0] for M in stacks)
-        scaled = riccati._riccati_scaling(a, b, q, r, None, None)
+        scaled = riccati._riccati_scaling(a, b, q, r, None, None, discrete=discrete)
         if scaled is not None:
             found[i] = scaled
     if not found:
@@ -555,7 +556,7 @@ def solve_care_batch(
     ((500, 2, 4), True)
     """
     stacks, found = _scaled_riccati_stacks(
-        (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
+        (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R")), False
     )
     solved = _solved("care_batch", stacks, (bool(refine),), client, worker_threads)
     batch = CareBatch(*_unscaled_riccati(solved, found, False))
@@ -628,7 +629,7 @@ def solve_dare_batch(
     ((200, 2, 4), True)
     """
     stacks, found = _scaled_riccati_stacks(
-        (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
+        (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R")), True
     )
     solved = _solved("dare_batch", stacks, (), client, worker_threads)
     batch = DareBatch(*_unscaled_riccati(solved, found, True))

@@ -254,7 +254,7 @@ def _solve_care(
     # The core shapes the weights (a scalar R as 1 x 1, as numpy.atleast_2d); A and B are
     # read here (a scalar as 1 x 1, a 1-D B as a column).
     A_matrix, B_matrix = matrix_view(A, "A"), matrix_view(B, "B")
-    scaled = _riccati_scaling(A_matrix, B_matrix, Q, R, S, E)
+    scaled = _riccati_scaling(A_matrix, B_matrix, Q, R, S, E, discrete=False)
     result: tuple[FloatArray, FloatArray, ComplexArray, float, float, int]
     if scaled is None:
         result = _core.solve_care(A_matrix, B_matrix, Q, R, S, E, bool(refine), cross == "N")
@@ -482,7 +482,7 @@ def _solve_dare(
     """The native solve, warning (at the caller of :func:`solve_dare` or :func:`dlqr`) when
     the solution may be inaccurate; ``cross`` names the cross weight in errors (N for dlqr)."""
     A_matrix, B_matrix = matrix_view(A, "A"), matrix_view(B, "B")
-    scaled = _riccati_scaling(A_matrix, B_matrix, Q, R, S, E)
+    scaled = _riccati_scaling(A_matrix, B_matrix, Q, R, S, E, discrete=True)
     if scaled is None:
         result = _core.solve_dare(A_matrix, B_matrix, Q, R, S, E, cross == "N")
     else:
@@ -560,6 +560,8 @@ def _riccati_scaling(
     R: ArrayLike,
     S: ArrayLike | None,
     E: ArrayLike | None,
+    *,
+    discrete: bool,
 ) -> _ScaledRiccati | None:
     """The Riccati equation scaled exactly (powers of two) to sizes the core's pencil
     resolves, or None where it is scaled well enough already, an argument is not a finite
@@ -570,6 +572,8 @@ def _riccati_scaling(
     similarity that balances A (and E: :func:`~aerocontrol._scaling.state_balancing` of
     |A| + |E|); then one factor 2^c on all the states, which brings max |B̃| to about 1; then
     the factor 2^k on the costs, which brings max |Q̃| to about 1 (max |R̃|, for Q = 0). The
+    last two are applied with the first, or, for the ``discrete`` equation, also alone where
+    B or Q is far from 1 (the continuous solve scales its Hamiltonian itself). The
     Schur and QZ algorithms' errors are relative to the norm of the Hamiltonian matrix or
     the symplectic pencil, whose blocks are A, B, Q, R and the identity: states scaled by
     1e±6 (one by one, or, for the discrete equation, all together) or discrete weights Q and
@@ -594,7 +598,8 @@ def _riccati_scaling(
         return None
     pattern = A if E_matrix is None else np.abs(A) + np.abs(E_matrix)
     balancing = _scaling.state_balancing(pattern)
-    if balancing is None and _scaled_well(B, Q_matrix, R_matrix):
+    # The continuous solve scales its Hamiltonian itself: it needs only the balancing.
+    if balancing is None and (not discrete or _scaled_well(B, Q_matrix, R_matrix)):
         return None
     given = [A, B, Q_matrix, R_matrix] + [M for M in (S_matrix, E_matrix) if M is not None]
     if not all(np.all(np.isfinite(M)) for M in given):
