@@ -6,8 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.linalg
+import scipy.linalg as sl
 
 import aerocontrol
+from aerocontrol import batch
 from aerocontrol.batch import lqr_sweep, solve_care_batch
 
 LATERAL = aerocontrol.aircraft.load().lateral()
@@ -38,6 +40,16 @@ def test_sweep_against_scipy() -> None:
 def test_root_locus_and_critical_weight_use_the_sweep() -> None:
     poles = aerocontrol.design.lqr_root_locus(LATERAL, WEIGHTS)
     np.testing.assert_array_equal(poles, lqr_sweep(LATERAL, weights=WEIGHTS).poles)
+
+
+def test_critical_weight_bounds_beyond_the_doubles_are_named() -> None:
+    """Found by a hunt: bounds (1e-300, 1e300) were refused as "weights[0] = 1e-300 is out
+    of range", naming an argument critical_weight does not have. Now named bounds; the
+    default bounds still give the chapter's c = 9.7727 (to 1e-4)."""
+    with pytest.raises(aerocontrol.InvalidArgumentError, match="bounds") as caught:
+        aerocontrol.design.critical_weight(LATERAL, bounds=(1e-300, 1e300))
+    assert caught.value.argument == "bounds"
+    assert aerocontrol.design.critical_weight(LATERAL) == pytest.approx(9.7727, abs=1e-4)
 
 
 def test_monte_carlo_stack_with_shared_weights() -> None:
@@ -311,3 +323,49 @@ def test_sweep_weight_whose_square_is_subnormal_or_overflows() -> None:
     reference = scipy.linalg.solve_continuous_are(A, B, np.eye(2), [[1e-10]])
     sweep = lqr_sweep(A, B, np.eye(2), [[1e290]], weights=[1e150])
     np.testing.assert_allclose(sweep.X[0], reference, rtol=1e-9)
+
+
+def test_batches_of_states_scaled_apart_are_solved_as_alone() -> None:
+    """Found by a hunt: the batch solvers refused (NoStabilizingSolutionError, "problem 0 of
+    the batch") the regulators of models in states scaled by 1e±6 that the single solves, with
+    their exact scaling, solve. Each problem is now scaled as alone: the batch's X, K and
+    poles equal the single solves' bitwise, and K that of the unscaled model transformed
+    (K0 T, scipy's solve_*_are on the unscaled model) to 1e-9, mixed with a well-scaled
+    problem that is left as it was."""
+    rng = np.random.default_rng(11)
+    A0, B0 = rng.standard_normal((4, 4)), rng.standard_normal((4, 1))
+    t = np.array([1e-6, 1e6, 1e-3, 1e3])
+    A = A0 * (t[np.newaxis, :] / t[:, np.newaxis])
+    B, Q, R = B0 / t[:, np.newaxis], np.diag(t**2), np.eye(1)
+    sampled = aerocontrol.discretize(A0, B0, dt=0.1)
+    Ad = sampled.Phi * (t[np.newaxis, :] / t[:, np.newaxis])
+    Bd = sampled.Gamma0 / t[:, np.newaxis]
+    for solve, single, plant, gain, oracle in (
+        (batch.solve_care_batch, aerocontrol.solve_care, (A, B), B0, sl.solve_continuous_are),
+        (batch.solve_dare_batch, aerocontrol.solve_dare, (Ad, Bd), None, sl.solve_discrete_are),
+    ):
+        a, b = plant
+        stack_A = np.stack([a, A0 if gain is not None else sampled.Phi])
+        stack_B = np.stack([b, B0 if gain is not None else sampled.Gamma0])
+        stack_Q = np.stack([Q, np.eye(4)])
+        result = solve(stack_A, stack_B, stack_Q, R)
+        for i in range(2):
+            alone = single(stack_A[i], stack_B[i], stack_Q[i], R)
+            np.testing.assert_array_equal(result.X[i], alone.X)
+            np.testing.assert_array_equal(result.K[i], alone.K)
+            np.testing.assert_array_equal(result.closed_loop_poles[i], alone.closed_loop_poles)
+        if gain is not None:
+            X0 = oracle(A0, B0, np.eye(4), R)
+            K0 = B0.T @ X0
+        else:
+            X0 = oracle(sampled.Phi, sampled.Gamma0, np.eye(4), R)
+            Bs = sampled.Gamma0
+            K0 = np.linalg.solve(R + Bs.T @ X0 @ Bs, Bs.T @ X0 @ sampled.Phi)
+        np.testing.assert_allclose(result.K[0], K0 * t[np.newaxis, :], rtol=1e-9)
+        np.testing.assert_allclose(result.K[1], K0, rtol=1e-9)
+        assert np.all(result.residual < 1e-12)
+    sweep = batch.dlqr_sweep(Ad, Bd, Q, R, weights=[1.0, 2.0])
+    K, X, poles = aerocontrol.dlqr(Ad, Bd, Q, R / 4.0)
+    np.testing.assert_array_equal(sweep.X[1], X)
+    np.testing.assert_array_equal(sweep.K[1], K)
+    np.testing.assert_array_equal(sweep.poles[1], poles)

@@ -440,3 +440,84 @@ def test_cross_weight_errors_name_the_callers_argument() -> None:
     for solver in (aerocontrol.solve_care, aerocontrol.solve_dare):
         with pytest.raises(ShapeError, match=r"^S must have as many rows as A"):
             solver(A, B, Q, R, S=np.ones((3, 1)))
+
+
+# ----- equations scaled far from 1 (an exact scaling before the core's solve) ---------------
+
+
+def _sampled_model(seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """A random 4-state, 1-input model sampled (ZOH) at 0.1 s."""
+    rng = np.random.default_rng(seed)
+    A, B = rng.standard_normal((4, 4)), rng.standard_normal((4, 1))
+    sampled = aerocontrol.discretize(A, B, dt=0.1)
+    return sampled.Phi, sampled.Gamma0
+
+
+@pytest.mark.parametrize(
+    ("seed", "t", "alpha"),
+    [
+        # Found by a hunt: each refused by the unscaled core (too few pencil eigenvalues
+        # inside the unit circle, or a swap of the reordering refused).
+        (23, [1e-6, 1e6, 1e-3, 1e3], 1.0),  # states scaled one by one
+        (54, [1e6, 1e6, 1e6, 1e6], 1.0),  # all states scaled together
+        (41, [1.0, 1.0, 1.0, 1.0], 1e12),  # Q and R both multiplied by 1e12
+        (5, [1e8, 1e-8, 1e4, 1e-4], 1e-12),
+    ],
+)
+def test_scaled_states_and_weights(seed: int, t: list[float], alpha: float) -> None:
+    """The regulator of x0 = T x (A = T^-1 A0 T, B = T^-1 B0, Q = alpha T Q0 T, R = alpha R0)
+    is that of the unscaled equation: X = alpha T X0 T, K = K0 T, the same closed loop
+    (X0, K0 by scipy's solve_discrete_are on the unscaled model). Tolerances: 1e-9 relative
+    for K (column by column) and for X (entry by entry relative to sqrt(X_ii X_jj)), 1e-10
+    for the closed-loop moduli."""
+    A0, B0 = _sampled_model(seed)
+    Q0, R0 = np.eye(4), np.eye(1)
+    X0 = sl.solve_discrete_are(A0, B0, Q0, R0)
+    K0 = np.linalg.solve(R0 + B0.T @ X0 @ B0, B0.T @ X0 @ A0)
+    T = np.array(t)
+    A, B = A0 * (T[np.newaxis, :] / T[:, np.newaxis]), B0 / T[:, np.newaxis]
+    Q, R = alpha * Q0 * np.outer(T, T), alpha * R0
+    solution = aerocontrol.solve_dare(A, B, Q, R)
+    K_expected, X_expected = K0 * T[np.newaxis, :], alpha * X0 * np.outer(T, T)
+    np.testing.assert_allclose(solution.K, K_expected, rtol=1e-9)
+    size = np.sqrt(np.outer(np.diag(X_expected), np.diag(X_expected)))
+    assert np.max(np.abs(solution.X - X_expected) / size) < 1e-9
+    np.testing.assert_array_equal(solution.X, solution.X.T)
+    np.testing.assert_allclose(
+        np.sort(np.abs(solution.closed_loop_poles)),
+        np.sort(np.abs(np.linalg.eigvals(A0 - B0 @ K0))),
+        rtol=1e-10,
+    )
+    # The reported residual is that of the caller's equation.
+    assert solution.residual < 1e-12
+    K, X, poles = aerocontrol.dlqr(A, B, Q, R)
+    np.testing.assert_array_equal(K, solution.K)
+    np.testing.assert_array_equal(X, solution.X)
+    np.testing.assert_array_equal(poles, solution.closed_loop_poles)
+
+
+def test_scaled_equation_with_cross_weight_and_descriptor() -> None:
+    """S and E take the same exact scaling (S -> T S, E -> T^-1 E T): the solution with a cross
+    weight and a descriptor matrix E in states scaled by 1e±6 is that of the unscaled one
+    (scipy's solve_discrete_are with s and e), to 1e-9 as above."""
+    A0, B0 = _sampled_model(23)
+    rng = np.random.default_rng(7)
+    E0 = np.eye(4) + 0.1 * rng.standard_normal((4, 4))
+    S0 = 0.1 * rng.standard_normal((4, 1))
+    Q0, R0 = np.eye(4), np.eye(1)
+    X0 = sl.solve_discrete_are(A0, B0, Q0, R0, e=E0, s=S0)
+    K0 = np.linalg.solve(R0 + B0.T @ X0 @ B0, B0.T @ X0 @ A0 + S0.T)
+    T = np.array([1e-6, 1e6, 1e-3, 1e3])
+    similar = T[np.newaxis, :] / T[:, np.newaxis]
+    solution = aerocontrol.solve_dare(
+        A0 * similar,
+        B0 / T[:, np.newaxis],
+        Q0 * np.outer(T, T),
+        R0,
+        S0 * T[:, np.newaxis],
+        E0 * similar,
+    )
+    np.testing.assert_allclose(solution.K, K0 * T[np.newaxis, :], rtol=1e-9)
+    X_expected = X0 * np.outer(T, T)
+    size = np.sqrt(np.outer(np.diag(X_expected), np.diag(X_expected)))
+    assert np.max(np.abs(solution.X - X_expected) / size) < 1e-9

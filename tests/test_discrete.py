@@ -948,6 +948,48 @@ def test_sampled_weights_of_a_stiff_plant_do_not_overflow() -> None:
         aerocontrol.design.sampled_weights(aerocontrol.c2d(sys, 0.1), 0.1)
 
 
+@pytest.mark.parametrize("scale", [1e6, 1e8])
+def test_sampled_weights_and_regulator_of_states_scaled_apart(scale: float) -> None:
+    """Found by a hunt: in states x = T x̃ scaled apart (T = diag(1/s, s, s^-1/2, s^1/2)) the
+    Van Loan exponential's errors, relative to ||F||, left Q_d wrong by 5e-7 (s = 1e6) and
+    4e-3 (s = 1e8) relative to sqrt(Q_ii Q_jj), and K by 0.6 % at 1e8, silently. Now the
+    states are balanced exactly first: the weights are those of the unscaled plant
+    transformed (Q_d -> T Q_d T, N_d -> T N_d), against scipy's quadrature of the unscaled
+    cost (1e-11 relative, as above), and the gain K0 T against python-control's dlqr of the
+    unscaled problem (1e-9)."""
+    sys = MODELS["random n=6"]
+    n, m = sys.n_states, sys.n_inputs
+    dt = 0.1
+    W = _quadrature_weights(sys, dt, np.eye(n), np.eye(m))
+    t = np.array([1 / scale, scale, scale**-0.5, scale**0.5, 1.0, 3.0])[:n]
+    scaled = StateSpace(sys.A * (t[np.newaxis, :] / t[:, np.newaxis]), sys.B / t[:, np.newaxis])
+    w = aerocontrol.design.sampled_weights(scaled, dt, np.diag(t**2), np.eye(m))
+    Q_expected = W[:n, :n] * np.outer(t, t)
+    size = np.sqrt(np.outer(np.diag(Q_expected), np.diag(Q_expected)))
+    assert np.max(np.abs(w.Q - Q_expected) / size) < 1e-11
+    assert _relative(w.R, W[n:, n:]) < 1e-11
+    N_size = np.sqrt(np.outer(np.diag(Q_expected), np.diag(W[n:, n:])))
+    assert np.max(np.abs(w.N - W[:n, n:] * t[:, np.newaxis]) / N_size) < 1e-11
+    Phi, Gamma, *_ = scipy.signal.cont2discrete((sys.A, sys.B, sys.C, sys.D), dt)
+    K0 = np.asarray(control.dlqr(Phi, Gamma, W[:n, :n], W[n:, n:], W[:n, n:])[0])
+    K, _, _ = aerocontrol.design.sampled_data_lqr(scaled, dt, np.diag(t**2), np.eye(m))
+    K_expected = K0 * t[np.newaxis, :]
+    assert np.max(np.abs(K - K_expected) / np.abs(K_expected).max(axis=0)) < 1e-9
+
+
+def test_sampled_weights_that_overflow_are_refused() -> None:
+    """Found by a hunt: a B of 1e300 gave weights of NaN (with numpy's overflow warnings) and
+    sampled_data_lqr then blamed Q ("Q must be finite, but Q[0, 0] is NaN"), which the caller
+    had not given. Refused by name."""
+    sys = StateSpace([[-1.0, 0.5], [0.0, -2.0]], [[1e300], [1e300]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InvalidArgumentError, match="sampled weights overflow"):
+            aerocontrol.design.sampled_weights(sys, 0.05)
+        with pytest.raises(InvalidArgumentError, match="sampled weights overflow"):
+            aerocontrol.design.sampled_data_lqr(sys, 0.05)
+
+
 # ----- matched pole-zero beyond |z| = 1e154 (trust fixes) ------------------------------------
 
 

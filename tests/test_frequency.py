@@ -161,3 +161,60 @@ def _scaled(
     """T A T⁻¹, T B, C T⁻¹ with T = diag(10^e): the same model in badly scaled states."""
     t = 10.0 ** np.array(exponents, dtype=float)
     return A * (t[:, None] / t[None, :]), B * t[:, None], C / t[None, :]
+
+
+@pytest.mark.parametrize(
+    ("A", "dt", "slowest", "fastest"),
+    [
+        (np.diag([-1e6, -1e-7]), None, 1e-7, 1e6),
+        (np.array([[-1e6, 1.0], [0.0, -1e-7]]), None, 1e-7, 1e6),
+        (np.diag([-1.0, -1e-13]), None, 1e-13, 1.0),
+        # z = 1 - 1e-14: s = ln(z)/dt = -1.0000000000000049e-13 rad/s
+        (np.diag([0.5, 1.0 - 1e-14]), 0.1, -np.log1p(-1e-14) / 0.1, np.pi / 0.1),
+    ],
+)
+def test_default_frequency_grid_reaches_the_slowest_mode_of_a_stiff_model(
+    A: np.ndarray, dt: float | None, slowest: float, fastest: float
+) -> None:
+    """Found by a hunt: a mode slower than 1e-12 of the fastest (or of the Nyquist frequency)
+    was taken as zero, so the grid started at a tenth of the fast mode (1e5 rad/s for modes
+    of 1e-7 and 1e6) and missed the slow corner, where the gain is 1e7. Now from a tenth of
+    the slowest natural frequency, as promised (the closed forms above, to 1e-6: the grid's
+    ends are 10^(log10 ω ∓ 1))."""
+    n = A.shape[0]
+    model = aerocontrol.StateSpace(A, np.ones((n, 1)), np.ones((1, n)), np.zeros((1, 1)), dt=dt)
+    omega = aerocontrol.default_frequency_grid(model)
+    assert omega[0] == pytest.approx(slowest / 10.0, rel=1e-6)
+    upper = fastest if dt else fastest * 10.0
+    assert omega[-1] == pytest.approx(upper, rel=1e-6)
+
+
+@pytest.mark.parametrize("dt", [1e-4, 1e-8, 1e-10])
+def test_discrete_response_of_a_model_sampled_fast(dt: float) -> None:
+    """Found by a hunt: a model sampled fast against its modes (A = e^{A_c dt}, eigenvalues
+    clustered at z = 1) lost a relative u / (ω dt²) of G at low frequencies, silently: 1.7e-4
+    at dt = 1e-10, ω = 1e-3 rad/s (Hessenberg errors of u ||A|| beside A - I of size dt).
+    Now evaluated about z = 1, C ((z - 1) I - (A - I))^-1 B: against the resolvent in 50-digit
+    arithmetic (mpmath, A and B, C as given, z = e^{jω dt} exact), to 1e-12."""
+    import mpmath
+    import scipy.linalg
+
+    rng = np.random.default_rng(1)
+    n = 6
+    A_c = rng.standard_normal((n, n)) / np.sqrt(n) - 0.5 * np.eye(n)
+    B, C = rng.standard_normal((n, 1)), rng.standard_normal((1, n))
+    A = scipy.linalg.expm(A_c * dt)
+    omega = np.array([1e-3, 1e-1, 10.0, 1e3])
+    response = aerocontrol.frequency_response(
+        aerocontrol.StateSpace(A, B, C, np.zeros((1, 1)), dt=dt), omega
+    ).response[:, 0, 0]
+    with mpmath.workdps(50):
+        for k, w in enumerate(omega):
+            z = mpmath.exp(mpmath.mpc(0, 1) * mpmath.mpf(float(w)) * mpmath.mpf(dt))
+            M = mpmath.matrix(n, n)
+            for i in range(n):
+                for j in range(n):
+                    M[i, j] = (z if i == j else 0) - mpmath.mpf(float(A[i, j]))
+            x = mpmath.lu_solve(M, mpmath.matrix([mpmath.mpf(float(b)) for b in B[:, 0]]))
+            exact = complex(sum(mpmath.mpf(float(C[0, i])) * x[i] for i in range(n)))
+            assert abs(response[k] - exact) <= 1e-12 * abs(exact)

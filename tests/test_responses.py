@@ -15,7 +15,13 @@ import scipy.linalg
 import scipy.signal
 
 import aerocontrol
-from aerocontrol import InvalidArgumentError, NonFiniteError, ShapeError, SingularMatrixError
+from aerocontrol import (
+    InvalidArgumentError,
+    NonFiniteError,
+    ShapeError,
+    SingularMatrixError,
+    responses,
+)
 
 A_LON, B_LON = aerocontrol.chapter.boeing747_longitudinal()
 A_LAT, B_LAT = aerocontrol.chapter.boeing747_lateral()
@@ -193,8 +199,15 @@ def test_dc_gain_and_steady_state_of_a_badly_scaled_closed_loop(discrete: bool) 
     exact = [-v for v in _exact_solve(_A_BADLY_SCALED, B[:, 0])]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        x = aerocontrol.steady_state(model, [1.0])
         gain = aerocontrol.dc_gain(model)
+        if discrete:
+            # z = 1 + λ: -0.25 ± 2e231 j outside the unit circle, so the sampled model is
+            # unstable and has no steady state; (I - A)^-1 B is still its equilibrium.
+            with pytest.raises(InvalidArgumentError, match="sys is unstable"):
+                aerocontrol.steady_state(model, [1.0])
+            x = responses._steady_state(model.A, model.B, 0.1, np.ones(1))
+        else:
+            x = aerocontrol.steady_state(model, [1.0])
     np.testing.assert_allclose(x, [float(v) for v in exact], rtol=2 * np.finfo(float).eps)
     expected = float(exact[1] + 2 * exact[2])
     assert expected == pytest.approx(-1.0 / 3.0, rel=1e-15)
@@ -519,10 +532,16 @@ def test_default_grids_refuse_eigenvalues_beyond_double_precision() -> None:
     with pytest.raises(InvalidArgumentError, match="default frequency grid"):
         aerocontrol.default_frequency_grid(overflowing)
     omega = aerocontrol.default_frequency_grid(huge)
-    assert np.all(np.isfinite(omega)) and omega[0] == pytest.approx(1e307) and omega[-1] == 1e308
+    # From a tenth of the mode at -1 (resolved from A^-1, 1e-308 of the fastest) to 1e308.
+    assert np.all(np.isfinite(omega)) and omega[0] == pytest.approx(0.1) and omega[-1] == 1e308
     # Just below the limit the grid keeps its 100,001 samples at most.
-    t = aerocontrol.default_time_grid(aerocontrol.StateSpace(np.diag([-1e300, -1e-11]), [[0], [0]]))
+    t = aerocontrol.default_time_grid(aerocontrol.StateSpace(np.diag([-1e300, -1e299]), [[0], [0]]))
     assert len(t) <= aerocontrol.responses.MAX_DEFAULT_SAMPLES
+    # Beside a slow mode (7 time constants: 7e11 s) the steps e^(hA) allows (h of 4.5e-285 s)
+    # would need more samples than that: refused by name.
+    slow = aerocontrol.StateSpace(np.diag([-1e300, -1e-11]), [[0], [0]])
+    with pytest.raises(InvalidArgumentError, match="give the grid T"):
+        aerocontrol.default_time_grid(slow)
 
 
 def test_a_number_is_not_a_model() -> None:
@@ -708,3 +727,77 @@ def test_doublet_initial_state_is_formed_as_a_times_b_eta0() -> None:
     )
     assert response.x[0, 0] == pytest.approx(a * (b * eta), rel=4e-16)
     assert response.x[0, 0] == pytest.approx(1.9875544616903434e-303, rel=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("A", "dt"),
+    [
+        (np.array([[1.0]]), None),  # x' = x + u: -A^-1 B = -1, never reached
+        (np.array([[-2.0, 0.0], [0.0, 1e-6]]), None),  # a slow unstable mode beside a fast one
+        (np.array([[0.2, 1.0], [-1.0, 0.2]]), None),  # a growing oscillation
+        (np.array([[1.5]]), 0.1),  # z = 1.5
+        (np.array([[0.5, 0.0], [0.0, -1.001]]), 0.1),  # z = -1.001, alternating
+    ],
+)
+def test_steady_state_of_an_unstable_model_is_refused(A: np.ndarray, dt: float | None) -> None:
+    """Found by a hunt: steady_state returned -A^-1 B η0 of an unstable model silently, a
+    state the step grows away from. Refused by name; dc_gain (the output of that equilibrium,
+    valid whatever the stability) still gives D - C A^-1 B, against numpy's solve to 1e-14."""
+    n = A.shape[0]
+    B, C = np.ones((n, 1)), np.ones((1, n))
+    model = aerocontrol.StateSpace(A, B, C, np.zeros((1, 1)), dt=dt)
+    with pytest.raises(InvalidArgumentError, match="sys is unstable") as caught:
+        aerocontrol.steady_state(model, [1.0])
+    assert caught.value.argument == "sys"
+    M = A - np.eye(n) if dt else A
+    np.testing.assert_allclose(aerocontrol.dc_gain(model), -C @ np.linalg.solve(M, B), rtol=1e-14)
+
+
+@pytest.mark.parametrize(
+    ("A", "dt"),
+    [
+        (np.diag([-1e6, -1e-7]), None),  # stiff: the slow mode settles, if slowly
+        (np.array([[0.0, 1.0], [-1.0, 0.0]]), None),  # undamped: Re s is rounding
+        (np.array([[-1.0, 0.0], [0.0, -1.0 + 1e-9]]) + np.eye(2), 0.1),  # z = 0 and 1e-9
+        (np.array([[0.0, 1.0], [-1.0, 0.0]]), 0.1),  # z = ±j on the unit circle
+    ],
+)
+def test_steady_state_of_a_stable_or_undamped_model(A: np.ndarray, dt: float | None) -> None:
+    """Not refused: every mode decays, or lies on the stability boundary to rounding (an
+    undamped mode is not called unstable). x∞ = -A^-1 B (discrete: (I - A)^-1 B) against
+    numpy's solve, to 1e-14."""
+    n = A.shape[0]
+    B = np.ones((n, 1))
+    model = aerocontrol.StateSpace(A, B, np.eye(n), np.zeros((n, 1)), dt=dt)
+    M = A - np.eye(n) if dt else A
+    np.testing.assert_allclose(
+        aerocontrol.steady_state(model, [1.0]), -np.linalg.solve(M, B[:, 0]), rtol=1e-14
+    )
+
+
+@pytest.mark.parametrize(
+    ("A", "slowest"),
+    [
+        (np.diag([-1e6, -1e-7]), 1e-7),  # the slow mode 1e-13 of the fast one
+        (np.array([[-1e6, 1.0], [0.0, -1e-7]]), 1e-7),
+        (np.diag([-1.0, -1e-13]), 1e-13),
+        (np.array([[-1e3, 0.0, 0.0], [0.0, -1e-10, 2e-10], [0.0, -2e-10, -1e-10]]), 1e-10),
+    ],
+)
+def test_default_grid_reaches_the_slowest_mode_of_a_stiff_model(
+    A: np.ndarray, slowest: float
+) -> None:
+    """Found by a hunt: a decaying mode slower than 1e-12 of the fastest was taken as an
+    integrator (the eigenvalues of A resolve it only to u ||A||), so the default grid ended at
+    7 time constants of the fast mode and the step response was cut before the slow mode
+    moved (x = 7e-6 of 1e7). Now 7 time constants of the slowest decaying mode, 7 / 1e-7 s
+    (the step grown to fit 100,001 samples), as the module promises; the response's last
+    sample within 1 % of -A^-1 B (e^-7 = 0.09 % of a slow real mode remains, and of the
+    oscillating pair about 0.3 %)."""
+    n = A.shape[0]
+    B = np.ones((n, 1))
+    t = aerocontrol.default_time_grid((A, B))
+    assert t[-1] == pytest.approx(7.0 / slowest, rel=1e-9)
+    assert len(t) == 100_001
+    x = aerocontrol.step_response((A, B)).x[-1]
+    np.testing.assert_allclose(x, -np.linalg.solve(A, B[:, 0]), rtol=1e-2)

@@ -633,3 +633,25 @@ def test_riccati_ode_work_is_bounded_by_the_transient(a: float) -> None:
     assert solution.substeps < 200
     exact = a + np.sqrt(a * a + 1.0)
     assert abs(solution.S[0][0, 0] - exact) <= 4e-16 * exact
+
+
+@pytest.mark.parametrize("seed", [11, 14, 23])
+def test_lqr_states_scaled_apart(seed: int) -> None:
+    """Found by a hunt: the core refused (NoStabilizingSolutionError) the regulator of a
+    random 4-state model in states x0 = T x, T = diag(1e-6, 1e6, 1e-3, 1e3); with the exact
+    balancing before the solve it is the unscaled one's (scipy's solve_continuous_are):
+    K = K0 T to 1e-9 relative, X = T X0 T to 1e-9 relative to sqrt(X_ii X_jj)."""
+    rng = np.random.default_rng(seed)
+    A0, B0 = rng.standard_normal((4, 4)), rng.standard_normal((4, 1))
+    X0 = sl.solve_continuous_are(A0, B0, np.eye(4), np.eye(1))
+    K0 = B0.T @ X0
+    T = np.array([1e-6, 1e6, 1e-3, 1e3])
+    A, B = A0 * (T[np.newaxis, :] / T[:, np.newaxis]), B0 / T[:, np.newaxis]
+    K, X, poles = aerocontrol.lqr(A, B, np.diag(T**2), np.eye(1))
+    np.testing.assert_allclose(K, K0 * T[np.newaxis, :], rtol=1e-9)
+    X_expected = X0 * np.outer(T, T)
+    size = np.sqrt(np.outer(np.diag(X_expected), np.diag(X_expected)))
+    assert np.max(np.abs(X - X_expected) / size) < 1e-9
+    np.testing.assert_allclose(
+        np.sort(poles.real), np.sort(np.linalg.eigvals(A0 - B0 @ K0).real), rtol=1e-9
+    )

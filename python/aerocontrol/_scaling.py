@@ -181,6 +181,29 @@ def similarity(
         )
 
 
+def _balanced_enough_scalar(rows: list[list[float]]) -> bool:
+    """The second test of :func:`state_balancing` in scalar arithmetic (a small A as nested
+    lists): every state's largest off-diagonal entries in its row and in its column within
+    2^10 of each other (or one of them zero). A NaN may pass it: the finiteness check that
+    follows in :func:`state_balancing` refuses it."""
+    n = len(rows)
+    row_max = [0.0] * n
+    column_max = [0.0] * n
+    for i, row in enumerate(rows):
+        for j, value in enumerate(row):
+            if i != j:
+                size = abs(value)
+                if not size <= row_max[i]:
+                    row_max[i] = size
+                if not size <= column_max[j]:
+                    column_max[j] = size
+    for r, c in zip(row_max, column_max, strict=True):
+        low, high = (r, c) if r <= c else (c, r)
+        if not (low == 0.0 or high <= _SPREAD_RATIO * low):
+            return False
+    return True
+
+
 def state_balancing(
     A: FloatArray,
     inputs: tuple[FloatArray, ...] = (),
@@ -215,12 +238,16 @@ def state_balancing(
     # more than 2^10 apart. A random matrix, whose entries spread over decades, passes it;
     # states scaled apart by 1e3 or more (a row divided and a column multiplied by that)
     # fail it.
-    off_diagonal = np.abs(A)
-    np.fill_diagonal(off_diagonal, 0.0)
-    rows, columns = off_diagonal.max(axis=1), off_diagonal.max(axis=0)
-    low, high = np.minimum(rows, columns), np.maximum(rows, columns)
-    if np.all((low == 0.0) | (high <= _SPREAD_RATIO * low)):
-        return None
+    if A.size <= _SCALAR_TEST_MAX_ENTRIES:
+        if _balanced_enough_scalar(A.tolist()):
+            return None
+    else:
+        off_diagonal = np.abs(A)
+        np.fill_diagonal(off_diagonal, 0.0)
+        rows, columns = off_diagonal.max(axis=1), off_diagonal.max(axis=0)
+        low, high = np.minimum(rows, columns), np.maximum(rows, columns)
+        if np.all((low == 0.0) | (high <= _SPREAD_RATIO * low)):
+            return None
     given = (A, *inputs, *outputs, *weights)
     if not all(np.all(np.isfinite(M)) for M in given):
         return None

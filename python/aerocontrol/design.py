@@ -16,6 +16,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _scaling
 from ._results import Result, register_model
 from ._validation import real_array, real_scalar
 from .aircraft.model import Aircraft
@@ -211,8 +212,9 @@ def critical_weight(
     Raises
     ------
     InvalidArgumentError
-        ``bounds`` not 0 < low < high finite; ``mode`` not an oscillatory lateral mode; or the
-        mode does not become critically damped within ``bounds``.
+        ``bounds`` not 0 < low < high finite, or so wide that R / c^2 leaves the doubles;
+        ``mode`` not an oscillatory lateral mode; or the mode does not become critically
+        damped within ``bounds``.
     ShapeError
         Q or R is not of the plant's size.
     AerocontrolError
@@ -237,7 +239,18 @@ def critical_weight(
         return _split(lqr(sys.A, sys.B, Q_matrix, R_matrix / c**2)[2], mode)
 
     grid = np.geomspace(low, high, 61)
-    values = [_split(poles, mode) for poles in lqr_sweep(sys, Q=Q, R=R, weights=grid).poles]
+    try:
+        sweep = lqr_sweep(sys, Q=Q, R=R, weights=grid)
+    except InvalidArgumentError as error:
+        if getattr(error, "argument", None) != "weights":
+            raise
+        refused = InvalidArgumentError(
+            f"bounds ({low:g}, {high:g}) reach weights c for which R / c^2 leaves the range "
+            "of double precision (narrow the bounds, or scale R)"
+        )
+        refused.argument = "bounds"
+        raise refused from error
+    values = [_split(poles, mode) for poles in sweep.poles]
     for k in range(len(grid) - 1):
         if values[k] < 0 <= values[k + 1]:
             a, b = math.log(grid[k]), math.log(grid[k + 1])
@@ -325,8 +338,8 @@ def sampled_weights(
     Raises
     ------
     InvalidArgumentError
-        ``sys`` is discrete, ``dt`` is not a positive finite period, or Q or R is not of the
-        plant's size.
+        ``sys`` is discrete, ``dt`` is not a positive finite period, Q or R is not of the
+        plant's size, or the weights overflow double precision.
 
     Examples
     --------
@@ -353,8 +366,18 @@ def sampled_weights(
             f"Q must be {n} x {n} and R {m} x {m}, got {Q_matrix.shape} and {R_matrix.shape}"
         )
     size = n + m
+    # The states balanced first, x = T x̃ with T = diag(2^e) (exact): W̃ = [[T Q_d T, T N_d],
+    # [N_d^T T, R_d]] is that of T^-1 A T, T^-1 B and T Q T. The Van Loan exponential's
+    # errors are relative to ||F||, so that states scaled by 1e±6 otherwise lose Q_d's small
+    # entries (3e-7 relative to sqrt(Q_ii Q_jj), 4e-3 at 1e±8).
+    e = _weight_balancing(sys.A, sys.B, Q_matrix)
+    A_matrix, B_matrix = sys.A, sys.B
+    if e is not None:
+        A_matrix = np.ldexp(A_matrix, e[np.newaxis, :] - e[:, np.newaxis])
+        B_matrix = np.ldexp(B_matrix, -e[:, np.newaxis])
+        Q_matrix = np.ldexp(Q_matrix, e[:, np.newaxis] + e[np.newaxis, :])
     F = np.zeros((size, size))
-    F[:n, :n], F[:n, n:] = sys.A, sys.B
+    F[:n, :n], F[:n, n:] = A_matrix, B_matrix
     H = np.zeros((size, size))
     H[:n, :n], H[n:, n:] = Q_matrix, R_matrix
     norm = float(np.abs(F).sum(axis=0).max()) * period
@@ -364,15 +387,41 @@ def sampled_weights(
     exponential = expm(block * step)
     transition = exponential[size:, size:]
     W = transition.T @ exponential[:size, size:]
-    for _ in range(doublings):
-        W = W + transition.T @ W @ transition
-        transition = transition @ transition
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below
+        for _ in range(doublings):
+            W = W + transition.T @ W @ transition
+            transition = transition @ transition
     W = 0.5 * (W + W.T)
+    Q_d, R_d, N_d = W[:n, :n], W[n:, n:], W[:n, n:]
+    if e is not None:
+        with np.errstate(over="ignore", under="ignore"):
+            Q_d = np.ldexp(Q_d, -(e[:, np.newaxis] + e[np.newaxis, :]))
+            N_d = np.ldexp(N_d, -e[:, np.newaxis])
+    if not (np.all(np.isfinite(Q_d)) and np.all(np.isfinite(R_d)) and np.all(np.isfinite(N_d))):
+        raise InvalidArgumentError(
+            "the sampled weights overflow double precision (the continuous cost over one "
+            f"period dt = {period:g} s leaves the range of doubles): sys, Q or R is too "
+            "large for this dt"
+        )
     return SampledWeights(
-        np.ascontiguousarray(W[:n, :n]),
-        np.ascontiguousarray(W[n:, n:]),
-        np.ascontiguousarray(W[:n, n:]),
+        np.ascontiguousarray(Q_d), np.ascontiguousarray(R_d), np.ascontiguousarray(N_d)
     )
+
+
+def _weight_balancing(
+    A: NDArray[np.float64], B: NDArray[np.float64], Q: NDArray[np.float64]
+) -> NDArray[np.int64] | None:
+    """Exponents e of the state scaling T = diag(2^e) that balances A
+    (:func:`~aerocontrol._scaling.state_balancing`), or None where A is balanced well enough
+    or a scaled entry of A, B (T^-1 B) or Q (T Q T) would leave the normal doubles."""
+    e = _scaling.state_balancing(A, inputs=(B,))
+    if e is None or not np.all(np.isfinite(Q)):
+        return None
+    sizes = _scaling.log2_sizes(Q) + e[:, np.newaxis] + e[np.newaxis, :]
+    finite = sizes[np.isfinite(sizes)]
+    if finite.size and (finite.min() < -1020.0 or finite.max() > 1020.0):
+        return None
+    return e
 
 
 def sampled_data_lqr(
@@ -408,8 +457,8 @@ def sampled_data_lqr(
     Raises
     ------
     InvalidArgumentError
-        As :func:`sampled_weights`: ``sys`` discrete, ``dt`` not positive and finite, or Q or R
-        of the wrong size.
+        As :func:`sampled_weights`: ``sys`` discrete, ``dt`` not positive and finite, Q or R
+        of the wrong size, or weights that overflow double precision.
     NoStabilizingSolutionError, SingularMatrixError
         As :func:`~aerocontrol.dlqr`: the sampled plant is not stabilisable.
 

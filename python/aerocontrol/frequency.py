@@ -24,7 +24,14 @@ from ._balance import balanced_matrices
 from ._results import Result
 from ._validation import FloatArray, real_array
 from .exceptions import InvalidArgumentError, ShapeError
-from .statespace import as_state_space, continuous_eigenvalues, grid_frequencies, period
+from .responses import _slow_modes
+from .statespace import (
+    StateSpace,
+    as_state_space,
+    continuous_eigenvalues,
+    grid_frequencies,
+    period,
+)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -121,6 +128,51 @@ class FrequencyResponse(Result):
         return plot_bode(self, ax=ax, output=output, input=input)
 
 
+#: A discrete model's A is evaluated about z = 1 (:func:`_response_about_one`) where
+#: ||A - I||_1 is below 2^-CLUSTER_EXPONENT ||A||_1.
+CLUSTER_EXPONENT = 10
+
+
+def _clustered_at_one(A: FloatArray) -> bool:
+    """Whether A is within 2^-10 of the identity relative to its norm (1-norms): a model
+    sampled fast against its modes (A = e^{A_c dt} with ||A_c|| dt small), whose
+    eigenvalues cluster about z = 1."""
+    n = A.shape[0]
+    if n == 0 or not np.all(np.isfinite(A)):
+        return False
+    norm = float(np.abs(A).sum(axis=0).max())
+    distance = float(np.abs(A - np.eye(n)).sum(axis=0).max())
+    return distance < norm * 2.0**-CLUSTER_EXPONENT
+
+
+def _response_about_one(model: StateSpace, frequencies: FloatArray) -> NDArray[np.complex128]:
+    """G(z) = C ((z - 1) I - (A - I))^-1 B + D of a discrete model whose A clusters about 1.
+
+    The core's solve reduces the matrix it is given to Hessenberg form with errors relative
+    to its norm: for A = I + dt A_c those are u ||A|| = u beside the entries of A - I of
+    size dt ||A_c||, and G at low frequencies (z - 1 of size ω dt) lost a relative
+    u / (ω dt²) (1.7e-4 at dt = 1e-10, ω = 1e-3 rad/s; a plain LU solve of zI - A: 1e-14).
+    Here A - I (its diagonal exact by Sterbenz's lemma where the entries of A lie in [1/2, 2])
+    is balanced and given to the core's continuous solve, one frequency at a time, as
+    jν I - (A - I - σ I) with z - 1 = σ + jν, σ = -2 sin²(ω dt / 2) and ν = sin(ω dt)
+    (formed without the cancellation of cos(ω dt) - 1)."""
+    n = model.n_states
+    dt = period(model)
+    A, B, C = balanced_matrices(model.A - np.eye(n), model.B, model.C)
+    angles = frequencies * dt
+    half = np.sin(0.5 * angles)
+    shifts, imaginary = -2.0 * half * half, np.sin(angles)
+    response = np.empty((len(frequencies), *model.D.shape), dtype=np.complex128)
+    diagonal = np.arange(n)
+    for k in range(len(frequencies)):
+        shifted = A.copy()
+        shifted[diagonal, diagonal] -= shifts[k]
+        response[k] = _core.frequency_response(shifted, B, C, model.D, imaginary[k : k + 1], None)[
+            0
+        ]
+    return response
+
+
 def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
     """G(jω) = C (jωI - A)^-1 B + D at each frequency of ``omega`` (rad/s); for a discrete
     model, G(e^{jω dt}) = C (e^{jω dt} I - A)^-1 B + D.
@@ -130,6 +182,10 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
     badly scaled coordinates has the response of the well-scaled one: the core's Hessenberg
     solve has errors relative to the size of the matrix it is given (relative errors of 1.6e-3
     for a well-conditioned 4-state model in states scaled by 10^(-4, -3, 4, 6)).
+
+    A discrete model whose A is within 2^-10 of the identity (sampled fast against its
+    modes) is evaluated about z = 1, as C ((z - 1) I - (A - I))^-1 B + D, so that its low
+    frequencies keep their digits.
 
     A frequency at an imaginary-axis pole (a pole on the unit circle, for a discrete model)
     gives infinite or NaN entries.
@@ -173,15 +229,18 @@ def frequency_response(sys: System, omega: ArrayLike) -> FrequencyResponse:
         frequencies = frequencies.reshape(1)
     if frequencies.ndim != 1:
         raise ShapeError(f"omega must be a 1-D array of frequencies, got {frequencies.shape}")
-    A, B, C = balanced_matrices(model.A, model.B, model.C)
-    response = _core.frequency_response(
-        A,
-        B,
-        C,
-        model.D,
-        frequencies,
-        period(model) if model.is_discrete else None,
-    )
+    if model.is_discrete and _clustered_at_one(model.A):
+        response = _response_about_one(model, frequencies)
+    else:
+        A, B, C = balanced_matrices(model.A, model.B, model.C)
+        response = _core.frequency_response(
+            A,
+            B,
+            C,
+            model.D,
+            frequencies,
+            period(model) if model.is_discrete else None,
+        )
     return FrequencyResponse(
         omega=np.array(frequencies, dtype=np.float64),
         response=response,
@@ -195,7 +254,9 @@ def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> Flo
     the fastest nonzero natural frequency of the modes (0.01 to 100 rad/s when every
     eigenvalue is zero; at most 1e308). For a discrete model: from a tenth of the slowest
     natural frequency of s = ln(z)/dt (or a thousandth of the Nyquist frequency, if lower) to
-    the Nyquist frequency π/dt.
+    the Nyquist frequency π/dt. A mode slower than 1e-12 of the fastest (or of the Nyquist
+    frequency), which the eigenvalues of A do not resolve from zero, is found from the
+    eigenvalues of A^-1 (discrete: (A - I)^-1) where that matrix is nonsingular.
 
     Parameters
     ----------
@@ -233,9 +294,15 @@ def default_frequency_grid(sys: System, count: int = DEFAULT_FREQUENCIES) -> Flo
         s = continuous_eigenvalues(model)
         magnitudes = np.abs(s[np.isfinite(s)])
         nonzero = magnitudes[magnitudes > 1e-12 * nyquist]
+        if nonzero.size < magnitudes.size:  # modes below 1e-12 of it: resolved from (A - I)^-1
+            nonzero = np.concatenate([nonzero, np.abs(_slow_modes(model, nyquist))])
         low = min(nonzero.min() / 10, nyquist / 1000) if nonzero.size else nyquist / 1000
         return np.logspace(np.log10(low), np.log10(nyquist), int(count))
-    _, nonzero = grid_frequencies([model], "the default frequency grid")
+    eigenvalues, nonzero = grid_frequencies([model], "the default frequency grid")
+    if nonzero.size < eigenvalues.size and nonzero.size:
+        # Modes below 1e-12 of the fastest, which the eigenvalues of A do not resolve from
+        # zero: resolved from A^-1 where A is nonsingular.
+        nonzero = np.concatenate([nonzero, np.abs(_slow_modes(model, float(nonzero.max())))])
     if nonzero.size == 0:
         return np.logspace(-2.0, 2.0, int(count))
     return np.logspace(

@@ -43,13 +43,14 @@ share their sampling period.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal, cast
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _scaling
 from ._results import Result, Tabular
@@ -222,7 +223,10 @@ def default_time_grid(sys: Systems) -> FloatArray:
 
     A step of a twentieth of 1/ρ_max, ρ_max the largest modulus of an eigenvalue, and a final
     time of 7 time constants -1/σ of the slowest decaying mode (σ its real part; 10/ρ_min when
-    no mode decays), at most 100,001 samples; a discrete model steps by its dt.
+    no mode decays), at most 100,001 samples; a discrete model steps by its dt. A decaying
+    mode slower than 1e-12 ρ_max, which the eigenvalues of A do not resolve from an
+    integrator, is found from the largest eigenvalues of A^-1 (for a discrete model, of
+    (A - I)^-1) where A is nonsingular.
 
     Parameters
     ----------
@@ -331,12 +335,57 @@ def _default_step_and_final(models: list[StateSpace]) -> tuple[float, float]:
             f"the default time grid: the fastest mode (|λ| = {fastest:.3g}) needs a step "
             f"of {step:.3g}, below the normal doubles; give the grid T"
         )
-    decaying = -eigenvalues.real[eigenvalues.real < -1e-12 * fastest]
+    resolved = eigenvalues.real < -1e-12 * fastest
+    decaying = -eigenvalues.real[resolved]
+    if not np.all(resolved):
+        # Modes within 1e-12 |λ|max of the imaginary axis, where the eigenvalues of A are
+        # rounding: those that decay, found from the largest eigenvalues of A^-1.
+        decaying = np.concatenate([decaying, *(_slow_decay_rates(m, fastest) for m in models)])
     final = 7.0 / decaying.min() if decaying.size else 10.0 / nonzero.min()
     final = max(final, 100 * step)
-    if final / step > MAX_DEFAULT_SAMPLES - 1:
+    with np.errstate(over="ignore"):  # 7e11 s over a step of 5e-302 s: inf, beyond the cap
+        ratio = final / step
+    if ratio > MAX_DEFAULT_SAMPLES - 1:
         step = final / (MAX_DEFAULT_SAMPLES - 1)
     return step, final
+
+
+def _slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
+    """The model's nonzero modes slower than 1e-12 ``fastest`` (continuous eigenvalues; for a
+    discrete model s = ln(z)/dt), which the eigenvalues of A (errors of u ||A||) do not
+    resolve from zero: the eigenvalues of M = A (discrete: A - I) are 1/μ for μ those of
+    M^-1, whose largest are resolved to a relative u. M^-1 is solved as the steady state is
+    (equilibrated where the core refuses M); a singular M (an integrator) gives none, as its
+    slow modes cannot be told from the integrator's zero."""
+    n = model.n_states
+    none = np.zeros(0, dtype=np.complex128)
+    if n == 0:
+        return none
+    dt = period(model)
+    M = model.A - np.eye(n) if dt else model.A
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            inverse = -_equilibrated_solve(M, np.eye(n), np.eye(n), False)
+    except SingularMatrixError:
+        return none
+    if not np.all(np.isfinite(inverse)):
+        return none
+    mu = _core.eigenvalues(inverse)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        slow = 1.0 / mu[mu != 0]
+        if dt:
+            slow = np.log1p(slow) / dt
+    keep = np.isfinite(slow) & (slow != 0) & (np.abs(slow) < 1e-12 * fastest)
+    return np.asarray(slow[keep], dtype=np.complex128)
+
+
+def _slow_decay_rates(model: StateSpace, fastest: float) -> FloatArray:
+    """The decay rates -Re λ of the ``_slow_modes`` that decay (Re λ < -1e-12 |λ|: an
+    undamped one with a real part of rounding does not)."""
+    slow = _slow_modes(model, fastest)
+    decaying = slow.real < -1e-12 * np.abs(slow)
+    return np.asarray(-slow.real[decaying], dtype=np.float64)
 
 
 def _grid(T: ArrayLike | None, models: list[StateSpace]) -> tuple[FloatArray, float]:
@@ -1056,7 +1105,8 @@ def forced_response(
 
 def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     """The state a step η0 settles to, x∞ = -A^-1 B η0 (6.45), for a stable system; for a
-    discrete model, x∞ = (I - A)^-1 B η0.
+    discrete model, x∞ = (I - A)^-1 B η0. An unstable system has none, and is refused
+    (:func:`dc_gain` gives the output of the equilibrium -A^-1 B η0 whatever the stability).
 
     Raises SingularMatrixError naming the zero eigenvalue when A is singular (an integrator
     has no steady state); for a discrete model, the eigenvalue 1 of A. The core refuses an A
@@ -1083,6 +1133,9 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
 
     Raises
     ------
+    InvalidArgumentError
+        ``sys`` is unstable: an eigenvalue with Re s > 1e-12 |s| (for a discrete model,
+        |z| > 1: s = ln(z)/dt); the step then never settles.
     SingularMatrixError
         A (for a discrete model A - I) is singular, even equilibrated.
     ShapeError
@@ -1111,7 +1164,46 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
             f"eta0 must be a 1-D array of one value per input, got an array of shape "
             f"{weights.shape}"
         )
-    return _steady_state(A, B, dt, weights) if dt else _equilibrated_solve(A, B, weights, True)
+    x = _steady_state(A, B, dt, weights) if dt else _equilibrated_solve(A, B, weights, True)
+    _require_settling(A, dt)  # after the solve: a singular A is refused as such
+    return x
+
+
+#: A mode counts as unstable where Re s > UNSTABLE_MARGIN |s| (s = ln(z)/dt for a discrete
+#: model): an undamped mode computed with a real part of rounding size is not one.
+UNSTABLE_MARGIN = 1e-12
+
+
+def _require_settling(A: FloatArray, dt: float) -> None:
+    """InvalidArgumentError naming ``sys`` where a mode of A grows (Re s > 1e-12 |s|; for a
+    discrete model s = ln(z)/dt, |z| > 1): x∞ = -A^-1 B η0 is then an equilibrium that a step
+    never reaches. The margin is relative to each mode's own modulus, so that the slow mode
+    of a stiff model (-1e-7 beside -1e6) and a decaying mode of a badly scaled one (-1.25 ±
+    2e231 j) pass, and an undamped mode whose real part is rounding (±1e-17 beside j) is not
+    called unstable. A zero eigenvalue is left to the solve, which refuses it as singular."""
+    if A.shape[0] == 0:
+        return
+    eigenvalues = _core.eigenvalues(A)
+    if dt:
+        eigenvalues = eigenvalues[eigenvalues != 0]
+        if not eigenvalues.size or float(np.abs(eigenvalues).max()) <= 1.0:
+            return
+        eigenvalues = np.log(eigenvalues) / dt
+    elif float(eigenvalues.real.max()) <= 0.0:
+        return
+    with np.errstate(over="ignore", invalid="ignore"):
+        growing = eigenvalues.real > UNSTABLE_MARGIN * np.abs(eigenvalues)
+    if not np.any(growing):
+        return
+    worst = eigenvalues[growing][np.argmax(eigenvalues.real[growing])]
+    mode = f"z = {complex(np.exp(worst * dt)):.6g}" if dt else f"s = {complex(worst):.6g}"
+    error = InvalidArgumentError(
+        f"sys is unstable (a mode at {mode}), so a step never settles and has no steady "
+        "state (-A^-1 B η0 is an equilibrium it grows away from; dc_gain gives the output "
+        "there)"
+    )
+    error.argument = "sys"
+    raise error
 
 
 def _steady_state(

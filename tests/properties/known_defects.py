@@ -188,28 +188,3 @@ CLOSED_LOOP_POLES_OF_GRADED_LOOPS = known_defect(
     "poles on the factored characteristic polynomial, find -2 and Z = 0)",
     _loop_poles_far_apart,
 )
-
-
-def _badly_scaled_state_matrix(args: dict[str, Any]) -> bool:
-    """An A whose largest and smallest nonzero entries differ by more than 1e12 (states
-    scaled by 10^±6 or so)."""
-    A = args.get("A", args.get("sys_or_A"))
-    if A is None or np.ndim(A) != 2:
-        return False
-    entries = np.abs(np.asarray(A, dtype=float))
-    entries = entries[entries > 0]
-    return bool(entries.size) and float(np.max(entries)) > 1e12 * float(np.min(entries))
-
-
-DARE_BADLY_SCALED_STATES = known_defect(
-    "dare-badly-scaled-states",
-    {"solve_dare", "dlqr"},
-    "the core's solve_dare refuses a well-posed discrete Riccati equation whose states are "
-    "scaled by 10^±6 (NoStabilizingSolutionError: 2 of the 6 pencil eigenvalues inside the "
-    "unit circle, not 3): a random ZOH 3-state model with Q = I, R = 1, in the coordinates "
-    "T = diag(1e-5, 1e6, 1e-4) (Q = T^-T T^-1), which scipy's solve_discrete_are solves "
-    "(relative residual 1.6e-13, closed-loop |λ| 0.572, 0.228, 0.228, as aerocontrol's own "
-    "solve of the unscaled equation); the symplectic pencil is not balanced before the QZ "
-    "(found by an oracle hunt; slycot's dlqr gives a different, wrong, closed loop there)",
-    _badly_scaled_state_matrix,
-)

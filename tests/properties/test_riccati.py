@@ -48,7 +48,6 @@ from aerocontrol.exceptions import AerocontrolError, IllConditionedWarning
 from aerocontrol.riccati import RCOND_WARNING, RESIDUAL_WARNING
 
 from .harness import SAME, Arg, Outcome, Warned, _known_defect, exercise, plain
-from .known_defects import DARE_BADLY_SCALED_STATES
 from .oracles import (
     SLACK,
     TINY,
@@ -911,11 +910,12 @@ def test_riccati_difference(data: st.DataObject) -> None:
 # ----- known defects of the core (see known_defects.py) ------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason="dare-badly-scaled-states: refused in states scaled by 1e6")
-def test_known_defect_dare_badly_scaled_states() -> None:
-    """A defect of the native core found by an oracle hunt (see ``known_defects.py``): the
-    regulator of a well-conditioned 3-state model in states T = diag(1e-5, 1e6, 1e-4), which
-    is that of the unscaled model (X = T^-T X0 T^-1, K = K0 T^-1, the same closed loop)."""
+def test_regression_dare_badly_scaled_states() -> None:
+    """Found by an oracle hunt (the core refused it: 2 of the 6 pencil eigenvalues inside the
+    unit circle, not 3), fixed by the exact scaling of the equation before the core's solve:
+    the regulator of a well-conditioned 3-state model in states T = diag(1e-5, 1e6, 1e-4),
+    which is that of the unscaled model (X = T^-T X0 T^-1, K = K0 T^-1, the same closed
+    loop)."""
     A = np.array(
         [
             [0.9153299667155719, -4.225366333414862e-12, 0.08260637158803313],
@@ -931,9 +931,12 @@ def test_known_defect_dare_badly_scaled_states() -> None:
     K = np.linalg.solve(B.T @ X @ B + R, B.T @ X @ A)
     theirs = np.sort(np.abs(np.linalg.eigvals(A - B @ K)))
     np.testing.assert_allclose(np.sort(np.abs(unscaled)), theirs, rtol=1e-8)
-    with DARE_BADLY_SCALED_STATES.reproducing():
-        _, _, poles = aerocontrol.dlqr(A, B, Q, R)
-    np.testing.assert_allclose(np.sort(np.abs(poles)), theirs, rtol=1e-6)
+    K_ours, X_ours, poles = aerocontrol.dlqr(A, B, Q, R)
+    np.testing.assert_allclose(np.sort(np.abs(poles)), theirs, rtol=1e-10)
+    np.testing.assert_allclose(K_ours, K, rtol=1e-8)
+    # X in the scaled states: entry (i, j) relative to sqrt(X_ii X_jj).
+    size = np.sqrt(np.outer(np.diag(X), np.diag(X)))
+    assert np.max(np.abs(X_ours - X) / size) < 1e-9
 
 
 def test_regression_care_empty_indefinite_rcond() -> None:
