@@ -56,6 +56,7 @@ __all__ = [
     "solve_care",
     "solve_dare",
     "solve_lyapunov",
+    "states_scaled_apart",
     "steady_state",
     "transfer_channels",
     "transition_matrices",
@@ -132,6 +133,7 @@ def steady_state(
     a: ArrayLike, b: ArrayLike, eta0: ArrayLike, warn: bool, /
 ) -> NDArray[np.float64]: ...
 def dc_gain(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /) -> NDArray[np.float64]: ...
+def states_scaled_apart(a: ArrayLike, /) -> bool: ...
 def balance_states(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...

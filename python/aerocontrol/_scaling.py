@@ -30,6 +30,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from . import _core
+
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
@@ -41,11 +43,6 @@ SWEEPS = 100
 #: exponents span at least this many powers of two (states scaled apart by about 1e3 or
 #: more); below, it would change the results only by rounding.
 BALANCING_SPREAD = 10
-_SPREAD_RATIO = 2.0**BALANCING_SPREAD
-
-#: Matrices of at most this many entries take state_balancing's first test in scalar
-#: arithmetic.
-_SCALAR_TEST_MAX_ENTRIES = 64
 
 
 def log2_sizes(M: NDArray[np.floating[Any]]) -> FloatArray:
@@ -181,29 +178,6 @@ def similarity(
         )
 
 
-def _balanced_enough_scalar(rows: list[list[float]]) -> bool:
-    """The second test of :func:`state_balancing` in scalar arithmetic (a small A as nested
-    lists): every state's largest off-diagonal entries in its row and in its column within
-    2^10 of each other (or one of them zero). A NaN may pass it: the finiteness check that
-    follows in :func:`state_balancing` refuses it."""
-    n = len(rows)
-    row_max = [0.0] * n
-    column_max = [0.0] * n
-    for i, row in enumerate(rows):
-        for j, value in enumerate(row):
-            if i != j:
-                size = abs(value)
-                if not size <= row_max[i]:
-                    row_max[i] = size
-                if not size <= column_max[j]:
-                    column_max[j] = size
-    for r, c in zip(row_max, column_max, strict=True):
-        low, high = (r, c) if r <= c else (c, r)
-        if not (low == 0.0 or high <= _SPREAD_RATIO * low):
-            return False
-    return True
-
-
 def state_balancing(
     A: FloatArray,
     inputs: tuple[FloatArray, ...] = (),
@@ -220,34 +194,12 @@ def state_balancing(
     n = A.shape[0] if A.ndim == 2 else 0
     if n < 2 or A.shape != (n, n):
         return None
-    # First the cheap test: the nonzero entries within 2^10 of each other are scaled well
-    # enough (NaN is left out: the finiteness check below refuses it). In scalar arithmetic
-    # up to order 8 (about 1.5 us, where numpy's five calls cost 5.6 us beside a placement of
-    # 4 states in 3).
-    if A.size <= _SCALAR_TEST_MAX_ENTRIES:
-        values = [m for m in map(abs, A.ravel().tolist()) if m > 0.0]
-        if len(values) < 2 or not max(values) >= _SPREAD_RATIO * min(values):
-            return None
-    else:
-        magnitudes = np.abs(A)
-        nonzero = magnitudes[magnitudes > 0.0]
-        if nonzero.size < 2 or not nonzero.max() >= _SPREAD_RATIO * nonzero.min():
-            return None
-    # Then a test of the scaling itself (a few microseconds, where the balancing below costs
-    # hundreds at n = 16): no state's largest off-diagonal entry in its row and in its column
-    # more than 2^10 apart. A random matrix, whose entries spread over decades, passes it;
-    # states scaled apart by 1e3 or more (a row divided and a column multiplied by that)
-    # fail it.
-    if A.size <= _SCALAR_TEST_MAX_ENTRIES:
-        if _balanced_enough_scalar(A.tolist()):
-            return None
-    else:
-        off_diagonal = np.abs(A)
-        np.fill_diagonal(off_diagonal, 0.0)
-        rows, columns = off_diagonal.max(axis=1), off_diagonal.max(axis=0)
-        low, high = np.minimum(rows, columns), np.maximum(rows, columns)
-        if np.all((low == 0.0) | (high <= _SPREAD_RATIO * low)):
-            return None
+    # First the core's cheap test (one pass over A, about 0.3 us from Python): no state's
+    # largest off-diagonal entry in its row and in its column more than 2^10 apart. A random
+    # matrix, whose entries spread over decades, passes it; states scaled apart by 1e3 or more
+    # (a row divided and a column multiplied by that) fail it.
+    if not _core.states_scaled_apart(A):
+        return None
     given = (A, *inputs, *outputs, *weights)
     if not all(np.all(np.isfinite(M)) for M in given):
         return None

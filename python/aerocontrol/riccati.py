@@ -582,6 +582,8 @@ def _riccati_scaling(
     n = A.shape[0] if A.ndim == 2 else 0
     if n == 0 or A.shape != (n, n) or B.ndim != 2 or B.shape[0] != n:
         return None
+    if not discrete and E is None and not _core.states_scaled_apart(A):
+        return None  # the balancing's own first test, before the weights are read
     try:
         Q_matrix, R_matrix = matrix_view(Q, "Q"), matrix_view(R, "R")
         S_matrix = None if S is None else matrix_view(S, "S")

@@ -9,7 +9,10 @@ use crate::control::root_locus::{
     loop_root_locus as loop_root_locus_core, root_locus as root_locus_core,
 };
 use crate::error::Error;
-use crate::linalg::balance::{balanced_loop as balanced_loop_core, balanced_states};
+use crate::linalg::balance::{
+    balanced_loop as balanced_loop_core, balanced_states,
+    states_scaled_apart as states_scaled_apart_core,
+};
 use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -289,7 +292,20 @@ fn balance_states<'py>(
     Ok(result)
 }
 
+/// Whether some state of the square matrix A is scaled apart from the others
+/// (`linalg/balance.rs`, states_scaled_apart: its row's and its column's largest off-diagonal
+/// magnitudes more than 2^10 apart): the cheap test before a balancing. False for a matrix that
+/// is not square (its caller refuses it by name); a NaN entry is passed over.
+#[pyfunction]
+#[pyo3(signature = (a, /))]
+fn states_scaled_apart(py: Python<'_>, a: &Bound<'_, PyAny>) -> PyResult<bool> {
+    let a = Real::convert(py, a, "A")?;
+    let a = a.matrix().map_err(|e| to_py_err(py, e))?;
+    Ok(a.nrows() == a.ncols() && states_scaled_apart_core(a))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(states_scaled_apart, m)?)?;
     m.add_function(wrap_pyfunction!(balance_states, m)?)?;
     m.add_function(wrap_pyfunction!(balanced_loop, m)?)?;
     m.add_function(wrap_pyfunction!(loop_root_locus, m)?)?;

@@ -69,9 +69,7 @@
 
 use crate::control::modal::eigen;
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::linalg::balance::{
-    balanced_states_with_scaling, range_scale, scale_for_largest, states_scaled_apart,
-};
+use crate::linalg::balance::{balanced_where_scaled_apart, range_scale, scale_for_largest};
 use crate::linalg::dense::view_product_into;
 use crate::linalg::householder::reflector;
 use crate::linalg::norm::{frobenius_norm, max_abs, vector_norm};
@@ -221,18 +219,15 @@ enum Duality {
 
 /// (T A T^-1, T B) and the diagonal of T: the states of the pair balanced by powers of two
 /// (`linalg/balance.rs`'s Osborne iteration on the rows of [A B] and the columns of A), where
-/// A's states are scaled apart ([`states_scaled_apart`]); None where they are not (the pair
+/// A's states are scaled apart ([`balanced_where_scaled_apart`]); None where they are not (the pair
 /// is analysed as given) or the scaling would not be exact. Controllability does not depend
 /// on the coordinates, but the staircase's reflections and the modal test's unit eigenvectors
 /// are accurate to u times the norm of the pair they are given: states in units 10^6 apart put
 /// errors of the large states' size into the small states' entries, and a controllable pair
 /// came out uncontrollable, with a staircase eigenvalue that A does not have.
 fn balanced_pair(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Option<(Mat<f64>, Mat<f64>, Vec<f64>)> {
-    if !states_scaled_apart(a) {
-        return None;
-    }
     let outputs = Mat::<f64>::zeros(0, a.nrows());
-    balanced_states_with_scaling(a, b, outputs.as_ref()).map(|(a, b, _, t)| (a, b, t))
+    balanced_where_scaled_apart(a, b, outputs.as_ref()).map(|(a, b, _, t)| (a, b, t))
 }
 
 /// A pair (A, B) of a plant matrix and its inputs (or the dual (A^T, C^T)).
@@ -626,6 +621,7 @@ fn reflect_columns(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::balance::states_scaled_apart;
     use faer::mat;
 
     fn pseudo_random(n: usize, m: usize, seed: u64) -> Mat<f64> {

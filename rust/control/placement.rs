@@ -48,9 +48,7 @@
 use crate::control::controllability::{controllability, controllability_staircase, krylov_blocks};
 use crate::control::modal::polynomial_from_roots;
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
-use crate::linalg::balance::{
-    balanced_states_with_scaling, range_scale, scale_for_largest, states_scaled_apart,
-};
+use crate::linalg::balance::{balanced_where_scaled_apart, range_scale, scale_for_largest};
 use crate::linalg::charpoly::charpoly;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
@@ -263,8 +261,7 @@ pub fn place_ackermann(
 }
 
 /// The design `placer` makes for (A, B), made for the pair with its states balanced where A's
-/// states are scaled apart (`linalg/balance.rs`'s states_scaled_apart: units 10^3 or more
-/// apart): with A' = T A T^-1 and B' = T B (T diagonal, of powers of two: exact), the gain K'
+/// states are scaled apart ([`balanced_where_scaled_apart`]: units 10^3 or more apart): with A' = T A T^-1 and B' = T B (T diagonal, of powers of two: exact), the gain K'
 /// of the same poles gives K = K' T and A - B K = T^-1 (A' - B' K') T, while the methods'
 /// errors are relative to the size of A' rather than of A (states scaled by 1e±6 came back
 /// with poles 147 % off, or were refused as uncontrollable). The conditions reported are
@@ -274,11 +271,12 @@ fn on_balanced_states(
     b: MatRef<'_, f64>,
     placer: impl FnOnce(MatRef<'_, f64>, MatRef<'_, f64>) -> Result<Placement, Error>,
 ) -> Result<Placement, Error> {
-    if a.nrows() != a.ncols() || b.nrows() != a.nrows() || !states_scaled_apart(a) {
-        return placer(a, b);
-    }
     let outputs = Mat::<f64>::zeros(0, a.nrows());
-    let Some((a2, b2, _, t)) = balanced_states_with_scaling(a, b, outputs.as_ref()) else {
+    let conformal = a.nrows() == a.ncols() && b.nrows() == a.nrows();
+    let Some((a2, b2, _, t)) = conformal
+        .then(|| balanced_where_scaled_apart(a, b, outputs.as_ref()))
+        .flatten()
+    else {
         return placer(a, b);
     };
     let mut design = placer(a2.as_ref(), b2.as_ref())?;
@@ -788,6 +786,7 @@ fn condition_number(x: &Mat<c64>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::balance::states_scaled_apart;
     use crate::linalg::schur::eigenvalues;
     use faer::mat;
 

@@ -253,6 +253,21 @@ pub(crate) fn balanced_loop(
     (a2, scaled(&b2, -p), scaled(&c2, -q))
 }
 
+/// [`balanced_states_with_scaling`] of (A, B, C) (A square, B with n rows, C with n
+/// columns) where A's states are scaled apart ([`states_scaled_apart`]); None where they are
+/// not, or where the scaling would not be exact: the caller then works on the system as
+/// given, so that a well-scaled system's results do not change.
+pub(crate) fn balanced_where_scaled_apart(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+) -> Option<ScaledStates> {
+    if !states_scaled_apart(a) {
+        return None;
+    }
+    balanced_states_with_scaling(a, b, c)
+}
+
 /// Balances A in place by a diagonal similarity D^-1 A D with powers of two (no permutations):
 /// row and column i are scaled until their off-diagonal 2-norms are within a factor of two, and
 /// the sweep repeats while a scaling reduces the sum of the two norms by 5 % or more. Returns

@@ -30,7 +30,7 @@
 //! these orders (the 4-state models of flight dynamics, and the Riccati solver's Newton steps).
 
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::linalg::balance::{balanced_states_with_scaling, range_scale, states_scaled_apart};
+use crate::linalg::balance::{balanced_where_scaled_apart, range_scale};
 use crate::linalg::dense::view_product;
 use crate::linalg::matrix::{FaerView, Symmetrize, from_faer, with_order};
 use crate::linalg::schur::real_schur;
@@ -42,7 +42,7 @@ use nalgebra::DMatrix;
 
 /// The solution X of A X + X A^T + Q = 0 (symmetric when Q is).
 ///
-/// Where A's states are scaled apart ([`states_scaled_apart`]: units 10^3 or more apart) the
+/// Where A's states are scaled apart ([`balanced_where_scaled_apart`]: units 10^3 or more apart) the
 /// equation is solved in balanced states, exactly: with A' = T A T^-1 (T diagonal, of powers
 /// of two), X' = T X T solves A' X' + X' A'^T + T Q T = 0, and X = T^-1 X' T^-1. The method's
 /// errors are relative to ||A|| and ||X||: unbalanced, states scaled by 1e±6 had entries of X
@@ -52,8 +52,7 @@ pub fn solve_lyapunov(a: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Result<Mat<f64>
     let n = a.nrows();
     let conformal = a.ncols() == n && q.nrows() == n && q.ncols() == n;
     if conformal
-        && states_scaled_apart(a)
-        && let Some((a2, _, _, t)) = balanced_states_with_scaling(
+        && let Some((a2, _, _, t)) = balanced_where_scaled_apart(
             a,
             Mat::<f64>::zeros(n, 0).as_ref(),
             Mat::<f64>::zeros(0, n).as_ref(),
