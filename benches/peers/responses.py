@@ -322,6 +322,14 @@ def _steady_numpy(A: Any, B: Any, C: Any, D: Any, eta0: Any) -> Any:
     return np.linalg.solve(A, -(B @ eta0))
 
 
+def _steady_checked_numpy(A: Any, B: Any, C: Any, D: Any, eta0: Any) -> Any:
+    """What steady_state computes: the equilibrium, and whether the response reaches it
+    (every eigenvalue of A in the open left half-plane; steady_state refuses it otherwise)."""
+    if not np.all(np.linalg.eigvals(A).real < 0.0):
+        raise ValueError("unstable: no steady state")
+    return np.linalg.solve(A, -(B @ eta0))
+
+
 def _dc_gain_ours(A: Any, B: Any, C: Any, D: Any, eta0: Any) -> Any:
     return aerocontrol.dc_gain((A, B, C, D))
 
@@ -339,7 +347,9 @@ def steady_state_cases() -> list[Case]:
     longitudinal model, random stable plants with 2 inputs and 2 outputs (n = 16, 64, 256).
 
     Peers: numpy.linalg.solve (both), python-control's dcgain (squeezed for one input, so
-    compared after a reshape).
+    compared after a reshape); for steady_state also the composite that gives what it
+    computes, numpy's eigenvalues to decide that the response settles (steady_state refuses
+    an unstable model) and the solve.
     """
     cases = []
     for n in (4, *SIZES):
@@ -352,7 +362,10 @@ def steady_state_cases() -> list[Case]:
                 seed=n,
                 setup=setup,
                 ours=_steady_ours,
-                peers=[Peer("numpy.linalg.solve", _steady_numpy)],
+                peers=[
+                    Peer("numpy.linalg.solve", _steady_numpy),
+                    Peer("numpy eigvals (stable?) + solve", _steady_checked_numpy),
+                ],
             )
         )
         cases.append(
