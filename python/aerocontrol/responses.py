@@ -1134,8 +1134,8 @@ def steady_state(sys: System, eta0: ArrayLike) -> FloatArray:
     Raises
     ------
     InvalidArgumentError
-        ``sys`` is unstable: an eigenvalue with Re s > 1e-12 |s| (for a discrete model,
-        |z| > 1: s = ln(z)/dt); the step then never settles.
+        ``sys`` is unstable: an eigenvalue with Re s > 1e-12 abs(s) (for a discrete model,
+        abs(z) > 1: s = ln(z)/dt); the step then never settles.
     SingularMatrixError
         A (for a discrete model A - I) is singular, even equilibrated.
     ShapeError
