@@ -206,24 +206,7 @@ fn balanced_loop<'py>(
     Bound<'py, PyArrayDyn<f64>>,
     Bound<'py, PyArrayDyn<f64>>,
 )> {
-    let a = Real::convert(py, a, "A")?;
-    let b = Real::convert(py, b, "B")?;
-    let c = Real::convert(py, c, "C")?;
-    let (a, b, c) = (
-        a.matrix().map_err(|e| to_py_err(py, e))?,
-        b.matrix().map_err(|e| to_py_err(py, e))?,
-        c.matrix().map_err(|e| to_py_err(py, e))?,
-    );
-    check_system_shapes(py, a, b, c)?;
-    let (am, bm, cm) = balanced_loop_core(a, b, c);
-    let mut outputs = Outputs::new(py);
-    let result = (
-        outputs.matrix("A", am.as_ref())?,
-        outputs.matrix("B", bm.as_ref())?,
-        outputs.matrix("C", cm.as_ref())?,
-    );
-    outputs.finish()?;
-    Ok(result)
+    balanced_system(py, (a, b, c), balanced_loop_core)
 }
 
 /// InvalidArgumentError unless A is n x n, B n x m and C p x n.
@@ -271,6 +254,26 @@ fn balance_states<'py>(
     Bound<'py, PyArrayDyn<f64>>,
     Bound<'py, PyArrayDyn<f64>>,
 )> {
+    balanced_system(py, (a, b, c), |a, b, c| {
+        balanced_states(a, b, c).unwrap_or_else(|| (a.to_owned(), b.to_owned(), c.to_owned()))
+    })
+}
+
+/// The system (A, B, C) converted and checked, through `balance`, as three arrays.
+#[allow(clippy::type_complexity)]
+fn balanced_system<'py>(
+    py: Python<'py>,
+    (a, b, c): (&Bound<'py, PyAny>, &Bound<'py, PyAny>, &Bound<'py, PyAny>),
+    balance: impl FnOnce(
+        faer::MatRef<'_, f64>,
+        faer::MatRef<'_, f64>,
+        faer::MatRef<'_, f64>,
+    ) -> (faer::Mat<f64>, faer::Mat<f64>, faer::Mat<f64>),
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
+)> {
     let a = Real::convert(py, a, "A")?;
     let b = Real::convert(py, b, "B")?;
     let c = Real::convert(py, c, "C")?;
@@ -280,8 +283,7 @@ fn balance_states<'py>(
         c.matrix().map_err(|e| to_py_err(py, e))?,
     );
     check_system_shapes(py, a, b, c)?;
-    let (am, bm, cm) =
-        balanced_states(a, b, c).unwrap_or_else(|| (a.to_owned(), b.to_owned(), c.to_owned()));
+    let (am, bm, cm) = balance(a, b, c);
     let mut outputs = Outputs::new(py);
     let result = (
         outputs.matrix("A", am.as_ref())?,
