@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _scaling, riccati
+from . import _core
 from ._results import Result
 from ._validation import FloatArray, positive_int, real_array
 from .exceptions import AerocontrolError, IllConditionedWarning, InvalidArgumentError, ShapeError
@@ -325,68 +325,6 @@ def place_batch(A: ArrayLike, B: ArrayLike, poles: ArrayLike, method: str = "knv
     return batch
 
 
-def _scaled_riccati_stacks(
-    stacks: tuple[FloatArray, ...], discrete: bool
-) -> tuple[tuple[FloatArray, ...], dict[int, Any]]:
-    """The stacks of :func:`solve_care_batch` and :func:`solve_dare_batch` with each problem
-    scaled as the single solves scale it (``riccati._riccati_scaling``: the states balanced,
-    all states and the costs by powers of two), so that each problem is solved exactly as
-    alone; and the scalings of the problems scaled, by index (their X and K are taken back
-    by :func:`_unscaled_riccati`). Stacks the core will refuse by shape, as given."""
-    A, B, Q, R = stacks
-    if any(M.ndim != 3 for M in stacks) or A.shape[1:] != (A.shape[1], A.shape[1]):
-        return stacks, {}
-    count, n = max(len(M) for M in stacks), A.shape[1]
-    if count == 0 or n == 0 or any(len(M) not in (1, count) for M in stacks):
-        return stacks, {}
-    if B.shape[1] != n or Q.shape[1:] != (n, n) or R.shape[1:] != (B.shape[2], B.shape[2]):
-        return stacks, {}
-    # The cheap tests, over the stacks at once: A's entries spread over 2^10 or more (states
-    # that may be scaled apart), or B or Q far from 1 (all the states or the costs scaled).
-    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        magnitudes = np.abs(A)
-        largest = magnitudes.max(axis=(1, 2))
-        smallest = np.min(magnitudes, axis=(1, 2), where=magnitudes > 0.0, initial=np.inf)
-        flagged = largest >= 2.0**_scaling.BALANCING_SPREAD * smallest
-        far = ((B, _scaling.BALANCING_SPREAD), (Q, 2 * _scaling.BALANCING_SPREAD))
-        for M, limit in far if discrete else ():
-            size = np.abs(np.log2(np.abs(M).max(axis=(1, 2), initial=0.0)))
-            flagged = flagged | ((size >= limit) & np.isfinite(size))
-    flagged = np.broadcast_to(flagged, (count,)) if flagged.size == 1 else flagged
-    found: dict[int, Any] = {}
-    for i in np.flatnonzero(flagged).tolist():
-        a, b, q, r = (M[i if len(M) > 1 else 0] for M in stacks)
-        scaled = riccati._riccati_scaling(a, b, q, r, None, None, discrete=discrete)
-        if scaled is not None:
-            found[i] = scaled
-    if not found:
-        return stacks, {}
-    full = [np.array(np.broadcast_to(M, (count, *M.shape[1:]))) for M in stacks]
-    for i, scaled in found.items():
-        full[0][i], full[1][i], full[2][i], full[3][i] = scaled.A, scaled.B, scaled.Q, scaled.R
-    return tuple(full), found
-
-
-def _unscaled_riccati(result: Any, found: dict[int, Any], discrete: bool) -> Any:
-    """The core's batch result with the X and K of the scaled problems taken back to the
-    caller's states and costs (X = 2^-k T^-1 X̃ T^-1, K = K̃ T^-1) and their residuals those
-    of the caller's equations, as the single solves report them."""
-    if not found:
-        return result
-    X, K, poles, residual, rcond, *rest = result
-    X, K, residual = np.array(X), np.array(K), np.array(residual)
-    for i, scaled in found.items():
-        e = scaled.exponents
-        with np.errstate(over="ignore", under="ignore"):
-            X[i] = np.ldexp(X[i], -scaled.cost - (e[:, np.newaxis] + e[np.newaxis, :]))
-            K[i] = np.ldexp(K[i], -e[np.newaxis, :])
-        if np.all(np.isfinite(X[i])) and np.all(np.isfinite(K[i])):
-            unscaled = riccati._riccati_residual(scaled, X[i], K[i], discrete)
-            if np.isfinite(unscaled):
-                residual[i] = unscaled
-    return (X, K, poles, residual, rcond, *rest)
-
-
 def _stack(value: object, name: str) -> FloatArray:
     array = real_array(value, name)
     if array.ndim == 2:
@@ -555,11 +493,8 @@ def solve_care_batch(
     >>> batch.K.shape, bool(np.all(batch.closed_loop_poles.real < 0))
     ((500, 2, 4), True)
     """
-    stacks, found = _scaled_riccati_stacks(
-        (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R")), False
-    )
-    solved = _solved("care_batch", stacks, (bool(refine),), client, worker_threads)
-    batch = CareBatch(*_unscaled_riccati(solved, found, False))
+    stacks = (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
+    batch = CareBatch(*_solved("care_batch", stacks, (bool(refine),), client, worker_threads))
     _warn(
         np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING)),
         f"of the {len(batch)} Riccati solutions may be inaccurate (rcond(U11) < "
@@ -628,11 +563,8 @@ def solve_dare_batch(
     >>> batch.K.shape, bool(np.all(abs(batch.closed_loop_poles) < 1))
     ((200, 2, 4), True)
     """
-    stacks, found = _scaled_riccati_stacks(
-        (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R")), True
-    )
-    solved = _solved("dare_batch", stacks, (), client, worker_threads)
-    batch = DareBatch(*_unscaled_riccati(solved, found, True))
+    stacks = (_stack(A, "A"), _stack(B, "B"), _stack(Q, "Q"), _stack(R, "R"))
+    batch = DareBatch(*_solved("dare_batch", stacks, (), client, worker_threads))
     _warn(
         np.flatnonzero((batch.rcond < RCOND_WARNING) | (batch.residual > RESIDUAL_WARNING)),
         f"of the {len(batch)} discrete Riccati solutions may be inaccurate (rcond(U11) < "

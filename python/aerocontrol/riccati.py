@@ -21,7 +21,6 @@ S(t_f) = S_f, or, for an infinite horizon, the algebraic equation (6.199).
 
 from __future__ import annotations
 
-import math
 import operator
 import warnings
 from dataclasses import dataclass
@@ -30,14 +29,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _scaling
+from . import _core
 from ._results import Result, Tabular, format_complex, format_number
 from ._validation import FloatArray, real_array
 from .exceptions import (
-    AerocontrolError,
     IllConditionedWarning,
     InvalidArgumentError,
-    NumericalOverflowWarning,
 )
 from .statespace import (
     as_state_space,
@@ -170,6 +167,10 @@ def solve_care(
     (relative). On the 747's lateral regulator over c = 1e-3..10 the relative error of X
     against 50-digit solutions is then 1.8 u in the median and 12.6 u at worst (scipy's: 15 u
     and 82 u; python-control's: 70 u and 628 u).
+    Where the states are measured in units 1e3 or more apart, the equation is first taken
+    to balanced states by an exact diagonal similarity of powers of two (x = T x̃:
+    T^-1 A T, T^-1 B, T Q T, T S, T^-1 E T), solved there, and X and K taken back; the
+    residual reported is that of the equation as given.
 
     Parameters
     ----------
@@ -254,12 +255,7 @@ def _solve_care(
     # The core shapes the weights (a scalar R as 1 x 1, as numpy.atleast_2d); A and B are
     # read here (a scalar as 1 x 1, a 1-D B as a column).
     A_matrix, B_matrix = matrix_view(A, "A"), matrix_view(B, "B")
-    scaled = _riccati_scaling(A_matrix, B_matrix, Q, R, S, E, discrete=False)
-    result: tuple[FloatArray, FloatArray, ComplexArray, float, float, int]
-    if scaled is None:
-        result = _core.solve_care(A_matrix, B_matrix, Q, R, S, E, bool(refine), cross == "N")
-    else:
-        result = _scaled_solve(scaled, False, bool(refine), cross == "N")
+    result = _core.solve_care(A_matrix, B_matrix, Q, R, S, E, bool(refine), cross == "N")
     rcond, residual = result[4], result[3]
     if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
         warnings.warn(
@@ -418,7 +414,10 @@ def solve_dare(
     columns compressed away by a QR factorisation, then aerocontrol's own QZ algorithm
     (:func:`~aerocontrol.qz`) reordered to put the eigenvalues inside the unit circle first;
     X = U21 (E U11)^-1 from that deflating subspace, then Newton steps (Hewer 1971; each a
-    Stein equation; with E only up to n = 16) while the residual decreases. Neither A nor R need be
+    Stein equation; with E only up to n = 16) while the residual decreases. Where the states
+    are measured in units 1e3 or more apart, or B or the weights are far from 1, the equation
+    is solved in exactly scaled units (states balanced and shifted by powers of two, the costs
+    multiplied by one), whose X and K are taken back. Neither A nor R need be
     invertible, and R need not be definite (only R + B^T X B nonsingular). Before it is
     returned the solution is verified: no eigenvalue of the pencil on the unit circle,
     exactly n inside, E U11 nonsingular, and every closed-loop eigenvalue inside the unit
@@ -482,11 +481,7 @@ def _solve_dare(
     """The native solve, warning (at the caller of :func:`solve_dare` or :func:`dlqr`) when
     the solution may be inaccurate; ``cross`` names the cross weight in errors (N for dlqr)."""
     A_matrix, B_matrix = matrix_view(A, "A"), matrix_view(B, "B")
-    scaled = _riccati_scaling(A_matrix, B_matrix, Q, R, S, E, discrete=True)
-    if scaled is None:
-        result = _core.solve_dare(A_matrix, B_matrix, Q, R, S, E, cross == "N")
-    else:
-        result = _scaled_solve(scaled, True, False, cross == "N")
+    result = _core.solve_dare(A_matrix, B_matrix, Q, R, S, E, cross == "N")
     residual, rcond = result[3], result[4]
     if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
         warnings.warn(
@@ -496,217 +491,6 @@ def _solve_dare(
             stacklevel=3,
         )
     return result
-
-
-@dataclass(frozen=True)
-class _ScaledRiccati:
-    """A Riccati equation (continuous or discrete) in the states x = T x̃ (T = diag(2^e))
-    with its costs multiplied by 2^k: Ã = T^-1 A T, B̃ = T^-1 B, Q̃ = 2^k T Q T, R̃ = 2^k R,
-    S̃ = 2^k T S, Ẽ = T^-1 E T (S and E None where not given). Its solution is
-    X̃ = 2^k T X T and its gain K̃ = K T, with the same closed loop."""
-
-    exponents: NDArray[np.int64]
-    cost: int
-    A: FloatArray
-    B: FloatArray
-    Q: FloatArray
-    R: FloatArray
-    S: FloatArray | None
-    E: FloatArray | None
-    given: tuple[FloatArray, FloatArray, FloatArray, FloatArray | None, FloatArray | None]
-    """The caller's A, B, Q, S and E (for the residual in the caller's equation)."""
-
-
-def _log2_size(sizes: FloatArray) -> float | None:
-    """round(max sizes_ij) for log2 sizes (-inf for a zero entry, as
-    :func:`~aerocontrol._scaling.log2_sizes`), or None where every entry is zero."""
-    largest = float(np.max(sizes, initial=-np.inf))
-    return float(np.round(largest)) if np.isfinite(largest) else None
-
-
-def _largest_entry(M: FloatArray) -> float:
-    """max |M_ij| (0 for no entries), in scalar arithmetic up to 64 entries (numpy's calls
-    cost a good part of a 4-state solve). A NaN may be passed over: the callers check
-    finiteness before they scale."""
-    if M.size <= 64:
-        return max(map(abs, M.ravel().tolist()), default=0.0)
-    return float(np.max(np.abs(M), initial=0.0))
-
-
-def _scaled_well(B: FloatArray, Q: FloatArray, R: FloatArray) -> bool:
-    """The quick test of :func:`_riccati_scaling` for a balanced A: max |B| within 2^10 of 1
-    and max |Q| (or max |R|, for Q = 0) within 2^20 of 1 after the shift of all states that
-    brings B to 1; True also where an entry is not finite (the core refuses it by name)."""
-    b = _largest_entry(B)
-    if not math.isfinite(b):
-        return True
-    c = round(math.log2(b)) if b > 0.0 else 0
-    if abs(c) >= _scaling.BALANCING_SPREAD:
-        return False
-    q = _largest_entry(Q)
-    weight = q if q > 0.0 else _largest_entry(R)
-    if not math.isfinite(weight):
-        return True
-    if weight == 0.0:
-        return True
-    size = math.log2(weight) + (2 * c if q > 0.0 else 0)
-    return abs(round(size)) < 2 * _scaling.BALANCING_SPREAD
-
-
-def _riccati_scaling(
-    A: FloatArray,
-    B: FloatArray,
-    Q: ArrayLike,
-    R: ArrayLike,
-    S: ArrayLike | None,
-    E: ArrayLike | None,
-    *,
-    discrete: bool,
-) -> _ScaledRiccati | None:
-    """The Riccati equation scaled exactly (powers of two) to sizes the core's pencil
-    resolves, or None where it is scaled well enough already, an argument is not a finite
-    matrix of the right size (the core refuses it by name) or a scaled entry would leave the
-    normal doubles (the scaling must be exact).
-
-    Three scalings leave the regulator unchanged (:class:`_ScaledRiccati`): the diagonal
-    similarity that balances A (and E: :func:`~aerocontrol._scaling.state_balancing` of
-    |A| + |E|); then one factor 2^c on all the states, which brings max |B̃| to about 1; then
-    the factor 2^k on the costs, which brings max |Q̃| to about 1 (max |R̃|, for Q = 0). The
-    last two are applied with the first, or, for the ``discrete`` equation, also alone where
-    B or Q is far from 1 (the continuous solve scales its Hamiltonian itself). The
-    Schur and QZ algorithms' errors are relative to the norm of the Hamiltonian matrix or
-    the symplectic pencil, whose blocks are A, B, Q, R and the identity: states scaled by
-    1e±6 (one by one, or, for the discrete equation, all together) or discrete weights Q and
-    R both multiplied by 1e12 lose its small eigenvalues (too few found in the stable half,
-    or a swap refused), where the same equation scaled is solved to rounding."""
-    n = A.shape[0] if A.ndim == 2 else 0
-    if n == 0 or A.shape != (n, n) or B.ndim != 2 or B.shape[0] != n:
-        return None
-    if not discrete and E is None and not _core.states_scaled_apart(A):
-        return None  # the balancing's own first test, before the weights are read
-    try:
-        Q_matrix, R_matrix = matrix_view(Q, "Q"), matrix_view(R, "R")
-        S_matrix = None if S is None else matrix_view(S, "S")
-        E_matrix = None if E is None else matrix_view(E, "E")
-    except AerocontrolError:
-        return None  # the core refuses it, naming the argument
-    m = B.shape[1]
-    if (
-        Q_matrix.shape != (n, n)
-        or R_matrix.shape != (m, m)
-        or (S_matrix is not None and S_matrix.shape != B.shape)
-        or (E_matrix is not None and E_matrix.shape != (n, n))
-    ):
-        return None
-    pattern = A if E_matrix is None else np.abs(A) + np.abs(E_matrix)
-    balancing = _scaling.state_balancing(pattern)
-    # The continuous solve scales its Hamiltonian itself: it needs only the balancing.
-    if balancing is None and (not discrete or _scaled_well(B, Q_matrix, R_matrix)):
-        return None
-    given = [A, B, Q_matrix, R_matrix] + [M for M in (S_matrix, E_matrix) if M is not None]
-    if not all(np.all(np.isfinite(M)) for M in given):
-        return None
-    e = np.zeros(n, dtype=np.int64) if balancing is None else balancing
-    # The sizes in log2, where the scaled matrices themselves could over- or underflow.
-    shift = _log2_size(_scaling.log2_sizes(B) - e[:, np.newaxis])
-    c = 0 if shift is None else int(shift)
-    e = e + c
-    Q_size = _log2_size(_scaling.log2_sizes(Q_matrix) + e[:, np.newaxis] + e[np.newaxis, :])
-    R_size = _log2_size(_scaling.log2_sizes(R_matrix))
-    k = -int(Q_size) if Q_size is not None else -int(R_size) if R_size is not None else 0
-    if (
-        balancing is None
-        and abs(c) < _scaling.BALANCING_SPREAD
-        and abs(k) < 2 * (_scaling.BALANCING_SPREAD)
-    ):
-        return None
-    similar = e[np.newaxis, :] - e[:, np.newaxis]
-    with np.errstate(over="ignore", under="ignore"):
-        scaled = [
-            np.ldexp(A, similar),
-            np.ldexp(B, -e[:, np.newaxis]),
-            np.ldexp(Q_matrix, k + e[:, np.newaxis] + e[np.newaxis, :]),
-            np.ldexp(R_matrix, k),
-        ]
-        if S_matrix is not None:
-            scaled.append(np.ldexp(S_matrix, k + e[:, np.newaxis]))
-        if E_matrix is not None:
-            scaled.append(np.ldexp(E_matrix, similar))
-    tiny = np.finfo(np.float64).tiny
-    for before, after in zip(given, scaled, strict=True):
-        size = np.abs(after)
-        if not np.all(np.isfinite(size)) or np.any((before != 0) & (size < tiny)):
-            return None
-    S_scaled = scaled[4] if S_matrix is not None else None
-    E_scaled = scaled[-1] if E_matrix is not None else None
-    return _ScaledRiccati(
-        e,
-        k,
-        scaled[0],
-        scaled[1],
-        scaled[2],
-        scaled[3],
-        S_scaled,
-        E_scaled,
-        (A, B, Q_matrix, S_matrix, E_matrix),
-    )
-
-
-def _scaled_solve(
-    scaled: _ScaledRiccati, discrete: bool, refine: bool, cross: bool
-) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
-    """The core's solve of the scaled equation (:func:`_riccati_scaling`; ``refine`` for the
-    continuous one), its X and K taken back to the caller's states and costs:
-    X = 2^-k T^-1 X̃ T^-1, K = K̃ T^-1 (the closed-loop eigenvalues, the relative residual,
-    rcond and the steps are those of the scaled solve)."""
-    e = scaled.exponents
-    arguments = (scaled.A, scaled.B, scaled.Q, scaled.R, scaled.S, scaled.E)
-    if discrete:
-        solved = _core.solve_dare(*arguments, cross)
-    else:
-        solved = _core.solve_care(*arguments, refine, cross)
-    X, K, poles, residual, rcond, steps = solved
-    with np.errstate(over="ignore", under="ignore"):
-        X = np.ldexp(X, -scaled.cost - (e[:, np.newaxis] + e[np.newaxis, :]))
-        K = np.ldexp(K, -e[np.newaxis, :])
-    if not (np.all(np.isfinite(X)) and np.all(np.isfinite(K))):
-        warnings.warn(
-            "the result overflowed double precision: X or K has infinite entries (the states "
-            "or the weights are scaled far apart)",
-            NumericalOverflowWarning,
-            stacklevel=4,
-        )
-        return X, K, poles, residual, rcond, steps
-    unscaled = _riccati_residual(scaled, X, K, discrete)
-    return X, K, poles, unscaled if np.isfinite(unscaled) else residual, rcond, steps
-
-
-def _riccati_residual(
-    scaled: _ScaledRiccati, X: FloatArray, K: FloatArray, discrete: bool
-) -> float:
-    """The relative residual of X and K in the caller's equation, the measure the core
-    reports (:class:`CareSolution`, :class:`DareSolution`): for the continuous equation
-    ||A^T X E + E^T X A - (E^T X B + S) K + Q||_F / (||Q||_F + 2 ||A^T X E||_F +
-    ||(E^T X B + S) K||_F), for the discrete one ||A^T X A - E^T X E - (A^T X B + S) K + Q||_F
-    / (||Q||_F + ||A^T X A||_F + ||E^T X E||_F + ||(A^T X B + S) K||_F)."""
-    A, B, Q, S, E = scaled.given
-    norm = np.linalg.norm
-    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-        XE = X if E is None else X @ E
-        cross = A.T @ X @ B if discrete else XE.T @ B
-        if S is not None:
-            cross = cross + S
-        quadratic = cross @ K
-        if discrete:
-            AXA = A.T @ X @ A
-            EXE = X if E is None else E.T @ XE
-            residual = AXA - EXE - quadratic + Q
-            size = norm(Q) + norm(AXA) + norm(EXE) + norm(quadratic)
-        else:
-            AXE = A.T @ XE
-            residual = AXE + AXE.T - quadratic + Q
-            size = norm(Q) + 2.0 * norm(AXE) + norm(quadratic)
-        return float(norm(residual) / size) if size > 0.0 else 0.0
 
 
 def dlqr(

@@ -6,7 +6,7 @@
 //! which is the efficient split for many small problems; an error names the index of the problem.
 
 use crate::control::placement::Placement;
-use crate::control::riccati::care::{CareOptions, solve_care, solve_care_dense};
+use crate::control::riccati::care::{CareOptions, solve_care, solve_care_dense, solve_care_scaled};
 use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
 use crate::linalg::expm::expm_into_validated;
@@ -398,8 +398,9 @@ impl Solved {
 }
 
 /// One problem of a batch, solved exactly as the single solver solves it: the continuous
-/// equation by the Cholesky path, or (an R symmetric but not positive definite) by
-/// [`solve_care`]'s extended pencil; the discrete one by [`solve_dare`].
+/// equation in scaled units where [`solve_care_scaled`] scales it, else by the Cholesky path,
+/// or (an R symmetric but not positive definite) by [`solve_care`]'s extended pencil; the
+/// discrete one by [`solve_dare`].
 fn solve_one(
     (a, b, q, r): (
         MatRef<'_, f64>,
@@ -415,6 +416,18 @@ fn solve_one(
                 refine,
                 ..CareOptions::default()
             };
+            if let Some(scaled) = solve_care_scaled(a, b, q, r, options) {
+                let care = scaled?;
+                return Ok(Solved {
+                    solution: Solution::Faer {
+                        x: care.x,
+                        gain: care.gain,
+                    },
+                    poles: care.closed_loop_eigenvalues,
+                    residual: care.residual,
+                    rcond: care.rcond,
+                });
+            }
             match solve_care_dense(a, b, q, r, options) {
                 Ok(care) => Ok(Solved {
                     solution: Solution::Small {

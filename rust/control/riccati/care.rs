@@ -80,6 +80,7 @@
 //! and unstable eigenvalues of H too ill-conditioned to be told apart).
 
 use super::AlgebraicSolution;
+use super::scaling::{Equation, ScaledEquation};
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::{balance, nearest_power_of_two};
 use crate::linalg::dense::{
@@ -224,9 +225,59 @@ impl Evaluation {
     }
 }
 
-/// Solves the CARE for its stabilising solution; an R that is symmetric and nonsingular but
-/// not positive definite goes to the extended pencil ([`super::care_pencil`]).
+/// Solves the CARE for its stabilising solution, in exactly scaled units where its states are
+/// scaled apart ([`super::scaling`]); an R that is symmetric and nonsingular but not positive
+/// definite goes to the extended pencil ([`super::care_pencil`]).
 pub fn solve_care(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    options: CareOptions<'_>,
+) -> Result<AlgebraicSolution, Error> {
+    solve_care_scaled(a, b, q, r, options)
+        .unwrap_or_else(|| solve_care_as_given(a, b, q, r, options))
+}
+
+/// [`solve_care`] in the scaled units of [`super::scaling`], or None where the equation is
+/// solved as given.
+pub(crate) fn solve_care_scaled(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    options: CareOptions<'_>,
+) -> Option<Result<AlgebraicSolution, Error>> {
+    let given = Equation {
+        a,
+        b,
+        q,
+        r,
+        s: options.s,
+        e: options.e,
+    };
+    let scaled = ScaledEquation::of(given, false)?;
+    let equation = scaled.equation();
+    let solution = solve_care_as_given(
+        equation.a,
+        equation.b,
+        equation.q,
+        equation.r,
+        CareOptions {
+            s: equation.s,
+            e: equation.e,
+            ..options
+        },
+    );
+    Some(solution.map(|solution| {
+        scaled.unscaled(solution, |x, gain| {
+            general_residual(a, b, q, options.s, options.e, x, gain)
+        })
+    }))
+}
+
+/// [`solve_care`] of the equation as given.
+fn solve_care_as_given(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
@@ -450,7 +501,7 @@ fn solve_care_balanced(
             let mut x = xt.transpose().to_owned();
             x.symmetrize();
             let gain = gain.to_faer();
-            let residual = general_residual(a, b, q.as_faer(), options.s, e, &x, &gain);
+            let residual = general_residual(a, b, q.as_faer(), options.s, Some(e), &x, &gain);
             (from_faer(x.as_ref()), residual)
         }
         None => (y, reduced_residual),
@@ -929,17 +980,21 @@ fn refine(
     steps
 }
 
-/// The relative residual of A^T X E + E^T X A - M^T K + Q = 0, M = B^T X E + S^T.
+/// The relative residual of A^T X E + E^T X A - M^T K + Q = 0, M = B^T X E + S^T (E = I where
+/// none is given).
 fn general_residual(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     s: Option<MatRef<'_, f64>>,
-    e: MatRef<'_, f64>,
+    e: Option<MatRef<'_, f64>>,
     x: &Mat<f64>,
     gain: &Mat<f64>,
 ) -> f64 {
-    let xe = x * e;
+    let xe = match e {
+        Some(e) => x * e,
+        None => x.clone(),
+    };
     let axe = a.transpose() * &xe;
     let mut m = b.transpose() * &xe;
     if let Some(s) = s {

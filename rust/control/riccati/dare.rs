@@ -65,6 +65,7 @@ use super::AlgebraicSolution;
 use super::cayley::{cayley_solution, standard_form};
 use super::doubling::doubling_solution;
 use super::pencil::{checked_weights, compress, graph_solution};
+use super::scaling::{Equation, ScaledEquation};
 use crate::error::Error;
 use crate::linalg::dense::view_product;
 use crate::linalg::lu::{solve_in_place, solve_with_inverse};
@@ -104,8 +105,69 @@ pub struct DareOptions<'a> {
     pub s_name: Option<&'static str>,
 }
 
-/// Solves the DARE for its stabilising solution, verified (see the module documentation).
+/// Solves the DARE for its stabilising solution, verified (see the module documentation), in
+/// exactly scaled units where its states, or B or the weights, are far from the sizes of the
+/// identity blocks of the pencil ([`super::scaling`]).
 pub fn solve_dare(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    q: MatRef<'_, f64>,
+    r: MatRef<'_, f64>,
+    options: DareOptions<'_>,
+) -> Result<AlgebraicSolution, Error> {
+    let given = Equation {
+        a,
+        b,
+        q,
+        r,
+        s: options.s,
+        e: options.e,
+    };
+    let Some(scaled) = ScaledEquation::of(given, true) else {
+        return solve_dare_as_given(a, b, q, r, options);
+    };
+    let equation = scaled.equation();
+    let solution = solve_dare_as_given(
+        equation.a,
+        equation.b,
+        equation.q,
+        equation.r,
+        DareOptions {
+            s: equation.s,
+            e: equation.e,
+            ..options
+        },
+    )?;
+    Ok(scaled.unscaled(solution, |x, gain| general_residual(given, x, gain)))
+}
+
+/// The relative residual of the caller's equation (module documentation) for X and its gain K:
+/// ||A^T X A - E^T X E - M^T K + Q||_F / (||Q||_F + ||A^T X A||_F + ||E^T X E||_F +
+/// ||M^T K||_F), M = B^T X A + S^T.
+fn general_residual(given: Equation<'_>, x: &Mat<f64>, gain: &Mat<f64>) -> f64 {
+    let Equation { a, b, q, s, e, .. } = given;
+    let xa = x * a;
+    let axa = a.transpose() * &xa;
+    let mut mixed = b.transpose() * &xa;
+    if let Some(s) = s {
+        mixed += s.transpose();
+    }
+    let quadratic = mixed.transpose() * gain;
+    let exe = match e {
+        Some(e) => e.transpose() * (x * e),
+        None => x.clone(),
+    };
+    let residual = &axa - &exe - &quadratic + q;
+    let scale = frobenius_norm(q)
+        + frobenius_norm(axa.as_ref())
+        + frobenius_norm(exe.as_ref())
+        + frobenius_norm(quadratic.as_ref());
+    let size = frobenius_norm(residual.as_ref());
+    if scale > 0.0 { size / scale } else { size }
+}
+
+/// [`solve_dare`] of the equation as given.
+fn solve_dare_as_given(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,

@@ -12,6 +12,7 @@ pub mod difference;
 pub mod doubling;
 pub mod ode;
 pub(crate) mod pencil;
+pub(crate) mod scaling;
 
 use faer::{Mat, c64};
 
