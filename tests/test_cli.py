@@ -4,6 +4,7 @@ with a non-zero exit (never a traceback) for every kind of bad input."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import warnings
@@ -526,8 +527,10 @@ def test_robustness_writes_its_page_under_the_report_folder_rules(
     names = sorted(p.name for p in (out / "figures").iterdir())
     assert names == ["robustness-convergence-sensitivity.png", "robustness-distributions.png"]
     page = (out / "report.md").read_text(encoding="utf-8")
-    # The regulator (Q = I, c = 1) couples roll and spiral in these samples: said, not hidden.
-    assert "roll and spiral coupled: not assessed, Level 4" in page
+    # The regulator (Q = I, c = 1) couples roll and spiral in these samples: said, and judged
+    # as one oscillation by MIL-F-8785C 3.3.1.4 (its ζ ω_n of about 0.8 rad/s: Level 1).
+    assert "roll and spiral coupled: judged as one oscillation (3.3.1.4)" in page
+    assert re.search(r"closed loop \| roll Level 1 or better \| (1|0\.9\d+) \(", page), page
     assert "dutch roll Level 1 or better" in page
     # Run again: the earlier page is replaced; a folder of the user's is refused.
     status, text, _ = _run(capsys, *argv, "--out", str(out))

@@ -27,6 +27,7 @@ from aerocontrol.handling import (
     Requirement,
     assess,
     compare,
+    level_limits,
     margin_requirement,
     margins_check,
 )
@@ -322,6 +323,67 @@ def test_stable_or_neutral_spiral_is_level_1(root: float) -> None:
     assert hq.level("spiral") == 1
 
 
+# --- 3.3.1.4: coupled roll-spiral oscillation --------------------------------------------------
+
+ROLL_SPIRAL_LIMITS = (0.5, 0.3, 0.15)  # ζ_RS ω_nRS, rad/s, "shall exceed" (Categories B, C)
+
+
+@pytest.mark.parametrize(("cls", "category"), COLUMNS)
+def test_roll_spiral_3_3_1_4(cls: str, category: str) -> None:
+    """ζ ω_n = -Re λ of the pair, judged against 0.5, 0.3, 0.15 rad/s (strictly: on the limit
+    is the next Level) in Categories B and C, for every Class; not permitted in Category A
+    (Level 4 whatever its damping, and no limits for a histogram)."""
+    for k, limit in enumerate(ROLL_SPIRAL_LIMITS, start=1):
+        for zw, expected in ((limit * (1 + EPS), k), (limit, k + 1), (limit * (1 - EPS), k + 1)):
+            root = complex(-zw, 0.3)
+            hq = assess({"roll-spiral": [root, root.conjugate()]}, cls, category)
+            (r,) = hq.requirements
+            assert (r.mode, r.quantity, r.value) == ("roll-spiral", "zeta*omega_n", zw)
+            assert r.level == (4 if category == "A" else expected), (cls, category, zw)
+            assert r.reference == "MIL-F-8785C 3.3.1.4"
+    if category == "A":
+        assert r.limits == "L1 not permitted in Category A; L2 not permitted in Category A; " + (
+            "L3 not permitted in Category A"
+        )
+        assert level_limits("roll-spiral", "zeta*omega_n", cls, category) == []
+    else:
+        assert r.limits == "L1 > 0.5; L2 > 0.3; L3 > 0.15"
+        assert level_limits("roll-spiral", "zeta*omega_n", cls, category) == [
+            (1, 0.5),
+            (2, 0.3),
+            (3, 0.15),
+        ]
+
+
+def test_roll_spiral_of_the_747_regulator_and_its_names() -> None:
+    """The 747 cruise regulator (Q = I, R = I) couples the roll and spiral into one oscillation,
+    -0.8283 ± 0.2821j (ζ ω_n = 0.8283 rad/s: Level 1, Category B), as classify_modes names it;
+    "roll spiral", "Roll_Spiral" name the same mode; an unstable or undamped one is Level 4;
+    the array forms agree with assess to the bit."""
+    from aerocontrol.handling import level_arrays, mode_quantities
+
+    plane = aerocontrol.aircraft.load("b747-cruise")
+    sys = plane.lateral()
+    K = aerocontrol.lqr(sys.A, sys.B, np.eye(4), np.eye(2))[0]
+    named = aerocontrol.aircraft.classify_modes(aerocontrol.modes(sys.A - sys.B @ K), "lateral")
+    assert set(named) == {"dutch roll", "roll-spiral"}
+    hq = assess(named, plane.aircraft_class, plane.category)
+    assert hq.levels == {"dutch roll": 1, "roll-spiral": 1}
+    assert row(hq, "roll-spiral", "zeta*omega_n").value == pytest.approx(0.8283, abs=1e-4)
+    for name in ("roll spiral", "Roll_Spiral", "ROLL-SPIRAL"):
+        assert assess({name: named["roll-spiral"]}, "III", "B").modes == ("roll-spiral",)
+    pairs = np.array([named["roll-spiral"], [0.1 + 0.2j, 0.1 - 0.2j], [0.2j, -0.2j], [-0.2, -0.3]])
+    for category in CATEGORIES:
+        bulk = level_arrays({"roll-spiral": pairs}, "III", category)["roll-spiral"]
+        one = [
+            assess({"roll-spiral": list(p)}, "III", category).level("roll-spiral") for p in pairs
+        ]
+        assert bulk.tolist() == one
+    assert one == [1, 4, 4, 3]  # Category C (the last); two real roots: ζ ω_n = 0.25 rad/s
+    wn = mode_quantities("roll-spiral", pairs)["omega_n"]
+    np.testing.assert_allclose(wn, [abs(named["roll-spiral"][0]), abs(0.1 + 0.2j), 0.2, 0.06**0.5])
+
+
 # --- On the limit itself: the wording of each paragraph ----------------------------------------
 
 
@@ -515,7 +577,7 @@ def test_pair_must_be_conjugate() -> None:
 
 
 def test_complex_roll_or_spiral_is_refused() -> None:
-    with pytest.raises(InvalidArgumentError, match=r"modes\['roll'\] must be real.*3\.3\.1\.4"):
+    with pytest.raises(InvalidArgumentError, match=r"modes\['roll'\] must be real.*'roll-spiral'"):
         assess({"roll": [-1 + 0.5j]}, "I", "A")
 
 

@@ -38,16 +38,21 @@ def _one_condition(
     plane: aircraft.Aircraft, axis: str, K: np.ndarray, altitude: float, mach: float, weight: float
 ) -> tuple[dict[str, int], np.ndarray]:
     """The closed loop built and judged one condition at a time, as envelope_sweep judges a
-    condition: the Level of each mode (0 where not assessed) and the eigenvalues."""
+    condition: the Level of each mode (0 where not assessed; a roll and spiral coupled into
+    one oscillation both carry its Level, MIL-F-8785C 3.3.1.4) and the eigenvalues."""
     condition = plane.at(altitude, mach, weight)
     sys = condition.lateral() if axis == "lateral" else condition.longitudinal()
     closed = sys.A - sys.B @ K
     named = classify_modes(aerocontrol.modes(closed), axis)
     modes = ("dutch roll", "roll", "spiral") if axis == "lateral" else ("short period", "phugoid")
     judged = assess(
-        {m: named[m] for m in modes if m in named}, plane.aircraft_class, plane.category
+        {m: named[m] for m in (*modes, "roll-spiral") if m in named},
+        plane.aircraft_class,
+        plane.category,
     )
     levels = {m: judged.levels.get(m, 0) for m in modes}
+    if "roll-spiral" in judged.levels:
+        levels["roll"] = levels["spiral"] = judged.levels["roll-spiral"]
     return levels, np.linalg.eigvals(closed)
 
 
@@ -250,6 +255,7 @@ def test_levels_at_grid_points_are_assess_of_each_closed_loop(
     schedule = gain_schedule(PLANE, ALTITUDES, MACHS, WEIGHTS, design=kind, **options)
     envelope = schedule.closed_loop
     seen: set[int] = set()
+    coupled_seen = False
     for i, j, k in np.ndindex(schedule.shape):
         levels, poles = _one_condition(
             PLANE, schedule.axis, schedule.gains[i, j, k], ALTITUDES[i], MACHS[j], WEIGHTS[k]
@@ -258,7 +264,11 @@ def test_levels_at_grid_points_are_assess_of_each_closed_loop(
             assert envelope.levels[mode][i, j, k] == level, (mode, i, j, k)
             seen.add(level)
             value = envelope.eigenvalues[mode][i, j, k]
-            if level:  # a judged mode's eigenvalue is one of the closed loop's
+            coupled = mode in ("roll", "spiral") and np.all(np.iscomplex(poles))
+            if coupled:  # judged as the roll-spiral: no real root of its own
+                assert np.isnan(value)
+                coupled_seen = True
+            elif level:  # a judged mode's eigenvalue is one of the closed loop's
                 assert np.min(np.abs(poles - value)) < 1e-10 * np.max(np.abs(poles))
         assert ((i, j, k) in envelope.failures) == (0 in levels.values())
     # The evaluation at the design grid is the design's own judgement.
@@ -269,8 +279,8 @@ def test_levels_at_grid_points_are_assess_of_each_closed_loop(
     assert again.failures == envelope.failures
     if kind == "damper":  # the checks met more than one Level
         assert {1, 2, 3} <= seen
-    if options.get("c") == 10.0:  # and coupled roll-spiral modes, not assessed
-        assert envelope.failures and 0 in seen
+    if options.get("c") == 10.0:  # and roll-spiral oscillations, judged by 3.3.1.4
+        assert coupled_seen and not envelope.failures and 0 not in seen
 
 
 def test_levels_between_grid_points_use_the_interpolated_gains() -> None:
@@ -308,7 +318,9 @@ def test_evaluate_on_chunks_and_on_a_dask_cluster_is_bitwise_the_local_run(
             np.testing.assert_array_equal(other.levels[mode], whole.levels[mode])
             np.testing.assert_array_equal(other.eigenvalues[mode], whole.eigenvalues[mode])
         assert other.failures == whole.failures
-    assert whole.failures  # the comparison covers the unresolved conditions too
+    # The comparison covers conditions whose roll and spiral coupled (judged by 3.3.1.4) too.
+    coupled = np.isnan(whole.eigenvalues["roll"])
+    assert coupled.any() and np.all(whole.levels["roll"][coupled] > 0)
     for mode in whole.levels:
         np.testing.assert_array_equal(
             designed.closed_loop.levels[mode], schedule.closed_loop.levels[mode]

@@ -28,7 +28,11 @@ class Judgement(NamedTuple):
     """(k, modes), the modes in the order of :data:`AXIS_MODES`: each mode's Level (4 where
     the mode could not be judged)."""
     known: NDArray[np.bool_]
-    """(k, modes): the mode was named, so its Level was judged."""
+    """(k, modes): the mode was named, so its quantities are known."""
+    judged: NDArray[np.bool_]
+    """(k, modes): the mode's Level was judged: the mode was named, or (roll and spiral) the
+    two coupled into a roll-spiral oscillation, whose Level (MIL-F-8785C 3.3.1.4) both then
+    carry."""
     stable: NDArray[np.bool_]
     """(k,): every eigenvalue in the open left half-plane."""
     unresolved: NDArray[np.bool_]
@@ -55,10 +59,20 @@ def judge_stack(
         known[:, k] = ~np.isnan(named[name]).reshape(count, -1).any(axis=1)
         judged = level_arrays({name: named[name][known[:, k]]}, aircraft_class, category)
         levels[known[:, k], k] = judged[name]
+    assessed = known.copy()
+    if "roll-spiral" in named:
+        coupled = ~np.isnan(named["roll-spiral"]).any(axis=1)
+        if coupled.any():
+            pairs = {"roll-spiral": named["roll-spiral"][coupled]}
+            level = level_arrays(pairs, aircraft_class, category)["roll-spiral"]
+            for k in (mode_names.index("roll"), mode_names.index("spiral")):
+                levels[coupled, k] = level
+                assessed[coupled, k] = True
     return Judgement(
         named,
         levels,
         known,
+        assessed,
         np.asarray((eigenvalues.real < 0.0).all(axis=1)),
         unresolved,
         eigenvalues.real.max(axis=1),

@@ -24,6 +24,7 @@ phugoid         ζ_p at least 0.04 / 0; T2 at least 55 s      3.2.1.2
 dutch roll      ζ_d, ζ_d ω_nd, ω_nd exceed the minimums      3.3.1.1, Table VI
 roll            τ_R no greater than the maximum              3.3.1.2, Table VII
 spiral          T2 greater than the minimum                  3.3.1.3, Table VIII
+roll-spiral     ζ_RS ω_nRS exceeds the minimum               3.3.1.4
 ==============  ==========================================  ===================================
 
 Every number below was read from a scan of the specification (the EverySpec copy, "Downloaded
@@ -45,8 +46,18 @@ given here cannot decide it, so it is left to the caller:
 * The short-period frequency limits of 3.2.2.1.1 (Figures 1-3, against n/α), and Table IV's
   note that the Level 3 minimum may be reduced above 20,000 ft if the procuring activity
   approves.
-* The coupled roll-spiral oscillation of 3.3.1.4: a complex roll or spiral eigenvalue is
-  refused.
+* Category A's Flight Phases: 3.3.1.4 permits a coupled roll-spiral oscillation in none of
+  them as this module reads it (its prohibition names the phases of Category A that need
+  precise maneuvering; the Flight Phase is not an argument here), so a coupled roll-spiral
+  mode is Level 4 in Category A and judged by its ζ_RS ω_nRS in Categories B and C.
+
+Not read from the scan: the minimums of 3.3.1.4 (ζ_RS ω_nRS of 0.5, 0.3 and 0.15 rad/s for
+Levels 1 to 3, "shall exceed"), taken as three independent secondary sources quote them; they
+are marked so in :data:`ROLL_SPIRAL_MIN_ZETA_OMEGA`.
+
+A complex roll or spiral eigenvalue is refused: a roll and a spiral that have coupled into one
+oscillation are given as the mode "roll-spiral" (two eigenvalues, as the names of
+:func:`aerocontrol.aircraft.classify_modes` give them).
 
 Examples
 --------
@@ -108,13 +119,13 @@ __all__ = [
 SPECIFICATION = "MIL-F-8785C"
 
 #: The modes that can be assessed, in the order the tables list them.
-MODES: tuple[str, ...] = ("short period", "phugoid", "dutch roll", "roll", "spiral")
+MODES: tuple[str, ...] = ("short period", "phugoid", "dutch roll", "roll", "spiral", "roll-spiral")
 #: Airplane Classes (1.3, 1.3.1); "II" alone is taken as "II-L".
 AIRCRAFT_CLASSES: tuple[str, ...] = ("I", "II-C", "II-L", "III", "IV")
 #: Flight Phase Categories (1.4).
 CATEGORIES: tuple[str, ...] = ("A", "B", "C")
 
-_OSCILLATORY = frozenset({"short period", "phugoid", "dutch roll"})
+_OSCILLATORY = frozenset({"short period", "phugoid", "dutch roll", "roll-spiral"})
 _CLASS_ALIASES = {"II": "II-L"}
 _LN2 = math.log(2.0)
 
@@ -126,6 +137,7 @@ _REFERENCES = {
     "dutch roll": f"{SPECIFICATION} 3.3.1.1, Table VI",
     "roll": f"{SPECIFICATION} 3.3.1.2, Table VII",
     "spiral": f"{SPECIFICATION} 3.3.1.3, Table VIII",
+    "roll-spiral": f"{SPECIFICATION} 3.3.1.4",
 }
 _UNITS = {
     "zeta": "",
@@ -194,6 +206,15 @@ SPIRAL_MIN_TIME_TO_DOUBLE: dict[str, tuple[float, float, float]] = {
 }
 
 
+#: 3.3.1.4 Coupled roll-spiral oscillation (p. 23): where the roll and spiral modes couple into
+#: one oscillation, its ζ_RS ω_nRS (rad/s) shall exceed these for Levels 1, 2 and 3 in the
+#: Categories B and C; Category A: not permitted (see the module notes). The numbers as three
+#: independent secondary sources quote the paragraph, not read from the scan.
+ROLL_SPIRAL_MIN_ZETA_OMEGA: tuple[float, float, float] = (0.5, 0.3, 0.15)
+#: The Categories in which 3.3.1.4 permits a coupled roll-spiral oscillation.
+ROLL_SPIRAL_CATEGORIES: frozenset[str] = frozenset({"B", "C"})
+
+
 @register
 @dataclass(frozen=True)
 class Requirement:
@@ -202,7 +223,7 @@ class Requirement:
     Attributes
     ----------
     mode : str
-        The mode: "short period", "phugoid", "dutch roll", "roll" or "spiral".
+        The mode: "short period", "phugoid", "dutch roll", "roll", "spiral" or "roll-spiral".
     quantity : str
         "zeta", "zeta*omega_n", "omega_n", "time constant" or "time to double".
     value : float
@@ -229,7 +250,7 @@ class Requirement:
     """
 
     mode: str
-    """The mode: "short period", "phugoid", "dutch roll", "roll" or "spiral"."""
+    """The mode: "short period", "phugoid", "dutch roll", "roll", "spiral" or "roll-spiral"."""
     quantity: str
     """"zeta", "zeta*omega_n", "omega_n", "time constant" or "time to double"."""
     value: float
@@ -377,14 +398,17 @@ def assess(modes: Mapping[str, object], aircraft_class: str, category: str) -> H
     * dutch roll: "zeta", "zeta*omega_n" and "omega_n" against Table VI (for Class III a
       ζ >= 0.7 meets the ζ ω_n minimum, Table VI note ``*``);
     * roll: "time constant" against Table VII;
-    * spiral: "time to double" against Table VIII (a stable spiral: inf, Level 1).
+    * spiral: "time to double" against Table VIII (a stable spiral: inf, Level 1);
+    * roll-spiral (a roll and spiral coupled into one oscillation): "zeta*omega_n" against
+      3.3.1.4 (Categories B and C; not permitted, Level 4, in Category A).
 
     Parameters
     ----------
     modes : mapping of str to sequence of complex
-        Mode name ("short period", "phugoid", "dutch roll", "roll", "spiral"; any subset, in
-        any case, with hyphens or underscores for spaces) to its eigenvalues: two for the
-        oscillatory modes, one real eigenvalue (or a bare number) for roll and spiral.
+        Mode name ("short period", "phugoid", "dutch roll", "roll", "spiral", "roll-spiral";
+        any subset, in any case, with hyphens or underscores for spaces) to its eigenvalues:
+        two for the oscillatory modes (the roll-spiral among them), one real eigenvalue (or a
+        bare number) for roll and spiral.
     aircraft_class : str
         "I", "II-C" (carrier-based), "II-L" (land-based), "III" or "IV" (1.3, 1.3.1); "II" is
         taken as "II-L". The two differ only in Category C (Tables VI and VII), where II-C is
@@ -399,7 +423,7 @@ def assess(modes: Mapping[str, object], aircraft_class: str, category: str) -> H
     Raises
     ------
     InvalidArgumentError
-        A mode name that is not one of the five (the message names it), an ``aircraft_class``
+        A mode name that is not one of the six (the message names it), an ``aircraft_class``
         or ``category`` not among the choices (the message lists them), eigenvalues that are not
         numbers, an oscillatory pair that is not a conjugate pair or two real roots, a complex
         roll or spiral eigenvalue, or no modes at all.
@@ -438,8 +462,10 @@ def assess(modes: Mapping[str, object], aircraft_class: str, category: str) -> H
             requirements.extend(_dutch_roll(lam, cls, cat))
         elif mode == "roll":
             requirements.append(_roll(lam, cls, cat))
-        else:
+        elif mode == "spiral":
             requirements.append(_spiral(lam, cat))
+        else:
+            requirements.append(_roll_spiral(lam, cat))
     return HandlingQualities(aircraft_class=cls, category=cat, requirements=tuple(requirements))
 
 
@@ -536,6 +562,8 @@ def _category(value: object) -> str:
 def _mode_name(key: object, name: str) -> str:
     if isinstance(key, str):
         normal = " ".join(key.lower().replace("-", " ").replace("_", " ").split())
+        if normal == "roll spiral":
+            return "roll-spiral"
         if normal in MODES:
             return normal
     raise InvalidArgumentError(f"{name} {key!r} is not a mode; the modes are {_choices(MODES)}")
@@ -594,7 +622,8 @@ def _eigenvalues(modes: object) -> dict[str, NDArray[np.complex128]]:
         elif abs(lam[0].imag) > 1e-9 * abs(lam[0]):
             raise InvalidArgumentError(
                 f"{label} must be real, got {complex(lam[0])}: a complex roll or spiral "
-                "root is a coupled roll-spiral oscillation (3.3.1.4), which is not assessed"
+                "root is a coupled roll-spiral oscillation (3.3.1.4); give its pair as the "
+                "mode 'roll-spiral'"
             )
         result[mode] = lam
     return result
@@ -720,6 +749,15 @@ def _spiral(lam: NDArray[np.complex128], category: str) -> Requirement:
     return _requirement("spiral", "time to double", t2, [(f"> {m:g} s", t2 > m) for m in limits])
 
 
+def _roll_spiral(lam: NDArray[np.complex128], category: str) -> Requirement:
+    _, _, zw = _pair(lam)
+    if category not in ROLL_SPIRAL_CATEGORIES:
+        refused = f"not permitted in Category {category}"
+        return _requirement("roll-spiral", "zeta*omega_n", zw, [(refused, False)] * 3)
+    checks = [(f"> {m:g}", zw > m) for m in ROLL_SPIRAL_MIN_ZETA_OMEGA]
+    return _requirement("roll-spiral", "zeta*omega_n", zw, checks)
+
+
 # --- Many aircraft at once ------------------------------------------------------------------
 
 
@@ -732,8 +770,9 @@ def level_arrays(
     Parameters
     ----------
     modes : mapping of str to array_like
-        Mode name to its eigenvalues: shape (k, 2) for "short period", "phugoid" and "dutch
-        roll" (a conjugate pair or two real roots per aircraft), (k,) for "roll" and "spiral".
+        Mode name to its eigenvalues: shape (k, 2) for "short period", "phugoid", "dutch
+        roll" and "roll-spiral" (a conjugate pair or two real roots per aircraft), (k,) for
+        "roll" and "spiral".
     aircraft_class, category : str
         As for :func:`assess`.
 
@@ -787,7 +826,7 @@ def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
     Parameters
     ----------
     mode : str
-        "short period", "phugoid", "dutch roll", "roll" or "spiral".
+        "short period", "phugoid", "dutch roll", "roll", "spiral" or "roll-spiral".
     eigenvalues : array_like (k, 2) or (k,) of complex
         The mode's roots for each of k aircraft: a pair (oscillatory modes) or one root (roll,
         spiral).
@@ -837,10 +876,11 @@ def level_limits(
     Parameters
     ----------
     mode : str
-        "short period", "phugoid", "dutch roll", "roll" or "spiral".
+        "short period", "phugoid", "dutch roll", "roll", "spiral" or "roll-spiral".
     quantity : str
-        The quantity: "zeta" (short period, phugoid, Dutch roll), "zeta*omega_n" or "omega_n"
-        (Dutch roll), "time to double" (phugoid, spiral), "time constant" (roll).
+        The quantity: "zeta" (short period, phugoid, Dutch roll), "zeta*omega_n" (Dutch roll,
+        roll-spiral; none for the roll-spiral in Category A, where it is not permitted),
+        "omega_n" (Dutch roll), "time to double" (phugoid, spiral), "time constant" (roll).
     aircraft_class : str
         The airplane Class, "I", "II-C", "II-L" (or "II"), "III" or "IV".
     category : str
@@ -886,6 +926,9 @@ def level_limits(
         limits = list(enumerate(ROLL_MODE_MAX_TIME_CONSTANT[cat, cls], start=1))
     elif (name, quantity) == ("spiral", "time to double"):
         limits = list(enumerate(SPIRAL_MIN_TIME_TO_DOUBLE[cat], start=1))
+    elif (name, quantity) == ("roll-spiral", "zeta*omega_n"):
+        permitted = cat in ROLL_SPIRAL_CATEGORIES
+        limits = list(enumerate(ROLL_SPIRAL_MIN_ZETA_OMEGA if permitted else (), start=1))
     else:
         raise InvalidArgumentError(f"the {name} has no Level limits on {quantity!r}")
     return [(k, float(value)) for k, value in limits if value is not None]
@@ -926,7 +969,8 @@ def _eigenvalue_arrays(value: object, label: str, mode: str) -> NDArray[np.compl
             i = int(np.flatnonzero(bad)[0])
             raise InvalidArgumentError(
                 f"{label}[{i}] must be real, got {complex(lam[i])}: a complex roll or spiral "
-                "root is a coupled roll-spiral oscillation (3.3.1.4), which is not assessed"
+                "root is a coupled roll-spiral oscillation (3.3.1.4); give its pairs as the "
+                "mode 'roll-spiral'"
             )
     return lam
 
@@ -1019,6 +1063,11 @@ def _mode_levels(
         tau = _roll_time_constant(lam.real)
         limits = ROLL_MODE_MAX_TIME_CONSTANT[category, aircraft_class]
         return _first_met([tau <= m for m in limits], count)
+    if mode == "roll-spiral":
+        _, _, zw = _pair_arrays(lam)
+        if category not in ROLL_SPIRAL_CATEGORIES:
+            return np.full(count, 4, dtype=np.int8)
+        return _first_met([zw > m for m in ROLL_SPIRAL_MIN_ZETA_OMEGA], count)
     t2 = _time_to_double_arrays(lam.real)
     return _first_met([t2 > m for m in SPIRAL_MIN_TIME_TO_DOUBLE[category]], count)
 

@@ -898,8 +898,9 @@ class LoopOutcome:
     stable : ndarray (samples,) of bool
         Every eigenvalue in the open left half-plane.
     unresolved : ndarray (samples,) of bool
-        Models whose modes are not the classical ones, whose roll and spiral (or both
-        longitudinal modes) are Level 4.
+        Models whose modes are not the classical ones: a roll and spiral coupled into one
+        oscillation (both carry its Level, MIL-F-8785C 3.3.1.4), or interleaved longitudinal
+        roots (both longitudinal modes Level 4).
     max_real : ndarray (samples,)
         The largest real part of the eigenvalues (1/s).
     quantities : dict of str to ndarray (samples,)
@@ -929,9 +930,9 @@ class LoopOutcome:
     stable: NDArray[np.bool_]
     """(samples,): every eigenvalue in the open left half-plane."""
     unresolved: NDArray[np.bool_]
-    """(samples,): models whose modes are not the classical ones (a coupled roll-spiral, or
-    interleaved longitudinal roots), whose roll and spiral (or both longitudinal modes) are
-    Level 4."""
+    """(samples,): models whose modes are not the classical ones: a roll and spiral coupled
+    into one oscillation (both carry its Level, MIL-F-8785C 3.3.1.4), or interleaved
+    longitudinal roots (both longitudinal modes Level 4)."""
     max_real: FloatArray
     """(samples,): the largest real part of the eigenvalues."""
     quantities: dict[str, FloatArray]
@@ -1053,8 +1054,8 @@ class MonteCarlo(Result):
         confidence: float = 0.95,
     ) -> Estimate:
         """The probability of ``event``: "unstable", "unresolved" (modes that are not the
-        classical ones, such as a coupled roll-spiral, whose roll and spiral count as Level
-        4), "failed", or "level" (``mode`` meets ``level`` or better), for the closed loop if
+        classical ones, such as a roll and spiral coupled into one oscillation, judged by
+        3.3.1.4), "failed", or "level" (``mode`` meets ``level`` or better), for the closed loop if
         there is one (``loop="auto"``) or the loop named ("open", "closed"), with its
         Clopper-Pearson interval."""
         count = int(self.indicator(event, mode, level, loop).sum())

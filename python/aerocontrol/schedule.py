@@ -101,8 +101,9 @@ def _judge_chunk(
     chunk: _Chunk, conditions: FloatArray, gains: FloatArray
 ) -> dict[str, NDArray[Any]]:
     """The closed loops A - B K at the conditions, judged: each mode's Level (0 where it was
-    not named), its eigenvalue with Im >= 0 (the larger real root of a split pair), and the
-    conditions whose modes are not the classical ones."""
+    not judged; a roll and spiral coupled into one oscillation both carry its Level), its
+    eigenvalue with Im >= 0 (the larger real root of a split pair; NaN for a coupled roll and
+    spiral), and the conditions whose modes could not be judged."""
     A, B, _ = _models(chunk.plane, chunk.axis, conditions)
     closed = A - np.einsum("kij,kjl->kil", B, gains)
     judged = judge_stack(
@@ -112,9 +113,9 @@ def _judge_chunk(
         chunk.plane.aircraft_class,
         chunk.plane.category,
     )
-    out: dict[str, NDArray[Any]] = {"unresolved": judged.unresolved}
+    out: dict[str, NDArray[Any]] = {"unresolved": np.asarray(~judged.judged.all(axis=1))}
     for k, mode in enumerate(AXIS_MODES[chunk.axis]):
-        out[f"level {mode}"] = np.where(judged.known[:, k], judged.levels[:, k], 0)
+        out[f"level {mode}"] = np.where(judged.judged[:, k], judged.levels[:, k], 0)
         roots = judged.named[mode]
         if roots.ndim == 2:
             first, second = roots[:, 0], roots[:, 1]
@@ -156,7 +157,7 @@ def _closed_loop(
     modes = AXIS_MODES[axis]
     unresolved = joined["unresolved"].reshape(shape)
     reason = (
-        "roll and spiral coupled (3.3.1.4): not assessed"
+        "roll and spiral coupled, the Dutch roll not told apart: not assessed"
         if axis == "lateral"
         else "short period and phugoid not separable by size: not assessed"
     )

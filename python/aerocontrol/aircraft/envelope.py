@@ -66,9 +66,12 @@ class Envelope(Result):
     force_unit : str
         The unit of the weights ("lbf" or "N").
     levels : dict of str to ndarray (a, b, c) of int
-        The Level of each mode (1-4) at each condition; 0 where it was not assessed.
+        The Level of each mode (1-4) at each condition; 0 where it was not assessed. Where the
+        roll and spiral couple into one oscillation, both carry its Level (MIL-F-8785C
+        3.3.1.4).
     eigenvalues : dict of str to ndarray (a, b, c), complex
-        Each mode's eigenvalue with Im >= 0 (rad/s; the larger real root of a split pair).
+        Each mode's eigenvalue with Im >= 0 (rad/s; the larger real root of a split pair; NaN
+        for a roll and spiral coupled into one oscillation).
     failures : dict of (int, int, int) to str
         Conditions whose model or modes could not be assessed, with the reason.
     worst : ndarray (a, b, c) of int
@@ -254,8 +257,11 @@ def envelope_sweep(
     mach_grid = _grid(machs, "machs", plane.mach)
     weight_grid = _grid(weights, "weights", plane.mass * plane.gravity)
     shape = (len(altitude_grid), len(mach_grid), len(weight_grid))
-    levels = {mode: np.zeros(shape, dtype=np.int_) for mode in handling.MODES}
-    eigenvalues = {mode: np.full(shape, np.nan + 0j) for mode in handling.MODES}
+    # A roll and spiral coupled into one oscillation are judged as it (3.3.1.4): both carry
+    # its Level, and have no eigenvalue of their own.
+    separate = [mode for mode in handling.MODES if mode != "roll-spiral"]
+    levels = {mode: np.zeros(shape, dtype=np.int_) for mode in separate}
+    eigenvalues = {mode: np.full(shape, np.nan + 0j) for mode in separate}
     failures: dict[tuple[int, int, int], str] = {}
     for index in np.ndindex(shape):
         i, j, k = index
@@ -271,18 +277,18 @@ def envelope_sweep(
                 **classify_modes(modes(condition.longitudinal().A), "longitudinal"),
                 **classify_modes(modes(condition.lateral().A), "lateral"),
             }
-            assessable = {key: value for key, value in named.items() if key in levels}
-            assessed = handling.assess(assessable, plane.aircraft_class, plane.category)
+            assessed = handling.assess(named, plane.aircraft_class, plane.category)
         except _NotAnAircraft:
             raise
         except CONDITION_FAILURES as error:
             failures[index] = _reason(error)
             continue
         for mode, level in assessed.levels.items():
+            if mode == "roll-spiral":
+                levels["roll"][index] = levels["spiral"][index] = level
+                continue
             levels[mode][index] = level
             eigenvalues[mode][index] = max(named[mode], key=lambda v: (v.imag, v.real))
-        if "roll-spiral" in named:
-            failures[index] = "roll and spiral coupled (3.3.1.4): not assessed"
     return Envelope(
         altitude_grid,
         mach_grid,

@@ -114,7 +114,8 @@ def classify_mode_stack(
     magnitudes: no mode is defined by magnitude). Given the state matrices ``A`` (k, 4, 4),
     the Dutch roll of a lateral model with two complex pairs is the pair whose eigenvector has
     the larger sideslip share, as :func:`classify_modes` decides it (the eigenvectors from the
-    adjugate of A - λI, whose columns span its null space); its roll and spiral stay NaN.
+    adjugate of A - λI, whose columns span its null space), and the other pair is its
+    "roll-spiral" (NaN for every other model); its roll and spiral stay NaN.
 
     Examples
     --------
@@ -159,8 +160,12 @@ def classify_mode_stack(
             np.argsort(upper.imag <= 0, axis=1, kind="stable"),
         ][:, :2]
         shares = np.stack([_sideslip_share(matrices, upper[:, k]) for k in range(2)], axis=1)
-        dutch = np.where(shares[:, 0] >= shares[:, 1], upper[:, 0], upper[:, 1])
+        first = shares[:, 0] >= shares[:, 1]
+        dutch = np.where(first, upper[:, 0], upper[:, 1])
+        other = np.where(first, upper[:, 1], upper[:, 0])
         named["dutch roll"][coupled] = np.stack([dutch, dutch.conj()], axis=1)
+        named["roll-spiral"] = np.full((values.shape[0], 2), np.nan + 0j)
+        named["roll-spiral"][coupled] = np.stack([other, other.conj()], axis=1)
     return named, coupled
 
 

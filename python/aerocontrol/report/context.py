@@ -47,7 +47,6 @@ def closed_loop(
 
 
 def assess(ctx: Context, named: dict[str, tuple[complex, ...]]) -> handling.HandlingQualities:
-    """The Levels of the named modes; a coupled roll-spiral oscillation (MIL-F-8785C 3.3.1.4)
-    is left out (it is shown as such in the tables)."""
-    kept = {key: value for key, value in named.items() if key != "roll-spiral"}
-    return handling.assess(kept, ctx.plane.aircraft_class, ctx.plane.category)
+    """The Levels of the named modes (a coupled roll-spiral oscillation by MIL-F-8785C
+    3.3.1.4)."""
+    return handling.assess(named, ctx.plane.aircraft_class, ctx.plane.category)

@@ -3,8 +3,6 @@ of the lateral motion (the dampers and the regulator at each weight)."""
 
 from __future__ import annotations
 
-from typing import Any
-
 from .. import handling
 from ..exceptions import InvalidArgumentError
 from .context import Context, assess
@@ -12,9 +10,7 @@ from .context import Context, assess
 __all__ = ["section"]
 
 
-def _level(assessment: handling.HandlingQualities, named: dict[str, Any], mode: str) -> str:
-    if mode == "roll-spiral":
-        return "coupled (3.3.1.4), not assessed" if mode in named else "-"
+def _level(assessment: handling.HandlingQualities, mode: str) -> str:
     return str(assessment.levels.get(mode, "-"))
 
 
@@ -34,24 +30,17 @@ def section(ctx: Context) -> str:
     for label, lateral in ctx.augmented.items():
         named = {**longitudinal, **lateral}
         columns[label] = (assess(ctx, named), named)
-    modes = [*handling.MODES]
-    if any("roll-spiral" in named for _, named in columns.values()):
-        modes.append("roll-spiral")
     rows = [
-        (mode, *(_level(hq, named, mode) for hq, named in columns.values()))
-        for mode in modes
+        (mode, *(_level(hq, mode) for hq, _ in columns.values()))
+        for mode in handling.MODES
         if any(mode in named for _, named in columns.values())
     ]
     rows.append(("all modes", *(str(max(hq.levels.values())) for hq, _ in columns.values())))
     report.paragraph(
         f"MIL-F-8785C Levels, Class {ctx.plane.aircraft_class}, Flight Phase Category "
         f"{ctx.plane.category}, open loop and with each design of the lateral motion (the "
-        "longitudinal modes are not changed)."
-        + (
-            " A coupled roll-spiral oscillation (3.3.1.4) is listed but not assessed."
-            if "roll-spiral" in modes
-            else ""
-        )
+        "longitudinal modes are not changed); a roll and spiral coupled into one oscillation "
+        "are judged as the roll-spiral mode (3.3.1.4)."
     )
     report.table(("mode", *columns), rows)
     changed = [

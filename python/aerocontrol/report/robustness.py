@@ -53,8 +53,12 @@ def robustness_report(result: MonteCarlo, uncertainty: Uncertainty, title: str) 
         rows.append((f"{loop} loop", "unstable", str(result.probability("unstable", loop=loop))))
         unresolved = result.probability("unresolved", loop=loop)
         if unresolved.count:
-            what = "roll and spiral coupled" if result.axis == "lateral" else "modes interleaved"
-            rows.append((f"{loop} loop", f"{what}: not assessed, Level 4", str(unresolved)))
+            what = (
+                "roll and spiral coupled: judged as one oscillation (3.3.1.4)"
+                if result.axis == "lateral"
+                else "modes interleaved: not assessed, Level 4"
+            )
+            rows.append((f"{loop} loop", what, str(unresolved)))
         for mode in result.modes:
             for level in (1, 2):
                 estimate = result.probability("level", mode, level, loop=loop)
@@ -70,8 +74,9 @@ def robustness_report(result: MonteCarlo, uncertainty: Uncertainty, title: str) 
         f"MIL-F-8785C Levels, Class {result.aircraft_class}, Flight Phase Category "
         f"{result.category}; each estimate with its 95 % Clopper-Pearson interval (exact, "
         "valid for rare events). Instability alone is not failure: the specification allows a "
-        "slow spiral or phugoid divergence. A coupled roll-spiral oscillation (3.3.1.4) is not "
-        "assessed here: its roll and spiral count as Level 4, so they fail."
+        "slow spiral or phugoid divergence. Where the roll and spiral couple into one "
+        "oscillation, both carry its Level by its ζ ω_n (3.3.1.4; not permitted, Level 4, in "
+        "Category A)."
     )
     report.table(("loop", "event", "probability"), rows)
     report.heading("Distributions")
