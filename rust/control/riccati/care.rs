@@ -80,7 +80,7 @@
 //! and unstable eigenvalues of H too ill-conditioned to be told apart).
 
 use super::AlgebraicSolution;
-use super::scaling::{Equation, ScaledEquation};
+use super::scaling::{Equation, Scale, ScaledEquation};
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::{balance, nearest_power_of_two};
 use crate::linalg::dense::{
@@ -255,8 +255,9 @@ pub(crate) fn solve_care_scaled(
         r,
         s: options.s,
         e: options.e,
+        terminal: None,
     };
-    let scaled = ScaledEquation::of(given, false)?;
+    let scaled = ScaledEquation::of(given, Scale::WhereBalanced)?;
     let equation = scaled.equation();
     let solution = solve_care_as_given(
         equation.a,

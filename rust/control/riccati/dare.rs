@@ -65,7 +65,7 @@ use super::AlgebraicSolution;
 use super::cayley::{cayley_solution, standard_form};
 use super::doubling::doubling_solution;
 use super::pencil::{checked_weights, compress, graph_solution};
-use super::scaling::{Equation, ScaledEquation};
+use super::scaling::{Equation, Scale, ScaledEquation};
 use crate::error::Error;
 use crate::linalg::dense::view_product;
 use crate::linalg::lu::{solve_in_place, solve_with_inverse};
@@ -122,8 +122,9 @@ pub fn solve_dare(
         r,
         s: options.s,
         e: options.e,
+        terminal: None,
     };
-    let Some(scaled) = ScaledEquation::of(given, true) else {
+    let Some(scaled) = ScaledEquation::of(given, Scale::AlsoWeights) else {
         return solve_dare_as_given(a, b, q, r, options);
     };
     let equation = scaled.equation();

@@ -1,5 +1,6 @@
-//! Exact scalings of an algebraic Riccati equation, continuous ([`super::care`]) or discrete
-//! ([`super::dare`]), to the sizes its Hamiltonian matrix or symplectic pencil resolves.
+//! Exact scalings of a Riccati equation, continuous ([`super::care`]) or discrete
+//! ([`super::dare`], and the difference equation of [`super::difference`]), to the sizes its
+//! Hamiltonian matrix, symplectic pencil or recursion resolves.
 //!
 //! Three changes of units leave the regulator unchanged: the states x = T x̃ with
 //! T = diag(2^e), and the costs multiplied by 2^k. The equation in those units is
@@ -29,7 +30,10 @@
 //! the discrete one also where B or Q alone is far from 1 (2^10, 2^20 or more).
 //!
 //! The solution is taken back, X = 2^-k T^-1 X̃ T^-1 and K = K̃ T^-1, and its relative residual
-//! is that of the caller's equation, recomputed in the caller's units.
+//! is that of the caller's equation, recomputed in the caller's units. The difference
+//! equation's terminal weight S_f scales as Q; its recursion is scaled where the states are
+//! balanced: its error estimate, normwise in A and B K, is then that of the balanced
+//! recursion, not of the units.
 
 use super::AlgebraicSolution;
 use crate::linalg::balance::{
@@ -42,7 +46,8 @@ use faer::{Mat, MatRef};
 /// by rounding.
 pub const BALANCING_SPREAD: i32 = 10;
 
-/// The equation as the caller gave it: A, B, Q, R, the cross weight S and the descriptor E.
+/// The equation as the caller gave it: A, B, Q, R, the cross weight S and the descriptor E;
+/// for the difference equation ([`super::difference`]) also the terminal weight S_f.
 #[derive(Clone, Copy)]
 pub(crate) struct Equation<'a> {
     pub(crate) a: MatRef<'a, f64>,
@@ -51,6 +56,18 @@ pub(crate) struct Equation<'a> {
     pub(crate) r: MatRef<'a, f64>,
     pub(crate) s: Option<MatRef<'a, f64>>,
     pub(crate) e: Option<MatRef<'a, f64>>,
+    pub(crate) terminal: Option<MatRef<'a, f64>>,
+}
+
+/// Where an equation is scaled.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Scale {
+    /// Only where its states are balanced (the continuous solver, which scales its
+    /// Hamiltonian's blocks itself, and the difference equation, whose steps are products).
+    WhereBalanced,
+    /// Also where B or the weights alone are far from 1 (the discrete solver's pencil, whose
+    /// identity blocks set the scale).
+    AlsoWeights,
 }
 
 /// The equation in scaled units (module documentation) and the exponents that scaled it.
@@ -65,6 +82,7 @@ pub(crate) struct ScaledEquation {
     pub(crate) r: Mat<f64>,
     pub(crate) s: Option<Mat<f64>>,
     pub(crate) e: Option<Mat<f64>>,
+    pub(crate) terminal: Option<Mat<f64>>,
 }
 
 /// round(max_ij log2 |M_ij| + row_i + col_j) (ties to even) over the nonzero entries, None
@@ -130,13 +148,21 @@ impl ScaledEquation {
     /// The equation in scaled units, or None where it is scaled well enough already, an
     /// argument is not a finite matrix of the right shape (the solver then refuses it by
     /// name), or a scaled entry would leave the normal doubles.
-    pub(crate) fn of(given: Equation<'_>, discrete: bool) -> Option<Self> {
-        let Equation { a, b, q, r, s, e } = given;
+    pub(crate) fn of(given: Equation<'_>, scale: Scale) -> Option<Self> {
+        let Equation {
+            a,
+            b,
+            q,
+            r,
+            s,
+            e,
+            terminal,
+        } = given;
         let (n, m) = (a.nrows(), b.ncols());
         if n == 0 || a.ncols() != n || b.nrows() != n {
             return None;
         }
-        if !discrete && e.is_none() && !states_scaled_apart(a) {
+        if scale == Scale::WhereBalanced && e.is_none() && !states_scaled_apart(a) {
             return None; // the balancing's own first test, before the weights are read
         }
         let shapes = q.nrows() == n
@@ -144,8 +170,9 @@ impl ScaledEquation {
             && r.nrows() == m
             && r.ncols() == m
             && s.is_none_or(|s| s.nrows() == n && s.ncols() == m)
-            && e.is_none_or(|e| e.nrows() == n && e.ncols() == n);
-        let finite = [Some(a), Some(b), Some(q), Some(r), s, e]
+            && e.is_none_or(|e| e.nrows() == n && e.ncols() == n)
+            && terminal.is_none_or(|t| t.nrows() == n && t.ncols() == n);
+        let finite = [Some(a), Some(b), Some(q), Some(r), s, e, terminal]
             .into_iter()
             .flatten()
             .all(|m| m.is_all_finite());
@@ -153,8 +180,8 @@ impl ScaledEquation {
             return None;
         }
         let balancing = balancing(a, e);
-        if balancing.is_none() && !discrete {
-            return None; // the continuous solver scales its Hamiltonian itself
+        if balancing.is_none() && scale == Scale::WhereBalanced {
+            return None;
         }
         let mut exponents = balancing.clone().unwrap_or_else(|| vec![0; n]);
         let shift = log2_size(b, |i| -exponents[i], |_| 0).unwrap_or(0);
@@ -185,6 +212,10 @@ impl ScaledEquation {
                 Some(e) => Some(exactly_scaled(e, |i| -t[i], |j| t[j])?),
                 None => None,
             },
+            terminal: match terminal {
+                Some(sf) => Some(exactly_scaled(sf, |i| cost + t[i], |j| t[j])?),
+                None => None,
+            },
             exponents,
             cost,
         })
@@ -199,7 +230,24 @@ impl ScaledEquation {
             r: self.r.as_ref(),
             s: self.s.as_ref().map(|s| s.as_ref()),
             e: self.e.as_ref().map(|e| e.as_ref()),
+            terminal: self.terminal.as_ref().map(|t| t.as_ref()),
         }
+    }
+
+    /// A solution X̃ of the scaled equation in the caller's units, X = 2^-k T^-1 X̃ T^-1.
+    pub(crate) fn unscaled_solution(&self, x: &Mat<f64>) -> Mat<f64> {
+        let t = &self.exponents;
+        Mat::from_fn(x.nrows(), x.ncols(), |i, j| {
+            times_power_of_two(x[(i, j)], f64::from(-self.cost - t[i] - t[j]))
+        })
+    }
+
+    /// A gain K̃ of the scaled equation in the caller's units, K = K̃ T^-1.
+    pub(crate) fn unscaled_gain(&self, gain: &Mat<f64>) -> Mat<f64> {
+        let t = &self.exponents;
+        Mat::from_fn(gain.nrows(), gain.ncols(), |i, j| {
+            times_power_of_two(gain[(i, j)], f64::from(-t[j]))
+        })
     }
 
     /// The scaled equation's solution in the caller's units: X = 2^-k T^-1 X̃ T^-1,
@@ -211,13 +259,8 @@ impl ScaledEquation {
         solution: AlgebraicSolution,
         residual: impl FnOnce(&Mat<f64>, &Mat<f64>) -> f64,
     ) -> AlgebraicSolution {
-        let t = &self.exponents;
-        let x = Mat::from_fn(solution.x.nrows(), solution.x.ncols(), |i, j| {
-            times_power_of_two(solution.x[(i, j)], f64::from(-self.cost - t[i] - t[j]))
-        });
-        let gain = Mat::from_fn(solution.gain.nrows(), solution.gain.ncols(), |i, j| {
-            times_power_of_two(solution.gain[(i, j)], f64::from(-t[j]))
-        });
+        let x = self.unscaled_solution(&solution.x);
+        let gain = self.unscaled_gain(&solution.gain);
         let mut residual_of_given = solution.residual;
         if x.is_all_finite() && gain.is_all_finite() {
             let unscaled = residual(&x, &gain);
@@ -263,9 +306,10 @@ mod tests {
             r: r.as_ref(),
             s: None,
             e: None,
+            terminal: None,
         };
-        assert!(ScaledEquation::of(given, false).is_none());
-        assert!(ScaledEquation::of(given, true).is_none());
+        assert!(ScaledEquation::of(given, Scale::WhereBalanced).is_none());
+        assert!(ScaledEquation::of(given, Scale::AlsoWeights).is_none());
     }
 
     #[test]
@@ -281,9 +325,10 @@ mod tests {
             r: r.as_ref(),
             s: None,
             e: None,
+            terminal: None,
         };
-        for discrete in [false, true] {
-            let scaled = ScaledEquation::of(given, discrete).expect("scaled apart");
+        for scale in [Scale::WhereBalanced, Scale::AlsoWeights] {
+            let scaled = ScaledEquation::of(given, scale).expect("scaled apart");
             assert!(largest(&scaled.a) < 64.0 && largest(&scaled.b) < 4.0);
             let t = &scaled.exponents;
             for i in 0..3 {
@@ -312,9 +357,10 @@ mod tests {
             r: r.as_ref(),
             s: None,
             e: None,
+            terminal: None,
         };
-        assert!(ScaledEquation::of(given, false).is_none());
-        let scaled = ScaledEquation::of(given, true).expect("costs far from 1");
+        assert!(ScaledEquation::of(given, Scale::WhereBalanced).is_none());
+        let scaled = ScaledEquation::of(given, Scale::AlsoWeights).expect("costs far from 1");
         assert_eq!(scaled.cost, -40);
         assert!(scaled.exponents.iter().all(|&x| x == 0));
         assert_eq!(scaled.q[(0, 0)], 1e12 * 2f64.powi(-40));
@@ -334,7 +380,8 @@ mod tests {
             r: r.as_ref(),
             s: None,
             e: None,
+            terminal: None,
         };
-        assert!(ScaledEquation::of(given, true).is_none());
+        assert!(ScaledEquation::of(given, Scale::AlsoWeights).is_none());
     }
 }
