@@ -801,3 +801,33 @@ def test_default_grid_reaches_the_slowest_mode_of_a_stiff_model(
     assert len(t) == 100_001
     x = aerocontrol.step_response((A, B)).x[-1]
     np.testing.assert_allclose(x, -np.linalg.solve(A, B[:, 0]), rtol=1e-2)
+
+
+@pytest.mark.parametrize(
+    "A",
+    [
+        np.diag([-1e6, -1e-7, 0.0]),  # an integrator beside the stiff pair
+        np.array([[-1e6, 1.0, 0.0, 0.0], [0.0, -1e-7, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], [0.0] * 4]),
+        np.array([[-1e6, 1.0, 0.0], [0.0, -1e-7, 1.0], [0.0, 0.0, 0.0]]),  # coupled to it
+    ],
+)
+def test_default_grid_reaches_a_slow_mode_beside_an_integrator(A: np.ndarray) -> None:
+    """Found by a hunt: the slow modes are found from the eigenvalues of A^-1, which a
+    singular A (an integrator, or a double one) does not have, so the grid ended at 7 time
+    constants of the fast mode (7e-6 s) beside a mode of -1e-7. A's null space, an invariant
+    subspace, is now deflated first: the grid runs to 7 / 1e-7 s, and the slow state of the
+    step response there is within 1 % of its equilibrium (the first two states of -A^-1 B
+    restricted to the decaying modes: 1e-6 and 1e7 for the diagonal model)."""
+    n = A.shape[0]
+    B = np.zeros((n, 1))
+    B[:2, 0] = 1.0
+    t = aerocontrol.default_time_grid((A, B))
+    assert t[-1] == pytest.approx(7.0 / 1e-7, rel=1e-9)
+    x = aerocontrol.step_response((A, B)).x[-1]
+    decaying = -np.linalg.solve(A[:2, :2], B[:2, 0])
+    np.testing.assert_allclose(x[:2], decaying, rtol=1e-2)
+    # The same model sampled (z = 1 for the integrator): the grid also reaches the slow mode.
+    dt = 1e-7
+    Phi = aerocontrol.expm(A * dt)
+    samples = aerocontrol.default_time_grid(aerocontrol.StateSpace(Phi, B, dt=dt))
+    assert samples[-1] >= 7.0 / 1e-7 * 0.99

@@ -226,7 +226,7 @@ def default_time_grid(sys: Systems) -> FloatArray:
     no mode decays), at most 100,001 samples; a discrete model steps by its dt. A decaying
     mode slower than 1e-12 ρ_max, which the eigenvalues of A do not resolve from an
     integrator, is found from the largest eigenvalues of A^-1 (for a discrete model, of
-    (A - I)^-1) where A is nonsingular.
+    (A - I)^-1), of A on the complement of its null space where A is singular.
 
     Parameters
     ----------
@@ -355,21 +355,28 @@ def _slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
     discrete model s = ln(z)/dt), which the eigenvalues of A (errors of u ||A||) do not
     resolve from zero: the eigenvalues of M = A (discrete: A - I) are 1/μ for μ those of
     M^-1, whose largest are resolved to a relative u. M^-1 is solved as the steady state is
-    (equilibrated where the core refuses M); a singular M (an integrator) gives none, as its
-    slow modes cannot be told from the integrator's zero."""
+    (equilibrated where the core refuses M). A singular M (an integrator) is first deflated
+    (:func:`_deflated`): its null space is invariant, so the nonzero eigenvalues are those of
+    M on the orthogonal complement, which is inverted instead."""
     n = model.n_states
     none = np.zeros(0, dtype=np.complex128)
     if n == 0:
         return none
     dt = period(model)
     M = model.A - np.eye(n) if dt else model.A
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            inverse = -_equilibrated_solve(M, np.eye(n), np.eye(n), False)
-    except SingularMatrixError:
-        return none
-    if not np.all(np.isfinite(inverse)):
+    inverse = None
+    for _ in range(n):  # each deflation removes at least one state
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                inverse = -_equilibrated_solve(M, np.eye(len(M)), np.eye(len(M)), False)
+            break
+        except SingularMatrixError:
+            deflated = _deflated(M)
+            if deflated is None:
+                return none
+            M = deflated
+    if inverse is None or not np.all(np.isfinite(inverse)):
         return none
     mu = _core.eigenvalues(inverse)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
@@ -378,6 +385,22 @@ def _slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
             slow = np.log1p(slow) / dt
     keep = np.isfinite(slow) & (slow != 0) & (np.abs(slow) < 1e-12 * fastest)
     return np.asarray(slow[keep], dtype=np.complex128)
+
+
+def _deflated(M: FloatArray) -> FloatArray | None:
+    """W^T M W for W an orthonormal basis of the complement of M's numerical null space (the
+    right singular vectors of the singular values above n u σ_max), or None where M has no
+    such null space or is all null space. M V_0 = 0 for the null vectors V_0, so in the
+    orthogonal basis [W V_0], M = [[W^T M W, 0], [V_0^T M W, 0]]: the eigenvalues of M are
+    those of W^T M W and zeros (a chain of them, a double integrator, leaves W^T M W singular,
+    and is deflated again)."""
+    n = len(M)
+    _, sigma, Vt = np.linalg.svd(M)
+    rank = int(np.sum(sigma > n * np.finfo(np.float64).eps * sigma[0])) if n else 0
+    if rank == 0 or rank == n:
+        return None
+    W = Vt[:rank].T
+    return np.asarray(W.T @ M @ W, dtype=np.float64)
 
 
 def _slow_decay_rates(model: StateSpace, fastest: float) -> FloatArray:
