@@ -103,6 +103,14 @@ FACTORIES: dict[str, Callable[[], Any]] = {
     ),
     "MonteCarlo (LQR)": lambda: _monte_carlo(Lqr(c=0.5)),
     "MonteCarlo (damper)": lambda: _monte_carlo(Damper(0.3)),
+    "MonteCarloCounts": lambda: monte_carlo(
+        aircraft.load("b747-cruise"),
+        Uncertainty({"Cn_beta": Normal(0.5)}),
+        500,
+        Lqr(c=0.5),
+        seed=3,
+        keep="counts",
+    ),
     "MonteCarlo (fixed gains)": lambda: _monte_carlo(
         aerocontrol.lqr(aircraft.load("b747-cruise").lateral(), np.eye(4), np.eye(2))[0]
     ),

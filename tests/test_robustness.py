@@ -23,6 +23,7 @@ from aerocontrol.aircraft.naming import classify_mode_stack, classify_modes
 from aerocontrol.exceptions import InvalidArgumentError, ShapeError
 from aerocontrol.handling import assess, level_arrays
 from aerocontrol.robustness import (
+    Damper,
     LogNormal,
     Lqr,
     Normal,
@@ -332,6 +333,76 @@ def test_monte_carlo_on_a_dask_cluster_is_bitwise_the_local_run(dask_client: obj
     assert set(counts.values()) <= {0, 2} and 2 in counts.values()
     with pytest.raises(InvalidArgumentError, match="worker_threads"):
         monte_carlo(plane, _LATERAL, 10, worker_threads=0)
+
+
+def _counted_by_hand(full: aerocontrol.robustness.MonteCarlo) -> dict[str, object]:
+    """The counts of a full run, from its per-sample arrays: the oracle of keep="counts"."""
+    loops = {"open": full.open_loop} | ({"closed": full.closed_loop} if full.closed_loop else {})
+    return {
+        "level_counts": {
+            loop: [
+                [int((o.levels[:, k] == level).sum()) for level in (1, 2, 3, 4)]
+                for k in range(len(full.modes))
+            ]
+            for loop, o in loops.items()
+        },
+        "unstable": {loop: int((~o.stable).sum()) for loop, o in loops.items()},
+        "unresolved": {loop: int(o.unresolved.sum()) for loop, o in loops.items()},
+        "failed": int(full.failed.sum()),
+    }
+
+
+@pytest.mark.parametrize(
+    ("axis", "controller"),
+    [
+        ("lateral", None),
+        ("lateral", "gains"),
+        ("lateral", Lqr(1.0)),  # roll and spiral coupled in most closed loops
+        ("lateral", Damper(0.3)),
+        ("longitudinal", Lqr(2.0)),
+    ],
+)
+def test_counts_are_those_of_the_full_run(axis: str, controller: object) -> None:
+    """keep="counts" reduces each chunk where it runs; its counts are those of the per-sample
+    arrays of the same run (chunks of 700 over 2,500 samples: the last one short), and so its
+    probabilities, sensitivity ranking and text are the full run's to the bit."""
+    plane = aircraft.load("b747-cruise")
+    uncertainty = _LATERAL if axis == "lateral" else Uncertainty({"Cm_alpha": Normal(0.3)})
+    chosen = _gains() if controller == "gains" else controller
+    options = {"axis": axis, "seed": 4, "chunk_size": 700}
+    full = monte_carlo(plane, uncertainty, 2500, chosen, **options)  # type: ignore[arg-type]
+    counts = monte_carlo(plane, uncertainty, 2500, chosen, keep="counts", **options)  # type: ignore[arg-type,call-overload]
+    expected = _counted_by_hand(full)
+    assert {k: v.tolist() for k, v in counts.level_counts.items()} == expected["level_counts"]
+    assert counts.unstable == expected["unstable"]
+    assert counts.unresolved == expected["unresolved"]
+    assert counts.failed == expected["failed"]
+    np.testing.assert_array_equal(counts.failures_by_bin, full.failures_by_bin)
+    np.testing.assert_array_equal(counts.samples_by_bin, full.samples_by_bin)
+    assert str(counts) == str(full)
+    assert counts.sensitivity() == full.sensitivity()
+    for loop in ("open", "closed") if full.closed_loop else ("open",):
+        for mode in full.modes:
+            for level in (1, 2, 3):
+                assert counts.probability("level", mode, level, loop) == full.probability(
+                    "level", mode, level, loop
+                )
+    if full.closed_loop is None:
+        with pytest.raises(InvalidArgumentError, match="no closed loop"):
+            counts.probability("unstable", loop="closed")
+
+
+def test_counts_on_a_dask_cluster_are_the_local_counts(dask_client: object) -> None:
+    """Each chunk reduced on its worker (only counts are shipped): the local run's counts."""
+    plane = aircraft.load("b747-cruise")
+    options = {"seed": 9, "chunk_size": 1500, "keep": "counts"}
+    local = monte_carlo(plane, _LATERAL, 6000, Lqr(1.0), **options)  # type: ignore[call-overload]
+    remote = monte_carlo(plane, _LATERAL, 6000, Lqr(1.0), client=dask_client, **options)  # type: ignore[call-overload]
+    assert str(remote) == str(local) and remote.unresolved == local.unresolved
+    for loop in ("open", "closed"):
+        np.testing.assert_array_equal(remote.level_counts[loop], local.level_counts[loop])
+    with pytest.raises(InvalidArgumentError, match="keep must be 'samples' or 'counts'"):
+        monte_carlo(plane, _LATERAL, 10, keep="all")  # type: ignore[call-overload]
 
 
 def test_monte_carlo_results() -> None:

@@ -39,7 +39,7 @@ import math
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Literal, Protocol, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -63,6 +63,7 @@ __all__ = [
     "LoopOutcome",
     "Lqr",
     "MonteCarlo",
+    "MonteCarloCounts",
     "Normal",
     "Uncertainty",
     "Uniform",
@@ -493,6 +494,8 @@ class _Run:
     chunk_size: int
     required_level: int
     worker_threads: int | None = None
+    counts_only: bool = False
+    """Each chunk is reduced to its counts where it runs (``keep="counts"``)."""
 
     def chunk_bounds(self, index: int) -> tuple[int, int]:
         start = index * self.chunk_size
@@ -566,14 +569,23 @@ def _judge(
 
 
 def _run_chunk_on_worker(run: _Run, index: int) -> dict[str, NDArray[Any]]:
-    """:func:`_run_chunk` on a Dask worker, its parallel work on ``run.worker_threads``
+    """:func:`_chunk_result` on a Dask worker, its parallel work on ``run.worker_threads``
     threads when given."""
     if run.worker_threads is None:
-        return _run_chunk(run, index)
+        return _chunk_result(run, index)
     from .threads import limit_threads
 
     with limit_threads(run.worker_threads):
-        return _run_chunk(run, index)
+        return _chunk_result(run, index)
+
+
+def _chunk_result(run: _Run, index: int) -> dict[str, NDArray[Any]]:
+    """What a chunk sends back: its per-sample results (:func:`_run_chunk`), or their counts
+    (:func:`_counted`) for a run that keeps the counts alone."""
+    part = _run_chunk(run, index)
+    if not run.counts_only:
+        return part
+    return _counted(part, ("open", "closed") if run.controller is not None else ("open",))
 
 
 def _run_chunk(run: _Run, index: int) -> dict[str, NDArray[Any]]:
@@ -945,8 +957,100 @@ class LoopOutcome:
     :class:`Damper` has no Dutch roll oscillation to damp)."""
 
 
+class _RunSummary:
+    """The probabilities, the sensitivity ranking and the text of a Monte Carlo run, from its
+    counts (:class:`MonteCarlo` counts its per-sample arrays, :class:`MonteCarloCounts` holds
+    the counts alone)."""
+
+    aircraft: str
+    axis: str
+    parameters: tuple[str, ...]
+    samples: int
+    seed: int
+    modes: tuple[str, ...]
+    failures_by_bin: NDArray[np.int64]
+    samples_by_bin: NDArray[np.int64]
+
+    def _count(self, event: str, mode: str | None, level: int, loop: str) -> int:
+        raise NotImplementedError
+
+    def _has_closed_loop(self) -> bool:
+        raise NotImplementedError
+
+    def probability(
+        self,
+        event: str,
+        mode: str | None = None,
+        level: int = 1,
+        loop: str = "auto",
+        confidence: float = 0.95,
+    ) -> Estimate:
+        """The probability of ``event``: "unstable", "unresolved" (modes that are not the
+        classical ones, such as a roll and spiral coupled into one oscillation, judged by
+        3.3.1.4), "failed", or "level" (``mode`` meets ``level`` or better), for the closed loop if
+        there is one (``loop="auto"``) or the loop named ("open", "closed"), with its
+        Clopper-Pearson interval."""
+        count = self._count(event, mode, level, loop)
+        return clopper_pearson(count, self.samples, confidence)
+
+    def sensitivity(self) -> list[tuple[str, float]]:
+        """The parameters ranked by how much the failure rate depends on them: the spread
+        (highest minus lowest) of the failure rate over the deciles of each parameter's draw,
+        largest first."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            rates = self.failures_by_bin / self.samples_by_bin
+        spread = np.nanmax(rates, axis=1) - np.nanmin(rates, axis=1)
+        order = np.argsort(-spread, kind="stable")
+        return [(self.parameters[k], float(spread[k])) for k in order]
+
+    def _cells(self) -> tuple[str, list[tuple[str, str, str]], list[tuple[str, str]]]:
+        """The title, (loop, event, estimate) per probability, and (parameter, spread) by
+        decreasing failure-rate spread, as text."""
+        title = (
+            f"Monte Carlo: {self.aircraft}, {self.axis}, {self.samples} samples (seed "
+            f"{self.seed}), parameters {', '.join(self.parameters)}"
+        )
+        loops = [("open loop", "open")] + (
+            [("closed loop", "closed")] if self._has_closed_loop() else []
+        )
+        rows = []
+        for label, loop in loops:
+            rows.append((label, "P(unstable)", str(self.probability("unstable", loop=loop))))
+            for mode in self.modes:
+                estimate = self.probability("level", mode, 1, loop=loop)
+                rows.append((label, f"P({mode} Level 1)", str(estimate)))
+        rows.append(("", "P(failed)", str(self.probability("failed"))))
+        ranked = [(name, f"{spread:.3g}") for name, spread in self.sensitivity()]
+        return title, rows, ranked
+
+    def __str__(self) -> str:
+        title, rows, ranked = self._cells()
+        lines = [title]
+        for k, (label, event, estimate) in enumerate(rows):
+            if not label:
+                lines.append(f"  {event} = {estimate}")
+            elif k == 0 or rows[k - 1][0] != label:
+                lines.append(f"  {label}: {event} = {estimate}")
+            else:
+                lines.append(f"    {event} = {estimate}")
+        listed = ", ".join(f"{name} {spread}" for name, spread in ranked)
+        lines.append(f"  sensitivity (failure-rate spread over deciles): {listed}")
+        return "\n".join(lines)
+
+    def _tables(self) -> list[Tabular]:
+        title, rows, ranked = self._cells()
+        return [
+            Tabular(title, ("loop", "event", "probability (interval)"), rows),
+            Tabular(
+                "sensitivity: failure-rate spread over the deciles of each parameter",
+                ("parameter", "spread"),
+                ranked,
+            ),
+        ]
+
+
 @dataclass(frozen=True, eq=False)
-class MonteCarlo(Result):
+class MonteCarlo(_RunSummary, Result):
     """The result of :func:`monte_carlo`.
 
     Attributes
@@ -1045,22 +1149,6 @@ class MonteCarlo(Result):
                 out[name][rows] = drawn[name][wanted[rows] - int(chunk) * run.chunk_size]
         return out
 
-    def probability(
-        self,
-        event: str,
-        mode: str | None = None,
-        level: int = 1,
-        loop: str = "auto",
-        confidence: float = 0.95,
-    ) -> Estimate:
-        """The probability of ``event``: "unstable", "unresolved" (modes that are not the
-        classical ones, such as a roll and spiral coupled into one oscillation, judged by
-        3.3.1.4), "failed", or "level" (``mode`` meets ``level`` or better), for the closed loop if
-        there is one (``loop="auto"``) or the loop named ("open", "closed"), with its
-        Clopper-Pearson interval."""
-        count = int(self.indicator(event, mode, level, loop).sum())
-        return clopper_pearson(count, self.samples, confidence)
-
     def indicator(
         self, event: str, mode: str | None = None, level: int = 1, loop: str = "auto"
     ) -> NDArray[np.bool_]:
@@ -1093,58 +1181,108 @@ class MonteCarlo(Result):
             return self.closed_loop
         raise InvalidArgumentError(f"loop must be 'auto', 'open' or 'closed', got {loop!r}")
 
-    def sensitivity(self) -> list[tuple[str, float]]:
-        """The parameters ranked by how much the failure rate depends on them: the spread
-        (highest minus lowest) of the failure rate over the deciles of each parameter's draw,
-        largest first."""
-        with np.errstate(invalid="ignore", divide="ignore"):
-            rates = self.failures_by_bin / self.samples_by_bin
-        spread = np.nanmax(rates, axis=1) - np.nanmin(rates, axis=1)
-        order = np.argsort(-spread, kind="stable")
-        return [(self.parameters[k], float(spread[k])) for k in order]
+    def _count(self, event: str, mode: str | None, level: int, loop: str) -> int:
+        return int(self.indicator(event, mode, level, loop).sum())
 
-    def _cells(self) -> tuple[str, list[tuple[str, str, str]], list[tuple[str, str]]]:
-        """The title, (loop, event, estimate) per probability, and (parameter, spread) by
-        decreasing failure-rate spread, as text."""
-        title = (
-            f"Monte Carlo: {self.aircraft}, {self.axis}, {self.samples} samples (seed "
-            f"{self.seed}), parameters {', '.join(self.parameters)}"
+    def _has_closed_loop(self) -> bool:
+        return self.closed_loop is not None
+
+
+@dataclass(frozen=True, eq=False)
+class MonteCarloCounts(_RunSummary, Result):
+    """The result of :func:`monte_carlo` with ``keep="counts"``: the counts its probabilities
+    and sensitivity ranking are made of, without the per-sample arrays (each chunk is reduced
+    where it runs, so a run of 10^9 samples on a cluster ships a few hundred integers a
+    chunk). Its probabilities, sensitivity ranking and tables are those of the
+    :class:`MonteCarlo` of the same run, to the bit.
+
+    Attributes
+    ----------
+    aircraft, aircraft_class, category, axis, parameters, modes, samples, seed, required_level
+        As for :class:`MonteCarlo`.
+    level_counts : dict of str to ndarray (modes, 4) of int
+        For "open" (and "closed", with a controller): the samples whose mode (a row, in the
+        order of ``modes``) is at Level 1, 2, 3 and 4 (the columns).
+    unstable, unresolved : dict of str to int
+        For each loop: the samples with an eigenvalue in Re s >= 0, and those whose modes are
+        not the classical ones (:attr:`LoopOutcome.unresolved`).
+    failed : int
+        The samples with a mode worse than ``required_level`` (of the closed loop when there
+        is a controller).
+    failures_by_bin, samples_by_bin : ndarray (parameters, 10) of int
+        As for :class:`MonteCarlo`.
+
+    Examples
+    --------
+    >>> from aerocontrol import aircraft
+    >>> from aerocontrol.robustness import Normal, Uncertainty, monte_carlo
+    >>> uncertainty = Uncertainty({"Cn_beta": Normal(0.3)})
+    >>> counts = monte_carlo(aircraft.load(), uncertainty, 4000, seed=1, keep="counts")
+    >>> full = monte_carlo(aircraft.load(), uncertainty, 4000, seed=1)
+    >>> counts.probability("level", "dutch roll") == full.probability("level", "dutch roll")
+    True
+    >>> counts.level_counts["open"][0].tolist()      # dutch roll at Levels 1, 2, 3, 4
+    [1, 3973, 26, 0]
+    """
+
+    aircraft: str
+    aircraft_class: str
+    category: str
+    axis: str
+    parameters: tuple[str, ...]
+    modes: tuple[str, ...]
+    samples: int
+    seed: int
+    required_level: int
+    level_counts: dict[str, NDArray[np.int64]]
+    unstable: dict[str, int]
+    unresolved: dict[str, int]
+    failed: int
+    failures_by_bin: NDArray[np.int64]
+    samples_by_bin: NDArray[np.int64]
+
+    def _has_closed_loop(self) -> bool:
+        return "closed" in self.level_counts
+
+    def _count(self, event: str, mode: str | None, level: int, loop: str) -> int:
+        if loop not in ("auto", "open", "closed"):
+            raise InvalidArgumentError(f"loop must be 'auto', 'open' or 'closed', got {loop!r}")
+        if loop == "auto":
+            loop = "closed" if self._has_closed_loop() else "open"
+        elif loop == "closed" and not self._has_closed_loop():
+            raise InvalidArgumentError("this run has no controller: no closed loop")
+        if event == "unstable":
+            return self.unstable[loop]
+        if event == "failed":
+            return self.failed
+        if event == "unresolved":
+            return self.unresolved[loop]
+        if event == "level":
+            if mode not in self.modes:
+                raise InvalidArgumentError(f"mode must be one of {self.modes}, got {mode!r}")
+            level = _level(level, "level")
+            return int(self.level_counts[loop][self.modes.index(mode), :level].sum())
+        raise InvalidArgumentError(
+            f"event must be 'unstable', 'unresolved', 'failed' or 'level', got {event!r}"
         )
-        loops = [("open loop", "open")] + ([("closed loop", "closed")] if self.closed_loop else [])
-        rows = []
-        for label, loop in loops:
-            rows.append((label, "P(unstable)", str(self.probability("unstable", loop=loop))))
-            for mode in self.modes:
-                estimate = self.probability("level", mode, 1, loop=loop)
-                rows.append((label, f"P({mode} Level 1)", str(estimate)))
-        rows.append(("", "P(failed)", str(self.probability("failed"))))
-        ranked = [(name, f"{spread:.3g}") for name, spread in self.sensitivity()]
-        return title, rows, ranked
 
-    def __str__(self) -> str:
-        title, rows, ranked = self._cells()
-        lines = [title]
-        for k, (label, event, estimate) in enumerate(rows):
-            if not label:
-                lines.append(f"  {event} = {estimate}")
-            elif k == 0 or rows[k - 1][0] != label:
-                lines.append(f"  {label}: {event} = {estimate}")
-            else:
-                lines.append(f"    {event} = {estimate}")
-        listed = ", ".join(f"{name} {spread}" for name, spread in ranked)
-        lines.append(f"  sensitivity (failure-rate spread over deciles): {listed}")
-        return "\n".join(lines)
 
-    def _tables(self) -> list[Tabular]:
-        title, rows, ranked = self._cells()
-        return [
-            Tabular(title, ("loop", "event", "probability (interval)"), rows),
-            Tabular(
-                "sensitivity: failure-rate spread over the deciles of each parameter",
-                ("parameter", "spread"),
-                ranked,
-            ),
-        ]
+def _counted(part: Mapping[str, NDArray[Any]], loops: Sequence[str]) -> dict[str, NDArray[Any]]:
+    """A chunk's per-sample results (:func:`_run_chunk`) reduced to the counts of
+    :class:`MonteCarloCounts`, as int64 arrays (sums over chunks in any order are exact)."""
+    counts: dict[str, NDArray[Any]] = {
+        "failed": np.array(int(part["failed"].sum())),
+        "bin_total": part["bin_total"],
+        "bin_failed": part["bin_failed"],
+    }
+    for loop in loops:
+        levels = part[f"{loop}_levels"]
+        counts[f"{loop}_levels"] = np.stack(
+            [np.bincount(levels[:, k] - 1, minlength=4)[:4] for k in range(levels.shape[1])]
+        ).astype(np.int64)
+        counts[f"{loop}_unstable"] = np.array(int((~part[f"{loop}_stable"]).sum()))
+        counts[f"{loop}_unresolved"] = np.array(int(part[f"{loop}_unresolved"].sum()))
+    return counts
 
 
 def _outcome(parts: Sequence[dict[str, NDArray[Any]]], prefix: str) -> LoopOutcome:
@@ -1163,6 +1301,7 @@ def _outcome(parts: Sequence[dict[str, NDArray[Any]]], prefix: str) -> LoopOutco
     )
 
 
+@overload
 def monte_carlo(
     aircraft: Aircraft,
     uncertainty: Uncertainty,
@@ -1176,7 +1315,43 @@ def monte_carlo(
     client: Any = None,
     progress: Callable[[int, int], object] | None = None,
     worker_threads: int | None = None,
-) -> MonteCarlo:
+    keep: Literal["samples"] = "samples",
+) -> MonteCarlo: ...
+
+
+@overload
+def monte_carlo(
+    aircraft: Aircraft,
+    uncertainty: Uncertainty,
+    samples: int,
+    controller: ArrayLike | Lqr | Damper | None = None,
+    *,
+    axis: str = "lateral",
+    seed: int = 0,
+    required_level: int = 1,
+    chunk_size: int = CHUNK_SIZE,
+    client: Any = None,
+    progress: Callable[[int, int], object] | None = None,
+    worker_threads: int | None = None,
+    keep: Literal["counts"],
+) -> MonteCarloCounts: ...
+
+
+def monte_carlo(
+    aircraft: Aircraft,
+    uncertainty: Uncertainty,
+    samples: int,
+    controller: ArrayLike | Lqr | Damper | None = None,
+    *,
+    axis: str = "lateral",
+    seed: int = 0,
+    required_level: int = 1,
+    chunk_size: int = CHUNK_SIZE,
+    client: Any = None,
+    progress: Callable[[int, int], object] | None = None,
+    worker_threads: int | None = None,
+    keep: str = "samples",
+) -> MonteCarlo | MonteCarloCounts:
     """Stochastic robustness by Monte Carlo evaluation: draw ``samples`` variants of
     ``aircraft`` from ``uncertainty``, and judge each one's modes (stability, MIL-F-8785C
     Levels), open loop and, with a ``controller``, closed loop.
@@ -1208,10 +1383,16 @@ def monte_carlo(
         With a ``client``: each chunk's parallel work runs on this many threads of its worker
         (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
         machine. The setting is per process: give it with workers of one task thread each.
+    keep : {"samples", "counts"}
+        "samples": the judgement of every sample (:class:`MonteCarlo`, about 90 bytes a
+        sample). "counts": only the counts the probabilities and the sensitivity ranking are
+        made of (:class:`MonteCarloCounts`, the same numbers to the bit), each chunk reduced
+        where it runs: for runs whose per-sample arrays would not fit, such as 10^9 samples
+        on a cluster.
 
     Returns
     -------
-    MonteCarlo
+    MonteCarlo or MonteCarloCounts
 
     Raises
     ------
@@ -1301,6 +1482,8 @@ def monte_carlo(
             )
     if worker_threads is not None:
         worker_threads = positive_int(worker_threads, "worker_threads")
+    if keep not in ("samples", "counts"):
+        raise InvalidArgumentError(f"keep must be 'samples' or 'counts', got {keep!r}")
     run = _Run(
         aircraft,
         uncertainty,
@@ -1311,6 +1494,7 @@ def monte_carlo(
         chunk_size,
         required_level,
         worker_threads,
+        keep == "counts",
     )
     indices = range(run.chunk_count)
     done = 0
@@ -1325,8 +1509,8 @@ def monte_carlo(
     parts: list[dict[str, NDArray[Any]]] = []
     if client is None:
         for i in indices:
-            parts.append(_run_chunk(run, i))
-            if i == 0:
+            parts.append(_chunk_result(run, i))
+            if i == 0 and not run.counts_only:
                 _check_results_fit(parts[0], run)
             advanced(i)
     else:
@@ -1335,13 +1519,15 @@ def monte_carlo(
         )
         for i, future in enumerate(futures):  # in chunk order; the cluster runs them all
             parts.append(future.result())
-            if i == 0:
+            if i == 0 and not run.counts_only:
                 try:
                     _check_results_fit(parts[0], run)
                 except MemoryError:
                     client.cancel(futures)
                     raise
             advanced(i)
+    if run.counts_only:
+        return _counts(parts, run)
     return MonteCarlo(
         aircraft=aircraft.name,
         aircraft_class=aircraft.aircraft_class,
@@ -1358,6 +1544,32 @@ def monte_carlo(
         failures_by_bin=np.sum([part["bin_failed"] for part in parts], axis=0),
         samples_by_bin=np.sum([part["bin_total"] for part in parts], axis=0),
         source=run,
+    )
+
+
+def _counts(parts: Sequence[Mapping[str, NDArray[Any]]], run: _Run) -> MonteCarloCounts:
+    """The chunks' counts (:func:`_counted`) summed into the run's."""
+    loops = ("open", "closed") if run.controller is not None else ("open",)
+
+    def total(key: str) -> Any:
+        return np.sum([part[key] for part in parts], axis=0)
+
+    return MonteCarloCounts(
+        aircraft=run.aircraft.name,
+        aircraft_class=run.aircraft.aircraft_class,
+        category=run.aircraft.category,
+        axis=run.axis,
+        parameters=run.uncertainty.names,
+        modes=_AXIS_MODES[run.axis],
+        samples=run.samples,
+        seed=run.seed,
+        required_level=run.required_level,
+        level_counts={loop: np.asarray(total(f"{loop}_levels"), dtype=np.int64) for loop in loops},
+        unstable={loop: int(total(f"{loop}_unstable")) for loop in loops},
+        unresolved={loop: int(total(f"{loop}_unresolved")) for loop in loops},
+        failed=int(total("failed")),
+        failures_by_bin=np.asarray(total("bin_failed"), dtype=np.int64),
+        samples_by_bin=np.asarray(total("bin_total"), dtype=np.int64),
     )
 
 
