@@ -76,19 +76,24 @@ def test_counts_that_would_exhaust_the_machine_are_refused(count: int) -> None:
     assert _named_threads() < 300 if Path("/proc/self/task").is_dir() else True
 
 
-def test_blocks_of_two_threads_that_overlap_restore_the_setting() -> None:
+def test_blocks_of_two_threads_are_each_their_own() -> None:
     """Thread 1 enters limit_threads(1), thread 2 enters limit_threads(3), thread 1 leaves,
-    then thread 2: the setting is 3 while thread 2's block is open, and the one from before
-    both when it closes (each block restored the setting it found, so thread 2 once restored
-    thread 1's 1 and left the process on one thread)."""
+    then thread 2 (blocks that overlap without nesting, as a Dask worker's task threads run
+    their chunks): each thread's work runs on its own count while both are open (a batch
+    started in each runs on that many threads), the main thread keeps the process's setting
+    throughout, and nothing is left changed after. (The setting was the process's: thread 2's
+    block saw 3, but thread 1's work ran on thread 2's count.)"""
     before = aerocontrol.get_num_threads()
-    entered_1, entered_2, left_1 = threading.Event(), threading.Event(), threading.Event()
+    entered_1, entered_2, checked, left_1 = (threading.Event() for _ in range(4))
     seen: dict[str, int] = {}
+    A = np.repeat(np.diag([-1.0, -2.0, -3.0])[np.newaxis], 512, axis=0)
 
     def first() -> None:
         with aerocontrol.limit_threads(1):
             entered_1.set()
-            entered_2.wait(10)
+            checked.wait(10)
+            seen["first"] = aerocontrol.get_num_threads()
+            aerocontrol.linalg.expm(A)  # a batch on this thread's one thread
         left_1.set()
 
     def second() -> None:
@@ -96,14 +101,23 @@ def test_blocks_of_two_threads_that_overlap_restore_the_setting() -> None:
         with aerocontrol.limit_threads(3):
             entered_2.set()
             left_1.wait(10)
-            seen["inside"] = aerocontrol.get_num_threads()
+            seen["second"] = aerocontrol.get_num_threads()
+        seen["second after"] = aerocontrol.get_num_threads()
 
     threads = [threading.Thread(target=first), threading.Thread(target=second)]
     for thread in threads:
         thread.start()
+    entered_2.wait(10)  # both blocks open
+    seen["main while both open"] = aerocontrol.get_num_threads()
+    checked.set()
     for thread in threads:
         thread.join(20)
-    assert seen == {"inside": 3}
+    assert seen == {
+        "first": 1,
+        "main while both open": before,
+        "second": 3,
+        "second after": before,
+    }
     assert aerocontrol.get_num_threads() == before
     # Nested blocks of one thread, and a count set inside a block, restore as before.
     with aerocontrol.limit_threads(2):

@@ -458,7 +458,8 @@ def solve_care_batch(
     worker_threads : int, optional
         With a ``client``: each chunk's parallel work runs on this many threads of its worker
         (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
-        machine. The setting is per process: give it with workers of one task thread each.
+        machine. The setting is the task thread's own, so a worker of several task threads
+        runs each chunk on that many threads.
 
     Returns
     -------
@@ -530,7 +531,8 @@ def solve_dare_batch(
     worker_threads : int, optional
         With a ``client``: each chunk's parallel work runs on this many threads of its worker
         (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
-        machine. The setting is per process: give it with workers of one task thread each.
+        machine. The setting is the task thread's own, so a worker of several task threads
+        runs each chunk on that many threads.
 
     Returns
     -------
@@ -604,7 +606,8 @@ def dlqr_sweep(
     worker_threads : int, optional
         With a ``client``: each chunk's parallel work runs on this many threads of its worker
         (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
-        machine. The setting is per process: give it with workers of one task thread each.
+        machine. The setting is the task thread's own, so a worker of several task threads
+        runs each chunk on that many threads.
 
     Returns
     -------
@@ -671,7 +674,8 @@ def lqr_sweep(
     worker_threads : int, optional
         With a ``client``: each chunk's parallel work runs on this many threads of its worker
         (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
-        machine. The setting is per process: give it with workers of one task thread each.
+        machine. The setting is the task thread's own, so a worker of several task threads
+        runs each chunk on that many threads.
 
     Returns
     -------

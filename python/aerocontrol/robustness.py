@@ -1382,7 +1382,8 @@ def monte_carlo(
     worker_threads : int, optional
         With a ``client``: each chunk's parallel work runs on this many threads of its worker
         (:func:`aerocontrol.limit_threads`), so that workers do not oversubscribe their
-        machine. The setting is per process: give it with workers of one task thread each.
+        machine. The setting is the task thread's own, so a worker of several task threads
+        runs each chunk on that many threads.
     keep : {"samples", "counts"}
         "samples": the judgement of every sample (:class:`MonteCarlo`, about 90 bytes a
         sample). "counts": only the counts the probabilities and the sensitivity ranking are

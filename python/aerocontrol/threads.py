@@ -3,9 +3,10 @@
 By default, rayon's pool: ``RAYON_NUM_THREADS`` threads if that is set when the first parallel
 computation starts, else one per core. :func:`set_num_threads` changes it for the process from
 then on (computations already running finish on the threads they started on);
-:func:`limit_threads` changes it for a ``with`` block. A process that runs several computations
-side by side (a Dask worker with several task threads, a multiprocessing pool) gives each a
-share of the cores, so that together they do not oversubscribe the machine.
+:func:`limit_threads` changes it for a ``with`` block of the calling thread alone. A process
+that runs several computations side by side (a Dask worker with several task threads, a
+multiprocessing pool) gives each a share of the cores, so that together they do not
+oversubscribe the machine.
 
 Small problems run on the calling thread whatever the setting; batches and large problems are
 the ones that spread over threads.
@@ -22,7 +23,7 @@ from __future__ import annotations
 
 import contextlib
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
@@ -32,11 +33,18 @@ from .exceptions import InvalidArgumentError
 
 __all__ = ["get_num_threads", "limit_threads", "set_num_threads"]
 
-_chosen: int | None = None
-#: The open ``limit_threads`` blocks of all threads, in the order they were entered, each
-#: the one-element list of the setting that comes back when it closes.
-_blocks: list[list[int | None]] = []
-_blocks_lock = threading.RLock()
+
+class _Blocks(threading.local):
+    """The calling thread's open ``limit_threads`` blocks: the count in force in the innermost
+    (None: the default pool), and the counts to come back as the blocks close (innermost
+    last; the first entry None: no block, the process's setting)."""
+
+    def __init__(self) -> None:
+        self.current: int | None = None
+        self.earlier: list[int | None] = []
+
+
+_blocks = _Blocks()
 
 
 def _count(count: object) -> int:
@@ -79,16 +87,24 @@ def set_num_threads(count: int | None) -> None:
     ...     aerocontrol.get_num_threads()
     1
     """
-    global _chosen
     value = None if count is None else _count(count)
+    if _blocks.earlier:  # inside a block of this thread: the block's setting, until it closes
+        _set(_core.set_thread_num_threads, value)
+        _blocks.current = value
+    else:
+        _set(_core.set_num_threads, value)
+
+
+def _set(setter: Callable[[int], None], value: int | None) -> None:
+    """``setter(value)`` (0 for None: the default pool), a count beyond the machine's integers
+    refused as beyond the limit."""
     try:
-        _core.set_num_threads(0 if value is None else value)
+        setter(0 if value is None else value)
     except OverflowError:  # beyond the machine's integers: beyond the limit too
         try:
-            _core.set_num_threads(2**32)  # raises the limit's own InvalidArgumentError
+            setter(2**32)  # raises the limit's own InvalidArgumentError
         except InvalidArgumentError as error:  # which names 2^32, not the count given
             raise InvalidArgumentError(str(error).replace(f"got {2**32}", f"got {value}")) from None
-    _chosen = value
 
 
 def get_num_threads() -> int:
@@ -117,10 +133,10 @@ def get_num_threads() -> int:
 
 @contextlib.contextmanager
 def limit_threads(count: int | None) -> Iterator[None]:
-    """:func:`set_num_threads` for a ``with`` block; the earlier setting comes back after it
-    (also when the block raises). The setting is the process's: while blocks of several
-    threads are open, the latest entered of them sets it, and when the last closes, the
-    setting from before the first comes back (in whatever order they close).
+    """:func:`set_num_threads` for a ``with`` block of the calling thread; the earlier setting
+    comes back after it (also when the block raises). The setting is the thread's own: blocks
+    of several threads (the task threads of a Dask worker) each run their work on their own
+    count, and the process's setting is unchanged for the other threads.
 
     Parameters
     ----------
@@ -145,23 +161,16 @@ def limit_threads(count: int | None) -> Iterator[None]:
     ...     aerocontrol.get_num_threads()
     1
     """
-    block: list[int | None] = []  # the setting before the block: its own, or passed on
-    with _blocks_lock:
-        earlier = _chosen
-        set_num_threads(count)  # a refused count leaves the setting and the blocks unchanged
-        block.append(earlier)
-        _blocks.append(block)
+    value = None if count is None else _count(count)
+    _set(_core.set_thread_num_threads, value)  # a refused count leaves the setting unchanged
+    _blocks.earlier.append(_blocks.current)
+    _blocks.current = value
     try:
         yield
     finally:
-        with _blocks_lock:
-            position = next(i for i, open_block in enumerate(_blocks) if open_block is block)
-            del _blocks[position]
-            if position == len(_blocks):  # the latest block: its earlier setting comes back
-                set_num_threads(block[0])
-            else:
-                # Blocks of several threads that overlap without nesting (one entered, another
-                # entered, the first left): the later block keeps the setting, and inherits
-                # the one to come back when it closes, so that the setting from before the
-                # first block comes back when the last closes, in whatever order they close.
-                _blocks[position][0] = block[0]
+        earlier = _blocks.earlier.pop()
+        _blocks.current = earlier
+        if _blocks.earlier:  # still inside an outer block: its count
+            _set(_core.set_thread_num_threads, earlier)
+        else:  # the process's setting again
+            _core.set_thread_num_threads(None)

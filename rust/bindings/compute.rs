@@ -214,6 +214,14 @@ pub fn set_num_threads(py: Python<'_>, count: usize) -> PyResult<()> {
     threads::set_num_threads(count).map_err(|e| to_py_err(py, e))
 }
 
+/// Runs the parallel work the calling thread starts on `count` threads (0: rayon's global
+/// pool), whatever the process's choice; None follows the process's choice again.
+#[pyfunction]
+#[pyo3(signature = (count, /))]
+pub fn set_thread_num_threads(py: Python<'_>, count: Option<usize>) -> PyResult<()> {
+    threads::set_thread_num_threads(count).map_err(|e| to_py_err(py, e))
+}
+
 /// The number of threads parallel work runs on.
 #[pyfunction]
 pub fn get_num_threads() -> usize {
@@ -222,6 +230,7 @@ pub fn get_num_threads() -> usize {
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(set_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(set_thread_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(get_num_threads, m)?)?;
     Ok(())
 }

@@ -1,13 +1,15 @@
 //! The number of threads parallel work runs on: rayon's global pool (`RAYON_NUM_THREADS`, else
-//! one thread per core) unless a caller chose a count ([`set_num_threads`]), in which case the
-//! work runs on a pool of that many threads. A process that runs several computations side by
-//! side (a Dask worker, a multiprocessing pool) chooses one or a few threads for each, so that
-//! together they do not oversubscribe the cores.
+//! one thread per core) unless a caller chose a count, for the process ([`set_num_threads`])
+//! or for the calling thread ([`set_thread_num_threads`], which takes precedence), in which
+//! case the work runs on a pool of that many threads. A process that runs several
+//! computations side by side (a Dask worker's task threads, a multiprocessing pool) chooses
+//! one or a few threads for each, so that together they do not oversubscribe the cores.
 //!
 //! Each pool records whether every one of its threads holds faer's product workspace
 //! ([`crate::platform::memory::ensure_pool_product_workspace`]).
 
 use crate::error::Error;
+use std::cell::RefCell;
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex, RwLock};
 
@@ -20,11 +22,21 @@ pub struct Pool {
 
 static CHOSEN: RwLock<Option<Arc<Pool>>> = RwLock::new(None);
 
+thread_local! {
+    /// The calling thread's own choice ([`set_thread_num_threads`]): None where it made none;
+    /// Some(None) for rayon's global pool.
+    static THREAD_CHOSEN: RefCell<Option<Option<Arc<Pool>>>> = const { RefCell::new(None) };
+}
+
 /// Whether every thread of rayon's global pool holds faer's product workspace.
 pub static GLOBAL_PRODUCT_WORKSPACE: AtomicBool = AtomicBool::new(false);
 
-/// The pool chosen by [`set_num_threads`], None for rayon's global pool.
+/// The pool chosen for the calling thread ([`set_thread_num_threads`]), else for the process
+/// ([`set_num_threads`]); None for rayon's global pool.
 pub fn chosen() -> Option<Arc<Pool>> {
+    if let Some(own) = THREAD_CHOSEN.with(|own| own.borrow().clone()) {
+        return own;
+    }
     CHOSEN
         .read()
         .unwrap_or_else(|poisoned| poisoned.into_inner())
@@ -41,6 +53,25 @@ pub fn max_threads() -> usize {
 /// Runs parallel work on `count` threads from now on; 0 returns to rayon's global pool.
 /// Computations already running finish on the pool they started on.
 pub fn set_num_threads(count: usize) -> Result<(), Error> {
+    let pool = chosen_pool(count)?;
+    *CHOSEN
+        .write()
+        .unwrap_or_else(|poisoned| poisoned.into_inner()) = pool;
+    Ok(())
+}
+
+/// [`set_num_threads`] for the parallel work the calling thread starts, whatever the process's
+/// choice: Some(count) (0: rayon's global pool), or None to follow the process's choice
+/// again.
+pub fn set_thread_num_threads(count: Option<usize>) -> Result<(), Error> {
+    let own = count.map(chosen_pool).transpose()?;
+    THREAD_CHOSEN.with(|chosen| *chosen.borrow_mut() = own);
+    Ok(())
+}
+
+/// The pool of `count` threads (None for 0: rayon's global pool), refusing more than
+/// [`max_threads`].
+fn chosen_pool(count: usize) -> Result<Option<Arc<Pool>>, Error> {
     let most = max_threads();
     if count > most {
         return Err(Error::InvalidArgument {
@@ -50,15 +81,11 @@ pub fn set_num_threads(count: usize) -> Result<(), Error> {
             ),
         });
     }
-    let pool = if count == 0 {
-        None
+    if count == 0 {
+        Ok(None)
     } else {
-        Some(pool_of(count)?)
-    };
-    *CHOSEN
-        .write()
-        .unwrap_or_else(|poisoned| poisoned.into_inner()) = pool;
-    Ok(())
+        pool_of(count).map(Some)
+    }
 }
 
 /// The pools started so far, at most [`KEPT_POOLS`], the most recently chosen last: choosing
@@ -147,5 +174,22 @@ mod tests {
         assert_eq!(num_threads(), rayon::current_num_threads());
         assert!(set_num_threads(max_threads() + 1).is_err());
         assert_eq!(num_threads(), rayon::current_num_threads());
+    }
+
+    #[test]
+    fn a_thread_choice_is_the_threads_own() {
+        // Another thread's choice does not change this one's, and follows the process's
+        // choice again when cleared.
+        std::thread::spawn(|| {
+            set_thread_num_threads(Some(2)).unwrap();
+            assert_eq!(num_threads(), 2);
+            let other = std::thread::spawn(num_threads).join().unwrap();
+            assert_eq!(other, rayon::current_num_threads());
+            set_thread_num_threads(None).unwrap();
+            assert_eq!(num_threads(), rayon::current_num_threads());
+            assert!(set_thread_num_threads(Some(max_threads() + 1)).is_err());
+        })
+        .join()
+        .unwrap();
     }
 }
