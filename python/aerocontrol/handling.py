@@ -53,7 +53,7 @@ given here cannot decide it, so it is left to the caller:
 
 Not read from the scan: the minimums of 3.3.1.4 (ζ_RS ω_nRS of 0.5, 0.3 and 0.15 rad/s for
 Levels 1 to 3, "shall exceed"), taken as three independent secondary sources quote them; they
-are marked so in :data:`ROLL_SPIRAL_MIN_ZETA_OMEGA`.
+are marked so in ``ROLL_SPIRAL_MIN_ZETA_OMEGA``.
 
 A complex roll or spiral eigenvalue is refused: a roll and a spiral that have coupled into one
 oscillation are given as the mode "roll-spiral" (two eigenvalues, as the names of
