@@ -188,10 +188,13 @@ no worker oversubscribes its cores. 10^9 samples are then 15,259 tasks, about 10
   change the draws (the chunk size is part of the result's identity, the worker count is not);
 - **the reduction**: each chunk sends back its per-sample arrays, about 90 bytes a sample
   (the Levels of each mode open and closed, stability, the largest real part, the mode
-  quantities). That is 6 MB a chunk and 90 GB for 10^9 samples: at that size, keep the
-  arrays on the cluster and bring back only the counts (they are sums over chunks, exact
-  in any order). Up to about 10^7 samples (1 GB), gathering them to the client as
-  `monte_carlo` does is the simpler choice.
+  quantities). That is 6 MB a chunk and 90 GB for 10^9 samples: at that size, run with
+  `keep="counts"`, which reduces each chunk on its worker to the counts the probabilities
+  and the sensitivity ranking are made of (a few hundred integers a chunk, 15,259 chunks:
+  a few MB in all; sums over chunks, exact in any order, so the result is bitwise that of
+  the full run's counts). Up to about 10^7 samples (1 GB), gathering the per-sample arrays
+  to the client (the default, `keep="samples"`) keeps the histograms and the failed
+  samples' indices.
 """
 
 
