@@ -6,6 +6,7 @@
 //! which is the efficient split for many small problems; an error names the index of the problem.
 
 use crate::control::placement::Placement;
+use crate::control::riccati::AlgebraicSolution;
 use crate::control::riccati::care::{CareOptions, solve_care, solve_care_dense, solve_care_scaled};
 use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
@@ -381,6 +382,20 @@ enum Solution {
     Faer { x: Mat<f64>, gain: Mat<f64> },
 }
 
+impl From<AlgebraicSolution> for Solved {
+    fn from(solution: AlgebraicSolution) -> Self {
+        Self {
+            solution: Solution::Faer {
+                x: solution.x,
+                gain: solution.gain,
+            },
+            poles: solution.closed_loop_eigenvalues,
+            residual: solution.residual,
+            rcond: solution.rcond,
+        }
+    }
+}
+
 impl Solved {
     /// X (n x n) and K (m x n), row-major, into `x` and `gain`.
     fn write(&self, x: &mut [f64], gain: &mut [f64], n: usize, m: usize) {
@@ -417,16 +432,7 @@ fn solve_one(
                 ..CareOptions::default()
             };
             if let Some(scaled) = solve_care_scaled(a, b, q, r, options) {
-                let care = scaled?;
-                return Ok(Solved {
-                    solution: Solution::Faer {
-                        x: care.x,
-                        gain: care.gain,
-                    },
-                    poles: care.closed_loop_eigenvalues,
-                    residual: care.residual,
-                    rcond: care.rcond,
-                });
+                return scaled.map(Solved::from);
             }
             match solve_care_dense(a, b, q, r, options) {
                 Ok(care) => Ok(Solved {
@@ -441,32 +447,12 @@ fn solve_one(
                 // solve_care routes such an R to the extended pencil (or refuses it as the
                 // single call does).
                 Err(Error::NotPositiveDefinite { arg: "R", .. }) => {
-                    let care = solve_care(a, b, q, r, options)?;
-                    Ok(Solved {
-                        solution: Solution::Faer {
-                            x: care.x,
-                            gain: care.gain,
-                        },
-                        poles: care.closed_loop_eigenvalues,
-                        residual: care.residual,
-                        rcond: care.rcond,
-                    })
+                    solve_care(a, b, q, r, options).map(Solved::from)
                 }
                 Err(error) => Err(error),
             }
         }
-        RiccatiKind::Discrete => {
-            let dare = solve_dare(a, b, q, r, DareOptions::default())?;
-            Ok(Solved {
-                solution: Solution::Faer {
-                    x: dare.x,
-                    gain: dare.gain,
-                },
-                poles: dare.closed_loop_eigenvalues,
-                residual: dare.residual,
-                rcond: dare.rcond,
-            })
-        }
+        RiccatiKind::Discrete => solve_dare(a, b, q, r, DareOptions::default()).map(Solved::from),
     }
 }
 

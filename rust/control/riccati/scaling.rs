@@ -287,6 +287,24 @@ mod tests {
         max_abs(m.as_ref())
     }
 
+    /// The equation (A, B, Q, R) without cross weight, descriptor or terminal weight.
+    fn plain<'a>(
+        a: &'a Mat<f64>,
+        b: &'a Mat<f64>,
+        q: &'a Mat<f64>,
+        r: &'a Mat<f64>,
+    ) -> Equation<'a> {
+        Equation {
+            a: a.as_ref(),
+            b: b.as_ref(),
+            q: q.as_ref(),
+            r: r.as_ref(),
+            s: None,
+            e: None,
+            terminal: None,
+        }
+    }
+
     /// A 3-state model scaled by s: A_ij s_i / s_j, B_i s_i.
     fn scaled_model(s: [f64; 3]) -> (Mat<f64>, Mat<f64>) {
         let base = [[-1.0, 2.0, 0.5], [-3.0, -2.0, 1.0], [0.25, -1.0, -4.0]];
@@ -299,15 +317,7 @@ mod tests {
     fn well_scaled_equations_are_left_alone() {
         let (a, b) = scaled_model([1.0, 1.0, 1.0]);
         let (q, r) = (Mat::<f64>::identity(3, 3), Mat::<f64>::identity(1, 1));
-        let given = Equation {
-            a: a.as_ref(),
-            b: b.as_ref(),
-            q: q.as_ref(),
-            r: r.as_ref(),
-            s: None,
-            e: None,
-            terminal: None,
-        };
+        let given = plain(&a, &b, &q, &r);
         assert!(ScaledEquation::of(given, Scale::WhereBalanced).is_none());
         assert!(ScaledEquation::of(given, Scale::AlsoWeights).is_none());
     }
@@ -318,15 +328,7 @@ mod tests {
         // exact power-of-two multiple of the given one.
         let (a, b) = scaled_model([1e6, 1e-6, 1.0]);
         let (q, r) = (Mat::<f64>::identity(3, 3), Mat::<f64>::identity(1, 1));
-        let given = Equation {
-            a: a.as_ref(),
-            b: b.as_ref(),
-            q: q.as_ref(),
-            r: r.as_ref(),
-            s: None,
-            e: None,
-            terminal: None,
-        };
+        let given = plain(&a, &b, &q, &r);
         for scale in [Scale::WhereBalanced, Scale::AlsoWeights] {
             let scaled = ScaledEquation::of(given, scale).expect("scaled apart");
             assert!(largest(&scaled.a) < 64.0 && largest(&scaled.b) < 4.0);
@@ -350,15 +352,7 @@ mod tests {
         let (a, b) = scaled_model([1.0, 1.0, 1.0]);
         let q = Mat::<f64>::identity(3, 3) * 1e12;
         let r = Mat::<f64>::identity(1, 1) * 1e12;
-        let given = Equation {
-            a: a.as_ref(),
-            b: b.as_ref(),
-            q: q.as_ref(),
-            r: r.as_ref(),
-            s: None,
-            e: None,
-            terminal: None,
-        };
+        let given = plain(&a, &b, &q, &r);
         assert!(ScaledEquation::of(given, Scale::WhereBalanced).is_none());
         let scaled = ScaledEquation::of(given, Scale::AlsoWeights).expect("costs far from 1");
         assert_eq!(scaled.cost, -40);
@@ -373,15 +367,7 @@ mod tests {
         let mut q = Mat::<f64>::identity(3, 3);
         q[(1, 1)] = 1e-300;
         let r = Mat::<f64>::identity(1, 1);
-        let given = Equation {
-            a: a.as_ref(),
-            b: b.as_ref(),
-            q: q.as_ref(),
-            r: r.as_ref(),
-            s: None,
-            e: None,
-            terminal: None,
-        };
+        let given = plain(&a, &b, &q, &r);
         assert!(ScaledEquation::of(given, Scale::AlsoWeights).is_none());
     }
 }
