@@ -463,9 +463,10 @@ impl Quadratic {
 ///
 /// The entry that the row rotation leaves below the diagonal of the other matrix is the
 /// backward error of the split (H z = λ T z + r: along T z it leaves r_2 in H, along H z it
-/// leaves r_2 / λ in T). Each real root of each of the `quadratics` is tried with both row
-/// rotations, and the split whose larger remainder, relative to the block norms of H and T,
-/// is smallest is taken; the remainders are set to zero. (LAPACK's dlagv2 chooses the row
+/// leaves r_2 / λ in T). The real roots of the `quadratics` (the most accurate first) are
+/// tried with both row rotations until a split leaves remainders of rounding (2 u relative
+/// to the block norms of H and T); else the split whose larger remainder is smallest is
+/// taken. The remainders are set to zero. (LAPACK's dlagv2 chooses the row
 /// rotation by the block norms and the eigenvalue alone; an eigenvalue with a forward error
 /// of κ u, far below a diagonal ratio or beside a near-infinite one, left a remainder of
 /// κ u.)
@@ -517,6 +518,11 @@ fn split_real_pair(p: &mut Pencil<'_>, k: usize, quadratics: &[Quadratic; 3]) {
             if best.is_none_or(|(least, _, _)| remainder < least) {
                 best = Some((remainder, g, rows_g));
             }
+        }
+        // Remainders of rounding (2 u) with the most accurate quadratic's root: the others
+        // cannot do better.
+        if best.is_some_and(|(least, _, _)| least <= U) {
+            break;
         }
     }
     // Without a finite root (not reached: the quadratic of s = 0 is finite), the identity.
