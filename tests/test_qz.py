@@ -174,3 +174,96 @@ def test_regression_pencil_with_exact_zeros_and_a_double_zero_eigenvalue() -> No
     values = np.sort((result.alpha / result.beta).real)
     np.testing.assert_allclose(values, [-1.0, 0.0, 0.0], atol=1e-7)
     _check(A, B, aerocontrol.qz(A, B))
+
+
+# ----- classes of pencils: near-proportional, infinite eigenvalues, singular B -----------------
+
+U = 2.0**-53
+CLASSES = ("near-proportional", "all-infinite", "mixed", "zero-diagonals", "generic")
+
+
+def _orthogonal(rng: np.random.Generator, n: int) -> np.ndarray:
+    q, r = np.linalg.qr(rng.standard_normal((n, n)))
+    return q * np.sign(np.diag(r))
+
+
+def _pencil(kind: str, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A seeded pencil of the class: A = c B + E with E of 1e-2 down to 1e-14 times a random
+    matrix; A = Q S Z^T nonsingular and B = Q N Z^T (N strictly upper triangular, Z = Q in a
+    third of them: B = H N H^T), every eigenvalue infinite; the same with some of T's diagonal
+    zero (finite and infinite eigenvalues); a random A beside a triangular B with several zero
+    diagonal entries; a random pencil (the control)."""
+    if kind == "near-proportional":
+        B = rng.standard_normal((n, n))
+        c = float(rng.choice([1.0, -2.5, 0.3, 1e3, rng.standard_normal()]))
+        size = 10.0 ** -float(rng.integers(2, 15))
+        return c * B + size * abs(c) * rng.standard_normal((n, n)), B
+    if kind in ("all-infinite", "mixed"):
+        Q = _orthogonal(rng, n)
+        Z = Q if rng.random() < 1 / 3 else _orthogonal(rng, n)
+        S = np.triu(rng.standard_normal((n, n)), 1)
+        S += np.diag(rng.choice([-1.0, 1.0], n) * rng.uniform(0.5, 2.0, n))
+        if kind == "all-infinite":
+            T = np.triu(rng.standard_normal((n, n)), 1)
+        else:
+            T = np.triu(rng.standard_normal((n, n)))
+            T[np.diag_indices(n)] *= rng.permutation(n) >= rng.integers(1, n)
+        return Q @ S @ Z.T, Q @ T @ Z.T
+    if kind == "zero-diagonals":
+        T = np.triu(rng.standard_normal((n, n)))
+        zeros = rng.choice(n, int(rng.integers(1, n + 1)), replace=False)
+        T[zeros, zeros] = 0.0
+        return rng.standard_normal((n, n)), T
+    return rng.standard_normal((n, n)), rng.standard_normal((n, n))
+
+
+def _chordal(a1: complex, b1: float, a2: complex, b2: complex) -> float:
+    return float(abs(a1 * b2 - a2 * b1) / (np.hypot(abs(a1), abs(b1)) * np.hypot(abs(a2), abs(b2))))
+
+
+@pytest.mark.parametrize("kind", CLASSES)
+def test_classes_of_pencils_are_backward_stable(kind: str) -> None:
+    """Formerly known defects (qz-near-proportional-pencil, qz-all-infinite-pencil): 300 seeded
+    pencils of orders 2-8 in each class; the form has backward errors ||Q AA Z^T - A|| / ||A||
+    and ||Q BB Z^T - B|| / ||B|| below 20 n u each (scipy's dgges: a few n u), with no
+    ConvergenceError, and each eigenvalue of scipy.linalg.eig (homogeneous) whose chordal
+    condition number kappa (Stewart and Sun: ||x|| ||y|| ||(A, B)|| / |(y^H A x, y^H B x)|)
+    puts it within 1e-6 is matched by one of ours within 2 (20 n u) kappa. An all-infinite
+    pencil's eigenvalues are defective (a nilpotent B of index up to n moves them by
+    (n u)^(1/n)): each of ours is within 4 (20 n u)^(1/n) of infinity in the chordal metric
+    (measured: 1.25 (n u)^(1/n) at most over 1000 seeds). Measured over 1000 seeds per class:
+    backward errors at most 11.4 n u (scipy's: 8.5 n u)."""
+    from scipy.optimize import linear_sum_assignment
+
+    compared = 0
+    for seed in range(300):
+        rng = np.random.default_rng([CLASSES.index(kind), seed])
+        n = int(rng.integers(2, 9))
+        A, B = _pencil(kind, n, rng)
+        AA, BB, alpha, beta, Q, Z, _ = aerocontrol.qz(A, B)
+        for M, MM in ((A, AA), (B, BB)):
+            error = np.linalg.norm(Q @ MM @ Z.T - M) / np.linalg.norm(M)
+            assert error <= 20 * n * U, f"{kind} seed {seed}: {error / (n * U):.3g} n u"
+        if kind == "all-infinite":
+            to_infinity = np.abs(beta) / np.hypot(np.abs(alpha), beta)
+            assert np.all(to_infinity <= 4 * (20 * n * U) ** (1 / n)), f"seed {seed}: {beta}"
+        (their_alpha, their_beta), y, x = sl.eig(A, B, left=True, homogeneous_eigvals=True)
+        size = np.hypot(np.linalg.norm(A, 2), np.linalg.norm(B, 2))
+        distance = np.array(
+            [
+                [_chordal(a, b, ta, tb) for ta, tb in zip(their_alpha, their_beta, strict=True)]
+                for a, b in zip(alpha, beta, strict=True)
+            ]
+        )
+        rows, columns = linear_sum_assignment(distance)
+        for i, j in zip(rows, columns, strict=True):
+            Ax, Bx = y[:, j].conj() @ A @ x[:, j], y[:, j].conj() @ B @ x[:, j]
+            denominator = np.hypot(abs(Ax), abs(Bx))
+            kappa = np.linalg.norm(x[:, j]) * np.linalg.norm(y[:, j]) * size / denominator
+            bound = 2 * 20 * n * U * kappa
+            if bound <= 1e-6:
+                compared += 1
+                assert distance[i, j] <= bound, f"{kind} seed {seed}: {distance[i, j]:.3g}"
+    # Enough well-conditioned eigenvalues compared (about 1500 of the near-proportional,
+    # zero-diagonal and generic pencils', 850 of the mixed ones'); none of the all-infinite.
+    assert compared >= (0 if kind == "all-infinite" else 500)

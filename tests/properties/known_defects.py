@@ -119,58 +119,6 @@ def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
 
 
-def _near_proportional_pencil(args: dict[str, Any]) -> bool:
-    """A within a relative 1e-3 of c B for the c of least squares (B nonzero, same shape)."""
-    A, B = (np.asarray(args[key], dtype=float) for key in ("A", "B"))
-    if A.shape != B.shape or A.ndim != 2 or not np.any(B) or not np.any(A):
-        return False
-    scale = float(np.max(np.abs(B)))
-    a, b = A / float(np.max(np.abs(A))), B / scale
-    c = float(np.sum(a * b) / np.sum(b * b))
-    return float(np.linalg.norm(a - c * b)) <= 1e-3 * float(np.linalg.norm(a))
-
-
-QZ_NEAR_PROPORTIONAL = known_defect(
-    "qz-near-proportional-pencil",
-    {"qz"},
-    "qz of a pencil near a proportional one, A = c B + E with ||E|| small beside ||A|| (all "
-    "eigenvalues clustered about c): the core's QZ iteration loses backward stability, "
-    "||Q AA Z^T - A|| / ||A|| = 9.3e-10 for A the float32 rounding of a 2 x 2 B (scipy's "
-    "dgges: 5.8e-16), up to 1e-9 for E of 1e-6, and for E of 1e-12 it often fails to "
-    "converge (ConvergenceError in 23 of 40 random 3 x 3 pencils); found through the "
-    "big-endian float32 presentation of A = B",
-    _near_proportional_pencil,
-    "Z^T !=",
-)
-
-
-def _all_infinite_pencil(args: dict[str, Any]) -> bool:
-    """B nonzero and A well conditioned with A^-1 B nilpotent to rounding (every generalized
-    eigenvalue of A - λB infinite: det(A - λB) is constant)."""
-    A, B = (np.asarray(args[key], dtype=float) for key in ("A", "B"))
-    if A.shape != B.shape or A.ndim != 2 or A.shape[0] < 2 or not np.any(B):
-        return False
-    with np.errstate(all="ignore"):
-        if not np.isfinite(np.linalg.cond(A)) or np.linalg.cond(A) > 1e12:
-            return False
-        M = np.linalg.solve(A, B)
-        radius = float(np.max(np.abs(np.linalg.eigvals(M))))
-    return radius <= 1e-2 * float(np.linalg.norm(M))
-
-
-QZ_ALL_INFINITE = known_defect(
-    "qz-all-infinite-pencil",
-    {"qz"},
-    "qz of a pencil whose eigenvalues are all infinite, A nonsingular and B = H N H^T (N "
-    "strictly upper triangular, H orthogonal): the core's deflation of infinite eigenvalues "
-    "loses backward stability, ||Q BB Z^T - B|| / ||B|| = 3e-12 on a 3 x 3 example and up to "
-    "2.7e-10 in 40 of 150 random ones of orders 3 to 5 (scipy's dgges: at most 3.1e-15); B "
-    "already triangular, or B nilpotent beside a random A, is exact",
-    _all_infinite_pencil,
-    "Z^T !=",
-)
-
-
 def _loop_poles_far_apart(args: dict[str, Any]) -> bool:
     """The open-loop poles of the ``loop`` argument span more than 1e12 in modulus."""
     return "loop" in args and _poles_far_apart(args)

@@ -415,7 +415,7 @@ def test_regression_zeros_of_badly_scaled_blocks() -> None:
 
 @pytest.mark.xfail(strict=True, reason="zeros-dropped-badly-scaled: zeros at two scales")
 def test_known_defect_zeros_at_two_scales() -> None:
-    rng = np.random.default_rng(0)
+    rng = np.random.default_rng(6)
     A = rng.standard_normal((3, 3)) * 1e-8
     B, C, D = (
         np.array([[0.1257302210933933], [-0.1321048632913019], [0.6404226504432821]]),

@@ -6,7 +6,11 @@
 //!
 //! The shifts are the eigenvalues of the trailing 2 x 2 block of M = H T^-1 (formed from the
 //! trailing 3 x 3 of T^-1, which is the inverse of T's trailing 3 x 3); the first column of
-//! (M - σ1)(M - σ2) has three nonzero entries and is formed without M. A reflector on rows
+//! (M - σ1)(M - σ2) has three nonzero entries and is formed without M, about the shift
+//! s = h_ll / t_ll at the top of the active block (as (M - s)^2 - (σ1 + σ2 - 2 s)(M - s) +
+//! (σ1 - s)(σ2 - s), from differences of diagonal ratios: Moler and Stewart's formula), so
+//! that a pencil near a proportional one, M = s I + O(E), has a first column of E^2 formed
+//! from terms of E, not of s^2. A reflector on rows
 //! (k, k+1, k+2) creates the bulge; each step of the chase restores T with a reflector on
 //! columns (k, k+1, k+2) that zeroes T[k+2, k..k+2] (the reflector of the row reversed) and a
 //! rotation of columns (k, k+1) that zeroes T[k+1, k], and moves the bulge of H one row down.
@@ -25,10 +29,14 @@
 //!
 //! # Standard form
 //!
-//! A deflated 2 x 2 block with real eigenvalues is split (a rotation through the right
-//! eigenvector of the pencil from the right, through H z or T z from the left); one with complex
+//! A deflated 2 x 2 block's eigenvalues are real or complex by the sign of the discriminant of
+//! det(H - λ T) about the shift (0 or a diagonal ratio) that forms it most accurately. A block
+//! with real eigenvalues is split (a rotation through the right eigenvector of the pencil from
+//! the right, through H z or T z from the left), at the root and with the rotation that leave
+//! the smallest remainders below the diagonal, which are its backward error; one with complex
 //! eigenvalues keeps H's block full and makes T's block diagonal with positive entries (two
-//! rotations: the columns of T's block made orthogonal, then aligned with the axes). Every 1 x 1
+//! rotations: the columns of T's block made orthogonal, then the longer aligned with its axis,
+//! which leaves u ||T_kk|| off the diagonal even where T's block is nearly singular). Every 1 x 1
 //! block has t_kk >= 0 (a column of S, T and Z negated where needed), as LAPACK's dgges returns.
 
 use crate::error::Error;
@@ -189,17 +197,24 @@ fn deflate_infinite(p: &mut Pencil<'_>, lo: usize, j: usize, hi: usize) {
 fn double_shift_step(p: &mut Pencil<'_>, lo: usize, hi: usize, exceptional: bool) {
     let n = p.n();
     let (h, t) = (&*p.h, &*p.t);
-    // The trailing 2 x 2 of M = H T^-1 from the trailing 3 x 3 of T^-1.
+    // Everything in terms of M - s I = (H - s T) T^-1, s = h_aa / t_aa the ratio at the top
+    // of the block: the shifts as σ - s, and h_aa - s t_aa taken as 0. Where the pencil is
+    // near a proportional one (H = c T + E), M = c I + O(E) and the first column of
+    // (M - σ1)(M - σ2), of size E^2, is a difference of terms of size c^2 formed directly;
+    // shifted, its terms are differences of ratios h_ii / t_ii (errors of u c) times O(E).
+    let (a, b, c) = (lo, lo + 1, lo + 2);
+    let shift = h[(a, a)] / t[(a, a)];
+    // The trailing 2 x 2 of M - s I from the trailing 3 x 3 of T^-1.
     let (i0, i1, i2) = (hi - 2, hi - 1, hi);
     let (t00, t01, t02) = (t[(i0, i0)], t[(i0, i1)], t[(i0, i2)]);
     let (t11, t12, t22) = (t[(i1, i1)], t[(i1, i2)], t[(i2, i2)]);
     let inv01 = -t01 / (t00 * t11);
     let inv02 = (t01 * t12 - t02 * t11) / (t00 * t11 * t22);
-    let (inv11, inv12, inv22) = (1.0 / t11, -t12 / (t11 * t22), 1.0 / t22);
-    let m11 = h[(i1, i0)] * inv01 + h[(i1, i1)] * inv11;
-    let m12 = h[(i1, i0)] * inv02 + h[(i1, i1)] * inv12 + h[(i1, i2)] * inv22;
-    let m21 = h[(i2, i1)] * inv11;
-    let m22 = h[(i2, i1)] * inv12 + h[(i2, i2)] * inv22;
+    let inv12 = -t12 / (t11 * t22);
+    let m11 = (h[(i1, i1)] / t11 - shift) + h[(i1, i0)] * inv01;
+    let m12 = h[(i1, i0)] * inv02 + h[(i1, i1)] * inv12 + h[(i1, i2)] / t22;
+    let m21 = h[(i2, i1)] / t11;
+    let m22 = (h[(i2, i2)] / t22 - shift) + h[(i2, i1)] * inv12;
     let (sum, product) = if exceptional {
         let e = m21.abs() + (h[(i1, i0)] / t00).abs();
         let d = 0.75 * e + m22;
@@ -207,14 +222,14 @@ fn double_shift_step(p: &mut Pencil<'_>, lo: usize, hi: usize, exceptional: bool
     } else {
         (m11 + m22, m11 * m22 - m12 * m21)
     };
-    // The first column of (M - σ1)(M - σ2) = M^2 - sum M + product.
-    let (a, b, c) = (lo, lo + 1, lo + 2);
-    let (m1, m2) = (h[(a, a)] / t[(a, a)], h[(b, a)] / t[(a, a)]);
+    // The first column of (M - s - σ1')(M - s - σ2') = (M - s)^2 - sum (M - s) + product:
+    // (M - s) e1 = m2 e_b with m2 = h_ba / t_aa, and (M - s) e_b m2 is (H - s T) times
+    // T^-1 m2 e_b = (-t_ab / t_aa, 1, 0) m2 / t_bb.
+    let m2 = h[(b, a)] / t[(a, a)];
     let zb = m2 / t[(b, b)];
-    let za = (m1 - t[(a, b)] * zb) / t[(a, a)];
     let mut v = [
-        h[(a, a)] * za + h[(a, b)] * zb - sum * m1 + product,
-        h[(b, a)] * za + h[(b, b)] * zb - sum * m2,
+        (h[(a, b)] - shift * t[(a, b)]) * zb + product,
+        m2 * ((h[(b, b)] / t[(b, b)] - shift) - m2 * t[(a, b)] / t[(b, b)] - sum),
         h[(c, b)] * zb,
     ];
     let scale = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -283,25 +298,17 @@ pub(crate) fn standardize_pair(p: &mut Pencil<'_>, k: usize) -> Result<bool, Err
         g.rows(p.h, k, l, k..n);
         g.columns(p.q, k, l, 0..n);
     }
-    let (t11, t12, t22) = (p.t[(k, k)], p.t[(k, l)], p.t[(l, l)]);
-    let (h11, h12, h21, h22) = (p.h[(k, k)], p.h[(k, l)], p.h[(l, k)], p.h[(l, l)]);
-    // M = H T^-1, whose eigenvalues are the pencil's.
-    let m = [
-        [h11 / t11, (h12 - h11 * t12 / t11) / t22],
-        [h21 / t11, (h22 - h21 * t12 / t11) / t22],
-    ];
-    if !m.iter().flatten().all(|x| x.is_finite()) {
-        return Err(Error::NoConvergence {
-            algorithm: "QZ iteration (a 2 x 2 block overflowed)",
-        });
-    }
-    let block = standardize_block(m[0][0], m[0][1], m[1][0], m[1][1]);
-    if block.c == 0.0 {
-        split_real_pair(p, k, real_pair_eigenvalue(p, k, block.a));
+    let quadratics = Quadratic::of_block(p, k)?;
+    if quadratics[0].discriminant >= 0.0 {
+        split_real_pair(p, k, &quadratics);
         return Ok(false);
     }
-    // Complex: T's block diagonal and positive. Columns of T's block made orthogonal
-    // (a one-sided Jacobi rotation), then a row rotation aligns them with the axes.
+    // Complex: T's block diagonal and positive. Columns of T's block made orthogonal (a
+    // one-sided Jacobi rotation), then a row rotation aligns the longer with its axis: the
+    // Jacobi rotation leaves the columns' inner product at u ||T_kk||^2, and the entry that
+    // the alignment leaves off the diagonal is that product over the aligned column's length
+    // (over the shorter one's, it grew to u ||T_kk||^2 / σ_min: a pair near infinity, σ_min of
+    // 1e-4, lost B's backward error).
     let (a, b, d) = (
         p.t[(k, k)].powi(2) + p.t[(l, k)].powi(2),
         p.t[(k, l)].powi(2) + p.t[(l, l)].powi(2),
@@ -314,8 +321,15 @@ pub(crate) fn standardize_pair(p: &mut Pencil<'_>, k: usize) -> Result<bool, Err
         let c = 1.0 / (1.0 + tan * tan).sqrt();
         p.rotate_columns(Rotation { c, s: c * tan }, k, l, l + 1, l + 1);
     }
-    let (g, _) = Rotation::zeroing(p.t[(k, k)], p.t[(l, k)]);
-    p.rotate_rows(g, k, l, k);
+    let first = p.t[(k, k)].hypot(p.t[(l, k)]);
+    let second = p.t[(k, l)].hypot(p.t[(l, l)]);
+    if first >= second {
+        let (g, _) = Rotation::zeroing(p.t[(k, k)], p.t[(l, k)]);
+        p.rotate_rows(g, k, l, k);
+    } else {
+        let (g, _) = Rotation::zeroing(p.t[(l, l)], p.t[(k, l)]);
+        p.rotate_rows(g, l, k, k);
+    }
     p.t[(l, k)] = 0.0;
     p.t[(k, l)] = 0.0;
     for r in [k, l] {
@@ -341,89 +355,181 @@ pub(crate) fn standardize_pair(p: &mut Pencil<'_>, k: usize) -> Result<bool, Err
         p.h[(l, l)] / t22,
     );
     if block.c == 0.0 {
-        split_real_pair(p, k, real_pair_eigenvalue(p, k, block.a));
+        split_real_pair(p, k, &Quadratic::of_block(p, k)?);
         return Ok(false);
     }
     Ok(true)
 }
 
-/// The real eigenvalue of the 2 x 2 block at (k, k+1) (T's block upper triangular) nearest
-/// `estimate`, as a homogeneous pair (α, β), λ = α / β, from the block's own entries.
+/// The characteristic polynomial of the 2 x 2 block at (k, k+1) (T's block upper triangular,
+/// nonsingular) about a shift s: det(H' - μ T) = a μ^2 - b μ + c with H' = H - s T and
+/// λ = s + μ,
 ///
-/// `estimate` comes from M = H T^-1, whose entries grow like 1 / t22: where T's block is
-/// nearly singular, M's small eigenvalue carries an absolute error of about u ||M|| and so a
-/// large relative one. Here both roots of det(βH - αT) = 0, that is of
-/// t11 t22 λ^2 - (h11 t22 + h22 t11 - h21 t12) λ + (h11 h22 - h12 h21) = 0, are formed
-/// without cancellation (the larger as q / (2 t11 t22), the smaller as 2 det H / q, with
-/// q = b + sign(b) sqrt(b^2 - 4 det T det H)), each as a pair so that an infinite eigenvalue
-/// (t11 t22 = 0) is (q, 0); the one nearer the estimate is returned. (LAPACK's dlag2 likewise
-/// avoids forming H T^-1.)
-fn real_pair_eigenvalue(p: &Pencil<'_>, k: usize, estimate: f64) -> (f64, f64) {
-    let l = k + 1;
-    let (t11, t12, t22) = (p.t[(k, k)], p.t[(k, l)], p.t[(l, l)]);
-    let (h11, h12, h21, h22) = (p.h[(k, k)], p.h[(k, l)], p.h[(l, k)], p.h[(l, l)]);
-    let a = t11 * t22;
-    let b = h11 * t22 + h22 * t11 - h21 * t12;
-    let c = h11 * h22 - h12 * h21;
-    let discriminant = (b * b - 4.0 * a * c).max(0.0);
-    let q = b + b.signum() * discriminant.sqrt();
-    let roots = [(q, 2.0 * a), (2.0 * c, q)];
-    if !roots.iter().all(|&(x, y)| x.is_finite() && y.is_finite()) || q == 0.0 {
-        return (estimate, 1.0);
-    }
-    // The chordal distance |α - estimate β| / (||(α, β)|| ||(estimate, 1)||) (the common
-    // factor dropped). Normalised by |α| + |estimate β| instead, an estimate of 0 put every
-    // root at distance 1: a defective double zero (H and T's blocks nilpotent to rounding,
-    // b and det H of 1e-17) took the 0/0 root 2 det H / q = 0.67, and the split that forced
-    // its h_{k+1,k} to zero had a backward error of 0.2.
-    let distance = |&(alpha, beta): &(f64, f64)| {
-        let scale = alpha.hypot(beta);
-        if scale == 0.0 {
-            f64::INFINITY
+/// ```text
+/// a = t11 t22,   b = h'11 t22 + h'22 t11 - h21 t12,   c = h'11 h'22 - h'12 h21,
+/// ```
+///
+/// for s = 0 and for the diagonal ratios s = h_ii / t_ii (with h'_ii taken as 0, a change of
+/// u |h_ii|). The discriminant b^2 - 4 a c is the same for every shift in exact arithmetic; in
+/// floating point its error is about u (b^2 + 4 |a c|), so the shift with the smallest of these
+/// terms tells real from complex. A pencil near a proportional one, H = s T + E, has terms of
+/// ||E||^2 about s = h_ii / t_ii against terms of s^2 ||T||^2 unshifted (its pair was split
+/// with backward errors of sqrt(u)); a pair with one eigenvalue near infinity and the other
+/// far below the diagonal ratios needs s = 0. (LAPACK's dlag2 shifts by a diagonal ratio.)
+#[derive(Debug, Clone, Copy)]
+struct Quadratic {
+    shift: f64,
+    a: f64,
+    b: f64,
+    c: f64,
+    discriminant: f64,
+}
+
+impl Quadratic {
+    /// The quadratics of the block about the three shifts, the most accurate first.
+    fn of_block(p: &Pencil<'_>, k: usize) -> Result<[Quadratic; 3], Error> {
+        let l = k + 1;
+        let (t11, t12, t22) = (p.t[(k, k)], p.t[(k, l)], p.t[(l, l)]);
+        let (h11, h12, h21, h22) = (p.h[(k, k)], p.h[(k, l)], p.h[(l, k)], p.h[(l, l)]);
+        let about = |shift: f64, h11: f64, h22: f64| {
+            let h12 = h12 - shift * t12;
+            let (a, b, c) = (
+                t11 * t22,
+                h11 * t22 + h22 * t11 - h21 * t12,
+                h11 * h22 - h12 * h21,
+            );
+            Quadratic {
+                shift,
+                a,
+                b,
+                c,
+                discriminant: b * b - 4.0 * a * c,
+            }
+        };
+        let (s1, s2) = (h11 / t11, h22 / t22);
+        let mut quadratics = [
+            about(0.0, h11, h22),
+            about(s1, 0.0, h22 - s1 * t22),
+            about(s2, h11 - s2 * t11, 0.0),
+        ];
+        let error = |q: &Quadratic| {
+            let terms = q.b * q.b + 4.0 * (q.a * q.c).abs();
+            if [q.shift, q.a, q.b, q.c, q.discriminant, terms]
+                .iter()
+                .all(|x| x.is_finite())
+            {
+                terms
+            } else {
+                f64::INFINITY
+            }
+        };
+        quadratics.sort_by(|x, y| error(x).total_cmp(&error(y)));
+        if error(&quadratics[0]).is_finite() {
+            Ok(quadratics)
         } else {
-            (alpha - estimate * beta).abs() / scale
+            Err(Error::NoConvergence {
+                algorithm: "QZ iteration (a 2 x 2 block overflowed)",
+            })
         }
-    };
-    if distance(&roots[0]) <= distance(&roots[1]) {
-        roots[0]
-    } else {
-        roots[1]
+    }
+
+    /// The real roots λ = s + μ as homogeneous pairs (α, β), λ = α / β: μ = q / a and c / q
+    /// with q = (b + sign(b) sqrt(b^2 - 4 a c)) / 2 (no cancellation), so that a root at
+    /// infinity (a = 0) is (q, 0); where the discriminant is negative (a pair found real only
+    /// after standardisation), the real part b / (2 a). Empty if not finite.
+    fn real_roots(&self) -> impl Iterator<Item = (f64, f64)> {
+        let roots = if self.discriminant < 0.0 {
+            [Some((self.b, 2.0 * self.a)), None]
+        } else {
+            let q = 0.5 * (self.b + self.b.signum() * self.discriminant.sqrt());
+            if q == 0.0 {
+                [Some((0.0, 1.0)), None]
+            } else {
+                [Some((self.c, q)), Some((q, self.a))]
+            }
+        };
+        let shift = self.shift;
+        roots
+            .into_iter()
+            .flatten()
+            .map(move |(alpha, beta)| (shift * beta + alpha, beta))
+            .filter(|(alpha, beta)| alpha.is_finite() && beta.is_finite())
     }
 }
 
-/// Splits the 2 x 2 block at (k, k+1) with the real eigenvalue λ = α / β (T's block upper
-/// triangular): a column rotation through the right eigenvector of λ (the null vector of
-/// β H - α T) and a row rotation that annihilates below, leaving h_{k+1,k} = t_{k+1,k} = 0.
-fn split_real_pair(p: &mut Pencil<'_>, k: usize, (alpha, beta): (f64, f64)) {
+/// Splits the 2 x 2 block at (k, k+1) (T's block upper triangular) at a real eigenvalue: a
+/// column rotation through its right eigenvector (the null vector of β H - α T, λ = α / β)
+/// and a row rotation along T z or H z, leaving h_{k+1,k} = t_{k+1,k} = 0.
+///
+/// The entry that the row rotation leaves below the diagonal of the other matrix is the
+/// backward error of the split (H z = λ T z + r: along T z it leaves r_2 in H, along H z it
+/// leaves r_2 / λ in T). The real roots of the `quadratics` (the most accurate first) are
+/// tried with both row rotations until a split leaves remainders of rounding (2 u relative
+/// to the block norms of H and T); else the split whose larger remainder is smallest is
+/// taken. The remainders are set to zero. (LAPACK's dlagv2 chooses the row
+/// rotation by the block norms and the eigenvalue alone; an eigenvalue with a forward error
+/// of κ u, far below a diagonal ratio or beside a near-infinite one, left a remainder of
+/// κ u.)
+fn split_real_pair(p: &mut Pencil<'_>, k: usize, quadratics: &[Quadratic; 3]) {
     let l = k + 1;
-    let (t11, t12, t22) = (p.t[(k, k)], p.t[(k, l)], p.t[(l, l)]);
-    let (h11, h12, h21, h22) = (p.h[(k, k)], p.h[(k, l)], p.h[(l, k)], p.h[(l, l)]);
-    // (α, β) scaled to the larger of unit size: the rows keep the size of H and T.
-    let size = alpha.abs().max(beta.abs());
-    let (alpha, beta) = (alpha / size, beta / size);
-    let rows = [
-        [beta * h11 - alpha * t11, beta * h12 - alpha * t12],
-        [beta * h21, beta * h22 - alpha * t22],
-    ];
+    let h = [[p.h[(k, k)], p.h[(k, l)]], [p.h[(l, k)], p.h[(l, l)]]];
+    let t = [[p.t[(k, k)], p.t[(k, l)]], [0.0, p.t[(l, l)]]];
+    let block_norm = |m: &[[f64; 2]; 2]| {
+        let norm = (m[0][0].abs() + m[0][1].abs()).max(m[1][0].abs() + m[1][1].abs());
+        norm.max(f64::MIN_POSITIVE)
+    };
+    let (h_norm, t_norm) = (block_norm(&h), block_norm(&t));
     let norm = |r: &[f64; 2]| r[0].hypot(r[1]);
-    let row = if norm(&rows[0]) >= norm(&rows[1]) {
-        rows[0]
-    } else {
-        rows[1]
+    // Column k of a 2 x 2 block after the column rotation g.
+    let first_column = |m: &[[f64; 2]; 2], g: Rotation| {
+        [g.c * m[0][0] + g.s * m[0][1], g.c * m[1][0] + g.s * m[1][1]]
     };
-    // z ⟂ row: the right eigenvector; the column rotation's first column is z.
-    let (g, _) = if row == [0.0, 0.0] {
-        Rotation::zeroing(1.0, 0.0)
-    } else {
-        Rotation::zeroing(row[1], -row[0])
-    };
+    let mut best: Option<(f64, Rotation, Rotation)> = None;
+    for (alpha, beta) in quadratics.iter().flat_map(Quadratic::real_roots) {
+        // (α, β) scaled to the larger of unit size: the rows keep the size of H and T.
+        let size = alpha.abs().max(beta.abs());
+        if size == 0.0 {
+            continue;
+        }
+        let (alpha, beta) = (alpha / size, beta / size);
+        let rows = [
+            [
+                beta * h[0][0] - alpha * t[0][0],
+                beta * h[0][1] - alpha * t[0][1],
+            ],
+            [beta * h[1][0], beta * h[1][1] - alpha * t[1][1]],
+        ];
+        let row = if norm(&rows[0]) >= norm(&rows[1]) {
+            rows[0]
+        } else {
+            rows[1]
+        };
+        // z ⟂ row: the right eigenvector; the column rotation's first column is z.
+        let (g, _) = if row == [0.0, 0.0] {
+            Rotation::zeroing(1.0, 0.0)
+        } else {
+            Rotation::zeroing(row[1], -row[0])
+        };
+        let (hz, tz) = (first_column(&h, g), first_column(&t, g));
+        for w in [tz, hz] {
+            let (rows_g, _) = Rotation::zeroing(w[0], w[1]);
+            let below = |x: [f64; 2]| (-rows_g.s * x[0] + rows_g.c * x[1]).abs();
+            let remainder = (below(hz) / h_norm).max(below(tz) / t_norm);
+            if best.is_none_or(|(least, _, _)| remainder < least) {
+                best = Some((remainder, g, rows_g));
+            }
+        }
+        // Remainders of rounding (2 u) with the most accurate quadratic's root: the others
+        // cannot do better.
+        if best.is_some_and(|(least, _, _)| least <= U) {
+            break;
+        }
+    }
+    // Without a finite root (not reached: the quadratic of s = 0 is finite), the identity.
+    let identity = Rotation { c: 1.0, s: 0.0 };
+    let (_, g, rows_g) = best.unwrap_or((0.0, identity, identity));
     p.rotate_columns(g, k, l, l + 1, l + 1);
-    // Q's first column along H z or T z, whichever is larger.
-    let hz = [p.h[(k, k)], p.h[(l, k)]];
-    let tz = [p.t[(k, k)], p.t[(l, k)]];
-    let w = if norm(&hz) >= norm(&tz) { hz } else { tz };
-    let (g, _) = Rotation::zeroing(w[0], w[1]);
-    p.rotate_rows(g, k, l, k);
+    p.rotate_rows(rows_g, k, l, k);
     p.h[(l, k)] = 0.0;
     p.t[(l, k)] = 0.0;
     p.make_positive(k);
