@@ -123,22 +123,35 @@ pub(crate) const UNBLOCKED_HESSENBERG_MAX_ORDER: usize = 32;
 /// A's entries into range ([`range_scale`]): returns (H, s). H is similar to A / s, so
 /// it has the eigenvalues and the characteristic polynomial of A / s (the balancing is exact,
 /// the reduction backward stable). The caller checks that A is finite.
-pub(crate) fn balanced_hessenberg<O: Order>(mut h: Square<O>) -> (Square<O>, f64) {
+pub(crate) fn balanced_hessenberg<O: Order>(a: Square<O>) -> (Square<O>, f64) {
+    let (mut h, scale, _) = balanced(a);
+    reduce_in_place(&mut h);
+    (h, scale)
+}
+
+/// D^-1 (A / s) D of [`balanced_hessenberg`] before its reduction: returns it, s, and whether
+/// its states were graded (and ordered).
+pub(crate) fn balanced<O: Order>(mut h: Square<O>) -> (Square<O>, f64, bool) {
     let scale = range_scale(h.as_faer());
     if scale != 1.0 {
         h.as_mut_slice().iter_mut().for_each(|x| *x /= scale);
     }
     let _ = balance(&mut h);
-    order_graded_states(&mut h);
+    let graded = order_graded_states(&mut h);
+    (h, scale, graded)
+}
+
+/// H alone, in place: the plain reduction up to [`UNBLOCKED_HESSENBERG_MAX_ORDER`], faer's
+/// blocked one above.
+pub(crate) fn reduce_in_place<O: Order>(h: &mut Square<O>) {
     if h.nrows() <= UNBLOCKED_HESSENBERG_MAX_ORDER {
-        reduce_to_hessenberg(&mut h, None);
+        reduce_to_hessenberg(h, None);
     } else {
-        h = from_faer_in(
+        *h = from_faer_in(
             h.shape_generic().0,
             hessenberg_matrix(h.to_faer().as_ref()).as_ref(),
         );
     }
-    (h, scale)
 }
 
 /// Householder reduction to upper Hessenberg form in place, H = Q^T A Q; `q` (the identity on
