@@ -107,7 +107,8 @@ pub struct LoopMargins {
     /// max |S| = 1/min |1 + L|.
     pub sensitivity: Peak,
     /// Eigenvalues of A - B (1 + d)^-1 C, by [`root_locus::closed_loop_poles`] (normwise
-    /// backward stable, the small ones of a graded spectrum polished), sorted by real part, then imaginary part (as `numpy.sort_complex`).
+    /// backward stable, the small ones of a graded spectrum polished), sorted by real part,
+    /// then imaginary part (as `numpy.sort_complex`).
     pub closed_loop_poles: Vec<c64>,
     /// Eigenvalues of A.
     pub open_loop_poles: Vec<c64>,

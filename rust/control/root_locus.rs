@@ -167,7 +167,9 @@ pub fn closed_loop_poles(
     if g == 0.0 || n == 0 {
         return eigenvalues(a);
     }
-    let values = with_order!(n, order => closed_loop_eigenvalues(&controller_hessenberg(order, a, b, c), g))?;
+    let values = with_order!(n, order => {
+        closed_loop_eigenvalues(&controller_hessenberg(order, a, b, c), g)
+    })?;
     let moduli = values.iter().map(|v| v.norm()).filter(|&m| m > 0.0);
     let (smallest, largest) =
         moduli.fold((f64::INFINITY, 0.0f64), |(s, l), m| (s.min(m), l.max(m)));

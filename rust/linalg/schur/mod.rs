@@ -82,7 +82,13 @@
 //! [`eigenvalues`] first balances A (Parlett & Reinsch 1969: a diagonal similarity by powers of
 //! two that equalises row and column norms, exact in floating point), which can only improve
 //! the computed eigenvalues of badly scaled matrices such as models in mixed units. The Schur
-//! form itself is not balanced, since its Z must be orthogonal.
+//! form itself is not balanced, since its Z must be orthogonal. Where the balanced states
+//! are graded (their sizes spread over more than 2^20) they are ordered by decreasing size
+//! (`balance::order_graded_states`: the QR iteration keeps the small eigenvalues of a matrix
+//! graded downward), and where they are graded or the eigenvalues spread as far, the small
+//! eigenvalues are refined to their own size by the two-sided Rayleigh quotient iteration
+//! on the balanced matrix (`refine`), each kept only where it verifies; other matrices take
+//! exactly the path they took before.
 
 mod eigenvectors;
 mod form;

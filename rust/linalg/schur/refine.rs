@@ -5,11 +5,13 @@
 //! ([`crate::linalg::balance::order_graded_states`]) keep most small eigenvalues of a graded
 //! matrix, not all (a companion matrix of roots spread over twenty decades lost up to 6e-6 of
 //! its small ones, a diagonal of twenty decades plus a rank-one term all of them). Each
-//! eigenvalue of B (balanced, ordered, graded, of order up to [`REFINED_MAX_ORDER`]) below
+//! eigenvalue of B (balanced and ordered, of order up to [`REFINED_MAX_ORDER`], whose states
+//! are graded or whose eigenvalues spread over more than 2^20: `eigenvalues` decides) below
 //! 1 / [`REFINED_BELOW`] of the largest is therefore refined by the two-sided Rayleigh
 //! quotient iteration (Ostrowski 1958/59; Parlett, "The Rayleigh quotient iteration and some
-//! generalizations for nonnormal matrices", Math. Comp. 28, 1974): from σ = λ, the right and left vectors x, y by two steps of inverse
-//! iteration each on B - σI (LU with partial pivoting, complex for a complex σ), then
+//! generalizations for nonnormal matrices", Math. Comp. 28, 1974): from σ = λ, the right and
+//! left vectors x, y by two steps of inverse iteration each on B - σI (LU with partial
+//! pivoting, complex for a complex σ), then
 //!
 //! ```text
 //!     σ <- σ + y^H (B x - σ x) / y^H x,
