@@ -2832,12 +2832,14 @@ def _boundary_flags(
     error of a double root, the worst a flight loop has), and, for those, within their
     first-order error bound n u ||M|| κ(λ) in the balanced coordinates M the eigenvalues are
     computed in, with κ(λ) = 1/|yᴴx| from the left and right singular vectors of M - λI
-    (Golub & Van Loan, Matrix Computations, §7.2.2). A defective root (the double
-    integrator's, κ ~ 1/√u) stays on the boundary; a simple one in badly scaled coordinates
-    (+0.001 beside an entry of 1e6, √u ||M|| = 0.015) is off it, as it is computed. The
-    ``matrix`` is formed only when a root is near the boundary; where it is not finite, the
-    tolerance alone decides. A size beyond the doubles (B C overflows) is replaced by the
-    roots' own."""
+    (Golub & Van Loan, Matrix Computations, §7.2.2), and, for those, within the
+    componentwise bound of :func:`_componentwise_reach` (which takes -2 beside -2^60 off the
+    axis, as the core computes it on the graded ordering or polishes it). A defective root
+    (the double integrator's, κ ~ 1/√u) stays on the boundary; a simple one in badly scaled
+    coordinates (+0.001 beside an entry of 1e6, √u ||M|| = 0.015) is off it, as it is
+    computed. The ``matrix`` is formed only when a root is near the boundary; where it is not
+    finite, the tolerance alone decides. A size beyond the doubles (B C overflows) is replaced
+    by the roots' own."""
     if not math.isfinite(size):
         size = max((math.hypot(r.real, r.imag) for r in roots.tolist()), default=0.0)
     tolerance = _boundary_tolerance(size, discrete)
@@ -2856,8 +2858,47 @@ def _boundary_flags(
             continue
         left, _, right = np.linalg.svd(shifted)
         overlap = abs(complex(np.vdot(left[:, -1], right[-1].conj())))
-        flags[i] = overlap == 0.0 or abs(distances[i]) <= unit / overlap
+        if overlap == 0.0 or abs(distances[i]) <= unit / overlap:
+            flags[i] = abs(distances[i]) <= _componentwise_reach(
+                balanced, roots[i], left[:, -1], right[-1].conj()
+            )
+        else:
+            flags[i] = False
     return flags
+
+
+def _componentwise_reach(M: FloatArray, root: complex, y: ComplexArray, x: ComplexArray) -> float:
+    """A first-order bound on the error of the computed eigenvalue ``root`` of M measured
+    componentwise, a posteriori: with x and y the right and left null vectors of M - λI
+    refined by a step of inverse iteration (from the singular vectors ``x``, ``y``), the
+    componentwise backward error η = max_i |(M x - λ x)_i| / ((|M| + |λ| I) |x|)_i of the pair
+    (Oettli & Prager's measure, rounding included), and the bound
+    (η + n u) |y|ᵀ (|M| + |λ| I) |x| / |yᴴx| (the componentwise condition of a simple
+    eigenvalue; Golub & Van Loan, Matrix Computations, §7.2.2, with |M| in place of ||M||).
+    It is at most the normwise bound where the root is computed to a small relative backward
+    error, the small roots of a graded M (-2 beside -2^60, which the normwise bound puts on
+    the axis), and at least |λ| where it is not (a root at 0 computed as -5e-18 beside a zero
+    column of M, whose exact eigenvalue 0 the rounding of M cannot move: η = 1). Infinite
+    where the vectors are not finite or orthogonal."""
+    n = M.shape[0]
+    shifted = M - root * np.eye(n)
+    with np.errstate(all="ignore"):
+        try:
+            x = np.asarray(np.linalg.solve(shifted, x), dtype=np.complex128)
+            y = np.asarray(np.linalg.solve(shifted.conj().T, y), dtype=np.complex128)
+        except np.linalg.LinAlgError:
+            pass  # M - λI singular to working precision: the singular vectors are its null vectors
+        x, y = x / np.max(np.abs(x)), y / np.max(np.abs(y))
+        size = np.abs(M) + abs(root) * np.eye(n)
+        scale = size @ np.abs(x)
+        residual = np.abs(M @ x - root * x)
+        ratios = np.where(scale > 0.0, residual / np.where(scale > 0.0, scale, 1.0), np.inf)
+        eta = float(np.max(np.where(residual == 0.0, 0.0, ratios)))
+        overlap = abs(complex(np.vdot(y, x)))
+        spread = (eta + n * _EPS) * float(np.abs(y) @ size @ np.abs(x))
+    if not (overlap > 0.0 and math.isfinite(spread)):
+        return math.inf
+    return float(spread / overlap)
 
 
 def _matrix_size(M: FloatArray) -> float:

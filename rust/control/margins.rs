@@ -75,7 +75,7 @@
 use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::control::root_locus;
 use crate::error::Error;
-use crate::linalg::balance::{balanced_states, nearest_power_of_two};
+use crate::linalg::balance::{GRADED_SPREAD, balanced_states, nearest_power_of_two};
 use crate::linalg::norm::{frobenius_norm, max_abs};
 use crate::linalg::schur::eigenvalues;
 use faer::{Mat, MatRef, c64};
@@ -107,7 +107,8 @@ pub struct LoopMargins {
     /// max |S| = 1/min |1 + L|.
     pub sensitivity: Peak,
     /// Eigenvalues of A - B (1 + d)^-1 C, by [`root_locus::closed_loop_poles`] (normwise
-    /// backward stable), sorted by real part, then imaginary part (as `numpy.sort_complex`).
+    /// backward stable, the small ones of a graded spectrum polished), sorted by real part,
+    /// then imaginary part (as `numpy.sort_complex`).
     pub closed_loop_poles: Vec<c64>,
     /// Eigenvalues of A.
     pub open_loop_poles: Vec<c64>,
@@ -556,9 +557,19 @@ fn peak(
 ) -> Result<Peak, Error> {
     let n = a.nrows();
     let scale = poles.iter().fold(max_abs(a), |m, p| m.max(p.norm()));
+    // A pole on the axis to its accuracy makes the peak infinite: u ||A|| in general, its own
+    // size where the nonzero poles' moduli span more than GRADED_SPREAD (the small ones are
+    // then computed on the graded ordering, or polished, to about their own size).
+    let smallest = poles
+        .iter()
+        .map(|p| p.norm())
+        .filter(|&m| m > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let graded = scale > GRADED_SPREAD * smallest;
+    let size = |p: &c64| if graded { p.norm() } else { scale };
     if let Some(p) = poles
         .iter()
-        .find(|p| p.re.abs() <= 1e-14 * scale.max(f64::MIN_POSITIVE) && n > 0)
+        .find(|p| p.re.abs() <= 1e-14 * size(p).max(f64::MIN_POSITIVE) && n > 0)
     {
         return Ok(Peak {
             omega: p.im.abs(),

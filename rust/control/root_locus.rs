@@ -66,7 +66,7 @@
 use crate::control::margins::RESCALE_EXPONENT;
 use crate::control::transfer::transfer_channels;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
-use crate::linalg::balance::{balanced_loop, range_scale};
+use crate::linalg::balance::{GRADED_SPREAD, balanced_loop, range_scale};
 use crate::linalg::hessenberg::reduce_to_hessenberg;
 use crate::linalg::householder::reflector;
 use crate::linalg::matrix::{
@@ -151,10 +151,12 @@ fn closed_loop_eigenvalues<O: Order>(
 }
 
 /// The eigenvalues of A - g b c (A n x n, b and c of length n) by the controller-Hessenberg
-/// form (see the module's documentation): normwise backward stable, the QR iteration's poles
-/// at that gain before [`root_locus`]'s continuation polishes them (which can move a pole
-/// small beside ||A|| by more than its size: see the known defect
-/// closed-loop-poles-of-graded-loops in the tests).
+/// form (see the module's documentation), normwise backward stable, and, where their moduli
+/// span more than [`GRADED_SPREAD`] (so that the small ones, accurate to u ||A - g b c|| only,
+/// may have lost all their digits: L = 1/(s + 2^60) + 1/(s + 1) closed to -2^60 and +64 for
+/// -2), polished as [`root_locus`] polishes the QR iteration's poles at the start of a run
+/// ([`polished`]: Aberth's iteration on the factored characteristic polynomial, verified by
+/// the traces of the closed loop and its square; kept as they are where that fails).
 pub fn closed_loop_poles(
     a: MatRef<'_, f64>,
     b: &[f64],
@@ -165,7 +167,45 @@ pub fn closed_loop_poles(
     if g == 0.0 || n == 0 {
         return eigenvalues(a);
     }
-    with_order!(n, order => closed_loop_eigenvalues(&controller_hessenberg(order, a, b, c), g))
+    let values = with_order!(n, order => {
+        closed_loop_eigenvalues(&controller_hessenberg(order, a, b, c), g)
+    })?;
+    let moduli = values.iter().map(|v| v.norm()).filter(|&m| m > 0.0);
+    let (smallest, largest) =
+        moduli.fold((f64::INFINITY, 0.0f64), |(s, l), m| (s.min(m), l.max(m)));
+    if largest <= GRADED_SPREAD * smallest {
+        return Ok(values);
+    }
+    let factored = factored_loop(a, b, c)?;
+    let mut poles = values.clone();
+    polished(factored.as_ref(), g, &values, &mut poles);
+    Ok(poles)
+}
+
+/// [`Factored::of`] the loop, None where it fails (its eigenvalues, say: that only forgoes
+/// the polishing and the continuation), an interruption passed on.
+fn factored_loop(a: MatRef<'_, f64>, b: &[f64], c: &[f64]) -> Result<Option<Factored>, Error> {
+    match Factored::of(a, b, c) {
+        Ok(factored) => Ok(factored),
+        Err(Error::Interrupted) => Err(Error::Interrupted),
+        Err(_) => Ok(None),
+    }
+}
+
+/// The QR iteration's poles `values` at the gain g polished by Aberth's iteration at the same
+/// gain (their errors are relative to g ||b|| ||c||, which dominates at high gain, and to
+/// ||A||, which hides a small pole), into `out`, each as it is where that fails (no factored
+/// form, no convergence, or the traces' check missed); returns the continuation that starts a
+/// run there.
+fn polished(factored: Option<&Factored>, g: f64, values: &[c64], out: &mut [c64]) -> Continuation {
+    let mut continuation = match factored {
+        Some(f) => Continuation::restart(g, values, &f.fixed),
+        None => Continuation::default(),
+    };
+    if !factored.is_some_and(|f| continuation.next(f, g, out)) {
+        out.copy_from_slice(values);
+    }
+    continuation
 }
 
 /// Sorted by real part, then imaginary part (as `numpy.sort_complex`).
@@ -227,12 +267,7 @@ pub fn root_locus(
     } else {
         Vec::new()
     };
-    // A failure of the fast path (its eigenvalues, say) only forgoes the continuation.
-    let factored = match Factored::of(a, &bv, &cv) {
-        Ok(factored) => factored,
-        Err(Error::Interrupted) => return Err(Error::Interrupted),
-        Err(_) => None,
-    };
+    let factored = factored_loop(a, &bv, &cv)?;
     // Runs of consecutive gains, a few per thread: each starts with the QR iteration.
     let runs = (rayon::current_num_threads() * 4).max(1);
     let run_length = gains.len().div_ceil(runs).max(MIN_RUN);
@@ -258,16 +293,8 @@ pub fn root_locus(
                         }
                         let values = closed_loop_eigenvalues(&form, g)
                             .map_err(|e| Error::in_batch(run * run_length + k, e))?;
-                        // The QR iteration's poles start a run, polished by the continuation
-                        // at the same gain (their errors are relative to g ||b|| ||c||, which
-                        // dominates at high gain); kept as they are where that fails.
-                        continuation = match &factored {
-                            Some(f) => Continuation::restart(g, &values, &f.fixed),
-                            None => Continuation::default(),
-                        };
-                        if !factored.as_ref().is_some_and(|f| continuation.next(f, g, poles)) {
-                            poles.copy_from_slice(&values);
-                        }
+                        // The QR iteration's poles start a run, polished.
+                        continuation = polished(factored.as_ref(), g, &values, poles);
                         sort(poles);
                     }
                     Ok(())

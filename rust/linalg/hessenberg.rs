@@ -6,7 +6,7 @@
 //! Q H Q^T = A + E with ||E|| = O(u ||A||).
 
 use crate::error::Error;
-use crate::linalg::balance::{balance, range_scale};
+use crate::linalg::balance::{balance, order_graded_states, range_scale};
 use crate::linalg::householder::reflector;
 use crate::linalg::matrix::{
     FaerView, Order, Square, Transformations, from_faer_in, identity_in, with_order,
@@ -118,25 +118,40 @@ fn reduce(mut h: MatMut<'_, f64>, q: Option<MatMut<'_, f64>>) -> Result<(), Erro
 /// faer's blocked reduction (whose set-up costs more than the whole reduction at n = 4).
 pub(crate) const UNBLOCKED_HESSENBERG_MAX_ORDER: usize = 32;
 
-/// The upper Hessenberg form H of the balanced D^-1 (A / s) D, with s the power of two that
-/// brings A's entries into range ([`range_scale`]): returns (H, s). H is similar to A / s, so
+/// The upper Hessenberg form H of the balanced D^-1 (A / s) D, its states ordered by decreasing
+/// size where they are graded ([`order_graded_states`]), with s the power of two that brings
+/// A's entries into range ([`range_scale`]): returns (H, s). H is similar to A / s, so
 /// it has the eigenvalues and the characteristic polynomial of A / s (the balancing is exact,
 /// the reduction backward stable). The caller checks that A is finite.
-pub(crate) fn balanced_hessenberg<O: Order>(mut h: Square<O>) -> (Square<O>, f64) {
+pub(crate) fn balanced_hessenberg<O: Order>(a: Square<O>) -> (Square<O>, f64) {
+    let (mut h, scale, _) = balanced(a);
+    reduce_in_place(&mut h);
+    (h, scale)
+}
+
+/// D^-1 (A / s) D of [`balanced_hessenberg`] before its reduction: returns it, s, and whether
+/// its states were graded (and ordered).
+pub(crate) fn balanced<O: Order>(mut h: Square<O>) -> (Square<O>, f64, bool) {
     let scale = range_scale(h.as_faer());
     if scale != 1.0 {
         h.as_mut_slice().iter_mut().for_each(|x| *x /= scale);
     }
     let _ = balance(&mut h);
+    let graded = order_graded_states(&mut h);
+    (h, scale, graded)
+}
+
+/// H alone, in place: the plain reduction up to [`UNBLOCKED_HESSENBERG_MAX_ORDER`], faer's
+/// blocked one above.
+pub(crate) fn reduce_in_place<O: Order>(h: &mut Square<O>) {
     if h.nrows() <= UNBLOCKED_HESSENBERG_MAX_ORDER {
-        reduce_to_hessenberg(&mut h, None);
+        reduce_to_hessenberg(h, None);
     } else {
-        h = from_faer_in(
+        *h = from_faer_in(
             h.shape_generic().0,
             hessenberg_matrix(h.to_faer().as_ref()).as_ref(),
         );
     }
-    (h, scale)
 }
 
 /// Householder reduction to upper Hessenberg form in place, H = Q^T A Q; `q` (the identity on

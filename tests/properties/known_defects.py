@@ -94,45 +94,5 @@ ZEROS_OF_GRADED_MODELS = known_defect(
 )
 
 
-def _entry_spread(A: np.ndarray) -> float:
-    """The ratio of the largest to the smallest nonzero |entry| of A (1 for none)."""
-    entries = np.abs(A[np.isfinite(A) & (A != 0)])
-    return float(np.max(entries) / np.min(entries)) if entries.size else 1.0
-
-
-POLES_OF_GRADED_COMPANION = known_defect(
-    "poles-of-graded-companion",
-    {"transfer_function", "transfer_matrix"},
-    "the eigenvalues of a 2 x 2 block [[0, -a], [b, -c]] with c much larger than "
-    "sqrt(a b) (two real poles far apart: tf's companion form of 1e-20 s^2 + s + 1, zpk's "
-    "quadratic of two real poles that hold a zero) lose the small one: poles -1e20 and 0 for "
-    "-1e20 and -1, so that transfer_function's G(0.3 + 0.7j) is off by 131 % and G(0) is "
-    "infinite, silently. The realisation itself is exact (a solve of C (sI - A)^-1 B is right "
-    "to 1e-16); the core's eigenvalues, as LAPACK's dhseqr on this ordering, are backward "
-    "stable only normwise (u ||A|| = 1e4 here); LAPACK on the block with its states reversed "
-    "(the large entry first) finds -1",
-    lambda args: _entry_spread(_models_of(args)[0][0]) > 1e8,
-)
-
-
 def _mode_without_poles(args: dict[str, Any]) -> bool:
     return args.get("mode") is not None and _models_of(args)[0][0].shape[0] == 0
-
-
-def _loop_poles_far_apart(args: dict[str, Any]) -> bool:
-    """The open-loop poles of the ``loop`` argument span more than 1e12 in modulus."""
-    return "loop" in args and _poles_far_apart(args)
-
-
-CLOSED_LOOP_POLES_OF_GRADED_LOOPS = known_defect(
-    "closed-loop-poles-of-graded-loops",
-    {"stability_margins", "disk_margins"},
-    "the closed-loop poles of a loop whose poles lie 1e15 or more apart are computed "
-    "normwise (the controller-Hessenberg QR of the core's loop_margins, and the boundary "
-    "test n u ||M|| kappa of loops.py): L = 1/(s + 2^60) + 1/(s + 1) closes to poles near "
-    "-2^60 and -2, stable, with min |1 + L| = 1 at infinity; stability_margins gives the "
-    "small pole as +64 and the loop unstable, and at 2^50 the pole -1.875, counted on the "
-    "axis, with stability and disk margins 0 (root_locus and nyquist, which polish the QR's "
-    "poles on the factored characteristic polynomial, find -2 and Z = 0)",
-    _loop_poles_far_apart,
-)

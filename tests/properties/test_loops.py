@@ -28,7 +28,6 @@ import aerocontrol
 from aerocontrol.exceptions import IllConditionedWarning, NumericalOverflowWarning
 
 from .harness import Arg, Warned, exercise, plain
-from .known_defects import CLOSED_LOOP_POLES_OF_GRADED_LOOPS
 from .oracles import (
     SLACK,
     TINY,
@@ -760,19 +759,25 @@ def test_regression_frequency_point_beyond_the_scaled_range() -> None:
     assert far == pytest.approx(float((C @ B)[0, 0]) / 1e200j, rel=1e-15)
 
 
-@pytest.mark.xfail(strict=True, reason="closed-loop-poles-of-graded-loops: poles 1e15 apart")
-def test_known_defect_closed_loop_poles_of_graded_loops() -> None:
-    """A defect of the native core (see ``known_defects.py``): L = 1/(s + 2^e) + 1/(s + 1)
-    closes to poles near -2^e and -2 (the closed-loop matrix [[-2^e - 1, -1], [-1, -2]] is
-    symmetric), and min |1 + L| = 1 at infinity (Re 1/(jω + 1) >= 0)."""
-    with CLOSED_LOOP_POLES_OF_GRADED_LOOPS.reproducing():
-        for e in (50, 60):
-            loop = (np.diag([-(2.0**e), -1.0]), np.ones((2, 1)), np.ones((1, 2)), np.zeros((1, 1)))
-            margins = aerocontrol.stability_margins(loop)
-            small = margins.closed_loop_poles[np.argmin(np.abs(margins.closed_loop_poles))]
-            assert abs(small - (-2.0)) <= 1e-9
-            assert margins.closed_loop_stable
-            assert margins.stability_margin == pytest.approx(1.0, rel=1e-9)
+def test_regression_closed_loop_poles_of_graded_loops() -> None:
+    """L = 1/(s + 2^e) + 1/(s + 1) closes to poles near -2^e and -2 (the closed-loop matrix
+    [[-2^e - 1, -1], [-1, -2]] is symmetric: each eigenvalue is well conditioned relative to
+    its size), and min |1 + L| = 1 at infinity (Re 1/(jω + 1) >= 0). The core's loop_margins
+    took the QR iteration's poles (accurate to u 2^e only): at e = 60 the small pole was +64
+    and the loop unstable; at e = 50 it was -1.875, counted on the axis by the normwise
+    boundary test, with stability and disk margins 0. Oracle: the closed forms, the poles
+    -(2^e + 3)/2 ± sqrt(((2^e - 1)/2)^2 + 1) (the smaller as det / the larger, Vieta), and
+    the stability margin min |1 + L| = 1."""
+    for e in (40, 50, 60):
+        loop = (np.diag([-(2.0**e), -1.0]), np.ones((2, 1)), np.ones((1, 2)), np.zeros((1, 1)))
+        margins = aerocontrol.stability_margins(loop)
+        large = -(2.0**e + 3.0) / 2.0 - math.sqrt(((2.0**e - 1.0) / 2.0) ** 2 + 1.0)
+        small = ((2.0**e + 1.0) * 2.0 - 1.0) / large
+        poles = np.sort_complex(margins.closed_loop_poles)
+        assert abs(poles[0] - large) <= 1e-12 * abs(large)
+        assert abs(poles[1] - small) <= 1e-12 * abs(small)
+        assert margins.closed_loop_stable
+        assert margins.stability_margin == pytest.approx(1.0, rel=1e-9)
 
 
 def _order_forty_loop() -> tuple[np.ndarray, ...]:

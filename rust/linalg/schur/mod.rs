@@ -82,12 +82,19 @@
 //! [`eigenvalues`] first balances A (Parlett & Reinsch 1969: a diagonal similarity by powers of
 //! two that equalises row and column norms, exact in floating point), which can only improve
 //! the computed eigenvalues of badly scaled matrices such as models in mixed units. The Schur
-//! form itself is not balanced, since its Z must be orthogonal.
+//! form itself is not balanced, since its Z must be orthogonal. Where the balanced states
+//! are graded (their sizes spread over more than 2^20) they are ordered by decreasing size
+//! (`balance::order_graded_states`: the QR iteration keeps the small eigenvalues of a matrix
+//! graded downward), and where they are graded or the eigenvalues spread as far, the small
+//! eigenvalues are refined to their own size by the two-sided Rayleigh quotient iteration
+//! on the balanced matrix (`refine`), each kept only where it verifies; other matrices take
+//! exactly the path they took before.
 
 mod eigenvectors;
 mod form;
 mod francis;
 pub(crate) mod multishift;
+mod refine;
 pub mod reorder;
 
 pub use eigenvectors::schur_eigenvectors;
@@ -96,9 +103,9 @@ pub use francis::Spectrum;
 pub(crate) use francis::{Finished, Until, francis_qr, francis_qr_until};
 
 use crate::error::{Error, check_finite, check_square};
-use crate::linalg::balance::range_scale;
+use crate::linalg::balance::{GRADED_SPREAD, range_scale};
 use crate::linalg::hessenberg::{
-    UNBLOCKED_HESSENBERG_MAX_ORDER, balanced_hessenberg, hessenberg, reduce_to_hessenberg,
+    UNBLOCKED_HESSENBERG_MAX_ORDER, balanced, hessenberg, reduce_in_place, reduce_to_hessenberg,
 };
 use crate::linalg::matrix::{
     FaerView, Order, Square, from_faer, from_faer_in, identity_in, with_order,
@@ -232,14 +239,59 @@ fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c6
     };
     if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
         with_order!(n, order => {
-            let (mut h, scale) = balanced_hessenberg(from_faer_in(order, a));
-            francis_qr(&mut h, None, (0, n.saturating_sub(1)), false, unscaled(scale))?;
-            Ok(block_eigenvalues(n, |i, j| h[(i, j)] * scale))
+            let (h, scale, graded) = balanced(from_faer_in(order, a));
+            unblocked_eigenvalues(h, scale, graded, unscaled(scale))
         })
     } else {
-        let (mut h, scale) = balanced_hessenberg(from_faer(a));
+        let (mut h, scale, _) = balanced(from_faer(a));
+        reduce_in_place(&mut h);
         schur_of_hessenberg(&mut h, None, false, unscaled(scale))?;
-        Ok(block_eigenvalues(n, |i, j| h[(i, j)] * scale))
+        Ok(form_eigenvalues(&h, scale, None))
+    }
+}
+
+/// The eigenvalues of s B for the balanced B of the unblocked orders (`graded`: whether its
+/// states were graded), by the Hessenberg reduction and the double-shift iteration, B kept
+/// for [`form_eigenvalues`].
+fn unblocked_eigenvalues<O: Order>(
+    b: Square<O>,
+    scale: f64,
+    graded: bool,
+    spectrum: Spectrum<'_>,
+) -> Result<Vec<c64>, Error> {
+    let n = b.nrows();
+    let mut h = b.clone();
+    reduce_in_place(&mut h);
+    francis_qr(&mut h, None, (0, n.saturating_sub(1)), false, spectrum)?;
+    Ok(form_eigenvalues(&h, scale, Some((&b, graded))))
+}
+
+/// The eigenvalues of s T for the quasi-triangular T of the balanced B = D^-1 (A / s) D, those
+/// of B (`balanced`: B, and whether its states were graded) refined first where its states
+/// were graded or its eigenvalues' nonzero moduli span more than [`GRADED_SPREAD`]
+/// ([`refine::refine_small_eigenvalues`]; the QR iteration's may then have lost more than
+/// 2^20 u of the small ones).
+fn form_eigenvalues<O: Order>(
+    t: &Square<O>,
+    scale: f64,
+    balanced: Option<(&Square<O>, bool)>,
+) -> Vec<c64> {
+    let n = t.nrows();
+    let mut values = block_eigenvalues(n, |i, j| t[(i, j)]);
+    let spread = |values: &[c64]| {
+        let moduli = values.iter().map(|v| v.norm()).filter(|&m| m > 0.0);
+        let (smallest, largest) =
+            moduli.fold((f64::INFINITY, 0.0f64), |(s, l), m| (s.min(m), l.max(m)));
+        largest > GRADED_SPREAD * smallest
+    };
+    match balanced {
+        Some((b, graded)) if graded || spread(&values) => {
+            refine::refine_small_eigenvalues(b, &mut values);
+            values.iter_mut().for_each(|v| *v *= scale);
+            values
+        }
+        _ if scale == 1.0 => values,
+        _ => block_eigenvalues(n, |i, j| t[(i, j)] * scale),
     }
 }
 
