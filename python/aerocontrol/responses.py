@@ -355,30 +355,15 @@ def _slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
     discrete model s = ln(z)/dt), which the eigenvalues of A (errors of u ||A||) do not
     resolve from zero: the eigenvalues of M = A (discrete: A - I) are 1/μ for μ those of
     M^-1, whose largest are resolved to a relative u. M^-1 is solved as the steady state is
-    (equilibrated where the core refuses M). A singular M (an integrator) is first deflated
-    (:func:`_deflated`): its null space is invariant, so the nonzero eigenvalues are those of
-    M on the orthogonal complement, which is inverted instead."""
+    (equilibrated where the core refuses M), block by block (:func:`_inverse_eigenvalues_of`),
+    so that an integrator is set apart exactly."""
     n = model.n_states
     none = np.zeros(0, dtype=np.complex128)
     if n == 0:
         return none
     dt = period(model)
     M = model.A - np.eye(n) if dt else model.A
-    inverse = None
-    for _ in range(n):  # each deflation removes at least one state
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                inverse = -_equilibrated_solve(M, np.eye(len(M)), np.eye(len(M)), False)
-            break
-        except SingularMatrixError:
-            deflated = _deflated(M)
-            if deflated is None:
-                return none
-            M = deflated
-    if inverse is None or not np.all(np.isfinite(inverse)):
-        return none
-    mu = _core.eigenvalues(inverse)
+    mu = _inverse_eigenvalues_of(M)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         slow = 1.0 / mu[mu != 0]
         if dt:
@@ -387,19 +372,76 @@ def _slow_modes(model: StateSpace, fastest: float) -> NDArray[np.complex128]:
     return np.asarray(slow[keep], dtype=np.complex128)
 
 
-def _deflated(M: FloatArray) -> FloatArray | None:
-    """W^T M W for W an orthonormal basis of the complement of M's numerical null space (the
-    right singular vectors of the singular values above n u σ_max), or None where M has no
-    such null space or is all null space. M V_0 = 0 for the null vectors V_0, so in the
-    orthogonal basis [W V_0], M = [[W^T M W, 0], [V_0^T M W, 0]]: the eigenvalues of M are
-    those of W^T M W and zeros (a chain of them, a double integrator, leaves W^T M W singular,
-    and is deflated again)."""
-    n = len(M)
-    _, sigma, Vt = np.linalg.svd(M)
-    rank = int(np.sum(sigma > n * np.finfo(np.float64).eps * sigma[0])) if n else 0
-    if rank == 0 or rank == n:
+def _inverse_eigenvalues(M: FloatArray) -> NDArray[np.complex128] | None:
+    """The eigenvalues of M^-1, or None where M is singular to working precision after
+    equilibration (refused, or an inverse beyond the doubles)."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            inverse = -_equilibrated_solve(M, np.eye(len(M)), np.eye(len(M)), False)
+    except SingularMatrixError:
         return None
-    W = Vt[:rank].T
+    if not np.all(np.isfinite(inverse)):
+        return None
+    return np.asarray(_core.eigenvalues(inverse), dtype=np.complex128)
+
+
+def _inverse_eigenvalues_of(M: FloatArray) -> NDArray[np.complex128]:
+    """The eigenvalues of M^-1, M on the complement of its zero eigenvalues where it is
+    singular. M is first split, exactly, into its irreducible diagonal blocks
+    (:func:`_irreducible_blocks`: the eigenvalues of M are theirs); an integrator is a block
+    [0], dropped. A block singular to working precision is deflated (:func:`_deflated`),
+    again while it is singular, before it is inverted. The exact split keeps the slow modes
+    of a model whose integrator is coupled one way (x_i' = c x_j), which an orthogonal
+    deflation of all of M would blur by u ||M||, and which an LU solve of all of M (an exactly
+    singular triangular M, permuted) may not even find singular."""
+    found = [np.zeros(0, dtype=np.complex128)]
+    for block in _irreducible_blocks(M):
+        if block.shape == (1, 1) and block[0, 0] == 0.0:
+            continue
+        for _ in range(len(block)):  # each deflation removes one state
+            mu = _inverse_eigenvalues(block)
+            if mu is not None:
+                found.append(mu)
+                break
+            deflated = _deflated(block)
+            if deflated is None:
+                break
+            block = deflated
+    return np.concatenate(found)
+
+
+def _irreducible_blocks(M: FloatArray) -> list[FloatArray]:
+    """The diagonal blocks of M's block triangular form by a permutation: the states of each
+    strongly connected component of the graph with an edge j -> i where M_ij != 0. In that
+    form M is block triangular, so its eigenvalues are the blocks' (a permutation: exact)."""
+    n = len(M)
+    reach = (M != 0) | np.eye(n, dtype=bool)
+    for k in range(n):  # Warshall's transitive closure
+        reach |= reach[:, k : k + 1] & reach[k : k + 1, :]
+    component = reach & reach.T
+    blocks = []
+    assigned = np.zeros(n, dtype=bool)
+    for i in range(n):
+        if not assigned[i]:
+            members = np.flatnonzero(component[i])
+            assigned[members] = True
+            blocks.append(M[np.ix_(members, members)])
+    return blocks
+
+
+def _deflated(M: FloatArray) -> FloatArray | None:
+    """W^T M W for W an orthonormal basis of the complement of M's most nearly null direction
+    v_0 (the right singular vector of its smallest singular value), or None for a single
+    state. M v_0 = 0 for an integrator's state, so in the orthogonal basis [W v_0],
+    M = [[W^T M W, 0], [v_0^T M W, 0]]: the eigenvalues of M are those of W^T M W and a zero
+    (a chain or several of them leave W^T M W singular, and it is deflated again). One
+    direction at a time: a threshold on the singular values (n u σ_max) would take a decaying
+    mode slower than it for null space too, the very modes the inverse is to resolve."""
+    n = len(M)
+    if n < 2:
+        return None
+    W = np.linalg.svd(M)[2][:-1].T
     return np.asarray(W.T @ M @ W, dtype=np.float64)
 
 

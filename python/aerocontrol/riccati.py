@@ -180,7 +180,9 @@ def solve_care(
         Positive definite: the Hamiltonian method above. Indefinite (as the H-infinity
         equations have): the extended Hamiltonian pencil of order 2n + m, compressed and
         reduced by aerocontrol's QZ algorithm (:func:`~aerocontrol.qz`), X = U21 (E U11)^-1
-        from its stable deflating subspace, with the same checks (no refinement).
+        from its stable deflating subspace, with the same checks (no refinement); the
+        equation is first scaled exactly as above, and also where B or the weights alone are
+        far from 1 (the pencil's identity blocks set its scale).
     S : array_like (n, m), optional; the cross weight (python-control's N)
     E : array_like (n, n), optional; nonsingular
     refine : bool, optional

@@ -227,7 +227,8 @@ impl Evaluation {
 
 /// Solves the CARE for its stabilising solution, in exactly scaled units where its states are
 /// scaled apart ([`super::scaling`]); an R that is symmetric and nonsingular but not positive
-/// definite goes to the extended pencil ([`super::care_pencil`]).
+/// definite goes to the extended pencil ([`super::care_pencil`]), scaled as the discrete
+/// pencil is (also where B or the weights alone are far from 1).
 pub fn solve_care(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -257,7 +258,14 @@ pub(crate) fn solve_care_scaled(
         e: options.e,
         terminal: None,
     };
-    let scaled = ScaledEquation::of(given, Scale::WhereBalanced)?;
+    // The extended pencil of an indefinite R, like the discrete pencil, has identity blocks
+    // that set its scale, and no scaling of its own (the Hamiltonian's ρ and balancing).
+    let scale = if indefinite_weight(b, r) {
+        Scale::AlsoWeights
+    } else {
+        Scale::WhereBalanced
+    };
+    let scaled = ScaledEquation::of(given, scale)?;
     let equation = scaled.equation();
     let solution = solve_care_as_given(
         equation.a,
@@ -277,6 +285,18 @@ pub(crate) fn solve_care_scaled(
     }))
 }
 
+/// An R that is symmetric but not positive definite: the extended pencil solves the equation,
+/// which needs no Cholesky factor (an asymmetric R is refused by the same check in both
+/// paths).
+fn indefinite_weight(b: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
+    r.nrows() == r.ncols()
+        && r.nrows() == b.ncols()
+        && r.is_all_finite()
+        && symmetric(r, "R", b.ncols(), "the columns of B")
+            .map(|r| cholesky(&r).is_none())
+            .unwrap_or(false)
+}
+
 /// [`solve_care`] of the equation as given.
 fn solve_care_as_given(
     a: MatRef<'_, f64>,
@@ -285,15 +305,7 @@ fn solve_care_as_given(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<AlgebraicSolution, Error> {
-    // An R that is symmetric but not positive definite: the extended pencil, which needs no
-    // Cholesky factor (an asymmetric R is refused by the same check in both paths).
-    if r.nrows() == r.ncols()
-        && r.nrows() == b.ncols()
-        && r.is_all_finite()
-        && symmetric(r, "R", b.ncols(), "the columns of B")
-            .map(|r| cholesky(&r).is_none())
-            .unwrap_or(false)
-    {
+    if indefinite_weight(b, r) {
         return super::care_pencil::solve_care_indefinite(a, b, q, r, options);
     }
     solve_care_dense(a, b, q, r, options).map(|care| AlgebraicSolution {

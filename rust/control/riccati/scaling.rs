@@ -36,9 +36,12 @@
 //! recursion, not of the units.
 
 use super::AlgebraicSolution;
+use super::care::SYMMETRY_TOLERANCE;
 use crate::linalg::balance::{
     balanced_where_scaled_apart, states_scaled_apart, times_power_of_two,
 };
+use crate::linalg::matrix::Symmetrize;
+use crate::linalg::norm::max_abs;
 use faer::{Mat, MatRef};
 
 /// The balancing of the states is applied where its exponents span at least this many powers
@@ -125,6 +128,22 @@ fn exactly_scaled(
     exact.then_some(scaled)
 }
 
+/// Q symmetrised where it is symmetric to [`SYMMETRY_TOLERANCE`] in the caller's units, the
+/// check the solvers make: Q̃ = 2^k T Q T weighs its entries unequally, so the check made on
+/// Q̃ would refuse an asymmetry the caller's Q may carry (or accept one it may not), and name
+/// sizes the caller never gave. None where Q is refused: the solver then refuses it as given.
+fn symmetrized(q: MatRef<'_, f64>) -> Option<Mat<f64>> {
+    let n = q.nrows();
+    let asymmetry = (0..n)
+        .flat_map(|j| (0..j).map(move |i| (q[(i, j)] - q[(j, i)]).abs()))
+        .fold(0.0, f64::max);
+    (asymmetry <= SYMMETRY_TOLERANCE * max_abs(q)).then(|| {
+        let mut symmetric = q.to_owned();
+        symmetric.symmetrize();
+        symmetric
+    })
+}
+
 /// The exponents of Osborne's balancing of |A| + |E| (e with T^-1 A T balanced), where the
 /// states are scaled apart and the exponents span [`BALANCING_SPREAD`] or more.
 fn balancing(a: MatRef<'_, f64>, e: Option<MatRef<'_, f64>>) -> Option<Vec<i32>> {
@@ -179,6 +198,10 @@ impl ScaledEquation {
         if !(shapes && finite) {
             return None;
         }
+        // R and S_f are scaled by one factor or congruently as Q; only Q's check depends on
+        // the units (R's is unchanged by 2^k, S_f's is the bindings').
+        let q = symmetrized(q)?;
+        let q = q.as_ref();
         let balancing = balancing(a, e);
         if balancing.is_none() && scale == Scale::WhereBalanced {
             return None;
@@ -280,7 +303,6 @@ impl ScaledEquation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linalg::norm::max_abs;
 
     /// The largest |entry| of a matrix.
     fn largest(m: &Mat<f64>) -> f64 {
