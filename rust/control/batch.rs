@@ -7,7 +7,9 @@
 
 use crate::control::placement::Placement;
 use crate::control::riccati::AlgebraicSolution;
-use crate::control::riccati::care::{CareOptions, solve_care, solve_care_dense, solve_care_scaled};
+use crate::control::riccati::care::{
+    CareOptions, indefinite_weight, solve_care, solve_care_dense, solve_care_scaled,
+};
 use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
 use crate::linalg::expm::expm_into_validated;
@@ -431,7 +433,7 @@ fn solve_one(
                 refine,
                 ..CareOptions::default()
             };
-            if let Some(scaled) = solve_care_scaled(a, b, q, r, options) {
+            if let Some(scaled) = solve_care_scaled(a, b, q, r, options, indefinite_weight(b, r)) {
                 return scaled.map(Solved::from);
             }
             match solve_care_dense(a, b, q, r, options) {

@@ -236,18 +236,20 @@ pub fn solve_care(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<AlgebraicSolution, Error> {
-    solve_care_scaled(a, b, q, r, options)
-        .unwrap_or_else(|| solve_care_as_given(a, b, q, r, options))
+    let indefinite = indefinite_weight(b, r);
+    solve_care_scaled(a, b, q, r, options, indefinite)
+        .unwrap_or_else(|| solve_care_as_given(a, b, q, r, options, indefinite))
 }
 
 /// [`solve_care`] in the scaled units of [`super::scaling`], or None where the equation is
-/// solved as given.
+/// solved as given; `indefinite`: R is [`indefinite_weight`] (so is 2^k R, the scaled one).
 pub(crate) fn solve_care_scaled(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
+    indefinite: bool,
 ) -> Option<Result<AlgebraicSolution, Error>> {
     let given = Equation {
         a,
@@ -260,7 +262,7 @@ pub(crate) fn solve_care_scaled(
     };
     // The extended pencil of an indefinite R, like the discrete pencil, has identity blocks
     // that set its scale, and no scaling of its own (the Hamiltonian's ρ and balancing).
-    let scale = if indefinite_weight(b, r) {
+    let scale = if indefinite {
         Scale::AlsoWeights
     } else {
         Scale::WhereBalanced
@@ -277,6 +279,7 @@ pub(crate) fn solve_care_scaled(
             e: equation.e,
             ..options
         },
+        indefinite,
     );
     Some(solution.map(|solution| {
         scaled.unscaled(solution, |x, gain| {
@@ -288,7 +291,7 @@ pub(crate) fn solve_care_scaled(
 /// An R that is symmetric but not positive definite: the extended pencil solves the equation,
 /// which needs no Cholesky factor (an asymmetric R is refused by the same check in both
 /// paths).
-fn indefinite_weight(b: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
+pub(crate) fn indefinite_weight(b: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
     r.nrows() == r.ncols()
         && r.nrows() == b.ncols()
         && r.is_all_finite()
@@ -297,15 +300,16 @@ fn indefinite_weight(b: MatRef<'_, f64>, r: MatRef<'_, f64>) -> bool {
             .unwrap_or(false)
 }
 
-/// [`solve_care`] of the equation as given.
+/// [`solve_care`] of the equation as given (`indefinite`: R is [`indefinite_weight`]).
 fn solve_care_as_given(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     q: MatRef<'_, f64>,
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
+    indefinite: bool,
 ) -> Result<AlgebraicSolution, Error> {
-    if indefinite_weight(b, r) {
+    if indefinite {
         return super::care_pencil::solve_care_indefinite(a, b, q, r, options);
     }
     solve_care_dense(a, b, q, r, options).map(|care| AlgebraicSolution {
