@@ -16,6 +16,8 @@
 //! ```text
 //! bindings   the Python module (feature `python`): arguments in, results out
 //!    |
+//! flight     flight vehicles: models from stability derivatives, MIL-F-8785C Levels of modes
+//!    |
 //! control    control algorithms on plain matrices: discretisation, responses, frequency
 //!    |       responses, modes, controllability, pole placement, Riccati equations, batches
 //! linalg     numerical kernels: small fixed-order matrices, LU, norms, Hessenberg and real
@@ -36,6 +38,7 @@
 
 pub mod control;
 pub mod error;
+pub mod flight;
 pub mod linalg;
 pub mod platform;
 #[cfg(test)]

@@ -927,3 +927,33 @@ def test_pairs_of_any_magnitude_keep_their_frequency_and_damping(scale: float) -
     np.testing.assert_allclose(quantities["zeta"], [1 / math.sqrt(2), 1.25], rtol=4e-16)
     expected = 1 if scale > 1.0 else (4 if scale < 1.0 else 1)  # ω_n > 0.4 rad/s needed
     assert levels[0] == single.level("dutch roll") == expected
+
+
+def test_pair_quantities_agree_with_mpmath_over_every_magnitude() -> None:
+    """ω_n, ζ and ζω_n of 3000 random pairs (conjugate pairs and real pairs of one sign, of
+    magnitudes 1e-250 to 1e250), computed in the core, against mpmath at 40 digits: within
+    3 u (ω_n is one rounded square root of a product formed exactly after the power-of-two
+    scaling, up to one rounding in the product)."""
+    import mpmath
+
+    from aerocontrol.handling import mode_quantities
+
+    mpmath.mp.dps = 40
+    rng = np.random.default_rng(21)
+    count = 3000
+    size = 10.0 ** rng.uniform(-250, 250, count)
+    re = -size * rng.uniform(0.01, 1.0, count) * rng.choice([-1.0, 1.0], count)
+    im = size * rng.uniform(0.01, 1.0, count)
+    real_pair = rng.random(count) < 0.3
+    second_re = np.where(real_pair, re * rng.uniform(0.1, 10.0, count), re)
+    lam = np.stack(
+        [re + 1j * np.where(real_pair, 0.0, im), second_re - 1j * np.where(real_pair, 0.0, im)],
+        axis=1,
+    )
+    got = mode_quantities("dutch roll", lam)
+    for i in range(count):
+        l1, l2 = (mpmath.mpc(complex(v)) for v in lam[i])
+        wn = mpmath.sqrt(mpmath.re(l1 * l2))
+        zw = -(mpmath.re(l1) + mpmath.re(l2)) / 2
+        assert abs(got["omega_n"][i] - wn) <= 3 * 2.2e-16 * wn, i
+        assert abs(got["zeta"][i] - zw / wn) <= 4 * 2.2e-16 * abs(zw / wn), i

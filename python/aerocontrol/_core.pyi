@@ -68,6 +68,10 @@ EXACT_NORM_MAX_ORDER: int
 RESCALE_EXPONENT: float
 SMALL_MAX_ORDER: int
 FMA_KERNELS: bool
+LONGITUDINAL_PARAMETERS: list[str]
+LONGITUDINAL_DIMENSIONAL: list[str]
+LATERAL_PARAMETERS: list[str]
+LATERAL_DIMENSIONAL: list[str]
 ILL_CONDITIONED_CONTROLLABILITY: float
 POLE_ERROR_WARNING: float
 PRODUCT_WORKSPACE_BYTES: int
@@ -77,6 +81,13 @@ def set_thread_num_threads(count: int | None, /) -> None: ...
 def get_num_threads() -> int: ...
 def exception_classes() -> list[str]: ...
 def eigenvalues(a: ArrayLike, /) -> NDArray[np.complex128]: ...
+def aircraft_models(
+    axis: str, nominal: list[float], sampled: NDArray[np.float64], columns: list[int], /
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], int | None]: ...
+def mode_quantities(kind: str, roots: NDArray[np.complex128], /) -> NDArray[np.float64]: ...
+def mode_levels(
+    mode: str, roots: NDArray[np.complex128], limits: list[float], /
+) -> NDArray[np.int8]: ...
 def qz(
     a: ArrayLike, b: ArrayLike, select: Callable[[complex, float], bool] | None, /
 ) -> tuple[

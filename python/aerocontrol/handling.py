@@ -94,6 +94,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _core
 from ._results import Result, Tabular, register
 from ._validation import check_choice, real_scalar
 from .exceptions import InvalidArgumentError, NonFiniteError, ShapeError
@@ -861,9 +862,8 @@ def mode_quantities(mode: str, eigenvalues: ArrayLike) -> dict[str, FloatArray]:
     if name in _OSCILLATORY:
         wn, zeta, _ = _pair_arrays(lam)
         return {"omega_n": wn, "zeta": zeta}
-    if name == "roll":
-        return {"time constant": _roll_time_constant(lam.real)}
-    return {"time to double": _time_to_double_arrays(lam.real)}
+    kind = "time constant" if name == "roll" else "time to double"
+    return {kind: _core.mode_quantities(kind, lam)}
 
 
 def level_limits(
@@ -975,101 +975,43 @@ def _eigenvalue_arrays(value: object, label: str, mode: str) -> NDArray[np.compl
     return lam
 
 
-def _roll_time_constant(root: FloatArray) -> FloatArray:
-    with np.errstate(divide="ignore"):
-        tau: FloatArray = np.where(root < 0, -1.0 / np.where(root < 0, root, -1.0), np.inf)
-    return tau
-
-
 def _pair_arrays(lam: NDArray[np.complex128]) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """:func:`_pair` on k pairs: (ω_n, ζ, ζ ω_n)."""
-    # Each pair scaled by a power of two, 2^-e with 2^e about its largest part: exact, so the
-    # doubles are those of the unscaled formulas wherever those neither overflow nor
-    # underflow, and ω_n² of roots of 1e200 (or 1e-200) is no inf (or 0).
-    parts = np.abs(np.stack([lam.real, lam.imag], axis=-1)).reshape(lam.shape[0], -1)
-    exponent = np.frexp(parts.max(axis=1, initial=0.0))[1]
-    r1, i1 = np.ldexp(lam[:, 0].real, -exponent), np.ldexp(lam[:, 0].imag, -exponent)
-    r2, i2 = np.ldexp(lam[:, 1].real, -exponent), np.ldexp(lam[:, 1].imag, -exponent)
-    # Re(λ1 λ2) by real operations: numpy's complex product may fuse them (FMA), and an ω_n
-    # one ulp apart would put a mode on either side of a limit (ω_n > 0.4).
-    wn2 = r1 * r2 - i1 * i2
-    zw_scaled = -0.5 * (r1 + r2)
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        wn_scaled = np.where(wn2 > 0, np.sqrt(np.abs(wn2)), np.where(wn2 == 0, 0.0, np.nan))
-        zeta = np.where(
-            wn2 > 0,
-            zw_scaled / np.where(wn2 > 0, wn_scaled, 1.0),
-            np.where((wn2 == 0) & (zw_scaled != 0), np.copysign(np.inf, zw_scaled), np.nan),
-        )
-        wn = np.ldexp(wn_scaled, exponent)
-        zw = np.ldexp(zw_scaled, exponent)
-    return wn, zeta, zw
+    """(ω_n, ζ, ζ ω_n) of k pairs of roots (k, 2), in the core (``rust/flight/levels.rs``:
+    each pair scaled exactly by a power of two, so roots of 1e200 or 1e-200 neither overflow
+    nor underflow, and Re(λ1 λ2) never fused, so a mode at a limit lands on one side)."""
+    quantities = _core.mode_quantities("pair", lam)
+    return quantities[:, 0], quantities[:, 1], quantities[:, 2]
 
 
-def _time_to_double_arrays(growth: FloatArray) -> FloatArray:
-    with np.errstate(divide="ignore"):
-        return np.where(growth > 0, _LN2 / np.where(growth > 0, growth, 1.0), np.inf)
-
-
-def _first_met(checks: Sequence[NDArray[np.bool_] | None], count: int) -> NDArray[np.int8]:
-    """The first Level (1-3) whose check is met (None: no limit, met), else 4."""
-    level = np.full(count, 4, dtype=np.int8)
-    for k in range(len(checks), 0, -1):
-        met = checks[k - 1]
-        level = np.where(True if met is None else met, np.int8(k), level).astype(np.int8)
-    return level
+@functools.lru_cache(maxsize=128)
+def _limit_values(mode: str, aircraft_class: str, category: str) -> list[float]:
+    """The limits of Levels 1-3 on ``mode`` for the Class and Category, as the core's
+    ``Limits::from_values`` reads them (``rust/flight/levels.rs``): the tables above, the one
+    place they are written."""
+    if mode == "short period":
+        bands = SHORT_PERIOD_ZETA[category]
+        return [v for low, high in bands for v in (low, math.inf if high is None else high)]
+    if mode == "phugoid":
+        return [*PHUGOID_MIN_ZETA, PHUGOID_MIN_TIME_TO_DOUBLE]
+    if mode == "dutch roll":
+        rows = (DUTCH_ROLL_LEVEL1[category, aircraft_class], DUTCH_ROLL_LEVEL2, DUTCH_ROLL_LEVEL3)
+        columns = [
+            [math.nan if v is None else v for v in column] for column in zip(*rows, strict=True)
+        ]
+        cap = [DUTCH_ROLL_CLASS_III_MAX_REQUIRED_ZETA] if aircraft_class == "III" else []
+        return [v for column in columns for v in column] + cap
+    if mode == "roll":
+        return list(ROLL_MODE_MAX_TIME_CONSTANT[category, aircraft_class])
+    if mode == "spiral":
+        return list(SPIRAL_MIN_TIME_TO_DOUBLE[category])
+    return list(ROLL_SPIRAL_MIN_ZETA_OMEGA) if category in ROLL_SPIRAL_CATEGORIES else []
 
 
 def _mode_levels(
     mode: str, lam: NDArray[np.complex128], aircraft_class: str, category: str
 ) -> NDArray[np.int8]:
-    count = lam.shape[0]
-    if mode == "short period":
-        _, zeta, _ = _pair_arrays(lam)
-        checks = [
-            zeta >= low if high is None else (low <= zeta) & (zeta <= high)
-            for low, high in SHORT_PERIOD_ZETA[category]
-        ]
-        return _first_met(checks, count)
-    if mode == "phugoid":
-        _, zeta, _ = _pair_arrays(lam)
-        level1, level2 = PHUGOID_MIN_ZETA
-        t2 = _time_to_double_arrays(lam.real.max(axis=1))
-        damping = _first_met([zeta >= level1, zeta >= level2, None], count)
-        doubling = _first_met([t2 == np.inf, t2 == np.inf, t2 >= PHUGOID_MIN_TIME_TO_DOUBLE], count)
-        return np.maximum(damping, doubling)
-    if mode == "dutch roll":
-        wn, zeta, zw = _pair_arrays(lam)
-        rows = (DUTCH_ROLL_LEVEL1[category, aircraft_class], DUTCH_ROLL_LEVEL2, DUTCH_ROLL_LEVEL3)
-        capped = aircraft_class == "III"
-        cap = DUTCH_ROLL_CLASS_III_MAX_REQUIRED_ZETA
-        zeta_checks: list[NDArray[np.bool_] | None] = []
-        zw_checks: list[NDArray[np.bool_] | None] = []
-        wn_checks: list[NDArray[np.bool_] | None] = []
-        for min_zeta, min_zw, min_wn in rows:
-            zeta_checks.append(zeta > min_zeta)
-            if min_zw is None:
-                zw_checks.append(None)
-            elif capped:
-                zw_checks.append((zw > min_zw) | (zeta >= cap))
-            else:
-                zw_checks.append(zw > min_zw)
-            wn_checks.append(wn > min_wn)
-        levels: NDArray[np.int8] = np.maximum.reduce(
-            [_first_met(c, count) for c in (zeta_checks, zw_checks, wn_checks)]
-        )
-        return levels
-    if mode == "roll":
-        tau = _roll_time_constant(lam.real)
-        limits = ROLL_MODE_MAX_TIME_CONSTANT[category, aircraft_class]
-        return _first_met([tau <= m for m in limits], count)
-    if mode == "roll-spiral":
-        _, _, zw = _pair_arrays(lam)
-        if category not in ROLL_SPIRAL_CATEGORIES:
-            return np.full(count, 4, dtype=np.int8)
-        return _first_met([zw > m for m in ROLL_SPIRAL_MIN_ZETA_OMEGA], count)
-    t2 = _time_to_double_arrays(lam.real)
-    return _first_met([t2 > m for m in SPIRAL_MIN_TIME_TO_DOUBLE[category]], count)
+    """The Levels of k aircraft's ``mode`` from its checked roots, in the core."""
+    return _core.mode_levels(mode, lam, _limit_values(mode, aircraft_class, category))
 
 
 # --- Text ------------------------------------------------------------------------------------

@@ -15,6 +15,7 @@ mod compute;
 mod controllability;
 mod conversion;
 mod errors;
+mod flight;
 mod frequency;
 mod linalg;
 mod loops;
@@ -47,6 +48,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     placement::register(m)?;
     riccati::register(m)?;
     batch::register(m)?;
+    flight::register(m)?;
     compute::register(m)?;
     m.add(
         "EXACT_NORM_MAX_ORDER",

@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .. import _core
 from .._validation import real_array, real_scalar
 from ..exceptions import InvalidArgumentError
 from ..modal import Modes, modes
@@ -79,6 +80,9 @@ SAMPLED_FIELDS = ("mass", "Ix", "Iy", "Iz", "Ixz", "speed", "density")
 
 #: The sampled fields that must be positive (all but the product of inertia Ixz).
 _POSITIVE_FIELDS = ("mass", "Ix", "Iy", "Iz", "speed", "density")
+
+#: The geometry a model is built from, the aircraft's own in every sample.
+_GEOMETRY = ("S", "cbar", "b", "mach")
 
 FloatArray = NDArray[np.float64]
 
@@ -293,68 +297,14 @@ class Aircraft:
 
     def dimensional_longitudinal(self) -> dict[str, float]:
         """Xu, Xw, Xde, Zu, Zw, Zwdot, Zq, Zde, Mu, Mw, Mwdot, Mq, Mde: the chapter's (6.48)."""
-        return self._dimensional_longitudinal(_Values(self, {}))
-
-    def _dimensional_longitudinal(self, v: _Values) -> dict[str, Any]:
-        c = v.derivatives
-        rho, u0, S, cbar, m, Iy, M = (
-            v["density"],
-            v["speed"],
-            self.S,
-            self.cbar,
-            v["mass"],
-            v["Iy"],
-            self.mach,
-        )
-        force = rho * S * u0 / (2 * m)
-        control_force = rho * u0**2 * S / (2 * m)
-        moment = rho * u0 * S * cbar / (2 * Iy)
-        values = {
-            "Xu": -force * (2 * c["CD"] + M * c["CD_M"]),
-            "Xw": force * (c["CL"] - c["CD_alpha"]),
-            "Xde": -control_force * c["CD_de"],
-            "Zu": -force * (2 * c["CL"] + M * c["CL_M"]),
-            "Zw": -force * (c["CL_alpha"] + c["CD"]),
-            "Zwdot": -rho * S * cbar / (4 * m) * c["CL_alphadot"],
-            "Zq": -rho * u0 * S * cbar / (4 * m) * c["CL_q"],
-            "Zde": -control_force * c["CL_de"],
-            "Mu": moment * M * c["Cm_M"],
-            "Mw": moment * c["Cm_alpha"],
-            "Mwdot": rho * S * cbar**2 / (4 * Iy) * c["Cm_alphadot"],
-            "Mq": rho * u0 * S * cbar**2 / (4 * Iy) * c["Cm_q"],
-            "Mde": rho * u0**2 * S * cbar / (2 * Iy) * c["Cm_de"],
-        }
-        return {key: value + 0.0 for key, value in values.items()}
+        dimensional, _, _ = self._models("longitudinal", _Values(self, {}))
+        return dict(zip(_core.LONGITUDINAL_DIMENSIONAL, dimensional[0].tolist(), strict=True))
 
     def dimensional_lateral(self) -> dict[str, float]:
         """Yv, Yp, Yr, Ydr, Yda, Lv, Lp, Lr, Ldr, Lda, Nv, Np, Nr, Ndr, Nda and the product-of-
         inertia factors ix = Ixz/Ix, iz = Ixz/Iz: the chapter's (6.148)-(6.149)."""
-        return self._dimensional_lateral(_Values(self, {}))
-
-    def _dimensional_lateral(self, v: _Values) -> dict[str, Any]:
-        c = v.derivatives
-        rho, u0, S, b, m = v["density"], v["speed"], self.S, self.b, v["mass"]
-        values = {
-            "Yv": rho * u0 * S / (2 * m) * c["Cy_beta"],
-            "Yp": rho * u0 * S * b / (4 * m) * c["Cy_p"],
-            "Yr": rho * u0 * S * b / (4 * m) * c["Cy_r"],
-            "Ydr": rho * u0**2 * S / (2 * m) * c["Cy_dr"],
-            "Yda": rho * u0**2 * S / (2 * m) * c["Cy_da"],
-        }
-        for letter, inertia in (("L", v["Ix"]), ("N", v["Iz"])):
-            coefficient = "Cl" if letter == "L" else "Cn"
-            values[f"{letter}v"] = rho * u0 * S * b / (2 * inertia) * c[f"{coefficient}_beta"]
-            for rate in ("p", "r"):
-                values[f"{letter}{rate}"] = (
-                    rho * u0 * S * b**2 / (4 * inertia) * c[f"{coefficient}_{rate}"]
-                )
-            for surface in ("dr", "da"):
-                values[f"{letter}{surface}"] = (
-                    rho * u0**2 * S * b / (2 * inertia) * c[f"{coefficient}_{surface}"]
-                )
-        values["ix"] = v["Ixz"] / v["Ix"]
-        values["iz"] = v["Ixz"] / v["Iz"]
-        return {key: value + 0.0 for key, value in values.items()}
+        dimensional, _, _ = self._models("lateral", _Values(self, {}))
+        return dict(zip(_core.LATERAL_DIMENSIONAL, dimensional[0].tolist(), strict=True))
 
     # ------------------------------------------------------------------------------------
     # State-space models
@@ -362,82 +312,66 @@ class Aircraft:
 
     def longitudinal(self) -> StateSpace:
         """The longitudinal model (6.49): x = (u/u0, α, q, θ), input the elevator δe (rad)."""
-        A, B = self._longitudinal_matrices(_Values(self, {}))
-        return StateSpace(A, B, state_names=list(LONGITUDINAL_STATES), input_names=["elevator"])
-
-    def _longitudinal_matrices(self, v: _Values) -> tuple[FloatArray, FloatArray]:
-        # Rows as Python floats for one model (the same double-precision operations as
-        # numpy's, without a numpy call per row), or as arrays of sampled values; one array at
-        # the end.
-        d = self._dimensional_longitudinal(v)
-        u0, g, theta0 = v["speed"], self.gravity, self.theta0
-        surge = [d["Xu"], d["Xw"], 0.0, -g * math.cos(theta0) / u0]
-        if np.any(d["Zwdot"] == 1.0):  # (1 - Zẇ) dα/dt: the α equation would have no dα/dt
-            raise AircraftDataError(
-                f"{self.name}: the longitudinal model is singular: 1 - Zẇ = 0 with "
-                f"CL_alphadot = {self.derivatives['CL_alphadot']:g}" + v.where(d["Zwdot"] == 1.0)
-            )
-        scale = 1.0 / (1.0 - d["Zwdot"])
-        heave = [
-            d["Zu"] * scale,
-            d["Zw"] * scale,
-            (1.0 + d["Zq"] / u0) * scale,
-            -g * math.sin(theta0) / u0 * scale,
-        ]
-        heave_control = d["Zde"] / u0 * scale
-        alpha_rate = u0 * d["Mwdot"]
-        pitch = [
-            x + alpha_rate * z
-            for x, z in zip([u0 * d["Mu"], u0 * d["Mw"], d["Mq"], 0.0], heave, strict=True)
-        ]
-        pitch_control = d["Mde"] + alpha_rate * heave_control
-        # (+ 0.0 turns the negative zeros of -g sin 0 and -CD_de = -0 into zeros.)
-        A = _assemble([surge, heave, pitch, [0.0, 0.0, 1.0, 0.0]])
-        B = _assemble([[d["Xde"] / u0], [heave_control], [pitch_control], [0.0]])
-        return A, B
+        _, A, B = self._models("longitudinal", _Values(self, {}))
+        return StateSpace(
+            A[0], B[0], state_names=list(LONGITUDINAL_STATES), input_names=["elevator"]
+        )
 
     def lateral(self) -> StateSpace:
         """The lateral-directional model (6.150): x = (β, p, φ, r), inputs (rudder, aileron) in
         rad, the order of the chapter's LQR example (6.224)."""
-        A, B = self._lateral_matrices(_Values(self, {}))
-        return StateSpace(A, B, state_names=list(LATERAL_STATES), input_names=["rudder", "aileron"])
-
-    def _lateral_matrices(self, v: _Values) -> tuple[FloatArray, FloatArray]:
-        # Rows as Python floats or arrays, as in _longitudinal_matrices().
-        d = self._dimensional_lateral(v)
-        u0, g, theta0 = v["speed"], self.gravity, self.theta0
-        ix, iz = d["ix"], d["iz"]
-        coupling = 1.0 - ix * iz
-        if not np.all(coupling > 0.0):  # Ix Iz > Ixz^2, checked by the loader, lost to rounding
-            raise AircraftDataError(
-                f"{self.name}: the lateral model is singular: 1 - Ixz^2/(Ix Iz) = "
-                f"{np.min(coupling):g}" + v.where(~(coupling > 0.0))
-            )
-        roll = [u0 * d["Lv"], d["Lp"], 0.0, d["Lr"]]
-        yaw = [u0 * d["Nv"], d["Np"], 0.0, d["Nr"]]
-        roll_control = [d["Ldr"], d["Lda"]]
-        yaw_control = [d["Ndr"], d["Nda"]]
-
-        def combined(first: list[float], second: list[float], factor: float) -> list[float]:
-            return [(x + factor * y) / coupling for x, y in zip(first, second, strict=True)]
-
-        A = _assemble(
-            [
-                [d["Yv"], d["Yp"] / u0, g * math.cos(theta0) / u0, d["Yr"] / u0 - 1.0],
-                combined(roll, yaw, ix),
-                [0.0, 1.0, 0.0, math.tan(theta0)],
-                combined(yaw, roll, iz),
-            ]
+        _, A, B = self._models("lateral", _Values(self, {}))
+        return StateSpace(
+            A[0], B[0], state_names=list(LATERAL_STATES), input_names=["rudder", "aileron"]
         )
-        B = _assemble(
-            [
-                [d["Ydr"] / u0, d["Yda"] / u0],
-                combined(roll_control, yaw_control, ix),
-                [0.0, 0.0],
-                combined(yaw_control, roll_control, iz),
-            ]
+
+    def _models(self, axis: str, v: _Values) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The dimensional derivatives (k, d), A (k, 4, 4) and B (k, 4, inputs) of the k models
+        of ``v``, built in the core (``rust/flight/model.rs``: the same operations for one
+        model and for a stack, so each model of a stack is, to the bit, the one built alone
+        from its values). Raises AircraftDataError for a singular model (1 - Zẇ = 0, or
+        Ixz^2 >= Ix Iz lost to rounding) or one that overflows, naming the first sample."""
+        parameters = (
+            _core.LONGITUDINAL_PARAMETERS if axis == "longitudinal" else _core.LATERAL_PARAMETERS
         )
-        return A, B
+        constants = {
+            "g cos theta0": self.gravity * math.cos(self.theta0),
+            "g sin theta0": self.gravity * math.sin(self.theta0),
+            "tan theta0": math.tan(self.theta0),
+        }
+        nominal = [
+            constants[name]
+            if name in constants
+            else float(getattr(self, name) if name in _GEOMETRY else v.nominal(name))
+            for name in parameters
+        ]
+        columns = [k for k, name in enumerate(parameters) if name in v.sampled]
+        sampled = np.empty((v.count, len(columns)))
+        for j, k in enumerate(columns):
+            sampled[:, j] = v.sampled[parameters[k]]
+        dimensional, A, B, first_missing = _core.aircraft_models(axis, nominal, sampled, columns)
+        if first_missing is None:
+            return dimensional, A, B
+        if axis == "longitudinal":
+            zwdot = dimensional[:, _core.LONGITUDINAL_DIMENSIONAL.index("Zwdot")]
+            if (zwdot == 1.0).any():  # (1 - Zẇ) dα/dt: the α equation would have no dα/dt
+                raise AircraftDataError(
+                    f"{self.name}: the longitudinal model is singular: 1 - Zẇ = 0 with "
+                    f"CL_alphadot = {self.derivatives['CL_alphadot']:g}" + v.where(zwdot == 1.0)
+                )
+        else:
+            ix = dimensional[:, _core.LATERAL_DIMENSIONAL.index("ix")]
+            iz = dimensional[:, _core.LATERAL_DIMENSIONAL.index("iz")]
+            coupling = 1.0 - ix * iz
+            if not (coupling > 0.0).all():  # Ix Iz > Ixz^2, checked by the loader, lost to rounding
+                raise AircraftDataError(
+                    f"{self.name}: the lateral model is singular: 1 - Ixz^2/(Ix Iz) = "
+                    f"{np.min(coupling):g}" + v.where(~(coupling > 0.0))
+                )
+        raise AircraftDataError(
+            f"{self.name}: the {axis} model overflows"
+            + v.where(np.arange(v.count) == first_missing)
+        )
 
     def model_stack(
         self, axis: str, values: Mapping[str, ArrayLike]
@@ -488,12 +422,7 @@ class Aircraft:
         """
         if axis not in ("longitudinal", "lateral"):
             raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
-        sampled = _Values(self, values)
-        build = self._longitudinal_matrices if axis == "longitudinal" else self._lateral_matrices
-        A, B = build(sampled)
-        count = sampled.count
-        A = np.ascontiguousarray(np.broadcast_to(A, (count, 4, 4)))
-        B = np.ascontiguousarray(np.broadcast_to(B, (count, 4, B.shape[-1])))
+        _, A, B = self._models(axis, _Values(self, values))
         return A, B
 
     def modes(self, axis: str) -> Modes:
@@ -775,20 +704,17 @@ class _Values:
             )
         if counts:
             self.count = counts.pop()
-        self.derivatives: Mapping[str, Any] = (
-            {
-                **aircraft.derivatives,
-                **{k: v for k, v in self._sampled.items() if k not in SAMPLED_FIELDS},
-            }
-            if self._sampled
-            else aircraft.derivatives
-        )
 
-    def __getitem__(self, name: str) -> Any:
-        """A field's sampled values, else the aircraft's own (a float)."""
-        if name in self._sampled:
-            return self._sampled[name]
-        return getattr(self._aircraft, name)
+    @property
+    def sampled(self) -> Mapping[str, FloatArray]:
+        """The sampled values by name."""
+        return self._sampled
+
+    def nominal(self, name: str) -> float:
+        """The aircraft's own value of a derivative or of one of ``SAMPLED_FIELDS``."""
+        if name in SAMPLED_FIELDS:
+            return float(getattr(self._aircraft, name))
+        return float(self._aircraft.derivatives[name])
 
     def where(self, bad: Any) -> str:
         """ " (sample i)" naming the first sample flagged in ``bad``; "" for one model."""
@@ -796,16 +722,3 @@ class _Values:
             return ""
         first = int(np.flatnonzero(np.broadcast_to(bad, (self.count,)))[0])
         return f" (sample {first} of the values)"
-
-
-def _assemble(rows: list[list[Any]]) -> FloatArray:
-    """The matrix of ``rows`` (floats, or arrays of k values: then a stack of k matrices),
-    + 0.0 turning negative zeros into zeros."""
-    if all(isinstance(value, float) for row in rows for value in row):
-        return np.array(rows) + 0.0
-    shape = np.broadcast_shapes(*(np.shape(value) for row in rows for value in row))
-    out = np.empty((*shape, len(rows), len(rows[0])))
-    for i, row in enumerate(rows):
-        for j, value in enumerate(row):
-            out[..., i, j] = value
-    return out + 0.0

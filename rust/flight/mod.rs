@@ -1,0 +1,12 @@
+//! Flight vehicles: the state-space models of an aircraft built from its nondimensional
+//! stability derivatives, and the MIL-F-8785C Levels of its modes, for one aircraft or for a
+//! stack of sampled variants (the stochastic robustness analysis and the envelope sweeps).
+//!
+//! * [`model`]: the longitudinal (6.49) and lateral-directional (6.150) models from the
+//!   derivatives, through the dimensional derivatives (6.48), (6.148)-(6.149).
+//! * [`levels`]: each mode's quantities (ω_n, ζ, ζω_n, τ_R, T2) and its Level against limits
+//!   given as numbers (the specification's tables live with their citations in the Python
+//!   package's `handling` module, the one place they are written).
+
+pub mod levels;
+pub mod model;
