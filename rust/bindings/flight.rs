@@ -5,8 +5,10 @@ use super::compute::{Cost, compute};
 use super::conversion::{Real, copy_values, new_array, new_array_data};
 use super::errors::to_py_err;
 use crate::error::Error;
+use crate::flight::Axis;
 use crate::flight::levels::{self, Limits};
-use crate::flight::model::{self, Axis, ParameterRows};
+use crate::flight::model::{self, ParameterRows};
+use crate::flight::modes;
 use faer::c64;
 use numpy::{PyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -83,6 +85,66 @@ fn aircraft_models<'py>(
             first_missing.into_pyobject(py)?.into_any(),
         ],
     )
+}
+
+/// The classical modes of k 4-state models of `axis` from their eigenvalues (k, 4), and for
+/// the lateral axis optionally their state matrices A (k, 4, 4) (see `crate::flight::modes`):
+/// the named modes (k, slots) and which models are unresolved (k,).
+#[pyfunction]
+#[pyo3(signature = (axis, eigenvalues, a, /))]
+fn classify_mode_stack<'py>(
+    py: Python<'py>,
+    axis: &str,
+    eigenvalues: &Bound<'py, PyAny>,
+    a: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let axis = axis_of(py, axis)?;
+    let array = eigenvalues.cast::<PyArrayDyn<c64>>().map_err(|_| {
+        to_py_err(
+            py,
+            Error::InvalidArgument {
+                arg: "eigenvalues",
+                message: "must be a complex128 array".to_string(),
+            },
+        )
+    })?;
+    let count = match array.shape() {
+        [count, 4] => *count,
+        shape => {
+            return Err(to_py_err(
+                py,
+                Error::WrongDimensions {
+                    arg: "eigenvalues",
+                    expected: "(k, 4)",
+                    shape: shape.to_vec(),
+                },
+            ));
+        }
+    };
+    let values = copy_values(py, array)?;
+    let a = Real::convert_optional(py, a, "A")?;
+    if let Some(a) = &a
+        && a.shape() != [count, 4, 4]
+    {
+        return Err(to_py_err(
+            py,
+            Error::WrongDimensions {
+                arg: "A",
+                expected: "(k, 4, 4), one state matrix per row of eigenvalues",
+                shape: a.shape().to_vec(),
+            },
+        ));
+    }
+    let named = new_array::<c64>(py, &[count, axis.mode_slots()])?;
+    let unresolved = new_array::<bool>(py, &[count])?;
+    // SAFETY: the arrays are new and not visible to Python until returned.
+    let (named_data, unresolved_data) =
+        unsafe { (new_array_data(&named), new_array_data(&unresolved)) };
+    let matrices = a.as_ref().map(Real::values);
+    compute(py, Cost::of(200.0, 0.0, 4).times(count), || {
+        modes::classify_stack(axis, &values, matrices, named_data, unresolved_data)
+    })?;
+    PyTuple::new(py, [named.into_any(), unresolved.into_any()])
 }
 
 /// The roots of k aircraft's mode, a complex128 array of shape (k, roots).
@@ -179,6 +241,7 @@ fn mode_levels<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(aircraft_models, m)?)?;
+    m.add_function(wrap_pyfunction!(classify_mode_stack, m)?)?;
     m.add_function(wrap_pyfunction!(mode_quantities, m)?)?;
     m.add_function(wrap_pyfunction!(mode_levels, m)?)?;
     for axis in [Axis::Longitudinal, Axis::Lateral] {

@@ -4,9 +4,20 @@
 //!
 //! * [`model`]: the longitudinal (6.49) and lateral-directional (6.150) models from the
 //!   derivatives, through the dimensional derivatives (6.48), (6.148)-(6.149).
+//! * [`modes`]: which eigenvalues are which classical mode, for a stack of models.
 //! * [`levels`]: each mode's quantities (ω_n, ζ, ζω_n, τ_R, T2) and its Level against limits
 //!   given as numbers (the specification's tables live with their citations in the Python
 //!   package's `handling` module, the one place they are written).
 
 pub mod levels;
 pub mod model;
+pub mod modes;
+
+/// The two models of an aircraft.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    /// x = (u/u0, α, q, θ), input the elevator (6.49).
+    Longitudinal,
+    /// x = (β, p, φ, r), inputs (rudder, aileron) (6.150).
+    Lateral,
+}

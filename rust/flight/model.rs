@@ -12,18 +12,10 @@
 //! A sample without a model, singular (1 - Zẇ = 0, or Ixz² >= Ix Iz, lost to rounding) or
 //! overflowing, is reported by its index; the caller names it with the reason.
 
+use super::Axis;
 use crate::error::Error;
 use crate::platform::parallel::ParallelContext;
 use rayon::prelude::*;
-
-/// The two models of an aircraft.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Axis {
-    /// x = (u/u0, α, q, θ), input the elevator (6.49).
-    Longitudinal,
-    /// x = (β, p, φ, r), inputs (rudder, aileron) (6.150).
-    Lateral,
-}
 
 impl Axis {
     /// The names of a parameter row's entries, in order.

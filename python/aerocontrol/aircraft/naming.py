@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .. import _core
 from ..exceptions import InvalidArgumentError
 from ..modal import Modes
 
@@ -131,84 +132,20 @@ def classify_mode_stack(
         raise InvalidArgumentError(
             f"eigenvalues must have shape (k, 4) (4 per aircraft model), got {values.shape}"
         )
-    rows = np.arange(values.shape[0])[:, np.newaxis]
-    by_size = values[rows, np.argsort(np.abs(values), axis=1, kind="stable")]
-    if axis == "longitudinal":
-        named = {"phugoid": _pairs(by_size[:, :2]), "short period": _pairs(by_size[:, 2:])}
-        split = (by_size.imag != 0.0).sum(axis=1) == 2
-        unresolved = split & ((by_size[:, 0].imag == 0.0) != (by_size[:, 1].imag == 0.0))
-        return _unset(named, unresolved), unresolved
-    if axis != "lateral":
+    if axis not in ("longitudinal", "lateral"):
         raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
-    is_complex = by_size.imag != 0.0
-    count = is_complex.sum(axis=1)
-    # The real roots first, each group in order of magnitude: with one pair, (spiral, roll,
-    # pair); with four real roots, (spiral, two of the Dutch roll, roll).
-    ordered = by_size[rows, np.argsort(is_complex, axis=1, kind="stable")]
-    one_pair = (count == 2)[:, np.newaxis]
-    dutch_roll = np.where(one_pair, ordered[:, 2:], ordered[:, 1:3])
-    roll = np.where(one_pair[:, 0], ordered[:, 1], ordered[:, 3])
-    named = {"spiral": ordered[:, 0].copy(), "dutch roll": _pairs(dutch_roll), "roll": roll}
-    coupled = count == 4
-    named = _unset(named, coupled)
-    if A is not None and coupled.any():
-        matrices = np.asarray(A, dtype=np.float64)[coupled]
-        upper = values[coupled]
-        # The two members with Im > 0, in the order of the eigenvalues given.
-        upper = upper[
-            np.arange(upper.shape[0])[:, np.newaxis],
-            np.argsort(upper.imag <= 0, axis=1, kind="stable"),
-        ][:, :2]
-        shares = np.stack([_sideslip_share(matrices, upper[:, k]) for k in range(2)], axis=1)
-        first = shares[:, 0] >= shares[:, 1]
-        dutch = np.where(first, upper[:, 0], upper[:, 1])
-        other = np.where(first, upper[:, 1], upper[:, 0])
-        named["dutch roll"][coupled] = np.stack([dutch, dutch.conj()], axis=1)
-        named["roll-spiral"] = np.full((values.shape[0], 2), np.nan + 0j)
-        named["roll-spiral"][coupled] = np.stack([other, other.conj()], axis=1)
-    return named, coupled
-
-
-def _sideslip_share(A: NDArray[np.float64], lam: NDArray[np.complex128]) -> NDArray[np.float64]:
-    """|v_β| / ||v|| of the eigenvector v of each A (k, 4, 4) for its eigenvalue λ (k,): the
-    column of largest norm of adj(A - λI) (rank one for a simple eigenvalue)."""
-    M = A - lam[:, np.newaxis, np.newaxis] * np.eye(4)
-    columns = np.empty(M.shape, dtype=np.complex128)
-    rows = np.arange(4)
-    for i in range(4):
-        for j in range(4):
-            minor = M[:, rows != j][:, :, rows != i]
-            columns[:, i, j] = (-1) ** (i + j) * _det3(minor)
-    norms = np.linalg.norm(columns, axis=1)  # (k, columns)
-    best = columns[np.arange(M.shape[0]), :, np.argmax(norms, axis=1)]
-    share: NDArray[np.float64] = np.abs(best[:, 0]) / np.maximum(
-        np.linalg.norm(best, axis=1), np.finfo(float).tiny
-    )
-    return share
-
-
-def _det3(m: NDArray[np.complex128]) -> NDArray[np.complex128]:
-    """The determinants of k 3 x 3 matrices, by the cofactors of the first row (on arrays:
-    no factorisation per matrix)."""
-    return (
-        m[:, 0, 0] * (m[:, 1, 1] * m[:, 2, 2] - m[:, 1, 2] * m[:, 2, 1])
-        - m[:, 0, 1] * (m[:, 1, 0] * m[:, 2, 2] - m[:, 1, 2] * m[:, 2, 0])
-        + m[:, 0, 2] * (m[:, 1, 0] * m[:, 2, 1] - m[:, 1, 1] * m[:, 2, 0])
-    )
-
-
-def _unset(
-    named: dict[str, NDArray[np.complex128]], unresolved: NDArray[np.bool_]
-) -> dict[str, NDArray[np.complex128]]:
-    for value in named.values():
-        value[unresolved] = np.nan
-    return named
-
-
-def _pairs(values: NDArray[np.complex128]) -> NDArray[np.complex128]:
-    """:func:`_pair` on k rows of two roots."""
-    swap = values[:, 0].imag < values[:, 1].imag
-    return np.where(swap[:, np.newaxis], values[:, ::-1], values)
+    matrices = None if A is None or axis == "longitudinal" else np.asarray(A, dtype=np.float64)
+    slots, unresolved = _core.classify_mode_stack(axis, values, matrices)
+    if axis == "longitudinal":
+        return {"phugoid": slots[:, 0:2].copy(), "short period": slots[:, 2:4].copy()}, unresolved
+    named = {
+        "spiral": slots[:, 0].copy(),
+        "dutch roll": slots[:, 1:3].copy(),
+        "roll": slots[:, 3].copy(),
+    }
+    if matrices is not None and unresolved.any():
+        named["roll-spiral"] = slots[:, 4:6].copy()
+    return named, unresolved
 
 
 def _pair(values: list[complex]) -> tuple[complex, ...]:
