@@ -18,6 +18,13 @@ and each chunk is judged by the same batch kernels wherever it runs. So a run gi
 result, bitwise, on one core, on all local cores, or chunk by chunk on a Dask cluster
 (``client=``) of any size.
 
+A chunk runs in the Rust core, each step one parallel call over its samples: the models from
+the drawn derivatives (``Aircraft.model_stack``), their eigenvalues, the modes named
+(``classify_mode_stack``), each mode's quantities and MIL-F-8785C Level
+(:func:`aerocontrol.handling.level_arrays`), and for a controller the closed loops (a Riccati
+solve or a Bass-Gura placement per sample). What Python does is draw (numpy's generator, for
+the seeds' sake) and move arrays between the calls.
+
 Examples
 --------
 >>> import aerocontrol
