@@ -9,6 +9,8 @@
 //!   given as numbers (the specification's tables live with their citations in the Python
 //!   package's `handling` module, the one place they are written).
 
+use crate::error::Error;
+
 pub mod levels;
 pub mod model;
 pub mod modes;
@@ -20,4 +22,25 @@ pub enum Axis {
     Longitudinal,
     /// x = (β, p, φ, r), inputs (rudder, aileron) (6.150).
     Lateral,
+}
+
+/// Models handled per parallel task: a few microseconds of work, so that rayon's dispatch is
+/// paid once per block, not once per model.
+const BLOCK: usize = 1024;
+
+/// Checks that each output (name, length, entries per model) holds `count` models.
+fn check_lengths(count: usize, outputs: &[(&'static str, usize, usize)]) -> Result<(), Error> {
+    for &(arg, got, per_model) in outputs {
+        let expected = count.saturating_mul(per_model);
+        if got != expected {
+            return Err(Error::Mismatch {
+                arg,
+                what: "as many entries as",
+                expected,
+                other: "models x entries per model",
+                got,
+            });
+        }
+    }
+    Ok(())
 }

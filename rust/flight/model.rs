@@ -13,6 +13,7 @@
 //! overflowing, is reported by its index; the caller names it with the reason.
 
 use super::Axis;
+use super::{BLOCK, check_lengths};
 use crate::error::Error;
 use crate::platform::parallel::ParallelContext;
 use rayon::prelude::*;
@@ -204,17 +205,16 @@ struct Model<const D: usize, const M: usize> {
 }
 
 impl<const D: usize, const M: usize> Model<D, M> {
-    /// Writes the model, negative zeros turned into zeros, into its slots of the outputs;
+    /// Writes the model, negative zeros of A and B turned into zeros (the dimensional
+    /// derivatives have none), into its slots of the outputs;
     /// whether it is a model: not singular, and finite.
     fn write(&self, dimensional: &mut [f64], a: &mut [f64], b: &mut [f64]) -> bool {
-        for (out, value) in dimensional.iter_mut().zip(self.dimensional) {
-            *out = value + 0.0;
-        }
+        dimensional.copy_from_slice(&self.dimensional);
         for (out, value) in a.iter_mut().zip(self.a.iter().flatten()) {
-            *out = value + 0.0;
+            *out = positive_zero(*value);
         }
         for (out, value) in b.iter_mut().zip(self.b.iter().flatten()) {
-            *out = value + 0.0;
+            *out = positive_zero(*value);
         }
         !self.singular && a.iter().chain(b.iter()).all(|v| v.is_finite())
     }
@@ -266,7 +266,7 @@ fn longitudinal(p: &[f64; 24]) -> Model<13, 1> {
     let mq = rho * u0 * s * (cbar * cbar) / (4.0 * iy) * cm_q;
     let mde = rho * (u0 * u0) * s * cbar / (2.0 * iy) * cm_de;
     let dimensional =
-        [xu, xw, xde, zu, zw, zwdot, zq, zde, mu, mw, mwdot, mq, mde].map(|value| value + 0.0);
+        [xu, xw, xde, zu, zw, zwdot, zq, zde, mu, mw, mwdot, mq, mde].map(positive_zero);
     let [xu, xw, xde, zu, zw, zwdot, zq, zde, mu, mw, mwdot, mq, mde] = dimensional;
     // (6.49): the α equation divided by its dα/dt coefficient 1 - Zẇ, and ẇ's effect on the
     // pitching moment, Mẇ u0 dα/dt, replaced by that equation.
@@ -329,11 +329,11 @@ fn lateral(p: &[f64; 25]) -> Model<17, 2> {
         cn_da,
     ] = *p;
     // (6.148): side force per unit mass.
-    let yv = rho * u0 * s / (2.0 * m) * cy_beta;
-    let yp = rho * u0 * s * b / (4.0 * m) * cy_p;
-    let yr = rho * u0 * s * b / (4.0 * m) * cy_r;
-    let ydr = rho * (u0 * u0) * s / (2.0 * m) * cy_dr;
-    let yda = rho * (u0 * u0) * s / (2.0 * m) * cy_da;
+    let yv = positive_zero(rho * u0 * s / (2.0 * m) * cy_beta);
+    let yp = positive_zero(rho * u0 * s * b / (4.0 * m) * cy_p);
+    let yr = positive_zero(rho * u0 * s * b / (4.0 * m) * cy_r);
+    let ydr = positive_zero(rho * (u0 * u0) * s / (2.0 * m) * cy_dr);
+    let yda = positive_zero(rho * (u0 * u0) * s / (2.0 * m) * cy_da);
     // (6.149): rolling (L) and yawing (N) moments per unit inertia.
     let moments = |inertia: f64, beta: f64, p: f64, r: f64, dr: f64, da: f64| {
         [
@@ -343,48 +343,14 @@ fn lateral(p: &[f64; 25]) -> Model<17, 2> {
             rho * (u0 * u0) * s * b / (2.0 * inertia) * dr,
             rho * (u0 * u0) * s * b / (2.0 * inertia) * da,
         ]
+        .map(positive_zero)
     };
     let [lv, lp, lr, ldr, lda] = moments(ix, cl_beta, cl_p, cl_r, cl_dr, cl_da);
     let [nv, np, nr, ndr, nda] = moments(iz, cn_beta, cn_p, cn_r, cn_dr, cn_da);
+    let (ix_ratio, iz_ratio) = (positive_zero(ixz / ix), positive_zero(ixz / iz));
     let dimensional = [
-        yv,
-        yp,
-        yr,
-        ydr,
-        yda,
-        lv,
-        lp,
-        lr,
-        ldr,
-        lda,
-        nv,
-        np,
-        nr,
-        ndr,
-        nda,
-        ixz / ix,
-        ixz / iz,
-    ]
-    .map(|value| value + 0.0);
-    let [
-        yv,
-        yp,
-        yr,
-        ydr,
-        yda,
-        lv,
-        lp,
-        lr,
-        ldr,
-        lda,
-        nv,
-        np,
-        nr,
-        ndr,
-        nda,
-        ix_ratio,
-        iz_ratio,
-    ] = dimensional;
+        yv, yp, yr, ydr, yda, lv, lp, lr, ldr, lda, nv, np, nr, ndr, nda, ix_ratio, iz_ratio,
+    ];
     // (6.150): the roll and yaw equations decoupled from each other's rate derivative through
     // the product of inertia, each divided by 1 - ix iz.
     let coupling = 1.0 - ix_ratio * iz_ratio;
@@ -417,9 +383,10 @@ fn lateral(p: &[f64; 25]) -> Model<17, 2> {
     }
 }
 
-/// Models built per parallel task: a few microseconds of work, so that rayon's dispatch is
-/// paid once per block, not once per model.
-const BLOCK: usize = 1024;
+/// x + 0.0: x, with a negative zero turned into a zero.
+fn positive_zero(x: f64) -> f64 {
+    x + 0.0
+}
 
 /// The k models of `rows`: their dimensional derivatives into `dimensional` (k x
 /// [`Axis::dimensional`]), their state matrices into `a` (k x 4 x 4) and input matrices into
@@ -436,22 +403,14 @@ pub fn model_stack(
 ) -> Result<Option<usize>, Error> {
     let count = rows.count();
     let (d, m) = (axis.dimensional().len(), axis.inputs());
-    for (arg, got, per_model) in [
-        ("dimensional", dimensional.len(), d),
-        ("A", a.len(), 16),
-        ("B", b.len(), 4 * m),
-    ] {
-        let expected = count.saturating_mul(per_model);
-        if got != expected {
-            return Err(Error::Mismatch {
-                arg,
-                what: "as many entries as",
-                expected,
-                other: "models x entries per model",
-                got,
-            });
-        }
-    }
+    check_lengths(
+        count,
+        &[
+            ("dimensional", dimensional.len(), d),
+            ("A", a.len(), 16),
+            ("B", b.len(), 4 * m),
+        ],
+    )?;
     let context = ParallelContext::capture(4);
     dimensional
         .par_chunks_mut(BLOCK * d)

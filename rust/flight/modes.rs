@@ -21,6 +21,7 @@
 //! magnitude. Modes that are not named in a model are NaN.
 
 use super::Axis;
+use super::{BLOCK, check_lengths};
 use crate::error::Error;
 use crate::platform::parallel::ParallelContext;
 use faer::c64;
@@ -121,9 +122,6 @@ impl Axis {
     }
 }
 
-/// Models named per parallel task (see `model::BLOCK`).
-const BLOCK: usize = 1024;
-
 /// The modes of k models of `axis` from their eigenvalues (k x 4) and, for the lateral axis,
 /// optionally their state matrices `a` (k x 4 x 4, row-major): into `out` (k x
 /// [`Axis::mode_slots`]) and `unresolved` (k), in parallel over blocks of models.
@@ -136,22 +134,14 @@ pub fn classify_stack(
 ) -> Result<(), Error> {
     let count = unresolved.len();
     let slots = axis.mode_slots();
-    for (arg, got, per_model) in [
-        ("eigenvalues", values.len(), 4),
-        ("A", a.map_or(16 * count, <[f64]>::len), 16),
-        ("named", out.len(), slots),
-    ] {
-        let expected = count.saturating_mul(per_model);
-        if got != expected {
-            return Err(Error::Mismatch {
-                arg,
-                what: "as many entries as",
-                expected,
-                other: "models x entries per model",
-                got,
-            });
-        }
-    }
+    check_lengths(
+        count,
+        &[
+            ("eigenvalues", values.len(), 4),
+            ("A", a.map_or(16 * count, <[f64]>::len), 16),
+            ("named", out.len(), slots),
+        ],
+    )?;
     let context = ParallelContext::capture(4);
     out.par_chunks_mut(BLOCK * slots)
         .zip(unresolved.par_chunks_mut(BLOCK))
