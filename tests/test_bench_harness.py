@@ -1,14 +1,18 @@
 """The peer bench (benches/compare_peers.py and benches/peers/) runs: its harness times a tiny
 case with a 0.01 s budget and writes the performance record with the expected columns, its
-groups are named after the case files, and the command line lists and selects them. Speed
-itself is not checked here (that is the bench's job)."""
+groups are named after the case files, and the command line lists and selects them. The
+growth bench (benches/growth.py) computes its slopes and crossings, stops a size at its time
+limit, and runs its --quick mode end to end. Speed itself is not checked here (that is the
+benches' job)."""
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 BENCHES = Path(__file__).resolve().parents[1] / "benches"
@@ -20,6 +24,7 @@ pytest.importorskip("slycot")
 sys.path.insert(0, str(BENCHES))
 
 import compare_peers  # noqa: E402
+import growth  # noqa: E402
 import peers  # noqa: E402
 import scipy.linalg  # noqa: E402
 from peers import harness  # noqa: E402
@@ -155,3 +160,67 @@ def test_command_line_lists_and_runs(tmp_path: Path, capsys: pytest.CaptureFixtu
     cells = [cell.strip() for cell in row.strip("|").split("|")]
     assert cells[:3] == ["charpoly", "n=4 747 lateral", "numpy.poly"]
     assert cells[5].endswith("x") and float(cells[5][:-1]) > 0
+
+
+# ---------------------------------------------------------------------------------------------
+# benches/growth.py: cost against n and against the batch size
+# ---------------------------------------------------------------------------------------------
+
+
+def test_growth_slopes_and_crossings() -> None:
+    """The log-log slopes of an exact power law, and where a ratio n / 16 crosses 1."""
+    pts = [(float(n), 2e-9 * n**3) for n in (4, 8, 16, 64)]
+    assert growth.fitted_slope(pts) == pytest.approx(3.0, abs=1e-12)
+    assert growth.slope(pts[0], pts[-1]) == pytest.approx(3.0, abs=1e-12)
+    cells = [
+        {"size": n, "ours_s": 1e-3 * n / 16, "peer_s": 1e-3, "agree": True} for n in (4, 8, 32)
+    ]
+    cells.insert(1, {"size": 6, "ours_s": None, "peer_s": 1e-3, "agree": None})
+    assert growth.successive_slopes(cells, "ours_s") == [None, None, None, pytest.approx(1.0)]
+    (crossing,) = growth.crossings(cells)
+    assert (crossing["from"], crossing["to"], crossing["beyond"]) == (8, 32, "peer")
+    assert crossing["at"] == pytest.approx(16.0)
+
+
+def test_growth_sweep_stops_at_the_limit() -> None:
+    """A peer predicted over its limit is not run, and no later size of it either."""
+    op = growth.Operation(
+        "double",
+        "Double",
+        "x2",
+        "ours",
+        "peer",
+        lambda x: 2 * x,
+        lambda x: x + x,
+        lambda d: (d,),
+        harness.same,
+    )
+    cells = growth.sweep(op, (1, 10, 100), lambda k: (np.ones(k),), 1, 0.0, 0.001, 1)
+    assert [c["ours_s"] is not None for c in cells] == [True, True, True]
+    assert [c["peer_s"] is not None for c in cells] == [True, False, False]
+    assert cells[0]["agree"] is True
+    assert cells[1]["peer_predicted_s"] == pytest.approx(10 * cells[0]["peer_s"])
+    table = "\n".join(growth.cell_table(cells, "batch"))
+    assert table.count("not run") == 2
+
+
+def test_growth_quick_run(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--quick`` in one fresh one-thread process: every cell agrees with its peer, and the
+    record and both plots are written."""
+    paths = {name: tmp_path / name for name in ("growth.md", "size.png", "batch.png")}
+    argv = ["--quick", "--threads", "one", "--json", "--markdown", str(paths["growth.md"])]
+    argv += ["--size-plot", str(paths["size.png"]), "--batch-plot", str(paths["batch.png"])]
+    assert growth.main(argv) == 0
+    (run,) = json.loads(capsys.readouterr().out)["runs"]
+    assert run["threads"] == "one"
+    for kind, sizes in (("size", [4, 8]), ("batch", [1, 10])):
+        for cells in run[kind].values():
+            assert [c["size"] for c in cells] == sizes
+            assert all(c["agree"] and c["ours_s"] > 0 and c["peer_s"] > 0 for c in cells)
+    for name in ("size.png", "batch.png"):
+        assert paths[name].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    text = paths["growth.md"].read_text(encoding="utf-8")
+    assert text.startswith("# How cost grows with size\n")
+    assert "![time against n, log-log](size.png)" in text
+    assert "| care | 1 thread |" in text
+    assert "| 1,000,000 |" not in text and "| 10 | " in text

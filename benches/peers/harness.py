@@ -665,7 +665,8 @@ def _cell(text: str) -> str:
     return text.replace("|", "\\|")
 
 
-def _machine_table(info: dict[str, Any]) -> list[str]:
+def machine_table(info: dict[str, Any]) -> list[str]:
+    """The Markdown table of the machine a record was measured on (:func:`machine`)."""
     affinity = info["affinity"]
     cores = f"{info['cpu_count']} logical (os.cpu_count), {affinity} usable by this process"
     flags = ", ".join(info["cpu_flags"]) or "none of avx2, fma, avx512f"
@@ -685,7 +686,9 @@ def _machine_table(info: dict[str, Any]) -> list[str]:
     return lines
 
 
-def _run_lines(runs: Sequence[dict[str, Any]]) -> list[str]:
+def run_lines(runs: Sequence[dict[str, Any]]) -> list[str]:
+    """One Markdown bullet per run: its thread setting, start and end, thread variables,
+    thread pools and the load average at both ends."""
     lines = []
     for run in runs:
         env = run["environment"]
@@ -740,15 +743,20 @@ def format_markdown(
         "peak memory) are recorded in [robustness.md](robustness.md), written by",
         "`python benches/robustness.py --markdown docs/robustness.md`.",
         "",
+        "How the cost grows with the order n (expm, CARE and a response at n = 4 to 1024)",
+        "and with the batch size (1 to 10^6 problems), with log-log plots and the sizes where",
+        "ours and the peer cross, is recorded in [growth.md](growth.md), written by",
+        "`python benches/growth.py`.",
+        "",
         f"{settings[0].upper()}{settings[1:]}.",
         "",
         "## Machine",
         "",
-        *_machine_table(info),
+        *machine_table(info),
         "",
         "## Runs",
         "",
-        *_run_lines(runs),
+        *run_lines(runs),
         "",
         "'1 thread' sets RAYON_NUM_THREADS, OMP_NUM_THREADS, OPENBLAS_NUM_THREADS and",
         "MKL_NUM_THREADS to 1 in a fresh process before numpy is imported, so that ours and the",
