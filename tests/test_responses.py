@@ -857,3 +857,11 @@ def test_regression_default_grid_slow_mode_beside_a_coupled_integrator(seed: int
         assert t[-1] == pytest.approx(7.0 / slow, rel=1e-9)
     t = aerocontrol.default_time_grid((np.diag([-1e6, -1e-10, 0.0]), np.ones((3, 1))))
     assert t[-1] == pytest.approx(7e10, rel=1e-9)
+
+
+def test_steady_state_underflowing_to_a_subnormal_is_correctly_rounded() -> None:
+    """x∞ = -A^-1 B of A = [[-1e308]], B = [[1.2573e-4]] is 1.2573e-312, a subnormal: the
+    correctly rounded quotient (a property campaign's residual bound once missed that its
+    residual, 1.4e-16, is ||A|| times the subnormals' spacing)."""
+    x = aerocontrol.steady_state((np.array([[-1e308]]), np.array([[1.2573e-4]])), [1.0])
+    assert x.tolist() == [1.2573e-4 / 1e308]
