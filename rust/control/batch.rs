@@ -13,7 +13,7 @@ use crate::control::riccati::care::{
 use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
 use crate::linalg::expm::expm_into_validated;
-use crate::platform::parallel::{ParallelContext, par_chunks};
+use crate::platform::parallel::{ParallelContext, min_items_per_task, par_chunks};
 use faer::{Mat, MatMut, MatRef, c64};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -109,6 +109,7 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
     let context = ParallelContext::capture(n);
     out.par_chunks_mut(n * n)
         .enumerate()
+        .with_min_len(min_items_per_task(stack.len(), n))
         .try_for_each(|(index, chunk)| {
             context.run(|| {
                 // Validated above: every matrix is square and finite.
@@ -142,6 +143,7 @@ pub fn eigenvalues_batch(stack: MatrixStack<'_>, out: &mut [c64]) -> Result<(), 
     let context = ParallelContext::capture(n);
     out.par_chunks_mut(n)
         .enumerate()
+        .with_min_len(min_items_per_task(stack.len(), n))
         .try_for_each(|(index, chunk)| {
             context.run(|| {
                 let values = crate::linalg::schur::eigenvalues(stack.get(index))

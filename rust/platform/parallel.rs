@@ -55,6 +55,23 @@ pub fn parallelism_for_order(n: usize) -> faer::Par {
     }
 }
 
+/// A batch whose problems' total work count · n³ is below this runs on the calling thread:
+/// splitting it costs a wake-up of rayon's pool (several microseconds, more on a loaded
+/// machine) for about as much work (sixty-four 4 x 4 exponentials, eight of order 8).
+pub const SEQUENTIAL_MAX_WORK: usize = 4096;
+
+/// The fewest items a task of a parallel loop over `count` problems of order `n` takes, for
+/// rayon's `with_min_len`: all of them (one task, run on the calling thread without touching
+/// the pool) when count · n³ is below [`SEQUENTIAL_MAX_WORK`], else 1.
+pub fn min_items_per_task(count: usize, n: usize) -> usize {
+    let work = count.saturating_mul(n.saturating_pow(3));
+    if work < SEQUENTIAL_MAX_WORK {
+        count.max(1)
+    } else {
+        1
+    }
+}
+
 /// The `count` consecutive chunks of `size` entries of `data` (which holds `count * size`), as
 /// an indexed parallel iterator: `count` empty slices when `size` is 0, where rayon's
 /// `par_chunks_mut` would yield none (and panics for a size of 0).
@@ -87,6 +104,19 @@ pub fn chunks<T>(data: &mut [T], size: usize, count: usize) -> impl Iterator<Ite
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn small_batches_stay_on_the_calling_thread() {
+        let caller = std::thread::current().id();
+        let mut out = [0u8; 8];
+        out.par_chunks_mut(1)
+            .with_min_len(min_items_per_task(8, 4))
+            .for_each(|_| assert_eq!(std::thread::current().id(), caller));
+        assert_eq!(min_items_per_task(8, 4), 8);
+        assert_eq!(min_items_per_task(64, 4), 1);
+        assert_eq!(min_items_per_task(1, 16), 1);
+        assert_eq!(min_items_per_task(0, 4), 1);
+    }
 
     #[test]
     fn empty_chunks_keep_their_count() {
