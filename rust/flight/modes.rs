@@ -124,7 +124,8 @@ impl Axis {
 
 /// The modes of k models of `axis` from their eigenvalues (k x 4) and, for the lateral axis,
 /// optionally their state matrices `a` (k x 4 x 4, row-major): into `out` (k x
-/// [`Axis::mode_slots`]) and `unresolved` (k), in parallel over blocks of models.
+/// [`Axis::mode_slots`]) and `unresolved` (k), in parallel over blocks of models. A NaN or
+/// infinite eigenvalue or entry of A is an error naming the first.
 pub fn classify_stack(
     axis: Axis,
     values: &[c64],
@@ -142,6 +143,28 @@ pub fn classify_stack(
             ("named", out.len(), slots),
         ],
     )?;
+    // A NaN has no magnitude to order by: no mode is named from one (never a NaN mode of a
+    // model called resolved), nor from a NaN sideslip share.
+    if let Some(k) = values
+        .iter()
+        .position(|v| !(v.re.is_finite() && v.im.is_finite()))
+    {
+        let v = values[k];
+        return Err(Error::NonFinite {
+            arg: "eigenvalues",
+            index: vec![k / 4, k % 4],
+            value: if v.re.is_finite() { v.im } else { v.re },
+        });
+    }
+    if let Some(a) = a
+        && let Some(k) = a.iter().position(|v| !v.is_finite())
+    {
+        return Err(Error::NonFinite {
+            arg: "A",
+            index: vec![k / 16, k % 16 / 4, k % 4],
+            value: a[k],
+        });
+    }
     let context = ParallelContext::capture(4);
     out.par_chunks_mut(BLOCK * slots)
         .zip(unresolved.par_chunks_mut(BLOCK))

@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _core
-from .._validation import check_finite, real_array
-from ..exceptions import InvalidArgumentError, NonFiniteError
+from .._validation import real_array
+from ..exceptions import InvalidArgumentError
 from ..modal import Modes
 
 __all__ = ["DISPLAY_NAMES", "classify_mode_stack", "classify_modes", "name_modes"]
@@ -118,7 +118,7 @@ def classify_mode_stack(
     the larger sideslip share, as :func:`classify_modes` decides it (the eigenvectors from the
     adjugate of A - λI, whose columns span its null space), and the other pair is its
     "roll-spiral" (NaN for every other model); its roll and spiral stay NaN. A NaN or
-    infinite eigenvalue, or entry of ``A``, is NonFiniteError.
+    infinite eigenvalue, or entry of ``A``, is NonFiniteError (checked in the core).
 
     Examples
     --------
@@ -138,18 +138,6 @@ def classify_mode_stack(
         raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
     # real_array: a complex A is NotRealError, not its real part with a ComplexWarning.
     matrices = None if A is None or axis == "longitudinal" else real_array(A, "A")
-    # A NaN has no magnitude to order by: no mode is named from one, never a NaN mode of a
-    # model called resolved.
-    if not np.isfinite(values).all():
-        row, column = (int(k) for k in np.argwhere(~np.isfinite(values))[0])
-        error = NonFiniteError(
-            f"eigenvalues must be finite, but eigenvalues[{row}, {column}] is "
-            f"{complex(values[row, column])}"
-        )
-        error.argument, error.entry = "eigenvalues", [row, column]
-        raise error
-    if matrices is not None:
-        check_finite(matrices, "A")
     slots, unresolved = _core.classify_mode_stack(axis, values, matrices)
     if axis == "longitudinal":
         return {"phugoid": slots[:, 0:2].copy(), "short period": slots[:, 2:4].copy()}, unresolved
