@@ -429,7 +429,8 @@ def test_regression_large_stacks_of_mode_quantities_release_the_gil() -> None:
     count = 2_000_000
     pairs = np.empty((count, 2), dtype=complex)
     pairs[:, 0], pairs[:, 1] = -0.3 + 0.7j, -0.3 - 0.7j
-    roots = pairs[:, 0].real.copy().astype(complex)
+    # Three roots per pair's work: the roots' calls are about as long as the pairs'.
+    roots = np.tile(pairs[:, 0].real.astype(complex), 3)
     # The core's calls alone: numpy's own loops around them in mode_quantities and
     # level_arrays release the GIL anyway.
     limits = _limit_values("dutch roll", "III", "B")
@@ -457,7 +458,7 @@ def test_regression_large_stacks_of_mode_quantities_release_the_gil() -> None:
         elapsed, during = time.perf_counter() - start, ticks[0] - before
         running.clear()
         thread.join()
-        assert len(result) == count
+        assert len(result) in (count, 3 * count)
         # The core's part alone takes tens of milliseconds; a thread held off by the GIL
         # ticks a few times at most (before and after it).
         assert elapsed > 0.02, name
