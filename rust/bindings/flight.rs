@@ -141,11 +141,20 @@ fn classify_mode_stack<'py>(
     let (named_data, unresolved_data) =
         unsafe { (new_array_data(&named), new_array_data(&unresolved)) };
     let matrices = a.as_ref().map(Real::values);
-    compute(py, Cost::of(200.0, 0.0, 4).times(count), || {
+    // With A, each model with two complex pairs takes the 16 cofactors of A - λI for each of
+    // its two pairs.
+    let flops = if matrices.is_some() { 3400.0 } else { 200.0 };
+    compute(py, Cost::of(flops, 0.0, 4).times(count), || {
         modes::classify_stack(axis, &values, matrices, named_data, unresolved_data)
     })?;
     PyTuple::new(py, [named.into_any(), unresolved.into_any()])
 }
+
+/// The cost, in floating-point operations, of one pair's quantities and Level (the exact
+/// scaling by 2^-e and back, four products, a square root and the comparisons), and of one
+/// root's: for `compute` to release the GIL for a large stack and make it interruptible.
+const PAIR_FLOPS: f64 = 60.0;
+const ROOT_FLOPS: f64 = 4.0;
 
 /// The roots of k aircraft's mode, a complex128 array of shape (k, roots).
 fn roots_of(py: Python<'_>, roots: &Bound<'_, PyAny>, width: usize) -> PyResult<(usize, Vec<c64>)> {
@@ -190,10 +199,13 @@ fn mode_quantities<'py>(
             let array = new_array::<f64>(py, &[count, 3])?;
             // SAFETY: the array is new and not visible to Python until returned.
             let data = unsafe { new_array_data(&array) };
-            for (out, pair) in data.chunks_exact_mut(3).zip(values.chunks_exact(2)) {
-                let q = levels::pair(pair[0], pair[1]);
-                out.copy_from_slice(&[q.omega_n, q.zeta, q.zeta_omega]);
-            }
+            compute(py, Cost::of(PAIR_FLOPS, 0.0, 1).times(count), || {
+                for (out, pair) in data.chunks_exact_mut(3).zip(values.chunks_exact(2)) {
+                    let q = levels::pair(pair[0], pair[1]);
+                    out.copy_from_slice(&[q.omega_n, q.zeta, q.zeta_omega]);
+                }
+                Ok(())
+            })?;
             return Ok(array);
         }
         "time constant" => levels::roll_time_constant,
@@ -214,9 +226,12 @@ fn mode_quantities<'py>(
     let array = new_array::<f64>(py, &[count])?;
     // SAFETY: the array is new and not visible to Python until returned.
     let data = unsafe { new_array_data(&array) };
-    for (out, root) in data.iter_mut().zip(&values) {
-        *out = single(root.re);
-    }
+    compute(py, Cost::of(ROOT_FLOPS, 0.0, 1).times(count), || {
+        for (out, root) in data.iter_mut().zip(&values) {
+            *out = single(root.re);
+        }
+        Ok(())
+    })?;
     Ok(array)
 }
 
@@ -235,7 +250,8 @@ fn mode_levels<'py>(
     let array = new_array::<i8>(py, &[count])?;
     // SAFETY: the array is new and not visible to Python until returned.
     let out = unsafe { new_array_data(&array) };
-    levels::levels(&limits, &values, out).map_err(|e| to_py_err(py, e))?;
+    let cost = Cost::of(PAIR_FLOPS, 0.0, 1).times(count);
+    compute(py, cost, || levels::levels(&limits, &values, out))?;
     Ok(array)
 }
 

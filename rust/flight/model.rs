@@ -366,8 +366,11 @@ fn lateral(p: &[f64; 25]) -> Model<17, 2> {
     };
     Model {
         dimensional,
-        // Ix Iz > Ixz² (checked where the aircraft is read), lost to rounding.
-        singular: coupling.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater),
+        // Ixz² >= Ix Iz (an inertia tensor that is not positive definite; decided exactly:
+        // 1 - ix iz of rounded ratios can be positive, about 1e-16, when Ixz² = Ix Iz), or
+        // Ix Iz > Ixz² lost to rounding.
+        singular: !product_of_inertia_below(ix, iz, ixz)
+            || coupling.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater),
         a: [
             [yv, yp / u0, g_cos / u0, yr / u0 - 1.0],
             combined(roll, yaw, ix_ratio),
@@ -388,12 +391,45 @@ fn positive_zero(x: f64) -> f64 {
     x + 0.0
 }
 
+/// Whether Ixz² < Ix Iz exactly, for inertias Ix, Iz > 0 (false for a NaN).
+///
+/// Ix and Iz are scaled by powers of two to [1/2, 1) and Ixz by the power that keeps the
+/// comparison (2^(a + b) for Ix 2^-2a and Iz 2^-2b, the odd exponent's half taken from Iz into
+/// [1/2, 2)): exact. A scaled |Ixz| outside [2^-4, 2) decides it by size (Ix Iz is in [1/4,
+/// 2)); otherwise both products are compared exactly as unevaluated sums p + e of their
+/// rounded value and its error, each error exact by a fused multiply-add (Dekker's two-product;
+/// Ogita, Rump and Oishi, "Accurate sum and dot product", SIAM J. Sci. Comput. 26 (2005)),
+/// with no overflow or underflow at these sizes.
+fn product_of_inertia_below(ix: f64, iz: f64, ixz: f64) -> bool {
+    if !(ix > 0.0 && iz > 0.0 && ix.is_finite() && iz.is_finite() && ixz.is_finite()) {
+        return false;
+    }
+    let (ix, ex) = libm::frexp(ix);
+    let (iz, ez) = libm::frexp(iz);
+    // Ix Iz = ix iz 2^(ex + ez); with ex + ez odd, one factor 2 moves into iz.
+    let (iz, total) = if (ex + ez) % 2 == 0 {
+        (iz, ex + ez)
+    } else {
+        (2.0 * iz, ex + ez - 1)
+    };
+    let ixz = libm::scalbn(ixz, -(total / 2)).abs();
+    if ixz >= 2.0 {
+        return false;
+    }
+    if ixz < 0.0625 {
+        return true;
+    }
+    let (square, square_error) = (ixz * ixz, ixz.mul_add(ixz, -(ixz * ixz)));
+    let (product, product_error) = (ix * iz, ix.mul_add(iz, -(ix * iz)));
+    square < product || (square == product && square_error < product_error)
+}
+
 /// The k models of `rows`: their dimensional derivatives into `dimensional` (k x
 /// [`Axis::dimensional`]), their state matrices into `a` (k x 4 x 4) and input matrices into
 /// `b` (k x 4 x [`Axis::inputs`]), all row-major. In parallel over blocks of models.
 ///
 /// Returns the index of the first sample that has no model, for the caller to name: a
-/// singular one (1 - Zẇ = 0; 1 - ix iz <= 0), or one whose A or B overflows.
+/// singular one (1 - Zẇ = 0; Ixz² >= Ix Iz, or 1 - ix iz <= 0), or one whose A or B overflows.
 pub fn model_stack(
     axis: Axis,
     rows: &ParameterRows<'_>,
@@ -441,4 +477,45 @@ pub fn model_stack(
         })
         .collect::<Result<Vec<_>, Error>>()
         .map(|blocks| blocks.into_iter().flatten().next())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn product_of_inertia_is_compared_exactly() {
+        // Ixz² = Ix Iz exactly where the rounded 1 - (Ixz/Ix)(Ixz/Iz) is 2^-53 > 0.
+        let (ix, iz, ixz) = (9.0, 121.0, 33.0);
+        assert!(1.0 - (ixz / ix) * (ixz / iz) > 0.0);
+        assert!(!product_of_inertia_below(ix, iz, ixz));
+        assert!(!product_of_inertia_below(ix, iz, -ixz));
+        assert!(product_of_inertia_below(ix, iz, ixz - 1e-14));
+        assert!(!product_of_inertia_below(ix, iz, ixz + 1e-14));
+        // At any size: scaled by 2^±600 (Ix Iz itself would overflow or underflow).
+        for e in [-600, 600] {
+            let s = |x: f64| libm::scalbn(x, e);
+            assert!(!product_of_inertia_below(s(ix), s(iz), s(ixz)));
+            assert!(product_of_inertia_below(
+                s(ix),
+                s(iz),
+                s(ixz) * (1.0 - f64::EPSILON)
+            ));
+        }
+        // Odd exponent sums, and sizes that decide without the products.
+        // The double nearest sqrt(2) is above it; the one below it is below.
+        assert!(!product_of_inertia_below(
+            2.0,
+            1.0,
+            std::f64::consts::SQRT_2
+        ));
+        assert!(product_of_inertia_below(
+            2.0,
+            1.0,
+            std::f64::consts::SQRT_2.next_down()
+        ));
+        assert!(product_of_inertia_below(1e300, 1e-300, 0.0));
+        assert!(!product_of_inertia_below(1e-300, 1e-300, 1.0));
+        assert!(!product_of_inertia_below(1.0, 1.0, f64::NAN));
+    }
 }

@@ -124,7 +124,8 @@ impl Axis {
 
 /// The modes of k models of `axis` from their eigenvalues (k x 4) and, for the lateral axis,
 /// optionally their state matrices `a` (k x 4 x 4, row-major): into `out` (k x
-/// [`Axis::mode_slots`]) and `unresolved` (k), in parallel over blocks of models.
+/// [`Axis::mode_slots`]) and `unresolved` (k), in parallel over blocks of models. A NaN or
+/// infinite eigenvalue or entry of A is an error naming the first.
 pub fn classify_stack(
     axis: Axis,
     values: &[c64],
@@ -142,6 +143,28 @@ pub fn classify_stack(
             ("named", out.len(), slots),
         ],
     )?;
+    // A NaN has no magnitude to order by: no mode is named from one (never a NaN mode of a
+    // model called resolved), nor from a NaN sideslip share.
+    if let Some(k) = values
+        .iter()
+        .position(|v| !(v.re.is_finite() && v.im.is_finite()))
+    {
+        let v = values[k];
+        return Err(Error::NonFinite {
+            arg: "eigenvalues",
+            index: vec![k / 4, k % 4],
+            value: if v.re.is_finite() { v.im } else { v.re },
+        });
+    }
+    if let Some(a) = a
+        && let Some(k) = a.iter().position(|v| !v.is_finite())
+    {
+        return Err(Error::NonFinite {
+            arg: "A",
+            index: vec![k / 16, k % 16 / 4, k % 4],
+            value: a[k],
+        });
+    }
     let context = ParallelContext::capture(4);
     out.par_chunks_mut(BLOCK * slots)
         .zip(unresolved.par_chunks_mut(BLOCK))
@@ -166,19 +189,36 @@ pub fn classify_stack(
 
 /// |v_β| / ||v|| of the eigenvector v of A (4 x 4, row-major) for its simple eigenvalue λ:
 /// the column of largest norm of adj(A - λI).
+///
+/// A - λI is first scaled by 2^-e, with 2^e about its largest entry: the share is the same
+/// for any scaling (the adjugate scales by its cube), the scaling is exact, so the share is
+/// that of the unscaled cofactors wherever those neither overflow nor underflow, and a model
+/// of entries about 1e100 or 1e-120 (whose cofactors would overflow to inf or underflow to
+/// 0, and leave the two pairs' shares NaN or equal) is named as one of entries about 1.
 fn sideslip_share(a: &[f64], lambda: c64) -> f64 {
+    let largest = a
+        .iter()
+        .fold(lambda.re.abs().max(lambda.im.abs()), |m, v| m.max(v.abs()));
+    let e = if largest > 0.0 && largest.is_finite() {
+        libm::frexp(largest).1
+    } else {
+        0
+    };
+    let lambda = c64::new(libm::scalbn(lambda.re, -e), libm::scalbn(lambda.im, -e));
     let m = |i: usize, j: usize| {
         let diagonal = if i == j { lambda } else { c64::new(0.0, 0.0) };
-        c64::new(a[4 * i + j], 0.0) - diagonal
+        c64::new(libm::scalbn(a[4 * i + j], -e), 0.0) - diagonal
     };
+    // The three indices of 0..4 other than `skip`.
+    let others =
+        |skip: usize| -> [usize; 3] { std::array::from_fn(|k| k + usize::from(k >= skip)) };
     let mut best = [c64::new(0.0, 0.0); 4];
     let mut best_norm = -1.0;
     for j in 0..4 {
         // Column j of adj(M): entry i is the cofactor C_ji = (-1)^(i+j) det of M without row j
         // and column i.
         let column: [c64; 4] = std::array::from_fn(|i| {
-            let rows: Vec<usize> = (0..4).filter(|&r| r != j).collect();
-            let cols: Vec<usize> = (0..4).filter(|&c| c != i).collect();
+            let (rows, cols) = (others(j), others(i));
             let e = |r: usize, c: usize| m(rows[r], cols[c]);
             let det = e(0, 0) * (e(1, 1) * e(2, 2) - e(1, 2) * e(2, 1))
                 - e(0, 1) * (e(1, 0) * e(2, 2) - e(1, 2) * e(2, 0))

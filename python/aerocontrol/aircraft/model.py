@@ -41,6 +41,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -329,8 +330,9 @@ class Aircraft:
         """The dimensional derivatives (k, d), A (k, 4, 4) and B (k, 4, inputs) of the k models
         of ``v``, built in the core (``rust/flight/model.rs``: the same operations for one
         model and for a stack, so each model of a stack is, to the bit, the one built alone
-        from its values). Raises AircraftDataError for a singular model (1 - Zẇ = 0, or
-        Ixz^2 >= Ix Iz lost to rounding) or one that overflows, naming the first sample."""
+        from its values). Raises AircraftDataError for the first sample without a model,
+        named: singular (1 - Zẇ = 0, or Ixz^2 >= Ix Iz, decided exactly, or lost to
+        rounding) or overflowing."""
         parameters = (
             _core.LONGITUDINAL_PARAMETERS if axis == "longitudinal" else _core.LATERAL_PARAMETERS
         )
@@ -352,26 +354,33 @@ class Aircraft:
         dimensional, A, B, first_missing = _core.aircraft_models(axis, nominal, sampled, columns)
         if first_missing is None:
             return dimensional, A, B
+        i = first_missing
+        where = v.where(np.arange(v.count) == i)
         if axis == "longitudinal":
-            zwdot = dimensional[:, _core.LONGITUDINAL_DIMENSIONAL.index("Zwdot")]
-            if (zwdot == 1.0).any():  # (1 - Zẇ) dα/dt: the α equation would have no dα/dt
+            if dimensional[i, _core.LONGITUDINAL_DIMENSIONAL.index("Zwdot")] == 1.0:
+                # (1 - Zẇ) dα/dt: the α equation would have no dα/dt
                 raise AircraftDataError(
                     f"{self.name}: the longitudinal model is singular: 1 - Zẇ = 0 with "
-                    f"CL_alphadot = {self.derivatives['CL_alphadot']:g}" + v.where(zwdot == 1.0)
+                    f"CL_alphadot = {v.value('CL_alphadot', i):g}" + where
                 )
         else:
-            ix = dimensional[:, _core.LATERAL_DIMENSIONAL.index("ix")]
-            iz = dimensional[:, _core.LATERAL_DIMENSIONAL.index("iz")]
+            ix = dimensional[i, _core.LATERAL_DIMENSIONAL.index("ix")]
+            iz = dimensional[i, _core.LATERAL_DIMENSIONAL.index("iz")]
             coupling = 1.0 - ix * iz
-            if not (coupling > 0.0).all():  # Ix Iz > Ixz^2, checked by the loader, lost to rounding
+            Ix, Iz, Ixz = (v.value(name, i) for name in ("Ix", "Iz", "Ixz"))
+            # Decided exactly, as the core decides it: 1 - ix iz of the rounded ratios can be
+            # about +1e-16 when Ixz^2 = Ix Iz.
+            if Fraction(Ixz) ** 2 >= Fraction(Ix) * Fraction(Iz):
                 raise AircraftDataError(
-                    f"{self.name}: the lateral model is singular: 1 - Ixz^2/(Ix Iz) = "
-                    f"{np.min(coupling):g}" + v.where(~(coupling > 0.0))
+                    f"{self.name}: the lateral model is singular: Ixz^2 >= Ix Iz with Ix = "
+                    f"{Ix:g}, Iz = {Iz:g}, Ixz = {Ixz:g}: 1 - Ixz^2/(Ix Iz) = {coupling:g}" + where
                 )
-        raise AircraftDataError(
-            f"{self.name}: the {axis} model overflows"
-            + v.where(np.arange(v.count) == first_missing)
-        )
+            if not coupling > 0.0:
+                raise AircraftDataError(
+                    f"{self.name}: the lateral model is singular: Ix Iz > Ixz^2 lost to "
+                    f"rounding: 1 - Ixz^2/(Ix Iz) = {coupling:g}" + where
+                )
+        raise AircraftDataError(f"{self.name}: the {axis} model overflows" + where)
 
     def model_stack(
         self, axis: str, values: Mapping[str, ArrayLike]
@@ -407,8 +416,8 @@ class Aircraft:
         NotRealError
             Values that are not real numbers.
         AircraftDataError
-            A sample whose model is singular (1 - Zẇ = 0, or Ixz² >= Ix Iz); the message
-            names the first such sample.
+            A sample without a model: singular (1 - Zẇ = 0, or Ixz² >= Ix Iz, decided
+            exactly) or overflowing; the message names the first such sample.
 
         Examples
         --------
@@ -709,6 +718,12 @@ class _Values:
     def sampled(self) -> Mapping[str, FloatArray]:
         """The sampled values by name."""
         return self._sampled
+
+    def value(self, name: str, index: int) -> float:
+        """Sample ``index``'s value of a derivative or of one of ``SAMPLED_FIELDS``."""
+        if name in self._sampled:
+            return float(self._sampled[name][index])
+        return self.nominal(name)
 
     def nominal(self, name: str) -> float:
         """The aircraft's own value of a derivative or of one of ``SAMPLED_FIELDS``."""

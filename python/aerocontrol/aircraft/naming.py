@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import _core
+from .._validation import real_array
 from ..exceptions import InvalidArgumentError
 from ..modal import Modes
 
@@ -116,7 +117,8 @@ def classify_mode_stack(
     the Dutch roll of a lateral model with two complex pairs is the pair whose eigenvector has
     the larger sideslip share, as :func:`classify_modes` decides it (the eigenvectors from the
     adjugate of A - λI, whose columns span its null space), and the other pair is its
-    "roll-spiral" (NaN for every other model); its roll and spiral stay NaN.
+    "roll-spiral" (NaN for every other model); its roll and spiral stay NaN. A NaN or
+    infinite eigenvalue, or entry of ``A``, is NonFiniteError (checked in the core).
 
     Examples
     --------
@@ -134,7 +136,8 @@ def classify_mode_stack(
         )
     if axis not in ("longitudinal", "lateral"):
         raise InvalidArgumentError(f"axis must be 'longitudinal' or 'lateral', got {axis!r}")
-    matrices = None if A is None or axis == "longitudinal" else np.asarray(A, dtype=np.float64)
+    # real_array: a complex A is NotRealError, not its real part with a ComplexWarning.
+    matrices = None if A is None or axis == "longitudinal" else real_array(A, "A")
     slots, unresolved = _core.classify_mode_stack(axis, values, matrices)
     if axis == "longitudinal":
         return {"phugoid": slots[:, 0:2].copy(), "short period": slots[:, 2:4].copy()}, unresolved
