@@ -792,7 +792,18 @@ pub fn loop_margins(
     })();
     let peaks = (|| {
         let mut closed_response = strictly_proper_evaluator(closed.as_ref(), &bs, &cs)?;
-        let mut response = |w: f64| closed_response.siso(w);
+        // Both peaks start from S at the same test frequencies (0 and the closed-loop poles'):
+        // each value is computed once and looked up the second time (the same value, so the
+        // same peaks bit for bit).
+        let mut evaluated: Vec<(f64, c64)> = Vec::with_capacity(8 * n + 8);
+        let mut response = |w: f64| {
+            if let Some(&(_, value)) = evaluated.iter().find(|(x, _)| x.to_bits() == w.to_bits()) {
+                return value;
+            }
+            let value = closed_response.siso(w);
+            evaluated.push((w, value));
+            value
+        };
         let (s_d, disk_d) = (1.0 / denominator, 1.0 / denominator - 0.5);
         let sensitivity = peak(
             closed.as_ref(),
