@@ -170,7 +170,8 @@ pub fn within_range(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>, 
 /// By Van Loan's square-reduced method (`linalg/hamiltonian.rs`: the squares μ = λ^2 of the
 /// eigenvalues from an eigenvalue problem of order n) where the squares decide the test of the
 /// axis ([`squares_decide`]); otherwise (a small eigenvalue near the axis beside large ones,
-/// or an H^2 beyond the doubles) by the QR iteration on H itself.
+/// an H^2 beyond the doubles, or squares that fail their check) by the QR iteration on H
+/// itself.
 fn hamiltonian_axis_frequencies(
     a: MatRef<'_, f64>,
     b: &[f64],

@@ -28,6 +28,9 @@
 //! as good for |λ| of the order of ||H|| and worse for small ones; the caller decides from the
 //! returned ||H||_F^2 which μ_i it can take (see `control/margins.rs`).
 //!
+//! **Verification.** The μ_i must sum to half the trace of H^2 (which the similarity keeps)
+//! to within 8 (2n)^2 u ||H||_F^2; a miss is [`Error::IllConditioned`].
+//!
 //! Reference: C. F. Van Loan, "A symplectic method for approximating all the eigenvalues of a
 //! Hamiltonian matrix", Linear Algebra and its Applications 61, 233-251, 1984.
 
@@ -47,9 +50,10 @@ pub struct SquaredSpectrum {
 }
 
 /// The squares of the eigenvalues of the Hamiltonian matrix `h` (2n x 2n) by Van Loan's
-/// square-reduced method (see the module's documentation); None where H^2 overflows. The
-/// structure is not checked: for a matrix that is not Hamiltonian the values are those of the
-/// block W of its reduced square.
+/// square-reduced method (see the module's documentation), verified by their sum (a miss is
+/// [`Error::IllConditioned`]); None where H^2 overflows. The
+/// structure is not checked as such: a matrix that is not Hamiltonian has a reduced square
+/// whose block W does not hold half its trace, and fails the check.
 pub fn squared_eigenvalues(h: MatRef<'_, f64>) -> Result<Option<SquaredSpectrum>, Error> {
     check_square(h, "H")?;
     check_finite(h, "H")?;
@@ -85,6 +89,7 @@ pub fn squared_eigenvalues(h: MatRef<'_, f64>) -> Result<Option<SquaredSpectrum>
     if !(size.is_finite() && m.iter().all(|x| x.is_finite())) {
         return Ok(None);
     }
+    let trace: f64 = (0..order).map(|i| m[i + i * order]).sum();
     let mut v = vec![0.0; n];
     let mut work = vec![0.0; order];
     for k in 0..n.saturating_sub(1) {
@@ -120,6 +125,19 @@ pub fn squared_eigenvalues(h: MatRef<'_, f64>) -> Result<Option<SquaredSpectrum>
         francis_qr(&mut w, None, (0, n - 1), false, Spectrum::General)?;
         quasi_triangular_eigenvalues(w.as_faer())
     });
+    // The similarity keeps the trace: tr H^2 = tr W + tr W^T = 2 Σ μ_i.
+    let sum: f64 = squares.iter().map(|mu| mu.re).sum();
+    if !sum.is_finite()
+        || (2.0 * sum - trace).abs() > 8.0 * (order * order) as f64 * f64::EPSILON * size
+    {
+        return Err(Error::IllConditioned {
+            message: format!(
+                "squared_eigenvalues: the squares sum to {sum:.6e}, not half the trace of H^2 \
+                 ({:.6e})",
+                trace / 2.0
+            ),
+        });
+    }
     Ok(Some(SquaredSpectrum { squares, size }))
 }
 
@@ -267,6 +285,17 @@ mod tests {
     fn an_overflowing_square_is_none() {
         let h = faer::mat![[1e200, 0.0], [0.0, -1e200]];
         assert!(squared_eigenvalues(h.as_ref()).unwrap().is_none());
+    }
+
+    /// A matrix that is not Hamiltonian fails the check of the trace: [[1, 2], [3, 4]] has
+    /// the square [[7, 10], [15, 22]], whose W = [7] is not half of its trace 29.
+    #[test]
+    fn a_matrix_that_is_not_hamiltonian_fails_the_check() {
+        let h = faer::mat![[1.0, 2.0], [3.0, 4.0]];
+        assert!(matches!(
+            squared_eigenvalues(h.as_ref()),
+            Err(Error::IllConditioned { .. })
+        ));
     }
 
     #[test]
