@@ -11,7 +11,13 @@
 //! ```
 //!
 //! whose eigenvalues are the zeros of 1 - L(-s) L(s) (plus any uncontrollable or unobservable
-//! modes). When d^2 = 1 to rounding (r = 0, the Hamiltonian does not exist) the zeros are the
+//! modes). They are computed as ±√μ from the squares μ = λ^2, the eigenvalues of an n x n
+//! Hessenberg matrix, by Van Loan's square-reduced method (`linalg/hamiltonian.rs`: a fraction
+//! of the cost of the QR iteration of order 2n) wherever those decide which eigenvalues lie
+//! within [`AXIS_TOLERANCE`] of the axis (their error, about n u ||H||^2, at most 1e-8 of |μ|,
+//! or smaller than μ's distance from the negative real axis); otherwise (a small eigenvalue
+//! near the axis beside large ones: a crossover far below the loop's size) by the QR iteration
+//! on H. When d^2 = 1 to rounding (r = 0, the Hamiltonian does not exist) the zeros are the
 //! finite generalized eigenvalues of the system pencil of 1 - L(-s) L(s), the realisation
 //! A_f = [[A, 0], [B C, -A]], B_f = [B; d B], C_f = [-d C, C], D_f = 1 - d^2 (the series
 //! connection of L(s) and L(-s) = d - C (sI + A)^-1 B).
@@ -28,7 +34,11 @@
 //! of Emami-Naeini and Van Dooren, reduced for one input and one output to an ordinary
 //! eigenvalue problem of order at most 2n - 1 ([`siso_zeros`]: orthogonal reflections that
 //! peel off the relative degree, the equivalent of QZ on the deflated pencil, at a fraction of
-//! its cost). ω = 0 is always a candidate (the odd function vanishes there when L(0)
+//! its cost). Since L(jω) = d - c A (A^2 + ω^2 I)^-1 b - jω c (A^2 + ω^2 I)^-1 b, that odd
+//! function is -2s Q(-s^2) with Q(μ) = c (μI + A^2)^-1 b: its zeros other than 0 are ±√(-μ)
+//! for the zeros μ of Q, a realisation of order n, taken as the squares of the Hamiltonian's
+//! are (where they decide the test of the axis, with the error of forming A^2), and from the
+//! pencil of order 2n otherwise. ω = 0 is always a candidate (the odd function vanishes there when L(0)
 //! is finite). A pencil that is singular (L(s) - L(-s) vanishing identically: L even, real on
 //! the whole axis) is reported as [`LoopMargins::degenerate`] and no phase crossover is given.
 //! A phase crossover beyond 1e8 times the largest pole's modulus counts as at infinity (a zero
@@ -70,12 +80,15 @@
 //! H∞-norm of a transfer function matrix", Systems & Control Letters 14, 1990; A. Emami-Naeini
 //! and P. Van Dooren, "Computation of zeros of linear multivariable systems", Automatica 18,
 //! 1982 (zeros as generalized eigenvalues of the system pencil); P. Seiler, A. Packard and
-//! P. Gahinet, "An introduction to disk margins", IEEE Control Systems 40(5), 2020.
+//! P. Gahinet, "An introduction to disk margins", IEEE Control Systems 40(5), 2020; C. F. Van
+//! Loan, "A symplectic method for approximating all the eigenvalues of a Hamiltonian matrix",
+//! Linear Algebra and its Applications 61, 1984 (the squared Hamiltonian).
 
 use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::control::root_locus;
 use crate::error::Error;
 use crate::linalg::balance::{GRADED_SPREAD, balanced_states, nearest_power_of_two};
+use crate::linalg::hamiltonian::squared_eigenvalues;
 use crate::linalg::norm::{frobenius_norm, max_abs};
 use crate::linalg::schur::eigenvalues;
 use faer::{Mat, MatRef, c64};
@@ -151,13 +164,20 @@ pub fn within_range(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>, 
     size_a.max(size_b).max(size_c).max(closed) <= RESCALE_EXPONENT
 }
 
-/// The eigenvalues of the Hamiltonian of 1 - G(-s) G(s) for G = (A, B, C, d), r = 1 - d^2 != 0.
-fn hamiltonian_eigenvalues(
+/// The frequencies ω >= 0 of the eigenvalues within [`AXIS_TOLERANCE`] of the imaginary axis
+/// of the Hamiltonian of 1 - G(-s) G(s) for G = (A, B, C, d), r = 1 - d^2 != 0.
+///
+/// By Van Loan's square-reduced method (`linalg/hamiltonian.rs`: the squares μ = λ^2 of the
+/// eigenvalues from an eigenvalue problem of order n) where the squares decide the test of the
+/// axis ([`squares_decide`]); otherwise (a small eigenvalue near the axis beside large ones,
+/// an H^2 beyond the doubles, or squares that fail their check) by the QR iteration on H
+/// itself.
+fn hamiltonian_axis_frequencies(
     a: MatRef<'_, f64>,
     b: &[f64],
     c: &[f64],
     d: f64,
-) -> Result<Vec<c64>, Error> {
+) -> Result<Vec<f64>, Error> {
     let n = a.nrows();
     let r = 1.0 - d * d;
     // B β and C / β leave G unchanged; β balances B B^T against C^T C.
@@ -176,11 +196,54 @@ fn hamiltonian_eigenvalues(
         (false, true) => -(c[i - n] / beta) * (c[j] / beta) / r,
         (false, false) => -(a[(j - n, i - n)] + (d / r) * b[j - n] * c[i - n]),
     });
-    eigenvalues(h.as_ref())
+    match squared_eigenvalues(h.as_ref()) {
+        Ok(Some(squared)) if squares_decide(&squared.squares, squared.size) => {
+            Ok(squared_axis_candidates(&squared.squares))
+        }
+        Err(Error::Interrupted) => Err(Error::Interrupted),
+        _ => Ok(axis_candidates(&eigenvalues(h.as_ref())?)),
+    }
 }
 
-/// The finite zeros of the strictly proper SISO realisation (A, b, c, 0), or None when its
-/// transfer vanishes identically (the system pencil is singular).
+/// The error of a computed square, in units of n u times the size of the matrix it is an
+/// eigenvalue of (the backward error of orthogonal transformations, with room for the
+/// eigenvalue's condition).
+const SQUARED_ERROR_UNITS: f64 = 64.0;
+
+/// Whether the computed squares μ (n of them, eigenvalues of a matrix formed with errors
+/// relative to `size`: ||H||_F^2 for H^2) decide the test of the axis for their roots ±√μ as
+/// exactly known squares would: with
+/// e = [`SQUARED_ERROR_UNITS`] n u `size` the error of each, every μ either has e <= 1e-8 |μ|
+/// (√μ then has a relative error of at most about 5e-9, far inside [`AXIS_TOLERANCE`]), or
+/// lies farther than 2 e (and 4 [`AXIS_TOLERANCE`] |μ|) from the negative real axis, where
+/// the squares of the imaginary numbers are: no μ within its error is then the square of a
+/// root near the axis. A small μ near that axis (a crossover at a frequency far below the
+/// size of the loop: its root's error is about e / √|μ|) is not decided.
+fn squares_decide(squares: &[c64], size: f64) -> bool {
+    let error = SQUARED_ERROR_UNITS * squares.len() as f64 * f64::EPSILON * size;
+    squares.iter().all(|mu| {
+        let modulus = mu.norm();
+        let from_axis = if mu.re <= 0.0 { mu.im.abs() } else { modulus };
+        error <= 1e-8 * modulus || from_axis > 2.0 * error + 4.0 * AXIS_TOLERANCE * modulus
+    })
+}
+
+/// [`axis_candidates`] of the roots ±√μ of the squares μ: the frequencies ω >= 0 of those
+/// within [`AXIS_TOLERANCE`] of the imaginary axis (√μ with Im >= 0 of a negative real μ).
+fn squared_axis_candidates(squares: &[c64]) -> Vec<f64> {
+    let roots: Vec<c64> = squares
+        .iter()
+        .map(|mu| {
+            let root = mu.sqrt();
+            if root.im >= 0.0 { root } else { -root }
+        })
+        .collect();
+    axis_candidates(&roots)
+}
+
+/// The finite zeros of the strictly proper SISO realisation (A, b, c, 0), with the size their
+/// errors are relative to, or None when its transfer vanishes identically (the system pencil
+/// is singular).
 ///
 /// The reduction of Emami-Naeini and Van Dooren (1982) for one input and one output: a
 /// Householder reflection H with H b = β e_N brings the input onto the last state; the last
@@ -189,10 +252,13 @@ fn hamiltonian_eigenvalues(
 /// Ã_11 - ã_12 c̃_1 / c̃_N (order N - 1); otherwise x_N is the input of the system
 /// (Ã_11, ã_12, c̃_1, 0) of order N - 1, which has the same zeros, and the step repeats. The
 /// reflections are orthogonal; the one division is by the largest Markov parameter direction
-/// left, and a zero it makes large is a candidate the caller verifies like any other.
-fn siso_zeros(a: MatRef<'_, f64>, b: &[f64], c: &[f64]) -> Result<Option<Vec<c64>>, Error> {
+/// left, and a zero it makes large is a candidate the caller verifies like any other. The size
+/// is ||A||_F + ||ã_12|| ||c̃_1|| / |c̃_N|: the reflections' errors are relative to A, and the
+/// division's to the rank-one term before it cancels against Ã_11.
+fn siso_zeros(a: MatRef<'_, f64>, b: &[f64], c: &[f64]) -> Result<Option<(Vec<c64>, f64)>, Error> {
     let norm = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
     let a_scale = max_abs(a).max(f64::MIN_POSITIVE);
+    let a_size = frobenius_norm(a);
     let c_scale = norm(c);
     let b_scale = norm(b);
     let mut a = a.to_owned();
@@ -238,7 +304,9 @@ fn siso_zeros(a: MatRef<'_, f64>, b: &[f64], c: &[f64]) -> Result<Option<Vec<c64
         let m = n - 1;
         if last.abs() > 1e-10 * nc {
             let reduced = Mat::from_fn(m, m, |i, j| a[(i, j)] - a[(i, m)] * c[j] / last);
-            return Ok(Some(eigenvalues(reduced.as_ref())?));
+            let column = norm(&(0..m).map(|i| a[(i, m)]).collect::<Vec<_>>());
+            let size = a_size + column * norm(&c[..m]) / last.abs();
+            return Ok(Some((eigenvalues(reduced.as_ref())?, size)));
         }
         b = (0..m).map(|i| a[(i, m)]).collect();
         c.truncate(m);
@@ -324,7 +392,7 @@ impl Loop<'_> {
         let n = self.a.nrows();
         let d = self.d;
         let candidates = if (1.0 - d * d).abs() > 1e-12 {
-            axis_candidates(&hamiltonian_eigenvalues(self.a, &self.b, &self.c, d)?)
+            hamiltonian_axis_frequencies(self.a, &self.b, &self.c, d)?
         } else {
             // d^2 = 1: the system pencil of 1 - L(-s) L(s).
             let a2 = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
@@ -340,7 +408,7 @@ impl Loop<'_> {
                 .map(|j| if j < n { -d * self.c[j] } else { self.c[j - n] })
                 .collect();
             match siso_zeros(a2.as_ref(), &b2, &c2)? {
-                Some(zeros) => axis_candidates(&zeros),
+                Some((zeros, _)) => axis_candidates(&zeros),
                 None => Vec::new(),
             }
         };
@@ -381,8 +449,29 @@ impl Loop<'_> {
         scale
     }
 
-    fn phase_crossovers(&mut self, poles: &[c64]) -> Result<(Vec<Crossover>, bool), Error> {
+    /// The frequencies ω >= 0 of the zeros within [`AXIS_TOLERANCE`] of the imaginary axis of
+    /// the odd function L(s) - L(-s), and whether it vanishes identically (degenerate).
+    ///
+    /// L(jω) = d - c A (A^2 + ω^2 I)^-1 b - jω c (A^2 + ω^2 I)^-1 b, so L(s) - L(-s) =
+    /// -2s Q(-s^2) with Q(μ) = c (μI - M)^-1 b, M = -A^2: its zeros other than 0 are ±√(-μ)
+    /// for the zeros μ of Q, a realisation of order n where the pencil of L(s) - L(-s) has
+    /// order 2n. The squares s^2 = -μ are taken where they decide the test of the axis
+    /// ([`squares_decide`], with the size ||A||_F^2 of forming M and that of the reduction's
+    /// division); otherwise
+    /// (a zero near the axis at a frequency far below the loop's size, or Q vanishing
+    /// identically to the reduction's tolerance) the zeros of the pencil of order 2n decide.
+    fn phase_axis_frequencies(&self) -> Result<(Vec<f64>, bool), Error> {
         let n = self.a.nrows();
+        let m = Mat::from_fn(n, n, |i, j| {
+            -(0..n).map(|k| self.a[(i, k)] * self.a[(k, j)]).sum::<f64>()
+        });
+        if let Some((zeros, size)) = siso_zeros(m.as_ref(), &self.b, &self.c)? {
+            let squares: Vec<c64> = zeros.iter().map(|z| -z).collect();
+            let product = frobenius_norm(self.a).powi(2);
+            if squares_decide(&squares, size + product) {
+                return Ok((squared_axis_candidates(&squares), false));
+            }
+        }
         let a2 = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
             (true, true) => self.a[(i, j)],
             (false, false) => -self.a[(i - n, j - n)],
@@ -390,14 +479,18 @@ impl Loop<'_> {
         });
         let b2: Vec<f64> = (0..2 * n).map(|i| self.b[i % n.max(1)]).collect();
         let c2: Vec<f64> = (0..2 * n).map(|j| self.c[j % n.max(1)]).collect();
-        let (zeros, degenerate) = match siso_zeros(a2.as_ref(), &b2, &c2)? {
-            Some(zeros) => (zeros, false),
+        Ok(match siso_zeros(a2.as_ref(), &b2, &c2)? {
+            Some((zeros, _)) => (axis_candidates(&zeros), false),
             None => (Vec::new(), true),
-        };
+        })
+    }
+
+    fn phase_crossovers(&mut self, poles: &[c64]) -> Result<(Vec<Crossover>, bool), Error> {
+        let (frequencies, degenerate) = self.phase_axis_frequencies()?;
         let frequency_scale = poles.iter().fold(max_abs(self.a), |m, p| m.max(p.norm()));
         let mut candidates = vec![0.0];
         candidates.extend(
-            axis_candidates(&zeros)
+            frequencies
                 .into_iter()
                 .filter(|&w| w > 1e-10 * frequency_scale && w < 1e8 * frequency_scale),
         );
@@ -612,8 +705,7 @@ fn peak(
         crate::platform::interrupt::check()?;
         let gamma = (1.0 + 2.0 * PEAK_TOLERANCE) * best.value;
         let scaled: Vec<f64> = c.iter().map(|v| v / gamma).collect();
-        let values = hamiltonian_eigenvalues(a, b, &scaled, d / gamma)?;
-        let mut omegas = axis_candidates(&values);
+        let mut omegas = hamiltonian_axis_frequencies(a, b, &scaled, d / gamma)?;
         if omegas.is_empty() {
             break;
         }
@@ -701,7 +793,18 @@ pub fn loop_margins(
     })();
     let peaks = (|| {
         let mut closed_response = strictly_proper_evaluator(closed.as_ref(), &bs, &cs)?;
-        let mut response = |w: f64| closed_response.siso(w);
+        // Both peaks start from S at the same test frequencies (0 and the closed-loop poles'):
+        // each value is computed once and looked up the second time (the same value, so the
+        // same peaks bit for bit).
+        let mut evaluated: Vec<(f64, c64)> = Vec::with_capacity(8 * n + 8);
+        let mut response = |w: f64| {
+            if let Some(&(_, value)) = evaluated.iter().find(|(x, _)| x.to_bits() == w.to_bits()) {
+                return value;
+            }
+            let value = closed_response.siso(w);
+            evaluated.push((w, value));
+            value
+        };
         let (s_d, disk_d) = (1.0 / denominator, 1.0 / denominator - 0.5);
         let sensitivity = peak(
             closed.as_ref(),
