@@ -99,29 +99,7 @@ fn classify_mode_stack<'py>(
     a: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let axis = axis_of(py, axis)?;
-    let array = eigenvalues.cast::<PyArrayDyn<c64>>().map_err(|_| {
-        to_py_err(
-            py,
-            Error::InvalidArgument {
-                arg: "eigenvalues",
-                message: "must be a complex128 array".to_string(),
-            },
-        )
-    })?;
-    let count = match array.shape() {
-        [count, 4] => *count,
-        shape => {
-            return Err(to_py_err(
-                py,
-                Error::WrongDimensions {
-                    arg: "eigenvalues",
-                    expected: "(k, 4)",
-                    shape: shape.to_vec(),
-                },
-            ));
-        }
-    };
-    let values = copy_values(py, array)?;
+    let (count, values) = complex_rows(py, eigenvalues, "eigenvalues", 4)?;
     let a = Real::convert_optional(py, a, "A")?;
     if let Some(a) = &a
         && a.shape() != [count, 4, 4]
@@ -156,27 +134,37 @@ fn classify_mode_stack<'py>(
 const PAIR_FLOPS: f64 = 60.0;
 const ROOT_FLOPS: f64 = 4.0;
 
-/// The roots of k aircraft's mode, a complex128 array of shape (k, roots).
-fn roots_of(py: Python<'_>, roots: &Bound<'_, PyAny>, width: usize) -> PyResult<(usize, Vec<c64>)> {
-    let array = roots.cast::<PyArrayDyn<c64>>().map_err(|_| {
+/// The rows of a complex128 argument `arg` of k rows of `width` numbers: shape (k, width), or
+/// (k,) for a width of 1; its row count and values in C order.
+fn complex_rows(
+    py: Python<'_>,
+    value: &Bound<'_, PyAny>,
+    arg: &'static str,
+    width: usize,
+) -> PyResult<(usize, Vec<c64>)> {
+    let array = value.cast::<PyArrayDyn<c64>>().map_err(|_| {
         to_py_err(
             py,
             Error::InvalidArgument {
-                arg: "roots",
+                arg,
                 message: "must be a complex128 array".to_string(),
             },
         )
     })?;
-    let shape = array.shape().to_vec();
-    let count = match (shape.as_slice(), width) {
-        ([count, 2], 2) | ([count], 1) => *count,
-        _ => {
+    let count = match (array.shape(), width) {
+        ([count], 1) => *count,
+        ([count, w], _) if *w == width && width > 1 => *count,
+        (shape, _) => {
             return Err(to_py_err(
                 py,
                 Error::WrongDimensions {
-                    arg: "roots",
-                    expected: if width == 2 { "(k, 2)" } else { "(k,)" },
-                    shape,
+                    arg,
+                    expected: match width {
+                        1 => "(k,)",
+                        2 => "(k, 2)",
+                        _ => "(k, 4)",
+                    },
+                    shape: shape.to_vec(),
                 },
             ));
         }
@@ -195,7 +183,7 @@ fn mode_quantities<'py>(
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let single: fn(f64) -> f64 = match kind {
         "pair" => {
-            let (count, values) = roots_of(py, roots, 2)?;
+            let (count, values) = complex_rows(py, roots, "roots", 2)?;
             let array = new_array::<f64>(py, &[count, 3])?;
             // SAFETY: the array is new and not visible to Python until returned.
             let data = unsafe { new_array_data(&array) };
@@ -222,7 +210,7 @@ fn mode_quantities<'py>(
             ));
         }
     };
-    let (count, values) = roots_of(py, roots, 1)?;
+    let (count, values) = complex_rows(py, roots, "roots", 1)?;
     let array = new_array::<f64>(py, &[count])?;
     // SAFETY: the array is new and not visible to Python until returned.
     let data = unsafe { new_array_data(&array) };
@@ -246,7 +234,7 @@ fn mode_levels<'py>(
     limits: Vec<f64>,
 ) -> PyResult<Bound<'py, PyArrayDyn<i8>>> {
     let limits = Limits::from_values(mode, &limits).map_err(|e| to_py_err(py, e))?;
-    let (count, values) = roots_of(py, roots, limits.roots())?;
+    let (count, values) = complex_rows(py, roots, "roots", limits.roots())?;
     let array = new_array::<i8>(py, &[count])?;
     // SAFETY: the array is new and not visible to Python until returned.
     let out = unsafe { new_array_data(&array) };
