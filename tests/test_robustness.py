@@ -16,6 +16,7 @@ import mpmath
 import numpy as np
 import pytest
 import scipy.stats
+from properties.strategies import scattered_values
 
 import aerocontrol
 from aerocontrol import aircraft, batch, design, linalg, robustness
@@ -36,21 +37,11 @@ from aerocontrol.robustness import (
 AXES = ("longitudinal", "lateral")
 
 
-def _scattered(plane: aircraft.Aircraft, count: int, spread: float, seed: int) -> dict:
-    rng = np.random.default_rng(seed)
-    values = {
-        k: v * (1 + spread * rng.standard_normal(count)) for k, v in plane.derivatives.items()
-    }
-    for name in ("mass", "Ix", "Iy", "Iz", "speed", "density"):
-        values[name] = getattr(plane, name) * np.exp(0.05 * rng.standard_normal(count))
-    return values
-
-
 @pytest.mark.parametrize("name", aircraft.available())
 @pytest.mark.parametrize("axis", AXES)
 def test_model_stack_is_each_model_bitwise(name: str, axis: str) -> None:
     plane = aircraft.load(name)
-    values = _scattered(plane, 6, 0.2, 1)
+    values = scattered_values(plane, 6, 0.2, 1)
     A, B = plane.model_stack(axis, values)
     assert A.shape == (6, 4, 4) and B.shape == (6, 4, 1 if axis == "longitudinal" else 2)
     for i in range(6):
@@ -146,7 +137,7 @@ def test_model_stack_follows_the_chapters_formulas(name: str) -> None:
     density scattered, against the formulas in mpmath: within 64 u of the entry's size or of
     the terms that cancel in it (the pitch row adds u0 Mẇ times the heave row)."""
     plane = aircraft.load(name)
-    values = _scattered(plane, 50, 0.3, 11)
+    values = scattered_values(plane, 50, 0.3, 11)
     values["Ixz"] = plane.Ixz * (1 + 0.3 * np.random.default_rng(12).standard_normal(50))
     A_lon, B_lon = plane.model_stack("longitudinal", values)
     A_lat, B_lat = plane.model_stack("lateral", values)
@@ -204,7 +195,7 @@ def test_model_stack_refuses_bad_values() -> None:
 def test_levels_in_bulk_are_those_of_assess(name: str, axis: str) -> None:
     # 40 % scatter on every derivative: stable and unstable, oscillatory and split modes.
     plane = aircraft.load(name)
-    A, _ = plane.model_stack(axis, _scattered(plane, 400, 0.4, 2))
+    A, _ = plane.model_stack(axis, scattered_values(plane, 400, 0.4, 2))
     eigenvalues = linalg.eigenvalues(A)
     named, unresolved = classify_mode_stack(eigenvalues, axis)
     known = ~unresolved
@@ -222,7 +213,7 @@ def test_coupled_roll_spiral_is_named_as_classify_modes_names_it() -> None:
     # The regulator with Q = I couples roll and spiral into one oscillation: the Dutch roll is
     # the pair with the larger sideslip share of its eigenvector.
     plane = aircraft.load("b747-cruise")
-    A, B = plane.model_stack("lateral", _scattered(plane, 300, 0.3, 3))
+    A, B = plane.model_stack("lateral", scattered_values(plane, 300, 0.3, 3))
     closed = A - B @ batch.solve_care_batch(A, B, np.eye(4), np.eye(2)).K
     eigenvalues = linalg.eigenvalues(closed)
     named, unresolved = classify_mode_stack(eigenvalues, "lateral", closed)

@@ -564,3 +564,19 @@ def riccati_problem(
     if descriptor_matrix and draw(st.sampled_from((False, False, False, True))):
         E = draw(descriptor(n))
     return {"A": A, "B": B, "Q": Q, "R": R, "S": S, "E": E}
+
+
+# ----- scattered aircraft ----------------------------------------------------------------------
+
+
+def scattered_values(plane: Any, count: int, spread: float, seed: int) -> dict[str, np.ndarray]:
+    """``count`` seeded variants of an :class:`aerocontrol.aircraft.Aircraft`, as
+    ``model_stack`` takes them: each derivative scaled by 1 + ``spread`` N(0, 1), the mass,
+    inertias (not Ixz), speed and density by a log-normal factor exp(0.05 N(0, 1))."""
+    rng = np.random.default_rng(seed)
+    values = {
+        k: v * (1 + spread * rng.standard_normal(count)) for k, v in plane.derivatives.items()
+    }
+    for name in ("mass", "Ix", "Iy", "Iz", "speed", "density"):
+        values[name] = getattr(plane, name) * np.exp(0.05 * rng.standard_normal(count))
+    return values

@@ -35,19 +35,11 @@ from aerocontrol.handling import (
     mode_quantities,
 )
 
+from .strategies import scattered_values
+
 AXES = ("longitudinal", "lateral")
 CLASSES = ("I", "II-C", "II-L", "III", "IV")
 CATEGORIES = ("A", "B", "C")
-
-
-def _scattered(plane: aircraft.Aircraft, count: int, spread: float, seed: int) -> dict:
-    rng = np.random.default_rng(seed)
-    values = {
-        k: v * (1 + spread * rng.standard_normal(count)) for k, v in plane.derivatives.items()
-    }
-    for name in ("mass", "Ix", "Iy", "Iz", "speed", "density"):
-        values[name] = getattr(plane, name) * np.exp(0.05 * rng.standard_normal(count))
-    return values
 
 
 def _layouts(x: np.ndarray) -> Iterator[tuple[str, Any]]:
@@ -137,7 +129,7 @@ def test_stacks_of_any_count_are_their_models_built_alone(count: int, axis: str)
     alone from an aircraft with its values; each model's modes those classify_mode_stack
     names for it alone."""
     plane = aircraft.load("navion")
-    values = _scattered(plane, count, 0.2, count)
+    values = scattered_values(plane, count, 0.2, count)
     A, B = plane.model_stack(axis, values)
     assert A.shape == (count, 4, 4) and B.shape == (count, 4, 1 if axis == "longitudinal" else 2)
     eigenvalues = linalg.eigenvalues(A) if count else np.empty((0, 4), complex)
@@ -250,7 +242,7 @@ def _lqr_closed_loops(
     name: str, count: int, seed: int, q: float, r: float
 ) -> tuple[np.ndarray, np.ndarray]:
     plane = aircraft.load(name)
-    A, B = plane.model_stack("lateral", _scattered(plane, count, 0.3, seed))
+    A, B = plane.model_stack("lateral", scattered_values(plane, count, 0.3, seed))
     closed = A - B @ batch.solve_care_batch(A, B, q * np.eye(4), r * np.eye(2)).K
     return A, closed
 
