@@ -116,3 +116,91 @@ def test_a_tuple_in_any_layout_gives_the_state_spaces_modes() -> None:
         aerocontrol.modes((A_LAT, bad))
     with pytest.raises(aerocontrol.ShapeError, match="B must have as many rows as A"):
         aerocontrol.modes((A_LAT, B_LAT[:3]))
+
+
+_MODES_FIELDS = (
+    "eigenvalues",
+    "eigenvalue",
+    "oscillatory",
+    "natural_frequency",
+    "damping_ratio",
+    "damped_frequency",
+    "period",
+    "time_to_half",
+    "time_to_double",
+    "cycles_to_half",
+    "time_constant",
+    "modal_matrix",
+    "modal_matrix_condition",
+    "modal_input",
+    "characteristic_polynomial",
+    "mode_names",
+)
+
+
+def test_the_deferred_modal_matrix_is_that_of_one_analysis_bit_for_bit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Above EAGER_VECTORS_MAX_ORDER the modes come from the Schur form without Z and the
+    modal matrix, its condition number and P^-1 B on first access: every field equals, bit for
+    bit, that of one analysis with the eigenvectors (the order raised past n), over 60 seeded
+    systems of orders 17 to 120 (both QR iterations), continuous and discrete, graded states
+    among them; and A P = P Λ for the deferred P."""
+    rng = np.random.default_rng(2026)
+    import aerocontrol.modal as modal
+
+    cases = 0
+    for n in (17, 20, 33, 64, 80, 120):
+        for variant in range(10):
+            A = rng.standard_normal((n, n)) / np.sqrt(n)
+            if variant % 3 == 1:
+                grade = 10.0 ** np.linspace(-3, 3, n)
+                A = A * grade[:, None] / grade[None, :]
+            B = rng.standard_normal((n, 2))
+            dt = 0.05 if variant % 2 else 0.0
+            system = aerocontrol.StateSpace(A, B, np.eye(n)[:1], np.zeros((1, 2)), dt=dt)
+            deferred = aerocontrol.modes(system)
+            assert "_plant" in vars(deferred)
+            P = deferred.modal_matrix
+            assert "_plant" not in vars(deferred)
+            with monkeypatch.context() as patch:
+                patch.setattr(modal, "EAGER_VECTORS_MAX_ORDER", 10**6)
+                eager = aerocontrol.modes(system)
+            assert "_plant" not in vars(eager)
+            for name in _MODES_FIELDS:
+                got, expected = getattr(deferred, name), getattr(eager, name)
+                if isinstance(expected, np.ndarray):
+                    np.testing.assert_array_equal(got, expected, err_msg=f"n = {n}: {name}")
+                else:
+                    assert got == expected, f"n = {n}: {name}"
+            assert P is not None
+            if dt == 0.0 and variant % 3 != 1:
+                residual = np.linalg.norm(A @ P - P * deferred.eigenvalues[None, :])
+                assert residual <= 1e-12 * np.linalg.norm(A) * np.linalg.norm(P)
+            cases += 1
+    assert cases == 60
+
+
+def test_a_deferred_singular_modal_matrix_warns_at_the_first_access() -> None:
+    """Ten defective 2 x 2 Jordan blocks (λ = -1, ..., -10, each with one eigenvector): above
+    16 states ``modes`` does not warn; the first access to the modal matrix does, once, and
+    gives None, P^-1 B None and κ₂ above 1e8, as the analysis at the call gives them for a
+    small model."""
+    n = 20
+    A = np.zeros((n, n))
+    for k in range(n // 2):
+        A[2 * k, 2 * k] = A[2 * k + 1, 2 * k + 1] = -(k + 1.0)
+        A[2 * k, 2 * k + 1] = 1.0
+    B = np.ones((n, 1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = aerocontrol.modes((A, B))
+    np.testing.assert_array_equal(
+        np.sort(m.eigenvalues.real), np.repeat(-np.arange(10.0, 0, -1), 2)
+    )
+    with pytest.warns(IllConditionedWarning, match="modal matrix P is singular"):
+        assert m.modal_matrix is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert m.modal_input is None
+        assert m.modal_matrix_condition > 1e8

@@ -27,6 +27,12 @@ P^-1 B (6.61) shows which modes each input reaches: a zero row is a mode no inpu
 defective A (a repeated eigenvalue without a full set of eigenvectors, such as a double
 integrator) has no modal matrix: then ``modal_matrix`` and ``modal_input`` are None, and a
 warning gives the condition number that showed it.
+
+Up to 16 states (``EAGER_VECTORS_MAX_ORDER``) one call computes everything. Above, ``modes``
+computes the eigenvalues alone (the real Schur form without its transformation, about half the
+work), and the modal matrix, its condition number and P^-1 B come on the first access to any
+of the three, from a second analysis with the eigenvectors: the warning of a singular P is then
+given at that access, not at the call.
 """
 
 from __future__ import annotations
@@ -53,6 +59,15 @@ if TYPE_CHECKING:
 __all__ = ["Modes", "charpoly", "modes"]
 
 ComplexArray = NDArray[np.complex128]
+
+
+#: Up to this order ``modes`` computes the modal matrix, its condition number and P^-1 B with
+#: the modes, in one call; above it, on the first access to any of the three (the
+#: eigenvectors cost about as much again as the eigenvalues).
+EAGER_VECTORS_MAX_ORDER = 16
+
+#: The fields of :class:`Modes` that need the eigenvectors.
+_MODAL_FIELDS = frozenset({"modal_matrix", "modal_matrix_condition", "modal_input"})
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,7 +109,8 @@ class Modes(Result):
         κ₂(P) also grows with their spread (1e12 for simple, well-separated eigenvalues of
         states in units 10^±6 apart).
     modal_input : ndarray (n, m), complex, or None
-        P^-1 B (6.61), when B was given and P is not singular.
+        P^-1 B (6.61), when B was given and P is not singular. Above 16 states these three
+        are computed on the first access to any of them (see the module documentation).
     characteristic_polynomial : ndarray (n + 1,)
         Coefficients of det(λI - A), highest power first.
     mode_names : tuple of str
@@ -138,6 +154,26 @@ class Modes(Result):
 
     def __len__(self) -> int:
         return len(self.eigenvalue)
+
+    def __getattr__(self, name: str) -> Any:
+        """The modal matrix, its condition number and P^-1 B of an analysis of more than
+        ``EAGER_VECTORS_MAX_ORDER`` states, computed on the first access to any of them (a
+        second analysis with the eigenvectors, whose eigenvalues are checked to be these bit
+        for bit), with the warning of a singular P then."""
+        state = vars(self)
+        if name not in _MODAL_FIELDS or "_plant" not in state:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        A, B, dt = state["_plant"]
+        result = _core.modal_analysis(A, B, True)
+        if dt > 0.0:
+            result = _equivalent_continuous(result, dt)
+        if not np.array_equal(result["eigenvalues"], self.eigenvalues):
+            raise RuntimeError(
+                "the eigenvalues of the analysis with eigenvectors differ from those of the modes"
+            )  # pragma: no cover
+        state.update(_modal_fields(result, stacklevel=3))
+        del state["_plant"]
+        return state[name]
 
     _HEADER = ("mode", "eigenvalue", "damping", "freq (rad/s)", "period (s)", "t½ / t₂ (s)")
 
@@ -219,7 +255,8 @@ def _default_names(count: int) -> tuple[str, ...]:
 def _equivalent_continuous(result: dict[str, Any], dt: float) -> dict[str, Any]:
     """The modal analysis of a discrete A (eigenvalues z) with the characteristics of the
     equivalent continuous modes s = ln(z)/dt, reordered by their natural frequency (then by
-    decreasing damping), eigenvalues, modal matrix columns and modal input rows alike."""
+    decreasing damping), eigenvalues, modal matrix columns and modal input rows alike (when the
+    analysis has them)."""
     eigenvalues = result["eigenvalues"]
     groups = [list(range(first, last + 1)) for first, last in result["mode_indices"]]
     z = np.array([eigenvalues[group[0]] for group in groups], dtype=np.complex128)
@@ -238,9 +275,13 @@ def _equivalent_continuous(result: dict[str, Any], dt: float) -> dict[str, Any]:
         constant = np.where(oscillatory | (natural == 0), np.nan, 1.0 / natural)
     order = np.lexsort((-np.nan_to_num(damping, nan=-np.inf), natural))
     columns = [index for k in order for index in groups[k]]
-    modal_input = result["modal_input"]
+    reordered = dict(result)
+    if "modal_matrix" in result:
+        modal_input = result["modal_input"]
+        reordered["modal_matrix"] = result["modal_matrix"][:, columns]
+        reordered["modal_input"] = None if modal_input is None else modal_input[columns]
     return {
-        **result,
+        **reordered,
         "eigenvalues": eigenvalues[columns],
         "mode_eigenvalue": z[order],
         "oscillatory": oscillatory[order],
@@ -252,8 +293,6 @@ def _equivalent_continuous(result: dict[str, Any], dt: float) -> dict[str, Any]:
         "time_to_double": double[order],
         "cycles_to_half": cycles[order],
         "time_constant": constant[order],
-        "modal_matrix": result["modal_matrix"][:, columns],
-        "modal_input": None if modal_input is None else modal_input[columns],
     }
 
 
@@ -299,7 +338,8 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
     [0.0464, 0.7477, 1.2308]
     """
     A, B, dt = _plant(A_or_sys)
-    result = _core.modal_analysis(A, B)
+    vectors = A.shape[0] <= EAGER_VECTORS_MAX_ORDER
+    result = _core.modal_analysis(A, B, vectors)
     if dt > 0.0:
         result = _equivalent_continuous(result, dt)
     count = len(result["mode_eigenvalue"])
@@ -309,17 +349,6 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
         names = name_sequence(mode_names, "mode_names")
         if len(names) != count:
             raise ShapeError(f"mode_names must name {count} modes, got {len(names)}")
-    singular = bool(result["modal_matrix_is_singular"])
-    if singular:
-        warnings.warn(
-            f"the modal matrix P is singular (condition number "
-            f"{result['balanced_modal_matrix_condition']:.2e} with the states balanced): A has "
-            "a repeated eigenvalue without a "
-            "full set of eigenvectors, so there is no modal decomposition; modal_matrix and "
-            "modal_input are None",
-            IllConditionedWarning,
-            stacklevel=2,
-        )
     # The frozen dataclass's __init__ sets each of the 16 fields through object.__setattr__,
     # which costs half of the analysis of a 4-state A; filling the instance dictionary
     # directly is the same object.
@@ -336,13 +365,35 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
         time_to_double=result["time_to_double"],
         cycles_to_half=result["cycles_to_half"],
         time_constant=result["time_constant"],
-        modal_matrix=None if singular else result["modal_matrix"],
-        modal_matrix_condition=float(result["modal_matrix_condition"]),
-        modal_input=result["modal_input"],
         characteristic_polynomial=result["characteristic_polynomial"],
         mode_names=names,
     )
+    if vectors:
+        vars(analysis).update(_modal_fields(result, stacklevel=3))
+    else:
+        vars(analysis)["_plant"] = (A, B, dt)
     return analysis
+
+
+def _modal_fields(result: dict[str, Any], stacklevel: int) -> dict[str, Any]:
+    """The modal matrix, its condition number and P^-1 B of a full analysis, with the warning
+    of a singular P (at ``stacklevel``)."""
+    singular = bool(result["modal_matrix_is_singular"])
+    if singular:
+        warnings.warn(
+            f"the modal matrix P is singular (condition number "
+            f"{result['balanced_modal_matrix_condition']:.2e} with the states balanced): A has "
+            "a repeated eigenvalue without a "
+            "full set of eigenvectors, so there is no modal decomposition; modal_matrix and "
+            "modal_input are None",
+            IllConditionedWarning,
+            stacklevel=stacklevel,
+        )
+    return {
+        "modal_matrix": None if singular else result["modal_matrix"],
+        "modal_matrix_condition": float(result["modal_matrix_condition"]),
+        "modal_input": result["modal_input"],
+    }
 
 
 def charpoly(A: ArrayLike) -> FloatArray:

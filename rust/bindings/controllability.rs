@@ -6,7 +6,7 @@ use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
 use super::modal::eigen_cost;
 use crate::control::controllability::{
-    Controllability, controllability as controllability_core, ctrb,
+    Controllability, controllability as controllability_core, ctrb, is_controllable, is_observable,
     observability as observability_core, obsv,
 };
 use numpy::PyArrayDyn;
@@ -69,7 +69,7 @@ fn controllability<'py>(
     modal_test: bool,
     dual: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let analysis = analyse(py, a, b, tol, modal_test, dual, true)?;
+    let analysis = analyse(py, a, b, tol, modal_test, dual)?;
     let mut outputs = Outputs::new(py);
     let result = PyDict::new(py);
     let staircase = &analysis.staircase;
@@ -112,7 +112,8 @@ fn controllability<'py>(
 
 /// Whether (A, B) is controllable (with `dual`, (A, C) observable): the verdict of
 /// [`controllability`] (no uncontrollable eigenvalue) without its form, transformation or
-/// arrays.
+/// arrays, and without the modal test where the staircase already finds an uncontrollable
+/// mode.
 #[pyfunction]
 #[pyo3(signature = (a, b, tol, modal_test, dual, /))]
 fn controllability_verdict(
@@ -123,12 +124,36 @@ fn controllability_verdict(
     modal_test: bool,
     dual: bool,
 ) -> PyResult<bool> {
-    Ok(analyse(py, a, b, tol, modal_test, dual, false)?.is_complete())
+    let (a, second) = pair(py, a, b, dual)?;
+    let (a, second) = (|| Ok((a.matrix()?, second.matrix()?)))().map_err(|e| to_py_err(py, e))?;
+    compute(
+        py,
+        verdict_cost(a.nrows(), second, modal_test, dual),
+        || {
+            if dual {
+                is_observable(a, second, tol, modal_test)
+            } else {
+                is_controllable(a, second, tol, modal_test)
+            }
+        },
+    )
 }
 
-/// The core's analysis of the converted pair (the observability of (A, C) with `dual`), the
-/// staircase's transformation formed when asked; the GIL released by the cost of the
-/// staircase, and of the eigenvectors with the modal test.
+/// The cost of the staircase of a pair of order n (`second` B, or C with `dual`), and of the
+/// eigenvectors with the modal test.
+fn verdict_cost(n: usize, second: faer::MatRef<'_, f64>, modal_test: bool, dual: bool) -> Cost {
+    let width = if dual { second.nrows() } else { second.ncols() };
+    let staircase = Cost::of(10.0 * (n as f64).powi(3), 6.0, n.max(width));
+    if modal_test {
+        staircase.then(eigen_cost(n))
+    } else {
+        staircase
+    }
+}
+
+/// The core's analysis of the converted pair (the observability of (A, C) with `dual`), with
+/// the staircase's transformation; the GIL released by the cost of the staircase, and of the
+/// eigenvectors with the modal test.
 fn analyse(
     py: Python<'_>,
     a: &Bound<'_, PyAny>,
@@ -136,23 +161,15 @@ fn analyse(
     tol: Option<f64>,
     modal_test: bool,
     dual: bool,
-    with_transformation: bool,
 ) -> PyResult<Controllability> {
     let (a, second) = pair(py, a, second, dual)?;
     let (a, second) = (|| Ok((a.matrix()?, second.matrix()?)))().map_err(|e| to_py_err(py, e))?;
-    let n = a.nrows();
-    let width = if dual { second.nrows() } else { second.ncols() };
-    let staircase = Cost::of(10.0 * (n as f64).powi(3), 6.0, n.max(width));
-    let cost = if modal_test {
-        staircase.then(eigen_cost(n))
-    } else {
-        staircase
-    };
+    let cost = verdict_cost(a.nrows(), second, modal_test, dual);
     compute(py, cost, || {
         if dual {
-            observability_core(a, second, tol, modal_test, with_transformation)
+            observability_core(a, second, tol, modal_test, true)
         } else {
-            controllability_core(a, second, tol, modal_test, with_transformation)
+            controllability_core(a, second, tol, modal_test, true)
         }
     })
 }

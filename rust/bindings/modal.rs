@@ -3,7 +3,7 @@
 use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real};
 use super::errors::to_py_err;
-use crate::control::modal::{Mode, modal_analysis as modal_analysis_core};
+use crate::control::modal::{Mode, modal_analysis as modal_analysis_core, mode_spectrum};
 use crate::linalg::charpoly::charpoly as charpoly_core;
 use faer::c64;
 use numpy::PyArrayDyn;
@@ -15,13 +15,21 @@ pub fn eigen_cost(n: usize) -> Cost {
     Cost::of(30.0 * (n as f64).powi(3), 12.0, n)
 }
 
-/// The modal analysis of A (and P^-1 B if B is given), as a dict of numpy arrays.
+/// The cost of the eigenvalues of order n by the real Schur form without Z.
+fn eigenvalue_cost(n: usize) -> Cost {
+    Cost::of(13.0 * (n as f64).powi(3), 3.0, n)
+}
+
+/// The modal analysis of A (and P^-1 B if B is given), as a dict of numpy arrays; without
+/// `vectors`, only the modes (no modal matrix, its condition numbers or P^-1 B; B is still
+/// checked).
 #[pyfunction]
-#[pyo3(signature = (a, b, /))]
+#[pyo3(signature = (a, b, vectors, /))]
 fn modal_analysis<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     b: Option<&Bound<'py, PyAny>>,
+    vectors: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let a = Real::convert(py, a, "A")?;
     let b = Real::convert_optional(py, b, "B")?;
@@ -32,17 +40,66 @@ fn modal_analysis<'py>(
         .transpose()
         .map_err(|e| to_py_err(py, e))?;
     let n = a_matrix.nrows();
+    let mut outputs = Outputs::new(py);
+    let result = PyDict::new(py);
+    if !vectors {
+        let spectrum = compute(py, eigenvalue_cost(n), || mode_spectrum(a_matrix, b_matrix))?;
+        set_modes(
+            &mut outputs,
+            &result,
+            &spectrum.eigenvalues,
+            &spectrum.modes,
+            &spectrum.characteristic_polynomial,
+        )?;
+        outputs.finish()?;
+        return Ok(result);
+    }
     let analysis = compute(py, eigen_cost(n), || {
         modal_analysis_core(a_matrix, b_matrix)
     })?;
-    let mut outputs = Outputs::new(py);
-    let result = PyDict::new(py);
-    let eigenvalues = &analysis.eigenvalues;
+    set_modes(
+        &mut outputs,
+        &result,
+        &analysis.eigenvalues,
+        &analysis.modes,
+        &analysis.characteristic_polynomial,
+    )?;
+    result.set_item(
+        "modal_matrix",
+        outputs.complex_matrix("the modal matrix", analysis.modal_matrix.as_ref())?,
+    )?;
+    result.set_item("modal_matrix_condition", analysis.modal_matrix_condition)?;
+    result.set_item(
+        "balanced_modal_matrix_condition",
+        analysis.balanced_modal_matrix_condition,
+    )?;
+    result.set_item(
+        "modal_matrix_is_singular",
+        analysis.modal_matrix_is_singular(),
+    )?;
+    let modal_input = analysis
+        .modal_input
+        .as_ref()
+        .map(|m| outputs.complex_matrix("P^-1 B", m.as_ref()))
+        .transpose()?;
+    result.set_item("modal_input", modal_input)?;
+    outputs.finish()?;
+    Ok(result)
+}
+
+/// The eigenvalues, the modes' characteristics and the characteristic polynomial into
+/// `result`.
+fn set_modes<'py>(
+    outputs: &mut Outputs<'py>,
+    result: &Bound<'py, PyDict>,
+    eigenvalues: &[c64],
+    modes: &[Mode],
+    polynomial: &[f64],
+) -> PyResult<()> {
     result.set_item(
         "eigenvalues",
         outputs.complex("the eigenvalues", &[eigenvalues.len()], eigenvalues)?,
     )?;
-    let modes = &analysis.modes;
     let mode_eigenvalues: Vec<c64> = modes.iter().map(|m| m.eigenvalue).collect();
     result.set_item(
         "mode_eigenvalue",
@@ -76,26 +133,6 @@ fn modal_analysis<'py>(
         result.set_item(name, outputs.real_as_is(&[values.len()], &values)?)?;
     }
     result.set_item(
-        "modal_matrix",
-        outputs.complex_matrix("the modal matrix", analysis.modal_matrix.as_ref())?,
-    )?;
-    result.set_item("modal_matrix_condition", analysis.modal_matrix_condition)?;
-    result.set_item(
-        "balanced_modal_matrix_condition",
-        analysis.balanced_modal_matrix_condition,
-    )?;
-    result.set_item(
-        "modal_matrix_is_singular",
-        analysis.modal_matrix_is_singular(),
-    )?;
-    let modal_input = analysis
-        .modal_input
-        .as_ref()
-        .map(|m| outputs.complex_matrix("P^-1 B", m.as_ref()))
-        .transpose()?;
-    result.set_item("modal_input", modal_input)?;
-    let polynomial = &analysis.characteristic_polynomial;
-    result.set_item(
         "characteristic_polynomial",
         outputs.real(
             "the characteristic polynomial",
@@ -103,8 +140,7 @@ fn modal_analysis<'py>(
             polynomial,
         )?,
     )?;
-    outputs.finish()?;
-    Ok(result)
+    Ok(())
 }
 
 /// The coefficients [1, a_1, ..., a_n] of det(λI - A).

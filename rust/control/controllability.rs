@@ -340,6 +340,60 @@ pub fn observability(
     )
 }
 
+/// Whether (A, B) is controllable: the verdict of [`controllability`] (no uncontrollable
+/// eigenvalue), without the transformation. The modal test runs only where the staircase
+/// finds every mode controllable: each eigenvalue of a nonempty A_u stands for an eigenvalue
+/// of A among the uncontrollable ones ([`combine_with_modal_test`]), so the verdict is then
+/// "not controllable" whatever the modal test adds.
+pub fn is_controllable(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    tolerance: Option<f64>,
+    modal_test: bool,
+) -> Result<bool, Error> {
+    check_square(a, "A")?;
+    check_finite(a, "A")?;
+    check_rows(b, "B", a.nrows(), "A")?;
+    check_finite(b, "B")?;
+    let (form, balanced) = balanced_staircase(a, b, tolerance, false, Duality::Primal)?;
+    if !modal_test || !form.is_complete() {
+        return Ok(form.is_complete());
+    }
+    let (a, b) = balanced
+        .as_ref()
+        .map_or((a, b), |(a, b)| (a.as_ref(), b.as_ref()));
+    Ok(combine_with_modal_test(form, a.transpose(), b.transpose(), true)?.is_complete())
+}
+
+/// Whether (A, C) is observable: [`is_controllable`] of the dual pair (A^T, C^T), the verdict
+/// of [`observability`].
+pub fn is_observable(
+    a: MatRef<'_, f64>,
+    c: MatRef<'_, f64>,
+    tolerance: Option<f64>,
+    modal_test: bool,
+) -> Result<bool, Error> {
+    check_output_pair(a, c)?;
+    let (form, balanced) = balanced_staircase(
+        a.transpose(),
+        c.transpose(),
+        tolerance,
+        false,
+        Duality::Dual,
+    )?;
+    if !modal_test || !form.is_complete() {
+        return Ok(form.is_complete());
+    }
+    // The modal test of the dual pair (A^T, C^T) takes the eigenvectors of its transpose (the
+    // form is only read for its tolerance and A_u's eigenvalues: not transposed back).
+    let (a_dual, c_dual) = balanced
+        .as_ref()
+        .map_or((a.transpose(), c.transpose()), |(a, c)| {
+            (a.as_ref(), c.as_ref())
+        });
+    Ok(combine_with_modal_test(form, a_dual.transpose(), c_dual.transpose(), true)?.is_complete())
+}
+
 /// Adds the modal test to a staircase verdict. The eigenvectors of `a_dual` (A^T for
 /// controllability) are the left eigenvectors of the pair's plant matrix; `coupling_dual`
 /// (B^T) maps them to the measures.
@@ -779,6 +833,53 @@ mod tests {
             let residual = x.transpose() * z - z * dual.staircase.a.as_ref();
             assert!(frobenius_norm(residual.as_ref()) <= 1e-12 * frobenius_norm(x.as_ref()));
         }
+    }
+
+    #[test]
+    fn the_verdicts_are_those_of_the_analyses() {
+        // Random pairs (controllable) and planted ones (2 uncontrollable modes, interior or
+        // dominant, which only the modal test sees at n = 64), states scaled apart or not,
+        // both tests or the staircase alone: is_controllable and is_observable give the
+        // verdicts of controllability and observability.
+        let mut cases = 0;
+        for n in [1usize, 2, 4, 8, 16, 64] {
+            for seed in 0..6u64 {
+                let (a, b) = match seed % 3 {
+                    0 => (
+                        pseudo_random(n, n, seed + 11 * n as u64),
+                        pseudo_random(n, 2, seed),
+                    ),
+                    _ if n < 4 => (Mat::<f64>::identity(n, n), pseudo_random(n, 1, seed)),
+                    1 => planted(n, 2, [-0.5, 0.25], seed),
+                    _ => planted(n, 2, [-5.0, 6.0], seed),
+                };
+                let d = Mat::from_fn(n, 1, |i, _| {
+                    if seed % 2 == 0 {
+                        1.0
+                    } else {
+                        1e4f64.powi(i as i32 % 3 - 1)
+                    }
+                });
+                let scaled_a = Mat::from_fn(n, n, |i, j| a[(i, j)] * d[(i, 0)] / d[(j, 0)]);
+                let scaled_b = Mat::from_fn(n, b.ncols(), |i, j| b[(i, j)] * d[(i, 0)]);
+                for modal_test in [true, false] {
+                    let (x, y) = (scaled_a.as_ref(), scaled_b.as_ref());
+                    let full = controllability(x, y, None, modal_test, false).unwrap();
+                    assert_eq!(
+                        is_controllable(x, y, None, modal_test).unwrap(),
+                        full.is_complete()
+                    );
+                    let full = observability(x.transpose(), y.transpose(), None, modal_test, false)
+                        .unwrap();
+                    assert_eq!(
+                        is_observable(x.transpose(), y.transpose(), None, modal_test).unwrap(),
+                        full.is_complete()
+                    );
+                    cases += 1;
+                }
+            }
+        }
+        assert_eq!(cases, 72);
     }
 
     #[test]

@@ -30,11 +30,12 @@
 
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::balance;
-use crate::linalg::matrix::{FaerView, from_faer};
+use crate::linalg::matrix::{FaerView, Square, from_faer};
 use crate::linalg::norm::vector_norm;
-use crate::linalg::schur::{real_schur, schur_eigenvectors};
+use crate::linalg::schur::{real_schur, schur_eigenvectors, schur_form_eigenvalues};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, c64};
+use nalgebra::Dyn;
 
 /// The modal matrix counts as singular (no modal decomposition) above this condition number,
 /// about 1/sqrt(u): beyond it P^-1 B would carry no correct digits in the worst case.
@@ -153,6 +154,27 @@ type EigenAndBalancing = (Vec<c64>, Mat<c64>, Vec<f64>);
 
 /// [`eigen`] with the diagonal of its balancing D (D^-1 A D balanced).
 fn eigen_and_balancing(a: MatRef<'_, f64>) -> Result<EigenAndBalancing, Error> {
+    let (balanced, d, scale) = balanced_for_eigen(a)?;
+    // D^-1 A D = Z T Z^T: the eigenvectors of A are D Z x.
+    let (values, vectors) = schur_eigenvectors(&real_schur(balanced.as_faer())?, &d);
+    Ok((values.into_iter().map(|v| v * scale).collect(), vectors, d))
+}
+
+/// The eigenvalues of [`eigen`], bit for bit and in its order, without the eigenvectors: the
+/// same balancing and real Schur form, its transformation Z not accumulated
+/// ([`schur_form_eigenvalues`]), read from T's diagonal blocks as [`schur_eigenvectors`]
+/// reads them.
+pub fn eigen_values(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
+    let (balanced, _, scale) = balanced_for_eigen(a)?;
+    Ok(schur_form_eigenvalues(balanced.as_faer())?
+        .into_iter()
+        .map(|v| v * scale)
+        .collect())
+}
+
+/// The balanced D^-1 (A / s) D of [`eigen`], the diagonal of D and s (A checked square and
+/// finite).
+fn balanced_for_eigen(a: MatRef<'_, f64>) -> Result<(Square<Dyn>, Vec<f64>, f64), Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let scale = crate::linalg::balance::range_scale(a);
@@ -160,10 +182,8 @@ fn eigen_and_balancing(a: MatRef<'_, f64>) -> Result<EigenAndBalancing, Error> {
     if scale != 1.0 {
         balanced.as_mut_slice().iter_mut().for_each(|x| *x /= scale);
     }
-    // D^-1 A D = Z T Z^T: the eigenvectors of A are D Z x.
     let d = balance(&mut balanced);
-    let (values, vectors) = schur_eigenvectors(&real_schur(balanced.as_faer())?, &d);
-    Ok((values.into_iter().map(|v| v * scale).collect(), vectors, d))
+    Ok((balanced, d, scale))
 }
 
 /// The coefficients of prod (λ - λ_i), highest power first, multiplied out in real arithmetic
@@ -231,17 +251,43 @@ fn condition_number(p: &Mat<c64>, eigenvalues: &[c64]) -> f64 {
     }
 }
 
-/// The modal analysis of A, and P^-1 B when `b` is given (n x m).
-pub fn modal_analysis(
+/// The modes of A without its eigenvectors: the eigenvalues, the modes and the characteristic
+/// polynomial of [`modal_analysis`], bit for bit, from the real Schur form without Z
+/// ([`eigen_values`]). `b` (n x m) is checked as [`modal_analysis`] checks it, with the same
+/// errors, though P^-1 B is not formed.
+pub fn mode_spectrum(
     a: MatRef<'_, f64>,
     b: Option<MatRef<'_, f64>>,
-) -> Result<ModalAnalysis, Error> {
-    let (values, vectors, balancing) = eigen_and_balancing(a)?;
+) -> Result<ModeSpectrum, Error> {
+    let values = eigen_values(a)?;
     if let Some(b) = b {
         check_rows(b, "B", a.nrows(), "A")?;
         check_finite(b, "B")?;
     }
-    // Group into modes and order them by natural frequency, then by decreasing damping.
+    let (eigenvalues, modes, _) = ordered_modes(&values);
+    let characteristic_polynomial = polynomial_from_roots(&eigenvalues);
+    Ok(ModeSpectrum {
+        eigenvalues,
+        modes,
+        characteristic_polynomial,
+    })
+}
+
+/// The part of a [`ModalAnalysis`] that needs no eigenvector.
+#[derive(Debug, Clone)]
+pub struct ModeSpectrum {
+    /// The eigenvalues, each conjugate pair adjacent (Im > 0 first), in the order of `modes`.
+    pub eigenvalues: Vec<c64>,
+    /// The modes, by increasing natural frequency (then by decreasing damping).
+    pub modes: Vec<Mode>,
+    /// Coefficients of det(λI - A), highest power first: [1, a_1, ..., a_n].
+    pub characteristic_polynomial: Vec<f64>,
+}
+
+/// The modes of the eigenvalues `values` (conjugate pairs adjacent, Im > 0 first), ordered by
+/// natural frequency, then by decreasing damping: the eigenvalues in that order, the modes
+/// (their indices into it) and, for each, its position in `values`.
+fn ordered_modes(values: &[c64]) -> (Vec<c64>, Vec<Mode>, Vec<usize>) {
     let mut modes = Vec::new();
     let mut k = 0;
     while k < values.len() {
@@ -256,8 +302,6 @@ pub fn modal_analysis(
             .then(y.damping_ratio.total_cmp(&x.damping_ratio))
             .then(x.eigenvalue.re.total_cmp(&y.eigenvalue.re))
     });
-    // Reorder eigenvalues and eigenvectors to follow the modes.
-    let n = values.len();
     let order: Vec<usize> = modes
         .iter()
         .flat_map(|m| {
@@ -269,7 +313,6 @@ pub fn modal_analysis(
         })
         .collect();
     let eigenvalues: Vec<c64> = order.iter().map(|&i| values[i]).collect();
-    let modal_matrix = Mat::from_fn(n, n, |i, j| vectors[(i, order[j])]);
     let mut position = 0;
     for mode in &mut modes {
         mode.indices = if mode.oscillatory {
@@ -279,6 +322,22 @@ pub fn modal_analysis(
         };
         position += if mode.oscillatory { 2 } else { 1 };
     }
+    (eigenvalues, modes, order)
+}
+
+/// The modal analysis of A, and P^-1 B when `b` is given (n x m).
+pub fn modal_analysis(
+    a: MatRef<'_, f64>,
+    b: Option<MatRef<'_, f64>>,
+) -> Result<ModalAnalysis, Error> {
+    let (values, vectors, balancing) = eigen_and_balancing(a)?;
+    if let Some(b) = b {
+        check_rows(b, "B", a.nrows(), "A")?;
+        check_finite(b, "B")?;
+    }
+    let n = values.len();
+    let (eigenvalues, modes, order) = ordered_modes(&values);
+    let modal_matrix = Mat::from_fn(n, n, |i, j| vectors[(i, order[j])]);
     // P = D P_b S with P_b the unit eigenvectors of the balanced D^-1 A D and S diagonal (the
     // columns' norms): P^-1 B = S^-1 P_b^-1 D^-1 B, solved with the better conditioned P_b.
     let mut balanced_modal = Mat::from_fn(n, n, |i, j| modal_matrix[(i, j)] / balancing[i]);
@@ -387,6 +446,77 @@ mod tests {
                 "n = {n}: {got} vs {expected}"
             );
         }
+    }
+
+    #[test]
+    fn the_spectrum_without_vectors_is_that_of_the_full_analysis_bit_for_bit() {
+        // Random matrices of orders 1 to 120 (both QR iterations and both Hessenberg
+        // reductions), plain, graded by 10^±4, with repeated eigenvalues (a block diagonal of
+        // equal blocks) and scaled near the ends of the range: the eigenvalues, the modes and
+        // the characteristic polynomial of mode_spectrum are those of modal_analysis exactly.
+        let mut seed = 0xC0FFEE_u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut cases = 0;
+        for n in [1usize, 2, 3, 4, 5, 8, 9, 16, 33, 64, 80, 120] {
+            for variant in 0..4 {
+                let grade = |i: usize| match variant {
+                    1 => 10f64.powf(8.0 * i as f64 / n as f64 - 4.0),
+                    _ => 1.0,
+                };
+                let factor = if variant == 3 { 1e-200 } else { 1.0 };
+                let mut a = Mat::from_fn(n, n, |i, j| next() * grade(i) / grade(j) * factor);
+                if variant == 2 && n >= 4 {
+                    let half = n / 2;
+                    for i in 0..n {
+                        for j in 0..n {
+                            a[(i, j)] = if (i < half) == (j < half) {
+                                a[(i % half, j % half)]
+                            } else {
+                                0.0
+                            };
+                        }
+                    }
+                }
+                let b = Mat::from_fn(n, 2, |_, _| next());
+                let full = modal_analysis(a.as_ref(), Some(b.as_ref())).unwrap();
+                let spectrum = mode_spectrum(a.as_ref(), Some(b.as_ref())).unwrap();
+                let bits = |v: &[c64]| -> Vec<(u64, u64)> {
+                    v.iter().map(|x| (x.re.to_bits(), x.im.to_bits())).collect()
+                };
+                assert_eq!(
+                    bits(&spectrum.eigenvalues),
+                    bits(&full.eigenvalues),
+                    "n = {n}"
+                );
+                // (Debug prints each f64 exactly, NaN included, which == would not match.)
+                assert_eq!(
+                    format!("{:?}", spectrum.modes),
+                    format!("{:?}", full.modes),
+                    "n = {n}, variant {variant}"
+                );
+                let polynomial = |p: &[f64]| p.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    polynomial(&spectrum.characteristic_polynomial),
+                    polynomial(&full.characteristic_polynomial)
+                );
+                cases += 1;
+            }
+        }
+        assert_eq!(cases, 48);
+        // B is refused as the full analysis refuses it.
+        let error = mode_spectrum(
+            Mat::<f64>::identity(2, 2).as_ref(),
+            Some(Mat::<f64>::zeros(3, 1).as_ref()),
+        );
+        assert_eq!(
+            error.unwrap_err().to_string(),
+            "B must have as many rows as A (2), got 3"
+        );
     }
 
     #[test]

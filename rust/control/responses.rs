@@ -512,7 +512,7 @@ pub fn steady_state(
         && (root_n * bound * tolerance < 1.0
             || 10.0 * root_n * one_norm_estimate(&Inverse(&lu), 2) * tolerance < 1.0);
     if !cleared {
-        let (eigenvalues, _) = crate::control::modal::eigen(a)?;
+        let eigenvalues = crate::control::modal::eigen_values(a)?;
         if let Some(lambda) = eigenvalues.iter().find(|l| l.norm() <= tolerance) {
             return Err(Error::Singular {
                 arg: "A",

@@ -105,7 +105,8 @@ pub(crate) use francis::{Finished, Until, francis_qr, francis_qr_until};
 use crate::error::{Error, check_finite, check_square};
 use crate::linalg::balance::{GRADED_SPREAD, range_scale};
 use crate::linalg::hessenberg::{
-    UNBLOCKED_HESSENBERG_MAX_ORDER, balanced, hessenberg, reduce_in_place, reduce_to_hessenberg,
+    UNBLOCKED_HESSENBERG_MAX_ORDER, balanced, hessenberg, hessenberg_matrix, reduce_in_place,
+    reduce_to_hessenberg,
 };
 use crate::linalg::matrix::{
     FaerView, Order, Square, from_faer, from_faer_in, identity_in, with_order,
@@ -128,6 +129,22 @@ pub fn real_schur_with(a: MatRef<'_, f64>, spectrum: Spectrum) -> Result<RealSch
     with_order!(a.nrows(), order => {
         square_real_schur(from_faer_in(order, a), spectrum, Until::Complete)
             .map(|(schur, _)| schur)
+    })
+}
+
+/// The eigenvalues of the real Schur form T of [`real_schur`], bit for bit and in the order
+/// of its diagonal (each conjugate pair adjacent, Im > 0 first), without Z: the same reduction
+/// and iteration, the transformations not accumulated. Below [`MULTISHIFT_MIN_ORDER`] the
+/// double-shift iteration transforms only the active window (its entries, the shifts and the
+/// deflations take the same operations as in the whole form); from that order the multishift
+/// iteration forms all of T, since its path depends on whether it does. About half the work
+/// of [`real_schur`] at order 64.
+pub fn schur_form_eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
+    check_square(a, "A")?;
+    let n = a.nrows();
+    with_order!(n, order => {
+        schur_form_in(from_faer_in(order, a), Spectrum::General, Until::Complete, false)
+            .map(|((t, _, scale), _)| block_eigenvalues(n, |i, j| t[(i, j)] * scale))
     })
 }
 
@@ -163,19 +180,36 @@ pub(crate) struct SquareSchur<O: Order> {
 /// [`square_real_schur`] without the conversion to faer matrices, for a caller that reads a
 /// few blocks of T and Z (the Riccati solver).
 pub(crate) fn square_schur_form<O: Order>(
-    mut a: Square<O>,
+    a: Square<O>,
     spectrum: Spectrum,
     until: Until,
 ) -> Result<(SquareSchur<O>, Finished), Error> {
+    schur_form_in(a, spectrum, until, true).map(|((t, z, scale), finished)| {
+        let z = z.expect("Z is accumulated when asked for");
+        (SquareSchur { t, z, scale }, finished)
+    })
+}
+
+/// [`square_schur_form`] with Z accumulated only `with_z` (else None, and T formed only as
+/// far as [`schur_form_eigenvalues`] needs it). The transformations of T are the same either
+/// way: Z only receives them.
+fn schur_form_in<O: Order>(
+    mut a: Square<O>,
+    spectrum: Spectrum,
+    until: Until,
+    with_z: bool,
+) -> Result<(SquareSchurOf<O>, Finished), Error> {
     check_finite(a.as_faer(), "A")?;
     let n = a.nrows();
     let scale = range_scale(a.as_faer());
     if scale != 1.0 {
         a.as_mut_slice().iter_mut().for_each(|x| *x /= scale);
     }
+    let order = a.shape_generic().0;
+    let full = with_z || n >= MULTISHIFT_MIN_ORDER;
     if n <= UNBLOCKED_HESSENBERG_MAX_ORDER {
-        let mut z = identity_in(a.shape_generic().0);
-        reduce_to_hessenberg(&mut a, Some(&mut z));
+        let mut z = with_z.then(|| identity_in(order));
+        reduce_to_hessenberg(&mut a, z.as_mut());
         // The iteration works on A / scale.
         let until = match until {
             Until::UnstableHalf { margin } => Until::UnstableHalf {
@@ -185,25 +219,33 @@ pub(crate) fn square_schur_form<O: Order>(
         };
         let finished = francis_qr_until(
             &mut a,
-            Some(&mut z),
+            z.as_mut(),
             (0, n.saturating_sub(1)),
-            true,
+            full,
             spectrum,
             until,
         )?;
-        Ok((SquareSchur { t: a, z, scale }, finished))
+        Ok(((a, z, scale), finished))
     } else {
         // (Above the fixed orders: O is Dyn, and the copies back are O(n^2).)
-        let reduced = hessenberg(a.as_faer())?;
-        let (mut t, mut z) = (from_faer(reduced.h.as_ref()), from_faer(reduced.q.as_ref()));
-        schur_of_hessenberg(&mut t, Some(&mut z), true, spectrum)?;
-        let (t, z) = (
-            from_faer_in(a.shape_generic().0, t.as_faer()),
-            from_faer_in(a.shape_generic().0, z.as_faer()),
-        );
-        Ok((SquareSchur { t, z, scale }, Finished::Complete))
+        let (mut t, mut z) = if with_z {
+            let reduced = hessenberg(a.as_faer())?;
+            (
+                from_faer(reduced.h.as_ref()),
+                Some(from_faer(reduced.q.as_ref())),
+            )
+        } else {
+            (from_faer(hessenberg_matrix(a.as_faer()).as_ref()), None)
+        };
+        schur_of_hessenberg(&mut t, z.as_mut(), full, spectrum)?;
+        let t = from_faer_in(order, t.as_faer());
+        let z = z.map(|z| from_faer_in(order, z.as_faer()));
+        Ok(((t, z, scale), Finished::Complete))
     }
 }
+
+/// T, Z (when accumulated) and the scale s of A = Z (s T) Z^T.
+type SquareSchurOf<O> = (Square<O>, Option<Square<O>>, f64);
 
 /// The eigenvalues of a square, finite matrix, in the order of the diagonal of its Schur form,
 /// each conjugate pair adjacent with Im > 0 first (and exactly conjugate).
