@@ -48,7 +48,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._results import Result, Tabular
 from ._validation import FloatArray, real_array
-from .exceptions import IllConditionedWarning, ShapeError
+from .exceptions import AerocontrolError, IllConditionedWarning, ShapeError
 from .statespace import is_system, name_sequence, plant_arrays
 
 if TYPE_CHECKING:
@@ -168,8 +168,9 @@ class Modes(Result):
         if dt > 0.0:
             result = _equivalent_continuous(result, dt)
         if not np.array_equal(result["eigenvalues"], self.eigenvalues):
-            raise RuntimeError(
-                "the eigenvalues of the analysis with eigenvectors differ from those of the modes"
+            raise AerocontrolError(
+                "internal error: the eigenvalues of the analysis with eigenvectors differ from "
+                "those of the modes"
             )  # pragma: no cover
         state.update(_modal_fields(result, stacklevel=3))
         del state["_plant"]
