@@ -25,21 +25,6 @@
 //! G(e^{jωh}) = C (e^{jωh} I - A)^-1 B + D ([`discrete_frequency_response_into`]): the same
 //! kernel at the point z = cos ωh + j sin ωh of the unit circle instead of jω, periodic in ω
 //! with period 2π/h (a pole on the unit circle gives infinite or NaN entries likewise).
-//!
-//! Many frequencies against the order (at least [`SCHUR_FREQUENCIES_PER_ORDER`] n, from order
-//! [`SCHUR_MIN_ORDER`] on) take the real Schur form A = Z T Z^T (`linalg::schur`, as backward
-//! stable as the Hessenberg reduction) instead: T is quasi-upper-triangular, so sI - T needs
-//! no elimination, only a back substitution with T's real rows (a 2 x 2 complex solve with
-//! partial pivoting at each 2 x 2 block), a third of the arithmetic per frequency of the
-//! Hessenberg solve for the price of the Schur form's O(n^3) once. This is the Schur-form
-//! method Laub (1981, "Efficient multivariable frequency response computations", IEEE TAC
-//! 26(2)) weighs against his Hessenberg one: cheaper per frequency, dearer to set up.
-//! The Schur form's backward error, though O(u ||A||) as the Hessenberg form's, has a larger
-//! constant (the QR sweeps apply many more reflectors), which shows at frequencies near a
-//! lightly damped pole: there the error, of order n u ||T||_F / min_k |s - λ_k|, is larger
-//! (8e-11 against 2.5e-13 for a 64-state model at 1e-3 from a pole of a normal matrix, against
-//! mpmath). A frequency where that estimate exceeds [`SCHUR_ERROR_ESTIMATE`] is therefore
-//! evaluated by the Hessenberg solve, the reduction made only when some frequency needs it.
 
 use crate::error::{
     Error, check_finite, check_finite_values, check_output_len, check_positive, check_rows,
@@ -47,7 +32,6 @@ use crate::error::{
 };
 use crate::linalg::balance::{range_scale, times_power_of_two};
 use crate::linalg::hessenberg::{Hessenberg, hessenberg};
-use crate::linalg::schur::{RealSchur, quasi_triangular_eigenvalues, real_schur};
 use crate::platform::dispatch::{fma_dispatch, multiply_add};
 use crate::platform::parallel::ParallelContext;
 use faer::{Mat, MatRef, c64};
@@ -56,19 +40,6 @@ use rayon::prelude::*;
 /// 2^600: |s| / σ (σ the power of two A is divided by) beyond which G(s) is taken from its
 /// expansion at infinity ([`HessenbergModel::far`]).
 const FAR: f64 = 4.149515568880993e180;
-
-/// The smallest order that takes the real Schur form for many frequencies: the small models
-/// of flight control keep the Hessenberg solve (and its results bit for bit).
-pub const SCHUR_MIN_ORDER: usize = 9;
-
-/// The Schur form is taken for at least this many frequencies per state: its set-up costs
-/// about as much as 3 n Hessenberg solves more than the Hessenberg reduction does.
-pub const SCHUR_FREQUENCIES_PER_ORDER: usize = 4;
-
-/// 2^-36: the largest error estimate n u ||T||_F / min_k |s - λ_k| of the Schur form's
-/// back substitution that keeps it for a frequency (its errors were a fifth to an eighth of
-/// the estimate, against mpmath).
-pub const SCHUR_ERROR_ESTIMATE: f64 = 1.4551915228366852e-11;
 
 /// Checks A (n x n), B (n x m), C (p x n) and D (p x m) of a state-space model.
 pub fn check_state_space(
@@ -105,24 +76,12 @@ pub fn check_state_space(
     check_finite(d, "D")
 }
 
-/// Which orthogonal similarity the model is held in.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Form {
-    /// Upper Hessenberg H = Q^T A Q.
-    Hessenberg,
-    /// The real Schur form T = Z^T A Z, quasi-upper-triangular with its 2 x 2 blocks in
-    /// standard form.
-    Schur,
-}
-
-/// The model in Hessenberg (or real Schur) coordinates, laid out for the per-frequency
-/// kernel: H row-major, Q^T B column by column, C Q and D row-major.
+/// The model in Hessenberg coordinates, laid out for the per-frequency kernel: H row-major,
+/// Q^T B column by column, C Q and D row-major.
 struct HessenbergModel {
     n: usize,
     m: usize,
     p: usize,
-    form: Form,
-    /// H, or T (which is upper Hessenberg too).
     h: Vec<f64>,
     b: Vec<f64>,
     c: Vec<f64>,
@@ -132,38 +91,22 @@ struct HessenbergModel {
     exponent: f64,
     /// σ, the power of two the point s is divided by.
     sigma: f64,
-    /// The eigenvalues of T / σ (the Schur form; empty for the Hessenberg form).
-    eigenvalues: Vec<c64>,
-    /// n u ||T / σ||_F (the Schur form).
-    error_scale: f64,
 }
 
 impl HessenbergModel {
-    /// The model of a checked (A, B, C, D), scaled and reduced once to the given form.
+    /// The model of a checked (A, B, C, D), scaled and reduced once.
     fn new(
         a: MatRef<'_, f64>,
         b: MatRef<'_, f64>,
         c: MatRef<'_, f64>,
         d: MatRef<'_, f64>,
-        form: Form,
     ) -> Result<Self, Error> {
         let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
         let (sigma, beta, gamma) = (range_scale(a), range_scale(b), range_scale(c));
         let scaled =
             |x: MatRef<'_, f64>, s: f64| Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)] / s);
         let (a, b, c) = (scaled(a, sigma), scaled(b, beta), scaled(c, gamma));
-        let (h, q, eigenvalues) = match form {
-            Form::Hessenberg => {
-                let Hessenberg { h, q } = hessenberg(a.as_ref())?;
-                (h, q, Vec::new())
-            }
-            Form::Schur => {
-                let RealSchur { t, z } = real_schur(a.as_ref())?;
-                let eigenvalues = quasi_triangular_eigenvalues(t.as_ref());
-                (t, z, eigenvalues)
-            }
-        };
-        let error_scale = n as f64 * f64::EPSILON / 2.0 * h.norm_l2();
+        let Hessenberg { h, q } = hessenberg(a.as_ref())?;
         let (qb, cq) = (q.transpose() * &b, &c * &q);
         let row_major = |x: &Mat<f64>| -> Vec<f64> {
             (0..x.nrows())
@@ -174,7 +117,6 @@ impl HessenbergModel {
             n,
             m,
             p,
-            form,
             h: row_major(&h),
             b: (0..m)
                 .flat_map(|j| (0..n).map(move |i| (j, i)))
@@ -184,27 +126,7 @@ impl HessenbergModel {
             d: row_major(&d.to_owned()),
             exponent: gamma.log2() + beta.log2() - sigma.log2(),
             sigma,
-            eigenvalues,
-            error_scale,
         })
-    }
-
-    /// Whether the Schur form's back substitution keeps its error estimate at the point s
-    /// within [`SCHUR_ERROR_ESTIMATE`] (always for the Hessenberg form, and beyond [`FAR`],
-    /// where the expansion at infinity is taken).
-    fn trusts(&self, point: c64) -> bool {
-        if self.form == Form::Hessenberg || point.norm() / self.sigma > FAR {
-            return true;
-        }
-        // Squared distances (no square root per eigenvalue): one that overflows is far, one
-        // that underflows is near, both the right verdict.
-        let s = point / self.sigma;
-        let squared = self.eigenvalues.iter().fold(f64::INFINITY, |d, &l| {
-            let (re, im) = (s.re - l.re, s.im - l.im);
-            d.min(re * re + im * im)
-        });
-        let bound = self.error_scale / SCHUR_ERROR_ESTIMATE;
-        bound * bound <= squared
     }
 
     /// G at the point s: by the Hessenberg solve at s / σ, or where |s| / σ exceeds
@@ -219,10 +141,7 @@ impl HessenbergModel {
             } else {
                 point / self.sigma
             };
-            match self.form {
-                Form::Hessenberg => evaluate_frequency(self, s, ws, g),
-                Form::Schur => evaluate_quasi_triangular(self, s, ws, g),
-            }
+            evaluate_frequency(self, s, ws, g);
         }
     }
 
@@ -298,21 +217,14 @@ impl HessenbergModel {
         }
     }
 
-    /// Scratch for one evaluation at a time (the Schur form's back substitution needs no
-    /// copy of the matrix).
+    /// Scratch for one evaluation at a time.
     fn workspace(&self) -> Workspace {
         let (n, m) = (self.n, self.m);
-        let (square, diagonal) = match self.form {
-            Form::Hessenberg => (n * n, 0),
-            Form::Schur => (0, n),
-        };
         Workspace {
-            re: vec![0.0; square],
-            im: vec![0.0; square],
+            re: vec![0.0; n * n],
+            im: vec![0.0; n * n],
             x_re: vec![0.0; n * m],
             x_im: vec![0.0; n * m],
-            inverse_re: vec![0.0; diagonal],
-            inverse_im: vec![0.0; diagonal],
         }
     }
 }
@@ -334,7 +246,7 @@ impl FrequencyEvaluator {
         d: MatRef<'_, f64>,
     ) -> Result<Self, Error> {
         check_state_space(a, b, c, d)?;
-        let model = HessenbergModel::new(a, b, c, d, Form::Hessenberg)?;
+        let model = HessenbergModel::new(a, b, c, d)?;
         let workspace = model.workspace();
         let g = vec![c64::new(0.0, 0.0); model.p * model.m];
         Ok(Self {
@@ -380,9 +292,6 @@ struct Workspace {
     im: Vec<f64>,
     x_re: Vec<f64>,
     x_im: Vec<f64>,
-    /// 1 / (s - t_kk), real and imaginary parts (the Schur form).
-    inverse_re: Vec<f64>,
-    inverse_im: Vec<f64>,
 }
 
 /// Σ u_i v_i for complex vectors given as real and imaginary planes, in four independent lanes
@@ -427,10 +336,8 @@ fn evaluate_kernel<const FMA: bool>(
     ws: &mut Workspace,
     g: &mut [c64],
 ) {
-    let (n, m) = (model.n, model.m);
-    let Workspace {
-        re, im, x_re, x_im, ..
-    } = ws;
+    let (n, m, p) = (model.n, model.m, model.p);
+    let Workspace { re, im, x_re, x_im } = ws;
     // sI - H; entries left of the subdiagonal are never read. A zero real part (s = jω) is not
     // added, so that -h keeps its sign of zero.
     for i in 0..n {
@@ -501,13 +408,7 @@ fn evaluate_kernel<const FMA: bool>(
             (xr[k], xi[k]) = complex_divide(sr, si, pr, pi);
         }
     }
-    output::<FMA>(model, x_re, x_im, g);
-}
-
-/// G = C Q X + D into `g` (p x m row-major) from the solution X of (sI - H) X = Q^T B.
-#[inline(always)]
-fn output<const FMA: bool>(model: &HessenbergModel, x_re: &[f64], x_im: &[f64], g: &mut [c64]) {
-    let (n, m, p) = (model.n, model.m, model.p);
+    // G = C Q X + D.
     for i in 0..p {
         let c_row = &model.c[i * n..(i + 1) * n];
         for column in 0..m {
@@ -530,160 +431,6 @@ fn output<const FMA: bool>(model: &HessenbergModel, x_re: &[f64], x_im: &[f64], 
 }
 
 fma_dispatch!(fn evaluate_frequency(model: &HessenbergModel, point: c64, ws: &mut Workspace, g: &mut [c64]) => evaluate_kernel);
-
-/// Σ_i t_i v_i for a real row t and R real vectors v (the real and imaginary planes of the
-/// right-hand sides' solutions, each read from `start` on), in four independent lanes each
-/// (as [`complex_dot`]): one pass over t for every plane.
-#[inline(always)]
-fn real_dots<const FMA: bool, const R: usize>(
-    t: &[f64],
-    planes: [&[f64]; R],
-    start: usize,
-) -> [f64; R] {
-    const LANES: usize = 4;
-    let len = t.len();
-    let planes = planes.map(|v| &v[start..start + len]);
-    let mut lanes = [[0.0; LANES]; R];
-    let chunks = len / LANES;
-    for c in 0..chunks {
-        let range = c * LANES..(c + 1) * LANES;
-        let t = &t[range.clone()];
-        for (lane, v) in lanes.iter_mut().zip(&planes) {
-            let v = &v[range.clone()];
-            for l in 0..LANES {
-                lane[l] = multiply_add::<FMA>(t[l], v[l], lane[l]);
-            }
-        }
-    }
-    let mut sums = lanes.map(|l| (l[0] + l[1]) + (l[2] + l[3]));
-    for i in chunks * LANES..len {
-        for (sum, v) in sums.iter_mut().zip(&planes) {
-            *sum = multiply_add::<FMA>(t[i], v[i], *sum);
-        }
-    }
-    sums
-}
-
-/// Σ_j t_j x_j over a real row t for the right-hand sides `first` and `first + 1` (when
-/// `pair`) of the solution planes, each read from `start` on: the real and imaginary parts of
-/// one or two sums.
-#[inline(always)]
-fn row_sums<const FMA: bool>(
-    t: &[f64],
-    x_re: &[f64],
-    x_im: &[f64],
-    n: usize,
-    first: usize,
-    pair: bool,
-    start: usize,
-) -> [c64; 2] {
-    let (r0, i0) = (&x_re[first * n..], &x_im[first * n..]);
-    if pair {
-        let (r1, i1) = (&x_re[(first + 1) * n..], &x_im[(first + 1) * n..]);
-        let [a, b, c, d] = real_dots::<FMA, 4>(t, [r0, i0, r1, i1], start);
-        [c64::new(a, b), c64::new(c, d)]
-    } else {
-        let [a, b] = real_dots::<FMA, 2>(t, [r0, i0], start);
-        [c64::new(a, b), c64::new(0.0, 0.0)]
-    }
-}
-
-/// The solution of [[d, -b], [-c, d]] [x_1, x_2]^T = [r_1, r_2]^T (d = s - a complex; a, b, c
-/// real entries of a standard 2 x 2 block [[a, b], [c, a]], b c < 0, so c != 0) by Gaussian
-/// elimination with partial pivoting in the first column (by |re| + |im|) and Smith's
-/// divisions, so that no square of an entry is formed.
-#[inline(always)]
-fn solve_block(d: c64, b: f64, c: f64, r1: c64, r2: c64) -> (c64, c64) {
-    let divide = |x: c64, y: c64| {
-        let (re, im) = complex_divide(x.re, x.im, y.re, y.im);
-        c64::new(re, im)
-    };
-    if d.re.abs() + d.im.abs() >= c.abs() {
-        // f = -c / d; row 2 - f row 1: (d + f b) x_2 = r_2 - f r_1.
-        let f = divide(c64::new(-c, 0.0), d);
-        let x2 = divide(r2 - f * r1, d + f * b);
-        (divide(r1 + x2 * b, d), x2)
-    } else {
-        // Rows swapped: f = d / (-c); row 1 - f row 2: (-b - f d) x_2 = r_1 - f r_2.
-        let f = d * (-1.0 / c);
-        let x2 = divide(r1 - f * r2, c64::new(-b, 0.0) - f * d);
-        (divide(r2 - d * x2, c64::new(-c, 0.0)), x2)
-    }
-}
-
-/// G(s) into `g` from the real Schur form: back substitution of (sI - T) X = Z^T B row by
-/// row from the bottom, a 1 x 1 block multiplying by 1 / (s - t_kk) (Smith's division,
-/// formed for every row before the substitution), a 2 x 2 block solved by
-/// [`solve_block`]; then G = C Z X + D.
-#[inline(always)]
-fn quasi_triangular_kernel<const FMA: bool>(
-    model: &HessenbergModel,
-    point: c64,
-    ws: &mut Workspace,
-    g: &mut [c64],
-) {
-    let (n, m) = (model.n, model.m);
-    let t = &model.h;
-    let Workspace {
-        x_re,
-        x_im,
-        inverse_re,
-        inverse_im,
-        ..
-    } = ws;
-    x_re.copy_from_slice(&model.b);
-    x_im.fill(0.0);
-    // 1 / (s - t_kk) for every row first, independent of one another (the divisions overlap
-    // instead of waiting on the substitution's chain).
-    for (k, (inverse_re, inverse_im)) in
-        inverse_re.iter_mut().zip(inverse_im.iter_mut()).enumerate()
-    {
-        (*inverse_re, *inverse_im) = complex_divide(1.0, 0.0, point.re - t[k * n + k], point.im);
-    }
-    // The right-hand sides two at a time, so that each row of T is read once per pair.
-    let mut k = n;
-    while k > 0 {
-        if k >= 2 && t[(k - 1) * n + k - 2] != 0.0 {
-            let i = k - 2;
-            let (a, b, c) = (t[i * n + i], t[i * n + i + 1], t[(i + 1) * n + i]);
-            let d = c64::new(point.re - a, point.im);
-            let (upper, lower) = (&t[i * n + k..(i + 1) * n], &t[(i + 1) * n + k..k * n]);
-            for first in (0..m).step_by(2) {
-                let pair = first + 1 < m;
-                let ups = row_sums::<FMA>(upper, x_re, x_im, n, first, pair, k);
-                let lows = row_sums::<FMA>(lower, x_re, x_im, n, first, pair, k);
-                for (column, (up, low)) in (first..m.min(first + 2)).zip(ups.into_iter().zip(lows))
-                {
-                    let (at, below) = (column * n + i, column * n + i + 1);
-                    let r1 = c64::new(x_re[at] + up.re, x_im[at] + up.im);
-                    let r2 = c64::new(x_re[below] + low.re, x_im[below] + low.im);
-                    let (x1, x2) = solve_block(d, b, c, r1, r2);
-                    (x_re[at], x_im[at]) = (x1.re, x1.im);
-                    (x_re[below], x_im[below]) = (x2.re, x2.im);
-                }
-            }
-            k -= 2;
-        } else {
-            let i = k - 1;
-            let row = &t[i * n + k..(i + 1) * n];
-            let (vr, vi) = (inverse_re[i], inverse_im[i]);
-            for first in (0..m).step_by(2) {
-                let pair = first + 1 < m;
-                let sums = row_sums::<FMA>(row, x_re, x_im, n, first, pair, k);
-                for (column, sum) in (first..m.min(first + 2)).zip(sums) {
-                    let at = column * n + i;
-                    let (ar, ai) = (x_re[at] + sum.re, x_im[at] + sum.im);
-                    x_re[at] = multiply_add::<FMA>(ar, vr, -ai * vi);
-                    x_im[at] = multiply_add::<FMA>(ar, vi, ai * vr);
-                }
-            }
-            k -= 1;
-        }
-    }
-    output::<FMA>(model, x_re, x_im, g);
-}
-
-fma_dispatch!(fn evaluate_quasi_triangular(model: &HessenbergModel, point: c64, ws: &mut Workspace, g: &mut [c64]) => quasi_triangular_kernel);
 
 /// Writes G(jω_k) = C (jω_k I - A)^-1 B + D for every ω_k into `out`, a row-major
 /// len(omega) x p x m stack.
@@ -750,34 +497,17 @@ fn transfer_function_into(
     if p * m == 0 {
         return Ok(());
     }
-    let n = a.nrows();
-    let form = if n >= SCHUR_MIN_ORDER && omega.len() >= SCHUR_FREQUENCIES_PER_ORDER * n {
-        Form::Schur
-    } else {
-        Form::Hessenberg
-    };
-    let model = HessenbergModel::new(a, b, c, d, form)?;
-    let trusted: Vec<bool> = omega.iter().map(|&w| model.trusts(point(w))).collect();
-    let fallback = if trusted.iter().all(|&t| t) {
-        None
-    } else {
-        Some(HessenbergModel::new(a, b, c, d, Form::Hessenberg)?)
-    };
-    let workspace = || (model.workspace(), fallback.as_ref().map(|f| f.workspace()));
+    let model = HessenbergModel::new(a, b, c, d)?;
+    let workspace = || model.workspace();
     // The evaluations multiply by their own kernels, not faer's.
     let context = ParallelContext::capture(0);
     omega
         .par_iter()
-        .zip(&trusted)
         .zip(out.par_chunks_mut(p * m))
         .with_min_len(32)
-        .try_for_each_init(workspace, |(ws, fallback_ws), ((&w, &trusted), g)| {
+        .try_for_each_init(workspace, |ws, (&w, g)| {
             context.run(|| {
-                let s = point(w);
-                match (&fallback, fallback_ws) {
-                    (Some(f), Some(f_ws)) if !trusted => f.evaluate(s, f_ws, g),
-                    _ => model.evaluate(s, ws, g),
-                }
+                model.evaluate(point(w), ws, g);
                 Ok(())
             })
         })
@@ -840,90 +570,6 @@ mod tests {
                 assert!(err < 1e-12, "n={n} w={w}: {err}");
             }
         }
-    }
-
-    #[test]
-    fn the_schur_form_matches_a_dense_solve() {
-        // Orders from SCHUR_MIN_ORDER on, with enough frequencies to take the Schur form:
-        // random matrices (real eigenvalues and 2 x 2 blocks), a frequency at each of the
-        // first eigenvalues' imaginary parts, and both pivot branches of the 2 x 2 solve
-        // (frequencies far below and near the blocks' eigenvalues).
-        for n in [SCHUR_MIN_ORDER, 16, 33] {
-            let mut state = 7 * n as u64;
-            let a = Mat::from_fn(n, n, |_, _| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-            });
-            let b = Mat::from_fn(n, 2, |i, j| (i + 3 * j) as f64 / n as f64 - 0.5);
-            let c = Mat::from_fn(3, n, |i, j| ((i + j) % 4) as f64 - 1.5);
-            let d = Mat::from_fn(3, 2, |i, j| (i as f64) - (j as f64));
-            let count = SCHUR_FREQUENCIES_PER_ORDER * n;
-            let mut omega: Vec<f64> = (0..count)
-                .map(|k| 10f64.powf(-3.0 + 6.0 * k as f64 / count as f64))
-                .collect();
-            let eigenvalues = crate::linalg::schur::eigenvalues(a.as_ref()).unwrap();
-            omega.extend(eigenvalues.iter().map(|l| l.im));
-            omega.extend([0.0, -2.5, 1e6]);
-            assert!(omega.len() >= SCHUR_FREQUENCIES_PER_ORDER * n);
-            let g =
-                frequency_response(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), &omega).unwrap();
-            for (k, &w) in omega.iter().enumerate() {
-                let expected = dense(&a, &b, &c, &d, w);
-                let err = (&g[k] - &expected).norm_l2() / expected.norm_l2().max(1e-300);
-                assert!(err < 1e-12, "n={n} w={w}: {err}");
-            }
-        }
-    }
-
-    #[test]
-    fn frequencies_near_a_lightly_damped_pole_take_the_hessenberg_solve() {
-        // A = S - 1e-3 I, S skew-symmetric (poles 1e-3 left of the axis): at the poles'
-        // frequencies the Schur form's error estimate is above SCHUR_ERROR_ESTIMATE, and the
-        // result is the Hessenberg solve's bit for bit (the rest of the grid takes the Schur
-        // form and still matches a dense solve).
-        let n = 40;
-        let mut state = 3u64;
-        let r = Mat::from_fn(n, n, |_, _| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        });
-        let a = Mat::from_fn(n, n, |i, j| {
-            r[(i, j)] - r[(j, i)] - if i == j { 1e-3 } else { 0.0 }
-        });
-        let b = Mat::from_fn(n, 1, |i, _| (i % 5) as f64 - 2.0);
-        let c = Mat::from_fn(1, n, |_, j| (j % 3) as f64 - 1.0);
-        let d = Mat::<f64>::zeros(1, 1);
-        let poles: Vec<f64> = crate::linalg::schur::eigenvalues(a.as_ref())
-            .unwrap()
-            .iter()
-            .map(|l| l.im)
-            .filter(|w| *w > 0.0)
-            .collect();
-        let mut omega: Vec<f64> = (0..SCHUR_FREQUENCIES_PER_ORDER * n)
-            .map(|k| 0.01 * (k + 1) as f64)
-            .collect();
-        omega.extend(&poles);
-        let g = frequency_response(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), &omega).unwrap();
-        let model =
-            HessenbergModel::new(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref(), Form::Schur)
-                .unwrap();
-        let mut evaluator =
-            FrequencyEvaluator::new(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()).unwrap();
-        let mut near = 0;
-        for (k, &w) in omega.iter().enumerate() {
-            if !model.trusts(c64::new(0.0, w)) {
-                near += 1;
-                assert_eq!(g[k][(0, 0)], evaluator.siso(w), "w={w}");
-            }
-            let expected = dense(&a, &b, &c, &d, w);
-            let err = (&g[k] - &expected).norm_l2() / expected.norm_l2();
-            assert!(err < 1e-11, "w={w}: {err}");
-        }
-        assert!(near >= poles.len(), "{near} of {} poles", poles.len());
     }
 
     #[test]
