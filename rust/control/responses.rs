@@ -90,6 +90,8 @@ struct Recurrence {
     gamma_next: Option<Vec<f64>>,
     c: Vec<f64>,
     d: Vec<f64>,
+    /// C is the identity (the outputs are the states): Y = X + D η, without the product.
+    states_out: bool,
 }
 
 fn row_major(m: MatRef<'_, f64>) -> Vec<f64> {
@@ -141,6 +143,9 @@ impl Recurrence {
             gamma_next: d.gamma1.as_ref().map(|g| row_major(g.as_ref())),
             c: row_major(c),
             d: row_major(dd),
+            states_out: c.nrows() == c.ncols()
+                && (0..c.nrows())
+                    .all(|i| (0..c.ncols()).all(|j| c[(i, j)] == if i == j { 1.0 } else { 0.0 })),
         }
     }
 
@@ -219,7 +224,14 @@ impl Recurrence {
                 }
             }
         }
-        if product && steps > 0 {
+        if product && steps > 0 && self.states_out {
+            // Y already holds D η[k]; add X (the product with C = I costs as much as the
+            // recurrence itself and gives the same values, up to the sign of zeros: 1 x + 0
+            // for x = -0 is +0).
+            for (y, &x) in y[..steps * p].iter_mut().zip(&x[..steps * n]) {
+                *y += x;
+            }
+        } else if product && steps > 0 {
             let states = MatRef::from_row_major_slice(x, steps, n);
             let c = MatRef::from_row_major_slice(&self.c, p, n);
             let outputs = MatMut::from_row_major_slice_mut(y, steps, p);
@@ -694,6 +706,50 @@ mod tests {
         }
         assert!((steady[0] - 0.045965).abs() < 1e-6 && (steady[3] + 0.015954).abs() < 1e-6);
         assert_eq!(x, y);
+    }
+
+    #[test]
+    fn identity_outputs_of_a_large_model_are_its_states() {
+        // From OUTPUT_PRODUCT_MIN_ORDER on, C = I takes Y = X + D η instead of the product
+        // X C^T: the outputs are the states plus D η, as the product path gives them for
+        // C = 2 I (doubled, exactly).
+        let n = OUTPUT_PRODUCT_MIN_ORDER + 4;
+        let a = Mat::from_fn(n, n, |i, j| {
+            if i == j {
+                -1.0 - i as f64 / n as f64
+            } else {
+                0.3 * ((i * 7 + j * 3) % 5) as f64 / n as f64 - 0.05
+            }
+        });
+        let b = Mat::from_fn(n, 1, |i, _| (i % 3) as f64 - 1.0);
+        let c = Mat::<f64>::identity(n, n);
+        let d = Mat::from_fn(n, 1, |i, _| if i == 2 { 0.5 } else { 0.0 });
+        let steps = 50;
+        let run = |c: &Mat<f64>| {
+            let (mut x, mut y) = (vec![0.0; steps * n], vec![0.0; steps * n]);
+            simulate_into(
+                model(&a, &b, c, &d),
+                states(&vec![0.0; n], n),
+                Input::Constant(&[1.0]),
+                0.1,
+                steps,
+                Hold::Zero,
+                &mut x,
+                &mut y,
+            )
+            .unwrap();
+            (x, y)
+        };
+        let (x, y) = run(&c);
+        let (_, doubled) = run(&(&c * faer::Scale(2.0)));
+        for k in 0..steps {
+            for i in 0..n {
+                let feedthrough = if i == 2 { 0.5 } else { 0.0 };
+                let at = k * n + i;
+                assert_eq!(y[at], x[at] + feedthrough, "k={k} i={i}");
+                assert_eq!(doubled[at], 2.0 * x[at] + feedthrough, "k={k} i={i}");
+            }
+        }
     }
 
     #[test]
