@@ -489,3 +489,28 @@ def test_the_report_and_its_sections_show_in_a_notebook() -> None:
     assert "<table>" in markup and "short period" in markup
     assert modes._repr_markdown_().count("](data:image/png;base64,") == 1
     assert pickle.loads(pickle.dumps(modes)) == modes
+
+
+def test_set_at_once_builds_what_the_dataclass_builds() -> None:
+    """StabilityMargins' __init__ (``set_at_once``: the fields set in one step) takes the
+    generated __init__'s parameters, raises its TypeErrors and keeps the instance frozen."""
+    margins = aerocontrol.stability_margins(aerocontrol.zpk([], [0.0, -1.0, -2.0], 2.0))
+    names = [f.name for f in dataclasses.fields(margins)]
+    values = [getattr(margins, n) for n in names]
+    by_name = type(margins)(**dict(zip(names, values, strict=True)))
+    by_position = type(margins)(*values)
+    mixed = type(margins)(*values[:3], **dict(zip(names[3:], values[3:], strict=True)))
+    for built in (by_name, by_position, mixed):
+        assert built == margins
+        assert vars(built).keys() == set(names)
+    assert dataclasses.replace(margins, gain_margin=2.0).gain_margin == 2.0
+    with pytest.raises(TypeError, match="missing the fields \\['encirclements'\\]"):
+        type(margins)(*values[:-1])
+    with pytest.raises(TypeError, match="unknown fields \\['colour'\\]"):
+        type(margins)(*values, colour=1)
+    with pytest.raises(TypeError, match="given twice \\['gain_margin'\\]"):
+        type(margins)(*values, gain_margin=1.0)
+    with pytest.raises(TypeError, match="positional"):
+        type(margins)(*values, 1)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        margins.gain_margin = 1.0  # type: ignore[misc]

@@ -102,7 +102,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._balance import balanced_matrix, balanced_states
-from ._results import Result, Tabular
+from ._results import Result, Tabular, set_at_once
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
@@ -321,8 +321,15 @@ def _census(
     loop (the double integrator 1/s² in rotated coordinates has its poles computed as
     ±1.5e-8, and was counted one unstable pole or none by the rotation). As :func:`nyquist`
     counts P and Z. A NaN root is neither outside nor inside. Scalar arithmetic: a loop's few
-    poles."""
+    poles; where every root is farther from the boundary than :func:`_boundary_tolerance`
+    (none flagged, no NaN), the count is taken from the distances alone, as the flags would
+    give it."""
     distances = _outward_distances(roots, discrete)
+    if math.isfinite(size):
+        tolerance = _boundary_tolerance(size, discrete)
+        if all(abs(x) > tolerance for x in distances):
+            unstable = sum(x > 0.0 for x in distances)
+            return unstable, unstable == 0
     flags = _boundary_flags(roots, distances, discrete, size, matrix)
     unstable, inside = 0, True
     for x, on in zip(distances, flags, strict=True):
@@ -629,6 +636,7 @@ def _separated(omega: FloatArray) -> FloatArray:
 # ----- margins ------------------------------------------------------------------------------
 
 
+@set_at_once
 @dataclass(frozen=True, eq=False)
 class StabilityMargins(Result):
     """The margins of a SISO loop, negative feedback (1 + L = 0); ``print`` shows a table.
@@ -1095,36 +1103,42 @@ def _assemble(
     180° + ∠L in (-180°, 180°] and the delay margins (phase margin mod 360°)/ω; the critical
     margins are picked from these. Formed in scalar arithmetic: the arrays hold a few values,
     and numpy's calls on them cost more than the core's whole computation."""
-    disk_w, disk_peak = disk
-    gains = [_inverse_modulus(value) for _, value in phase_crossings]
-    phases = [
-        _wrap_degrees(180.0 + math.degrees(math.atan2(value.imag, value.real)))
-        for _, value in gain_crossings
-    ]
-    delays = [
-        math.radians(pm % 360.0) / w
-        for (w, _), pm in zip(gain_crossings, phases, strict=True)
-        if w > 0
-    ]
-    if gains:
+    # Plain loops: the lists hold a crossover or two, and each comprehension (a function
+    # object per call before Python 3.12) costs more than its work.
+    values: list[float] = []  # the gain margins, then their crossovers (one conversion)
+    gm, w_gm, nearest = math.inf, math.nan, math.inf
+    for w, value in phase_crossings:
+        g = _inverse_modulus(value)
+        values.append(g)
         # The gain margin nearest 0 dB (the first of equals).
-        critical = min(
-            range(len(gains)),
-            key=lambda i: abs(math.log(gains[i])) if gains[i] > 0.0 else math.inf,
-        )
-        gm, w_gm = gains[critical], phase_crossings[critical][0]
-    else:
-        gm, w_gm = math.inf, math.nan
-    if phases:
-        critical = min(range(len(phases)), key=lambda i: abs(phases[i]))
-        pm, w_pm = phases[critical], gain_crossings[critical][0]
-    else:
-        pm, w_pm = math.inf, math.nan
+        distance = abs(math.log(g)) if g > 0.0 else math.inf
+        if distance < nearest or len(values) == 1:
+            gm, w_gm, nearest = g, w, distance
+    for w, _ in phase_crossings:
+        values.append(w)
+    phases: list[float] = []
+    delays: list[float] = []
+    pm, w_pm, nearest = math.inf, math.nan, math.inf
+    for w, value in gain_crossings:
+        phase = _wrap_degrees(180.0 + math.degrees(math.atan2(value.imag, value.real)))
+        phases.append(phase)
+        if w > 0:
+            delays.append(math.radians(phase % 360.0) / w)
+        # The phase margin of least magnitude (the first of equals).
+        if abs(phase) < nearest or len(phases) == 1:
+            pm, w_pm, nearest = phase, w, abs(phase)
+    values += phases
+    for w, _ in gain_crossings:
+        values.append(w)
+    values += delays
     if not stable:
         delay, alpha = 0.0, 0.0
     else:
         delay = min(delays, default=math.inf)
-        alpha = 1.0 / disk_peak if disk_peak > 0 else math.inf
+        alpha = 1.0 / disk[1] if disk[1] > 0 else math.inf
+    # The five real arrays are views of disjoint parts of one.
+    array = np.array(values, np.float64)
+    g, c = len(phase_crossings), len(gain_crossings)
     return StabilityMargins(
         gain_margin=gm,
         phase_crossover=w_gm,
@@ -1132,14 +1146,14 @@ def _assemble(
         gain_crossover=w_pm,
         delay_margin=delay,
         disk_margin=alpha,
-        disk_frequency=disk_w,
+        disk_frequency=disk[0],
         stability_margin=stability[1],
         stability_frequency=stability[0],
-        gain_margins=np.array(gains, np.float64),
-        phase_crossovers=np.array([w for w, _ in phase_crossings], np.float64),
-        phase_margins=np.array(phases, np.float64),
-        gain_crossovers=np.array([w for w, _ in gain_crossings], np.float64),
-        delay_margins=np.array(delays, np.float64),
+        gain_margins=array[:g],
+        phase_crossovers=array[g : 2 * g],
+        phase_margins=array[2 * g : 2 * g + c],
+        gain_crossovers=array[2 * g + c : 2 * g + 2 * c],
+        delay_margins=array[2 * g + 2 * c :],
         closed_loop_poles=closed,
         closed_loop_stable=stable,
         open_loop_unstable_poles=unstable_open,

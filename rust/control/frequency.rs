@@ -133,7 +133,9 @@ impl HessenbergModel {
     /// [`FAR`] by the leading term of G's expansion at infinity
     /// ([`HessenbergModel::far`]).
     fn evaluate(&self, point: c64, ws: &mut Workspace, g: &mut [c64]) {
-        if point.norm() / self.sigma > FAR {
+        // |s| <= √2 max(|Re s|, |Im s|): the modulus (a hypot) is formed only near FAR.
+        let largest = point.re.abs().max(point.im.abs());
+        if largest > 0.5 * FAR * self.sigma && point.norm() / self.sigma > FAR {
             self.far(point, g);
         } else {
             let s = if self.sigma == 1.0 {
@@ -141,7 +143,11 @@ impl HessenbergModel {
             } else {
                 point / self.sigma
             };
-            evaluate_frequency(self, s, ws, g);
+            if self.m == 1 && self.p == 1 && self.n <= SISO_ORDER {
+                g[0] = evaluate_siso(self, s);
+            } else {
+                evaluate_frequency(self, s, ws, g);
+            }
         }
     }
 
@@ -430,6 +436,81 @@ fn evaluate_kernel<const FMA: bool>(
     }
 }
 
+/// The largest order [`evaluate_siso_kernel`] takes (its arrays live on the stack).
+const SISO_ORDER: usize = 8;
+
+/// [`evaluate_kernel`] for one input and one output of order at most [`SISO_ORDER`]: the same
+/// operations in the same order (the same value, bit for bit), on stack arrays of row stride
+/// [`SISO_ORDER`] instead of the workspace's vectors. A loop's margins evaluate L(jω) some sixty
+/// times a call (root finders, peak searches), where the vectors' bounds checks and fills
+/// cost as much as the arithmetic.
+#[inline(always)]
+fn evaluate_siso_kernel<const FMA: bool>(model: &HessenbergModel, point: c64) -> c64 {
+    const S: usize = SISO_ORDER;
+    let n = model.n.min(S);
+    let mut re = [0.0f64; S * S];
+    let mut im = [0.0f64; S * S];
+    for i in 0..n {
+        for j in i.saturating_sub(1)..n {
+            re[i * S + j] = -model.h[i * n + j];
+        }
+        if point.re != 0.0 {
+            re[i * S + i] += point.re;
+        }
+        im[i * S + i] = point.im;
+    }
+    let (mut x_re, mut x_im) = ([0.0f64; S], [0.0f64; S]);
+    x_re[..n].copy_from_slice(&model.b[..n]);
+    for k in 0..n.saturating_sub(1) {
+        let (this, next) = (k * S, (k + 1) * S);
+        if re[next + k].abs() + im[next + k].abs() > re[this + k].abs() + im[this + k].abs() {
+            for j in k..n {
+                re.swap(this + j, next + j);
+                im.swap(this + j, next + j);
+            }
+            x_re.swap(k, k + 1);
+            x_im.swap(k, k + 1);
+        }
+        let (pr, pi) = (re[this + k], im[this + k]);
+        let (sr, si) = (re[next + k], im[next + k]);
+        if sr == 0.0 && si == 0.0 {
+            continue;
+        }
+        let (fr, fi) = complex_divide(sr, si, pr, pi);
+        for j in k + 1..n {
+            let (a, b) = (re[this + j], im[this + j]);
+            re[next + j] = multiply_add::<FMA>(-fr, a, multiply_add::<FMA>(fi, b, re[next + j]));
+            im[next + j] = multiply_add::<FMA>(-fr, b, multiply_add::<FMA>(-fi, a, im[next + j]));
+        }
+        let (a, b) = (x_re[k], x_im[k]);
+        x_re[k + 1] -= fr * a - fi * b;
+        x_im[k + 1] -= fr * b + fi * a;
+    }
+    for k in (0..n).rev() {
+        let row = k * S;
+        let (dr, di) = complex_dot::<FMA>(
+            &re[row + k + 1..row + n],
+            &im[row + k + 1..row + n],
+            &x_re[k + 1..n],
+            &x_im[k + 1..n],
+        );
+        let (sr, si) = (x_re[k] - dr, x_im[k] - di);
+        (x_re[k], x_im[k]) = complex_divide(sr, si, re[row + k], im[row + k]);
+    }
+    let (mut gr, mut gi) = (0.0, 0.0);
+    for ((&c, &vr), &vi) in model.c[..n].iter().zip(&x_re[..n]).zip(&x_im[..n]) {
+        gr = multiply_add::<FMA>(c, vr, gr);
+        gi = multiply_add::<FMA>(c, vi, gi);
+    }
+    if model.exponent != 0.0 {
+        gr = times_power_of_two(gr, model.exponent);
+        gi = times_power_of_two(gi, model.exponent);
+    }
+    c64::new(gr + model.d[0], gi)
+}
+
+fma_dispatch!(fn evaluate_siso(model: &HessenbergModel, point: c64) -> c64 => evaluate_siso_kernel);
+
 fma_dispatch!(fn evaluate_frequency(model: &HessenbergModel, point: c64, ws: &mut Workspace, g: &mut [c64]) => evaluate_kernel);
 
 /// Writes G(jω_k) = C (jω_k I - A)^-1 B + D for every ω_k into `out`, a row-major
@@ -546,6 +627,70 @@ mod tests {
         let cc = Mat::from_fn(c.nrows(), n, |i, j| c64::new(c[(i, j)], 0.0));
         let dd = Mat::from_fn(d.nrows(), d.ncols(), |i, j| c64::new(d[(i, j)], 0.0));
         cc * x + dd
+    }
+
+    #[test]
+    fn siso_kernel_is_the_general_kernel_bit_for_bit() {
+        // Seeded SISO models of orders 0 to SISO_ORDER, entries of several sizes, at points
+        // on and off the axis (and near the poles' size): the stack kernel's value must be
+        // the workspace kernel's, bit for bit, with and without fused multiply-adds.
+        let mut state = 0x2545f4914f6cdd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut compared = 0;
+        for n in 0..=SISO_ORDER {
+            for trial in 0..40 {
+                let size = [1.0, 1e-3, 1e4][trial % 3];
+                let a = Mat::from_fn(n, n, |_, _| next() * size);
+                let b = Mat::from_fn(n, 1, |_, _| next());
+                let c = Mat::from_fn(1, n, |_, _| next() * 7.0);
+                let d = Mat::from_fn(1, 1, |_, _| if trial % 2 == 0 { next() } else { 0.0 });
+                let model =
+                    HessenbergModel::new(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()).unwrap();
+                let mut ws = model.workspace();
+                let mut g = vec![c64::new(0.0, 0.0); 1];
+                for k in 0..25 {
+                    let w = size * (k as f64 / 4.0 - 2.0).exp2() * next().abs();
+                    let re = if k % 5 == 0 { next() * size } else { 0.0 };
+                    let point = c64::new(re, w);
+                    for fma in [false, true] {
+                        if fma && !crate::platform::dispatch::fma_available() {
+                            continue;
+                        }
+                        if fma {
+                            #[cfg(target_arch = "x86_64")]
+                            {
+                                #[target_feature(enable = "avx2,fma")]
+                                fn both(
+                                    model: &HessenbergModel,
+                                    point: c64,
+                                    ws: &mut Workspace,
+                                    g: &mut [c64],
+                                ) -> c64 {
+                                    evaluate_kernel::<true>(model, point, ws, g);
+                                    evaluate_siso_kernel::<true>(model, point)
+                                }
+                                // SAFETY: the CPU supports AVX2 and FMA, checked above.
+                                let siso = unsafe { both(&model, point, &mut ws, &mut g) };
+                                assert_eq!(siso.re.to_bits(), g[0].re.to_bits());
+                                assert_eq!(siso.im.to_bits(), g[0].im.to_bits());
+                            }
+                        } else {
+                            evaluate_kernel::<false>(&model, point, &mut ws, &mut g);
+                            let siso = evaluate_siso_kernel::<false>(&model, point);
+                            assert_eq!(siso.re.to_bits(), g[0].re.to_bits(), "n = {n}");
+                            assert_eq!(siso.im.to_bits(), g[0].im.to_bits(), "n = {n}");
+                        }
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert!(compared >= 9 * 40 * 25);
     }
 
     #[test]

@@ -324,19 +324,35 @@ fn axis_candidates(values: &[c64]) -> Vec<f64> {
         .collect()
 }
 
-/// The secant method on f from ω0, at most 12 steps, staying within 1e-3 of ω0 (relative);
-/// returns the point of smallest |f| met.
-fn secant(mut f: impl FnMut(f64) -> f64, omega: f64) -> f64 {
+/// The secant method on f(ω) = objective(L(jω)) from ω0, at most 12 steps, staying within
+/// 1e-3 of ω0 (relative); returns the point of smallest |f| met (not below 0) and L there
+/// (the value already evaluated, or L(0) where the best point was negative).
+fn secant(
+    mut evaluate: impl FnMut(f64) -> c64,
+    objective: impl Fn(c64) -> f64,
+    omega: f64,
+) -> (f64, c64) {
+    let mut f = |w: f64| {
+        let value = evaluate(w);
+        (objective(value), value)
+    };
     let step = if omega > 0.0 { 1e-7 * omega } else { 1e-7 };
-    let (mut x0, mut f0) = (omega, f(omega));
-    let (mut x1, mut f1) = (omega + step, f(omega + step));
-    let (mut best, mut best_f) = if f1.abs() < f0.abs() {
-        (x1, f1)
+    let ((mut f0, v0), (mut f1, v1)) = (f(omega), f(omega + step));
+    let (mut x0, mut x1) = (omega, omega + step);
+    let (mut best, mut best_f, mut best_value) = if f1.abs() < f0.abs() {
+        (x1, f1, v1)
     } else {
-        (x0, f0)
+        (x0, f0, v0)
     };
     if !best_f.is_finite() {
-        return omega;
+        return (
+            omega,
+            if best == omega {
+                best_value
+            } else {
+                evaluate(omega)
+            },
+        );
     }
     for _ in 0..12 {
         if f1 == f0 || best_f == 0.0 {
@@ -346,19 +362,23 @@ fn secant(mut f: impl FnMut(f64) -> f64, omega: f64) -> f64 {
         if !x2.is_finite() || (x2 - omega).abs() > 1e-3 * omega.max(1e-300) + step {
             break;
         }
-        let f2 = f(x2);
+        let (f2, v2) = f(x2);
         if !f2.is_finite() {
             break;
         }
         if f2.abs() < best_f.abs() {
-            (best, best_f) = (x2, f2);
+            (best, best_f, best_value) = (x2, f2, v2);
         }
         if (x2 - x1).abs() <= 4.0 * f64::EPSILON * x2.abs() {
             break;
         }
         (x0, f0, x1, f1) = (x1, f1, x2, f2);
     }
-    best.max(0.0)
+    if best < 0.0 {
+        (0.0, evaluate(0.0))
+    } else {
+        (best, best_value)
+    }
 }
 
 /// Sorted, with crossovers within 1e-9 of each other (relative) merged.
@@ -414,8 +434,7 @@ impl Loop<'_> {
         };
         let mut found = Vec::with_capacity(candidates.len());
         for omega in candidates {
-            let w = secant(|w| self.at(w).norm().ln(), omega);
-            let value = self.at(w);
+            let (w, value) = secant(|w| self.at(w), |v| v.norm().ln(), omega);
             if (value.norm() - 1.0).abs() <= CROSSOVER_TOLERANCE {
                 found.push(Crossover { omega: w, value });
             }
@@ -497,18 +516,11 @@ impl Loop<'_> {
         let vanishing = 1e-10 * self.scale(poles);
         let mut found = Vec::with_capacity(candidates.len());
         for omega in candidates {
-            let w = if omega == 0.0 {
-                0.0
+            let (w, value) = if omega == 0.0 {
+                (0.0, self.at(0.0))
             } else {
-                secant(
-                    |w| {
-                        let v = self.at(w);
-                        v.im / v.norm()
-                    },
-                    omega,
-                )
+                secant(|w| self.at(w), |v| v.im / v.norm(), omega)
             };
-            let value = self.at(w);
             if value.re.is_finite()
                 && value.im.is_finite()
                 && value.norm() > vanishing

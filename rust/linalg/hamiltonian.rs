@@ -141,8 +141,19 @@ pub fn squared_eigenvalues(h: MatRef<'_, f64>) -> Result<Option<SquaredSpectrum>
     Ok(Some(SquaredSpectrum { squares, size }))
 }
 
+/// The columns of M read again from step `first - 1` of the reduction on: column
+/// `first - 1` (being reduced) and those after it in each half, except the right half's
+/// column n + first - 1. The others are never read again (the later steps' right-hand
+/// transformations and rotations combine columns `first`.. and n + `first`.. only, and W
+/// takes rows up to j + 1 of its column j, above the rows the later steps change), so the
+/// left-hand transformations skip them: W is the same bit for bit.
+fn live_columns(n: usize, first: usize) -> [std::ops::Range<usize>; 2] {
+    [first - 1..n, n + first..2 * n]
+}
+
 /// M <- D M D for D = diag(P, P), P = I - τ v v^T acting on the indices first..first + len of
-/// each half (column-major M of order `order` = 2n; `work` of length `order`).
+/// each half (column-major M of order `order` = 2n; `work` of length `order`), from the left
+/// on the columns still read ([`live_columns`]).
 fn reflect_both(
     m: &mut [f64],
     order: usize,
@@ -153,12 +164,14 @@ fn reflect_both(
     work: &mut [f64],
 ) {
     for offset in [first, n + first] {
-        // From the left: rows offset.. of every column.
-        for column in m.chunks_exact_mut(order) {
-            let part = &mut column[offset..offset + v.len()];
-            let f = tau * part.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
-            for (x, y) in part.iter_mut().zip(v) {
-                *x -= f * y;
+        // From the left: rows offset.. of every column still read.
+        for range in live_columns(n, first) {
+            for column in m[range.start * order..range.end * order].chunks_exact_mut(order) {
+                let part = &mut column[offset..offset + v.len()];
+                let f = tau * part.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+                for (x, y) in part.iter_mut().zip(v) {
+                    *x -= f * y;
+                }
             }
         }
         // From the right: w = M[:, offset..] v, then M[:, offset + t] -= τ v_t w.
@@ -179,10 +192,11 @@ fn reflect_both(
     }
 }
 
-/// M <- G^T M G for the rotation G in the plane (p, q) that maps (x_p, x_q) to
-/// (c x_p + s x_q, -s x_p + c x_q) (symplectic for q = n + p).
+/// M <- G^T M G for the rotation G in the plane (p, q = n + p) that maps (x_p, x_q) to
+/// (c x_p + s x_q, -s x_p + c x_q) (symplectic), from the left on the columns still read
+/// ([`live_columns`] with first = p).
 fn rotate_both(m: &mut [f64], order: usize, p: usize, q: usize, r: Rotation) {
-    for j in 0..order {
+    for j in live_columns(order / 2, p).into_iter().flatten() {
         let (x, y) = (m[p + j * order], m[q + j * order]);
         m[p + j * order] = r.c * x + r.s * y;
         m[q + j * order] = -r.s * x + r.c * y;
