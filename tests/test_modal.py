@@ -204,3 +204,27 @@ def test_a_deferred_singular_modal_matrix_warns_at_the_first_access() -> None:
         warnings.simplefilter("error")
         assert m.modal_input is None
         assert m.modal_matrix_condition > 1e8
+
+
+@pytest.mark.parametrize("given", ["matrix", "pair"])
+def test_the_deferred_modal_matrix_is_of_the_arrays_as_given_at_the_call(given: str) -> None:
+    """The deferred analysis works on copies: a caller who changes its A and B in place
+    between ``modes`` and the first access still gets the modal matrix and P^-1 B of the
+    matrices it passed (A P = P Λ and P (P^-1 B) = B for them), not an error or another
+    plant's. (It held the caller's arrays, and the second analysis read them as changed.)"""
+    rng = np.random.default_rng(7)
+    n = 24
+    A = rng.standard_normal((n, n)) / np.sqrt(n)
+    B = rng.standard_normal((n, 2))
+    A_given, B_given = A.copy(), B.copy()
+    m = aerocontrol.modes(A if given == "matrix" else (A, B))
+    A *= 3.0
+    A[0, 1] += 1.0
+    B[:] = 0.0
+    P = m.modal_matrix
+    assert P is not None
+    residual = np.linalg.norm(A_given @ P - P * m.eigenvalues[None, :])
+    assert residual <= 1e-12 * np.linalg.norm(A_given) * np.linalg.norm(P)
+    if given == "pair":
+        assert m.modal_input is not None
+        np.testing.assert_allclose(P @ m.modal_input, B_given, atol=1e-12 * np.abs(B_given).max())

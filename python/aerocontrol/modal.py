@@ -372,7 +372,8 @@ def modes(A_or_sys: ArrayLike | System, mode_names: list[str] | None = None) -> 
     if vectors:
         vars(analysis).update(_modal_fields(result, stacklevel=3))
     else:
-        vars(analysis)["_plant"] = (A, B, dt)
+        # Copies: the caller may change its arrays before the first access.
+        vars(analysis)["_plant"] = (A.copy(), None if B is None else B.copy(), dt)
     return analysis
 
 
