@@ -708,6 +708,11 @@ def run_lines(runs: Sequence[dict[str, Any]]) -> list[str]:
     return lines
 
 
+def machine_and_runs(info: dict[str, Any], runs: Sequence[dict[str, Any]]) -> list[str]:
+    """The "Machine" and "Runs" sections of a record (performance.md, growth.md)."""
+    return ["## Machine", "", *machine_table(info), "", "## Runs", "", *run_lines(runs)]
+
+
 def _verdict(record: dict[str, Any] | None) -> str:
     if record is None:
         return "-"
@@ -750,13 +755,7 @@ def format_markdown(
         "",
         f"{settings[0].upper()}{settings[1:]}.",
         "",
-        "## Machine",
-        "",
-        *machine_table(info),
-        "",
-        "## Runs",
-        "",
-        *run_lines(runs),
+        *machine_and_runs(info, runs),
         "",
         "'1 thread' sets RAYON_NUM_THREADS, OMP_NUM_THREADS, OPENBLAS_NUM_THREADS and",
         "MKL_NUM_THREADS to 1 in a fresh process before numpy is imported, so that ours and the",
