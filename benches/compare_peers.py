@@ -99,6 +99,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.list:
         print(harness.format_listing(args.groups))
         return 0
+    if not harness.selected_cases(args.groups, args.filter):
+        print(f"no case's name contains {args.filter!r} (see --list)", file=sys.stderr)
+        return 2
     repeat = args.repeat or (3 if args.quick else 7)
     min_time = args.min_time if args.min_time is not None else (0.01 if args.quick else 0.1)
     # When stdout carries records (JSON, Markdown, a worker's run) the header and warnings go
