@@ -33,6 +33,7 @@ __all__ = [
     "companion_form",
     "controllability",
     "controllability_verdict",
+    "crossover_margins",
     "dare_batch",
     "dc_gain",
     "discretize",
@@ -165,11 +166,14 @@ def balanced_loop(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
 
+_CrossoverMarginsOutput: TypeAlias = tuple[
+    NDArray[np.float64],
+    tuple[int, int],
+    tuple[float, float, float, float, float],
+]
+
 _LoopMarginsOutput: TypeAlias = tuple[
-    NDArray[np.float64],
-    NDArray[np.complex128],
-    NDArray[np.float64],
-    NDArray[np.complex128],
+    _CrossoverMarginsOutput,
     tuple[float, float],
     tuple[float, float],
     NDArray[np.complex128],
@@ -177,11 +181,20 @@ _LoopMarginsOutput: TypeAlias = tuple[
     bool,
     float,
     float,
+    tuple[int, bool] | None,
+    tuple[int, bool] | None,
 ]
 
 def loop_margins(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /
 ) -> _LoopMarginsOutput | None: ...
+def crossover_margins(
+    phase_omega: list[float],
+    phase_values: list[tuple[float, float]],
+    gain_omega: list[float],
+    gain_values: list[tuple[float, float]],
+    /,
+) -> _CrossoverMarginsOutput: ...
 def root_locus(
     a: ArrayLike, b: ArrayLike, c: ArrayLike, gains: ArrayLike, /
 ) -> NDArray[np.complex128]: ...

@@ -804,12 +804,6 @@ def _db(factor: float) -> float:
     return 20.0 * math.log10(factor) if math.isfinite(factor) else math.inf
 
 
-def _wrap_degrees(angle: float) -> float:
-    """``angle`` in (-180, 180]."""
-    wrapped = math.remainder(angle, 360.0)
-    return 180.0 if wrapped == -180.0 else wrapped
-
-
 def stability_margins(loop: System) -> StabilityMargins:
     """Gain, phase, delay and disk margins of a SISO loop, with every crossover, and the
     closed loop's stability from its poles (negative feedback: 1 + L(s) = 0).
@@ -956,40 +950,39 @@ def _in_frequency_units(margins: StabilityMargins, exponent: int) -> StabilityMa
 
 def _continuous_margins(model: StateSpace, core: _core._LoopMarginsOutput) -> StabilityMargins:
     """:func:`stability_margins` of a continuous loop from the core's eigenvalue methods'
-    results on it, ``core``."""
+    results on it, ``core``: the crossovers' margins, the peaks, the poles, and the census of
+    the poles where each is farther from the axis than :func:`_boundary_tolerance` (else
+    None, and :func:`_census` decides with the poles' error bounds)."""
     (
-        gain_w,
-        gain_values,
-        phase_w,
-        phase_values,
-        (disk_w, disk_peak),
+        crossovers,
+        disk,
         (stab_w, sensitivity_peak),
         closed,
         open_poles,
         degenerate,
         closed_size,
         open_size,
+        closed_census,
+        open_census,
     ) = core
     if degenerate:
         # L(s) - L(-s) vanishes identically (L real on the whole axis): no pencil to locate
         # the phase crossovers, so the grid search decides.
         return _grid_margins(model)
-    phase_crossings = [
-        (w, value)
-        for w, value in zip(phase_w.tolist(), phase_values.tolist(), strict=True)
-        if value.real < 0.0
-    ]
-    unstable_closed, stable = _census(
-        closed, False, closed_size, functools.partial(_closed_matrix, model)
-    )
+    if closed_census is None:
+        closed_census = _census(
+            closed, False, closed_size, functools.partial(_closed_matrix, model)
+        )
+    if open_census is None:
+        open_census = _census(open_poles, False, open_size, lambda: model.A)
+    unstable_closed, stable = closed_census
     return _assemble(
-        phase_crossings,
-        list(zip(gain_w.tolist(), gain_values.tolist(), strict=True)),
-        disk=(disk_w, disk_peak),
+        crossovers,
+        disk=disk,
         stability=(stab_w, 1.0 / sensitivity_peak),
         closed=closed,
         stable=stable,
-        unstable_open=_unstable_count(open_poles, False, open_size, lambda: model.A),
+        unstable_open=open_census[0],
         unstable_closed=unstable_closed,
     )
 
@@ -1073,8 +1066,12 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
     stab_w, stab_peak = _extremum(omega, -_magnitude(1 + values), distance)
 
     result = _assemble(
-        phase_crossings,
-        gain_crossings,
+        _core.crossover_margins(
+            [w for w, _ in phase_crossings],
+            [(value.real, value.imag) for _, value in phase_crossings],
+            [w for w, _ in gain_crossings],
+            [(value.real, value.imag) for _, value in gain_crossings],
+        ),
         disk=(disk_w, disk_peak),
         stability=(stab_w, -stab_peak),
         closed=closed,
@@ -1087,8 +1084,7 @@ def _grid_margins(model: StateSpace) -> StabilityMargins:
 
 
 def _assemble(
-    phase_crossings: list[tuple[float, complex]],
-    gain_crossings: list[tuple[float, complex]],
+    crossovers: _core._CrossoverMarginsOutput,
     *,
     disk: tuple[float, float],
     stability: tuple[float, float],
@@ -1097,48 +1093,17 @@ def _assemble(
     unstable_open: int,
     unstable_closed: int,
 ) -> StabilityMargins:
-    """The result object from the crossovers (ω, L) by increasing ω and the ``closed``-loop
-    poles sorted as ``numpy.sort_complex``: the phase crossovers
-    where L < 0 give the gain margins 1/|L|, the gain crossovers (|L| = 1) the phase margins
-    180° + ∠L in (-180°, 180°] and the delay margins (phase margin mod 360°)/ω; the critical
-    margins are picked from these. Formed in scalar arithmetic: the arrays hold a few values,
-    and numpy's calls on them cost more than the core's whole computation."""
-    # Plain loops: the lists hold a crossover or two, and each comprehension (a function
-    # object per call before Python 3.12) costs more than its work.
-    values: list[float] = []  # the gain margins, then their crossovers (one conversion)
-    gm, w_gm, nearest = math.inf, math.nan, math.inf
-    for w, value in phase_crossings:
-        g = _inverse_modulus(value)
-        values.append(g)
-        # The gain margin nearest 0 dB (the first of equals).
-        distance = abs(math.log(g)) if g > 0.0 else math.inf
-        if distance < nearest or len(values) == 1:
-            gm, w_gm, nearest = g, w, distance
-    for w, _ in phase_crossings:
-        values.append(w)
-    phases: list[float] = []
-    delays: list[float] = []
-    pm, w_pm, nearest = math.inf, math.nan, math.inf
-    for w, value in gain_crossings:
-        phase = _wrap_degrees(180.0 + math.degrees(math.atan2(value.imag, value.real)))
-        phases.append(phase)
-        if w > 0:
-            delays.append(math.radians(phase % 360.0) / w)
-        # The phase margin of least magnitude (the first of equals).
-        if abs(phase) < nearest or len(phases) == 1:
-            pm, w_pm, nearest = phase, w, abs(phase)
-    values += phases
-    for w, _ in gain_crossings:
-        values.append(w)
-    values += delays
+    """The result object from the margins of the crossovers (the core's
+    ``crossover_margins``: the gain margins 1/|L| at the phase crossovers where L < 0, the
+    phase margins 180° + ∠L in (-180°, 180°] at the gain crossovers and the delay margins
+    (phase margin mod 360°)/ω, in one array, with the critical ones), the peaks and the
+    ``closed``-loop poles sorted as ``numpy.sort_complex``. The five arrays are views of
+    disjoint parts of the core's one."""
+    array, (g, c), (gm, w_gm, pm, w_pm, delay) = crossovers
     if not stable:
         delay, alpha = 0.0, 0.0
     else:
-        delay = min(delays, default=math.inf)
         alpha = 1.0 / disk[1] if disk[1] > 0 else math.inf
-    # The five real arrays are views of disjoint parts of one.
-    array = np.array(values, np.float64)
-    g, c = len(phase_crossings), len(gain_crossings)
     return StabilityMargins(
         gain_margin=gm,
         phase_crossover=w_gm,
@@ -1159,12 +1124,6 @@ def _assemble(
         open_loop_unstable_poles=unstable_open,
         encirclements=unstable_open - unstable_closed,
     )
-
-
-def _inverse_modulus(value: complex) -> float:
-    """1/|value|: infinite at 0, 0 where |value| exceeds the doubles."""
-    modulus = math.hypot(value.real, value.imag)
-    return 1.0 / modulus if modulus > 0.0 else math.inf
 
 
 def _extremum(

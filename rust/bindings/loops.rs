@@ -4,7 +4,10 @@ use super::compute::{Cost, compute};
 use super::conversion::{Outputs, Real, new_array, new_array_data};
 use super::errors::to_py_err;
 use super::statespace::ModelArgs;
-use crate::control::margins::{Crossover, loop_margins as loop_margins_core, within_range};
+use crate::control::margins::{
+    Crossover, CrossoverMargins, census_off_axis, crossover_margins as crossover_margins_core,
+    loop_margins as loop_margins_core, within_range,
+};
 use crate::control::root_locus::{
     loop_root_locus as loop_root_locus_core, root_locus as root_locus_core,
 };
@@ -17,11 +20,18 @@ use faer::c64;
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
 
+/// The crossover margins as `loops.py`'s `_assemble` takes them: (the five parts of
+/// [`CrossoverMargins::values`] in one array, (their counts g and c), (the critical gain
+/// margin and its crossover, the critical phase margin and its crossover, the least delay
+/// margin)).
+type CrossoverOutput<'py> = (
+    Bound<'py, PyArrayDyn<f64>>,
+    (usize, usize),
+    (f64, f64, f64, f64, f64),
+);
+
 type MarginsOutput<'py> = (
-    Bound<'py, PyArrayDyn<f64>>,
-    Bound<'py, PyArrayDyn<c64>>,
-    Bound<'py, PyArrayDyn<f64>>,
-    Bound<'py, PyArrayDyn<c64>>,
+    CrossoverOutput<'py>,
     (f64, f64),
     (f64, f64),
     Bound<'py, PyArrayDyn<c64>>,
@@ -29,7 +39,69 @@ type MarginsOutput<'py> = (
     bool,
     f64,
     f64,
+    Option<(usize, bool)>,
+    Option<(usize, bool)>,
 );
+
+fn crossover_output<'py>(
+    outputs: &mut Outputs<'py>,
+    margins: &CrossoverMargins,
+) -> PyResult<CrossoverOutput<'py>> {
+    Ok((
+        outputs.real_as_is(&[margins.values.len()], &margins.values)?,
+        (margins.gain_margins, margins.phase_margins),
+        (
+            margins.gain_margin.0,
+            margins.gain_margin.1,
+            margins.phase_margin.0,
+            margins.phase_margin.1,
+            margins.delay_margin,
+        ),
+    ))
+}
+
+/// The margins of the crossovers (ω, (Re L(jω), Im L(jω))) of a SISO loop, each list by increasing ω
+/// ([`crossover_margins`]): the crossover part of [`loop_margins`]'s result, for the margins
+/// found on a frequency grid.
+#[pyfunction]
+#[pyo3(signature = (phase_omega, phase_values, gain_omega, gain_values, /))]
+fn crossover_margins<'py>(
+    py: Python<'py>,
+    phase_omega: Vec<f64>,
+    phase_values: Vec<(f64, f64)>,
+    gain_omega: Vec<f64>,
+    gain_values: Vec<(f64, f64)>,
+) -> PyResult<CrossoverOutput<'py>> {
+    let pair = |omega: Vec<f64>, values: Vec<(f64, f64)>, name: &'static str| {
+        if omega.len() != values.len() {
+            return Err(to_py_err(
+                py,
+                Error::InvalidArgument {
+                    arg: name,
+                    message: format!(
+                        "{name} must have as many frequencies as values, got {} and {}",
+                        omega.len(),
+                        values.len()
+                    ),
+                },
+            ));
+        }
+        Ok(omega
+            .into_iter()
+            .zip(values)
+            .map(|(omega, (re, im))| Crossover {
+                omega,
+                value: c64::new(re, im),
+            })
+            .collect::<Vec<_>>())
+    };
+    let phase = pair(phase_omega, phase_values, "phase crossovers")?;
+    let gain = pair(gain_omega, gain_values, "gain crossovers")?;
+    let mut outputs = Outputs::new(py);
+    let result = crossover_output(&mut outputs, &crossover_margins_core(&phase, &gain))?;
+    outputs.finish()?;
+    Ok(result)
+}
 
 /// The crossovers of the continuous SISO loop L(s) = C (sI - A)^-1 B + D by eigenvalue
 /// methods (`control/margins.rs`): (gain-crossover ω, L there, phase-crossover ω, L there,
@@ -64,19 +136,18 @@ fn loop_margins<'py>(
         loop_margins_core(model.a, model.b, model.c, model.d)
     })?;
     let mut outputs = Outputs::new(py);
-    let split = |x: &[Crossover]| -> (Vec<f64>, Vec<c64>) {
-        (
-            x.iter().map(|c| c.omega).collect(),
-            x.iter().map(|c| c.value).collect(),
-        )
-    };
-    let (gain_w, gain_v) = split(&margins.gain_crossovers);
-    let (phase_w, phase_v) = split(&margins.phase_crossovers);
+    for (name, found) in [
+        ("gain crossovers", &margins.gain_crossovers),
+        ("phase crossovers", &margins.phase_crossovers),
+    ] {
+        let omegas: Vec<f64> = found.iter().map(|x| x.omega).collect();
+        let values: Vec<c64> = found.iter().map(|x| x.value).collect();
+        outputs.check(name, &omegas);
+        outputs.check_complex(name, &values);
+    }
+    let crossovers = crossover_margins_core(&margins.phase_crossovers, &margins.gain_crossovers);
     let result = (
-        outputs.real("gain crossovers", &[gain_w.len()], &gain_w)?,
-        outputs.complex("L at the gain crossovers", &[gain_v.len()], &gain_v)?,
-        outputs.real("phase crossovers", &[phase_w.len()], &phase_w)?,
-        outputs.complex("L at the phase crossovers", &[phase_v.len()], &phase_v)?,
+        crossover_output(&mut outputs, &crossovers)?,
         (margins.disk.omega, margins.disk.value),
         (margins.sensitivity.omega, margins.sensitivity.value),
         outputs.complex(
@@ -92,6 +163,8 @@ fn loop_margins<'py>(
         margins.degenerate,
         margins.closed_loop_size,
         margins.open_loop_size,
+        census_off_axis(&margins.closed_loop_poles, margins.closed_loop_size),
+        census_off_axis(&margins.open_loop_poles, margins.open_loop_size),
     );
     outputs.finish()?;
     Ok(Some(result))
@@ -312,6 +385,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(balanced_loop, m)?)?;
     m.add_function(wrap_pyfunction!(loop_root_locus, m)?)?;
     m.add_function(wrap_pyfunction!(loop_margins, m)?)?;
+    m.add_function(wrap_pyfunction!(crossover_margins, m)?)?;
     m.add_function(wrap_pyfunction!(root_locus, m)?)?;
     Ok(())
 }

@@ -13,7 +13,8 @@
 //! whose eigenvalues are the zeros of 1 - L(-s) L(s) (plus any uncontrollable or unobservable
 //! modes). They are computed as ±√μ from the squares μ = λ^2, the eigenvalues of an n x n
 //! Hessenberg matrix, by Van Loan's square-reduced method (`linalg/hamiltonian.rs`: a fraction
-//! of the cost of the QR iteration of order 2n) wherever those decide which eigenvalues lie
+//! of the cost of the QR iteration of order 2n; H^2 formed from the blocks, the off-diagonal
+//! ones of rank one, in n^3 multiplications) wherever those decide which eigenvalues lie
 //! within [`AXIS_TOLERANCE`] of the axis (their error, about n u ||H||^2, at most 1e-8 of |μ|,
 //! or smaller than μ's distance from the negative real axis); otherwise (a small eigenvalue
 //! near the axis beside large ones: a crossover far below the loop's size) by the QR iteration
@@ -46,7 +47,8 @@
 //!
 //! **Acceptance.** An eigenvalue λ with |Re λ| <= 1e-6 |λ| (and Im λ >= 0) is a candidate; it
 //! is polished by the secant method on the exact L(jω) (f = ln|L| or f = Im L / |L|, evaluated
-//! by `control/frequency.rs`'s Hessenberg kernel on a model reduced once), and kept only if
+//! by `control/frequency.rs`'s Hessenberg kernel on a model reduced once; it stops where the
+//! next correction of its best point is below 1e-13 of ω), and kept only if
 //! it then satisfies | |L| - 1 | <= 1e-8, respectively |Im L| <= 1e-8 |L|; candidates within
 //! 1e-9 of each other (relative) are merged. A phase crossover where L vanishes (|L| below
 //! 1e-10 of the loop's scale, a zero on the axis or at the origin) is not one.
@@ -88,7 +90,7 @@ use crate::control::frequency::{FrequencyEvaluator, check_state_space};
 use crate::control::root_locus;
 use crate::error::Error;
 use crate::linalg::balance::{GRADED_SPREAD, balanced_states, nearest_power_of_two};
-use crate::linalg::hamiltonian::squared_eigenvalues;
+use crate::linalg::hamiltonian::squared_eigenvalues_rank_one;
 use crate::linalg::norm::{frobenius_norm, max_abs};
 use crate::linalg::schur::eigenvalues;
 use faer::{Mat, MatRef, c64};
@@ -168,7 +170,9 @@ pub fn within_range(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>, 
 /// of the Hamiltonian of 1 - G(-s) G(s) for G = (A, B, C, d), r = 1 - d^2 != 0.
 ///
 /// By Van Loan's square-reduced method (`linalg/hamiltonian.rs`: the squares μ = λ^2 of the
-/// eigenvalues from an eigenvalue problem of order n) where the squares decide the test of the
+/// eigenvalues from an eigenvalue problem of order n, H = [[F, G], [K, -F^T]] with
+/// F = A + (d/r) B C, G = B B^T / r and K = -C^T C / r, squared from these blocks by
+/// `squared_eigenvalues_rank_one`) where the squares decide the test of the
 /// axis ([`squares_decide`]); otherwise (a small eigenvalue near the axis beside large ones,
 /// an H^2 beyond the doubles, or squares that fail their check) by the QR iteration on H
 /// itself.
@@ -190,18 +194,23 @@ fn hamiltonian_axis_frequencies(
     } else {
         1.0
     };
-    let h = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
-        (true, true) => a[(i, j)] + (d / r) * b[i] * c[j],
-        (true, false) => (b[i] * beta) * (b[j - n] * beta) / r,
-        (false, true) => -(c[i - n] / beta) * (c[j] / beta) / r,
-        (false, false) => -(a[(j - n, i - n)] + (d / r) * b[j - n] * c[i - n]),
-    });
-    match squared_eigenvalues(h.as_ref()) {
+    let f = Mat::from_fn(n, n, |i, j| a[(i, j)] + (d / r) * b[i] * c[j]);
+    let u: Vec<f64> = b.iter().map(|x| x * beta).collect();
+    let v: Vec<f64> = c.iter().map(|x| x / beta).collect();
+    match squared_eigenvalues_rank_one(f.as_ref(), &u, 1.0 / r, &v, -1.0 / r) {
         Ok(Some(squared)) if squares_decide(&squared.squares, squared.size) => {
             Ok(squared_axis_candidates(&squared.squares))
         }
         Err(Error::Interrupted) => Err(Error::Interrupted),
-        _ => Ok(axis_candidates(&eigenvalues(h.as_ref())?)),
+        _ => {
+            let h = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+                (true, true) => f[(i, j)],
+                (true, false) => u[i] * u[j - n] / r,
+                (false, true) => -v[i - n] * v[j] / r,
+                (false, false) => -f[(j - n, i - n)],
+            });
+            Ok(axis_candidates(&eigenvalues(h.as_ref())?))
+        }
     }
 }
 
@@ -324,9 +333,14 @@ fn axis_candidates(values: &[c64]) -> Vec<f64> {
         .collect()
 }
 
+/// Relative correction below which the secant method stops without evaluating the next point.
+const SECANT_TOLERANCE: f64 = 1e-13;
+
 /// The secant method on f(ω) = objective(L(jω)) from ω0, at most 12 steps, staying within
-/// 1e-3 of ω0 (relative); returns the point of smallest |f| met (not below 0) and L there
-/// (the value already evaluated, or L(0) where the best point was negative).
+/// 1e-3 of ω0 (relative), until a step is within 4u of ω or the next correction of the best
+/// point is within [`SECANT_TOLERANCE`] of it; returns the point of smallest |f| met (not
+/// below 0) and L there (the value already evaluated, or L(0) where the best point was
+/// negative).
 fn secant(
     mut evaluate: impl FnMut(f64) -> c64,
     objective: impl Fn(c64) -> f64,
@@ -360,6 +374,11 @@ fn secant(
         }
         let x2 = x1 - f1 * (x1 - x0) / (f1 - f0);
         if !x2.is_finite() || (x2 - omega).abs() > 1e-3 * omega.max(1e-300) + step {
+            break;
+        }
+        if best == x1 && (x2 - x1).abs() <= SECANT_TOLERANCE * x1.abs() {
+            // The correction the step would make: x1, the best point, is that close to the
+            // root (the method converges superlinearly), and the value there is kept.
             break;
         }
         let (f2, v2) = f(x2);
@@ -741,6 +760,106 @@ fn peak(
         best = Peak { omega: w, value };
     }
     Ok(best)
+}
+
+/// The margins of a SISO loop's crossovers (negative feedback, 1 + L = 0), as
+/// `StabilityMargins` holds them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CrossoverMargins {
+    /// The gain margins 1/|L| at the phase crossovers where L < 0 (∞ where L = 0, 0 where |L|
+    /// overflows), those crossovers, the phase margins 180° + ∠L in (-180°, 180°] at the gain
+    /// crossovers, those crossovers, and the delay margins (phase margin mod 360°, in
+    /// radians)/ω at the gain crossovers above 0: five parts of one array, by increasing ω.
+    pub values: Vec<f64>,
+    /// The number of gain margins (of phase crossovers where L < 0).
+    pub gain_margins: usize,
+    /// The number of phase margins (of gain crossovers).
+    pub phase_margins: usize,
+    /// The critical gain margin (the nearest 0 dB, the first of equals; ∞ without one) and
+    /// its crossover (NaN without one).
+    pub gain_margin: (f64, f64),
+    /// The critical phase margin (of least magnitude, the first of equals; ∞ without one)
+    /// and its crossover (NaN without one).
+    pub phase_margin: (f64, f64),
+    /// The least delay margin (∞ without a gain crossover above 0).
+    pub delay_margin: f64,
+}
+
+/// ``angle`` in [0°, 360°] wrapped to (-180°, 180°] (Python's `math.remainder(angle, 360)`
+/// with -180 taken as 180: exact, as 360 - angle is by Sterbenz's lemma).
+fn wrap_degrees(angle: f64) -> f64 {
+    if angle > 180.0 { angle - 360.0 } else { angle }
+}
+
+/// The gain, phase and delay margins of the `phase` and `gain` crossovers (each by
+/// increasing ω; see [`CrossoverMargins`]): 1/|L| at each phase crossover with L < 0,
+/// 180° + atan2(Im L, Re L) in degrees wrapped to (-180°, 180°] at each gain crossover, and
+/// (PM mod 360°)/ω in radians per second for those with ω > 0.
+pub fn crossover_margins(phase: &[Crossover], gain: &[Crossover]) -> CrossoverMargins {
+    let negative: Vec<&Crossover> = phase.iter().filter(|x| x.value.re < 0.0).collect();
+    let mut values = Vec::with_capacity(2 * negative.len() + 3 * gain.len());
+    let (mut gm, mut w_gm, mut nearest) = (f64::INFINITY, f64::NAN, f64::INFINITY);
+    for (index, x) in negative.iter().enumerate() {
+        let modulus = x.value.norm();
+        let g = if modulus > 0.0 {
+            1.0 / modulus
+        } else {
+            f64::INFINITY
+        };
+        values.push(g);
+        let distance = if g > 0.0 { g.ln().abs() } else { f64::INFINITY };
+        if distance < nearest || index == 0 {
+            (gm, w_gm, nearest) = (g, x.omega, distance);
+        }
+    }
+    values.extend(negative.iter().map(|x| x.omega));
+    let (mut pm, mut w_pm, mut nearest) = (f64::INFINITY, f64::NAN, f64::INFINITY);
+    let mut delays = Vec::with_capacity(gain.len());
+    for (index, x) in gain.iter().enumerate() {
+        let phase = wrap_degrees(180.0 + x.value.im.atan2(x.value.re).to_degrees());
+        values.push(phase);
+        if x.omega > 0.0 {
+            // Python's phase % 360: in [0, 360).
+            let turned = if phase < 0.0 {
+                phase + 360.0
+            } else {
+                phase % 360.0
+            };
+            delays.push(turned.to_radians() / x.omega);
+        }
+        if phase.abs() < nearest || index == 0 {
+            (pm, w_pm, nearest) = (phase, x.omega, phase.abs());
+        }
+    }
+    values.extend(gain.iter().map(|x| x.omega));
+    let delay_margin = delays.iter().copied().fold(f64::INFINITY, f64::min);
+    values.extend(delays);
+    CrossoverMargins {
+        values,
+        gain_margins: negative.len(),
+        phase_margins: gain.len(),
+        gain_margin: (gm, w_gm),
+        phase_margin: (pm, w_pm),
+        delay_margin,
+    }
+}
+
+/// (the number of roots in the open right half plane, whether every root is in the open left
+/// half plane) where every root is farther from the imaginary axis than √u `size` (the
+/// boundary tolerance of `loops.py`'s `_census`, `size` the balanced matrix's Frobenius
+/// norm); None where one is not (or is NaN, or `size` is not finite), for the caller's
+/// census with the roots' own error bounds.
+pub fn census_off_axis(roots: &[c64], size: f64) -> Option<(usize, bool)> {
+    if !size.is_finite() {
+        return None;
+    }
+    let tolerance = f64::EPSILON.sqrt() * size;
+    if roots.iter().all(|r| r.re.abs() > tolerance) {
+        let unstable = roots.iter().filter(|r| r.re > 0.0).count();
+        Some((unstable, unstable == 0))
+    } else {
+        None
+    }
 }
 
 /// Crossovers, disk and stability peaks, and poles of the continuous SISO loop
@@ -1131,5 +1250,86 @@ mod tests {
         let pm = |x: &Crossover| 180.0 + x.value.arg().to_degrees();
         close(pm(&m.gain_crossovers[0]), -66.10486781 + 360.0, 1e-9);
         close(pm(&m.gain_crossovers[1]), 114.65090329, 1e-9);
+    }
+
+    /// The yaw damper's margins from its crossovers against python-control's (as above):
+    /// GM 6.35517022, PM -66.10486781° and 114.65090329°, and the delay margins
+    /// ((PM mod 360°) in rad)/ω; the critical ones are the only gain margin and the phase
+    /// margin of least magnitude.
+    #[test]
+    fn crossover_margins_of_the_yaw_damper() {
+        let (a, b, c, d) = yaw_loop();
+        let m = loop_margins(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()).unwrap();
+        let x = crossover_margins(&m.phase_crossovers, &m.gain_crossovers);
+        assert_eq!((x.gain_margins, x.phase_margins), (1, 2));
+        assert_eq!(x.values.len(), 2 + 3 * 2);
+        close(x.values[0], 6.35517022, 1e-8);
+        close(x.values[1], 0.46389296, 1e-7);
+        close(x.values[2], -66.10486781, 1e-9);
+        close(x.values[3], 114.65090329, 1e-9);
+        let delays = [
+            (-66.10486781 + 360.0f64).to_radians() / 0.78037584,
+            114.65090329f64.to_radians() / 1.18732058,
+        ];
+        close(x.values[6], delays[0], 1e-7);
+        close(x.values[7], delays[1], 1e-7);
+        assert_eq!(x.gain_margin, (x.values[0], x.values[1]));
+        assert_eq!(x.phase_margin, (x.values[2], x.values[4]));
+        assert_eq!(x.delay_margin, x.values[7]);
+    }
+
+    /// Without crossovers every critical margin is infinite and its frequency NaN; a phase
+    /// crossover where L >= 0 gives no gain margin, one where 1/|L| overflows an infinite
+    /// one; a gain crossover at ω = 0 has no delay margin; of margins equally far from 0 dB
+    /// the first is critical; L = -1 is a phase margin of 0° and L = 1 one of 180° (not
+    /// -180°).
+    #[test]
+    fn crossover_margins_edge_cases() {
+        let none = crossover_margins(&[], &[]);
+        assert!(none.values.is_empty());
+        assert_eq!(none.gain_margin.0, f64::INFINITY);
+        assert!(none.gain_margin.1.is_nan() && none.phase_margin.1.is_nan());
+        assert_eq!(none.phase_margin.0, f64::INFINITY);
+        assert_eq!(none.delay_margin, f64::INFINITY);
+        let at = |omega: f64, re: f64, im: f64| Crossover {
+            omega,
+            value: c64::new(re, im),
+        };
+        let phase = [at(1.0, 0.5, 0.0), at(2.0, -0.5, 0.0), at(3.0, -2.0, 0.0)];
+        let gain = [at(0.0, 1.0, 0.0), at(4.0, -1.0, 0.0), at(5.0, 0.0, -1.0)];
+        let x = crossover_margins(&phase, &gain);
+        // Gain margins 2 and 0.5 (equally far from 0 dB: the first), at 2 and 3 rad/s.
+        assert_eq!(x.values[..4], [2.0, 0.5, 2.0, 3.0]);
+        assert_eq!(x.gain_margin, (2.0, 2.0));
+        // L = 1: 180°; L = -1: 0°; L = -j: 90°.
+        assert_eq!(x.values[4..7], [180.0, 0.0, 90.0]);
+        assert_eq!(x.values[7..10], [0.0, 4.0, 5.0]);
+        assert_eq!(x.phase_margin, (0.0, 4.0));
+        // No delay margin at ω = 0; 0° at 4 rad/s; 90° = π/2 at 5 rad/s.
+        assert_eq!(x.values[10..], [0.0, std::f64::consts::FRAC_PI_2 / 5.0]);
+        assert_eq!(x.delay_margin, 0.0);
+        let zero = crossover_margins(&[at(1.0, -0.0, 0.0)], &[]);
+        assert!(zero.values.is_empty(), "L = -0 is not below 0");
+        let vanishing = crossover_margins(&[at(1.0, -1e-320, 0.0)], &[]);
+        assert_eq!(vanishing.gain_margin.0, f64::INFINITY);
+    }
+
+    /// The census is taken only where every root is farther than √u size from the axis.
+    #[test]
+    fn census_off_axis_defers_roots_near_the_axis() {
+        let roots = [
+            c64::new(-1.0, 2.0),
+            c64::new(-1.0, -2.0),
+            c64::new(0.5, 0.0),
+        ];
+        assert_eq!(census_off_axis(&roots, 1.0), Some((1, false)));
+        assert_eq!(census_off_axis(&roots[..2], 1.0), Some((0, true)));
+        // 1e-9 from the axis beside a size of 1: within √u = 1.5e-8.
+        let near = [c64::new(-1.0, 0.0), c64::new(1e-9, 1.0)];
+        assert_eq!(census_off_axis(&near, 1.0), None);
+        assert_eq!(census_off_axis(&near, 1e-2), Some((1, false)));
+        assert_eq!(census_off_axis(&roots, f64::INFINITY), None);
+        assert_eq!(census_off_axis(&[c64::new(f64::NAN, 0.0)], 1.0), None);
+        assert_eq!(census_off_axis(&[], 0.0), Some((0, true)));
     }
 }
