@@ -57,7 +57,9 @@ pub struct SquaredSpectrum {
 /// square-reduced method (see the module's documentation), verified by their sum (a miss is
 /// [`Error::IllConditioned`]); None where H^2 overflows. The
 /// structure is not checked as such: a matrix that is not Hamiltonian has a reduced square
-/// whose block W does not hold half its trace, and fails the check.
+/// whose block W does not hold half its trace, and fails the check. The tests' reference for
+/// [`squared_eigenvalues_rank_one`], which the margins use.
+#[cfg(test)]
 pub fn squared_eigenvalues(h: MatRef<'_, f64>) -> Result<Option<SquaredSpectrum>, Error> {
     check_square(h, "H")?;
     check_finite(h, "H")?;
@@ -93,7 +95,7 @@ pub fn squared_eigenvalues(h: MatRef<'_, f64>) -> Result<Option<SquaredSpectrum>
     square_reduced_eigenvalues(m, n, size)
 }
 
-/// [`squared_eigenvalues`] of the Hamiltonian matrix with rank-one off-diagonal blocks
+/// The squares of the eigenvalues of the Hamiltonian matrix with rank-one off-diagonal blocks,
 ///
 /// ```text
 ///     H = [ F              σ_g u u^T ]
@@ -113,8 +115,9 @@ pub fn squared_eigenvalues(h: MatRef<'_, f64>) -> Result<Option<SquaredSpectrum>
 /// off-diagonal blocks are skew-symmetric exactly (their diagonals are zero, as the reduction
 /// takes them to be). The squares' errors are those of the product (each entry is formed from
 /// the same terms, up to n u |H| |H| entrywise), and so is the size ||H||_F^2 =
-/// 2 ||F||_F^2 + σ_g^2 ||u||^4 + σ_k^2 ||v||^4 returned with them; verified as
-/// [`squared_eigenvalues`]. None where H^2 or the size overflows.
+/// 2 ||F||_F^2 + σ_g^2 ||u||^4 + σ_k^2 ||v||^4 returned with them; verified by the sum of
+/// the squares against the trace (see the module's documentation). None where H^2 or the size
+/// overflows.
 pub fn squared_eigenvalues_rank_one(
     f: MatRef<'_, f64>,
     u: &[f64],
