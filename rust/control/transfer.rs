@@ -864,7 +864,7 @@ fn lower_to_nearest(points: &[c64], roots: &[c64], nearest: &mut [f64]) {
         .filter(|r| r.im >= 0.0 || !roots.contains(&r.conj()))
     {
         // min(m, x) as a select: the same value (m is never NaN: it starts infinite and takes
-        // only smaller values; a NaN x leaves it), and it vectorises.
+        // only smaller values; a NaN x leaves it).
         if on_axis {
             let real = r.re * r.re;
             for (m, p) in nearest.iter_mut().zip(points) {
