@@ -775,6 +775,21 @@ def test_transfer_matrix_of_any_memory_layout() -> None:
     np.testing.assert_array_equal(aerocontrol.transfer_matrix(fortran)(w), g(w))
 
 
+def test_factored_response_refuses_a_shape_that_does_not_hold_its_values() -> None:
+    # The core writes channels x points values into a new array of the shape it is given: a
+    # shape of another size is an InvalidArgumentError, never a write past the array.
+    # G = K/(s + 1) with K = 0.5 2^2 = 2.
+    none = np.zeros(0, np.complex128)
+    pole = np.array([-1.0 + 0j])
+    points = np.array([1j, 2j])
+    values, finite = aerocontrol._core.factored_response([0.5], [2], [none], pole, points, (1, 2))
+    assert finite and values.shape == (1, 2)
+    np.testing.assert_allclose(values, [2.0 / (points + 1.0)], rtol=4e-16)
+    for shape in ((2, 2), (3,), (), (0, 2)):
+        with pytest.raises(InvalidArgumentError, match="shape"):
+            aerocontrol._core.factored_response([0.5], [2], [none], pole, points, shape)
+
+
 def _graded_matrix(rng: np.random.Generator, family: int) -> np.ndarray:
     """A seeded graded matrix of order 2 to 8: the companion matrix of a polynomial with roots
     (real, and complex pairs) of moduli spread log-uniformly over 1e0..1e20, with its

@@ -220,6 +220,7 @@ def factored_response(
     zeros: list[NDArray[np.complex128]],
     poles: NDArray[np.complex128],
     points: NDArray[np.complex128],
+    shape: tuple[int, ...],
     /,
 ) -> tuple[NDArray[np.complex128], bool]: ...
 def frequency_response(

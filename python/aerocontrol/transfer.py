@@ -45,7 +45,7 @@ import cmath
 import math
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -799,14 +799,14 @@ class TransferFunction(Result):
         below them rounds to 0 (or a subnormal), as a product of doubles does."""
         value = np.asarray(s, dtype=np.complex128)
         k, e = self.scaled_gain if self.scaled_gain is not None else math.frexp(self.gain)
-        values, finite = _core.factored_response(
+        result, finite = _core.factored_response(
             [float(k)],
             [int(e)],
             [np.asarray(self.zeros, dtype=np.complex128).reshape(-1)],
             np.asarray(self.poles, dtype=np.complex128).reshape(-1),
-            value.reshape(-1),
+            value,
+            value.shape,
         )
-        result = values[0].reshape(value.shape)
         if not finite and np.isfinite(value).all():
             warnings.warn(
                 "the result overflowed double precision: G is infinite or NaN (at a pole, or "
@@ -1414,6 +1414,7 @@ class TransferMatrix(Result):
         "_channels",
         "_exponents",
         "_mantissas",
+        "_shape",
         "_zeros",
         "denominator",
         "dt",
@@ -1440,24 +1441,29 @@ class TransferMatrix(Result):
         self.output_names = output_names
         self.input_names = input_names
         self._channels = channels
+        self._shape = (len(output_names), len(input_names))
         # Each channel's gain as a mantissa and a power of two, and its zeros, for __call__.
-        self._mantissas: list[float] = []
-        self._exponents: list[int] = []
-        self._zeros: list[ComplexArray] = []
+        mantissas: list[float] = []
+        exponents: list[int] = []
+        zeros: list[ComplexArray] = []
+        frexp = math.frexp
         for channel in channels:
-            if isinstance(channel, TransferFunction):
-                k, e = channel.scaled_gain or math.frexp(channel.gain)
-                self._zeros.append(channel.zeros)
+            if isinstance(channel, tuple):  # the core's (zeros, gain, numerator)
+                k, e = frexp(channel[1])
+                zeros.append(channel[0])
             else:
-                k, e = math.frexp(channel[1])
-                self._zeros.append(channel[0])
-            self._mantissas.append(k)
-            self._exponents.append(e)
+                k, e = channel.scaled_gain or frexp(channel.gain)
+                zeros.append(channel.zeros)
+            mantissas.append(k)
+            exponents.append(e)
+        self._mantissas = mantissas
+        self._exponents = exponents
+        self._zeros = zeros
 
     @property
     def shape(self) -> tuple[int, int]:
         """(outputs, inputs)."""
-        return len(self.output_names), len(self.input_names)
+        return self._shape
 
     @property
     def channels(self) -> tuple[TransferFunction, ...]:
@@ -1490,18 +1496,22 @@ class TransferMatrix(Result):
         """G(s) of every channel from its factored form (as :meth:`TransferFunction.__call__`):
         shape (outputs, inputs) + the shape of ``s``."""
         value = np.asarray(s, dtype=np.complex128)
-        points = value.reshape(-1)
         result, finite = _core.factored_response(
-            self._mantissas, self._exponents, self._zeros, self.poles, points
+            self._mantissas,
+            self._exponents,
+            self._zeros,
+            self.poles,
+            value,
+            self._shape + value.shape,
         )
-        if not finite and np.isfinite(points).all():
+        if not finite and np.isfinite(value).all():
             warnings.warn(
                 "the result overflowed double precision: G is infinite or NaN (at a pole, or "
                 "beyond the doubles)",
                 NumericalOverflowWarning,
                 stacklevel=2,
             )
-        return result.reshape((len(self.output_names), len(self.input_names), *value.shape))
+        return result
 
     def __str__(self) -> str:
         return "\n".join(
@@ -1566,12 +1576,17 @@ def transfer_matrix(sys: System) -> TransferMatrix:
         (s + 0.0464)(s + 1.23)(s² + 2(0.108)(0.748)s + (0.748)²)
     """
     model = as_state_space(sys)
-    dt = period(model) if model.is_discrete else 0.0
-    m = model.n_inputs
+    dt = period(model)
     poles, denominator, fast = _core.transfer_channels(model.A, model.B, model.C, model.D, dt, None)
     denominator = _checked_denominator(poles, denominator, 2)
-    channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray]] = [
-        result if result is not None else _reference_channel(model, k // m, k % m, dt, stacklevel=2)
-        for k, result in enumerate(fast)
-    ]
+    if None in fast:  # channels the core leaves to the reference path
+        m = model.n_inputs
+        channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray]] = [
+            result
+            if result is not None
+            else _reference_channel(model, k // m, k % m, dt, stacklevel=2)
+            for k, result in enumerate(fast)
+        ]
+    else:
+        channels = cast("list[TransferFunction | tuple[ComplexArray, float, FloatArray]]", fast)
     return TransferMatrix(poles, denominator, dt, model.output_names, model.input_names, channels)

@@ -69,11 +69,12 @@ fn transfer_channels<'py>(
 }
 
 /// K_k Π(s - z_ki) / Π(s - p_j) for each channel k (K_k = mantissas[k] 2^exponents[k], its
-/// zeros zeros[k]) at each of `points` (1-D complex128): a (channels, points) complex array,
-/// the products renormalised by powers of two after each factor; infinite or NaN at a pole
-/// (not warned of: the caller does), with whether every value is finite.
+/// zeros zeros[k]) at each of `points` (complex128, any shape, taken in C order): a complex
+/// array of `shape` (the channels' shape, such as (outputs, inputs), then the points'), channel
+/// by channel, the products renormalised by powers of two after each factor; infinite or NaN
+/// at a pole (not warned of: the caller does), with whether every value is finite.
 #[pyfunction]
-#[pyo3(signature = (mantissas, exponents, zeros, poles, points, /))]
+#[pyo3(signature = (mantissas, exponents, zeros, poles, points, shape, /))]
 fn factored_response<'py>(
     py: Python<'py>,
     mantissas: Vec<f64>,
@@ -81,6 +82,7 @@ fn factored_response<'py>(
     zeros: Vec<Bound<'py, PyArrayDyn<c64>>>,
     poles: &Bound<'py, PyArrayDyn<c64>>,
     points: &Bound<'py, PyArrayDyn<c64>>,
+    shape: Vec<usize>,
 ) -> PyResult<(Bound<'py, PyArrayDyn<c64>>, bool)> {
     if exponents.len() != mantissas.len() || zeros.len() != mantissas.len() {
         return Err(to_py_err(
@@ -96,7 +98,21 @@ fn factored_response<'py>(
         .map(|z| copy_values(py, z))
         .collect::<PyResult<Vec<_>>>()?;
     let (poles, points) = (copy_values(py, poles)?, copy_values(py, points)?);
-    let out = new_array::<c64>(py, &[mantissas.len(), points.len()])?;
+    let entries = shape.iter().try_fold(1usize, |p, &k| p.checked_mul(k));
+    if entries != mantissas.len().checked_mul(points.len()) {
+        return Err(to_py_err(
+            py,
+            crate::error::Error::InvalidArgument {
+                arg: "shape",
+                message: format!(
+                    "shape {shape:?} does not hold {} channels at {} points",
+                    mantissas.len(),
+                    points.len()
+                ),
+            },
+        ));
+    }
+    let out = new_array::<c64>(py, &shape)?;
     // SAFETY: new and not visible to Python until returned.
     let data = unsafe { new_array_data(&out) };
     let roots = zeros.iter().map(Vec::len).sum::<usize>() + poles.len() * zeros.len();

@@ -51,6 +51,7 @@ use crate::linalg::norm::max_abs;
 use crate::linalg::qz::{generalized_eigenvalues, qz};
 use crate::linalg::schur::eigenvalues;
 use faer::{Mat, MatRef, c64};
+use nalgebra::DMatrix;
 
 /// One channel's zeros (sorted, as `numpy.sort_complex`), gain K and numerator K Π(s - z_i)
 /// (highest power first).
@@ -101,12 +102,13 @@ pub fn transfer_channels(
     };
     let denominator = polynomial(&poles, 1.0).unwrap_or_default();
     let shared = Shared::of(a, dt, &poles);
+    let mut lu = ShiftedLu::default();
     let mut out = Vec::with_capacity(channels.len());
     for &(i, j) in channels {
         crate::platform::interrupt::check()?;
         let bv: Vec<f64> = (0..n).map(|k| b[(k, j)]).collect();
         let cv: Vec<f64> = (0..n).map(|k| c[(i, k)]).collect();
-        out.push(channel(a, &bv, &cv, d[(i, j)], dt, &poles, &shared)?);
+        out.push(channel(a, &bv, &cv, d[(i, j)], &poles, &shared, &mut lu)?);
     }
     Ok(Transfer {
         poles,
@@ -137,7 +139,10 @@ fn polynomial(roots: &[c64], k: f64) -> Option<Vec<f64>> {
     if upper != lower {
         return None;
     }
-    let mut p = vec![k];
+    // Two buffers of the final length, the product so far in one, the next formed in the other.
+    let mut p = Vec::with_capacity(roots.len() + 1);
+    p.push(k);
+    let mut next = Vec::with_capacity(roots.len() + 1);
     for r in roots {
         if r.im < 0.0 {
             continue;
@@ -147,13 +152,14 @@ fn polynomial(roots: &[c64], k: f64) -> Option<Vec<f64>> {
         } else {
             &[1.0, -2.0 * r.re, r.re * r.re + r.im * r.im]
         };
-        let mut next = vec![0.0; p.len() + factor.len() - 1];
+        next.clear();
+        next.resize(p.len() + factor.len() - 1, 0.0);
         for (x, &pi) in p.iter().enumerate() {
             for (y, &fi) in factor.iter().enumerate() {
                 next[x + y] += pi * fi;
             }
         }
-        p = next;
+        std::mem::swap(&mut p, &mut next);
     }
     p.iter().all(|v| v.is_finite()).then_some(p)
 }
@@ -208,7 +214,7 @@ const ORIGIN_SINGULARITY: f64 = 100.0;
 /// as 0. `transfer._singular_at_origin` is the reference path's.
 fn singular_at_origin(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> bool {
     let n = a.nrows();
-    let mut s0 = Mat::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
+    let mut s0 = DMatrix::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
         (true, true) => a[(i, j)],
         (true, false) => b[i],
         (false, true) => c[j],
@@ -242,7 +248,7 @@ fn singular_at_origin(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> bool 
 /// (square): at step k the largest |m_ij| of the trailing block (the first in column order)
 /// is brought to (k, k), then m_ij -= (m_ik / m_kk) m_kj below and right of it. The pivots
 /// after a zero one are 0.
-fn complete_pivots(mut m: Mat<f64>) -> Vec<f64> {
+fn complete_pivots(mut m: DMatrix<f64>) -> Vec<f64> {
     let size = m.nrows();
     let mut pivots = Vec::with_capacity(size);
     for k in 0..size {
@@ -441,13 +447,26 @@ fn half_exponent(norm: f64) -> i64 {
     }
 }
 
-/// A SISO system (A, b, c, d).
+/// A SISO system (A, b, c, d), A in nalgebra's column-major storage (`linalg/matrix.rs`: at
+/// these orders the index arithmetic of one contiguous buffer, not a general view).
 #[derive(Debug, Clone)]
 struct Siso {
-    a: Mat<f64>,
+    a: DMatrix<f64>,
     b: Vec<f64>,
     c: Vec<f64>,
     d: f64,
+}
+
+impl Siso {
+    /// A copy of the model's channel (A, b, c, d).
+    fn of(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> Self {
+        Siso {
+            a: DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)]),
+            b: b.to_vec(),
+            c: c.to_vec(),
+            d,
+        }
+    }
 }
 
 fn squares(values: impl Iterator<Item = f64>) -> f64 {
@@ -481,17 +500,13 @@ fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
             units += k;
             changed = true;
         }
-        let mut size = squares((0..n * n).map(|x| s.a[(x % n, x / n)])).sqrt();
+        let mut size = squares(s.a.iter().copied()).sqrt();
         if size == 0.0 {
             size = squares(s.b.iter().copied()).sqrt();
         }
         let k = half_exponent(size);
         if k != 0 {
-            for j in 0..n {
-                for i in 0..n {
-                    scale(&mut s.a[(i, j)], k);
-                }
-            }
+            s.a.iter_mut().for_each(|x| scale(x, k));
             s.b.iter_mut().for_each(|x| scale(x, k));
             frequency -= k;
             changed = true;
@@ -538,9 +553,9 @@ fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
 
 /// The entries of the system matrix [[A, b], [c, d]].
 fn entries(s: &Siso) -> impl Iterator<Item = f64> + Clone + '_ {
-    let n = s.a.nrows();
-    (0..n * n)
-        .map(move |x| s.a[(x % n, x / n)])
+    s.a.as_slice()
+        .iter()
+        .copied()
         .chain(s.b.iter().copied())
         .chain(s.c.iter().copied())
         .chain(std::iter::once(s.d))
@@ -554,13 +569,7 @@ fn frobenius(s: &Siso) -> f64 {
 fn unit_scaled(mut s: Siso) -> (Siso, i64) {
     let e = exponent_of(frobenius(&s));
     let factor = two_to(-e);
-    let n = s.a.nrows();
-    for j in 0..n {
-        for i in 0..n {
-            s.a[(i, j)] *= factor;
-        }
-    }
-    for x in s.b.iter_mut().chain(s.c.iter_mut()) {
+    for x in s.a.iter_mut().chain(s.b.iter_mut()).chain(s.c.iter_mut()) {
         *x *= factor;
     }
     s.d *= factor;
@@ -655,12 +664,13 @@ fn reduce(mut s: Siso, tol: f64) -> Reduced {
         let (u, tau) = output_reflector(&s.c);
         reflect(&mut s, &u, tau);
         let m = n - 1;
-        s = Siso {
-            a: Mat::from_fn(m, m, |i, j| s.a[(i, j)]),
-            b: s.b[..m].to_vec(),
-            c: (0..m).map(|j| s.a[(m, j)]).collect(),
-            d: s.b[m],
-        };
+        for (j, cj) in s.c.iter_mut().enumerate().take(m) {
+            *cj = s.a[(m, j)];
+        }
+        s.c.truncate(m);
+        s.d = s.b[m];
+        s.b.truncate(m);
+        s.a = DMatrix::from_fn(m, m, |i, j| s.a[(i, j)]);
     }
 }
 
@@ -695,10 +705,10 @@ fn regular_zeros(s: &Siso) -> Result<Option<Vec<c64>>, Error> {
 }
 
 /// The number of finite zeros the reduction of `s` as given leaves, None if ambiguous.
-fn zero_count(s: &Siso) -> Option<usize> {
+fn zero_count(s: Siso) -> Option<usize> {
     let n = s.a.nrows();
-    let tol = ((n + 1) * (n + 1)) as f64 * f64::EPSILON * frobenius(s).max(f64::MIN_POSITIVE);
-    match reduce(s.clone(), tol) {
+    let tol = ((n + 1) * (n + 1)) as f64 * f64::EPSILON * frobenius(&s).max(f64::MIN_POSITIVE);
+    match reduce(s, tol) {
         Reduced::Regular(r) => Some(r.a.nrows()),
         Reduced::Zero => Some(0),
         Reduced::Ambiguous => None,
@@ -707,31 +717,39 @@ fn zero_count(s: &Siso) -> Option<usize> {
 
 // ----- one channel -----------------------------------------------------------------------------
 
-/// The LU factorisation with partial pivoting (by |re| + |im|) of point I - A, row-major.
+/// The LU factorisation with partial pivoting (by |re| + |im|) of point I - A, row-major, in
+/// buffers reused from point to point and channel to channel.
+#[derive(Default)]
 struct ShiftedLu {
-    n: usize,
     m: Vec<c64>,
     rows: Vec<usize>,
+    x: Vec<c64>,
 }
 
 impl ShiftedLu {
-    /// None when a pivot vanishes (point is an eigenvalue of A to rounding).
-    fn new(a: MatRef<'_, f64>, point: c64) -> Option<Self> {
+    /// Factorises point I - A; false when a pivot vanishes (point is an eigenvalue of A to
+    /// rounding).
+    fn factor(&mut self, a: &DMatrix<f64>, point: c64) -> bool {
         let n = a.nrows();
-        let mut m: Vec<c64> = (0..n * n)
-            .map(|x| {
-                let (i, j) = (x / n, x % n);
+        let (m, rows) = (&mut self.m, &mut self.rows);
+        m.clear();
+        for i in 0..n {
+            for j in 0..n {
                 let diagonal = if i == j { point } else { c64::new(0.0, 0.0) };
-                diagonal - a[(i, j)]
-            })
-            .collect();
-        let mut rows: Vec<usize> = (0..n).collect();
+                m.push(diagonal - a[(i, j)]);
+            }
+        }
+        rows.clear();
+        rows.extend(0..n);
         let size = |z: c64| z.re.abs() + z.im.abs();
         for k in 0..n {
-            let pivot =
-                (k..n).max_by(|&p, &q| size(m[p * n + k]).total_cmp(&size(m[q * n + k])))?;
+            let Some(pivot) =
+                (k..n).max_by(|&p, &q| size(m[p * n + k]).total_cmp(&size(m[q * n + k])))
+            else {
+                return false;
+            };
             if size(m[pivot * n + k]) == 0.0 {
-                return None;
+                return false;
             }
             if pivot != k {
                 for j in 0..n {
@@ -739,42 +757,49 @@ impl ShiftedLu {
                 }
                 rows.swap(k, pivot);
             }
-            for i in k + 1..n {
-                let l = quotient(m[i * n + k], m[k * n + k]);
-                m[i * n + k] = l;
-                for j in k + 1..n {
-                    let t = m[k * n + j];
-                    m[i * n + j] -= l * t;
+            // Row i -= l_ik row k below the pivot, l_ik = m_ik / m_kk kept in place.
+            let (top, below) = m.split_at_mut((k + 1) * n);
+            let pivot_row = &top[k * n..];
+            for row in below.chunks_exact_mut(n) {
+                let l = quotient(row[k], pivot_row[k]);
+                row[k] = l;
+                for (x, &t) in row[k + 1..].iter_mut().zip(&pivot_row[k + 1..]) {
+                    *x -= l * t;
                 }
             }
         }
-        Some(ShiftedLu { n, m, rows })
+        true
     }
 
-    /// c (point I - A)^-1 b + d.
-    fn response(&self, b: &[f64], c: &[f64], d: f64) -> c64 {
-        let (n, m) = (self.n, &self.m);
-        let mut x: Vec<c64> = self.rows.iter().map(|&r| c64::new(b[r], 0.0)).collect();
+    /// c (point I - A)^-1 b + d, from the factors of [`ShiftedLu::factor`].
+    fn response(&mut self, b: &[f64], c: &[f64], d: f64) -> c64 {
+        let (m, x) = (&self.m, &mut self.x);
+        let n = self.rows.len();
+        x.clear();
+        x.extend(self.rows.iter().map(|&r| c64::new(b[r], 0.0)));
         for i in 0..n {
-            for k in 0..i {
-                let t = x[k];
-                x[i] -= m[i * n + k] * t;
+            let row = &m[i * n..i * n + i];
+            let mut total = x[i];
+            for (&l, &t) in row.iter().zip(x.iter()) {
+                total -= l * t;
             }
+            x[i] = total;
         }
         for i in (0..n).rev() {
+            let row = &m[i * n..(i + 1) * n];
             let mut total = x[i];
-            for j in i + 1..n {
-                total -= m[i * n + j] * x[j];
+            for (&u, &t) in row[i + 1..].iter().zip(&x[i + 1..]) {
+                total -= u * t;
             }
-            x[i] = quotient(total, m[i * n + i]);
+            x[i] = quotient(total, row[i]);
         }
-        (0..n).map(|j| x[j] * c[j]).sum::<c64>() + d
+        x.iter().zip(c).map(|(&xj, &cj)| xj * cj).sum::<c64>() + d
     }
 }
 
 /// G(point) = c (point I - A)^-1 b + d of a SISO system, or None when a pivot vanishes.
-fn response(s: &Siso, point: c64) -> Option<c64> {
-    Some(ShiftedLu::new(s.a.as_ref(), point)?.response(&s.b, &s.c, s.d))
+fn response(s: &Siso, point: c64, lu: &mut ShiftedLu) -> Option<c64> {
+    lu.factor(&s.a, point).then(|| lu.response(&s.b, &s.c, s.d))
 }
 
 /// log10 of the roots' finite, nonzero moduli, in their order.
@@ -830,14 +855,28 @@ fn grid(dt: f64, centre: f64) -> Vec<c64> {
 /// left out when its conjugate is one of `roots`, which leaves every minimum as it is (so the
 /// minima over two sets of roots, each filtered so, are those over their union). The minimum
 /// is exact, so it is taken root by root over every point at once (independent comparisons,
-/// not one chain per point).
+/// not one chain per point). On the imaginary axis (a continuous model's grid) the first term
+/// of |jω - r|^2 = (0 - Re r)^2 + (ω - Im r)^2 is (Re r)^2 exactly, the same at every point.
 fn lower_to_nearest(points: &[c64], roots: &[c64], nearest: &mut [f64]) {
+    let on_axis = points.iter().all(|p| p.re == 0.0);
     for r in roots
         .iter()
         .filter(|r| r.im >= 0.0 || !roots.contains(&r.conj()))
     {
-        for (m, p) in nearest.iter_mut().zip(points) {
-            *m = m.min((p - r).norm_sqr());
+        // min(m, x) as a select: the same value (m is never NaN: it starts infinite and takes
+        // only smaller values; a NaN x leaves it).
+        if on_axis {
+            let real = r.re * r.re;
+            for (m, p) in nearest.iter_mut().zip(points) {
+                let y = p.im - r.im;
+                let x = real + y * y;
+                *m = if x < *m { x } else { *m };
+            }
+        } else {
+            for (m, p) in nearest.iter_mut().zip(points) {
+                let x = (p - r).norm_sqr();
+                *m = if x < *m { x } else { *m };
+            }
         }
     }
 }
@@ -888,10 +927,11 @@ fn best_points(
     farthest_two(points, &nearest)
 }
 
-/// What the channels of a model share: the poles by modulus, their log10 moduli, and for a
-/// continuous model the check grid (around max|A|, else around 1) with each point's minimum
-/// over the poles ([`lower_to_nearest`]).
+/// What the channels of a model share: the sampling period (0: continuous), the poles by
+/// modulus, their log10 moduli, and for a continuous model the check grid (around max|A|,
+/// else around 1) with each point's minimum over the poles ([`lower_to_nearest`]).
 struct Shared {
+    dt: f64,
     sorted_poles: Vec<c64>,
     pole_logs: Vec<f64>,
     check: Option<(Vec<c64>, Vec<f64>)>,
@@ -907,6 +947,7 @@ impl Shared {
             (points, nearest)
         });
         Shared {
+            dt,
             sorted_poles: by_modulus(poles),
             pole_logs: log_moduli(poles),
             check,
@@ -920,21 +961,17 @@ fn channel(
     b: &[f64],
     c: &[f64],
     d: f64,
-    dt: f64,
     poles: &[c64],
     shared: &Shared,
+    lu: &mut ShiftedLu,
 ) -> Result<Option<Channel>, Error> {
     let n = a.nrows();
-    let given = Siso {
-        a: a.to_owned(),
-        b: b.to_vec(),
-        c: c.to_vec(),
-        d,
-    };
+    let dt = shared.dt;
+    let given = Siso::of(a, b, c, d);
     if !entries(&given).all(|v| v == 0.0 || (ENTRY_RANGE.0..=ENTRY_RANGE.1).contains(&v.abs())) {
         return Ok(None);
     }
-    let (s, frequency, units) = equilibrated(given.clone());
+    let (s, frequency, units) = equilibrated(given);
     let (s, e) = unit_scaled(s);
     // Products of up to n + 1 entries must stay normal: no entry below 2^(-1000 / (n + 1)).
     let smallest = entries(&s)
@@ -962,7 +999,10 @@ fn channel(
     // reach: there must be none. (With d = 0 exactly the unequilibrated pencil has at most
     // n - 1 zeros, so n - 1 here needs no second reduction.)
     let at_most = d == 0.0 && zeros.len() + 1 == n;
-    if zeros.len() < n && !at_most && zero_count(&given).is_none_or(|k| k > zeros.len()) {
+    if zeros.len() < n
+        && !at_most
+        && zero_count(Siso::of(a, b, c, d)).is_none_or(|k| k > zeros.len())
+    {
         return Ok(None);
     }
     let scale = frequency + e;
@@ -996,10 +1036,11 @@ fn channel(
                 if best != first { best } else { after }
             }
         };
-        let at = |point: c64| -> Option<Scaled> {
+        let mut at = |point: c64| -> Option<Scaled> {
             let value = response(
                 &s,
                 c64::new(ldexp_any(point.re, -scale), ldexp_any(point.im, -scale)),
+                lu,
             )?;
             let part = value.re.abs().max(value.im.abs());
             (part.is_finite() && part >= f64::MIN_POSITIVE).then(|| Scaled::new(value, e - units))
@@ -1104,16 +1145,16 @@ mod tests {
     fn complete_pivots_of_known_matrices() {
         // [[1, 2], [3, 4]]: pivot 4, then 1 - 2·3/4 = ... with rows and columns swapped:
         // [[4, 3], [2, 1]] -> 1 - (2/4)·3 = -0.5; |det| = 4 · 0.5 = 2.
-        let m = faer::mat![[1.0, 2.0], [3.0, 4.0]];
+        let m = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 3.0, 4.0]);
         assert_eq!(complete_pivots(m), vec![4.0, 0.5]);
         // A rank-one matrix: the second pivot is 0 to rounding, a zero matrix all 0.
-        let m = Mat::from_fn(3, 3, |i, j| (i + 1) as f64 * (j + 2) as f64);
+        let m = DMatrix::from_fn(3, 3, |i, j| (i + 1) as f64 * (j + 2) as f64);
         let pivots = complete_pivots(m);
         assert_eq!(pivots[0], 12.0);
         assert!(pivots[1] <= 4.0 * f64::EPSILON * 12.0 && pivots[2] <= 4.0 * f64::EPSILON * 12.0);
-        assert_eq!(complete_pivots(Mat::zeros(2, 2)), vec![0.0, 0.0]);
+        assert_eq!(complete_pivots(DMatrix::zeros(2, 2)), vec![0.0, 0.0]);
         // The product of the pivots is |det| (a permuted triangular factorisation).
-        let m = faer::mat![[2.0, -1.0, 0.5], [0.25, 3.0, 1.0], [-1.5, 0.75, 4.0]];
+        let m = DMatrix::from_row_slice(3, 3, &[2.0, -1.0, 0.5, 0.25, 3.0, 1.0, -1.5, 0.75, 4.0]);
         let det: f64 =
             2.0 * (3.0 * 4.0 - 0.75) + 1.0 * (0.25 * 4.0 + 1.5) + 0.5 * (0.25 * 0.75 + 4.5);
         let product: f64 = complete_pivots(m).iter().product();
