@@ -12,7 +12,7 @@
 //!
 //! which differs from H in its first row only and is again upper Hessenberg: each gain costs
 //! the double-shift QR iteration alone, with no reduction (and no balancing), in parallel
-//! over the gains.
+//! over runs of gains (a single run on the calling thread where the pool has one thread).
 //!
 //! **Backward stability.** The reduction and the QR iteration are orthogonal and unbalanced:
 //! each gain's eigenvalues are those of A - g b c + E with ||E|| = O(n u (||A|| + |g| ||b|| ||c||)),
@@ -25,8 +25,9 @@
 //! a triangular A exactly (a repeated pole would otherwise split by sqrt(u) ||A||).
 //!
 //! **Continuation.** Along a run of gains, each gain's poles are found from the previous
-//! gain's (extrapolated through the two before) by Aberth's simultaneous iteration on the
-//! closed-loop characteristic polynomial in factored form,
+//! gains' (extrapolated by the parabola through the last three, or the secant through the last
+//! two where the parabola departs from the secant by more than the secant's step) by Aberth's
+//! simultaneous iteration on the closed-loop characteristic polynomial in factored form,
 //!
 //! ```text
 //!     χ_g(s) = det(sI - A + g b c) = Π(s - p_i) + g K Π(s - z_j) = D(s) (1 + R(s)),
@@ -36,7 +37,9 @@
 //! with the open-loop poles p_i, the zeros z_j and the gain K of c (sI - A)^-1 b from
 //! [`transfer::transfer_channels`], and S_p = Σ 1/(s - p_i), S_z = Σ 1/(s - z_j). Each
 //! approximation x_i moves by 1 / (χ'/χ(x_i) - Σ_{j≠i} 1/(x_i - x_j)) (Aberth 1973, eq. 2),
-//! and stops once |1 + R(x_i)| <= η max(1, |R(x_i)|), η = 32 (n + m + 1) u: x_i is then a root of
+//! and stops once |1 + R(x_i)| <= η max(1, |R(x_i)|), η = 32 (n + m + 1) u (tested as
+//! |D + G N| <= η max(|D|, |G N|) with D = Π(x_i - p_i) and G N = g K Π(x_i - z_j), in squares
+//! without a division where they are in range): x_i is then a root of
 //! the factored χ_g with its factors perturbed by O(η); or once the disk about x_i of radius
 //! deg χ |χ(x_i) / χ'(x_i)|, which holds a root of χ_g, is within 8 ulps of x_i (a pole next to
 //! a zero, where the rounding of x_i itself keeps the residual above η). The iteration keeps the real
@@ -219,6 +222,29 @@ pub(crate) fn sort(values: &mut [c64]) {
     values.sort_unstable_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
 }
 
+/// `values` sorted as [`sort`] sorts them, into `out`: an insertion sort of the permutation
+/// `order` by the values (kept from the call before, where the values keep their order from gain
+/// to gain, it costs one comparison a value), then `out` gathered through it.
+fn sort_into(values: &[c64], order: &mut Vec<usize>, out: &mut [c64]) {
+    if order.len() != values.len() {
+        order.clear();
+        order.extend(0..values.len());
+    }
+    let before = |x: c64, y: c64| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)).is_lt();
+    for k in 1..order.len() {
+        let item = order[k];
+        let mut j = k;
+        while j > 0 && before(values[item], values[order[j - 1]]) {
+            order[j] = order[j - 1];
+            j -= 1;
+        }
+        order[j] = item;
+    }
+    for (slot, &k) in out.iter_mut().zip(order.iter()) {
+        *slot = values[k];
+    }
+}
+
 /// InvalidArgument unless A is n x n, b n x 1 and c 1 x n.
 fn check_loop(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<(), Error> {
     check_square(a, "A")?;
@@ -241,8 +267,9 @@ fn check_loop(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Res
 
 /// The closed-loop poles of the SISO loop (A n x n, b n x 1, c 1 x n) at each closed-loop gain
 /// g of `gains` (the eigenvalues of A - g b c), written into `out` (n per gain, sorted by real
-/// part, then imaginary part, as `numpy.sort_complex`), in parallel over chunks of gains. See
-/// the module's documentation.
+/// part, then imaginary part, as `numpy.sort_complex`), in parallel over runs of gains (one
+/// run on the calling thread where rayon's pool has one thread). See the module's
+/// documentation.
 pub fn root_locus(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -268,38 +295,47 @@ pub fn root_locus(
         Vec::new()
     };
     let factored = factored_loop(a, &bv, &cv)?;
-    // Runs of consecutive gains, a few per thread: each starts with the QR iteration.
-    let runs = (rayon::current_num_threads() * 4).max(1);
+    // Runs of consecutive gains, a few per thread, each starting with the QR iteration; on one
+    // thread a single run, on the calling thread.
+    let threads = rayon::current_num_threads();
+    let runs = if threads > 1 { threads * 4 } else { 1 };
     let run_length = gains.len().div_ceil(runs).max(MIN_RUN);
     let context = ParallelContext::capture(0);
     with_order!(n, order => {
         let form = controller_hessenberg(order, a, &bv, &cv);
-        out.par_chunks_mut(run_length * n)
-            .zip(gains.par_chunks(run_length))
-            .enumerate()
-            .try_for_each(|(run, (poles, run_gains))| {
-                context.run(|| {
-                    let mut continuation = Continuation::default();
-                    for (k, (poles, &g)) in poles.chunks_mut(n).zip(run_gains).enumerate() {
-                        crate::platform::interrupt::check()?;
-                        if g == 0.0 {
-                            poles.copy_from_slice(&open_loop);
-                            continuation = Continuation::default();
-                            continue;
-                        }
-                        if factored.as_ref().is_some_and(|f| continuation.next(f, g, poles)) {
-                            sort(poles);
-                            continue;
-                        }
-                        let values = closed_loop_eigenvalues(&form, g)
-                            .map_err(|e| Error::in_batch(run * run_length + k, e))?;
-                        // The QR iteration's poles start a run, polished.
-                        continuation = polished(factored.as_ref(), g, &values, poles);
-                        sort(poles);
+        let solve = |(run, (poles, run_gains)): (usize, (&mut [c64], &[f64]))| {
+            context.run(|| {
+                let mut continuation = Continuation::default();
+                for (k, (poles, &g)) in poles.chunks_mut(n).zip(run_gains).enumerate() {
+                    crate::platform::interrupt::check()?;
+                    if g == 0.0 {
+                        poles.copy_from_slice(&open_loop);
+                        continuation = Continuation::default();
+                        continue;
                     }
-                    Ok(())
-                })
+                    if factored.as_ref().is_some_and(|f| continuation.next(f, g, poles)) {
+                        continue;
+                    }
+                    let values = closed_loop_eigenvalues(&form, g)
+                        .map_err(|e| Error::in_batch(run * run_length + k, e))?;
+                    // The QR iteration's poles start a run, polished.
+                    continuation = polished(factored.as_ref(), g, &values, poles);
+                    sort(poles);
+                }
+                Ok(())
             })
+        };
+        if threads > 1 {
+            out.par_chunks_mut(run_length * n)
+                .zip(gains.par_chunks(run_length))
+                .enumerate()
+                .try_for_each(solve)
+        } else {
+            out.chunks_mut(run_length * n)
+                .zip(gains.chunks(run_length))
+                .enumerate()
+                .try_for_each(solve)
+        }
     })
 }
 
@@ -403,12 +439,6 @@ impl Conjugates {
         (upper == lower).then_some(Self { real, upper })
     }
 
-    /// Every root, conjugates included.
-    fn all(&self) -> impl Iterator<Item = c64> + '_ {
-        let real = self.real.iter().map(|&x| c64::new(x, 0.0));
-        real.chain(self.upper.iter().flat_map(|&y| [y, y.conj()]))
-    }
-
     /// Σ 1/(x_i - v) over every root v but x_i itself (its conjugate included), x_i the i-th
     /// real root or, from i = real.len(), the upper member of the (i - real.len())-th pair.
     fn repulsion(&self, i: usize) -> c64 {
@@ -434,7 +464,7 @@ impl Conjugates {
         }
         for (j, v) in self.upper.iter().enumerate() {
             if j + reals != i {
-                sum += reciprocal(x - v) + reciprocal(x - v.conj());
+                sum += pair_reciprocals(x - v, x - v.conj());
             }
         }
         sum
@@ -492,7 +522,7 @@ impl Conjugates {
             sum += reciprocal(c64::new(x.re - v, x.im));
         }
         for v in &self.upper {
-            sum += reciprocal(x - v) + reciprocal(x - v.conj());
+            sum += pair_reciprocals(x - v, x - v.conj());
         }
         sum
     }
@@ -581,19 +611,41 @@ impl Factored {
         }))
     }
 
-    /// R(x) = g K Π(x - z_j) / Π(x - p_i); None where it is not finite or is 0 (x on a pole
-    /// or a zero, or a product beyond the doubles).
+    /// Whether x is a root of the factored χ_g ([`is_root`]), and R(x) = G N / D where it is
+    /// not (G = g K, N = Π(x - z_j), D = Π(x - p_i)). Where |D|^2 and |G N|^2 are in the
+    /// normal range the test is |D + G N| <= η max(|D|, |G N|) (that of [`is_root`] times |D|),
+    /// squared, without a division; a failure where R is not finite or is 0 (x on a pole or a
+    /// zero, or a product beyond the doubles).
     #[inline]
-    fn r(&self, x: c64, g: f64) -> Option<c64> {
-        let r = self.zeros.product(x) * reciprocal(self.poles.product(x)) * (g * self.gain);
-        (r.re.is_finite() && r.im.is_finite() && r != c64::new(0.0, 0.0)).then_some(r)
+    fn residual(&self, x: c64, g: f64, eta: f64) -> Residual {
+        let (d, n) = (
+            self.poles.product(x),
+            self.zeros.product(x) * (g * self.gain),
+        );
+        let square = |z: c64| z.re * z.re + z.im * z.im;
+        let (d2, n2) = (square(d), square(n));
+        let range = 1e-290..=1e290;
+        if range.contains(&d2) && range.contains(&n2) {
+            if square(d + n) <= eta * eta * d2.max(n2) {
+                return Residual::Root;
+            }
+            return Residual::Off(n * reciprocal(d));
+        }
+        let r = n * reciprocal(d);
+        if !(r.re.is_finite() && r.im.is_finite() && r != c64::new(0.0, 0.0)) {
+            Residual::Failed
+        } else if is_root(r, eta) {
+            Residual::Root
+        } else {
+            Residual::Off(r)
+        }
     }
 
     /// χ'/χ = (S_p + R S_z) / (1 + R) at x, formed as (S_p / R + S_z) / (1 / R + 1) where
     /// |R| > 1; not finite where 1 + R = 0 exactly.
     fn logarithmic_derivative(&self, x: c64, r: c64) -> c64 {
         let (s_p, s_z) = (self.poles.sum(x), self.zeros.sum(x));
-        if modulus(r) <= 1.0 {
+        if r.re * r.re + r.im * r.im <= 1.0 {
             (s_p + r * s_z) * reciprocal(r + 1.0)
         } else {
             let inverse = reciprocal(r);
@@ -616,6 +668,16 @@ impl Factored {
     }
 }
 
+/// [`Factored::residual`] at a point.
+enum Residual {
+    /// A root of the factored χ_g.
+    Root,
+    /// Not a root: R at the point.
+    Off(c64),
+    /// R is not finite or is 0.
+    Failed,
+}
+
 /// Whether |1 + R| <= η max(1, |R|) (squared, without a root or a division): a point where
 /// R(x) = r is then a root of the factored χ_g with its factors perturbed by O(η) (relative).
 #[inline]
@@ -625,6 +687,20 @@ fn is_root(r: c64, eta: f64) -> bool {
     }
     let one_plus = (r.re + 1.0) * (r.re + 1.0) + r.im * r.im;
     one_plus <= eta * eta * (r.re * r.re + r.im * r.im).max(1.0)
+}
+
+/// Whether deg χ / |χ'/χ| (the radius of a disk about x that holds a root of χ) is within
+/// [`INCLUSION_ULPS`] units in the last place of |x|; compared in squares, without a root or a
+/// division, where they stay in the normal range.
+#[inline]
+fn included(degree: f64, ratio: c64, x: c64) -> bool {
+    let square = |z: c64| z.re * z.re + z.im * z.im;
+    let (r2, x2) = (square(ratio), square(x));
+    let units = INCLUSION_ULPS * f64::EPSILON;
+    if (1e-100..=1e100).contains(&r2) && (1e-100..=1e100).contains(&x2) {
+        return degree * degree <= units * units * x2 * r2;
+    }
+    degree * modulus(reciprocal(ratio)) <= units * modulus(x)
 }
 
 /// |z|, by a square root where |z|^2 stays in the normal range.
@@ -653,14 +729,32 @@ fn reciprocal(z: c64) -> c64 {
     c64::new(re / denominator, -im / denominator)
 }
 
-/// A run of the continuation: the approximations at its last gain and at the one before, and
-/// the buffers of the next gain's.
+/// 1/d + 1/e as (d + e) / (d e), by one real division (|1/d + 1/e| <= 1/|d| + 1/|e|: no
+/// less accurate than the two reciprocals, which it takes where |d e|^2 would leave the normal
+/// range).
+#[inline]
+fn pair_reciprocals(d: c64, e: c64) -> c64 {
+    let product = d * e;
+    let norm = product.re * product.re + product.im * product.im;
+    if (1e-290..=1e290).contains(&norm) {
+        return (d + e) * product.conj() * (1.0 / norm);
+    }
+    reciprocal(d) + reciprocal(e)
+}
+
+/// A run of the continuation: the approximations at its last three gains, and the buffers of
+/// the next gain's.
 #[derive(Default)]
 struct Continuation {
     last: Option<(f64, Conjugates)>,
     before: Option<(f64, Conjugates)>,
+    earlier: Option<(f64, Conjugates)>,
     work: Conjugates,
     converged: Vec<bool>,
+    /// The last gain's poles, unsorted (the common factors, the real roots, then each pair),
+    /// and the permutation that sorted them.
+    roots: Vec<c64>,
+    order: Vec<usize>,
 }
 
 impl Continuation {
@@ -693,7 +787,7 @@ impl Continuation {
     }
 
     /// The closed-loop poles at g by Aberth's iteration from the run's last gain, written
-    /// into `out`; false where the caller must take the QR iteration.
+    /// into `out` sorted (as [`sort`]); false where the caller must take the QR iteration.
     fn next(&mut self, factored: &Factored, g: f64, out: &mut [c64]) -> bool {
         let Some((g1, last)) = &self.last else {
             return false;
@@ -704,14 +798,51 @@ impl Continuation {
         let x = &mut self.work;
         x.clone_from(last);
         if let Some((g0, before)) = &self.before {
-            // The secant through the two previous gains' poles.
             let t = (g - g1) / (g1 - g0);
             if t.is_finite() && t.abs() <= 4.0 {
-                for (y, y0) in x.real.iter_mut().zip(&before.real) {
-                    *y += (*y - y0) * t;
+                // The secant through the two previous gains' poles, and the parabola through
+                // the three where the run has them (Lagrange's weights, formed once for every
+                // pole): the parabola where it departs from the secant by less than the
+                // secant's own step (its curvature a correction, not the turn of a path near
+                // a breakaway point).
+                let weights = self.earlier.as_ref().and_then(|(g2, _)| {
+                    let w = [
+                        (g - g0) * (g - g2) / ((g1 - g0) * (g1 - g2)),
+                        (g - g1) * (g - g2) / ((g0 - g1) * (g0 - g2)),
+                        (g - g1) * (g - g0) / ((g2 - g1) * (g2 - g0)),
+                    ];
+                    w.iter().all(|w| w.is_finite()).then_some(w)
+                });
+                let earlier = self.earlier.as_ref().map(|(_, roots)| roots);
+                for (i, (y, y0)) in x.real.iter_mut().zip(&before.real).enumerate() {
+                    let secant = *y + (*y - y0) * t;
+                    let parabola = match (weights, earlier) {
+                        (Some(w), Some(e)) => e
+                            .real
+                            .get(i)
+                            .map_or(secant, |y2| w[0] * *y + w[1] * y0 + w[2] * y2),
+                        _ => secant,
+                    };
+                    *y = if (parabola - secant).abs() < (secant - *y).abs() {
+                        parabola
+                    } else {
+                        secant
+                    };
                 }
-                for (y, y0) in x.upper.iter_mut().zip(&before.upper) {
-                    let predicted = *y + (*y - y0) * t;
+                for (i, (y, y0)) in x.upper.iter_mut().zip(&before.upper).enumerate() {
+                    let secant = *y + (*y - y0) * t;
+                    let parabola = match (weights, earlier) {
+                        (Some(w), Some(e)) => e
+                            .upper
+                            .get(i)
+                            .map_or(secant, |y2| *y * w[0] + y0 * w[1] + y2 * w[2]),
+                        _ => secant,
+                    };
+                    let predicted = if (parabola - secant).norm_sqr() < (secant - *y).norm_sqr() {
+                        parabola
+                    } else {
+                        secant
+                    };
                     if predicted.im > 0.0 {
                         *y = predicted;
                     }
@@ -721,18 +852,21 @@ impl Continuation {
         if !aberth(factored, g, x, &mut self.converged) {
             return false;
         }
-        for (slot, root) in out
-            .iter_mut()
-            .zip(factored.fixed.iter().copied().chain(x.all()))
-        {
-            *slot = root;
+        let roots = &mut self.roots;
+        roots.clear();
+        roots.extend_from_slice(&factored.fixed);
+        roots.extend(x.real.iter().map(|&v| c64::new(v, 0.0)));
+        for &y in &x.upper {
+            roots.extend([y, y.conj()]);
         }
-        if !factored.verified(out, g) {
+        if !factored.verified(roots, g) {
             return false;
         }
-        // The work buffer becomes the last gain's, the one before's is reused as the next work.
+        sort_into(roots, &mut self.order, out);
+        // The work buffer becomes the last gain's, the earliest's is reused as the next work.
         let previous = self.last.replace((g, std::mem::take(&mut self.work)));
-        if let Some((_, mut reused)) = std::mem::replace(&mut self.before, previous) {
+        let previous = std::mem::replace(&mut self.before, previous);
+        if let Some((_, mut reused)) = std::mem::replace(&mut self.earlier, previous) {
             std::mem::swap(&mut self.work, &mut reused);
         }
         true
@@ -759,15 +893,16 @@ fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<b
             } else {
                 x.upper[i - reals]
             };
-            let Some(r) = factored.r(xi, g) else {
-                return false;
+            let r = match factored.residual(xi, g, eta) {
+                Residual::Root => {
+                    *converged = true;
+                    continue;
+                }
+                Residual::Off(r) => r,
+                Residual::Failed => return false,
             };
-            if is_root(r, eta) {
-                *converged = true;
-                continue;
-            }
             let ratio = factored.logarithmic_derivative(xi, r);
-            if degree * modulus(reciprocal(ratio)) <= INCLUSION_ULPS * f64::EPSILON * modulus(xi) {
+            if included(degree, ratio, xi) {
                 // A disk about x_i of radius deg χ |χ / χ'| holds a root of χ: within a few
                 // units of x_i's last place, so x_i is that root to working precision (near a
                 // zero, where the rounding of x_i - z bounds the residual, not the root).
@@ -968,6 +1103,69 @@ mod tests {
         );
         assert!(!none.unwrap());
         assert!(untouched.iter().all(|x| *x == c64::new(7.0, 0.0)));
+    }
+
+    /// On one thread the gains form a single run on the calling thread; its poles agree with
+    /// those of the runs of the parallel path (the same gains, other run starts) to rounding.
+    #[test]
+    fn one_thread_takes_one_run_with_the_same_poles() {
+        let n = 6;
+        let a = Mat::from_fn(n, n, |i, j| {
+            let x = ((i * 7 + j * 13 + 3) % 17) as f64 / 8.0 - 1.0;
+            if i == j { x - 1.5 } else { x }
+        });
+        let b = Mat::from_fn(n, 1, |i, _| ((i * 5 + 2) % 7) as f64 / 3.0 - 1.0);
+        let c = Mat::from_fn(1, n, |_, j| ((j * 3 + 2) % 5) as f64 / 2.0 - 1.0);
+        let gains: Vec<f64> = (0..500).map(|i| 0.01 * i as f64).collect();
+        let mut parallel = vec![c64::new(0.0, 0.0); gains.len() * n];
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        pool.install(|| root_locus(a.as_ref(), b.as_ref(), c.as_ref(), &gains, &mut parallel))
+            .unwrap();
+        let mut single = vec![c64::new(0.0, 0.0); gains.len() * n];
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        pool.install(|| root_locus(a.as_ref(), b.as_ref(), c.as_ref(), &gains, &mut single))
+            .unwrap();
+        for (k, (x, y)) in single.chunks(n).zip(parallel.chunks(n)).enumerate() {
+            let scale = y.iter().fold(1.0f64, |m, v| m.max(v.norm()));
+            for (x, y) in x.iter().zip(y) {
+                assert!((x - y).norm() <= 1e-12 * scale, "gain {k}: {x} vs {y}");
+            }
+        }
+    }
+
+    /// The permutation kept from call to call sorts exactly as `sort` does: values in any
+    /// order, ties, conjugate pairs, -0 beside +0.
+    #[test]
+    fn sort_into_sorts_as_sort_does() {
+        let mut order = Vec::new();
+        let mut out = vec![c64::new(0.0, 0.0); 7];
+        for shift in 0..40 {
+            let values: Vec<c64> = (0..7)
+                .map(|i| {
+                    let re = [(i * 5 + shift) % 7, 3, 0][i % 3] as f64 - 3.0;
+                    let im = if i % 2 == 0 {
+                        0.0
+                    } else {
+                        (shift % 3) as f64 - 1.0
+                    };
+                    c64::new(if i == 6 { -0.0 } else { re }, im)
+                })
+                .collect();
+            sort_into(&values, &mut order, &mut out);
+            let expected = sorted(values.clone());
+            for (x, y) in out.iter().zip(&expected) {
+                assert_eq!(
+                    (x.re.to_bits(), x.im.to_bits()),
+                    (y.re.to_bits(), y.im.to_bits())
+                );
+            }
+        }
     }
 
     #[test]
