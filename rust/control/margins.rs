@@ -72,7 +72,9 @@
 //! **Verification.** Every phase crossover with L(jω) < 0 gives a gain margin k = 1/|L(jω)|;
 //! the loop closed with k must have a pole at jω (the eigenvalues of A - k B (1 + k d)^-1 C
 //! by the root locus's controller-Hessenberg form, `control/root_locus.rs`,
-//! within 1e-6 of max(1 + max|A|, ω)), else [`Error::IllConditioned`].
+//! within 1e-6 of max(1 + max|A|, ω)), else [`Error::IllConditioned`]. The closed loop's
+//! poles and those of every such check come from one form of (A, b, c)
+//! (`closed_loop_poles_at`: the same poles, bit for bit, as one form per gain).
 //!
 //! References: S. Boyd, V. Balakrishnan and P. Kabamba, "A bisection method for computing the
 //! H∞ norm of a transfer matrix and related problems", Math. Control Signals Systems 2, 1989;
@@ -903,7 +905,6 @@ pub fn loop_margins(
     let cv: Vec<f64> = (0..n).map(|j| c[(0, j)]).collect();
     let open_loop_poles = eigenvalues(a)?;
     let closed = Mat::from_fn(n, n, |i, j| a[(i, j)] - bv[i] * cv[j] / denominator);
-    let closed_loop_poles = root_locus::closed_loop_poles(a, &bv, &cv, 1.0 / denominator)?;
     let mut this = Loop {
         a,
         b: bv.clone(),
@@ -917,11 +918,28 @@ pub fn loop_margins(
     // The crossovers and the two peaks are independent, but each is a few tens of µs at n = 6:
     // split between two threads, the worker left spinning after the join slowed the caller's
     // Python (on a sibling hyperthread) by more than the split saved.
-    let crossovers = (|| {
-        let gain = this.gain_crossovers()?;
-        let phase = this.phase_crossovers(&open_loop_poles)?;
-        Ok::<_, Error>((gain, phase))
-    })();
+    let gain_crossovers = this.gain_crossovers()?;
+    let (phase_crossovers, degenerate) = this.phase_crossovers(&open_loop_poles)?;
+    // The closed loop's poles (gain 1/(1 + d)) and those of the loops closed with the gain
+    // margins (verified below) from one controller-Hessenberg form of (A, b, c).
+    let margin_gains: Vec<(&Crossover, f64)> = phase_crossovers
+        .iter()
+        .filter(|x| x.value.re < 0.0)
+        .filter_map(|crossover| {
+            let k = 1.0 / crossover.value.norm();
+            let shifted = 1.0 + k * d0;
+            if shifted.abs() <= 8.0 * f64::EPSILON * (k * d0).abs().max(1.0) || n == 0 {
+                None
+            } else {
+                Some((crossover, k))
+            }
+        })
+        .collect();
+    let gains: Vec<f64> = std::iter::once(1.0 / denominator)
+        .chain(margin_gains.iter().map(|&(_, k)| k / (1.0 + k * d0)))
+        .collect();
+    let mut spectra = root_locus::closed_loop_poles_at(a, &bv, &cv, &gains)?.into_iter();
+    let closed_loop_poles = spectra.next().unwrap_or_default();
     let peaks = (|| {
         let mut closed_response = strictly_proper_evaluator(closed.as_ref(), &bs, &cs)?;
         // Both peaks start from S at the same test frequencies (0 and the closed-loop poles'):
@@ -955,19 +973,13 @@ pub fn loop_margins(
         )?;
         Ok::<_, Error>((sensitivity, disk))
     })();
-    let ((gain_crossovers, (phase_crossovers, degenerate)), (sensitivity, disk)) =
-        (crossovers?, peaks?);
+    let (sensitivity, disk) = peaks?;
 
     // Each gain margin k puts a closed-loop pole at its crossover.
     let size = 1.0 + max_abs(a);
-    for crossover in phase_crossovers.iter().filter(|x| x.value.re < 0.0) {
-        let k = 1.0 / crossover.value.norm();
-        let shifted = 1.0 + k * d0;
-        if shifted.abs() <= 8.0 * f64::EPSILON * (k * d0).abs().max(1.0) || n == 0 {
-            continue;
-        }
+    for ((crossover, k), poles) in margin_gains.into_iter().zip(spectra) {
         let point = c64::new(0.0, crossover.omega);
-        let miss = root_locus::closed_loop_poles(a, &bv, &cv, k / shifted)?
+        let miss = poles
             .iter()
             .map(|p| (p - point).norm())
             .fold(f64::INFINITY, f64::min);
