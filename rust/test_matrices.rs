@@ -2,15 +2,21 @@
 
 use faer::{Mat, c64};
 
-/// A rows x cols matrix with entries in [-1, 1) from a xorshift generator seeded by `seed`.
-pub(crate) fn seeded(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
-    let mut state = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
-    Mat::from_fn(rows, cols, |_, _| {
+/// Values in [-1, 1) from Marsaglia's xorshift generator (shifts 13, 7, 17) started at
+/// `state` (nonzero).
+pub(crate) fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
+    move || {
         state ^= state << 13;
         state ^= state >> 7;
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    })
+    }
+}
+
+/// A rows x cols matrix with entries in [-1, 1) from a xorshift generator seeded by `seed`.
+pub(crate) fn seeded(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
+    let mut next = xorshift(seed.wrapping_mul(0x9E3779B97F4A7C15) | 1);
+    Mat::from_fn(rows, cols, |_, _| next())
 }
 
 /// A square [`seeded`] matrix.

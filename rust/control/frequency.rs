@@ -634,13 +634,7 @@ mod tests {
         // Seeded SISO models of orders 0 to SISO_ORDER, entries of several sizes, at points
         // on and off the axis (and near the poles' size): the stack kernel's value must be
         // the workspace kernel's, bit for bit, with and without fused multiply-adds.
-        let mut state = 0x2545f4914f6cdd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut next = crate::test_matrices::xorshift(0x2545f4914f6cdd1d);
         let mut compared = 0;
         for n in 0..=SISO_ORDER {
             for trial in 0..40 {

@@ -1245,13 +1245,7 @@ mod tests {
     /// factored form shared), with a zero gain among the others.
     #[test]
     fn poles_at_several_gains_are_those_at_each_alone() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut draw = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut draw = crate::test_matrices::xorshift(0x2545_f491_4f6c_dd1d);
         let mut loops = Vec::new();
         for n in 1..=8 {
             for _ in 0..8 {
