@@ -1382,7 +1382,9 @@ def dc_gain(sys: System) -> FloatArray:
     ...
     aerocontrol.exceptions.SingularMatrixError: A is singular: it has the eigenvalue 0 ...
     """
-    A, B, C, D, dt = plant_arrays(sys)
+    # A tuple is continuous, and its four matrices are checked by the core's dc_gain (before
+    # any SingularMatrixError); a discrete model is a StateSpace, checked when it was made.
+    A, B, C, D, dt = plant_arrays(sys, check=False)
     if not dt:
         try:
             gain: FloatArray = _core.dc_gain(A, B, C, D)  # one call: a small model's cost

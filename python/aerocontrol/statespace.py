@@ -644,7 +644,7 @@ def as_state_space(model: System, name: str = "sys") -> StateSpace:
 
 
 def plant_arrays(
-    model: System, name: str = "sys"
+    model: System, name: str = "sys", check: bool = True
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, float]:
     """(A, B, C, D, dt) of ``model``, without building a :class:`StateSpace` from a tuple: for
     a function that passes the matrices to the core once, where the read-only copies a model
@@ -654,9 +654,11 @@ def plant_arrays(
     by :func:`as_state_space`. A tuple ``(A, B)`` or ``(A, B, C, D)`` gives its arrays as they
     are (float64 views: no copy; a 1-D B as one column; C = I and D = 0 where absent, as
     StateSpace makes them, shared and read-only), continuous (dt = 0.0). Given C and D are
-    checked against A and B here (the core's ``check_model``, as StateSpace checks them); the
-    A and B of an ``(A, B)`` tuple are not: the caller must pass them to a core function, which
-    checks its arguments by name (shapes and finiteness) as StateSpace would.
+    checked against A and B here (the core's ``check_model``, as StateSpace checks them) unless
+    ``check`` is False, for a caller that passes all four to a core function which checks them
+    (a second pass over A costs a fifth of a solve of order 64); the A and B of an ``(A, B)``
+    tuple are not: the caller must pass them to a core function, which checks its arguments by
+    name (shapes and finiteness) as StateSpace would.
     """
     if isinstance(model, StateSpace):
         return model.A, model.B, model.C, model.D, period(model)
@@ -670,7 +672,7 @@ def plant_arrays(
         D = _constant(C.shape[0], B.shape[1], False)
         if len(model) == 4 and model[3] is not None:
             D = _feedthrough(model[3], C.shape[0], B.shape[1])
-        if given:
+        if given and check:
             _core.check_model(A, B, C, D)
         return A, B, C, D, 0.0
     sys = as_state_space(model, name)

@@ -490,7 +490,6 @@ pub fn steady_state(
     b: MatRef<'_, f64>,
     eta0: MatRef<'_, f64>,
 ) -> Result<Mat<f64>, Error> {
-    check_finite(a, "A")?;
     let empty = Mat::<f64>::zeros(0, a.nrows());
     let no_feedthrough = Mat::<f64>::zeros(0, b.ncols());
     check_state_space(a, b, empty.as_ref(), no_feedthrough.as_ref())?;
@@ -504,6 +503,15 @@ pub fn steady_state(
         });
     }
     check_finite(eta0, "eta0")?;
+    solve_steady_state(a, b, eta0)
+}
+
+/// [`steady_state`] of arguments already checked.
+fn solve_steady_state(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    eta0: MatRef<'_, f64>,
+) -> Result<Mat<f64>, Error> {
     let n = a.nrows();
     let lu = a.partial_piv_lu();
     let mut x = -(b * eta0);
@@ -546,7 +554,7 @@ pub fn dc_gain(
     d: MatRef<'_, f64>,
 ) -> Result<Mat<f64>, Error> {
     check_state_space(a, b, c, d)?;
-    let states = steady_state(a, b, Mat::<f64>::identity(b.ncols(), b.ncols()).as_ref())?;
+    let states = solve_steady_state(a, b, Mat::<f64>::identity(b.ncols(), b.ncols()).as_ref())?;
     let mut gain = d.to_owned();
     matmul(gain.as_mut(), Accum::Add, c, states.as_ref(), 1.0, Par::Seq);
     Ok(gain)
