@@ -1408,3 +1408,30 @@ def test_root_locus_of_a_jordan_chain_at_high_gain_closed_form() -> None:
     assert np.max(np.abs(dense - exact)) <= 1e-14 * scale
     single = root_locus(loop, [k]).poles[0]
     assert np.max(np.abs(single - exact)) <= 1e-12 * scale
+
+
+@pytest.mark.parametrize(
+    ("phase", "gain", "named"),
+    [
+        (([math.nan], [(1.0, 0.0)]), ([], []), "phase crossovers"),
+        (([math.inf], [(-1.0, 0.0)]), ([], []), "phase crossovers"),
+        (([1.0], [(-0.5, math.nan)]), ([], []), "phase crossovers"),
+        (([], []), ([-1.0], [(0.0, 1.0)]), "gain crossovers"),
+        (([], []), ([1.0], [(math.inf, 0.0)]), "gain crossovers"),
+    ],
+)
+def test_core_crossover_margins_refuse_bad_crossovers_by_name(
+    phase: tuple[list[float], list[tuple[float, float]]],
+    gain: tuple[list[float], list[tuple[float, float]]],
+    named: str,
+) -> None:
+    """The core's margins of crossovers divide by ω and take L's phase: a crossover at a
+    negative, NaN or infinite frequency, or with a non-finite L, is an InvalidArgumentError
+    naming the list, not NaN margins."""
+    with pytest.raises(InvalidArgumentError, match=named) as error:
+        aerocontrol._core.crossover_margins(*phase, *gain)
+    assert getattr(error.value, "argument", None) == named
+    # The valid crossovers of the same kinds give the margins by hand: 1/|L| = 2 at ω = 1
+    # (L = -0.5), and at ω = 2 the phase margin 90° with the delay margin (π/2)/2.
+    margins = aerocontrol._core.crossover_margins([1.0], [(-0.5, 0.0)], [2.0], [(0.0, -1.0)])[0]
+    np.testing.assert_allclose(margins, [2.0, 1.0, 90.0, 2.0, math.pi / 4], rtol=1e-15)

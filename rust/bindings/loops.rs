@@ -86,6 +86,24 @@ fn crossover_margins<'py>(
                 },
             ));
         }
+        // A crossover is at a frequency ω >= 0 with a finite L(jω): the margins divide by ω
+        // and take the phase of L.
+        let finite = |x: f64| x.is_finite();
+        if let Some(k) = (0..omega.len()).find(|&k| {
+            !(finite(omega[k]) && omega[k] >= 0.0 && finite(values[k].0) && finite(values[k].1))
+        }) {
+            return Err(to_py_err(
+                py,
+                Error::InvalidArgument {
+                    arg: name,
+                    message: format!(
+                        "{name} must be at finite frequencies >= 0 with finite values, got \
+                         ω = {} with L = {} + {}j at index {k}",
+                        omega[k], values[k].0, values[k].1
+                    ),
+                },
+            ));
+        }
         Ok(omega
             .into_iter()
             .zip(values)
