@@ -546,30 +546,31 @@ fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
             units += k;
             changed = true;
         }
-        let mut size = squares(s.a.iter().copied()).sqrt();
+        let mut size = squares(s.a.as_slice().iter().copied()).sqrt();
         if size == 0.0 {
             size = squares(s.b.iter().copied()).sqrt();
         }
         let k = half_exponent(size);
         if k != 0 {
-            s.a.iter_mut().for_each(|x| scale(x, k));
+            s.a.as_mut_slice().iter_mut().for_each(|x| scale(x, k));
             s.b.iter_mut().for_each(|x| scale(x, k));
             frequency -= k;
             changed = true;
         }
         for i in 0..n {
-            let row = squares(
-                (0..n)
-                    .filter(|&j| j != i)
-                    .map(|j| s.a[(i, j)])
-                    .chain([s.b[i]]),
-            );
-            let col = squares(
-                (0..n)
-                    .filter(|&j| j != i)
-                    .map(|j| s.a[(j, i)])
-                    .chain([s.c[i]]),
-            );
+            // The sums of squares of the other states' entries, in order, then b_i's (c_i's):
+            // two loops around the diagonal, no test per entry.
+            let (mut row, mut col) = (0.0, 0.0);
+            for j in 0..i {
+                row += s.a[(i, j)] * s.a[(i, j)];
+                col += s.a[(j, i)] * s.a[(j, i)];
+            }
+            for j in i + 1..n {
+                row += s.a[(i, j)] * s.a[(i, j)];
+                col += s.a[(j, i)] * s.a[(j, i)];
+            }
+            row += s.b[i] * s.b[i];
+            col += s.c[i] * s.c[i];
             if row == 0.0 || col == 0.0 {
                 continue;
             }
@@ -615,7 +616,12 @@ fn frobenius(s: &Siso) -> f64 {
 fn unit_scaled(mut s: Siso) -> (Siso, i64) {
     let e = exponent_of(frobenius(&s));
     let factor = two_to(-e);
-    for x in s.a.iter_mut().chain(s.b.iter_mut()).chain(s.c.iter_mut()) {
+    for x in
+        s.a.as_mut_slice()
+            .iter_mut()
+            .chain(s.b.iter_mut())
+            .chain(s.c.iter_mut())
+    {
         *x *= factor;
     }
     s.d *= factor;
