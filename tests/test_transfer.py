@@ -4,6 +4,7 @@ generalized eigenvalues of the Rosenbrock pencil, and hand-derived examples."""
 from __future__ import annotations
 
 import math
+import pickle
 import warnings
 
 import control
@@ -563,9 +564,10 @@ def test_fast_path_agrees_with_the_reference_path(seed: int) -> None:
     channels = _random_channels(seed)
     for model, i, j in channels:
         dt = model.dt or 0.0
-        poles, denominator, (fast,) = _core.transfer_channels(
+        poles, denominator, channels_of_model = _core.transfer_channels(
             model.A, model.B, model.C, model.D, dt, [(i, j)]
         )
+        fast = channels_of_model.channel(0)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             reference = _reference_channel(model, i, j, dt, stacklevel=2)
@@ -788,6 +790,40 @@ def test_factored_response_refuses_a_shape_that_does_not_hold_its_values() -> No
     for shape in ((2, 2), (3,), (), (0, 2)):
         with pytest.raises(InvalidArgumentError, match="shape"):
             aerocontrol._core.factored_response([0.5], [2], [none], pole, points, shape)
+
+
+def test_matrix_values_from_the_core_equal_each_channels() -> None:
+    # transfer_matrix keeps the fast path's channels in the core and evaluates them there from
+    # the roots it sorted once; each channel's TransferFunction evaluates its own arrays: the
+    # same products in the same order, so the same values, bit for bit, before and after the
+    # channels are made and after a pickle round trip (which holds the TransferFunctions).
+    rng = np.random.default_rng(25)
+    points = 1j * np.array([0.05, 0.3, 1.0, 4.0, 30.0])
+    for trial in range(40):
+        n, m, p = int(rng.integers(1, 7)), int(rng.integers(1, 4)), int(rng.integers(1, 4))
+        model = aerocontrol.StateSpace(
+            rng.standard_normal((n, n)) - 0.5 * np.eye(n),
+            rng.standard_normal((n, m)),
+            rng.standard_normal((p, n)),
+            rng.standard_normal((p, m)) * (trial % 2),
+        )
+        g = aerocontrol.transfer_matrix(model)
+        before = g(points)
+        each = np.array([[g[i, j](points) for j in range(m)] for i in range(p)])
+        np.testing.assert_array_equal(before, each)
+        np.testing.assert_array_equal(g(points), before)
+        again = pickle.loads(pickle.dumps(g))
+        assert again == g
+        np.testing.assert_array_equal(again(points), before)
+    # The core's object refuses a channel it does not hold and a shape that does not hold the
+    # values.
+    model = aerocontrol.aircraft.load("b747-cruise").lateral()[["p", "r"], :]
+    _, _, fast = aerocontrol._core.transfer_channels(model.A, model.B, model.C, model.D, 0.0, None)
+    assert len(fast) == 4 and fast.deferred == []
+    with pytest.raises(InvalidArgumentError, match="no channel 4"):
+        fast.channel(4)
+    with pytest.raises(InvalidArgumentError, match="shape"):
+        fast.response(points, (2, 2, 4))
 
 
 def _graded_matrix(rng: np.random.Generator, family: int) -> np.ndarray:

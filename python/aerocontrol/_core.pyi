@@ -21,6 +21,7 @@ __all__ = [
     "PRODUCT_WORKSPACE_BYTES",
     "RESCALE_EXPONENT",
     "SMALL_MAX_ORDER",
+    "FastChannels",
     "Placement",
     "aircraft_models",
     "balance_states",
@@ -212,8 +213,21 @@ def transfer_channels(
 ) -> tuple[
     NDArray[np.complex128],
     NDArray[np.float64],
-    list[tuple[NDArray[np.complex128], float, NDArray[np.float64]] | None],
+    FastChannels,
 ]: ...
+
+@final
+class FastChannels:
+    def __len__(self) -> int: ...
+    @property
+    def deferred(self) -> list[int]: ...
+    def channel(
+        self, k: int
+    ) -> tuple[NDArray[np.complex128], float, NDArray[np.float64]] | None: ...
+    def response(
+        self, points: NDArray[np.complex128], shape: tuple[int, ...], /
+    ) -> tuple[NDArray[np.complex128], bool]: ...
+
 def factored_response(
     mantissas: list[float],
     exponents: list[int],

@@ -1291,9 +1291,10 @@ def transfer_function(
     i = _single(output, model.output_names, "output")
     j = _single(input, model.input_names, "input")
     dt = period(model) if model.is_discrete else 0.0
-    poles, denominator, (fast,) = _core.transfer_channels(
+    poles, denominator, channels = _core.transfer_channels(
         model.A, model.B, model.C, model.D, dt, [(i, j)]
     )
+    fast = channels.channel(0)
     if fast is not None:
         denominator = _checked_denominator(poles, denominator, 3)
         names = (model.output_names[i], model.input_names[j])
@@ -1412,10 +1413,8 @@ class TransferMatrix(Result):
 
     __slots__ = (
         "_channels",
-        "_exponents",
-        "_mantissas",
+        "_fast",
         "_shape",
-        "_zeros",
         "denominator",
         "dt",
         "input_names",
@@ -1430,7 +1429,8 @@ class TransferMatrix(Result):
         dt: float,
         output_names: tuple[str, ...],
         input_names: tuple[str, ...],
-        channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray]],
+        channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray]]
+        | _core.FastChannels,
     ) -> None:
         self.poles = poles
         """The eigenvalues of A, sorted."""
@@ -1440,25 +1440,17 @@ class TransferMatrix(Result):
         """0.0 for a continuous model, else the sampling period in seconds."""
         self.output_names = output_names
         self.input_names = input_names
-        self._channels = channels
         self._shape = (len(output_names), len(input_names))
-        # Each channel's gain as a mantissa and a power of two, and its zeros, for __call__.
-        mantissas: list[float] = []
-        exponents: list[int] = []
-        zeros: list[ComplexArray] = []
-        frexp = math.frexp
-        for channel in channels:
-            if isinstance(channel, tuple):  # the core's (zeros, gain, numerator)
-                k, e = frexp(channel[1])
-                zeros.append(channel[0])
-            else:
-                k, e = channel.scaled_gain or frexp(channel.gain)
-                zeros.append(channel.zeros)
-            mantissas.append(k)
-            exponents.append(e)
-        self._mantissas = mantissas
-        self._exponents = exponents
-        self._zeros = zeros
+        # Every channel from the core's fast path: kept there (its arrays made on first use, G(s)
+        # evaluated there); else each channel's TransferFunction or the core's (zeros, gain,
+        # numerator).
+        self._fast: _core.FastChannels | None = None
+        self._channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray] | None]
+        if isinstance(channels, _core.FastChannels):
+            self._fast = channels
+            self._channels = [None] * len(channels)
+        else:
+            self._channels = list(channels)
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -1478,6 +1470,10 @@ class TransferMatrix(Result):
         channel = self._channels[index]
         if isinstance(channel, TransferFunction):
             return channel
+        if channel is None:
+            channel = cast("_core.FastChannels", self._fast).channel(index)
+            if channel is None:  # pragma: no cover - a FastChannels here holds every channel
+                raise AssertionError("a deferred channel among the fast path's")
         names = (self.output_names[i], self.input_names[j])
         made = _fast_channel(names, self.dt, self.poles, self.denominator, channel)
         self._channels[index] = made
@@ -1496,14 +1492,26 @@ class TransferMatrix(Result):
         """G(s) of every channel from its factored form (as :meth:`TransferFunction.__call__`):
         shape (outputs, inputs) + the shape of ``s``."""
         value = np.asarray(s, dtype=np.complex128)
-        result, finite = _core.factored_response(
-            self._mantissas,
-            self._exponents,
-            self._zeros,
-            self.poles,
-            value,
-            self._shape + value.shape,
-        )
+        shape = self._shape + value.shape
+        if self._fast is not None:
+            result, finite = self._fast.response(value, shape)
+        else:
+            # Each channel's gain as a mantissa and a power of two, and its zeros.
+            mantissas: list[float] = []
+            exponents: list[int] = []
+            zeros: list[ComplexArray] = []
+            for channel in self._channels:
+                if isinstance(channel, TransferFunction):
+                    k, e = channel.scaled_gain or math.frexp(channel.gain)
+                    zeros.append(channel.zeros)
+                else:  # the core's (zeros, gain, numerator)
+                    k, e = math.frexp(cast("tuple[ComplexArray, float, FloatArray]", channel)[1])
+                    zeros.append(cast("tuple[ComplexArray, float, FloatArray]", channel)[0])
+                mantissas.append(k)
+                exponents.append(e)
+            result, finite = _core.factored_response(
+                mantissas, exponents, zeros, self.poles, value, shape
+            )
         if not finite and np.isfinite(value).all():
             warnings.warn(
                 "the result overflowed double precision: G is infinite or NaN (at a pole, or "
@@ -1522,6 +1530,20 @@ class TransferMatrix(Result):
         return (
             f"TransferMatrix(outputs={list(self.output_names)}, inputs={list(self.input_names)}, "
             f"poles={self.poles!r})"
+        )
+
+    def __reduce__(self) -> tuple[type[TransferMatrix], tuple[object, ...]]:
+        # By the channels (the core's FastChannels does not pickle), as ``==`` compares.
+        return (
+            TransferMatrix,
+            (
+                self.poles,
+                self.denominator,
+                self.dt,
+                self.output_names,
+                self.input_names,
+                list(self.channels),
+            ),
         )
 
 
@@ -1579,14 +1601,16 @@ def transfer_matrix(sys: System) -> TransferMatrix:
     dt = period(model)
     poles, denominator, fast = _core.transfer_channels(model.A, model.B, model.C, model.D, dt, None)
     denominator = _checked_denominator(poles, denominator, 2)
-    if None in fast:  # channels the core leaves to the reference path
+    deferred = fast.deferred
+    if deferred:  # channels the core leaves to the reference path
         m = model.n_inputs
         channels: list[TransferFunction | tuple[ComplexArray, float, FloatArray]] = [
-            result
-            if result is not None
-            else _reference_channel(model, k // m, k % m, dt, stacklevel=2)
-            for k, result in enumerate(fast)
+            _reference_channel(model, k // m, k % m, dt, stacklevel=2)
+            if k in deferred
+            else cast("tuple[ComplexArray, float, FloatArray]", fast.channel(k))
+            for k in range(len(fast))
         ]
-    else:
-        channels = cast("list[TransferFunction | tuple[ComplexArray, float, FloatArray]]", fast)
-    return TransferMatrix(poles, denominator, dt, model.output_names, model.input_names, channels)
+        return TransferMatrix(
+            poles, denominator, dt, model.output_names, model.input_names, channels
+        )
+    return TransferMatrix(poles, denominator, dt, model.output_names, model.input_names, fast)

@@ -53,20 +53,23 @@ use crate::linalg::schur::eigenvalues;
 use faer::{Mat, MatRef, c64};
 use nalgebra::DMatrix;
 
-/// One channel's zeros (sorted, as `numpy.sort_complex`), gain K and numerator K Π(s - z_i)
+/// One channel's zeros (sorted, as `numpy.sort_complex`), the same by increasing modulus (the
+/// order in which [`factored_response_sorted`] takes them), gain K and numerator K Π(s - z_i)
 /// (highest power first).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Channel {
     pub zeros: Vec<c64>,
+    pub zeros_by_modulus: Vec<c64>,
     pub gain: f64,
     pub numerator: Vec<f64>,
 }
 
-/// The poles (the eigenvalues of A, sorted), the denominator Π(s - p_j) and each requested
-/// channel (None: deferred to the reference path).
+/// The poles (the eigenvalues of A, sorted), the same by increasing modulus, the denominator
+/// Π(s - p_j) and each requested channel (None: deferred to the reference path).
 #[derive(Debug, Clone)]
 pub struct Transfer {
     pub poles: Vec<c64>,
+    pub poles_by_modulus: Vec<c64>,
     pub denominator: Vec<f64>,
     pub channels: Vec<Option<Channel>>,
 }
@@ -112,6 +115,7 @@ pub fn transfer_channels(
     }
     Ok(Transfer {
         poles,
+        poles_by_modulus: shared.sorted_poles,
         denominator,
         channels: out,
     })
@@ -300,7 +304,10 @@ struct Scaled {
 /// which could fall into the subnormals there, is negligible beside it.
 const MANTISSA_RANGE: (f64, f64) = (6.223015277861142e-61, 1.6069380442589903e60);
 
+// The operations of a factor are inlined into the loops of [`factored`] (a few instructions each
+// where the mantissa stays in range); the renormalisation itself is kept out of line.
 impl Scaled {
+    #[inline(always)]
     fn new(m: c64, e: i64) -> Self {
         let mut s = Scaled { m, e };
         s.renormalize();
@@ -310,19 +317,29 @@ impl Scaled {
     /// Brings the largest part to [1/2, 1) by a power of two (exact) when it has left
     /// [`MANTISSA_RANGE`]: multiplications by powers of two commute with the rounding of
     /// the products in between, so renormalising less often changes nothing else.
+    #[inline(always)]
     fn renormalize(&mut self) {
         let part = self.m.re.abs().max(self.m.im.abs());
         if part > 0.0 && part.is_finite() && !(MANTISSA_RANGE.0..=MANTISSA_RANGE.1).contains(&part)
         {
-            let k = exponent_of(part);
-            self.m = c64::new(ldexp(self.m.re, -k), ldexp(self.m.im, -k));
-            self.e += k;
+            self.rescale(part);
         }
+    }
+
+    /// The mantissa divided by the power of two of `part`, its largest part, and the exponent
+    /// raised by it.
+    #[cold]
+    #[inline(never)]
+    fn rescale(&mut self, part: f64) {
+        let k = exponent_of(part);
+        self.m = c64::new(ldexp(self.m.re, -k), ldexp(self.m.im, -k));
+        self.e += k;
     }
 
     /// (point - root) as a scaled value: both divided by the power of two of their largest
     /// part first when that is near the overflow threshold, so that the difference of two
     /// numbers near ±1e308 stays finite.
+    #[inline(always)]
     fn difference(point: c64, root: c64) -> Self {
         let largest = [point.re, point.im, root.re, root.im]
             .iter()
@@ -330,6 +347,13 @@ impl Scaled {
         if largest < 1e300 {
             return Scaled::new(point - root, 0);
         }
+        Scaled::large_difference(point, root, largest)
+    }
+
+    /// [`Scaled::difference`] where the largest part, `largest`, is at least 1e300.
+    #[cold]
+    #[inline(never)]
+    fn large_difference(point: c64, root: c64, largest: f64) -> Self {
         let q = if largest.is_finite() {
             exponent_of(largest)
         } else {
@@ -339,12 +363,14 @@ impl Scaled {
         Scaled::new(scale(point) - scale(root), q)
     }
 
+    #[inline(always)]
     fn times(&mut self, other: Scaled) {
         self.m *= other.m;
         self.e += other.e;
         self.renormalize();
     }
 
+    #[inline(always)]
     fn divided_by(&mut self, other: Scaled) {
         self.m = quotient(self.m, other.m);
         self.e -= other.e;
@@ -369,6 +395,7 @@ impl Scaled {
 
 /// x / y as numpy divides complex numbers (Smith's method; x / 0 is inf or NaN, never an
 /// error).
+#[inline]
 fn quotient(x: c64, y: c64) -> c64 {
     if y.re == 0.0 && y.im == 0.0 {
         return c64::new(x.re / 0.0, x.im / 0.0);
@@ -423,10 +450,29 @@ pub fn factored_response(
     out: &mut [c64],
 ) {
     let (zeros, poles) = (by_modulus(zeros), by_modulus(poles));
+    factored_response_sorted(mantissa, exponent, &zeros, &poles, points, out);
+}
+
+/// [`factored_response`] with the zeros and the poles already by increasing modulus (as
+/// [`Channel::zeros_by_modulus`] and [`Transfer::poles_by_modulus`] hold them).
+pub fn factored_response_sorted(
+    mantissa: f64,
+    exponent: i64,
+    zeros: &[c64],
+    poles: &[c64],
+    points: &[c64],
+    out: &mut [c64],
+) {
     let start = Scaled::new(c64::new(mantissa, 0.0), exponent);
     for (point, value) in points.iter().zip(out.iter_mut()) {
-        *value = factored(start, *point, &zeros, &poles).value();
+        *value = factored(start, *point, zeros, poles).value();
     }
+}
+
+/// (m, e) with x = m 2^e and |m| in [1/2, 1) (as C's frexp; (0, 0) for 0), for a finite x.
+pub fn mantissa_and_exponent(x: f64) -> (f64, i64) {
+    let e = exponent_of(x);
+    (ldexp_any(x, -e), e)
 }
 
 // ----- equilibration ---------------------------------------------------------------------------
@@ -500,30 +546,31 @@ fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
             units += k;
             changed = true;
         }
-        let mut size = squares(s.a.iter().copied()).sqrt();
+        let mut size = squares(s.a.as_slice().iter().copied()).sqrt();
         if size == 0.0 {
             size = squares(s.b.iter().copied()).sqrt();
         }
         let k = half_exponent(size);
         if k != 0 {
-            s.a.iter_mut().for_each(|x| scale(x, k));
+            s.a.as_mut_slice().iter_mut().for_each(|x| scale(x, k));
             s.b.iter_mut().for_each(|x| scale(x, k));
             frequency -= k;
             changed = true;
         }
         for i in 0..n {
-            let row = squares(
-                (0..n)
-                    .filter(|&j| j != i)
-                    .map(|j| s.a[(i, j)])
-                    .chain([s.b[i]]),
-            );
-            let col = squares(
-                (0..n)
-                    .filter(|&j| j != i)
-                    .map(|j| s.a[(j, i)])
-                    .chain([s.c[i]]),
-            );
+            // The sums of squares of the other states' entries, in order, then b_i's (c_i's):
+            // two loops around the diagonal, no test per entry.
+            let (mut row, mut col) = (0.0, 0.0);
+            for j in 0..i {
+                row += s.a[(i, j)] * s.a[(i, j)];
+                col += s.a[(j, i)] * s.a[(j, i)];
+            }
+            for j in i + 1..n {
+                row += s.a[(i, j)] * s.a[(i, j)];
+                col += s.a[(j, i)] * s.a[(j, i)];
+            }
+            row += s.b[i] * s.b[i];
+            col += s.c[i] * s.c[i];
             if row == 0.0 || col == 0.0 {
                 continue;
             }
@@ -569,7 +616,12 @@ fn frobenius(s: &Siso) -> f64 {
 fn unit_scaled(mut s: Siso) -> (Siso, i64) {
     let e = exponent_of(frobenius(&s));
     let factor = two_to(-e);
-    for x in s.a.iter_mut().chain(s.b.iter_mut()).chain(s.c.iter_mut()) {
+    for x in
+        s.a.as_mut_slice()
+            .iter_mut()
+            .chain(s.b.iter_mut())
+            .chain(s.c.iter_mut())
+    {
         *x *= factor;
     }
     s.d *= factor;
@@ -823,6 +875,10 @@ fn log_centre(zero_logs: &[f64], pole_logs: &[f64]) -> f64 {
     }
 }
 
+/// 10^0.1 (the double `10f64.powf(0.1)` gives: a unit test checks), the ratio of neighbouring
+/// frequencies of a continuous model's grid.
+const GRID_STEP: f64 = 1.2589254117941673;
+
 /// The grid of `transfer._evaluation_points`: s = jω at 31 frequencies
 /// 10^(centre - 1.5 + k/10), or z = e^{jθ} at 19 angles of the unit circle for a discrete
 /// model.
@@ -837,12 +893,11 @@ fn grid(dt: f64, centre: f64) -> Vec<c64> {
     } else {
         // One power, then steps of 10^0.1: any point of the grid serves (the gain does not
         // depend on it).
-        let step = 10f64.powf(0.1);
         let mut omega = 10f64.powf(centre - 1.5);
         (0..31)
             .map(|_| {
                 let point = c64::new(0.0, omega.clamp(1e-300, 1e307));
-                omega *= step;
+                omega *= GRID_STEP;
                 point
             })
             .collect()
@@ -986,6 +1041,7 @@ fn channel(
         Reduced::Zero => {
             return Ok(Some(Channel {
                 zeros: Vec::new(),
+                zeros_by_modulus: Vec::new(),
                 gain: 0.0,
                 numerator: vec![0.0],
             }));
@@ -1020,6 +1076,7 @@ fn channel(
         return Ok(None);
     }
     let zeros = cleaned(zeros);
+    let zeros_by_modulus = by_modulus(&zeros);
     let gain = if d != 0.0 && zeros.len() == n {
         d
     } else {
@@ -1045,11 +1102,11 @@ fn channel(
             let part = value.re.abs().max(value.im.abs());
             (part.is_finite() && part >= f64::MIN_POSITIVE).then(|| Scaled::new(value, e - units))
         };
-        let (sorted_zeros, sorted_poles) = (by_modulus(&zeros), &shared.sorted_poles[..]);
+        let (sorted_zeros, sorted_poles) = (&zeros_by_modulus[..], &shared.sorted_poles[..]);
         let Some(g0) = at(first) else {
             return Ok(None);
         };
-        let k = factored(g0, first, sorted_poles, &sorted_zeros).value().re;
+        let k = factored(g0, first, sorted_poles, sorted_zeros).value().re;
         if !(k.is_finite() && k.abs() >= f64::MIN_POSITIVE) {
             return Ok(None);
         }
@@ -1058,7 +1115,7 @@ fn channel(
             return Ok(None);
         };
         let start = Scaled::new(c64::new(k, 0.0), 0);
-        let mut factored_value = factored(start, check, &sorted_zeros, sorted_poles);
+        let mut factored_value = factored(start, check, sorted_zeros, sorted_poles);
         factored_value.divided_by(g1);
         let ratio = factored_value.value();
         let agrees = (ratio - 1.0).norm() <= 1e-8; // false for NaN
@@ -1072,6 +1129,7 @@ fn channel(
     };
     Ok(Some(Channel {
         zeros,
+        zeros_by_modulus,
         gain,
         numerator,
     }))
@@ -1228,6 +1286,15 @@ mod tests {
         assert_eq!(ldexp(0.75, -1073), 1e-323);
         assert_eq!(ldexp(0.5, 1024), 8.98846567431158e307);
         assert_eq!(ldexp(0.5, 1025), f64::INFINITY);
+        assert_eq!(GRID_STEP, 10f64.powf(0.1));
+        for x in [1.0, -0.75, 3e-300, 1e300, 5e-324] {
+            let (m, e) = mantissa_and_exponent(x);
+            assert!(
+                (0.5..1.0).contains(&m.abs()) && ldexp_any(m, e) == x,
+                "{x}: {m} {e}"
+            );
+        }
+        assert_eq!(mantissa_and_exponent(0.0), (0.0, 0));
     }
 
     #[test]
