@@ -14,7 +14,7 @@ import scipy.linalg
 from scipy.optimize import linear_sum_assignment
 
 import aerocontrol
-from aerocontrol import InvalidArgumentError, transfer_function, transmission_zeros
+from aerocontrol import InvalidArgumentError, ShapeError, transfer_function, transmission_zeros
 
 
 def _matched_error(ours: np.ndarray, theirs: np.ndarray) -> float:
@@ -787,9 +787,12 @@ def test_factored_response_refuses_a_shape_that_does_not_hold_its_values() -> No
     values, finite = aerocontrol._core.factored_response([0.5], [2], [none], pole, points, (1, 2))
     assert finite and values.shape == (1, 2)
     np.testing.assert_allclose(values, [2.0 / (points + 1.0)], rtol=4e-16)
-    for shape in ((2, 2), (3,), (), (0, 2)):
-        with pytest.raises(InvalidArgumentError, match="shape"):
+    # Negative extents (whose product could be the count) and extents whose product
+    # overflows are named too, not a bare OverflowError.
+    for shape in ((2, 2), (3,), (), (0, 2), (-1, -2), (-2,), (2**62, 4, 2)):
+        with pytest.raises(InvalidArgumentError, match="shape") as error:
             aerocontrol._core.factored_response([0.5], [2], [none], pole, points, shape)
+        assert getattr(error.value, "argument", None) == "shape"
 
 
 def test_matrix_values_from_the_core_equal_each_channels() -> None:
@@ -822,8 +825,9 @@ def test_matrix_values_from_the_core_equal_each_channels() -> None:
     assert len(fast) == 4 and fast.deferred == []
     with pytest.raises(InvalidArgumentError, match="no channel 4"):
         fast.channel(4)
-    with pytest.raises(InvalidArgumentError, match="shape"):
-        fast.response(points, (2, 2, 4))
+    for shape in ((2, 2, 4), (-2, -2, len(points)), (2, 2, -len(points))):
+        with pytest.raises(InvalidArgumentError, match="shape"):
+            fast.response(points, shape)
 
 
 def _graded_matrix(rng: np.random.Generator, family: int) -> np.ndarray:
@@ -898,3 +902,16 @@ def test_eigenvalues_of_graded_matrices_to_their_own_size(family: int) -> None:
             found.remove(nearest)
             if A.shape[0] * 2.2e-16 * condition < 1e-12:
                 assert abs(nearest - value) <= 1e-10 * abs(value), (A, value, nearest)
+
+
+@pytest.mark.parametrize("bad", [object(), "1j", None, [[1.0, 2.0], [3.0]]])
+def test_evaluation_refuses_what_is_not_numbers_by_name(bad: object) -> None:
+    """G(s) of a channel and of the matrix take numbers and arrays of numbers (real ones as
+    complex); anything else is an error naming ``s``, not numpy's bare TypeError."""
+    G = aerocontrol.transfer_function(aerocontrol.tf([1.0], [1.0, 1.0]))
+    M = aerocontrol.transfer_matrix(aerocontrol.tf([1.0], [1.0, 1.0]))
+    for evaluate in (G, M):
+        with pytest.raises((InvalidArgumentError, ShapeError), match=r"^s must be"):
+            evaluate(bad)
+    assert G(1j) == pytest.approx(0.5 - 0.5j, rel=1e-15)
+    np.testing.assert_allclose(M(np.array([1j, 2.0])), [[[0.5 - 0.5j, 1 / 3]]], rtol=1e-15)

@@ -52,6 +52,25 @@ def real_array(value: object, name: str) -> FloatArray:
     return array
 
 
+def complex_array(value: object, name: str) -> NDArray[np.complex128]:
+    """``value`` as a complex128 ndarray (real numbers as complex), or an error naming ``name``:
+    ShapeError for a ragged sequence, InvalidArgumentError for anything else that is not an
+    array of numbers (strings, objects)."""
+    if type(value) is np.ndarray and value.dtype == np.complex128:
+        return value
+    try:
+        array = np.asarray(value)
+    except ValueError as error:  # ragged nested sequences
+        raise ShapeError(f"{name} must be a rectangular array of numbers: {error}") from None
+    if array.dtype.kind not in "biufc":
+        refusal = InvalidArgumentError(
+            f"{name} must be a number or an array of numbers, got dtype {array.dtype}"
+        )
+        refusal.argument = name
+        raise refusal
+    return array.astype(np.complex128, copy=False)
+
+
 #: How a 1-D array given for a matrix argument is read, by the argument's role (as
 #: python-control reads it): an input matrix (B, G, b) as one column, an output matrix (C, c)
 #: as one row. Any other matrix has no single reading of a vector and refuses one by name.

@@ -52,7 +52,7 @@ from numpy.typing import NDArray
 
 from . import _core
 from ._results import Result, Tabular, register
-from ._validation import FloatArray, finite_or_warn, real_scalar
+from ._validation import FloatArray, complex_array, finite_or_warn, real_scalar
 from .exceptions import (
     ConvergenceError,
     IllConditionedWarning,
@@ -797,7 +797,7 @@ class TransferFunction(Result):
         overflow where their ratio does not, and a K of 1e450 beside poles of 1e150 gives a
         G of 1e300. A G beyond the doubles is infinite, with a NumericalOverflowWarning; one
         below them rounds to 0 (or a subnormal), as a product of doubles does."""
-        value = np.asarray(s, dtype=np.complex128)
+        value = complex_array(s, "s")
         k, e = self.scaled_gain if self.scaled_gain is not None else math.frexp(self.gain)
         result, finite = _core.factored_response(
             [float(k)],
@@ -1491,7 +1491,7 @@ class TransferMatrix(Result):
     def __call__(self, s: complex | ComplexArray) -> ComplexArray:
         """G(s) of every channel from its factored form (as :meth:`TransferFunction.__call__`):
         shape (outputs, inputs) + the shape of ``s``."""
-        value = np.asarray(s, dtype=np.complex128)
+        value = complex_array(s, "s")
         shape = self._shape + value.shape
         if self._fast is not None:
             result, finite = self._fast.response(value, shape)

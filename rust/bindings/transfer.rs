@@ -73,7 +73,7 @@ impl FastChannels {
         &self,
         py: Python<'py>,
         points: &Bound<'py, PyArrayDyn<c64>>,
-        shape: Vec<usize>,
+        shape: Vec<i64>,
     ) -> PyResult<(Bound<'py, PyArrayDyn<c64>>, bool)> {
         let mut channels = Vec::with_capacity(self.channels.len());
         for channel in &self.channels {
@@ -112,11 +112,15 @@ fn evaluate<'py>(
     py: Python<'py>,
     count: usize,
     points: &[c64],
-    shape: &[usize],
+    shape: &[i64],
     roots: usize,
     fill: impl Fn(usize, &mut [c64]) + Send + Sync,
 ) -> PyResult<(Bound<'py, PyArrayDyn<c64>>, bool)> {
-    let entries = shape.iter().try_fold(1usize, |p, &k| p.checked_mul(k));
+    // A negative extent is no shape: None, as for a count of entries beyond usize.
+    let extents: Option<Vec<usize>> = shape.iter().map(|&k| usize::try_from(k).ok()).collect();
+    let entries = extents
+        .as_ref()
+        .and_then(|e| e.iter().try_fold(1usize, |p, &k| p.checked_mul(k)));
     if entries != count.checked_mul(points.len()) {
         return Err(to_py_err(
             py,
@@ -129,7 +133,7 @@ fn evaluate<'py>(
             },
         ));
     }
-    let out = new_array::<c64>(py, shape)?;
+    let out = new_array::<c64>(py, extents.as_deref().unwrap_or_default())?;
     // SAFETY: new and not visible to Python until returned.
     let data = unsafe { new_array_data(&out) };
     let cost = Cost {
@@ -210,7 +214,7 @@ fn factored_response<'py>(
     zeros: Vec<Bound<'py, PyArrayDyn<c64>>>,
     poles: &Bound<'py, PyArrayDyn<c64>>,
     points: &Bound<'py, PyArrayDyn<c64>>,
-    shape: Vec<usize>,
+    shape: Vec<i64>,
 ) -> PyResult<(Bound<'py, PyArrayDyn<c64>>, bool)> {
     if exponents.len() != mantissas.len() || zeros.len() != mantissas.len() {
         return Err(to_py_err(
