@@ -17,10 +17,11 @@
 //!
 //! with H_k -> X and A_k -> 0 as ρ(A - B K)^(2^k): a closed loop sampled at 50 Hz, whose
 //! eigenvalues have |z| ≈ 0.99, takes about a dozen doublings, each six products and one LU
-//! factorisation of order n, on the stack, in one kernel compiled for the order (the matrices
-//! stay in registers at n = 4). Where G and H_k are positive semidefinite
-//! W_k is nonsingular. The iteration stops when the increment of H no longer changes it at
-//! working precision and A_k has decayed.
+//! factorisation of order n, on the stack, in one kernel compiled for the order, in vector
+//! form (the two solves with W_k on the rows of their right-hand sides:
+//! [`doubling_step_kernel`]). Where G and H_k are positive semidefinite W_k is nonsingular.
+//! The iteration stops when the increment of H no longer changes it at working precision and
+//! A_k has decayed.
 //!
 //! The result is a candidate only: [`super::dare`] refines it by Newton's method and keeps it
 //! only if its residual is within a few units of rounding and its closed loop passes every
