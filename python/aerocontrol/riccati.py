@@ -44,6 +44,8 @@ from .statespace import (
     require_discrete,
 )
 
+_FLOAT64 = np.dtype(np.float64)
+
 if TYPE_CHECKING:
     from ._typing import SystemObject
 
@@ -482,8 +484,13 @@ def _solve_dare(
 ) -> tuple[FloatArray, FloatArray, ComplexArray, float, float, int]:
     """The native solve, warning (at the caller of :func:`solve_dare` or :func:`dlqr`) when
     the solution may be inaccurate; ``cross`` names the cross weight in errors (N for dlqr)."""
-    A_matrix, B_matrix = matrix_view(A, "A"), matrix_view(B, "B")
-    result = _core.solve_dare(A_matrix, B_matrix, Q, R, S, E, cross == "N")
+    # A float64 matrix goes to the core as it is (the core reads every layout of one); anything
+    # else is read by matrix_view (a 1-D B is a column).
+    if not (type(A) is np.ndarray and A.ndim == 2 and A.dtype == _FLOAT64):
+        A = matrix_view(A, "A")
+    if not (type(B) is np.ndarray and B.ndim == 2 and B.dtype == _FLOAT64):
+        B = matrix_view(B, "B")
+    result = _core.solve_dare(A, B, Q, R, S, E, cross == "N")
     residual, rcond = result[3], result[4]
     if rcond < RCOND_WARNING or residual > RESIDUAL_WARNING:
         warnings.warn(

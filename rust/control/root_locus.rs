@@ -77,6 +77,7 @@ use crate::linalg::matrix::{
 };
 use crate::linalg::norm::max_abs;
 use crate::linalg::schur::{Spectrum, eigenvalues, francis_qr, quasi_triangular_eigenvalues};
+use crate::platform::dispatch::fma_dispatch;
 use crate::platform::parallel::ParallelContext;
 use faer::{MatRef, c64};
 use rayon::prelude::*;
@@ -477,6 +478,7 @@ impl Conjugates {
 
     /// Σ 1/(x_i - v) over every root v but x_i itself (its conjugate included), x_i the i-th
     /// real root or, from i = real.len(), the upper member of the (i - real.len())-th pair.
+    #[inline(always)]
     fn repulsion(&self, i: usize) -> c64 {
         let reals = self.real.len();
         if i < reals {
@@ -511,7 +513,7 @@ impl Conjugates {
     }
 
     /// Π (x - v) over the roots v (for a real x, in real arithmetic).
-    #[inline]
+    #[inline(always)]
     fn product(&self, x: c64) -> c64 {
         if x.im == 0.0 {
             let x = x.re;
@@ -538,7 +540,7 @@ impl Conjugates {
     }
 
     /// Σ 1/(x - v) over the roots v (for a real x, in real arithmetic).
-    #[inline]
+    #[inline(always)]
     fn sum(&self, x: c64) -> c64 {
         if x.im == 0.0 {
             let x = x.re;
@@ -652,7 +654,7 @@ impl Factored {
     /// normal range the test is |D + G N| <= η max(|D|, |G N|) (that of [`is_root`] times |D|),
     /// squared, without a division; a failure where R is not finite or is 0 (x on a pole or a
     /// zero, or a product beyond the doubles).
-    #[inline]
+    #[inline(always)]
     fn residual(&self, x: c64, g: f64, eta: f64) -> Residual {
         let (d, n) = (
             self.poles.product(x),
@@ -679,6 +681,7 @@ impl Factored {
 
     /// χ'/χ = (S_p + R S_z) / (1 + R) at x, formed as (S_p / R + S_z) / (1 / R + 1) where
     /// |R| > 1; not finite where 1 + R = 0 exactly.
+    #[inline(always)]
     fn logarithmic_derivative(&self, x: c64, r: c64) -> c64 {
         let (s_p, s_z) = (self.poles.sum(x), self.zeros.sum(x));
         if r.re * r.re + r.im * r.im <= 1.0 {
@@ -716,7 +719,7 @@ enum Residual {
 
 /// Whether |1 + R| <= η max(1, |R|) (squared, without a root or a division): a point where
 /// R(x) = r is then a root of the factored χ_g with its factors perturbed by O(η) (relative).
-#[inline]
+#[inline(always)]
 fn is_root(r: c64, eta: f64) -> bool {
     if r.re.abs().max(r.im.abs()) > 1e150 {
         return false; // |1 + R| is |R| to rounding: far from a root, and the squares overflow
@@ -728,7 +731,7 @@ fn is_root(r: c64, eta: f64) -> bool {
 /// Whether deg χ / |χ'/χ| (the radius of a disk about x that holds a root of χ) is within
 /// [`INCLUSION_ULPS`] units in the last place of |x|; compared in squares, without a root or a
 /// division, where they stay in the normal range.
-#[inline]
+#[inline(always)]
 fn included(degree: f64, ratio: c64, x: c64) -> bool {
     let square = |z: c64| z.re * z.re + z.im * z.im;
     let (r2, x2) = (square(ratio), square(x));
@@ -740,7 +743,7 @@ fn included(degree: f64, ratio: c64, x: c64) -> bool {
 }
 
 /// |z|, by a square root where |z|^2 stays in the normal range.
-#[inline]
+#[inline(always)]
 fn modulus(z: c64) -> f64 {
     let norm = z.re * z.re + z.im * z.im;
     if (1e-290..=1e290).contains(&norm) {
@@ -752,7 +755,7 @@ fn modulus(z: c64) -> f64 {
 
 /// 1/z by one real division, its parts scaled first only where |z|^2 would leave the normal
 /// range.
-#[inline]
+#[inline(always)]
 fn reciprocal(z: c64) -> c64 {
     let norm = z.re * z.re + z.im * z.im;
     if (1e-290..=1e290).contains(&norm) {
@@ -768,7 +771,7 @@ fn reciprocal(z: c64) -> c64 {
 /// 1/d + 1/e as (d + e) / (d e), by one real division (|1/d + 1/e| <= 1/|d| + 1/|e|: no
 /// less accurate than the two reciprocals, which it takes where |d e|^2 would leave the normal
 /// range).
-#[inline]
+#[inline(always)]
 fn pair_reciprocals(d: c64, e: c64) -> c64 {
     let product = d * e;
     let norm = product.re * product.re + product.im * product.im;
@@ -824,7 +827,15 @@ impl Continuation {
 
     /// The closed-loop poles at g by Aberth's iteration from the run's last gain, written
     /// into `out` sorted (as [`sort`]); false where the caller must take the QR iteration.
+    /// Compiled also for AVX2 and chosen by the CPU ([`advance`]): the same operations (no
+    /// fused multiply-adds), in three-operand instructions.
     fn next(&mut self, factored: &Factored, g: f64, out: &mut [c64]) -> bool {
+        advance(self, factored, g, out)
+    }
+
+    /// [`Continuation::next`] in the body of [`advance`].
+    #[inline(always)]
+    fn next_kernel(&mut self, factored: &Factored, g: f64, out: &mut [c64]) -> bool {
         let Some((g1, last)) = &self.last else {
             return false;
         };
@@ -909,9 +920,23 @@ impl Continuation {
     }
 }
 
+/// [`Continuation::next`], its variant chosen by the CPU ([`fma_dispatch`]).
+#[inline(always)]
+fn advance_kernel<const FMA: bool>(
+    continuation: &mut Continuation,
+    factored: &Factored,
+    g: f64,
+    out: &mut [c64],
+) -> bool {
+    continuation.next_kernel(factored, g, out)
+}
+
+fma_dispatch!(fn advance(continuation: &mut Continuation, factored: &Factored, g: f64, out: &mut [c64]) -> bool => advance_kernel);
+
 /// Aberth's iteration on the approximations `x` of the roots of χ_g (a real one kept real, a
 /// pair iterated as its upper member), updated in place; false if they do not all converge
 /// within [`ABERTH_ITERATIONS`] sweeps.
+#[inline(always)]
 fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<bool>) -> bool {
     let eta = 32.0 * (factored.poles.len() + factored.zeros.len() + 1) as f64 * f64::EPSILON;
     let reals = x.real.len();

@@ -25,6 +25,15 @@ use crate::platform::dispatch::{fma_dispatch, multiply_add};
 /// The storage of an N x N matrix: N columns of N entries.
 pub(crate) type Columns<const N: usize> = [[f64; N]; N];
 
+/// A value on a 64-byte boundary, the start of a cache line. A kernel's column arrays that stay
+/// in memory (those indexed at run time, as by the LU's pivots) are read and written as whole
+/// AVX vectors, and a vector that straddles two cache lines costs a split access; a local of
+/// this type also makes the kernel's prologue align its frame, so that the kernel's speed does
+/// not depend on the depth of its caller's stack.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+pub(crate) struct CacheAligned<T>(pub(crate) T);
+
 /// The columns of `m`.
 #[inline(always)]
 pub(crate) fn columns<const N: usize>(m: &SMatrix<f64, N, N>) -> &Columns<N> {
@@ -186,6 +195,77 @@ pub(crate) fn lu_solve_kernel<const N: usize, const FMA: bool>(
 
 fma_dispatch!(fn lu_solve_columns<const N: usize>(lu: &Columns<N>, pivots: &[usize; N], rhs: &mut Columns<N>) => lu_solve_kernel);
 
+/// Solves with the factors of [`lu_kernel`] in place for the N right-hand sides stored as the
+/// rows of `rows` (`rows[i][j]` = b_ij, the storage of B^T), giving the rows of the solution
+/// X. Each entry of X gets the operations of [`lu_solve_kernel`] in the same order (equal bit
+/// for bit); the N columns advance together, one vector operation per row, so that the
+/// substitutions' divisions and multiply-adds are vector instructions rather than N chains
+/// of scalar ones.
+#[inline(always)]
+pub(crate) fn lu_solve_rows_kernel<const N: usize, const FMA: bool>(
+    lu: &Columns<N>,
+    pivots: &[usize; N],
+    rows: &mut Columns<N>,
+) {
+    for (k, &pivot_row) in pivots.iter().enumerate() {
+        rows.swap(k, pivot_row);
+    }
+    // Forward substitution with the unit lower factor.
+    for k in 0..N {
+        let (solved, rest) = rows.split_at_mut(k + 1);
+        let solved = &solved[k];
+        for (row, &factor) in rest.iter_mut().zip(&lu[k][k + 1..]) {
+            for (entry, &x) in row.iter_mut().zip(solved) {
+                *entry = multiply_add::<FMA>(-factor, x, *entry);
+            }
+        }
+    }
+    // Back substitution with the upper factor, dividing by each pivot.
+    for k in (0..N).rev() {
+        let (rest, solved) = rows.split_at_mut(k);
+        let solved = &mut solved[0];
+        let pivot = lu[k][k];
+        for x in solved.iter_mut() {
+            *x /= pivot;
+        }
+        for (row, &factor) in rest.iter_mut().zip(&lu[k][..k]) {
+            for (entry, &x) in row.iter_mut().zip(solved.iter()) {
+                *entry = multiply_add::<FMA>(-factor, x, *entry);
+            }
+        }
+    }
+}
+
+/// out += lhs * rhs with rhs given by its rows (`rhs_rows[k][j]` = rhs_kj): each entry the
+/// sum over k, in order, of lhs_ik rhs_kj, as [`add_product_kernel`] forms it.
+#[inline(always)]
+pub(crate) fn add_product_rows_kernel<const N: usize, const FMA: bool>(
+    lhs: &Columns<N>,
+    rhs_rows: &Columns<N>,
+    out: &mut Columns<N>,
+) {
+    for (j, out_column) in out.iter_mut().enumerate() {
+        for (lhs_column, rhs_row) in lhs.iter().zip(rhs_rows) {
+            let coefficient = rhs_row[j];
+            for (o, &x) in out_column.iter_mut().zip(lhs_column) {
+                *o = multiply_add::<FMA>(x, coefficient, *o);
+            }
+        }
+    }
+}
+
+/// The storage of M^T: M's rows as columns.
+#[inline(always)]
+pub(crate) fn transposed<const N: usize>(m: &Columns<N>) -> Columns<N> {
+    let mut out = [[0.0; N]; N];
+    for (j, column) in m.iter().enumerate() {
+        for (i, &value) in column.iter().enumerate() {
+            out[i][j] = value;
+        }
+    }
+    out
+}
+
 /// lhs * rhs.
 pub(crate) fn product<const N: usize>(
     lhs: &SMatrix<f64, N, N>,
@@ -345,6 +425,49 @@ mod tests {
         for (p, d) in plain.as_flattened().iter().zip(dispatched.as_slice()) {
             assert!((p - d).abs() <= 1e-15);
         }
+    }
+
+    /// The row-storage solve and product against the column-storage ones, bit for bit, in
+    /// both variants, at the order N over seeded matrices (pivoting forced by reversed rows).
+    fn check_row_kernels<const N: usize, const FMA: bool>() {
+        for seed in 0..20 {
+            let system = SMatrix::<f64, N, N>::from_fn(|i, j| sample::<N>(seed)[(N - 1 - i, j)]);
+            let mut lu = *columns(&system);
+            let mut pivots = [0usize; N];
+            lu_kernel::<N, FMA>(&mut lu, &mut pivots);
+            let rhs = sample::<N>(seed + 100);
+            let mut by_columns = *columns(&rhs);
+            lu_solve_kernel::<N, FMA>(&lu, &pivots, &mut by_columns);
+            let mut by_rows = transposed(columns(&rhs));
+            lu_solve_rows_kernel::<N, FMA>(&lu, &pivots, &mut by_rows);
+            assert_eq!(
+                transposed(&by_rows),
+                by_columns,
+                "solve, N = {N}, seed {seed}"
+            );
+
+            let (lhs, start) = (sample::<N>(seed + 200), sample::<N>(seed + 300));
+            let mut expected = *columns(&start);
+            add_product_kernel::<N, FMA>(columns(&lhs), columns(&rhs), &mut expected);
+            let mut got = *columns(&start);
+            add_product_rows_kernel::<N, FMA>(columns(&lhs), &transposed(columns(&rhs)), &mut got);
+            assert_eq!(got, expected, "product, N = {N}, seed {seed}");
+        }
+    }
+
+    #[test]
+    fn row_storage_kernels_equal_the_column_ones_bit_for_bit() {
+        check_row_kernels::<1, false>();
+        check_row_kernels::<2, false>();
+        check_row_kernels::<3, false>();
+        check_row_kernels::<4, false>();
+        check_row_kernels::<5, false>();
+        check_row_kernels::<8, false>();
+        // The fused variant's multiply-adds are mul_add: exact on every CPU.
+        check_row_kernels::<1, true>();
+        check_row_kernels::<4, true>();
+        check_row_kernels::<7, true>();
+        check_row_kernels::<8, true>();
     }
 
     #[test]

@@ -17,10 +17,11 @@
 //!
 //! with H_k -> X and A_k -> 0 as ρ(A - B K)^(2^k): a closed loop sampled at 50 Hz, whose
 //! eigenvalues have |z| ≈ 0.99, takes about a dozen doublings, each six products and one LU
-//! factorisation of order n, on the stack, in one kernel compiled for the order (the matrices
-//! stay in registers at n = 4). Where G and H_k are positive semidefinite
-//! W_k is nonsingular. The iteration stops when the increment of H no longer changes it at
-//! working precision and A_k has decayed.
+//! factorisation of order n, on the stack, in one kernel compiled for the order, in vector
+//! form (the two solves with W_k on the rows of their right-hand sides:
+//! [`doubling_step_kernel`]). Where G and H_k are positive semidefinite W_k is nonsingular.
+//! The iteration stops when the increment of H no longer changes it at working precision and
+//! A_k has decayed.
 //!
 //! The result is a candidate only: [`super::dare`] refines it by Newton's method and keeps it
 //! only if its residual is within a few units of rounding and its closed loop passes every
@@ -36,7 +37,8 @@
 use super::care::Standard;
 use crate::linalg::matrix::{FaerView, with_order};
 use crate::linalg::small_matrix::{
-    self, Columns, SmallLu, add_product_kernel, columns_mut, lu_kernel, lu_solve_kernel,
+    self, CacheAligned, Columns, SmallLu, add_product_kernel, add_product_rows_kernel, columns,
+    lu_kernel, lu_solve_rows_kernel, transposed,
 };
 use crate::platform::dispatch::fma_dispatch;
 use faer::Mat;
@@ -84,22 +86,19 @@ pub(crate) fn doubling_solution(plant: &Standard) -> Option<DoublingSolution> {
 /// The recursion at the order N (module documentation), each doubling one fused kernel: the
 /// limit of H and the doublings taken, or `None` if it diverged or did not converge.
 fn double<const N: usize>(
-    mut a: SMatrix<f64, N, N>,
-    mut g: SMatrix<f64, N, N>,
-    mut h: SMatrix<f64, N, N>,
+    a: SMatrix<f64, N, N>,
+    g: SMatrix<f64, N, N>,
+    h: SMatrix<f64, N, N>,
 ) -> Option<(SMatrix<f64, N, N>, usize)> {
+    let mut state = CacheAligned([*columns(&a), *columns(&g), *columns(&h)]);
     for doublings in 1..=MAX_DOUBLINGS {
-        let [increment, h_norm, a_norm] = doubling_step(
-            columns_mut(&mut a),
-            columns_mut(&mut g),
-            columns_mut(&mut h),
-        );
+        let [increment, h_norm, a_norm] = doubling_step(&mut state);
         // The norms are NaN or infinite exactly when an entry is.
         if !(increment.is_finite() && h_norm.is_finite() && a_norm.is_finite()) {
             return None;
         }
         if increment <= f64::EPSILON * h_norm && a_norm <= 1.0 {
-            return Some((h, doublings));
+            return Some((small_matrix::from_columns(state.0[2]), doublings));
         }
     }
     None
@@ -108,54 +107,57 @@ fn double<const N: usize>(
 /// One doubling in place (module documentation): A, G, H <- A_{k+1}, G_{k+1}, H_{k+1}, G and
 /// H symmetrised. Returns the 1-norms of H's increment, of the new H and of the new A (NaN
 /// or infinite when an entry is).
+///
+/// W^-1 A and W^-1 G are solved for as their rows (from the rows of A and G, the columns of
+/// A^T and G^T), all columns at once ([`lu_solve_rows_kernel`]), and the products take them,
+/// and A^T in G's update, by their rows ([`add_product_rows_kernel`]): every entry is formed
+/// by the same operations in the same order as with column storage. The kernel's matrices are
+/// cache-aligned ([`CacheAligned`]), and A^T is stored whole before the products read it, so
+/// that they load its columns as vectors (the optimiser would otherwise gather A's rows lane
+/// by lane into the products, as scalar and partial-vector multiply-adds).
 #[inline(always)]
 fn doubling_step_kernel<const N: usize, const FMA: bool>(
-    a: &mut Columns<N>,
-    g: &mut Columns<N>,
-    h: &mut Columns<N>,
+    state: &mut CacheAligned<[Columns<N>; 3]>,
 ) -> [f64; 3] {
-    let zeros = [[0.0; N]; N];
+    let [a, g, h] = &mut state.0;
+    let zeros = CacheAligned([[0.0; N]; N]);
     let mut w = zeros;
-    for (k, column) in w.iter_mut().enumerate() {
+    for (k, column) in w.0.iter_mut().enumerate() {
         column[k] = 1.0;
     }
-    add_product_kernel::<N, FMA>(g, h, &mut w);
+    add_product_kernel::<N, FMA>(g, h, &mut w.0);
     let mut pivots = [0usize; N];
-    lu_kernel::<N, FMA>(&mut w, &mut pivots);
-    // W^-1 A and W^-1 G.
-    let (mut wa, mut wg) = (*a, *g);
-    lu_solve_kernel::<N, FMA>(&w, &pivots, &mut wa);
-    lu_solve_kernel::<N, FMA>(&w, &pivots, &mut wg);
-    let mut a_transposed = zeros;
-    for (j, column) in a.iter().enumerate() {
-        for (i, &value) in column.iter().enumerate() {
-            a_transposed[i][j] = value;
-        }
-    }
+    lu_kernel::<N, FMA>(&mut w.0, &mut pivots);
+    let mut a_transposed = CacheAligned(transposed(a));
+    std::hint::black_box(&mut a_transposed);
+    // The rows of W^-1 A and W^-1 G.
+    let (mut wa, mut wg) = (a_transposed, CacheAligned(transposed(g)));
+    lu_solve_rows_kernel::<N, FMA>(&w.0, &pivots, &mut wa.0);
+    lu_solve_rows_kernel::<N, FMA>(&w.0, &pivots, &mut wg.0);
     // H += A^T (H W^-1 A).
     let mut hwa = zeros;
-    add_product_kernel::<N, FMA>(h, &wa, &mut hwa);
+    add_product_rows_kernel::<N, FMA>(h, &wa.0, &mut hwa.0);
     let mut increment = zeros;
-    add_product_kernel::<N, FMA>(&a_transposed, &hwa, &mut increment);
+    add_product_kernel::<N, FMA>(&a_transposed.0, &hwa.0, &mut increment.0);
     // G += (A W^-1 G) A^T.
     let mut awg = zeros;
-    add_product_kernel::<N, FMA>(a, &wg, &mut awg);
-    add_product_kernel::<N, FMA>(&awg, &a_transposed, g);
+    add_product_rows_kernel::<N, FMA>(a, &wg.0, &mut awg.0);
+    add_product_rows_kernel::<N, FMA>(&awg.0, a, g);
     // A <- A W^-1 A.
     let mut next = zeros;
-    add_product_kernel::<N, FMA>(a, &wa, &mut next);
-    *a = next;
-    for (h_column, increment_column) in h.iter_mut().zip(&increment) {
+    add_product_rows_kernel::<N, FMA>(a, &wa.0, &mut next.0);
+    *a = next.0;
+    for (h_column, increment_column) in h.iter_mut().zip(&increment.0) {
         for (x, &d) in h_column.iter_mut().zip(increment_column) {
             *x += d;
         }
     }
     symmetrize(g);
     symmetrize(h);
-    [one_norm(&increment), one_norm(h), one_norm(a)]
+    [one_norm(&increment.0), one_norm(h), one_norm(a)]
 }
 
-fma_dispatch!(fn doubling_step<const N: usize>(a: &mut Columns<N>, g: &mut Columns<N>, h: &mut Columns<N>) -> [f64; 3] => doubling_step_kernel);
+fma_dispatch!(fn doubling_step<const N: usize>(state: &mut CacheAligned<[Columns<N>; 3]>) -> [f64; 3] => doubling_step_kernel);
 
 /// (M + M^T) / 2 in place.
 #[inline(always)]
