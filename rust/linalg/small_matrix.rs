@@ -429,6 +429,8 @@ mod tests {
 
     /// The row-storage solve and product against the column-storage ones, bit for bit, in
     /// both variants, at the order N over seeded matrices (pivoting forced by reversed rows).
+    /// (Inlined as every function generic over `FMA` is: `fma_kernels_are_always_inlined`.)
+    #[inline(always)]
     fn check_row_kernels<const N: usize, const FMA: bool>() {
         for seed in 0..20 {
             let system = SMatrix::<f64, N, N>::from_fn(|i, j| sample::<N>(seed)[(N - 1 - i, j)]);
