@@ -5,6 +5,8 @@
 //! * [`responses`]: time responses on a uniform grid, by one discretisation and a recurrence.
 //! * [`frequency`]: frequency responses through one Hessenberg reduction.
 //! * [`modal`]: eigenvalues, modes and their characteristics, the modal matrix.
+//! * [`partial_fraction`]: the partial-fraction form of a model, for frequency responses at
+//!   many points.
 //! * [`controllability`]: controllability and observability matrices, the staircase and modal
 //!   verdicts.
 //! * [`placement`]: pole placement: Bass–Gura, Ackermann and the robust multi-input method.
@@ -21,6 +23,7 @@ pub mod discretize;
 pub mod frequency;
 pub mod margins;
 pub mod modal;
+pub mod partial_fraction;
 pub mod placement;
 pub mod responses;
 pub mod riccati;

@@ -23,11 +23,11 @@
 use crate::control::discretize::{Discretization, Hold, discretize};
 use crate::control::frequency::check_state_space;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_positive};
-use crate::linalg::norm::{LinearOperator, one_norm_estimate, triangular_inverse_norm_bound};
+use crate::linalg::norm::{Inverse, one_norm_estimate, triangular_inverse_norm_bound};
 use crate::platform::interrupt;
 use crate::platform::parallel::{ParallelContext, chunks, par_chunks};
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::{PartialPivLu, ShapeCore, Solve};
+use faer::linalg::solvers::Solve;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
@@ -563,25 +563,6 @@ pub fn dc_gain(
 /// An eigenvalue of A within this many n u ||A||_max of zero makes A singular for
 /// [`steady_state`]: an integrator or a neutral mode, which has no steady state.
 const SINGULAR_EIGENVALUE: f64 = 100.0;
-
-/// A^-1 as an operator, applied through the LU factors of A.
-struct Inverse<'a>(&'a PartialPivLu<f64>);
-
-impl LinearOperator for Inverse<'_> {
-    fn dim(&self) -> usize {
-        self.0.nrows()
-    }
-
-    fn apply(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
-        out.copy_from(x);
-        self.0.solve_in_place(out);
-    }
-
-    fn apply_transpose(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
-        out.copy_from(x);
-        self.0.solve_transpose_in_place(out);
-    }
-}
 
 #[cfg(test)]
 mod tests {

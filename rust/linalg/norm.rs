@@ -17,6 +17,7 @@
 
 use crate::platform::pool::scratch;
 use faer::linalg::matmul::matmul;
+use faer::linalg::solvers::{PartialPivLu, ShapeCore, Solve};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
 /// Matrices of up to this many entries take [`frobenius_norm`]'s plain sum of squares.
@@ -238,6 +239,26 @@ impl LinearOperator for MatrixProduct<'_> {
     fn apply_transpose(&self, x: MatRef<'_, f64>, out: MatMut<'_, f64>) {
         // (F_1 ... F_k)^T x = F_k^T (... (F_1^T x)): the transposes, left to right.
         Self::apply_factors(self.factors.iter().rev().map(|f| f.transpose()), x, out);
+    }
+}
+
+/// A^-1 as an operator, applied through the LU factors of A (for [`one_norm_estimate`] of
+/// ||A^-1||_1 at O(n^2) a step).
+pub struct Inverse<'a>(pub &'a PartialPivLu<f64>);
+
+impl LinearOperator for Inverse<'_> {
+    fn dim(&self) -> usize {
+        self.0.nrows()
+    }
+
+    fn apply(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+        out.copy_from(x);
+        self.0.solve_in_place(out);
+    }
+
+    fn apply_transpose(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
+        out.copy_from(x);
+        self.0.solve_transpose_in_place(out);
     }
 }
 
