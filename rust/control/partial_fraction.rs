@@ -75,9 +75,13 @@ enum Block {
 /// The partial-fraction form of (A, B, C, D), with what its points' checks need.
 pub struct PartialFractions {
     n: usize,
-    blocks: Vec<Block>,
-    /// The real coefficients, channel by channel (p m rows of n, row-major): r_k, or S_k and
-    /// T_k at a pair's two columns.
+    /// The real eigenvalues λ_k.
+    reals: Vec<f64>,
+    /// The pairs a_k ± i b_k (b_k > 0): a_k, then b_k.
+    pairs: (Vec<f64>, Vec<f64>),
+    /// The real coefficients, channel by channel (p m rows of n, row-major), each row laid out
+    /// as the weights are: the r_k of the real eigenvalues, then the S_k of the pairs, then
+    /// their T_k.
     coefficients: Vec<f64>,
     d: Vec<f64>,
     /// A / σ, B / β and C / γ are held (the point s is divided by σ): the sum is multiplied
@@ -139,23 +143,41 @@ impl PartialFractions {
         }
         let modal_b = lu.solve(&b);
         let modal_c = &c * &w;
+        let reals: Vec<f64> = blocks
+            .iter()
+            .filter_map(|block| match block {
+                Block::Real(lambda) => Some(*lambda),
+                Block::Pair(..) => None,
+            })
+            .collect();
+        let pair_count = (n - reals.len()) / 2;
+        let mut pairs = (
+            Vec::with_capacity(pair_count),
+            Vec::with_capacity(pair_count),
+        );
         let mut coefficients = vec![0.0; p * m * n];
         for i in 0..p {
             for j in 0..m {
                 let row = &mut coefficients[(i * m + j) * n..(i * m + j + 1) * n];
-                let mut k = 0;
+                let (mut column, mut real, mut pair) = (0, 0, 0);
                 for block in &blocks {
-                    match block {
+                    match *block {
                         Block::Real(_) => {
-                            row[k] = modal_c[(i, k)] * modal_b[(k, j)];
-                            k += 1;
+                            row[real] = modal_c[(i, column)] * modal_b[(column, j)];
+                            real += 1;
+                            column += 1;
                         }
-                        Block::Pair(..) => {
-                            let (c1, c2) = (modal_c[(i, k)], modal_c[(i, k + 1)]);
-                            let (b1, b2) = (modal_b[(k, j)], modal_b[(k + 1, j)]);
-                            row[k] = c1 * b1 + c2 * b2;
-                            row[k + 1] = c1 * b2 - c2 * b1;
-                            k += 2;
+                        Block::Pair(a, b) => {
+                            let (c1, c2) = (modal_c[(i, column)], modal_c[(i, column + 1)]);
+                            let (b1, b2) = (modal_b[(column, j)], modal_b[(column + 1, j)]);
+                            row[reals.len() + pair] = c1 * b1 + c2 * b2;
+                            row[reals.len() + pair_count + pair] = c1 * b2 - c2 * b1;
+                            if i == 0 && j == 0 {
+                                pairs.0.push(a);
+                                pairs.1.push(b);
+                            }
+                            pair += 1;
+                            column += 2;
                         }
                     }
                 }
@@ -167,7 +189,8 @@ impl PartialFractions {
         let reach = 2.0 * inverse_norm * residual_norm;
         Some(PartialFractions {
             n,
-            blocks,
+            reals,
+            pairs,
             coefficients,
             d: (0..p * m).map(|k| d[(k / m, k % m)]).collect(),
             exponent: gamma.log2() + beta.log2() - sigma.log2(),
@@ -251,39 +274,39 @@ fn evaluate_kernel<const FMA: bool>(
     }
     let (w_re, w_im) = weights;
     let (w_re, w_im) = (&mut w_re[..n], &mut w_im[..n]);
-    let mut nearest = f64::INFINITY;
-    let mut k = 0;
-    for block in &form.blocks {
-        match *block {
-            Block::Real(lambda) => {
-                let x = s.re - lambda;
-                let squared = x * x + s.im * s.im;
-                nearest = nearest.min(squared);
-                let reciprocal = 1.0 / squared;
-                w_re[k] = x * reciprocal;
-                w_im[k] = -s.im * reciprocal;
-                k += 1;
-            }
-            Block::Pair(a, b) => {
-                let x = s.re - a;
-                let (below, above) = (s.im - b, s.im + b);
-                nearest = nearest
-                    .min(x * x + below * below)
-                    .min(x * x + above * above);
-                // (s - λ)(s - conj λ) = (x + i below)(x + i above).
-                let (pr, pi) = (x * x - below * above, x * (below + above));
-                let reciprocal = 1.0 / (pr * pr + pi * pi);
-                let (qr, qi) = (pr * reciprocal, -pi * reciprocal);
-                // (s - a) q = (x + i Im s) q.
-                w_re[k] = x * qr - s.im * qi;
-                w_im[k] = x * qi + s.im * qr;
-                w_re[k + 1] = b * qr;
-                w_im[k + 1] = b * qi;
-                k += 2;
-            }
-        }
+    let (real_count, pair_count) = (form.reals.len(), form.pairs.0.len());
+    let (real_re, pair_re) = w_re.split_at_mut(real_count);
+    let (real_im, pair_im) = w_im.split_at_mut(real_count);
+    let (u_re, v_re) = pair_re.split_at_mut(pair_count);
+    let (u_im, v_im) = pair_im.split_at_mut(pair_count);
+    // Comparisons false for NaN: a point is refused only where it is near an eigenvalue.
+    let mut near = false;
+    let y = s.im;
+    for ((&lambda, w_re), w_im) in form.reals.iter().zip(real_re).zip(real_im) {
+        let x = s.re - lambda;
+        let squared = x * x + y * y;
+        near |= squared < form.nearest;
+        let reciprocal = 1.0 / squared;
+        *w_re = x * reciprocal;
+        *w_im = -y * reciprocal;
     }
-    if nearest < form.nearest {
+    let pairs = form.pairs.0.iter().zip(&form.pairs.1);
+    let weights = u_re.iter_mut().zip(u_im).zip(v_re.iter_mut().zip(v_im));
+    for ((&a, &b), ((u_re, u_im), (v_re, v_im))) in pairs.zip(weights) {
+        let x = s.re - a;
+        let (below, above) = (y - b, y + b);
+        near |= (x * x + below * below < form.nearest) | (x * x + above * above < form.nearest);
+        // (s - λ)(s - conj λ) = (x + i below)(x + i above).
+        let (pr, pi) = (x * x - below * above, x * (below + above));
+        let reciprocal = 1.0 / (pr * pr + pi * pi);
+        let (qr, qi) = (pr * reciprocal, -pi * reciprocal);
+        // (s - a) q = (x + i Im s) q.
+        *u_re = x * qr - y * qi;
+        *u_im = x * qi + y * qr;
+        *v_re = b * qr;
+        *v_im = b * qi;
+    }
+    if near {
         return false;
     }
     for (channel, g) in g.iter_mut().enumerate() {
