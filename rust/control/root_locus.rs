@@ -267,7 +267,17 @@ fn sort_into(values: &[c64], order: &mut Vec<usize>, out: &mut [c64]) {
         order.clear();
         order.extend(0..values.len());
     }
-    let before = |x: c64, y: c64| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)).is_lt();
+    // Distinct real parts decide by `<` (as `total_cmp` does for numbers); equal ones (a pair,
+    // or -0 beside +0) and NaNs by `total_cmp` of both parts.
+    let before = |x: c64, y: c64| {
+        if x.re < y.re {
+            true
+        } else if x.re > y.re {
+            false
+        } else {
+            x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)).is_lt()
+        }
+    };
     for k in 1..order.len() {
         let item = order[k];
         let mut j = k;
@@ -450,10 +460,26 @@ const ABERTH_ITERATIONS: usize = 12;
 
 /// A set of roots closed under conjugation: the real ones, and the upper member (Im > 0) of
 /// each complex pair.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 struct Conjugates {
     real: Vec<f64>,
     upper: Vec<c64>,
+}
+
+impl Clone for Conjugates {
+    fn clone(&self) -> Self {
+        Self {
+            real: self.real.clone(),
+            upper: self.upper.clone(),
+        }
+    }
+
+    /// Into the buffers already held (the continuation copies the last gain's roots into its
+    /// work buffers at every gain; derived, this would allocate both anew).
+    fn clone_from(&mut self, source: &Self) {
+        self.real.clone_from(&source.real);
+        self.upper.clone_from(&source.upper);
+    }
 }
 
 impl Conjugates {
@@ -564,6 +590,42 @@ impl Conjugates {
         }
         sum
     }
+
+    /// [`Conjugates::product`] and [`Conjugates::sum`] at x in one pass over the roots, each
+    /// by the same operations in the same order (so bit for bit the same), the differences
+    /// x - v and a pair's product (x - v)(x - v̄) formed once for both.
+    #[inline(always)]
+    fn product_and_sum(&self, x: c64) -> (c64, c64) {
+        if x.im == 0.0 {
+            let x = x.re;
+            let (mut product, mut sum) = (1.0, 0.0);
+            for v in &self.real {
+                let d = x - v;
+                product *= d;
+                sum += 1.0 / d;
+            }
+            for v in &self.upper {
+                let d = x - v.re;
+                let pair = d * d + v.im * v.im;
+                product *= pair;
+                sum += 2.0 * d / pair;
+            }
+            return (c64::new(product, 0.0), c64::new(sum, 0.0));
+        }
+        let (mut product, mut sum) = (c64::new(1.0, 0.0), c64::new(0.0, 0.0));
+        for v in &self.real {
+            let d = c64::new(x.re - v, x.im);
+            product *= d;
+            sum += reciprocal(d);
+        }
+        for v in &self.upper {
+            let (d, e) = (x - v, x - v.conj());
+            let pair = d * e;
+            product *= pair;
+            sum += pair_reciprocals_of_product(d, e, pair);
+        }
+        (product, sum)
+    }
 }
 
 /// The loop in the factored form of the continuation (see the module's documentation), and
@@ -656,40 +718,28 @@ impl Factored {
     /// zero, or a product beyond the doubles).
     #[inline(always)]
     fn residual(&self, x: c64, g: f64, eta: f64) -> Residual {
-        let (d, n) = (
+        residual_of(
             self.poles.product(x),
             self.zeros.product(x) * (g * self.gain),
-        );
-        let square = |z: c64| z.re * z.re + z.im * z.im;
-        let (d2, n2) = (square(d), square(n));
-        let range = 1e-290..=1e290;
-        if range.contains(&d2) && range.contains(&n2) {
-            if square(d + n) <= eta * eta * d2.max(n2) {
-                return Residual::Root;
-            }
-            return Residual::Off(n * reciprocal(d));
-        }
-        let r = n * reciprocal(d);
-        if !(r.re.is_finite() && r.im.is_finite() && r != c64::new(0.0, 0.0)) {
-            Residual::Failed
-        } else if is_root(r, eta) {
-            Residual::Root
-        } else {
-            Residual::Off(r)
-        }
+            eta,
+        )
+    }
+
+    /// [`Factored::residual`] and the sums S_p and S_z at x, in one pass over the poles and
+    /// one over the zeros ([`Conjugates::product_and_sum`]): for the first sweep at a gain,
+    /// where a predicted point is rarely a root already and both are needed.
+    #[inline(always)]
+    fn residual_and_sums(&self, x: c64, g: f64, eta: f64) -> (Residual, c64, c64) {
+        let (d, s_p) = self.poles.product_and_sum(x);
+        let (n, s_z) = self.zeros.product_and_sum(x);
+        (residual_of(d, n * (g * self.gain), eta), s_p, s_z)
     }
 
     /// χ'/χ = (S_p + R S_z) / (1 + R) at x, formed as (S_p / R + S_z) / (1 / R + 1) where
     /// |R| > 1; not finite where 1 + R = 0 exactly.
     #[inline(always)]
     fn logarithmic_derivative(&self, x: c64, r: c64) -> c64 {
-        let (s_p, s_z) = (self.poles.sum(x), self.zeros.sum(x));
-        if r.re * r.re + r.im * r.im <= 1.0 {
-            (s_p + r * s_z) * reciprocal(r + 1.0)
-        } else {
-            let inverse = reciprocal(r);
-            (s_p * inverse + s_z) * reciprocal(inverse + 1.0)
-        }
+        logarithmic_derivative_of(self.poles.sum(x), self.zeros.sum(x), r)
     }
 
     /// Whether `roots` (every closed-loop pole at g) pass the trace and trace-of-square checks
@@ -704,6 +754,40 @@ impl Factored {
         let u = f64::EPSILON;
         (sum - trace).abs() <= 8.0 * n * n * u * size.sqrt()
             && (square - trace_square).abs() <= 16.0 * n * n * u * size
+    }
+}
+
+/// The test of [`Factored::residual`] on D = Π(x - p_i) and G N = g K Π(x - z_j).
+#[inline(always)]
+fn residual_of(d: c64, n: c64, eta: f64) -> Residual {
+    let square = |z: c64| z.re * z.re + z.im * z.im;
+    let (d2, n2) = (square(d), square(n));
+    let range = 1e-290..=1e290;
+    if range.contains(&d2) && range.contains(&n2) {
+        if square(d + n) <= eta * eta * d2.max(n2) {
+            return Residual::Root;
+        }
+        return Residual::Off(n * reciprocal(d));
+    }
+    let r = n * reciprocal(d);
+    if !(r.re.is_finite() && r.im.is_finite() && r != c64::new(0.0, 0.0)) {
+        Residual::Failed
+    } else if is_root(r, eta) {
+        Residual::Root
+    } else {
+        Residual::Off(r)
+    }
+}
+
+/// χ'/χ = (S_p + R S_z) / (1 + R) from S_p, S_z and R, formed as (S_p / R + S_z) / (1 / R + 1)
+/// where |R| > 1; not finite where 1 + R = 0 exactly.
+#[inline(always)]
+fn logarithmic_derivative_of(s_p: c64, s_z: c64, r: c64) -> c64 {
+    if r.re * r.re + r.im * r.im <= 1.0 {
+        (s_p + r * s_z) * reciprocal(r + 1.0)
+    } else {
+        let inverse = reciprocal(r);
+        (s_p * inverse + s_z) * reciprocal(inverse + 1.0)
     }
 }
 
@@ -773,7 +857,12 @@ fn reciprocal(z: c64) -> c64 {
 /// range).
 #[inline(always)]
 fn pair_reciprocals(d: c64, e: c64) -> c64 {
-    let product = d * e;
+    pair_reciprocals_of_product(d, e, d * e)
+}
+
+/// [`pair_reciprocals`] with the product d e already formed.
+#[inline(always)]
+fn pair_reciprocals_of_product(d: c64, e: c64, product: c64) -> c64 {
     let norm = product.re * product.re + product.im * product.im;
     if (1e-290..=1e290).contains(&norm) {
         return (d + e) * product.conj() * (1.0 / norm);
@@ -902,9 +991,12 @@ impl Continuation {
         let roots = &mut self.roots;
         roots.clear();
         roots.extend_from_slice(&factored.fixed);
-        roots.extend(x.real.iter().map(|&v| c64::new(v, 0.0)));
+        for &v in &x.real {
+            roots.push(c64::new(v, 0.0));
+        }
         for &y in &x.upper {
-            roots.extend([y, y.conj()]);
+            roots.push(y);
+            roots.push(y.conj());
         }
         if !factored.verified(roots, g) {
             return false;
@@ -943,7 +1035,7 @@ fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<b
     let degree = factored.poles.len() as f64;
     converged.clear();
     converged.resize(reals + x.upper.len(), false);
-    for _ in 0..ABERTH_ITERATIONS {
+    for sweep in 0..ABERTH_ITERATIONS {
         let mut done = true;
         for (i, converged) in converged.iter_mut().enumerate() {
             if *converged {
@@ -954,7 +1046,15 @@ fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<b
             } else {
                 x.upper[i - reals]
             };
-            let r = match factored.residual(xi, g, eta) {
+            // The first sweep forms the sums with the products (a predicted point is rarely a
+            // root already); later ones only where the residual asks for a step.
+            let (residual, sums) = if sweep == 0 {
+                let (residual, s_p, s_z) = factored.residual_and_sums(xi, g, eta);
+                (residual, Some((s_p, s_z)))
+            } else {
+                (factored.residual(xi, g, eta), None)
+            };
+            let r = match residual {
                 Residual::Root => {
                     *converged = true;
                     continue;
@@ -962,7 +1062,10 @@ fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<b
                 Residual::Off(r) => r,
                 Residual::Failed => return false,
             };
-            let ratio = factored.logarithmic_derivative(xi, r);
+            let ratio = match sums {
+                Some((s_p, s_z)) => logarithmic_derivative_of(s_p, s_z, r),
+                None => factored.logarithmic_derivative(xi, r),
+            };
             if included(degree, ratio, xi) {
                 // A disk about x_i of radius deg χ |χ / χ'| holds a root of χ: within a few
                 // units of x_i's last place, so x_i is that root to working precision (near a
