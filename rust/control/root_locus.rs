@@ -37,7 +37,8 @@
 //! with the open-loop poles p_i, the zeros z_j and the gain K of c (sI - A)^-1 b from
 //! [`transfer::transfer_channels`], and S_p = Σ 1/(s - p_i), S_z = Σ 1/(s - z_j). Each
 //! approximation x_i moves by 1 / (χ'/χ(x_i) - Σ_{j≠i} 1/(x_i - x_j)) (Aberth 1973, eq. 2),
-//! and stops once |1 + R(x_i)| <= η max(1, |R(x_i)|), η = 32 (n + m + 1) u (tested as
+//! formed as Q / (P - Q Σ_{j≠i} 1/(x_i - x_j)) with χ'/χ = P / Q = (D S_p + G N S_z) / (D + G N)
+//! (one complex division; by R where D or G N leaves the normal range), and stops once |1 + R(x_i)| <= η max(1, |R(x_i)|), η = 32 (n + m + 1) u (tested as
 //! |D + G N| <= η max(|D|, |G N|) with D = Π(x_i - p_i) and G N = g K Π(x_i - z_j), in squares
 //! without a division where they are in range): x_i is then a root of
 //! the factored χ_g with its factors perturbed by O(η); or once the disk about x_i of radius
@@ -711,11 +712,12 @@ impl Factored {
         }))
     }
 
-    /// Whether x is a root of the factored χ_g ([`is_root`]), and R(x) = G N / D where it is
-    /// not (G = g K, N = Π(x - z_j), D = Π(x - p_i)). Where |D|^2 and |G N|^2 are in the
-    /// normal range the test is |D + G N| <= η max(|D|, |G N|) (that of [`is_root`] times |D|),
-    /// squared, without a division; a failure where R is not finite or is 0 (x on a pole or a
-    /// zero, or a product beyond the doubles).
+    /// Whether x is a root of the factored χ_g ([`is_root`]), and where it is not D and G N
+    /// (G = g K, N = Π(x - z_j), D = Π(x - p_i)), or R(x) = G N / D where they leave the
+    /// normal range. Where |D|^2 and |G N|^2 are in the normal range the test is
+    /// |D + G N| <= η max(|D|, |G N|) (that of [`is_root`] times |D|), squared, without a
+    /// division; a failure where R is not finite or is 0 (x on a pole or a zero, or a product
+    /// beyond the doubles).
     #[inline(always)]
     fn residual(&self, x: c64, g: f64, eta: f64) -> Residual {
         residual_of(
@@ -733,13 +735,6 @@ impl Factored {
         let (d, s_p) = self.poles.product_and_sum(x);
         let (n, s_z) = self.zeros.product_and_sum(x);
         (residual_of(d, n * (g * self.gain), eta), s_p, s_z)
-    }
-
-    /// χ'/χ = (S_p + R S_z) / (1 + R) at x, formed as (S_p / R + S_z) / (1 / R + 1) where
-    /// |R| > 1; not finite where 1 + R = 0 exactly.
-    #[inline(always)]
-    fn logarithmic_derivative(&self, x: c64, r: c64) -> c64 {
-        logarithmic_derivative_of(self.poles.sum(x), self.zeros.sum(x), r)
     }
 
     /// Whether `roots` (every closed-loop pole at g) pass the trace and trace-of-square checks
@@ -767,7 +762,7 @@ fn residual_of(d: c64, n: c64, eta: f64) -> Residual {
         if square(d + n) <= eta * eta * d2.max(n2) {
             return Residual::Root;
         }
-        return Residual::Off(n * reciprocal(d));
+        return Residual::Off(d, n);
     }
     let r = n * reciprocal(d);
     if !(r.re.is_finite() && r.im.is_finite() && r != c64::new(0.0, 0.0)) {
@@ -775,7 +770,7 @@ fn residual_of(d: c64, n: c64, eta: f64) -> Residual {
     } else if is_root(r, eta) {
         Residual::Root
     } else {
-        Residual::Off(r)
+        Residual::OffRatio(r)
     }
 }
 
@@ -795,8 +790,10 @@ fn logarithmic_derivative_of(s_p: c64, s_z: c64, r: c64) -> c64 {
 enum Residual {
     /// A root of the factored χ_g.
     Root,
-    /// Not a root: R at the point.
-    Off(c64),
+    /// Not a root: D and G N at the point, both in the normal range.
+    Off(c64, c64),
+    /// Not a root, D or G N beyond the normal range: R = G N / D at the point.
+    OffRatio(c64),
     /// R is not finite or is 0.
     Failed,
 }
@@ -810,6 +807,63 @@ fn is_root(r: c64, eta: f64) -> bool {
     }
     let one_plus = (r.re + 1.0) * (r.re + 1.0) + r.im * r.im;
     one_plus <= eta * eta * (r.re * r.re + r.im * r.im).max(1.0)
+}
+
+/// What Aberth's iteration does with an approximation x_i that is not a root by the residual.
+enum Correction {
+    /// Converged: the inclusion disk about x_i is within [`INCLUSION_ULPS`] of it.
+    Included,
+    /// Moves by -step: step = 1 / (χ'/χ(x_i) - Σ_{j≠i} 1/(x_i - x_j)).
+    Step(c64),
+}
+
+/// The [`Correction`] of x from D and G N (in the normal range, not a root) and the sums S_p and
+/// S_z at x, `repulsion` giving Σ_{j≠i} 1/(x - x_j): χ'/χ = (D S_p + G N S_z) / (D + G N)
+/// (the common factors of χ and χ' cancel) kept as its numerator P and denominator Q, so that
+/// the inclusion test is deg χ |Q| <= ε |x| |P| (in squares) and the step is
+/// Q / (P - Q Σ_{j≠i} 1/(x - x_j)), one complex division where the quotient R = G N / D, then
+/// χ'/χ, then the step took three; by the quotient R ([`correction_of_ratio`]) where P, Q or x
+/// squared leave [1e-100, 1e100].
+#[inline(always)]
+fn correction(
+    d: c64,
+    n: c64,
+    s_p: c64,
+    s_z: c64,
+    degree: f64,
+    x: c64,
+    repulsion: impl FnOnce() -> c64,
+) -> Correction {
+    let numerator = d * s_p + n * s_z;
+    let denominator = d + n;
+    let square = |z: c64| z.re * z.re + z.im * z.im;
+    let (p2, q2, x2) = (square(numerator), square(denominator), square(x));
+    let range = 1e-100..=1e100;
+    if range.contains(&p2) && range.contains(&q2) && range.contains(&x2) {
+        let units = INCLUSION_ULPS * f64::EPSILON;
+        if degree * degree * q2 <= units * units * x2 * p2 {
+            return Correction::Included;
+        }
+        return Correction::Step(denominator * reciprocal(numerator - repulsion() * denominator));
+    }
+    let r = n * reciprocal(d);
+    correction_of_ratio(logarithmic_derivative_of(s_p, s_z, r), degree, x, repulsion)
+}
+
+/// The [`Correction`] of x from `ratio` = χ'/χ(x): [`included`], or the step
+/// 1 / (χ'/χ - Σ_{j≠i} 1/(x - x_j)).
+#[inline(always)]
+fn correction_of_ratio(
+    ratio: c64,
+    degree: f64,
+    x: c64,
+    repulsion: impl FnOnce() -> c64,
+) -> Correction {
+    if included(degree, ratio, x) {
+        Correction::Included
+    } else {
+        Correction::Step(reciprocal(ratio - repulsion()))
+    }
 }
 
 /// Whether deg χ / |χ'/χ| (the radius of a disk about x that holds a root of χ) is within
@@ -1054,27 +1108,33 @@ fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<b
             } else {
                 (factored.residual(xi, g, eta), None)
             };
-            let r = match residual {
+            // The sums where the residual asks for a step (formed already in the first sweep).
+            let sums = || sums.unwrap_or_else(|| (factored.poles.sum(xi), factored.zeros.sum(xi)));
+            let repulsion = || x.repulsion(i);
+            let correction = match residual {
                 Residual::Root => {
                     *converged = true;
                     continue;
                 }
-                Residual::Off(r) => r,
+                Residual::Off(d, n) => {
+                    let (s_p, s_z) = sums();
+                    correction(d, n, s_p, s_z, degree, xi, repulsion)
+                }
+                Residual::OffRatio(r) => {
+                    let (s_p, s_z) = sums();
+                    let ratio = logarithmic_derivative_of(s_p, s_z, r);
+                    correction_of_ratio(ratio, degree, xi, repulsion)
+                }
                 Residual::Failed => return false,
             };
-            let ratio = match sums {
-                Some((s_p, s_z)) => logarithmic_derivative_of(s_p, s_z, r),
-                None => factored.logarithmic_derivative(xi, r),
-            };
-            if included(degree, ratio, xi) {
+            let Correction::Step(step) = correction else {
                 // A disk about x_i of radius deg χ |χ / χ'| holds a root of χ: within a few
                 // units of x_i's last place, so x_i is that root to working precision (near a
                 // zero, where the rounding of x_i - z bounds the residual, not the root).
                 *converged = true;
                 continue;
-            }
+            };
             done = false;
-            let step = reciprocal(ratio - x.repulsion(i));
             let next = xi - step;
             if !(next.re.is_finite() && next.im.is_finite()) {
                 return false;
