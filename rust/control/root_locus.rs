@@ -1242,6 +1242,77 @@ mod tests {
         }
     }
 
+    /// The step from P / Q (one division) against the step by R, χ'/χ and their reciprocals
+    /// (the form kept where P or Q leave the range), on seeded D, G N, sums and repulsions over
+    /// twelve decades: the same step to rounding, and the same inclusion decision away from its
+    /// boundary; and the quotient form taken where P or Q leave the range.
+    #[test]
+    fn the_step_by_one_division_is_the_step_by_the_quotient() {
+        let mut draw = crate::test_matrices::xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut complex = |decades: f64| {
+            let scale = 10f64.powf(decades * draw());
+            c64::new(draw(), draw()) * scale
+        };
+        let mut steps = 0;
+        for _ in 0..20_000 {
+            let (d, n) = (complex(6.0), complex(6.0));
+            let (s_p, s_z, repulsion, x) = (complex(3.0), complex(3.0), complex(3.0), complex(3.0));
+            let degree = 6.0;
+            let ratio = logarithmic_derivative_of(s_p, s_z, n * reciprocal(d));
+            let by_ratio = correction_of_ratio(ratio, degree, x, || repulsion);
+            match (
+                correction(d, n, s_p, s_z, degree, x, || repulsion),
+                by_ratio,
+            ) {
+                (Correction::Step(step), Correction::Step(expected)) => {
+                    // Both are 1 / (χ'/χ - Σ) to a few units of its condition: that of
+                    // χ'/χ - Σ, and of χ'/χ through the cancellations in P and Q.
+                    let (p, q) = (d * s_p + n * s_z, d + n);
+                    let cancellation = (d.norm() * s_p.norm() + n.norm() * s_z.norm()) / p.norm()
+                        + (d.norm() + n.norm()) / q.norm();
+                    let condition =
+                        (ratio.norm() * cancellation + repulsion.norm()) * expected.norm();
+                    assert!(
+                        (step - expected).norm()
+                            <= 64.0 * f64::EPSILON * condition * expected.norm(),
+                        "{d} {n} {s_p} {s_z}: {step} vs {expected}"
+                    );
+                    steps += 1;
+                }
+                (Correction::Included, Correction::Included) => {}
+                _ => {
+                    // Only where deg χ / |χ'/χ| is at the inclusion radius to rounding.
+                    let radius = degree / ratio.norm();
+                    let limit = INCLUSION_ULPS * f64::EPSILON * x.norm();
+                    assert!(
+                        (radius - limit).abs() <= 1e-12 * limit,
+                        "{radius} vs {limit}"
+                    );
+                }
+            }
+        }
+        assert!(steps > 19_000, "{steps}");
+        // P and Q beyond 1e50 in modulus: the quotient form, bit for bit.
+        let (d, n) = (c64::new(3e60, 1e60), c64::new(-1e60, 2e60));
+        let (s_p, s_z, x, repulsion) = (
+            c64::new(0.5, 0.1),
+            c64::new(-0.2, 0.3),
+            c64::new(1.5, 0.5),
+            c64::new(0.1, -0.4),
+        );
+        let ratio = logarithmic_derivative_of(s_p, s_z, n * reciprocal(d));
+        let (Correction::Step(step), Correction::Step(expected)) = (
+            correction(d, n, s_p, s_z, 4.0, x, || repulsion),
+            correction_of_ratio(ratio, 4.0, x, || repulsion),
+        ) else {
+            panic!("a step expected");
+        };
+        assert_eq!(
+            (step.re.to_bits(), step.im.to_bits()),
+            (expected.re.to_bits(), expected.im.to_bits())
+        );
+    }
+
     /// A mode the loop does not see (a pole cancelled by an equal zero) stays at its place for
     /// every gain (taken out of the continuation as a common factor).
     #[test]
