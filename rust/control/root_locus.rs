@@ -37,7 +37,8 @@
 //! with the open-loop poles p_i, the zeros z_j and the gain K of c (sI - A)^-1 b from
 //! [`transfer::transfer_channels`], and S_p = Σ 1/(s - p_i), S_z = Σ 1/(s - z_j). Each
 //! approximation x_i moves by 1 / (χ'/χ(x_i) - Σ_{j≠i} 1/(x_i - x_j)) (Aberth 1973, eq. 2),
-//! and stops once |1 + R(x_i)| <= η max(1, |R(x_i)|), η = 32 (n + m + 1) u (tested as
+//! formed as Q / (P - Q Σ_{j≠i} 1/(x_i - x_j)) with χ'/χ = P / Q = (D S_p + G N S_z) / (D + G N)
+//! (one complex division; by R where D or G N leaves the normal range), and stops once |1 + R(x_i)| <= η max(1, |R(x_i)|), η = 32 (n + m + 1) u (tested as
 //! |D + G N| <= η max(|D|, |G N|) with D = Π(x_i - p_i) and G N = g K Π(x_i - z_j), in squares
 //! without a division where they are in range): x_i is then a root of
 //! the factored χ_g with its factors perturbed by O(η); or once the disk about x_i of radius
@@ -267,7 +268,17 @@ fn sort_into(values: &[c64], order: &mut Vec<usize>, out: &mut [c64]) {
         order.clear();
         order.extend(0..values.len());
     }
-    let before = |x: c64, y: c64| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)).is_lt();
+    // Distinct real parts decide by `<` (as `total_cmp` does for numbers); equal ones (a pair,
+    // or -0 beside +0) and NaNs by `total_cmp` of both parts.
+    let before = |x: c64, y: c64| {
+        if x.re < y.re {
+            true
+        } else if x.re > y.re {
+            false
+        } else {
+            x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)).is_lt()
+        }
+    };
     for k in 1..order.len() {
         let item = order[k];
         let mut j = k;
@@ -450,10 +461,26 @@ const ABERTH_ITERATIONS: usize = 12;
 
 /// A set of roots closed under conjugation: the real ones, and the upper member (Im > 0) of
 /// each complex pair.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 struct Conjugates {
     real: Vec<f64>,
     upper: Vec<c64>,
+}
+
+impl Clone for Conjugates {
+    fn clone(&self) -> Self {
+        Self {
+            real: self.real.clone(),
+            upper: self.upper.clone(),
+        }
+    }
+
+    /// Into the buffers already held (the continuation copies the last gain's roots into its
+    /// work buffers at every gain; derived, this would allocate both anew).
+    fn clone_from(&mut self, source: &Self) {
+        self.real.clone_from(&source.real);
+        self.upper.clone_from(&source.upper);
+    }
 }
 
 impl Conjugates {
@@ -564,6 +591,42 @@ impl Conjugates {
         }
         sum
     }
+
+    /// [`Conjugates::product`] and [`Conjugates::sum`] at x in one pass over the roots, each
+    /// by the same operations in the same order (so bit for bit the same), the differences
+    /// x - v and a pair's product (x - v)(x - v̄) formed once for both.
+    #[inline(always)]
+    fn product_and_sum(&self, x: c64) -> (c64, c64) {
+        if x.im == 0.0 {
+            let x = x.re;
+            let (mut product, mut sum) = (1.0, 0.0);
+            for v in &self.real {
+                let d = x - v;
+                product *= d;
+                sum += 1.0 / d;
+            }
+            for v in &self.upper {
+                let d = x - v.re;
+                let pair = d * d + v.im * v.im;
+                product *= pair;
+                sum += 2.0 * d / pair;
+            }
+            return (c64::new(product, 0.0), c64::new(sum, 0.0));
+        }
+        let (mut product, mut sum) = (c64::new(1.0, 0.0), c64::new(0.0, 0.0));
+        for v in &self.real {
+            let d = c64::new(x.re - v, x.im);
+            product *= d;
+            sum += reciprocal(d);
+        }
+        for v in &self.upper {
+            let (d, e) = (x - v, x - v.conj());
+            let pair = d * e;
+            product *= pair;
+            sum += pair_reciprocals_of_product(d, e, pair);
+        }
+        (product, sum)
+    }
 }
 
 /// The loop in the factored form of the continuation (see the module's documentation), and
@@ -649,47 +712,29 @@ impl Factored {
         }))
     }
 
-    /// Whether x is a root of the factored χ_g ([`is_root`]), and R(x) = G N / D where it is
-    /// not (G = g K, N = Π(x - z_j), D = Π(x - p_i)). Where |D|^2 and |G N|^2 are in the
-    /// normal range the test is |D + G N| <= η max(|D|, |G N|) (that of [`is_root`] times |D|),
-    /// squared, without a division; a failure where R is not finite or is 0 (x on a pole or a
-    /// zero, or a product beyond the doubles).
+    /// Whether x is a root of the factored χ_g ([`is_root`]), and where it is not D and G N
+    /// (G = g K, N = Π(x - z_j), D = Π(x - p_i)), or R(x) = G N / D where they leave the
+    /// normal range. Where |D|^2 and |G N|^2 are in the normal range the test is
+    /// |D + G N| <= η max(|D|, |G N|) (that of [`is_root`] times |D|), squared, without a
+    /// division; a failure where R is not finite or is 0 (x on a pole or a zero, or a product
+    /// beyond the doubles).
     #[inline(always)]
     fn residual(&self, x: c64, g: f64, eta: f64) -> Residual {
-        let (d, n) = (
+        residual_of(
             self.poles.product(x),
             self.zeros.product(x) * (g * self.gain),
-        );
-        let square = |z: c64| z.re * z.re + z.im * z.im;
-        let (d2, n2) = (square(d), square(n));
-        let range = 1e-290..=1e290;
-        if range.contains(&d2) && range.contains(&n2) {
-            if square(d + n) <= eta * eta * d2.max(n2) {
-                return Residual::Root;
-            }
-            return Residual::Off(n * reciprocal(d));
-        }
-        let r = n * reciprocal(d);
-        if !(r.re.is_finite() && r.im.is_finite() && r != c64::new(0.0, 0.0)) {
-            Residual::Failed
-        } else if is_root(r, eta) {
-            Residual::Root
-        } else {
-            Residual::Off(r)
-        }
+            eta,
+        )
     }
 
-    /// χ'/χ = (S_p + R S_z) / (1 + R) at x, formed as (S_p / R + S_z) / (1 / R + 1) where
-    /// |R| > 1; not finite where 1 + R = 0 exactly.
+    /// [`Factored::residual`] and the sums S_p and S_z at x, in one pass over the poles and
+    /// one over the zeros ([`Conjugates::product_and_sum`]): for the first sweep at a gain,
+    /// where a predicted point is rarely a root already and both are needed.
     #[inline(always)]
-    fn logarithmic_derivative(&self, x: c64, r: c64) -> c64 {
-        let (s_p, s_z) = (self.poles.sum(x), self.zeros.sum(x));
-        if r.re * r.re + r.im * r.im <= 1.0 {
-            (s_p + r * s_z) * reciprocal(r + 1.0)
-        } else {
-            let inverse = reciprocal(r);
-            (s_p * inverse + s_z) * reciprocal(inverse + 1.0)
-        }
+    fn residual_and_sums(&self, x: c64, g: f64, eta: f64) -> (Residual, c64, c64) {
+        let (d, s_p) = self.poles.product_and_sum(x);
+        let (n, s_z) = self.zeros.product_and_sum(x);
+        (residual_of(d, n * (g * self.gain), eta), s_p, s_z)
     }
 
     /// Whether `roots` (every closed-loop pole at g) pass the trace and trace-of-square checks
@@ -707,12 +752,48 @@ impl Factored {
     }
 }
 
+/// The test of [`Factored::residual`] on D = Π(x - p_i) and G N = g K Π(x - z_j).
+#[inline(always)]
+fn residual_of(d: c64, n: c64, eta: f64) -> Residual {
+    let square = |z: c64| z.re * z.re + z.im * z.im;
+    let (d2, n2) = (square(d), square(n));
+    let range = 1e-290..=1e290;
+    if range.contains(&d2) && range.contains(&n2) {
+        if square(d + n) <= eta * eta * d2.max(n2) {
+            return Residual::Root;
+        }
+        return Residual::Off(d, n);
+    }
+    let r = n * reciprocal(d);
+    if !(r.re.is_finite() && r.im.is_finite() && r != c64::new(0.0, 0.0)) {
+        Residual::Failed
+    } else if is_root(r, eta) {
+        Residual::Root
+    } else {
+        Residual::OffRatio(r)
+    }
+}
+
+/// χ'/χ = (S_p + R S_z) / (1 + R) from S_p, S_z and R, formed as (S_p / R + S_z) / (1 / R + 1)
+/// where |R| > 1; not finite where 1 + R = 0 exactly.
+#[inline(always)]
+fn logarithmic_derivative_of(s_p: c64, s_z: c64, r: c64) -> c64 {
+    if r.re * r.re + r.im * r.im <= 1.0 {
+        (s_p + r * s_z) * reciprocal(r + 1.0)
+    } else {
+        let inverse = reciprocal(r);
+        (s_p * inverse + s_z) * reciprocal(inverse + 1.0)
+    }
+}
+
 /// [`Factored::residual`] at a point.
 enum Residual {
     /// A root of the factored χ_g.
     Root,
-    /// Not a root: R at the point.
-    Off(c64),
+    /// Not a root: D and G N at the point, both in the normal range.
+    Off(c64, c64),
+    /// Not a root, D or G N beyond the normal range: R = G N / D at the point.
+    OffRatio(c64),
     /// R is not finite or is 0.
     Failed,
 }
@@ -726,6 +807,63 @@ fn is_root(r: c64, eta: f64) -> bool {
     }
     let one_plus = (r.re + 1.0) * (r.re + 1.0) + r.im * r.im;
     one_plus <= eta * eta * (r.re * r.re + r.im * r.im).max(1.0)
+}
+
+/// What Aberth's iteration does with an approximation x_i that is not a root by the residual.
+enum Correction {
+    /// Converged: the inclusion disk about x_i is within [`INCLUSION_ULPS`] of it.
+    Included,
+    /// Moves by -step: step = 1 / (χ'/χ(x_i) - Σ_{j≠i} 1/(x_i - x_j)).
+    Step(c64),
+}
+
+/// The [`Correction`] of x from D and G N (in the normal range, not a root) and the sums S_p and
+/// S_z at x, `repulsion` giving Σ_{j≠i} 1/(x - x_j): χ'/χ = (D S_p + G N S_z) / (D + G N)
+/// (the common factors of χ and χ' cancel) kept as its numerator P and denominator Q, so that
+/// the inclusion test is deg χ |Q| <= ε |x| |P| (in squares) and the step is
+/// Q / (P - Q Σ_{j≠i} 1/(x - x_j)), one complex division where the quotient R = G N / D, then
+/// χ'/χ, then the step took three; by the quotient R ([`correction_of_ratio`]) where P, Q or x
+/// squared leave [1e-100, 1e100].
+#[inline(always)]
+fn correction(
+    d: c64,
+    n: c64,
+    s_p: c64,
+    s_z: c64,
+    degree: f64,
+    x: c64,
+    repulsion: impl FnOnce() -> c64,
+) -> Correction {
+    let numerator = d * s_p + n * s_z;
+    let denominator = d + n;
+    let square = |z: c64| z.re * z.re + z.im * z.im;
+    let (p2, q2, x2) = (square(numerator), square(denominator), square(x));
+    let range = 1e-100..=1e100;
+    if range.contains(&p2) && range.contains(&q2) && range.contains(&x2) {
+        let units = INCLUSION_ULPS * f64::EPSILON;
+        if degree * degree * q2 <= units * units * x2 * p2 {
+            return Correction::Included;
+        }
+        return Correction::Step(denominator * reciprocal(numerator - repulsion() * denominator));
+    }
+    let r = n * reciprocal(d);
+    correction_of_ratio(logarithmic_derivative_of(s_p, s_z, r), degree, x, repulsion)
+}
+
+/// The [`Correction`] of x from `ratio` = χ'/χ(x): [`included`], or the step
+/// 1 / (χ'/χ - Σ_{j≠i} 1/(x - x_j)).
+#[inline(always)]
+fn correction_of_ratio(
+    ratio: c64,
+    degree: f64,
+    x: c64,
+    repulsion: impl FnOnce() -> c64,
+) -> Correction {
+    if included(degree, ratio, x) {
+        Correction::Included
+    } else {
+        Correction::Step(reciprocal(ratio - repulsion()))
+    }
 }
 
 /// Whether deg χ / |χ'/χ| (the radius of a disk about x that holds a root of χ) is within
@@ -773,7 +911,12 @@ fn reciprocal(z: c64) -> c64 {
 /// range).
 #[inline(always)]
 fn pair_reciprocals(d: c64, e: c64) -> c64 {
-    let product = d * e;
+    pair_reciprocals_of_product(d, e, d * e)
+}
+
+/// [`pair_reciprocals`] with the product d e already formed.
+#[inline(always)]
+fn pair_reciprocals_of_product(d: c64, e: c64, product: c64) -> c64 {
     let norm = product.re * product.re + product.im * product.im;
     if (1e-290..=1e290).contains(&norm) {
         return (d + e) * product.conj() * (1.0 / norm);
@@ -902,9 +1045,12 @@ impl Continuation {
         let roots = &mut self.roots;
         roots.clear();
         roots.extend_from_slice(&factored.fixed);
-        roots.extend(x.real.iter().map(|&v| c64::new(v, 0.0)));
+        for &v in &x.real {
+            roots.push(c64::new(v, 0.0));
+        }
         for &y in &x.upper {
-            roots.extend([y, y.conj()]);
+            roots.push(y);
+            roots.push(y.conj());
         }
         if !factored.verified(roots, g) {
             return false;
@@ -943,7 +1089,7 @@ fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<b
     let degree = factored.poles.len() as f64;
     converged.clear();
     converged.resize(reals + x.upper.len(), false);
-    for _ in 0..ABERTH_ITERATIONS {
+    for sweep in 0..ABERTH_ITERATIONS {
         let mut done = true;
         for (i, converged) in converged.iter_mut().enumerate() {
             if *converged {
@@ -954,24 +1100,41 @@ fn aberth(factored: &Factored, g: f64, x: &mut Conjugates, converged: &mut Vec<b
             } else {
                 x.upper[i - reals]
             };
-            let r = match factored.residual(xi, g, eta) {
+            // The first sweep forms the sums with the products (a predicted point is rarely a
+            // root already); later ones only where the residual asks for a step.
+            let (residual, sums) = if sweep == 0 {
+                let (residual, s_p, s_z) = factored.residual_and_sums(xi, g, eta);
+                (residual, Some((s_p, s_z)))
+            } else {
+                (factored.residual(xi, g, eta), None)
+            };
+            // The sums where the residual asks for a step (formed already in the first sweep).
+            let sums = || sums.unwrap_or_else(|| (factored.poles.sum(xi), factored.zeros.sum(xi)));
+            let repulsion = || x.repulsion(i);
+            let correction = match residual {
                 Residual::Root => {
                     *converged = true;
                     continue;
                 }
-                Residual::Off(r) => r,
+                Residual::Off(d, n) => {
+                    let (s_p, s_z) = sums();
+                    correction(d, n, s_p, s_z, degree, xi, repulsion)
+                }
+                Residual::OffRatio(r) => {
+                    let (s_p, s_z) = sums();
+                    let ratio = logarithmic_derivative_of(s_p, s_z, r);
+                    correction_of_ratio(ratio, degree, xi, repulsion)
+                }
                 Residual::Failed => return false,
             };
-            let ratio = factored.logarithmic_derivative(xi, r);
-            if included(degree, ratio, xi) {
+            let Correction::Step(step) = correction else {
                 // A disk about x_i of radius deg χ |χ / χ'| holds a root of χ: within a few
                 // units of x_i's last place, so x_i is that root to working precision (near a
                 // zero, where the rounding of x_i - z bounds the residual, not the root).
                 *converged = true;
                 continue;
-            }
+            };
             done = false;
-            let step = reciprocal(ratio - x.repulsion(i));
             let next = xi - step;
             if !(next.re.is_finite() && next.im.is_finite()) {
                 return false;
@@ -1077,6 +1240,77 @@ mod tests {
                 gains.len()
             );
         }
+    }
+
+    /// The step from P / Q (one division) against the step by R, χ'/χ and their reciprocals
+    /// (the form kept where P or Q leave the range), on seeded D, G N, sums and repulsions over
+    /// twelve decades: the same step to rounding, and the same inclusion decision away from its
+    /// boundary; and the quotient form taken where P or Q leave the range.
+    #[test]
+    fn the_step_by_one_division_is_the_step_by_the_quotient() {
+        let mut draw = crate::test_matrices::xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut complex = |decades: f64| {
+            let scale = 10f64.powf(decades * draw());
+            c64::new(draw(), draw()) * scale
+        };
+        let mut steps = 0;
+        for _ in 0..20_000 {
+            let (d, n) = (complex(6.0), complex(6.0));
+            let (s_p, s_z, repulsion, x) = (complex(3.0), complex(3.0), complex(3.0), complex(3.0));
+            let degree = 6.0;
+            let ratio = logarithmic_derivative_of(s_p, s_z, n * reciprocal(d));
+            let by_ratio = correction_of_ratio(ratio, degree, x, || repulsion);
+            match (
+                correction(d, n, s_p, s_z, degree, x, || repulsion),
+                by_ratio,
+            ) {
+                (Correction::Step(step), Correction::Step(expected)) => {
+                    // Both are 1 / (χ'/χ - Σ) to a few units of its condition: that of
+                    // χ'/χ - Σ, and of χ'/χ through the cancellations in P and Q.
+                    let (p, q) = (d * s_p + n * s_z, d + n);
+                    let cancellation = (d.norm() * s_p.norm() + n.norm() * s_z.norm()) / p.norm()
+                        + (d.norm() + n.norm()) / q.norm();
+                    let condition =
+                        (ratio.norm() * cancellation + repulsion.norm()) * expected.norm();
+                    assert!(
+                        (step - expected).norm()
+                            <= 64.0 * f64::EPSILON * condition * expected.norm(),
+                        "{d} {n} {s_p} {s_z}: {step} vs {expected}"
+                    );
+                    steps += 1;
+                }
+                (Correction::Included, Correction::Included) => {}
+                _ => {
+                    // Only where deg χ / |χ'/χ| is at the inclusion radius to rounding.
+                    let radius = degree / ratio.norm();
+                    let limit = INCLUSION_ULPS * f64::EPSILON * x.norm();
+                    assert!(
+                        (radius - limit).abs() <= 1e-12 * limit,
+                        "{radius} vs {limit}"
+                    );
+                }
+            }
+        }
+        assert!(steps > 19_000, "{steps}");
+        // P and Q beyond 1e50 in modulus: the quotient form, bit for bit.
+        let (d, n) = (c64::new(3e60, 1e60), c64::new(-1e60, 2e60));
+        let (s_p, s_z, x, repulsion) = (
+            c64::new(0.5, 0.1),
+            c64::new(-0.2, 0.3),
+            c64::new(1.5, 0.5),
+            c64::new(0.1, -0.4),
+        );
+        let ratio = logarithmic_derivative_of(s_p, s_z, n * reciprocal(d));
+        let (Correction::Step(step), Correction::Step(expected)) = (
+            correction(d, n, s_p, s_z, 4.0, x, || repulsion),
+            correction_of_ratio(ratio, 4.0, x, || repulsion),
+        ) else {
+            panic!("a step expected");
+        };
+        assert_eq!(
+            (step.re.to_bits(), step.im.to_bits()),
+            (expected.re.to_bits(), expected.im.to_bits())
+        );
     }
 
     /// A mode the loop does not see (a pole cancelled by an equal zero) stays at its place for
