@@ -81,6 +81,32 @@ pub fn check_state_space(
     check_finite(d, "D")
 }
 
+/// A / σ, B / β and C / γ, each divided by the power of two of its largest entry where that is
+/// outside [2^-100, 2^100] ([`range_scale`], exact): C (sI - A)^-1 B = 2^`exponent`
+/// C' (s/σ I - A')^-1 B', `exponent` = log2(γ β / σ).
+pub(crate) struct RangeScaled {
+    pub a: Mat<f64>,
+    pub b: Mat<f64>,
+    pub c: Mat<f64>,
+    pub sigma: f64,
+    pub exponent: f64,
+}
+
+impl RangeScaled {
+    pub fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Self {
+        let (sigma, beta, gamma) = (range_scale(a), range_scale(b), range_scale(c));
+        let scaled =
+            |x: MatRef<'_, f64>, s: f64| Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)] / s);
+        RangeScaled {
+            a: scaled(a, sigma),
+            b: scaled(b, beta),
+            c: scaled(c, gamma),
+            sigma,
+            exponent: gamma.log2() + beta.log2() - sigma.log2(),
+        }
+    }
+}
+
 /// The model in Hessenberg coordinates, laid out for the per-frequency kernel: H row-major,
 /// Q^T B column by column, C Q and D row-major.
 struct HessenbergModel {
@@ -107,10 +133,13 @@ impl HessenbergModel {
         d: MatRef<'_, f64>,
     ) -> Result<Self, Error> {
         let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
-        let (sigma, beta, gamma) = (range_scale(a), range_scale(b), range_scale(c));
-        let scaled =
-            |x: MatRef<'_, f64>, s: f64| Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)] / s);
-        let (a, b, c) = (scaled(a, sigma), scaled(b, beta), scaled(c, gamma));
+        let RangeScaled {
+            a,
+            b,
+            c,
+            sigma,
+            exponent,
+        } = RangeScaled::new(a, b, c);
         let Hessenberg { h, q } = hessenberg(a.as_ref())?;
         let (qb, cq) = (q.transpose() * &b, &c * &q);
         let row_major = |x: &Mat<f64>| -> Vec<f64> {
@@ -129,7 +158,7 @@ impl HessenbergModel {
                 .collect(),
             c: row_major(&cq),
             d: row_major(&d.to_owned()),
-            exponent: gamma.log2() + beta.log2() - sigma.log2(),
+            exponent,
             sigma,
         })
     }

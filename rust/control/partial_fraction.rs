@@ -37,8 +37,9 @@
 //! eigen-decomposition, or a conjugate pair not adjacent: no form, the Hessenberg solve takes
 //! every point.
 
+use crate::control::frequency::RangeScaled;
 use crate::control::modal::eigen;
-use crate::linalg::balance::{range_scale, times_power_of_two};
+use crate::linalg::balance::times_power_of_two;
 use crate::linalg::norm::{Inverse, one_norm, one_norm_estimate};
 use crate::platform::dispatch::{fma_dispatch, multiply_add};
 use faer::linalg::matmul::matmul;
@@ -102,10 +103,13 @@ impl PartialFractions {
         d: MatRef<'_, f64>,
     ) -> Option<Self> {
         let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
-        let (sigma, beta, gamma) = (range_scale(a), range_scale(b), range_scale(c));
-        let scaled =
-            |x: MatRef<'_, f64>, s: f64| Mat::from_fn(x.nrows(), x.ncols(), |i, j| x[(i, j)] / s);
-        let (a, b, c) = (scaled(a, sigma), scaled(b, beta), scaled(c, gamma));
+        let RangeScaled {
+            a,
+            b,
+            c,
+            sigma,
+            exponent,
+        } = RangeScaled::new(a, b, c);
         let (values, vectors) = eigen(a.as_ref()).ok()?;
         let (blocks, w, lambda) = real_modal_form(&values, vectors.as_ref())?;
         // R = A W - W Λ.
@@ -193,7 +197,7 @@ impl PartialFractions {
             pairs,
             coefficients,
             d: (0..p * m).map(|k| d[(k / m, k % m)]).collect(),
-            exponent: gamma.log2() + beta.log2() - sigma.log2(),
+            exponent,
             sigma,
             nearest: (reach * reach).max(NEAREST_POINT),
         })
