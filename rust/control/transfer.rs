@@ -218,23 +218,30 @@ const ORIGIN_SINGULARITY: f64 = 100.0;
 /// as 0. `transfer._singular_at_origin` is the reference path's.
 fn singular_at_origin(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> bool {
     let n = a.nrows();
-    let mut s0 = DMatrix::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
-        (true, true) => a[(i, j)],
-        (true, false) => b[i],
-        (false, true) => c[j],
-        (false, false) => d,
-    });
-    for i in 0..=n {
-        let e = exponent_of((0..=n).fold(0.0, |m: f64, j| m.max(s0[(i, j)].abs())));
-        for j in 0..=n {
-            s0[(i, j)] = ldexp_any(s0[(i, j)], -e);
+    let size = n + 1;
+    let mut s0 = DMatrix::<f64>::zeros(size, size);
+    // Column-major: entry (i, j) at i + j size.
+    let m = s0.as_mut_slice();
+    for (j, column) in m.chunks_exact_mut(size).enumerate() {
+        if j < n {
+            for (i, x) in column[..n].iter_mut().enumerate() {
+                *x = a[(i, j)];
+            }
+            column[n] = c[j];
+        } else {
+            column[..n].copy_from_slice(b);
+            column[n] = d;
         }
     }
-    for j in 0..=n {
-        let e = exponent_of((0..=n).fold(0.0, |m: f64, i| m.max(s0[(i, j)].abs())));
-        for i in 0..=n {
-            s0[(i, j)] = ldexp_any(s0[(i, j)], -e);
-        }
+    // The largest magnitude by selects (a NaN is never taken, as by f64::max).
+    let larger = |x: f64, v: &f64| if v.abs() > x { v.abs() } else { x };
+    for i in 0..size {
+        let e = exponent_of(m[i..].iter().step_by(size).fold(0.0, larger));
+        scale_by_power_of_two(m[i..].iter_mut().step_by(size), -e);
+    }
+    for column in m.chunks_exact_mut(size) {
+        let e = exponent_of(column.iter().fold(0.0, larger));
+        scale_by_power_of_two(column.iter_mut(), -e);
     }
     // The smallest pivot of Gaussian elimination with complete pivoting bounds σ_min above
     // (σ_min(S0) <= ||L||_2 σ_min(U) <= (n + 1) min |u_ii|, |l_ij| <= 1): a small pivot is a
@@ -248,44 +255,64 @@ fn singular_at_origin(a: MatRef<'_, f64>, b: &[f64], c: &[f64], d: f64) -> bool 
     smallest <= ORIGIN_SINGULARITY * (n + 1) as f64 * f64::EPSILON * largest
 }
 
+/// Each value v <- v 2^e as [`ldexp_any`] gives it: one multiplication by 2^e where that is a
+/// normal double (the same value for 0 and non-finite v).
+fn scale_by_power_of_two<'a>(values: impl Iterator<Item = &'a mut f64>, e: i64) {
+    if (-1022..=1023).contains(&e) {
+        let factor = two_to(e);
+        values.for_each(|v| *v *= factor);
+    } else {
+        values.for_each(|v| *v = ldexp_any(*v, e));
+    }
+}
+
 /// The magnitudes |u_kk| of the pivots of Gaussian elimination with complete pivoting on M
 /// (square): at step k the largest |m_ij| of the trailing block (the first in column order)
 /// is brought to (k, k), then m_ij -= (m_ik / m_kk) m_kj below and right of it. The pivots
-/// after a zero one are 0.
-fn complete_pivots(mut m: DMatrix<f64>) -> Vec<f64> {
-    let size = m.nrows();
+/// after a zero one are 0. Only the trailing block is read after step k, so the swaps and the
+/// elimination touch only it (the multipliers m_ik / m_kk are kept in column k).
+fn complete_pivots(mut matrix: DMatrix<f64>) -> Vec<f64> {
+    let size = matrix.nrows();
+    // Column-major: entry (i, j) at i + j size.
+    let m = matrix.as_mut_slice();
     let mut pivots = Vec::with_capacity(size);
     for k in 0..size {
-        let (mut row, mut col, mut largest) = (k, k, -1.0f64);
+        // The first largest magnitude; a NaN anywhere in the block is the pivot NaN.
+        let (mut row, mut col, mut largest, mut unordered) = (k, k, -1.0f64, false);
         for j in k..size {
-            for i in k..size {
-                let x = m[(i, j)].abs();
-                if x > largest || x.is_nan() {
-                    (row, col, largest) = (i, j, x);
+            for (i, x) in m[j * size + k..(j + 1) * size].iter().enumerate() {
+                let x = x.abs();
+                unordered |= x.is_nan();
+                if x > largest {
+                    (row, col, largest) = (k + i, j, x);
                 }
             }
         }
-        if largest.is_nan() || largest == 0.0 {
-            pivots.push(largest);
+        if unordered || largest == 0.0 {
+            pivots.push(if unordered { f64::NAN } else { largest });
             pivots.resize(size, 0.0);
             break;
         }
-        for j in 0..size {
-            let t = m[(k, j)];
-            m[(k, j)] = m[(row, j)];
-            m[(row, j)] = t;
+        if row != k {
+            for j in k..size {
+                m.swap(j * size + k, j * size + row);
+            }
         }
-        for i in 0..size {
-            let t = m[(i, k)];
-            m[(i, k)] = m[(i, col)];
-            m[(i, col)] = t;
+        if col != k {
+            let (left, right) = m.split_at_mut(col * size);
+            left[k * size + k..(k + 1) * size].swap_with_slice(&mut right[k..size]);
         }
-        let pivot = m[(k, k)];
+        let pivot = m[k * size + k];
         pivots.push(pivot.abs());
-        for i in k + 1..size {
-            let l = m[(i, k)] / pivot;
-            for j in k + 1..size {
-                m[(i, j)] -= l * m[(k, j)];
+        let (head, tail) = m.split_at_mut((k + 1) * size);
+        let multipliers = &mut head[k * size + k + 1..];
+        for l in multipliers.iter_mut() {
+            *l /= pivot;
+        }
+        for column in tail.chunks_exact_mut(size) {
+            let t = column[k];
+            for (x, &l) in column[k + 1..].iter_mut().zip(multipliers.iter()) {
+                *x -= l * t;
             }
         }
     }
@@ -319,6 +346,22 @@ impl Scaled {
     /// the products in between, so renormalising less often changes nothing else.
     #[inline(always)]
     fn renormalize(&mut self) {
+        // Non-negative doubles are ordered as their bits, and a NaN's lie above infinity's: the
+        // larger magnitude's bits within the range's is the common case, decided by one
+        // comparison; anything else is decided as below, out of line.
+        let magnitude = |v: f64| v.to_bits() & !(1u64 << 63);
+        let largest = magnitude(self.m.re).max(magnitude(self.m.im));
+        let (low, high) = (MANTISSA_RANGE.0.to_bits(), MANTISSA_RANGE.1.to_bits());
+        if largest.wrapping_sub(low) > high - low {
+            self.renormalize_outside_range();
+        }
+    }
+
+    /// [`Scaled::renormalize`] where the larger magnitude's bits are not within the range's:
+    /// 0, a NaN and the infinities are left as they are.
+    #[cold]
+    #[inline(never)]
+    fn renormalize_outside_range(&mut self) {
         let part = self.m.re.abs().max(self.m.im.abs());
         if part > 0.0 && part.is_finite() && !(MANTISSA_RANGE.0..=MANTISSA_RANGE.1).contains(&part)
         {
@@ -328,8 +371,6 @@ impl Scaled {
 
     /// The mantissa divided by the power of two of `part`, its largest part, and the exponent
     /// raised by it.
-    #[cold]
-    #[inline(never)]
     fn rescale(&mut self, part: f64) {
         let k = exponent_of(part);
         self.m = c64::new(ldexp(self.m.re, -k), ldexp(self.m.im, -k));
@@ -341,12 +382,14 @@ impl Scaled {
     /// numbers near ±1e308 stays finite.
     #[inline(always)]
     fn difference(point: c64, root: c64) -> Self {
+        // No part at or beyond 1e300 (a NaN part is none), tested without a branch per part.
+        let large = |v: f64| v.abs() >= 1e300;
+        if !(large(point.re) | large(point.im) | large(root.re) | large(root.im)) {
+            return Scaled::new(point - root, 0);
+        }
         let largest = [point.re, point.im, root.re, root.im]
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()));
-        if largest < 1e300 {
-            return Scaled::new(point - root, 0);
-        }
         Scaled::large_difference(point, root, largest)
     }
 
@@ -559,15 +602,24 @@ fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
         }
         for i in 0..n {
             // The sums of squares of the other states' entries, in order, then b_i's (c_i's):
-            // two loops around the diagonal, no test per entry.
+            // two runs around the diagonal, no test per entry. A is column-major: column i is
+            // contiguous, row i every n-th entry from i.
+            let entries = s.a.as_slice();
+            let column = &entries[i * n..(i + 1) * n];
             let (mut row, mut col) = (0.0, 0.0);
             for j in 0..i {
-                row += s.a[(i, j)] * s.a[(i, j)];
-                col += s.a[(j, i)] * s.a[(j, i)];
+                let v = entries[i + j * n];
+                row += v * v;
             }
             for j in i + 1..n {
-                row += s.a[(i, j)] * s.a[(i, j)];
-                col += s.a[(j, i)] * s.a[(j, i)];
+                let v = entries[i + j * n];
+                row += v * v;
+            }
+            for v in &column[..i] {
+                col += v * v;
+            }
+            for v in &column[i + 1..] {
+                col += v * v;
             }
             row += s.b[i] * s.b[i];
             col += s.c[i] * s.c[i];
@@ -582,9 +634,10 @@ fn equilibrated(mut s: Siso) -> (Siso, i64, i64) {
                 ((col.log2() - row.log2()) / 4.0).round_ties_even() as i64
             };
             if k != 0 {
+                let entries = s.a.as_mut_slice();
                 for j in (0..n).filter(|&j| j != i) {
-                    scale(&mut s.a[(i, j)], k);
-                    scale(&mut s.a[(j, i)], -k);
+                    scale(&mut entries[i + j * n], k);
+                    scale(&mut entries[j + i * n], -k);
                 }
                 scale(&mut s.b[i], k);
                 scale(&mut s.c[i], -k);
@@ -785,28 +838,35 @@ impl ShiftedLu {
         let n = a.nrows();
         let (m, rows) = (&mut self.m, &mut self.rows);
         m.clear();
-        for i in 0..n {
-            for j in 0..n {
-                let diagonal = if i == j { point } else { c64::new(0.0, 0.0) };
-                m.push(diagonal - a[(i, j)]);
+        m.resize(n * n, c64::new(0.0, 0.0));
+        // Row-major from A's column-major storage; 0 - a_ij off the diagonal (as point - a_ij
+        // with a point of 0: a_ij = 0 gives +0).
+        let entries = a.as_slice();
+        for (i, row) in m.chunks_exact_mut(n).enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                *x = c64::new(0.0 - entries[i + j * n], 0.0);
             }
+            row[i] = c64::new(point.re - entries[i + i * n], point.im);
         }
         rows.clear();
         rows.extend(0..n);
-        let size = |z: c64| z.re.abs() + z.im.abs();
+        // |re| + |im| is never negative (a NaN's sign is cleared too), so its bits are in the
+        // order of f64::total_cmp: the last largest, as Iterator::max_by gives it.
+        let size = |z: c64| (z.re.abs() + z.im.abs()).to_bits();
         for k in 0..n {
-            let Some(pivot) =
-                (k..n).max_by(|&p, &q| size(m[p * n + k]).total_cmp(&size(m[q * n + k])))
-            else {
-                return false;
-            };
-            if size(m[pivot * n + k]) == 0.0 {
+            let (mut pivot, mut largest) = (k, size(m[k * n + k]));
+            for p in k + 1..n {
+                let candidate = size(m[p * n + k]);
+                if candidate >= largest {
+                    (pivot, largest) = (p, candidate);
+                }
+            }
+            if f64::from_bits(largest) == 0.0 {
                 return false;
             }
             if pivot != k {
-                for j in 0..n {
-                    m.swap(k * n + j, pivot * n + j);
-                }
+                let (upper, lower) = m.split_at_mut(pivot * n);
+                upper[k * n..(k + 1) * n].swap_with_slice(&mut lower[..n]);
                 rows.swap(k, pivot);
             }
             // Row i -= l_ik row k below the pivot, l_ik = m_ik / m_kk kept in place.
@@ -879,29 +939,52 @@ fn log_centre(zero_logs: &[f64], pole_logs: &[f64]) -> f64 {
 /// frequencies of a continuous model's grid.
 const GRID_STEP: f64 = 1.2589254117941673;
 
+/// The number of points of a continuous model's grid (a discrete model's has 19).
+const GRID_POINTS: usize = 31;
+
+/// The points of a grid of `transfer._evaluation_points`, held on the stack, and for a
+/// continuous model's grid (on the imaginary axis) their imaginary parts apart.
+struct Grid {
+    points: [c64; GRID_POINTS],
+    heights: [f64; GRID_POINTS],
+    len: usize,
+    on_axis: bool,
+}
+
+impl Grid {
+    fn points(&self) -> &[c64] {
+        &self.points[..self.len]
+    }
+}
+
 /// The grid of `transfer._evaluation_points`: s = jω at 31 frequencies
 /// 10^(centre - 1.5 + k/10), or z = e^{jθ} at 19 angles of the unit circle for a discrete
 /// model.
-fn grid(dt: f64, centre: f64) -> Vec<c64> {
-    if dt > 0.0 {
-        (0..19)
-            .map(|k| {
-                let theta = (0.05 + 0.05 * k as f64) * std::f64::consts::PI;
-                c64::new(theta.cos(), theta.sin())
-            })
-            .collect()
-    } else {
+fn grid(dt: f64, centre: f64) -> Grid {
+    let mut grid = Grid {
+        points: [c64::new(0.0, 0.0); GRID_POINTS],
+        heights: [0.0; GRID_POINTS],
+        len: 0,
+        on_axis: dt.is_nan() || dt <= 0.0,
+    };
+    if grid.on_axis {
         // One power, then steps of 10^0.1: any point of the grid serves (the gain does not
         // depend on it).
         let mut omega = 10f64.powf(centre - 1.5);
-        (0..31)
-            .map(|_| {
-                let point = c64::new(0.0, omega.clamp(1e-300, 1e307));
-                omega *= GRID_STEP;
-                point
-            })
-            .collect()
+        for (point, height) in grid.points.iter_mut().zip(&mut grid.heights) {
+            *height = omega.clamp(1e-300, 1e307);
+            *point = c64::new(0.0, *height);
+            omega *= GRID_STEP;
+        }
+        grid.len = GRID_POINTS;
+    } else {
+        for (k, point) in grid.points.iter_mut().take(19).enumerate() {
+            let theta = (0.05 + 0.05 * k as f64) * std::f64::consts::PI;
+            *point = c64::new(theta.cos(), theta.sin());
+        }
+        grid.len = 19;
     }
+    grid
 }
 
 /// `nearest[k]` lowered to min |p_k - r|^2 over the roots r, for the points p_k of a grid.
@@ -911,24 +994,24 @@ fn grid(dt: f64, centre: f64) -> Vec<c64> {
 /// minima over two sets of roots, each filtered so, are those over their union). The minimum
 /// is exact, so it is taken root by root over every point at once (independent comparisons,
 /// not one chain per point). On the imaginary axis (a continuous model's grid) the first term
-/// of |jω - r|^2 = (0 - Re r)^2 + (ω - Im r)^2 is (Re r)^2 exactly, the same at every point.
-fn lower_to_nearest(points: &[c64], roots: &[c64], nearest: &mut [f64]) {
-    let on_axis = points.iter().all(|p| p.re == 0.0);
+/// of |jω - r|^2 = (0 - Re r)^2 + (ω - Im r)^2 is (Re r)^2 exactly, the same at every point,
+/// and the second is taken from the heights ω alone.
+fn lower_to_nearest(grid: &Grid, roots: &[c64], nearest: &mut [f64]) {
     for r in roots
         .iter()
         .filter(|r| r.im >= 0.0 || !roots.contains(&r.conj()))
     {
         // min(m, x) as a select: the same value (m is never NaN: it starts infinite and takes
         // only smaller values; a NaN x leaves it).
-        if on_axis {
+        if grid.on_axis {
             let real = r.re * r.re;
-            for (m, p) in nearest.iter_mut().zip(points) {
-                let y = p.im - r.im;
+            for (m, &height) in nearest.iter_mut().zip(&grid.heights[..grid.len]) {
+                let y = height - r.im;
                 let x = real + y * y;
                 *m = if x < *m { x } else { *m };
             }
         } else {
-            for (m, p) in nearest.iter_mut().zip(points) {
+            for (m, p) in nearest.iter_mut().zip(grid.points()) {
                 let x = (p - r).norm_sqr();
                 *m = if x < *m { x } else { *m };
             }
@@ -958,28 +1041,27 @@ fn farthest_two(points: &[c64], nearest: &[f64]) -> (c64, c64) {
 }
 
 /// The two points of the grid ([`grid`]) farthest from the zeros and the poles (the poles'
-/// minima `pole_nearest` over `points`, None to take them here), best first; without roots,
+/// minima `pole_nearest` over its points, None to take them here), best first; without roots,
 /// the middle of the grid and the point after it.
 fn best_points(
-    points: &[c64],
+    grid: &Grid,
     zeros: &[c64],
     poles: &[c64],
     pole_nearest: Option<&[f64]>,
 ) -> (c64, c64) {
+    let points = grid.points();
     if zeros.is_empty() && poles.is_empty() {
         let middle = points.len() / 2;
         return (points[middle], points[middle + 1]);
     }
-    let mut nearest = match pole_nearest {
-        Some(minima) => minima.to_vec(),
-        None => {
-            let mut minima = vec![f64::INFINITY; points.len()];
-            lower_to_nearest(points, poles, &mut minima);
-            minima
-        }
-    };
-    lower_to_nearest(points, zeros, &mut nearest);
-    farthest_two(points, &nearest)
+    let mut minima = [f64::INFINITY; GRID_POINTS];
+    let nearest = &mut minima[..points.len()];
+    match pole_nearest {
+        Some(pole_minima) => nearest.copy_from_slice(pole_minima),
+        None => lower_to_nearest(grid, poles, nearest),
+    }
+    lower_to_nearest(grid, zeros, nearest);
+    farthest_two(points, nearest)
 }
 
 /// What the channels of a model share: the sampling period (0: continuous), the poles by
@@ -989,7 +1071,7 @@ struct Shared {
     dt: f64,
     sorted_poles: Vec<c64>,
     pole_logs: Vec<f64>,
-    check: Option<(Vec<c64>, Vec<f64>)>,
+    check: Option<(Grid, Vec<f64>)>,
 }
 
 impl Shared {
@@ -997,7 +1079,7 @@ impl Shared {
         let check = (dt.is_nan() || dt <= 0.0).then(|| {
             let size = max_abs(a);
             let points = grid(dt, if size > 0.0 { size.log10() } else { 0.0 });
-            let mut nearest = vec![f64::INFINITY; points.len()];
+            let mut nearest = vec![f64::INFINITY; points.len];
             lower_to_nearest(&points, poles, &mut nearest);
             (points, nearest)
         });
@@ -1222,6 +1304,152 @@ mod tests {
         );
     }
 
+    /// Gaussian elimination with complete pivoting as written out in full (every row and
+    /// column swapped whole, a NaN taken as the pivot where it is met): the oracle of
+    /// [`complete_pivots`], which swaps and eliminates only the trailing block.
+    fn complete_pivots_in_full(mut m: DMatrix<f64>) -> Vec<f64> {
+        let size = m.nrows();
+        let mut pivots = Vec::new();
+        for k in 0..size {
+            let (mut row, mut col, mut largest) = (k, k, -1.0f64);
+            for j in k..size {
+                for i in k..size {
+                    let x = m[(i, j)].abs();
+                    if x > largest || x.is_nan() {
+                        (row, col, largest) = (i, j, x);
+                    }
+                }
+            }
+            if largest.is_nan() || largest == 0.0 {
+                pivots.push(largest);
+                pivots.resize(size, 0.0);
+                break;
+            }
+            m.swap_rows(k, row);
+            m.swap_columns(k, col);
+            let pivot = m[(k, k)];
+            pivots.push(pivot.abs());
+            for i in k + 1..size {
+                let l = m[(i, k)] / pivot;
+                for j in k + 1..size {
+                    m[(i, j)] -= l * m[(k, j)];
+                }
+            }
+        }
+        pivots
+    }
+
+    #[test]
+    fn complete_pivots_equal_the_full_elimination_bit_for_bit() {
+        // Seeded matrices of orders 1-13: plain, with zero rows and columns, rank-deficient
+        // (a repeated column), graded over 2^±200, and with a NaN or an infinity.
+        let mut count = 0;
+        for seed in 1..=600u64 {
+            let size = 1 + (seed % 13) as usize;
+            let mut next = crate::test_matrices::xorshift(seed.wrapping_mul(0x9E37_79B9) | 1);
+            let mut m = DMatrix::from_fn(size, size, |_, _| next());
+            match seed % 6 {
+                1 => m.row_mut((seed as usize / 6) % size).fill(0.0),
+                2 if size > 1 => {
+                    let first = m.column(0).clone_owned();
+                    m.set_column(size - 1, &first);
+                }
+                3 => {
+                    for ((i, j), x) in (0..size)
+                        .flat_map(|j| (0..size).map(move |i| (i, j)))
+                        .zip(m.iter_mut())
+                    {
+                        *x *= 2f64.powi(((i * 37 + j * 11) % 401) as i32 - 200);
+                    }
+                }
+                4 => m[((seed as usize) % size, (seed as usize / 7) % size)] = f64::NAN,
+                5 => m[((seed as usize / 3) % size, 0)] = f64::INFINITY,
+                _ => {}
+            }
+            let (fast, full) = (complete_pivots(m.clone()), complete_pivots_in_full(m));
+            assert_eq!(fast.len(), full.len());
+            for (x, y) in fast.iter().zip(&full) {
+                assert!(
+                    x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
+                    "{seed}"
+                );
+            }
+            count += 1;
+        }
+        assert_eq!(count, 600);
+    }
+
+    #[test]
+    fn renormalization_is_the_rule_as_written() {
+        // The bit test of Scaled::renormalize against "rescale where 0 < part < inf lies outside
+        // the range", at the range's ends and their neighbours, 0, subnormals, infinities and
+        // NaN, in either part and both signs.
+        let (low, high) = MANTISSA_RANGE;
+        let step =
+            |x: f64, up: bool| f64::from_bits(if up { x.to_bits() + 1 } else { x.to_bits() - 1 });
+        let values = [
+            0.0,
+            5e-324,
+            f64::MIN_POSITIVE,
+            step(low, false),
+            low,
+            step(low, true),
+            1e-30,
+            0.75,
+            1e30,
+            step(high, false),
+            high,
+            step(high, true),
+            f64::MAX,
+            f64::INFINITY,
+            f64::NAN,
+        ];
+        for &re in &values {
+            for &im in &values {
+                for (sr, si) in [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)] {
+                    let m = c64::new(sr * re, si * im);
+                    let mut fast = Scaled { m, e: 3 };
+                    fast.renormalize();
+                    let mut rule = Scaled { m, e: 3 };
+                    let part = m.re.abs().max(m.im.abs());
+                    if part > 0.0 && part.is_finite() && !(low..=high).contains(&part) {
+                        rule.rescale(part);
+                    }
+                    let same =
+                        |x: f64, y: f64| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan());
+                    assert!(
+                        same(fast.m.re, rule.m.re)
+                            && same(fast.m.im, rule.m.im)
+                            && fast.e == rule.e,
+                        "{m:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn powers_of_two_scale_as_ldexp_any() {
+        let values = [
+            0.0,
+            -0.0,
+            5e-324,
+            -3e-310,
+            f64::MIN_POSITIVE,
+            0.3,
+            -1.5,
+            1e300,
+            f64::MAX,
+        ];
+        for e in [-1100, -1074, -1023, -1022, -5, 0, 7, 1023, 1024, 1100] {
+            let mut scaled = values;
+            scale_by_power_of_two(scaled.iter_mut(), e);
+            for (x, y) in values.iter().zip(scaled) {
+                assert_eq!(ldexp_any(*x, e).to_bits(), y.to_bits(), "{x} {e}");
+            }
+        }
+    }
+
     #[test]
     fn best_points_split_between_zeros_and_poles() {
         // The poles' minima taken once (as for the shared check grid) and the zeros' added give
@@ -1233,12 +1461,14 @@ mod tests {
             c64::new(-2.0, 0.0),
         ];
         let zeros = [c64::new(0.1, -0.4), c64::new(0.1, 0.4), c64::new(0.0, 0.0)];
-        for centre in [-1.0, 0.0, 0.3] {
-            let points = grid(0.0, centre);
+        for (dt, centre) in [(0.0, -1.0), (0.0, 0.0), (0.0, 0.3), (0.1, 0.0)] {
+            let g = grid(dt, centre);
+            let points = g.points();
+            assert_eq!(g.on_axis, points.iter().all(|p| p.re == 0.0));
             let mut pole_nearest = vec![f64::INFINITY; points.len()];
-            lower_to_nearest(&points, &poles, &mut pole_nearest);
-            let split = best_points(&points, &zeros, &poles, Some(&pole_nearest));
-            assert_eq!(split, best_points(&points, &zeros, &poles, None));
+            lower_to_nearest(&g, &poles, &mut pole_nearest);
+            let split = best_points(&g, &zeros, &poles, Some(&pole_nearest));
+            assert_eq!(split, best_points(&g, &zeros, &poles, None));
             let all: Vec<f64> = points
                 .iter()
                 .map(|p| {
@@ -1249,16 +1479,16 @@ mod tests {
                         .fold(f64::INFINITY, f64::min)
                 })
                 .collect();
-            assert_eq!(split, farthest_two(&points, &all));
+            assert_eq!(split, farthest_two(points, &all));
             // The first is a point of the grid no nearer to a root than any other.
             let value = |q: c64| all[points.iter().position(|p| *p == q).unwrap()] / q.norm_sqr();
             assert!(points.iter().all(|p| value(*p) <= value(split.0)));
         }
         // Without roots: the middle of the grid and the point after it.
-        let points = grid(0.0, 0.0);
+        let g = grid(0.0, 0.0);
         assert_eq!(
-            best_points(&points, &[], &[], None),
-            (points[15], points[16])
+            best_points(&g, &[], &[], None),
+            (g.points[15], g.points[16])
         );
     }
 
