@@ -11,10 +11,10 @@
 //! ```
 //!
 //! whose eigenvalues are the zeros of 1 - L(-s) L(s) (plus any uncontrollable or unobservable
-//! modes). They are computed as ±√μ from the squares μ = λ^2, the eigenvalues of an n x n
-//! Hessenberg matrix, by Van Loan's square-reduced method (`linalg/hamiltonian.rs`: a fraction
-//! of the cost of the QR iteration of order 2n; H^2 formed from the blocks, the off-diagonal
-//! ones of rank one, in n^3 multiplications) wherever those decide which eigenvalues lie
+//! modes). They are computed as ±√μ from the squares μ = λ^2 (Van Loan's squared
+//! Hamiltonian), the eigenvalues of one n x n matrix formed from the blocks, whose off-diagonal
+//! ones are of rank one (`linalg/hamiltonian.rs`: a fraction of the cost of the QR iteration of
+//! order 2n, and of the square-reduced form of H^2) wherever those decide which eigenvalues lie
 //! within [`AXIS_TOLERANCE`] of the axis (their error, about n u ||H||^2, at most 1e-8 of |μ|,
 //! or smaller than μ's distance from the negative real axis); otherwise (a small eigenvalue
 //! near the axis beside large ones: a crossover far below the loop's size) by the QR iteration
@@ -174,10 +174,10 @@ pub fn within_range(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>, 
 /// The frequencies ω >= 0 of the eigenvalues within [`AXIS_TOLERANCE`] of the imaginary axis
 /// of the Hamiltonian of 1 - G(-s) G(s) for G = (A, B, C, d), r = 1 - d^2 != 0.
 ///
-/// By Van Loan's square-reduced method (`linalg/hamiltonian.rs`: the squares μ = λ^2 of the
-/// eigenvalues from an eigenvalue problem of order n, H = [[F, G], [K, -F^T]] with
-/// F = A + (d/r) B C, G = B B^T / r and K = -C^T C / r, squared from these blocks by
-/// `squared_eigenvalues_rank_one`) where the squares decide the test of the
+/// From the squares μ = λ^2 of the eigenvalues (`linalg/hamiltonian.rs`: an eigenvalue problem
+/// of order n, H = [[F, G], [K, -F^T]] with F = A + (d/r) B C, G = B B^T / r and
+/// K = -C^T C / r, its matrix formed from these blocks by `squared_eigenvalues_rank_one`)
+/// where the squares decide the test of the
 /// axis ([`squares_decide`]); otherwise (a small eigenvalue near the axis beside large ones,
 /// an H^2 beyond the doubles, or squares that fail their check) by the QR iteration on H
 /// itself.
@@ -202,7 +202,7 @@ fn hamiltonian_axis_frequencies(
     let f = Mat::from_fn(n, n, |i, j| a[(i, j)] + (d / r) * b[i] * c[j]);
     let u: Vec<f64> = b.iter().map(|x| x * beta).collect();
     let v: Vec<f64> = c.iter().map(|x| x / beta).collect();
-    match squared_eigenvalues_rank_one(f.as_ref(), &u, 1.0 / r, &v, -1.0 / r) {
+    match squared_eigenvalues_rank_one(f.as_ref(), &u, &v, 1.0 / r) {
         Ok(Some(squared)) if squares_decide(&squared.squares, squared.size) => {
             Ok(squared_axis_candidates(&squared.squares))
         }
