@@ -11,10 +11,10 @@
 //! ```
 //!
 //! whose eigenvalues are the zeros of 1 - L(-s) L(s) (plus any uncontrollable or unobservable
-//! modes). They are computed as ±√μ from the squares μ = λ^2, the eigenvalues of an n x n
-//! Hessenberg matrix, by Van Loan's square-reduced method (`linalg/hamiltonian.rs`: a fraction
-//! of the cost of the QR iteration of order 2n; H^2 formed from the blocks, the off-diagonal
-//! ones of rank one, in n^3 multiplications) wherever those decide which eigenvalues lie
+//! modes). They are computed as ±√μ from the squares μ = λ^2 (Van Loan's squared
+//! Hamiltonian), the eigenvalues of one n x n matrix formed from the blocks, whose off-diagonal
+//! ones are of rank one (`linalg/hamiltonian.rs`: a fraction of the cost of the QR iteration of
+//! order 2n, and of the square-reduced form of H^2) wherever those decide which eigenvalues lie
 //! within [`AXIS_TOLERANCE`] of the axis (their error, about n u ||H||^2, at most 1e-8 of |μ|,
 //! or smaller than μ's distance from the negative real axis); otherwise (a small eigenvalue
 //! near the axis beside large ones: a crossover far below the loop's size) by the QR iteration
@@ -60,9 +60,13 @@
 //! maximum by Brent's method (golden section and parabolic interpolation, to 1e-8 in ω)
 //! is the new γ; until no imaginary
 //! eigenvalue remains (usually the second Hamiltonian). The disk margin's transfer is
-//! (1 - L)/(2 (1 + L)) = S - 1/2, with S = 1/(1 + L) realised as
+//! (1 - L)/(2 (1 + L)) = S - 1/2, with S = 1/(1 + L) realised for the Hamiltonians as
 //! (A - B C/(1 + d), B/(1 + d), -C/(1 + d), 1/(1 + d)); the stability margin min |1 + L| is
-//! 1/max |S|.
+//! 1/max |S|. The magnitudes the search evaluates, 1/|1 + L| and |1 - L|/(2 |1 + L|), come
+//! from L(jω) by the loop's own evaluator (no second Hessenberg reduction, of the closed
+//! loop): their relative error, about u |L| |S|, is that of evaluating the closed loop's
+//! realisation near its resonance, and a peak found lower than the true one by more than the
+//! iteration's ε leaves an imaginary eigenvalue in the next Hamiltonian, which then goes on.
 //!
 //! **Scaling.** The loop's states are balanced first by a diagonal similarity of powers of two
 //! (`linalg/balance.rs`'s balanced_states: Osborne's iteration on [[A, b], [c, 0]] over the
@@ -174,10 +178,10 @@ pub fn within_range(a: MatRef<'_, f64>, b: MatRef<'_, f64>, c: MatRef<'_, f64>, 
 /// The frequencies ω >= 0 of the eigenvalues within [`AXIS_TOLERANCE`] of the imaginary axis
 /// of the Hamiltonian of 1 - G(-s) G(s) for G = (A, B, C, d), r = 1 - d^2 != 0.
 ///
-/// By Van Loan's square-reduced method (`linalg/hamiltonian.rs`: the squares μ = λ^2 of the
-/// eigenvalues from an eigenvalue problem of order n, H = [[F, G], [K, -F^T]] with
-/// F = A + (d/r) B C, G = B B^T / r and K = -C^T C / r, squared from these blocks by
-/// `squared_eigenvalues_rank_one`) where the squares decide the test of the
+/// From the squares μ = λ^2 of the eigenvalues (`linalg/hamiltonian.rs`: an eigenvalue problem
+/// of order n, H = [[F, G], [K, -F^T]] with F = A + (d/r) B C, G = B B^T / r and
+/// K = -C^T C / r, its matrix formed from these blocks by `squared_eigenvalues_rank_one`)
+/// where the squares decide the test of the
 /// axis ([`squares_decide`]); otherwise (a small eigenvalue near the axis beside large ones,
 /// an H^2 beyond the doubles, or squares that fail their check) by the QR iteration on H
 /// itself.
@@ -202,7 +206,7 @@ fn hamiltonian_axis_frequencies(
     let f = Mat::from_fn(n, n, |i, j| a[(i, j)] + (d / r) * b[i] * c[j]);
     let u: Vec<f64> = b.iter().map(|x| x * beta).collect();
     let v: Vec<f64> = c.iter().map(|x| x / beta).collect();
-    match squared_eigenvalues_rank_one(f.as_ref(), &u, 1.0 / r, &v, -1.0 / r) {
+    match squared_eigenvalues_rank_one(f.as_ref(), &u, &v, 1.0 / r) {
         Ok(Some(squared)) if squares_decide(&squared.squares, squared.size) => {
             Ok(squared_axis_candidates(&squared.squares))
         }
@@ -648,29 +652,15 @@ pub fn peak_gain(
     d: f64,
     poles: &[c64],
 ) -> Result<Peak, Error> {
-    let mut strictly_proper = strictly_proper_evaluator(a, b, c)?;
-    peak(a, b, c, d, poles, &mut |w| strictly_proper.siso(w))
-}
-
-/// The evaluator of C (jωI - A)^-1 B (one Hessenberg reduction), shared by the peaks of
-/// several feedthroughs d.
-fn strictly_proper_evaluator(
-    a: MatRef<'_, f64>,
-    b: &[f64],
-    c: &[f64],
-) -> Result<FrequencyEvaluator, Error> {
     let n = a.nrows();
     let bm = Mat::from_fn(n, 1, |i, _| b[i]);
     let cm = Mat::from_fn(1, n, |_, j| c[j]);
-    FrequencyEvaluator::new(
-        a,
-        bm.as_ref(),
-        cm.as_ref(),
-        Mat::<f64>::zeros(1, 1).as_ref(),
-    )
+    let dm = Mat::from_fn(1, 1, |_, _| d);
+    let mut evaluator = FrequencyEvaluator::new(a, bm.as_ref(), cm.as_ref(), dm.as_ref())?;
+    peak(a, b, c, d, poles, &mut |w| evaluator.siso(w).norm())
 }
 
-/// [`peak_gain`] with `strictly_proper(ω)` = C (jωI - A)^-1 B.
+/// [`peak_gain`] with `magnitude(ω)` = |G(jω)|.
 ///
 /// The lower bound before the first Hamiltonian is the best of ω = ∞, ω = 0 and the poles'
 /// frequencies (|p| and |Im p|), refined by Brent's method between that frequency's
@@ -682,7 +672,7 @@ fn peak(
     c: &[f64],
     d: f64,
     poles: &[c64],
-    strictly_proper: &mut impl FnMut(f64) -> c64,
+    magnitude: &mut impl FnMut(f64) -> f64,
 ) -> Result<Peak, Error> {
     let n = a.nrows();
     let scale = poles.iter().fold(max_abs(a), |m, p| m.max(p.norm()));
@@ -705,7 +695,6 @@ fn peak(
             value: f64::INFINITY,
         });
     }
-    let mut magnitude = |w: f64| (strictly_proper(w) + d).norm();
     // The lower bound: ∞ first (ties keep it), then 0, then the poles' frequencies.
     let mut best = Peak {
         omega: f64::INFINITY,
@@ -731,7 +720,7 @@ fn peak(
         let lo = if index > 0 { tests[index - 1] } else { 0.0 };
         let hi = tests.get(index + 1).copied().unwrap_or(2.0 * tests[index]);
         if hi > lo {
-            let (w, value) = golden_maximum(&mut magnitude, lo, hi);
+            let (w, value) = golden_maximum(magnitude, lo, hi);
             if value > best.value {
                 best = Peak { omega: w, value };
             }
@@ -758,7 +747,7 @@ fn peak(
             }
         }
         let Some((lo, hi, _)) = chosen else { break };
-        let (w, value) = golden_maximum(&mut magnitude, lo, hi);
+        let (w, value) = golden_maximum(magnitude, lo, hi);
         if value.is_nan() || value <= best.value {
             break;
         }
@@ -943,40 +932,38 @@ pub fn loop_margins(
         .collect();
     let mut spectra = root_locus::closed_loop_poles_at(a, &bv, &cv, &gains)?.into_iter();
     let closed_loop_poles = spectra.next().unwrap_or_default();
-    let peaks = (|| {
-        let mut closed_response = strictly_proper_evaluator(closed.as_ref(), &bs, &cs)?;
-        // Both peaks start from S at the same test frequencies (0 and the closed-loop poles'):
-        // each value is computed once and looked up the second time (the same value, so the
-        // same peaks bit for bit).
-        let mut evaluated: Vec<(f64, c64)> = Vec::with_capacity(8 * n + 8);
-        let mut response = |w: f64| {
-            if let Some(&(_, value)) = evaluated.iter().find(|(x, _)| x.to_bits() == w.to_bits()) {
-                return value;
-            }
-            let value = closed_response.siso(w);
-            evaluated.push((w, value));
-            value
-        };
-        let (s_d, disk_d) = (1.0 / denominator, 1.0 / denominator - 0.5);
-        let sensitivity = peak(
-            closed.as_ref(),
-            &bs,
-            &cs,
-            s_d,
-            &closed_loop_poles,
-            &mut response,
-        )?;
-        let disk = peak(
-            closed.as_ref(),
-            &bs,
-            &cs,
-            disk_d,
-            &closed_loop_poles,
-            &mut response,
-        )?;
-        Ok::<_, Error>((sensitivity, disk))
-    })();
-    let (sensitivity, disk) = peaks?;
+    // Both peaks start from L at the same test frequencies (0 and the closed-loop poles'):
+    // each value is computed once and looked up the second time (the same value, so the
+    // same peaks bit for bit).
+    let mut evaluated: Vec<(f64, c64)> = Vec::with_capacity(8 * n + 8);
+    let mut response = |w: f64| {
+        if let Some(&(_, value)) = evaluated.iter().find(|(x, _)| x.to_bits() == w.to_bits()) {
+            return value;
+        }
+        let value = this.at(w);
+        evaluated.push((w, value));
+        value
+    };
+    let (s_d, disk_d) = (1.0 / denominator, 1.0 / denominator - 0.5);
+    let sensitivity = peak(
+        closed.as_ref(),
+        &bs,
+        &cs,
+        s_d,
+        &closed_loop_poles,
+        &mut |w| 1.0 / (1.0 + response(w)).norm(),
+    )?;
+    let disk = peak(
+        closed.as_ref(),
+        &bs,
+        &cs,
+        disk_d,
+        &closed_loop_poles,
+        &mut |w| {
+            let value = response(w);
+            (1.0 - value).norm() / (2.0 * (1.0 + value).norm())
+        },
+    )?;
 
     // Each gain margin k puts a closed-loop pole at its crossover.
     let size = 1.0 + max_abs(a);

@@ -7,8 +7,8 @@
 //! * [`lu`]: linear solves by LU with partial pivoting.
 //! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
 //! * [`hessenberg`]: the Hessenberg form and its transformation.
-//! * [`hamiltonian`]: the eigenvalues of a Hamiltonian matrix by Van Loan's square-reduced
-//!   method.
+//! * [`hamiltonian`]: the squared eigenvalues of a Hamiltonian matrix with rank-one
+//!   off-diagonal blocks, from one matrix of half its order.
 //! * [`schur`]: the real Schur form (Francis double-shift QR, and small-bulge multishift QR with
 //!   aggressive early deflation at large orders), its eigenvalues, and reordering.
 //! * `polynomial_roots`: closed-form roots of polynomials of degree <= 4 (QR shifts).
