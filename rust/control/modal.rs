@@ -156,7 +156,7 @@ type EigenAndBalancing = (Vec<c64>, Mat<c64>, Vec<f64>);
 fn eigen_and_balancing(a: MatRef<'_, f64>) -> Result<EigenAndBalancing, Error> {
     let (balanced, d, scale) = balanced_for_eigen(a)?;
     // D^-1 A D = Z T Z^T: the eigenvectors of A are D Z x.
-    let (values, vectors) = schur_eigenvectors(&real_schur(balanced.as_faer())?, &d);
+    let (values, vectors) = schur_eigenvectors(&real_schur(balanced.as_faer())?, &d)?;
     Ok((values.into_iter().map(|v| v * scale).collect(), vectors, d))
 }
 

@@ -21,7 +21,9 @@
 //! chain of such pivots cannot overflow; each vector is normalised at the end. The
 //! eigenvector of the conjugate eigenvalue is the conjugate vector.
 
+use crate::error::Error;
 use crate::linalg::schur::RealSchur;
+use crate::platform::interrupt;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par, c64};
 
@@ -32,7 +34,13 @@ const RESCALE: f64 = 3.054936363499605e-151; // 2^-500
 /// The eigenvalues of A = Z T Z^T in the order of T's diagonal (each conjugate pair adjacent,
 /// Im > 0 first) and the unit eigenvectors of D A D^-1 as columns, in the same order, for D
 /// the diagonal `scaling` (empty: the identity; a balancing's, to undo it).
-pub fn schur_eigenvectors(schur: &RealSchur, scaling: &[f64]) -> (Vec<c64>, Mat<c64>) {
+///
+/// Each eigenvector's back substitution (O(k^2) for the k-th, O(n^3) in all) starts with a
+/// check of the computation's interrupt, so that Ctrl-C stops a large one between vectors.
+pub fn schur_eigenvectors(
+    schur: &RealSchur,
+    scaling: &[f64],
+) -> Result<(Vec<c64>, Mat<c64>), Error> {
     let t = schur.t.as_ref();
     let n = t.nrows();
     let largest = (0..n)
@@ -43,6 +51,7 @@ pub fn schur_eigenvectors(schur: &RealSchur, scaling: &[f64]) -> (Vec<c64>, Mat<
     let (mut x_re, mut x_im) = (Mat::<f64>::zeros(n, n), Mat::<f64>::zeros(n, n));
     let mut k = 0;
     while k < n {
+        interrupt::check()?;
         let pair = k + 1 < n && t[(k + 1, k)] != 0.0;
         let mut x = vec![c64::new(0.0, 0.0); n];
         let lambda = if pair {
@@ -114,7 +123,7 @@ pub fn schur_eigenvectors(schur: &RealSchur, scaling: &[f64]) -> (Vec<c64>, Mat<
             }
         }
     }
-    (values, vectors)
+    Ok((values, vectors))
 }
 
 /// Solves (T[..k, ..k] - λI) x[..k] = x[..k] in place, block by block upwards, updating the
@@ -207,7 +216,8 @@ mod tests {
     fn eigenvectors_satisfy_a_v_equals_v_lambda() {
         for n in [1, 2, 3, 4, 7, 16, 40, 90] {
             let a = seeded_square(n, 7 + n as u64);
-            let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]);
+            let (values, vectors) =
+                schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]).unwrap();
             let size = a.norm_l2();
             assert!(residual(&a, &values, &vectors) <= 100.0 * n as f64 * f64::EPSILON * size);
             for j in 0..n {
@@ -230,7 +240,7 @@ mod tests {
                 0.0
             }
         });
-        let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]);
+        let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]).unwrap();
         assert!(
             values
                 .iter()
@@ -252,7 +262,7 @@ mod tests {
         // [[0, -2], [0.5, 0]]: λ = ±i, the eigenvector of i proportional to [2, -i]; the
         // conjugate pair in order, the second vector the first's conjugate.
         let a = Mat::from_fn(2, 2, |i, j| [[0.0, -2.0], [0.5, 0.0]][i][j]);
-        let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]);
+        let (values, vectors) = schur_eigenvectors(&real_schur(a.as_ref()).unwrap(), &[]).unwrap();
         assert!((values[0] - c64::new(0.0, 1.0)).norm() <= 1e-15);
         assert_eq!(values[1], values[0].conj());
         assert!(residual(&a, &values, &vectors) <= 1e-15);
