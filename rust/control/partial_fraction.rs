@@ -154,11 +154,14 @@ impl PartialFractions {
                 Block::Pair(..) => None,
             })
             .collect();
-        let pair_count = (n - reals.len()) / 2;
-        let mut pairs = (
-            Vec::with_capacity(pair_count),
-            Vec::with_capacity(pair_count),
-        );
+        let pairs: (Vec<f64>, Vec<f64>) = blocks
+            .iter()
+            .filter_map(|block| match block {
+                Block::Real(_) => None,
+                Block::Pair(a, b) => Some((*a, *b)),
+            })
+            .unzip();
+        let pair_count = pairs.0.len();
         let mut coefficients = vec![0.0; p * m * n];
         for i in 0..p {
             for j in 0..m {
@@ -171,15 +174,11 @@ impl PartialFractions {
                             real += 1;
                             column += 1;
                         }
-                        Block::Pair(a, b) => {
+                        Block::Pair(..) => {
                             let (c1, c2) = (modal_c[(i, column)], modal_c[(i, column + 1)]);
                             let (b1, b2) = (modal_b[(column, j)], modal_b[(column + 1, j)]);
                             row[reals.len() + pair] = c1 * b1 + c2 * b2;
                             row[reals.len() + pair_count + pair] = c1 * b2 - c2 * b1;
-                            if i == 0 && j == 0 {
-                                pairs.0.push(a);
-                                pairs.1.push(b);
-                            }
                             pair += 1;
                             column += 2;
                         }
