@@ -27,7 +27,12 @@
 //! only to a tolerance and cost many more steps on the long horizons where S(t) settles to the
 //! algebraic solution; here the accuracy is that of double precision whatever the step.
 //!
-//! For a uniform grid (the usual case) one exponential serves every step.
+//! For a uniform grid (the usual case) one exponential serves every step. A grid counts as
+//! uniform when every t_k is within [`GRID_ROUNDING`] max(|t_0|, |t_last|) of t_0 + k h̄,
+//! h̄ = (t_last - t_0) / (len - 1): the spacing of `numpy.linspace` and `numpy.arange`, whose
+//! intervals differ from one another in their last bits. Such a grid is integrated with the
+//! step h̄, so S is computed at times within that rounding of the caller's, the uncertainty
+//! with which the times themselves are stored; any other grid takes each interval as given.
 //!
 //! The work is bounded: once a substep leaves S unchanged to rounding ([`STATIONARY`]), S has
 //! reached the fixed point of the step, the algebraic solution, and every earlier time has
@@ -58,6 +63,10 @@ pub const MAX_SUBSTEPS: usize = 1_000_000;
 
 /// Substeps between two checks for an interrupt.
 const INTERRUPT_INTERVAL: usize = 4096;
+
+/// The distance, in units of max(|t_0|, |t_last|), within which every time of a grid must lie
+/// of the evenly spaced times for the grid to count as uniform: a few roundings of the times.
+pub const GRID_ROUNDING: f64 = 8.0 * f64::EPSILON;
 
 /// S(t) and K(t) at every time of the grid.
 #[derive(Debug, Clone)]
@@ -125,12 +134,13 @@ pub fn riccati_ode(
     solutions[count - 1] = s.clone();
     // The transition matrix of the last substep length, reused while it repeats.
     let mut cached: Option<(f64, Mat<f64>)> = None;
+    let uniform_step = uniform_step(times);
     let mut substeps = 0;
     let mut stationary = false;
     for k in (0..count - 1).rev() {
         interrupt::check()?;
         if !stationary {
-            let interval = times[k + 1] - times[k];
+            let interval = uniform_step.unwrap_or(times[k + 1] - times[k]);
             // (The float-to-integer conversion saturates: a horizon of 1e300 gives usize::MAX
             // pieces, of which only those before S settles are taken.)
             let pieces = ((interval * growth_rate / MAX_GROWTH_EXPONENT).ceil() as usize).max(1);
@@ -166,7 +176,6 @@ pub fn riccati_ode(
     })
 }
 
-/// One step: [X; Y] = Φ [I; S], S <- Y X^-1 (by X^T S'^T = Y^T), symmetrised.
 /// Whether a substep from `previous` to `next` changed no entry by more than
 /// [`STATIONARY`] max|S|.
 fn is_stationary(next: &Mat<f64>, previous: &Mat<f64>) -> bool {
@@ -187,6 +196,21 @@ fn too_many_substeps(times: &[f64], growth_rate: f64) -> Error {
     }
 }
 
+/// The step h̄ = (t_last - t_0) / (len - 1) of a grid of two times or more whose every time is
+/// within [`GRID_ROUNDING`] max(|t_0|, |t_last|) of t_0 + k h̄; `None` for any other grid.
+fn uniform_step(times: &[f64]) -> Option<f64> {
+    let (first, last) = (*times.first()?, *times.last()?);
+    let intervals = times.len().checked_sub(1).filter(|&count| count > 0)?;
+    let step = (last - first) / intervals as f64;
+    let tolerance = GRID_ROUNDING * first.abs().max(last.abs());
+    times
+        .iter()
+        .enumerate()
+        .all(|(k, &t)| (first + k as f64 * step - t).abs() <= tolerance)
+        .then_some(step)
+}
+
+/// One step: [X; Y] = Φ [I; S], S <- Y X^-1 (by X^T S'^T = Y^T), symmetrised.
 fn step(phi: MatRef<'_, f64>, s: &Mat<f64>) -> Result<Mat<f64>, Error> {
     let n = s.nrows();
     let x = phi.submatrix(0, 0, n, n) + phi.submatrix(0, n, n, n) * s;
@@ -234,4 +258,50 @@ fn check_times(times: &[f64]) -> Result<(), Error> {
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// t_k = t_0 + k (t_last - t_0) / (len - 1) rounded, as numpy.linspace makes it.
+    fn linspace(first: f64, last: f64, len: usize) -> Vec<f64> {
+        let step = (last - first) / (len - 1) as f64;
+        let mut grid: Vec<f64> = (0..len).map(|k| first + k as f64 * step).collect();
+        grid[len - 1] = last;
+        grid
+    }
+
+    #[test]
+    fn uniform_step_accepts_grids_uniform_to_rounding() {
+        // The intervals of linspace(0, 20, 201) take 9 different values around 0.1.
+        let grid = linspace(0.0, 20.0, 201);
+        let intervals: std::collections::BTreeSet<u64> =
+            grid.windows(2).map(|w| (w[1] - w[0]).to_bits()).collect();
+        assert!(intervals.len() > 1);
+        assert_eq!(uniform_step(&grid), Some(0.1));
+        let shifted = linspace(-3.0, 1e3, 1001);
+        assert_eq!(uniform_step(&shifted), Some(1003.0 / 1000.0));
+        assert_eq!(uniform_step(&[2.0, 5.0]), Some(3.0));
+    }
+
+    #[test]
+    fn uniform_step_refuses_other_grids() {
+        assert_eq!(uniform_step(&[1.0]), None);
+        assert_eq!(uniform_step(&[0.0, 0.1, 0.3]), None);
+        let mut grid = linspace(0.0, 20.0, 201);
+        // One time moved by 64 units of roundoff of the grid's largest time.
+        grid[100] += 64.0 * f64::EPSILON * 20.0;
+        assert_eq!(uniform_step(&grid), None);
+        // Accumulated by a loop (numpy.arange computes start + k step instead): the times
+        // drift from the even spacing by far more than their rounding, so each interval is
+        // taken as given.
+        let mut summed = vec![0.0];
+        for _ in 0..1000 {
+            summed.push(summed[summed.len() - 1] + 0.01);
+        }
+        assert_eq!(uniform_step(&summed), None);
+        let logarithmic: Vec<f64> = (0..50).map(|k| 1.1f64.powi(k)).collect();
+        assert_eq!(uniform_step(&logarithmic), None);
+    }
 }
