@@ -768,17 +768,31 @@ fn output_reflector(c: &[f64]) -> (Vec<f64>, f64) {
 
 /// A <- H A H, b <- H b for H = I - τ u u^T.
 fn reflect(s: &mut Siso, u: &[f64], tau: f64) {
-    let n = u.len();
+    // The order a constant of the loops for the orders of flight models.
+    with_order!(
+        u.len(),
+        [1, 2, 3, 4, 5, 6, 7, 8],
+        N => reflect_of_order(s, u, tau, N),
+        n => reflect_of_order(s, u, tau, n)
+    )
+}
+
+/// [`reflect`] for a system of order n (A's column-major storage indexed directly; the same
+/// products and sums in the same order).
+#[inline(always)]
+fn reflect_of_order(s: &mut Siso, u: &[f64], tau: f64, n: usize) {
+    let (a, u) = (&mut s.a.as_mut_slice()[..n * n], &u[..n]);
     for j in 0..n {
-        let dot: f64 = (0..n).map(|i| u[i] * s.a[(i, j)]).sum();
-        for (i, ui) in u.iter().enumerate() {
-            s.a[(i, j)] -= tau * dot * ui;
+        let column = &mut a[j * n..(j + 1) * n];
+        let dot: f64 = (0..n).map(|i| u[i] * column[i]).sum();
+        for (x, ui) in column.iter_mut().zip(u) {
+            *x -= tau * dot * ui;
         }
     }
     for i in 0..n {
-        let dot: f64 = (0..n).map(|j| s.a[(i, j)] * u[j]).sum();
+        let dot: f64 = (0..n).map(|j| a[i + j * n] * u[j]).sum();
         for (j, uj) in u.iter().enumerate() {
-            s.a[(i, j)] -= tau * dot * uj;
+            a[i + j * n] -= tau * dot * uj;
         }
     }
     let dot: f64 = u.iter().zip(&s.b).map(|(x, y)| x * y).sum();
