@@ -306,6 +306,34 @@ impl FrequencyEvaluator {
     pub fn siso(&mut self, omega: f64) -> c64 {
         self.at(c64::new(0.0, omega))[0]
     }
+
+    /// [L(jω), dL/dω, d²L/dω², d³L/dω³] of a SISO model of order at most [`SISO_ORDER`] (L
+    /// the value [`FrequencyEvaluator::siso`] gives, bit for bit; the derivatives from three
+    /// more solves with the same elimination: dL/dω = j G'(jω), d²L/dω² = -G''(jω),
+    /// d³L/dω³ = -j G'''(jω)), or None for another model or where |ω| is within a factor of
+    /// two of the expansion at infinity's range.
+    pub fn siso_derivatives(&mut self, omega: f64) -> Option<[c64; 4]> {
+        let model = &self.model;
+        if model.m != 1 || model.p != 1 || model.n > SISO_ORDER {
+            return None;
+        }
+        if omega.abs() > 0.5 * FAR * model.sigma {
+            return None;
+        }
+        let point = c64::new(0.0, omega);
+        let s = if model.sigma == 1.0 {
+            point
+        } else {
+            point / model.sigma
+        };
+        let [value, first, second, third] = evaluate_siso_derivatives(model, s);
+        Some([
+            value,
+            c64::new(-first.im, first.re),
+            -second,
+            c64::new(third.im, -third.re),
+        ])
+    }
 }
 
 /// (a + jb) / (c + jd) by Smith's algorithm (Smith 1962): the ratio of the smaller to the
@@ -480,6 +508,74 @@ const SISO_ORDER: usize = 8;
 /// cost as much as the arithmetic.
 #[inline(always)]
 fn evaluate_siso_kernel<const FMA: bool>(model: &HessenbergModel, point: c64) -> c64 {
+    siso_solve::<FMA, false>(model, point)[0]
+}
+
+/// [`evaluate_siso_kernel`] with the first three derivatives: [G(s), G'(s), G''(s), G'''(s)],
+/// G the same value bit for bit, G' = -C (sI - A)^-2 B, G'' = 2 C (sI - A)^-3 B and
+/// G''' = -6 C (sI - A)^-4 B from three more solves with the same elimination (its
+/// multipliers and row exchanges applied to the previous solution, then the back
+/// substitution).
+#[inline(always)]
+fn evaluate_siso_derivatives_kernel<const FMA: bool>(
+    model: &HessenbergModel,
+    point: c64,
+) -> [c64; 4] {
+    siso_solve::<FMA, true>(model, point)
+}
+
+/// x_k = (x_k - U_k,k+1.. x_k+1..) / U_kk for k = n - 1 down to 0, U the eliminated sI - H
+/// (rows of stride [`SISO_ORDER`]).
+#[inline(always)]
+fn siso_back_substitute<const FMA: bool>(
+    re: &[f64; SISO_ORDER * SISO_ORDER],
+    im: &[f64; SISO_ORDER * SISO_ORDER],
+    n: usize,
+    x_re: &mut [f64; SISO_ORDER],
+    x_im: &mut [f64; SISO_ORDER],
+) {
+    const S: usize = SISO_ORDER;
+    for k in (0..n).rev() {
+        let row = k * S;
+        let (dr, di) = complex_dot::<FMA>(
+            &re[row + k + 1..row + n],
+            &im[row + k + 1..row + n],
+            &x_re[k + 1..n],
+            &x_im[k + 1..n],
+        );
+        let (sr, si) = (x_re[k] - dr, x_im[k] - di);
+        (x_re[k], x_im[k]) = complex_divide(sr, si, re[row + k], im[row + k]);
+    }
+}
+
+/// c x multiplied back by 2^`exponent` (c of length n <= [`SISO_ORDER`]).
+#[inline(always)]
+fn siso_output<const FMA: bool>(
+    c: &[f64],
+    x_re: &[f64; SISO_ORDER],
+    x_im: &[f64; SISO_ORDER],
+    exponent: f64,
+) -> c64 {
+    let (mut gr, mut gi) = (0.0, 0.0);
+    for ((&c, &vr), &vi) in c.iter().zip(x_re).zip(x_im) {
+        gr = multiply_add::<FMA>(c, vr, gr);
+        gi = multiply_add::<FMA>(c, vi, gi);
+    }
+    if exponent != 0.0 {
+        gr = times_power_of_two(gr, exponent);
+        gi = times_power_of_two(gi, exponent);
+    }
+    c64::new(gr, gi)
+}
+
+/// C (sI - H)^-1 B + D of a SISO model of order at most [`SISO_ORDER`], and with `DERIVATIVES`
+/// its first three derivatives in s, (-1)^k k! C (sI - H)^-(k+1) B (else zeros), each
+/// multiplied back by its power of two of the scaling.
+#[inline(always)]
+fn siso_solve<const FMA: bool, const DERIVATIVES: bool>(
+    model: &HessenbergModel,
+    point: c64,
+) -> [c64; 4] {
     const S: usize = SISO_ORDER;
     let n = model.n.min(S);
     let mut re = [0.0f64; S * S];
@@ -495,6 +591,10 @@ fn evaluate_siso_kernel<const FMA: bool>(model: &HessenbergModel, point: c64) ->
     }
     let (mut x_re, mut x_im) = ([0.0f64; S], [0.0f64; S]);
     x_re[..n].copy_from_slice(&model.b[..n]);
+    // The elimination's row exchanges and multipliers (zero where a step had nothing to
+    // eliminate), kept for the derivatives' solves.
+    let mut swapped = [false; S];
+    let mut factors = [(0.0f64, 0.0f64); S];
     for k in 0..n.saturating_sub(1) {
         let (this, next) = (k * S, (k + 1) * S);
         if re[next + k].abs() + im[next + k].abs() > re[this + k].abs() + im[this + k].abs() {
@@ -504,6 +604,9 @@ fn evaluate_siso_kernel<const FMA: bool>(model: &HessenbergModel, point: c64) ->
             }
             x_re.swap(k, k + 1);
             x_im.swap(k, k + 1);
+            if DERIVATIVES {
+                swapped[k] = true;
+            }
         }
         let (pr, pi) = (re[this + k], im[this + k]);
         let (sr, si) = (re[next + k], im[next + k]);
@@ -511,6 +614,9 @@ fn evaluate_siso_kernel<const FMA: bool>(model: &HessenbergModel, point: c64) ->
             continue;
         }
         let (fr, fi) = complex_divide(sr, si, pr, pi);
+        if DERIVATIVES {
+            factors[k] = (fr, fi);
+        }
         for j in k + 1..n {
             let (a, b) = (re[this + j], im[this + j]);
             re[next + j] = multiply_add::<FMA>(-fr, a, multiply_add::<FMA>(fi, b, re[next + j]));
@@ -520,30 +626,43 @@ fn evaluate_siso_kernel<const FMA: bool>(model: &HessenbergModel, point: c64) ->
         x_re[k + 1] -= fr * a - fi * b;
         x_im[k + 1] -= fr * b + fi * a;
     }
-    for k in (0..n).rev() {
-        let row = k * S;
-        let (dr, di) = complex_dot::<FMA>(
-            &re[row + k + 1..row + n],
-            &im[row + k + 1..row + n],
-            &x_re[k + 1..n],
-            &x_im[k + 1..n],
-        );
-        let (sr, si) = (x_re[k] - dr, x_im[k] - di);
-        (x_re[k], x_im[k]) = complex_divide(sr, si, re[row + k], im[row + k]);
+    siso_back_substitute::<FMA>(&re, &im, n, &mut x_re, &mut x_im);
+    let value = siso_output::<FMA>(&model.c[..n], &x_re, &x_im, model.exponent);
+    let mut out = [
+        c64::new(value.re + model.d[0], value.im),
+        c64::new(0.0, 0.0),
+        c64::new(0.0, 0.0),
+        c64::new(0.0, 0.0),
+    ];
+    if DERIVATIVES {
+        // d^k/ds^k C (sI - A)^-1 B = (-1)^k k! C (sI - A)^-(k+1) B; the solves are at s / σ, so
+        // the k-th term is divided by σ^k once more.
+        let log_sigma = model.sigma.log2();
+        for (order, coefficient) in [(1usize, -1.0f64), (2, 2.0), (3, -6.0)] {
+            for k in 0..n.saturating_sub(1) {
+                if swapped[k] {
+                    x_re.swap(k, k + 1);
+                    x_im.swap(k, k + 1);
+                }
+                let (fr, fi) = factors[k];
+                if fr != 0.0 || fi != 0.0 {
+                    let (a, b) = (x_re[k], x_im[k]);
+                    x_re[k + 1] -= fr * a - fi * b;
+                    x_im[k + 1] -= fr * b + fi * a;
+                }
+            }
+            siso_back_substitute::<FMA>(&re, &im, n, &mut x_re, &mut x_im);
+            let exponent = model.exponent - order as f64 * log_sigma;
+            let term = siso_output::<FMA>(&model.c[..n], &x_re, &x_im, exponent);
+            out[order] = term * coefficient;
+        }
     }
-    let (mut gr, mut gi) = (0.0, 0.0);
-    for ((&c, &vr), &vi) in model.c[..n].iter().zip(&x_re[..n]).zip(&x_im[..n]) {
-        gr = multiply_add::<FMA>(c, vr, gr);
-        gi = multiply_add::<FMA>(c, vi, gi);
-    }
-    if model.exponent != 0.0 {
-        gr = times_power_of_two(gr, model.exponent);
-        gi = times_power_of_two(gi, model.exponent);
-    }
-    c64::new(gr + model.d[0], gi)
+    out
 }
 
 fma_dispatch!(fn evaluate_siso(model: &HessenbergModel, point: c64) -> c64 => evaluate_siso_kernel);
+
+fma_dispatch!(fn evaluate_siso_derivatives(model: &HessenbergModel, point: c64) -> [c64; 4] => evaluate_siso_derivatives_kernel);
 
 fma_dispatch!(fn evaluate_frequency(model: &HessenbergModel, point: c64, ws: &mut Workspace, g: &mut [c64]) => evaluate_kernel);
 
@@ -752,6 +871,78 @@ mod tests {
             }
         }
         assert!(compared >= 9 * 40 * 25);
+    }
+
+    /// [L, dL/dω, d²L/dω², d³L/dω³] against dense complex solves, dL/dω = -j C (jωI - A)^-2 B,
+    /// d²L/dω² = -2 C (jωI - A)^-3 B and d³L/dω³ = 6j C (jωI - A)^-4 B, on seeded SISO
+    /// models of orders 1 to SISO_ORDER with entries of sizes 1e-3 to 1e4 and scaled by
+    /// 2^±200 (the range scaling's powers of two applied to each term); L is the value `siso`
+    /// gives, bit for bit. A model of another shape or order has no derivatives here.
+    #[test]
+    fn siso_derivatives_match_dense_solves() {
+        let mut next = crate::test_matrices::xorshift(0x9e3779b97f4a7c15);
+        let mut compared = 0;
+        for n in 1..=SISO_ORDER {
+            for trial in 0..24 {
+                let size = [1.0, 1e-3, 1e4][trial % 3];
+                let range = [1.0, 2f64.powi(200), 2f64.powi(-200)][(trial / 3) % 3];
+                let a = Mat::from_fn(n, n, |_, _| next() * size * range);
+                let b = Mat::from_fn(n, 1, |_, _| next());
+                let c = Mat::from_fn(1, n, |_, _| next() * 7.0);
+                let d = Mat::from_fn(1, 1, |_, _| next());
+                let mut evaluator =
+                    FrequencyEvaluator::new(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref())
+                        .unwrap();
+                for k in 0..6 {
+                    let w = size * range * (k as f64 / 2.0 - 1.5).exp2() * (0.5 + next().abs());
+                    let [value, first, second, third] = evaluator.siso_derivatives(w).unwrap();
+                    let plain = evaluator.siso(w);
+                    assert_eq!(value.re.to_bits(), plain.re.to_bits());
+                    assert_eq!(value.im.to_bits(), plain.im.to_bits());
+                    let shifted = Mat::from_fn(n, n, |i, j| {
+                        c64::new(-a[(i, j)], if i == j { w } else { 0.0 })
+                    });
+                    let lu = shifted.partial_piv_lu();
+                    let x1 = lu.solve(&Mat::from_fn(n, 1, |i, _| c64::new(b[(i, 0)], 0.0)));
+                    let x2 = lu.solve(&x1);
+                    let x3 = lu.solve(&x2);
+                    let x4 = lu.solve(&x3);
+                    let cx = |x: &Mat<c64>| {
+                        (0..n).fold(c64::new(0.0, 0.0), |s, i| s + x[(i, 0)] * c[(0, i)])
+                    };
+                    let expected_first = cx(&x2) * c64::new(0.0, -1.0);
+                    let expected_second = cx(&x3) * -2.0;
+                    let expected_third = cx(&x4) * c64::new(0.0, 6.0);
+                    // Relative to the terms' sizes: |C| |x_k| bounds the sums' cancellation.
+                    let scale =
+                        |x: &Mat<c64>| (0..n).map(|i| (x[(i, 0)] * c[(0, i)]).norm()).sum::<f64>();
+                    let cond = 1e-10;
+                    assert!(
+                        (first - expected_first).norm() <= cond * scale(&x2),
+                        "n={n} trial={trial}: {first} vs {expected_first}"
+                    );
+                    assert!(
+                        (second - expected_second).norm() <= 2.0 * cond * scale(&x3),
+                        "n={n} trial={trial}: {second} vs {expected_second}"
+                    );
+                    assert!(
+                        (third - expected_third).norm() <= 6.0 * cond * scale(&x4),
+                        "n={n} trial={trial}: {third} vs {expected_third}"
+                    );
+                    compared += 1;
+                }
+            }
+        }
+        assert_eq!(compared, SISO_ORDER * 24 * 6);
+        let (a, b, c, d) = (
+            Mat::<f64>::identity(9, 9),
+            Mat::<f64>::zeros(9, 1),
+            Mat::<f64>::zeros(1, 9),
+            Mat::<f64>::zeros(1, 1),
+        );
+        let mut large =
+            FrequencyEvaluator::new(a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()).unwrap();
+        assert!(large.siso_derivatives(1.0).is_none());
     }
 
     #[test]
