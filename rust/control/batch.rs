@@ -613,6 +613,27 @@ mod tests {
     }
 
     #[test]
+    fn error_in_a_later_group_names_its_index() {
+        // 40 matrices of order 4 run in groups of 16: a rotation by 1e50 rad at index 37 (the
+        // sixth of the third group) is refused as ill-conditioned, with its own index.
+        let (k, n) = (40, 4);
+        let mut data = vec![0.0; k * n * n];
+        for (index, matrix) in data.chunks_exact_mut(n * n).enumerate() {
+            for i in 0..n {
+                matrix[i * n + i] = -0.1 * (index + i) as f64;
+            }
+        }
+        data[37 * n * n + 1] = 1e50;
+        data[37 * n * n + n] = -1e50;
+        let mut out = vec![0.0; k * n * n];
+        let err = expm_batch(MatrixStack::new(&data, k, n, n).unwrap(), &mut out).unwrap_err();
+        assert!(
+            err.to_string().starts_with("problem 37 of the batch: "),
+            "{err}"
+        );
+    }
+
+    #[test]
     fn empty_stacks() {
         let mut out = vec![];
         expm_batch(MatrixStack::new(&[], 0, 3, 3).unwrap(), &mut out).unwrap();

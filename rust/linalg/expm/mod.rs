@@ -1641,6 +1641,55 @@ mod tests {
     }
 
     #[test]
+    fn the_compiled_small_exponential_equals_the_dispatched_plan_bit_for_bit() {
+        // `small_exponential` (the plan on `Inlined`, one dispatch) against the same plan on
+        // SMatrix (a dispatch per kernel): general matrices through every degree, none to many
+        // squarings (double-double from two), triangular ones, and entries small and large
+        // enough for the time scaling and the pre-scaling.
+        let mut rng = StdRng::seed_from_u64(31);
+        let mut cases = 0;
+        for n in 2..=SMALL_MAX_ORDER {
+            for scale in [1e-30, 1e-3, 0.05, 0.4, 1.0, 3.0, 20.0, 300.0, 1e25] {
+                for structure in 0..3 {
+                    let mut a = random_matrix(n, scale, &mut rng);
+                    for j in 0..n {
+                        for i in 0..n {
+                            if (structure == 1 && i > j) || (structure == 2 && i < j) {
+                                a[(i, j)] = 0.0;
+                            }
+                        }
+                    }
+                    let (mut compiled, mut dispatched) = (Mat::zeros(n, n), Mat::zeros(n, n));
+                    let (finite_compiled, finite_dispatched) = with_order!(
+                        n,
+                        [2, 3, 4, 5, 6, 7, 8],
+                        N => (
+                            small_exponential::<N>(a.as_ref(), compiled.as_mut()),
+                            single_exponential::<SMatrix<f64, N, N>>(
+                                a.as_ref(),
+                                dispatched.as_mut(),
+                            )
+                        ),
+                        _ => unreachable!("orders up to SMALL_MAX_ORDER")
+                    );
+                    assert_eq!(finite_compiled, finite_dispatched);
+                    for j in 0..n {
+                        for i in 0..n {
+                            assert_eq!(
+                                compiled[(i, j)].to_bits(),
+                                dispatched[(i, j)].to_bits(),
+                                "n = {n}, scale {scale:e}, structure {structure}"
+                            );
+                        }
+                    }
+                    cases += 1;
+                }
+            }
+        }
+        assert_eq!(cases, 7 * 9 * 3);
+    }
+
+    #[test]
     fn double_double_evaluation_beats_double_on_a_hump() {
         // Moler & Van Loan's [[-49, 24], [-64, 31]]: eigenvalues -17 and -1, a large hump.
         // Closed form: e^A = U diag(e^-17, e^-1) V, U = [[3, 1], [4, 2]], V = [[1, -1/2], [-2, 3/2]].
