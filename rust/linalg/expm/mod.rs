@@ -1148,12 +1148,15 @@ impl<const N: usize, const FMA: bool> PadeArithmetic for Inlined<N, FMA> {
             small_matrix::columns_mut(&mut denominator.0),
             &mut pivots,
         );
-        let mut quotient = odd;
-        small_matrix::lu_solve_kernel::<N, FMA>(
+        // The N right-hand sides solved together as rows (the operations of the column-wise
+        // solve that SMatrix uses, in the same order on each entry, as vector instructions).
+        let mut rows = small_matrix::transposed(small_matrix::columns(&odd.0));
+        small_matrix::lu_solve_rows_kernel::<N, FMA>(
             small_matrix::columns(&denominator.0),
             &pivots,
-            small_matrix::columns_mut(&mut quotient.0),
+            &mut rows,
         );
+        let quotient = Self(small_matrix::from_columns(small_matrix::transposed(&rows)));
         Self::combination(1.0, &[(2.0, &quotient)])
     }
 }
