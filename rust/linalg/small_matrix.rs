@@ -71,21 +71,34 @@ pub(crate) fn add_product_kernel<const N: usize, const FMA: bool>(
 
 fma_dispatch!(fn add_product_columns<const N: usize>(lhs: &Columns<N>, rhs: &Columns<N>, out: &mut Columns<N>) => add_product_kernel);
 
+/// A matrix stored as the N columns of N entries of an `SMatrix`: the stack matrix itself, or a
+/// type that wraps one.
+pub(crate) trait StackColumns<const N: usize> {
+    fn stack_columns(&self) -> &Columns<N>;
+}
+
+impl<const N: usize> StackColumns<N> for SMatrix<f64, N, N> {
+    #[inline(always)]
+    fn stack_columns(&self) -> &Columns<N> {
+        columns(self)
+    }
+}
+
 /// identity * I + sum_k coefficient_k * M_k.
 #[inline(always)]
-fn combination_kernel<const N: usize, const FMA: bool>(
+pub(crate) fn combination_kernel<const N: usize, const FMA: bool>(
     identity: f64,
-    terms: &[(f64, &SMatrix<f64, N, N>)],
+    terms: &[(f64, &impl StackColumns<N>)],
 ) -> Columns<N> {
     let (&(first_coefficient, first), rest) = terms.split_first().expect("at least one term");
     let mut out = [[0.0; N]; N];
-    for (out_column, column) in out.iter_mut().zip(columns(first)) {
+    for (out_column, column) in out.iter_mut().zip(first.stack_columns()) {
         for (o, &v) in out_column.iter_mut().zip(column) {
             *o = first_coefficient * v;
         }
     }
     for &(coefficient, m) in rest {
-        for (out_column, column) in out.iter_mut().zip(columns(m)) {
+        for (out_column, column) in out.iter_mut().zip(m.stack_columns()) {
             for (o, &v) in out_column.iter_mut().zip(column) {
                 *o = multiply_add::<FMA>(coefficient, v, *o);
             }
@@ -100,25 +113,27 @@ fn combination_kernel<const N: usize, const FMA: bool>(
 fma_dispatch!(fn combination_columns<const N: usize>(identity: f64, terms: &[(f64, &SMatrix<f64, N, N>)]) -> Columns<N> => combination_kernel);
 
 /// ||(|A| / scale)^p||_1 by p row-vector products (for B >= 0, ||B^p||_1 = max 1^T B^p):
-/// entry j of the next row vector is the sum over i, in order, of v_i b_ij.
+/// entry j of the next row vector is the sum over i, in order, of v_i b_ij. B is stored by rows,
+/// so that the next vector is formed as the sum of the rows of B weighted by v, whole rows at a
+/// time (vector operations, each entry's terms in the same order).
 #[inline(always)]
-fn absolute_power_norm_kernel<const N: usize, const FMA: bool>(
+pub(crate) fn absolute_power_norm_kernel<const N: usize, const FMA: bool>(
     a: &Columns<N>,
     scale: f64,
     p: usize,
 ) -> f64 {
     let inverse = 1.0 / scale;
-    let mut b = [[0.0; N]; N];
-    for (b_column, column) in b.iter_mut().zip(a) {
-        for (x, value) in b_column.iter_mut().zip(column) {
-            *x = value.abs() * inverse;
+    let mut b_rows = [[0.0; N]; N];
+    for (j, column) in a.iter().enumerate() {
+        for (row, value) in b_rows.iter_mut().zip(column) {
+            row[j] = value.abs() * inverse;
         }
     }
     let mut vector = [1.0; N];
     for _ in 0..p {
         let mut next = [0.0; N];
-        for (n, b_column) in next.iter_mut().zip(&b) {
-            for (&weight, &x) in vector.iter().zip(b_column) {
+        for (&weight, b_row) in vector.iter().zip(&b_rows) {
+            for (n, &x) in next.iter_mut().zip(b_row) {
                 *n = multiply_add::<FMA>(weight, x, *n);
             }
         }
@@ -294,6 +309,7 @@ pub(crate) fn combination<const N: usize>(
 }
 
 /// The 1-norm, max_j sum_i |a_ij|.
+#[inline]
 pub(crate) fn one_norm<const N: usize>(a: &SMatrix<f64, N, N>) -> f64 {
     columns(a)
         .iter()
@@ -310,7 +326,16 @@ pub(crate) fn absolute_power_norm<const N: usize>(
     absolute_power_norm_columns(columns(a), scale, p)
 }
 
+/// Whether every entry is finite (one pass without early exit, which vectorises).
+#[inline]
+pub(crate) fn is_finite<const N: usize>(a: &SMatrix<f64, N, N>) -> bool {
+    a.as_slice()
+        .iter()
+        .fold(true, |finite, value| finite & value.is_finite())
+}
+
 /// Whether every entry below the diagonal is zero.
+#[inline]
 pub(crate) fn is_upper_triangular<const N: usize>(a: &SMatrix<f64, N, N>) -> bool {
     columns(a)
         .iter()
@@ -319,6 +344,7 @@ pub(crate) fn is_upper_triangular<const N: usize>(a: &SMatrix<f64, N, N>) -> boo
 }
 
 /// Whether every entry above the diagonal is zero.
+#[inline]
 pub(crate) fn is_lower_triangular<const N: usize>(a: &SMatrix<f64, N, N>) -> bool {
     columns(a)
         .iter()

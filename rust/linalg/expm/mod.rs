@@ -64,8 +64,8 @@ use crate::error::{Error, check_finite, check_finite_values, check_output_len, c
 use crate::linalg::expm::double_double::DoubleDoubleMatrix;
 use crate::linalg::matrix::{from_faer_in, with_order};
 use crate::linalg::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
-use crate::linalg::small_matrix;
-use crate::platform::dispatch::{add_scaled, scale_into};
+use crate::linalg::small_matrix::{self, Columns, StackColumns};
+use crate::platform::dispatch::{add_scaled, fma_dispatch, scale_into};
 use crate::platform::parallel::{PARALLEL_MIN_ORDER, ParallelContext, parallelism_for_order};
 use crate::platform::pool::{Scratch, scratch};
 use faer::linalg::matmul::matmul;
@@ -95,6 +95,12 @@ const MAX_UNSCALED_NORM_LOG2: f64 = 64.0;
 /// underflow while the powers of the scalar (t 2^-s) that multiply them overflow, and their
 /// product (0 · inf) is NaN: A = -I / t at t = 1e100 gave NaN for e^{-I}.
 const MIN_UNSCALED_ENTRY_LOG2: f64 = -64.0;
+
+/// 2^-63 and 2^63: a matrix whose largest entry is at least the first, and whose order times
+/// that entry is at most the second, is within both bounds above by a factor of 2, so that it
+/// is known to need no scaling without computing a logarithm.
+const ORDINARY_ENTRY_MIN: f64 = 1.0842021724855044e-19;
+const ORDINARY_NORM_MAX: f64 = 9_223_372_036_854_775_808.0;
 
 /// ln of the largest double (about 709.78), less a margin: e^{tA} with ||e^{tA}||_2 below
 /// e^this has finite entries.
@@ -248,6 +254,8 @@ pub(crate) trait ExpmMatrix: PadeArithmetic + Send + Sync {
     fn one_norm(&self) -> f64;
     /// max |a_ij|.
     fn max_abs(&self) -> f64;
+    /// Whether every entry is finite.
+    fn is_finite(&self) -> bool;
     /// A lower bound (usually the value) of ||F_1 ... F_k||_1 without forming the product.
     fn estimate_product_norm(factors: &[&Self]) -> f64;
     /// ||(|A| / scale)^p||_1.
@@ -268,6 +276,7 @@ pub(crate) trait ExpmMatrix: PadeArithmetic + Send + Sync {
 
 /// r_m(A) = I + 2 (V - U)^-1 U for the approximant given A, A^2 and the higher even powers
 /// [A^4, A^6, A^8] that the degree needs (the others may be None).
+#[inline(always)]
 fn pade_approximant<M: PadeArithmetic>(
     approximant: usize,
     a: &M,
@@ -312,6 +321,7 @@ fn pade_approximant<M: PadeArithmetic>(
 
 /// X <- X^2, `squarings` times; `refine(X, i)` may correct X, which then approximates
 /// e^{2^-i tA}, after each square (and before the first).
+#[inline(always)]
 fn square_repeatedly<M: PadeArithmetic>(
     mut x: M,
     squarings: u32,
@@ -328,6 +338,7 @@ fn square_repeatedly<M: PadeArithmetic>(
 /// c^k P for P = A^k, given `factor` = c^k: when c^k overflows (a large c, which only a matrix
 /// whose powers vanish or are small allows, a nilpotent A), c is applied k times instead, so
 /// that a zero entry stays zero instead of becoming 0 · inf = NaN.
+#[inline(always)]
 fn scaled_power<M: PadeArithmetic>(power: &M, c: f64, k: usize, factor: f64) -> M {
     if factor.is_finite() {
         return M::combination(0.0, &[(factor, power)]);
@@ -337,6 +348,20 @@ fn scaled_power<M: PadeArithmetic>(power: &M, c: f64, k: usize, factor: f64) -> 
         scaled = M::combination(0.0, &[(c, &scaled)]);
     }
     scaled
+}
+
+/// [`scaled_power`] of a power that may not have been formed.
+#[inline(always)]
+fn scaled_formed_power<M: PadeArithmetic>(
+    power: &Option<M>,
+    c: f64,
+    k: usize,
+    factor: f64,
+) -> Option<M> {
+    match power {
+        Some(p) => Some(scaled_power(p, c, k, factor)),
+        None => None,
+    }
 }
 
 /// Whether e^{tA} is certainly finite, by the logarithmic norm: ||e^{tA}||_2 <= e^{|t| μ},
@@ -419,7 +444,7 @@ fn exp_divided_difference(a: f64, b: f64) -> f64 {
 
 /// x^k for a small integer k, by repeated multiplication (inlined, unlike `powi` with a
 /// variable exponent, which is a library call).
-#[inline]
+#[inline(always)]
 fn integer_power(x: f64, k: usize) -> f64 {
     let mut result = 1.0;
     let mut base = x;
@@ -471,6 +496,7 @@ pub(crate) struct ExponentialPlan<M> {
 
 impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// Prepares e^{tA} for a square, finite A of order at least 2 (the caller validates).
+    #[inline(always)]
     pub fn new(a: MatRef<'_, f64>) -> Self {
         let mut a = M::from_ref(a);
         let mut transposed = false;
@@ -486,12 +512,20 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         });
         // ||A||_1 <= n max|a_ij|, a bound that cannot overflow (the column sums can).
         let largest = a.max_abs();
-        let log2_norm_bound = largest.log2() + (n as f64).log2();
         let (mut prescale, mut time_scale) = (0, 1.0);
+        // Entries in [2^-63, 2^63 / n] need neither scaling (the logarithms below are then
+        // certainly within (-64, 64)); only others pay for them.
+        let ordinary = largest == 0.0
+            || (largest >= ORDINARY_ENTRY_MIN && largest * n as f64 <= ORDINARY_NORM_MAX);
+        let log2_norm_bound = if ordinary {
+            MAX_UNSCALED_NORM_LOG2
+        } else {
+            largest.log2() + (n as f64).log2()
+        };
         if log2_norm_bound > MAX_UNSCALED_NORM_LOG2 {
             prescale = (log2_norm_bound - MAX_UNSCALED_NORM_LOG2).ceil() as u32;
             a = M::combination(0.0, &[((-(prescale as f64)).exp2(), &a)]);
-        } else if largest > 0.0 && largest.log2() < MIN_UNSCALED_ENTRY_LOG2 {
+        } else if !ordinary && largest > 0.0 && largest.log2() < MIN_UNSCALED_ENTRY_LOG2 {
             // largest in [2^e, 2^(e+1)); 2^-e is applied in two halves, as 2^1074 overflows.
             let exponent = largest.log2().floor();
             let half = (-exponent / 2.0).floor();
@@ -518,12 +552,14 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         }
     }
 
+    #[inline(always)]
     fn ensure_a4(&mut self) {
         if self.a4.is_none() {
             self.a4 = Some(self.a2.product(&self.a2));
         }
     }
 
+    #[inline(always)]
     fn ensure_a6(&mut self) {
         self.ensure_a4();
         if self.a6.is_none() {
@@ -531,6 +567,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         }
     }
 
+    #[inline(always)]
     fn ensure_a8(&mut self) {
         self.ensure_a4();
         if self.a8.is_none() {
@@ -542,6 +579,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// ||A^k||_1 for k in {4, 6, 8, 10}: exact from a formed power when there is one (forming it
     /// if norms are exact at this order), otherwise estimated from the product of the powers at
     /// hand. Bounded by ||A||_1^k, which also stands in for a power that overflowed.
+    #[inline(always)]
     fn power_norm(&mut self, k: usize) -> f64 {
         let slot = k / 2 - 2;
         let formed = |plan: &Self| match k {
@@ -597,6 +635,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 
     /// Whether τ max(||A^p||^(1/p), ||A^q||^(1/q)) <= θ, i.e. τ^k ||A^k|| <= θ^k for k = p, q:
     /// the selection compares powers, so that it needs no roots or logarithms.
+    #[inline(always)]
     fn scaled_root_norms_within(&mut self, p: usize, q: usize, tau: f64, theta: f64) -> bool {
         let ratio = tau / theta;
         self.power_norm(p) * integer_power(ratio, p) <= 1.0
@@ -604,6 +643,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     }
 
     /// log2 τ d_k, d_k = ||A^k||_1^(1/k).
+    #[inline(always)]
     fn log2_scaled_root_norm(&mut self, k: usize, tau: f64) -> f64 {
         tau.log2() + self.power_norm(k).log2() / k as f64
     }
@@ -620,6 +660,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// ℓ = 0 without computing the power norm. Otherwise α / u = |c_{2m+1}| / u ||τA||^{2m} N,
     /// N = ||(|A| / ||A||_1)^{2m+1}||_1 <= 1, is formed directly (logarithms only when ℓ > 0 or
     /// the product leaves the range of doubles).
+    #[inline(always)]
     fn extra_squarings(&mut self, approximant: usize, tau: f64) -> u32 {
         let pade = &APPROXIMANTS[approximant];
         let scaled_norm = tau * self.a_norm;
@@ -627,8 +668,16 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             return 0;
         }
         let m = pade.degree;
-        let power_norm = *self.abs_power_norms[approximant]
-            .get_or_insert_with(|| self.a.absolute_power_norm(self.a_norm, 2 * m + 1));
+        // No closures here or below where a kernel runs: a closure is compiled on its own,
+        // without the target features of [`small_exponential`] (see `Inlined`).
+        let power_norm = match self.abs_power_norms[approximant] {
+            Some(norm) => norm,
+            None => {
+                let norm = self.a.absolute_power_norm(self.a_norm, 2 * m + 1);
+                self.abs_power_norms[approximant] = Some(norm);
+                norm
+            }
+        };
         if power_norm == 0.0 {
             return 0;
         }
@@ -651,6 +700,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 
     /// The Padé degree and number of squarings for e^{tA} (Al-Mohy & Higham 2009, Algorithm 5.1,
     /// with every norm scaled by τ = |t|).
+    #[inline(always)]
     pub fn choose(&mut self, t: f64) -> PadeChoice {
         let choice = |approximant, squarings: u32| PadeChoice {
             approximant,
@@ -697,6 +747,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     }
 
     /// Forms the powers that evaluating `choice` needs; call before evaluating it.
+    #[inline(always)]
     pub fn prepare(&mut self, choice: PadeChoice) {
         match choice.approximant {
             M3 => {}
@@ -710,25 +761,32 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     }
 
     /// Writes e^{tA}, with the given (prepared) choice of degree and squarings, into `out`.
-    pub fn exponential_into(&self, t: f64, choice: PadeChoice, mut out: MatMut<'_, f64>) {
+    /// Returns true when every entry written is certainly finite (false may also mean that
+    /// only entries cleared afterwards, outside a triangular result, were not).
+    #[inline(always)]
+    pub fn exponential_into(&self, t: f64, choice: PadeChoice, mut out: MatMut<'_, f64>) -> bool {
         let n = self.a.order();
         if t == 0.0 {
             out.fill(0.0);
             out.diagonal_mut().fill(1.0);
-            return;
+            return true;
         }
         // r_m is evaluated at c * (pre-scaled A); the squarings undo both scalings.
         let c =
             t * self.time_scale * (-(choice.squarings.saturating_sub(self.prescale) as f64)).exp2();
         let accurate = choice.squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS;
-        let x = accurate
-            .then(|| {
-                self.a
-                    .double_double_exponential(c, choice.approximant, choice.squarings)
-            })
-            .flatten()
-            .unwrap_or_else(|| self.double_exponential(t, c, choice));
+        let accurate = if accurate {
+            self.a
+                .double_double_exponential(c, choice.approximant, choice.squarings)
+        } else {
+            None
+        };
+        let x = match accurate {
+            Some(x) => x,
+            None => self.double_exponential(t, c, choice),
+        };
         x.write_to(out.as_mut(), self.transposed);
+        let finite = x.is_finite();
         if self.diagonals.is_some() {
             // The exponential of a triangular matrix is triangular: clear any rounding (or NaN
             // from an overflowed square) in the other triangle.
@@ -740,9 +798,11 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
                 }
             }
         }
+        finite
     }
 
     /// r_m(cA) squared in double precision, refining triangular structure on the way.
+    #[inline(always)]
     fn double_exponential(&self, t: f64, c: f64, choice: PadeChoice) -> M {
         let x = if c == 1.0 {
             pade_approximant(
@@ -754,14 +814,11 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         } else {
             // The powers of cA: c^k A^k.
             let c2 = c * c;
-            let scaled = |power: &Option<M>, factor: f64, k: usize| {
-                power.as_ref().map(|p| scaled_power(p, c, k, factor))
-            };
             let a = M::combination(0.0, &[(c, &self.a)]);
             let a2 = scaled_power(&self.a2, c, 2, c2);
-            let a4 = scaled(&self.a4, c2 * c2, 4);
-            let a6 = scaled(&self.a6, c2 * c2 * c2, 6);
-            let a8 = scaled(&self.a8, (c2 * c2) * (c2 * c2), 8);
+            let a4 = scaled_formed_power(&self.a4, c, 4, c2 * c2);
+            let a6 = scaled_formed_power(&self.a6, c, 6, c2 * c2 * c2);
+            let a8 = scaled_formed_power(&self.a8, c, 8, (c2 * c2) * (c2 * c2));
             pade_approximant(choice.approximant, &a, &[&a2], [&a4, &a6, &a8])
         };
         square_repeatedly(x, choice.squarings, |x, i| {
@@ -884,6 +941,10 @@ impl ExpmMatrix for Scratch {
         self.as_ref().norm_max()
     }
 
+    fn is_finite(&self) -> bool {
+        self.as_ref().is_all_finite()
+    }
+
     fn estimate_product_norm(factors: &[&Self]) -> f64 {
         one_norm_estimate(
             &MatrixProduct::new(factors.iter().map(|f| f.as_ref()).collect()),
@@ -946,6 +1007,7 @@ impl<const N: usize> PadeArithmetic for DoubleDoubleMatrix<N> {
 }
 
 impl<const N: usize> ExpmMatrix for SMatrix<f64, N, N> {
+    #[inline(always)]
     fn from_ref(a: MatRef<'_, f64>) -> Self {
         from_faer_in(Const::<N>, a)
     }
@@ -978,8 +1040,13 @@ impl<const N: usize> ExpmMatrix for SMatrix<f64, N, N> {
         small_matrix::one_norm(self)
     }
 
+    #[inline(always)]
     fn max_abs(&self) -> f64 {
         self.as_slice().iter().fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    fn is_finite(&self) -> bool {
+        small_matrix::is_finite(self)
     }
 
     fn estimate_product_norm(factors: &[&Self]) -> f64 {
@@ -996,6 +1063,7 @@ impl<const N: usize> ExpmMatrix for SMatrix<f64, N, N> {
         small_matrix::absolute_power_norm(self, scale, p)
     }
 
+    #[inline(always)]
     fn write_to(&self, mut out: MatMut<'_, f64>, transpose: bool) {
         for (j, column) in small_matrix::columns(self).iter().enumerate() {
             for (i, &value) in column.iter().enumerate() {
@@ -1030,6 +1098,164 @@ impl<const N: usize> ExpmMatrix for SMatrix<f64, N, N> {
     }
 }
 
+// ----- stack matrices in one compiled exponential ----------------------------------------------
+
+/// A stack matrix whose arithmetic calls the small-order kernels of one instruction set (`FMA`:
+/// the AVX2 + FMA variant) directly instead of through their run-time dispatch, so that a whole
+/// exponential, from the degree selection to the written result, compiles into one function
+/// ([`small_exponential`]) with one dispatch, its kernels inlined. Each operation is the kernel
+/// that the `SMatrix` implementation dispatches to, on the same operands in the same order, so
+/// the results are equal bit for bit; everything else is delegated to that implementation.
+#[derive(Clone, Copy)]
+struct Inlined<const N: usize, const FMA: bool>(SMatrix<f64, N, N>);
+
+impl<const N: usize, const FMA: bool> StackColumns<N> for Inlined<N, FMA> {
+    #[inline(always)]
+    fn stack_columns(&self) -> &Columns<N> {
+        small_matrix::columns(&self.0)
+    }
+}
+
+impl<const N: usize, const FMA: bool> PadeArithmetic for Inlined<N, FMA> {
+    #[inline(always)]
+    fn product(&self, rhs: &Self) -> Self {
+        let mut out = Self(SMatrix::zeros());
+        out.add_product(self, rhs);
+        out
+    }
+
+    #[inline(always)]
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) {
+        small_matrix::add_product_kernel::<N, FMA>(
+            small_matrix::columns(&lhs.0),
+            small_matrix::columns(&rhs.0),
+            small_matrix::columns_mut(&mut self.0),
+        );
+    }
+
+    #[inline(always)]
+    fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
+        Self(small_matrix::from_columns(
+            small_matrix::combination_kernel::<N, FMA>(identity, terms),
+        ))
+    }
+
+    #[inline(always)]
+    fn pade_quotient(even: Self, odd: Self) -> Self {
+        let mut denominator = Self::combination(0.0, &[(1.0, &even), (-1.0, &odd)]);
+        let mut pivots = [0; N];
+        small_matrix::lu_kernel::<N, FMA>(
+            small_matrix::columns_mut(&mut denominator.0),
+            &mut pivots,
+        );
+        // The N right-hand sides solved together as rows (the operations of the column-wise
+        // solve that SMatrix uses, in the same order on each entry, as vector instructions).
+        let mut rows = small_matrix::transposed(small_matrix::columns(&odd.0));
+        small_matrix::lu_solve_rows_kernel::<N, FMA>(
+            small_matrix::columns(&denominator.0),
+            &pivots,
+            &mut rows,
+        );
+        let quotient = Self(small_matrix::from_columns(small_matrix::transposed(&rows)));
+        Self::combination(1.0, &[(2.0, &quotient)])
+    }
+}
+
+impl<const N: usize, const FMA: bool> ExpmMatrix for Inlined<N, FMA> {
+    #[inline(always)]
+    fn from_ref(a: MatRef<'_, f64>) -> Self {
+        Self(<SMatrix<f64, N, N> as ExpmMatrix>::from_ref(a))
+    }
+
+    #[inline(always)]
+    fn order(&self) -> usize {
+        N
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize, j: usize) -> f64 {
+        self.0[(i, j)]
+    }
+
+    #[inline(always)]
+    fn is_upper_triangular(&self) -> bool {
+        small_matrix::is_upper_triangular(&self.0)
+    }
+
+    #[inline(always)]
+    fn is_lower_triangular(&self) -> bool {
+        small_matrix::is_lower_triangular(&self.0)
+    }
+
+    #[inline(always)]
+    fn transpose(&self) -> Self {
+        Self(self.0.transpose())
+    }
+
+    #[inline(always)]
+    fn set(&mut self, i: usize, j: usize, value: f64) {
+        self.0[(i, j)] = value;
+    }
+
+    #[inline(always)]
+    fn one_norm(&self) -> f64 {
+        small_matrix::one_norm(&self.0)
+    }
+
+    #[inline(always)]
+    fn max_abs(&self) -> f64 {
+        self.0.max_abs()
+    }
+
+    #[inline(always)]
+    fn is_finite(&self) -> bool {
+        small_matrix::is_finite(&self.0)
+    }
+
+    #[inline(always)]
+    fn estimate_product_norm(factors: &[&Self]) -> f64 {
+        let (first, rest) = factors.split_first().expect("at least one factor");
+        let mut product = **first;
+        for factor in rest {
+            product = product.product(factor);
+        }
+        product.one_norm()
+    }
+
+    #[inline(always)]
+    fn absolute_power_norm(&self, scale: f64, p: usize) -> f64 {
+        small_matrix::absolute_power_norm_kernel::<N, FMA>(small_matrix::columns(&self.0), scale, p)
+    }
+
+    #[inline(always)]
+    fn write_to(&self, out: MatMut<'_, f64>, transpose: bool) {
+        self.0.write_to(out, transpose);
+    }
+
+    fn double_double_exponential(
+        &self,
+        c: f64,
+        approximant: usize,
+        squarings: u32,
+    ) -> Option<Self> {
+        self.0
+            .double_double_exponential(c, approximant, squarings)
+            .map(Self)
+    }
+}
+
+/// e^A for A of order N (2 to [`SMALL_MAX_ORDER`]) on [`Inlined`] stack matrices: the plan of
+/// [`single_exponential`] compiled as one function for each instruction set.
+#[inline(always)]
+fn small_exponential_kernel<const N: usize, const FMA: bool>(
+    a: MatRef<'_, f64>,
+    out: MatMut<'_, f64>,
+) -> bool {
+    single_exponential::<Inlined<N, FMA>>(a, out)
+}
+
+fma_dispatch!(fn small_exponential<const N: usize>(a: MatRef<'_, f64>, out: MatMut<'_, f64>) -> bool => small_exponential_kernel);
+
 // ----- public functions ---------------------------------------------------------------------
 
 /// Runs `$body` with `$m` bound to the matrix type for order `$n`: a stack matrix for orders
@@ -1057,11 +1283,14 @@ fn check_square_finite(a: MatRef<'_, f64>, arg: &'static str) -> Result<(), Erro
     check_finite(a, arg)
 }
 
-fn single_exponential<M: ExpmMatrix>(a: MatRef<'_, f64>, out: MatMut<'_, f64>) {
+/// Writes e^A into `out`; true when every entry is certainly finite (see
+/// [`ExponentialPlan::exponential_into`]).
+#[inline(always)]
+fn single_exponential<M: ExpmMatrix>(a: MatRef<'_, f64>, out: MatMut<'_, f64>) -> bool {
     let mut plan = ExponentialPlan::<M>::new(a);
     let choice = plan.choose(1.0);
     plan.prepare(choice);
-    plan.exponential_into(1.0, choice, out);
+    plan.exponential_into(1.0, choice, out)
 }
 
 /// Writes e^A into `out` (n x n), for a square A of finite entries.
@@ -1077,10 +1306,21 @@ pub(crate) fn expm_into_validated(
     a: MatRef<'_, f64>,
     mut out: MatMut<'_, f64>,
 ) -> Result<(), Error> {
-    match a.nrows() {
-        0 => {}
-        1 => out[(0, 0)] = a[(0, 0)].exp(),
-        n => with_matrix_type!(n, M => single_exponential::<M>(a, out.as_mut())),
+    let finite = match a.nrows() {
+        0 => true,
+        1 => {
+            out[(0, 0)] = a[(0, 0)].exp();
+            out[(0, 0)].is_finite()
+        }
+        n => with_order!(
+            n,
+            [2, 3, 4, 5, 6, 7, 8],
+            N => small_exponential::<N>(a, out.as_mut()),
+            _ => single_exponential::<Scratch>(a, out.as_mut())
+        ),
+    };
+    if finite {
+        return Ok(());
     }
     check_computed_exponential(a, 1.0, out.as_ref())
 }
@@ -1401,6 +1641,55 @@ mod tests {
                 "scale {scale}"
             );
         }
+    }
+
+    #[test]
+    fn the_compiled_small_exponential_equals_the_dispatched_plan_bit_for_bit() {
+        // `small_exponential` (the plan on `Inlined`, one dispatch) against the same plan on
+        // SMatrix (a dispatch per kernel): general matrices through every degree, none to many
+        // squarings (double-double from two), triangular ones, and entries small and large
+        // enough for the time scaling and the pre-scaling.
+        let mut rng = StdRng::seed_from_u64(31);
+        let mut cases = 0;
+        for n in 2..=SMALL_MAX_ORDER {
+            for scale in [1e-30, 1e-3, 0.05, 0.4, 1.0, 3.0, 20.0, 300.0, 1e25] {
+                for structure in 0..3 {
+                    let mut a = random_matrix(n, scale, &mut rng);
+                    for j in 0..n {
+                        for i in 0..n {
+                            if (structure == 1 && i > j) || (structure == 2 && i < j) {
+                                a[(i, j)] = 0.0;
+                            }
+                        }
+                    }
+                    let (mut compiled, mut dispatched) = (Mat::zeros(n, n), Mat::zeros(n, n));
+                    let (finite_compiled, finite_dispatched) = with_order!(
+                        n,
+                        [2, 3, 4, 5, 6, 7, 8],
+                        N => (
+                            small_exponential::<N>(a.as_ref(), compiled.as_mut()),
+                            single_exponential::<SMatrix<f64, N, N>>(
+                                a.as_ref(),
+                                dispatched.as_mut(),
+                            )
+                        ),
+                        _ => unreachable!("orders up to SMALL_MAX_ORDER")
+                    );
+                    assert_eq!(finite_compiled, finite_dispatched);
+                    for j in 0..n {
+                        for i in 0..n {
+                            assert_eq!(
+                                compiled[(i, j)].to_bits(),
+                                dispatched[(i, j)].to_bits(),
+                                "n = {n}, scale {scale:e}, structure {structure}"
+                            );
+                        }
+                    }
+                    cases += 1;
+                }
+            }
+        }
+        assert_eq!(cases, 7 * 9 * 3);
     }
 
     #[test]
