@@ -662,9 +662,9 @@ def riccati_ode(
     propagates [I; S] by the transition matrix e^{-Hh} and forms S = Y X^-1 anew (the modified
     Davison-Maki method). There is no truncation error, so the accuracy (about 1e-13
     relative) does not depend on the grid; a long horizon converges to the algebraic solution.
-    A grid uniform to rounding (every t_k within 8u max(|t_0|, |t_-1|) of evenly spaced
-    times, as ``numpy.linspace`` and ``numpy.arange`` make) is integrated with its one step,
-    one exponential for the whole horizon.
+    A grid uniform to rounding (every t_k within ``8u max(abs(t[0]), abs(t[-1]))`` of evenly
+    spaced times, as ``numpy.linspace`` and ``numpy.arange`` make) is integrated with its one
+    step, one exponential for the whole horizon.
 
     Parameters
     ----------
