@@ -348,11 +348,11 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
 
 @pytest.mark.parametrize(
     "work",
-    # (setup, work on what setup made): the timer starts after the setup. The longest step
-    # that cannot be interrupted is the Hessenberg reduction of the Schur form (faer's, one
-    # call): about 0.5 s at n = 1200 on this 2-core machine, 1.1 s at n = 1500, where a CI
-    # host slower by half put the latency at 1.2-1.5 s. Order 1200 keeps the Schur form and the
-    # Lyapunov solve long enough (about 2 s) that the interrupt lands mid-work.
+    # (setup, work on what setup made): the timer starts after the setup. Order 1200 keeps the
+    # Schur form and the Lyapunov solve long enough (about 2 s) that the interrupt lands
+    # mid-work. At n = 2500 the interrupt lands in the Hessenberg reduction of the eigenvalues
+    # (about 4 s here), which stops between panels of 24 columns; it was one uninterruptible
+    # call of faer's, whose latency grew as n^3 (1.1 s at n = 1500).
     [
         "(lambda: rng.standard_normal((1200, 1200)), aerocontrol.schur)",
         "(lambda: np.geomspace(1e-3, 10, 2_000_000), lambda c: aerocontrol.batch.lqr_sweep("
@@ -360,8 +360,9 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "(lambda: rng.standard_normal((1_000_000, 6, 6)), aerocontrol.expm)",
         "(lambda: rng.standard_normal((1200, 1200)) - 40 * np.eye(1200), "
         "lambda a: aerocontrol.solve_lyapunov(a, np.eye(1200)))",
+        "(lambda: rng.standard_normal((2500, 2500)), aerocontrol.linalg.eigenvalues)",
     ],
-    ids=["schur n=1200", "lqr_sweep 2e6", "expm stack 1e6", "lyapunov n=1200"],
+    ids=["schur n=1200", "lqr_sweep 2e6", "expm stack 1e6", "lyapunov n=1200", "eigenvalues n=2500"],
 )
 def test_ctrl_c_stops_a_long_computation_within_a_second(work: str) -> None:
     result = _child(_INTERRUPT.format(work=work))

@@ -24,7 +24,7 @@ use crate::control::discretize::{Discretization, Hold, discretize};
 use crate::control::frequency::check_state_space;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_positive};
 use crate::linalg::norm::{Inverse, one_norm_estimate, triangular_inverse_norm_bound};
-use crate::platform::dispatch::fma_dispatch;
+use crate::platform::dispatch::{DOT_LANES, dot_rows};
 use crate::platform::interrupt;
 use crate::platform::parallel::{ParallelContext, chunks, par_chunks};
 use faer::linalg::matmul::matmul;
@@ -105,96 +105,6 @@ fn row_major(m: MatRef<'_, f64>) -> Vec<f64> {
 /// matrix-vector products per step are faster (the product of a long, 4-column X with a 4 x 4
 /// C^T runs far below the speed of a square one).
 pub const OUTPUT_PRODUCT_MIN_ORDER: usize = 16;
-
-/// Independent partial sums of [`dot`]: enough to hide the latency of the additions and to
-/// fill the vector registers (a single running sum is one dependent addition per entry).
-const DOT_LANES: usize = 8;
-
-/// Σ a_i b_i, in [`DOT_LANES`] partial sums over the full chunks and one over the remainder.
-#[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut lanes = [0.0; DOT_LANES];
-    let (a_chunks, b_chunks) = (a.chunks_exact(DOT_LANES), b.chunks_exact(DOT_LANES));
-    let tail = dot_tail(a_chunks.remainder(), b_chunks.remainder());
-    for (x, y) in a_chunks.zip(b_chunks) {
-        for lane in 0..DOT_LANES {
-            lanes[lane] += x[lane] * y[lane];
-        }
-    }
-    dot_sum(&lanes, tail)
-}
-
-/// [`dot`] with its [`DOT_LANES`] partial sums in two AVX registers: the same operations in
-/// the same order, so the same bits, in a quarter of the arithmetic instructions.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn dot_avx2(a: &[f64], b: &[f64]) -> f64 {
-    use std::arch::x86_64::{
-        _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_storeu_pd,
-    };
-    const HALF: usize = DOT_LANES / 2;
-    let (a_chunks, b_chunks) = (a.chunks_exact(DOT_LANES), b.chunks_exact(DOT_LANES));
-    let tail = dot_tail(a_chunks.remainder(), b_chunks.remainder());
-    let (mut low, mut high) = (_mm256_setzero_pd(), _mm256_setzero_pd());
-    for (x, y) in a_chunks.zip(b_chunks) {
-        // SAFETY: x and y hold DOT_LANES = 2 HALF values each: both halves are in bounds
-        // (unaligned loads).
-        let (x_low, x_high, y_low, y_high) = unsafe {
-            (
-                _mm256_loadu_pd(x.as_ptr()),
-                _mm256_loadu_pd(x.as_ptr().add(HALF)),
-                _mm256_loadu_pd(y.as_ptr()),
-                _mm256_loadu_pd(y.as_ptr().add(HALF)),
-            )
-        };
-        low = _mm256_add_pd(low, _mm256_mul_pd(x_low, y_low));
-        high = _mm256_add_pd(high, _mm256_mul_pd(x_high, y_high));
-    }
-    let mut lanes = [0.0; DOT_LANES];
-    // SAFETY: lanes holds DOT_LANES = 2 HALF values: both stores are in bounds.
-    unsafe {
-        _mm256_storeu_pd(lanes.as_mut_ptr(), low);
-        _mm256_storeu_pd(lanes.as_mut_ptr().add(HALF), high);
-    }
-    dot_sum(&lanes, tail)
-}
-
-/// The single partial sum of [`dot`] over the entries past the last full chunk.
-#[inline(always)]
-fn dot_tail(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// The partial sums of [`dot`] added: lane i to lane i + DOT_LANES / 2, those in order, then
-/// the tail.
-#[inline(always)]
-fn dot_sum(lanes: &[f64; DOT_LANES], tail: f64) -> f64 {
-    let (low, high) = lanes.split_at(DOT_LANES / 2);
-    low.iter().zip(high).map(|(l, h)| l + h).sum::<f64>() + tail
-}
-
-/// out = M v (or out += M v when `accumulate`) for a row-major M of len(v) >= 1 columns, by
-/// [`dot`] per row; with AVX2 (the variant `fma_dispatch!` selects) by [`dot_avx2`], which
-/// gives the same bits.
-#[inline(always)]
-fn dot_rows_kernel<const FMA: bool>(matrix: &[f64], v: &[f64], out: &mut [f64], accumulate: bool) {
-    let row_dot = |row: &[f64]| {
-        #[cfg(target_arch = "x86_64")]
-        if FMA {
-            // SAFETY: the FMA variant runs only on CPUs with AVX2 and FMA (fma_dispatch!).
-            return unsafe { dot_avx2(row, v) };
-        }
-        dot(row, v)
-    };
-    let rows = out.iter_mut().zip(matrix.chunks_exact(v.len()));
-    if accumulate {
-        rows.for_each(|(o, row)| *o += row_dot(row));
-    } else {
-        rows.for_each(|(o, row)| *o = row_dot(row));
-    }
-}
-
-fma_dispatch!(fn dot_rows(matrix: &[f64], v: &[f64], out: &mut [f64], accumulate: bool) => dot_rows_kernel);
 
 impl Recurrence {
     fn new(d: &Discretization, c: MatRef<'_, f64>, dd: MatRef<'_, f64>) -> Self {
@@ -636,46 +546,6 @@ const SINGULAR_EIGENVALUE: f64 = 100.0;
 mod tests {
     use super::*;
     use faer::mat;
-
-    /// The AVX2 dot product gives the bits of the portable one, whatever the length (full
-    /// chunks and a tail), signs of zero and magnitudes, and so do both variants of dot_rows.
-    #[test]
-    fn dot_variants_agree_bitwise() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let unit = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-            // Magnitudes over 2^-40 .. 2^40, a zero of either sign now and then.
-            match state % 17 {
-                0 => 0.0,
-                1 => -0.0,
-                k => unit * 2f64.powi((k as i32 - 8) * 5),
-            }
-        };
-        for len in 0..70 {
-            for _ in 0..20 {
-                let a: Vec<f64> = (0..len).map(|_| next()).collect();
-                let b: Vec<f64> = (0..len).map(|_| next()).collect();
-                let portable = dot(&a, &b);
-                #[cfg(target_arch = "x86_64")]
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    // SAFETY: the CPU has AVX2, checked just above.
-                    let wide = unsafe { dot_avx2(&a, &b) };
-                    assert_eq!(wide.to_bits(), portable.to_bits(), "length {len}");
-                }
-                if len == 0 {
-                    continue;
-                }
-                let matrix: Vec<f64> = [a.clone(), b.clone()].concat();
-                let mut rows = [1.0, 2.0];
-                dot_rows(&matrix, &b, &mut rows, true);
-                assert_eq!(rows[0].to_bits(), (1.0 + dot(&a, &b)).to_bits());
-                assert_eq!(rows[1].to_bits(), (2.0 + dot(&b, &b)).to_bits());
-            }
-        }
-    }
 
     /// `values` as initial states of order n, one per row.
     fn states(values: &[f64], n: usize) -> MatRef<'_, f64> {

@@ -32,7 +32,7 @@ pub fn charpoly(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
     check_square(a, "A")?;
     check_finite(a, "A")?;
     let (mut coefficients, scale) = with_order!(a.nrows(), order => {
-        let (h, scale) = balanced_hessenberg(from_faer_in(order, a));
+        let (h, scale) = balanced_hessenberg(from_faer_in(order, a))?;
         (hessenberg_characteristic_polynomial(&h), scale)
     });
     // H is similar to A / s: a_k(A) = s^k a_k(A / s), exactly for s a power of two.

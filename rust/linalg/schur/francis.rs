@@ -480,9 +480,10 @@ pub(super) fn hamiltonian_estimates<O: Order>(h: &Square<O>) -> Vec<c64> {
                     companion[(j + 1, j)] = 1.0;
                 }
             }
-            let (mut companion, scale) = balanced_hessenberg(companion);
-            francis_qr(&mut companion, None, (0, order - 1), false, Spectrum::General)
-                .map(|()| block_eigenvalues(order, |i, j| companion[(i, j)] * scale))
+            balanced_hessenberg(companion).and_then(|(mut companion, scale)| {
+                francis_qr(&mut companion, None, (0, order - 1), false, Spectrum::General)
+                    .map(|()| block_eigenvalues(order, |i, j| companion[(i, j)] * scale))
+            })
         }),
     };
     match roots {

@@ -13,8 +13,8 @@
 //!
 //! # Algorithm
 //!
-//! A is first reduced to upper Hessenberg form H = Q^T A Q ([`crate::linalg::hessenberg`], faer's blocked
-//! Householder reduction). The QR iteration then works on the active window H[l..=i, l..=i]
+//! A is first reduced to upper Hessenberg form H = Q^T A Q ([`crate::linalg::hessenberg`], a
+//! blocked Householder reduction). The QR iteration then works on the active window H[l..=i, l..=i]
 //! between negligible subdiagonal entries (the deflation test of Ahues & Tisseur, as in LAPACK's
 //! small-matrix QR, which declares h_{k,k-1} negligible only when doing so perturbs the
 //! eigenvalues of the neighbouring 2 x 2 block by at most u times their size). Each step is an
@@ -151,7 +151,7 @@ pub fn schur_form_eigenvalues(a: MatRef<'_, f64>) -> Result<Vec<c64>, Error> {
 /// [`real_schur_with`] of a matrix held as a [`Square`] (as the Riccati solver builds its
 /// Hamiltonian), possibly partial (see [`Until`]; up to [`UNBLOCKED_HESSENBERG_MAX_ORDER`]):
 /// checked finite, scaled into range, reduced by the unblocked Hessenberg reduction and the
-/// double-shift iteration at the order type of `a` up to that order, by faer's blocked
+/// double-shift iteration at the order type of `a` up to that order, by the blocked
 /// reduction and the QR iteration of [`schur_of_hessenberg`] above it.
 pub(crate) fn square_real_schur<O: Order>(
     a: Square<O>,
@@ -235,7 +235,7 @@ fn schur_form_in<O: Order>(
                 Some(from_faer(reduced.q.as_ref())),
             )
         } else {
-            (from_faer(hessenberg_matrix(a.as_faer()).as_ref()), None)
+            (from_faer(hessenberg_matrix(a.as_faer())?.as_ref()), None)
         };
         schur_of_hessenberg(&mut t, z.as_mut(), full, spectrum)?;
         let t = from_faer_in(order, t.as_faer());
@@ -286,7 +286,7 @@ fn eigenvalues_with(a: MatRef<'_, f64>, spectrum: Spectrum<'_>) -> Result<Vec<c6
         })
     } else {
         let (mut h, scale, _) = balanced(from_faer(a));
-        reduce_in_place(&mut h);
+        reduce_in_place(&mut h)?;
         schur_of_hessenberg(&mut h, None, false, unscaled(scale))?;
         Ok(form_eigenvalues(&h, scale, None))
     }
@@ -303,7 +303,7 @@ fn unblocked_eigenvalues<O: Order>(
 ) -> Result<Vec<c64>, Error> {
     let n = b.nrows();
     let mut h = b.clone();
-    reduce_in_place(&mut h);
+    reduce_in_place(&mut h)?;
     francis_qr(&mut h, None, (0, n.saturating_sub(1)), false, spectrum)?;
     Ok(form_eigenvalues(&h, scale, Some((&b, graded))))
 }
@@ -402,7 +402,7 @@ mod tests {
     /// for the multishift iteration.
     fn double_shift_eigenvalues(a: &Mat<f64>) -> Vec<c64> {
         let n = a.nrows();
-        let mut h = from_faer(hessenberg_matrix(a.as_ref()).as_ref());
+        let mut h = from_faer(hessenberg_matrix(a.as_ref()).unwrap().as_ref());
         francis_qr(&mut h, None, (0, n - 1), false, Spectrum::General).unwrap();
         block_eigenvalues(n, |i, j| h[(i, j)])
     }
