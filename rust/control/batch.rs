@@ -253,8 +253,10 @@ pub fn batch_count(lengths: &[(&'static str, usize)]) -> Result<usize, Error> {
 /// A matrix's entries, row by row.
 fn write_row_major(matrix: &DMatrix<f64>, out: &mut [f64]) {
     let cols = matrix.ncols();
-    for (index, x) in out.iter_mut().enumerate() {
-        *x = matrix[(index / cols, index % cols)];
+    for (i, row) in out.chunks_exact_mut(cols.max(1)).enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = matrix[(i, j)];
+        }
     }
 }
 

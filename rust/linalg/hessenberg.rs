@@ -335,7 +335,18 @@ pub(crate) fn reduce_to_hessenberg<O: Order>(h: &mut Square<O>, mut q: Option<&m
             continue;
         }
         w[0] = 1.0;
-        h.reflect_rows(k + 1, w, tau, k + 1..n);
+        // The short reflectors of the small orders with their length a constant, so that
+        // each column's product unrolls (the same operations: w_0 = 1 is not multiplied).
+        let columns = k + 1..n;
+        match length {
+            2 => h.reflect_rows_fixed::<2>(k + 1, fixed(w), tau, columns),
+            3 => h.reflect_rows_fixed::<3>(k + 1, fixed(w), tau, columns),
+            4 => h.reflect_rows_fixed::<4>(k + 1, fixed(w), tau, columns),
+            5 => h.reflect_rows_fixed::<5>(k + 1, fixed(w), tau, columns),
+            6 => h.reflect_rows_fixed::<6>(k + 1, fixed(w), tau, columns),
+            7 => h.reflect_rows_fixed::<7>(k + 1, fixed(w), tau, columns),
+            _ => h.reflect_rows(k + 1, w, tau, columns),
+        }
         h.reflect_columns(k + 1, w, tau, 0..n);
         h[(k + 1, k)] = beta;
         for r in k + 2..n {
@@ -345,6 +356,12 @@ pub(crate) fn reduce_to_hessenberg<O: Order>(h: &mut Square<O>, mut q: Option<&m
             q.reflect_columns(k + 1, w, tau, 0..n);
         }
     }
+}
+
+/// The first `L` entries of `w` as an array.
+#[inline(always)]
+fn fixed<const L: usize>(w: &[f64]) -> [f64; L] {
+    std::array::from_fn(|r| w[r])
 }
 
 #[cfg(test)]

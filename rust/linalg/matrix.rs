@@ -277,6 +277,26 @@ impl<O: Order> Transformations for Square<O> {
         const CHUNK: usize = 32;
         let n = self.nrows();
         let columns = &mut self.as_mut_slice()[k * n..(k + w.len()) * n];
+        if O::FIXED && n <= CHUNK && rows == (0..n) {
+            // Every row at a compile-time order: one chunk of constant length, whose loops
+            // unroll (the same operations on each entry as below).
+            let mut y = [0.0; CHUNK];
+            let y = &mut y[..n];
+            for (column, v) in columns.chunks_exact(n).zip(w) {
+                for (sum, x) in y.iter_mut().zip(column) {
+                    *sum += v * x;
+                }
+            }
+            for sum in y.iter_mut() {
+                *sum *= tau;
+            }
+            for (column, v) in columns.chunks_exact_mut(n).zip(w) {
+                for (x, scaled) in column.iter_mut().zip(y.iter()) {
+                    *x -= scaled * v;
+                }
+            }
+            return;
+        }
         let mut start = rows.start;
         while start < rows.end {
             let chunk = start..(start + CHUNK).min(rows.end);
