@@ -514,3 +514,26 @@ def test_set_at_once_builds_what_the_dataclass_builds() -> None:
         type(margins)(*values, 1)
     with pytest.raises(dataclasses.FrozenInstanceError):
         margins.gain_margin = 1.0  # type: ignore[misc]
+
+
+def test_from_fields_builds_what_the_dataclass_builds() -> None:
+    """stability_margins builds its result by ``from_fields`` (the dict literal becomes the
+    instance's __dict__): on continuous loops of each kind (crossovers or none, an integrator,
+    an unstable open loop, unit feedthrough: the eigenvalue path, and a discrete one: the grid
+    path) its keys are exactly the dataclass's fields, it equals the result built by the
+    generated parameters, and stays frozen."""
+    loops = [
+        aerocontrol.zpk([], [0.0, -1.0, -2.0], 2.0),
+        aerocontrol.zpk([], [-1.0, -2.0], 0.1),
+        aerocontrol.zpk([-1.0], [1.0, -3.0], 4.0),
+        aerocontrol.tf([1.0, 2.0], [1.0, 3.0]),
+        aerocontrol.StateSpace([[0.5]], [[1.0]], [[0.3]], [[0.0]], dt=0.1),
+    ]
+    for loop in loops:
+        margins = aerocontrol.stability_margins(loop)
+        names = [f.name for f in dataclasses.fields(margins)]
+        assert list(vars(margins)) == names
+        rebuilt = type(margins)(**{n: getattr(margins, n) for n in names})
+        assert rebuilt == margins
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            margins.gain_margin = 1.0  # type: ignore[misc]

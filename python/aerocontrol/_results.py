@@ -37,6 +37,7 @@ __all__ = [
     "field_names",
     "format_complex",
     "format_number",
+    "from_fields",
     "html_table",
     "markdown_table",
     "register",
@@ -565,6 +566,18 @@ def set_at_once(cls: type[T]) -> type[T]:
     __init__.__doc__ = cls.__init__.__doc__
     cls.__init__ = __init__  # type: ignore[method-assign]
     return cls
+
+
+def from_fields(cls: type[T], fields: dict[str, Any]) -> T:
+    """An instance of the :func:`set_at_once` dataclass ``cls`` whose ``__dict__`` is the
+    dict ``fields`` itself, which must hold every field by name and nothing else (not
+    checked here: each caller's tests compare its keys with the fields). For a result built
+    on every call of a fast function from a dict literal: what ``cls(**fields)`` does by the
+    generated ``__init__``, without packing and comparing the keyword arguments (about 1 µs
+    of 2 for eighteen fields)."""
+    instance = object.__new__(cls)
+    object.__setattr__(instance, "__dict__", fields)
+    return instance
 
 
 def attach(cls: type, names: tuple[str, ...]) -> None:

@@ -102,7 +102,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core
 from ._balance import balanced_matrix, balanced_states
-from ._results import Result, Tabular, set_at_once
+from ._results import Result, Tabular, from_fields, set_at_once
 from ._validation import FloatArray, check_finite, finite_or_warn, real_array, real_scalar
 from .exceptions import (
     AerocontrolLinAlgError,
@@ -1104,25 +1104,28 @@ def _assemble(
         delay, alpha = 0.0, 0.0
     else:
         alpha = 1.0 / disk[1] if disk[1] > 0 else math.inf
-    return StabilityMargins(
-        gain_margin=gm,
-        phase_crossover=w_gm,
-        phase_margin=pm,
-        gain_crossover=w_pm,
-        delay_margin=delay,
-        disk_margin=alpha,
-        disk_frequency=disk[0],
-        stability_margin=stability[1],
-        stability_frequency=stability[0],
-        gain_margins=array[:g],
-        phase_crossovers=array[g : 2 * g],
-        phase_margins=array[2 * g : 2 * g + c],
-        gain_crossovers=array[2 * g + c : 2 * g + 2 * c],
-        delay_margins=array[2 * g + 2 * c :],
-        closed_loop_poles=closed,
-        closed_loop_stable=stable,
-        open_loop_unstable_poles=unstable_open,
-        encirclements=unstable_open - unstable_closed,
+    return from_fields(
+        StabilityMargins,
+        {
+            "gain_margin": gm,
+            "phase_crossover": w_gm,
+            "phase_margin": pm,
+            "gain_crossover": w_pm,
+            "delay_margin": delay,
+            "disk_margin": alpha,
+            "disk_frequency": disk[0],
+            "stability_margin": stability[1],
+            "stability_frequency": stability[0],
+            "gain_margins": array[:g],
+            "phase_crossovers": array[g : 2 * g],
+            "phase_margins": array[2 * g : 2 * g + c],
+            "gain_crossovers": array[2 * g + c : 2 * g + 2 * c],
+            "delay_margins": array[2 * g + 2 * c :],
+            "closed_loop_poles": closed,
+            "closed_loop_stable": stable,
+            "open_loop_unstable_poles": unstable_open,
+            "encirclements": unstable_open - unstable_closed,
+        },
     )
 
 

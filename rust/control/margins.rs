@@ -351,9 +351,11 @@ fn axis_candidates(values: &[c64]) -> Vec<f64> {
 /// Relative correction below which the secant method stops without evaluating the next point.
 const SECANT_TOLERANCE: f64 = 1e-13;
 
-/// The secant method on f(ω) = objective(L(jω)) from ω0, at most 12 steps, staying within
-/// 1e-3 of ω0 (relative), until a step is within 4u of ω or the next correction of the best
-/// point is within [`SECANT_TOLERANCE`] of it; returns the point of smallest |f| met (not
+/// The secant method on f(ω) = objective(L(jω)) from ω0 (its first step through
+/// ω0 (1 + 1e-7) and ω0, the later point), at most 12 steps, staying within 1e-3 of ω0
+/// (relative), until a step is within 4u of ω or the next correction of the best point is
+/// within [`SECANT_TOLERANCE`] of it (an accurate ω0 takes two values); returns the point of
+/// smallest |f| met (not
 /// below 0) and L there (the value already evaluated, or L(0) where the best point was
 /// negative).
 fn secant(
@@ -366,12 +368,14 @@ fn secant(
         (objective(value), value)
     };
     let step = if omega > 0.0 { 1e-7 * omega } else { 1e-7 };
-    let ((mut f0, v0), (mut f1, v1)) = (f(omega), f(omega + step));
-    let (mut x0, mut x1) = (omega, omega + step);
-    let (mut best, mut best_f, mut best_value) = if f1.abs() < f0.abs() {
-        (x1, f1, v1)
+    let ((fa, va), (fb, vb)) = (f(omega), f(omega + step));
+    // ω itself is the later point: where the first correction of it is below the tolerance,
+    // the candidate is already the root to that accuracy and no third value is needed.
+    let (mut x0, mut f0, mut x1, mut f1) = (omega + step, fb, omega, fa);
+    let (mut best, mut best_f, mut best_value) = if fb.abs() < fa.abs() {
+        (x0, fb, vb)
     } else {
-        (x0, f0, v0)
+        (x1, fa, va)
     };
     if !best_f.is_finite() {
         return (
