@@ -362,7 +362,13 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "lambda a: aerocontrol.solve_lyapunov(a, np.eye(1200)))",
         "(lambda: rng.standard_normal((2500, 2500)), aerocontrol.linalg.eigenvalues)",
     ],
-    ids=["schur n=1200", "lqr_sweep 2e6", "expm stack 1e6", "lyapunov n=1200", "eigenvalues n=2500"],
+    ids=[
+        "schur n=1200",
+        "lqr_sweep 2e6",
+        "expm stack 1e6",
+        "lyapunov n=1200",
+        "eigenvalues n=2500",
+    ],
 )
 def test_ctrl_c_stops_a_long_computation_within_a_second(work: str) -> None:
     result = _child(_INTERRUPT.format(work=work))
