@@ -7,7 +7,7 @@
 //! its root locus over 1000 gains (root_locus) at n = 4, 8 and 16, and the transfer functions
 //! of every channel of two-input, two-output models (transfer_channels) at n = 4, 8 and 16.
 
-use aerocontrol::control::controllability::{controllability_staircase, ctrb, obsv};
+use aerocontrol::control::controllability::{controllability_staircase, ctrb, obsv_transposed};
 use aerocontrol::control::margins::loop_margins;
 use aerocontrol::control::modal::modal_analysis;
 use aerocontrol::control::placement::companion_form;
@@ -48,7 +48,7 @@ fn spectra(c: &mut Criterion) {
             bench.iter(|| ctrb(black_box(a.as_ref()), b.as_ref()))
         });
         group.bench_with_input(BenchmarkId::new("obsv", n), &a, |bench, a| {
-            bench.iter(|| obsv(black_box(a.as_ref()), c_out.as_ref()))
+            bench.iter(|| obsv_transposed(black_box(a.as_ref()), c_out.as_ref()))
         });
         group.bench_with_input(BenchmarkId::new("staircase verdict", n), &a, |bench, a| {
             bench.iter(|| controllability_staircase(black_box(a.as_ref()), b.as_ref(), None, false))

@@ -7,7 +7,7 @@ use super::errors::to_py_err;
 use super::modal::eigen_cost;
 use crate::control::controllability::{
     Controllability, controllability as controllability_core, ctrb, is_controllable, is_observable,
-    observability as observability_core, obsv,
+    observability as observability_core, obsv_transposed,
 };
 use numpy::PyArrayDyn;
 use pyo3::prelude::*;
@@ -46,14 +46,25 @@ fn krylov_matrix<'py>(
         bytes: 0.0,
         order: n.max(width),
     };
-    let matrix = compute(py, cost, || if dual { obsv(a, b) } else { ctrb(a, b) })?;
+    let matrix = compute(py, cost, || {
+        if dual {
+            obsv_transposed(a, b)
+        } else {
+            ctrb(a, b)
+        }
+    })?;
+    let matrix = if dual {
+        matrix.transpose()
+    } else {
+        matrix.as_ref()
+    };
     let mut outputs = Outputs::new(py);
     let name = if dual {
         "the observability matrix"
     } else {
         "the controllability matrix"
     };
-    let out = outputs.matrix(name, matrix.as_ref())?;
+    let out = outputs.matrix(name, matrix)?;
     outputs.finish()?;
     Ok(out)
 }

@@ -104,12 +104,13 @@ fn check_output_pair(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<(), Error
     check_finite(c, "C")
 }
 
-/// The observability matrix [C; CA; CA^2; ...; CA^{n-1}] (6.89), np x n.
-pub fn obsv(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+/// The transpose of the observability matrix [C; CA; CA^2; ...; CA^{n-1}] (6.89): the
+/// n x np matrix [C^T A^T C^T ...], whose transpose view is the observability matrix. Its
+/// column-major storage is the observability matrix's row-major one, so a caller that writes
+/// row-major (a numpy array) copies it contiguously instead of transposing it twice.
+pub fn obsv_transposed(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
     check_output_pair(a, c)?;
-    Ok(krylov_blocks(a.transpose(), c.transpose())
-        .transpose()
-        .to_owned())
+    Ok(krylov_blocks(a.transpose(), c.transpose()))
 }
 
 /// [B AB ... A^{n-1}B] for checked arguments. Each block is the product of A with the
@@ -727,8 +728,8 @@ mod tests {
     fn observability_is_the_dual() {
         let a = mat![[-3.0, 8.0], [0.0, 0.0]];
         let c = mat![[1.0, 0.0]];
-        let o = obsv(a.as_ref(), c.as_ref()).unwrap();
-        assert_eq!(o, mat![[1.0, 0.0], [-3.0, 8.0]]);
+        let o = obsv_transposed(a.as_ref(), c.as_ref()).unwrap();
+        assert_eq!(o.transpose(), mat![[1.0, 0.0], [-3.0, 8.0]]);
         assert!(
             observability_staircase(a.as_ref(), c.as_ref(), None, true)
                 .unwrap()
