@@ -199,7 +199,9 @@ def _placement_arguments(
     A_or_sys: ArrayLike | System, B: ArrayLike | None, poles: ArrayLike | None
 ) -> tuple[FloatArray, FloatArray, ArrayLike]:
     """(A, B, poles) of ``place*(A, B, poles)`` or ``place*(sys, poles)``: A and B read as
-    matrices (a 1-D B a column), the poles as a vector (:func:`_poles`)."""
+    matrices (a 1-D B a column), the poles as a vector (:func:`_poles`). The core calls this
+    for any call but the common one, of two 2-D float64 arrays and the poles as a sequence or
+    a vector, which it reads as given."""
     A: ArrayLike
     B_matrix: ArrayLike
     if poles is not None and is_float_matrix(A_or_sys) and is_float_matrix(B):
@@ -269,8 +271,7 @@ def place_bass_gura(
     >>> np.round(design.k, 5)                                # (6.102)
     array([16.49844,  8.0875 ])
     """
-    A, B_matrix, requested = _placement_arguments(A_or_sys, b, poles)
-    return _core.place(A, B_matrix, requested, "bass-gura")
+    return _core.place(A_or_sys, b, poles, "bass-gura")
 
 
 def place_ackermann(
@@ -327,8 +328,7 @@ def place_ackermann(
     >>> design.k
     array([28.,  8.])
     """
-    A, B_matrix, requested = _placement_arguments(A_or_sys, b, poles)
-    return _core.place(A, B_matrix, requested, "ackermann")
+    return _core.place(A_or_sys, b, poles, "ackermann")
 
 
 def place(
@@ -383,8 +383,7 @@ def place(
     >>> design.K.shape, bool(design.max_relative_error < 1e-12)
     ((2, 4), True)
     """
-    A, B_matrix, requested = _placement_arguments(A_or_sys, B, poles)
-    return _core.place(A, B_matrix, requested, "knv0")
+    return _core.place(A_or_sys, B, poles, "knv0")
 
 
 @dataclass(frozen=True, eq=False)

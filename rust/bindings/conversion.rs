@@ -35,7 +35,7 @@ static REAL_ARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
 /// `aerocontrol.placement._poles`.
 static POLES: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
 
-fn python_function<'py>(
+pub(crate) fn python_function<'py>(
     py: Python<'py>,
     cell: &'static PyOnceLock<Py<PyAny>>,
     module: &str,

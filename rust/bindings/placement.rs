@@ -1,7 +1,7 @@
 //! Bindings of `aerocontrol.placement`: the companion form and pole placement.
 
 use super::compute::{Cost, compute};
-use super::conversion::{Complex, Outputs, Real};
+use super::conversion::{Complex, Outputs, Real, python_function};
 use super::errors::{Class, raise, to_py_err, warn};
 use crate::control::batch::Placer;
 use crate::control::placement::{
@@ -10,7 +10,9 @@ use crate::control::placement::{
 };
 use crate::error::Error;
 use faer::c64;
-use numpy::{PyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArrayDyn, PyUntypedArray, PyUntypedArrayMethods};
+use pyo3::PyTypeInfo;
+use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyDict, PyFloat, PyString, PyType};
@@ -115,6 +117,34 @@ struct PlacementResult {
     /// κ_2(X) of the closed-loop eigenvectors for the robust method, NaN otherwise.
     #[pyo3(get)]
     eigenvector_condition: f64,
+}
+
+/// `aerocontrol.placement._placement_arguments`: (A, B, poles) of a call that is not read as
+/// given ([`read_as_given`]): a system, lists, a 1-D B, poles as a column.
+static PLACEMENT_ARGUMENTS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+
+/// Whether `place*(A, B, poles)` is the common call, read as given: A and B 2-D float64 numpy
+/// arrays (exactly ndarray, any memory layout: the conversion copies it) and the poles given,
+/// other than a complex array of more or fewer than one dimension (which `_poles` reads as
+/// python-control does). Deciding here rather than in Python saves the wrapper's test.
+fn read_as_given(
+    py: Python<'_>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
+    poles: &Bound<'_, PyAny>,
+) -> bool {
+    let ndarray = PyUntypedArray::type_object(py);
+    let matrix = |x: &Bound<'_, PyAny>| {
+        x.get_type().is(&ndarray)
+            && x.cast::<PyArrayDyn<f64>>()
+                .is_ok_and(|array| array.ndim() == 2)
+    };
+    matrix(a)
+        && matrix(b)
+        && !poles.is_none()
+        && poles
+            .cast::<PyArrayDyn<c64>>()
+            .map_or(true, |array| array.ndim() == 1)
 }
 
 /// `aerocontrol.placement._describe`, the text of a design (`str`).
@@ -277,6 +307,20 @@ fn place<'py>(
     method: &str,
 ) -> PyResult<Bound<'py, PlacementResult>> {
     let placer = placer_for(py, method)?;
+    let read;
+    let (a, b, poles) = if read_as_given(py, a, b, poles) {
+        (a, b, poles)
+    } else {
+        read = python_function(
+            py,
+            &PLACEMENT_ARGUMENTS,
+            "aerocontrol.placement",
+            "_placement_arguments",
+        )?
+        .call1((a, b, poles))?
+        .extract::<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)>()?;
+        (&read.0, &read.1, &read.2)
+    };
     let (a, b) = (Real::convert(py, a, "A")?, Real::convert(py, b, "B")?);
     let poles = Complex::poles(py, poles)?;
     let (a, b) = (|| {
@@ -301,10 +345,14 @@ fn place<'py>(
     let requested = &poles.values;
     let cost = placement_cost(method, a.nrows(), b.ncols());
     let design = compute(py, cost, || placer(a, b, requested))?;
+    // The method's name, interned once per process (PyString::intern hashes it per call).
     let (name, measure) = match method {
-        "bass-gura" => ("Bass-Gura", "controllability matrix"),
-        "ackermann" => ("Ackermann", "controllability matrix"),
-        _ => ("Kautsky-Nichols-Van Dooren", "closed-loop eigenvector"),
+        "bass-gura" => (intern!(py, "Bass-Gura"), "controllability matrix"),
+        "ackermann" => (intern!(py, "Ackermann"), "controllability matrix"),
+        _ => (
+            intern!(py, "Kautsky-Nichols-Van Dooren"),
+            "closed-loop eigenvector",
+        ),
     };
     let (error, condition) = match method {
         "knv0" => (design.max_relative_error, design.eigenvector_condition),
@@ -324,7 +372,7 @@ fn place<'py>(
         max_relative_error: design.max_relative_error,
         iterations: design.iterations,
         converged: design.converged,
-        method: PyString::intern(py, name).unbind(),
+        method: name.clone().unbind(),
         controllability_condition: design.controllability_condition,
         eigenvector_condition: design.eigenvector_condition,
     };

@@ -493,13 +493,8 @@ fn finish(
     let mut max_relative_error = 0.0f64;
     for &pole in &poles {
         // Greedy matching: the nearest eigenvalue not yet taken.
-        let (nearest, distance) = computed
-            .iter()
-            .enumerate()
-            .filter(|&(k, _)| !taken[k])
-            .map(|(k, &value)| (k, (value - pole).norm()))
-            .min_by(|x, y| x.1.total_cmp(&y.1))
-            .expect("as many eigenvalues as poles");
+        let nearest = nearest_untaken(&computed, &taken, pole);
+        let distance = (computed[nearest] - pole).norm();
         taken[nearest] = true;
         achieved_poles.push(computed[nearest]);
         // Relative to the pole; a pole below u ||A - B K||_F (which no design places more
@@ -526,6 +521,34 @@ fn finish(
         eigenvector_condition,
         method,
     })
+}
+
+/// The index of the value not yet taken nearest to `target` (the first of equally near ones).
+/// Distances are compared by their squares when every square is a normal number (the same
+/// order up to a rounding of the squares, without a hypot per pair), and by the distances
+/// themselves when a square over- or underflows.
+fn nearest_untaken(values: &[c64], taken: &[bool], target: c64) -> usize {
+    let mut best = (usize::MAX, f64::INFINITY);
+    for (k, &value) in values.iter().enumerate() {
+        if taken[k] {
+            continue;
+        }
+        let square = (value - target).norm_sqr();
+        if !square.is_normal() {
+            return values
+                .iter()
+                .enumerate()
+                .filter(|&(k, _)| !taken[k])
+                .map(|(k, &value)| (k, (value - target).norm()))
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .expect("a value not yet taken")
+                .0;
+        }
+        if square < best.1 || best.0 == usize::MAX {
+            best = (k, square);
+        }
+    }
+    best.0
 }
 
 /// The error of a design whose gain or closed loop overflows double precision.
