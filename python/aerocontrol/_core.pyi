@@ -50,6 +50,8 @@ __all__ = [
     "krylov_matrix",
     "loop_margins",
     "loop_root_locus",
+    "max_cycle_mean",
+    "max_plus",
     "modal_analysis",
     "mode_levels",
     "mode_quantities",
@@ -246,6 +248,8 @@ def frequency_response(
     dt: float | None = None,
     /,
 ) -> NDArray[np.complex128]: ...
+def max_cycle_mean(g: ArrayLike, /) -> float: ...
+def max_plus(p: ArrayLike, q: ArrayLike, /) -> NDArray[np.float64]: ...
 def modal_analysis(a: ArrayLike, b: ArrayLike | None, vectors: bool, /) -> dict[str, Any]: ...
 def krylov_matrix(a: ArrayLike, b: ArrayLike, dual: bool, /) -> NDArray[np.float64]: ...
 def controllability(

@@ -54,11 +54,9 @@ def log2_sizes(M: NDArray[np.floating[Any]]) -> FloatArray:
 def max_plus(P: FloatArray, Q: FloatArray) -> FloatArray:
     """The (max, +) product of two matrices of log2 sizes: entry (i, j) is max_k P[i, k] +
     Q[k, j], the log2 of the largest term of the product of the matrices they measure
-    (-inf where every term is zero, also for an inner dimension of 0)."""
-    if P.shape[1] == 0 or P.shape[0] == 0 or Q.shape[1] == 0:
-        return np.full((P.shape[0], Q.shape[1]), -math.inf)
-    with np.errstate(invalid="ignore"):  # -inf + inf cannot occur: the sizes are finite or -inf
-        return np.asarray(np.max(P[:, :, None] + Q[None, :, :], axis=1), dtype=np.float64)
+    (-inf where every term is zero, also for an inner dimension of 0). In the core: O(rows x
+    inner x columns) work in the memory of the result."""
+    return _core.max_plus(P, Q)
 
 
 def largest_scaled(G: FloatArray, exponents: FloatArray) -> float:
@@ -70,23 +68,9 @@ def largest_scaled(G: FloatArray, exponents: FloatArray) -> float:
 
 def max_cycle_mean(G: FloatArray) -> float:
     """The largest mean of G over a cycle of the graph (-inf for a graph without cycles), by
-    Karp's algorithm: with D_k(v) the largest weight of a walk of k edges ending at v,
-    max_v min_k (D_N(v) - D_k(v)) / (N - k)."""
-    N = G.shape[0]
-    if N == 0:
-        return -math.inf
-    walks = np.empty((N + 1, N))
-    walks[0] = 0.0
-    for k in range(1, N + 1):
-        walks[k] = np.max(walks[k - 1][:, None] + G, axis=0)
-    last = walks[N]
-    best = -math.inf
-    for v in np.flatnonzero(np.isfinite(last)):
-        earlier = walks[:N, v]
-        finite = np.isfinite(earlier)
-        lengths = N - np.arange(N)
-        best = max(best, float(np.min((last[v] - earlier[finite]) / lengths[finite])))
-    return best
+    Karp's algorithm in the core: with D_k(v) the largest weight of a walk of k edges ending at
+    v, max_v min_k (D_N(v) - D_k(v)) / (N - k)."""
+    return _core.max_cycle_mean(G)
 
 
 def _potentials(G: FloatArray, bound: float) -> FloatArray:

@@ -10,6 +10,7 @@ use crate::control::discretize::{
 };
 use crate::error::{Error, check_square};
 use crate::linalg::expm::{ILL_CONDITIONED_NORM, expm_into, pade_choice, transition_matrices_into};
+use crate::linalg::max_plus::{max_cycle_mean as max_cycle_mean_core, product as max_plus_product};
 use crate::linalg::norm::one_norm;
 use crate::linalg::qz::{
     GeneralizedEigenvalue, generalized_eigenvalues, qz as qz_core, reorder_qz,
@@ -540,7 +541,47 @@ fn qz<'py>(
     Ok(result)
 }
 
+/// The (max, +) product P ⊗ Q of two matrices of log2 sizes (`_scaling.max_plus`):
+/// entry (i, j) is max_k P[i, k] + Q[k, j].
+#[pyfunction]
+#[pyo3(signature = (p, q, /))]
+fn max_plus<'py>(
+    py: Python<'py>,
+    p: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let (p, q) = (Real::convert(py, p, "P")?, Real::convert(py, q, "Q")?);
+    let (p, q) = (
+        p.matrix().map_err(|e| to_py_err(py, e))?,
+        q.matrix().map_err(|e| to_py_err(py, e))?,
+    );
+    let work = (p.nrows() * p.ncols()) as f64 * q.ncols() as f64;
+    let cost = Cost::of(work, 2.0, p.nrows().max(q.ncols()));
+    let product = compute(py, cost, || max_plus_product(p, q))?;
+    // -inf entries are sizes of zeros, not overflows: written unchecked.
+    let out = new_array(py, &[product.nrows(), product.ncols()])?;
+    // SAFETY: `out` is new and not visible to Python until returned.
+    let data = unsafe { new_array_data(&out) };
+    MatMut::from_row_major_slice_mut(data, product.nrows(), product.ncols())
+        .copy_from(product.as_ref());
+    Ok(out)
+}
+
+/// The largest mean weight of a cycle of the graph of log2 sizes G
+/// (`_scaling.max_cycle_mean`), by Karp's algorithm; -inf without a cycle.
+#[pyfunction]
+#[pyo3(signature = (g, /))]
+fn max_cycle_mean(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let g = Real::convert(py, g, "G")?;
+    let g = g.matrix().map_err(|e| to_py_err(py, e))?;
+    let n = g.nrows();
+    let cost = Cost::of((n as f64).powi(3), 1.0, n);
+    compute(py, cost, || max_cycle_mean_core(g))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(max_plus, m)?)?;
+    m.add_function(wrap_pyfunction!(max_cycle_mean, m)?)?;
     m.add_function(wrap_pyfunction!(eigenvalues, m)?)?;
     m.add_function(wrap_pyfunction!(qz, m)?)?;
     m.add_function(wrap_pyfunction!(schur, m)?)?;
