@@ -35,10 +35,6 @@ from . import _core
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
-#: Sweeps of the max-balancing at most (each one pass over the states).
-SWEEPS = 100
-
-
 #: A diagonal balancing (of d2c's block matrix, of solve_lyapunov's A) is applied where its
 #: exponents span at least this many powers of two (states scaled apart by about 1e3 or
 #: more); below, it would change the results only by rounding.
@@ -59,13 +55,6 @@ def max_plus(P: FloatArray, Q: FloatArray) -> FloatArray:
     return _core.max_plus(P, Q)
 
 
-def largest_scaled(G: FloatArray, exponents: FloatArray) -> float:
-    """max_ij G[i, j] + e_j - e_i: the log2 of the largest entry under the scaling."""
-    if G.size == 0:
-        return -math.inf
-    return float(np.max(G + exponents[None, :] - exponents[:, None]))
-
-
 def max_cycle_mean(G: FloatArray) -> float:
     """The largest mean of G over a cycle of the graph (-inf for a graph without cycles), by
     Karp's algorithm in the core: with D_k(v) the largest weight of a walk of k edges ending at
@@ -73,79 +62,17 @@ def max_cycle_mean(G: FloatArray) -> float:
     return _core.max_cycle_mean(G)
 
 
-def _potentials(G: FloatArray, bound: float) -> FloatArray:
-    """Exponents with G[i, j] + e_j - e_i <= bound wherever the graph has no cycle of mean
-    above ``bound``: e_i the longest walk from i in G - bound (at least 0)."""
-    N = G.shape[0]
-    weights = G - bound
-    exponents = np.zeros(N)
-    for _ in range(N + 1):
-        longer = np.maximum(0.0, np.max(weights + exponents[None, :], axis=1))
-        if np.array_equal(longer, exponents):
-            break
-        exponents = longer
-    return exponents
-
-
-def _sweep(G: FloatArray, exponents: FloatArray, movable: int) -> bool:
-    """One pass of max-balancing over the nodes 0 .. movable - 1; True if an exponent moved.
-
-    Node i's row entries are G[i, j] + e_j - e_i and its column entries G[j, i] + e_i - e_j
-    (j != i); the best e_i makes the largest of each equal, and is taken (as an integer) only
-    where it lowers the largest entry of the node's row and column. A node with entries on one
-    side only brings their largest to the size of 1 (or to the largest entry of the graph, if
-    that is smaller), so that nothing is left far above or below the rest."""
-    changed = False
-    N = G.shape[0]
-    ceiling = min(0.0, largest_scaled(G, exponents))
-    for i in range(movable):
-        others = np.arange(N) != i
-        row = float(np.max(G[i, others] + exponents[others], initial=-math.inf))
-        column = float(np.max(G[others, i] - exponents[others], initial=-math.inf))
-        current = exponents[i]
-        if math.isfinite(row) and math.isfinite(column):
-            middle = (row - column) / 2.0
-            best, best_size = current, max(row - current, column + current)
-            for candidate in (math.floor(middle), math.ceil(middle)):
-                size = max(row - candidate, column + candidate)
-                if size < best_size:
-                    best, best_size = float(candidate), size
-        elif math.isfinite(row):
-            best = float(math.ceil(row - ceiling))
-        elif math.isfinite(column):
-            best = float(math.floor(ceiling - column))
-        else:
-            continue
-        if best != current:
-            exponents[i], changed = best, True
-    return changed
-
-
 def balancing_exponents(G: FloatArray, *, outside: bool) -> tuple[IntArray, float]:
     """Integer exponents e of the nodes of G that bring its largest scaled entry
     max_ij G[i, j] + e_j - e_i to the least value any scaling reaches (to within one, for the
-    rounding to integers), the others evened out below it; and that largest entry.
+    rounding to integers), the others evened out below it; and that largest entry. In the
+    core: the potentials of G minus its maximum cycle mean, then at most 100 sweeps of
+    max-balancing (see the module documentation).
 
     With ``outside`` the last node is the outside of the model (its exponent 0, left out of
     the answer); otherwise the exponents are centred on 0 (the scaling of a square matrix
     alone is unchanged by adding a constant to all of them)."""
-    N = G.shape[0]
-    if N == 0 or not np.any(np.isfinite(G)):
-        return np.zeros(N - 1 if outside else N, dtype=np.int64), -math.inf
-    movable = N - 1 if outside else N
-    least = max_cycle_mean(G)
-    if math.isfinite(least):
-        exponents = np.round(_potentials(G, least + 1e-9 * (1.0 + abs(least))))
-    else:  # no cycle: every entry can be made as small as wished; start unscaled
-        exponents = np.zeros(N)
-    if outside:
-        exponents -= exponents[-1]
-    for _ in range(SWEEPS):
-        if not _sweep(G, exponents, movable):
-            break
-    if not outside and movable:
-        exponents -= np.round((np.max(exponents) + np.min(exponents)) / 2.0)
-    return exponents[:movable].astype(np.int64), largest_scaled(G, exponents)
+    return _core.balancing_exponents(G, outside)
 
 
 def similarity(

@@ -10,7 +10,10 @@ use crate::control::discretize::{
 };
 use crate::error::{Error, check_square};
 use crate::linalg::expm::{ILL_CONDITIONED_NORM, expm_into, pade_choice, transition_matrices_into};
-use crate::linalg::max_plus::{max_cycle_mean as max_cycle_mean_core, product as max_plus_product};
+use crate::linalg::max_plus::{
+    balancing_exponents as balancing_exponents_core, max_cycle_mean as max_cycle_mean_core,
+    product as max_plus_product,
+};
 use crate::linalg::norm::one_norm;
 use crate::linalg::qz::{
     GeneralizedEigenvalue, generalized_eigenvalues, qz as qz_core, reorder_qz,
@@ -579,7 +582,28 @@ fn max_cycle_mean(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<f64> {
     compute(py, cost, || max_cycle_mean_core(g))
 }
 
+/// The max-balancing exponents of the graph of log2 sizes G and its largest scaled entry
+/// (`_scaling.balancing_exponents`).
+#[pyfunction]
+#[pyo3(signature = (g, outside, /))]
+fn balancing_exponents<'py>(
+    py: Python<'py>,
+    g: &Bound<'py, PyAny>,
+    outside: bool,
+) -> PyResult<(Bound<'py, PyArrayDyn<i64>>, f64)> {
+    let g = Real::convert(py, g, "G")?;
+    let g = g.matrix().map_err(|e| to_py_err(py, e))?;
+    let n = g.nrows();
+    let cost = Cost::of((n as f64).powi(3), 3.0, n);
+    let (exponents, largest) = compute(py, cost, || balancing_exponents_core(g, outside))?;
+    let out = new_array::<i64>(py, &[exponents.len()])?;
+    // SAFETY: `out` is new and not visible to Python until returned.
+    unsafe { new_array_data(&out) }.copy_from_slice(&exponents);
+    Ok((out, largest))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(balancing_exponents, m)?)?;
     m.add_function(wrap_pyfunction!(max_plus, m)?)?;
     m.add_function(wrap_pyfunction!(max_cycle_mean, m)?)?;
     m.add_function(wrap_pyfunction!(eigenvalues, m)?)?;

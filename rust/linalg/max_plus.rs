@@ -16,6 +16,14 @@
 //! D_k(v) = max_u D_{k-1}(u) + G[u, v]   (D_k = D_{k-1} ⊗ G).
 //! ```
 //!
+//! * [`balancing_exponents`]: integer exponents e of the nodes that bring the largest scaled
+//!   entry max_ij G[i, j] + e_j - e_i to the least value any scaling reaches (the maximum
+//!   cycle mean, to within one for the rounding to integers), the others evened out below it:
+//!   longest-walk potentials of G minus that mean (Bellman-Ford in the (max, +) algebra), then
+//!   sweeps in the manner of Osborne's balancing, each exponent in turn lowering the largest
+//!   entry of its row and column (the max-balancing of Schneider and Schneider, "Max-balancing
+//!   weighted directed graphs", Mathematics of Operations Research 16, 1991).
+//!
 //! Maxima and single sums are exact in floating point, so both results are the same bits as
 //! any evaluation order gives (numpy's included). Both cost O(N^3) at order N, work in O(N^2)
 //! memory, and answer Ctrl-C between rows or walk lengths.
@@ -63,6 +71,47 @@ fn raise_to_kernel<const FMA: bool>(row: &mut [f64], p: f64, q: &[f64]) {
 }
 
 fma_dispatch!(fn raise_to(row: &mut [f64], p: f64, q: &[f64]) => raise_to_kernel);
+
+/// Independent running maxima of [`largest_sum`]: enough to fill the vector registers.
+const LANES: usize = 8;
+
+/// max_j a[j] + b[j] (-inf for empty slices), or max_j a[j] - b[j] when `DIFFERENCE`, in
+/// [`LANES`] running maxima (maxima are exact: the same value in any order).
+#[inline(always)]
+fn largest_sum_kernel<const DIFFERENCE: bool, const FMA: bool>(a: &[f64], b: &[f64]) -> f64 {
+    let term = |x: f64, y: f64| if DIFFERENCE { x - y } else { x + y };
+    let mut lanes = [f64::NEG_INFINITY; LANES];
+    let (a_chunks, b_chunks) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
+    let tail = a_chunks
+        .remainder()
+        .iter()
+        .zip(b_chunks.remainder())
+        .fold(f64::NEG_INFINITY, |m, (&x, &y)| m.max(term(x, y)));
+    for (x, y) in a_chunks.zip(b_chunks) {
+        for lane in 0..LANES {
+            let value = term(x[lane], y[lane]);
+            lanes[lane] = if value > lanes[lane] {
+                value
+            } else {
+                lanes[lane]
+            };
+        }
+    }
+    lanes.iter().fold(tail, |m, &x| m.max(x))
+}
+
+#[inline(always)]
+fn largest_sum_of<const FMA: bool>(a: &[f64], b: &[f64]) -> f64 {
+    largest_sum_kernel::<false, FMA>(a, b)
+}
+
+#[inline(always)]
+fn largest_difference_of<const FMA: bool>(a: &[f64], b: &[f64]) -> f64 {
+    largest_sum_kernel::<true, FMA>(a, b)
+}
+
+fma_dispatch!(fn largest_sum(a: &[f64], b: &[f64]) -> f64 => largest_sum_of);
+fma_dispatch!(fn largest_difference(a: &[f64], b: &[f64]) -> f64 => largest_difference_of);
 
 /// The (max, +) product P ⊗ Q: entry (i, j) is max_k P[i, k] + Q[k, j] (-inf where every
 /// term is -inf, and for an inner dimension of 0).
@@ -146,6 +195,146 @@ pub fn max_cycle_mean(g: MatRef<'_, f64>) -> Result<f64, Error> {
     Ok(best)
 }
 
+/// Sweeps of the max-balancing at most (each one pass over the nodes).
+pub const SWEEPS: usize = 100;
+
+/// max_ij G[i, j] + e_j - e_i: the log2 of the largest entry under the scaling (-inf for an
+/// empty graph). `g` row-major, of order e.len().
+/// (Subtracting e_i is monotone in floating point, so it commutes with the row's maximum:
+/// max_j (G[i, j] + e_j) - e_i is the same number.)
+fn largest_scaled(g: &[f64], exponents: &[f64]) -> f64 {
+    let n = exponents.len();
+    exponents
+        .iter()
+        .enumerate()
+        .map(|(i, &e_i)| largest_sum(&g[i * n..(i + 1) * n], exponents) - e_i)
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// Exponents with G[i, j] + e_j - e_i <= bound wherever the graph has no cycle of mean above
+/// `bound`: e_i the longest walk from i in G - bound (at least 0), by at most N + 1 rounds of
+/// e_i <- max(0, max_j (G[i, j] - bound) + e_j).
+fn potentials(g: &[f64], n: usize, bound: f64) -> Result<Vec<f64>, Error> {
+    let weights: Vec<f64> = g.iter().map(|&x| x - bound).collect();
+    let mut exponents = vec![0.0; n];
+    let mut longer = vec![0.0; n];
+    for _ in 0..=n {
+        interrupt::check()?;
+        for (i, value) in longer.iter_mut().enumerate() {
+            *value = largest_sum(&weights[i * n..(i + 1) * n], &exponents).max(0.0);
+        }
+        if longer == exponents {
+            break;
+        }
+        std::mem::swap(&mut exponents, &mut longer);
+    }
+    Ok(exponents)
+}
+
+/// One pass of max-balancing over the nodes 0 .. movable - 1; true if an exponent moved.
+///
+/// Node i's row entries are G[i, j] + e_j - e_i and its column entries G[j, i] + e_i - e_j
+/// (j != i); the best e_i makes the largest of each equal, and is taken (as an integer) only
+/// where it lowers the largest entry of the node's row and column. A node with entries on one
+/// side only brings their largest to the size of 1 (or to the largest entry of the graph, if
+/// that is smaller), so that nothing is left far above or below the rest.
+fn sweep(g: &[f64], g_transposed: &[f64], exponents: &mut [f64], movable: usize) -> bool {
+    let n = exponents.len();
+    let mut changed = false;
+    let largest = largest_scaled(g, exponents);
+    let ceiling = if largest < 0.0 { largest } else { 0.0 };
+    for i in 0..movable {
+        // Over j != i: the entries before and after the diagonal.
+        let (g_row, g_column) = (&g[i * n..(i + 1) * n], &g_transposed[i * n..(i + 1) * n]);
+        let (before, after) = (&exponents[..i], &exponents[i + 1..]);
+        let row = largest_sum(&g_row[..i], before).max(largest_sum(&g_row[i + 1..], after));
+        let column = largest_difference(&g_column[..i], before)
+            .max(largest_difference(&g_column[i + 1..], after));
+        let current = exponents[i];
+        let best = match (row.is_finite(), column.is_finite()) {
+            (true, true) => {
+                let middle = (row - column) / 2.0;
+                let (mut best, mut best_size) = (current, (row - current).max(column + current));
+                for candidate in [middle.floor(), middle.ceil()] {
+                    let size = (row - candidate).max(column + candidate);
+                    if size < best_size {
+                        (best, best_size) = (candidate, size);
+                    }
+                }
+                best
+            }
+            (true, false) => (row - ceiling).ceil(),
+            (false, true) => (ceiling - column).floor(),
+            (false, false) => continue,
+        };
+        if best != current {
+            exponents[i] = best;
+            changed = true;
+        }
+    }
+    changed
+}
+
+/// Integer exponents e of the nodes of G (square, log2 sizes) that bring its largest scaled
+/// entry max_ij G[i, j] + e_j - e_i to the least value any scaling reaches, to within one (the
+/// rounding to integers), the others evened out below it; and that largest entry (see the
+/// module documentation).
+///
+/// With `outside` the last node is the outside of a model (the rows of B and the columns of
+/// C; its exponent 0, left out of the answer); otherwise the exponents are centred on 0 (the
+/// scaling of a square matrix alone is unchanged by adding a constant to all of them).
+pub fn balancing_exponents(g: MatRef<'_, f64>, outside: bool) -> Result<(Vec<i64>, f64), Error> {
+    check_sizes(g, "G")?;
+    if g.nrows() != g.ncols() {
+        return Err(Error::NotSquare {
+            arg: "G",
+            rows: g.nrows(),
+            cols: g.ncols(),
+        });
+    }
+    let n = g.nrows();
+    let movable = if outside { n.saturating_sub(1) } else { n };
+    let g_rows = rows_of(g);
+    if !g_rows.iter().any(|x| x.is_finite()) {
+        return Ok((vec![0; movable], f64::NEG_INFINITY));
+    }
+    let least = max_cycle_mean(g)?;
+    let mut exponents = if least.is_finite() {
+        let bound = least + 1e-9 * (1.0 + least.abs());
+        let mut e = potentials(&g_rows, n, bound)?;
+        e.iter_mut().for_each(|x| *x = x.round_ties_even());
+        e
+    } else {
+        // No cycle: every entry can be made as small as wished; start unscaled.
+        vec![0.0; n]
+    };
+    if outside {
+        let last = exponents[n - 1];
+        exponents.iter_mut().for_each(|x| *x -= last);
+    }
+    let g_transposed = rows_of(g.transpose());
+    for _ in 0..SWEEPS {
+        interrupt::check()?;
+        if !sweep(&g_rows, &g_transposed, &mut exponents, movable) {
+            break;
+        }
+    }
+    if !outside && movable > 0 {
+        let (high, low) = exponents
+            .iter()
+            .fold((f64::NEG_INFINITY, f64::INFINITY), |(h, l), &x| {
+                (h.max(x), l.min(x))
+            });
+        let centre = ((high + low) / 2.0).round_ties_even();
+        exponents.iter_mut().for_each(|x| *x -= centre);
+    }
+    let largest = largest_scaled(&g_rows, &exponents);
+    Ok((
+        exponents[..movable].iter().map(|&x| x as i64).collect(),
+        largest,
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -200,6 +389,37 @@ mod tests {
             .flat_map(|c| c.iter().copied().collect::<Vec<_>>())
             .fold(NONE, f64::max);
         assert!(largest >= mean);
+    }
+
+    #[test]
+    fn balancing_reaches_the_cycle_mean_of_a_graded_cascade() {
+        // A cycle 0 -> 1 -> 2 -> 3 -> 0 of sizes 2^30, 2^30, 2^30 and 2^-90 (mean 0): states
+        // scaled 2^30 apart. The balanced entries are all within one of 2^0.
+        let g = mat![
+            [0.0, 30.0, NONE, NONE],
+            [NONE, 0.0, 30.0, NONE],
+            [NONE, NONE, 0.0, 30.0],
+            [-90.0, NONE, NONE, 0.0]
+        ];
+        let (exponents, largest) = balancing_exponents(g.as_ref(), false).unwrap();
+        assert_eq!(max_cycle_mean(g.as_ref()).unwrap(), 0.0);
+        assert!((0.0..=1.0).contains(&largest), "{largest}");
+        let e: Vec<f64> = exponents.iter().map(|&x| x as f64).collect();
+        let scaled = (0..4)
+            .flat_map(|i| (0..4).map(move |j| (i, j)))
+            .filter(|&(i, j)| g[(i, j)] > NONE)
+            .map(|(i, j)| g[(i, j)] + e[j] - e[i])
+            .fold(NONE, f64::max);
+        assert_eq!(scaled, largest);
+        // Centred: the exponents span 0 symmetrically (to within one).
+        let (high, low) = (
+            exponents.iter().max().unwrap(),
+            exponents.iter().min().unwrap(),
+        );
+        assert!((high + low).abs() <= 1, "{exponents:?}");
+        // With an outside node (the last) its exponent is 0 and left out.
+        let (outside, _) = balancing_exponents(g.as_ref(), true).unwrap();
+        assert_eq!(outside.len(), 3);
     }
 
     #[test]
