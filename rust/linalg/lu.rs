@@ -78,16 +78,15 @@ impl Lu {
         for (i, &row) in forward.iter().enumerate() {
             inverse[row] = i;
         }
-        let l = Mat::from_fn(n, n, |i, j| match i.cmp(&j) {
-            std::cmp::Ordering::Greater => factors[(i, j)],
-            std::cmp::Ordering::Equal => 1.0,
-            std::cmp::Ordering::Less => 0.0,
-        });
+        // L takes the multipliers below the diagonal and a unit diagonal, U keeps the rest.
+        let mut l = Mat::<f64>::zeros(n, n);
         let mut u = factors;
         for j in 0..n {
-            for i in j + 1..n {
-                u[(i, j)] = 0.0;
-            }
+            let lower = &mut u.col_as_slice_mut(j)[j + 1..];
+            let column = l.col_as_slice_mut(j);
+            column[j] = 1.0;
+            column[j + 1..].copy_from_slice(lower);
+            lower.fill(0.0);
         }
         let perm = Perm::new_checked(forward.into_boxed_slice(), inverse.into_boxed_slice(), n);
         Ok(Self { l, u, perm })
