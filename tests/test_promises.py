@@ -353,6 +353,9 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
     # mid-work. At n = 2500 the interrupt lands in the Hessenberg reduction of the eigenvalues
     # (about 4 s here), which stops between panels of 24 columns; it was one uninterruptible
     # call of faer's, whose latency grew as n^3 (1.1 s at n = 1500).
+    # The DC gain at n = 3500 is one LU factorisation (1.7 s of latency when it was one call of
+    # faer's), and Tustin's transformation at n = 3000 an LU factorisation, solves with n
+    # right-hand sides and products (7.5 s): both now stop between column panels.
     [
         "(lambda: rng.standard_normal((1200, 1200)), aerocontrol.schur)",
         "(lambda: np.geomspace(1e-3, 10, 2_000_000), lambda c: aerocontrol.batch.lqr_sweep("
@@ -361,6 +364,12 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "(lambda: rng.standard_normal((1200, 1200)) - 40 * np.eye(1200), "
         "lambda a: aerocontrol.solve_lyapunov(a, np.eye(1200)))",
         "(lambda: rng.standard_normal((2500, 2500)), aerocontrol.linalg.eigenvalues)",
+        "(lambda: (rng.standard_normal((3500, 3500)) - 60 * np.eye(3500), "
+        "rng.standard_normal((3500, 2)), rng.standard_normal((2, 3500)), np.zeros((2, 2))), "
+        "aerocontrol.dc_gain)",
+        "(lambda: aerocontrol.StateSpace(rng.standard_normal((3000, 3000)) - 60 * np.eye(3000), "
+        "rng.standard_normal((3000, 2)), rng.standard_normal((2, 3000)), np.zeros((2, 2))), "
+        "lambda sys: aerocontrol.c2d(sys, 0.01, 'tustin'))",
     ],
     ids=[
         "schur n=1200",
@@ -368,6 +377,8 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "expm stack 1e6",
         "lyapunov n=1200",
         "eigenvalues n=2500",
+        "dc_gain n=3500",
+        "c2d tustin n=3000",
     ],
 )
 def test_ctrl_c_stops_a_long_computation_within_a_second(work: str) -> None:

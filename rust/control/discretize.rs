@@ -67,12 +67,13 @@ use crate::control::frequency::check_state_space;
 use crate::error::{Error, check_finite, check_positive, check_rows, check_square};
 use crate::linalg::balance::times_power_of_two;
 use crate::linalg::expm::expm;
+use crate::linalg::lu::Lu;
 use crate::linalg::norm::one_norm;
+use crate::linalg::product::product;
 use crate::linalg::schur::real_schur;
 use crate::linalg::sylvester::solve_small_sylvester;
 use faer::Mat;
 use faer::MatRef;
-use faer::linalg::solvers::Solve;
 
 /// How the input is reconstructed between samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -196,14 +197,18 @@ fn check_alpha(alpha: f64) -> Result<(), Error> {
     }
 }
 
-/// The inverse of a square matrix by LU with partial pivoting, or None when its reciprocal
-/// condition number 1 / (||M||_1 ||M^-1||_1) is below n u (singular to working precision).
-fn checked_inverse(m: MatRef<'_, f64>) -> Option<Mat<f64>> {
+/// The LU factorisation with partial pivoting of a square matrix and its inverse, or None when
+/// its reciprocal condition number 1 / (||M||_1 ||M^-1||_1) is below n u (singular to working
+/// precision); `Err(Error::Interrupted)` if the computation was interrupted.
+fn checked_inverse(m: MatRef<'_, f64>) -> Result<Option<(Lu, Mat<f64>)>, Error> {
     let n = m.nrows();
-    let inverse = m.partial_piv_lu().solve(Mat::<f64>::identity(n, n));
+    let lu = Lu::new(m)?;
+    let inverse = lu.solve(Mat::<f64>::identity(n, n).as_ref())?;
     let condition = one_norm(m) * one_norm(inverse.as_ref());
-    (inverse.is_all_finite() && condition.is_finite() && condition * n as f64 * f64::EPSILON < 1.0)
-        .then_some(inverse)
+    Ok((inverse.is_all_finite()
+        && condition.is_finite()
+        && condition * n as f64 * f64::EPSILON < 1.0)
+        .then_some((lu, inverse)))
 }
 
 /// The generalized bilinear transformation of x' = Ax + Bη, y = Cx + Dη with step `dt` and
@@ -231,7 +236,7 @@ pub fn bilinear(
             requirement: "small enough that A dt is finite",
         });
     }
-    let Some(inverse) = checked_inverse(m.as_ref()) else {
+    let Some((lu, inverse)) = checked_inverse(m.as_ref())? else {
         return Err(Error::InvalidArgument {
             arg: "dt",
             message: format!(
@@ -242,10 +247,9 @@ pub fn bilinear(
             ),
         });
     };
-    let lu = m.partial_piv_lu();
-    let ad = lu.solve(&identity + faer::Scale((1.0 - alpha) * dt) * a);
-    let bd = lu.solve(faer::Scale(dt) * b);
-    let cd = c * &inverse;
+    let ad = lu.solve((&identity + faer::Scale((1.0 - alpha) * dt) * a).as_ref())?;
+    let bd = lu.solve((faer::Scale(dt) * b).as_ref())?;
+    let cd = product(c, inverse.as_ref())?;
     let dd = d + faer::Scale(alpha) * (c * &bd);
     Ok(StateSpaceMatrices {
         a: ad,
@@ -273,7 +277,7 @@ pub fn inverse_bilinear(
     let n = ad.nrows();
     let identity = Mat::<f64>::identity(n, n);
     let w = faer::Scale(alpha) * ad + faer::Scale(1.0 - alpha) * &identity;
-    let Some(w_inverse) = checked_inverse(w.as_ref()) else {
+    let Some((lu, w_inverse)) = checked_inverse(w.as_ref())? else {
         return Err(Error::InvalidArgument {
             arg: "A",
             message: format!(
@@ -284,10 +288,9 @@ pub fn inverse_bilinear(
             ),
         });
     };
-    let lu = w.partial_piv_lu();
-    let a = faer::Scale(1.0 / dt) * lu.solve(ad - &identity);
-    let b = faer::Scale(1.0 / dt) * lu.solve(bd);
-    let c = cd * &w_inverse;
+    let a = faer::Scale(1.0 / dt) * lu.solve((ad - &identity).as_ref())?;
+    let b = faer::Scale(1.0 / dt) * lu.solve(bd)?;
+    let c = product(cd, w_inverse.as_ref())?;
     let d = dd - faer::Scale(alpha) * (&c * bd);
     if !(a.is_all_finite() && b.is_all_finite()) {
         return Err(Error::InvalidValue {
@@ -625,14 +628,17 @@ fn real_logarithm(m: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
     let mut logarithm = Mat::<f64>::zeros(n, n);
     for (&node, &weight) in LOG_PADE_NODES.iter().zip(&LOG_PADE_WEIGHTS) {
         let shifted = &identity + faer::Scale(node) * &x;
-        let term = shifted.partial_piv_lu().solve(&x);
+        let term = Lu::new(shifted.as_ref())?.solve(x.as_ref())?;
         logarithm += faer::Scale(weight) * term;
     }
     logarithm *= faer::Scale(f64::from(roots).exp2());
     for &block in &blocks {
         block_logarithm(t.as_ref(), block, &mut logarithm);
     }
-    Ok(&schur.z * logarithm * schur.z.transpose())
+    product(
+        product(schur.z.as_ref(), logarithm.as_ref())?.as_ref(),
+        schur.z.transpose(),
+    )
 }
 
 #[cfg(test)]

@@ -40,10 +40,10 @@
 use crate::control::frequency::RangeScaled;
 use crate::control::modal::eigen;
 use crate::linalg::balance::times_power_of_two;
+use crate::linalg::lu::Lu;
 use crate::linalg::norm::{Inverse, one_norm, one_norm_estimate};
 use crate::platform::dispatch::{fma_dispatch, multiply_add};
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::Solve;
 use faer::{Accum, Mat, MatRef, Par, c64};
 
 /// The largest κ_1(W) of a form in use (2^14): its results stay within this factor of the
@@ -139,13 +139,14 @@ impl PartialFractions {
         if !decomposed {
             return None;
         }
-        let lu = w.partial_piv_lu();
+        // An interruption refuses the form (the caller's next check stops).
+        let lu = Lu::new(w.as_ref()).ok()?;
         let inverse_norm = ESTIMATE_SAFETY * one_norm_estimate(&Inverse(&lu), 2);
         let conditioned = w_norm * inverse_norm <= MAX_CONDITION;
         if !conditioned {
             return None;
         }
-        let modal_b = lu.solve(&b);
+        let modal_b = lu.solve(b.as_ref()).ok()?;
         let modal_c = &c * &w;
         let reals: Vec<f64> = blocks
             .iter()

@@ -23,12 +23,12 @@
 use crate::control::discretize::{Discretization, Hold, discretize};
 use crate::control::frequency::check_state_space;
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_positive};
+use crate::linalg::lu::Lu;
 use crate::linalg::norm::{Inverse, one_norm_estimate, triangular_inverse_norm_bound};
 use crate::platform::dispatch::{DOT_LANES, dot_rows};
 use crate::platform::interrupt;
 use crate::platform::parallel::{ParallelContext, chunks, par_chunks};
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::Solve;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
@@ -491,9 +491,9 @@ fn solve_steady_state(
     eta0: MatRef<'_, f64>,
 ) -> Result<Mat<f64>, Error> {
     let n = a.nrows();
-    let lu = a.partial_piv_lu();
+    let lu = Lu::new(a)?;
     let mut x = -(b * eta0);
-    lu.solve_in_place(x.as_mut());
+    lu.solve_in_place(x.as_mut())?;
     // A has an eigenvalue within `tolerance` of zero only if σ_min(A) <= tolerance, and
     // σ_min(A) >= 1 / (sqrt(n) ||A^-1||_inf). With A = P^T L U, ||A^-1||_inf is at most the
     // product of the comparison-matrix bounds of U^-1 and L^-1 (two O(n^2) substitutions),

@@ -12,7 +12,9 @@ use faer::prelude::ReborrowMut;
 use faer::{Mat, MatMut, MatRef};
 use nalgebra::DMatrix;
 
+use crate::error::Error;
 use crate::linalg::matrix::{FaerView, from_faer, with_order};
+use crate::linalg::product::multiply;
 
 /// Products of at most this many multiply-adds are plain loops, larger ones faer's blocked
 /// kernel (as [`view_product`]).
@@ -20,11 +22,23 @@ const LOOP_PRODUCT_MAX_WORK: usize = 16 * 16 * 16;
 
 /// lhs * rhs for matrices of any (conforming) shapes and strides: a plain column-by-column
 /// loop when the product is small (the Riccati and Lyapunov solvers form a dozen products of
-/// order n and m at n = 4), faer's blocked kernel otherwise.
-pub fn view_product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
+/// order n and m at n = 4), faer's blocked kernel otherwise, in column panels with a check of
+/// the interruption between them ([`crate::linalg::product::multiply`]: bitwise one call).
+pub fn view_product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
     let mut out = Mat::<f64>::zeros(lhs.nrows(), rhs.ncols());
-    view_product_into(out.as_mut(), lhs, rhs, faer::Par::Seq);
-    out
+    if lhs.nrows() * lhs.ncols() * rhs.ncols() > LOOP_PRODUCT_MAX_WORK {
+        multiply(
+            out.as_mut(),
+            faer::Accum::Replace,
+            lhs,
+            rhs,
+            1.0,
+            faer::Par::Seq,
+        )?;
+    } else {
+        view_product_into(out.as_mut(), lhs, rhs, faer::Par::Seq);
+    }
+    Ok(out)
 }
 
 /// out = lhs * rhs, as [`view_product`] forms it, with faer's kernel on `par` for large
@@ -336,7 +350,7 @@ mod tests {
     #[test]
     fn small_products_round_like_the_faer_matrix_product_loop() {
         let (a, b) = (seeded(4, 4, 3), seeded(4, 2, 4));
-        let expected = view_product(a.as_ref(), b.as_ref());
+        let expected = view_product(a.as_ref(), b.as_ref()).unwrap();
         let found = product(&from_faer(a.as_ref()), &from_faer(b.as_ref()));
         assert_eq!(found.to_faer(), expected);
         let found = transposed_product(&from_faer(a.transpose()), &from_faer(b.as_ref()));

@@ -1,13 +1,32 @@
-//! Linear solves by LU with partial pivoting (faer), without ever forming an inverse.
+//! Linear solves by LU with partial pivoting (faer), without ever forming an inverse, stopping
+//! between blocks of work when the computation is interrupted.
 //!
 //! A thin layer over faer's in-place factorisation. For small systems the pivot vectors and
-//! faer's scratch live on the stack, so a solve allocates nothing.
+//! faer's scratch live on the stack, so a solve allocates nothing. For large ones (more than
+//! about [`PANEL_MULTIPLY_ADDS`] multiply-adds) faer's recursive factorisation (Toledo's
+//! left-and-right recursion: factor the left half of the columns, update the right half by a
+//! triangular solve and a product, factor its lower part) is driven from here, one level of
+//! recursion at a time, with the same split of the columns as faer's and faer's kernels for
+//! every step, so that [`interrupt::check`] runs between steps, the product and the triangular
+//! solve of each level are split into column panels ([`crate::linalg::product`]), and the
+//! factors are bitwise those of one faer call. The substitutions of many right-hand sides go
+//! in column panels too (each column is solved independently, so bitwise as one call). The
+//! tests below check both against faer's calls.
+//!
+//! S. Toledo, "Locality of reference in LU decomposition with partial pivoting", SIAM J.
+//! Matrix Anal. Appl. 18(4), 1997.
 
+use crate::error::Error;
 use crate::linalg::matrix::with_order;
+use crate::linalg::product::{PANEL_MULTIPLY_ADDS, multiply, panel_columns};
+use crate::platform::interrupt;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
 use faer::linalg::lu::partial_pivoting::{factor, solve};
-use faer::{Mat, MatMut, MatRef, Par, Spec};
+use faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place;
+use faer::perm::{Perm, PermRef};
+use faer::prelude::{Reborrow, ReborrowMut};
+use faer::{Accum, Mat, MatMut, MatRef, Par, Spec};
 use std::mem::MaybeUninit;
 
 /// The order below which faer's recursive LU switches to its unblocked kernel. faer's default
@@ -29,18 +48,233 @@ const UNBLOCKED_MAX_ORDER: usize = 12;
 const STACK_ORDER: usize = 64;
 const STACK_BYTES: usize = 4096;
 
+/// The LU factorisation with partial pivoting P A = L U of a square matrix, as faer's
+/// `PartialPivLu` (faer's default parameters and global parallelism, bitwise the same
+/// factors), formed and applied with stops between blocks of work when the computation is
+/// interrupted (see the module documentation). A singular A gives a zero or non-finite pivot
+/// and non-finite solutions, never a panic or an error: callers check the conditioning.
+#[derive(Debug, Clone)]
+pub struct Lu {
+    /// Unit lower triangular (its unit diagonal stored).
+    l: Mat<f64>,
+    /// Upper triangular.
+    u: Mat<f64>,
+    perm: Perm<usize>,
+}
+
+impl Lu {
+    /// Factors the square matrix `a`; `Err(Error::Interrupted)` if the computation was
+    /// interrupted.
+    pub fn new(a: MatRef<'_, f64>) -> Result<Self, Error> {
+        let n = a.nrows();
+        debug_assert_eq!(n, a.ncols());
+        let mut factors = a.to_owned();
+        let forward = factor_in_place(
+            factors.as_mut(),
+            faer::get_global_parallelism(),
+            Default::default(),
+        )?;
+        let mut inverse = vec![0; n];
+        for (i, &row) in forward.iter().enumerate() {
+            inverse[row] = i;
+        }
+        // L takes the multipliers below the diagonal and a unit diagonal, U keeps the rest.
+        let mut l = Mat::<f64>::zeros(n, n);
+        let mut u = factors;
+        for j in 0..n {
+            let lower = &mut u.col_as_slice_mut(j)[j + 1..];
+            let column = l.col_as_slice_mut(j);
+            column[j] = 1.0;
+            column[j + 1..].copy_from_slice(lower);
+            lower.fill(0.0);
+        }
+        let perm = Perm::new_checked(forward.into_boxed_slice(), inverse.into_boxed_slice(), n);
+        Ok(Self { l, u, perm })
+    }
+
+    /// The order of A.
+    pub fn nrows(&self) -> usize {
+        self.l.nrows()
+    }
+
+    /// The unit lower triangular factor L.
+    #[allow(non_snake_case)]
+    pub fn L(&self) -> MatRef<'_, f64> {
+        self.l.as_ref()
+    }
+
+    /// The upper triangular factor U.
+    #[allow(non_snake_case)]
+    pub fn U(&self) -> MatRef<'_, f64> {
+        self.u.as_ref()
+    }
+
+    /// Overwrites B with A^-1 B (P B, then L Y = P B, U X = Y), in column panels of B.
+    pub fn solve_in_place(&self, b: MatMut<'_, f64>) -> Result<(), Error> {
+        let n = self.nrows();
+        let par = faer::get_global_parallelism();
+        in_column_panels(n, b, |panel| {
+            let k = panel.ncols();
+            let mut buffer = MemBuffer::new(solve::solve_in_place_scratch::<usize, f64>(n, k, par));
+            solve::solve_in_place(
+                self.L(),
+                self.U(),
+                self.perm.as_ref(),
+                panel,
+                par,
+                MemStack::new(&mut buffer),
+            );
+        })
+    }
+
+    /// A^-1 B.
+    pub fn solve(&self, b: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+        let mut x = b.to_owned();
+        self.solve_in_place(x.as_mut())?;
+        Ok(x)
+    }
+
+    /// Overwrites B with A^-T B, in column panels of B.
+    pub fn solve_transpose_in_place(&self, b: MatMut<'_, f64>) -> Result<(), Error> {
+        let n = self.nrows();
+        let par = faer::get_global_parallelism();
+        in_column_panels(n, b, |panel| {
+            let k = panel.ncols();
+            let mut buffer = MemBuffer::new(solve::solve_transpose_in_place_scratch::<usize, f64>(
+                n, k, par,
+            ));
+            solve::solve_transpose_in_place(
+                self.L(),
+                self.U(),
+                self.perm.as_ref(),
+                panel,
+                par,
+                MemStack::new(&mut buffer),
+            );
+        })
+    }
+}
+
+/// Runs `substitute` (two triangular substitutions with an order-n factor, 2 n^2
+/// multiply-adds a column, on columns independently) on column panels of `b`, with
+/// [`interrupt::check`] between them.
+fn in_column_panels(
+    n: usize,
+    mut b: MatMut<'_, f64>,
+    mut substitute: impl FnMut(MatMut<'_, f64>),
+) -> Result<(), Error> {
+    let k = b.ncols();
+    let width = panel_columns(n, 2 * n, k);
+    let mut first = 0;
+    while first < k {
+        let columns = width.min(k - first);
+        if first > 0 {
+            interrupt::check()?;
+        }
+        substitute(b.rb_mut().subcols_mut(first, columns));
+        first += columns;
+    }
+    Ok(())
+}
+
+/// Factors the m x w panel `a` (m >= w) in place, P a = L U with L unit lower trapezoidal and
+/// U upper triangular sharing its storage, as faer's `lu_in_place` with `parameters` and `par`
+/// (bitwise the same), and returns P as forward indices: row i of P a is row `perm[i]` of a.
+/// A panel of at most [`PANEL_MULTIPLY_ADDS`] (m w^2) is one faer call; a larger one is split
+/// at faer's column split of its recursion (half of w, rounded up to a multiple of
+/// min(16, its next power of two)) into the factorisation of the left columns, the row swaps
+/// and the unit lower triangular solve of the top right block, the product updating the
+/// bottom right block, and the factorisation of that block, with the triangular solve and the
+/// product in column panels and a check of the interruption between every step.
+fn factor_in_place(
+    mut a: MatMut<'_, f64>,
+    par: Par,
+    parameters: Spec<PartialPivLuParams, f64>,
+) -> Result<Vec<usize>, Error> {
+    let (m, w) = a.shape();
+    debug_assert!(m >= w);
+    if m.saturating_mul(w).saturating_mul(w) <= PANEL_MULTIPLY_ADDS
+        || w <= parameters.config.recursion_threshold
+    {
+        let mut perm = vec![0; m];
+        let mut perm_inverse = vec![0; m];
+        let mut buffer = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(
+            m, w, par, parameters,
+        ));
+        factor::lu_in_place(
+            a,
+            &mut perm,
+            &mut perm_inverse,
+            par,
+            MemStack::new(&mut buffer),
+            parameters,
+        );
+        return Ok(perm);
+    }
+    interrupt::check()?;
+    let half = w / 2;
+    let split = half.next_multiple_of(16.min(half.next_power_of_two()));
+    let left = factor_in_place(a.rb_mut().subcols_mut(0, split), par, parameters)?;
+    permute_rows(a.rb_mut().subcols_mut(split, w - split), &left);
+    let (a00, mut a01, a10, mut a11) = a.rb_mut().split_at_mut(split, split);
+    let rhs_width = panel_columns(split, split, w - split);
+    let mut first = 0;
+    while first < w - split {
+        interrupt::check()?;
+        let columns = rhs_width.min(w - split - first);
+        solve_unit_lower_triangular_in_place(
+            a00.rb(),
+            a01.rb_mut().subcols_mut(first, columns),
+            par,
+        );
+        first += columns;
+    }
+    multiply(a11.rb_mut(), Accum::Add, a10.rb(), a01.rb(), -1.0, par)?;
+    let right = factor_in_place(a11, par, parameters)?;
+    permute_rows(a.rb_mut().submatrix_mut(split, 0, m - split, split), &right);
+    let mut perm = left.clone();
+    for (i, &row) in right.iter().enumerate() {
+        perm[split + i] = left[split + row];
+    }
+    Ok(perm)
+}
+
+/// Replaces the rows of `a` by their permutation: row i becomes row `perm[i]`, moving only
+/// the rows that change (a panel's pivoting moves at most twice its width of rows).
+fn permute_rows(mut a: MatMut<'_, f64>, perm: &[usize]) {
+    let moved: Vec<(usize, usize)> = perm
+        .iter()
+        .enumerate()
+        .filter(|&(i, &row)| i != row)
+        .map(|(i, &row)| (i, row))
+        .collect();
+    let mut values = vec![0.0; moved.len()];
+    for j in 0..a.ncols() {
+        let mut column = a.rb_mut().col_mut(j);
+        for (value, &(_, row)) in values.iter_mut().zip(&moved) {
+            *value = column[row];
+        }
+        for (&value, &(i, _)) in values.iter().zip(&moved) {
+            column[i] = value;
+        }
+    }
+}
+
 /// Solves A X = B for X, overwriting B, by LU factorisation of A with partial pivoting
-/// (P A = L U, then L Y = P B, U X = Y); A is overwritten by its factors.
+/// (P A = L U, then L Y = P B, U X = Y); A is overwritten by its factors. Large systems stop
+/// with `Err(Error::Interrupted)` between blocks of work (see the module documentation) when
+/// the computation is interrupted; that is the only error.
 ///
 /// A singular A gives infinite or NaN entries, never a panic. (The exponential's Padé
 /// denominators are well conditioned by the choice of degree and scaling, Higham 2005, §3;
 /// other callers that can meet a singular matrix must check its conditioning.)
-pub fn solve_in_place(a: MatMut<'_, f64>, b: MatMut<'_, f64>, par: Par) {
+pub fn solve(mut a: MatMut<'_, f64>, b: MatMut<'_, f64>, par: Par) -> Result<(), Error> {
     let n = a.nrows();
     debug_assert_eq!(n, a.ncols());
     debug_assert_eq!(n, b.nrows());
     if n <= UNBLOCKED_MAX_ORDER {
-        return eliminate_and_substitute(a, b);
+        eliminate_and_substitute(a, b);
+        return Ok(());
     }
     let requirement = factor::lu_in_place_scratch::<usize, f64>(n, n, par, lu_parameters()).or(
         solve::solve_in_place_scratch::<usize, f64>(n, b.ncols(), par),
@@ -57,19 +291,39 @@ pub fn solve_in_place(a: MatMut<'_, f64>, b: MatMut<'_, f64>, par: Par) {
             MemStack::new(&mut bytes),
             par,
         );
-    } else {
-        let mut perm = vec![0usize; n];
-        let mut perm_inverse = vec![0usize; n];
-        let mut buffer = MemBuffer::new(requirement.or(StackReq::EMPTY));
-        factor_and_solve(
-            a,
-            b,
-            &mut perm,
-            &mut perm_inverse,
-            MemStack::new(&mut buffer),
-            par,
-        );
+        return Ok(());
     }
+    let perm = factor_in_place(a.rb_mut(), par, lu_parameters())?;
+    let mut perm_inverse = vec![0; n];
+    for (i, &row) in perm.iter().enumerate() {
+        perm_inverse[row] = i;
+    }
+    let perm = PermRef::new_checked(&perm, &perm_inverse, n);
+    let factors = a.rb();
+    in_column_panels(n, b, |panel| {
+        let k = panel.ncols();
+        let mut buffer = MemBuffer::new(
+            solve::solve_in_place_scratch::<usize, f64>(n, k, par).or(StackReq::EMPTY),
+        );
+        // The unit lower factor L and the upper factor U share the storage of `a`.
+        solve::solve_in_place(
+            factors,
+            factors,
+            perm,
+            panel,
+            par,
+            MemStack::new(&mut buffer),
+        );
+    })
+}
+
+/// [`solve`] run to its end whatever an interruption, for the exponential's Padé solves (of
+/// the small orders of its arguments; it checks for an interruption between its own steps)
+/// and the callers of [`solve_with_inverse`].
+pub fn solve_in_place(a: MatMut<'_, f64>, b: MatMut<'_, f64>, par: Par) {
+    // Without a token, `interrupt::check` never fails, and an interruption is the only error
+    // of `solve`.
+    let _uninterrupted = interrupt::within_ref(None, || solve(a, b, par));
 }
 
 /// Solves A X = B together with A X' = I, in one factorisation: returns [X | A^-1] (split it
@@ -268,6 +522,114 @@ mod tests {
         let mut b = Mat::<f64>::ones(2, 1);
         solve_in_place(Mat::<f64>::zeros(2, 2).as_mut(), b.as_mut(), Par::Seq);
         assert!(!b.is_all_finite());
+    }
+
+    /// Bit patterns, so that NaNs compare equal to themselves.
+    fn bits(m: MatRef<'_, f64>) -> Vec<u64> {
+        (0..m.ncols())
+            .flat_map(|j| (0..m.nrows()).map(move |i| m[(i, j)].to_bits()))
+            .collect()
+    }
+
+    /// Orders above the one-call limit (n^3 > 2^30), one not a multiple of 16; a matrix with
+    /// graded columns, and rank-deficient and singular ones.
+    fn large_cases() -> Vec<(String, Mat<f64>)> {
+        let mut cases = Vec::new();
+        for (n, seed) in [(1100, 1), (1531, 2)] {
+            let a = crate::test_matrices::seeded(n, n, seed);
+            cases.push((format!("random {n}"), a.clone()));
+            let graded = Mat::from_fn(n, n, |i, j| {
+                a[(i, j)] * 10f64.powf(-12.0 * j as f64 / n as f64)
+            });
+            cases.push((format!("graded {n}"), graded));
+            // Rank n - 40: the last columns repeat earlier ones.
+            let deficient =
+                Mat::from_fn(n, n, |i, j| a[(i, if j + 40 >= n { j - 600 } else { j })]);
+            cases.push((format!("rank-deficient {n}"), deficient));
+            let mut zero_column = a.clone();
+            zero_column.col_mut(700).fill(0.0);
+            cases.push((format!("zero column {n}"), zero_column));
+        }
+        cases
+    }
+
+    #[test]
+    fn large_factorisations_and_solves_are_bitwise_faers() {
+        for (name, a) in large_cases() {
+            let n = a.nrows();
+            let b = crate::test_matrices::seeded(n, 300, n as u64);
+            let ours = Lu::new(a.as_ref()).unwrap();
+            let faers = a.partial_piv_lu();
+            assert_eq!(bits(ours.L()), bits(faers.L()), "{name}: L");
+            assert_eq!(bits(ours.U()), bits(faers.U()), "{name}: U");
+            assert_eq!(
+                ours.perm.as_ref().arrays().0,
+                faers.P().arrays().0,
+                "{name}: P"
+            );
+            use faer::linalg::solvers::Solve;
+            assert_eq!(
+                bits(ours.solve(b.as_ref()).unwrap().as_ref()),
+                bits(faers.solve(&b).as_ref()),
+                "{name}: solve"
+            );
+            let mut transposed = b.clone();
+            ours.solve_transpose_in_place(transposed.as_mut()).unwrap();
+            assert_eq!(
+                bits(transposed.as_ref()),
+                bits(faers.solve_transpose(&b).as_ref()),
+                "{name}: solve_transpose"
+            );
+            // `solve`, against the one faer factorisation and solve of before.
+            let mut x = b.clone();
+            solve(a.clone().as_mut(), x.as_mut(), Par::Seq).unwrap();
+            let mut expected = b.clone();
+            let mut perm = vec![0; n];
+            let mut perm_inverse = vec![0; n];
+            let mut buffer = MemBuffer::new(
+                factor::lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, lu_parameters()).or(
+                    solve::solve_in_place_scratch::<usize, f64>(n, 300, Par::Seq),
+                ),
+            );
+            factor_and_solve(
+                a.clone().as_mut(),
+                expected.as_mut(),
+                &mut perm,
+                &mut perm_inverse,
+                MemStack::new(&mut buffer),
+                Par::Seq,
+            );
+            assert_eq!(bits(x.as_ref()), bits(expected.as_ref()), "{name}: solve");
+            if name.starts_with("random") {
+                let residual = (&a * &x - &b).norm_max();
+                assert!(residual < 1e-9, "{name}: {residual:e}");
+            } else if name.starts_with("zero") {
+                assert!(!x.is_all_finite(), "{name}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_interrupted_factorisation_stops() {
+        let a = crate::test_matrices::seeded(1100, 1100, 5);
+        let token = crate::platform::interrupt::Token::default();
+        token.cancel();
+        crate::platform::interrupt::within(&token, || {
+            assert_eq!(Lu::new(a.as_ref()).err(), Some(Error::Interrupted));
+            let mut b = Mat::<f64>::zeros(1100, 1);
+            assert_eq!(
+                solve(a.clone().as_mut(), b.as_mut(), Par::Seq),
+                Err(Error::Interrupted)
+            );
+            // The exponential's solve runs to its end.
+            let x_true = Mat::from_fn(1100, 1, |i, _| i as f64);
+            let mut b = &a * &x_true;
+            solve_in_place(a.clone().as_mut(), b.as_mut(), Par::Seq);
+            assert!((&b - &x_true).norm_max() < 1e-8);
+            // Small factorisations are one call, and finish.
+            let small = crate::test_matrices::seeded(100, 100, 6);
+            assert!(Lu::new(small.as_ref()).is_ok());
+        });
     }
 
     #[test]

@@ -120,12 +120,12 @@ pub(crate) fn solve(
     }
     let schur = real_schur(a)?;
     let (t, z) = (schur.t.as_ref(), schur.z.as_ref());
-    let mut f = from_faer(view_product(view_product(z.transpose(), q).as_ref(), z).as_ref());
+    let mut f = from_faer(view_product(view_product(z.transpose(), q)?.as_ref(), z)?.as_ref());
     for x in f.as_mut_slice() {
         *x = -*x;
     }
     let y = solve_quasi_triangular(&from_faer(t), f, singularity)?;
-    let mut x = view_product(view_product(z, y.as_faer()).as_ref(), z.transpose());
+    let mut x = view_product(view_product(z, y.as_faer())?.as_ref(), z.transpose())?;
     if is_symmetric(q) {
         x.symmetrize();
     }

@@ -4,7 +4,10 @@
 //!   compile-time constant or known at run time) and the one dispatch between them;
 //!   `small_matrix` and `dense`: products, solves and factorisations on it, for kernels whose
 //!   arithmetic is cheaper than a general library's call.
-//! * [`lu`]: linear solves by LU with partial pivoting.
+//! * [`product`]: matrix products of any size that stop between column panels when the
+//!   computation is interrupted.
+//! * [`lu`]: LU factorisation with partial pivoting and linear solves, stopping between blocks
+//!   of work when the computation is interrupted.
 //! * [`norm`]: exact and estimated (Higham & Tisseur 2000) matrix 1-norms.
 //! * [`hessenberg`]: the Hessenberg form and its transformation.
 //! * [`hamiltonian`]: the squared eigenvalues of a Hamiltonian matrix with rank-one
@@ -34,6 +37,7 @@ pub(crate) mod matrix;
 pub(crate) mod max_plus;
 pub mod norm;
 pub(crate) mod polynomial_roots;
+pub mod product;
 pub mod qz;
 pub(crate) mod rotation;
 pub mod schur;

@@ -15,9 +15,10 @@
 //!   each iteration costs two applications of the operator to an n x t block, so estimating the
 //!   norm of a product of k n x n matrices costs O(k t n^2) instead of the O(k n^3) of forming it.
 
+use crate::linalg::lu::Lu;
+use crate::platform::interrupt;
 use crate::platform::pool::scratch;
 use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::{PartialPivLu, ShapeCore, Solve};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
 /// Matrices of up to this many entries take [`frobenius_norm`]'s plain sum of squares.
@@ -244,7 +245,7 @@ impl LinearOperator for MatrixProduct<'_> {
 
 /// A^-1 as an operator, applied through the LU factors of A (for [`one_norm_estimate`] of
 /// ||A^-1||_1 at O(n^2) a step).
-pub struct Inverse<'a>(pub &'a PartialPivLu<f64>);
+pub struct Inverse<'a>(pub &'a Lu);
 
 impl LinearOperator for Inverse<'_> {
     fn dim(&self) -> usize {
@@ -253,12 +254,13 @@ impl LinearOperator for Inverse<'_> {
 
     fn apply(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
         out.copy_from(x);
-        self.0.solve_in_place(out);
+        // A few columns: one panel, which runs to its end.
+        let _uninterrupted = interrupt::within_ref(None, || self.0.solve_in_place(out));
     }
 
     fn apply_transpose(&self, x: MatRef<'_, f64>, mut out: MatMut<'_, f64>) {
         out.copy_from(x);
-        self.0.solve_transpose_in_place(out);
+        let _uninterrupted = interrupt::within_ref(None, || self.0.solve_transpose_in_place(out));
     }
 }
 

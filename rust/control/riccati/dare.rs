@@ -317,10 +317,10 @@ impl Problem<'_> {
     fn evaluate(&self, x: &Mat<f64>) -> Result<Evaluation, Error> {
         let (a, b) = (self.a, self.b);
         let m = b.ncols();
-        let xb = view_product(x.as_ref(), b);
-        let mut weight = view_product(b.transpose(), xb.as_ref());
+        let xb = view_product(x.as_ref(), b)?;
+        let mut weight = view_product(b.transpose(), xb.as_ref())?;
         weight += self.r;
-        let mut mixed = view_product(xb.transpose(), a);
+        let mut mixed = view_product(xb.transpose(), a)?;
         if let Some(s) = self.s {
             mixed += s.transpose();
         }
@@ -337,23 +337,23 @@ impl Problem<'_> {
         }
         let gain = gain.to_owned();
         // A - B K, in the product's storage.
-        let mut closed_loop = view_product(b, gain.as_ref());
+        let mut closed_loop = view_product(b, gain.as_ref())?;
         for j in 0..a.ncols() {
             for (i, entry) in closed_loop.col_as_slice_mut(j).iter_mut().enumerate() {
                 *entry = a[(i, j)] - *entry;
             }
         }
-        let mut residual = view_product(view_product(a.transpose(), x.as_ref()).as_ref(), a);
+        let mut residual = view_product(view_product(a.transpose(), x.as_ref())?.as_ref(), a)?;
         let axa_norm = frobenius_norm(residual.as_ref());
-        let quadratic = view_product(mixed.transpose(), gain.as_ref());
+        let quadratic = view_product(mixed.transpose(), gain.as_ref())?;
         let exe_norm = if self.identity_e {
             residual -= x;
             frobenius_norm(x.as_ref())
         } else {
             let exe = view_product(
-                view_product(self.e.transpose(), x.as_ref()).as_ref(),
+                view_product(self.e.transpose(), x.as_ref())?.as_ref(),
                 self.e,
-            );
+            )?;
             residual -= &exe;
             frobenius_norm(exe.as_ref())
         };

@@ -22,9 +22,9 @@
 //! eigenvector of the conjugate eigenvalue is the conjugate vector.
 
 use crate::error::Error;
+use crate::linalg::product::multiply;
 use crate::linalg::schur::RealSchur;
 use crate::platform::interrupt;
-use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par, c64};
 
 /// A component beyond this makes the vector be scaled by [`RESCALE`].
@@ -97,22 +97,22 @@ pub fn schur_eigenvectors(
     // The eigenvectors of A: Z X.
     let (mut v_re, mut v_im) = (Mat::<f64>::zeros(n, n), Mat::<f64>::zeros(n, n));
     let z = schur.z.as_ref();
-    matmul(
+    multiply(
         v_re.as_mut(),
         Accum::Replace,
         z,
         x_re.as_ref(),
         1.0,
         Par::Seq,
-    );
-    matmul(
+    )?;
+    multiply(
         v_im.as_mut(),
         Accum::Replace,
         z,
         x_im.as_ref(),
         1.0,
         Par::Seq,
-    );
+    )?;
     let row = |i: usize| scaling.get(i).copied().unwrap_or(1.0);
     let mut vectors = Mat::from_fn(n, n, |i, j| c64::new(v_re[(i, j)], v_im[(i, j)]) * row(i));
     for j in 0..n {
