@@ -150,9 +150,8 @@ pub fn product(p: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Result<Mat<f64>, Error
     Ok(out)
 }
 
-/// The largest mean weight of a cycle of the graph G (square), by Karp's algorithm (see the
-/// module documentation); -inf for a graph without a cycle (and for N = 0).
-pub fn max_cycle_mean(g: MatRef<'_, f64>) -> Result<f64, Error> {
+/// Refuses a graph that is not square or has a size that is +inf or NaN.
+fn check_graph(g: MatRef<'_, f64>) -> Result<(), Error> {
     check_sizes(g, "G")?;
     if g.nrows() != g.ncols() {
         return Err(Error::NotSquare {
@@ -161,11 +160,21 @@ pub fn max_cycle_mean(g: MatRef<'_, f64>) -> Result<f64, Error> {
             cols: g.ncols(),
         });
     }
-    let n = g.nrows();
+    Ok(())
+}
+
+/// The largest mean weight of a cycle of the graph G (square), by Karp's algorithm (see the
+/// module documentation); -inf for a graph without a cycle (and for N = 0).
+pub fn max_cycle_mean(g: MatRef<'_, f64>) -> Result<f64, Error> {
+    check_graph(g)?;
+    cycle_mean_of_rows(&rows_of(g), g.nrows())
+}
+
+/// [`max_cycle_mean`] of the checked graph of order n held row by row in `g`.
+fn cycle_mean_of_rows(g: &[f64], n: usize) -> Result<f64, Error> {
     if n == 0 {
         return Ok(f64::NEG_INFINITY);
     }
-    let g_rows = rows_of(g);
     // walks[k * n + v] = D_k(v).
     let mut walks = vec![f64::NEG_INFINITY; (n + 1) * n];
     walks[..n].fill(0.0);
@@ -175,7 +184,7 @@ pub fn max_cycle_mean(g: MatRef<'_, f64>) -> Result<f64, Error> {
         let (previous, next) = (&done[(k - 1) * n..], &mut rest[..n]);
         for (u, &walk) in previous.iter().enumerate() {
             if walk > f64::NEG_INFINITY {
-                raise_to(next, walk, &g_rows[u * n..(u + 1) * n]);
+                raise_to(next, walk, &g[u * n..(u + 1) * n]);
             }
         }
     }
@@ -284,21 +293,14 @@ fn sweep(g: &[f64], g_transposed: &[f64], exponents: &mut [f64], movable: usize)
 /// C; its exponent 0, left out of the answer); otherwise the exponents are centred on 0 (the
 /// scaling of a square matrix alone is unchanged by adding a constant to all of them).
 pub fn balancing_exponents(g: MatRef<'_, f64>, outside: bool) -> Result<(Vec<i64>, f64), Error> {
-    check_sizes(g, "G")?;
-    if g.nrows() != g.ncols() {
-        return Err(Error::NotSquare {
-            arg: "G",
-            rows: g.nrows(),
-            cols: g.ncols(),
-        });
-    }
+    check_graph(g)?;
     let n = g.nrows();
     let movable = if outside { n.saturating_sub(1) } else { n };
     let g_rows = rows_of(g);
     if !g_rows.iter().any(|x| x.is_finite()) {
         return Ok((vec![0; movable], f64::NEG_INFINITY));
     }
-    let least = max_cycle_mean(g)?;
+    let least = cycle_mean_of_rows(&g_rows, n)?;
     let mut exponents = if least.is_finite() {
         let bound = least + 1e-9 * (1.0 + least.abs());
         let mut e = potentials(&g_rows, n, bound)?;
