@@ -28,6 +28,7 @@
 //!   hand: the bound within θ implies d_k within θ, so the choice is that of the norms, and a
 //!   power is formed (or a norm estimated) only when the bound cannot decide or the chosen
 //!   degree needs it. For a matrix of degree 7 with d_4 <= θ_7, A^8 is not formed at all.
+//!   (Above [`SMALL_MAX_ORDER`]; at the small orders a product costs what the bound does.)
 //! * The ℓ(A, m) correction (Al-Mohy & Higham 2009, (5.1)-(5.2)) adds squarings when the
 //!   relative forward error bound |c_{2m+1}| || |A|^{2m+1} ||_1 / ||A||_1 exceeds u, with
 //!   |c_{2m+1}| = (m!)^2 / ((2m)! (2m+1)!), the leading coefficient of the error series.
@@ -488,6 +489,10 @@ pub(crate) struct ExponentialPlan<M> {
     time_scale: f64,
     a_norm: f64,
     exact_norms: bool,
+    /// Whether the degree tests try [`Self::power_norm_bound`] first: above
+    /// [`SMALL_MAX_ORDER`]. Below it a product of stack matrices costs about what the bound's
+    /// bookkeeping does, and the tests use the norms alone.
+    bound_norms: bool,
     a2: M,
     /// Cached ||A^2||_1, for the bounds of the higher powers' norms.
     a2_norm: Option<f64>,
@@ -549,6 +554,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             time_scale,
             a_norm,
             exact_norms: n <= EXACT_NORM_MAX_ORDER,
+            bound_norms: n > SMALL_MAX_ORDER,
             a2,
             a2_norm: None,
             a4: None,
@@ -685,7 +691,8 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     #[inline(always)]
     fn scaled_power_norm_within(&mut self, k: usize, ratio: f64) -> bool {
         let scale = integer_power(ratio, k);
-        self.power_norm_bound(k) * scale <= 1.0 || self.power_norm(k) * scale <= 1.0
+        (self.bound_norms && self.power_norm_bound(k) * scale <= 1.0)
+            || self.power_norm(k) * scale <= 1.0
     }
 
     /// log2 τ d_k, d_k = ||A^k||_1^(1/k).
