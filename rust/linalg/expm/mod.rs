@@ -23,7 +23,12 @@
 //!   instead of ||A|| avoids the overscaling that loses accuracy in the squaring phase. The
 //!   d_k = ||A^k||_1^(1/k) for k = 4, 6 are exact norms of formed powers; d_8 and d_10 are exact
 //!   (products formed) for n <= [`EXACT_NORM_MAX_ORDER`] and estimated above it by the block
-//!   1-norm estimator of Higham & Tisseur (2000), see `norm.rs`.
+//!   1-norm estimator of Higham & Tisseur (2000), see `norm.rs`. A test d_k <= θ is first
+//!   tried on the bound ||A^k||_1 <= ||A^i||_1 ||A^j||_1 (i + j = k) from the exact norms at
+//!   hand: the bound within θ implies d_k within θ, so the choice is that of the norms, and a
+//!   power is formed (or a norm estimated) only when the bound cannot decide or the chosen
+//!   degree needs it. For a matrix of degree 7 with d_4 <= θ_7, A^8 is not formed at all.
+//!   (Above [`SMALL_MAX_ORDER`]; at the small orders a product costs what the bound does.)
 //! * The ℓ(A, m) correction (Al-Mohy & Higham 2009, (5.1)-(5.2)) adds squarings when the
 //!   relative forward error bound |c_{2m+1}| || |A|^{2m+1} ||_1 / ||A||_1 exceeds u, with
 //!   |c_{2m+1}| = (m!)^2 / ((2m)! (2m+1)!), the leading coefficient of the error series.
@@ -484,7 +489,13 @@ pub(crate) struct ExponentialPlan<M> {
     time_scale: f64,
     a_norm: f64,
     exact_norms: bool,
+    /// Whether the degree tests try [`Self::power_norm_bound`] first: above
+    /// [`SMALL_MAX_ORDER`]. Below it a product of stack matrices costs about what the bound's
+    /// bookkeeping does, and the tests use the norms alone.
+    bound_norms: bool,
     a2: M,
+    /// Cached ||A^2||_1, for the bounds of the higher powers' norms.
+    a2_norm: Option<f64>,
     a4: Option<M>,
     a6: Option<M>,
     a8: Option<M>,
@@ -543,7 +554,9 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             time_scale,
             a_norm,
             exact_norms: n <= EXACT_NORM_MAX_ORDER,
+            bound_norms: n > SMALL_MAX_ORDER,
             a2,
+            a2_norm: None,
             a4: None,
             a6: None,
             a8: None,
@@ -633,13 +646,53 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         norm
     }
 
+    /// An upper bound of ||A^k||_1 for k in {4, 6, 8, 10} from the norms at hand, by
+    /// submultiplicativity: the least of ||A^i||_1 ||A^j||_1 over i + j = k, with ||A^2||_1 and
+    /// the exact cached norms of the higher even powers (an estimate is a lower bound, and is
+    /// never used). Costs no product; infinite if a norm overflowed.
+    #[inline(always)]
+    fn power_norm_bound(&mut self, k: usize) -> f64 {
+        let a2_norm = match self.a2_norm {
+            Some(norm) => norm,
+            None => {
+                let norm = self.a2.one_norm();
+                self.a2_norm = Some(norm);
+                norm
+            }
+        };
+        // bounds[i] bounds ||A^(2i + 2)||_1.
+        let mut bounds = [a2_norm; 5];
+        for i in 1..k / 2 {
+            let mut bound = f64::INFINITY;
+            for (low, high) in bounds[..i].iter().zip(bounds[..i].iter().rev()) {
+                bound = bound.min(low * high);
+            }
+            if let Some((norm, true)) = self.power_norms[i - 1] {
+                bound = bound.min(norm);
+            }
+            bounds[i] = bound;
+        }
+        bounds[k / 2 - 1]
+    }
+
     /// Whether τ max(||A^p||^(1/p), ||A^q||^(1/q)) <= θ, i.e. τ^k ||A^k|| <= θ^k for k = p, q:
-    /// the selection compares powers, so that it needs no roots or logarithms.
+    /// the selection compares powers, so that it needs no roots or logarithms. A norm is
+    /// computed (and its power formed, at orders of exact norms) only when its bound
+    /// [`Self::power_norm_bound`] does not already decide: the bound within θ implies the norm
+    /// within θ, so the answer is that of the norms themselves (Al-Mohy & Higham 2009 likewise
+    /// form a power only for a degree that needs it).
     #[inline(always)]
     fn scaled_root_norms_within(&mut self, p: usize, q: usize, tau: f64, theta: f64) -> bool {
         let ratio = tau / theta;
-        self.power_norm(p) * integer_power(ratio, p) <= 1.0
-            && self.power_norm(q) * integer_power(ratio, q) <= 1.0
+        self.scaled_power_norm_within(p, ratio) && self.scaled_power_norm_within(q, ratio)
+    }
+
+    /// Whether ratio^k ||A^k||_1 <= 1, by the bound first (see above).
+    #[inline(always)]
+    fn scaled_power_norm_within(&mut self, k: usize, ratio: f64) -> bool {
+        let scale = integer_power(ratio, k);
+        (self.bound_norms && self.power_norm_bound(k) * scale <= 1.0)
+            || self.power_norm(k) * scale <= 1.0
     }
 
     /// log2 τ d_k, d_k = ||A^k||_1^(1/k).
@@ -1739,6 +1792,66 @@ mod tests {
             exact.exponential_into(1.0, cx, x2.as_mut());
             assert!(relative_difference(&x1, &x2) < 1e-12);
         }
+    }
+
+    #[test]
+    fn norm_bounds_choose_as_the_exact_norms_and_skip_unneeded_powers() {
+        // The degree tests try the submultiplicative bound of ||A^k|| before forming A^k: the
+        // choice must be the one from all exact norms (formed and cached beforehand, which
+        // makes every bound the norm itself), for general, non-normal and graded matrices over
+        // norms 1e-3..1e3 and several times, and a degree-7 choice with d4 <= θ7 (the bound
+        // ||A^8|| <= ||A^4||^2 decides) must not form A^8.
+        let mut rng = StdRng::seed_from_u64(26);
+        let (mut cases, mut skipped) = (0, 0);
+        for case in 0..400 {
+            let n = [9, 12, 16, 24, 40, 64][case % 6];
+            let norm = 10f64.powf(rng.random_range(-3.0..3.0));
+            let mut a = random_matrix(n, 1.0, &mut rng);
+            match case % 3 {
+                // Strictly upper triangular part amplified: non-normal, with humps.
+                1 => {
+                    for j in 0..n {
+                        for i in 0..j {
+                            a[(i, j)] *= 30.0;
+                        }
+                    }
+                }
+                // Graded rows and columns.
+                2 => {
+                    for j in 0..n {
+                        for i in 0..n {
+                            a[(i, j)] *= 2f64.powi(i as i32 - j as i32);
+                        }
+                    }
+                }
+                _ => {}
+            }
+            let a = &a * faer::Scale(norm / one_norm(a.as_ref()));
+            for t in [1.0, -0.3, 2.5] {
+                let mut lazy = ExponentialPlan::<Scratch>::new(a.as_ref());
+                let mut exact = ExponentialPlan::<Scratch>::new(a.as_ref());
+                exact.ensure_a6();
+                exact.ensure_a8();
+                for k in [4, 6, 8, 10] {
+                    exact.power_norm(k);
+                }
+                let (cl, cx) = (lazy.choose(t), exact.choose(t));
+                assert_eq!(cl, cx, "case {case} n={n} norm={norm:e} t={t}");
+                cases += 1;
+                if cl.degree() == 7 {
+                    let d4 = lazy.power_norm(4).powf(0.25) * t.abs();
+                    if d4 <= APPROXIMANTS[M7].theta * (1.0 - 1e-12) {
+                        assert!(lazy.a8.is_none(), "case {case}: A^8 formed for its norm");
+                        skipped += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(cases, 1200);
+        assert!(
+            skipped >= 20,
+            "only {skipped} degree-7 choices decided by the bound"
+        );
     }
 
     #[test]
