@@ -6,7 +6,7 @@
 //! The columns A^k B of V = [B AB ... A^{n-1}B] (6.74) line up with the dominant eigenvectors
 //! as k grows, so the singular values of V decay geometrically even for a strongly controllable
 //! system: the numerical rank of V understates controllability (a random controllable system
-//! of order 64 has a V whose rank numpy puts at about 61). [`ctrb`] and [`obsv`] are provided
+//! of order 64 has a V whose rank numpy puts at about 61). [`ctrb`] and [`obsv_transposed`] (O^T) are provided
 //! for the chapter's hand analysis and for Bass–Gura; the verdict comes from the staircase form.
 //!
 //! # Staircase form

@@ -19,7 +19,7 @@
 //! * [`qz`]: the generalized real Schur form of a pencil (QZ) and its reordering.
 //! * [`stein`]: the symmetric Stein (discrete Lyapunov) equation at small orders.
 //! * [`lyapunov`]: the continuous Lyapunov equation.
-//! * `max_plus`: the (max, +) product of matrices of log2 sizes and Karp's maximum cycle mean,
+//! * [`max_plus`]: the (max, +) product of matrices of log2 sizes and Karp's maximum cycle mean,
 //!   for diagonal scalings by powers of two.
 //! * [`expm`]: the matrix exponential, with double-double arithmetic where squarings amplify
 //!   rounding.
@@ -34,7 +34,7 @@ pub(crate) mod householder;
 pub mod lu;
 pub mod lyapunov;
 pub(crate) mod matrix;
-pub(crate) mod max_plus;
+pub mod max_plus;
 pub mod norm;
 pub(crate) mod polynomial_roots;
 pub mod product;
