@@ -186,6 +186,14 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// For generic code whose operations may stop with an [`Error`] for some types and never for
+/// others (those whose error type is [`std::convert::Infallible`]).
+impl From<std::convert::Infallible> for Error {
+    fn from(never: std::convert::Infallible) -> Self {
+        match never {}
+    }
+}
+
 /// Checks that `a` is square.
 pub fn check_square(a: MatRef<'_, f64>, arg: &'static str) -> Result<(), Error> {
     if a.nrows() == a.ncols() {

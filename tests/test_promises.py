@@ -355,7 +355,10 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
     # call of faer's, whose latency grew as n^3 (1.1 s at n = 1500).
     # The DC gain at n = 3500 is one LU factorisation (1.7 s of latency when it was one call of
     # faer's), and Tustin's transformation at n = 3000 an LU factorisation, solves with n
-    # right-hand sides and products (7.5 s): both now stop between column panels.
+    # right-hand sides and products (7.5 s): both now stop between column panels. The
+    # exponential at n = 2000 (9.6 s of latency when its products and Padé solve were single
+    # calls of faer's) stops between panels, and at n = 1000 with ||A|| = 1e4 (2.2 s) between
+    # its squarings.
     [
         "(lambda: rng.standard_normal((1200, 1200)), aerocontrol.schur)",
         "(lambda: np.geomspace(1e-3, 10, 2_000_000), lambda c: aerocontrol.batch.lqr_sweep("
@@ -370,6 +373,8 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "(lambda: aerocontrol.StateSpace(rng.standard_normal((3000, 3000)) - 60 * np.eye(3000), "
         "rng.standard_normal((3000, 2)), rng.standard_normal((2, 3000)), np.zeros((2, 2))), "
         "lambda sys: aerocontrol.c2d(sys, 0.01, 'tustin'))",
+        "(lambda: 3 / np.sqrt(2000) * rng.standard_normal((2000, 2000)), aerocontrol.expm)",
+        "(lambda: 1e4 / np.sqrt(1000) * rng.standard_normal((1000, 1000)), aerocontrol.expm)",
     ],
     ids=[
         "schur n=1200",
@@ -379,6 +384,8 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "eigenvalues n=2500",
         "dc_gain n=3500",
         "c2d tustin n=3000",
+        "expm n=2000",
+        "expm n=1000 squarings",
     ],
 )
 def test_ctrl_c_stops_a_long_computation_within_a_second(work: str) -> None:

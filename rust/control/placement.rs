@@ -358,7 +358,7 @@ fn place_single_input(
     }
     let v_norm = one_norm(v.as_ref());
     let mut factors = v;
-    let combined = solve_with_inverse(factors.as_mut().transpose_mut(), rhs.as_ref());
+    let combined = solve_with_inverse(factors.as_mut().transpose_mut(), rhs.as_ref())?;
     let (solution, inverse) = combined.as_ref().split_at_col(1);
     let condition = v_norm * one_norm(inverse);
     // V is exactly singular for an uncontrollable pair, but its computed condition number can

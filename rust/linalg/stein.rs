@@ -19,7 +19,7 @@
 //! three products of order n per step, until A_k is negligible.
 
 use crate::error::Error;
-use crate::linalg::lu::solve_in_place;
+use crate::linalg::lu;
 use faer::{Mat, MatRef, Par};
 
 /// The largest order solved in vectorised form (136 unknowns).
@@ -60,7 +60,7 @@ pub fn solve_stein_kronecker(
         }
     }
     let scale = crate::linalg::norm::max_abs(system.as_ref());
-    solve_in_place(system.as_mut(), rhs.as_mut(), Par::Seq);
+    lu::solve(system.as_mut(), rhs.as_mut(), Par::Seq)?;
     if !rhs.is_all_finite() || scale.is_nan() || scale <= 0.0 {
         return Ok(None);
     }

@@ -86,7 +86,7 @@ use crate::linalg::balance::{balance, nearest_power_of_two};
 use crate::linalg::dense::{
     cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place, transposed_product,
 };
-use crate::linalg::lu::{solve_in_place, solve_with_inverse};
+use crate::linalg::lu::{self, solve_with_inverse};
 use crate::linalg::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity};
 use crate::linalg::matrix::{FaerView, Order, Symmetrize, from_faer, with_order};
 use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
@@ -511,10 +511,10 @@ fn solve_care_balanced(
         Some(e) => {
             let mut x = y.to_faer();
             let mut factors = e.transpose().to_owned();
-            solve_in_place(factors.as_mut(), x.as_mut(), Par::Seq);
+            lu::solve(factors.as_mut(), x.as_mut(), Par::Seq)?;
             let mut xt = x.transpose().to_owned();
             let mut factors = e.transpose().to_owned();
-            solve_in_place(factors.as_mut(), xt.as_mut(), Par::Seq);
+            lu::solve(factors.as_mut(), xt.as_mut(), Par::Seq)?;
             let mut x = xt.transpose().to_owned();
             x.symmetrize();
             let gain = gain.to_faer();
@@ -603,7 +603,7 @@ fn remove_descriptor(
     let mut plant = Mat::<f64>::zeros(n, n + m);
     plant.as_mut().subcols_mut(0, n).copy_from(a);
     plant.as_mut().subcols_mut(n, m).copy_from(b);
-    let combined = solve_with_inverse(e.to_owned().as_mut(), plant.as_ref());
+    let combined = solve_with_inverse(e.to_owned().as_mut(), plant.as_ref())?;
     let (solution, inverse) = combined.as_ref().split_at_col(n + m);
     let condition = one_norm(e) * one_norm(inverse);
     // (A solve that broke down gives a NaN condition number, which the finiteness test catches.)
@@ -838,7 +838,7 @@ fn hamiltonian_solution_in<O: Order>(
         }
         combined[(j, n + j)] = 1.0;
     }
-    solve_in_place(factors.as_faer_mut(), combined.as_faer_mut(), Par::Seq);
+    lu::solve(factors.as_faer_mut(), combined.as_faer_mut(), Par::Seq)?;
     let inverse_transposed = DMatrix::from_fn(n, n, |i, j| combined[(i, n + j)]);
     let broke_down = !combined.as_slice().iter().all(|x| x.is_finite());
     // A solve that broke down (an exactly singular U11: inf / inf) has rcond 0.

@@ -47,7 +47,7 @@ pub(crate) fn solve_care_indefinite(
     let (n, m) = (a.nrows(), b.ncols());
     // R must be invertible (the gain is R^-1 (B^T X E + S^T)).
     let r_norm = one_norm(r.as_ref());
-    let r_inverse = solve_with_inverse(r.clone().as_mut(), Mat::<f64>::zeros(m, 0).as_ref());
+    let r_inverse = solve_with_inverse(r.clone().as_mut(), Mat::<f64>::zeros(m, 0).as_ref())?;
     // An inverse that is not finite is that of an exactly singular R: rcond 0 (not the NaN
     // of inf / inf, which the message printed).
     let r_rcond = if r_inverse.is_all_finite() {
@@ -125,7 +125,7 @@ pub(crate) fn solve_care_indefinite(
     if let Some(s) = options.s {
         mixed += s.transpose();
     }
-    let combined = solve_with_inverse(r.clone().as_mut(), mixed.as_ref());
+    let combined = solve_with_inverse(r.clone().as_mut(), mixed.as_ref())?;
     let gain = combined.as_ref().split_at_col(n).0.to_owned();
     let closed_loop = a - b * &gain;
     let closed_loop_eigenvalues: Vec<c64> = match options.e {

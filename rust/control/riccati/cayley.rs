@@ -107,7 +107,8 @@ fn cayley_transform(plant: &Standard) -> Option<Standard> {
         }
     }
     let norm = one_norm(sum.as_ref());
-    let combined = solve_with_inverse(sum.as_mut(), difference.as_ref());
+    // An interruption refuses the transform (the caller's next check stops).
+    let combined = solve_with_inverse(sum.as_mut(), difference.as_ref()).ok()?;
     let (h, inverse) = combined.as_ref().split_at_col(2 * n);
     let rcond = 1.0 / (norm * one_norm(inverse));
     if rcond.is_nan() || rcond < MIN_RCOND || !h.is_all_finite() {

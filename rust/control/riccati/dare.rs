@@ -68,7 +68,7 @@ use super::pencil::{checked_weights, compress, graph_solution};
 use super::scaling::{Equation, Scale, ScaledEquation};
 use crate::error::Error;
 use crate::linalg::dense::view_product;
-use crate::linalg::lu::{solve_in_place, solve_with_inverse};
+use crate::linalg::lu::{self, solve_with_inverse};
 use crate::linalg::matrix::Symmetrize;
 use crate::linalg::norm::{frobenius_norm, one_norm};
 use crate::linalg::qz::{generalized_eigenvalues, qz, reorder_qz};
@@ -325,7 +325,7 @@ impl Problem<'_> {
             mixed += s.transpose();
         }
         let norm = one_norm(weight.as_ref());
-        let combined = solve_with_inverse(weight.as_mut(), mixed.as_ref());
+        let combined = solve_with_inverse(weight.as_mut(), mixed.as_ref())?;
         let (gain, inverse) = combined.as_ref().split_at_col(a.nrows());
         let rcond = 1.0 / (norm * one_norm(inverse));
         if m > 0 && (!gain.is_all_finite() || rcond.is_nan() || rcond <= f64::EPSILON) {
@@ -402,7 +402,7 @@ fn refine(
                 evaluation.closed_loop.as_ref(),
                 problem.e,
                 evaluation.residual.as_ref(),
-            );
+            )?;
             solve_stein_smith(a.as_ref(), c.as_ref())?
         };
         let Some(delta) = delta else {
@@ -434,7 +434,7 @@ fn without_descriptor(
     closed_loop: MatRef<'_, f64>,
     e: MatRef<'_, f64>,
     residual: MatRef<'_, f64>,
-) -> (Mat<f64>, Mat<f64>) {
+) -> Result<(Mat<f64>, Mat<f64>), Error> {
     let n = e.nrows();
     // E^T [Y | W] = [A_c^T | Res]: Ã = Y^T, W = E^-T Res.
     let mut rhs = Mat::<f64>::zeros(n, 2 * n);
@@ -442,18 +442,18 @@ fn without_descriptor(
         .subcols_mut(0, n)
         .copy_from(closed_loop.transpose());
     rhs.as_mut().subcols_mut(n, n).copy_from(residual);
-    solve_in_place(e.transpose().to_owned().as_mut(), rhs.as_mut(), Par::Seq);
+    lu::solve(e.transpose().to_owned().as_mut(), rhs.as_mut(), Par::Seq)?;
     let a_tilde = rhs.as_ref().subcols(0, n).transpose().to_owned();
     // E^T V = W^T: C̃ = W E^-1 = V^T.
     let mut c_tilde = rhs.as_ref().subcols(n, n).transpose().to_owned();
-    solve_in_place(
+    lu::solve(
         e.transpose().to_owned().as_mut(),
         c_tilde.as_mut(),
         Par::Seq,
-    );
+    )?;
     let mut c_tilde = c_tilde.transpose().to_owned();
     c_tilde.symmetrize();
-    (a_tilde, c_tilde)
+    Ok((a_tilde, c_tilde))
 }
 
 /// The pencil of order 2n + m (module documentation) with its last m columns compressed away:

@@ -160,7 +160,7 @@ fn recursion(
             mixed += cross.transpose();
         }
         let norm = one_norm(weight.as_ref());
-        let combined = solve_with_inverse(weight.as_mut(), mixed.as_ref());
+        let combined = solve_with_inverse(weight.as_mut(), mixed.as_ref())?;
         let (gain, inverse) = combined.as_ref().split_at_col(n);
         if m > 0 {
             let step_rcond = 1.0 / (norm * one_norm(inverse));

@@ -43,7 +43,7 @@
 use crate::control::riccati::care::check_problem;
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::expm::expm;
-use crate::linalg::lu::solve_in_place;
+use crate::linalg::lu;
 use crate::linalg::matrix::{FaerView, Symmetrize};
 use crate::linalg::schur::eigenvalues;
 use crate::platform::interrupt;
@@ -217,7 +217,7 @@ fn step(phi: MatRef<'_, f64>, s: &Mat<f64>) -> Result<Mat<f64>, Error> {
     let y = phi.submatrix(n, 0, n, n) + phi.submatrix(n, n, n, n) * s;
     let mut factors = x.transpose().to_owned();
     let mut next = y.transpose().to_owned();
-    solve_in_place(factors.as_mut(), next.as_mut(), Par::Seq);
+    lu::solve(factors.as_mut(), next.as_mut(), Par::Seq)?;
     if !next.is_all_finite() {
         return Err(Error::IllConditioned {
             message: "the Riccati differential equation's solution could not be continued: \

@@ -71,7 +71,8 @@ pub(crate) fn graph_solution(
     let eu11 = e * u11;
     let norm = one_norm(eu11.as_ref());
     let mut factor = eu11.transpose().to_owned();
-    let combined = solve_with_inverse(factor.as_mut(), u21.transpose());
+    // An interruption refuses the subspace (the caller's next check stops).
+    let combined = solve_with_inverse(factor.as_mut(), u21.transpose()).ok()?;
     let (xt, inverse) = combined.as_ref().split_at_col(n);
     // The inverse of (E U11)^T: the 1-norm of its transpose is that of (E U11)^-1.
     let rcond = 1.0 / (norm * one_norm(inverse.transpose()));

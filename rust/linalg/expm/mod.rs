@@ -67,16 +67,19 @@ pub mod double_double;
 
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
 use crate::linalg::expm::double_double::DoubleDoubleMatrix;
+use crate::linalg::lu;
 use crate::linalg::matrix::{from_faer_in, with_order};
 use crate::linalg::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
+use crate::linalg::product::multiply;
 use crate::linalg::small_matrix::{self, Columns, StackColumns};
 use crate::platform::dispatch::{add_scaled, fma_dispatch, scale_into};
+use crate::platform::interrupt;
 use crate::platform::parallel::{PARALLEL_MIN_ORDER, ParallelContext, parallelism_for_order};
 use crate::platform::pool::{Scratch, scratch};
-use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef};
 use nalgebra::{Const, SMatrix};
 use rayon::prelude::*;
+use std::convert::Infallible;
 
 /// For n up to this order the norms ||A^8||_1 and ||A^10||_1 of the degree selection are exact
 /// (from formed products); above it they are estimated (Higham & Tisseur 2000), which costs
@@ -237,14 +240,19 @@ impl PadeChoice {
 /// The arithmetic of evaluating r_m and squaring: implemented by double matrices of small and
 /// of any order, and by double-double matrices.
 pub(crate) trait PadeArithmetic: Sized {
+    /// Why a product or solve stopped short: [`Error::Interrupted`] for matrices of any order,
+    /// whose products and solves answer an interruption ([`interrupt`]); [`Infallible`] for
+    /// stack matrices, whose operations always complete, so that the compiled small
+    /// exponentials carry no error path.
+    type Stop: Into<Error>;
     /// self * rhs.
-    fn product(&self, rhs: &Self) -> Self;
+    fn product(&self, rhs: &Self) -> Result<Self, Self::Stop>;
     /// self += lhs * rhs.
-    fn add_product(&mut self, lhs: &Self, rhs: &Self);
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) -> Result<(), Self::Stop>;
     /// identity * I + sum_k coefficient_k * M_k, for at least one term.
     fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self;
     /// r_m = I + 2 (V - U)^-1 U from the even part V and the odd part U.
-    fn pade_quotient(even: Self, odd: Self) -> Self;
+    fn pade_quotient(even: Self, odd: Self) -> Result<Self, Self::Stop>;
 }
 
 /// The operations the degree selection and the double evaluation need besides arithmetic.
@@ -287,7 +295,7 @@ fn pade_approximant<M: PadeArithmetic>(
     a: &M,
     a2: &[&M; 1],
     higher: [&Option<M>; 3],
-) -> M {
+) -> Result<M, M::Stop> {
     let mut powers = [a2[0]; 4];
     for (slot, power) in powers[1..].iter_mut().zip(higher) {
         if let Some(p) = power {
@@ -317,11 +325,11 @@ fn pade_approximant<M: PadeArithmetic>(
         let even_high = M::combination(0.0, &[(b[12], a6), (b[10], a4), (b[8], a2)]);
         let mut odd = M::combination(b[1], &[(b[7], a6), (b[5], a4), (b[3], a2)]);
         let mut even = M::combination(b[0], &[(b[6], a6), (b[4], a4), (b[2], a2)]);
-        odd.add_product(a6, &odd_high);
-        even.add_product(a6, &even_high);
+        odd.add_product(a6, &odd_high)?;
+        even.add_product(a6, &even_high)?;
         (odd, even)
     };
-    M::pade_quotient(even, a.product(&odd_inner))
+    M::pade_quotient(even, a.product(&odd_inner)?)
 }
 
 /// X <- X^2, `squarings` times; `refine(X, i)` may correct X, which then approximates
@@ -331,13 +339,13 @@ fn square_repeatedly<M: PadeArithmetic>(
     mut x: M,
     squarings: u32,
     mut refine: impl FnMut(&mut M, u32),
-) -> M {
+) -> Result<M, M::Stop> {
     refine(&mut x, squarings);
     for i in (0..squarings).rev() {
-        x = x.product(&x);
+        x = x.product(&x)?;
         refine(&mut x, i);
     }
-    x
+    Ok(x)
 }
 
 /// c^k P for P = A^k, given `factor` = c^k: when c^k overflows (a large c, which only a matrix
@@ -508,7 +516,7 @@ pub(crate) struct ExponentialPlan<M> {
 impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// Prepares e^{tA} for a square, finite A of order at least 2 (the caller validates).
     #[inline(always)]
-    pub fn new(a: MatRef<'_, f64>) -> Self {
+    pub fn new(a: MatRef<'_, f64>) -> Result<Self, M::Stop> {
         let mut a = M::from_ref(a);
         let mut transposed = false;
         let mut triangular = a.is_upper_triangular();
@@ -545,8 +553,8 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             time_scale = exponent.exp2();
         }
         let a_norm = a.one_norm();
-        let a2 = a.product(&a);
-        Self {
+        let a2 = a.product(&a)?;
+        Ok(Self {
             a,
             transposed,
             diagonals,
@@ -562,38 +570,41 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             a8: None,
             power_norms: [None; 4],
             abs_power_norms: [None; 5],
-        }
+        })
     }
 
     #[inline(always)]
-    fn ensure_a4(&mut self) {
+    fn ensure_a4(&mut self) -> Result<(), M::Stop> {
         if self.a4.is_none() {
-            self.a4 = Some(self.a2.product(&self.a2));
+            self.a4 = Some(self.a2.product(&self.a2)?);
         }
+        Ok(())
     }
 
     #[inline(always)]
-    fn ensure_a6(&mut self) {
-        self.ensure_a4();
+    fn ensure_a6(&mut self) -> Result<(), M::Stop> {
+        self.ensure_a4()?;
         if self.a6.is_none() {
-            self.a6 = Some(self.a4.as_ref().expect("formed above").product(&self.a2));
+            self.a6 = Some(self.a4.as_ref().expect("formed above").product(&self.a2)?);
         }
+        Ok(())
     }
 
     #[inline(always)]
-    fn ensure_a8(&mut self) {
-        self.ensure_a4();
+    fn ensure_a8(&mut self) -> Result<(), M::Stop> {
+        self.ensure_a4()?;
         if self.a8.is_none() {
             let a4 = self.a4.as_ref().expect("formed above");
-            self.a8 = Some(a4.product(a4));
+            self.a8 = Some(a4.product(a4)?);
         }
+        Ok(())
     }
 
     /// ||A^k||_1 for k in {4, 6, 8, 10}: exact from a formed power when there is one (forming it
     /// if norms are exact at this order), otherwise estimated from the product of the powers at
     /// hand. Bounded by ||A||_1^k, which also stands in for a power that overflowed.
     #[inline(always)]
-    fn power_norm(&mut self, k: usize) -> f64 {
+    fn power_norm(&mut self, k: usize) -> Result<f64, M::Stop> {
         let slot = k / 2 - 2;
         let formed = |plan: &Self| match k {
             4 => plan.a4.is_some(),
@@ -604,14 +615,14 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         if let Some((value, exact)) = self.power_norms[slot]
             && (exact || !formed(self))
         {
-            return value;
+            return Ok(value);
         }
         if self.exact_norms {
             match k {
-                4 => self.ensure_a4(),
-                6 => self.ensure_a6(),
-                8 => self.ensure_a8(),
-                _ => self.ensure_a6(),
+                4 => self.ensure_a4()?,
+                6 => self.ensure_a6()?,
+                8 => self.ensure_a8()?,
+                _ => self.ensure_a6()?,
             }
         }
         let (norm, exact) = match k {
@@ -620,7 +631,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             8 if self.a8.is_some() => (self.a8.as_ref().unwrap().one_norm(), true),
             10 if self.exact_norms => {
                 let (a4, a6) = (self.a4.as_ref().unwrap(), self.a6.as_ref().unwrap());
-                (a4.product(a6).one_norm(), true)
+                (a4.product(a6)?.one_norm(), true)
             }
             _ => {
                 let a2 = &self.a2;
@@ -643,7 +654,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             integer_power(self.a_norm, k)
         };
         self.power_norms[slot] = Some((norm, exact));
-        norm
+        Ok(norm)
     }
 
     /// An upper bound of ||A^k||_1 for k in {4, 6, 8, 10} from the norms at hand, by
@@ -682,23 +693,31 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// within θ, so the answer is that of the norms themselves (Al-Mohy & Higham 2009 likewise
     /// form a power only for a degree that needs it).
     #[inline(always)]
-    fn scaled_root_norms_within(&mut self, p: usize, q: usize, tau: f64, theta: f64) -> bool {
+    fn scaled_root_norms_within(
+        &mut self,
+        p: usize,
+        q: usize,
+        tau: f64,
+        theta: f64,
+    ) -> Result<bool, M::Stop> {
         let ratio = tau / theta;
-        self.scaled_power_norm_within(p, ratio) && self.scaled_power_norm_within(q, ratio)
+        Ok(self.scaled_power_norm_within(p, ratio)? && self.scaled_power_norm_within(q, ratio)?)
     }
 
     /// Whether ratio^k ||A^k||_1 <= 1, by the bound first (see above).
     #[inline(always)]
-    fn scaled_power_norm_within(&mut self, k: usize, ratio: f64) -> bool {
+    fn scaled_power_norm_within(&mut self, k: usize, ratio: f64) -> Result<bool, M::Stop> {
         let scale = integer_power(ratio, k);
-        (self.bound_norms && self.power_norm_bound(k) * scale <= 1.0)
-            || self.power_norm(k) * scale <= 1.0
+        Ok(
+            (self.bound_norms && self.power_norm_bound(k) * scale <= 1.0)
+                || self.power_norm(k)? * scale <= 1.0,
+        )
     }
 
     /// log2 τ d_k, d_k = ||A^k||_1^(1/k).
     #[inline(always)]
-    fn log2_scaled_root_norm(&mut self, k: usize, tau: f64) -> f64 {
-        tau.log2() + self.power_norm(k).log2() / k as f64
+    fn log2_scaled_root_norm(&mut self, k: usize, tau: f64) -> Result<f64, M::Stop> {
+        Ok(tau.log2() + self.power_norm(k)?.log2() / k as f64)
     }
 
     /// ℓ(τA, m) of Al-Mohy & Higham (2009, (5.1)): the extra squarings needed so that the
@@ -754,60 +773,60 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// The Padé degree and number of squarings for e^{tA} (Al-Mohy & Higham 2009, Algorithm 5.1,
     /// with every norm scaled by τ = |t|).
     #[inline(always)]
-    pub fn choose(&mut self, t: f64) -> PadeChoice {
+    pub fn choose(&mut self, t: f64) -> Result<PadeChoice, M::Stop> {
         let choice = |approximant, squarings: u32| PadeChoice {
             approximant,
             squarings: squarings.min(MAX_SQUARINGS),
         };
         let tau = t.abs() * self.time_scale;
         if tau == 0.0 || self.a_norm == 0.0 {
-            return choice(M3, self.prescale);
+            return Ok(choice(M3, self.prescale));
         }
         // η1 = τ max(d4, d6) <= θ3 (d4 and d6 estimated at large orders, before A4 is formed).
-        if self.scaled_root_norms_within(4, 6, tau, APPROXIMANTS[M3].theta)
+        if self.scaled_root_norms_within(4, 6, tau, APPROXIMANTS[M3].theta)?
             && self.extra_squarings(M3, tau) == 0
         {
-            return choice(M3, self.prescale);
+            return Ok(choice(M3, self.prescale));
         }
         // η2 = τ max(d4, d6) <= θ5, with A4 formed (d4 exact).
-        self.ensure_a4();
-        if self.scaled_root_norms_within(4, 6, tau, APPROXIMANTS[M5].theta)
+        self.ensure_a4()?;
+        if self.scaled_root_norms_within(4, 6, tau, APPROXIMANTS[M5].theta)?
             && self.extra_squarings(M5, tau) == 0
         {
-            return choice(M5, self.prescale);
+            return Ok(choice(M5, self.prescale));
         }
         // η3 = τ max(d6, d8) <= θ7 or θ9, with A6 formed.
-        self.ensure_a6();
+        self.ensure_a6()?;
         for approximant in [M7, M9] {
-            if self.scaled_root_norms_within(6, 8, tau, APPROXIMANTS[approximant].theta)
+            if self.scaled_root_norms_within(6, 8, tau, APPROXIMANTS[approximant].theta)?
                 && self.extra_squarings(approximant, tau) == 0
             {
-                return choice(approximant, self.prescale);
+                return Ok(choice(approximant, self.prescale));
             }
         }
         // η5 = min(η3, η4), η4 = τ max(d8, d10); s = ⌈log2(η5 / θ13)⌉ plus ℓ.
         let (d6, d8, d10) = (
-            self.log2_scaled_root_norm(6, tau),
-            self.log2_scaled_root_norm(8, tau),
-            self.log2_scaled_root_norm(10, tau),
+            self.log2_scaled_root_norm(6, tau)?,
+            self.log2_scaled_root_norm(8, tau)?,
+            self.log2_scaled_root_norm(10, tau)?,
         );
         let eta5 = d6.max(d8).min(d8.max(d10));
         let squarings = (eta5 - THETA_13.log2())
             .ceil()
             .clamp(0.0, MAX_SQUARINGS as f64) as u32;
         let squarings = squarings + self.extra_squarings(M13, tau * (-(squarings as f64)).exp2());
-        choice(M13, squarings.saturating_add(self.prescale))
+        Ok(choice(M13, squarings.saturating_add(self.prescale)))
     }
 
     /// Forms the powers that evaluating `choice` needs; call before evaluating it.
     #[inline(always)]
-    pub fn prepare(&mut self, choice: PadeChoice) {
+    pub fn prepare(&mut self, choice: PadeChoice) -> Result<(), M::Stop> {
         match choice.approximant {
-            M3 => {}
+            M3 => Ok(()),
             M5 => self.ensure_a4(),
             M9 => {
-                self.ensure_a6();
-                self.ensure_a8();
+                self.ensure_a6()?;
+                self.ensure_a8()
             }
             _ => self.ensure_a6(),
         }
@@ -817,12 +836,17 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// Returns true when every entry written is certainly finite (false may also mean that
     /// only entries cleared afterwards, outside a triangular result, were not).
     #[inline(always)]
-    pub fn exponential_into(&self, t: f64, choice: PadeChoice, mut out: MatMut<'_, f64>) -> bool {
+    pub fn exponential_into(
+        &self,
+        t: f64,
+        choice: PadeChoice,
+        mut out: MatMut<'_, f64>,
+    ) -> Result<bool, M::Stop> {
         let n = self.a.order();
         if t == 0.0 {
             out.fill(0.0);
             out.diagonal_mut().fill(1.0);
-            return true;
+            return Ok(true);
         }
         // r_m is evaluated at c * (pre-scaled A); the squarings undo both scalings.
         let c =
@@ -836,7 +860,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         };
         let x = match accurate {
             Some(x) => x,
-            None => self.double_exponential(t, c, choice),
+            None => self.double_exponential(t, c, choice)?,
         };
         x.write_to(out.as_mut(), self.transposed);
         let finite = x.is_finite();
@@ -851,19 +875,19 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
                 }
             }
         }
-        finite
+        Ok(finite)
     }
 
     /// r_m(cA) squared in double precision, refining triangular structure on the way.
     #[inline(always)]
-    fn double_exponential(&self, t: f64, c: f64, choice: PadeChoice) -> M {
+    fn double_exponential(&self, t: f64, c: f64, choice: PadeChoice) -> Result<M, M::Stop> {
         let x = if c == 1.0 {
             pade_approximant(
                 choice.approximant,
                 &self.a,
                 &[&self.a2],
                 [&self.a4, &self.a6, &self.a8],
-            )
+            )?
         } else {
             // The powers of cA: c^k A^k.
             let c2 = c * c;
@@ -872,7 +896,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             let a4 = scaled_formed_power(&self.a4, c, 4, c2 * c2);
             let a6 = scaled_formed_power(&self.a6, c, 6, c2 * c2 * c2);
             let a8 = scaled_formed_power(&self.a8, c, 8, (c2 * c2) * (c2 * c2));
-            pade_approximant(choice.approximant, &a, &[&a2], [&a4, &a6, &a8])
+            pade_approximant(choice.approximant, &a, &[&a2], [&a4, &a6, &a8])?
         };
         square_repeatedly(x, choice.squarings, |x, i| {
             if let Some((diagonal, superdiagonal)) = &self.diagonals {
@@ -896,31 +920,37 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 
 // ----- faer matrices (any order), pooled ----------------------------------------------------
 
+/// Each product and solve checks for an interruption before it starts, and those of large
+/// orders between their panels too ([`multiply`], [`lu::solve`]).
 impl PadeArithmetic for Scratch {
-    fn product(&self, rhs: &Self) -> Self {
+    type Stop = Error;
+
+    fn product(&self, rhs: &Self) -> Result<Self, Error> {
+        interrupt::check()?;
         let mut out = scratch(self.nrows(), rhs.ncols());
         let par = parallelism_for_order(self.nrows());
-        matmul(
+        multiply(
             out.as_mut(),
             Accum::Replace,
             self.as_ref(),
             rhs.as_ref(),
             1.0,
             par,
-        );
-        out
+        )?;
+        Ok(out)
     }
 
-    fn add_product(&mut self, lhs: &Self, rhs: &Self) {
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) -> Result<(), Error> {
+        interrupt::check()?;
         let par = parallelism_for_order(self.nrows());
-        matmul(
+        multiply(
             self.as_mut(),
             Accum::Add,
             lhs.as_ref(),
             rhs.as_ref(),
             1.0,
             par,
-        );
+        )
     }
 
     fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
@@ -938,12 +968,13 @@ impl PadeArithmetic for Scratch {
         out
     }
 
-    fn pade_quotient(mut even: Self, mut odd: Self) -> Self {
+    fn pade_quotient(mut even: Self, mut odd: Self) -> Result<Self, Error> {
+        interrupt::check()?;
         let n = even.nrows();
         for j in 0..n {
             add_scaled(even.col_as_slice_mut(j), -1.0, odd.col_as_slice(j));
         }
-        crate::linalg::lu::solve_in_place(even.as_mut(), odd.as_mut(), parallelism_for_order(n));
+        lu::solve(even.as_mut(), odd.as_mut(), parallelism_for_order(n))?;
         for j in 0..n {
             let column = odd.col_as_slice_mut(j);
             for value in column.iter_mut() {
@@ -951,7 +982,7 @@ impl PadeArithmetic for Scratch {
             }
             column[j] += 1.0;
         }
-        odd
+        Ok(odd)
     }
 }
 
@@ -1021,41 +1052,50 @@ impl ExpmMatrix for Scratch {
 // ----- stack matrices of a small order, with the double-double evaluation --------------------
 
 impl<const N: usize> PadeArithmetic for SMatrix<f64, N, N> {
-    fn product(&self, rhs: &Self) -> Self {
-        small_matrix::product(self, rhs)
+    type Stop = Infallible;
+
+    fn product(&self, rhs: &Self) -> Result<Self, Infallible> {
+        Ok(small_matrix::product(self, rhs))
     }
 
-    fn add_product(&mut self, lhs: &Self, rhs: &Self) {
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) -> Result<(), Infallible> {
         small_matrix::add_product(self, lhs, rhs);
+        Ok(())
     }
 
     fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
         small_matrix::combination(identity, terms)
     }
 
-    fn pade_quotient(even: Self, odd: Self) -> Self {
+    fn pade_quotient(even: Self, odd: Self) -> Result<Self, Infallible> {
         let denominator = small_matrix::combination(0.0, &[(1.0, &even), (-1.0, &odd)]);
-        small_matrix::combination(1.0, &[(2.0, &small_matrix::solve(denominator, odd))])
+        Ok(small_matrix::combination(
+            1.0,
+            &[(2.0, &small_matrix::solve(denominator, odd))],
+        ))
     }
 }
 
 impl<const N: usize> PadeArithmetic for DoubleDoubleMatrix<N> {
-    fn product(&self, rhs: &Self) -> Self {
-        DoubleDoubleMatrix::product(self, rhs)
+    type Stop = Infallible;
+
+    fn product(&self, rhs: &Self) -> Result<Self, Infallible> {
+        Ok(DoubleDoubleMatrix::product(self, rhs))
     }
 
-    fn add_product(&mut self, lhs: &Self, rhs: &Self) {
-        let product = lhs.product(rhs);
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) -> Result<(), Infallible> {
+        let product = DoubleDoubleMatrix::product(lhs, rhs);
         *self = DoubleDoubleMatrix::combination(0.0, &[(1.0, self), (1.0, &product)]);
+        Ok(())
     }
 
     fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
         DoubleDoubleMatrix::combination(identity, terms)
     }
 
-    fn pade_quotient(even: Self, odd: Self) -> Self {
+    fn pade_quotient(even: Self, odd: Self) -> Result<Self, Infallible> {
         let quotient = even.difference(&odd).solve(&odd);
-        DoubleDoubleMatrix::combination(1.0, &[(2.0, &quotient)])
+        Ok(DoubleDoubleMatrix::combination(1.0, &[(2.0, &quotient)]))
     }
 }
 
@@ -1145,8 +1185,9 @@ impl<const N: usize> ExpmMatrix for SMatrix<f64, N, N> {
             let b4 = b4.as_ref().expect("degree >= 5");
             b4.product(b4)
         });
-        let x = pade_approximant(approximant, &b, &[&b2], [&b4, &b6, &b8]);
-        let x = square_repeatedly(x, squarings, |_, _| {}).round();
+        let Ok(x) = pade_approximant(approximant, &b, &[&b2], [&b4, &b6, &b8]);
+        let Ok(x) = square_repeatedly(x, squarings, |_, _| {});
+        let x = x.round();
         x.as_slice().iter().all(|v| v.is_finite()).then_some(x)
     }
 }
@@ -1170,20 +1211,23 @@ impl<const N: usize, const FMA: bool> StackColumns<N> for Inlined<N, FMA> {
 }
 
 impl<const N: usize, const FMA: bool> PadeArithmetic for Inlined<N, FMA> {
+    type Stop = Infallible;
+
     #[inline(always)]
-    fn product(&self, rhs: &Self) -> Self {
+    fn product(&self, rhs: &Self) -> Result<Self, Infallible> {
         let mut out = Self(SMatrix::zeros());
-        out.add_product(self, rhs);
-        out
+        let Ok(()) = out.add_product(self, rhs);
+        Ok(out)
     }
 
     #[inline(always)]
-    fn add_product(&mut self, lhs: &Self, rhs: &Self) {
+    fn add_product(&mut self, lhs: &Self, rhs: &Self) -> Result<(), Infallible> {
         small_matrix::add_product_kernel::<N, FMA>(
             small_matrix::columns(&lhs.0),
             small_matrix::columns(&rhs.0),
             small_matrix::columns_mut(&mut self.0),
         );
+        Ok(())
     }
 
     #[inline(always)]
@@ -1194,7 +1238,7 @@ impl<const N: usize, const FMA: bool> PadeArithmetic for Inlined<N, FMA> {
     }
 
     #[inline(always)]
-    fn pade_quotient(even: Self, odd: Self) -> Self {
+    fn pade_quotient(even: Self, odd: Self) -> Result<Self, Infallible> {
         let mut denominator = Self::combination(0.0, &[(1.0, &even), (-1.0, &odd)]);
         let mut pivots = [0; N];
         small_matrix::lu_kernel::<N, FMA>(
@@ -1210,7 +1254,7 @@ impl<const N: usize, const FMA: bool> PadeArithmetic for Inlined<N, FMA> {
             &mut rows,
         );
         let quotient = Self(small_matrix::from_columns(small_matrix::transposed(&rows)));
-        Self::combination(1.0, &[(2.0, &quotient)])
+        Ok(Self::combination(1.0, &[(2.0, &quotient)]))
     }
 }
 
@@ -1270,7 +1314,8 @@ impl<const N: usize, const FMA: bool> ExpmMatrix for Inlined<N, FMA> {
         let (first, rest) = factors.split_first().expect("at least one factor");
         let mut product = **first;
         for factor in rest {
-            product = product.product(factor);
+            let Ok(next) = product.product(factor);
+            product = next;
         }
         product.one_norm()
     }
@@ -1304,7 +1349,8 @@ fn small_exponential_kernel<const N: usize, const FMA: bool>(
     a: MatRef<'_, f64>,
     out: MatMut<'_, f64>,
 ) -> bool {
-    single_exponential::<Inlined<N, FMA>>(a, out)
+    let Ok(finite) = single_exponential::<Inlined<N, FMA>>(a, out);
+    finite
 }
 
 fma_dispatch!(fn small_exponential<const N: usize>(a: MatRef<'_, f64>, out: MatMut<'_, f64>) -> bool => small_exponential_kernel);
@@ -1339,10 +1385,13 @@ fn check_square_finite(a: MatRef<'_, f64>, arg: &'static str) -> Result<(), Erro
 /// Writes e^A into `out`; true when every entry is certainly finite (see
 /// [`ExponentialPlan::exponential_into`]).
 #[inline(always)]
-fn single_exponential<M: ExpmMatrix>(a: MatRef<'_, f64>, out: MatMut<'_, f64>) -> bool {
-    let mut plan = ExponentialPlan::<M>::new(a);
-    let choice = plan.choose(1.0);
-    plan.prepare(choice);
+fn single_exponential<M: ExpmMatrix>(
+    a: MatRef<'_, f64>,
+    out: MatMut<'_, f64>,
+) -> Result<bool, M::Stop> {
+    let mut plan = ExponentialPlan::<M>::new(a)?;
+    let choice = plan.choose(1.0)?;
+    plan.prepare(choice)?;
     plan.exponential_into(1.0, choice, out)
 }
 
@@ -1369,7 +1418,7 @@ pub(crate) fn expm_into_validated(
             n,
             [2, 3, 4, 5, 6, 7, 8],
             N => small_exponential::<N>(a, out.as_mut()),
-            _ => single_exponential::<Scratch>(a, out.as_mut())
+            _ => single_exponential::<Scratch>(a, out.as_mut())?
         ),
     };
     if finite {
@@ -1408,8 +1457,14 @@ pub fn pade_choice(a: MatRef<'_, f64>) -> Result<(usize, u32), Error> {
     if a.nrows() <= 1 {
         return Ok((0, 0));
     }
-    let choice = with_matrix_type!(a.nrows(), M => ExponentialPlan::<M>::new(a).choose(1.0));
+    let choice = with_matrix_type!(a.nrows(), M => chosen_degree::<M>(a))?;
     Ok((choice.degree(), choice.squarings))
+}
+
+/// The choice of [`ExponentialPlan::choose`] for e^A.
+fn chosen_degree<M: ExpmMatrix>(a: MatRef<'_, f64>) -> Result<PadeChoice, Error> {
+    let mut plan = ExponentialPlan::<M>::new(a).map_err(Into::into)?;
+    plan.choose(1.0).map_err(Into::into)
 }
 
 fn transition_matrices_with<M: ExpmMatrix>(
@@ -1418,16 +1473,21 @@ fn transition_matrices_with<M: ExpmMatrix>(
     out: &mut [f64],
 ) -> Result<(), Error> {
     let n = a.nrows();
-    let mut plan = ExponentialPlan::<M>::new(a);
-    let choices: Vec<PadeChoice> = times.iter().map(|&t| plan.choose(t)).collect();
+    let mut plan = ExponentialPlan::<M>::new(a).map_err(Into::into)?;
+    let choices = times
+        .iter()
+        .map(|&t| plan.choose(t))
+        .collect::<Result<Vec<PadeChoice>, M::Stop>>()
+        .map_err(Into::into)?;
     for &choice in &choices {
-        plan.prepare(choice);
+        plan.prepare(choice).map_err(Into::into)?;
     }
     let plan = &plan;
     let context = ParallelContext::capture(n);
     let evaluate = |((&t, &choice), chunk): ((&f64, &PadeChoice), &mut [f64])| {
         context.run(|| {
-            plan.exponential_into(t, choice, MatMut::from_row_major_slice_mut(chunk, n, n));
+            plan.exponential_into(t, choice, MatMut::from_row_major_slice_mut(chunk, n, n))
+                .map_err(Into::into)?;
             check_computed_exponential(a, t, MatRef::from_row_major_slice(chunk, n, n))
         })
     };
@@ -1687,8 +1747,8 @@ mod tests {
         for scale in [0.05, 1.0, 3.0] {
             let a = random_matrix(5, scale, &mut rng);
             let (mut small, mut general) = (Mat::zeros(5, 5), Mat::zeros(5, 5));
-            single_exponential::<SMatrix<f64, 5, 5>>(a.as_ref(), small.as_mut());
-            single_exponential::<Scratch>(a.as_ref(), general.as_mut());
+            let Ok(_) = single_exponential::<SMatrix<f64, 5, 5>>(a.as_ref(), small.as_mut());
+            single_exponential::<Scratch>(a.as_ref(), general.as_mut()).unwrap();
             assert!(
                 relative_difference(&small, &general) < 1e-14,
                 "scale {scale}"
@@ -1719,13 +1779,16 @@ mod tests {
                     let (finite_compiled, finite_dispatched) = with_order!(
                         n,
                         [2, 3, 4, 5, 6, 7, 8],
-                        N => (
-                            small_exponential::<N>(a.as_ref(), compiled.as_mut()),
-                            single_exponential::<SMatrix<f64, N, N>>(
+                        N => {
+                            let Ok(finite_dispatched) = single_exponential::<SMatrix<f64, N, N>>(
                                 a.as_ref(),
                                 dispatched.as_mut(),
+                            );
+                            (
+                                small_exponential::<N>(a.as_ref(), compiled.as_mut()),
+                                finite_dispatched,
                             )
-                        ),
+                        },
                         _ => unreachable!("orders up to SMALL_MAX_ORDER")
                     );
                     assert_eq!(finite_compiled, finite_dispatched);
@@ -1755,14 +1818,15 @@ mod tests {
             [3.0 * e17 - 2.0 * e1, -1.5 * e17 + 1.5 * e1],
             [4.0 * e17 - 4.0 * e1, -2.0 * e17 + 3.0 * e1]
         ];
-        let mut plan = ExponentialPlan::<SMatrix<f64, 2, 2>>::new(a.as_ref());
-        let choice = plan.choose(1.0);
+        let Ok(mut plan) = ExponentialPlan::<SMatrix<f64, 2, 2>>::new(a.as_ref());
+        let Ok(choice) = plan.choose(1.0);
         assert!(choice.squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS);
-        plan.prepare(choice);
+        let Ok(()) = plan.prepare(choice);
         let mut accurate = Mat::zeros(2, 2);
-        plan.exponential_into(1.0, choice, accurate.as_mut());
+        let Ok(_) = plan.exponential_into(1.0, choice, accurate.as_mut());
         let c = (-(choice.squarings as f64)).exp2();
-        let double = plan.double_exponential(1.0, c, choice).to_faer();
+        let Ok(double) = plan.double_exponential(1.0, c, choice);
+        let double = double.to_faer();
         let (err_dd, err_double) = (
             relative_difference(&accurate, &expected),
             relative_difference(&double, &expected),
@@ -1779,17 +1843,17 @@ mod tests {
         let n = EXACT_NORM_MAX_ORDER + 20;
         for scale in [0.5, 3.0, 40.0] {
             let a = random_matrix(n, scale / (n as f64).sqrt(), &mut rng);
-            let mut estimated = ExponentialPlan::<Scratch>::new(a.as_ref());
-            let mut exact = ExponentialPlan::<Scratch>::new(a.as_ref());
+            let mut estimated = ExponentialPlan::<Scratch>::new(a.as_ref()).unwrap();
+            let mut exact = ExponentialPlan::<Scratch>::new(a.as_ref()).unwrap();
             exact.exact_norms = true;
-            let (ce, cx) = (estimated.choose(1.0), exact.choose(1.0));
+            let (ce, cx) = (estimated.choose(1.0).unwrap(), exact.choose(1.0).unwrap());
             assert_eq!(ce.degree(), cx.degree());
             assert!(ce.squarings.abs_diff(cx.squarings) <= 1, "{ce:?} vs {cx:?}");
-            estimated.prepare(ce);
-            exact.prepare(cx);
+            estimated.prepare(ce).unwrap();
+            exact.prepare(cx).unwrap();
             let (mut x1, mut x2) = (Mat::zeros(n, n), Mat::zeros(n, n));
-            estimated.exponential_into(1.0, ce, x1.as_mut());
-            exact.exponential_into(1.0, cx, x2.as_mut());
+            estimated.exponential_into(1.0, ce, x1.as_mut()).unwrap();
+            exact.exponential_into(1.0, cx, x2.as_mut()).unwrap();
             assert!(relative_difference(&x1, &x2) < 1e-12);
         }
     }
@@ -1828,18 +1892,18 @@ mod tests {
             }
             let a = &a * faer::Scale(norm / one_norm(a.as_ref()));
             for t in [1.0, -0.3, 2.5] {
-                let mut lazy = ExponentialPlan::<Scratch>::new(a.as_ref());
-                let mut exact = ExponentialPlan::<Scratch>::new(a.as_ref());
-                exact.ensure_a6();
-                exact.ensure_a8();
+                let mut lazy = ExponentialPlan::<Scratch>::new(a.as_ref()).unwrap();
+                let mut exact = ExponentialPlan::<Scratch>::new(a.as_ref()).unwrap();
+                exact.ensure_a6().unwrap();
+                exact.ensure_a8().unwrap();
                 for k in [4, 6, 8, 10] {
-                    exact.power_norm(k);
+                    exact.power_norm(k).unwrap();
                 }
-                let (cl, cx) = (lazy.choose(t), exact.choose(t));
+                let (cl, cx) = (lazy.choose(t).unwrap(), exact.choose(t).unwrap());
                 assert_eq!(cl, cx, "case {case} n={n} norm={norm:e} t={t}");
                 cases += 1;
                 if cl.degree() == 7 {
-                    let d4 = lazy.power_norm(4).powf(0.25) * t.abs();
+                    let d4 = lazy.power_norm(4).unwrap().powf(0.25) * t.abs();
                     if d4 <= APPROXIMANTS[M7].theta * (1.0 - 1e-12) {
                         assert!(lazy.a8.is_none(), "case {case}: A^8 formed for its norm");
                         skipped += 1;
