@@ -183,13 +183,9 @@ impl Reduced<'_> {
         let scale =
             self.q_norm + 2.0 * frobenius_norm(ay.as_faer()) + frobenius_norm(quadratic.as_faer());
         let n = y.nrows();
-        let ay_transposed = ay.transpose();
-        let mut residual = DMatrix::zeros(n, n);
-        let terms = ay.as_slice().iter().zip(ay_transposed.as_slice());
-        let terms = terms.zip(quadratic.as_slice()).zip(self.q.as_slice());
-        for (x, (((&ay, &ya), &quadratic), &q)) in residual.as_mut_slice().iter_mut().zip(terms) {
-            *x = ay + ya - quadratic + q;
-        }
+        let mut residual = DMatrix::from_fn(n, n, |i, j| {
+            ay[(i, j)] + ay[(j, i)] - quadratic[(i, j)] + self.q[(i, j)]
+        });
         residual.symmetrize();
         Evaluation {
             residual_norm: frobenius_norm(residual.as_faer()),
