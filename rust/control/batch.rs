@@ -8,7 +8,8 @@
 use crate::control::placement::Placement;
 use crate::control::riccati::AlgebraicSolution;
 use crate::control::riccati::care::{
-    CareOptions, indefinite_weight, solve_care, solve_care_dense, solve_care_scaled,
+    CareDense, CareOptions, SharedPlant, indefinite_weight, solve_care, solve_care_dense,
+    solve_care_scaled,
 };
 use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
@@ -345,7 +346,7 @@ pub fn riccati_batch(
                 member(&stacks.q, index),
                 member(&stacks.r, index),
             );
-            match solve_one(problem, kind) {
+            match solve_one(problem, kind, None) {
                 Ok(solved) => {
                     (out.residual[index], out.rcond[index]) = (solved.residual, solved.rcond);
                     None
@@ -355,6 +356,17 @@ pub fn riccati_batch(
         });
         return lowest_failure(failure);
     }
+    // A sweep over R (A, B and Q shared): their part of the continuous solve formed once.
+    let shared = match kind {
+        RiccatiKind::Continuous { .. }
+            if [&stacks.a, &stacks.b, &stacks.q]
+                .iter()
+                .all(|s| s.len() == 1) =>
+        {
+            SharedPlant::of(stacks.a.get(0), stacks.b.get(0), stacks.q.get(0))
+        }
+        _ => None,
+    };
     // The Hamiltonian (or the compressed symplectic pencil) is of order 2n.
     let context = ParallelContext::capture(2 * n);
     let failure = out
@@ -372,7 +384,7 @@ pub fn riccati_batch(
                 member(&stacks.q, index),
                 member(&stacks.r, index),
             );
-            let solved = context.run(|| solve_one((a, b, q, r), kind));
+            let solved = context.run(|| solve_one((a, b, q, r), kind, shared.as_ref()));
             match solved {
                 Ok(solved) => {
                     solved.write(x, gain, n, m);
@@ -431,10 +443,25 @@ impl Solved {
     }
 }
 
+impl From<CareDense> for Solved {
+    fn from(care: CareDense) -> Self {
+        Self {
+            solution: Solution::Small {
+                x: care.x,
+                gain: care.gain,
+            },
+            poles: care.closed_loop_eigenvalues,
+            residual: care.residual,
+            rcond: care.rcond,
+        }
+    }
+}
+
 /// One problem of a batch, solved exactly as the single solver solves it: the continuous
-/// equation in scaled units where [`solve_care_scaled`] scales it, else by the Cholesky path,
-/// or (an R symmetric but not positive definite) by [`solve_care`]'s extended pencil; the
-/// discrete one by [`solve_dare`].
+/// equation in scaled units where [`solve_care_scaled`] scales it, else by the Cholesky path
+/// (through `shared`, the part of A, B and Q that every problem shares, where it is given and
+/// applies), or (an R symmetric but not positive definite) by [`solve_care`]'s extended
+/// pencil; the discrete one by [`solve_dare`].
 fn solve_one(
     (a, b, q, r): (
         MatRef<'_, f64>,
@@ -443,9 +470,13 @@ fn solve_one(
         MatRef<'_, f64>,
     ),
     kind: RiccatiKind,
+    shared: Option<&SharedPlant>,
 ) -> Result<Solved, Error> {
     match kind {
         RiccatiKind::Continuous { refine } => {
+            if let Some(solved) = shared.and_then(|plant| plant.solve(a, b, r, refine)) {
+                return solved.map(Solved::from);
+            }
             let options = CareOptions {
                 refine,
                 ..CareOptions::default()
@@ -454,15 +485,7 @@ fn solve_one(
                 return scaled.map(Solved::from);
             }
             match solve_care_dense(a, b, q, r, options) {
-                Ok(care) => Ok(Solved {
-                    solution: Solution::Small {
-                        x: care.x,
-                        gain: care.gain,
-                    },
-                    poles: care.closed_loop_eigenvalues,
-                    residual: care.residual,
-                    rcond: care.rcond,
-                }),
+                Ok(care) => Ok(Solved::from(care)),
                 // solve_care routes such an R to the extended pencil (or refuses it as the
                 // single call does).
                 Err(Error::NotPositiveDefinite { arg: "R", .. }) => {

@@ -45,8 +45,12 @@ pub fn charpoly(a: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
 }
 
 /// det(λI - H) of an upper Hessenberg H by La Budde's recurrence (see [`charpoly`]),
-/// highest power first.
+/// highest power first. At the fixed orders the p_i are rows of a table on the stack
+/// ([`fixed_order_characteristic_polynomial`]).
 pub(crate) fn hessenberg_characteristic_polynomial<O: Order>(h: &Square<O>) -> Vec<f64> {
+    if O::FIXED && h.nrows() <= FIXED_MAX_ORDER {
+        return fixed_order_characteristic_polynomial(h);
+    }
     let n = h.nrows();
     // p_i's coefficients, lowest power first, at p[start(i)..start(i) + i + 1].
     let start = |i: usize| i * (i + 1) / 2;
@@ -75,11 +79,76 @@ pub(crate) fn hessenberg_characteristic_polynomial<O: Order>(h: &Square<O>) -> V
     p[start(n)..].iter().rev().copied().collect()
 }
 
+/// The largest order of [`with_order!`]'s constant orders.
+const FIXED_MAX_ORDER: usize = 8;
+
+/// [`hessenberg_characteristic_polynomial`] for n <= [`FIXED_MAX_ORDER`]: p_i's coefficients,
+/// lowest power first, in row i of a table on the stack, each formed by the same operations
+/// in the same order as the packed vector of the general recurrence (so bit for bit the
+/// same), without its slicing.
+fn fixed_order_characteristic_polynomial<O: Order>(h: &Square<O>) -> Vec<f64> {
+    let n = h.nrows();
+    let mut p = [[0.0f64; FIXED_MAX_ORDER + 1]; FIXED_MAX_ORDER + 1];
+    p[0][0] = 1.0;
+    for i in 1..=n {
+        let r = i - 1;
+        let (done, rest) = p.split_at_mut(i);
+        let current = &mut rest[0];
+        let previous = &done[i - 1];
+        // (λ - h_ii) p_{i-1}: the shifted copy, then the product subtracted (current[0]
+        // from 0, as in the zeroed vector).
+        current[1..=i].copy_from_slice(&previous[..i]);
+        let diagonal = h[(r, r)];
+        for k in 0..i {
+            current[k] -= diagonal * previous[k];
+        }
+        let mut subdiagonal_product = 1.0;
+        for m in 1..i {
+            subdiagonal_product *= h[(r + 1 - m, r - m)];
+            let term = h[(r - m, r)] * subdiagonal_product;
+            let lower = &done[i - m - 1];
+            for k in 0..i - m {
+                current[k] -= term * lower[k];
+            }
+        }
+    }
+    p[n][..=n].iter().rev().copied().collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::linalg::matrix::from_faer;
     use faer::{Mat, mat};
+
+    /// The stack table of the fixed orders gives the packed recurrence's coefficients bit for
+    /// bit: Hessenberg matrices of orders 2-8 (Gaussian, graded over 2^±40, with zero and
+    /// negative-zero subdiagonal entries), the fixed order against the same matrix of
+    /// run-time order.
+    #[test]
+    fn the_fixed_order_table_equals_the_packed_recurrence_bit_for_bit() {
+        use crate::linalg::matrix::from_faer_in;
+        use crate::test_matrices::seeded;
+        for n in 2..=8usize {
+            for seed in 0..40u64 {
+                let g = seeded(n, n, 500 + 40 * n as u64 + seed);
+                let grade = |i: usize| 2f64.powi(((seed as i32 * 7 + i as i32 * 13) % 81) - 40);
+                let h = Mat::from_fn(n, n, |i, j| match (i > j + 1, seed % 5) {
+                    (true, _) => 0.0,
+                    (false, 1) if i == j + 1 && j % 2 == 0 => 0.0,
+                    (false, 2) if i == j + 1 && j % 3 == 0 => -0.0,
+                    (false, 3) => g[(i, j)] * grade(i) / grade(j),
+                    _ => g[(i, j)],
+                });
+                let general = hessenberg_characteristic_polynomial(&from_faer(h.as_ref()));
+                let fixed = with_order!(n, order => {
+                    hessenberg_characteristic_polynomial(&from_faer_in(order, h.as_ref()))
+                });
+                let bits = |p: &[f64]| p.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fixed), bits(&general), "n={n} seed={seed}");
+            }
+        }
+    }
 
     #[test]
     fn la_budde_recurrence_expands_the_determinant() {

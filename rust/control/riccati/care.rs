@@ -82,7 +82,7 @@
 use super::AlgebraicSolution;
 use super::scaling::{Equation, Scale, ScaledEquation};
 use crate::error::{Error, check_finite, check_rows, check_square};
-use crate::linalg::balance::{balance, nearest_power_of_two};
+use crate::linalg::balance::{balance, nearest_power_of_two, states_scaled_apart};
 use crate::linalg::dense::{
     cholesky, product, solve_lower_in_place, solve_lower_transposed_in_place, transposed_product,
 };
@@ -153,8 +153,8 @@ pub(crate) struct Standard {
 /// with the Cholesky factor, keeps its accuracy when R is ill-conditioned, where
 /// Y B̂ B̂^T Y (B̂ = B̃ L^-T, entries of size ||B|| / σ_min(L)) loses digits to cancellation.
 struct Reduced<'a> {
-    a: DMatrix<f64>,
-    b: DMatrix<f64>,
+    a: &'a DMatrix<f64>,
+    b: &'a DMatrix<f64>,
     q: &'a DMatrix<f64>,
     /// ||Q||_F.
     q_norm: f64,
@@ -166,7 +166,7 @@ impl Reduced<'_> {
     /// The residual of Y (symmetric) and its gain K = R^-1 (B̃^T Y + S^T) = L^-T L^-1 M^T, with
     /// M = Y B̃ + S the coupling of the quadratic term, (Y B̃ + S) K.
     fn evaluate(&self, y: &DMatrix<f64>) -> Evaluation {
-        let mut gain = transposed_product(&self.b, y);
+        let mut gain = transposed_product(self.b, y);
         if let Some(s) = self.s {
             for j in 0..gain.ncols() {
                 for i in 0..gain.nrows() {
@@ -178,18 +178,14 @@ impl Reduced<'_> {
         let coupling = gain.transpose();
         solve_lower_in_place(self.l, &mut gain);
         solve_lower_transposed_in_place(self.l, &mut gain);
-        let ay = transposed_product(&self.a, y);
+        let ay = transposed_product(self.a, y);
         let quadratic = product(&coupling, &gain);
         let scale =
             self.q_norm + 2.0 * frobenius_norm(ay.as_faer()) + frobenius_norm(quadratic.as_faer());
         let n = y.nrows();
-        let ay_transposed = ay.transpose();
-        let mut residual = DMatrix::zeros(n, n);
-        let terms = ay.as_slice().iter().zip(ay_transposed.as_slice());
-        let terms = terms.zip(quadratic.as_slice()).zip(self.q.as_slice());
-        for (x, (((&ay, &ya), &quadratic), &q)) in residual.as_mut_slice().iter_mut().zip(terms) {
-            *x = ay + ya - quadratic + q;
-        }
+        let mut residual = DMatrix::from_fn(n, n, |i, j| {
+            ay[(i, j)] + ay[(j, i)] - quadratic[(i, j)] + self.q[(i, j)]
+        });
         residual.symmetrize();
         Evaluation {
             residual_norm: frobenius_norm(residual.as_faer()),
@@ -201,7 +197,7 @@ impl Reduced<'_> {
 
     /// Ã - B̃ K.
     fn closed_loop(&self, gain: &DMatrix<f64>) -> DMatrix<f64> {
-        let mut closed_loop = product(&self.b, gain);
+        let mut closed_loop = product(self.b, gain);
         for (x, &a) in closed_loop.as_mut_slice().iter_mut().zip(self.a.as_slice()) {
             *x = a - *x;
         }
@@ -350,13 +346,6 @@ pub(crate) fn solve_care_dense(
     r: MatRef<'_, f64>,
     options: CareOptions<'_>,
 ) -> Result<CareDense, Error> {
-    let log2 = |x: f64| {
-        if x > 0.0 && x.is_finite() {
-            x.log2()
-        } else {
-            0.0
-        }
-    };
     let (b_log, r_log, q_log) = (
         log2(frobenius_norm(b)),
         log2(frobenius_norm(r)),
@@ -365,12 +354,8 @@ pub(crate) fn solve_care_dense(
     let g_log = 2.0 * b_log - r_log;
     let finite = [a, b, q, r].iter().all(|m| m.is_all_finite())
         && options.s.is_none_or(|s| s.is_all_finite());
-    // Scaled when G or Q is huge (forming them or H overflows), or both are tiny; a tiny G
-    // beside a normal Q is a negligible quadratic term, solved as it is (scaling would make
-    // the gain underflow).
-    let huge = g_log > WEIGHT_RANGE_LOG2 || q_log > WEIGHT_RANGE_LOG2;
-    let tiny = g_log < -WEIGHT_RANGE_LOG2 && q_log < -WEIGHT_RANGE_LOG2;
-    if !finite || !(huge || tiny) {
+    // Scaled when G or Q is huge (forming them or H overflows), or both are tiny.
+    if !finite || !weights_need_scaling(b_log, r_log, q_log) {
         return solve_care_balanced(a, b, q, r, options);
     }
     // B' = β B, Q' = Q / β², S' = S / β (β a power of two) give X' = X / β² and K' = K / β:
@@ -403,6 +388,101 @@ pub(crate) fn solve_care_dense(
         *k *= beta;
     }
     Ok(care)
+}
+
+/// What [`solve_care`] computes from A, B and Q alone, formed once for problems that share
+/// them (a sweep over the control weight R): the checks of [`check_problem`] on A, B and Q, Q
+/// symmetrised and ||Q||_F, copies of A and B, and log2 ||B||_F, log2 ||Q||_F.
+///
+/// Formed only where those checks pass, every entry is finite and the states are not scaled
+/// apart (so [`solve_care_scaled`] solves the equation as given whenever R is positive
+/// definite); [`SharedPlant::solve`] then gives, for each R, bit for bit what
+/// [`solve_care_dense`] gives, with the same numbers not formed again.
+pub(crate) struct SharedPlant {
+    q: DMatrix<f64>,
+    q_norm: f64,
+    a: DMatrix<f64>,
+    b: DMatrix<f64>,
+    b_log: f64,
+    q_log: f64,
+}
+
+impl SharedPlant {
+    /// The shared data, or None where some problem could take another path than
+    /// [`solve_care_dense`]'s plain one whatever its R (see the type).
+    pub(crate) fn of(a: MatRef<'_, f64>, b: MatRef<'_, f64>, q: MatRef<'_, f64>) -> Option<Self> {
+        let n = a.nrows();
+        let checked = n > 0
+            && a.ncols() == n
+            && b.nrows() == n
+            && a.is_all_finite()
+            && b.is_all_finite()
+            && !states_scaled_apart(a);
+        if !checked {
+            return None;
+        }
+        let q_symmetric = symmetric(q, "Q", n, "A").ok()?;
+        Some(Self {
+            q_norm: frobenius_norm(q_symmetric.as_faer()),
+            q: q_symmetric,
+            a: from_faer(a),
+            b: from_faer(b),
+            b_log: log2(frobenius_norm(b)),
+            q_log: log2(frobenius_norm(q)),
+        })
+    }
+
+    /// [`solve_care`] without a cross term or E for the shared A, B, Q (`a`, `b` as given to
+    /// [`SharedPlant::of`]) and this R: Some of the result where R is symmetric positive
+    /// definite and the weights need no scaling (the path [`solve_care`] then takes:
+    /// [`solve_care_dense`] of the equation as given), None otherwise (the caller solves it as
+    /// [`solve_care`] does). R's symmetrisation and Cholesky factor serve both the test of an
+    /// indefinite R and the solve.
+    pub(crate) fn solve(
+        &self,
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        r: MatRef<'_, f64>,
+        refine: bool,
+    ) -> Option<Result<CareDense, Error>> {
+        let r_symmetric = symmetric(r, "R", b.ncols(), "the columns of B").ok()?;
+        let l = cholesky(&r_symmetric)?;
+        if weights_need_scaling(self.b_log, log2(frobenius_norm(r)), self.q_log) {
+            return None;
+        }
+        let options = CareOptions {
+            refine,
+            ..CareOptions::default()
+        };
+        let checked = Checked {
+            q: &self.q,
+            q_norm: self.q_norm,
+            l: &l,
+            a_tilde: &self.a,
+            b_tilde: &self.b,
+        };
+        Some(solve_checked(a, b, options, checked))
+    }
+}
+
+/// log2 of a norm, 0 for a zero or non-finite one.
+fn log2(x: f64) -> f64 {
+    if x > 0.0 && x.is_finite() {
+        x.log2()
+    } else {
+        0.0
+    }
+}
+
+/// Whether [`solve_care_dense`] scales the weights (G = B R^-1 B^T or Q beyond 2^500, or both
+/// below 2^-500), from the log2 of ||B||_F, ||R||_F and ||Q||_F.
+fn weights_need_scaling(b_log: f64, r_log: f64, q_log: f64) -> bool {
+    let g_log = 2.0 * b_log - r_log;
+    // A tiny G beside a normal Q is a negligible quadratic term, solved as it is (scaling
+    // would make the gain underflow).
+    let huge = g_log > WEIGHT_RANGE_LOG2 || q_log > WEIGHT_RANGE_LOG2;
+    let tiny = g_log < -WEIGHT_RANGE_LOG2 && q_log < -WEIGHT_RANGE_LOG2;
+    huge || tiny
 }
 
 /// The refusal of weights whose Hamiltonian leaves the range of doubles even when balanced.
@@ -454,8 +534,43 @@ fn solve_care_balanced(
         Some(e) => remove_descriptor(a, b, e)?,
         None => (from_faer(a), from_faer(b)),
     };
+    let checked = Checked {
+        q: &q,
+        q_norm: frobenius_norm(q.as_faer()),
+        l: &l,
+        a_tilde: &a_tilde,
+        b_tilde: &b_tilde,
+    };
+    solve_checked(a, b, options, checked)
+}
+
+/// The data of [`solve_care_balanced`] once checked: Q symmetrised and ||Q||_F, the Cholesky
+/// factor L of R, and Ã = E^-1 A, B̃ = E^-1 B (A and B where there is no E).
+struct Checked<'a> {
+    q: &'a DMatrix<f64>,
+    q_norm: f64,
+    l: &'a DMatrix<f64>,
+    a_tilde: &'a DMatrix<f64>,
+    b_tilde: &'a DMatrix<f64>,
+}
+
+/// [`solve_care_balanced`] after its checks (`a` and `b` as given, for the residual of a
+/// descriptor equation).
+fn solve_checked(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    options: CareOptions<'_>,
+    Checked {
+        q,
+        q_norm,
+        l,
+        a_tilde,
+        b_tilde,
+    }: Checked<'_>,
+) -> Result<CareDense, Error> {
+    let (n, m) = (a.nrows(), b.ncols());
     let s = options.s.map(from_faer);
-    let standard = standardize(&a_tilde, &b_tilde, &q, &l, s.as_ref());
+    let standard = standardize(a_tilde, b_tilde, q, l, s.as_ref());
     let finite = |m: &DMatrix<f64>| m.as_slice().iter().all(|x| x.is_finite());
     if !(finite(&standard.a) && finite(&standard.g) && finite(&standard.q)) {
         return Err(weights_out_of_range());
@@ -463,10 +578,10 @@ fn solve_care_balanced(
     let reduced = Reduced {
         a: a_tilde,
         b: b_tilde,
-        q_norm: frobenius_norm(q.as_faer()),
-        q: &q,
+        q_norm,
+        q,
         s: s.as_ref(),
-        l: &l,
+        l,
     };
     if n == 0 {
         return Ok(CareDense {
@@ -1170,8 +1285,8 @@ mod tests {
             let (a_tilde, b_tilde) = (from_faer(a.as_ref()), from_faer(b.as_ref()));
             let standard = standardize(&a_tilde, &b_tilde, &q, &l, s.as_ref());
             let reduced = Reduced {
-                a: a_tilde,
-                b: b_tilde,
+                a: &a_tilde,
+                b: &b_tilde,
                 q: &q,
                 q_norm: frobenius_norm(q.as_faer()),
                 s: s.as_ref(),

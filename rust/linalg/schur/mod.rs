@@ -321,6 +321,20 @@ fn form_eigenvalues<O: Order>(
     let n = t.nrows();
     let mut values = block_eigenvalues(n, |i, j| t[(i, j)]);
     let spread = |values: &[c64]| {
+        // Not spread, certainly, when the bounds max(|Re|, |Im|) <= |λ| <= |Re| + |Im| of the
+        // nonzero moduli (finite, normal; with room for the rounding of the sum and of hypot)
+        // are within the factor: the moduli themselves (hypot) only where they cannot decide,
+        // which they then decide as before.
+        let (mut lower, mut upper, mut finite) = (f64::INFINITY, 0.0f64, true);
+        for v in values.iter().filter(|v| v.re != 0.0 || v.im != 0.0) {
+            finite &= v.re.is_finite() && v.im.is_finite();
+            lower = lower.min(v.re.abs().max(v.im.abs()));
+            upper = upper.max(v.re.abs() + v.im.abs());
+        }
+        const ROOM: f64 = 1.0 + 1.0 / 1_099_511_627_776.0; // 1 + 2^-40
+        if finite && lower >= f64::MIN_POSITIVE && upper * ROOM <= GRADED_SPREAD * (lower / ROOM) {
+            return false;
+        }
         let moduli = values.iter().map(|v| v.norm()).filter(|&m| m > 0.0);
         let (smallest, largest) =
             moduli.fold((f64::INFINITY, 0.0f64), |(s, l), m| (s.min(m), l.max(m)));
