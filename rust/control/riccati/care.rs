@@ -90,6 +90,7 @@ use crate::linalg::lu::{self, solve_with_inverse};
 use crate::linalg::lyapunov::{self, KRONECKER_MAX_ORDER, Singularity};
 use crate::linalg::matrix::{FaerView, Order, Symmetrize, from_faer, with_order};
 use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
+use crate::linalg::product;
 use crate::linalg::schur::reorder::reorder_schur;
 use crate::linalg::schur::{
     Finished, RealSchur, Spectrum, Until, eigenvalues_near, quasi_triangular_eigenvalues,
@@ -277,7 +278,7 @@ pub(crate) fn solve_care_scaled(
         },
         indefinite,
     );
-    Some(solution.map(|solution| {
+    Some(solution.and_then(|solution| {
         scaled.unscaled(solution, |x, gain| {
             general_residual(a, b, q, options.s, options.e, x, gain)
         })
@@ -633,7 +634,7 @@ fn solve_checked(
             let mut x = xt.transpose().to_owned();
             x.symmetrize();
             let gain = gain.to_faer();
-            let residual = general_residual(a, b, q.as_faer(), options.s, Some(e), &x, &gain);
+            let residual = general_residual(a, b, q.as_faer(), options.s, Some(e), &x, &gain)?;
             (from_faer(x.as_ref()), residual)
         }
         None => (y, reduced_residual),
@@ -1113,7 +1114,7 @@ fn refine(
 }
 
 /// The relative residual of A^T X E + E^T X A - M^T K + Q = 0, M = B^T X E + S^T (E = I where
-/// none is given).
+/// none is given); its products stop when the computation is interrupted.
 fn general_residual(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -1122,22 +1123,22 @@ fn general_residual(
     e: Option<MatRef<'_, f64>>,
     x: &Mat<f64>,
     gain: &Mat<f64>,
-) -> f64 {
+) -> Result<f64, Error> {
     let xe = match e {
-        Some(e) => x * e,
+        Some(e) => product::product(x.as_ref(), e)?,
         None => x.clone(),
     };
-    let axe = a.transpose() * &xe;
-    let mut m = b.transpose() * &xe;
+    let axe = product::product(a.transpose(), xe.as_ref())?;
+    let mut m = product::product(b.transpose(), xe.as_ref())?;
     if let Some(s) = s {
         m += s.transpose();
     }
-    let quadratic = m.transpose() * gain;
+    let quadratic = product::product(m.transpose(), gain.as_ref())?;
     let residual = &axe + axe.transpose() - &quadratic + q;
     let scale = frobenius_norm(q.as_ref())
         + 2.0 * frobenius_norm(axe.as_ref())
         + frobenius_norm(quadratic.as_ref());
-    relative(frobenius_norm(residual.as_ref()), scale)
+    Ok(relative(frobenius_norm(residual.as_ref()), scale))
 }
 
 /// ||Res|| / scale, or ||Res|| itself when every term is zero.

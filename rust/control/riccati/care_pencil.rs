@@ -25,6 +25,7 @@ use super::pencil::{checked_weights, compress, graph_solution};
 use crate::error::Error;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::norm::{frobenius_norm, one_norm};
+use crate::linalg::product::product;
 use crate::linalg::qz::{generalized_eigenvalues, qz, reorder_qz};
 use faer::{Mat, MatRef, c64};
 
@@ -120,14 +121,14 @@ pub(crate) fn solve_care_indefinite(
         no_solution("the stable deflating subspace is not a graph: E U11 is singular".into())
     })?;
     // K = R^-1 (B^T X E + S^T).
-    let xe = &x * e;
-    let mut mixed = b.transpose() * &xe;
+    let xe = product(x.as_ref(), e)?;
+    let mut mixed = product(b.transpose(), xe.as_ref())?;
     if let Some(s) = options.s {
         mixed += s.transpose();
     }
     let combined = solve_with_inverse(r.clone().as_mut(), mixed.as_ref())?;
     let gain = combined.as_ref().split_at_col(n).0.to_owned();
-    let closed_loop = a - b * &gain;
+    let closed_loop = a - product(b, gain.as_ref())?;
     let closed_loop_eigenvalues: Vec<c64> = match options.e {
         None => crate::linalg::schur::eigenvalues(closed_loop.as_ref())?,
         Some(e) => {
@@ -151,8 +152,8 @@ pub(crate) fn solve_care_indefinite(
             unstable.join(", ")
         )));
     }
-    let axe = a.transpose() * &xe;
-    let quadratic = mixed.transpose() * &gain;
+    let axe = product(a.transpose(), xe.as_ref())?;
+    let quadratic = product(mixed.transpose(), gain.as_ref())?;
     let residual = &axe + axe.transpose() - &quadratic + &q;
     let scale = frobenius_norm(q.as_ref())
         + 2.0 * frobenius_norm(axe.as_ref())

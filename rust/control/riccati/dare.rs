@@ -71,6 +71,7 @@ use crate::linalg::dense::view_product;
 use crate::linalg::lu::{self, solve_with_inverse};
 use crate::linalg::matrix::Symmetrize;
 use crate::linalg::norm::{frobenius_norm, one_norm};
+use crate::linalg::product::product;
 use crate::linalg::qz::{generalized_eigenvalues, qz, reorder_qz};
 use crate::linalg::stein::{KRONECKER_MAX_ORDER, solve_stein_kronecker, solve_stein_smith};
 use crate::platform::interrupt;
@@ -139,23 +140,23 @@ pub fn solve_dare(
             ..options
         },
     )?;
-    Ok(scaled.unscaled(solution, |x, gain| general_residual(given, x, gain)))
+    scaled.unscaled(solution, |x, gain| general_residual(given, x, gain))
 }
 
 /// The relative residual of the caller's equation (module documentation) for X and its gain K:
 /// ||A^T X A - E^T X E - M^T K + Q||_F / (||Q||_F + ||A^T X A||_F + ||E^T X E||_F +
 /// ||M^T K||_F), M = B^T X A + S^T.
-fn general_residual(given: Equation<'_>, x: &Mat<f64>, gain: &Mat<f64>) -> f64 {
+fn general_residual(given: Equation<'_>, x: &Mat<f64>, gain: &Mat<f64>) -> Result<f64, Error> {
     let Equation { a, b, q, s, e, .. } = given;
-    let xa = x * a;
-    let axa = a.transpose() * &xa;
-    let mut mixed = b.transpose() * &xa;
+    let xa = product(x.as_ref(), a)?;
+    let axa = product(a.transpose(), xa.as_ref())?;
+    let mut mixed = product(b.transpose(), xa.as_ref())?;
     if let Some(s) = s {
         mixed += s.transpose();
     }
-    let quadratic = mixed.transpose() * gain;
+    let quadratic = product(mixed.transpose(), gain.as_ref())?;
     let exe = match e {
-        Some(e) => e.transpose() * (x * e),
+        Some(e) => product(e.transpose(), product(x.as_ref(), e)?.as_ref())?,
         None => x.clone(),
     };
     let residual = &axa - &exe - &quadratic + q;
@@ -164,7 +165,7 @@ fn general_residual(given: Equation<'_>, x: &Mat<f64>, gain: &Mat<f64>) -> f64 {
         + frobenius_norm(exe.as_ref())
         + frobenius_norm(quadratic.as_ref());
     let size = frobenius_norm(residual.as_ref());
-    if scale > 0.0 { size / scale } else { size }
+    Ok(if scale > 0.0 { size / scale } else { size })
 }
 
 /// [`solve_dare`] of the equation as given.

@@ -52,6 +52,7 @@ use crate::error::Error;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::matrix::{FaerView, Symmetrize};
 use crate::linalg::norm::{frobenius_norm, one_norm};
+use crate::linalg::product::product;
 use crate::platform::interrupt;
 use faer::{Mat, MatRef};
 
@@ -152,10 +153,10 @@ fn recursion(
     solutions.push(s.clone());
     for step in (0..steps).rev() {
         interrupt::check()?;
-        let sb = &s * b;
+        let sb = product(s.as_ref(), b)?;
         let mut weight = &r + b.transpose() * &sb;
         weight.symmetrize();
-        let mut mixed = sb.transpose() * a;
+        let mut mixed = product(sb.transpose(), a)?;
         if let Some(cross) = options.cross {
             mixed += cross.transpose();
         }
@@ -176,7 +177,7 @@ fn recursion(
             rcond = rcond.min(step_rcond);
         }
         let gain = gain.to_owned();
-        let (mut next, closed_loop_norm) = joseph_step(a, b, &q, &r, options.cross, &s, &gain);
+        let (mut next, closed_loop_norm) = joseph_step(a, b, &q, &r, options.cross, &s, &gain)?;
         next.symmetrize();
         // The rounding of A - B K, u (||A|| + ||B|| ||K||), carried through S twice.
         let s_norm = frobenius_norm(s.as_ref());
@@ -210,7 +211,8 @@ fn recursion(
     })
 }
 
-/// The step (2): (A - B K)^T S (A - B K) + K^T R K - N K - K^T N^T + Q, and ||A - B K||_F.
+/// The step (2): (A - B K)^T S (A - B K) + K^T R K - N K - K^T N^T + Q, and ||A - B K||_F;
+/// its products of order n stop when the computation is interrupted.
 fn joseph_step(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -219,14 +221,18 @@ fn joseph_step(
     cross: Option<MatRef<'_, f64>>,
     s: &Mat<f64>,
     gain: &Mat<f64>,
-) -> (Mat<f64>, f64) {
-    let closed_loop = a - b * gain;
-    let mut next = closed_loop.transpose() * s * &closed_loop + gain.transpose() * r * gain + q;
+) -> Result<(Mat<f64>, f64), Error> {
+    let closed_loop = a - product(b, gain.as_ref())?;
+    let sandwich = product(
+        product(closed_loop.transpose(), s.as_ref())?.as_ref(),
+        closed_loop.as_ref(),
+    )?;
+    let mut next = sandwich + gain.transpose() * r * gain + q;
     if let Some(cross) = cross {
         let coupling = cross * gain;
         next -= &coupling + coupling.transpose();
     }
-    (next, frobenius_norm(closed_loop.as_ref()))
+    Ok((next, frobenius_norm(closed_loop.as_ref())))
 }
 
 #[cfg(test)]

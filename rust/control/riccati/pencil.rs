@@ -14,6 +14,7 @@ use crate::linalg::householder::reflector;
 use crate::linalg::lu::solve_with_inverse;
 use crate::linalg::matrix::{FaerView, Symmetrize};
 use crate::linalg::norm::one_norm;
+use crate::linalg::product::product;
 use crate::linalg::qz::GeneralizedSchur;
 use faer::{Mat, MatRef};
 
@@ -68,10 +69,10 @@ pub(crate) fn graph_solution(
     let u11 = form.z.as_ref().submatrix(0, 0, n, n);
     let u21 = form.z.as_ref().submatrix(n, 0, n, n);
     // (E U11)^T X^T = U21^T.
-    let eu11 = e * u11;
+    // An interruption refuses the subspace (the caller's next check stops).
+    let eu11 = product(e, u11).ok()?;
     let norm = one_norm(eu11.as_ref());
     let mut factor = eu11.transpose().to_owned();
-    // An interruption refuses the subspace (the caller's next check stops).
     let combined = solve_with_inverse(factor.as_mut(), u21.transpose()).ok()?;
     let (xt, inverse) = combined.as_ref().split_at_col(n);
     // The inverse of (E U11)^T: the 1-norm of its transpose is that of (E U11)^-1.

@@ -37,6 +37,7 @@
 
 use super::AlgebraicSolution;
 use super::care::SYMMETRY_TOLERANCE;
+use crate::error::Error;
 use crate::linalg::balance::{
     balanced_where_scaled_apart, states_scaled_apart, times_power_of_two,
 };
@@ -280,23 +281,23 @@ impl ScaledEquation {
     pub(crate) fn unscaled(
         &self,
         solution: AlgebraicSolution,
-        residual: impl FnOnce(&Mat<f64>, &Mat<f64>) -> f64,
-    ) -> AlgebraicSolution {
+        residual: impl FnOnce(&Mat<f64>, &Mat<f64>) -> Result<f64, Error>,
+    ) -> Result<AlgebraicSolution, Error> {
         let x = self.unscaled_solution(&solution.x);
         let gain = self.unscaled_gain(&solution.gain);
         let mut residual_of_given = solution.residual;
         if x.is_all_finite() && gain.is_all_finite() {
-            let unscaled = residual(&x, &gain);
+            let unscaled = residual(&x, &gain)?;
             if unscaled.is_finite() {
                 residual_of_given = unscaled;
             }
         }
-        AlgebraicSolution {
+        Ok(AlgebraicSolution {
             x,
             gain,
             residual: residual_of_given,
             ..solution
-        }
+        })
     }
 }
 
