@@ -316,8 +316,8 @@ fn undiscretize_zoh<'py>(
     Ok(result)
 }
 
-/// The Padé degree m and the number of squarings s that the exponential of A uses: a
-/// diagnostic for tests and for users comparing algorithms.
+/// The Padé degree m (15: the Taylor approximant 15+) and the number of squarings s that the
+/// exponential of A uses: a diagnostic for tests and for users comparing algorithms.
 #[pyfunction]
 #[pyo3(signature = (a, /))]
 fn expm_pade_choice(py: Python<'_>, a: &Bound<'_, PyAny>) -> PyResult<(usize, u32)> {

@@ -46,6 +46,13 @@
 //! The Padé evaluation for m = 13 costs 6 matrix products plus one LU solve, and m = 3, 5, 7, 9
 //! cost 2, 3, 4, 5 products; each squaring is one product.
 //!
+//! Above [`SMALL_MAX_ORDER`], the Taylor approximant "15+" of `taylor.rs` (Sastre, Ibáñez &
+//! Defez 2019: degree 16, exact through degree 15, 4 products and no solve, θ = 0.676 by the
+//! same backward error analysis with α_4 = max(d_4, d_5)) replaces the Padé degrees 5 to 13
+//! wherever it needs at most [`TAYLOR_MAX_SQUARINGS`] squarings (see
+//! [`ExponentialPlan::choose`]); d_4 and d_5 are bounded first, then exact at the orders of
+//! exact norms and estimated above them.
+//!
 //! # Small orders, and accuracy beyond double precision
 //!
 //! Orders up to [`SMALL_MAX_ORDER`] run on stack matrices of constant size (nalgebra's `SMatrix`):
@@ -64,6 +71,7 @@
 //! final Padé evaluation and squaring are repeated per time.
 
 pub mod double_double;
+pub mod taylor;
 
 use crate::error::{Error, check_finite, check_finite_values, check_output_len, check_square};
 use crate::linalg::expm::double_double::DoubleDoubleMatrix;
@@ -220,20 +228,32 @@ const M5: usize = 1;
 const M7: usize = 2;
 const M9: usize = 3;
 const M13: usize = 4;
+/// The index of the Taylor approximant 15+ (`taylor.rs`) in [`PadeChoice`], past the Padé table.
+const TAYLOR_15: usize = APPROXIMANTS.len();
+
+/// The most squarings with which the Taylor approximant 15+ is chosen (see
+/// [`ExponentialPlan::choose`]). Measured against long-double references on 496 matrices
+/// (n = 9..160, norms 1e-3..1e3): routing every order above 8 to Taylor, whatever its
+/// squarings, was up to 15 times less accurate than Padé 13 on symmetric matrices of norm
+/// 1e3 (10 squarings against 8).
+const TAYLOR_MAX_SQUARINGS: u32 = 2;
 
 /// The degree and the number of squarings chosen for one scaled matrix tA.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PadeChoice {
-    /// Index into the table of approximants (degrees 3, 5, 7, 9, 13).
+    /// Index into the table of approximants (degrees 3, 5, 7, 9, 13), or [`TAYLOR_15`].
     approximant: usize,
     /// Number of squarings s (including any pre-scaling of a matrix of huge norm).
     pub squarings: u32,
 }
 
 impl PadeChoice {
-    /// The degree m of the Padé approximant.
+    /// The degree m of the Padé approximant, or 15 for the Taylor approximant 15+.
     pub fn degree(&self) -> usize {
-        APPROXIMANTS[self.approximant].degree
+        match APPROXIMANTS.get(self.approximant) {
+            Some(pade) => pade.degree,
+            None => 15,
+        }
     }
 }
 
@@ -509,6 +529,9 @@ pub(crate) struct ExponentialPlan<M> {
     a8: Option<M>,
     /// Cached ||A^k||_1 for k = 4, 6, 8, 10, with whether the value is exact.
     power_norms: [Option<(f64, bool)>; 4],
+    /// Cached ||A^4||_1 and ||A^5||_1 of the Taylor degree test: exact if A^4 is formed,
+    /// estimated otherwise (never forming a power for its norm).
+    taylor_norms: [Option<f64>; 2],
     /// Cached || (|A| / ||A||_1)^{2m+1} ||_1 for each approximant.
     abs_power_norms: [Option<f64>; 5],
 }
@@ -569,6 +592,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             a6: None,
             a8: None,
             power_norms: [None; 4],
+            taylor_norms: [None; 2],
             abs_power_norms: [None; 5],
         })
     }
@@ -770,18 +794,129 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         if value > 0.0 { value as u32 } else { 0 }
     }
 
-    /// The Padé degree and number of squarings for e^{tA} (Al-Mohy & Higham 2009, Algorithm 5.1,
+    /// ||A^k||_1 for k in {4, 5}, for the Taylor degree test: exact at the orders of exact norms
+    /// ([`EXACT_NORM_MAX_ORDER`]: A^4 formed, and ||A^4 A||_1 from the product, which there cost
+    /// less than the block 1-norm estimates), above them the estimate of the product A^2 A^2 (A)
+    /// (exact ||A^4|| if A^4 is formed); at most the bound ||A^4|| <=
+    /// [`Self::power_norm_bound`], ||A^5|| <= ||A^4|| ||A|| (an estimate is a lower bound), and
+    /// that bound where the norm overflowed.
+    #[inline(always)]
+    fn taylor_power_norm(&mut self, k: usize) -> Result<f64, M::Stop> {
+        if let Some(norm) = self.taylor_norms[k - 4] {
+            return Ok(norm);
+        }
+        let bound4 = self.power_norm_bound(4);
+        let bound = if k == 4 { bound4 } else { bound4 * self.a_norm };
+        if self.exact_norms {
+            self.ensure_a4()?;
+        }
+        let norm = match (&self.a4, k) {
+            (Some(a4), 4) => a4.one_norm(),
+            (Some(a4), _) if self.exact_norms => a4.product(&self.a)?.one_norm(),
+            (Some(a4), _) => M::estimate_product_norm(&[a4, &self.a]),
+            (None, 4) => M::estimate_product_norm(&[&self.a2, &self.a2]),
+            (None, _) => M::estimate_product_norm(&[&self.a2, &self.a2, &self.a]),
+        };
+        let norm = if norm.is_finite() {
+            norm.min(bound)
+        } else {
+            bound.min(integer_power(self.a_norm, k))
+        };
+        self.taylor_norms[k - 4] = Some(norm);
+        Ok(norm)
+    }
+
+    /// The squarings s for the Taylor approximant 15+: the least s with 2^-s τ α_4(A) <= θ,
+    /// α_4 = max(||A^4||^(1/4), ||A^5||^(1/5)) (`taylor.rs`). Tried first on the bounds of the
+    /// norms (no product, no estimate) and, if they need squarings, on ||A^4|| with the bound
+    /// ||A^5|| <= ||A^4|| ||A||, and on ||A^5|| only if that bound needs more squarings than
+    /// d_4 alone.
+    #[inline(always)]
+    fn taylor_squarings(&mut self, tau: f64) -> Result<u32, M::Stop> {
+        let squarings = |log2_norm4: f64, log2_norm5: f64| {
+            let log2_alpha = (log2_norm4 / 4.0).max(log2_norm5 / 5.0) + tau.log2();
+            (log2_alpha - taylor::THETA.log2())
+                .ceil()
+                .clamp(0.0, MAX_SQUARINGS as f64) as u32
+        };
+        let bound4 = self.power_norm_bound(4);
+        if bound4 == 0.0 {
+            return Ok(0);
+        }
+        let bounded = squarings(bound4.log2(), bound4.log2() + self.a_norm.log2());
+        if bounded == 0 {
+            return Ok(0);
+        }
+        let norm4 = self.taylor_power_norm(4)?;
+        if norm4 == 0.0 {
+            return Ok(0);
+        }
+        // ||A^5|| <= ||A^4|| ||A||: when that bound needs no more squarings than d_4 alone,
+        // ||A^5|| itself is not needed.
+        let least = squarings(norm4.log2(), f64::NEG_INFINITY);
+        let bounded = squarings(norm4.log2(), norm4.log2() + self.a_norm.log2());
+        if bounded == least {
+            return Ok(least);
+        }
+        Ok(squarings(norm4.log2(), self.taylor_power_norm(5)?.log2()))
+    }
+
+    /// The approximant and number of squarings for e^{tA} (Al-Mohy & Higham 2009, Algorithm 5.1,
     /// with every norm scaled by τ = |t|).
+    ///
+    /// Above [`SMALL_MAX_ORDER`] the Taylor approximant 15+ (`taylor.rs`: 4 products, no solve)
+    /// is taken with its s_T squarings when s_T <= [`TAYLOR_MAX_SQUARINGS`]. It then costs at
+    /// most 6 products, less than the Padé degrees 9 and 13 (5 and 6 products and an LU solve
+    /// with n right-hand sides, 4/3 of a product: 6.33 and 7.33) that the norms it covers would
+    /// otherwise need; the Padé degrees 5 and 7 (4.33, 5.33) cover norms below θ5 = 0.25 and
+    /// θ7 = 0.95, where Taylor needs no squaring (4) or one (5). Only a matrix that the bounds
+    /// alone admit to degree 3 (2 products and a solve) takes that first. Beyond, Taylor would
+    /// save a third of a product at most (its θ is 2.65 squarings below θ13 = 4.25) and square
+    /// 2 to 3 times more, so the Padé choice below is kept. At the small orders the choice is
+    /// the Padé one alone.
     #[inline(always)]
     pub fn choose(&mut self, t: f64) -> Result<PadeChoice, M::Stop> {
+        let tau = t.abs() * self.time_scale;
+        if tau == 0.0 || self.a_norm == 0.0 {
+            return Ok(PadeChoice {
+                approximant: M3,
+                squarings: self.prescale.min(MAX_SQUARINGS),
+            });
+        }
+        if !self.bound_norms {
+            return self.choose_pade(tau);
+        }
+        let theta3 = APPROXIMANTS[M3].theta;
+        if self.power_norm_bound(4) * integer_power(tau / theta3, 4) <= 1.0
+            && self.power_norm_bound(6) * integer_power(tau / theta3, 6) <= 1.0
+            && self.extra_squarings(M3, tau) == 0
+        {
+            return Ok(PadeChoice {
+                approximant: M3,
+                squarings: self.prescale.min(MAX_SQUARINGS),
+            });
+        }
+        let taylor_squarings = self.taylor_squarings(tau)?;
+        let taylor = PadeChoice {
+            approximant: TAYLOR_15,
+            squarings: taylor_squarings
+                .saturating_add(self.prescale)
+                .min(MAX_SQUARINGS),
+        };
+        if taylor_squarings <= TAYLOR_MAX_SQUARINGS {
+            return Ok(taylor);
+        }
+        self.choose_pade(tau)
+    }
+
+    /// The Padé degree and number of squarings for scale τ > 0 (Al-Mohy & Higham 2009,
+    /// Algorithm 5.1).
+    #[inline(always)]
+    fn choose_pade(&mut self, tau: f64) -> Result<PadeChoice, M::Stop> {
         let choice = |approximant, squarings: u32| PadeChoice {
             approximant,
             squarings: squarings.min(MAX_SQUARINGS),
         };
-        let tau = t.abs() * self.time_scale;
-        if tau == 0.0 || self.a_norm == 0.0 {
-            return Ok(choice(M3, self.prescale));
-        }
         // η1 = τ max(d4, d6) <= θ3 (d4 and d6 estimated at large orders, before A4 is formed).
         if self.scaled_root_norms_within(4, 6, tau, APPROXIMANTS[M3].theta)?
             && self.extra_squarings(M3, tau) == 0
@@ -822,7 +957,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     #[inline(always)]
     pub fn prepare(&mut self, choice: PadeChoice) -> Result<(), M::Stop> {
         match choice.approximant {
-            M3 => Ok(()),
+            M3 | TAYLOR_15 => Ok(()),
             M5 => self.ensure_a4(),
             M9 => {
                 self.ensure_a6()?;
@@ -881,7 +1016,14 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// r_m(cA) squared in double precision, refining triangular structure on the way.
     #[inline(always)]
     fn double_exponential(&self, t: f64, c: f64, choice: PadeChoice) -> Result<M, M::Stop> {
-        let x = if c == 1.0 {
+        let x = if choice.approximant == TAYLOR_15 {
+            if c == 1.0 {
+                taylor::taylor_approximant(&self.a, &self.a2)?
+            } else {
+                let a = M::combination(0.0, &[(c, &self.a)]);
+                taylor::taylor_approximant(&a, &scaled_power(&self.a2, c, 2, c * c))?
+            }
+        } else if c == 1.0 {
             pade_approximant(
                 choice.approximant,
                 &self.a,
@@ -1450,8 +1592,9 @@ pub fn expm(a: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
     Ok(out)
 }
 
-/// The degree m and number of squarings s that [`expm`] uses for A (for a 1 x 1 or empty A,
-/// which need no approximant, (0, 0)).
+/// The degree m and number of squarings s that [`expm`] uses for A: m in {3, 5, 7, 9, 13} for
+/// the Padé approximants, 15 for the Taylor approximant 15+ (for a 1 x 1 or empty A, which
+/// need no approximant, (0, 0)).
 pub fn pade_choice(a: MatRef<'_, f64>) -> Result<(usize, u32), Error> {
     check_square_finite(a, "A")?;
     if a.nrows() <= 1 {
@@ -1704,11 +1847,12 @@ mod tests {
     #[test]
     fn every_degree_is_exercised_and_accurate() {
         // Scaling one symmetric matrix walks the selection through every degree and many
-        // squarings; its exponential is known from the eigendecomposition.
+        // squarings (Padé 3 to 13 at order 6, Taylor 15+ and Padé 3 and 13 at order 12); its
+        // exponential is known from the eigendecomposition.
         let eigenvalues = [-1.0, -0.5, 0.1, 0.4, 0.9, 1.0];
         let mut degrees = std::collections::BTreeSet::new();
         for (order, matrix_type) in [(6, "small"), (12, "faer")] {
-            for scale in [1e-3, 1e-2, 0.2, 0.8, 1.8, 4.0, 30.0, 200.0] {
+            for scale in [1e-3, 1e-2, 0.1, 0.2, 0.8, 1.8, 4.0, 30.0, 200.0] {
                 let lambda: Vec<f64> = (0..order)
                     .map(|i| scale * eigenvalues[i % 6] * (1.0 + 0.01 * i as f64))
                     .collect();
@@ -1724,7 +1868,7 @@ mod tests {
         }
         assert_eq!(
             degrees.into_iter().collect::<Vec<_>>(),
-            vec![3, 5, 7, 9, 13]
+            vec![3, 5, 7, 9, 13, 15]
         );
     }
 
@@ -1860,8 +2004,8 @@ mod tests {
 
     #[test]
     fn norm_bounds_choose_as_the_exact_norms_and_skip_unneeded_powers() {
-        // The degree tests try the submultiplicative bound of ||A^k|| before forming A^k: the
-        // choice must be the one from all exact norms (formed and cached beforehand, which
+        // The Padé degree tests try the submultiplicative bound of ||A^k|| before forming A^k:
+        // the choice must be the one from all exact norms (formed and cached beforehand, which
         // makes every bound the norm itself), for general, non-normal and graded matrices over
         // norms 1e-3..1e3 and several times, and a degree-7 choice with d4 <= θ7 (the bound
         // ||A^8|| <= ||A^4||^2 decides) must not form A^8.
@@ -1891,7 +2035,7 @@ mod tests {
                 _ => {}
             }
             let a = &a * faer::Scale(norm / one_norm(a.as_ref()));
-            for t in [1.0, -0.3, 2.5] {
+            for t in [1.0f64, -0.3, 2.5] {
                 let mut lazy = ExponentialPlan::<Scratch>::new(a.as_ref()).unwrap();
                 let mut exact = ExponentialPlan::<Scratch>::new(a.as_ref()).unwrap();
                 exact.ensure_a6().unwrap();
@@ -1899,7 +2043,10 @@ mod tests {
                 for k in [4, 6, 8, 10] {
                     exact.power_norm(k).unwrap();
                 }
-                let (cl, cx) = (lazy.choose(t).unwrap(), exact.choose(t).unwrap());
+                let (cl, cx) = (
+                    lazy.choose_pade(t.abs()).unwrap(),
+                    exact.choose_pade(t.abs()).unwrap(),
+                );
                 assert_eq!(cl, cx, "case {case} n={n} norm={norm:e} t={t}");
                 cases += 1;
                 if cl.degree() == 7 {
@@ -1916,6 +2063,67 @@ mod tests {
             skipped >= 20,
             "only {skipped} degree-7 choices decided by the bound"
         );
+    }
+
+    #[test]
+    fn taylor_is_chosen_up_to_its_squarings_limit_and_agrees_with_pade() {
+        // Above the small orders, Taylor 15+ is chosen when it needs at most
+        // TAYLOR_MAX_SQUARINGS squarings, the Padé choice otherwise; on general, non-normal and
+        // graded matrices of norms 1e-3..1e3 (and both signs of t), its e^{tA} agrees with the
+        // Padé evaluation of the same plan. The bench's matrix (order 64, 1-norm 2) needs no
+        // squaring.
+        let mut rng = StdRng::seed_from_u64(15);
+        let (mut taylor, mut pade) = (0, 0);
+        for case in 0..300 {
+            let n = [9, 16, 33, 64][case % 4];
+            let norm = 10f64.powf(rng.random_range(-3.0..3.0));
+            let mut a = random_matrix(n, 1.0, &mut rng);
+            for j in 0..n {
+                for i in 0..n {
+                    match case % 3 {
+                        1 if i < j => a[(i, j)] *= 30.0,
+                        2 => a[(i, j)] *= 2f64.powi(i as i32 - j as i32),
+                        _ => {}
+                    }
+                }
+            }
+            let a = &a * faer::Scale(norm / one_norm(a.as_ref()));
+            let t = if case % 2 == 0 { 1.0 } else { -1.0 };
+            let mut plan = ExponentialPlan::<Scratch>::new(a.as_ref()).unwrap();
+            let choice = plan.choose(t).unwrap();
+            let squarings = plan.taylor_squarings(1.0).unwrap();
+            let pade_choice = plan.choose_pade(1.0).unwrap();
+            if choice.degree() == 3 {
+                // Admitted to Padé 3 by the norm bounds alone, before Taylor is considered.
+                assert_eq!(pade_choice.degree(), 3);
+                continue;
+            }
+            if squarings <= TAYLOR_MAX_SQUARINGS {
+                assert_eq!((choice.degree(), choice.squarings), (15, squarings));
+                taylor += 1;
+            } else {
+                assert_eq!(choice, pade_choice, "case {case}");
+                pade += 1;
+                continue;
+            }
+            plan.prepare(pade_choice).unwrap();
+            let (mut x, mut y) = (Mat::zeros(n, n), Mat::zeros(n, n));
+            plan.exponential_into(t, choice, x.as_mut()).unwrap();
+            plan.exponential_into(t, pade_choice, y.as_mut()).unwrap();
+            let difference = relative_difference(&x, &y);
+            assert!(
+                difference < 1e-14,
+                "case {case} n={n} norm={norm:e}: {difference:e}"
+            );
+        }
+        assert!(
+            taylor >= 90 && pade >= 50,
+            "{taylor} Taylor, {pade} Padé choices"
+        );
+        let mut rng = StdRng::seed_from_u64(64);
+        let a = random_matrix(64, 1.0, &mut rng);
+        let a = &a * faer::Scale(2.0 / one_norm(a.as_ref()));
+        assert_eq!(pade_choice(a.as_ref()).unwrap(), (15, 0));
     }
 
     #[test]
