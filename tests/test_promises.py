@@ -356,6 +356,10 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
     # The DC gain at n = 3500 is one LU factorisation (1.7 s of latency when it was one call of
     # faer's), and Tustin's transformation at n = 3000 an LU factorisation, solves with n
     # right-hand sides and products (7.5 s): both now stop between column panels.
+    # Pole placement at n = 300 forms a subspace per pole (a product and a QR each) with no
+    # check between poles (2.0 s of latency), then complex LU solves; the QZ form at n = 2500
+    # starts with the QR of B and two applications of its Q (1.2 s of latency at n = 2000):
+    # they now stop between poles, and between blocks of columns.
     [
         "(lambda: rng.standard_normal((1200, 1200)), aerocontrol.schur)",
         "(lambda: np.geomspace(1e-3, 10, 2_000_000), lambda c: aerocontrol.batch.lqr_sweep("
@@ -370,6 +374,10 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "(lambda: aerocontrol.StateSpace(rng.standard_normal((3000, 3000)) - 60 * np.eye(3000), "
         "rng.standard_normal((3000, 2)), rng.standard_normal((2, 3000)), np.zeros((2, 2))), "
         "lambda sys: aerocontrol.c2d(sys, 0.01, 'tustin'))",
+        "(lambda: (rng.standard_normal((300, 300)), rng.standard_normal((300, 2)), "
+        "-1 - np.arange(300) / 30), lambda d: aerocontrol.place(*d))",
+        "(lambda: (rng.standard_normal((2500, 2500)), rng.standard_normal((2500, 2500))), "
+        "lambda d: aerocontrol.linalg.qz(*d))",
     ],
     ids=[
         "schur n=1200",
@@ -379,6 +387,8 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "eigenvalues n=2500",
         "dc_gain n=3500",
         "c2d tustin n=3000",
+        "place n=300",
+        "qz n=2500",
     ],
 )
 def test_ctrl_c_stops_a_long_computation_within_a_second(work: str) -> None:
