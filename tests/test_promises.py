@@ -357,9 +357,9 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
     # faer's), and Tustin's transformation at n = 3000 an LU factorisation, solves with n
     # right-hand sides and products (7.5 s): both now stop between column panels.
     # Pole placement at n = 300 forms a subspace per pole (a product and a QR each) with no
-    # check between poles (2.0 s of latency), then complex LU solves; the QZ form at n = 2500
-    # starts with the QR of B and two applications of its Q (1.2 s of latency at n = 2000):
-    # they now stop between poles, and between blocks of columns.
+    # check between poles (2.0 s of latency), then complex LU solves; the QZ form at n = 3500
+    # starts with the QR of B and two applications of its Q (1.4 s of latency): they now stop
+    # between poles, and between blocks of columns.
     [
         "(lambda: rng.standard_normal((1200, 1200)), aerocontrol.schur)",
         "(lambda: np.geomspace(1e-3, 10, 2_000_000), lambda c: aerocontrol.batch.lqr_sweep("
@@ -376,7 +376,7 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "lambda sys: aerocontrol.c2d(sys, 0.01, 'tustin'))",
         "(lambda: (rng.standard_normal((300, 300)), rng.standard_normal((300, 2)), "
         "-1 - np.arange(300) / 30), lambda d: aerocontrol.place(*d))",
-        "(lambda: (rng.standard_normal((2500, 2500)), rng.standard_normal((2500, 2500))), "
+        "(lambda: (rng.standard_normal((3500, 3500)), rng.standard_normal((3500, 3500))), "
         "lambda d: aerocontrol.linalg.qz(*d))",
     ],
     ids=[
@@ -388,7 +388,7 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "dc_gain n=3500",
         "c2d tustin n=3000",
         "place n=300",
-        "qz n=2500",
+        "qz n=3500",
     ],
 )
 def test_ctrl_c_stops_a_long_computation_within_a_second(work: str) -> None:
