@@ -359,6 +359,10 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
     # exponential at n = 2000 (9.6 s of latency when its products and Padé solve were single
     # calls of faer's) stops between panels, and at n = 1000 with ||A|| = 1e4 (2.2 s) between
     # its squarings.
+    # Pole placement at n = 300 forms a subspace per pole (a product and a QR each) with no
+    # check between poles (2.0 s of latency), then complex LU solves; the QZ form at n = 3500
+    # starts with the QR of B and two applications of its Q (1.4 s of latency): they now stop
+    # between poles, and between blocks of columns.
     [
         "(lambda: rng.standard_normal((1200, 1200)), aerocontrol.schur)",
         "(lambda: np.geomspace(1e-3, 10, 2_000_000), lambda c: aerocontrol.batch.lqr_sweep("
@@ -375,6 +379,10 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "lambda sys: aerocontrol.c2d(sys, 0.01, 'tustin'))",
         "(lambda: 3 / np.sqrt(2000) * rng.standard_normal((2000, 2000)), aerocontrol.expm)",
         "(lambda: 1e4 / np.sqrt(1000) * rng.standard_normal((1000, 1000)), aerocontrol.expm)",
+        "(lambda: (rng.standard_normal((300, 300)), rng.standard_normal((300, 2)), "
+        "-1 - np.arange(300) / 30), lambda d: aerocontrol.place(*d))",
+        "(lambda: (rng.standard_normal((3500, 3500)), rng.standard_normal((3500, 3500))), "
+        "lambda d: aerocontrol.linalg.qz(*d))",
     ],
     ids=[
         "schur n=1200",
@@ -386,6 +394,8 @@ print(json.dumps({{"outcome": outcome, "latency": stopped - (sent or stopped),
         "c2d tustin n=3000",
         "expm n=2000",
         "expm n=1000 squarings",
+        "place n=300",
+        "qz n=3500",
     ],
 )
 def test_ctrl_c_stops_a_long_computation_within_a_second(work: str) -> None:

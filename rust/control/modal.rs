@@ -30,10 +30,10 @@
 
 use crate::error::{Error, check_finite, check_rows, check_square};
 use crate::linalg::balance::balance;
+use crate::linalg::lu::Lu;
 use crate::linalg::matrix::{FaerView, Square, from_faer};
 use crate::linalg::norm::vector_norm;
 use crate::linalg::schur::{real_schur, schur_eigenvectors, schur_form_eigenvalues};
-use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, c64};
 use nalgebra::Dyn;
 
@@ -376,7 +376,7 @@ pub fn modal_analysis(
         && !analysis.modal_matrix_is_singular()
     {
         let rhs = Mat::from_fn(n, b.ncols(), |i, j| c64::new(b[(i, j)] / balancing[i], 0.0));
-        let mut input = balanced_modal.partial_piv_lu().solve(&rhs);
+        let mut input = Lu::new(balanced_modal.as_ref())?.solve(rhs.as_ref())?;
         for (i, norm) in column_norms.iter().enumerate() {
             input.row_mut(i).iter_mut().for_each(|v| *v /= *norm);
         }

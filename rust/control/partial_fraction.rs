@@ -42,8 +42,8 @@ use crate::control::modal::eigen;
 use crate::linalg::balance::times_power_of_two;
 use crate::linalg::lu::Lu;
 use crate::linalg::norm::{Inverse, one_norm, one_norm_estimate};
+use crate::linalg::product::{multiply, product};
 use crate::platform::dispatch::{fma_dispatch, multiply_add};
-use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par, c64};
 
 /// The largest κ_1(W) of a form in use (2^14): its results stay within this factor of the
@@ -112,24 +112,26 @@ impl PartialFractions {
         } = RangeScaled::new(a, b, c);
         let (values, vectors) = eigen(a.as_ref()).ok()?;
         let (blocks, w, lambda) = real_modal_form(&values, vectors.as_ref())?;
-        // R = A W - W Λ.
+        // R = A W - W Λ. An interruption refuses the form (the caller's next check stops).
         let mut residual = Mat::<f64>::zeros(n, n);
-        matmul(
+        multiply(
             residual.as_mut(),
             Accum::Replace,
             a.as_ref(),
             w.as_ref(),
             1.0,
             Par::Seq,
-        );
-        matmul(
+        )
+        .ok()?;
+        multiply(
             residual.as_mut(),
             Accum::Add,
             w.as_ref(),
             lambda.as_ref(),
             -1.0,
             Par::Seq,
-        );
+        )
+        .ok()?;
         let residual_norm = one_norm(residual.as_ref());
         let w_norm = one_norm(w.as_ref());
         let unit = f64::EPSILON / 2.0;
@@ -139,7 +141,6 @@ impl PartialFractions {
         if !decomposed {
             return None;
         }
-        // An interruption refuses the form (the caller's next check stops).
         let lu = Lu::new(w.as_ref()).ok()?;
         let inverse_norm = ESTIMATE_SAFETY * one_norm_estimate(&Inverse(&lu), 2);
         let conditioned = w_norm * inverse_norm <= MAX_CONDITION;
@@ -147,7 +148,7 @@ impl PartialFractions {
             return None;
         }
         let modal_b = lu.solve(b.as_ref()).ok()?;
-        let modal_c = &c * &w;
+        let modal_c = product(c.as_ref(), w.as_ref()).ok()?;
         let reals: Vec<f64> = blocks
             .iter()
             .filter_map(|block| match block {

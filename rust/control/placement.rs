@@ -50,11 +50,11 @@ use crate::control::modal::polynomial_from_roots;
 use crate::error::{Error, check_finite, check_rows, check_square, format_complex};
 use crate::linalg::balance::{balanced_where_scaled_apart, range_scale, scale_for_largest};
 use crate::linalg::charpoly::charpoly;
-use crate::linalg::lu::solve_with_inverse;
+use crate::linalg::lu::{Lu, solve_with_inverse};
 use crate::linalg::norm::{frobenius_norm, max_abs, one_norm};
+use crate::linalg::product::product;
 use crate::linalg::schur::eigenvalues_near;
 use crate::platform::interrupt;
-use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef, c64};
 
 /// Sweeps of method 0 stop when |det X| grows by less than this, relatively. Method 0
@@ -221,7 +221,8 @@ pub fn companion_form(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<Companio
     let coefficients = charpoly(a)?;
     let v = krylov_blocks(a, b);
     let w = Mat::from_fn(n, n, |i, j| if j >= i { coefficients[j - i] } else { 0.0 });
-    let t = (&v * &w).partial_piv_lu().solve(Mat::<f64>::identity(n, n));
+    let t = Lu::new(product(v.as_ref(), w.as_ref())?.as_ref())?
+        .solve(Mat::<f64>::identity(n, n).as_ref())?;
     let companion = Mat::from_fn(n, n, |i, j| match i {
         0 => -coefficients[j + 1],
         _ if j + 1 == i => 1.0,
@@ -602,19 +603,18 @@ fn place_robust(a: MatRef<'_, f64>, b: MatRef<'_, f64>, poles: &[c64]) -> Result
     }
     let subspaces: Vec<Mat<c64>> = poles
         .iter()
-        .map(|&p| eigenvector_subspace(a, u1.as_ref(), p))
-        .collect();
+        .map(|&p| {
+            interrupt::check()?;
+            eigenvector_subspace(a, u1.as_ref(), p)
+        })
+        .collect::<Result<_, _>>()?;
     let (x, iterations, converged) = knv_method_0(&poles, &subspaces)?;
     // M = X Λ X^-1 from X^T M^T = (X Λ)^T; real up to rounding.
     let x_lambda = Mat::from_fn(n, n, |i, j| x[(i, j)] * poles[j]);
-    let m_transpose = x
-        .transpose()
-        .to_owned()
-        .partial_piv_lu()
-        .solve(x_lambda.transpose());
+    let m_transpose = Lu::new(x.transpose())?.solve(x_lambda.transpose())?;
     let target = Mat::from_fn(n, n, |i, j| m_transpose[(j, i)].re);
     // Z K = U0^T (A - M).
-    let rhs = u0.transpose() * (a - &target);
+    let rhs = product(u0.transpose(), (a - &target).as_ref())?;
     let mut gain = rhs;
     faer::linalg::triangular_solve::solve_upper_triangular_in_place(
         z.as_ref(),
@@ -707,23 +707,27 @@ fn check_multiplicities(poles: &[c64], m: usize) -> Result<(), Error> {
 
 /// An orthonormal basis S (n x m) of the null space of U1^T (A - λI): the last m columns of
 /// the full QR factor of (A - λI)^H U1 = (A^T - conj(λ) I) U1.
-fn eigenvector_subspace(a: MatRef<'_, f64>, u1: MatRef<'_, f64>, lambda: c64) -> Mat<c64> {
+fn eigenvector_subspace(
+    a: MatRef<'_, f64>,
+    u1: MatRef<'_, f64>,
+    lambda: c64,
+) -> Result<Mat<c64>, Error> {
     let n = a.nrows();
     let m = n - u1.ncols();
     if lambda.im == 0.0 {
         let shifted = Mat::from_fn(n, n, |i, j| {
             a[(j, i)] - if i == j { lambda.re } else { 0.0 }
         });
-        let q = (&shifted * u1).qr().compute_Q();
-        return Mat::from_fn(n, m, |i, j| c64::new(q[(i, n - m + j)], 0.0));
+        let q = product(shifted.as_ref(), u1)?.qr().compute_Q();
+        return Ok(Mat::from_fn(n, m, |i, j| c64::new(q[(i, n - m + j)], 0.0)));
     }
     let shifted = Mat::from_fn(n, n, |i, j| {
         let entry = c64::new(a[(j, i)], 0.0);
         if i == j { entry - lambda.conj() } else { entry }
     });
     let u1 = Mat::from_fn(n, u1.ncols(), |i, j| c64::new(u1[(i, j)], 0.0));
-    let q = (&shifted * &u1).qr().compute_Q();
-    q.subcols(n - m, m).to_owned()
+    let q = product(shifted.as_ref(), u1.as_ref())?.qr().compute_Q();
+    Ok(q.subcols(n - m, m).to_owned())
 }
 
 /// A deterministic pseudo-random complex vector (the starting directions of method 0).
@@ -778,18 +782,18 @@ fn knv_method_0(poles: &[c64], subspaces: &[Mat<c64>]) -> Result<(Mat<c64>, usiz
     if dimension <= 1 {
         return Ok((x, 0, true));
     }
-    let mut previous = x.determinant().norm();
+    let mut previous = Lu::new(x.as_ref())?.determinant().norm();
     for sweep in 1..=KNV_MAX_SWEEPS {
         for &j in &free {
             interrupt::check()?;
             // y = X^-H e_j is orthogonal to every other column of X.
             let mut e_j = Mat::<c64>::zeros(n, 1);
             e_j[(j, 0)] = c64::new(1.0, 0.0);
-            let y = x.adjoint().to_owned().partial_piv_lu().solve(&e_j);
+            let y = Lu::new(x.adjoint().to_owned().as_ref())?.solve(e_j.as_ref())?;
             let column = project(&subspaces[j], y.as_ref(), poles[j].im == 0.0);
             set_column(&mut x, j, &column);
         }
-        let determinant = x.determinant().norm();
+        let determinant = Lu::new(x.as_ref())?.determinant().norm();
         if (determinant - previous).abs() <= KNV_RELATIVE_TOLERANCE * determinant {
             return Ok((x, sweep, true));
         }

@@ -1,5 +1,5 @@
-//! Linear solves by LU with partial pivoting (faer), without ever forming an inverse, stopping
-//! between blocks of work when the computation is interrupted.
+//! Linear solves by LU with partial pivoting (faer), real or complex, without ever forming an
+//! inverse, stopping between blocks of work when the computation is interrupted.
 //!
 //! A thin layer over faer's in-place factorisation. For small systems the pivot vectors and
 //! faer's scratch live on the stack, so a solve allocates nothing. For large ones (more than
@@ -10,15 +10,16 @@
 //! every step, so that [`interrupt::check`] runs between steps, the product and the triangular
 //! solve of each level are split into column panels ([`crate::linalg::product`]), and the
 //! factors are bitwise those of one faer call. The substitutions of many right-hand sides go
-//! in column panels too (each column is solved independently, so bitwise as one call). The
-//! tests below check both against faer's calls.
+//! in column panels too (each column is solved independently, so bitwise as one call). Real
+//! and complex matrices ([`Entry`]) take the same steps, their blocks of work sized in real
+//! multiply-adds. The tests below check both against faer's calls, for both.
 //!
 //! S. Toledo, "Locality of reference in LU decomposition with partial pivoting", SIAM J.
 //! Matrix Anal. Appl. 18(4), 1997.
 
 use crate::error::Error;
 use crate::linalg::matrix::with_order;
-use crate::linalg::product::{PANEL_MULTIPLY_ADDS, multiply, panel_columns};
+use crate::linalg::product::{Entry, PANEL_MULTIPLY_ADDS, multiply, panel_columns};
 use crate::platform::interrupt;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
@@ -51,21 +52,24 @@ const STACK_BYTES: usize = 4096;
 /// The LU factorisation with partial pivoting P A = L U of a square matrix, as faer's
 /// `PartialPivLu` (faer's default parameters and global parallelism, bitwise the same
 /// factors), formed and applied with stops between blocks of work when the computation is
-/// interrupted (see the module documentation). A singular A gives a zero or non-finite pivot
-/// and non-finite solutions, never a panic or an error: callers check the conditioning.
+/// interrupted (see the module documentation), for real (`f64`) or complex (`c64`) entries. A
+/// singular A gives a zero or non-finite pivot and non-finite solutions, never a panic or an
+/// error: callers check the conditioning.
 #[derive(Debug, Clone)]
-pub struct Lu {
+pub struct Lu<T: Entry = f64> {
     /// Unit lower triangular (its unit diagonal stored).
-    l: Mat<f64>,
+    l: Mat<T>,
     /// Upper triangular.
-    u: Mat<f64>,
+    u: Mat<T>,
     perm: Perm<usize>,
+    /// Whether P is an odd permutation.
+    odd: bool,
 }
 
-impl Lu {
+impl<T: Entry> Lu<T> {
     /// Factors the square matrix `a`; `Err(Error::Interrupted)` if the computation was
     /// interrupted.
-    pub fn new(a: MatRef<'_, f64>) -> Result<Self, Error> {
+    pub fn new(a: MatRef<'_, T>) -> Result<Self, Error> {
         let n = a.nrows();
         debug_assert_eq!(n, a.ncols());
         let mut factors = a.to_owned();
@@ -78,18 +82,44 @@ impl Lu {
         for (i, &row) in forward.iter().enumerate() {
             inverse[row] = i;
         }
+        // The parity of P: a cycle of length k is k - 1 transpositions.
+        let mut seen = vec![false; n];
+        let mut transpositions = 0;
+        for start in 0..n {
+            let mut i = start;
+            while !seen[i] {
+                seen[i] = true;
+                i = forward[i];
+                transpositions += usize::from(i != start);
+            }
+        }
         // L takes the multipliers below the diagonal and a unit diagonal, U keeps the rest.
-        let mut l = Mat::<f64>::zeros(n, n);
+        let mut l = Mat::<T>::zeros(n, n);
         let mut u = factors;
         for j in 0..n {
             let lower = &mut u.col_as_slice_mut(j)[j + 1..];
             let column = l.col_as_slice_mut(j);
-            column[j] = 1.0;
+            column[j] = T::ONE;
             column[j + 1..].copy_from_slice(lower);
-            lower.fill(0.0);
+            lower.fill(T::ZERO);
         }
         let perm = Perm::new_checked(forward.into_boxed_slice(), inverse.into_boxed_slice(), n);
-        Ok(Self { l, u, perm })
+        Ok(Self {
+            l,
+            u,
+            perm,
+            odd: transpositions % 2 == 1,
+        })
+    }
+
+    /// det A = ±(the product of U's diagonal, in order), as faer's `determinant` forms it from
+    /// the same factors (bitwise the same).
+    pub fn determinant(&self) -> T {
+        let mut det = T::ONE;
+        for i in 0..self.nrows() {
+            det *= self.u[(i, i)];
+        }
+        if self.odd { -det } else { det }
     }
 
     /// The order of A.
@@ -99,23 +129,23 @@ impl Lu {
 
     /// The unit lower triangular factor L.
     #[allow(non_snake_case)]
-    pub fn L(&self) -> MatRef<'_, f64> {
+    pub fn L(&self) -> MatRef<'_, T> {
         self.l.as_ref()
     }
 
     /// The upper triangular factor U.
     #[allow(non_snake_case)]
-    pub fn U(&self) -> MatRef<'_, f64> {
+    pub fn U(&self) -> MatRef<'_, T> {
         self.u.as_ref()
     }
 
     /// Overwrites B with A^-1 B (P B, then L Y = P B, U X = Y), in column panels of B.
-    pub fn solve_in_place(&self, b: MatMut<'_, f64>) -> Result<(), Error> {
+    pub fn solve_in_place(&self, b: MatMut<'_, T>) -> Result<(), Error> {
         let n = self.nrows();
         let par = faer::get_global_parallelism();
         in_column_panels(n, b, |panel| {
             let k = panel.ncols();
-            let mut buffer = MemBuffer::new(solve::solve_in_place_scratch::<usize, f64>(n, k, par));
+            let mut buffer = MemBuffer::new(solve::solve_in_place_scratch::<usize, T>(n, k, par));
             solve::solve_in_place(
                 self.L(),
                 self.U(),
@@ -128,19 +158,19 @@ impl Lu {
     }
 
     /// A^-1 B.
-    pub fn solve(&self, b: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+    pub fn solve(&self, b: MatRef<'_, T>) -> Result<Mat<T>, Error> {
         let mut x = b.to_owned();
         self.solve_in_place(x.as_mut())?;
         Ok(x)
     }
 
     /// Overwrites B with A^-T B, in column panels of B.
-    pub fn solve_transpose_in_place(&self, b: MatMut<'_, f64>) -> Result<(), Error> {
+    pub fn solve_transpose_in_place(&self, b: MatMut<'_, T>) -> Result<(), Error> {
         let n = self.nrows();
         let par = faer::get_global_parallelism();
         in_column_panels(n, b, |panel| {
             let k = panel.ncols();
-            let mut buffer = MemBuffer::new(solve::solve_transpose_in_place_scratch::<usize, f64>(
+            let mut buffer = MemBuffer::new(solve::solve_transpose_in_place_scratch::<usize, T>(
                 n, k, par,
             ));
             solve::solve_transpose_in_place(
@@ -158,13 +188,13 @@ impl Lu {
 /// Runs `substitute` (two triangular substitutions with an order-n factor, 2 n^2
 /// multiply-adds a column, on columns independently) on column panels of `b`, with
 /// [`interrupt::check`] between them.
-fn in_column_panels(
+fn in_column_panels<T: Entry>(
     n: usize,
-    mut b: MatMut<'_, f64>,
-    mut substitute: impl FnMut(MatMut<'_, f64>),
+    mut b: MatMut<'_, T>,
+    mut substitute: impl FnMut(MatMut<'_, T>),
 ) -> Result<(), Error> {
     let k = b.ncols();
-    let width = panel_columns(n, 2 * n, k);
+    let width = panel_columns::<T>(n, 2 * n, k);
     let mut first = 0;
     while first < k {
         let columns = width.min(k - first);
@@ -180,25 +210,29 @@ fn in_column_panels(
 /// Factors the m x w panel `a` (m >= w) in place, P a = L U with L unit lower trapezoidal and
 /// U upper triangular sharing its storage, as faer's `lu_in_place` with `parameters` and `par`
 /// (bitwise the same), and returns P as forward indices: row i of P a is row `perm[i]` of a.
-/// A panel of at most [`PANEL_MULTIPLY_ADDS`] (m w^2) is one faer call; a larger one is split
+/// A panel of at most [`PANEL_MULTIPLY_ADDS`] (m w^2 real multiply-adds) is one faer call; a
+/// larger one is split
 /// at faer's column split of its recursion (half of w, rounded up to a multiple of
 /// min(16, its next power of two)) into the factorisation of the left columns, the row swaps
 /// and the unit lower triangular solve of the top right block, the product updating the
 /// bottom right block, and the factorisation of that block, with the triangular solve and the
 /// product in column panels and a check of the interruption between every step.
-fn factor_in_place(
-    mut a: MatMut<'_, f64>,
+fn factor_in_place<T: Entry>(
+    mut a: MatMut<'_, T>,
     par: Par,
-    parameters: Spec<PartialPivLuParams, f64>,
+    parameters: Spec<PartialPivLuParams, T>,
 ) -> Result<Vec<usize>, Error> {
     let (m, w) = a.shape();
     debug_assert!(m >= w);
-    if m.saturating_mul(w).saturating_mul(w) <= PANEL_MULTIPLY_ADDS
+    if m.saturating_mul(w)
+        .saturating_mul(w)
+        .saturating_mul(T::REAL_MULTIPLY_ADDS)
+        <= PANEL_MULTIPLY_ADDS
         || w <= parameters.config.recursion_threshold
     {
         let mut perm = vec![0; m];
         let mut perm_inverse = vec![0; m];
-        let mut buffer = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(
+        let mut buffer = MemBuffer::new(factor::lu_in_place_scratch::<usize, T>(
             m, w, par, parameters,
         ));
         factor::lu_in_place(
@@ -217,7 +251,7 @@ fn factor_in_place(
     let left = factor_in_place(a.rb_mut().subcols_mut(0, split), par, parameters)?;
     permute_rows(a.rb_mut().subcols_mut(split, w - split), &left);
     let (a00, mut a01, a10, mut a11) = a.rb_mut().split_at_mut(split, split);
-    let rhs_width = panel_columns(split, split, w - split);
+    let rhs_width = panel_columns::<T>(split, split, w - split);
     let mut first = 0;
     while first < w - split {
         interrupt::check()?;
@@ -229,7 +263,7 @@ fn factor_in_place(
         );
         first += columns;
     }
-    multiply(a11.rb_mut(), Accum::Add, a10.rb(), a01.rb(), -1.0, par)?;
+    multiply(a11.rb_mut(), Accum::Add, a10.rb(), a01.rb(), -T::ONE, par)?;
     let right = factor_in_place(a11, par, parameters)?;
     permute_rows(a.rb_mut().submatrix_mut(split, 0, m - split, split), &right);
     let mut perm = left.clone();
@@ -241,14 +275,14 @@ fn factor_in_place(
 
 /// Replaces the rows of `a` by their permutation: row i becomes row `perm[i]`, moving only
 /// the rows that change (a panel's pivoting moves at most twice its width of rows).
-fn permute_rows(mut a: MatMut<'_, f64>, perm: &[usize]) {
+fn permute_rows<T: Entry>(mut a: MatMut<'_, T>, perm: &[usize]) {
     let moved: Vec<(usize, usize)> = perm
         .iter()
         .enumerate()
         .filter(|&(i, &row)| i != row)
         .map(|(i, &row)| (i, row))
         .collect();
-    let mut values = vec![0.0; moved.len()];
+    let mut values = vec![T::ZERO; moved.len()];
     for j in 0..a.ncols() {
         let mut column = a.rb_mut().col_mut(j);
         for (value, &(_, row)) in values.iter_mut().zip(&moved) {
@@ -457,7 +491,7 @@ fn factor_and_solve(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::{Mat, mat};
+    use faer::{Mat, c64, mat};
 
     #[test]
     fn solves_a_system_that_needs_pivoting() {
@@ -592,6 +626,92 @@ mod tests {
         }
     }
 
+    /// A complex matrix from two seeded real ones.
+    fn complex(n: usize, seed: u64) -> Mat<c64> {
+        let (re, im) = (
+            crate::test_matrices::seeded(n, n, seed),
+            crate::test_matrices::seeded(n, n, seed + 1),
+        );
+        Mat::from_fn(n, n, |i, j| c64::new(re[(i, j)], im[(i, j)]))
+    }
+
+    #[test]
+    fn large_complex_factorisations_and_solves_are_bitwise_faers() {
+        // Complex multiply-adds count four real ones: orders above 645 are split. A random
+        // matrix, one with graded columns and a singular one (a zero column).
+        let a = complex(700, 11);
+        let graded = Mat::from_fn(700, 700, |i, j| {
+            a[(i, j)] * 10f64.powf(-12.0 * j as f64 / 700.0)
+        });
+        let mut zero_column = complex(900, 13);
+        zero_column.col_mut(400).fill(c64::new(0.0, 0.0));
+        for (name, a) in [
+            ("random", a),
+            ("graded", graded),
+            ("zero column", zero_column),
+        ] {
+            let n = a.nrows();
+            let b = complex(n, 20).subcols(0, 40).to_owned();
+            let ours = Lu::new(a.as_ref()).unwrap();
+            let faers = a.partial_piv_lu();
+            let complex_bits = |m: MatRef<'_, c64>| {
+                let re = Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)].re);
+                let im = Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)].im);
+                (bits(re.as_ref()), bits(im.as_ref()))
+            };
+            assert_eq!(complex_bits(ours.L()), complex_bits(faers.L()), "{name}: L");
+            assert_eq!(complex_bits(ours.U()), complex_bits(faers.U()), "{name}: U");
+            assert_eq!(
+                ours.perm.as_ref().arrays().0,
+                faers.P().arrays().0,
+                "{name}: P"
+            );
+            use faer::linalg::solvers::Solve;
+            let x = ours.solve(b.as_ref()).unwrap();
+            assert_eq!(
+                complex_bits(x.as_ref()),
+                complex_bits(faers.solve(&b).as_ref()),
+                "{name}"
+            );
+            let (det, expected) = (ours.determinant(), a.determinant());
+            assert_eq!(
+                (det.re.to_bits(), det.im.to_bits()),
+                (expected.re.to_bits(), expected.im.to_bits()),
+                "{name}: determinant"
+            );
+            if name == "random" {
+                let residual = (&a * &x - &b).norm_max();
+                assert!(residual < 1e-9, "{name}: {residual:e}");
+            } else if name == "zero column" {
+                assert!(!x.is_all_finite(), "{name}");
+            }
+        }
+    }
+
+    #[test]
+    fn determinants_are_faers() {
+        for (n, seed) in [(1, 1), (5, 2), (40, 3), (300, 4)] {
+            let a = crate::test_matrices::seeded(n, n, seed);
+            let det = Lu::new(a.as_ref()).unwrap().determinant();
+            assert_eq!(det.to_bits(), a.determinant().to_bits(), "n = {n}");
+            let a = complex(n, seed + 10);
+            let (det, expected) = (Lu::new(a.as_ref()).unwrap().determinant(), a.determinant());
+            assert_eq!(
+                (det.re.to_bits(), det.im.to_bits()),
+                (expected.re.to_bits(), expected.im.to_bits())
+            );
+        }
+        // A permutation of parity odd: det = -1.
+        let swap = faer::mat![[0.0, 1.0], [1.0, 0.0]];
+        assert_eq!(Lu::new(swap.as_ref()).unwrap().determinant(), -1.0);
+        assert_eq!(
+            Lu::<f64>::new(Mat::zeros(0, 0).as_ref())
+                .unwrap()
+                .determinant(),
+            1.0
+        );
+    }
+
     #[test]
     fn an_interrupted_factorisation_stops() {
         let a = crate::test_matrices::seeded(1100, 1100, 5);
@@ -603,6 +723,10 @@ mod tests {
             assert_eq!(
                 solve(a.clone().as_mut(), b.as_mut(), Par::Seq),
                 Err(Error::Interrupted)
+            );
+            assert_eq!(
+                Lu::new(complex(700, 7).as_ref()).err(),
+                Some(Error::Interrupted)
             );
             // Small factorisations are one call, and finish.
             let small = crate::test_matrices::seeded(100, 100, 6);

@@ -38,6 +38,7 @@ pub mod max_plus;
 pub mod norm;
 pub(crate) mod polynomial_roots;
 pub mod product;
+pub mod qr;
 pub mod qz;
 pub(crate) mod rotation;
 pub mod schur;

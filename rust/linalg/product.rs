@@ -1,6 +1,6 @@
-//! Matrix products that answer an interruption: C = C + α A B (or C = α A B) on operands of
-//! any size, as faer's product, but for large operands split into column panels of B and C,
-//! one faer product each, with [`interrupt::check`] between them.
+//! Matrix products that answer an interruption: C = C + α A B (or C = α A B) on real or
+//! complex operands of any size, as faer's product, but for large operands split into column
+//! panels of B and C, one faer product each, with [`interrupt::check`] between them.
 //!
 //! One faer product of order 3000 takes about a second on one core, during which Ctrl-C could
 //! not be answered; a panel costs at most about [`PANEL_MULTIPLY_ADDS`] multiply-adds (tens of
@@ -15,7 +15,30 @@ use crate::error::Error;
 use crate::platform::interrupt;
 use faer::linalg::matmul::matmul;
 use faer::prelude::ReborrowMut;
-use faer::{Accum, Mat, MatMut, MatRef, Par};
+use faer::traits::ComplexField;
+use faer::{Accum, Mat, MatMut, MatRef, Par, c64};
+
+/// An entry of the matrices of the interruptible kernels (this module, [`crate::linalg::lu`]):
+/// `f64` or `c64`, with the cost of its multiply-add in real ones (a complex multiply-add is
+/// four real ones), by which the kernels size their blocks of work.
+pub trait Entry: ComplexField + Copy + std::ops::Neg<Output = Self> + std::ops::MulAssign {
+    /// Real multiply-adds in one multiply-add of this type.
+    const REAL_MULTIPLY_ADDS: usize;
+    const ZERO: Self;
+    const ONE: Self;
+}
+
+impl Entry for f64 {
+    const REAL_MULTIPLY_ADDS: usize = 1;
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+}
+
+impl Entry for c64 {
+    const REAL_MULTIPLY_ADDS: usize = 4;
+    const ZERO: Self = c64::new(0.0, 0.0);
+    const ONE: Self = c64::new(1.0, 0.0);
+}
 
 /// A panel of a split product costs about this many multiply-adds: 2^30, about 40 ms on one
 /// core of a current x86-64 machine with FMA.
@@ -29,11 +52,15 @@ pub(crate) const SPLIT_MIN_MULTIPLY_ADDS: usize = 2 * PANEL_MULTIPLY_ADDS;
 /// micro-kernels), however large the other dimensions.
 const MIN_PANEL_COLUMNS: usize = 48;
 
-/// The width of the column panels of a product of m x k and k x n operands: `n` (one call) for
-/// a product of fewer than [`SPLIT_MIN_MULTIPLY_ADDS`] multiply-adds, else the multiple of 8
-/// columns nearest below [`PANEL_MULTIPLY_ADDS`] / (m k), at least [`MIN_PANEL_COLUMNS`].
-pub(crate) fn panel_columns(m: usize, k: usize, n: usize) -> usize {
-    let per_column = m.saturating_mul(k).max(1);
+/// The width of the column panels of a product of m x k and k x n operands of entries `T`:
+/// `n` (one call) for a product of fewer than [`SPLIT_MIN_MULTIPLY_ADDS`] real multiply-adds,
+/// else the multiple of 8 columns nearest below [`PANEL_MULTIPLY_ADDS`] / (m k) (in real
+/// multiply-adds), at least [`MIN_PANEL_COLUMNS`].
+pub(crate) fn panel_columns<T: Entry>(m: usize, k: usize, n: usize) -> usize {
+    let per_column = m
+        .saturating_mul(k)
+        .saturating_mul(T::REAL_MULTIPLY_ADDS)
+        .max(1);
     if per_column.saturating_mul(n) < SPLIT_MIN_MULTIPLY_ADDS {
         return n.max(1);
     }
@@ -44,16 +71,16 @@ pub(crate) fn panel_columns(m: usize, k: usize, n: usize) -> usize {
 /// same parallelism and bitwise the same result, stopping with [`Error::Interrupted`] between
 /// column panels (see the module documentation) when the computation is interrupted. Panics,
 /// as faer's does, if the shapes do not match.
-pub fn multiply(
-    mut c: MatMut<'_, f64>,
+pub fn multiply<T: Entry>(
+    mut c: MatMut<'_, T>,
     accum: Accum,
-    a: MatRef<'_, f64>,
-    b: MatRef<'_, f64>,
-    alpha: f64,
+    a: MatRef<'_, T>,
+    b: MatRef<'_, T>,
+    alpha: T,
     par: Par,
 ) -> Result<(), Error> {
     let n = b.ncols();
-    let width = panel_columns(a.nrows(), a.ncols(), n);
+    let width = panel_columns::<T>(a.nrows(), a.ncols(), n);
     if width >= n {
         matmul(c, accum, a, b, alpha, par);
         return Ok(());
@@ -82,14 +109,14 @@ pub fn multiply(
 
 /// A B, as faer's `*` operator (with faer's global parallelism) and bitwise the same, through
 /// [`multiply`].
-pub fn product(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
-    let mut c = Mat::<f64>::zeros(a.nrows(), b.ncols());
+pub fn product<T: Entry>(a: MatRef<'_, T>, b: MatRef<'_, T>) -> Result<Mat<T>, Error> {
+    let mut c = Mat::<T>::zeros(a.nrows(), b.ncols());
     multiply(
         c.as_mut(),
         Accum::Replace,
         a,
         b,
-        1.0,
+        T::ONE,
         faer::get_global_parallelism(),
     )?;
     Ok(c)
@@ -122,7 +149,10 @@ mod tests {
         .iter()
         .enumerate()
         {
-            assert!(panel_columns(m, k, n) < n, "({m}, {k}, {n}) is not split");
+            assert!(
+                panel_columns::<f64>(m, k, n) < n,
+                "({m}, {k}, {n}) is not split"
+            );
             let seed = 10 * seed as u64;
             let a = seeded(m, k, seed);
             let b = seeded(k, n, seed + 1);
@@ -158,19 +188,53 @@ mod tests {
         }
         let (a, b) = (seeded(1400, 1400, 7), seeded(1400, 1400, 8));
         assert!(product(a.as_ref(), b.as_ref()).unwrap() == &a * &b);
+        // Complex operands: a multiply-add counts four real ones, so this one is split.
+        let complex = |m: &Mat<f64>, shift: usize| {
+            Mat::from_fn(m.nrows(), m.ncols(), |i, j| {
+                c64::new(m[(i, j)], m[((i + shift) % m.nrows(), j)])
+            })
+        };
+        let (a, b) = (
+            complex(&seeded(800, 800, 9), 1),
+            complex(&seeded(800, 900, 10), 2),
+        );
+        assert!(panel_columns::<c64>(800, 800, 900) < 900);
+        for par in [Par::Seq, Par::rayon(2)] {
+            let mut split = Mat::<c64>::zeros(800, 900);
+            let alpha = c64::new(0.5, -1.5);
+            multiply(
+                split.as_mut(),
+                Accum::Replace,
+                a.as_ref(),
+                b.as_ref(),
+                alpha,
+                par,
+            )
+            .unwrap();
+            let mut one = Mat::<c64>::zeros(800, 900);
+            matmul(
+                one.as_mut(),
+                Accum::Replace,
+                a.as_ref(),
+                b.as_ref(),
+                alpha,
+                par,
+            );
+            assert!(split == one, "complex, {par:?}");
+        }
     }
 
     #[test]
     fn small_products_are_one_call_and_panels_are_bounded() {
-        assert_eq!(panel_columns(1024, 1024, 1024), 1024);
-        assert_eq!(panel_columns(4, 4, 4), 4);
-        assert_eq!(panel_columns(0, 0, 0), 1);
+        assert_eq!(panel_columns::<f64>(1024, 1024, 1024), 1024);
+        assert_eq!(panel_columns::<f64>(4, 4, 4), 4);
+        assert_eq!(panel_columns::<f64>(0, 0, 0), 1);
         for (m, k, n) in [
             (1300, 1300, 1300),
             (3000, 3000, 3000),
             (100_000, 100_000, 3),
         ] {
-            let width = panel_columns(m, k, n);
+            let width = panel_columns::<f64>(m, k, n);
             assert!(width >= MIN_PANEL_COLUMNS && width.is_multiple_of(8));
             assert!(m * k * width <= PANEL_MULTIPLY_ADDS || width == MIN_PANEL_COLUMNS);
         }

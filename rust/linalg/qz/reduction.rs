@@ -10,20 +10,11 @@
 
 use crate::error::Error;
 use crate::linalg::householder::reflector;
+use crate::linalg::qr::{apply_on_the_right, apply_transpose_on_the_left, block_size, qr_in_place};
 use crate::linalg::rotation::Rotation;
 use crate::platform::dispatch::clear_upper_avx_state;
 use crate::platform::interrupt;
 use crate::platform::pool::scratch;
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::householder::{
-    apply_block_householder_sequence_on_the_right_in_place_scratch,
-    apply_block_householder_sequence_on_the_right_in_place_with_conj,
-    apply_block_householder_sequence_transpose_on_the_left_in_place_scratch,
-    apply_block_householder_sequence_transpose_on_the_left_in_place_with_conj,
-};
-use faer::linalg::qr::no_pivoting::factor::{
-    qr_in_place, qr_in_place_scratch, recommended_block_size,
-};
 use faer::{Conj, Mat, Par};
 use std::ops::Range;
 
@@ -142,6 +133,8 @@ fn rotate_columns_down(
 const UNBLOCKED_QR_MAX_ORDER: usize = 32;
 
 /// B = Q R by Householder reflectors; `other` (A) is multiplied by Q^T and Q accumulated.
+/// Above [`UNBLOCKED_QR_MAX_ORDER`], faer's blocked QR and applications of Q, driven in
+/// blocks that answer an interruption ([`crate::linalg::qr`], bitwise one faer call each).
 fn triangularize(b: &mut Mat<f64>, other: &mut Mat<f64>, q: &mut Mat<f64>) -> Result<(), Error> {
     let n = b.nrows();
     if n <= UNBLOCKED_QR_MAX_ORDER {
@@ -149,41 +142,17 @@ fn triangularize(b: &mut Mat<f64>, other: &mut Mat<f64>, q: &mut Mat<f64>) -> Re
     }
     // Sequential, as the Hessenberg reduction: the result must not depend on the machine.
     let par = Par::Seq;
-    let block_size = recommended_block_size::<f64>(n, n);
-    let mut householder = scratch(block_size, n);
-    let requirement = StackReq::any_of(&[
-        qr_in_place_scratch::<f64>(n, n, block_size, par, Default::default()),
-        apply_block_householder_sequence_transpose_on_the_left_in_place_scratch::<f64>(
-            n, block_size, n,
-        ),
-        apply_block_householder_sequence_on_the_right_in_place_scratch::<f64>(n, block_size, n),
-    ]);
-    let mut buffer = MemBuffer::new(requirement);
-    let stack = MemStack::new(&mut buffer);
-    qr_in_place(
-        b.as_mut(),
-        householder.as_mut(),
-        par,
-        stack,
-        Default::default(),
-    );
+    let mut householder = scratch(block_size::<f64>(n, n), n);
+    qr_in_place(b.as_mut(), householder.as_mut(), par)?;
     interrupt::check()?;
-    apply_block_householder_sequence_transpose_on_the_left_in_place_with_conj(
+    apply_transpose_on_the_left(
         b.as_ref(),
         householder.as_ref(),
         Conj::No,
         other.as_mut(),
         par,
-        stack,
-    );
-    apply_block_householder_sequence_on_the_right_in_place_with_conj(
-        b.as_ref(),
-        householder.as_ref(),
-        Conj::No,
-        q.as_mut(),
-        par,
-        stack,
-    );
+    )?;
+    apply_on_the_right(b.as_ref(), householder.as_ref(), Conj::No, q.as_mut(), par)?;
     for j in 0..n {
         for i in j + 1..n {
             b[(i, j)] = 0.0;
