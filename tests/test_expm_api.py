@@ -176,9 +176,16 @@ def test_warning_points_at_the_caller() -> None:
     assert caught and caught[0].filename == __file__
 
 
-def test_pade_choice_diagnostic() -> None:
+def test_approximant_choice_diagnostic() -> None:
     from aerocontrol import _core
 
-    assert _core.expm_pade_choice(np.zeros((3, 3))) == (3, 0)
-    degree, squarings = _core.expm_pade_choice(100.0 * A747)
+    assert _core.expm_approximant_choice(np.zeros((3, 3))) == (3, 0)
+    degree, squarings = _core.expm_approximant_choice(100.0 * A747)
     assert degree == 13 and squarings > 0
+    # Above order 8, a matrix needing at most 2 squarings takes the Taylor approximant 15+,
+    # reported as degree 15; a larger norm goes back to Padé 13.
+    rng = np.random.default_rng(0)
+    a = rng.standard_normal((12, 12))
+    assert _core.expm_approximant_choice(0.1 * a) == (15, 0)
+    degree, squarings = _core.expm_approximant_choice(100.0 * a)
+    assert degree == 13 and squarings > 2

@@ -42,7 +42,7 @@ __all__ = [
     "eigenvalues",
     "exception_classes",
     "expm",
-    "expm_pade_choice",
+    "expm_approximant_choice",
     "factored_response",
     "frequency_response",
     "get_num_threads",
@@ -129,7 +129,7 @@ def inverse_bilinear(
 def undiscretize_zoh(
     phi: ArrayLike, gamma: ArrayLike, dt: float, /
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
-def expm_pade_choice(a: ArrayLike, /) -> tuple[int, int]: ...
+def expm_approximant_choice(a: ArrayLike, /) -> tuple[int, int]: ...
 def check_model(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike, /) -> None: ...
 def grid_step(t: ArrayLike, /) -> float: ...
 def simulate(

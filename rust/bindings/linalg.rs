@@ -9,7 +9,9 @@ use crate::control::discretize::{
     inverse_bilinear as inverse_bilinear_core, undiscretize_zoh as undiscretize_zoh_core,
 };
 use crate::error::{Error, check_square};
-use crate::linalg::expm::{ILL_CONDITIONED_NORM, expm_into, pade_choice, transition_matrices_into};
+use crate::linalg::expm::{
+    ILL_CONDITIONED_NORM, approximant_choice, expm_into, transition_matrices_into,
+};
 use crate::linalg::max_plus::{
     balancing_exponents as balancing_exponents_core, max_cycle_mean as max_cycle_mean_core,
     product as max_plus_product,
@@ -316,16 +318,19 @@ fn undiscretize_zoh<'py>(
     Ok(result)
 }
 
-/// The Padé degree m (15: the Taylor approximant 15+) and the number of squarings s that the
-/// exponential of A uses: a diagnostic for tests and for users comparing algorithms.
+/// The approximant's degree m (3, 5, 7, 9, 13: Padé; 15: the Taylor approximant 15+) and the
+/// number of squarings s that the exponential of A uses: a diagnostic for tests and for users
+/// comparing algorithms.
 #[pyfunction]
 #[pyo3(signature = (a, /))]
-fn expm_pade_choice(py: Python<'_>, a: &Bound<'_, PyAny>) -> PyResult<(usize, u32)> {
+fn expm_approximant_choice(py: Python<'_>, a: &Bound<'_, PyAny>) -> PyResult<(usize, u32)> {
     let a = Real::convert(py, a, "A")?;
     let a = a.matrix().map_err(|e| to_py_err(py, e))?;
     check_square(a, "A").map_err(|e| to_py_err(py, e))?;
     let n = a.nrows();
-    compute(py, Cost::of(expm_flops(n) / 4.0, 8.0, n), || pade_choice(a))
+    compute(py, Cost::of(expm_flops(n) / 4.0, 8.0, n), || {
+        approximant_choice(a)
+    })
 }
 
 /// The cost of the real Schur form of order n, with Z.
@@ -615,6 +620,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bilinear, m)?)?;
     m.add_function(wrap_pyfunction!(inverse_bilinear, m)?)?;
     m.add_function(wrap_pyfunction!(undiscretize_zoh, m)?)?;
-    m.add_function(wrap_pyfunction!(expm_pade_choice, m)?)?;
+    m.add_function(wrap_pyfunction!(expm_approximant_choice, m)?)?;
     Ok(())
 }

@@ -228,7 +228,7 @@ const M5: usize = 1;
 const M7: usize = 2;
 const M9: usize = 3;
 const M13: usize = 4;
-/// The index of the Taylor approximant 15+ (`taylor.rs`) in [`PadeChoice`], past the Padé table.
+/// The index of the Taylor approximant 15+ (`taylor.rs`) in [`ApproximantChoice`], past the Padé table.
 const TAYLOR_15: usize = APPROXIMANTS.len();
 
 /// The most squarings with which the Taylor approximant 15+ is chosen (see
@@ -240,14 +240,14 @@ const TAYLOR_MAX_SQUARINGS: u32 = 2;
 
 /// The degree and the number of squarings chosen for one scaled matrix tA.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PadeChoice {
+pub struct ApproximantChoice {
     /// Index into the table of approximants (degrees 3, 5, 7, 9, 13), or [`TAYLOR_15`].
     approximant: usize,
     /// Number of squarings s (including any pre-scaling of a matrix of huge norm).
     pub squarings: u32,
 }
 
-impl PadeChoice {
+impl ApproximantChoice {
     /// The degree m of the Padé approximant, or 15 for the Taylor approximant 15+.
     pub fn degree(&self) -> usize {
         match APPROXIMANTS.get(self.approximant) {
@@ -875,10 +875,10 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// 2 to 3 times more, so the Padé choice below is kept. At the small orders the choice is
     /// the Padé one alone.
     #[inline(always)]
-    pub fn choose(&mut self, t: f64) -> Result<PadeChoice, M::Stop> {
+    pub fn choose(&mut self, t: f64) -> Result<ApproximantChoice, M::Stop> {
         let tau = t.abs() * self.time_scale;
         if tau == 0.0 || self.a_norm == 0.0 {
-            return Ok(PadeChoice {
+            return Ok(ApproximantChoice {
                 approximant: M3,
                 squarings: self.prescale.min(MAX_SQUARINGS),
             });
@@ -891,13 +891,13 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             && self.power_norm_bound(6) * integer_power(tau / theta3, 6) <= 1.0
             && self.extra_squarings(M3, tau) == 0
         {
-            return Ok(PadeChoice {
+            return Ok(ApproximantChoice {
                 approximant: M3,
                 squarings: self.prescale.min(MAX_SQUARINGS),
             });
         }
         let taylor_squarings = self.taylor_squarings(tau)?;
-        let taylor = PadeChoice {
+        let taylor = ApproximantChoice {
             approximant: TAYLOR_15,
             squarings: taylor_squarings
                 .saturating_add(self.prescale)
@@ -912,8 +912,8 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     /// The Padé degree and number of squarings for scale τ > 0 (Al-Mohy & Higham 2009,
     /// Algorithm 5.1).
     #[inline(always)]
-    fn choose_pade(&mut self, tau: f64) -> Result<PadeChoice, M::Stop> {
-        let choice = |approximant, squarings: u32| PadeChoice {
+    fn choose_pade(&mut self, tau: f64) -> Result<ApproximantChoice, M::Stop> {
+        let choice = |approximant, squarings: u32| ApproximantChoice {
             approximant,
             squarings: squarings.min(MAX_SQUARINGS),
         };
@@ -955,7 +955,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 
     /// Forms the powers that evaluating `choice` needs; call before evaluating it.
     #[inline(always)]
-    pub fn prepare(&mut self, choice: PadeChoice) -> Result<(), M::Stop> {
+    pub fn prepare(&mut self, choice: ApproximantChoice) -> Result<(), M::Stop> {
         match choice.approximant {
             M3 | TAYLOR_15 => Ok(()),
             M5 => self.ensure_a4(),
@@ -974,7 +974,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
     pub fn exponential_into(
         &self,
         t: f64,
-        choice: PadeChoice,
+        choice: ApproximantChoice,
         mut out: MatMut<'_, f64>,
     ) -> Result<bool, M::Stop> {
         let n = self.a.order();
@@ -1015,7 +1015,7 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 
     /// r_m(cA) squared in double precision, refining triangular structure on the way.
     #[inline(always)]
-    fn double_exponential(&self, t: f64, c: f64, choice: PadeChoice) -> Result<M, M::Stop> {
+    fn double_exponential(&self, t: f64, c: f64, choice: ApproximantChoice) -> Result<M, M::Stop> {
         let x = if choice.approximant == TAYLOR_15 {
             if c == 1.0 {
                 taylor::taylor_approximant(&self.a, &self.a2)?
@@ -1595,17 +1595,17 @@ pub fn expm(a: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
 /// The degree m and number of squarings s that [`expm`] uses for A: m in {3, 5, 7, 9, 13} for
 /// the Padé approximants, 15 for the Taylor approximant 15+ (for a 1 x 1 or empty A, which
 /// need no approximant, (0, 0)).
-pub fn pade_choice(a: MatRef<'_, f64>) -> Result<(usize, u32), Error> {
+pub fn approximant_choice(a: MatRef<'_, f64>) -> Result<(usize, u32), Error> {
     check_square_finite(a, "A")?;
     if a.nrows() <= 1 {
         return Ok((0, 0));
     }
-    let choice = with_matrix_type!(a.nrows(), M => chosen_degree::<M>(a))?;
+    let choice = with_matrix_type!(a.nrows(), M => chosen_approximant::<M>(a))?;
     Ok((choice.degree(), choice.squarings))
 }
 
 /// The choice of [`ExponentialPlan::choose`] for e^A.
-fn chosen_degree<M: ExpmMatrix>(a: MatRef<'_, f64>) -> Result<PadeChoice, Error> {
+fn chosen_approximant<M: ExpmMatrix>(a: MatRef<'_, f64>) -> Result<ApproximantChoice, Error> {
     let mut plan = ExponentialPlan::<M>::new(a).map_err(Into::into)?;
     plan.choose(1.0).map_err(Into::into)
 }
@@ -1620,14 +1620,14 @@ fn transition_matrices_with<M: ExpmMatrix>(
     let choices = times
         .iter()
         .map(|&t| plan.choose(t))
-        .collect::<Result<Vec<PadeChoice>, M::Stop>>()
+        .collect::<Result<Vec<ApproximantChoice>, M::Stop>>()
         .map_err(Into::into)?;
     for &choice in &choices {
         plan.prepare(choice).map_err(Into::into)?;
     }
     let plan = &plan;
     let context = ParallelContext::capture(n);
-    let evaluate = |((&t, &choice), chunk): ((&f64, &PadeChoice), &mut [f64])| {
+    let evaluate = |((&t, &choice), chunk): ((&f64, &ApproximantChoice), &mut [f64])| {
         context.run(|| {
             plan.exponential_into(t, choice, MatMut::from_row_major_slice_mut(chunk, n, n))
                 .map_err(Into::into)?;
@@ -1834,7 +1834,7 @@ mod tests {
             let err = relative_difference(phi, &expected);
             // Double evaluation (fewer than two squarings) is within ten times the condition
             // number (at most 18 here) times u; double-double is correct to the last bits.
-            let (_, squarings) = pade_choice((&a * faer::Scale(t)).as_ref()).unwrap();
+            let (_, squarings) = approximant_choice((&a * faer::Scale(t)).as_ref()).unwrap();
             let tolerance = if squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS {
                 4e-16
             } else {
@@ -1857,7 +1857,7 @@ mod tests {
                     .map(|i| scale * eigenvalues[i % 6] * (1.0 + 0.01 * i as f64))
                     .collect();
                 let (a, expected) = symmetric_case(&lambda, 3);
-                degrees.insert(pade_choice(a.as_ref()).unwrap().0);
+                degrees.insert(approximant_choice(a.as_ref()).unwrap().0);
                 let got = expm(a.as_ref()).unwrap();
                 let err = relative_difference(&got, &expected);
                 assert!(
@@ -2123,7 +2123,7 @@ mod tests {
         let mut rng = StdRng::seed_from_u64(64);
         let a = random_matrix(64, 1.0, &mut rng);
         let a = &a * faer::Scale(2.0 / one_norm(a.as_ref()));
-        assert_eq!(pade_choice(a.as_ref()).unwrap(), (15, 0));
+        assert_eq!(approximant_choice(a.as_ref()).unwrap(), (15, 0));
     }
 
     #[test]
