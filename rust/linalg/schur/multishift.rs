@@ -468,19 +468,8 @@ fn apply_outside_window(
     }
     if last > w1 {
         let block = full_h.as_mut().submatrix_mut(w0, w1 + 1, w, last - w1);
-        let (rows, columns) = (block.nrows(), block.ncols());
-        scratch.clear();
-        scratch.resize(rows * columns, 0.0);
-        let mut copy = MatMut::from_column_major_slice_mut(scratch, rows, columns);
-        copy.copy_from(block.as_ref());
-        matmul(
-            block,
-            Accum::Replace,
-            u.transpose(),
-            copy.as_ref(),
-            1.0,
-            Par::Seq,
-        );
+        let copy = copy_to_scratch(block.as_ref(), scratch);
+        matmul(block, Accum::Replace, u.transpose(), copy, 1.0, Par::Seq);
     }
     if let Some(z) = z {
         let rows = z.nrows();
@@ -491,12 +480,17 @@ fn apply_outside_window(
 
 /// block <- block U, through a copy of the block in `scratch`.
 fn multiply_on_the_right(block: MatMut<'_, f64>, u: MatRef<'_, f64>, scratch: &mut Vec<f64>) {
-    let (rows, columns) = (block.nrows(), block.ncols());
+    let copy = copy_to_scratch(block.as_ref(), scratch);
+    matmul(block, Accum::Replace, copy, u, 1.0, Par::Seq);
+}
+
+/// A column-major copy of `block` in `scratch`, written once (not zeroed first).
+fn copy_to_scratch<'a>(block: MatRef<'_, f64>, scratch: &'a mut Vec<f64>) -> MatRef<'a, f64> {
     scratch.clear();
-    scratch.resize(rows * columns, 0.0);
-    let mut copy = MatMut::from_column_major_slice_mut(scratch, rows, columns);
-    copy.copy_from(block.as_ref());
-    matmul(block, Accum::Replace, copy.as_ref(), u, 1.0, Par::Seq);
+    for column in block.col_iter() {
+        scratch.extend(column.iter().copied());
+    }
+    MatRef::from_column_major_slice(scratch, block.nrows(), block.ncols())
 }
 
 /// One small-bulge multishift QR sweep over the active block ktop..=kbot (at least 3 rows)
