@@ -315,16 +315,7 @@ pub(crate) fn swap_blocks(
     }
 
     // Apply Q to the rest of T and to Z, and write the swapped block.
-    let n = t.nrows();
-    let mut buffer = [0.0f64; 4];
-    for c in j + order..n {
-        for (r, value) in buffer.iter_mut().enumerate().take(order) {
-            *value = (0..order).map(|s| q_matrix[s][r] * t[(j + s, c)]).sum();
-        }
-        for (r, value) in buffer.iter().enumerate().take(order) {
-            t[(j + r, c)] = *value;
-        }
-    }
+    multiply_rows(t, j, &q_matrix, order);
     multiply_columns(t, j, j, &q_matrix, order);
     multiply_columns(z, z.nrows(), j, &q_matrix, order);
     for r in 0..order {
@@ -341,7 +332,6 @@ pub(crate) fn swap_blocks(
     Ok(())
 }
 
-/// Rows 0..rows of columns j..j+order of `matrix` times the order x order `q`.
 /// The Frobenius norm of the block rows x columns of a 4 x 4 array.
 fn frobenius(m: &[[f64; 4]; 4], rows: Range<usize>, columns: Range<usize>) -> f64 {
     m[rows]
@@ -352,14 +342,59 @@ fn frobenius(m: &[[f64; 4]; 4], rows: Range<usize>, columns: Range<usize>) -> f6
         .sqrt()
 }
 
-fn multiply_columns(matrix: &mut Mat<f64>, rows: usize, j: usize, q: &[[f64; 4]; 4], order: usize) {
-    let mut buffer = [0.0f64; 4];
-    for r in 0..rows {
-        for (c, value) in buffer.iter_mut().enumerate().take(order) {
-            *value = (0..order).map(|s| matrix[(r, j + s)] * q[s][c]).sum();
+/// The rows j..j+order of T right of column j+order times the order x order `q^T`.
+fn multiply_rows(t: &mut Mat<f64>, j: usize, q: &[[f64; 4]; 4], order: usize) {
+    match order {
+        2 => multiply_rows_of::<2>(t, j, q),
+        3 => multiply_rows_of::<3>(t, j, q),
+        _ => multiply_rows_of::<4>(t, j, q),
+    }
+}
+
+/// [`multiply_rows`] for `ORDER` rows, a column slice at a time.
+fn multiply_rows_of<const ORDER: usize>(t: &mut Mat<f64>, j: usize, q: &[[f64; 4]; 4]) {
+    for c in j + ORDER..t.ncols() {
+        let rows = &mut t.col_as_slice_mut(c)[j..j + ORDER];
+        let x: [f64; ORDER] = std::array::from_fn(|s| rows[s]);
+        for (r, value) in rows.iter_mut().enumerate() {
+            *value = (0..ORDER).map(|s| q[s][r] * x[s]).sum();
         }
-        for (c, value) in buffer.iter().enumerate().take(order) {
-            matrix[(r, j + c)] = *value;
+    }
+}
+
+/// Rows 0..rows of columns j..j+order of `matrix` times the order x order `q`.
+fn multiply_columns(matrix: &mut Mat<f64>, rows: usize, j: usize, q: &[[f64; 4]; 4], order: usize) {
+    match order {
+        2 => multiply_columns_of::<2>(matrix, rows, j, q),
+        3 => multiply_columns_of::<3>(matrix, rows, j, q),
+        _ => multiply_columns_of::<4>(matrix, rows, j, q),
+    }
+}
+
+/// [`multiply_columns`] for `ORDER` columns, on the columns as slices.
+fn multiply_columns_of<const ORDER: usize>(
+    matrix: &mut Mat<f64>,
+    rows: usize,
+    j: usize,
+    q: &[[f64; 4]; 4],
+) {
+    let mut columns = matrix
+        .as_mut()
+        .submatrix_mut(0, j, rows, ORDER)
+        .col_iter_mut();
+    let mut columns: [&mut [f64]; ORDER] = std::array::from_fn(|_| {
+        let column = columns.next().expect("ORDER columns");
+        column
+            .try_as_col_major_mut()
+            .expect("a column of a Mat is contiguous")
+            .as_slice_mut()
+    });
+    for r in 0..rows {
+        let x: [f64; ORDER] = std::array::from_fn(|s| columns[s][r]);
+        let buffer: [f64; ORDER] =
+            std::array::from_fn(|c| (0..ORDER).map(|s| x[s] * q[s][c]).sum());
+        for (column, value) in columns.iter_mut().zip(buffer) {
+            column[r] = value;
         }
     }
 }
@@ -394,19 +429,35 @@ fn standardize_at(t: &mut Mat<f64>, z: &mut Mat<f64>, j: usize) {
 fn rotate(t: &mut Mat<f64>, z: &mut Mat<f64>, j: usize, cs: f64, sn: f64) {
     let n = t.nrows();
     for c in j + 2..n {
-        let (x, y) = (t[(j, c)], t[(j + 1, c)]);
-        t[(j, c)] = cs * x + sn * y;
-        t[(j + 1, c)] = cs * y - sn * x;
+        let rows = &mut t.col_as_slice_mut(c)[j..j + 2];
+        let (x, y) = (rows[0], rows[1]);
+        rows[0] = cs * x + sn * y;
+        rows[1] = cs * y - sn * x;
     }
-    for r in 0..j {
-        let (x, y) = (t[(r, j)], t[(r, j + 1)]);
-        t[(r, j)] = cs * x + sn * y;
-        t[(r, j + 1)] = cs * y - sn * x;
-    }
-    for r in 0..n {
-        let (x, y) = (z[(r, j)], z[(r, j + 1)]);
-        z[(r, j)] = cs * x + sn * y;
-        z[(r, j + 1)] = cs * y - sn * x;
+    rotate_columns(t, j, j, cs, sn);
+    rotate_columns(z, n, j, cs, sn);
+}
+
+/// Rows 0..rows of the columns j and j + 1 of `matrix` times G = [[cs, -sn], [sn, cs]].
+fn rotate_columns(matrix: &mut Mat<f64>, rows: usize, j: usize, cs: f64, sn: f64) {
+    let (left, right) = matrix
+        .as_mut()
+        .submatrix_mut(0, j, rows, 2)
+        .split_at_col_mut(1);
+    let left = left
+        .col_mut(0)
+        .try_as_col_major_mut()
+        .expect("a column of a Mat is contiguous")
+        .as_slice_mut();
+    let right = right
+        .col_mut(0)
+        .try_as_col_major_mut()
+        .expect("a column of a Mat is contiguous")
+        .as_slice_mut();
+    for (x, y) in left.iter_mut().zip(right.iter_mut()) {
+        let (a, b) = (*x, *y);
+        *x = cs * a + sn * b;
+        *y = cs * b - sn * a;
     }
 }
 
