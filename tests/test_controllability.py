@@ -143,6 +143,29 @@ def test_dominant_planted_mode_fools_the_staircase_alone() -> None:
     assert not aerocontrol.is_controllable(A, B)
 
 
+def test_interior_planted_block_in_a_rotated_basis_needs_the_modal_test() -> None:
+    """A 16-state pair with a planted 4 x 4 uncontrollable block A_u whose eigenvalues lie
+    among the controllable ones (benches/peers/controllability.py's case), in a random
+    orthogonal basis. The staircase alone sees a coupling of 2.2e-14 against its tolerance
+    1.8e-14 and calls all four controllable (documented under ``method``); the full analysis
+    names them: the eigenvalues of A_u (numpy's eigvals of the planted block) to 1e-9."""
+    rng = np.random.default_rng(16)
+    n, r = 16, 4
+    A0 = np.zeros((n, n))
+    A0[: n - r, :] = rng.standard_normal((n - r, n)) / np.sqrt(n)
+    A0[n - r :, n - r :] = rng.standard_normal((r, r)) / np.sqrt(r)
+    B0 = np.zeros((n, 2))
+    B0[: n - r] = rng.standard_normal((n - r, 2))
+    U = np.linalg.qr(rng.standard_normal((n, n)))[0]
+    A, B = U @ A0 @ U.T, U @ B0
+    planted = np.sort_complex(np.linalg.eigvals(A0[n - r :, n - r :]))
+    result = aerocontrol.controllability(A, B)
+    assert not result.controllable
+    found = np.sort_complex(result.uncontrollable_eigenvalues)
+    np.testing.assert_allclose(found, planted, rtol=1e-9, atol=1e-9)
+    assert aerocontrol.is_controllable(A, B, method="staircase")
+
+
 def test_repeated_eigenvalue_only_partly_reachable() -> None:
     # A = I, B = [1, 1]^T: every left eigenvector test passes, but only one direction is
     # reachable; the staircase sees it.
