@@ -77,6 +77,10 @@ def _observable_full(A: Any, C: Any) -> Any:
     return np.array([aerocontrol.is_observable(A, C)])
 
 
+def _observable_staircase(A: Any, C: Any) -> Any:
+    return np.array([aerocontrol.is_observable(A, C, method="staircase")])
+
+
 def _observable_rank(A: Any, C: Any) -> Any:
     return np.array([np.linalg.matrix_rank(control.obsv(A, C)) == A.shape[0]])
 
@@ -147,7 +151,8 @@ def controllability_cases() -> list[Case]:
       test on scipy's left eigenvectors. The rank answers False at n = 64 (rank 61) and 256:
       the rows report that disagreement, which is the point of not using the rank.
     * is_observable: the dual, the 747 lateral seen through r alone and random single-output
-      pairs; the same peers on obsv and on (A^T, C^T). The rank of obsv again answers False
+      pairs, the full verdict and the staircase alone; the same peers on obsv and on
+      (A^T, C^T). The rank of obsv again answers False
       at n = 64 and 256.
     * controllability: the uncontrollable eigenvalues of 2-input plants with n/4 planted
       uncontrollable modes (n = 4, 16, 64, 256), against the eigenvalues of AB01ND's
@@ -200,20 +205,35 @@ def controllability_cases() -> list[Case]:
                 )
             )
     for n in (4, *SIZES):
-        cases.append(
-            Case(
-                op="is_observable",
-                size="n=4 747 lateral, r" if n == 4 else f"n={n} p=1",
-                seed=n,
-                setup=functools.partial(_random_output_pair, n=n),
-                ours=_observable_full,
-                peers=[
-                    Peer("control.obsv + matrix_rank", _observable_rank),
-                    Peer("slycot ab01nd(A^T, C^T)", _observable_slycot),
-                    Peer("ab01nd + scipy eig PBH (A^T, C^T)", _observable_composite),
-                ],
+        for method, ours in (("full", _observable_full), ("staircase", _observable_staircase)):
+            cases.append(
+                Case(
+                    op=f"is_observable ({method})",
+                    size="n=4 747 lateral, r" if n == 4 else f"n={n} p=1",
+                    seed=n,
+                    setup=functools.partial(_random_output_pair, n=n),
+                    ours=ours,
+                    peers=[
+                        Peer("control.obsv + matrix_rank", _observable_rank),
+                        Peer(
+                            "slycot ab01nd(A^T, C^T)",
+                            _observable_slycot,
+                            target=staircase_target if method == "staircase" else None,
+                        ),
+                        *(
+                            [
+                                Peer(
+                                    "ab01nd + scipy eig PBH (A^T, C^T)",
+                                    _observable_composite,
+                                    target=composite_target,
+                                )
+                            ]
+                            if method == "full"
+                            else []
+                        ),
+                    ],
+                )
             )
-        )
     for n in (4, *SIZES):
         cases.append(
             Case(
