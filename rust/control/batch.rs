@@ -13,7 +13,7 @@ use crate::control::riccati::care::{
 };
 use crate::control::riccati::dare::{DareOptions, solve_dare};
 use crate::error::{Error, check_finite, check_output_len};
-use crate::linalg::expm::expm_into_validated;
+use crate::linalg::expm::expm_stack_into_validated;
 use crate::platform::parallel::{ParallelContext, min_items_per_task, par_chunks};
 use faer::{Mat, MatMut, MatRef, c64};
 use nalgebra::DMatrix;
@@ -117,16 +117,15 @@ pub fn expm_batch(stack: MatrixStack<'_>, out: &mut [f64]) -> Result<(), Error> 
         .with_min_len(min_items_per_task(stack.len(), n).div_ceil(group).max(1))
         .try_for_each(|(group_index, matrices)| {
             context.run(|| {
-                for (offset, chunk) in matrices.chunks_exact_mut(n * n).enumerate() {
-                    let index = group_index * group + offset;
-                    // Validated above: every matrix is square and finite.
-                    expm_into_validated(
-                        stack.get(index),
-                        MatMut::from_row_major_slice_mut(chunk, n, n),
-                    )
-                    .map_err(|e| Error::in_batch(index, e))?;
-                }
-                Ok(())
+                let first = group_index * group;
+                let count = matrices.len() / (n * n);
+                // Validated above: every matrix is square and finite.
+                expm_stack_into_validated(
+                    n,
+                    &stack.data[first * n * n..(first + count) * n * n],
+                    matrices,
+                )
+                .map_err(|(offset, e)| Error::in_batch(first + offset, e))
             })
         })
 }

@@ -179,6 +179,78 @@ pub(crate) fn lu_kernel<const N: usize, const FMA: bool>(
 
 fma_dispatch!(fn lu_in_place<const N: usize>(a: &mut Columns<N>, pivots: &mut [usize; N]) => lu_kernel);
 
+/// [`lu_kernel`] on the matrix stored by rows (`rows[i][j]` = a_ij): the same pivots and the
+/// same operations on each entry in the same order (equal bit for bit), with the factors left
+/// by rows. A row interchange moves two whole rows, and each elimination step updates a whole
+/// row with one vector operation, where the column storage swaps and updates entry by entry.
+#[inline(always)]
+pub(crate) fn lu_rows_kernel<const N: usize, const FMA: bool>(
+    rows: &mut Columns<N>,
+    pivots: &mut [usize; N],
+) {
+    for k in 0..N {
+        let mut pivot_row = k;
+        for i in k + 1..N {
+            if rows[i][k].abs() > rows[pivot_row][k].abs() {
+                pivot_row = i;
+            }
+        }
+        pivots[k] = pivot_row;
+        rows.swap(k, pivot_row);
+        let (done, rest) = rows.split_at_mut(k + 1);
+        let pivot_row_values = &done[k];
+        let pivot = pivot_row_values[k];
+        for row in rest.iter_mut() {
+            let factor = row[k] / pivot;
+            // Entries left of k hold factors already; only those right of it are updated.
+            for (j, (x, &value)) in row.iter_mut().zip(pivot_row_values).enumerate() {
+                let updated = multiply_add::<FMA>(-factor, value, *x);
+                *x = if j > k { updated } else { *x };
+            }
+            row[k] = factor;
+        }
+    }
+}
+
+/// [`lu_solve_rows_kernel`] with the factors of [`lu_rows_kernel`] (stored by rows): the same
+/// operations on each entry in the same order.
+#[inline(always)]
+pub(crate) fn lu_rows_solve_rows_kernel<const N: usize, const FMA: bool>(
+    lu_rows: &Columns<N>,
+    pivots: &[usize; N],
+    rows: &mut Columns<N>,
+) {
+    for (k, &pivot_row) in pivots.iter().enumerate() {
+        rows.swap(k, pivot_row);
+    }
+    // Forward substitution with the unit lower factor.
+    for k in 0..N {
+        let (solved, rest) = rows.split_at_mut(k + 1);
+        let solved = &solved[k];
+        for (row, lu_row) in rest.iter_mut().zip(&lu_rows[k + 1..]) {
+            let factor = lu_row[k];
+            for (entry, &x) in row.iter_mut().zip(solved) {
+                *entry = multiply_add::<FMA>(-factor, x, *entry);
+            }
+        }
+    }
+    // Back substitution with the upper factor, dividing by each pivot.
+    for k in (0..N).rev() {
+        let (rest, solved) = rows.split_at_mut(k);
+        let solved = &mut solved[0];
+        let pivot = lu_rows[k][k];
+        for x in solved.iter_mut() {
+            *x /= pivot;
+        }
+        for (row, lu_row) in rest.iter_mut().zip(lu_rows) {
+            let factor = lu_row[k];
+            for (entry, &x) in row.iter_mut().zip(solved.iter()) {
+                *entry = multiply_add::<FMA>(-factor, x, *entry);
+            }
+        }
+    }
+}
+
 /// Solves with the factors of [`lu_kernel`] for N right-hand sides in place, column by column.
 #[inline(always)]
 pub(crate) fn lu_solve_kernel<const N: usize, const FMA: bool>(
@@ -308,13 +380,30 @@ pub(crate) fn combination<const N: usize>(
     from_columns(combination_columns(identity, terms))
 }
 
-/// The 1-norm, max_j sum_i |a_ij|.
-#[inline]
+/// The 1-norm, max_j sum_i |a_ij|. The N column sums are formed together, row by row (each
+/// sum's terms in order i = 0, 1, ..., so as a sum down its column), as vector operations.
+#[inline(always)]
 pub(crate) fn one_norm<const N: usize>(a: &SMatrix<f64, N, N>) -> f64 {
-    columns(a)
-        .iter()
-        .map(|column| column.iter().fold(0.0, |sum, value| sum + value.abs()))
-        .fold(0.0, f64::max)
+    let mut sums = [0.0; N];
+    for i in 0..N {
+        for (sum, column) in sums.iter_mut().zip(columns(a)) {
+            *sum += column[i].abs();
+        }
+    }
+    sums.into_iter().fold(0.0, f64::max)
+}
+
+/// max |a_ij| (entries that are NaN ignored, as by `f64::max`), the maxima of the rows formed
+/// together as vector operations.
+#[inline(always)]
+pub(crate) fn max_abs<const N: usize>(a: &SMatrix<f64, N, N>) -> f64 {
+    let mut largest = [0.0; N];
+    for column in columns(a) {
+        for (m, value) in largest.iter_mut().zip(column) {
+            *m = f64::max(*m, value.abs());
+        }
+    }
+    largest.into_iter().fold(0.0, f64::max)
 }
 
 /// ||(|A| / scale)^p||_1 by p row-vector products (for B >= 0, ||B^p||_1 = max 1^T B^p).
@@ -473,6 +562,19 @@ mod tests {
                 by_columns,
                 "solve, N = {N}, seed {seed}"
             );
+            // Factored by rows too.
+            let mut lu_rows = transposed(columns(&system));
+            let mut row_pivots = [0usize; N];
+            lu_rows_kernel::<N, FMA>(&mut lu_rows, &mut row_pivots);
+            assert_eq!(row_pivots, pivots, "pivots, N = {N}, seed {seed}");
+            assert_eq!(transposed(&lu_rows), lu, "factors, N = {N}, seed {seed}");
+            let mut by_rows = transposed(columns(&rhs));
+            lu_rows_solve_rows_kernel::<N, FMA>(&lu_rows, &row_pivots, &mut by_rows);
+            assert_eq!(
+                transposed(&by_rows),
+                by_columns,
+                "solve with the row factors, N = {N}, seed {seed}"
+            );
 
             let (lhs, start) = (sample::<N>(seed + 200), sample::<N>(seed + 300));
             let mut expected = *columns(&start);
@@ -507,6 +609,22 @@ mod tests {
             let expected = one_norm(&power);
             assert!((absolute_power_norm(&a, 2.0, p) - expected).abs() <= 1e-14 * expected);
             power = product(&power, &abs);
+        }
+    }
+
+    #[test]
+    fn norms_equal_their_entrywise_definitions() {
+        for seed in 0..10 {
+            let mut a = sample::<5>(seed);
+            a[(2, 3)] = f64::NAN;
+            let by_columns = columns(&a)
+                .iter()
+                .map(|column| column.iter().fold(0.0, |sum, value| sum + value.abs()))
+                .fold(0.0, f64::max);
+            assert_eq!(one_norm(&a).to_bits(), by_columns.to_bits());
+            let largest = a.as_slice().iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+            assert_eq!(max_abs(&a).to_bits(), largest.to_bits());
+            assert!(largest.is_finite());
         }
     }
 

@@ -79,7 +79,7 @@ use crate::linalg::lu;
 use crate::linalg::matrix::{from_faer_in, with_order};
 use crate::linalg::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
 use crate::linalg::product::multiply;
-use crate::linalg::small_matrix::{self, Columns, StackColumns};
+use crate::linalg::small_matrix::{self, CacheAligned, Columns, StackColumns};
 use crate::platform::dispatch::{add_scaled, fma_dispatch, scale_into};
 use crate::platform::interrupt;
 use crate::platform::parallel::{PARALLEL_MIN_ORDER, ParallelContext, parallelism_for_order};
@@ -138,6 +138,8 @@ struct PadeApproximant {
     theta: f64,
     coefficients: &'static [f64],
     log2_error_coefficient: f64,
+    /// 2^(log2 |c_{2m+1}| - log2 u), |c_{2m+1}| / u.
+    error_coefficient_over_u: f64,
     norm_without_extra_squarings: f64,
 }
 
@@ -190,6 +192,7 @@ const APPROXIMANTS: [PadeApproximant; 5] = [
         theta: 1.495585217958292e-2,
         coefficients: &PADE_3,
         log2_error_coefficient: -16.62113611327464,
+        error_coefficient_over_u: 89357135463.7001,
         norm_without_extra_squarings: 0.014955873861991669,
     },
     PadeApproximant {
@@ -197,6 +200,7 @@ const APPROXIMANTS: [PadeApproximant; 5] = [
         theta: 0.253939833006323,
         coefficients: &PADE_5,
         log2_error_coefficient: -33.227772656854167,
+        error_coefficient_over_u: 895433.8570596895,
         norm_without_extra_squarings: 0.25397832160209977,
     },
     PadeApproximant {
@@ -204,6 +208,7 @@ const APPROXIMANTS: [PadeApproximant; 5] = [
         theta: 9.504178996162932e-1,
         coefficients: &PADE_7,
         log2_error_coefficient: -51.994974307382167,
+        error_coefficient_over_u: 2.0069792385235985,
         norm_without_extra_squarings: 0.95145837728564,
     },
     PadeApproximant {
@@ -211,6 +216,7 @@ const APPROXIMANTS: [PadeApproximant; 5] = [
         theta: 2.097847961257068e0,
         coefficients: &PADE_9,
         log2_error_coefficient: -72.32471809893495,
+        error_coefficient_over_u: 1.5229308857855229e-6,
         norm_without_extra_squarings: 2.1046720498232245,
     },
     PadeApproximant {
@@ -218,6 +224,7 @@ const APPROXIMANTS: [PadeApproximant; 5] = [
         theta: THETA_13,
         coefficients: &PADE_13,
         log2_error_coefficient: -116.447004251763,
+        error_coefficient_over_u: 7.953322356109394e-20,
         norm_without_extra_squarings: 5.427430678754456,
     },
 ];
@@ -311,6 +318,24 @@ pub(crate) trait ExpmMatrix: PadeArithmetic + Send + Sync {
 /// [A^4, A^6, A^8] that the degree needs (the others may be None).
 #[inline(always)]
 fn pade_approximant<M: PadeArithmetic>(
+    approximant: usize,
+    a: &M,
+    a2: &[&M; 1],
+    higher: [&Option<M>; 3],
+) -> Result<M, M::Stop> {
+    // One copy of the evaluation per degree, each with its number of terms a constant.
+    match approximant {
+        M3 => pade_approximant_of(M3, a, a2, higher),
+        M5 => pade_approximant_of(M5, a, a2, higher),
+        M7 => pade_approximant_of(M7, a, a2, higher),
+        M9 => pade_approximant_of(M9, a, a2, higher),
+        _ => pade_approximant_of(approximant, a, a2, higher),
+    }
+}
+
+/// [`pade_approximant`], for a degree that inlining makes a constant.
+#[inline(always)]
+fn pade_approximant_of<M: PadeArithmetic>(
     approximant: usize,
     a: &M,
     a2: &[&M; 1],
@@ -490,6 +515,17 @@ fn integer_power(x: f64, k: usize) -> f64 {
         exponent >>= 1;
     }
     result
+}
+
+/// 2^-k, exactly as `(-(k as f64)).exp2()` gives it, without the library call where it is a
+/// normal number (its bits built directly).
+#[inline(always)]
+fn inverse_power_of_two(k: u32) -> f64 {
+    if k <= 1022 {
+        f64::from_bits(u64::from(1023 - k) << 52)
+    } else {
+        (-(k as f64)).exp2()
+    }
 }
 
 fn is_upper_triangular(a: MatRef<'_, f64>) -> bool {
@@ -777,9 +813,8 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         if power_norm == 0.0 {
             return 0;
         }
-        let alpha_over_u = (pade.log2_error_coefficient - UNIT_ROUNDOFF_LOG2).exp2()
-            * integer_power(scaled_norm, 2 * m)
-            * power_norm;
+        let alpha_over_u =
+            pade.error_coefficient_over_u * integer_power(scaled_norm, 2 * m) * power_norm;
         let log2_alpha_over_u = if alpha_over_u.is_finite() && alpha_over_u > 0.0 {
             if alpha_over_u <= 1.0 {
                 return 0;
@@ -949,7 +984,8 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
         let squarings = (eta5 - THETA_13.log2())
             .ceil()
             .clamp(0.0, MAX_SQUARINGS as f64) as u32;
-        let squarings = squarings + self.extra_squarings(M13, tau * (-(squarings as f64)).exp2());
+        let squarings =
+            squarings + self.extra_squarings(M13, tau * inverse_power_of_two(squarings));
         Ok(choice(M13, squarings.saturating_add(self.prescale)))
     }
 
@@ -984,8 +1020,9 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
             return Ok(true);
         }
         // r_m is evaluated at c * (pre-scaled A); the squarings undo both scalings.
-        let c =
-            t * self.time_scale * (-(choice.squarings.saturating_sub(self.prescale) as f64)).exp2();
+        let c = t
+            * self.time_scale
+            * inverse_power_of_two(choice.squarings.saturating_sub(self.prescale));
         let accurate = choice.squarings >= DOUBLE_DOUBLE_MIN_SQUARINGS;
         let accurate = if accurate {
             self.a
@@ -1277,7 +1314,7 @@ impl<const N: usize> ExpmMatrix for SMatrix<f64, N, N> {
 
     #[inline(always)]
     fn max_abs(&self) -> f64 {
-        self.as_slice().iter().fold(0.0, |m, v| m.max(v.abs()))
+        small_matrix::max_abs(self)
     }
 
     fn is_finite(&self) -> bool {
@@ -1381,29 +1418,39 @@ impl<const N: usize, const FMA: bool> PadeArithmetic for Inlined<N, FMA> {
 
     #[inline(always)]
     fn pade_quotient(even: Self, odd: Self) -> Result<Self, Infallible> {
-        let mut denominator = Self::combination(0.0, &[(1.0, &even), (-1.0, &odd)]);
+        let denominator = Self::combination(0.0, &[(1.0, &even), (-1.0, &odd)]);
+        // The matrix factored by rows and the N right-hand sides solved together as rows (the
+        // operations of the column-wise factorisation and solve that SMatrix uses, in the same
+        // order on each entry, as vector instructions).
+        let mut factors = CacheAligned(small_matrix::transposed(small_matrix::columns(
+            &denominator.0,
+        )));
         let mut pivots = [0; N];
-        small_matrix::lu_kernel::<N, FMA>(
-            small_matrix::columns_mut(&mut denominator.0),
-            &mut pivots,
-        );
-        // The N right-hand sides solved together as rows (the operations of the column-wise
-        // solve that SMatrix uses, in the same order on each entry, as vector instructions).
-        let mut rows = small_matrix::transposed(small_matrix::columns(&odd.0));
-        small_matrix::lu_solve_rows_kernel::<N, FMA>(
-            small_matrix::columns(&denominator.0),
-            &pivots,
-            &mut rows,
-        );
-        let quotient = Self(small_matrix::from_columns(small_matrix::transposed(&rows)));
+        small_matrix::lu_rows_kernel::<N, FMA>(&mut factors.0, &mut pivots);
+        let mut rows = CacheAligned(small_matrix::transposed(small_matrix::columns(&odd.0)));
+        small_matrix::lu_rows_solve_rows_kernel::<N, FMA>(&factors.0, &pivots, &mut rows.0);
+        let quotient = Self(small_matrix::from_columns(small_matrix::transposed(
+            &rows.0,
+        )));
         Ok(Self::combination(1.0, &[(2.0, &quotient)]))
     }
 }
 
 impl<const N: usize, const FMA: bool> ExpmMatrix for Inlined<N, FMA> {
+    /// A row-major A (the layout of numpy's arrays) is copied a row at a time: its rows are
+    /// the columns of the storage of A^T.
     #[inline(always)]
     fn from_ref(a: MatRef<'_, f64>) -> Self {
-        Self(<SMatrix<f64, N, N> as ExpmMatrix>::from_ref(a))
+        match a.try_as_row_major() {
+            Some(by_rows) => {
+                let mut rows = [[0.0; N]; N];
+                for (i, row) in rows.iter_mut().enumerate() {
+                    row.copy_from_slice(by_rows.row(i).as_slice());
+                }
+                Self(small_matrix::from_columns(small_matrix::transposed(&rows)))
+            }
+            None => Self(<SMatrix<f64, N, N> as ExpmMatrix>::from_ref(a)),
+        }
     }
 
     #[inline(always)]
@@ -1443,7 +1490,7 @@ impl<const N: usize, const FMA: bool> ExpmMatrix for Inlined<N, FMA> {
 
     #[inline(always)]
     fn max_abs(&self) -> f64 {
-        self.0.max_abs()
+        small_matrix::max_abs(&self.0)
     }
 
     #[inline(always)]
@@ -1467,9 +1514,27 @@ impl<const N: usize, const FMA: bool> ExpmMatrix for Inlined<N, FMA> {
         small_matrix::absolute_power_norm_kernel::<N, FMA>(small_matrix::columns(&self.0), scale, p)
     }
 
+    /// Into a row-major `out`, a row at a time: the rows of the matrix are the columns of its
+    /// transposed storage, and those of its transpose its columns.
     #[inline(always)]
-    fn write_to(&self, out: MatMut<'_, f64>, transpose: bool) {
-        self.0.write_to(out, transpose);
+    fn write_to(&self, mut out: MatMut<'_, f64>, transpose: bool) {
+        match out.as_mut().try_as_row_major_mut() {
+            Some(mut by_rows) => {
+                let rows = if transpose {
+                    *small_matrix::columns(&self.0)
+                } else {
+                    small_matrix::transposed(small_matrix::columns(&self.0))
+                };
+                for (i, row) in rows.iter().enumerate() {
+                    by_rows
+                        .as_mut()
+                        .row_mut(i)
+                        .as_slice_mut()
+                        .copy_from_slice(row);
+                }
+            }
+            None => self.0.write_to(out, transpose),
+        }
     }
 
     fn double_double_exponential(
@@ -1496,6 +1561,81 @@ fn small_exponential_kernel<const N: usize, const FMA: bool>(
 }
 
 fma_dispatch!(fn small_exponential<const N: usize>(a: MatRef<'_, f64>, out: MatMut<'_, f64>) -> bool => small_exponential_kernel);
+
+/// e^{A_k} for the N x N matrices of a row-major stack (`out` of the same length) on
+/// [`Inlined`] stack matrices, the loop compiled with them ([`small_exponentials`], one
+/// dispatch for the whole stack). Stops after the first matrix whose result is not certainly
+/// finite and returns its index; None when every result is.
+#[inline(always)]
+fn small_exponentials_kernel<const N: usize, const FMA: bool>(
+    stack: &[f64],
+    out: &mut [f64],
+) -> Option<usize> {
+    let matrices = stack.chunks_exact(N * N).zip(out.chunks_exact_mut(N * N));
+    for (index, (a, x)) in matrices.enumerate() {
+        let Ok(finite) = single_exponential::<Inlined<N, FMA>>(
+            MatRef::from_row_major_slice(a, N, N),
+            MatMut::from_row_major_slice_mut(x, N, N),
+        );
+        if !finite {
+            return Some(index);
+        }
+    }
+    None
+}
+
+fma_dispatch!(fn small_exponentials<const N: usize>(stack: &[f64], out: &mut [f64]) -> Option<usize> => small_exponentials_kernel);
+
+/// The `index`-th n x n matrix of a row-major stack.
+fn stack_member(data: &[f64], index: usize, n: usize) -> MatRef<'_, f64> {
+    MatRef::from_row_major_slice(&data[index * n * n..(index + 1) * n * n], n, n)
+}
+
+/// Writes e^{A_k} for every n x n matrix A_k of a row-major stack into `out` (of the same
+/// length), for matrices already known to be square and finite (as [`expm_into_validated`]
+/// each). An error carries the index of its matrix in the stack.
+pub(crate) fn expm_stack_into_validated(
+    n: usize,
+    stack: &[f64],
+    out: &mut [f64],
+) -> Result<(), (usize, Error)> {
+    let size = n * n;
+    if size == 0 {
+        return Ok(());
+    }
+    let count = stack.len() / size;
+    let mut start = 0;
+    while start < count {
+        let (rest, rest_out) = (&stack[start * size..], &mut out[start * size..]);
+        let stopped = with_order!(
+            n,
+            [2, 3, 4, 5, 6, 7, 8],
+            N => small_exponentials::<N>(rest, rest_out),
+            _ => {
+                for (index, x) in rest_out.chunks_exact_mut(size).enumerate() {
+                    expm_into_validated(
+                        stack_member(rest, index, n),
+                        MatMut::from_row_major_slice_mut(x, n, n),
+                    )
+                    .map_err(|e| (start + index, e))?;
+                }
+                None
+            }
+        );
+        let Some(offset) = stopped else {
+            return Ok(());
+        };
+        let index = start + offset;
+        check_computed_exponential(
+            stack_member(stack, index, n),
+            1.0,
+            stack_member(out, index, n),
+        )
+        .map_err(|e| (index, e))?;
+        start = index + 1;
+    }
+    Ok(())
+}
 
 // ----- public functions ---------------------------------------------------------------------
 
@@ -1754,6 +1894,24 @@ mod tests {
     }
 
     #[test]
+    fn error_coefficients_over_u_are_their_powers_of_two_bit_for_bit() {
+        for approximant in &APPROXIMANTS {
+            let expected = (approximant.log2_error_coefficient - UNIT_ROUNDOFF_LOG2).exp2();
+            assert_eq!(
+                approximant.error_coefficient_over_u.to_bits(),
+                expected.to_bits()
+            );
+        }
+        for k in (0..1100).chain([2200, u32::MAX]) {
+            assert_eq!(
+                inverse_power_of_two(k).to_bits(),
+                (-(k as f64)).exp2().to_bits(),
+                "{k}"
+            );
+        }
+    }
+
+    #[test]
     fn norms_without_extra_squarings_follow_from_the_error_coefficients() {
         // (u / |c_{2m+1}|)^(1/(2m)), and close to θ_m: θ_m is where the whole backward error
         // series, not only its leading term, reaches u.
@@ -1950,6 +2108,54 @@ mod tests {
             }
         }
         assert_eq!(cases, 7 * 9 * 3);
+    }
+
+    #[test]
+    fn a_stack_equals_its_members_bit_for_bit_and_names_a_refused_one() {
+        let mut rng = StdRng::seed_from_u64(41);
+        for n in [2, 4, 8, 9] {
+            let scales = [0.3, 2.0, 800.0, 1e-30, 1.0];
+            let mut stack = Vec::new();
+            for scale in scales {
+                let mut a = random_matrix(n, if scale == 800.0 { 1.0 } else { scale }, &mut rng);
+                if scale == 800.0 {
+                    // e^A = e^800 e^(A - 800 I) overflows.
+                    for i in 0..n {
+                        a[(i, i)] += scale;
+                    }
+                }
+                stack.extend((0..n * n).map(|k| a[(k / n, k % n)]));
+            }
+            let mut out = vec![0.0; stack.len()];
+            expm_stack_into_validated(n, &stack, &mut out).unwrap();
+            let mut overflowed = 0;
+            for k in 0..scales.len() {
+                let mut expected = Mat::zeros(n, n);
+                expm_into_validated(stack_member(&stack, k, n), expected.as_mut()).unwrap();
+                let got = stack_member(&out, k, n);
+                overflowed += usize::from(!got[(0, 0)].is_finite());
+                for j in 0..n {
+                    for i in 0..n {
+                        assert_eq!(got[(i, j)].to_bits(), expected[(i, j)].to_bits());
+                    }
+                }
+            }
+            // The results after an overflowed one are computed too.
+            assert!(overflowed >= 1, "n = {n}");
+        }
+        // The rotation by 1e50 rad, refused, is named by its index.
+        let mut stack = vec![
+            0.0, 1.0, -1.0, 0.0, 0.0, 1e50, -1e50, 0.0, 1.0, 0.0, 0.0, 1.0,
+        ];
+        let mut out = vec![0.0; stack.len()];
+        let Err((index, error)) = expm_stack_into_validated(2, &stack, &mut out) else {
+            panic!("the rotation by 1e50 rad was not refused");
+        };
+        assert_eq!(index, 1);
+        assert!(matches!(error, Error::IllConditioned { .. }));
+        (stack[5], stack[6]) = (1.0, -1.0);
+        expm_stack_into_validated(2, &stack, &mut out).unwrap();
+        assert!((out[8] - 1f64.exp()).abs() < 1e-15);
     }
 
     #[test]
