@@ -95,19 +95,6 @@ macro_rules! fma_dispatch {
 }
 pub(crate) use fma_dispatch;
 
-/// out = coefficient * x (FMA-free: one multiplication per entry).
-#[inline(always)]
-fn scale_into_kernel<const FMA: bool>(out: &mut [f64], coefficient: f64, x: &[f64]) {
-    for (o, &v) in out.iter_mut().zip(x) {
-        *o = coefficient * v;
-    }
-}
-
-fma_dispatch!(
-    /// out = coefficient * x, for slices of one length.
-    pub(crate) fn scale_into(out: &mut [f64], coefficient: f64, x: &[f64]) => scale_into_kernel
-);
-
 #[inline(always)]
 fn add_scaled_kernel<const FMA: bool>(out: &mut [f64], coefficient: f64, x: &[f64]) {
     for (o, &v) in out.iter_mut().zip(x) {
@@ -294,8 +281,7 @@ mod tests {
     #[test]
     fn slice_kernels() {
         let x: Vec<f64> = (0..37).map(|i| i as f64 * 0.25).collect();
-        let mut out = vec![0.0; 37];
-        scale_into(&mut out, 2.0, &x);
+        let mut out: Vec<f64> = x.iter().map(|v| 2.0 * v).collect();
         add_scaled(&mut out, -1.0, &x);
         assert_eq!(out, x);
         // Both variants agree where the fused one can run.

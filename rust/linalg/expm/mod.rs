@@ -80,7 +80,7 @@ use crate::linalg::matrix::{from_faer_in, with_order};
 use crate::linalg::norm::{MatrixProduct, absolute_power_norm, one_norm, one_norm_estimate};
 use crate::linalg::product::multiply;
 use crate::linalg::small_matrix::{self, CacheAligned, Columns, StackColumns};
-use crate::platform::dispatch::{add_scaled, fma_dispatch, scale_into};
+use crate::platform::dispatch::{add_scaled, fma_dispatch, multiply_add};
 use crate::platform::interrupt;
 use crate::platform::parallel::{PARALLEL_MIN_ORDER, ParallelContext, parallelism_for_order};
 use crate::platform::pool::{Scratch, scratch};
@@ -1099,6 +1099,87 @@ impl<M: ExpmMatrix> ExponentialPlan<M> {
 
 // ----- faer matrices (any order), pooled ----------------------------------------------------
 
+/// Entries of a column that [`combination_into_kernel`] accumulates in registers at a time.
+const COMBINATION_CHUNK: usize = 32;
+
+/// The most terms of a combination (the Taylor approximant's longest has 5).
+const COMBINATION_MAX_TERMS: usize = 6;
+
+/// out = identity * I + Σ_k coefficient_k M_k for square matrices of one order: each entry is
+/// c_1 m_1, to which c_k m_k is added for k = 2, 3, ... (a fused multiply-add in the FMA
+/// variant), and then the identity's coefficient on the diagonal, in that order (the order of
+/// a pass over the output per term). The entries of a chunk of a column stay in registers
+/// through all the terms: one load per term and entry (folded into the multiply-add) and one
+/// store, instead of a load and a store of the output per term.
+#[inline(always)]
+fn combination_into_kernel<const FMA: bool>(
+    out: &mut Mat<f64>,
+    identity: f64,
+    terms: &[(f64, &Scratch)],
+) {
+    assert!(
+        (1..=COMBINATION_MAX_TERMS).contains(&terms.len()),
+        "1 to {COMBINATION_MAX_TERMS} terms"
+    );
+    let n = out.nrows();
+    let full = n - n % COMBINATION_CHUNK;
+    let mut columns = [(0.0, &[][..]); COMBINATION_MAX_TERMS];
+    for j in 0..out.ncols() {
+        for (column, &(coefficient, matrix)) in columns.iter_mut().zip(terms) {
+            *column = (coefficient, &matrix.col_as_slice(j)[..n]);
+        }
+        let ((first_coefficient, first), rest) = (columns[0], &columns[1..terms.len()]);
+        let column = &mut out.col_as_slice_mut(j)[..n];
+        for start in (0..full).step_by(COMBINATION_CHUNK) {
+            let chunk = start..start + COMBINATION_CHUNK;
+            let mut sums = [0.0; COMBINATION_CHUNK];
+            for (sum, &value) in sums.iter_mut().zip(&first[chunk.clone()]) {
+                *sum = first_coefficient * value;
+            }
+            for &(coefficient, x) in rest {
+                for (sum, &value) in sums.iter_mut().zip(&x[chunk.clone()]) {
+                    *sum = multiply_add::<FMA>(coefficient, value, *sum);
+                }
+            }
+            column[chunk].copy_from_slice(&sums);
+        }
+        for i in full..n {
+            let mut sum = first_coefficient * first[i];
+            for &(coefficient, x) in rest {
+                sum = multiply_add::<FMA>(coefficient, x[i], sum);
+            }
+            column[i] = sum;
+        }
+        column[j] += identity;
+    }
+}
+
+fma_dispatch!(
+    /// [`combination_into_kernel`].
+    fn combination_into(out: &mut Mat<f64>, identity: f64, terms: &[(f64, &Scratch)]) => combination_into_kernel
+);
+
+/// Whether every entry is finite: an entry is inf or NaN exactly when its exponent bits are
+/// all ones, i.e. when |x| as an integer is at least 0x7FF0...0, and adding 2^52 then sets the
+/// sign bit; the OR of those sums over a column (integer operations that vectorise) has its
+/// sign bit clear exactly when the column is finite.
+#[inline(always)]
+fn all_finite_kernel<const FMA: bool>(m: &Mat<f64>) -> bool {
+    const MAGNITUDE: u64 = !(1 << 63);
+    const EXPONENT_STEP: u64 = 1 << 52;
+    (0..m.ncols()).all(|j| {
+        let flags = m.col_as_slice(j).iter().fold(0u64, |flags, x| {
+            flags | ((x.to_bits() & MAGNITUDE) + EXPONENT_STEP)
+        });
+        flags >> 63 == 0
+    })
+}
+
+fma_dispatch!(
+    /// [`all_finite_kernel`].
+    fn all_finite(m: &Mat<f64>) -> bool => all_finite_kernel
+);
+
 /// Each product and solve checks for an interruption before it starts, and those of large
 /// orders between their panels too ([`multiply`], [`lu::solve`]).
 impl PadeArithmetic for Scratch {
@@ -1133,17 +1214,9 @@ impl PadeArithmetic for Scratch {
     }
 
     fn combination(identity: f64, terms: &[(f64, &Self)]) -> Self {
-        let (&(first_coefficient, first), rest) = terms.split_first().expect("at least one term");
-        let n = first.nrows();
+        let n = terms.first().expect("at least one term").1.nrows();
         let mut out = scratch(n, n);
-        for j in 0..n {
-            let column = out.col_as_slice_mut(j);
-            scale_into(column, first_coefficient, first.col_as_slice(j));
-            for &(coefficient, matrix) in rest {
-                add_scaled(column, coefficient, matrix.col_as_slice(j));
-            }
-            column[j] += identity;
-        }
+        combination_into(&mut out, identity, terms);
         out
     }
 
@@ -1205,7 +1278,7 @@ impl ExpmMatrix for Scratch {
     }
 
     fn is_finite(&self) -> bool {
-        self.as_ref().is_all_finite()
+        all_finite(self)
     }
 
     fn estimate_product_norm(factors: &[&Self]) -> f64 {
@@ -2108,6 +2181,62 @@ mod tests {
             }
         }
         assert_eq!(cases, 7 * 9 * 3);
+    }
+
+    /// The register-blocked combination of pooled matrices gives the bits of one pass over the
+    /// output per term (c_1 m_1, then += c_k m_k, then the identity on the diagonal), for
+    /// orders with and without a partial chunk and 1 to 6 terms; the finiteness scan finds an
+    /// inf or NaN anywhere and only those (not f64::MAX, subnormals or -0).
+    #[test]
+    fn pooled_combinations_and_finiteness_scan() {
+        let mut rng = StdRng::seed_from_u64(33);
+        for n in [9, 32, 33, 64, 70] {
+            let matrices: Vec<Scratch> = (0..6)
+                .map(|_| Scratch::from_ref(random_matrix(n, 1.0, &mut rng).as_ref()))
+                .collect();
+            for count in 1..=6 {
+                let terms: Vec<(f64, &Scratch)> = matrices[..count]
+                    .iter()
+                    .map(|m| (rng.random_range(-3.0..3.0), m))
+                    .collect();
+                let identity = if count % 2 == 0 { 0.0 } else { 1.5 };
+                let combined = Scratch::combination(identity, &terms);
+                let mut expected = Mat::<f64>::zeros(n, n);
+                for j in 0..n {
+                    let column = expected.col_as_slice_mut(j);
+                    for (value, &x) in column.iter_mut().zip(terms[0].1.col_as_slice(j)) {
+                        *value = terms[0].0 * x;
+                    }
+                    for &(coefficient, matrix) in &terms[1..] {
+                        add_scaled(column, coefficient, matrix.col_as_slice(j));
+                    }
+                    column[j] += identity;
+                }
+                for j in 0..n {
+                    for i in 0..n {
+                        assert_eq!(
+                            combined[(i, j)].to_bits(),
+                            expected[(i, j)].to_bits(),
+                            "n = {n}, {count} terms"
+                        );
+                    }
+                }
+            }
+            let mut m = Scratch::from_ref(Mat::<f64>::zeros(n, n).as_ref());
+            m[(1, 0)] = -0.0;
+            m[(n - 1, n - 1)] = f64::MAX;
+            m[(2, n / 2)] = -f64::MAX;
+            m[(0, 1)] = 4.9e-324;
+            assert!(ExpmMatrix::is_finite(&m));
+            for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN, -f64::NAN] {
+                for (i, j) in [(0, 0), (n - 1, 3), (n / 2, n - 1)] {
+                    let saved = m[(i, j)];
+                    m[(i, j)] = bad;
+                    assert!(!ExpmMatrix::is_finite(&m), "n = {n}, {bad} at ({i}, {j})");
+                    m[(i, j)] = saved;
+                }
+            }
+        }
     }
 
     #[test]
