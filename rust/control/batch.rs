@@ -297,7 +297,8 @@ pub enum RiccatiKind {
 
 /// Solves every Riccati equation of a batch, in parallel (one problem per rayon task, each
 /// exactly as [`crate::control::riccati::care::solve_care`] solves it alone, so the results are bitwise those of single
-/// calls). Every problem is attempted; if any fails, the error of the lowest index is
+/// calls), except a refined sweep over R alone, solved in groups by Newton's method from the
+/// problems before (`care_sweep`). If any problem fails, the error of the lowest index is
 /// returned, naming that index, and the outputs are unspecified.
 pub fn care_batch(
     stacks: CareStacks<'_>,
@@ -405,7 +406,7 @@ pub fn riccati_batch(
 }
 
 /// Consecutive problems of a sweep over R solved one after the other by one task of
-/// [`care_sweep`]. Fixed, so that the result does not depend on the number of threads, and a
+/// `care_sweep`. Fixed, so that the result does not depend on the number of threads, and a
 /// divisor of the Python package's DISTRIBUTED_CHUNK (4096), so that a sweep cut into chunks
 /// for a cluster is solved bit for bit as here.
 pub const SWEEP_GROUP: usize = 32;
