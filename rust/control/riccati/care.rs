@@ -328,6 +328,9 @@ pub(crate) struct CareDense {
     pub(crate) residual: f64,
     pub(crate) rcond: f64,
     pub(crate) refinement_steps: usize,
+    /// D of the symplectic balancing diag(D, D^-1) of the Hamiltonian that gave X (empty for
+    /// n = 0): the coordinates of rcond(U11), for [`SharedPlant::solve_near`].
+    pub(crate) balancing: Vec<f64>,
 }
 
 /// log2 of the size below which (and of its reciprocal, above which) the weights are scaled
@@ -464,6 +467,228 @@ impl SharedPlant {
         };
         Some(solve_checked(a, b, options, checked))
     }
+
+    /// [`SharedPlant::solve`] with refinement for this R, by Newton's method (Kleinman 1968)
+    /// started from `near`, the solution of a nearby R in the same sweep, instead of the
+    /// Schur form of the Hamiltonian: Y_{k+1} = Y_k + Δ_k with
+    /// (A - B K_k)^T Δ_k + Δ_k (A - B K_k) = -Res(Y_k), K_k the gain of Y_k, the step of
+    /// [`refine`] (at n = 4 one Lyapunov solve of order 4 against the Schur form of the
+    /// Hamiltonian of order 8). From a start close enough that A - B K_0 is stable the
+    /// iteration converges quadratically to the stabilising solution. The start is the
+    /// polynomial through the solutions in `history` (oldest first, at most
+    /// [`EXTRAPOLATION_WEIGHTS`]'s length) at the next point ([`EXTRAPOLATION_WEIGHTS`]): on
+    /// an evenly spaced sweep of 1000 weights with four solutions, one step from it reaches
+    /// the floor.
+    ///
+    /// Some of the result where it converged: the residual fell below [`REFINEMENT_FLOOR`]
+    /// within [`WARM_START_MAX_STEPS`] steps, or stopped decreasing below
+    /// [`WARM_START_STAGNATION`], and the closed loop passed the same check as the Schur
+    /// solution's ([`check_stabilising`], its eigenvalues found with extrapolated ones as
+    /// shifts) and is [`WARM_START_AXIS_DISTANCE`] clear of the axis.
+    /// None where R or the weights take another path ([`SharedPlant::solve`]'s None), and
+    /// where Newton's method failed any of those tests: the caller then solves by the Schur
+    /// method, which reports any failure with its own error. rcond(U11) is that of the
+    /// orthonormal basis [U11; U21] = [I; Y'] C^-T of the stable subspace of the Hamiltonian
+    /// scaled as the Schur method scales it (Y' = D Y D / ρ, ρ from this R, D the balancing
+    /// of the group's last Schur solve; I + Y'^2 = C C^T): with the same D its U11 has the
+    /// singular values of the Schur method's, and its 1-norm condition number is within a
+    /// factor n^2 of it.
+    pub(crate) fn solve_near(
+        &self,
+        b: MatRef<'_, f64>,
+        r: MatRef<'_, f64>,
+        history: &[CareDense],
+    ) -> Option<CareDense> {
+        let n = self.a.nrows();
+        let fits = |solution: &CareDense| {
+            solution.x.nrows() == n
+                && solution.balancing.len() == n
+                && solution.closed_loop_eigenvalues.len() == n
+        };
+        let (near, earlier) = history.split_last()?;
+        if !history.iter().all(fits) || earlier.len() >= EXTRAPOLATION_WEIGHTS.len() {
+            return None;
+        }
+        let r_symmetric = symmetric(r, "R", b.ncols(), "the columns of B").ok()?;
+        let l = cholesky(&r_symmetric)?;
+        if weights_need_scaling(self.b_log, log2(frobenius_norm(r)), self.q_log) {
+            return None;
+        }
+        let reduced = Reduced {
+            a: &self.a,
+            b: &self.b,
+            q: &self.q,
+            q_norm: self.q_norm,
+            s: None,
+            l: &l,
+        };
+        // The polynomial through the last solutions, at the next point.
+        let weights = EXTRAPOLATION_WEIGHTS[earlier.len()];
+        let mut y = DMatrix::from_fn(n, n, |i, j| {
+            history
+                .iter()
+                .rev()
+                .zip(weights)
+                .map(|(solution, w)| w * solution.x[(i, j)])
+                .sum()
+        });
+        y.symmetrize();
+        let estimates = match earlier.last() {
+            Some(before) => extrapolated_eigenvalues(
+                &near.closed_loop_eigenvalues,
+                &before.closed_loop_eigenvalues,
+            ),
+            None => near.closed_loop_eigenvalues.clone(),
+        };
+        let mut evaluation = reduced.evaluate(&y);
+        let mut steps = 0;
+        while evaluation.residual_norm > REFINEMENT_FLOOR * evaluation.scale {
+            if steps == WARM_START_MAX_STEPS {
+                return None;
+            }
+            let closed_loop = reduced.closed_loop(&evaluation.gain);
+            let delta = if n <= KRONECKER_MAX_ORDER {
+                lyapunov::solve_kronecker(
+                    &closed_loop.transpose(),
+                    &evaluation.residual,
+                    Singularity::Perturb,
+                )
+                .ok()?
+            } else {
+                let delta = lyapunov::solve(
+                    closed_loop.as_faer().transpose(),
+                    evaluation.residual.as_faer(),
+                    Singularity::Perturb,
+                )
+                .ok()?;
+                from_faer(delta.as_ref())
+            };
+            let mut candidate = y.clone();
+            for (x, &v) in candidate.as_mut_slice().iter_mut().zip(delta.as_slice()) {
+                *x += v;
+            }
+            candidate.symmetrize();
+            let candidate_evaluation = reduced.evaluate(&candidate);
+            // A NaN residual is no decrease.
+            let decreased = candidate_evaluation.residual_norm < evaluation.residual_norm;
+            if !decreased {
+                if evaluation.relative_residual() <= WARM_START_STAGNATION {
+                    break;
+                }
+                return None;
+            }
+            (y, evaluation) = (candidate, candidate_evaluation);
+            steps += 1;
+        }
+        let gain = evaluation.gain;
+        let closed_loop = reduced.closed_loop(&gain);
+        let finite = |m: &DMatrix<f64>| m.as_slice().iter().all(|x| x.is_finite());
+        if !(finite(&y) && finite(&gain) && finite(&closed_loop)) {
+            return None;
+        }
+        let closed_loop_eigenvalues = eigenvalues_near(closed_loop.as_faer(), &estimates).ok()?;
+        let closed_loop_norm = frobenius_norm(closed_loop.as_faer());
+        check_stabilising(&closed_loop_eigenvalues, closed_loop_norm).ok()?;
+        // Near the axis the Schur method decides (its separation test, or its error).
+        let margin = WARM_START_AXIS_DISTANCE * closed_loop_norm;
+        if closed_loop_eigenvalues.iter().any(|z| z.re >= -margin) {
+            return None;
+        }
+        let rcond = graph_rcond(&y, self.rho(&l), &near.balancing)?;
+        Some(CareDense {
+            residual: relative(evaluation.residual_norm, evaluation.scale),
+            x: y,
+            gain,
+            closed_loop_eigenvalues,
+            rcond,
+            refinement_steps: steps,
+            balancing: near.balancing.clone(),
+        })
+    }
+
+    /// The scaling ρ of [`hamiltonian_solution`] for R = L L^T: the power of two nearest to
+    /// sqrt(||Q||_F / ||G||_F), G = B̂ B̂^T, B̂ = B L^-T (1 where either is zero).
+    fn rho(&self, l: &DMatrix<f64>) -> f64 {
+        let mut b_hat_t = self.b.transpose();
+        solve_lower_in_place(l, &mut b_hat_t);
+        let g_norm = frobenius_norm(transposed_product(&b_hat_t, &b_hat_t).as_faer());
+        if g_norm > 0.0 && self.q_norm > 0.0 {
+            nearest_power_of_two((self.q_norm / g_norm).sqrt())
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Estimates of the next closed-loop eigenvalues of a sweep, 2 λ - μ for each λ of `near`
+/// (Im >= 0) and the μ of `before` nearest to it: exact to second order where the sweep moves
+/// them smoothly, and only shifts for the QR iteration (a poor one costs a sweep).
+fn extrapolated_eigenvalues(near: &[c64], before: &[c64]) -> Vec<c64> {
+    near.iter()
+        .filter(|lambda| lambda.im >= 0.0)
+        .map(|&lambda| {
+            let nearest = before
+                .iter()
+                .filter(|mu| mu.im >= 0.0)
+                .min_by(|x, y| {
+                    (*x - lambda)
+                        .norm_sqr()
+                        .total_cmp(&(*y - lambda).norm_sqr())
+                })
+                .copied()
+                .unwrap_or(lambda);
+            lambda * 2.0 - nearest
+        })
+        .collect()
+}
+
+/// The weights of the last solutions, the latest first, in the start of
+/// [`SharedPlant::solve_near`] from 1, 2, 3 or 4 of them: the polynomial of that degree - 1
+/// through them at the next point of an evenly spaced sweep, X_k = sum_j w_j X_{k-1-j}
+/// (Newton's backward differences; its error is O(h^p) for p solutions).
+pub const EXTRAPOLATION_WEIGHTS: [&[f64]; 4] = [
+    &[1.0],
+    &[2.0, -1.0],
+    &[3.0, -3.0, 1.0],
+    &[4.0, -6.0, 4.0, -1.0],
+];
+
+/// Newton steps at most from a nearby solution ([`SharedPlant::solve_near`]) before the
+/// Schur method takes over.
+pub const WARM_START_MAX_STEPS: usize = 4;
+
+/// The relative residual below which [`SharedPlant::solve_near`] accepts a solution whose
+/// residual stopped decreasing above [`REFINEMENT_FLOOR`] (as [`refine`] stops), the bound
+/// that refinement meets on small regulators.
+pub const WARM_START_STAGNATION: f64 = 64.0 * f64::EPSILON;
+
+/// A solution of [`SharedPlant::solve_near`] whose closed loop has an eigenvalue with
+/// Re λ >= -WARM_START_AXIS_DISTANCE ||A - B K||_F is left to the Schur method: there the
+/// equation is near one without a stabilising solution, and the Schur method's own tests
+/// (the separation of the Hamiltonian's eigenvalues, the convergence of its QR iteration)
+/// decide whether it is refused, so that a sweep refuses what the single solver refuses.
+/// Weakly controllable undamped modes (A = [[0, 2], [-2, 0]], B = [0, 1e-3]^T, Q = diag(1e-6,
+/// 0), c from 1e-8 to 10 in reverse) were solved by Newton's method for weights where the
+/// Schur method fails.
+pub const WARM_START_AXIS_DISTANCE: f64 = 1.4901161193847656e-8;
+
+/// rcond_1(U11) of the orthonormal basis [U11; U21] = [I; Y'] C^-T of the graph of
+/// Y' = D Y D / ρ, with I + Y'^2 = C C^T (C lower triangular): U11 = C^-T, and
+/// rcond = 1 / (||C^-T||_1 ||C^T||_1). None where the Cholesky factorisation fails (Y not
+/// finite).
+fn graph_rcond(y: &DMatrix<f64>, rho: f64, d: &[f64]) -> Option<f64> {
+    let n = y.nrows();
+    let scaled = DMatrix::from_fn(n, n, |i, j| d[i] * y[(i, j)] * d[j] / rho);
+    let mut w = transposed_product(&scaled, &scaled);
+    for i in 0..n {
+        w[(i, i)] += 1.0;
+    }
+    w.symmetrize();
+    let c = cholesky(&w)?;
+    let mut inverse = DMatrix::identity(n, n);
+    solve_lower_in_place(&c, &mut inverse);
+    let rcond = 1.0 / (one_norm(c.as_faer().transpose()) * one_norm(inverse.as_faer().transpose()));
+    rcond.is_finite().then_some(rcond)
 }
 
 /// log2 of a norm, 0 for a zero or non-finite one.
@@ -592,6 +817,7 @@ fn solve_checked(
             residual: 0.0,
             rcond: 1.0,
             refinement_steps: 0,
+            balancing: Vec::new(),
         });
     }
     let HamiltonianSolution {
@@ -599,6 +825,7 @@ fn solve_checked(
         rcond,
         stable_eigenvalues,
         closed_loop: factors,
+        balancing,
     } = hamiltonian_solution(&standard)?;
     let mut evaluation = reduced.evaluate(&y);
     let refinement_steps = if options.refine {
@@ -646,6 +873,7 @@ fn solve_checked(
         residual,
         rcond,
         refinement_steps,
+        balancing,
     })
 }
 
@@ -785,6 +1013,8 @@ pub(crate) struct HamiltonianSolution {
     pub(crate) rcond: f64,
     pub(crate) stable_eigenvalues: Vec<c64>,
     closed_loop: Option<ClosedLoopFactors>,
+    /// D of the symplectic balancing diag(D, D^-1).
+    balancing: Vec<f64>,
 }
 
 /// The closed loop of the Schur solution as V T11 V^-1.
@@ -984,13 +1214,14 @@ fn hamiltonian_solution_in<O: Order>(
         hessenberg: (finished == Finished::UnstableHalf).then(|| stable_eigenvalues.clone()),
         v: DMatrix::from_fn(n, n, |i, j| d[i] * u11[(i, j)]),
         inverse_transposed,
-        d,
+        d: d.clone(),
     });
     Ok(HamiltonianSolution {
         y,
         rcond,
         stable_eigenvalues,
         closed_loop,
+        balancing: d,
     })
 }
 
