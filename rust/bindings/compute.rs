@@ -62,6 +62,16 @@ impl Cost {
         }
     }
 
+    /// A computation of `flops` operations on `bytes` of working memory that multiplies no
+    /// matrices, so that it needs no product workspace.
+    pub fn without_products(flops: f64, bytes: f64) -> Self {
+        Self {
+            flops,
+            bytes,
+            order: 0,
+        }
+    }
+
     /// `count` computations of this cost one after another (the temporaries reused).
     pub fn times(self, count: usize) -> Self {
         Self {

@@ -582,8 +582,12 @@ fn max_plus<'py>(
         p.matrix().map_err(|e| to_py_err(py, e))?,
         q.matrix().map_err(|e| to_py_err(py, e))?,
     );
-    let work = (p.nrows() * p.ncols()) as f64 * q.ncols() as f64;
-    let cost = Cost::of(work, 2.0, p.nrows().max(q.ncols()));
+    // Rows x inner x columns of work in the memory of the result (not that of a square
+    // matrix of the larger side), and no floating-point matrix products.
+    let cost = Cost::without_products(
+        (p.nrows() * p.ncols()) as f64 * q.ncols() as f64,
+        (p.nrows() * q.ncols()) as f64 * 8.0,
+    );
     let product = compute(py, cost, || max_plus_product(p, q))?;
     // -inf entries are sizes of zeros, not overflows: written unchecked.
     let out = new_array(py, &[product.nrows(), product.ncols()])?;
@@ -602,7 +606,8 @@ fn max_cycle_mean(py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<f64> {
     let g = Real::convert(py, g, "G")?;
     let g = g.matrix().map_err(|e| to_py_err(py, e))?;
     let n = g.nrows();
-    let cost = Cost::of((n as f64).powi(3), 1.0, n);
+    let size = n as f64;
+    let cost = Cost::without_products(size.powi(3), size * size * 8.0);
     compute(py, cost, || max_cycle_mean_core(g))
 }
 
@@ -618,7 +623,8 @@ fn balancing_exponents<'py>(
     let g = Real::convert(py, g, "G")?;
     let g = g.matrix().map_err(|e| to_py_err(py, e))?;
     let n = g.nrows();
-    let cost = Cost::of((n as f64).powi(3), 3.0, n);
+    let size = n as f64;
+    let cost = Cost::without_products(size.powi(3), 3.0 * size * size * 8.0);
     let (exponents, largest) = compute(py, cost, || balancing_exponents_core(g, outside))?;
     let out = new_array::<i64>(py, &[exponents.len()])?;
     // SAFETY: `out` is new and not visible to Python until returned.
